@@ -1,0 +1,85 @@
+"""Dimension names, units and the attribute table of every variable the package emits.
+
+Names are defined here once and imported everywhere else; attributes of output
+variables come from :data:`ATTRS` so that every array that leaves the package
+carries CF-style ``units`` and ``long_name``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+# --- dimensions -----------------------------------------------------------
+THETA_I = "theta_i"
+DELTA_THETA = "delta_theta"
+PHI = "phi"
+WAVELENGTH = "wavelength"
+ATTITUDE = "attitude"
+PHASE_ANGLE = "phase_angle"
+BAND = "band"
+SAMPLE = "sample"
+FACET = "facet"
+MATERIAL = "material"
+GEOMETRY = "geometry"
+VECTOR = "xyz"
+
+#: Dimensions of a material sBRDF look-up table, in order.
+LUT_DIMS: tuple[str, str, str, str] = (THETA_I, DELTA_THETA, PHI, WAVELENGTH)
+#: Angular dimensions of a look-up table, in order.
+ANGLE_DIMS: tuple[str, str, str] = (THETA_I, DELTA_THETA, PHI)
+
+#: Name of the DataArray holding a material's sBRDF.
+SBRDF = "sbrdf"
+
+# --- units (UDUNITS strings) ---------------------------------------------
+DEGREE = "degree"
+NM = "nm"
+PER_SR = "sr-1"
+
+#: Attribute table: variable or coordinate name -> CF attributes.
+ATTRS: dict[str, dict[str, str]] = {
+    THETA_I: {"units": DEGREE, "long_name": "illumination polar angle from the facet normal"},
+    DELTA_THETA: {
+        "units": DEGREE,
+        "long_name": "difference-in-polar angle from the specular direction (signed)",
+    },
+    PHI: {"units": DEGREE, "long_name": "angle of the reflection direction from the illumination plane"},
+    WAVELENGTH: {
+        "units": NM,
+        "long_name": "vacuum wavelength",
+        "standard_name": "radiation_wavelength",
+    },
+    SBRDF: {"units": PER_SR, "long_name": "spectral bidirectional reflectance distribution function"},
+    "theta_r": {"units": DEGREE, "long_name": "reflection polar angle from the facet normal"},
+    "phi_i": {"units": DEGREE, "long_name": "illumination azimuth angle"},
+    "phi_r": {"units": DEGREE, "long_name": "reflection azimuth angle"},
+    PHASE_ANGLE: {"units": DEGREE, "long_name": "angle between the Sun and observer directions"},
+    "reference": {
+        "units": "1",
+        "long_name": "reference point where the reflectance is indistinguishable from noise (zero)",
+    },
+    "reflectance": {
+        "units": "1",
+        "long_name": "directional-hemispherical reflectance",
+    },
+}
+
+
+def attrs(name: str, **extra: Any) -> dict[str, Any]:
+    """Return a copy of the CF attributes of ``name``, updated with ``extra``.
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`ATTRS`.
+    **extra
+        Additional attributes that override or extend the table entry.
+
+    Returns
+    -------
+    dict
+        The attribute dictionary.
+    """
+    out = dict(ATTRS[name])
+    out.update(extra)
+    return out
