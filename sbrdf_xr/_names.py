@@ -62,6 +62,30 @@ ATTRS: dict[str, dict[str, str]] = {
         "units": "1",
         "long_name": "directional-hemispherical reflectance",
     },
+    # --- spacecraft facets and visibility (issue 4) ---
+    FACET: {"units": "1", "long_name": "facet index"},
+    VECTOR: {"units": "1", "long_name": "Cartesian component in the spacecraft body frame"},
+    "normal": {"units": "1", "long_name": "outward unit normal of the facet in the body frame"},
+    "area": {"units": "m2", "long_name": "facet area"},
+    "centroid": {"units": "m", "long_name": "facet centroid in the body frame"},
+    MATERIAL: {"units": "1", "long_name": "material name"},
+    "term": {"units": "1", "long_name": "index of a group of facets sharing normal and material"},
+    "n_facets": {"units": "1", "long_name": "number of facets merged into the term"},
+    "facet_term": {"units": "1", "long_name": "term that each facet is merged into"},
+    "lit_fraction": {
+        "units": "1",
+        "long_name": "fraction of the facet area from which the Sun is seen (not self-shadowed)",
+    },
+    "visible_fraction": {
+        "units": "1",
+        "long_name": "fraction of the facet area seen by the observer (not self-occluded)",
+    },
+    "lit_visible_fraction": {
+        "units": "1",
+        "long_name": "fraction of the facet area both lit by the Sun and seen by the observer",
+    },
+    "to_sun": {"units": "1", "long_name": "unit vector toward the Sun in the body frame"},
+    "to_observer": {"units": "1", "long_name": "unit vector toward the observer in the body frame"},
 }
 
 

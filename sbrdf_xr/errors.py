@@ -9,13 +9,13 @@ is allowed.  Warnings derive from :class:`SbrdfWarning` so users can filter them
 from __future__ import annotations
 
 __all__ = [
-    "SbrdfError",
-    "ValidationError",
     "CatalogError",
     "MeshError",
-    "SceneError",
-    "SbrdfWarning",
     "NonPhysicalWarning",
+    "SbrdfError",
+    "SbrdfWarning",
+    "SceneError",
+    "ValidationError",
 ]
 
 

@@ -1,0 +1,46 @@
+"""xarray accessors: ``da.sbrdf.<method>`` forwards to the module functions.
+
+Compose, never subclass: every accessor method is a one-line call of the function
+documented in :mod:`sbrdf_xr.material`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import xarray as xr
+from numpy.typing import ArrayLike
+
+from . import material as _material
+
+__all__ = ["SbrdfDataArrayAccessor"]
+
+
+@xr.register_dataarray_accessor("sbrdf")
+class SbrdfDataArrayAccessor:
+    """Methods of a material table, as ``da.sbrdf.lookup(...)`` and friends."""
+
+    def __init__(self, da: xr.DataArray) -> None:
+        self._da = da
+
+    def validate(self, **kwargs: Any) -> xr.DataArray:
+        """:func:`sbrdf_xr.material.validate_material`."""
+        return _material.validate_material(self._da, **kwargs)
+
+    def lookup(
+        self,
+        theta_i: ArrayLike | xr.DataArray,
+        delta_theta: ArrayLike | xr.DataArray,
+        phi: ArrayLike | xr.DataArray,
+        method: str = "linear",
+    ) -> xr.DataArray:
+        """:func:`sbrdf_xr.material.lookup` on this table."""
+        return _material.lookup(self._da, theta_i, delta_theta, phi, method=method)
+
+    def hemispherical_reflectance(self, theta_i: ArrayLike | None = None, **kwargs: Any) -> xr.DataArray:
+        """:func:`sbrdf_xr.material.hemispherical_reflectance` of this table."""
+        return _material.hemispherical_reflectance(self._da, theta_i, **kwargs)
+
+    def to_netcdf(self, path: Any, **kwargs: Any) -> Any:
+        """:func:`sbrdf_xr.material.to_netcdf` of this table."""
+        return _material.to_netcdf(self._da, path, **kwargs)

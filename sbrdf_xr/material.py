@@ -1,0 +1,692 @@
+"""Materials: spectral BRDF look-up tables as labelled xarray DataArrays.
+
+A material is a ``DataArray`` named ``sbrdf`` with dims
+``(theta_i, delta_theta, phi, wavelength)`` (paper 000 §3.2), values in ``sr-1``,
+and attributes ``material`` (name), ``source`` (``measured`` | ``synthetic`` |
+``model:<name>``), ``provenance`` and the construction parameters.
+
+This module wraps the pure-numpy kernels of :mod:`sbrdf_xr._lut`:
+
+* :func:`validate_material` - schema checks with a message naming the problem;
+* :func:`lookup` - spectra at arbitrary geometries (``nearest``, ``linear``, ``cubic``);
+* :func:`build_lut` - the look-up-table construction of paper 000 §3.2 from a sparse
+  measurement set (:func:`validate_measurements` describes its schema);
+* :func:`hemispherical_reflectance` - directional-hemispherical reflectance by
+  quadrature, to flag non-physical tables;
+* :func:`to_netcdf` / :func:`open_material` - lossless netCDF round trip.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import os
+import tempfile
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from numpy.typing import ArrayLike
+
+from . import _lut
+from ._names import (
+    ANGLE_DIMS,
+    DEGREE,
+    DELTA_THETA,
+    LUT_DIMS,
+    NM,
+    PER_SR,
+    PHI,
+    SAMPLE,
+    SBRDF,
+    THETA_I,
+    WAVELENGTH,
+    attrs,
+)
+from .catalog import CatalogEntry, register_loader
+from .errors import NonPhysicalWarning, ValidationError
+
+__all__ = [
+    "LOOKUP_METHODS",
+    "build_lut",
+    "hemispherical_reflectance",
+    "lookup",
+    "new_material",
+    "open_material",
+    "open_measurements",
+    "paper_delta_theta_grid",
+    "paper_phi_grid",
+    "to_netcdf",
+    "validate_material",
+    "validate_measurements",
+]
+
+LOOKUP_METHODS = tuple(_lut.LOOKUP_METHODS)
+SOURCES = ("measured", "synthetic")
+_UNITS = {THETA_I: DEGREE, DELTA_THETA: DEGREE, PHI: DEGREE, WAVELENGTH: NM}
+
+
+# ------------------------------------------------------------------ schema
+
+
+def _check_source(source: str) -> None:
+    if source not in SOURCES and not str(source).startswith("model:"):
+        raise ValidationError(
+            f"source: got {source!r}; allowed: 'measured', 'synthetic' or 'model:<name>'"
+        )
+
+
+def _check_coord(name: str, values: np.ndarray, *, strict: bool = True) -> None:
+    if values.ndim != 1:
+        raise ValidationError(f"{name}: coordinate must be 1-D, got shape {values.shape}")
+    if values.size == 0:
+        raise ValidationError(f"{name}: coordinate is empty")
+    if not np.issubdtype(values.dtype, np.number) or not np.all(np.isfinite(values)):
+        raise ValidationError(f"{name}: coordinate must be finite numbers")
+    if strict and np.any(np.diff(values) <= 0):
+        bad = int(np.flatnonzero(np.diff(values) <= 0)[0])
+        raise ValidationError(
+            f"{name}: coordinate must be strictly increasing; "
+            f"{values[bad]!r} is followed by {values[bad + 1]!r} at index {bad + 1}"
+        )
+
+
+def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.DataArray:
+    """Check that ``da`` is a valid material look-up table.
+
+    Parameters
+    ----------
+    da : xarray.DataArray
+        Candidate table.
+    check_values : bool, default True
+        Also check that every value is finite and non-negative (loads the values;
+        tables are small).
+
+    Returns
+    -------
+    xarray.DataArray
+        ``da`` with its dims in the canonical order ``(theta_i, delta_theta, phi,
+        wavelength)`` (a transpose, never a change of values).
+
+    Raises
+    ------
+    ValidationError
+        Naming the first problem found: wrong type or dims, missing or
+        non-monotonic coordinates, wrong units, angles out of their domain, NaN or
+        negative values.
+    """
+    if not isinstance(da, xr.DataArray):
+        raise ValidationError(f"material: expected an xarray.DataArray, got {type(da).__name__}")
+    if set(da.dims) != set(LUT_DIMS) or len(da.dims) != len(LUT_DIMS):
+        raise ValidationError(f"material: dims must be {LUT_DIMS}, got {da.dims}")
+    da = da.transpose(*LUT_DIMS)
+    for dim in LUT_DIMS:
+        if dim not in da.coords:
+            raise ValidationError(f"{dim}: coordinate is missing")
+        _check_coord(dim, np.asarray(da[dim].values))
+        units = da[dim].attrs.get("units")
+        if units != _UNITS[dim]:
+            raise ValidationError(f"{dim}: units must be {_UNITS[dim]!r}, got {units!r}")
+    if da.attrs.get("units") != PER_SR:
+        raise ValidationError(f"sbrdf: units must be {PER_SR!r}, got {da.attrs.get('units')!r}")
+    ti = da[THETA_I].values
+    if ti[0] < 0 or ti[-1] > 90:
+        raise ValidationError(f"theta_i: must lie in [0, 90] degree, got [{ti[0]}, {ti[-1]}]")
+    ph = da[PHI].values
+    if ph[0] < 0 or ph[-1] > 90:
+        raise ValidationError(f"phi: must lie in [0, 90] degree, got [{ph[0]}, {ph[-1]}]")
+    if da[WAVELENGTH].values[0] <= 0:
+        raise ValidationError("wavelength: must be positive")
+    if "source" in da.attrs:
+        _check_source(da.attrs["source"])
+    if check_values:
+        v = np.asarray(da.values)
+        if not np.all(np.isfinite(v)):
+            raise ValidationError(f"sbrdf: contains {int(np.sum(~np.isfinite(v)))} NaN or infinite values")
+        if np.any(v < 0):
+            raise ValidationError(
+                f"sbrdf: contains {int(np.sum(v < 0))} negative values (min {v.min():.3g}); a BRDF is >= 0"
+            )
+    return da
+
+
+def new_material(
+    values: ArrayLike,
+    theta_i: ArrayLike,
+    delta_theta: ArrayLike,
+    phi: ArrayLike,
+    wavelength: ArrayLike,
+    *,
+    material: str,
+    source: str,
+    provenance: str,
+    **parameters: Any,
+) -> xr.DataArray:
+    """Build a validated material ``DataArray`` from plain arrays.
+
+    Parameters
+    ----------
+    values : array_like, shape (n_theta_i, n_delta_theta, n_phi, n_wavelength)
+        sBRDF [sr-1].
+    theta_i, delta_theta, phi : array_like
+        Strictly increasing coordinates [degree].
+    wavelength : array_like
+        Strictly increasing vacuum wavelengths [nm].
+    material : str
+        Material name.
+    source : str
+        ``measured``, ``synthetic`` or ``model:<name>``.
+    provenance : str
+        Where the numbers come from.
+    **parameters
+        Construction parameters stored as attributes (numbers, strings, or
+        sequences of numbers; anything else is stored as JSON text).
+
+    Returns
+    -------
+    xarray.DataArray
+    """
+    _check_source(source)
+    coords = {
+        THETA_I: (THETA_I, np.asarray(theta_i, dtype=np.float64), attrs(THETA_I)),
+        DELTA_THETA: (DELTA_THETA, np.asarray(delta_theta, dtype=np.float64), attrs(DELTA_THETA)),
+        PHI: (PHI, np.asarray(phi, dtype=np.float64), attrs(PHI)),
+        WAVELENGTH: (WAVELENGTH, np.asarray(wavelength, dtype=np.float64), attrs(WAVELENGTH)),
+    }
+    a = attrs(SBRDF, material=material, source=source, provenance=provenance)
+    a.update({k: _attr_value(v) for k, v in parameters.items()})
+    da = xr.DataArray(np.asarray(values), dims=LUT_DIMS, coords=coords, name=SBRDF, attrs=a)
+    return validate_material(da)
+
+
+def _attr_value(v: Any) -> Any:
+    """netCDF-storable form of an attribute value (bools and containers as JSON)."""
+    if isinstance(v, bool) or v is None or isinstance(v, dict):
+        return json.dumps(v)
+    if isinstance(v, str | int | float | np.number):
+        return v
+    arr = np.asarray(v)
+    if arr.ndim == 1 and np.issubdtype(arr.dtype, np.number):
+        return arr
+    return json.dumps(v, default=str)
+
+
+# ------------------------------------------------------------------ lookup
+
+
+def lookup(
+    material: xr.DataArray,
+    theta_i: ArrayLike | xr.DataArray,
+    delta_theta: ArrayLike | xr.DataArray,
+    phi: ArrayLike | xr.DataArray,
+    method: str = "linear",
+) -> xr.DataArray:
+    """Spectra of a material at arbitrary geometries.
+
+    A thin xarray wrapper around :func:`sbrdf_xr._lut.lookup_kernel` (through
+    :func:`xarray.apply_ufunc`, lazy and parallel for Dask-backed angles).
+
+    Parameters
+    ----------
+    material : xarray.DataArray
+        Material look-up table (:func:`validate_material`).
+    theta_i, delta_theta, phi : array_like or xarray.DataArray
+        Angles [degree] (paper 000 Fig. 4).  DataArrays are broadcast by name;
+        plain arrays are broadcast by position and get dims ``dim_0, dim_1, ...``.
+    method : {"nearest", "linear", "cubic"}, default "linear"
+        ``nearest`` is the paper's look-up (§3.4); ``linear`` is multilinear;
+        ``cubic`` is tensor-product four-point Lagrange, clipped at zero.
+
+    Returns
+    -------
+    xarray.DataArray
+        Dims of the broadcast angles plus ``wavelength``; ``units = sr-1``.
+
+    Notes
+    -----
+    Out-of-range policy: ``theta_i`` is clamped to the table (0-90 deg);
+    beyond the table's ``delta_theta`` extent or above its largest ``phi`` the
+    sBRDF is zero (paper 000's reference points).  Whether a facet is lit and
+    visible is the caller's business.
+    """
+    _lut.check_method(method)
+    material = validate_material(material, check_values=False)
+    angles = []
+    for name, a in ((THETA_I, theta_i), (DELTA_THETA, delta_theta), (PHI, phi)):
+        if not isinstance(a, xr.DataArray):
+            arr = np.asarray(a, dtype=np.float64)
+            a = xr.DataArray(arr, dims=[f"dim_{k}" for k in range(arr.ndim)])
+        if a.chunks is None and not np.all(np.isfinite(a.values)):
+            raise ValidationError(f"{name}: query angles contain NaN or infinite values")
+        angles.append(a)
+    grids = [np.asarray(material[d].values) for d in ANGLE_DIMS]
+    values = np.asarray(material.values)
+    out = xr.apply_ufunc(
+        _lookup_core,
+        *angles,
+        kwargs={"values": values, "theta_grid": grids[0], "delta_theta_grid": grids[1],
+                "phi_grid": grids[2], "method": method},
+        output_core_dims=[[WAVELENGTH]],
+        dask="parallelized",
+        output_dtypes=[values.dtype],
+        dask_gufunc_kwargs={"output_sizes": {WAVELENGTH: material.sizes[WAVELENGTH]}},
+    )
+    out = out.assign_coords({WAVELENGTH: material[WAVELENGTH]})
+    out.name = SBRDF
+    out.attrs = attrs(SBRDF, material=material.attrs.get("material", ""), lookup_method=method)
+    return out
+
+
+def _lookup_core(
+    theta_i: np.ndarray, delta_theta: np.ndarray, phi: np.ndarray, **kw: Any
+) -> np.ndarray:
+    """apply_ufunc adapter: angles first, table as keywords."""
+    return _lut.lookup_kernel(theta_i=theta_i, delta_theta=delta_theta, phi=phi, **kw)
+
+
+# ----------------------------------------------------------- measurements
+
+
+def validate_measurements(ds: xr.Dataset) -> xr.Dataset:
+    """Check a goniospectrometer measurement set.
+
+    Schema: dims ``sample`` and ``wavelength``; a data variable ``sbrdf``
+    ``(sample, wavelength)`` [sr-1]; coordinates ``theta_i``, ``delta_theta``,
+    ``phi`` over ``sample`` [degree] and ``wavelength`` [nm]; an optional boolean
+    ``reference`` over ``sample`` marking the reference points of paper 000 §3.1
+    (where the reflectance is indistinguishable from noise and is taken as zero;
+    their spectra are ignored and treated as zero).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Candidate measurement set.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``ds`` unchanged.
+
+    Raises
+    ------
+    ValidationError
+        Naming the first problem found.
+    """
+    if not isinstance(ds, xr.Dataset):
+        raise ValidationError(f"measurements: expected an xarray.Dataset, got {type(ds).__name__}")
+    if SBRDF not in ds:
+        raise ValidationError("measurements: lacks the data variable 'sbrdf'")
+    da = ds[SBRDF]
+    if set(da.dims) != {SAMPLE, WAVELENGTH}:
+        raise ValidationError(f"sbrdf: dims must be ('sample', 'wavelength'), got {da.dims}")
+    if da.attrs.get("units") != PER_SR:
+        raise ValidationError(f"sbrdf: units must be {PER_SR!r}, got {da.attrs.get('units')!r}")
+    if ds.sizes[SAMPLE] == 0:
+        raise ValidationError("measurements: the set is empty (no samples)")
+    for name in (THETA_I, DELTA_THETA, PHI):
+        if name not in ds.coords and name not in ds:
+            raise ValidationError(f"{name}: coordinate over 'sample' is missing")
+        c = ds[name]
+        if c.dims != (SAMPLE,):
+            raise ValidationError(f"{name}: must be over ('sample',), got {c.dims}")
+        _check_coord(name, np.asarray(c.values), strict=False)
+        if c.attrs.get("units") != DEGREE:
+            raise ValidationError(f"{name}: units must be 'degree', got {c.attrs.get('units')!r}")
+    if WAVELENGTH not in ds.coords:
+        raise ValidationError("wavelength: coordinate is missing")
+    _check_coord(WAVELENGTH, np.asarray(ds[WAVELENGTH].values))
+    if ds[WAVELENGTH].attrs.get("units") != NM:
+        raise ValidationError(f"wavelength: units must be 'nm', got {ds[WAVELENGTH].attrs.get('units')!r}")
+    ti = ds[THETA_I].values
+    if np.any((ti < 0) | (ti >= 90)):
+        raise ValidationError("theta_i: measured incidence angles must lie in [0, 90) degree")
+    if np.any(ds[PHI].values < 0):
+        raise ValidationError("phi: must be >= 0 (unsigned angle from the illumination plane)")
+    ref = _reference(ds)
+    v = np.asarray(da.transpose(SAMPLE, WAVELENGTH).values)[~ref]
+    if not np.all(np.isfinite(v)):
+        bad = np.flatnonzero(~np.all(np.isfinite(np.asarray(da.transpose(SAMPLE, WAVELENGTH).values)), axis=1) & ~ref)
+        raise ValidationError(f"sbrdf: NaN or infinite values in sample(s) {bad[:10].tolist()}")
+    if np.any(v < 0):
+        raise ValidationError("sbrdf: contains negative values; a BRDF is >= 0")
+    return ds
+
+
+def _reference(ds: xr.Dataset) -> np.ndarray:
+    if "reference" in ds:
+        ref = np.asarray(ds["reference"].values)
+        if ref.dtype != bool:
+            ref = ref.astype(bool)
+        return ref
+    return np.zeros(ds.sizes[SAMPLE], dtype=bool)
+
+
+def paper_phi_grid(phi_max: float, n: int = 21) -> np.ndarray:
+    """Uniform ``phi`` grid of paper 000 §3.2: ``n`` points from 0 to ``phi_max`` [degree]."""
+    if not phi_max > 0:
+        raise ValidationError(f"phi_max: must be > 0 degree, got {phi_max}")
+    return np.linspace(0.0, float(phi_max), n)
+
+
+def paper_delta_theta_grid(dt_min: float, dt_max: float, n: int = 21) -> np.ndarray:
+    """``delta_theta`` grid of paper 000 §3.2: 0 at the median, ``dt_min/10`` and
+    ``dt_max/10`` steps on either side (for ``n = 21``) [degree]."""
+    if not (dt_min < 0 < dt_max):
+        raise ValidationError(
+            f"delta_theta: measured extent must straddle specular (min < 0 < max), got [{dt_min}, {dt_max}]"
+        )
+    if n < 3 or n % 2 == 0:
+        raise ValidationError(f"n_delta_theta: must be odd and >= 3, got {n}")
+    half = n // 2
+    return np.concatenate([np.linspace(dt_min, 0.0, half + 1)[:-1], np.linspace(0.0, dt_max, half + 1)])
+
+
+def _interp_weights(x_data: np.ndarray, x_out: np.ndarray) -> np.ndarray:
+    """Matrix (len(x_out), len(x_data)) of linear interpolation, zero outside the data."""
+    order = np.argsort(x_data, kind="stable")
+    xs = x_data[order]
+    w = np.zeros((x_out.size, x_data.size))
+    if xs.size == 1:
+        hit = np.isclose(x_out, xs[0], rtol=0, atol=_lut.EDGE_TOL_DEG)
+        w[hit, order[0]] = 1.0
+        return w
+    idx, wt = _lut.axis_weights(xs, x_out, "linear")
+    inside = (x_out >= xs[0] - _lut.EDGE_TOL_DEG) & (x_out <= xs[-1] + _lut.EDGE_TOL_DEG)
+    rows = np.arange(x_out.size)
+    for k in range(2):
+        np.add.at(w, (rows[inside], order[idx[inside, k]]), wt[inside, k])
+    return w
+
+
+def build_lut(
+    measurements: xr.Dataset,
+    *,
+    n_phi: int = 21,
+    n_delta_theta: int = 21,
+    theta_i: ArrayLike | None = None,
+    smoothing: float | str = "csaps",
+    extrapolation: str = "cubic",
+    material: str | None = None,
+    dtype: type | np.dtype = np.float64,
+) -> xr.DataArray:
+    """Look-up table from sparse measurements, by the construction of paper 000 §3.2.
+
+    1. ``phi``: ``n_phi`` uniform points from 0 to the largest measured ``phi`` of
+       the material; for every measured ``(theta_i, delta_theta)`` row, linear
+       interpolation in ``phi`` (zero beyond the row's largest ``phi``, whose
+       reference point is zero).
+    2. ``delta_theta``: ``n_delta_theta`` points with 0 at the median and steps
+       ``delta_theta_min/10`` and ``delta_theta_max/10`` on either side (for the
+       paper's 21), from the extremes over all ``theta_i``; for every measured
+       ``theta_i`` and grid ``phi``, linear interpolation in ``delta_theta``
+       (zero beyond that ``theta_i``'s measured extent).
+    3. ``theta_i``: a cubic smoothing spline over the measured incidence angles for
+       every ``(delta_theta, phi, wavelength)``, evaluated at every integer degree
+       0-90 (interpolating between and extrapolating beyond the measured angles).
+
+    Values are clipped at zero after step 3 (a smoothing spline can undershoot,
+    and a BRDF cannot be negative).  Everything is vectorised: each step is one
+    linear operator applied to all wavelengths at once.
+
+    Parameters
+    ----------
+    measurements : xarray.Dataset
+        Measurement set (:func:`validate_measurements`).
+    n_phi : int, default 21
+        Points of the ``phi`` grid (paper: 21).
+    n_delta_theta : int, default 21
+        Points of the ``delta_theta`` grid, odd (paper: 21).
+    theta_i : array_like, optional
+        Output incidence angles [degree]; default every integer 0-90 (paper).
+    smoothing : float or "csaps", default "csaps"
+        Smoothing parameter ``lam`` [degree**3] of the spline in ``theta_i``
+        (:func:`sbrdf_xr._lut.smoothing_spline_matrix`); ``"csaps"`` is MATLAB's
+        default ``h**3/6`` (:func:`sbrdf_xr._lut.csaps_default_lambda`); 0
+        interpolates.
+    extrapolation : {"cubic", "linear", "constant"}, default "cubic"
+        How the spline continues below the smallest and above the largest measured
+        ``theta_i``.  ``cubic`` (default) continues the end polynomial pieces, as
+        the paper's spline evaluation did; ``linear`` and ``constant`` are milder.
+    material : str, optional
+        Name; default the ``material`` attribute of ``measurements``.
+    dtype : numpy dtype, default float64
+        dtype of the table values.
+
+    Returns
+    -------
+    xarray.DataArray
+        The material table with ``source`` and ``provenance`` copied from the
+        measurement set and the construction parameters as attributes.
+
+    Raises
+    ------
+    ValidationError
+        For an invalid measurement set, fewer than two measured incidence angles,
+        no measured extent in ``phi`` or ``delta_theta``.
+    """
+    ds = validate_measurements(measurements)
+    ref = _reference(ds)
+    ti_s = np.asarray(ds[THETA_I].values, dtype=np.float64)
+    dt_s = np.asarray(ds[DELTA_THETA].values, dtype=np.float64)
+    ph_s = np.asarray(ds[PHI].values, dtype=np.float64)
+    spectra = np.asarray(ds[SBRDF].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64).copy()
+    spectra[ref] = 0.0
+    measured_ti = np.unique(ti_s)
+    if measured_ti.size < 2:
+        raise ValidationError(
+            f"theta_i: need measurements at >= 2 incidence angles to build a table, got {measured_ti.tolist()}"
+        )
+    phi_grid = paper_phi_grid(ph_s.max(), n_phi)
+    dt_grid = paper_delta_theta_grid(dt_s.min(), dt_s.max(), n_delta_theta)
+    ti_out = np.arange(0.0, 91.0) if theta_i is None else np.asarray(theta_i, dtype=np.float64)
+    _check_coord("theta_i", ti_out)
+
+    n_wl = spectra.shape[1]
+    per_theta = np.zeros((measured_ti.size, dt_grid.size, phi_grid.size, n_wl))
+    for a, t in enumerate(measured_ti):
+        in_t = np.flatnonzero(ti_s == t)
+        rows = np.unique(dt_s[in_t])
+        # Step 1: phi interpolation within every delta_theta row of this theta_i.
+        row_vals = np.zeros((rows.size, phi_grid.size, n_wl))
+        for r, d in enumerate(rows):
+            sel = in_t[dt_s[in_t] == d]
+            w = _interp_weights(ph_s[sel], phi_grid)  # (n_phi, n_sel)
+            row_vals[r] = w @ spectra[sel]
+        # Step 2: delta_theta interpolation for every grid phi.
+        if rows.size == 1:
+            raise ValidationError(
+                f"delta_theta: theta_i = {t} has measurements at a single delta_theta; need >= 2"
+            )
+        w = _interp_weights(rows, dt_grid)  # (n_dt, n_rows)
+        per_theta[a] = np.einsum("dr,rpl->dpl", w, row_vals)
+
+    lam = _lut.csaps_default_lambda(measured_ti) if smoothing == "csaps" else float(smoothing)
+    e = _lut.smoothing_spline_matrix(measured_ti, ti_out, lam, extrapolation)
+    lut = np.tensordot(e, per_theta, axes=(1, 0))
+    np.maximum(lut, 0.0, out=lut)
+
+    name = material or ds.attrs.get("material", "unnamed")
+    prov = ds.attrs.get("provenance", "")
+    return new_material(
+        lut.astype(dtype),
+        ti_out,
+        dt_grid,
+        phi_grid,
+        ds[WAVELENGTH].values,
+        material=name,
+        source=ds.attrs.get("source", "measured"),
+        provenance=(prov + "; " if prov else "") + "look-up table built by sbrdf_xr.build_lut "
+        "(paper 000 section 3.2)",
+        construction="paper000-3.2",
+        n_phi=n_phi,
+        n_delta_theta=n_delta_theta,
+        smoothing_lambda=lam,
+        extrapolation=extrapolation,
+        measured_theta_i=measured_ti,
+        n_measurements=int(ds.sizes[SAMPLE]),
+    )
+
+
+# ------------------------------------------------------------- reflectance
+
+
+def hemispherical_reflectance(
+    material: xr.DataArray,
+    theta_i: ArrayLike | None = None,
+    *,
+    method: str = "linear",
+    warn: bool = True,
+) -> xr.DataArray:
+    """Directional-hemispherical reflectance ``rho(theta_i, wavelength)`` of a table.
+
+    Quadrature over the visible hemisphere of the interpolated table
+    (:func:`sbrdf_xr._lut.hemispherical_reflectance_kernel`).  Values above one
+    are non-physical (energy is not conserved) and issue a
+    :class:`~sbrdf_xr.errors.NonPhysicalWarning` when ``warn`` is true.
+
+    Parameters
+    ----------
+    material : xarray.DataArray
+        Material table.
+    theta_i : array_like, optional
+        Incidence angles [degree]; default the table's own.
+    method : str, default "linear"
+        Look-up method of the integrand.
+    warn : bool, default True
+        Warn when any reflectance exceeds 1.
+
+    Returns
+    -------
+    xarray.DataArray
+        Dims ``(theta_i, wavelength)``, ``units = 1``.
+    """
+    material = validate_material(material, check_values=False)
+    grids = [np.asarray(material[d].values) for d in ANGLE_DIMS]
+    ti = grids[0] if theta_i is None else np.atleast_1d(np.asarray(theta_i, dtype=np.float64))
+    rho = _lut.hemispherical_reflectance_kernel(np.asarray(material.values), *grids, ti, method)
+    out = xr.DataArray(
+        rho,
+        dims=(THETA_I, WAVELENGTH),
+        coords={THETA_I: (THETA_I, ti, attrs(THETA_I)), WAVELENGTH: material[WAVELENGTH]},
+        name="reflectance",
+        attrs=attrs("reflectance", material=material.attrs.get("material", "")),
+    )
+    if warn and np.any(rho > 1.0):
+        worst = np.unravel_index(np.argmax(rho), rho.shape)
+        warnings.warn(
+            f"material {material.attrs.get('material', '')!r}: directional-hemispherical reflectance "
+            f"reaches {rho[worst]:.3f} > 1 at theta_i = {ti[worst[0]]} deg, wavelength = "
+            f"{material[WAVELENGTH].values[worst[1]]} nm; the table does not conserve energy",
+            NonPhysicalWarning,
+            stacklevel=2,
+        )
+    return out
+
+
+# --------------------------------------------------------------------- I/O
+
+
+def _encoding(obj: xr.Dataset) -> dict[str, dict[str, Any]]:
+    """No fill values anywhere; lossless zlib compression of the data variables."""
+    enc: dict[str, dict[str, Any]] = {name: {"_FillValue": None} for name in list(obj.variables)}
+    for name, var in obj.data_vars.items():
+        if var.ndim and np.issubdtype(var.dtype, np.floating):
+            enc[name].update(zlib=True, complevel=4, shuffle=True)
+    return enc
+
+
+def write_netcdf_atomic(ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
+    """Write ``ds`` to ``path`` atomically (temporary file, then rename).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Dataset to write.
+    path : path-like
+        Destination.
+    overwrite : bool, default False
+        Replace an existing file; otherwise an existing file is an error and is left
+        untouched.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    path = Path(path)
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{path} exists; pass overwrite=True to replace it")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".part", dir=path.parent)
+    os.close(fd)
+    try:
+        ds.to_netcdf(tmp, engine="netcdf4", encoding=_encoding(ds))
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def to_netcdf(
+    obj: xr.DataArray | xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False
+) -> Path:
+    """Write a material table or a measurement set to netCDF, losslessly and atomically.
+
+    Values, coordinates and attributes survive :func:`open_material` /
+    :func:`open_measurements` exactly (no fill values are added; float64 stays
+    float64).
+    """
+    if isinstance(obj, xr.DataArray):
+        obj = validate_material(obj).to_dataset()
+    else:
+        validate_measurements(obj)
+    obj = obj.copy()
+    obj.attrs.setdefault("Conventions", "CF-1.10")
+    return write_netcdf_atomic(obj, path, overwrite=overwrite)
+
+
+def open_material(path: str | os.PathLike[str]) -> xr.DataArray:
+    """Read a material table written by :func:`to_netcdf` (loaded into memory)."""
+    with xr.open_dataset(path, engine="netcdf4") as ds:
+        ds = ds.load()
+    if SBRDF not in ds:
+        raise ValidationError(f"{path}: no 'sbrdf' variable; not a material table")
+    da = ds[SBRDF]
+    da.attrs = {**{k: v for k, v in ds.attrs.items() if k != "Conventions"}, **da.attrs}
+    return validate_material(da)
+
+
+def open_measurements(path: str | os.PathLike[str]) -> xr.Dataset:
+    """Read a measurement set written by :func:`to_netcdf` (loaded into memory)."""
+    with xr.open_dataset(path, engine="netcdf4") as ds:
+        ds = ds.load()
+    if "reference" in ds:
+        ds["reference"] = ds["reference"].astype(bool)
+    return validate_measurements(ds)
+
+
+@register_loader("material")
+def _load_material_entry(e: CatalogEntry) -> xr.DataArray:
+    """A table file, or (``build_from`` set) a table built from a measurement entry."""
+    source = e.extra.get("build_from")
+    if source is None:
+        return open_material(e.file)
+    options = tuple(sorted(e.extra.get("build", {}).items()))
+    return _built_material(e.name, source, options).copy(deep=True)
+
+
+@functools.lru_cache(maxsize=16)
+def _built_material(name: str, measurements: str, options: tuple[tuple[str, Any], ...]) -> xr.DataArray:
+    from .catalog import load
+
+    return build_lut(load(measurements), material=name, **dict(options))
+
+
+@register_loader("measurements")
+def _load_measurements_entry(e: CatalogEntry) -> xr.Dataset:
+    return open_measurements(e.file)
