@@ -5,6 +5,7 @@ Sub-commands::
     sbrdf-xr catalog list [--kind KIND]     what ships in the catalogs, with provenance
     sbrdf-xr catalog show NAME              one entry and a summary of its contents
     sbrdf-xr info [FILE.nc]                 package and dependency versions, or a file's summary
+    sbrdf-xr bench [--quick]                accuracy/cost benchmarks, timings as ratios in one run
 """
 
 from __future__ import annotations
@@ -64,6 +65,13 @@ def _cmd_info(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_bench(args: argparse.Namespace) -> int:
+    from . import bench
+
+    print(bench.format_rows(bench.run(quick=args.quick)))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``sbrdf-xr``."""
     p = argparse.ArgumentParser(prog="sbrdf-xr", description="Spectral BRDF simulation of unresolved spacecraft.")
@@ -82,6 +90,10 @@ def build_parser() -> argparse.ArgumentParser:
     pi = sub.add_parser("info", help="versions, or a summary of a netCDF file")
     pi.add_argument("file", nargs="?")
     pi.set_defaults(func=_cmd_info)
+
+    pb = sub.add_parser("bench", help="accuracy/cost benchmarks (timings as ratios)")
+    pb.add_argument("--quick", action="store_true", help="small problems, for a smoke run")
+    pb.set_defaults(func=_cmd_bench)
     return p
 
 

@@ -60,7 +60,7 @@ def test_installed_package_finds_its_catalogs_from_any_directory(tmp_path):
     assert res.returncode == 0, res.stderr
     module_file, cat_dir, n = res.stdout.split()
     repo = Path(__file__).resolve().parent.parent
-    if Path(module_file).resolve().is_relative_to(repo):
+    if Path(module_file).resolve().parent == repo / "sbrdf_xr":
         pytest.skip("sbrdf_xr is installed in editable mode")
     assert Path(cat_dir).resolve().is_relative_to(Path(module_file).resolve().parent)
     assert int(n) == len(catalog.names())

@@ -43,3 +43,11 @@ def test_bad_subcommand_exits_with_usage():
     with pytest.raises(SystemExit) as exc:
         main(["fly"])
     assert exc.value.code == 2
+
+
+def test_bench_quick_runs_and_reports_ratios(capsys):
+    """The benchmark is code users run: it must not rot (no timing is asserted)."""
+    assert main(["bench", "--quick"]) == 0
+    out = capsys.readouterr().out
+    assert "sbrdf_xr linear kernel" in out and "xarray .interp (linear)" in out
+    assert "max rel diff" in out
