@@ -11,6 +11,7 @@ from __future__ import annotations
 __all__ = [
     "CatalogError",
     "MeshError",
+    "MeshRepairWarning",
     "NonPhysicalWarning",
     "SbrdfError",
     "SbrdfWarning",
@@ -45,3 +46,7 @@ class SbrdfWarning(UserWarning):
 
 class NonPhysicalWarning(SbrdfWarning):
     """A quantity that violates a physical bound (for example reflectance > 1)."""
+
+
+class MeshRepairWarning(SbrdfWarning):
+    """A spacecraft mesh was repaired as documented in :mod:`sbrdf_xr.spacecraft`."""

@@ -124,3 +124,122 @@ def make_material(
                         source="synthetic", provenance="sbrdf_xr.testing.make_material")
 
 # ---------------------------------------------------------------- spacecraft
+# (section owned by the spacecraft/visibility issue: cube, L-shaped body, plate with a fin)
+
+#: Material of the test spacecraft built below.
+TEST_SPACECRAFT_MATERIAL = "white-paint-a276"
+
+
+def _ear_clip(polygon: np.ndarray) -> np.ndarray:
+    """Triangles (index triples, counter-clockwise) of a simple counter-clockwise polygon."""
+    idx = list(range(len(polygon)))
+    tris = []
+
+    def cross(o, a, b):
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    while len(idx) > 3:
+        for k in range(len(idx)):
+            i0, i1, i2 = idx[k - 1], idx[k], idx[(k + 1) % len(idx)]
+            a, b, c = polygon[i0], polygon[i1], polygon[i2]
+            if cross(a, b, c) <= 0:
+                continue  # reflex or collinear corner
+            inside = any(
+                cross(a, b, polygon[j]) >= 0 and cross(b, c, polygon[j]) >= 0 and cross(c, a, polygon[j]) >= 0
+                for j in idx
+                if j not in (i0, i1, i2)
+            )
+            if not inside:
+                tris.append((i0, i1, i2))
+                idx.pop(k)
+                break
+        else:  # pragma: no cover - not a simple polygon
+            raise ValueError("polygon is not simple and counter-clockwise")
+    tris.append(tuple(idx))
+    return np.array(tris)
+
+
+def prism_mesh(polygon_xy, z0: float, z1: float):
+    """Closed, outward-wound prism: a simple counter-clockwise polygon in xy extruded along z.
+
+    Parameters
+    ----------
+    polygon_xy : array_like, shape (n, 2)
+        Vertices of the cross-section [m], counter-clockwise, without repeating the first.
+    z0, z1 : float
+        Bottom and top of the prism [m].
+
+    Returns
+    -------
+    trimesh.Trimesh
+        ``4 n - 4`` facets: two per side wall, ``n - 2`` per cap.
+    """
+    import trimesh
+
+    p = np.asarray(polygon_xy, dtype=float)
+    n = len(p)
+    vertices = np.vstack([np.column_stack([p, np.full(n, z0)]), np.column_stack([p, np.full(n, z1)])])
+    cap = _ear_clip(p)
+    faces = [cap[:, ::-1], cap + n]  # bottom faces -z, top faces +z
+    i = np.arange(n)
+    j = (i + 1) % n
+    faces.append(np.column_stack([i, j, j + n]))
+    faces.append(np.column_stack([i, j + n, i + n]))
+    return trimesh.Trimesh(vertices, np.vstack(faces), process=False)
+
+
+def _as_spacecraft(mesh, name: str):
+    from .spacecraft import load_spacecraft
+
+    mesh.visual.face_colors = np.tile([200, 200, 200, 255], (len(mesh.faces), 1))
+    return load_spacecraft(mesh, {(200, 200, 200): TEST_SPACECRAFT_MATERIAL}, name=name)
+
+
+def cube_spacecraft(size: float = 1.0, subdivisions: int = 1):
+    """A convex cube [m] centred at the origin, each face cut into ``2 * 4**(subdivisions - 1)`` facets.
+
+    Parameters
+    ----------
+    size : float
+        Edge length [m].
+    subdivisions : int
+        1 + number of rounds of :meth:`trimesh.Trimesh.subdivide` (coplanar facets test the
+        convexity detection).
+
+    Returns
+    -------
+    sbrdf_xr.spacecraft.Spacecraft
+    """
+    import trimesh
+
+    mesh = trimesh.creation.box(extents=(size, size, size))
+    for _ in range(subdivisions - 1):
+        mesh = mesh.subdivide()
+    return _as_spacecraft(mesh, f"cube-{size:g}m")
+
+
+#: Cross-section of :func:`l_shaped_spacecraft` in xy [m]: the union of [0, 2] x [0, 1] and
+#: [0, 1] x [0, 2]; its inner corner is at (1, 1).
+L_SECTION = ((0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 1.0), (1.0, 2.0), (0.0, 2.0))
+
+
+def l_shaped_spacecraft(depth: float = 2.0):
+    """An L-shaped prism: cross-section :data:`L_SECTION` extruded over z in [0, depth] [m].
+
+    The floor ``y = 1, 1 <= x <= 2`` (normal +y) is shadowed by the wall ``x = 1,
+    1 <= y <= 2`` (normal +x) when the Sun has ``s_x < 0``.
+    """
+    return _as_spacecraft(prism_mesh(L_SECTION, 0.0, depth), "l-shape")
+
+
+def plate_with_fin_section(half_width: float = 1.0, thickness: float = 0.1, fin_height: float = 1.0,
+                           fin_thickness: float = 0.1) -> np.ndarray:
+    """Cross-section in xy of :func:`plate_with_fin_spacecraft` (counter-clockwise) [m]."""
+    w, t, h, f = half_width, thickness, fin_height, fin_thickness / 2
+    return np.array([(-w, -t), (w, -t), (w, 0.0), (f, 0.0), (f, h), (-f, h), (-f, 0.0), (-w, 0.0)])
+
+
+def plate_with_fin_spacecraft(depth: float = 2.0, **section):
+    """A plate ``[-1, 1] x [-0.1, 0]`` with a perpendicular fin ``[-0.05, 0.05] x [0, 1]`` (xy, [m]),
+    extruded over z in [0, depth]; ``section`` overrides :func:`plate_with_fin_section`."""
+    return _as_spacecraft(prism_mesh(plate_with_fin_section(**section), 0.0, depth), "plate-with-fin")
