@@ -9,9 +9,14 @@ the paper's own model): a 100 mm cube centred at the origin, faces normal to +-x
   side face, raised 0.5 mm above the face (their 0.5 mm side walls are cell material too).
   On +-X they are arrayed horizontally (side by side along y: y in [-42, -2] and [2, 42],
   z in [-35, 35]); on +-Y vertically (stacked along z: z in [-42, -2] and [2, 42],
-  x in [-35, 35]).  All cells of one side share its normal, so during a rotation about z
-  they glint together; the layout differs as on the real spacecraft.  Every side has the
-  same cell area (paper: "All four sides are known to possess the same coverage").
+  x in [-35, 35]).  Every side has the same cell area (paper: "All four sides are known to
+  possess the same coverage").  The two cells of a +-X side are flush and share the side's
+  normal, so during a rotation about z they glint in unison.  The cells of a +-Y side are
+  mounted non-flush (paper 000 §4.2 and Fig. 17: the real cells are "not flat nor flush"):
+  each is tilted by :data:`Y_CELL_TILT` = 1 deg about z, the upper cell one way and the lower
+  the other, so that they glint one after the other, 2 deg of rotation apart, and the +-Y
+  glints are weaker than the +-X ones, as the paper observes.  Their top faces rise from
+  0.39 to 1.61 mm above the face (mean :data:`CELL_HEIGHT_Y` = 1 mm).
 * Frame rails (``aluminium-6061-t6``, red): flush border strips of the side faces along the
   cube edges, 5 mm wide on +-X; on +-Y the vertical rails are 10 mm and the horizontal ones
   5 mm wide, so the Y sides carry more aluminium (2800 mm2 vs 1900 mm2 per side) as the
@@ -36,7 +41,9 @@ from pathlib import Path
 import numpy as np
 
 HALF = 50.0  #: half the cube edge [mm]
-CELL_HEIGHT = 0.5  #: height of the cells above the face [mm]
+CELL_HEIGHT = 0.5  #: height of the +-X cells above the face [mm]
+CELL_HEIGHT_Y = 1.0  #: mean height of the tilted +-Y cells above the face [mm]
+Y_CELL_TILT = 1.0  #: azimuth tilt of the +-Y cells about z, upper +, lower - [degree]
 ALU, CELL, PAINT = "aluminium-6061-t6", "tjpv-cell", "white-paint-a276"
 COLORS = {ALU: (255, 0, 0), CELL: (0, 0, 255), PAINT: (255, 255, 255)}
 
@@ -72,10 +79,12 @@ class _Builder:
         self.material: list[str] = []
 
     def vertex(self, p: np.ndarray) -> int:
-        key = tuple(round(2 * c) for c in p)  # exact: every coordinate is a multiple of 0.5 mm
+        # Flat features lie on a 0.5 mm grid; tilted cell tops are computed by one function,
+        # so a shared corner always gets the same floats.  1e-6 mm keys merge them.
+        key = tuple(round(1e6 * c) for c in p)
         if key not in self.index:
             self.index[key] = len(self.vertices)
-            self.vertices.append(tuple(k / 2 for k in key))
+            self.vertices.append(tuple(float(c) for c in p))
         return self.index[key]
 
     def quad(self, corners: list[np.ndarray], outward: np.ndarray, material: str) -> None:
@@ -116,6 +125,14 @@ def build() -> tuple[np.ndarray, np.ndarray, list[str]]:
             def in_cell(u: float, v: float, cells: list = cells) -> bool:
                 return any(a0 < u < a1 and z0 < v < z1 for (a0, a1), (z0, z1) in cells)
 
+            def height(u: float, v: float, axis: int = axis, sign: float = sign) -> float:
+                """Height of a cell top above the face at in-plane (u, v) [mm]."""
+                if axis != 1:
+                    return CELL_HEIGHT
+                # Rotation by +-tilt about z of a +-Y face: the outward offset varies along x.
+                tilt = np.radians(Y_CELL_TILT) * (1.0 if v > 0 else -1.0)
+                return CELL_HEIGHT_Y + sign * np.tan(tilt) * u
+
             us, vs = bp[a_ax], bp[b_ax]
             for u0, u1 in itertools.pairwise(us):
                 for v0, v1 in itertools.pairwise(vs):
@@ -127,9 +144,14 @@ def build() -> tuple[np.ndarray, np.ndarray, list[str]]:
                         material = ALU
                     else:
                         material = PAINT
-                    h = CELL_HEIGHT if raised else 0.0
+                    vm = (v0 + v1) / 2  # which cell (upper or lower) the rectangle belongs to
+
+                    def h(u: float, raised: bool = raised, vm: float = vm) -> float:
+                        return height(u, vm) if raised else 0.0
+
                     b.quad(
-                        [point(u0, v0, h), point(u1, v0, h), point(u1, v1, h), point(u0, v1, h)],
+                        [point(u0, v0, h(u0)), point(u1, v0, h(u1)), point(u1, v1, h(u1)),
+                         point(u0, v1, h(u0))],
                         normal,
                         material,
                     )
@@ -154,8 +176,8 @@ def build() -> tuple[np.ndarray, np.ndarray, list[str]]:
                             [
                                 point(pu0, pv0, 0.0),
                                 point(pu1, pv1, 0.0),
-                                point(pu1, pv1, CELL_HEIGHT),
-                                point(pu0, pv0, CELL_HEIGHT),
+                                point(pu1, pv1, h(pu1)),
+                                point(pu0, pv0, h(pu0)),
                             ],
                             out,
                             CELL,
@@ -183,7 +205,7 @@ def ply_text() -> str:
         "property uchar blue",
         "end_header",
     ]
-    lines += [" ".join(f"{c:g}" for c in v) for v in vertices]
+    lines += [" ".join(f"{c:.9g}" for c in v) for v in vertices]
     lines += [
         "3 {} {} {} {} {} {}".format(*f, *COLORS[m])
         for f, m in zip(faces.tolist(), material, strict=True)

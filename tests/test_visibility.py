@@ -226,12 +226,12 @@ def test_triangle_engine_on_canx1_rotation():
 
 
 def test_canx1_shadowing_is_small():
-    """Raised 0.5 mm cells on a 100 mm cube shadow little.
+    """Raised cells (0.5 mm on +-X, 0.4-1.6 mm on +-Y) on a 100 mm cube shadow little.
 
     Projected-area-weighted shadowed fraction sum A mu (1 - f) / sum A mu (mu = N.s > 0)
-    over 200 random Sun directions: a wall of height h = 0.5 mm hides at most about its own
-    area seen from the Sun (total wall area 880 mm2 against >= 10^4 mm2 projected), about
-    1-2 % in practice; we require > 0 (the body is not convex) and < 3 %.
+    over 200 random Sun directions: a wall hides at most about its own area seen from the
+    Sun (total wall area about 1400 mm2 against >= 10^4 mm2 projected), 1-3 % in practice;
+    we require > 0 (the body is not convex) and < 5 %.
     """
     craft = sc.canx1()
     d = random_directions(200, seed=5)
@@ -240,12 +240,12 @@ def test_canx1_shadowing_is_small():
     a = craft.mesh.area_faces
     shadowed = 1 - (a * mu * f).sum(axis=1) / (a * mu).sum(axis=1)
     assert shadowed.min() >= 0
-    assert 0 < shadowed.max() < 0.03
+    assert 0 < shadowed.max() < 0.05
     # Sun straight along +x: the cells throw no shadow on the +X face
     f = vis.lit_fraction(craft, [1.0, 0.0, 0.0], density=3)
     plus_x = craft.mesh.face_normals[:, 0] > 0.5
     np.testing.assert_array_equal(f[plus_x], 1.0)
-    np.testing.assert_array_equal(f[~plus_x], 0.0)
+    np.testing.assert_array_equal(f[craft.mesh.face_normals[:, 0] <= 0], 0.0)
 
 
 def test_facet_visibility_dataset_and_joint_fraction():
