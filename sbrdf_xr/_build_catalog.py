@@ -10,12 +10,95 @@ from pathlib import Path
 
 import numpy as np
 
-from . import goniometer, material, testing
+from . import goniometer, material, models, testing
+from .brdf import optics
 
 ROOT = Path(__file__).resolve().parent.parent / "catalogs"
 
 #: 450-1100 nm in 5 nm steps: the range of paper 000 Figs. 14 and 16 (131 samples).
 WAVELENGTH_PAPER = np.arange(450.0, 1100.1, 5.0)
+#: 400-1100 nm in 5 nm steps: the CanX-1 material set.
+WAVELENGTH_CANX1 = np.arange(400.0, 1100.1, 5.0)
+#: Relative noise of the virtual measurements of the CanX-1 materials.
+CANX1_NOISE = 0.01
+
+
+def canx1_models() -> dict[str, "object"]:
+    """Generating models of the CanX-1 material set (synthetic stand-ins).
+
+    * aluminium 6061-T6: directional-diffuse metal; GGX roughness 0.15 over the
+      exact Fresnel reflectance of aluminium (Lorentz-Drude optical constants of
+      Rakic et al. 1998, with the interband absorption near 800 nm), plus a diffuse
+      term 0.02 R(lambda) (R the normal-incidence reflectance) for the milled
+      surface's scatter, which carries the same 800 nm feature;
+    * Emcore-like triple-junction cell: GaAs substrate under a two-layer
+      anti-reflection coating (Al2O3 100 nm on TiO2 70 nm), GGX roughness 0.03
+      (highly specular), diffuse 0.005: thin-film interference features in
+      600-800 nm that move to shorter wavelengths as the angle grows;
+    * Aeroglaze A276-like white paint: Robertson-Sandford with rho_D 0.80 (0.55
+      at 400 nm rising to the plateau by 450 nm, the titania edge), epsilon 0.12,
+      b 0.1, e 0.35 (near-Lambertian with a faint sheen).
+    """
+    wl = WAVELENGTH_CANX1
+    al = optics.aluminium_index(wl)
+    r_al = optics.normal_incidence_reflectance(al)
+    gaas = optics.gaas_index(wl)
+    rho_paint = 0.80 - 0.25 * np.exp(-(wl - 400.0) / 20.0)
+    return {
+        "aluminium-6061-t6": models.model_material(
+            "microfacet", wl, material="aluminium-6061-t6",
+            provenance="synthetic: GGX roughness 0.15, Fresnel of aluminium from the Lorentz-Drude "
+            "model of Rakic et al., Appl. Opt. 37, 5271 (1998), diffuse 0.02 R(lambda)",
+            roughness=0.15, n=al.real, k=al.imag, rho_d=0.02 * r_al),
+        "tjpv-cell": models.model_material(
+            "microfacet", wl, material="tjpv-cell",
+            provenance="synthetic: GaAs (sbrdf_xr.brdf.optics.gaas_index) under Al2O3 100 nm / "
+            "TiO2 70 nm anti-reflection coating, GGX roughness 0.03, diffuse 0.005",
+            layers=[(optics.sapphire_index(wl), 100.0), (optics.titania_index(wl), 70.0)],
+            roughness=0.03, n=gaas.real, k=gaas.imag, rho_d=0.005),
+        "white-paint-a276": models.model_material(
+            "robertson_sandford", wl, material="white-paint-a276",
+            provenance="synthetic: Robertson-Sandford (paper 001) rho_D 0.80 with a 400-450 nm "
+            "edge, epsilon 0.12, b 0.1, e 0.35",
+            rho_D=rho_paint, epsilon=0.12, b=0.1, e=0.35),
+    }
+
+
+#: Incidence angles of the virtual measurements (paper 000 §4.2: aluminium from
+#: 30 deg, the cell and the paint from 10 deg).
+CANX1_THETA_I = {
+    "aluminium-6061-t6": (30.0, 40.0, 50.0, 60.0, 70.0),
+    "tjpv-cell": (10.0, 25.0, 40.0, 55.0, 70.0),
+    "white-paint-a276": (10.0, 25.0, 40.0, 55.0, 70.0),
+}
+
+
+def canx1_materials() -> None:
+    """Write the CanX-1 models and their virtual measurement sets."""
+    for k, (name, spec) in enumerate(canx1_models().items()):
+        models.to_netcdf(spec, ROOT / "materials" / f"{name}-model.nc", overwrite=True)
+        meas = models.measure(spec, CANX1_THETA_I[name], noise=CANX1_NOISE, seed=10 + k)
+        material.to_netcdf(meas, ROOT / "materials" / f"{name}-measurements.nc", overwrite=True)
+
+
+def table4_paints() -> None:
+    """Paper 001 Table 4: Robertson-Sandford parameters at 4 um."""
+    import xarray as xr
+
+    ds = xr.Dataset(
+        {
+            "rho_D": ("sample", [0.07, 0.05], models.PARAM_ATTRS["rho_D"]),
+            "epsilon": ("sample", [0.85, 0.88], models.PARAM_ATTRS["epsilon"]),
+            "b": ("sample", [0.12, 0.08], models.PARAM_ATTRS["b"]),
+            "e": ("sample", [0.12, 0.012], models.PARAM_ATTRS["e"]),
+        },
+        coords={"sample": ("sample", ["AFGL-01", "AFGL-10"], {"long_name": "paint sample"}),
+                "description": ("sample", ["camouflage", "white gloss"], {"long_name": "paint"}),
+                "wavelength": ((), 4000.0, {"units": "nm", "long_name": "wavelength of the parameters"})},
+        attrs={"title": "Robertson-Sandford parameters, paper 001 Table 4 (4 um)",
+               "source": "measured", "Conventions": "CF-1.10"},
+    )
+    material.write_netcdf_atomic(ds, ROOT / "materials" / "table4-paints.nc", overwrite=True)
 
 
 def lambertian_grey() -> None:
@@ -54,6 +137,8 @@ def main() -> None:
     (ROOT / "materials").mkdir(parents=True, exist_ok=True)
     lambertian_grey()
     example_lobe_measurements()
+    canx1_materials()
+    table4_paints()
 
 
 if __name__ == "__main__":

@@ -4,7 +4,7 @@ The catalog directory holds ``index.toml``, one ``[[entry]]`` table per item::
 
     [[entry]]
     name = "lambertian-grey-50"          # unique, lower-case, used by load()
-    kind = "material"                    # material | measurements | paint_parameters | spacecraft
+    kind = "material"                    # material | measurements | model | paint_parameters | spacecraft
     path = "materials/lambertian-grey-50.nc"   # relative to the catalog directory
     source = "synthetic"                 # measured | synthetic | model:<name>
     description = "..."                  # what it is
@@ -28,7 +28,7 @@ from .errors import CatalogError
 
 __all__ = ["CatalogEntry", "catalog_dir", "data_path", "entries", "entry", "load", "names"]
 
-KINDS = ("material", "measurements", "paint_parameters", "spacecraft")
+KINDS = ("material", "measurements", "model", "paint_parameters", "spacecraft")
 SOURCES = ("measured", "synthetic")
 
 
@@ -142,7 +142,7 @@ def entries(kind: str | None = None) -> list[CatalogEntry]:
     Parameters
     ----------
     kind : str, optional
-        One of ``material``, ``measurements``, ``paint_parameters``, ``spacecraft``.
+        One of ``material``, ``measurements``, ``model``, ``paint_parameters``, ``spacecraft``.
 
     Returns
     -------
@@ -198,7 +198,8 @@ def load(name: str) -> Any:
     -------
     object
         A material ``DataArray`` for ``material``; a measurement ``Dataset`` for
-        ``measurements``; a parameter ``Dataset`` for ``paint_parameters``; a
+        ``measurements``; a parameter ``Dataset`` for ``model`` (see
+        :mod:`sbrdf_xr.models`) and ``paint_parameters``; a
         :class:`~sbrdf_xr.spacecraft.Spacecraft` for ``spacecraft``.
     """
     e = entry(name)
@@ -212,9 +213,4 @@ def load(name: str) -> Any:
 
 def _import_loaders() -> None:
     # Loaders live with the objects they build; importing registers them.
-    from . import material  # noqa: F401
-
-    try:
-        from . import spacecraft  # noqa: F401
-    except ImportError:  # pragma: no cover - optional until the module exists
-        pass
+    from . import material, models, spacecraft  # noqa: F401

@@ -8,7 +8,9 @@ on the source side) times four ``phi`` columns (0, a third, two thirds of the
 row's extent, and the extent itself).  The extents are *reference points*, where
 the signal has fallen into the noise and the reflectance is taken as zero: the
 ``phi`` extent of every row, and the two ``delta_theta`` extents (in the plane).
-Here that makes 21 measured spectra and 9 reference points per incidence angle.
+That makes 21 measured spectra and 9 reference points per incidence angle for a
+specular material; where the apparatus limit comes before the noise (diffuse
+materials), the extent is measured instead of being a zero reference point.
 
 The extents are found as the paper's operator found them: walking away from
 specular until the signal falls below the noise floor, within what the apparatus
@@ -50,6 +52,7 @@ def paper_scheme(
     dt_min: float,
     dt_max: float,
     phi_max: Sequence[float] | ArrayLike,
+    in_noise: Sequence[bool] | ArrayLike | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Reflection geometries of paper 000 Table 1 at one incidence angle.
 
@@ -63,13 +66,16 @@ def paper_scheme(
     phi_max : sequence of 7 floats
         ``phi`` extent of each row, in the row order ``0.75, 0.5, 0.25`` of
         ``dt_max``, 0, ``0.25, 0.5, 0.75`` of ``dt_min`` [degree].
+    in_noise : sequence of 9 bools, optional
+        Which extents are reference points (see :func:`scheme_extents`); default
+        all, as in the paper's Table 1.
 
     Returns
     -------
     delta_theta, phi : ndarray, shape (30,)
         Geometries [degree]: 7 rows x 4 columns, then the two in-plane extents.
     reference : ndarray of bool, shape (30,)
-        True for the 9 reference points.
+        True for the reference points (9 when every extent is in the noise).
     """
     phi_max = np.asarray(phi_max, dtype=np.float64)
     if phi_max.shape != (7,):
@@ -81,20 +87,28 @@ def paper_scheme(
     cols = np.asarray(COLUMN_FRACTIONS)
     dt = np.concatenate([np.repeat(rows, cols.size), [dt_max, dt_min]])
     ph = np.concatenate([(phi_max[:, None] * cols).ravel(), [0.0, 0.0]])
-    ref = np.concatenate([np.tile(cols == 1.0, rows.size), [True, True]])
+    flags = np.ones(9, dtype=bool) if in_noise is None else np.asarray(in_noise, dtype=bool)
+    if flags.shape != (9,):
+        raise ValidationError(f"in_noise: need 9 flags (7 phi extents, dt_max, dt_min), got {flags.shape}")
+    ref = np.concatenate([((cols == 1.0)[None, :] & flags[:7, None]).ravel(), flags[7:]])
     return dt, ph, ref
 
 
 def _walk_out(
     signal: Callable[[np.ndarray], np.ndarray], limit: float, floor: float, step: float
-) -> float:
-    """First coordinate from 0 towards ``limit`` where ``signal`` drops below ``floor``."""
+) -> tuple[float, bool]:
+    """First coordinate from 0 towards ``limit`` where ``signal`` drops below ``floor``.
+
+    Returns the coordinate and whether the signal fell into the noise there (True:
+    a reference point) or the apparatus limit was reached first (False: a
+    measured point).
+    """
     n = max(int(np.ceil(abs(limit) / step)), 1)
     xs = np.linspace(0.0, limit, n + 1)[1:]
     below = signal(xs) < floor
     if not np.any(below):
-        return float(limit)
-    return float(xs[np.argmax(below)])
+        return float(limit), False
+    return float(xs[np.argmax(below)]), True
 
 
 def scheme_extents(
@@ -133,6 +147,10 @@ def scheme_extents(
         ``delta_theta`` extents [degree].
     phi_max : ndarray, shape (7,)
         ``phi`` extent of each row [degree].
+    in_noise : ndarray of bool, shape (9,)
+        Whether each extent (the 7 ``phi`` extents, then ``dt_max`` and ``dt_min``)
+        is where the signal fell into the noise (a reference point, zero) rather
+        than an apparatus limit (a measured point).
     """
     def band(ti: float, dt: np.ndarray, ph: np.ndarray) -> np.ndarray:
         return np.mean(func(np.full(dt.shape, ti), dt, ph), axis=-1)
@@ -143,15 +161,15 @@ def scheme_extents(
         raise ValidationError(
             f"theta_i = {theta_i}: the apparatus limits leave no room on both sides of specular"
         )
-    dt_max = _walk_out(lambda x: band(theta_i, x, 0 * x), far_limit, noise_floor, step)
-    dt_min = _walk_out(lambda x: band(theta_i, x, 0 * x), near_limit, noise_floor, step)
+    dt_max, ref_max = _walk_out(lambda x: band(theta_i, x, 0 * x), far_limit, noise_floor, step)
+    dt_min, ref_min = _walk_out(lambda x: band(theta_i, x, 0 * x), near_limit, noise_floor, step)
     rows = np.array([f * dt_max for f in ROW_FRACTIONS_FAR] + [0.0]
                     + [f * dt_min for f in ROW_FRACTIONS_NEAR])
-    phi_max = np.array([
-        _walk_out(lambda x, d=d: band(theta_i, np.full(x.shape, d), x), max_phi, noise_floor, step)
-        for d in rows
-    ])
-    return dt_min, dt_max, phi_max
+    walks = [_walk_out(lambda x, d=d: band(theta_i, np.full(x.shape, d), x), max_phi, noise_floor, step)
+             for d in rows]
+    phi_max = np.array([w[0] for w in walks])
+    in_noise = np.array([w[1] for w in walks] + [ref_max, ref_min])
+    return dt_min, dt_max, phi_max, in_noise
 
 
 def measure(
@@ -160,6 +178,7 @@ def measure(
     theta_i: Sequence[float] = PAPER_THETA_I["default"],
     *,
     noise_floor: float | None = None,
+    dynamic_range: float = 1e-2,
     noise: float = 0.0,
     seed: int | None = 0,
     material: str = "unnamed",
@@ -179,8 +198,13 @@ def measure(
     theta_i : sequence of float
         Fixed incidence angles [degree] (paper: five).
     noise_floor : float, optional
-        Signal level of the reference points [sr-1]; default 1% of the smallest
-        specular (``delta_theta = phi = 0``) band-averaged sBRDF over ``theta_i``.
+        Band-averaged sBRDF below which the signal is indistinguishable from noise
+        [sr-1] (the reference points).  Default: ``dynamic_range`` times the
+        specular (``delta_theta = phi = 0``) band-averaged sBRDF at each incidence
+        angle, as for an instrument whose gain is set on the specular peak.
+    dynamic_range : float, default 1e-2
+        Ratio of the noise floor to the specular signal when ``noise_floor`` is
+        not given [1].
     noise : float, default 0
         Relative standard deviation of multiplicative Gaussian noise on the
         measured spectra [1] (clipped at zero).
@@ -202,13 +226,16 @@ def measure(
         raise ValidationError("theta_i: need at least one incidence angle")
     if noise < 0:
         raise ValidationError(f"noise: relative noise must be >= 0, got {noise}")
-    if noise_floor is None:
-        spec = func(tis, np.zeros_like(tis), np.zeros_like(tis))
-        noise_floor = 0.01 * float(np.min(np.mean(spec, axis=-1)))
+    if noise_floor is not None and not noise_floor > 0:
+        raise ValidationError(f"noise_floor: must be > 0 sr-1, got {noise_floor}")
+    if not 0 < dynamic_range < 1:
+        raise ValidationError(f"dynamic_range: must lie in (0, 1), got {dynamic_range}")
+    specular = np.mean(func(tis, np.zeros_like(tis), np.zeros_like(tis)), axis=-1)
+    floors = np.full(tis.shape, noise_floor) if noise_floor is not None else dynamic_range * specular
     ti_all, dt_all, ph_all, ref_all = [], [], [], []
-    for t in tis:
-        dt_min, dt_max, phi_max = scheme_extents(func, float(t), noise_floor=noise_floor, **limits)
-        dt, ph, ref = paper_scheme(float(t), dt_min, dt_max, phi_max)
+    for t, floor in zip(tis, floors, strict=True):
+        dt_min, dt_max, phi_max, in_noise = scheme_extents(func, float(t), noise_floor=float(floor), **limits)
+        dt, ph, ref = paper_scheme(float(t), dt_min, dt_max, phi_max, in_noise)
         ti_all.append(np.full(dt.shape, t))
         dt_all.append(dt)
         ph_all.append(ph)
@@ -237,7 +264,7 @@ def measure(
             "source": source,
             "provenance": provenance,
             "scheme": "paper 000 Fig. 6 / Table 1 (virtual goniospectrometer)",
-            "noise_floor": noise_floor,
+            "noise_floor": floors,
             "relative_noise": noise,
         },
     )

@@ -1,0 +1,231 @@
+"""Analytic materials as labelled parameter sets: evaluate, render to a table, measure.
+
+A *model material* is an :class:`xarray.Dataset` holding the parameters of one of
+the analytic models of :mod:`sbrdf_xr.brdf` over ``wavelength``: spectral
+parameters as variables over ``wavelength`` (scalars broadcast), an optional
+thin-film stack as ``layer_n``, ``layer_k`` ``(layer, wavelength)`` and
+``layer_thickness`` ``(layer,)`` [nm], and the attributes ``model``, ``material``,
+``source = model:<name>`` and ``provenance``.  It is the xarray layer over the
+pure-numpy models:
+
+* :func:`model_material` - build and validate one;
+* :func:`spectra` - evaluate at paper-000 angles (numpy);
+* :func:`render` - a look-up table on any grid (paper 000's by default);
+* :func:`measure` - sample it with the virtual goniospectrometer
+  (:mod:`sbrdf_xr.goniometer`), so that a table built from the measurements can
+  be compared with its ground truth.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from numpy.typing import ArrayLike
+
+from . import brdf as _brdf
+from ._names import WAVELENGTH, attrs
+from .catalog import CatalogEntry, register_loader
+from .errors import ValidationError
+from .material import new_material, write_netcdf_atomic
+
+__all__ = ["PARAM_ATTRS", "measure", "model_material", "open_model", "render", "spectra",
+           "spectrum_function", "to_netcdf"]
+
+PARAM_ATTRS: dict[str, dict[str, str]] = {
+    "rho": {"units": "1", "long_name": "Lambertian albedo"},
+    "rho_D": {"units": "1", "long_name": "diffuse spectral reflectance (Robertson-Sandford rho_D)"},
+    "epsilon": {"units": "1", "long_name": "spectral hemispherical emissivity (Robertson-Sandford)"},
+    "b": {"units": "1", "long_name": "grazing-angle parameter (Robertson-Sandford b)"},
+    "e": {"units": "1", "long_name": "specular lobe width (Robertson-Sandford e)"},
+    "roughness": {"units": "1", "long_name": "GGX roughness alpha"},
+    "n": {"units": "1", "long_name": "substrate refractive index"},
+    "k": {"units": "1", "long_name": "substrate extinction coefficient"},
+    "rho_d": {"units": "1", "long_name": "Lambertian albedo added to the microfacet term"},
+    "layer_n": {"units": "1", "long_name": "thin-film layer refractive index (ambient side first)"},
+    "layer_k": {"units": "1", "long_name": "thin-film layer extinction coefficient"},
+    "layer_thickness": {"units": "nm", "long_name": "thin-film layer thickness"},
+}
+
+
+def model_material(
+    model: str,
+    wavelength: ArrayLike,
+    *,
+    material: str,
+    provenance: str,
+    layers: Sequence[tuple[ArrayLike, float]] | None = None,
+    **params: ArrayLike,
+) -> xr.Dataset:
+    """A validated model material.
+
+    Parameters
+    ----------
+    model : str
+        A name of :data:`sbrdf_xr.brdf.MODELS`.
+    wavelength : array_like
+        Wavelengths [nm].
+    material : str
+        Material name.
+    provenance : str
+        Where the parameters come from.
+    layers : sequence of (complex index, thickness [nm]), optional
+        Thin-film stack (``microfacet`` only), ambient side first.
+    **params
+        The model's parameters (see the model's ``check_params``).
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    mod = _brdf.get_model(model)
+    wl = np.asarray(wavelength, dtype=np.float64)
+    checked = mod.check_params(wl, **params)
+    data = {k: (WAVELENGTH, np.asarray(v, dtype=np.float64), PARAM_ATTRS.get(k, {"units": "1", "long_name": k}))
+            for k, v in checked.items()}
+    if layers:
+        if model != "microfacet":
+            raise ValidationError(f"layers: only the microfacet model has a thin-film stack, not {model!r}")
+        idx = np.stack([np.broadcast_to(np.asarray(n, dtype=np.complex128), wl.shape) for n, _ in layers])
+        data["layer_n"] = (("layer", WAVELENGTH), idx.real, PARAM_ATTRS["layer_n"])
+        data["layer_k"] = (("layer", WAVELENGTH), idx.imag, PARAM_ATTRS["layer_k"])
+        thick = np.array([float(t) for _, t in layers])
+        if np.any(thick < 0) or not np.all(np.isfinite(thick)):
+            raise ValidationError(f"layers: thicknesses must be finite and >= 0 nm, got {thick.tolist()}")
+        data["layer_thickness"] = ("layer", thick, PARAM_ATTRS["layer_thickness"])
+    ds = xr.Dataset(data, coords={WAVELENGTH: (WAVELENGTH, wl, attrs(WAVELENGTH))})
+    ds.attrs = {"model": model, "material": material, "source": f"model:{model}",
+                "provenance": provenance, "Conventions": "CF-1.10"}
+    return ds
+
+
+def _params(spec: xr.Dataset) -> tuple[Any, np.ndarray, dict[str, Any]]:
+    if not isinstance(spec, xr.Dataset) or "model" not in spec.attrs:
+        raise ValidationError("model material: expected a Dataset with a 'model' attribute")
+    mod = _brdf.get_model(spec.attrs["model"])
+    wl = np.asarray(spec[WAVELENGTH].values)
+    kw: dict[str, Any] = {k: np.asarray(spec[k].values) for k in mod.PARAMS}
+    if "layer_thickness" in spec:
+        idx = np.asarray(spec["layer_n"].values) + 1j * np.asarray(spec["layer_k"].values)
+        kw["layers"] = [(idx[j], float(t)) for j, t in enumerate(spec["layer_thickness"].values)]
+    return mod, wl, kw
+
+
+def spectra(spec: xr.Dataset, theta_i: ArrayLike, delta_theta: ArrayLike, phi: ArrayLike) -> np.ndarray:
+    """The model's spectra at paper-000 angles.
+
+    Parameters
+    ----------
+    spec : xarray.Dataset
+        A model material.
+    theta_i, delta_theta, phi : array_like
+        Angles [degree], broadcast together.
+
+    Returns
+    -------
+    ndarray, shape broadcast + (n_wavelength,)
+        sBRDF [sr-1].
+    """
+    mod, wl, kw = _params(spec)
+    return mod.brdf_angles(theta_i, delta_theta, phi, wl, **kw)
+
+
+def spectrum_function(spec: xr.Dataset) -> Any:
+    """``func(theta_i, delta_theta, phi) -> spectra`` of a model material (for the goniometer)."""
+
+    def func(ti: np.ndarray, dt: np.ndarray, ph: np.ndarray) -> np.ndarray:
+        return spectra(spec, ti, dt, ph)
+
+    return func
+
+
+def render(
+    spec: xr.Dataset,
+    theta_i: ArrayLike | None = None,
+    delta_theta: ArrayLike | None = None,
+    phi: ArrayLike | None = None,
+    dtype: type | np.dtype = np.float64,
+) -> xr.DataArray:
+    """Render a model material to a look-up table.
+
+    Parameters
+    ----------
+    spec : xarray.Dataset
+        A model material.
+    theta_i, delta_theta, phi : array_like, optional
+        Grids [degree]; defaults: every integer 0-90, -180..90 in 1-degree steps
+        and 0-90 in 1-degree steps (the whole visible hemisphere).
+    dtype : numpy dtype
+
+    Returns
+    -------
+    xarray.DataArray
+        Material table with ``source = model:<name>``.
+    """
+    mod, wl, kw = _params(spec)
+    ti = np.arange(0.0, 91.0) if theta_i is None else np.asarray(theta_i, dtype=np.float64)
+    dt = np.arange(-180.0, 91.0) if delta_theta is None else np.asarray(delta_theta, dtype=np.float64)
+    ph = np.arange(0.0, 91.0) if phi is None else np.asarray(phi, dtype=np.float64)
+    vals = mod.render_grid(ti, dt, ph, wl, **kw)
+    return new_material(
+        vals.astype(dtype), ti, dt, ph, wl,
+        material=spec.attrs["material"], source=spec.attrs["source"],
+        provenance=f"{spec.attrs.get('provenance', '')}; rendered by sbrdf_xr.models.render",
+        model=spec.attrs["model"],
+    )
+
+
+def measure(spec: xr.Dataset, theta_i: Sequence[float], **kwargs: Any) -> xr.Dataset:
+    """Measure a model material with the virtual goniospectrometer.
+
+    Parameters
+    ----------
+    spec : xarray.Dataset
+        A model material (the ground truth).
+    theta_i : sequence of float
+        Incidence angles [degree].
+    **kwargs
+        Passed to :func:`sbrdf_xr.goniometer.measure` (``noise``, ``seed``,
+        ``noise_floor``, apparatus limits).
+
+    Returns
+    -------
+    xarray.Dataset
+        The measurement set, labelled ``synthetic`` with the model as provenance.
+    """
+    from .goniometer import measure as _measure
+
+    wl = np.asarray(spec[WAVELENGTH].values)
+    prov = (f"virtual goniospectrometer measurement of model {spec.attrs['model']!r} "
+            f"({spec.attrs.get('provenance', '')})")
+    return _measure(spectrum_function(spec), wl, theta_i, material=spec.attrs["material"],
+                    source="synthetic", provenance=prov, **kwargs)
+
+
+def to_netcdf(spec: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
+    """Write a model material to netCDF (atomic, lossless)."""
+    _params(spec)
+    return write_netcdf_atomic(spec, path, overwrite=overwrite)
+
+
+def open_model(path: str | os.PathLike[str]) -> xr.Dataset:
+    """Read a model material written by :func:`to_netcdf`."""
+    with xr.open_dataset(path, engine="netcdf4") as ds:
+        ds = ds.load()
+    _params(ds)
+    return ds
+
+
+@register_loader("model")
+def _load_model_entry(e: CatalogEntry) -> xr.Dataset:
+    return open_model(e.file)
+
+
+@register_loader("paint_parameters")
+def _load_paint_parameters(e: CatalogEntry) -> xr.Dataset:
+    with xr.open_dataset(e.file, engine="netcdf4") as ds:
+        return ds.load()
