@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import xarray as xr
 
 from . import goniometer, material, models, testing
 from .brdf import optics
@@ -23,7 +24,7 @@ WAVELENGTH_CANX1 = np.arange(400.0, 1100.1, 5.0)
 CANX1_NOISE = 0.01
 
 
-def canx1_models() -> dict[str, "object"]:
+def canx1_models() -> dict[str, xr.Dataset]:
     """Generating models of the CanX-1 material set (synthetic stand-ins).
 
     * aluminium 6061-T6: directional-diffuse metal; GGX roughness 0.15 over the
@@ -83,8 +84,6 @@ def canx1_materials() -> None:
 
 def table4_paints() -> None:
     """Paper 001 Table 4: Robertson-Sandford parameters at 4 um."""
-    import xarray as xr
-
     ds = xr.Dataset(
         {
             "rho_D": ("sample", [0.07, 0.05], models.PARAM_ATTRS["rho_D"]),

@@ -6,6 +6,9 @@ Sub-commands::
     sbrdf-xr catalog show NAME              one entry and a summary of its contents
     sbrdf-xr info [FILE.nc]                 package and dependency versions, or a file's summary
     sbrdf-xr bench [--quick]                accuracy/cost benchmarks, timings as ratios in one run
+    sbrdf-xr simulate SCENE -o CUBE.nc      run a scene (built-in name or TOML file) into a cube
+             [--scheduler ADDR] [--preset NAME] [--plot FIG.png] [--overwrite | --resume] [--plan]
+    sbrdf-xr plot CUBE.nc -o FIG.png        the cube's natural figure (light curve or spectra)
 """
 
 from __future__ import annotations
@@ -72,6 +75,45 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_simulate(args: argparse.Namespace) -> int:
+    from .scene import resolve_scene
+    from .simulate import simulate, write
+
+    scene = resolve_scene(args.scene)
+    if args.preset:
+        scene = scene.with_options(preset=args.preset)
+    plan = scene.plan()
+    print(plan)
+    if args.plan:
+        return 0
+    cube = simulate(scene, plan=plan)
+    path = write(cube, args.output, overwrite=args.overwrite, resume=args.resume,
+                 scheduler=args.scheduler, progress=not args.quiet)
+    print(f"wrote {path}")
+    if args.plot:
+        _save_figure(path, args.plot)
+    return 0
+
+
+def _save_figure(cube_path: str, figure_path: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import xarray as xr
+
+    from .plot import plot_cube
+
+    with xr.open_dataset(cube_path) as cube:
+        fig = plot_cube(cube.load())
+    fig.savefig(figure_path, dpi=120)
+    print(f"wrote {figure_path}")
+
+
+def _cmd_plot(args: argparse.Namespace) -> int:
+    _save_figure(args.cube, args.output)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``sbrdf-xr``."""
     p = argparse.ArgumentParser(prog="sbrdf-xr", description="Spectral BRDF simulation of unresolved spacecraft.")
@@ -94,6 +136,24 @@ def build_parser() -> argparse.ArgumentParser:
     pb = sub.add_parser("bench", help="accuracy/cost benchmarks (timings as ratios)")
     pb.add_argument("--quick", action="store_true", help="small problems, for a smoke run")
     pb.set_defaults(func=_cmd_bench)
+
+    psim = sub.add_parser("simulate", help="run a scene into a netCDF cube")
+    psim.add_argument("scene", help="built-in scene name (canx1-rotation, canx1-plusx-specular) or a TOML file")
+    psim.add_argument("-o", "--output", required=True, help="netCDF file to write")
+    psim.add_argument("--scheduler", help="address of a dask.distributed scheduler (default: threads)")
+    psim.add_argument("--preset", help="numerical preset: fast, balanced or reference")
+    psim.add_argument("--plot", help="also write the cube's figure to this PNG file")
+    g = psim.add_mutually_exclusive_group()
+    g.add_argument("--overwrite", action="store_true", help="replace an existing output file")
+    g.add_argument("--resume", action="store_true", help="resume an interrupted run from its .part file")
+    psim.add_argument("--plan", action="store_true", help="print the plan and stop")
+    psim.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    psim.set_defaults(func=_cmd_simulate)
+
+    pp = sub.add_parser("plot", help="draw a cube's figure")
+    pp.add_argument("cube")
+    pp.add_argument("-o", "--output", required=True)
+    pp.set_defaults(func=_cmd_plot)
     return p
 
 

@@ -1,0 +1,440 @@
+"""Scenes: what to simulate, and the minimal plan that computes exactly that.
+
+A :class:`Scene` holds a spacecraft, its materials, the geometry of a sweep and the
+outputs and effects asked for.  :meth:`Scene.plan` compiles it into a
+:class:`Plan` that states every step that will run and every step skipped, and
+why (DESIGN.md principle 3: simulate only the effects a scene calls for):
+
+* facets sharing (normal, material) are merged when no per-facet effect is on;
+* facets never lit-and-visible anywhere in the sweep are dropped;
+* self-shadowing runs only when asked for, and never on a convex body;
+* thermal emission runs only when asked for and the wavelengths reach where it
+  matters.
+
+Geometry is either a grid of attitudes (quaternions, body -> reference frame) times
+phase angles in an observation plane (paper 000 Figs. 12-13), or an explicit list of
+``(to_sun, to_observer)`` unit-vector pairs in the body frame.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from numpy.typing import ArrayLike
+
+from . import geometry
+from ._lut import check_method
+from .errors import SceneError, ValidationError
+from .material import validate_material
+
+__all__ = ["EFFECTS", "OUTPUTS", "PRESETS", "Plan", "Scene", "builtin_scene", "builtin_scenes",
+           "load_scene"]
+
+#: Outputs a scene may ask for.
+OUTPUTS = ("sbrdf", "signal", "brdf", "area", "per_material")
+#: Effects a scene may ask for.
+EFFECTS = ("sunlight", "shadowing")
+#: Numerical presets: the named knobs of an accuracy/cost trade-off.
+PRESETS: dict[str, dict[str, Any]] = {
+    "fast": {"method": "nearest", "dtype": "float32", "shadow_density": 2},
+    "balanced": {"method": "linear", "dtype": "float64", "shadow_density": 4},
+    "reference": {"method": "cubic", "dtype": "float64", "shadow_density": 8},
+}
+
+_UNIT_TOL = 1e-6
+
+
+def _unit_vectors(v: ArrayLike, name: str) -> np.ndarray:
+    arr = np.asarray(v, dtype=np.float64)
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise SceneError(f"{name}: expected shape (n, 3), got {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise SceneError(f"{name}: contains NaN or infinite components")
+    norm = np.linalg.norm(arr, axis=1)
+    bad = np.flatnonzero(np.abs(norm - 1.0) > _UNIT_TOL)
+    if bad.size:
+        raise SceneError(
+            f"{name}: vector {bad[0]} {arr[bad[0]].tolist()} has length {norm[bad[0]]:.6g}; "
+            f"directions must be unit vectors (|length - 1| <= {_UNIT_TOL})"
+        )
+    return arr / norm[:, None]
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A spacecraft, its materials, a geometry sweep, and what to compute.
+
+    Parameters
+    ----------
+    spacecraft : sbrdf_xr.spacecraft.Spacecraft
+        The body.
+    materials : mapping of str to DataArray, optional
+        Material tables by name; default: every material of the spacecraft loaded
+        from the catalog.
+    attitudes : array_like, shape (n, 4), optional
+        Attitudes (body -> reference frame, scalar-last unit quaternions).
+    phase_angles : array_like, shape (m,), optional
+        Phase angles [degree] of the observation plane (with ``attitudes``).
+    bisector, plane_normal : array_like, shape (3,)
+        Observation plane in the reference frame (default: bisector +x, plane xy).
+    to_sun, to_observer : array_like, shape (n, 3), optional
+        Explicit body-frame geometry pairs instead of a grid.
+    attitude_angle : array_like, shape (n,), optional
+        A label per attitude (for example the sweep angle [degree]).
+    outputs : sequence of str
+        Among :data:`OUTPUTS`.
+    effects : sequence of str
+        Among :data:`EFFECTS`; ``sunlight`` is always on.
+    method : str
+        Look-up method (``nearest``, ``linear``, ``cubic``).
+    dtype : str
+        ``float64`` or ``float32`` for the spectra.
+    merge : bool or None
+        Merge facets sharing (normal, material); default: whenever allowed.
+    shadow_density : int
+        Sub-facet sampling level of self-shadowing.
+    chunk : int
+        Geometries per Dask block along the attitude (or geometry) dimension.
+    name, description : str
+        Labels stored in the output.
+    """
+
+    spacecraft: Any
+    materials: Mapping[str, xr.DataArray] | None = None
+    attitudes: ArrayLike | None = None
+    phase_angles: ArrayLike | None = None
+    bisector: tuple[float, float, float] = (1.0, 0.0, 0.0)
+    plane_normal: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    to_sun: ArrayLike | None = None
+    to_observer: ArrayLike | None = None
+    attitude_angle: ArrayLike | None = None
+    outputs: Sequence[str] = ("sbrdf", "signal", "brdf", "area")
+    effects: Sequence[str] = ("sunlight",)
+    method: str = "linear"
+    dtype: str = "float64"
+    merge: bool | None = None
+    shadow_density: int = 4
+    chunk: int = 256
+    name: str = "scene"
+    description: str = ""
+    _checked: bool = field(default=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        bad = [o for o in self.outputs if o not in OUTPUTS]
+        if bad:
+            raise SceneError(f"outputs: unknown {bad}; allowed: {', '.join(OUTPUTS)}")
+        bad = [e for e in self.effects if e not in EFFECTS]
+        if bad:
+            raise SceneError(f"effects: unknown {bad}; allowed: {', '.join(EFFECTS)}")
+        try:
+            check_method(self.method)
+        except ValidationError as exc:
+            raise SceneError(str(exc)) from None
+        if self.dtype not in ("float32", "float64"):
+            raise SceneError(f"dtype: got {self.dtype!r}; allowed: float32, float64")
+        if self.chunk < 1:
+            raise SceneError(f"chunk: must be >= 1, got {self.chunk}")
+        grid = self.attitudes is not None or self.phase_angles is not None
+        explicit = self.to_sun is not None or self.to_observer is not None
+        if grid == explicit:
+            raise SceneError(
+                "geometry: give either attitudes and phase_angles (a grid) or to_sun and "
+                "to_observer (explicit pairs), not both and not neither"
+            )
+        if grid:
+            if self.attitudes is None or self.phase_angles is None:
+                raise SceneError("geometry: a grid needs both attitudes and phase_angles")
+            try:
+                q = geometry.check_quaternions(self.attitudes)
+                beta = np.atleast_1d(np.asarray(self.phase_angles, dtype=np.float64))
+                geometry.observation_plane(beta, self.bisector, self.plane_normal)
+            except ValidationError as exc:
+                raise SceneError(str(exc)) from None
+            if q.ndim != 2:
+                raise SceneError(f"attitudes: expected shape (n, 4), got {q.shape}")
+            object.__setattr__(self, "attitudes", q)
+            object.__setattr__(self, "phase_angles", beta)
+        else:
+            if self.to_sun is None or self.to_observer is None:
+                raise SceneError("geometry: explicit pairs need both to_sun and to_observer")
+            s = _unit_vectors(self.to_sun, "to_sun")
+            o = _unit_vectors(self.to_observer, "to_observer")
+            if s.shape != o.shape:
+                raise SceneError(f"to_sun {s.shape} and to_observer {o.shape} differ in shape")
+            object.__setattr__(self, "to_sun", s)
+            object.__setattr__(self, "to_observer", o)
+        if self.materials is None:
+            from . import catalog
+
+            object.__setattr__(self, "materials", {m: catalog.load(m) for m in self.spacecraft.materials})
+        missing = [m for m in self.spacecraft.materials if m not in self.materials]
+        if missing:
+            raise SceneError(f"materials: no table for {missing}; given: {sorted(self.materials)}")
+        for name, da in self.materials.items():
+            try:
+                validate_material(da, check_values=False)
+            except ValidationError as exc:
+                raise SceneError(f"material {name!r}: {exc}") from None
+
+    # ----------------------------------------------------------- geometry
+    @property
+    def is_grid(self) -> bool:
+        """True for an attitude x phase-angle grid, False for explicit pairs."""
+        return self.attitudes is not None
+
+    @property
+    def n_geometries(self) -> int:
+        """Number of (Sun, observer) geometries of the sweep."""
+        if self.is_grid:
+            return len(self.attitudes) * len(self.phase_angles)
+        return len(self.to_sun)
+
+    def body_vectors(self, attitude_slice: slice | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Sun and observer unit vectors in the body frame.
+
+        Returns
+        -------
+        to_sun, to_observer : ndarray
+            Shape ``(n_attitude, n_phase, 3)`` for a grid (optionally for a slice of
+            attitudes) or ``(n_geometry, 3)`` for explicit pairs.
+        """
+        if not self.is_grid:
+            sl = attitude_slice or slice(None)
+            return self.to_sun[sl], self.to_observer[sl]
+        q = self.attitudes if attitude_slice is None else self.attitudes[attitude_slice]
+        s, o = geometry.observation_plane(self.phase_angles, self.bisector, self.plane_normal)
+        return geometry.to_body_frame(q, s), geometry.to_body_frame(q, o)
+
+    def with_options(self, **changes: Any) -> Scene:
+        """A copy with some fields changed (for example ``preset`` knobs)."""
+        if "preset" in changes:
+            preset = changes.pop("preset")
+            if preset not in PRESETS:
+                raise SceneError(f"preset: unknown {preset!r}; allowed: {', '.join(PRESETS)}")
+            changes = {**PRESETS[preset], **changes}
+        return replace(self, **changes)
+
+    def plan(self) -> Plan:
+        """Compile the scene into the minimal :class:`Plan` (see the module docstring)."""
+        from .simulate import compile_plan
+
+        return compile_plan(self)
+
+
+@dataclass
+class Plan:
+    """What a simulation will compute, and why.
+
+    Attributes
+    ----------
+    scene : Scene
+        The scene.
+    terms : xarray.Dataset
+        The facet terms evaluated (merged or per facet, after dropping): ``normal``,
+        ``area``, ``material``, and the facet indices each term stands for.
+    shadowing : bool
+        Whether ray-cast self-shadowing/occlusion runs.
+    steps : list of (str, str)
+        ``(what, why)`` lines, in order; skipped steps say so.
+    """
+
+    scene: Scene
+    terms: xr.Dataset
+    shadowing: bool
+    merged: bool
+    steps: list[tuple[str, str]]
+
+    def __str__(self) -> str:
+        w = max(len(a) for a, _ in self.steps)
+        lines = [f"plan for scene {self.scene.name!r}:"]
+        lines += [f"  {a:<{w}}  {b}" for a, b in self.steps]
+        return "\n".join(lines)
+
+    def _repr_html_(self) -> str:  # pragma: no cover - Jupyter display
+        rows = "".join(f"<tr><td>{a}</td><td>{b}</td></tr>" for a, b in self.steps)
+        return f"<table><caption>plan for {self.scene.name}</caption>{rows}</table>"
+
+
+# ----------------------------------------------------------- scene files
+
+_SCENE_KEYS = {
+    "name": str, "description": str, "spacecraft": str, "materials": dict,
+    "attitude": dict, "phase_angles": list, "bisector": list, "plane_normal": list,
+    "geometry": dict, "outputs": list, "effects": list, "method": str, "dtype": str,
+    "merge": bool, "shadow_density": int, "chunk": int,
+}
+_ATTITUDE_KEYS = {"kind": str, "axis": list, "start": (int, float), "stop": (int, float),
+                  "step": (int, float), "initial_axis": list, "initial_angle": (int, float),
+                  "n": int, "seed": int, "sequence": str, "angles": list, "quaternions": list}
+
+
+def _check_keys(table: Mapping[str, Any], allowed: Mapping[str, Any], where: str) -> None:
+    for k, v in table.items():
+        if k not in allowed:
+            raise SceneError(f"{where}: unknown key {k!r}; allowed: {', '.join(sorted(allowed))}")
+        types = allowed[k]
+        if not isinstance(v, types) or (isinstance(v, bool) and types in (int, (int, float))):
+            raise SceneError(f"{where}: key {k!r} has type {type(v).__name__}; expected {types}")
+
+
+def _attitudes_from_table(t: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray | None]:
+    _check_keys(t, _ATTITUDE_KEYS, "[attitude]")
+    kind = t.get("kind", "sweep")
+    if kind == "sweep":
+        angles = np.arange(float(t.get("start", 0.0)), float(t["stop"]), float(t.get("step", 1.0)))
+        initial = None
+        if "initial_axis" in t:
+            initial = geometry.axis_rotation(t["initial_axis"], float(t.get("initial_angle", 0.0)))
+        return geometry.rotation_sweep(t.get("axis", [0, 0, 1]), angles, initial), angles
+    if kind == "uniform":
+        return geometry.uniform_attitudes(int(t["n"]), t.get("seed", 0)), None
+    if kind == "euler":
+        return geometry.euler_attitudes(t["sequence"], t["angles"]), None
+    if kind == "quaternions":
+        return geometry.check_quaternions(t["quaternions"]), None
+    raise SceneError(f"[attitude]: unknown kind {kind!r}; allowed: sweep, uniform, euler, quaternions")
+
+
+def scene_from_dict(d: Mapping[str, Any]) -> Scene:
+    """Build a scene from the contents of a scene file (see :func:`load_scene`)."""
+    _check_keys(d, _SCENE_KEYS, "scene")
+    from . import catalog
+    from .spacecraft import Spacecraft
+
+    sc_name = d.get("spacecraft")
+    if sc_name is None:
+        raise SceneError("scene: key 'spacecraft' is required (a catalog name)")
+    sc = catalog.load(sc_name)
+    if not isinstance(sc, Spacecraft):
+        raise SceneError(f"spacecraft: catalog entry {sc_name!r} is not a spacecraft")
+    materials = None
+    if "materials" in d:
+        materials = {}
+        for mat, entry in d["materials"].items():
+            if not isinstance(entry, str):
+                raise SceneError(f"[materials]: {mat!r} must name a catalog entry (a string)")
+            materials[mat] = catalog.load(entry)
+    kw: dict[str, Any] = {k: d[k] for k in ("name", "description", "method", "dtype", "merge",
+                                               "shadow_density", "chunk") if k in d}
+    for k in ("outputs", "effects"):
+        if k in d:
+            kw[k] = tuple(d[k])
+    for k in ("bisector", "plane_normal"):
+        if k in d:
+            kw[k] = tuple(float(x) for x in d[k])
+    if "geometry" in d:
+        g = d["geometry"]
+        _check_keys(g, {"to_sun": list, "to_observer": list}, "[geometry]")
+        kw["to_sun"], kw["to_observer"] = g.get("to_sun"), g.get("to_observer")
+    if "attitude" in d:
+        kw["attitudes"], angles = _attitudes_from_table(d["attitude"])
+        if angles is not None:
+            kw["attitude_angle"] = angles
+        kw["phase_angles"] = d.get("phase_angles")
+    elif "phase_angles" in d:
+        raise SceneError("scene: 'phase_angles' needs an [attitude] table")
+    return Scene(sc, materials=materials, **kw)
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Load a scene from a TOML file.
+
+    Example file::
+
+        name = "my-rotation"
+        spacecraft = "canx1"              # a catalog entry
+        phase_angles = [10.0]             # degree
+        outputs = ["sbrdf", "signal", "brdf", "area"]
+        effects = ["sunlight"]
+        method = "linear"
+
+        [attitude]                        # or [geometry] with to_sun / to_observer lists
+        kind = "sweep"                    # sweep | uniform | euler | quaternions
+        axis = [0, 0, -1]
+        start = 0
+        stop = 360
+        step = 1
+        initial_axis = [0, 0, 1]
+        initial_angle = 25
+
+        [materials]                       # optional: material name -> catalog entry
+        "white-paint-a276" = "white-paint-a276"
+
+    Unknown keys and wrong types raise :class:`~sbrdf_xr.errors.SceneError`.
+    """
+    path = Path(path)
+    try:
+        d = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path}: invalid TOML: {exc}") from exc
+    return scene_from_dict(d)
+
+
+# --------------------------------------------------------- built-in scenes
+
+
+def _canx1_plusx_specular() -> Scene:
+    from .spacecraft import canx1
+
+    return Scene(
+        canx1(),
+        attitudes=geometry.axis_rotation([0, 0, 1], [0.0]),
+        phase_angles=[5.0, 30.0, 60.0, 90.0],
+        outputs=("sbrdf", "signal", "brdf", "area", "per_material"),
+        name="canx1-plusx-specular",
+        description="CanX-1 +X side at specular geometry in the xy-plane, beta = 5, 30, 60, 90 deg "
+        "(paper 000 section 4, Fig. 12)",
+    )
+
+
+def _canx1_rotation() -> Scene:
+    from .spacecraft import canx1
+
+    angles = np.arange(360.0)
+    return Scene(
+        canx1(),
+        attitudes=geometry.rotation_sweep([0, 0, -1], angles, geometry.axis_rotation([0, 0, 1], 25.0)),
+        attitude_angle=angles,
+        phase_angles=[10.0],
+        outputs=("sbrdf", "signal", "brdf", "area", "per_material"),
+        chunk=90,
+        name="canx1-rotation",
+        description="CanX-1 initially rotated 25 deg about +z, then 360 steps of 1 deg about -z; "
+        "v_i and v_r 5 deg either side of +x (beta = 10 deg) (paper 000 section 4, Fig. 13)",
+    )
+
+
+_BUILTIN = {"canx1-plusx-specular": _canx1_plusx_specular, "canx1-rotation": _canx1_rotation}
+
+
+def builtin_scenes() -> list[str]:
+    """Names of the built-in scenes."""
+    return list(_BUILTIN)
+
+
+def builtin_scene(name: str) -> Scene:
+    """A built-in scene by name (see :func:`builtin_scenes`)."""
+    try:
+        return _BUILTIN[name]()
+    except KeyError:
+        raise SceneError(f"unknown scene {name!r}; built-in scenes: {', '.join(_BUILTIN)}") from None
+
+
+def resolve_scene(spec: str | Path | Scene) -> Scene:
+    """A scene from a Scene, a built-in name or a TOML file path."""
+    if isinstance(spec, Scene):
+        return spec
+    if str(spec) in _BUILTIN:
+        return builtin_scene(str(spec))
+    path = Path(spec)
+    if path.suffix == ".toml" or path.exists():
+        if not path.is_file():
+            raise SceneError(f"scene file {path} does not exist")
+        return load_scene(path)
+    raise SceneError(f"unknown scene {str(spec)!r}; built-in scenes: {', '.join(_BUILTIN)}, or a .toml file")
