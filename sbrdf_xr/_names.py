@@ -30,6 +30,9 @@ ANGLE_DIMS: tuple[str, str, str] = (THETA_I, DELTA_THETA, PHI)
 
 #: Name of the DataArray holding a material's sBRDF.
 SBRDF = "sbrdf"
+#: Name of the measured spectra in a measurement set (not ``sbrdf``: ``ds.sbrdf`` is the
+#: Dataset accessor).
+MEASURED = "measured_sbrdf"
 
 # --- units (UDUNITS strings) ---------------------------------------------
 DEGREE = "degree"
@@ -50,6 +53,7 @@ ATTRS: dict[str, dict[str, str]] = {
         "standard_name": "radiation_wavelength",
     },
     SBRDF: {"units": PER_SR, "long_name": "spectral bidirectional reflectance distribution function"},
+    MEASURED: {"units": PER_SR, "long_name": "measured spectral bidirectional reflectance distribution function"},
     "theta_r": {"units": DEGREE, "long_name": "reflection polar angle from the facet normal"},
     "phi_i": {"units": DEGREE, "long_name": "illumination azimuth angle"},
     "phi_r": {"units": DEGREE, "long_name": "reflection azimuth angle"},
@@ -86,6 +90,23 @@ ATTRS: dict[str, dict[str, str]] = {
     },
     "to_sun": {"units": "1", "long_name": "unit vector toward the Sun in the body frame"},
     "to_observer": {"units": "1", "long_name": "unit vector toward the observer in the body frame"},
+    # --- photometry (issue 6) ---
+    BAND: {"units": "1", "long_name": "photometric filter band"},
+    "filter": {"units": "1", "long_name": "filter curve (speclite name, or user:<label>)"},
+    "filter_source": {"units": "1", "long_name": "file and reference of the filter curve"},
+    "filter_response": {"units": "1", "long_name": "filter response"},
+    "solar_irradiance": {"units": "W m-2 nm-1", "long_name": "extraterrestrial solar spectral irradiance at 1 AU"},
+    "band_weight": {"units": "1", "long_name": "band-integration weight (solar spectrum x filter x spectral weighting x quadrature weight)"},
+    "band_signal": {"units": "m2 sr-1", "long_name": "solar-weighted band mean of the radiometric signal"},
+    "sun_magnitude": {"units": "mag", "long_name": "apparent magnitude of the Sun at 1 AU"},
+    "magnitude": {"units": "mag", "long_name": "apparent magnitude of the reflected sunlight"},
+    "magnitude_uncertainty": {"units": "mag", "long_name": "1-sigma magnitude uncertainty"},
+    "colour": {"units": "1", "long_name": "colour index (band pair)"},
+    "colour_index": {"units": "mag", "long_name": "colour index, difference of two band magnitudes"},
+    "srgb": {"units": "1", "long_name": "sRGB swatch of the reflected sunlight (display-normalised)"},
+    "obs": {"units": "1", "long_name": "observation index"},
+    "rotation_angle": {"units": DEGREE, "long_name": "body rotation angle"},
+    "time_since_first": {"units": "s", "long_name": "time since the first observation"},
 }
 
 

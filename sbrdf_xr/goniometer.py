@@ -29,7 +29,7 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from ._names import DELTA_THETA, PHI, SAMPLE, SBRDF, THETA_I, WAVELENGTH, attrs
+from ._names import DELTA_THETA, MEASURED, PHI, SAMPLE, THETA_I, WAVELENGTH, attrs
 from .errors import ValidationError
 
 __all__ = ["PAPER_THETA_I", "measure", "paper_scheme", "scheme_extents"]
@@ -251,7 +251,7 @@ def measure(
         spectra = np.maximum(spectra * (1.0 + noise * rng.standard_normal(spectra.shape)), 0.0)
     spectra[ref] = 0.0
     return xr.Dataset(
-        {SBRDF: ((SAMPLE, WAVELENGTH), spectra, attrs(SBRDF))},
+        {MEASURED: ((SAMPLE, WAVELENGTH), spectra, attrs(MEASURED))},
         coords={
             THETA_I: (SAMPLE, ti_s, attrs(THETA_I)),
             DELTA_THETA: (SAMPLE, dt_s, attrs(DELTA_THETA)),

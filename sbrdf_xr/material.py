@@ -36,6 +36,7 @@ from ._names import (
     DEGREE,
     DELTA_THETA,
     LUT_DIMS,
+    MEASURED,
     NM,
     PER_SR,
     PHI,
@@ -292,7 +293,7 @@ def _lookup_core(
 def validate_measurements(ds: xr.Dataset) -> xr.Dataset:
     """Check a goniospectrometer measurement set.
 
-    Schema: dims ``sample`` and ``wavelength``; a data variable ``sbrdf``
+    Schema: dims ``sample`` and ``wavelength``; a data variable ``measured_sbrdf``
     ``(sample, wavelength)`` [sr-1]; coordinates ``theta_i``, ``delta_theta``,
     ``phi`` over ``sample`` [degree] and ``wavelength`` [nm]; an optional boolean
     ``reference`` over ``sample`` marking the reference points of paper 000 §3.1
@@ -316,13 +317,13 @@ def validate_measurements(ds: xr.Dataset) -> xr.Dataset:
     """
     if not isinstance(ds, xr.Dataset):
         raise ValidationError(f"measurements: expected an xarray.Dataset, got {type(ds).__name__}")
-    if SBRDF not in ds:
-        raise ValidationError("measurements: lacks the data variable 'sbrdf'")
-    da = ds[SBRDF]
+    if MEASURED not in ds:
+        raise ValidationError(f"measurements: lacks the data variable {MEASURED!r}")
+    da = ds[MEASURED]
     if set(da.dims) != {SAMPLE, WAVELENGTH}:
-        raise ValidationError(f"sbrdf: dims must be ('sample', 'wavelength'), got {da.dims}")
+        raise ValidationError(f"{MEASURED}: dims must be ('sample', 'wavelength'), got {da.dims}")
     if da.attrs.get("units") != PER_SR:
-        raise ValidationError(f"sbrdf: units must be {PER_SR!r}, got {da.attrs.get('units')!r}")
+        raise ValidationError(f"{MEASURED}: units must be {PER_SR!r}, got {da.attrs.get('units')!r}")
     if ds.sizes[SAMPLE] == 0:
         raise ValidationError("measurements: the set is empty (no samples)")
     for name in (THETA_I, DELTA_THETA, PHI):
@@ -348,9 +349,9 @@ def validate_measurements(ds: xr.Dataset) -> xr.Dataset:
     v = np.asarray(da.transpose(SAMPLE, WAVELENGTH).values)[~ref]
     if not np.all(np.isfinite(v)):
         bad = np.flatnonzero(~np.all(np.isfinite(np.asarray(da.transpose(SAMPLE, WAVELENGTH).values)), axis=1) & ~ref)
-        raise ValidationError(f"sbrdf: NaN or infinite values in sample(s) {bad[:10].tolist()}")
+        raise ValidationError(f"{MEASURED}: NaN or infinite values in sample(s) {bad[:10].tolist()}")
     if np.any(v < 0):
-        raise ValidationError("sbrdf: contains negative values; a BRDF is >= 0")
+        raise ValidationError(f"{MEASURED}: contains negative values; a BRDF is >= 0")
     return ds
 
 
@@ -383,20 +384,35 @@ def paper_delta_theta_grid(dt_min: float, dt_max: float, n: int = 21) -> np.ndar
     return np.concatenate([np.linspace(dt_min, 0.0, half + 1)[:-1], np.linspace(0.0, dt_max, half + 1)])
 
 
-def _interp_weights(x_data: np.ndarray, x_out: np.ndarray) -> np.ndarray:
-    """Matrix (len(x_out), len(x_data)) of linear interpolation, zero outside the data."""
+def _interp_weights(
+    x_data: np.ndarray, x_out: np.ndarray, hold_lo: bool = False, hold_hi: bool = False
+) -> np.ndarray:
+    """Matrix (len(x_out), len(x_data)) of linear interpolation.
+
+    Outside the data the result is zero (the edge is a reference point, where the
+    signal is in the noise), or the edge value where ``hold_lo``/``hold_hi`` says the
+    edge is a measured point that only the apparatus kept from going further.
+    """
     order = np.argsort(x_data, kind="stable")
     xs = x_data[order]
     w = np.zeros((x_out.size, x_data.size))
-    if xs.size == 1:
-        hit = np.isclose(x_out, xs[0], rtol=0, atol=_lut.EDGE_TOL_DEG)
-        w[hit, order[0]] = 1.0
-        return w
-    idx, wt = _lut.axis_weights(xs, x_out, "linear")
-    inside = (x_out >= xs[0] - _lut.EDGE_TOL_DEG) & (x_out <= xs[-1] + _lut.EDGE_TOL_DEG)
+    lo = x_out < xs[0] - _lut.EDGE_TOL_DEG
+    hi = x_out > xs[-1] + _lut.EDGE_TOL_DEG
     rows = np.arange(x_out.size)
-    for k in range(2):
-        np.add.at(w, (rows[inside], order[idx[inside, k]]), wt[inside, k])
+    if xs.size == 1:
+        hit = ~lo & ~hi
+    else:
+        idx, wt = _lut.axis_weights(xs, x_out, "linear")
+        hit = np.zeros(x_out.size, dtype=bool)
+        inside = ~lo & ~hi
+        for k in range(2):
+            np.add.at(w, (rows[inside], order[idx[inside, k]]), wt[inside, k])
+    if xs.size == 1:
+        w[hit, order[0]] = 1.0
+    if hold_lo:
+        w[lo, order[0]] = 1.0
+    if hold_hi:
+        w[hi, order[-1]] = 1.0
     return w
 
 
@@ -410,18 +426,27 @@ def build_lut(
     extrapolation: str = "cubic",
     material: str | None = None,
     dtype: type | np.dtype = np.float64,
+    blend: float = 10.0,
+    normal_incidence: str = "paper",
+    blend_normal: float = 5.0,
 ) -> xr.DataArray:
     """Look-up table from sparse measurements, by the construction of paper 000 §3.2.
 
     1. ``phi``: ``n_phi`` uniform points from 0 to the largest measured ``phi`` of
        the material; for every measured ``(theta_i, delta_theta)`` row, linear
-       interpolation in ``phi`` (zero beyond the row's largest ``phi``, whose
-       reference point is zero).
+       interpolation in ``phi`` (zero beyond the row's largest ``phi`` when it is a
+       reference point, as in the paper).
     2. ``delta_theta``: ``n_delta_theta`` points with 0 at the median and steps
        ``delta_theta_min/10`` and ``delta_theta_max/10`` on either side (for the
        paper's 21), from the extremes over all ``theta_i``; for every measured
        ``theta_i`` and grid ``phi``, linear interpolation in ``delta_theta``
-       (zero beyond that ``theta_i``'s measured extent).
+       (zero beyond that ``theta_i``'s measured extent when it is a reference
+       point).
+
+    Where an extent is a measured point rather than a reference point (the
+    apparatus stopped before the signal reached the noise, as for diffuse
+    materials), the edge value is held beyond it instead of dropping to zero; the
+    paper's sets end in reference points, for which this is the paper's rule.
     3. ``theta_i``: a cubic smoothing spline over the measured incidence angles for
        every ``(delta_theta, phi, wavelength)``, evaluated at every integer degree
        0-90 (interpolating between and extrapolating beyond the measured angles).
@@ -445,10 +470,24 @@ def build_lut(
         (:func:`sbrdf_xr._lut.smoothing_spline_matrix`); ``"csaps"`` is MATLAB's
         default ``h**3/6`` (:func:`sbrdf_xr._lut.csaps_default_lambda`); 0
         interpolates.
-    extrapolation : {"cubic", "linear", "constant"}, default "cubic"
-        How the spline continues below the smallest and above the largest measured
-        ``theta_i``.  ``cubic`` (default) continues the end polynomial pieces, as
-        the paper's spline evaluation did; ``linear`` and ``constant`` are milder.
+    extrapolation : {"cubic", "linear", "constant", "model"}, default "cubic"
+        How the table continues below the smallest and above the largest measured
+        ``theta_i``.  ``cubic`` (default) continues the spline's end polynomial
+        pieces, as the paper's spline evaluation did (the source of the
+        discontinuities its §4.2 reports); ``linear`` and ``constant`` are milder.
+        ``model`` (beyond the paper) fits the Robertson-Sandford model (paper 001)
+        to the measurements (:func:`sbrdf_xr.brdf.robertson_sandford.fit_robertson_sandford`)
+        and lets it fill the unmeasurable range, blended into the linearly
+        extrapolated spline over ``blend`` degrees with a smoothstep weight.
+    blend : float, default 10
+        Width of the blend zone of ``extrapolation="model"`` [degree].
+    normal_incidence : {"paper", "symmetric"}, default "paper"
+        ``symmetric`` enforces what physics requires at ``theta_i = 0``: no
+        dependence on the undefined illumination plane (the row becomes a function
+        of the observer's polar angle only), blended into the rows below
+        ``blend_normal`` degrees.  ``paper`` leaves the row as extrapolated.
+    blend_normal : float, default 5
+        Width of that blend [degree].
     material : str, optional
         Name; default the ``material`` attribute of ``measurements``.
     dtype : numpy dtype, default float64
@@ -471,7 +510,7 @@ def build_lut(
     ti_s = np.asarray(ds[THETA_I].values, dtype=np.float64)
     dt_s = np.asarray(ds[DELTA_THETA].values, dtype=np.float64)
     ph_s = np.asarray(ds[PHI].values, dtype=np.float64)
-    spectra = np.asarray(ds[SBRDF].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64).copy()
+    spectra = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64).copy()
     spectra[ref] = 0.0
     measured_ti = np.unique(ti_s)
     if measured_ti.size < 2:
@@ -490,22 +529,56 @@ def build_lut(
         rows = np.unique(dt_s[in_t])
         # Step 1: phi interpolation within every delta_theta row of this theta_i.
         row_vals = np.zeros((rows.size, phi_grid.size, n_wl))
+        row_ref = np.zeros(rows.size, dtype=bool)
+        row_n = np.zeros(rows.size, dtype=int)
         for r, d in enumerate(rows):
             sel = in_t[dt_s[in_t] == d]
-            w = _interp_weights(ph_s[sel], phi_grid)  # (n_phi, n_sel)
+            edge = sel[np.argmax(ph_s[sel])]
+            # A row measured at phi = 0 only (the in-plane delta_theta extents of the
+            # scheme) says nothing about phi > 0: it is not held out of the plane.
+            hold = sel.size > 1 and not ref[edge]
+            w = _interp_weights(ph_s[sel], phi_grid, hold_hi=hold)  # (n_phi, n_sel)
             row_vals[r] = w @ spectra[sel]
+            row_ref[r] = bool(np.all(ref[sel]))
+            row_n[r] = sel.size
+        # A measured (apparatus-limited) in-plane extent borrows the phi profile of the
+        # nearest fully measured row, scaled to its own in-plane value.
+        full = np.flatnonzero(row_n > 1)
+        for r in np.flatnonzero((row_n == 1) & ~row_ref):
+            if full.size == 0:
+                break
+            adj = full[np.argmin(np.abs(full - r))]
+            base = row_vals[adj, 0]
+            scale = np.divide(row_vals[r, 0], base, out=np.zeros_like(base), where=base > 0)
+            row_vals[r, 1:] = row_vals[adj, 1:] * scale
         # Step 2: delta_theta interpolation for every grid phi.
         if rows.size == 1:
             raise ValidationError(
                 f"delta_theta: theta_i = {t} has measurements at a single delta_theta; need >= 2"
             )
-        w = _interp_weights(rows, dt_grid)  # (n_dt, n_rows)
+        w = _interp_weights(rows, dt_grid, hold_lo=not row_ref[0], hold_hi=not row_ref[-1])
         per_theta[a] = np.einsum("dr,rpl->dpl", w, row_vals)
 
     lam = _lut.csaps_default_lambda(measured_ti) if smoothing == "csaps" else float(smoothing)
-    e = _lut.smoothing_spline_matrix(measured_ti, ti_out, lam, extrapolation)
+    if extrapolation not in EXTRAPOLATIONS:
+        raise ValidationError(f"extrapolation: got {extrapolation!r}; allowed: {', '.join(EXTRAPOLATIONS)}")
+    spline_mode = "linear" if extrapolation == "model" else extrapolation
+    e = _lut.smoothing_spline_matrix(measured_ti, ti_out, lam, spline_mode)
     lut = np.tensordot(e, per_theta, axes=(1, 0))
     np.maximum(lut, 0.0, out=lut)
+    extra: dict[str, Any] = {}
+    if extrapolation == "model":
+        fitted, model_lut = _fitted_model_table(ds, ref, ti_out, dt_grid, phi_grid)
+        w = _blend_weights(ti_out, measured_ti[0], measured_ti[-1], blend)
+        lut = (1.0 - w)[:, None, None, None] * lut + w[:, None, None, None] * model_lut
+        extra = {"extrapolation_model": "robertson_sandford", "blend_width": blend,
+                 "fitted_b": fitted["b"], "fitted_e": fitted["e"],
+                 "fitted_chi2_reduced": fitted["chi2_reduced"]}
+    if normal_incidence not in ("paper", "symmetric"):
+        raise ValidationError(f"normal_incidence: got {normal_incidence!r}; allowed: paper, symmetric")
+    if normal_incidence == "symmetric":
+        lut = _symmetric_normal_incidence(lut, ti_out, dt_grid, phi_grid, blend_normal)
+        extra["normal_incidence_blend"] = blend_normal
 
     name = material or ds.attrs.get("material", "unnamed")
     prov = ds.attrs.get("provenance", "")
@@ -524,9 +597,80 @@ def build_lut(
         n_delta_theta=n_delta_theta,
         smoothing_lambda=lam,
         extrapolation=extrapolation,
+        normal_incidence=normal_incidence,
         measured_theta_i=measured_ti,
         n_measurements=int(ds.sizes[SAMPLE]),
+        **extra,
     )
+
+
+#: Extrapolation policies of :func:`build_lut` beyond the measured incidence angles.
+EXTRAPOLATIONS = ("cubic", "linear", "constant", "model")
+
+
+def _blend_weights(ti: np.ndarray, lo: float, hi: float, width: float) -> np.ndarray:
+    """Weight of the fitted model: 0 inside [lo, hi], rising smoothly to 1 over ``width``
+    degrees outside (a cubic smoothstep, so the table stays continuous in theta_i)."""
+    d = np.maximum(lo - ti, 0.0) + np.maximum(ti - hi, 0.0)
+    x = np.clip(d / width, 0.0, 1.0) if width > 0 else (d > 0).astype(float)
+    return x * x * (3.0 - 2.0 * x)
+
+
+def _fitted_model_table(
+    ds: xr.Dataset, ref: np.ndarray, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray
+) -> tuple[dict[str, Any], np.ndarray]:
+    """Robertson-Sandford fit to the measurements, rendered on the table grid."""
+    from .brdf import robertson_sandford as rs
+
+    spectra = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64)
+    wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
+    fit = rs.fit_robertson_sandford(ds[THETA_I].values, ds[DELTA_THETA].values, ds[PHI].values,
+                                    wl, spectra, reference=ref)
+    params = {k: np.asarray(fit[k], dtype=np.float64) for k in rs.PARAMS}
+    # The fit bounds each parameter, not rho_D + epsilon <= G(b) (Eq. 17's rho_s >= 0):
+    # where it lands marginally outside, epsilon gives way.
+    g_b = float(rs.normalisation_G(params["b"]))
+    params["epsilon"] = np.minimum(params["epsilon"], np.maximum(g_b - params["rho_D"], 0.0))
+    return fit, rs.render_grid(ti, dt, ph, wl, **params)
+
+
+def _symmetric_normal_incidence(
+    lut: np.ndarray, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, blend: float
+) -> np.ndarray:
+    """Make the theta_i = 0 row independent of the (undefined) illumination plane.
+
+    At normal incidence the sBRDF can depend on the observer only through its polar
+    angle ``theta_r`` (``cos theta_r = cos(phi) cos(delta_theta)``).  The in-plane
+    profile ``g(theta_r)`` is the mean of the table's ``theta_i = 0`` row at
+    ``delta_theta = +theta_r`` and ``-theta_r`` (one side where the other is beyond
+    the measured extent), and the row becomes ``g(theta_r(delta_theta, phi))``.
+    Rows ``0 < theta_i < blend`` are blended linearly towards the spline's, so the
+    table stays continuous.
+    """
+    if ti[0] != 0.0:
+        return lut
+    out = lut.copy()
+    row = lut[0, :, 0, :]  # (n_dt, n_wl) in the plane
+    trg = np.radians(np.abs(dt))
+    tr = np.degrees(np.arccos(np.clip(np.cos(np.radians(ph))[None, :] * np.cos(trg)[:, None], -1, 1)))
+
+    def side(sign: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        xs = sign * x
+        inside = (xs >= dt[0]) & (xs <= dt[-1])
+        idx, w = _lut.axis_weights(dt, xs, "linear")
+        vals = w[..., 0, None] * row[idx[..., 0]] + w[..., 1, None] * row[idx[..., 1]]
+        return vals, inside
+
+    flat = tr.ravel()
+    vp, ip = side(1.0, flat)
+    vm, im = side(-1.0, flat)
+    n = ip.astype(float) + im.astype(float)
+    g = (vp * ip[:, None] + vm * im[:, None]) / np.maximum(n, 1.0)[:, None]
+    sym = g.reshape(dt.size, ph.size, -1)
+    w = np.clip(1.0 - ti / blend, 0.0, 1.0) if blend > 0 else (ti == 0).astype(float)
+    for k in np.flatnonzero(w > 0):
+        out[k] = w[k] * sym + (1.0 - w[k]) * lut[k]
+    return out
 
 
 # ------------------------------------------------------------- reflectance

@@ -58,13 +58,13 @@ def light_curve(cube: xr.Dataset, variable: str = "brdf", ax: Any = None, log: b
     return fig
 
 
-def spectra(cube: xr.Dataset, variable: str = "sbrdf", ax: Any = None, log: bool = False, **sel: Any) -> Any:
+def spectra(cube: xr.Dataset, variable: str = "spacecraft_sbrdf", ax: Any = None, log: bool = False, **sel: Any) -> Any:
     """Spectra of a cube (paper 000 Figs. 14 and 16), one line per remaining geometry.
 
     Parameters
     ----------
     cube : xarray.Dataset
-    variable : str, default "sbrdf"
+    variable : str, default "spacecraft_sbrdf"
     ax : matplotlib axes, optional
     log : bool
         Logarithmic y axis (Fig. 16).
@@ -118,5 +118,5 @@ def plot_cube(cube: xr.Dataset) -> Any:
     """The natural figure of a cube: a light curve for attitude sweeps, spectra otherwise."""
     if "attitude" in cube.dims and cube.sizes["attitude"] > 1 and "brdf" in cube:
         return light_curve(cube)
-    var = "sbrdf" if "sbrdf" in cube else "signal"
+    var = "spacecraft_sbrdf" if "spacecraft_sbrdf" in cube else "signal"
     return spectra(cube, var)

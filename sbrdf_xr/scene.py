@@ -37,7 +37,7 @@ __all__ = ["EFFECTS", "OUTPUTS", "PRESETS", "Plan", "Scene", "builtin_scene", "b
            "load_scene"]
 
 #: Outputs a scene may ask for.
-OUTPUTS = ("sbrdf", "signal", "brdf", "area", "per_material")
+OUTPUTS = ("spacecraft_sbrdf", "signal", "brdf", "area", "per_material")
 #: Effects a scene may ask for.
 EFFECTS = ("sunlight", "shadowing")
 #: Numerical presets: the named knobs of an accuracy/cost trade-off.
@@ -114,7 +114,7 @@ class Scene:
     to_sun: ArrayLike | None = None
     to_observer: ArrayLike | None = None
     attitude_angle: ArrayLike | None = None
-    outputs: Sequence[str] = ("sbrdf", "signal", "brdf", "area")
+    outputs: Sequence[str] = ("spacecraft_sbrdf", "signal", "brdf", "area")
     effects: Sequence[str] = ("sunlight",)
     method: str = "linear"
     dtype: str = "float64"
@@ -350,7 +350,7 @@ def load_scene(path: str | Path) -> Scene:
         name = "my-rotation"
         spacecraft = "canx1"              # a catalog entry
         phase_angles = [10.0]             # degree
-        outputs = ["sbrdf", "signal", "brdf", "area"]
+        outputs = ["spacecraft_sbrdf", "signal", "brdf", "area"]
         effects = ["sunlight"]
         method = "linear"
 
@@ -386,7 +386,7 @@ def _canx1_plusx_specular() -> Scene:
         canx1(),
         attitudes=geometry.axis_rotation([0, 0, 1], [0.0]),
         phase_angles=[5.0, 30.0, 60.0, 90.0],
-        outputs=("sbrdf", "signal", "brdf", "area", "per_material"),
+        outputs=("spacecraft_sbrdf", "signal", "brdf", "area", "per_material"),
         name="canx1-plusx-specular",
         description="CanX-1 +X side at specular geometry in the xy-plane, beta = 5, 30, 60, 90 deg "
         "(paper 000 section 4, Fig. 12)",
@@ -402,7 +402,7 @@ def _canx1_rotation() -> Scene:
         attitudes=geometry.rotation_sweep([0, 0, -1], angles, geometry.axis_rotation([0, 0, 1], 25.0)),
         attitude_angle=angles,
         phase_angles=[10.0],
-        outputs=("sbrdf", "signal", "brdf", "area", "per_material"),
+        outputs=("spacecraft_sbrdf", "signal", "brdf", "area", "per_material"),
         chunk=90,
         name="canx1-rotation",
         description="CanX-1 initially rotated 25 deg about +z, then 360 steps of 1 deg about -z; "

@@ -8,7 +8,7 @@ This is the only module that knows about Dask scheduling.
 
 The cube (DESIGN.md data model)
 -------------------------------
-``sbrdf``
+``spacecraft_sbrdf``
     The paper's overall spacecraft sBRDF, paper 000 Eq. 4:
     ``sum_j a_2D,j f_r,j / sum_j a_2D,j`` with ``a_2D,j = A_j cos(theta_r,j)`` over
     the lit and visible facets [sr-1].  When nothing contributes (0/0) it is 0 and
@@ -16,9 +16,10 @@ The cube (DESIGN.md data model)
 ``signal``
     The radiometric signal ``S = sum_j A_j cos(theta_i,j) cos(theta_r,j) f_r,j``
     [m2 sr-1]: reflected intensity per unit solar irradiance.  Paper 000 Eq. 3
-    leaves out ``cos(theta_i)``; ``signal`` keeps it, ``sbrdf`` follows the paper.
+    leaves out ``cos(theta_i)``; ``signal`` keeps it, ``spacecraft_sbrdf`` follows
+    the paper.  (Not named ``sbrdf``: ``cube.sbrdf`` is the Dataset accessor.)
 ``brdf``
-    The paper's broadband BRDF, Eq. 2: ``sbrdf`` integrated over wavelength
+    The paper's broadband BRDF, Eq. 2: ``spacecraft_sbrdf`` integrated over wavelength
     (trapezoid) [sr-1 nm].
 ``area``
     The contributing projected area, ``sum_j a_2D,j`` [m2].
@@ -51,7 +52,7 @@ MATERIAL_DIM = "material"
 QUAT = "quaternion"
 
 OUTPUT_ATTRS: dict[str, dict[str, str]] = {
-    "sbrdf": {"units": "sr-1", "long_name": "overall spacecraft spectral BRDF (paper 000 Eq. 4)"},
+    "spacecraft_sbrdf": {"units": "sr-1", "long_name": "overall spacecraft spectral BRDF (paper 000 Eq. 4)"},
     "signal": {"units": "m2 sr-1", "long_name": "radiometric signal sum_j A_j cos(theta_i) cos(theta_r) f_r"},
     "brdf": {"units": "sr-1 nm", "long_name": "broadband BRDF, sBRDF integrated over wavelength (paper 000 Eq. 2)"},
     "area": {"units": "m2", "long_name": "contributing projected area sum_j A_j cos(theta_r) (paper 000 Eq. 4 denominator)"},
@@ -203,7 +204,7 @@ def _block(
     with np.errstate(invalid="ignore", divide="ignore"):
         sbrdf = np.where(area[:, None] > 0, paper / np.where(area > 0, area, 1.0)[:, None], 0.0).astype(dtype)
     out = {
-        "sbrdf": sbrdf.reshape(*lead, wl.size),
+        "spacecraft_sbrdf": sbrdf.reshape(*lead, wl.size),
         "signal": signal.reshape(*lead, wl.size),
         "area": area.reshape(lead),
         "brdf": np.trapezoid(sbrdf, wl, axis=-1).astype(dtype).reshape(lead)
@@ -248,11 +249,11 @@ def simulate(scene: Scene | str | os.PathLike[str], plan: Plan | None = None, **
     lead_dim = ATTITUDE if scene.is_grid else GEOMETRY
     extra = (len(scene.phase_angles),) if scene.is_grid else ()
     extra_dims = (PHASE_ANGLE,) if scene.is_grid else ()
-    outputs = [k for k in ("sbrdf", "signal", "brdf", "area") if k in scene.outputs]
+    outputs = [k for k in ("spacecraft_sbrdf", "signal", "brdf", "area") if k in scene.outputs]
     if "per_material" in scene.outputs:
         outputs.append("signal_material")
     shapes = {
-        "sbrdf": ((wl.size,), (WAVELENGTH,), dtype),
+        "spacecraft_sbrdf": ((wl.size,), (WAVELENGTH,), dtype),
         "signal": ((wl.size,), (WAVELENGTH,), dtype),
         "brdf": ((), (), dtype),
         "area": ((), (), np.dtype(np.float64)),
@@ -307,7 +308,7 @@ def simulate(scene: Scene | str | os.PathLike[str], plan: Plan | None = None, **
         "lookup_method": scene.method,
         "plan": str(plan),
         **{f"material_provenance_{m}": p for m, p in provenance.items()},
-        "note_sbrdf_zero_area": "sbrdf is 0 where area is 0 (no lit and visible facet; 0/0 of Eq. 4)",
+        "note_sbrdf_zero_area": "spacecraft_sbrdf is 0 where area is 0 (no lit and visible facet; 0/0 of Eq. 4)",
     }
     return ds
 

@@ -44,12 +44,12 @@ def test_measure_noise_and_references():
     clean = G.measure(f, wl, (20.0, 45.0), noise_floor=0.02)
     noisy = G.measure(f, wl, (20.0, 45.0), noise_floor=0.02, noise=0.05, seed=3)
     ref = clean.reference.values
-    assert ref.sum() == 18 and np.all(clean.sbrdf.values[ref] == 0)
-    ratio = noisy.sbrdf.values[~ref] / clean.sbrdf.values[~ref]
+    assert ref.sum() == 18 and np.all(clean.measured_sbrdf.values[ref] == 0)
+    ratio = noisy.measured_sbrdf.values[~ref] / clean.measured_sbrdf.values[~ref]
     # 1050 samples of N(1, 0.05): the sample std is within 10 % of 0.05 (~ 4.6 sigma).
     assert np.std(ratio) == pytest.approx(0.05, rel=0.1)
     again = G.measure(f, wl, (20.0, 45.0), noise_floor=0.02, noise=0.05, seed=3)
-    np.testing.assert_array_equal(again.sbrdf.values, noisy.sbrdf.values)
+    np.testing.assert_array_equal(again.measured_sbrdf.values, noisy.measured_sbrdf.values)
     material.validate_measurements(noisy)
 
 

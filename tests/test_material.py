@@ -138,9 +138,22 @@ def test_build_lut_follows_the_paper_construction(meas):
     assert lut.delta_theta.values[0] == pytest.approx(float(meas.delta_theta.min()))
     assert lut.delta_theta.values[-1] == pytest.approx(float(meas.delta_theta.max()))
     assert lut.attrs["construction"] == "paper000-3.2" and lut.attrs["n_measurements"] == 150
-    # Reference points at the edges make the table zero there.
+
+
+def test_reference_points_make_the_edges_zero_and_measured_extents_are_held():
+    # A narrow lobe on no floor: every extent is where the signal is in the noise.
+    narrow = testing.make_measurements(n_wavelength=7, width=3.0, diffuse=0.0)
+    assert int(narrow.reference.sum()) == 45
+    lut = M.build_lut(narrow)
     np.testing.assert_array_equal(lut.isel(phi=-1), 0.0)
     np.testing.assert_array_equal(lut.isel(delta_theta=[0, -1]), 0.0)
+    # A diffuse floor above the noise: the apparatus limits come first, the extents are
+    # measured points, and the table holds their values instead of dropping to zero.
+    floor = testing.make_measurements(n_wavelength=7, width=3.0, diffuse=0.2)
+    assert not floor.reference.any()
+    lut = M.build_lut(floor)
+    # (the floor is 0.16-0.24 sr-1; cubic extrapolation in theta_i may dip below it)
+    assert float(lut.isel(phi=-1).min()) > 0.05
 
 
 def test_build_lut_interpolating_spline_reproduces_specular_measurements(meas):
@@ -151,7 +164,7 @@ def test_build_lut_interpolating_spline_reproduces_specular_measurements(meas):
     for k in range(spec.sizes["sample"]):
         s = spec.isel(sample=k)
         got = lut.sel(theta_i=float(s.theta_i), delta_theta=0.0, phi=0.0)
-        np.testing.assert_allclose(got.values, s.sbrdf.values, rtol=1e-10)
+        np.testing.assert_allclose(got.values, s.measured_sbrdf.values, rtol=1e-10)
 
 
 def test_build_lut_error_against_truth_is_small_inside_the_measured_range(meas):
@@ -182,11 +195,12 @@ def test_build_lut_options_and_dtype(meas):
     [
         (lambda d: d.isel(sample=slice(0, 0)), "empty"),
         (lambda d: d.isel(sample=d.theta_i == 10.0), "need measurements at >= 2 incidence angles"),
-        (lambda d: d.assign(sbrdf=d.sbrdf.where(d.sample != 1).assign_attrs(units="sr-1")), r"NaN or infinite values in sample\(s\) \[1\]"),
-        (lambda d: d.assign(sbrdf=(d.sbrdf - 5).assign_attrs(units="sr-1")), "negative"),
+        (lambda d: d.assign(measured_sbrdf=d.measured_sbrdf.where(d.sample != 1).assign_attrs(units="sr-1")),
+         r"NaN or infinite values in sample\(s\) \[1\]"),
+        (lambda d: d.assign(measured_sbrdf=(d.measured_sbrdf - 5).assign_attrs(units="sr-1")), "negative"),
         (lambda d: d.assign_coords(phi=d.phi.assign_attrs(units="rad")), "phi: units"),
         (lambda d: d.drop_vars("delta_theta"), "delta_theta: coordinate over 'sample' is missing"),
-        (lambda d: d.rename(sbrdf="brdf"), "lacks the data variable 'sbrdf'"),
+        (lambda d: d.rename(measured_sbrdf="brdf"), "lacks the data variable 'measured_sbrdf'"),
     ],
 )
 def test_bad_measurement_sets_name_the_problem(meas, mutate, match):

@@ -76,7 +76,7 @@ def test_measure_then_build_reproduces_measured_geometries():
     spec0 = (meas.delta_theta == 0) & (meas.phi == 0)
     sel = meas.isel(sample=np.flatnonzero(spec0.values))
     got = material.lookup(lut, sel.theta_i.values, sel.delta_theta.values, sel.phi.values).values
-    np.testing.assert_allclose(got, sel.sbrdf.values, rtol=1e-10)
+    np.testing.assert_allclose(got, sel.measured_sbrdf.values, rtol=1e-10)
 
 
 def test_canx1_catalog_models_show_their_spectral_features():

@@ -19,7 +19,7 @@ ROTATION = """
 name = "toml-rotation"
 spacecraft = "canx1"
 phase_angles = [10.0, 20.0]
-outputs = ["sbrdf", "signal", "brdf", "area"]
+outputs = ["spacecraft_sbrdf", "signal", "brdf", "area"]
 method = "nearest"
 chunk = 50
 
@@ -60,7 +60,7 @@ def test_toml_explicit_geometry(tmp_path):
         (ROTATION.replace('method = "nearest"', 'methdo = "nearest"'), "unknown key 'methdo'"),
         (ROTATION.replace("chunk = 50", 'chunk = "fifty"'), "key 'chunk' has type str"),
         (ROTATION.replace('kind = "sweep"', 'kind = "tumble"'), "unknown kind 'tumble'"),
-        (ROTATION.replace('outputs = ["sbrdf", "signal", "brdf", "area"]', 'outputs = ["sbrdf", "smell"]'),
+        (ROTATION.replace('outputs = ["spacecraft_sbrdf", "signal", "brdf", "area"]', 'outputs = ["spacecraft_sbrdf", "smell"]'),
          "outputs: unknown"),
         (ROTATION.replace('spacecraft = "canx1"', 'spacecraft = "lambertian-grey-50"'), "not a spacecraft"),
         ("this is = not toml", "invalid TOML"),

@@ -52,8 +52,8 @@ def test_lambertian_cube_matches_closed_form():
     np.testing.assert_allclose(ds.signal.isel(wavelength=0), expected, rtol=1e-6)  # float32 table
     np.testing.assert_allclose(ds.area, area, rtol=RTOL, atol=1e-15)
     some = area > 0
-    np.testing.assert_allclose(ds.sbrdf.isel(wavelength=3)[some], 0.5 / np.pi, rtol=1e-6)
-    assert ds.signal.attrs["units"] == "m2 sr-1" and ds.sbrdf.attrs["units"] == "sr-1"
+    np.testing.assert_allclose(ds.spacecraft_sbrdf.isel(wavelength=3)[some], 0.5 / np.pi, rtol=1e-6)
+    assert ds.signal.attrs["units"] == "m2 sr-1" and ds.spacecraft_sbrdf.attrs["units"] == "sr-1"
     np.testing.assert_allclose(ds.phase_angle, geometry.phase_angle(s, o))
 
 
@@ -63,7 +63,7 @@ def test_nothing_contributes_gives_zero_not_nan():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         ds = simulate(cube_scene(to_sun=s, to_observer=-s)).compute()
-    assert np.all(ds.area == 0) and np.all(ds.sbrdf == 0) and np.all(ds.signal == 0)
+    assert np.all(ds.area == 0) and np.all(ds.spacecraft_sbrdf == 0) and np.all(ds.signal == 0)
     assert np.all(np.isfinite(ds.brdf))
 
 
@@ -144,7 +144,7 @@ def test_presets_and_float32():
 @pytest.mark.parametrize(
     ("kw", "match"),
     [
-        ({"outputs": ("sbrdf", "colour")}, "outputs: unknown"),
+        ({"outputs": ("spacecraft_sbrdf", "colour")}, "outputs: unknown"),
         ({"effects": ("sunlight", "moonshine")}, "effects: unknown"),
         ({"method": "quintic"}, "unknown look-up method"),
         ({"to_sun": [[2.0, 0, 0]], "to_observer": [[1.0, 0, 0]]}, "unit vectors"),
