@@ -1,0 +1,939 @@
+"""Stream a lazy cube to netCDF block by block: bounded memory, atomic, resumable.
+
+:func:`write_cube` computes a Dask-backed :class:`xarray.Dataset` one *block* at a
+time and writes each block into a netCDF-4 file as soon as it arrives, so peak
+memory is set by the chunk size and ``max_in_flight``, never by the cube size.
+
+Blocks
+    A block is one chunk of every chunked dimension of the Dataset (for a
+    spectral cube: one ``attitude`` x ``phase_angle`` chunk, or one ``geometry``
+    chunk, the spectral dimension being a single chunk), with all the lazy
+    variables that fall in it.  Blocks are numbered in C order over the grid of
+    chunks.  A lazy variable that lacks one of the chunked dimensions is written
+    with the block whose index along that dimension is 0.
+
+Atomicity
+    Everything is written to ``<path>.part`` in the same directory, which is
+    renamed (:func:`os.replace`) to ``path`` only after every block is written,
+    flushed and ``fsync``-ed.  A cube is never half-written under its final name,
+    and with ``overwrite=True`` the old file stays intact until the new one is
+    complete.
+
+Bookkeeping (``<path>.part.jsonl``)
+    A sidecar JSON-lines file next to the ``.part``.  Line 1 is a header object::
+
+        {"format": "sbrdf_xr.write_cube", "version": 1, "fingerprint": "<sha256>",
+         "n_blocks": 24, "block_dims": ["attitude", "phase_angle"],
+         "structure": {...}}
+
+    where ``structure`` describes the cube (dims and sizes, chunks of the block
+    dimensions, every variable's dims, dtype, attributes, laziness, and a SHA-256
+    of the values of every numpy-backed variable, global attributes except the
+    volatile ones in :data:`VOLATILE_ATTRS`) and ``fingerprint`` is the SHA-256
+    of its canonical JSON.  Every following line is ``{"block": k}``, appended
+    and ``fsync``-ed only after block ``k``'s data were written to the ``.part``
+    and flushed to disk; a torn last line (a crash mid-append) is ignored.  The
+    final netCDF file therefore carries no bookkeeping at all; the sidecar is
+    deleted after the rename.  (netCDF cannot delete a variable, so a
+    ``_block_done`` variable could not be removed without copying the cube.)
+
+Resume
+    ``resume=True`` with an existing ``.part`` checks that the header's
+    fingerprint equals the fingerprint of ``ds`` (same dims, sizes, chunking,
+    variables, dtypes, attributes and coordinate values) and then computes only
+    the blocks not listed.  The lazy values themselves are not hashed (that would
+    need computing them): resuming with a different computation of the same
+    structure is the caller's mistake.  Global attributes in
+    :data:`VOLATILE_ATTRS` (``history`` and the ACDD dates) may change between
+    runs; they are rewritten from ``ds`` on resume.
+
+Schedulers
+    By default blocks are computed in-process by a pool of threads (Dask's
+    synchronous scheduler within each block, ``dask.config`` ``num_workers`` or
+    the CPU count blocks at a time).  With ``client`` (a
+    :class:`distributed.Client`) or ``scheduler`` (an address), each block is
+    submitted to the cluster with :meth:`~distributed.Client.compute` and the
+    results are gathered, as they complete, by the calling process, which is the
+    only writer.  A lost worker's tasks are recomputed by Dask; a block is
+    written exactly once (the writer skips blocks already recorded).
+
+Encoding
+    Variables are stored in their in-memory dtype with no fill value and no
+    packing (``encoding`` set on the variables is ignored); ``bool`` is stored as
+    ``int8`` with the attribute ``dtype = "bool"`` and strings as variable-length
+    strings, as xarray does, so that :func:`xarray.open_dataset` gives back the
+    Dataset with identical values and attributes.  Non-dimension coordinates are
+    listed in ``coordinates`` attributes (per variable, or global for those that
+    belong to no variable), as xarray writes them.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import hashlib
+import json
+import math
+import os
+import sys
+import time
+from collections import deque
+from collections.abc import Callable, Hashable, Mapping
+from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
+from pathlib import Path
+from typing import Any
+
+import dask
+import dask.array as da
+import netCDF4
+import numpy as np
+import xarray as xr
+from dask.system import CPU_COUNT
+
+from .errors import SbrdfError, ValidationError
+
+__all__ = [
+    "LOG_SUFFIX",
+    "PART_SUFFIX",
+    "VOLATILE_ATTRS",
+    "BlockWritten",
+    "CubeWriteError",
+    "write_cube",
+]
+
+#: Suffix of the temporary file the cube is written to before the final rename.
+PART_SUFFIX = ".part"
+#: Suffix of the bookkeeping sidecar (JSON lines) of an unfinished cube.
+LOG_SUFFIX = ".part.jsonl"
+#: Global attributes that may change between an interrupted run and its resume.
+VOLATILE_ATTRS = frozenset(
+    {"history", "date_created", "date_modified", "date_issued", "date_metadata_modified"}
+)
+
+_FORMAT = "sbrdf_xr.write_cube"
+_FORMAT_VERSION = 1
+#: Largest HDF5 chunk of a streamed variable [byte]; larger Dask chunks are split.
+_HDF5_CHUNK_BYTES = 8 * 2**20
+_NUMERIC_KINDS = "iuf"
+_SYNC_NAMES = ("sync", "synchronous", "single-threaded")
+_THREAD_NAMES = ("threads", "threading")
+
+
+class CubeWriteError(SbrdfError):
+    """A cube could not be written, or an unfinished ``.part`` cannot be resumed."""
+
+
+@dataclasses.dataclass(frozen=True)
+class BlockWritten:
+    """What :func:`write_cube` passes to ``on_block`` after each block is committed.
+
+    Attributes
+    ----------
+    index : int
+        Block number (C order over the grid of chunks).
+    slices : dict of str to slice
+        Position of the block along each chunked dimension.
+    n_written : int
+        Blocks committed so far, including those of an earlier, resumed run.
+    n_blocks : int
+        Blocks in the cube.
+    in_flight : int
+        Blocks submitted for computation but not yet written, after this one.
+    """
+
+    index: int
+    slices: dict[str, slice]
+    n_written: int
+    n_blocks: int
+    in_flight: int
+
+
+# ------------------------------------------------------------------ planning
+
+
+@dataclasses.dataclass
+class _Lazy:
+    name: str
+    dims: tuple[str, ...]
+    data: da.Array
+
+
+@dataclasses.dataclass
+class _Plan:
+    """Blocks of a cube and its fingerprint (built from metadata only)."""
+
+    block_dims: tuple[str, ...]
+    chunks: dict[str, tuple[int, ...]]
+    offsets: dict[str, np.ndarray]
+    grid: tuple[int, ...]
+    lazy: list[_Lazy]
+    structure: dict[str, Any]
+    fingerprint: str
+
+    @property
+    def n_blocks(self) -> int:
+        return math.prod(self.grid) if self.block_dims else 0
+
+    def index(self, k: int) -> dict[str, int]:
+        return dict(zip(self.block_dims, np.unravel_index(k, self.grid), strict=True))
+
+    def slices(self, k: int) -> dict[str, slice]:
+        idx = self.index(k)
+        off = self.offsets
+        return {d: slice(int(off[d][i]), int(off[d][i + 1])) for d, i in idx.items()}
+
+    def pieces(self, k: int) -> list[tuple[str, tuple[slice, ...], da.Array]]:
+        """``(variable, region, lazy block)`` for every lazy variable written with block ``k``."""
+        idx = self.index(k)
+        sl = self.slices(k)
+        out = []
+        for v in self.lazy:
+            if any(idx[d] for d in self.block_dims if d not in v.dims):
+                continue
+            piece = v.data.blocks[tuple(idx[d] for d in v.dims)] if v.dims else v.data
+            out.append((v.name, tuple(sl[d] for d in v.dims), piece))
+        return out
+
+
+def _storage_kind(name: Hashable, dtype: np.dtype) -> str:
+    """``numeric``, ``bool`` or ``str``; anything else is an error."""
+    if dtype.kind in _NUMERIC_KINDS and dtype.itemsize in (1, 2, 4, 8):
+        if dtype.kind == "f" and dtype.itemsize < 4:
+            raise ValidationError(f"{name}: dtype {dtype} cannot be stored in netCDF; cast to float32")
+        return "numeric"
+    if dtype.kind == "b":
+        return "bool"
+    if dtype.kind in "UO":
+        return "str"
+    hint = "; encode times as numbers with CF units first" if dtype.kind in "mM" else ""
+    raise ValidationError(
+        f"{name}: dtype {dtype} is not supported by write_cube "
+        f"(allowed: integers, float32, float64, bool, str){hint}"
+    )
+
+
+def _attr_json(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return {"array": value.tolist(), "dtype": str(value.dtype)}
+    if isinstance(value, np.generic):
+        return {"scalar": value.item(), "dtype": str(value.dtype)}
+    if isinstance(value, list | tuple):
+        return [_attr_json(x) for x in value]
+    return value
+
+
+def _check_attrs(owner: str, attrs: Mapping[Any, Any]) -> None:
+    for key, value in attrs.items():
+        if not isinstance(key, str):
+            raise ValidationError(f"{owner}: attribute names must be str, got {key!r}")
+        if key == "coordinates":
+            raise ValidationError(
+                f"{owner}: attribute 'coordinates' is written by write_cube itself; remove it"
+            )
+        items = value if isinstance(value, list | tuple) else [value]
+        for item in items:
+            if isinstance(item, bool | np.bool_) or not isinstance(
+                item, str | int | float | np.number | np.ndarray
+            ):
+                raise ValidationError(
+                    f"{owner}: attribute {key!r} = {value!r} cannot be stored in netCDF "
+                    f"(allowed: str, numbers, sequences of them); convert it, e.g. to str"
+                )
+
+
+def _values_sha(values: np.ndarray, kind: str) -> str:
+    h = hashlib.sha256()
+    if kind == "str":
+        h.update(json.dumps([str(x) for x in values.ravel().tolist()]).encode())
+    else:
+        h.update(str(values.dtype).encode())
+        h.update(np.ascontiguousarray(values).tobytes())
+    return h.hexdigest()
+
+
+def _plan(ds: xr.Dataset) -> _Plan:
+    """Validate ``ds`` (metadata only, nothing is computed) and lay out its blocks."""
+    if not isinstance(ds, xr.Dataset):
+        raise ValidationError(f"ds: expected an xarray.Dataset, got {type(ds).__name__}")
+    try:
+        chunks = {str(d): tuple(int(c) for c in cs) for d, cs in ds.chunks.items()}
+    except ValueError as exc:
+        raise ValidationError(
+            f"ds: the variables are chunked differently ({exc}); call ds.unify_chunks() "
+            "or rechunk them alike"
+        ) from exc
+    _check_attrs("global attributes", ds.attrs)
+    lazy: list[_Lazy] = []
+    variables: list[dict[str, Any]] = []
+    for name, var in ds.variables.items():
+        if not isinstance(name, str) or any(c.isspace() for c in name):
+            raise ValidationError(f"{name!r}: variable names must be str without whitespace")
+        kind = _storage_kind(name, var.dtype)
+        _check_attrs(f"variable {name!r}", var.attrs)
+        if kind == "bool" and "dtype" in var.attrs:
+            raise ValidationError(f"{name}: a bool variable cannot carry a 'dtype' attribute")
+        is_dask = isinstance(var.data, da.Array)
+        if var.chunks is not None and not is_dask:
+            raise ValidationError(
+                f"{name}: chunked by {type(var.data).__name__}; only Dask arrays are supported"
+            )
+        entry: dict[str, Any] = {
+            "name": name,
+            "dims": list(map(str, var.dims)),
+            "dtype": str(var.dtype) if kind == "numeric" else kind,
+            "coord": name in ds.coords,
+            "lazy": is_dask,
+            "attrs": {k: _attr_json(v) for k, v in var.attrs.items()},
+        }
+        if is_dask:
+            lazy.append(_Lazy(name, tuple(map(str, var.dims)), var.data))
+        else:
+            values = np.asarray(var.values)
+            if values.dtype.kind == "O" and not all(isinstance(x, str) for x in values.flat):
+                raise ValidationError(f"{name}: object arrays must hold str only")
+            entry["sha256"] = _values_sha(values, kind)
+        variables.append(entry)
+    block_dims = tuple(str(d) for d in ds.sizes if str(d) in chunks)
+    structure = {
+        "dims": [[str(d), int(n)] for d, n in ds.sizes.items()],
+        "chunks": [[d, list(chunks[d])] for d in block_dims],  # in block-numbering order
+        "variables": sorted(variables, key=lambda v: v["name"]),
+        "attrs": {
+            k: _attr_json(v) for k, v in ds.attrs.items() if k not in VOLATILE_ATTRS
+        },
+    }
+    text = json.dumps(structure, sort_keys=True, allow_nan=True, separators=(",", ":"))
+    return _Plan(
+        block_dims=block_dims,
+        chunks={d: chunks[d] for d in block_dims},
+        offsets={d: np.concatenate([[0], np.cumsum(chunks[d])]) for d in block_dims},
+        grid=tuple(len(chunks[d]) for d in block_dims),
+        lazy=lazy,
+        structure=structure,
+        fingerprint=hashlib.sha256(text.encode()).hexdigest(),
+    )
+
+
+def _difference(old: Mapping[str, Any], new: Mapping[str, Any]) -> str:
+    """First difference between two ``structure`` records, in words."""
+    new = json.loads(json.dumps(new))  # compare like with like (tuples become lists)
+    if old.get("dims") != new.get("dims"):
+        return f"dims and sizes differ: {old.get('dims')} in the .part, {new.get('dims')} now"
+    if old.get("chunks") != new.get("chunks"):
+        return f"chunks differ: {old.get('chunks')} in the .part, {new.get('chunks')} now"
+    ov = {v["name"]: v for v in old.get("variables", [])}
+    nv = {v["name"]: v for v in new.get("variables", [])}
+    if set(ov) != set(nv):
+        return f"variables differ: {sorted(ov)} in the .part, {sorted(nv)} now"
+    for name in nv:
+        for key in ("dims", "dtype", "coord", "lazy", "sha256", "attrs"):
+            if ov[name].get(key) != nv[name].get(key):
+                what = "values" if key == "sha256" else key
+                return f"{what} of {name!r} differ"
+    if old.get("attrs") != new.get("attrs"):
+        return "global attributes differ"
+    return "the file format version differs"
+
+
+# ------------------------------------------------------------------- netCDF
+
+
+def _coordinates_attrs(ds: xr.Dataset) -> tuple[dict[str, str], str | None]:
+    """Per-variable and global ``coordinates`` attributes, as xarray writes them."""
+    non_dim = {str(c) for c in ds.coords if c not in ds.dims}
+    per_var: dict[str, set[str]] = {str(n): set() for n in ds.variables}
+    for c in non_dim:
+        target = set(ds.variables[c].dims)
+        for name, var in ds.variables.items():
+            if name not in non_dim and name not in var.dims and target <= set(var.dims):
+                per_var[str(name)].add(c)
+    attached = set().union(*per_var.values()) if per_var else set()
+    leftover = non_dim - attached
+    return (
+        {n: " ".join(sorted(cs)) for n, cs in per_var.items() if cs},
+        " ".join(sorted(leftover)) if leftover else None,
+    )
+
+
+def _nc_attr(value: Any) -> Any:
+    if isinstance(value, list | tuple) and value and all(isinstance(x, str) for x in value):
+        return list(value)
+    if isinstance(value, list | tuple):
+        return np.asarray(value)
+    return value
+
+
+def _set_attrs(target: Any, attrs: Mapping[str, Any]) -> None:
+    for key, value in attrs.items():
+        target.setncattr(key, _nc_attr(value))
+
+
+def _to_storage(values: Any, kind: str) -> np.ndarray:
+    arr = np.asarray(values)
+    if kind == "bool":
+        return arr.astype(np.int8)
+    if kind == "str":
+        out = np.empty(arr.shape, dtype=object)
+        out[...] = arr.astype(str) if arr.dtype.kind != "O" else arr
+        return out
+    if not arr.dtype.isnative:
+        arr = arr.astype(arr.dtype.newbyteorder("="))
+    return arr
+
+
+def _hdf5_chunks(shape: tuple[int, ...], itemsize: int) -> list[int] | None:
+    """HDF5 chunk shape for a streamed variable: its Dask chunk, halved until small."""
+    if not shape or 0 in shape:
+        return None
+    c = list(shape)
+    while math.prod(c) * itemsize > _HDF5_CHUNK_BYTES and max(c) > 1:
+        i = int(np.argmax(c))
+        c[i] = -(-c[i] // 2)
+    return c
+
+
+def _tune(v: netCDF4.Variable, streamed: bool) -> None:
+    """Raw values in and out; a chunk cache of one chunk for streamed variables.
+
+    netCDF's default cache (64 MiB per variable) would hold on to written chunks
+    and make memory grow with the number of variables rather than the block size.
+    Blocks cover whole HDF5 chunks except at irregular chunk edges, so one chunk
+    of cache is enough.
+    """
+    v.set_auto_maskandscale(False)
+    chunking = v.chunking()
+    if streamed and isinstance(chunking, list):
+        nbytes = math.prod(chunking) * v.dtype.itemsize if isinstance(v.dtype, np.dtype) else 0
+        v.set_var_chunk_cache(size=max(nbytes, 2**20), nelems=101, preemption=1.0)
+
+
+def _create(part: Path, ds: xr.Dataset, plan: _Plan, complevel: int) -> netCDF4.Dataset:
+    """Create ``part`` with every dim, variable and attribute; write the numpy-backed values."""
+    coords_attr, global_coords = _coordinates_attrs(ds)
+    nc = netCDF4.Dataset(part, mode="w", format="NETCDF4")
+    try:
+        for dim, size in ds.sizes.items():
+            nc.createDimension(str(dim), int(size))
+        lazy = {v.name for v in plan.lazy}
+        for name, var in ds.variables.items():
+            name = str(name)
+            kind = _storage_kind(name, var.dtype)
+            dtype: Any = {"bool": np.int8, "str": str}.get(kind, var.dtype.newbyteorder("="))
+            kw: dict[str, Any] = {}
+            if name in lazy and kind != "str":
+                shape = tuple(max(plan.chunks[d]) for d in map(str, var.dims))
+                kw["chunksizes"] = _hdf5_chunks(shape, np.dtype(dtype).itemsize)
+            if complevel and kind == "numeric" and var.ndim:
+                kw.update(zlib=True, complevel=int(complevel), shuffle=True)
+            attrs = dict(var.attrs)
+            fill = attrs.pop("_FillValue", False)
+            v = nc.createVariable(name, dtype, tuple(map(str, var.dims)), fill_value=fill, **kw)
+            _tune(v, name in lazy)
+            if kind == "bool":
+                attrs["dtype"] = "bool"
+            if name in coords_attr:
+                attrs["coordinates"] = coords_attr[name]
+            _set_attrs(v, attrs)
+            if name not in lazy:
+                v[...] = _to_storage(var.values, kind)
+        _set_global_attrs(nc, ds, global_coords)
+        nc.sync()
+    except BaseException:
+        nc.close()
+        raise
+    return nc
+
+
+def _set_global_attrs(nc: netCDF4.Dataset, ds: xr.Dataset, global_coords: str | None) -> None:
+    for key in nc.ncattrs():
+        nc.delncattr(key)
+    attrs = dict(ds.attrs)
+    if global_coords:
+        attrs["coordinates"] = global_coords
+    _set_attrs(nc, attrs)
+
+
+def _open_part(part: Path, ds: xr.Dataset, plan: _Plan) -> netCDF4.Dataset:
+    """Open an unfinished ``part`` for appending and check its layout against ``ds``."""
+    try:
+        nc = netCDF4.Dataset(part, mode="a")
+    except OSError as exc:
+        raise CubeWriteError(
+            f"{part} cannot be opened ({exc}); it was probably damaged by a crash while "
+            "writing. Pass overwrite=True, resume=False to discard it and start again"
+        ) from exc
+    try:
+        for dim, size in ds.sizes.items():
+            if str(dim) not in nc.dimensions or len(nc.dimensions[str(dim)]) != size:
+                raise CubeWriteError(f"{part}: dimension {dim!r} is missing or has another size")
+        for name, var in ds.variables.items():
+            if name not in nc.variables or nc.variables[name].dimensions != tuple(map(str, var.dims)):
+                raise CubeWriteError(f"{part}: variable {name!r} is missing or has other dims")
+            _tune(nc.variables[name], isinstance(var.data, da.Array))
+        _set_global_attrs(nc, ds, _coordinates_attrs(ds)[1])
+        nc.sync()
+    except BaseException:
+        nc.close()
+        raise
+    return nc
+
+
+# --------------------------------------------------------------- bookkeeping
+
+
+def _read_log(log: Path, part: Path) -> tuple[dict[str, Any], set[int]]:
+    """Header and completed blocks of an unfinished cube."""
+    if not log.exists():
+        raise CubeWriteError(
+            f"{part} has no bookkeeping file {log.name}, so which blocks it holds is unknown; "
+            "pass overwrite=True, resume=False to discard it and start again"
+        )
+    with open(log, encoding="utf-8") as f:
+        lines = f.read().split("\n")
+    try:
+        header = json.loads(lines[0])
+        if header.get("format") != _FORMAT:
+            raise ValueError(f"format {header.get('format')!r}")
+    except (ValueError, AttributeError) as exc:
+        raise CubeWriteError(
+            f"{log}: not a write_cube bookkeeping file ({exc}); pass overwrite=True, "
+            "resume=False to discard the unfinished cube and start again"
+        ) from exc
+    done: set[int] = set()
+    for line in lines[1:-1]:  # the last element follows the last newline: empty or torn
+        try:
+            done.add(int(json.loads(line)["block"]))
+        except (ValueError, KeyError, TypeError):
+            continue
+    return header, done
+
+
+def _write_header(log: Path, plan: _Plan) -> None:
+    header = {
+        "format": _FORMAT,
+        "version": _FORMAT_VERSION,
+        "fingerprint": plan.fingerprint,
+        "n_blocks": plan.n_blocks,
+        "block_dims": list(plan.block_dims),
+        "structure": plan.structure,
+    }
+    tmp = log.with_name(log.name + ".tmp")
+    with open(tmp, "w", encoding="utf-8") as f:
+        f.write(json.dumps(header, sort_keys=True) + "\n")
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, log)
+
+
+def _fsync_dir(directory: Path) -> None:
+    with contextlib.suppress(OSError):
+        fd = os.open(directory, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
+# ------------------------------------------------------------------ runners
+
+
+def _block_task(arrays: list[da.Array], k: int) -> Any:
+    """One Delayed computing every lazy piece of block ``k`` into a tuple of numpy arrays.
+
+    A builtin (``tuple``) packs them, so workers need nothing from this package.
+    """
+    key = f"write_cube-block-{k}-{dask.base.tokenize(*arrays)}"
+    return dask.delayed(tuple, pure=True)(arrays, dask_key_name=key)
+
+
+class _SyncRunner:
+    """Compute each block in the calling thread when its result is asked for."""
+
+    def __init__(self) -> None:
+        self.queue: deque[tuple[int, Any]] = deque()
+        self.n_workers = 1
+
+    @property
+    def pending(self) -> int:
+        return len(self.queue)
+
+    def submit(self, k: int, arrays: list[da.Array]) -> None:
+        self.queue.append((k, arrays))
+
+    def next_done(self) -> tuple[int, Any]:
+        return self.queue.popleft()
+
+    def result(self, arrays: list[da.Array]) -> tuple[np.ndarray, ...]:
+        return dask.compute(*arrays, scheduler="sync")
+
+    def close(self) -> None:
+        self.queue.clear()
+
+
+class _ThreadRunner:
+    """A pool of threads, each computing whole blocks with Dask's synchronous scheduler."""
+
+    def __init__(self, n_threads: int) -> None:
+        self.n_workers = n_threads
+        self.pool = ThreadPoolExecutor(n_threads, thread_name_prefix="write_cube")
+        self.futures: dict[Future[Any], int] = {}
+
+    @property
+    def pending(self) -> int:
+        return len(self.futures)
+
+    def submit(self, k: int, arrays: list[da.Array]) -> None:
+        self.futures[self.pool.submit(dask.compute, *arrays, scheduler="sync")] = k
+
+    def next_done(self) -> tuple[int, Future[Any]]:
+        done, _ = wait(self.futures, return_when=FIRST_COMPLETED)
+        fut = min(done, key=self.futures.__getitem__)
+        return self.futures.pop(fut), fut
+
+    def result(self, fut: Future[Any]) -> tuple[np.ndarray, ...]:
+        return fut.result()
+
+    def close(self) -> None:
+        self.pool.shutdown(wait=True, cancel_futures=True)
+        self.futures.clear()
+
+
+class _DistributedRunner:
+    """Blocks submitted to a Dask cluster; results gathered by the writing process."""
+
+    def __init__(self, client: Any, owned: bool) -> None:
+        from distributed import as_completed
+
+        self.client = client
+        self.owned = owned
+        self.done = as_completed(loop=client.loop)
+        self.futures: dict[str, tuple[int, Any]] = {}
+        self.n_workers = max(1, sum(client.nthreads().values()))
+
+    @property
+    def pending(self) -> int:
+        return len(self.futures)
+
+    def submit(self, k: int, arrays: list[da.Array]) -> None:
+        fut = self.client.compute(_block_task(arrays, k))
+        self.futures[fut.key] = (k, fut)
+        self.done.add(fut)
+
+    def next_done(self) -> tuple[int, Any]:
+        fut = next(self.done)
+        k, _ = self.futures.pop(fut.key)
+        return k, fut
+
+    def result(self, fut: Any) -> tuple[np.ndarray, ...]:
+        try:
+            return fut.result()
+        finally:
+            fut.release()
+
+    def close(self) -> None:
+        with contextlib.suppress(Exception):
+            self.done.clear()
+            if self.futures:
+                self.client.cancel([f for _, f in self.futures.values()])
+        self.futures.clear()
+        if self.owned:
+            self.client.close()
+
+
+def _runner(client: Any, scheduler: str | None) -> _SyncRunner | _ThreadRunner | _DistributedRunner:
+    if client is not None and scheduler is not None:
+        raise ValidationError("pass either client or scheduler, not both")
+    if client is not None:
+        return _DistributedRunner(client, owned=False)
+    if scheduler is None or scheduler in _THREAD_NAMES:
+        n = dask.config.get("num_workers", None) or CPU_COUNT
+        return _ThreadRunner(max(1, int(n)))
+    if scheduler in _SYNC_NAMES:
+        return _SyncRunner()
+    if not isinstance(scheduler, str) or ":" not in scheduler:
+        raise ValidationError(
+            f"scheduler: got {scheduler!r}; allowed: None or 'threads' (in-process threads), "
+            "'synchronous', or the address of a Dask scheduler such as 'tcp://127.0.0.1:8786'"
+        )
+    try:
+        from distributed import Client
+    except ImportError as exc:  # pragma: no cover - distributed is a test dependency
+        raise ValidationError(
+            f"scheduler={scheduler!r} needs the 'distributed' package (pip install sbrdf-xr[distributed])"
+        ) from exc
+    try:
+        c = Client(scheduler, set_as_default=False, timeout="30s")
+    except OSError as exc:
+        raise CubeWriteError(f"cannot connect to the Dask scheduler at {scheduler}: {exc}") from exc
+    return _DistributedRunner(c, owned=True)
+
+
+# ------------------------------------------------------------------ progress
+
+
+class _TextProgress:
+    """A one-line stderr counter, used when tqdm is not installed."""
+
+    def __init__(self, total: int, initial: int, desc: str) -> None:
+        self.n, self.total, self.desc = initial, total, desc
+        self.last = 0.0
+        self._show(force=True)
+
+    def _show(self, force: bool = False) -> None:
+        now = time.monotonic()
+        if force or now - self.last >= 0.5:
+            self.last = now
+            sys.stderr.write(f"\r{self.desc}: {self.n}/{self.total} blocks")
+            sys.stderr.flush()
+
+    def update(self, n: int = 1) -> None:
+        self.n += n
+        self._show(force=self.n == self.total)
+
+    def close(self) -> None:
+        self._show(force=True)
+        sys.stderr.write("\n")
+        sys.stderr.flush()
+
+
+class _NoProgress:
+    def update(self, n: int = 1) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+
+def _progress(enabled: bool, total: int, initial: int, desc: str) -> Any:
+    if not enabled:
+        return _NoProgress()
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        return _TextProgress(total, initial, desc)
+    return tqdm(total=total, initial=initial, desc=desc, unit="block", file=sys.stderr)
+
+
+# -------------------------------------------------------------------- write
+
+
+def _check_destination(path: Path, part: Path, log: Path, overwrite: bool, resume: bool) -> bool:
+    """Apply the overwrite/resume rules before anything is touched; True to resume."""
+    if path.is_dir():
+        raise CubeWriteError(f"{path} is a directory; give a file name for the cube")
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{path} exists; pass overwrite=True to replace it")
+    if part.exists():
+        if resume:
+            return True
+        if not overwrite:
+            raise FileExistsError(
+                f"{part} exists: an unfinished write of {path.name}. Pass resume=True to "
+                "continue it, or overwrite=True to discard it and start again"
+            )
+    return False
+
+
+def write_cube(
+    ds: xr.Dataset,
+    path: str | os.PathLike[str],
+    *,
+    overwrite: bool = False,
+    resume: bool = False,
+    client: Any = None,
+    scheduler: str | None = None,
+    max_in_flight: int | None = None,
+    progress: bool = False,
+    complevel: int = 0,
+    on_block: Callable[[BlockWritten], None] | None = None,
+) -> Path:
+    """Compute a lazy cube block by block and stream it to a netCDF-4 file.
+
+    The file is written as ``<path>.part`` and renamed to ``path`` when complete;
+    the blocks already written are recorded in ``<path>.part.jsonl`` so that an
+    interrupted write can be resumed (see the module documentation for the
+    format).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The cube.  Dask-backed variables are computed block by block (one chunk
+        of every chunked dimension at a time); numpy-backed variables (usually
+        the coordinates) are written first.  Chunks must agree between variables.
+    path : path-like
+        Destination file.
+    overwrite : bool, default False
+        Replace an existing ``path`` (kept intact until the new cube is
+        complete) and discard an unfinished ``.part`` when not resuming.
+    resume : bool, default False
+        Continue an unfinished ``<path>.part`` of the same cube, computing only
+        the missing blocks; without a ``.part`` the write starts afresh.
+    client : distributed.Client, optional
+        Compute the blocks on this cluster (left open).
+    scheduler : str, optional
+        Address of a Dask scheduler (``"tcp://host:port"``) to connect to for the
+        duration of the write; or ``"threads"`` (the default, in-process) or
+        ``"synchronous"`` (one block at a time in the calling thread, for
+        debugging).
+    max_in_flight : int, optional
+        Largest number of blocks being computed or waiting to be written at any
+        time; bounds memory at about ``max_in_flight`` block sizes.  Default
+        twice the number of worker threads.
+    progress : bool, default False
+        Show a progress bar of blocks on stderr (tqdm if installed).
+    complevel : int, default 0
+        zlib level (1-9, with byte shuffle) for the numeric variables; 0 stores
+        them uncompressed.
+    on_block : callable, optional
+        Called with a :class:`BlockWritten` in the writing thread after each
+        block is committed (written, flushed and recorded).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    FileExistsError
+        ``path`` exists and ``overwrite`` is false, or an unfinished ``.part``
+        exists and neither ``resume`` nor ``overwrite`` is given.  Nothing is
+        touched.
+    ValidationError
+        ``ds`` cannot be written (inconsistent chunks, unsupported dtypes or
+        attributes) or the arguments are invalid.  Nothing is touched.
+    CubeWriteError
+        A ``.part`` that does not belong to this cube or cannot be read
+        (``resume=True``; it is left untouched), or a block computation or write
+        that failed: the blocks written so far stay in the ``.part`` and
+        ``resume=True`` continues from them.  The original exception is chained.
+
+    Notes
+    -----
+    Only the calling process writes; workers only compute.  Tasks shared by
+    several blocks (for example a lazily built look-up table) are recomputed
+    for every block: persist or compute them first.
+    """
+    path = Path(path)
+    part = path.with_name(path.name + PART_SUFFIX)
+    log = path.with_name(path.name + LOG_SUFFIX)
+    plan = _plan(ds)
+    if max_in_flight is not None and (
+        not isinstance(max_in_flight, int | np.integer) or max_in_flight < 1
+    ):
+        raise ValidationError(f"max_in_flight: must be an integer >= 1, got {max_in_flight!r}")
+    if not 0 <= int(complevel) <= 9:
+        raise ValidationError(f"complevel: must be 0 (no compression) to 9, got {complevel!r}")
+    resuming = _check_destination(path, part, log, overwrite, resume)
+    done: set[int] = set()
+    if resuming:
+        header, done = _read_log(log, part)
+        if header.get("fingerprint") != plan.fingerprint:
+            why = _difference(header.get("structure", {}), plan.structure)
+            raise CubeWriteError(
+                f"{part} belongs to a different cube ({why}); it was left untouched. "
+                "Resume with the same cube, or pass overwrite=True, resume=False to discard it"
+            )
+        done = {k for k in done if 0 <= k < plan.n_blocks}
+
+    runner = _runner(client, scheduler)
+    nc: netCDF4.Dataset | None = None
+    try:
+        if resuming:
+            nc = _open_part(part, ds, plan)
+        else:
+            log.unlink(missing_ok=True)
+            part.unlink(missing_ok=True)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            try:
+                nc = _create(part, ds, plan, complevel)
+                _write_header(log, plan)
+            except BaseException:
+                if nc is not None:
+                    nc.close()
+                part.unlink(missing_ok=True)  # nothing recorded yet: nothing lost
+                raise
+    except BaseException:
+        runner.close()
+        raise
+
+    bar: Any = _NoProgress()
+    fd = log_fd = -1
+    k = -1
+    try:
+        fd = os.open(part, os.O_RDONLY)
+        os.fsync(fd)
+        log_fd = os.open(log, os.O_WRONLY | os.O_APPEND)
+        limit = int(max_in_flight or 2 * runner.n_workers)
+        todo = iter([b for b in range(plan.n_blocks) if b not in done])
+        kinds = {str(n): _storage_kind(n, v.dtype) for n, v in ds.variables.items()}
+        bar = _progress(progress, plan.n_blocks, len(done), path.name)
+        pieces: dict[int, list[tuple[str, tuple[slice, ...], da.Array]]] = {}
+        exhausted = False
+        while True:
+            while not exhausted and runner.pending < limit:
+                nxt = next(todo, None)
+                if nxt is None:
+                    exhausted = True
+                else:
+                    pieces[nxt] = plan.pieces(nxt)
+                    runner.submit(nxt, [p for _, _, p in pieces[nxt]])
+            if not runner.pending:
+                break
+            k, handle = runner.next_done()
+            arrays = runner.result(handle)
+            if k in done:  # a block is written exactly once
+                continue
+            for (name, region, _), values in zip(pieces.pop(k), arrays, strict=True):
+                expected = tuple(s.stop - s.start for s in region)
+                if np.shape(values) != expected:
+                    raise CubeWriteError(
+                        f"block {k}: {name!r} computed with shape {np.shape(values)}, "
+                        f"expected {expected} from the chunks"
+                    )
+                nc.variables[name][region] = _to_storage(values, kinds[name])
+            del arrays
+            nc.sync()
+            os.fsync(fd)
+            os.write(log_fd, (json.dumps({"block": k}) + "\n").encode())
+            os.fsync(log_fd)
+            done.add(k)
+            bar.update(1)
+            if on_block is not None:
+                on_block(BlockWritten(k, plan.slices(k), len(done), plan.n_blocks, runner.pending))
+            k = -1
+        nc.close()
+        nc = None
+        os.fsync(fd)
+        os.replace(part, path)
+    except Exception as exc:
+        where = f"at block {k} ({_describe(plan.slices(k))}) " if k >= 0 else ""
+        raise CubeWriteError(
+            f"writing {path} failed {where}after {len(done)} of {plan.n_blocks} blocks: "
+            f"{type(exc).__name__}: {exc}. The blocks written so far are kept in {part}; "
+            "fix the cause and call write_cube again with resume=True to compute only the "
+            "missing blocks"
+        ) from exc
+    except BaseException as exc:
+        exc.add_note(
+            f"write_cube: {len(done)} of {plan.n_blocks} blocks of {path} are kept in {part}; "
+            "call write_cube again with resume=True to finish it"
+        )
+        raise
+    finally:
+        runner.close()
+        bar.close()
+        if nc is not None:
+            with contextlib.suppress(Exception):
+                nc.close()
+        for f in (fd, log_fd):
+            if f >= 0:
+                os.close(f)
+    log.unlink(missing_ok=True)
+    _fsync_dir(path.parent)
+    return path
+
+
+def _describe(slices: Mapping[str, slice]) -> str:
+    return ", ".join(f"{d}[{s.start}:{s.stop}]" for d, s in slices.items())
+
