@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike
 
 from . import material as _material
 
-__all__ = ["SbrdfDataArrayAccessor"]
+__all__ = ["SbrdfDataArrayAccessor", "SbrdfDatasetAccessor"]
 
 
 @xr.register_dataarray_accessor("sbrdf")
@@ -44,3 +44,40 @@ class SbrdfDataArrayAccessor:
     def to_netcdf(self, path: Any, **kwargs: Any) -> Any:
         """:func:`sbrdf_xr.material.to_netcdf` of this table."""
         return _material.to_netcdf(self._da, path, **kwargs)
+
+
+@xr.register_dataset_accessor("sbrdf")
+class SbrdfDatasetAccessor:
+    """Methods of a simulation cube, as ``ds.sbrdf.photometry(...)`` and friends.
+
+    Each method forwards to the function of the same name in :mod:`sbrdf_xr.photometry`.
+    """
+
+    def __init__(self, ds: xr.Dataset) -> None:
+        self._ds = ds
+
+    def photometry(self, bands: Any, range_km: Any, **kwargs: Any) -> xr.Dataset:
+        """:func:`sbrdf_xr.photometry.photometry` of this cube."""
+        from . import photometry as _phot
+
+        return _phot.photometry(self._ds, bands, range_km, **kwargs)
+
+    def band_signal(self, bands: Any, **kwargs: Any) -> xr.DataArray:
+        """:func:`sbrdf_xr.photometry.band_signal` of this cube."""
+        from . import photometry as _phot
+
+        return _phot.band_signal(self._ds, bands, **kwargs)
+
+    def magnitudes(self, bands: Any, range_km: Any, **kwargs: Any) -> xr.DataArray:
+        """:func:`sbrdf_xr.photometry.magnitudes` of this cube."""
+        from . import photometry as _phot
+
+        return _phot.magnitudes(self._ds, bands, range_km, **kwargs)
+
+    def srgb(self, **kwargs: Any) -> xr.DataArray:
+        """:func:`sbrdf_xr.photometry.srgb` of this cube."""
+        from . import photometry as _phot
+
+        return _phot.srgb(self._ds, **kwargs)
+
+

@@ -9,6 +9,7 @@ Sub-commands::
     sbrdf-xr simulate SCENE -o CUBE.nc      run a scene (built-in name or TOML file) into a cube
              [--scheduler ADDR] [--preset NAME] [--plot FIG.png] [--overwrite | --resume] [--plan]
     sbrdf-xr plot CUBE.nc -o FIG.png        the cube's natural figure (light curve or spectra)
+    sbrdf-xr photometry CUBE.nc --bands B V R I --range-km 36000 [-o PHOT.nc] [--csv PHOT.csv]
 """
 
 from __future__ import annotations
@@ -114,6 +115,52 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_photometry(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    import numpy as np
+    import xarray as xr
+
+    from . import photometry as phot
+    from .material import write_netcdf_atomic
+
+    with xr.open_dataset(args.cube) as cube:
+        cube = cube.load()
+    ds = phot.photometry(cube, args.bands, args.range_km, weighting=args.weighting,
+                         quadrature=args.quadrature, extrapolate=args.extrapolate)
+    print(f"photometry of {args.cube}: range {args.range_km:g} km, {ds.attrs['magnitude_system']} "
+          f"magnitudes, {args.weighting} weighting, solar spectrum ASTM G173-03 (pvlib)")
+    print(f"{'band':<8} {'filter':<14} {'m_sun':>8} {'min':>8} {'median':>8} {'max':>8}")
+    for b in ds.band.values:
+        m = np.asarray(ds.magnitude.sel(band=b).values).ravel()
+        fin = m[np.isfinite(m)]
+        stats = (f"{fin.min():8.3f} {np.median(fin):8.3f} {fin.max():8.3f}" if fin.size
+                 else f"{'inf':>8} {'inf':>8} {'inf':>8}")
+        print(f"{b!s:<8} {ds.filter.sel(band=b).item()!s:<14} {float(ds.sun_magnitude.sel(band=b)):8.3f} {stats}")
+    if "colour_index" in ds:
+        for c in ds.colour.values:
+            v = np.asarray(ds.colour_index.sel(colour=c).values).ravel()
+            v = v[np.isfinite(v)]
+            med = f"{np.median(v):.3f}" if v.size else "nan"
+            print(f"colour {c!s:<10} median {med} mag")
+    if args.output:
+        write_netcdf_atomic(ds, args.output, overwrite=args.overwrite)
+        print(f"wrote {args.output}")
+    if args.csv:
+        if Path(args.csv).exists() and not args.overwrite:
+            raise FileExistsError(f"{args.csv} exists; pass --overwrite to replace it")
+        lead = set(ds.magnitude.dims) - {"band"}
+        parts = [ds.magnitude.to_dataset(dim="band").rename({str(b): f"mag_{b}" for b in ds.band.values})]
+        if "colour_index" in ds:
+            parts.append(ds.colour_index.to_dataset(dim="colour"))
+        wide = xr.merge(parts, compat="override")
+        wide = wide.drop_vars([c for c in wide.coords if not set(wide[c].dims) <= lead or c in ("band", "colour")],
+                              errors="ignore")
+        wide.to_dataframe().to_csv(args.csv)
+        print(f"wrote {args.csv}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``sbrdf-xr``."""
     p = argparse.ArgumentParser(prog="sbrdf-xr", description="Spectral BRDF simulation of unresolved spacecraft.")
@@ -149,6 +196,20 @@ def build_parser() -> argparse.ArgumentParser:
     psim.add_argument("--plan", action="store_true", help="print the plan and stop")
     psim.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     psim.set_defaults(func=_cmd_simulate)
+
+    pph = sub.add_parser("photometry", help="band magnitudes and colours of a cube")
+    pph.add_argument("cube", help="netCDF cube written by 'sbrdf-xr simulate'")
+    pph.add_argument("--bands", nargs="+", required=True,
+                     help="bands: aliases U B V R I u g r i z or speclite filter names")
+    pph.add_argument("--range-km", type=float, required=True, help="observer range [km]")
+    pph.add_argument("--weighting", choices=("photon", "energy"), default="photon")
+    pph.add_argument("--quadrature", choices=("trapezoid", "linear"), default="trapezoid")
+    pph.add_argument("--extrapolate", choices=("zero", "constant"),
+                     help="continue spectra past their grid into bands they do not cover")
+    pph.add_argument("-o", "--output", help="write the photometry Dataset to this netCDF file")
+    pph.add_argument("--csv", help="write magnitudes and colour indices to this CSV file")
+    pph.add_argument("--overwrite", action="store_true", help="replace existing output files")
+    pph.set_defaults(func=_cmd_photometry)
 
     pp = sub.add_parser("plot", help="draw a cube's figure")
     pp.add_argument("cube")
