@@ -33,7 +33,7 @@ def canx1_models() -> dict[str, xr.Dataset]:
       term 0.02 R(lambda) (R the normal-incidence reflectance) for the milled
       surface's scatter, which carries the same 800 nm feature;
     * Emcore-like triple-junction cell: GaAs substrate under a two-layer
-      anti-reflection coating (Al2O3 100 nm on TiO2 70 nm), GGX roughness 0.03
+      anti-reflection coating (Al2O3 135 nm on TiO2 95 nm), GGX roughness 0.03
       (highly specular), diffuse 0.005: thin-film interference features in
       600-800 nm that move to shorter wavelengths as the angle grows;
     * Aeroglaze A276-like white paint: Robertson-Sandford with rho_D 0.80 (0.55
@@ -53,9 +53,9 @@ def canx1_models() -> dict[str, xr.Dataset]:
             roughness=0.15, n=al.real, k=al.imag, rho_d=0.02 * r_al),
         "tjpv-cell": models.model_material(
             "microfacet", wl, material="tjpv-cell",
-            provenance="synthetic: GaAs (sbrdf_xr.brdf.optics.gaas_index) under Al2O3 100 nm / "
-            "TiO2 70 nm anti-reflection coating, GGX roughness 0.03, diffuse 0.005",
-            layers=[(optics.sapphire_index(wl), 100.0), (optics.titania_index(wl), 70.0)],
+            provenance="synthetic: GaAs (sbrdf_xr.brdf.optics.gaas_index) under Al2O3 135 nm / "
+            "TiO2 95 nm anti-reflection coating, GGX roughness 0.03, diffuse 0.005",
+            layers=[(optics.sapphire_index(wl), 135.0), (optics.titania_index(wl), 95.0)],
             roughness=0.03, n=gaas.real, k=gaas.imag, rho_d=0.005),
         "white-paint-a276": models.model_material(
             "robertson_sandford", wl, material="white-paint-a276",
@@ -80,6 +80,8 @@ def canx1_materials() -> None:
         models.to_netcdf(spec, ROOT / "materials" / f"{name}-model.nc", overwrite=True)
         meas = models.measure(spec, CANX1_THETA_I[name], noise=CANX1_NOISE, seed=10 + k)
         material.to_netcdf(meas, ROOT / "materials" / f"{name}-measurements.nc", overwrite=True)
+        fit = models.fit_robertson_sandford(meas)
+        models.to_netcdf(fit, ROOT / "materials" / f"{name}-fit.nc", overwrite=True)
 
 
 def table4_paints() -> None:

@@ -422,11 +422,12 @@ def build_lut(
     n_phi: int = 21,
     n_delta_theta: int = 21,
     theta_i: ArrayLike | None = None,
-    smoothing: float | str = "csaps",
+    smoothing: float | str = 0.0,
     extrapolation: str = "cubic",
     material: str | None = None,
     dtype: type | np.dtype = np.float64,
     blend: float = 10.0,
+    model: xr.Dataset | None = None,
     normal_incidence: str = "paper",
     blend_normal: float = 5.0,
 ) -> xr.DataArray:
@@ -465,11 +466,15 @@ def build_lut(
         Points of the ``delta_theta`` grid, odd (paper: 21).
     theta_i : array_like, optional
         Output incidence angles [degree]; default every integer 0-90 (paper).
-    smoothing : float or "csaps", default "csaps"
-        Smoothing parameter ``lam`` [degree**3] of the spline in ``theta_i``
-        (:func:`sbrdf_xr._lut.smoothing_spline_matrix`); ``"csaps"`` is MATLAB's
-        default ``h**3/6`` (:func:`sbrdf_xr._lut.csaps_default_lambda`); 0
-        interpolates.
+    smoothing : float or "csaps", default 0
+        Smoothing parameter ``lam`` [degree**3] of the cubic smoothing spline in
+        ``theta_i`` (:func:`sbrdf_xr._lut.smoothing_spline_matrix`).  Paper 000
+        does not give it.  The default 0 makes the spline pass through the
+        measurements (a natural cubic spline; ``p = 1`` in MATLAB's ``csaps``
+        terms).  ``"csaps"`` is MATLAB's default ``lam = h**3/6``
+        (:func:`sbrdf_xr._lut.csaps_default_lambda`), which with five incidence
+        angles 10-15 deg apart smooths spectral features that move with angle
+        (a solar cell's interference minima) by tens of nanometres.
     extrapolation : {"cubic", "linear", "constant", "model"}, default "cubic"
         How the table continues below the smallest and above the largest measured
         ``theta_i``.  ``cubic`` (default) continues the spline's end polynomial
@@ -481,6 +486,11 @@ def build_lut(
         extrapolated spline over ``blend`` degrees with a smoothstep weight.
     blend : float, default 10
         Width of the blend zone of ``extrapolation="model"`` [degree].
+    model : xarray.Dataset, optional
+        The model material that fills the unmeasurable range with
+        ``extrapolation="model"`` (:mod:`sbrdf_xr.models`); default: a
+        Robertson-Sandford fit to the measurements
+        (:func:`sbrdf_xr.models.fit_robertson_sandford`, a few seconds).
     normal_incidence : {"paper", "symmetric"}, default "paper"
         ``symmetric`` enforces what physics requires at ``theta_i = 0``: no
         dependence on the undefined illumination plane (the row becomes a function
@@ -568,12 +578,19 @@ def build_lut(
     np.maximum(lut, 0.0, out=lut)
     extra: dict[str, Any] = {}
     if extrapolation == "model":
-        fitted, model_lut = _fitted_model_table(ds, ref, ti_out, dt_grid, phi_grid)
+        if model is None:
+            from .models import fit_robertson_sandford
+
+            model = fit_robertson_sandford(ds)
         w = _blend_weights(ti_out, measured_ti[0], measured_ti[-1], blend)
-        lut = (1.0 - w)[:, None, None, None] * lut + w[:, None, None, None] * model_lut
-        extra = {"extrapolation_model": "robertson_sandford", "blend_width": blend,
-                 "fitted_b": fitted["b"], "fitted_e": fitted["e"],
-                 "fitted_chi2_reduced": fitted["chi2_reduced"]}
+        rows = np.flatnonzero(w > 0)
+        if rows.size:
+            filled = _model_rows(model, ti_out[rows], dt_grid, phi_grid,
+                                 np.asarray(ds[WAVELENGTH].values, dtype=np.float64))
+            wr = w[rows][:, None, None, None]
+            lut[rows] = (1.0 - wr) * lut[rows] + wr * filled
+        extra = {"extrapolation_model": model.attrs.get("model", ""), "blend_width": blend,
+                 "extrapolation_model_provenance": model.attrs.get("provenance", "")}
     if normal_incidence not in ("paper", "symmetric"):
         raise ValidationError(f"normal_incidence: got {normal_incidence!r}; allowed: paper, symmetric")
     if normal_incidence == "symmetric":
@@ -616,22 +633,16 @@ def _blend_weights(ti: np.ndarray, lo: float, hi: float, width: float) -> np.nda
     return x * x * (3.0 - 2.0 * x)
 
 
-def _fitted_model_table(
-    ds: xr.Dataset, ref: np.ndarray, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray
-) -> tuple[dict[str, Any], np.ndarray]:
-    """Robertson-Sandford fit to the measurements, rendered on the table grid."""
-    from .brdf import robertson_sandford as rs
+def _model_rows(
+    model: xr.Dataset, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, wl: np.ndarray
+) -> np.ndarray:
+    """A model material rendered on the table grid (rows ``ti``) at wavelengths ``wl``."""
+    from . import models
 
-    spectra = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64)
-    wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
-    fit = rs.fit_robertson_sandford(ds[THETA_I].values, ds[DELTA_THETA].values, ds[PHI].values,
-                                    wl, spectra, reference=ref)
-    params = {k: np.asarray(fit[k], dtype=np.float64) for k in rs.PARAMS}
-    # The fit bounds each parameter, not rho_D + epsilon <= G(b) (Eq. 17's rho_s >= 0):
-    # where it lands marginally outside, epsilon gives way.
-    g_b = float(rs.normalisation_G(params["b"]))
-    params["epsilon"] = np.minimum(params["epsilon"], np.maximum(g_b - params["rho_D"], 0.0))
-    return fit, rs.render_grid(ti, dt, ph, wl, **params)
+    if not np.array_equal(np.asarray(model[WAVELENGTH].values), wl):
+        model = model.interp({WAVELENGTH: wl})
+    mod, _, kw = models._params(model)
+    return mod.render_grid(ti, dt, ph, wl, **kw)
 
 
 def _symmetric_normal_incidence(
@@ -828,7 +839,10 @@ def _load_material_entry(e: CatalogEntry) -> xr.DataArray:
 def _built_material(name: str, measurements: str, options: tuple[tuple[str, Any], ...]) -> xr.DataArray:
     from .catalog import load
 
-    return build_lut(load(measurements), material=name, **dict(options))
+    kw = dict(options)
+    if "fit" in kw:  # a model entry that fills the unmeasurable range
+        kw["model"] = load(kw.pop("fit"))
+    return build_lut(load(measurements), material=name, **kw)
 
 
 @register_loader("measurements")

@@ -33,7 +33,7 @@ from .catalog import CatalogEntry, register_loader
 from .errors import ValidationError
 from .material import new_material, write_netcdf_atomic
 
-__all__ = ["PARAM_ATTRS", "measure", "model_material", "open_model", "render", "spectra",
+__all__ = ["PARAM_ATTRS", "fit_robertson_sandford", "measure", "model_material", "open_model", "render", "spectra",
            "spectrum_function", "to_netcdf"]
 
 PARAM_ATTRS: dict[str, dict[str, str]] = {
@@ -204,6 +204,56 @@ def measure(spec: xr.Dataset, theta_i: Sequence[float], **kwargs: Any) -> xr.Dat
             f"({spec.attrs.get('provenance', '')})")
     return _measure(spectrum_function(spec), wl, theta_i, material=spec.attrs["material"],
                     source="synthetic", provenance=prov, **kwargs)
+
+
+def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Dataset:
+    """Fit the Robertson-Sandford model (paper 001) to a measurement set.
+
+    Wraps :func:`sbrdf_xr.brdf.robertson_sandford.fit_robertson_sandford`
+    (log-residual least squares; ``rho_D`` and ``epsilon`` per wavelength, shared
+    ``b`` and ``e``) and returns a model material with the standard uncertainties
+    as variables ``u_rho_D``, ``u_epsilon``, ``u_b``, ``u_e`` and the reduced
+    chi-square as an attribute.  Where the fit lands marginally outside
+    ``rho_D + epsilon <= G(b)`` (Eq. 17's ``rho_s >= 0``; the fit bounds each
+    parameter, not their sum), ``epsilon`` gives way.
+
+    Parameters
+    ----------
+    measurements : xarray.Dataset
+        A measurement set (:func:`sbrdf_xr.material.validate_measurements`).
+    **kwargs
+        Passed to the numpy fit (``sigma``, ``cutoff``).
+
+    Returns
+    -------
+    xarray.Dataset
+        The fitted model material.
+    """
+    from ._names import DELTA_THETA, MEASURED, PHI, SAMPLE, THETA_I
+    from .brdf import robertson_sandford as rs
+    from .material import _reference, validate_measurements
+
+    ds = validate_measurements(measurements)
+    wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
+    spectra = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64)
+    fit = rs.fit_robertson_sandford(ds[THETA_I].values, ds[DELTA_THETA].values, ds[PHI].values,
+                                    wl, spectra, reference=_reference(ds), **kwargs)
+    p = {k: np.asarray(fit[k], dtype=np.float64) for k in rs.PARAMS}
+    g_b = float(rs.normalisation_G(p["b"]))
+    p["epsilon"] = np.minimum(np.broadcast_to(p["epsilon"], wl.shape), np.maximum(g_b - p["rho_D"], 0.0))
+    name = ds.attrs.get("material", "unnamed")
+    out = model_material(
+        "robertson_sandford", wl, material=name,
+        provenance=f"Robertson-Sandford fit to the measurements of {name} "
+        f"(reduced chi-square {fit['chi2_reduced']:.3g}, {fit['n_used']} residuals)",
+        **p,
+    )
+    for k in rs.PARAMS:
+        u = np.broadcast_to(np.asarray(fit[f"u_{k}"], dtype=np.float64), wl.shape)
+        out[f"u_{k}"] = (WAVELENGTH, np.array(u), {"units": "1", "long_name": f"standard uncertainty of {k}"})
+    out.attrs["chi2_reduced"] = float(fit["chi2_reduced"])
+    out.attrs["source"] = "model:robertson_sandford"
+    return out
 
 
 def to_netcdf(spec: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
