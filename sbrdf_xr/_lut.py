@@ -161,11 +161,11 @@ def lookup_matrix(
     scale = np.where(outside, 0.0, 1.0)
     if weights is not None:
         scale = scale * arrays[3]
-    w = (w * scale[:, None, None, None]).reshape(q, -1)
-    k = w.shape[1]
+    k = int(np.prod(w.shape[1:]))
+    w = (w * scale[:, None, None, None]).reshape(q, k)
     n_nodes = theta_grid.size * ndt * nph
     return sp.csr_matrix(
-        (w.ravel(), idx.reshape(q, -1).ravel(), np.arange(0, q * k + 1, k)),
+        (w.ravel(), idx.reshape(q, k).ravel(), np.arange(0, q * k + 1, k)),
         shape=(q, n_nodes),
     )
 

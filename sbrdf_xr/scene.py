@@ -37,9 +37,12 @@ __all__ = ["EFFECTS", "OUTPUTS", "PRESETS", "Plan", "Scene", "builtin_scene", "b
            "load_scene"]
 
 #: Outputs a scene may ask for.
-OUTPUTS = ("spacecraft_sbrdf", "signal", "brdf", "area", "per_material")
+OUTPUTS = ("spacecraft_sbrdf", "signal", "brdf", "area", "per_material", "band_signal")
+#: Spectral outputs (over wavelength); a scene asking for none of them, only band
+#: outputs, has its tables pre-integrated over the bands before the sweep.
+SPECTRAL_OUTPUTS = ("spacecraft_sbrdf", "signal", "brdf", "per_material")
 #: Effects a scene may ask for.
-EFFECTS = ("sunlight", "shadowing")
+EFFECTS = ("sunlight", "shadowing", "earthshine", "thermal")
 #: Numerical presets: the named knobs of an accuracy/cost trade-off.
 PRESETS: dict[str, dict[str, Any]] = {
     "fast": {"method": "nearest", "dtype": "float32", "shadow_density": 2},
@@ -101,6 +104,27 @@ class Scene:
         Sub-facet sampling level of self-shadowing.
     chunk : int
         Geometries per Dask block along the attitude (or geometry) dimension.
+    bands : sequence of str
+        Photometric bands of the ``band_signal`` output (see
+        :func:`sbrdf_xr.photometry.filters`).
+    band_extrapolate : {None, "zero", "constant"}
+        How spectra continue past the materials' wavelengths inside a band
+        (:func:`sbrdf_xr.photometry.band_weights`); by default a band the
+        wavelengths do not cover is an error.
+    earth_direction : array_like, shape (3,)
+        Direction from the spacecraft to the Earth in the reference frame (grids),
+        for the ``earthshine`` effect.
+    to_earth : array_like, shape (n, 3), optional
+        The same in the body frame, one per explicit geometry pair.
+    earth_albedo : float
+        Bond albedo of the Lambertian Earth [1].
+    earth_range_km : float
+        Distance from the spacecraft to the Earth's centre [km].
+    earth_phase_angle : float
+        Sun-Earth-spacecraft angle seen from the Earth's centre [degree] (0: the
+        spacecraft sees a full Earth).
+    temperature : float or mapping of str to float
+        Facet temperature [K] of the ``thermal`` effect, one for all or per material.
     name, description : str
         Labels stored in the output.
     """
@@ -121,6 +145,14 @@ class Scene:
     merge: bool | None = None
     shadow_density: int = 4
     chunk: int = 256
+    bands: Sequence[str] = ()
+    band_extrapolate: str | None = None
+    earth_direction: tuple[float, float, float] = (0.0, -1.0, 0.0)
+    to_earth: ArrayLike | None = None
+    earth_albedo: float = 0.3
+    earth_range_km: float = 42164.0
+    earth_phase_angle: float = 90.0
+    temperature: float | Mapping[str, float] = 300.0
     name: str = "scene"
     description: str = ""
     _checked: bool = field(default=False, repr=False, compare=False)
@@ -140,6 +172,24 @@ class Scene:
             raise SceneError(f"dtype: got {self.dtype!r}; allowed: float32, float64")
         if self.chunk < 1:
             raise SceneError(f"chunk: must be >= 1, got {self.chunk}")
+        if "band_signal" in self.outputs and not self.bands:
+            raise SceneError("bands: the band_signal output needs at least one band (e.g. bands=('B', 'V'))")
+        if self.bands:
+            from .photometry import filters
+
+            try:
+                filters(list(self.bands))
+            except ValidationError as exc:
+                raise SceneError(f"bands: {exc}") from None
+        if not 0.0 <= self.earth_albedo <= 1.0:
+            raise SceneError(f"earth_albedo: must lie in [0, 1], got {self.earth_albedo}")
+        if not self.earth_range_km > 6371.0:
+            raise SceneError(f"earth_range_km: must exceed the Earth's radius (6371 km), got {self.earth_range_km}")
+        if not 0.0 <= self.earth_phase_angle <= 180.0:
+            raise SceneError(f"earth_phase_angle: must lie in [0, 180] degree, got {self.earth_phase_angle}")
+        temps = self.temperature.values() if isinstance(self.temperature, Mapping) else [self.temperature]
+        if any(not (np.isfinite(x) and x > 0) for x in temps):
+            raise SceneError(f"temperature: must be positive kelvin, got {self.temperature}")
         grid = self.attitudes is not None or self.phase_angles is not None
         explicit = self.to_sun is not None or self.to_observer is not None
         if grid == explicit:
@@ -169,6 +219,13 @@ class Scene:
                 raise SceneError(f"to_sun {s.shape} and to_observer {o.shape} differ in shape")
             object.__setattr__(self, "to_sun", s)
             object.__setattr__(self, "to_observer", o)
+            if self.to_earth is not None:
+                e = _unit_vectors(self.to_earth, "to_earth")
+                if e.shape != s.shape:
+                    raise SceneError(f"to_earth {e.shape} and to_sun {s.shape} differ in shape")
+                object.__setattr__(self, "to_earth", e)
+            elif "earthshine" in self.effects:
+                raise SceneError("to_earth: explicit geometry with earthshine needs body-frame to_earth vectors")
         if self.materials is None:
             from . import catalog
 
@@ -211,6 +268,15 @@ class Scene:
         s, o = geometry.observation_plane(self.phase_angles, self.bisector, self.plane_normal)
         return geometry.to_body_frame(q, s), geometry.to_body_frame(q, o)
 
+    def earth_vectors(self, attitude_slice: slice | None = None) -> np.ndarray:
+        """Unit vectors to the Earth in the body frame (shaped like :meth:`body_vectors`)."""
+        if not self.is_grid:
+            return self.to_earth[attitude_slice or slice(None)]
+        q = self.attitudes if attitude_slice is None else self.attitudes[attitude_slice]
+        e = geometry.normalize(self.earth_direction, "earth_direction")
+        e = np.broadcast_to(e, (len(self.phase_angles), 3))
+        return geometry.to_body_frame(q, e)
+
     def with_options(self, **changes: Any) -> Scene:
         """A copy with some fields changed (for example ``preset`` knobs)."""
         if "preset" in changes:
@@ -240,8 +306,16 @@ class Plan:
         ``area``, ``material``, and the facet indices each term stands for.
     shadowing : bool
         Whether ray-cast self-shadowing/occlusion runs.
+    merged : bool
+        Whether facets sharing (normal, material) were merged.
     steps : list of (str, str)
         ``(what, why)`` lines, in order; skipped steps say so.
+    pre_integrate : bool
+        Whether the tables are integrated over the bands before the sweep.
+    earthshine_ratio : float or None
+        Earth-reflected irradiance relative to the Sun's, when earthshine runs.
+    thermal : bool
+        Whether thermal emission is computed.
     """
 
     scene: Scene
@@ -249,6 +323,9 @@ class Plan:
     shadowing: bool
     merged: bool
     steps: list[tuple[str, str]]
+    pre_integrate: bool = False
+    earthshine_ratio: float | None = None
+    thermal: bool = False
 
     def __str__(self) -> str:
         w = max(len(a) for a, _ in self.steps)
@@ -267,7 +344,9 @@ _SCENE_KEYS = {
     "name": str, "description": str, "spacecraft": str, "materials": dict,
     "attitude": dict, "phase_angles": list, "bisector": list, "plane_normal": list,
     "geometry": dict, "outputs": list, "effects": list, "method": str, "dtype": str,
-    "merge": bool, "shadow_density": int, "chunk": int,
+    "merge": bool, "shadow_density": int, "chunk": int, "bands": list, "band_extrapolate": str,
+    "earth_direction": list, "earth_albedo": (int, float), "earth_range_km": (int, float),
+    "earth_phase_angle": (int, float), "temperature": (int, float, dict),
 }
 _ATTITUDE_KEYS = {"kind": str, "axis": list, "start": (int, float), "stop": (int, float),
                   "step": (int, float), "initial_axis": list, "initial_angle": (int, float),
@@ -321,17 +400,21 @@ def scene_from_dict(d: Mapping[str, Any]) -> Scene:
                 raise SceneError(f"[materials]: {mat!r} must name a catalog entry (a string)")
             materials[mat] = catalog.load(entry)
     kw: dict[str, Any] = {k: d[k] for k in ("name", "description", "method", "dtype", "merge",
-                                               "shadow_density", "chunk") if k in d}
-    for k in ("outputs", "effects"):
+                                               "shadow_density", "chunk", "earth_albedo", "band_extrapolate",
+                                               "earth_range_km", "earth_phase_angle",
+                                               "temperature") if k in d}
+    for k in ("outputs", "effects", "bands"):
         if k in d:
             kw[k] = tuple(d[k])
-    for k in ("bisector", "plane_normal"):
+    for k in ("bisector", "plane_normal", "earth_direction"):
         if k in d:
             kw[k] = tuple(float(x) for x in d[k])
     if "geometry" in d:
         g = d["geometry"]
-        _check_keys(g, {"to_sun": list, "to_observer": list}, "[geometry]")
+        _check_keys(g, {"to_sun": list, "to_observer": list, "to_earth": list}, "[geometry]")
         kw["to_sun"], kw["to_observer"] = g.get("to_sun"), g.get("to_observer")
+        if "to_earth" in g:
+            kw["to_earth"] = g["to_earth"]
     if "attitude" in d:
         kw["attitudes"], angles = _attitudes_from_table(d["attitude"])
         if angles is not None:

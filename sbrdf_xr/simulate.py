@@ -41,11 +41,11 @@ import xarray as xr
 
 from . import __version__
 from ._kernels import material_sums
-from ._names import ATTITUDE, PHASE_ANGLE, VECTOR, WAVELENGTH, attrs
+from ._names import ATTITUDE, BAND, PHASE_ANGLE, VECTOR, WAVELENGTH, attrs
 from .errors import SceneError
-from .scene import Plan, Scene, resolve_scene
+from .scene import SPECTRAL_OUTPUTS, Plan, Scene, resolve_scene
 
-__all__ = ["compile_plan", "simulate", "write"]
+__all__ = ["compile_plan", "earthshine_irradiance_ratio", "planck", "simulate", "write"]
 
 GEOMETRY = "geometry"
 MATERIAL_DIM = "material"
@@ -57,6 +57,12 @@ OUTPUT_ATTRS: dict[str, dict[str, str]] = {
     "brdf": {"units": "sr-1 nm", "long_name": "broadband BRDF, sBRDF integrated over wavelength (paper 000 Eq. 2)"},
     "area": {"units": "m2", "long_name": "contributing projected area sum_j A_j cos(theta_r) (paper 000 Eq. 4 denominator)"},
     "signal_material": {"units": "m2 sr-1", "long_name": "radiometric signal of each material's facets"},
+    "signal_earthshine": {"units": "m2 sr-1", "long_name": "radiometric signal of the light reflected "
+                          "from a Lambertian Earth, per unit solar irradiance"},
+    "thermal_intensity": {"units": "W sr-1 nm-1", "long_name": "thermal emission intensity "
+                          "sum_j A_j cos(theta_r) epsilon(lambda, theta_r) B(lambda, T)"},
+    "band_signal": {"units": "m2 sr-1", "long_name": "solar-weighted band mean of the radiometric signal "
+                    "(photon counting)"},
     "attitude": {"units": "1", "long_name": "attitude index"},
     "attitude_angle": {"units": "degree", "long_name": "rotation angle of the attitude sweep"},
     "quaternion": {"units": "1", "long_name": "attitude quaternion, body to reference frame, scalar last (x, y, z, w)"},
@@ -69,15 +75,26 @@ _DROP_BLOCK = 2_000_000
 
 
 def _contributing_terms(scene: Scene, normals: np.ndarray) -> np.ndarray:
-    """Boolean per term: lit and visible for at least one geometry of the sweep."""
+    """Boolean per term: contributes for at least one geometry of the sweep.
+
+    A term contributes when it is visible and lit by the Sun (or by the Earth, with
+    earthshine); with thermal emission, visible is enough.
+    """
     keep = np.zeros(len(normals), dtype=bool)
     n_att = len(scene.attitudes) if scene.is_grid else len(scene.to_sun)
     per = len(scene.phase_angles) if scene.is_grid else 1
     step = max(1, _DROP_BLOCK // max(1, per * len(normals)))
     for start in range(0, n_att, step):
-        s, o = scene.body_vectors(slice(start, start + step))
-        ok = (s.reshape(-1, 3) @ normals.T > 0) & (o.reshape(-1, 3) @ normals.T > 0)
-        keep |= ok.any(axis=0)
+        sl = slice(start, start + step)
+        s, o = scene.body_vectors(sl)
+        visible = o.reshape(-1, 3) @ normals.T > 0
+        if "thermal" in scene.effects:
+            lit = True
+        else:
+            lit = s.reshape(-1, 3) @ normals.T > 0
+            if "earthshine" in scene.effects:
+                lit = lit | (scene.earth_vectors(sl).reshape(-1, 3) @ normals.T > 0)
+        keep |= (visible & lit).any(axis=0)
         if keep.all():
             break
     return keep
@@ -134,15 +151,141 @@ def compile_plan(scene: Scene) -> Plan:
     if not keep.all():
         dropped = int((~keep).sum())
         terms = terms.isel(term=np.flatnonzero(keep))
-        steps.append(("drop", f"{dropped} terms never both lit and visible in this sweep are dropped"))
+        steps.append(("drop", f"{dropped} terms that never contribute (lit and visible) in this sweep are dropped"))
     else:
-        steps.append(("drop", "none: every term is lit and visible somewhere in the sweep"))
+        steps.append(("drop", "none: every term contributes somewhere in the sweep"))
 
     used = sorted(set(np.asarray(terms["material"].values).tolist()))
     steps.append(("materials", f"{len(used)} tabulated materials ({', '.join(used)}), "
                   f"{scene.method} look-up, {scene.dtype}"))
+
+    pre = bool(scene.bands) and not any(o in SPECTRAL_OUTPUTS for o in scene.outputs)
+    if scene.bands:
+        _band_weights(scene, _common_wavelength(scene, used or list(scene.materials)))
+    if not scene.bands:
+        steps.append(("bands", "skipped: no band output requested"))
+    elif pre:
+        steps.append(("bands", f"tables pre-integrated over {', '.join(scene.bands)} (filter x Sun, photon "
+                      "counting) before the sweep: exact, the facet sum is linear in f_r"))
+    else:
+        steps.append(("bands", f"{', '.join(scene.bands)} integrated from the spectral signal "
+                      "(spectral outputs are requested too)"))
+
+    ratio = None
+    if "earthshine" in scene.effects:
+        ratio = earthshine_irradiance_ratio(scene.earth_albedo, scene.earth_range_km, scene.earth_phase_angle)
+        steps.append(("earthshine", f"Lambertian Earth (albedo {scene.earth_albedo:g}, range "
+                      f"{scene.earth_range_km:g} km, phase {scene.earth_phase_angle:g} deg): irradiance "
+                      f"{ratio:.3g} of the Sun's, a second distant source"))
+    else:
+        steps.append(("earthshine", "skipped: not requested"))
+
+    thermal = False
+    if "thermal" not in scene.effects:
+        steps.append(("thermal", "skipped: not requested"))
+    else:
+        wl = _common_wavelength(scene, used or list(scene.materials))
+        worst = _thermal_to_reflected(scene, wl)
+        if pre or worst < THERMAL_NEGLIGIBLE:
+            why = ("band outputs only" if pre else
+                   f"at most {worst:.1e} of reflected sunlight at {wl[0]:g}-{wl[-1]:g} nm")
+            steps.append(("thermal", f"skipped: negligible ({why})"))
+        else:
+            thermal = True
+            steps.append(("thermal", f"epsilon(lambda, theta) B(lambda, T) per facet, epsilon = 1 - rho "
+                          f"(Kirchhoff) from each table; up to {worst:.1e} of reflected sunlight"))
     steps.append(("outputs", ", ".join(scene.outputs)))
-    return Plan(scene=scene, terms=terms, shadowing=shadowing, merged=merge, steps=steps)
+    return Plan(scene=scene, terms=terms, shadowing=shadowing, merged=merge, steps=steps,
+                pre_integrate=pre, earthshine_ratio=ratio, thermal=thermal)
+
+
+#: Thermal emission below this fraction of the reflected sunlight is not computed.
+THERMAL_NEGLIGIBLE = 1e-6
+#: Earth's mean radius [km].
+EARTH_RADIUS_KM = 6371.0
+_H, _C, _K = 6.62607015e-34, 299792458.0, 1.380649e-23
+
+
+def planck(wavelength_nm: np.ndarray, temperature: float) -> np.ndarray:
+    """Blackbody spectral radiance B(lambda, T) [W m-2 sr-1 nm-1] (Planck's law).
+
+    Evaluated as ``2 h c^2 / lambda^5 * e^-x / (1 - e^-x)`` with ``x = h c / (lambda k T)``,
+    which underflows to 0 instead of overflowing at short wavelengths.
+    """
+    lam = np.asarray(wavelength_nm, dtype=np.float64) * 1e-9
+    x = _H * _C / (lam * _K * float(temperature))
+    with np.errstate(under="ignore"):
+        return 2.0 * _H * _C**2 / lam**5 * np.exp(-x) / -np.expm1(-x) * 1e-9
+
+
+def earthshine_irradiance_ratio(albedo: float, range_km: float, phase_angle_deg: float) -> float:
+    """Irradiance from a Lambertian Earth relative to the Sun's (at the same heliocentric distance).
+
+    A Lambertian sphere of radius ``R`` and albedo ``a`` seen at phase angle ``alpha``
+    from distance ``r`` gives ``E/E_sun = (2/3) a (R/r)^2 [(pi - alpha) cos alpha +
+    sin alpha] / pi`` (the diffuse-sphere phase law).  The Earth is then treated as
+    a distant source from its centre's direction: a good approximation when its
+    angular radius ``asin(R/r)`` is small (8.7 deg at GEO), a rough one in low orbit.
+
+    Parameters
+    ----------
+    albedo : float
+        Bond albedo [1].
+    range_km : float
+        Distance to the Earth's centre [km].
+    phase_angle_deg : float
+        Sun-Earth-spacecraft angle [degree].
+
+    Returns
+    -------
+    float
+        ``E_earth / E_sun`` [1].
+    """
+    a = np.radians(phase_angle_deg)
+    return float(2.0 / 3.0 * albedo * (EARTH_RADIUS_KM / range_km) ** 2
+                 * ((np.pi - a) * np.cos(a) + np.sin(a)) / np.pi)
+
+
+def _band_weights(scene: Scene, wl: np.ndarray) -> xr.DataArray:
+    """Normalised band weights of the scene's bands on ``wl``; SceneError if not covered."""
+    from .errors import ValidationError
+    from .photometry import band_weights
+
+    try:
+        return band_weights(list(scene.bands), wl, normalize=True, extrapolate=scene.band_extrapolate)
+    except ValidationError as exc:
+        raise SceneError(f"bands: {exc} (scene field band_extrapolate)") from None
+
+
+def _temperature(scene: Scene, material: str) -> float:
+    t = scene.temperature
+    return float(t.get(material, 300.0)) if isinstance(t, dict) else float(t)
+
+
+def _emissivity_tables(scene: Scene, used: list[str], wl: np.ndarray) -> dict[str, np.ndarray]:
+    """Directional emissivity epsilon(theta, lambda) = 1 - rho(theta, lambda) per material
+    (Kirchhoff's law with the table's directional-hemispherical reflectance), on 0-90 deg."""
+    from .material import hemispherical_reflectance
+
+    out = {}
+    for m in used:
+        da = scene.materials[m]
+        if not np.array_equal(da[WAVELENGTH].values, wl):
+            da = da.interp({WAVELENGTH: wl})
+        rho = hemispherical_reflectance(da, np.arange(0.0, 91.0), warn=False).values
+        out[m] = np.clip(1.0 - rho, 0.0, 1.0)
+    return out
+
+
+def _thermal_to_reflected(scene: Scene, wl: np.ndarray) -> float:
+    """Largest ratio of blackbody radiance (emissivity 1) to the radiance of a white
+    Lambertian surface in sunlight, E_sun / pi, over the scene's wavelengths."""
+    from .photometry import solar_spectrum
+
+    e_sun = solar_spectrum(wl).values
+    temps = [_temperature(scene, m) for m in scene.materials]
+    b = np.max([planck(wl, t) for t in temps], axis=0)
+    return float(np.max(b / np.maximum(e_sun / np.pi, 1e-300)))
 
 
 def _common_wavelength(scene: Scene, used: list[str]) -> np.ndarray:
@@ -157,22 +300,35 @@ def _common_wavelength(scene: Scene, used: list[str]) -> np.ndarray:
     return wl
 
 
-def _tables(scene: Scene, used: list[str], wl: np.ndarray) -> dict[str, tuple[np.ndarray, ...]]:
+def _tables(
+    scene: Scene, used: list[str], wl: np.ndarray, weights: np.ndarray | None = None
+) -> dict[str, tuple[np.ndarray, ...]]:
+    """Material tables on the common grid; with ``weights`` (band, wavelength) the
+    spectral axis is integrated into bands first (band pre-integration)."""
     out = {}
     dtype = np.dtype(scene.dtype)
     for m in used:
         da = scene.materials[m]
         if not np.array_equal(da[WAVELENGTH].values, wl):
             da = da.interp({WAVELENGTH: wl})
-        out[m] = (np.ascontiguousarray(da.values, dtype=dtype),
+        values = np.asarray(da.values, dtype=np.float64)
+        if weights is not None:
+            values = values @ weights.T
+        out[m] = (np.ascontiguousarray(values, dtype=dtype),
                   *(np.asarray(da[d].values) for d in ("theta_i", "delta_theta", "phi")))
     return out
 
 
 def _block(
-    plan: Plan, tables: dict[str, tuple[np.ndarray, ...]], wl: np.ndarray, sl: slice
+    plan: Plan, tables: dict[str, tuple[np.ndarray, ...]], wl: np.ndarray, sl: slice,
+    weights: np.ndarray | None = None, emissivity: dict[str, np.ndarray] | None = None,
 ) -> dict[str, np.ndarray]:
-    """Compute every output for one block of attitudes (or explicit geometries)."""
+    """Compute every output for one block of attitudes (or explicit geometries).
+
+    ``wl`` is the spectral axis of the tables: wavelengths, or band indices when the
+    tables are pre-integrated.  ``weights`` (band, wavelength) integrates the spectral
+    signal into bands; ``emissivity`` turns on thermal emission.
+    """
     scene = plan.scene
     s, o = scene.body_vectors(sl)
     lead = s.shape[:-1]
@@ -203,17 +359,59 @@ def _block(
         per_mat.append(r.signal)
     with np.errstate(invalid="ignore", divide="ignore"):
         sbrdf = np.where(area[:, None] > 0, paper / np.where(area > 0, area, 1.0)[:, None], 0.0).astype(dtype)
-    out = {
-        "spacecraft_sbrdf": sbrdf.reshape(*lead, wl.size),
-        "signal": signal.reshape(*lead, wl.size),
-        "area": area.reshape(lead),
-        "brdf": np.trapezoid(sbrdf, wl, axis=-1).astype(dtype).reshape(lead)
-        if wl.size > 1 else sbrdf[..., 0].reshape(lead),
-    }
+    n = wl.size
+    es = None
+    if plan.earthshine_ratio is not None:
+        e2 = scene.earth_vectors(sl).reshape(-1, 3)
+        es = np.zeros((g, n), dtype=dtype)
+        frac_e = None
+        if plan.shadowing:
+            from .visibility import lit_visible_fraction
+
+            frac_e = lit_visible_fraction(scene.spacecraft, e2, o2, density=scene.shadow_density)[
+                :, np.asarray(plan.terms["term"].values)]
+        for m, (values, tg, dg, pg) in tables.items():
+            sel = mats == m
+            es += material_sums(e2, o2, normals[sel], areas[sel], values, tg, dg, pg, scene.method,
+                                None if frac_e is None else frac_e[:, sel]).signal
+        es = (plan.earthshine_ratio * es).astype(dtype)
+    out = {"area": area.reshape(lead)}
+    if plan.pre_integrate:  # the spectral axis already is the band axis
+        out["band_signal"] = (signal if es is None else signal + es).reshape(*lead, n)
+        return out
+    out["spacecraft_sbrdf"] = sbrdf.reshape(*lead, n)
+    out["signal"] = signal.reshape(*lead, n)
+    out["brdf"] = (np.trapezoid(sbrdf, wl, axis=-1) if n > 1 else sbrdf[..., 0]).astype(dtype).reshape(lead)
     if "per_material" in scene.outputs:
-        pm = np.stack(per_mat, axis=-2) if per_mat else np.zeros((g, 0, wl.size), dtype=dtype)
-        out["signal_material"] = pm.reshape(*lead, len(tables), wl.size)
+        pm = np.stack(per_mat, axis=-2) if per_mat else np.zeros((g, 0, n), dtype=dtype)
+        out["signal_material"] = pm.reshape(*lead, len(tables), n)
+    if es is not None:
+        out["signal_earthshine"] = es.reshape(*lead, n)
+    if emissivity is not None:
+        out["thermal_intensity"] = _thermal(plan, o2, wl, emissivity).reshape(*lead, n)
+    if weights is not None:
+        total = signal if es is None else signal + es
+        out["band_signal"] = (total @ weights.T).astype(dtype).reshape(*lead, weights.shape[0])
     return out
+
+
+def _thermal(plan: Plan, o2: np.ndarray, wl: np.ndarray, emissivity: dict[str, np.ndarray]) -> np.ndarray:
+    """Thermal intensity ``sum_j A_j cos(theta_r) epsilon_j(lambda, theta_r) B(lambda, T_j)``
+    over the visible facets [W sr-1 nm-1] (the emission term of paper 001's signature model)."""
+    scene = plan.scene
+    normals = np.asarray(plan.terms["normal"].values)
+    areas = np.asarray(plan.terms["area"].values)
+    mats = np.asarray(plan.terms["material"].values)
+    out = np.zeros((o2.shape[0], wl.size))
+    for m, eps in emissivity.items():
+        sel = mats == m
+        cos_r = o2 @ normals[sel].T  # (G, F)
+        vis = cos_r > 0
+        theta_r = np.degrees(np.arctan2(np.sqrt(np.clip(1 - cos_r**2, 0, None)), cos_r))
+        idx = np.clip(np.rint(np.where(vis, theta_r, 0.0)).astype(int), 0, 90)  # 1-degree table
+        w = np.where(vis, cos_r, 0.0) * areas[sel]
+        out += np.einsum("gf,gfl->gl", w, eps[idx]) * planck(wl, _temperature(scene, m))
+    return out.astype(np.dtype(scene.dtype))
 
 
 def simulate(scene: Scene | str | os.PathLike[str], plan: Plan | None = None, **options: Any) -> xr.Dataset:
@@ -242,29 +440,45 @@ def simulate(scene: Scene | str | os.PathLike[str], plan: Plan | None = None, **
     plan = plan or compile_plan(scene)
     used = [m for m in scene.spacecraft.materials if m in set(plan.terms["material"].values.tolist())]
     wl = _common_wavelength(scene, used or list(scene.materials))
-    tables = _tables(scene, used, wl)
+    weights = band_coords = None
+    if scene.bands:
+        bw = _band_weights(scene, wl)
+        weights = np.asarray(bw.values)
+        band_coords = {c: bw[c] for c in bw.coords if BAND in bw[c].dims}
+    tables = _tables(scene, used, wl, weights if plan.pre_integrate else None)
+    emissivity = _emissivity_tables(scene, used, wl) if plan.thermal else None
+    spectral = np.arange(weights.shape[0], dtype=float) if plan.pre_integrate else wl
     dtype = np.dtype(scene.dtype)
 
     n_lead = len(scene.attitudes) if scene.is_grid else len(scene.to_sun)
     lead_dim = ATTITUDE if scene.is_grid else GEOMETRY
     extra = (len(scene.phase_angles),) if scene.is_grid else ()
     extra_dims = (PHASE_ANGLE,) if scene.is_grid else ()
-    outputs = [k for k in ("spacecraft_sbrdf", "signal", "brdf", "area") if k in scene.outputs]
+    outputs = [k for k in ("spacecraft_sbrdf", "signal", "brdf", "area", "band_signal") if k in scene.outputs]
     if "per_material" in scene.outputs:
         outputs.append("signal_material")
+    if plan.earthshine_ratio is not None and not plan.pre_integrate:
+        outputs.append("signal_earthshine")
+    if plan.thermal:
+        outputs.append("thermal_intensity")
+    n_band = 0 if weights is None else weights.shape[0]
     shapes = {
         "spacecraft_sbrdf": ((wl.size,), (WAVELENGTH,), dtype),
         "signal": ((wl.size,), (WAVELENGTH,), dtype),
         "brdf": ((), (), dtype),
         "area": ((), (), np.dtype(np.float64)),
         "signal_material": ((len(tables), wl.size), (MATERIAL_DIM, WAVELENGTH), dtype),
+        "signal_earthshine": ((wl.size,), (WAVELENGTH,), dtype),
+        "thermal_intensity": ((wl.size,), (WAVELENGTH,), dtype),
+        "band_signal": ((n_band,), (BAND,), dtype),
     }
     blocks: dict[str, list[Any]] = {k: [] for k in outputs}
     for start in range(0, n_lead, scene.chunk):
         sl = slice(start, min(start + scene.chunk, n_lead))
         n = sl.stop - sl.start
-        res = dask.delayed(_block, pure=True)(plan, tables, wl, sl,
-                                              dask_key_name=f"sbrdf-block-{scene.name}-{start}-{id(plan)}")
+        res = dask.delayed(_block, pure=True)(
+            plan, tables, spectral, sl, None if plan.pre_integrate else weights, emissivity,
+            dask_key_name=f"sbrdf-block-{scene.name}-{start}-{id(plan)}")
         for k in outputs:
             tail, _, dt = shapes[k]
             blocks[k].append(dsa.from_delayed(res[k], shape=(n, *extra, *tail), dtype=dt))
@@ -274,7 +488,11 @@ def simulate(scene: Scene | str | os.PathLike[str], plan: Plan | None = None, **
         arr = dsa.concatenate(blocks[k], axis=0)
         data_vars[k] = xr.Variable((lead_dim, *extra_dims, *tail_dims), arr, attrs=OUTPUT_ATTRS[k])
 
-    coords: dict[str, Any] = {WAVELENGTH: (WAVELENGTH, wl, attrs(WAVELENGTH)), VECTOR: (VECTOR, ["x", "y", "z"])}
+    coords: dict[str, Any] = {VECTOR: (VECTOR, ["x", "y", "z"])}
+    if any(WAVELENGTH in shapes[k][1] for k in outputs):
+        coords[WAVELENGTH] = (WAVELENGTH, wl, attrs(WAVELENGTH))
+    if band_coords is not None and "band_signal" in outputs:
+        coords.update(band_coords)
     s, o = scene.body_vectors()
     if scene.is_grid:
         coords[ATTITUDE] = (ATTITUDE, np.arange(n_lead), OUTPUT_ATTRS["attitude"])

@@ -194,3 +194,9 @@ def test_hemispherical_reflectance_of_narrow_band_matches_closed_form():
     expected = 2 * c * (p / 2 + np.sin(2 * p) / 4) * 2.0  # int cos^2 phi * int cos t
     # The last, 1e-6-degree-wide interval ramps down linearly: its share is ~1e-8.
     assert out == pytest.approx(expected, rel=1e-6)
+
+
+def test_empty_query_gives_empty_results():
+    m = _lut.lookup_matrix(TI, DT, PH, np.array([]), np.array([]), np.array([]))
+    assert m.shape == (0, TI.size * DT.size * PH.size)
+    assert _lut.lookup_kernel(table(), TI, DT, PH, np.array([]), np.array([]), np.array([])).shape == (0, 3)

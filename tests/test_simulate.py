@@ -106,7 +106,7 @@ def test_plan_says_what_runs_and_why():
     assert "skipped: the body is convex" in text
     assert "merged by (normal, material)" in text and "48 facets -> 6 terms" in text
     # A rotation about z in the xy-plane never lights the +-z faces: they are dropped.
-    assert "2 terms never both lit and visible" in text
+    assert "2 terms that never contribute" in text
     assert plan.terms.sizes["term"] == 4
 
 
@@ -165,3 +165,71 @@ def test_missing_material_table():
     sc = T.cube_spacecraft()
     with pytest.raises(SceneError, match="no table for"):
         Scene(sc, materials={"other": grey()}, to_sun=[[1.0, 0, 0]], to_observer=[[1.0, 0, 0]])
+
+
+# ------------------------------------------------------------- bands, earthshine, thermal
+
+
+def test_band_pre_integration_equals_spectral_path():
+    """Band-only scenes integrate the tables over the bands before the sweep: exact."""
+    q = geometry.uniform_attitudes(12, seed=4)
+    common = dict(attitudes=q, phase_angles=[20.0, 70.0], bands=("V", "R", "I"))
+    pre = cube_scene(outputs=("band_signal", "area"), **common)
+    spectral = cube_scene(outputs=("signal", "band_signal", "area"), **common)
+    assert "pre-integrated" in str(pre.plan()) and "from the spectral signal" in str(spectral.plan())
+    a = simulate(pre).compute()
+    b = simulate(spectral).compute()
+    assert "wavelength" not in a.dims and a.band_signal.dims == ("attitude", "phase_angle", "band")
+    np.testing.assert_allclose(a.band_signal, b.band_signal, rtol=RTOL, atol=1e-15)
+    # A grey Lambertian: the band mean of a flat signal is the signal itself.
+    np.testing.assert_allclose(a.band_signal.isel(band=0), b.signal.isel(wavelength=10), rtol=1e-6)
+
+
+def test_bands_outside_the_material_wavelengths_need_an_explicit_extrapolation():
+    with pytest.raises(SceneError, match="bands: band 'U'"):
+        cube_scene(to_sun=[[1.0, 0, 0]], to_observer=[[1.0, 0, 0]], outputs=("band_signal",),
+                   bands=("U",)).plan()
+    scene = cube_scene(to_sun=[[1.0, 0, 0]], to_observer=[[1.0, 0, 0]], outputs=("band_signal",),
+                       bands=("U",), band_extrapolate="constant")
+    assert np.isfinite(simulate(scene).compute().band_signal).all()
+
+
+def test_earthshine_is_a_second_lambertian_source():
+    """Earth straight behind the observer of a Lambertian cube: earthshine = ratio x the
+    signal the cube would give with the Sun there (closed form of the Lambert sphere)."""
+    from sbrdf_xr.simulate import earthshine_irradiance_ratio
+
+    s = np.array([[1.0, 0.0, 0.0]])
+    o = np.array([[0.0, 1.0, 0.0]])
+    e = np.array([[0.0, 0.6, 0.8]])
+    es = simulate(cube_scene(to_sun=s, to_observer=o, to_earth=e, effects=("sunlight", "earthshine"),
+                             earth_albedo=0.3, earth_range_km=42164.0, earth_phase_angle=60.0)).compute()
+    ratio = earthshine_irradiance_ratio(0.3, 42164.0, 60.0)
+    a = np.radians(60.0)
+    assert ratio == pytest.approx(2 / 3 * 0.3 * (6371 / 42164) ** 2 * ((np.pi - a) * np.cos(a) + np.sin(a)) / np.pi)
+    # faces +y (cos_e 0.6, cos_r 1) and +z (cos_e 0.8, cos_r 0) -> only +y counts
+    np.testing.assert_allclose(es.signal_earthshine.isel(wavelength=0), ratio * 0.5 / np.pi * 0.6, rtol=1e-6)
+    assert float(es.signal.isel(wavelength=0, geometry=0)) == 0.0  # the Sun lights +x, unseen
+    with pytest.raises(SceneError, match="to_earth"):
+        cube_scene(to_sun=s, to_observer=o, effects=("sunlight", "earthshine"))
+
+
+def test_thermal_emission_is_kirchhoff_times_planck_and_skipped_when_negligible():
+    from sbrdf_xr.simulate import planck
+
+    wl = np.array([5000.0, 10000.0])
+    # Planck at 300 K peaks near 9.7 um: B(10 um) = 9.92 W m-2 sr-1 um-1 (tables).
+    assert planck(wl, 300.0)[1] == pytest.approx(9.92e-3, rel=2e-3)
+    assert planck(np.array([10.0]), 300.0)[0] == 0.0  # exp(-4800) underflows, no warning
+    lam = catalog.load("lambertian-grey-50")
+    base = dict(to_sun=[[1.0, 0, 0]], to_observer=[[1.0, 0, 0]], effects=("sunlight", "thermal"))
+    plan = cube_scene(**base, temperature=300.0).plan()
+    assert "skipped: negligible" in str(plan) and not plan.thermal
+    hot = cube_scene(**base, temperature=900.0)
+    plan = hot.plan()
+    assert plan.thermal
+    cube = simulate(hot).compute()
+    # Only the +x face (1 m2) is seen, face on: I = 1 m2 x (1 - 0.5) x B(lambda, 900 K).
+    expected = 0.5 * planck(cube.wavelength.values, 900.0)
+    np.testing.assert_allclose(cube.thermal_intensity.isel(geometry=0), expected, rtol=1e-5)
+    assert lam.attrs["material"]
