@@ -1,24 +1,52 @@
-"""Benchmarks users can run: what accuracy costs in time.
+"""What accuracy costs in time: benchmarks users can run (``sbrdf-xr bench``).
 
-Every timing is reported as a ratio to a baseline measured in the same run, because
-absolute seconds on a shared machine mean little.  Run ``sbrdf-xr bench`` (or
-``python -m sbrdf_xr.bench``).
+Every approximation of a simulation is a named knob.  :func:`accuracy_cost`
+changes one knob at a time away from the ``reference`` configuration and reports,
+for the CanX-1 rotation and a larger sweep of random attitudes,
+
+* the error against the reference in units users feel: the worst and median
+  magnitude difference in V, R and I [mmag] where the reference signal is above
+  1e-3 of its maximum, and the 99th-percentile relative spectral error;
+* the wall time as a ratio to the reference's, measured in the same run (best of
+  a few repeats), because absolute seconds on a shared machine mean little.
+
+The knobs: look-up method, table resolution (theta_i step, delta_theta and phi
+points), wavelength sampling versus band pre-integration, facet merging,
+shadow-sampling density, tabulated versus analytic material evaluation (the
+generating models of the synthetic catalog materials), float32 versus float64.
+
+:func:`kernel_throughput` compares the simulation kernel with a straightforward
+per-facet numpy evaluation and estimates the machine's limit for it.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from . import material
+from . import catalog, material
 from .goniometer import measure
 from .testing import lobe_function
 
-__all__ = ["BenchRow", "bench_build_lut", "bench_lookup", "best_time", "format_rows", "run"]
+__all__ = [
+    "BenchRow",
+    "accuracy_cost",
+    "bench_build_lut",
+    "bench_lookup",
+    "best_time",
+    "format_rows",
+    "kernel_throughput",
+    "rows_to_dataset",
+    "run",
+]
+
+BANDS = ("V", "R", "I")
+CANX1_MATERIALS = ("aluminium-6061-t6", "tjpv-cell", "white-paint-a276")
 
 
 @dataclass
@@ -28,15 +56,20 @@ class BenchRow:
     Attributes
     ----------
     name : str
-        What was measured.
+        What was measured (the knob and its setting).
     seconds : float
         Best wall time over the repeats [s].
     baseline : str
-        Name of the baseline row of the ratio.
+        Name of the baseline of the ratio.
     ratio : float
-        ``baseline seconds / seconds``: > 1 is faster than the baseline.
+        ``seconds / baseline seconds``: the cost relative to the baseline
+        (< 1 is faster).
     extra : str
-        Throughput or error, in words.
+        Throughput or notes, in words.
+    sweep : str
+        Which sweep.
+    mmag_max, mmag_median, rel_p99 : float
+        Error against the reference (NaN when not applicable).
     """
 
     name: str
@@ -44,11 +77,16 @@ class BenchRow:
     baseline: str
     ratio: float
     extra: str = ""
+    sweep: str = ""
+    mmag_max: float = float("nan")
+    mmag_median: float = float("nan")
+    rel_p99: float = float("nan")
+    knob: str = field(default="", repr=False)
 
 
-def best_time(func: Callable[[], object], repeat: int = 5, number: int = 1) -> float:
-    """Best of ``repeat`` wall times of ``number`` calls of ``func`` [s per call]."""
-    func()  # warm-up
+def best_time(func: Callable[[], object], repeat: int = 3, number: int = 1) -> float:
+    """Best of ``repeat`` wall times of ``number`` calls of ``func`` after a warm-up [s per call]."""
+    func()
     best = np.inf
     for _ in range(repeat):
         t0 = time.perf_counter()
@@ -56,6 +94,9 @@ def best_time(func: Callable[[], object], repeat: int = 5, number: int = 1) -> f
             func()
         best = min(best, (time.perf_counter() - t0) / number)
     return float(best)
+
+
+# ------------------------------------------------------------- tables
 
 
 def _example_measurements(n_wavelength: int = 131) -> xr.Dataset:
@@ -66,26 +107,22 @@ def _example_measurements(n_wavelength: int = 131) -> xr.Dataset:
 def bench_build_lut(n_wavelength: int = 131, repeat: int = 3) -> list[BenchRow]:
     """Time :func:`sbrdf_xr.material.build_lut` on a paper-sized measurement set.
 
-    The set has 5 incidence angles x 30 geometries (105 measured spectra and 45
-    reference points) at ``n_wavelength`` wavelengths; the table is the paper's
-    91 x 21 x 21 x n_wavelength.  It is its own baseline: the row states the time.
+    5 incidence angles x 30 geometries (105 measured spectra, 45 reference points)
+    at ``n_wavelength`` wavelengths into the paper's 91 x 21 x 21 x n_wavelength
+    table.  It is its own baseline: the row states the time.
     """
     ds = _example_measurements(n_wavelength)
     t_build = best_time(lambda: material.build_lut(ds), repeat)
     n_meas = int((~ds.reference).sum())
-    return [
-        BenchRow(
-            f"build_lut ({ds.sizes['sample']} samples, {n_meas} measured, {n_wavelength} wl)",
-            t_build, "itself", 1.0, "91 x 21 x 21 table",
-        ),
-    ]
+    return [BenchRow(f"build_lut ({ds.sizes['sample']} samples, {n_meas} measured, {n_wavelength} wl)",
+                     t_build, "itself", 1.0, "91 x 21 x 21 table", sweep="tables")]
 
 
 def bench_lookup(n_geometries: int = 20000, n_wavelength: int = 131, repeat: int = 3) -> list[BenchRow]:
     """Spectra per second of the ``linear`` look-up against ``xarray.DataArray.interp``.
 
     Both interpolate multilinearly the same paper-sized table at the same random
-    geometries (inside the table); their results agree to 1e-12 relative.
+    geometries (inside the table); the row notes their largest relative difference.
     """
     lut = material.build_lut(_example_measurements(n_wavelength))
     rng = np.random.default_rng(0)
@@ -93,10 +130,11 @@ def bench_lookup(n_geometries: int = 20000, n_wavelength: int = 131, repeat: int
     dt = rng.uniform(float(lut.delta_theta[0]), float(lut.delta_theta[-1]), n_geometries)
     ph = rng.uniform(0, float(lut.phi[-1]), n_geometries)
     dims = [xr.DataArray(a, dims="geom") for a in (ti, dt, ph)]
+    grids = [np.asarray(lut[d].values) for d in ("theta_i", "delta_theta", "phi")]
+    values = np.asarray(lut.values)
 
     def ours() -> np.ndarray:
-        return material._lut.lookup_kernel(np.asarray(lut.values), lut.theta_i.values,
-                                           lut.delta_theta.values, lut.phi.values, ti, dt, ph)
+        return material._lut.lookup_kernel(values, *grids, ti, dt, ph)
 
     def xr_interp() -> xr.DataArray:
         return lut.interp(theta_i=dims[0], delta_theta=dims[1], phi=dims[2], method="linear").load()
@@ -104,32 +142,336 @@ def bench_lookup(n_geometries: int = 20000, n_wavelength: int = 131, repeat: int
     a = ours()
     b = xr_interp().transpose("geom", "wavelength").values
     err = float(np.max(np.abs(a - b) / np.maximum(np.abs(b), 1e-300)))
-    rows = []
-    rows_t = {name: best_time(f, repeat) for name, f in
-              (("sbrdf_xr linear kernel", ours), ("xarray .interp (linear)", xr_interp))}
-    base = rows_t["xarray .interp (linear)"]
-    for name, t in rows_t.items():
-        rows.append(BenchRow(name, t, "xarray .interp (linear)", base / t,
-                             f"{n_geometries / t:,.0f} spectra/s; max rel diff {err:.1e}"))
+    t_ours, t_xr = best_time(ours, repeat), best_time(xr_interp, repeat)
+    return [
+        BenchRow("sbrdf_xr linear look-up kernel", t_ours, "xarray .interp (linear)", t_ours / t_xr,
+                 f"{n_geometries / t_ours:,.0f} spectra/s; max rel diff {err:.1e}", sweep="tables"),
+        BenchRow("xarray .interp (linear)", t_xr, "xarray .interp (linear)", 1.0,
+                 f"{n_geometries / t_xr:,.0f} spectra/s", sweep="tables"),
+    ]
+
+
+# ---------------------------------------------------- accuracy and cost
+
+
+def _paper_tables(**build: Any) -> dict[str, xr.DataArray]:
+    """The CanX-1 tables rebuilt from their measurements with other construction knobs."""
+    out = {}
+    for m in CANX1_MATERIALS:
+        meas = catalog.load(f"{m}-measurements")
+        out[m] = material.build_lut(meas, extrapolation="model", model=catalog.load(f"{m}-fit"),
+                                    normal_incidence="symmetric", material=m, **build)
+    return out
+
+
+def _subsample_wavelengths(tables: dict[str, xr.DataArray], step: int) -> dict[str, xr.DataArray]:
+    return {k: v.isel(wavelength=slice(None, None, step)) for k, v in tables.items()}
+
+
+def _analytic_signal(scene: Any) -> np.ndarray:
+    """Radiometric signal with every material evaluated by its generating model (no table)."""
+    from . import models
+
+    specs = {m: catalog.load(f"{m}-model") for m in CANX1_MATERIALS}
+    sc = scene.spacecraft
+    terms = sc.merged()
+    s, o = scene.body_vectors()
+    lead = s.shape[:-1]
+    s2, o2 = s.reshape(-1, 3), o.reshape(-1, 3)
+    wl = np.asarray(specs[CANX1_MATERIALS[0]].wavelength.values)
+    out = np.zeros((s2.shape[0], wl.size))
+    for j in range(terms.sizes["term"]):
+        n = np.asarray(terms.normal.values[j])
+        spec = specs[str(terms.material.values[j])]
+        mod, _, kw = models._params(spec)
+        f = mod.brdf(n, s2, o2, wl, **kw)
+        w = float(terms.area.values[j]) * np.clip(s2 @ n, 0, None) * np.clip(o2 @ n, 0, None)
+        out += w[:, None] * f
+    return out.reshape(*lead, wl.size)
+
+
+def _band_mags(signal: xr.DataArray) -> np.ndarray:
+    from .photometry import pre_integrate
+
+    b = pre_integrate(signal, list(BANDS), normalize=True).values
+    with np.errstate(divide="ignore"):
+        return -2.5 * np.log10(np.maximum(b, 1e-300))
+
+
+def _errors(test: xr.DataArray, ref: xr.DataArray) -> tuple[float, float, float]:
+    """(max mmag, median mmag, p99 relative spectral error) of ``test`` against ``ref``."""
+    if "wavelength" in test.dims:
+        mt, mr = _band_mags(test), _band_mags(ref)
+        t_sp = test.interp(wavelength=ref.wavelength) if test.sizes["wavelength"] != ref.sizes["wavelength"] else test
+        rel = np.abs(t_sp.values - ref.values) / np.maximum(np.abs(ref.values), 1e-300)
+        keep_sp = np.abs(ref.values) > 1e-3 * np.abs(ref.values).max()
+        p99 = float(np.percentile(rel[keep_sp], 99))
+    else:  # band_signal over band
+        mt = -2.5 * np.log10(np.maximum(test.values, 1e-300))
+        mr = _band_mags(ref)
+        p99 = float("nan")
+    bref = 10 ** (-0.4 * mr)
+    keep = bref > 1e-3 * bref.max()
+    d = np.abs(mt - mr)[keep] * 1e3
+    return float(d.max()), float(np.median(d)), p99
+
+
+def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
+    """The accuracy/cost table: one knob at a time away from the reference.
+
+    Parameters
+    ----------
+    quick : bool
+        Smaller sweeps and fewer knob settings (a smoke run, for CI).
+    repeat : int
+        Timing repeats (the best is kept).
+
+    Returns
+    -------
+    list of BenchRow
+    """
+    from . import geometry
+    from .scene import builtin_scene
+    from .simulate import simulate
+
+    rot = builtin_scene("canx1-rotation")
+    n_big = 400 if quick else 5000
+    big = rot.with_options(attitudes=geometry.uniform_attitudes(n_big, seed=7), attitude_angle=None,
+                           phase_angles=[10.0, 45.0, 90.0], chunk=500, name=f"random-{n_big}x3")
+    sweeps = {"canx1-rotation": rot} if quick else {"canx1-rotation": rot, big.name: big}
+    if quick:
+        sweeps[big.name] = big
+    rows: list[BenchRow] = []
+    base_tables = _paper_tables()
+    reference = {"method": "cubic", "dtype": "float64", "merge": True, "materials": base_tables,
+                 "outputs": ("signal", "area")}
+
+    def run_cube(scene: Any, **opts: Any) -> xr.Dataset:
+        return simulate(scene.with_options(**opts)).compute(scheduler="sync")
+
+    for sweep_name, sweep in sweeps.items():
+        ref_cube = run_cube(sweep, **reference)
+        ref = ref_cube.signal
+        t_ref = best_time(lambda sweep=sweep: run_cube(sweep, **reference), repeat)
+        knobs: list[tuple[str, str, dict[str, Any]]] = [
+            ("reference", "cubic look-up, 1-deg theta_i, 21x21, 5 nm, merged, float64", {}),
+            ("lookup method", "nearest (the paper's)", {"method": "nearest"}),
+            ("lookup method", "linear", {"method": "linear"}),
+            ("precision", "float32", {"dtype": "float32"}),
+            ("wavelength", "10 nm sampling", {"materials": _subsample_wavelengths(base_tables, 2)}),
+            ("wavelength", "20 nm sampling", {"materials": _subsample_wavelengths(base_tables, 4)}),
+            ("wavelength", "band pre-integration (V, R, I)",
+             {"outputs": ("band_signal", "area"), "bands": BANDS}),
+            ("facets", "not merged (684 facets)", {"merge": False}),
+        ]
+        if not quick:
+            knobs += [
+                ("table", "theta_i every 2 deg", {"materials": _paper_tables(theta_i=np.arange(0.0, 91.0, 2.0))}),
+                ("table", "theta_i every 5 deg", {"materials": _paper_tables(theta_i=np.arange(0.0, 91.0, 5.0))}),
+                ("table", "11 x 11 delta_theta x phi", {"materials": _paper_tables(n_phi=11, n_delta_theta=11)}),
+                ("table", "41 x 41 delta_theta x phi", {"materials": _paper_tables(n_phi=41, n_delta_theta=41)}),
+            ]
+        for knob, setting, opts in knobs:
+            cfg = {**reference, **opts}
+            if knob == "reference":
+                cube, t = ref_cube, t_ref
+            else:
+                cube = run_cube(sweep, **cfg)
+                t = best_time(lambda sweep=sweep, cfg=cfg: run_cube(sweep, **cfg), repeat)
+            test = cube.band_signal if "band_signal" in cube else cube.signal
+            mx, med, p99 = _errors(test, ref)
+            rows.append(BenchRow(f"{knob}: {setting}", t, "reference", t / t_ref, sweep=sweep_name,
+                                 mmag_max=mx, mmag_median=med, rel_p99=p99, knob=knob))
+        # Tabulated vs analytic: the table method's own error, against the generating models.
+        t_an = best_time(lambda sweep=sweep: _analytic_signal(sweep), 1)
+        an = xr.DataArray(_analytic_signal(sweep), dims=ref.dims, coords=ref.coords)
+        mx, med, p99 = _errors(ref, an)
+        rows.append(BenchRow("materials: analytic generating models (ground truth)", t_an, "reference",
+                             t_an / t_ref, "error column: the tabulated reference against them",
+                             sweep=sweep_name, mmag_max=mx, mmag_median=med, rel_p99=p99, knob="materials"))
+    rows += shadow_density_rows(quick=quick, repeat=repeat)
     return rows
 
 
+def shadow_density_rows(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
+    """Self-shadowing on CanX-1 (non-convex: raised cells) at several sampling densities.
+
+    Reference: density 8 (64 samples per facet); also the cost of shadowing against the
+    unshadowed evaluation of the same sweep.
+    """
+    from . import geometry
+    from .scene import builtin_scene
+    from .simulate import simulate
+
+    n = 60 if quick else 300
+    scene = builtin_scene("canx1-rotation").with_options(
+        attitudes=geometry.uniform_attitudes(n, seed=3), attitude_angle=None, phase_angles=[40.0],
+        outputs=("signal", "area"), chunk=n, name=f"random-{n}-shadowed")
+    densities = (1, 2, 4) if quick else (1, 2, 4, 8)
+    ref_d = 6 if quick else 12
+
+    def run_cube(**opts: Any) -> xr.Dataset:
+        return simulate(scene.with_options(**opts)).compute(scheduler="sync")
+
+    ref_opts = {"effects": ("sunlight", "shadowing"), "shadow_density": ref_d}
+    ref = run_cube(**ref_opts).signal
+    t_ref = best_time(lambda: run_cube(**ref_opts), 1)
+    rows = []
+    for d in densities:
+        opts = {"effects": ("sunlight", "shadowing"), "shadow_density": d}
+        cube = run_cube(**opts)
+        t = best_time(lambda opts=opts: run_cube(**opts), repeat)
+        mx, med, p99 = _errors(cube.signal, ref)
+        rows.append(BenchRow(f"shadowing: density {d} ({d * d} samples/facet)", t,
+                             f"shadowing density {ref_d}", t / t_ref, sweep=scene.name, mmag_max=mx,
+                             mmag_median=med, rel_p99=p99, knob="shadowing"))
+    plain = run_cube()
+    t = best_time(lambda: run_cube(), repeat)
+    mx, med, p99 = _errors(plain.signal, ref)
+    rows.append(BenchRow("shadowing: off (convex assumption)", t, f"shadowing density {ref_d}", t / t_ref,
+                         sweep=scene.name, mmag_max=mx, mmag_median=med, rel_p99=p99, knob="shadowing"))
+    return rows
+
+
+# ------------------------------------------------------ kernel speed
+
+
+def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
+    """Geometry-facet-spectra per second of the simulation against a per-facet loop.
+
+    The baseline is the straightforward numpy evaluation: for every facet, its angles
+    for all geometries (:func:`sbrdf_xr.geometry.facet_angles`), its spectra by the
+    public ``linear`` look-up (:func:`sbrdf_xr.material.lookup`) and the weighted sum.
+    Both evaluate the CanX-1 rotation (360 geometries x 684 facets x 141 wavelengths).
+    The machine limit is estimated from the bytes each geometry-facet must gather
+    (8 table rows of the spectrum) and a measured memory bandwidth (a large
+    ``numpy`` copy).
+    """
+    from . import geometry
+    from .scene import builtin_scene
+    from .simulate import simulate
+
+    scene = builtin_scene("canx1-rotation").with_options(outputs=("signal", "area"), method="linear")
+    facets = scene.spacecraft.facets()
+    s, o = scene.body_vectors()
+    s2, o2 = s.reshape(-1, 3), o.reshape(-1, 3)
+    tables = {m: scene.materials[m] for m in scene.spacecraft.materials}
+    n_geom, n_fac = s2.shape[0], facets.sizes["facet"]
+    n_wl = tables[CANX1_MATERIALS[0]].sizes["wavelength"]
+
+    def per_facet_loop() -> np.ndarray:
+        out = np.zeros((n_geom, n_wl))
+        for j in range(n_fac):
+            n = facets.normal.values[j]
+            ang = geometry.facet_angles(n, s2, o2)
+            ok = ang.lit & ang.visible
+            if not ok.any():
+                continue
+            spec = material.lookup(tables[str(facets.material.values[j])], ang.theta_i[ok],
+                                   ang.delta_theta[ok], ang.phi[ok]).values
+            w = facets.area.values[j] * (s2[ok] @ n) * (o2[ok] @ n)
+            out[ok] += w[:, None] * spec
+        return out
+
+    def sim(merge: bool) -> np.ndarray:
+        return simulate(scene.with_options(merge=merge)).signal.compute(scheduler="sync").values
+
+    base, fast, unmerged = per_facet_loop(), sim(True), sim(False)
+    agree = float(np.max(np.abs(fast.reshape(base.shape) - base)) / np.abs(base).max())
+    agree2 = float(np.max(np.abs(unmerged.reshape(base.shape) - base)) / np.abs(base).max())
+    t_base = best_time(per_facet_loop, 1)
+    t_merged = best_time(lambda: sim(True), repeat)
+    t_unmerged = best_time(lambda: sim(False), repeat)
+    work = n_geom * n_fac  # geometry-facet pairs, each a full spectrum
+    big = np.ones(2**25)  # 256 MiB
+    t_copy = best_time(lambda: big.copy(), 2)
+    bandwidth = 2 * big.nbytes / t_copy  # read + write
+    limit = bandwidth / (8 * n_wl * 8)  # 8 gathered rows of n_wl float64 per geometry-facet
+    rows = [
+        BenchRow("per-facet numpy loop (baseline)", t_base, "per-facet loop", 1.0,
+                 f"{work / t_base:,.0f} geometry-facet-spectra/s", sweep="canx1-rotation"),
+        BenchRow("simulate, facets not merged", t_unmerged, "per-facet loop", t_unmerged / t_base,
+                 f"{work / t_unmerged:,.0f} g-f-spectra/s; speed-up {t_base / t_unmerged:.1f}x; "
+                 f"agrees to {agree2:.1e}", sweep="canx1-rotation"),
+        BenchRow("simulate, merged (684 facets -> 20 terms)", t_merged, "per-facet loop", t_merged / t_base,
+                 f"{work / t_merged:,.0f} facet-equivalent g-f-spectra/s; speed-up {t_base / t_merged:.1f}x; "
+                 f"agrees to {agree:.1e}", sweep="canx1-rotation"),
+        BenchRow("memory-bandwidth bound (estimate)", work / limit, "per-facet loop", (work / limit) / t_base,
+                 f"{limit:,.0f} g-f-spectra/s at {bandwidth / 1e9:.1f} GB/s (measured copy), "
+                 f"8 x {n_wl} float64 gathered per pair; unmerged kernel at "
+                 f"{(work / t_unmerged) / limit:.0%} of it", sweep="canx1-rotation"),
+    ]
+    return rows
+
+
+# ------------------------------------------------------------ output
+
+
 def format_rows(rows: list[BenchRow]) -> str:
-    """A plain-text table of benchmark rows."""
+    """A plain-text table of benchmark rows (time as a ratio to the row's baseline)."""
     w = max(len(r.name) for r in rows)
-    wb = max(len(r.baseline) for r in rows)
-    lines = [f"{'case':<{w}}  {'time [ms]':>10}  {'speed-up':>9}  {'baseline':<{wb}}  notes"]
+    out = []
+    sweep = None
     for r in rows:
-        lines.append(f"{r.name:<{w}}  {r.seconds * 1e3:>10.2f}  {r.ratio:>8.2f}x  "
-                     f"{r.baseline:<{wb}}  {r.extra}")
-    return "\n".join(lines)
+        if r.sweep != sweep:
+            sweep = r.sweep
+            out += ["", f"[{sweep}]",
+                    f"{'case':<{w}}  {'time/baseline':>13}  {'mmag max':>9}  {'mmag med':>9}  {'rel p99':>8}  notes"]
+        err = (f"{r.mmag_max:>9.3g}  {r.mmag_median:>9.3g}  {r.rel_p99:>8.2g}" if np.isfinite(r.mmag_max)
+               else f"{'':>9}  {'':>9}  {'':>8}")
+        note = r.extra or f"vs {r.baseline}"
+        out.append(f"{r.name:<{w}}  {r.ratio:>12.3g}x  {err}  {note}")
+    return "\n".join(out).lstrip("\n")
+
+
+def rows_to_dataset(rows: list[BenchRow]) -> xr.Dataset:
+    """The rows as a labelled Dataset over ``case`` (for netCDF or CSV)."""
+    def col(name: str) -> list[Any]:
+        return [getattr(r, name) for r in rows]
+
+    return xr.Dataset(
+        {
+            "seconds": ("case", col("seconds"), {"units": "s", "long_name": "best wall time"}),
+            "time_ratio": ("case", col("ratio"), {"units": "1", "long_name": "wall time / baseline wall time"}),
+            "mmag_max": ("case", col("mmag_max"), {"units": "mmag", "long_name": "largest band magnitude error"}),
+            "mmag_median": ("case", col("mmag_median"), {"units": "mmag", "long_name": "median band magnitude error"}),
+            "rel_p99": ("case", col("rel_p99"), {"units": "1", "long_name": "99th percentile relative spectral error"}),
+            "baseline": ("case", col("baseline"), {"long_name": "baseline of the time ratio"}),
+            "sweep": ("case", col("sweep"), {"long_name": "sweep"}),
+            "notes": ("case", col("extra"), {"long_name": "notes"}),
+        },
+        coords={"case": ("case", col("name"), {"long_name": "knob and setting"})},
+        attrs={"title": "sbrdf_xr accuracy/cost benchmark"},
+    )
+
+
+def plot_front(rows: list[BenchRow], ax: Any = None) -> Any:
+    """The accuracy/time front: worst band error against relative time, per sweep."""
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(7, 4.5), layout="constrained")
+    else:
+        fig = ax.figure
+    for sweep in dict.fromkeys(r.sweep for r in rows if np.isfinite(r.mmag_max)):
+        pts = [r for r in rows if r.sweep == sweep and np.isfinite(r.mmag_max)]
+        ax.scatter([r.ratio for r in pts], [max(r.mmag_max, 1e-6) for r in pts], label=sweep)
+        for r in pts:
+            ax.annotate(r.name.split(": ", 1)[-1], (r.ratio, max(r.mmag_max, 1e-6)), fontsize=6)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall time / reference wall time")
+    ax.set_ylabel("largest band error [mmag]")
+    ax.legend(fontsize=7)
+    return fig
 
 
 def run(quick: bool = False) -> list[BenchRow]:
-    """Run the benchmarks and return their rows (``quick``: smaller problems)."""
-    n = 2000 if quick else 20000
-    rows = bench_build_lut(repeat=2 if quick else 3)
-    rows += bench_lookup(n_geometries=n, repeat=2 if quick else 3)
+    """All benchmarks (``quick``: smaller problems, a smoke run)."""
+    rows = bench_build_lut(repeat=1 if quick else 3)
+    rows += bench_lookup(n_geometries=2000 if quick else 20000, repeat=1 if quick else 3)
+    rows += accuracy_cost(quick=quick, repeat=1 if quick else 2)
+    rows += kernel_throughput(repeat=1 if quick else 3)
     return rows
 
 

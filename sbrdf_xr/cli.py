@@ -72,7 +72,23 @@ def _cmd_info(args: argparse.Namespace) -> int:
 def _cmd_bench(args: argparse.Namespace) -> int:
     from . import bench
 
-    print(bench.format_rows(bench.run(quick=args.quick)))
+    rows = bench.run(quick=args.quick)
+    print(bench.format_rows(rows))
+    ds = bench.rows_to_dataset(rows)
+    if args.output:
+        from .material import write_netcdf_atomic
+
+        write_netcdf_atomic(ds, args.output, overwrite=True)
+        print(f"wrote {args.output}")
+    if args.csv:
+        ds.to_dataframe().to_csv(args.csv)
+        print(f"wrote {args.csv}")
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        bench.plot_front(rows).savefig(args.plot, dpi=120)
+        print(f"wrote {args.plot}")
     return 0
 
 
@@ -182,6 +198,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     pb = sub.add_parser("bench", help="accuracy/cost benchmarks (timings as ratios)")
     pb.add_argument("--quick", action="store_true", help="small problems, for a smoke run")
+    pb.add_argument("-o", "--output", help="write the table to this netCDF file")
+    pb.add_argument("--csv", help="write the table to this CSV file")
+    pb.add_argument("--plot", help="draw the accuracy/time front to this PNG file")
     pb.set_defaults(func=_cmd_bench)
 
     psim = sub.add_parser("simulate", help="run a scene into a netCDF cube")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from sbrdf_xr import catalog
@@ -45,9 +46,22 @@ def test_bad_subcommand_exits_with_usage():
     assert exc.value.code == 2
 
 
-def test_bench_quick_runs_and_reports_ratios(capsys):
+def test_bench_quick_runs_and_reports_ratios(capsys, tmp_path):
     """The benchmark is code users run: it must not rot (no timing is asserted)."""
-    assert main(["bench", "--quick"]) == 0
+    import xarray as xr
+
+    csv, nc, png = tmp_path / "b.csv", tmp_path / "b.nc", tmp_path / "front.png"
+    assert main(["bench", "--quick", "--csv", str(csv), "-o", str(nc), "--plot", str(png)]) == 0
     out = capsys.readouterr().out
-    assert "sbrdf_xr linear kernel" in out and "xarray .interp (linear)" in out
-    assert "max rel diff" in out
+    assert "sbrdf_xr linear look-up kernel" in out and "xarray .interp (linear)" in out
+    assert "lookup method: linear" in out and "band pre-integration" in out and "shadowing: density" in out
+    ds = xr.open_dataset(nc)
+    # The reference row is its own baseline; float32 changes magnitudes by far less than 1 mmag.
+    ref = [c for c in ds.case.values if c.startswith("reference")]
+    assert ref and float(ds.time_ratio.sel(case=ref[0])[0]) == 1.0
+    f32 = ds.mmag_max.sel(case="precision: float32").values
+    assert np.all(f32 < 0.1)
+    # The analytic generating models differ from the tabulated reference (the table method's error).
+    assert np.all(ds.mmag_max.sel(case="materials: analytic generating models (ground truth)").values > 1)
+    ds.close()
+    assert csv.stat().st_size > 0 and png.stat().st_size > 0
