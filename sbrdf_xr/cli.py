@@ -103,9 +103,18 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     print(plan)
     if args.plan:
         return 0
-    cube = simulate(scene, plan=plan)
-    path = write(cube, args.output, overwrite=args.overwrite, resume=args.resume,
-                 scheduler=args.scheduler, progress=not args.quiet)
+    client = None
+    if args.scheduler:
+        from distributed import Client
+
+        client = Client(args.scheduler)
+    try:
+        cube = simulate(scene, plan=plan, client=client)
+        path = write(cube, args.output, overwrite=args.overwrite, resume=args.resume,
+                     client=client, progress=not args.quiet)
+    finally:
+        if client is not None:
+            client.close()
     print(f"wrote {path}")
     if args.plot:
         _save_figure(path, args.plot)

@@ -414,7 +414,9 @@ def _thermal(plan: Plan, o2: np.ndarray, wl: np.ndarray, emissivity: dict[str, n
     return out.astype(np.dtype(scene.dtype))
 
 
-def simulate(scene: Scene | str | os.PathLike[str], plan: Plan | None = None, **options: Any) -> xr.Dataset:
+def simulate(
+    scene: Scene | str | os.PathLike[str], plan: Plan | None = None, *, client: Any = None, **options: Any
+) -> xr.Dataset:
     """Build the lazy simulation cube of a scene.
 
     Parameters
@@ -423,6 +425,10 @@ def simulate(scene: Scene | str | os.PathLike[str], plan: Plan | None = None, **
         A scene, a built-in scene name or a TOML scene file.
     plan : Plan, optional
         A compiled plan (default ``scene.plan()``).
+    client : dask.distributed.Client, optional
+        When the cube will be computed on a cluster: the plan and the material
+        tables (tens of MB) are scattered to every worker once instead of travelling
+        inside each block's task.
     **options
         Scene fields to override (``preset="fast"``, ``method="cubic"``, ``chunk=...``).
 
@@ -473,12 +479,16 @@ def simulate(scene: Scene | str | os.PathLike[str], plan: Plan | None = None, **
         "band_signal": ((n_band,), (BAND,), dtype),
     }
     blocks: dict[str, list[Any]] = {k: [] for k in outputs}
+    shared = [plan, tables, None if plan.pre_integrate else weights, emissivity]
+    if client is not None:
+        shared = client.scatter(shared, broadcast=True, hash=False)
+    token = dask.base.tokenize(id(plan), scene.name, n_lead, scene.chunk)
     for start in range(0, n_lead, scene.chunk):
         sl = slice(start, min(start + scene.chunk, n_lead))
         n = sl.stop - sl.start
         res = dask.delayed(_block, pure=True)(
-            plan, tables, spectral, sl, None if plan.pre_integrate else weights, emissivity,
-            dask_key_name=f"sbrdf-block-{scene.name}-{start}-{id(plan)}")
+            shared[0], shared[1], spectral, sl, shared[2], shared[3],
+            dask_key_name=f"sbrdf-block-{scene.name}-{start}-{token}")
         for k in outputs:
             tail, _, dt = shapes[k]
             blocks[k].append(dsa.from_delayed(res[k], shape=(n, *extra, *tail), dtype=dt))

@@ -233,3 +233,19 @@ def test_thermal_emission_is_kirchhoff_times_planck_and_skipped_when_negligible(
     expected = 0.5 * planck(cube.wavelength.values, 900.0)
     np.testing.assert_allclose(cube.thermal_intensity.isel(geometry=0), expected, rtol=1e-5)
     assert lam.attrs["material"]
+
+
+def test_simulation_on_a_local_cluster_equals_the_threaded_run(tmp_path):
+    """The tables are scattered to the workers once; the cube is identical to the threaded one."""
+    distributed = pytest.importorskip("distributed")
+    from sbrdf_xr.simulate import write
+
+    scene = cube_scene(table=catalog.load("example-lobe"), attitudes=geometry.uniform_attitudes(40, seed=9),
+                       phase_angles=[15.0, 60.0], chunk=10)
+    threaded = write(simulate(scene), tmp_path / "threads.nc")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=":0") as cluster, distributed.Client(cluster) as client:
+        cube = simulate(scene, client=client)
+        on_cluster = write(cube, tmp_path / "cluster.nc", client=client)
+    with xr.open_dataset(threaded) as a, xr.open_dataset(on_cluster) as b:
+        xr.testing.assert_identical(a.load(), b.load())
