@@ -428,7 +428,8 @@ def simulate(
     client : dask.distributed.Client, optional
         When the cube will be computed on a cluster: the plan and the material
         tables (tens of MB) are scattered to every worker once instead of travelling
-        inside each block's task.
+        inside each block's task.  The cube then refers to data on that cluster and
+        must be computed (or written) with that client.
     **options
         Scene fields to override (``preset="fast"``, ``method="cubic"``, ``chunk=...``).
 
