@@ -186,10 +186,13 @@ def compile_plan(scene: Scene) -> Plan:
     else:
         wl = _common_wavelength(scene, used or list(scene.materials))
         worst = _thermal_to_reflected(scene, wl)
-        if pre or worst < THERMAL_NEGLIGIBLE:
-            why = ("band outputs only" if pre else
-                   f"at most {worst:.1e} of reflected sunlight at {wl[0]:g}-{wl[-1]:g} nm")
-            steps.append(("thermal", f"skipped: negligible ({why})"))
+        if worst < THERMAL_NEGLIGIBLE:
+            steps.append(("thermal", f"skipped: negligible, at most {worst:.1e} of reflected sunlight "
+                          f"at {wl[0]:g}-{wl[-1]:g} nm"))
+        elif pre:
+            steps.append(("thermal", f"skipped: up to {worst:.1e} of reflected sunlight, but only band "
+                          "outputs of reflected light are asked for; add the 'signal' output for "
+                          "thermal_intensity"))
         else:
             thermal = True
             steps.append(("thermal", f"epsilon(lambda, theta) B(lambda, T) per facet, epsilon = 1 - rho "
