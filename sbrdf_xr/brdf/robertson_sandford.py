@@ -68,7 +68,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import optimize, special
+from scipy import optimize, sparse, special
 
 from .. import geometry
 from ..errors import ValidationError
@@ -965,37 +965,39 @@ def fit_robertson_sandford(
         f = model(rho, eps, b, e)[0]
         return ((np.log(f) - ly) / sig)[use]
 
-    def jac(x: np.ndarray) -> np.ndarray:
+    s_idx, l_idx = np.nonzero(use)  # residual order of resid() (row-major over samples)
+    n_res = s_idx.size
+    rows = np.repeat(np.arange(n_res), 4)
+    cols = np.stack([l_idx, n_wl + l_idx, np.full(n_res, 2 * n_wl), np.full(n_res, 2 * n_wl + 1)], 1).ravel()
+
+    def jac(x: np.ndarray) -> sparse.csr_matrix:
+        """Sparse Jacobian: a residual at wavelength l depends on rho_D[l], epsilon[l], b, ln e."""
         rho, eps, b, e = unpack(x)
         f, a_d, b_s, gi, pos = model(rho, eps, b, e)
-        n_s_ = f.shape[0]
-        d_rho = (a_d[:, None] - np.where(pos, gi[:, None] * b_s[:, None], 0.0)) / f
-        d_eps = -np.where(pos, gi[:, None] * b_s[:, None], 0.0) / f
-        jm = np.zeros((n_s_, n_wl, 2 * n_wl + 2))
-        idx = np.arange(n_wl)
-        jm[:, idx, idx] = d_rho
-        jm[:, idx, n_wl + idx] = d_eps
+        spec = np.where(pos, gi[:, None] * b_s[:, None], 0.0)
+        d_rho = (a_d[:, None] - spec) / f
+        d_eps = -spec / f
+        shared = []
         for k, step in ((2 * n_wl, 1e-6 * max(abs(x[-2]), 1e-3)), (2 * n_wl + 1, 1e-6)):
             xp, xm = x.copy(), x.copy()
             xp[k] += step
             xm[k] -= step
             fp = model(*unpack(xp))[0]
             fm = model(*unpack(xm))[0]
-            jm[:, :, k] = (np.log(fp) - np.log(fm)) / (2 * step)
-        jm = jm / sig[..., None]
-        return jm[use]
+            shared.append((np.log(fp) - np.log(fm)) / (2 * step))
+        vals = np.stack([d_rho[use], d_eps[use], shared[0][use], shared[1][use]], 1) / sig[use][:, None]
+        return sparse.csr_matrix((vals.ravel(), (rows, cols)), shape=(n_res, 2 * n_wl + 2))
 
     sol = optimize.least_squares(
         resid, x0, jac=jac, bounds=(lower, upper), method="trf", x_scale="jac",
-        xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=500,
+        tr_solver="lsmr", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=500,
     )
-    n_res = int(use.sum())
     n_par = 2 * n_wl + 2
     chi2 = float(np.sum(sol.fun**2))
     dof = max(n_res - n_par, 1)
     chi2_red = chi2 / dof
     jm = sol.jac
-    cov = np.linalg.pinv(jm.T @ jm)
+    cov = np.linalg.pinv(np.asarray((jm.T @ jm).todense()) if sparse.issparse(jm) else jm.T @ jm)
     if sigma is None:
         cov = cov * chi2_red
     u = np.sqrt(np.clip(np.diag(cov), 0.0, None))
