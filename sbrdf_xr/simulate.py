@@ -3,8 +3,9 @@
 :func:`simulate` returns a *lazy* :class:`xarray.Dataset` (nothing is computed
 until asked), chunked over attitude (or geometry) with the wavelength dimension
 whole.  :func:`write` streams it to netCDF block by block, atomically and
-resumably, with the threaded scheduler or on a ``dask.distributed`` cluster.
-This is the only module that knows about Dask scheduling.
+resumably, with the threaded scheduler or on a ``dask.distributed`` cluster
+(:func:`sbrdf_xr._writer.write_cube`, re-exported here as ``write``).  This module
+and its writer are the only ones that know about Dask scheduling.
 
 The cube (DESIGN.md data model)
 -------------------------------
@@ -42,6 +43,7 @@ import xarray as xr
 from . import __version__
 from ._kernels import material_sums
 from ._names import ATTITUDE, BAND, PHASE_ANGLE, VECTOR, WAVELENGTH, attrs
+from ._writer import write_cube as write
 from .errors import SceneError
 from .scene import SPECTRAL_OUTPUTS, Plan, Scene, resolve_scene
 
@@ -543,26 +545,3 @@ def simulate(
         "note_sbrdf_zero_area": "spacecraft_sbrdf is 0 where area is 0 (no lit and visible facet; 0/0 of Eq. 4)",
     }
     return ds
-
-
-def write(
-    ds: xr.Dataset,
-    path: str | os.PathLike[str],
-    *,
-    overwrite: bool = False,
-    resume: bool = False,
-    client: Any = None,
-    scheduler: str | None = None,
-    progress: bool = False,
-    max_in_flight: int | None = None,
-) -> os.PathLike[str]:
-    """Stream a lazy cube to netCDF, block by block, atomically and resumably.
-
-    See :func:`sbrdf_xr._writer.write_cube` for the guarantees (peak memory bounded
-    by the block size, no half-written file under the final name, resume from the
-    blocks already written, threaded scheduler by default or a Dask cluster).
-    """
-    from ._writer import write_cube
-
-    return write_cube(ds, path, overwrite=overwrite, resume=resume, client=client,
-                      scheduler=scheduler, progress=progress, max_in_flight=max_in_flight)
