@@ -157,8 +157,9 @@ def render(
     spec : xarray.Dataset
         A model material.
     theta_i, delta_theta, phi : array_like, optional
-        Grids [degree]; defaults: every integer 0-90, -180..90 in 1-degree steps
-        and 0-90 in 1-degree steps (the whole visible hemisphere).
+        Grids [degree]; defaults: every integer 0-90, and -180..90 and 0-90 in
+        3-degree steps (the whole visible hemisphere; with 141 wavelengths that is
+        already 290 MB in float64: pass narrower grids for narrow lobes).
     dtype : numpy dtype
 
     Returns
@@ -168,8 +169,8 @@ def render(
     """
     mod, wl, kw = _params(spec)
     ti = np.arange(0.0, 91.0) if theta_i is None else np.asarray(theta_i, dtype=np.float64)
-    dt = np.arange(-180.0, 91.0) if delta_theta is None else np.asarray(delta_theta, dtype=np.float64)
-    ph = np.arange(0.0, 91.0) if phi is None else np.asarray(phi, dtype=np.float64)
+    dt = np.arange(-180.0, 91.0, 3.0) if delta_theta is None else np.asarray(delta_theta, dtype=np.float64)
+    ph = np.arange(0.0, 91.0, 3.0) if phi is None else np.asarray(phi, dtype=np.float64)
     vals = mod.render_grid(ti, dt, ph, wl, **kw)
     return new_material(
         vals.astype(dtype), ti, dt, ph, wl,

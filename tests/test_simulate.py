@@ -249,3 +249,19 @@ def test_simulation_on_a_local_cluster_equals_the_threaded_run(tmp_path):
         on_cluster = write(cube, tmp_path / "cluster.nc", client=client)
     with xr.open_dataset(threaded) as a, xr.open_dataset(on_cluster) as b:
         xr.testing.assert_identical(a.load(), b.load())
+
+
+def test_materials_without_common_wavelengths_are_rejected():
+    sc = T.cube_spacecraft()
+    short = T.make_material(n_wavelength=3).assign_coords(
+        wavelength=np.array([2000.0, 2100.0, 2200.0]))
+    short.wavelength.attrs.update(units="nm", long_name="vacuum wavelength")
+    other = T.make_material(n_wavelength=3)
+    from sbrdf_xr.spacecraft import load_spacecraft
+
+    mesh = sc.mesh.copy()
+    mesh.visual.face_colors = np.where(np.arange(len(mesh.faces))[:, None] < 6, [255, 0, 0, 255], [0, 0, 255, 255])
+    two = load_spacecraft(mesh, {(255, 0, 0): "a", (0, 0, 255): "b"})
+    scene = Scene(two, materials={"a": short, "b": other}, to_sun=[[1.0, 0, 0]], to_observer=[[0.0, 0, 1.0]])
+    with pytest.raises(SceneError, match="no wavelengths in common"):
+        simulate(scene)
