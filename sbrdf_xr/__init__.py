@@ -1,6 +1,10 @@
 """sbrdf_xr: spectral BRDF simulation of unresolved spacecraft with xarray and Dask.
 
-Importing the package registers the ``.sbrdf`` xarray accessors.
+Importing the package registers the ``.sbrdf`` xarray accessors.  The main entry
+points: :func:`build_lut` and :func:`lookup` (materials), :func:`load_spacecraft` and
+:func:`canx1` (spacecraft), :class:`Scene`, :func:`simulate` and :func:`write`
+(simulations), :mod:`sbrdf_xr.photometry` (colour photometry) and
+:mod:`sbrdf_xr.catalog` (shipped data).
 """
 
 from __future__ import annotations
@@ -9,15 +13,26 @@ __version__ = "0.1.0"
 
 from . import accessors, catalog, errors, geometry, material  # noqa: F401
 from .material import build_lut, hemispherical_reflectance, lookup, open_material
+from .scene import Scene, builtin_scene, load_scene
+from .simulate import simulate, write
+from .spacecraft import Spacecraft, canx1, load_spacecraft
 
 __all__ = [
+    "Scene",
+    "Spacecraft",
     "__version__",
     "build_lut",
+    "builtin_scene",
+    "canx1",
     "catalog",
     "errors",
     "geometry",
     "hemispherical_reflectance",
+    "load_scene",
+    "load_spacecraft",
     "lookup",
     "material",
     "open_material",
+    "simulate",
+    "write",
 ]

@@ -78,9 +78,11 @@ def spectra(cube: xr.Dataset, variable: str = "spacecraft_sbrdf", ax: Any = None
     fig, ax = _axes(ax)
     da = cube[variable].sel(**sel) if sel else cube[variable]
     stacked = da.stack(_line=[d for d in da.dims if d != "wavelength"]) if da.ndim > 1 else da.expand_dims(_line=[0])
+    varying = [c for c in ("attitude_angle", "attitude", "geometry", "phase_angle")
+               if c in stacked.coords and stacked[c].size > 1 and "_line" in stacked[c].dims]
     for k in range(stacked.sizes["_line"]):
         line = stacked.isel(_line=k)
-        label = ", ".join(f"{c} = {line[c].values}" for c in ("phase_angle",) if c in line.coords)
+        label = ", ".join(f"{c} = {line[c].values:g}" for c in varying)
         ax.plot(line["wavelength"].values, line.values, lw=1, label=label or None)
     ax.set_xlabel(_label(cube["wavelength"]))
     ax.set_ylabel(_label(cube[variable]))
