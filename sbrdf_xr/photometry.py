@@ -1376,6 +1376,14 @@ def compare_light_curves(
     chi2, dm, mm, ok = fit(phi)
     if not ok.any():
         raise ValidationError("simulated_mags: the model reflects nothing at any measured angle")
+    # The best phase farther than 30 deg from the fitted one: a symmetric body (a cube
+    # turning about an axis) fits nearly as well half a turn away.
+    far = np.abs(((scan - phi + 180.0) % 360.0) - 180.0) > 30.0
+    if fit_phase and np.isfinite(chi_scan[far]).any():
+        k_alt = int(np.nanargmin(np.where(far, chi_scan, np.nan)))
+        phi_alt, dchi_alt = float(scan[k_alt]), float(chi_scan[k_alt] - chi2)
+    else:
+        phi_alt, dchi_alt = np.nan, np.nan
     n_par = 2 if fit_phase else 1
     dof = int(ok.sum()) - n_par
     resid = np.where(ok, m_obs - (mm + dm), np.nan)
@@ -1407,6 +1415,11 @@ def compare_light_curves(
             "phase_offset": ((), phi, attrs("rotation_angle", long_name="fitted rotation-phase offset "
                                             "(simulated angle = measured angle + offset), in [0, 360)")),
             "chi_square": ((), chi2, {"units": "1", "long_name": "chi-square of the fit"}),
+            "alternative_phase_offset": ((), phi_alt, attrs("rotation_angle", long_name="best phase offset more "
+                                                            "than 30 deg from the fitted one (scan resolution)")),
+            "alternative_delta_chi_square": ((), dchi_alt, {"units": "1", "long_name": "chi-square at the "
+                                                            "alternative phase minus the best; below ~4 the two "
+                                                            "phases are not distinguished at 2 sigma"}),
             "degrees_of_freedom": ((), dof, {"units": "1", "long_name": "observations used minus fitted "
                                              "parameters"}),
             "reduced_chi_square": ((), chi2 / dof if dof > 0 else np.nan,

@@ -518,3 +518,30 @@ def test_light_curve_iso_times_and_band_whitelist(tmp_path):
     assert lc.time.attrs["time_origin"].startswith("2024-01-01T00:00:00")
     with pytest.raises(ValidationError, match="does not have"):
         P.compare_light_curves(lc, _sim_curve(), period_s=600.0)
+
+
+def test_light_curve_fit_reports_the_half_turn_ambiguity_of_a_symmetric_body(tmp_path):
+    """A curve with period 180 deg fits equally well half a turn away; an asymmetric one does not."""
+    import pandas as pd
+
+    ang = np.arange(0.0, 360.0, 1.0)
+    th = np.deg2rad(ang)
+    sym = 12.0 + 0.5 * np.cos(2 * th) + 0.2 * np.sin(4 * th)
+    sim = xr.DataArray(np.stack([sym, sym], 1), dims=("attitude", "band"),
+                       coords={"attitude": np.arange(ang.size), "attitude_angle": ("attitude", ang),
+                               "band": ["B", "V"]})
+    rng = np.random.default_rng(1)
+    theta = np.sort(rng.uniform(0, 360, 200))
+    band = rng.choice(["B", "V"], 200)
+    mag = 12.0 + 0.5 * np.cos(2 * np.deg2rad(theta + 20)) + 0.2 * np.sin(4 * np.deg2rad(theta + 20))
+    path = tmp_path / "sym.csv"
+    pd.DataFrame({"rotation_angle": theta, "band": band, "magnitude": mag + rng.normal(0, 0.01, 200),
+                  "uncertainty": 0.01}).to_csv(path, index=False)
+    res = P.compare_light_curves(P.read_light_curve(path), sim)
+    best = float(res.phase_offset)
+    assert min(abs(best - 20.0), abs(best - 200.0)) < 0.5
+    alt = float(res.alternative_phase_offset)
+    assert abs(((alt - best) % 360) - 180) < 1.0  # the other minimum is half a turn away ...
+    assert float(res.alternative_delta_chi_square) < 4.0  # ... and not distinguished
+    asym = P.compare_light_curves(P.read_light_curve(_write_curve(tmp_path / "a.csv")), _sim_curve())
+    assert float(asym.alternative_delta_chi_square) > 100.0
