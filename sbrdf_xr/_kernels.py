@@ -51,6 +51,7 @@ def material_sums(
     phi_grid: NDArray[np.floating],
     method: str = "linear",
     fraction: NDArray[np.floating] | None = None,
+    zero_edges: tuple[bool, bool, bool] = (True, True, True),
 ) -> MaterialSums:
     """Facet sums of paper 000 Eqs. 3-4 and the radiometric signal for one material.
 
@@ -71,6 +72,8 @@ def material_sums(
     fraction : ndarray, shape (G, F), optional
         Fraction of each facet's area that is lit and visible [1] (self-shadowing
         and self-occlusion); default 1.
+    zero_edges : tuple of 3 bool
+        The table's out-of-range policy (:func:`sbrdf_xr._lut.lookup_matrix`).
 
     Returns
     -------
@@ -96,6 +99,7 @@ def material_sums(
     m = _lut.lookup_matrix(
         theta_grid, delta_theta_grid, phi_grid,
         ang.theta_i.ravel()[rows], ang.delta_theta.ravel()[rows], ang.phi.ravel()[rows], method,
+        zero_edges=zero_edges,
     ).tocoo()
     geom = rows[m.row] // f
     v2 = values.reshape(-1, n_wl)

@@ -22,6 +22,7 @@ __all__ = [
     "lookup_kernel",
     "lookup_matrix",
     "smoothing_spline_matrix",
+    "table_edges",
 ]
 
 #: Look-up methods and the number of grid nodes each uses per axis.
@@ -32,6 +33,17 @@ LOOKUP_METHODS: dict[str, int] = {"nearest": 1, "linear": 2, "cubic": 4}
 EDGE_TOL_DEG = 1e-9
 
 Method = Literal["nearest", "linear", "cubic"]
+
+
+def table_edges(attrs: dict) -> tuple[bool, bool, bool]:
+    """``zero_edges`` of a table from its attributes (default: all zero, the paper's policy).
+
+    :func:`sbrdf_xr.material.build_lut` records ``edge_delta_theta_min``,
+    ``edge_delta_theta_max`` and ``edge_phi_max`` as ``"zero"`` (a reference point)
+    or ``"hold"`` (a measured point where the apparatus stopped).
+    """
+    return tuple(attrs.get(k, "zero") != "hold"
+                 for k in ("edge_delta_theta_min", "edge_delta_theta_max", "edge_phi_max"))  # type: ignore[return-value]
 
 
 def check_method(method: str) -> str:
@@ -108,6 +120,7 @@ def lookup_matrix(
     phi: ArrayLike,
     method: str = "linear",
     weights: ArrayLike | None = None,
+    zero_edges: tuple[bool, bool, bool] = (True, True, True),
 ) -> sp.csr_matrix:
     """Sparse matrix mapping look-up-table nodes to query geometries.
 
@@ -123,7 +136,9 @@ def lookup_matrix(
     ``delta_theta`` extent, or for ``phi`` above its largest value, the weights are
     zero: paper 000 §3.1 places reference points, where the reflectance is
     indistinguishable from noise and taken as zero, at the edges of the measured
-    range.  ``phi`` below the first node is clamped.
+    range.  An edge that is a measured point instead (the apparatus stopped before
+    the noise; ``zero_edges`` False for it) is clamped, holding its value.  ``phi``
+    below the first node is clamped.
 
     Parameters
     ----------
@@ -135,6 +150,10 @@ def lookup_matrix(
         See :func:`axis_weights`.
     weights : array_like, optional
         Per-query factors (for example projected areas) [any unit].
+    zero_edges : tuple of 3 bool
+        Whether the table is zero beyond its smallest ``delta_theta``, its largest
+        ``delta_theta`` and its largest ``phi`` (reference points), or holds the
+        edge values there (:func:`table_edges`).
 
     Returns
     -------
@@ -153,10 +172,11 @@ def lookup_matrix(
     ndt, nph = delta_theta_grid.size, phi_grid.size
     idx = ((it[:, :, None, None] * ndt + idt[:, None, :, None]) * nph + iph[:, None, None, :])
     w = wt[:, :, None, None] * wdt[:, None, :, None] * wph[:, None, None, :]
+    z_lo, z_hi, z_phi = zero_edges
     outside = (
-        (dt < delta_theta_grid[0] - EDGE_TOL_DEG)
-        | (dt > delta_theta_grid[-1] + EDGE_TOL_DEG)
-        | (ph > phi_grid[-1] + EDGE_TOL_DEG)
+        (z_lo & (dt < delta_theta_grid[0] - EDGE_TOL_DEG))
+        | (z_hi & (dt > delta_theta_grid[-1] + EDGE_TOL_DEG))
+        | (z_phi & (ph > phi_grid[-1] + EDGE_TOL_DEG))
     )
     scale = np.where(outside, 0.0, 1.0)
     if weights is not None:
@@ -179,6 +199,7 @@ def lookup_kernel(
     delta_theta: ArrayLike,
     phi: ArrayLike,
     method: str = "linear",
+    zero_edges: tuple[bool, bool, bool] = (True, True, True),
 ) -> NDArray[np.floating]:
     """Spectra of a look-up table at arbitrary geometries (paper 000 §3.4).
 
@@ -194,6 +215,8 @@ def lookup_kernel(
         Interpolation method (:func:`axis_weights`).  ``cubic`` can overshoot below
         zero next to steep edges; results are clipped at 0 because a BRDF is
         non-negative.
+    zero_edges : tuple of 3 bool
+        See :func:`lookup_matrix`.
 
     Returns
     -------
@@ -202,7 +225,8 @@ def lookup_kernel(
         :func:`lookup_matrix`.
     """
     shape = np.broadcast_shapes(np.shape(theta_i), np.shape(delta_theta), np.shape(phi))
-    m = lookup_matrix(theta_grid, delta_theta_grid, phi_grid, theta_i, delta_theta, phi, method)
+    m = lookup_matrix(theta_grid, delta_theta_grid, phi_grid, theta_i, delta_theta, phi, method,
+                      zero_edges=zero_edges)
     v2 = values.reshape(-1, values.shape[-1])
     if v2.dtype != np.float64:
         m = m.astype(v2.dtype)
@@ -355,6 +379,7 @@ def hemispherical_reflectance_kernel(
     phi_grid: NDArray[np.floating],
     theta_i: ArrayLike | None = None,
     method: str = "linear",
+    zero_edges: tuple[bool, bool, bool] = (True, True, True),
 ) -> NDArray[np.float64]:
     """Directional-hemispherical reflectance of a look-up table by quadrature.
 
@@ -381,6 +406,9 @@ def hemispherical_reflectance_kernel(
         Incidence angles [degree]; default the table's ``theta_grid``.
     method : str
         Look-up method used for the integrand.
+    zero_edges : tuple of 3 bool
+        See :func:`lookup_matrix`; a held edge extends the integral to the horizon
+        (and to ``phi`` = 90 deg).
 
     Returns
     -------
@@ -388,13 +416,17 @@ def hemispherical_reflectance_kernel(
         Reflectance [1].
     """
     ti_all = theta_grid if theta_i is None else np.atleast_1d(np.asarray(theta_i, float))
-    phi_nodes, phi_w = _gauss_nodes(np.asarray(phi_grid, dtype=np.float64))
     if phi_grid.size == 1:
         raise ValidationError("phi: at least two phi nodes are needed for the quadrature")
+    z_lo, z_hi, z_phi = zero_edges
+    phi_breaks = np.asarray(phi_grid, dtype=np.float64)
+    if not z_phi and phi_breaks[-1] < 90.0:
+        phi_breaks = np.append(phi_breaks, 90.0)
+    phi_nodes, phi_w = _gauss_nodes(phi_breaks)
     out = np.empty((ti_all.size, values.shape[-1]))
     for k, ti in enumerate(ti_all):
-        lo = max(-90.0, ti + delta_theta_grid[0])
-        hi = min(90.0, ti + delta_theta_grid[-1])
+        lo = -90.0 if not z_lo else max(-90.0, ti + delta_theta_grid[0])
+        hi = 90.0 if not z_hi else min(90.0, ti + delta_theta_grid[-1])
         if hi <= lo:
             out[k] = 0.0
             continue
@@ -404,7 +436,7 @@ def hemispherical_reflectance_kernel(
         tt, pp = np.meshgrid(t_nodes, phi_nodes, indexing="ij")
         ww = (np.outer(t_w, phi_w) * np.cos(np.radians(pp)) ** 2 * np.cos(np.radians(tt)))
         m = lookup_matrix(theta_grid, delta_theta_grid, phi_grid, ti, tt - ti, pp, method,
-                          weights=ww)
+                          weights=ww, zero_edges=zero_edges)
         spectra = np.asarray(m.sum(axis=0)) @ values.reshape(-1, values.shape[-1]).astype(np.float64)
         out[k] = 2.0 * np.radians(1.0) ** 2 * spectra.ravel()
     return out

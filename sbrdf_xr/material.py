@@ -249,8 +249,10 @@ def lookup(
     -----
     Out-of-range policy: ``theta_i`` is clamped to the table (0-90 deg);
     beyond the table's ``delta_theta`` extent or above its largest ``phi`` the
-    sBRDF is zero (paper 000's reference points).  Whether a facet is lit and
-    visible is the caller's business.
+    sBRDF is zero (paper 000's reference points), unless the table records that
+    edge as a measured point (attribute ``edge_* = "hold"``, set by
+    :func:`build_lut` where the apparatus stopped before the noise): then the edge
+    value is held.  Whether a facet is lit and visible is the caller's business.
     """
     _lut.check_method(method)
     material = validate_material(material, check_values=False)
@@ -268,7 +270,7 @@ def lookup(
         _lookup_core,
         *angles,
         kwargs={"values": values, "theta_grid": grids[0], "delta_theta_grid": grids[1],
-                "phi_grid": grids[2], "method": method},
+                "phi_grid": grids[2], "method": method, "zero_edges": _lut.table_edges(material.attrs)},
         output_core_dims=[[WAVELENGTH]],
         dask="parallelized",
         output_dtypes=[values.dtype],
@@ -529,6 +531,12 @@ def build_lut(
         )
     phi_grid = paper_phi_grid(ph_s.max(), n_phi)
     dt_grid = paper_delta_theta_grid(dt_s.min(), dt_s.max(), n_delta_theta)
+    # Table edges: zero beyond them if the extreme samples are reference points.
+    edges = {
+        "edge_delta_theta_min": "zero" if np.all(ref[dt_s == dt_s.min()]) else "hold",
+        "edge_delta_theta_max": "zero" if np.all(ref[dt_s == dt_s.max()]) else "hold",
+        "edge_phi_max": "zero" if np.all(ref[ph_s == ph_s.max()]) else "hold",
+    }
     ti_out = np.arange(0.0, 91.0) if theta_i is None else np.asarray(theta_i, dtype=np.float64)
     _check_coord("theta_i", ti_out)
 
@@ -617,6 +625,7 @@ def build_lut(
         normal_incidence=normal_incidence,
         measured_theta_i=measured_ti,
         n_measurements=int(ds.sizes[SAMPLE]),
+        **edges,
         **extra,
     )
 
@@ -720,7 +729,8 @@ def hemispherical_reflectance(
     material = validate_material(material, check_values=False)
     grids = [np.asarray(material[d].values) for d in ANGLE_DIMS]
     ti = grids[0] if theta_i is None else np.atleast_1d(np.asarray(theta_i, dtype=np.float64))
-    rho = _lut.hemispherical_reflectance_kernel(np.asarray(material.values), *grids, ti, method)
+    rho = _lut.hemispherical_reflectance_kernel(np.asarray(material.values), *grids, ti, method,
+                                                zero_edges=_lut.table_edges(material.attrs))
     out = xr.DataArray(
         rho,
         dims=(THETA_I, WAVELENGTH),

@@ -42,6 +42,7 @@ import xarray as xr
 
 from . import __version__
 from ._kernels import material_sums
+from ._lut import table_edges
 from ._names import ATTITUDE, BAND, PHASE_ANGLE, VECTOR, WAVELENGTH, attrs
 from ._writer import write_cube as write
 from .errors import SceneError
@@ -320,7 +321,8 @@ def _tables(
         if weights is not None:
             values = values @ weights.T
         out[m] = (np.ascontiguousarray(values, dtype=dtype),
-                  *(np.asarray(da[d].values) for d in ("theta_i", "delta_theta", "phi")))
+                  *(np.asarray(da[d].values) for d in ("theta_i", "delta_theta", "phi")),
+                  table_edges(scene.materials[m].attrs))
     return out
 
 
@@ -354,10 +356,10 @@ def _block(
     paper = np.zeros((g, wl.size), dtype=dtype)
     area = np.zeros(g)
     per_mat = []
-    for m, (values, tg, dg, pg) in tables.items():
+    for m, (values, tg, dg, pg, edges) in tables.items():
         sel = mats == m
         r = material_sums(s2, o2, normals[sel], areas[sel], values, tg, dg, pg, scene.method,
-                          None if fraction is None else fraction[:, sel])
+                          None if fraction is None else fraction[:, sel], edges)
         signal += r.signal
         paper += r.paper
         area += r.area
@@ -375,10 +377,10 @@ def _block(
 
             frac_e = lit_visible_fraction(scene.spacecraft, e2, o2, density=scene.shadow_density)[
                 :, np.asarray(plan.terms["term"].values)]
-        for m, (values, tg, dg, pg) in tables.items():
+        for m, (values, tg, dg, pg, edges) in tables.items():
             sel = mats == m
             es += material_sums(e2, o2, normals[sel], areas[sel], values, tg, dg, pg, scene.method,
-                                None if frac_e is None else frac_e[:, sel]).signal
+                                None if frac_e is None else frac_e[:, sel], edges).signal
         es = (plan.earthshine_ratio * es).astype(dtype)
     out = {"area": area.reshape(lead)}
     if plan.pre_integrate:  # the spectral axis already is the band axis

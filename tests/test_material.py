@@ -149,9 +149,17 @@ def test_reference_points_make_the_edges_zero_and_measured_extents_are_held():
     np.testing.assert_array_equal(lut.isel(delta_theta=[0, -1]), 0.0)
     # A diffuse floor above the noise: the apparatus limits come first, the extents are
     # measured points, and the table holds their values instead of dropping to zero.
+    assert (lut.attrs["edge_delta_theta_min"], lut.attrs["edge_phi_max"]) == ("zero", "zero")
+    beyond = M.lookup(lut, 40.0, float(lut.delta_theta[0]) - 5.0, 0.0)
+    np.testing.assert_array_equal(beyond, 0.0)
     floor = testing.make_measurements(n_wavelength=7, width=3.0, diffuse=0.2)
     assert not floor.reference.any()
     lut = M.build_lut(floor)
+    assert lut.attrs["edge_delta_theta_min"] == lut.attrs["edge_phi_max"] == "hold"
+    # Beyond a held edge the look-up holds the edge value instead of dropping to zero.
+    edge = M.lookup(lut, 70.0, float(lut.delta_theta[0]), 10.0)
+    np.testing.assert_allclose(M.lookup(lut, 70.0, float(lut.delta_theta[0]) - 5.0, 10.0), edge)
+    assert float(edge.min()) > 0
     # (the floor is 0.16-0.24 sr-1; cubic extrapolation in theta_i may dip below it)
     assert float(lut.isel(phi=-1).min()) > 0.05
 
