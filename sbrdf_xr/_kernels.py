@@ -1,4 +1,4 @@
-"""Pure-numpy kernel of the spacecraft sum of paper 000 §3.4 (Eqs. 3-4).
+"""Kernels of the spacecraft sum of paper 000 §3.4 (Eqs. 3-4): numpy reference and fused.
 
 For a block of geometries (Sun and observer unit vectors in the body frame) and the
 facets of one material, :func:`material_sums` returns, without materialising one
@@ -15,20 +15,29 @@ over the facets that are lit (``N.s > 0``) and visible (``N.o > 0``); ``c_j`` is
 an optional per-geometry-and-facet fraction (lit-and-visible area fraction when
 self-shadowing is on).  The sums are linear in ``f_r``, so each is one sparse
 matrix (geometries x table nodes) times the table (nodes x wavelengths).
+
+:func:`material_sums` (numpy and scipy.sparse) is the reference implementation
+and the specification.  :func:`fused_sums` computes the same sums for all
+materials of a block in one compiled pass (numba, ``nogil`` so that threads run
+blocks in parallel): angles, the lit-and-visible test before any look-up, the
+out-of-range policy, the interpolation weights and the accumulation straight into
+the outputs, in the table's dtype (float32 stays float32).
 """
 
 from __future__ import annotations
 
 from typing import NamedTuple
 
+import numba
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from . import _lut
-from .geometry import facet_angles
+from .geometry import facet_angles, normal_incidence_tolerance
 
-__all__ = ["MaterialSums", "material_sums"]
+__all__ = ["METHOD_CODES", "FusedSums", "MaterialSums", "PackedTables", "fused_sums",
+           "material_sums", "pack_tables"]
 
 
 class MaterialSums(NamedTuple):
@@ -119,3 +128,383 @@ def material_sums(
         a2d.sum(axis=1),
         eff_area.sum(axis=1),
     )
+
+
+# ---------------------------------------------------------------- fused kernel
+#
+# One compiled pass over (geometry x term) for a block: the angles exactly as
+# geometry.facet_angles (arctan2 throughout, the same normal-incidence rule), the
+# lit/visible test before any look-up, the out-of-range policy of
+# _lut.lookup_matrix, the interpolation weights of _lut.axis_weights, and the
+# accumulation of the outputs of material_sums.  material_sums above is its
+# specification; tests/test_kernels.py checks one against the other.
+
+#: Look-up method codes of the fused kernel.
+METHOD_CODES: dict[str, int] = {"nearest": 0, "linear": 1, "cubic": 2}
+
+_RAD2DEG = 180.0 / np.pi
+
+
+@numba.njit(nogil=True, cache=True, inline="always")
+def _axis(grid: np.ndarray, lo: int, n: int, x: float, method: int,
+          idx: np.ndarray, w: np.ndarray) -> int:  # pragma: no cover - compiled
+    """Node indices and weights along one axis (``_lut.axis_weights``); returns the count."""
+    g0 = grid[lo]
+    g1 = grid[lo + n - 1]
+    if x < g0:
+        x = g0
+    elif x > g1:
+        x = g1
+    if n == 1:
+        idx[0] = 0
+        w[0] = 1.0
+        return 1
+    # searchsorted(grid, x, side="right") - 1, clipped to [0, n - 2]
+    a, b = 0, n
+    while a < b:
+        mid = (a + b) // 2
+        if grid[lo + mid] <= x:
+            a = mid + 1
+        else:
+            b = mid
+    i = a - 1
+    if i < 0:
+        i = 0
+    elif i > n - 2:
+        i = n - 2
+    t = (x - grid[lo + i]) / (grid[lo + i + 1] - grid[lo + i])
+    if method == 0:
+        idx[0] = i + 1 if t >= 0.5 else i
+        w[0] = 1.0
+        return 1
+    if method == 1:
+        idx[0] = i
+        idx[1] = i + 1
+        w[0] = 1.0 - t
+        w[1] = t
+        return 2
+    k = 4 if n >= 4 else n
+    j0 = i - 1
+    if j0 < 0:
+        j0 = 0
+    elif j0 > n - k:
+        j0 = n - k
+    for p in range(k):
+        idx[p] = j0 + p
+        w[p] = 1.0
+    for p in range(k):
+        xp = grid[lo + j0 + p]
+        for q in range(k):
+            if p != q:
+                xq = grid[lo + j0 + q]
+                w[p] *= (x - xq) / (xp - xq)
+    return k
+
+
+@numba.njit(nogil=True, cache=True)
+def _gather(values, rows, wn, nk, f, acc_s, acc_p, ws, wp):  # pragma: no cover - compiled
+    """``acc_s += ws * sum_n wn[n] values[rows[n]]`` and likewise ``acc_p`` with ``wp``.
+
+    Four table rows per pass over the spectrum (fewer loads and stores of ``f``);
+    the last pass adds straight into the accumulators.
+    """
+    n_wl = values.shape[1]
+    n4 = nk - nk % 4
+    n = 0
+    started = False
+    while n < nk:
+        last = (n + 4 >= nk) if n < n4 else (n + 1 == nk)
+        if n < n4:
+            r0, r1, r2, r3 = rows[n], rows[n + 1], rows[n + 2], rows[n + 3]
+            w0, w1, w2, w3 = wn[n], wn[n + 1], wn[n + 2], wn[n + 3]
+            if last and not started:
+                for k in range(n_wl):
+                    v = (w0 * values[r0, k] + w1 * values[r1, k]) + (w2 * values[r2, k] + w3 * values[r3, k])
+                    acc_s[k] += ws * v
+                    acc_p[k] += wp * v
+            elif last:
+                for k in range(n_wl):
+                    v = f[k] + ((w0 * values[r0, k] + w1 * values[r1, k])
+                                + (w2 * values[r2, k] + w3 * values[r3, k]))
+                    acc_s[k] += ws * v
+                    acc_p[k] += wp * v
+            elif not started:
+                for k in range(n_wl):
+                    f[k] = (w0 * values[r0, k] + w1 * values[r1, k]) + (w2 * values[r2, k] + w3 * values[r3, k])
+            else:
+                for k in range(n_wl):
+                    f[k] += (w0 * values[r0, k] + w1 * values[r1, k]) + (w2 * values[r2, k] + w3 * values[r3, k])
+            n += 4
+        else:
+            r0 = rows[n]
+            w0 = wn[n]
+            if last and not started:
+                for k in range(n_wl):
+                    v = w0 * values[r0, k]
+                    acc_s[k] += ws * v
+                    acc_p[k] += wp * v
+            elif last:
+                for k in range(n_wl):
+                    v = f[k] + w0 * values[r0, k]
+                    acc_s[k] += ws * v
+                    acc_p[k] += wp * v
+            elif not started:
+                for k in range(n_wl):
+                    f[k] = w0 * values[r0, k]
+            else:
+                for k in range(n_wl):
+                    f[k] += w0 * values[r0, k]
+            n += 1
+        started = True
+
+
+@numba.njit(nogil=True, cache=True)
+def _fused_sums(s, o, normals, areas, term_mat, frac, values, tgrid, t_off, dgrid, d_off,
+                pgrid, p_off, node_off, edges, method, tol, edge_tol,
+                out_sig, out_pap, out_area, out_lit, out_pm):  # pragma: no cover - compiled
+    n_geom = s.shape[0]
+    n_term = normals.shape[0]
+    n_wl = values.shape[1]
+    has_frac = frac.shape[0] > 0
+    want_pm = out_pm.shape[0] > 0
+    f = np.empty(n_wl, dtype=values.dtype)
+    acc_s = np.empty(n_wl, dtype=values.dtype)
+    acc_p = np.empty(n_wl, dtype=values.dtype)
+    wbuf = np.empty(2, dtype=values.dtype)
+    rows = np.empty(64, dtype=np.int64)
+    wn = np.empty(64, dtype=values.dtype)
+    it = np.empty(4, dtype=np.int64)
+    idt = np.empty(4, dtype=np.int64)
+    iph = np.empty(4, dtype=np.int64)
+    wt = np.empty(4)
+    wdt = np.empty(4)
+    wph = np.empty(4)
+    for g in range(n_geom):
+        sx, sy, sz = s[g, 0], s[g, 1], s[g, 2]
+        ox, oy, oz = o[g, 0], o[g, 1], o[g, 2]
+        area_g = 0.0
+        lit_g = 0.0
+        t = 0
+        while t < n_term:
+            m = term_mat[t]
+            stop = t
+            while stop < n_term and term_mat[stop] == m:
+                stop += 1
+            any_lookup = False
+            for tt in range(t, stop):
+                nx, ny, nz = normals[tt, 0], normals[tt, 1], normals[tt, 2]
+                ns = nx * sx + ny * sy + nz * sz
+                no = nx * ox + ny * oy + nz * oz
+                if not (ns > 0.0 and no > 0.0):
+                    continue
+                a_eff = areas[tt]
+                if has_frac:
+                    a_eff = a_eff * frac[g, tt]
+                a2d = a_eff * no
+                area_g += a2d
+                lit_g += a_eff
+                # angles of paper 000 Fig. 4, as geometry.facet_angles
+                stx, sty, stz = sx - ns * nx, sy - ns * ny, sz - ns * nz
+                st_len = np.sqrt(stx * stx + sty * sty + stz * stz)
+                theta_i = np.arctan2(st_len, ns)
+                if st_len <= tol:
+                    otx, oty, otz = ox - no * nx, oy - no * ny, oz - no * nz
+                    ot_len = np.sqrt(otx * otx + oty * oty + otz * otz)
+                    if ot_len > tol:
+                        ex, ey, ez = otx / ot_len, oty / ot_len, otz / ot_len
+                    else:
+                        # a perpendicular: cross with the axis least aligned with n
+                        ax, ay, az = abs(nx), abs(ny), abs(nz)
+                        if ax <= ay and ax <= az:
+                            ex, ey, ez = 0.0, nz, -ny
+                        elif ay <= az:
+                            ex, ey, ez = -nz, 0.0, nx
+                        else:
+                            ex, ey, ez = ny, -nx, 0.0
+                        el = np.sqrt(ex * ex + ey * ey + ez * ez)
+                        ex, ey, ez = ex / el, ey / el, ez / el
+                else:
+                    ex, ey, ez = -stx / st_len, -sty / st_len, -stz / st_len
+                px = ny * ez - nz * ey
+                py = nz * ex - nx * ez
+                pz = nx * ey - ny * ex
+                of = ox * ex + oy * ey + oz * ez
+                op = ox * px + oy * py + oz * pz
+                trp = np.arctan2(of, no)
+                phi = np.arctan2(abs(op), np.hypot(of, no)) * _RAD2DEG
+                dt = trp * _RAD2DEG - theta_i * _RAD2DEG
+                ti = theta_i * _RAD2DEG
+                d0 = d_off[m]
+                nd = d_off[m + 1] - d0
+                p0 = p_off[m]
+                npp = p_off[m + 1] - p0
+                if ((edges[m, 0] and dt < dgrid[d0] - edge_tol)
+                        or (edges[m, 1] and dt > dgrid[d0 + nd - 1] + edge_tol)
+                        or (edges[m, 2] and phi > pgrid[p0 + npp - 1] + edge_tol)):
+                    continue
+                t0 = t_off[m]
+                nt = t_off[m + 1] - t0
+                kt = _axis(tgrid, t0, nt, ti, method, it, wt)
+                kd = _axis(dgrid, d0, nd, dt, method, idt, wdt)
+                kp = _axis(pgrid, p0, npp, phi, method, iph, wph)
+                if not any_lookup:
+                    acc_s[:] = 0.0
+                    acc_p[:] = 0.0
+                    any_lookup = True
+                # gather the K = kt * kd * kp nodes, then sum them in passes of 4 rows
+                base = node_off[m]
+                nk = 0
+                for a in range(kt):
+                    for b in range(kd):
+                        row0 = base + (it[a] * nd + idt[b]) * npp
+                        wab = wt[a] * wdt[b]
+                        for c in range(kp):
+                            rows[nk] = row0 + iph[c]
+                            wn[nk] = wab * wph[c]
+                            nk += 1
+                wbuf[0] = a2d * ns
+                wbuf[1] = a2d
+                ws = wbuf[0]
+                wp = wbuf[1]
+                _gather(values, rows, wn, nk, f, acc_s, acc_p, ws, wp)
+            if any_lookup:
+                if method == 2:
+                    for k in range(n_wl):
+                        if acc_s[k] < 0.0:
+                            acc_s[k] = 0.0
+                        if acc_p[k] < 0.0:
+                            acc_p[k] = 0.0
+                for k in range(n_wl):
+                    out_sig[g, k] += acc_s[k]
+                    out_pap[g, k] += acc_p[k]
+                if want_pm:
+                    for k in range(n_wl):
+                        out_pm[g, m, k] += acc_s[k]
+            t = stop
+        out_area[g] = area_g
+        out_lit[g] = lit_g
+
+
+class PackedTables(NamedTuple):
+    """Material tables packed for the fused kernel (one flat node x spectral array).
+
+    Material ``m`` owns rows ``node_off[m]:node_off[m + 1]`` of ``values`` (its
+    ``(theta_i, delta_theta, phi)`` nodes in C order) and the slices ``t_off[m]:t_off[m + 1]``
+    (likewise ``d_off``, ``p_off``) of the concatenated grids.
+    """
+
+    values: NDArray[np.floating]  #: (n_nodes, L) [sr-1]
+    tgrid: NDArray[np.float64]
+    t_off: NDArray[np.int64]
+    dgrid: NDArray[np.float64]
+    d_off: NDArray[np.int64]
+    pgrid: NDArray[np.float64]
+    p_off: NDArray[np.int64]
+    node_off: NDArray[np.int64]
+    edges: NDArray[np.bool_]  #: (M, 3) zero beyond delta_theta min, max, phi max
+
+
+def pack_tables(
+    tables: list[tuple[NDArray[np.floating], NDArray[np.floating], NDArray[np.floating],
+                       NDArray[np.floating], tuple[bool, bool, bool]]],
+    n_spectral: int = 1,
+    dtype: np.dtype | str = np.float64,
+) -> PackedTables:
+    """Pack ``(values, theta_grid, delta_theta_grid, phi_grid, zero_edges)`` per material.
+
+    ``values`` has shape ``(n_theta, n_delta_theta, n_phi, L)``; every table has the
+    same ``L`` and dtype.  ``n_spectral`` and ``dtype`` shape an empty packing (no
+    tables).
+    """
+    def cat(arrays: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        off = np.concatenate([[0], np.cumsum([a.size for a in arrays])]).astype(np.int64)
+        return np.ascontiguousarray(np.concatenate(arrays), dtype=np.float64), off
+
+    if not tables:
+        z = np.zeros(1, dtype=np.int64)
+        return PackedTables(np.zeros((0, n_spectral), dtype=dtype), np.zeros(0), z, np.zeros(0), z, np.zeros(0), z, z,
+                            np.zeros((0, 3), dtype=bool))
+    n_wl = tables[0][0].shape[-1]
+    values = np.ascontiguousarray(np.concatenate([v.reshape(-1, n_wl) for v, *_ in tables]))
+    tgrid, t_off = cat([np.asarray(t[1]) for t in tables])
+    dgrid, d_off = cat([np.asarray(t[2]) for t in tables])
+    pgrid, p_off = cat([np.asarray(t[3]) for t in tables])
+    node_off = np.concatenate([[0], np.cumsum([v[..., 0].size for v, *_ in tables])]).astype(np.int64)
+    edges = np.array([t[4] for t in tables], dtype=bool).reshape(-1, 3)
+    return PackedTables(values, tgrid, t_off, dgrid, d_off, pgrid, p_off, node_off, edges)
+
+
+class FusedSums(NamedTuple):
+    """Outputs of :func:`fused_sums` for a block of geometries."""
+
+    signal: NDArray[np.floating]  #: (G, L) [m2 sr-1]
+    paper: NDArray[np.floating]  #: (G, L) [m2 sr-1]
+    area: NDArray[np.float64]  #: (G,) [m2]
+    lit_visible_area: NDArray[np.float64]  #: (G,) [m2]
+    per_material: NDArray[np.floating] | None  #: (G, M, L) [m2 sr-1]
+
+
+def fused_sums(
+    to_sun: NDArray[np.floating],
+    to_observer: NDArray[np.floating],
+    normals: NDArray[np.floating],
+    areas: NDArray[np.floating],
+    term_material: NDArray[np.integer],
+    tables: PackedTables,
+    method: str = "linear",
+    fraction: NDArray[np.floating] | None = None,
+    per_material: bool = False,
+) -> FusedSums:
+    """The facet sums of :func:`material_sums`, over all materials at once, compiled.
+
+    Parameters
+    ----------
+    to_sun, to_observer : ndarray, shape (G, 3)
+        Unit vectors in the body frame [1] (computed in float64).
+    normals : ndarray, shape (T, 3)
+        Unit term normals [1].
+    areas : ndarray, shape (T,)
+        Term areas [m2].
+    term_material : ndarray of int, shape (T,)
+        Material index of each term into ``tables``; terms of one material must be
+        contiguous (sorted).
+    tables : PackedTables
+        From :func:`pack_tables`; its dtype is the dtype of the spectral outputs.
+    method : {"nearest", "linear", "cubic"}
+        Look-up method.
+    fraction : ndarray, shape (G, T), optional
+        Lit-and-visible area fraction of each term [1].
+    per_material : bool
+        Also return the signal of each material.
+
+    Returns
+    -------
+    FusedSums
+        The spectral sums in the dtype of ``tables.values`` (no promotion of float32);
+        ``area`` and ``lit_visible_area`` in float64.  For ``cubic`` each material's
+        sums are clipped at 0 as in :func:`material_sums`.
+    """
+    tm = np.ascontiguousarray(term_material, dtype=np.int64)
+    if tm.size and np.any(np.diff(tm) < 0):
+        raise ValueError("term_material: terms of one material must be contiguous (sorted)")
+    s = np.ascontiguousarray(to_sun, dtype=np.float64)
+    o = np.ascontiguousarray(to_observer, dtype=np.float64)
+    g = s.shape[0]
+    n_wl = tables.values.shape[1]
+    dt = tables.values.dtype
+    n_mat = tables.edges.shape[0]
+    out_sig = np.zeros((g, n_wl), dtype=dt)
+    out_pap = np.zeros((g, n_wl), dtype=dt)
+    out_area = np.zeros(g)
+    out_lit = np.zeros(g)
+    out_pm = np.zeros((g, n_mat, n_wl) if per_material else (0, 0, 0), dtype=dt)
+    frac = (np.zeros((0, 0)) if fraction is None
+            else np.ascontiguousarray(fraction, dtype=np.float64))
+    if g and normals.shape[0]:
+        _fused_sums(s, o, np.ascontiguousarray(normals, dtype=np.float64),
+                    np.ascontiguousarray(areas, dtype=np.float64), tm, frac, tables.values,
+                    tables.tgrid, tables.t_off, tables.dgrid, tables.d_off, tables.pgrid,
+                    tables.p_off, tables.node_off, tables.edges, METHOD_CODES[method],
+                    normal_incidence_tolerance(np.float64), _lut.EDGE_TOL_DEG,
+                    out_sig, out_pap, out_area, out_lit, out_pm)
+    return FusedSums(out_sig, out_pap, out_area, out_lit, out_pm if per_material else None)

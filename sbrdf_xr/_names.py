@@ -106,6 +106,12 @@ ATTRS: dict[str, dict[str, str]] = {
     "srgb": {"units": "1", "long_name": "sRGB swatch of the reflected sunlight (display-normalised)"},
     "obs": {"units": "1", "long_name": "observation index"},
     "rotation_angle": {"units": DEGREE, "long_name": "body rotation angle"},
+    # --- simulation cubes ---
+    ATTITUDE: {"units": "1", "long_name": "attitude index"},
+    "attitude_angle": {"units": DEGREE, "long_name": "rotation angle of the attitude sweep"},
+    "quaternion": {"units": "1", "long_name": "attitude quaternion, body to reference frame, scalar last (x, y, z, w)"},
+    "component": {"units": "1", "long_name": "quaternion component"},
+    GEOMETRY: {"units": "1", "long_name": "geometry index"},
     "time_since_first": {"units": "s", "long_name": "time since the first observation"},
 }
 

@@ -169,6 +169,7 @@ class _Plan:
     lazy: list[_Lazy]
     structure: dict[str, Any]
     fingerprint: str
+    _graph: dict[Any, Any] | None = None
 
     @property
     def n_blocks(self) -> int:
@@ -182,17 +183,36 @@ class _Plan:
         off = self.offsets
         return {d: slice(int(off[d][i]), int(off[d][i + 1])) for d, i in idx.items()}
 
-    def pieces(self, k: int) -> list[tuple[str, tuple[slice, ...], da.Array]]:
-        """``(variable, region, lazy block)`` for every lazy variable written with block ``k``."""
+    def pieces(self, k: int) -> list[tuple[str, tuple[slice, ...], Any]]:
+        """``(variable, region, Dask key)`` for every lazy variable written with block ``k``."""
         idx = self.index(k)
         sl = self.slices(k)
         out = []
         for v in self.lazy:
             if any(idx[d] for d in self.block_dims if d not in v.dims):
                 continue
-            piece = v.data.blocks[tuple(idx[d] for d in v.dims)] if v.dims else v.data
-            out.append((v.name, tuple(sl[d] for d in v.dims), piece))
+            key = (v.data.name, *(idx[d] for d in v.dims))
+            out.append((v.name, tuple(sl[d] for d in v.dims), key))
         return out
+
+    def task(self, k: int, keys: list[Any]) -> tuple[dict[Any, Any], Any]:
+        """The part of the cube's graph that block ``k`` needs, and the key of a task
+        that packs its pieces into a tuple.
+
+        The whole graph is materialised once; each block then takes only the tasks its
+        keys depend on (culling walks the block's own dependencies), so the cost of a
+        block does not grow with the number of blocks.
+        """
+        if self._graph is None:
+            from dask.highlevelgraph import HighLevelGraph
+
+            self._graph = dict(HighLevelGraph.merge(*[v.data.__dask_graph__() for v in self.lazy]))
+        from dask.optimization import cull
+
+        sub, _ = cull(self._graph, keys)
+        out = f"write_cube-block-{k}-{self.fingerprint[:16]}"
+        sub[out] = (tuple, list(keys))
+        return sub, out
 
 
 def _storage_kind(name: Hashable, dtype: np.dtype) -> str:
@@ -537,15 +557,6 @@ def _fsync_dir(directory: Path) -> None:
 # ------------------------------------------------------------------ runners
 
 
-def _block_task(arrays: list[da.Array], k: int) -> Any:
-    """One Delayed computing every lazy piece of block ``k`` into a tuple of numpy arrays.
-
-    A builtin (``tuple``) packs them, so workers need nothing from this package.
-    """
-    key = f"write_cube-block-{k}-{dask.base.tokenize(*arrays)}"
-    return dask.delayed(tuple, pure=True)(arrays, dask_key_name=key)
-
-
 class _SyncRunner:
     """Compute each block in the calling thread when its result is asked for."""
 
@@ -557,14 +568,14 @@ class _SyncRunner:
     def pending(self) -> int:
         return len(self.queue)
 
-    def submit(self, k: int, arrays: list[da.Array]) -> None:
-        self.queue.append((k, arrays))
+    def submit(self, k: int, task: tuple[dict[Any, Any], Any]) -> None:
+        self.queue.append((k, task))
 
     def next_done(self) -> tuple[int, Any]:
         return self.queue.popleft()
 
-    def result(self, arrays: list[da.Array]) -> tuple[np.ndarray, ...]:
-        return dask.compute(*arrays, scheduler="sync")
+    def result(self, task: tuple[dict[Any, Any], Any]) -> tuple[np.ndarray, ...]:
+        return dask.get(*task)
 
     def close(self) -> None:
         self.queue.clear()
@@ -582,8 +593,8 @@ class _ThreadRunner:
     def pending(self) -> int:
         return len(self.futures)
 
-    def submit(self, k: int, arrays: list[da.Array]) -> None:
-        self.futures[self.pool.submit(dask.compute, *arrays, scheduler="sync")] = k
+    def submit(self, k: int, task: tuple[dict[Any, Any], Any]) -> None:
+        self.futures[self.pool.submit(dask.get, *task)] = k
 
     def next_done(self) -> tuple[int, Future[Any]]:
         done, _ = wait(self.futures, return_when=FIRST_COMPLETED)
@@ -614,8 +625,8 @@ class _DistributedRunner:
     def pending(self) -> int:
         return len(self.futures)
 
-    def submit(self, k: int, arrays: list[da.Array]) -> None:
-        fut = self.client.compute(_block_task(arrays, k))
+    def submit(self, k: int, task: tuple[dict[Any, Any], Any]) -> None:
+        fut = self.client.get(task[0], task[1], sync=False)
         self.futures[fut.key] = (k, fut)
         self.done.add(fut)
 
@@ -868,7 +879,7 @@ def write_cube(
         todo = iter([b for b in range(plan.n_blocks) if b not in done])
         kinds = {str(n): _storage_kind(n, v.dtype) for n, v in ds.variables.items()}
         bar = _progress(progress, plan.n_blocks, len(done), path.name)
-        pieces: dict[int, list[tuple[str, tuple[slice, ...], da.Array]]] = {}
+        pieces: dict[int, list[tuple[str, tuple[slice, ...], Any]]] = {}
         exhausted = False
         while True:
             while not exhausted and runner.pending < limit:
@@ -877,7 +888,7 @@ def write_cube(
                     exhausted = True
                 else:
                     pieces[nxt] = plan.pieces(nxt)
-                    runner.submit(nxt, [p for _, _, p in pieces[nxt]])
+                    runner.submit(nxt, plan.task(nxt, [p for _, _, p in pieces[nxt]]))
             if not runner.pending:
                 break
             k, handle = runner.next_done()

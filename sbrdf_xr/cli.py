@@ -109,7 +109,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
         client = Client(args.scheduler)
     try:
-        cube = simulate(scene, plan=plan, client=client)
+        cube = simulate(plan, client=client)
         path = write(cube, args.output, overwrite=args.overwrite, resume=args.resume,
                      client=client, progress=not args.quiet)
     finally:

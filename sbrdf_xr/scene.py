@@ -1,19 +1,17 @@
-"""Scenes: what to simulate, and the minimal plan that computes exactly that.
+"""Scenes: what to simulate.
 
-A :class:`Scene` holds a spacecraft, its materials, the geometry of a sweep and the
-outputs and effects asked for.  :meth:`Scene.plan` compiles it into a
-:class:`Plan` that states every step that will run and every step skipped, and
-why (DESIGN.md principle 3: simulate only the effects a scene calls for):
-
-* facets sharing (normal, material) are merged when no per-facet effect is on;
-* facets never lit-and-visible anywhere in the sweep are dropped;
-* self-shadowing runs only when asked for, and never on a convex body;
-* thermal emission runs only when asked for and the wavelengths reach where it
-  matters.
+A :class:`Scene` holds a spacecraft, its materials, the geometry of a sweep, the
+outputs and effects asked for and the value of every numerical knob
+(:mod:`sbrdf_xr.knobs`).  :meth:`Scene.plan` compiles it into a
+:class:`~sbrdf_xr.plan.Plan` that states every step that will run and every step
+skipped, and why (DESIGN.md principle 3: simulate only the effects a scene calls
+for).  A scene does no I/O and computes nothing in its constructor beyond checking
+its inputs.
 
 Geometry is either a grid of attitudes (quaternions, body -> reference frame) times
-phase angles in an observation plane (paper 000 Figs. 12-13), or an explicit list of
-``(to_sun, to_observer)`` unit-vector pairs in the body frame.
+phase angles in an observation plane (paper 000 Figs. 12-13) (:class:`GridGeometry`),
+or an explicit list of ``(to_sun, to_observer)`` unit-vector pairs in the body frame
+(:class:`PairGeometry`).
 """
 
 from __future__ import annotations
@@ -21,6 +19,7 @@ from __future__ import annotations
 import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -29,30 +28,24 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from . import geometry
-from ._lut import check_method
+from ._names import ATTITUDE, GEOMETRY, PHASE_ANGLE, VECTOR, attrs
+from .effects import SCENE_OUTPUTS, SPECTRAL_OUTPUTS
 from .errors import SceneError, ValidationError
+from .knobs import KNOBS, PRESETS, apply_preset, check_knob
 from .material import validate_material
+from .plan import BlockInputs, Plan, compile_plan
 
-__all__ = ["EFFECTS", "OUTPUTS", "PRESETS", "Plan", "Scene", "builtin_scene", "builtin_scenes",
-           "load_scene"]
+__all__ = ["EFFECTS", "OUTPUTS", "PRESETS", "GridGeometry", "PairGeometry", "Scene",
+           "builtin_scene", "builtin_scenes", "load_scene"]
 
 #: Outputs a scene may ask for.
-OUTPUTS = ("spacecraft_sbrdf", "signal", "brdf", "area", "per_material", "band_signal")
-#: Spectral outputs (over wavelength); a scene asking for none of them, only band
-#: outputs, has its tables pre-integrated over the bands before the sweep.
-SPECTRAL_OUTPUTS = ("spacecraft_sbrdf", "signal", "brdf", "per_material")
-#: Effects a scene may ask for.
+OUTPUTS = tuple(SCENE_OUTPUTS)
+#: Effects a scene may ask for (the Earth's shadow comes with an observation).
 EFFECTS = ("sunlight", "shadowing", "earthshine", "thermal")
-#: Numerical presets, chosen from the accuracy/cost table of ``sbrdf-xr bench`` (README):
-#: against ``reference``, linear look-up costs ~0.4x the time for glint errors of tens of
-#: mmag (median ~1 mmag); float32 adds ~0.001 mmag; nearest (the paper's look-up) saves
-#: little more time for ~5x the error of linear, so no preset uses it.  Shadow sampling
-#: of 2 x 2 per facet halves the error of 1 sample at little cost; 4 x 4 halves it again.
-PRESETS: dict[str, dict[str, Any]] = {
-    "fast": {"method": "linear", "dtype": "float32", "shadow_density": 2},
-    "balanced": {"method": "linear", "dtype": "float64", "shadow_density": 4},
-    "reference": {"method": "cubic", "dtype": "float64", "shadow_density": 8},
-}
+_ = SPECTRAL_OUTPUTS  # re-exported
+
+#: Component names of the attitude quaternions (scalar last).
+QUATERNION_COMPONENTS = ("x", "y", "z", "w")
 
 _UNIT_TOL = 1e-6
 
@@ -71,6 +64,140 @@ def _unit_vectors(v: ArrayLike, name: str) -> np.ndarray:
             f"directions must be unit vectors (|length - 1| <= {_UNIT_TOL})"
         )
     return arr / norm[:, None]
+
+
+@dataclass(frozen=True)
+class GridGeometry:
+    """Attitudes x phase angles in an observation plane (paper 000 Figs. 12-13).
+
+    Sun and observer directions lie in the reference-frame plane of ``bisector`` and
+    ``plane_normal``, ``phase_angle / 2`` either side of the bisector; each attitude
+    (body -> reference quaternion) turns them into the body frame.
+    """
+
+    attitudes: np.ndarray  #: (n, 4) scalar-last quaternions
+    phase_angles: np.ndarray  #: (P,) [degree]
+    sun_ref: np.ndarray  #: (P, 3)
+    obs_ref: np.ndarray  #: (P, 3)
+    earth_ref: np.ndarray | None  #: (P, 3), with earthshine
+    attitude_angle: np.ndarray | None = None
+    sun_scale: None = None
+
+    @property
+    def dims(self) -> tuple[str, str]:
+        return (ATTITUDE, PHASE_ANGLE)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return (len(self.attitudes), len(self.phase_angles))
+
+    @property
+    def n_lead(self) -> int:
+        return len(self.attitudes)
+
+    @property
+    def n_geometries(self) -> int:
+        return len(self.attitudes) * len(self.phase_angles)
+
+    @property
+    def attrs(self) -> dict[str, Any]:
+        return {}
+
+    def describe(self) -> str:
+        return (f"{self.n_lead} attitudes x {len(self.phase_angles)} phase angles = "
+                f"{self.n_geometries} geometries")
+
+    def block(self, sl: slice) -> BlockInputs:
+        """Body-frame directions of the attitudes in ``sl`` (flattened to (n * P, 3))."""
+        from scipy.spatial.transform import Rotation
+
+        q = self.attitudes[sl]  # unit quaternions, checked by the Scene
+        p = len(self.phase_angles)
+        refs = [self.sun_ref, self.obs_ref] + ([] if self.earth_ref is None else [self.earth_ref])
+        # v_body = R^T v for every attitude, as row vectors: v^T R
+        body = np.matmul(np.concatenate(refs)[None], Rotation.from_quat(q).as_matrix()) if len(q) else \
+            np.zeros((0, len(refs) * p, 3))
+        s, o = body[:, :p].reshape(-1, 3), body[:, p:2 * p].reshape(-1, 3)
+        e = None if self.earth_ref is None else body[:, 2 * p:].reshape(-1, 3)
+        return BlockInputs(s, o, e, None, (len(q), p))
+
+    def coords(self) -> dict[str, Any]:
+        """Coordinates of a cube over this geometry."""
+        b = self.block(slice(None))
+        s, o = b.to_sun.reshape(*self.shape, 3), b.to_observer.reshape(*self.shape, 3)
+        c: dict[str, Any] = {
+            ATTITUDE: (ATTITUDE, np.arange(self.n_lead), attrs("attitude")),
+            PHASE_ANGLE: (PHASE_ANGLE, np.asarray(self.phase_angles), attrs(PHASE_ANGLE)),
+            "quaternion": ((ATTITUDE, "component"), self.attitudes, attrs("quaternion")),
+            "component": ("component", list(QUATERNION_COMPONENTS), attrs("component")),
+            "to_sun": ((ATTITUDE, PHASE_ANGLE, VECTOR), s, attrs("to_sun")),
+            "to_observer": ((ATTITUDE, PHASE_ANGLE, VECTOR), o, attrs("to_observer")),
+        }
+        if self.attitude_angle is not None:
+            c["attitude_angle"] = (ATTITUDE, np.asarray(self.attitude_angle, dtype=np.float64),
+                                   attrs("attitude_angle"))
+        return c
+
+
+@dataclass(frozen=True)
+class PairGeometry:
+    """Explicit ``(to_sun, to_observer)`` pairs in the body frame, one per geometry.
+
+    ``dim`` names the dimension (``geometry``, or ``time`` for an observation);
+    ``sun_scale`` is the sunlit fraction of the solar disc per geometry (the Earth's
+    shadow), or None; ``extra_coords`` are further coordinates along ``dim``.
+    """
+
+    to_sun: np.ndarray
+    to_observer: np.ndarray
+    to_earth: np.ndarray | None = None
+    sun_scale: np.ndarray | None = None
+    dim: str = GEOMETRY
+    index: Any = None
+    extra_coords: Mapping[str, Any] = field(default_factory=dict)
+    extra_attrs: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def dims(self) -> tuple[str]:
+        return (self.dim,)
+
+    @property
+    def shape(self) -> tuple[int]:
+        return (len(self.to_sun),)
+
+    @property
+    def n_lead(self) -> int:
+        return len(self.to_sun)
+
+    @property
+    def n_geometries(self) -> int:
+        return len(self.to_sun)
+
+    @property
+    def attrs(self) -> dict[str, Any]:
+        return dict(self.extra_attrs)
+
+    def describe(self) -> str:
+        what = "times of an observation" if self.dim != GEOMETRY else "explicit (to_sun, to_observer) pairs"
+        return f"{self.n_lead} {what}"
+
+    def block(self, sl: slice) -> BlockInputs:
+        e = None if self.to_earth is None else self.to_earth[sl]
+        sc = None if self.sun_scale is None else self.sun_scale[sl]
+        s = self.to_sun[sl]
+        return BlockInputs(s, self.to_observer[sl], e, sc, (s.shape[0],))
+
+    def coords(self) -> dict[str, Any]:
+        d = self.dim
+        index = np.arange(self.n_lead) if self.index is None else self.index
+        c: dict[str, Any] = {
+            d: (d, index, attrs(d) if d == GEOMETRY else self.extra_coords.get(f"{d}_attrs", {})),
+            PHASE_ANGLE: (d, geometry.phase_angle(self.to_sun, self.to_observer), attrs(PHASE_ANGLE)),
+            "to_sun": ((d, VECTOR), self.to_sun, attrs("to_sun")),
+            "to_observer": ((d, VECTOR), self.to_observer, attrs("to_observer")),
+        }
+        c.update({k: v for k, v in self.extra_coords.items() if not k.endswith("_attrs")})
+        return c
 
 
 @dataclass(frozen=True)
@@ -104,10 +231,16 @@ class Scene:
         ``float64`` or ``float32`` for the spectra.
     merge : bool or None
         Merge facets sharing (normal, material); default: whenever allowed.
+    shadow_method : {"exact", "sampled"}
+        Self-shadowing by polygon clipping (area-exact) or by sub-facet ray sampling.
     shadow_density : int
-        Sub-facet sampling level of self-shadowing.
-    chunk : int
-        Geometries per Dask block along the attitude (or geometry) dimension.
+        Sampled shadowing: samples per facet side.
+    wavelength_stride, band_integration, table_theta_step, evaluation, kernel, block_bytes
+        The other numerical knobs (:data:`sbrdf_xr.knobs.KNOBS` says what each trades).
+    chunk : int, optional
+        Geometries per block along the attitude (or geometry) dimension; default from
+        ``block_bytes``.  Given explicitly, :func:`~sbrdf_xr.simulate.simulate` always
+        returns a Dask-backed cube with that chunking.
     bands : sequence of str
         Photometric bands of the ``band_signal`` output (see
         :func:`sbrdf_xr.photometry.filters`).
@@ -129,6 +262,12 @@ class Scene:
         spacecraft sees a full Earth).
     temperature : float or mapping of str to float
         Facet temperature [K] of the ``thermal`` effect, one for all or per material.
+    models : mapping of str to Dataset, optional
+        BRDF model parameters per material for ``evaluation="analytic"`` (default:
+        the catalog entry ``<material>-model``).
+    size_limit : float
+        Factor on the limits of output size and work beyond which a plan is refused
+        (:data:`sbrdf_xr.plan.SIZE_LIMIT_BYTES`, :data:`sbrdf_xr.plan.WORK_LIMIT`).
     name, description : str
         Labels stored in the output.
     """
@@ -147,8 +286,15 @@ class Scene:
     method: str = "linear"
     dtype: str = "float64"
     merge: bool | None = None
+    shadow_method: str = "exact"
     shadow_density: int = 4
-    chunk: int = 256
+    wavelength_stride: int = 1
+    band_integration: str = "auto"
+    table_theta_step: float | None = None
+    evaluation: str = "table"
+    kernel: str = "fused"
+    chunk: int | None = None
+    block_bytes: int = 32 * 2**20
     bands: Sequence[str] = ()
     band_extrapolate: str | None = None
     earth_direction: tuple[float, float, float] = (0.0, -1.0, 0.0)
@@ -157,9 +303,11 @@ class Scene:
     earth_range_km: float = 42164.0
     earth_phase_angle: float = 90.0
     temperature: float | Mapping[str, float] = 300.0
+    models: Mapping[str, xr.Dataset] | None = None
+    size_limit: float = 1.0
     name: str = "scene"
     description: str = ""
-    _checked: bool = field(default=False, repr=False, compare=False)
+    _cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         bad = [o for o in self.outputs if o not in OUTPUTS]
@@ -168,14 +316,11 @@ class Scene:
         bad = [e for e in self.effects if e not in EFFECTS]
         if bad:
             raise SceneError(f"effects: unknown {bad}; allowed: {', '.join(EFFECTS)}")
-        try:
-            check_method(self.method)
-        except ValidationError as exc:
-            raise SceneError(str(exc)) from None
-        if self.dtype not in ("float32", "float64"):
-            raise SceneError(f"dtype: got {self.dtype!r}; allowed: float32, float64")
-        if self.chunk < 1:
-            raise SceneError(f"chunk: must be >= 1, got {self.chunk}")
+        for k in KNOBS:
+            check_knob(k, getattr(self, k))
+        if not (isinstance(self.size_limit, int | float) and np.isfinite(self.size_limit)
+                and self.size_limit > 0):
+            raise SceneError(f"size_limit: must be a positive factor, got {self.size_limit!r}")
         if "band_signal" in self.outputs and not self.bands:
             raise SceneError("bands: the band_signal output needs at least one band (e.g. bands=('B', 'V'))")
         if self.bands:
@@ -252,9 +397,19 @@ class Scene:
     @property
     def n_geometries(self) -> int:
         """Number of (Sun, observer) geometries of the sweep."""
+        return self.geometry.n_geometries
+
+    @cached_property
+    def geometry(self) -> GridGeometry | PairGeometry:
+        """The sweep's geometry (:class:`GridGeometry` or :class:`PairGeometry`)."""
         if self.is_grid:
-            return len(self.attitudes) * len(self.phase_angles)
-        return len(self.to_sun)
+            s, o = geometry.observation_plane(self.phase_angles, self.bisector, self.plane_normal)
+            e = None
+            if "earthshine" in self.effects:
+                e = geometry.normalize(self.earth_direction, "earth_direction")
+                e = np.broadcast_to(e, (len(self.phase_angles), 3)).copy()
+            return GridGeometry(self.attitudes, self.phase_angles, s, o, e, self.attitude_angle)
+        return PairGeometry(self.to_sun, self.to_observer, self.to_earth)
 
     def body_vectors(self, attitude_slice: slice | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Sun and observer unit vectors in the body frame.
@@ -265,12 +420,8 @@ class Scene:
             Shape ``(n_attitude, n_phase, 3)`` for a grid (optionally for a slice of
             attitudes) or ``(n_geometry, 3)`` for explicit pairs.
         """
-        if not self.is_grid:
-            sl = attitude_slice or slice(None)
-            return self.to_sun[sl], self.to_observer[sl]
-        q = self.attitudes if attitude_slice is None else self.attitudes[attitude_slice]
-        s, o = geometry.observation_plane(self.phase_angles, self.bisector, self.plane_normal)
-        return geometry.to_body_frame(q, s), geometry.to_body_frame(q, o)
+        b = self.geometry.block(attitude_slice or slice(None))
+        return b.to_sun.reshape(*b.lead_shape, 3), b.to_observer.reshape(*b.lead_shape, 3)
 
     def earth_vectors(self, attitude_slice: slice | None = None) -> np.ndarray:
         """Unit vectors to the Earth in the body frame (shaped like :meth:`body_vectors`)."""
@@ -281,65 +432,25 @@ class Scene:
         e = np.broadcast_to(e, (len(self.phase_angles), 3))
         return geometry.to_body_frame(q, e)
 
+    @classmethod
+    def knob_names(cls) -> tuple[str, ...]:
+        """The numerical knobs, each a field of the scene (:data:`sbrdf_xr.knobs.KNOBS`)."""
+        return tuple(KNOBS)
+
     def with_options(self, **changes: Any) -> Scene:
-        """A copy with some fields changed (for example ``preset`` knobs)."""
+        """A copy with some fields changed; ``preset=`` sets the knobs of a preset first."""
         if "preset" in changes:
-            preset = changes.pop("preset")
-            if preset not in PRESETS:
-                raise SceneError(f"preset: unknown {preset!r}; allowed: {', '.join(PRESETS)}")
-            changes = {**PRESETS[preset], **changes}
-        return replace(self, **changes)
+            changes = apply_preset(changes.pop("preset"), changes)
+        try:
+            return replace(self, **changes)
+        except TypeError as exc:
+            raise SceneError(f"with_options: {exc}") from None
 
     def plan(self) -> Plan:
-        """Compile the scene into the minimal :class:`Plan` (see the module docstring)."""
-        from .simulate import compile_plan
-
-        return compile_plan(self)
-
-
-@dataclass
-class Plan:
-    """What a simulation will compute, and why.
-
-    Attributes
-    ----------
-    scene : Scene
-        The scene.
-    terms : xarray.Dataset
-        The facet terms evaluated (merged or per facet, after dropping): ``normal``,
-        ``area``, ``material``, and the facet indices each term stands for.
-    shadowing : bool
-        Whether ray-cast self-shadowing/occlusion runs.
-    merged : bool
-        Whether facets sharing (normal, material) were merged.
-    steps : list of (str, str)
-        ``(what, why)`` lines, in order; skipped steps say so.
-    pre_integrate : bool
-        Whether the tables are integrated over the bands before the sweep.
-    earthshine_ratio : float or None
-        Earth-reflected irradiance relative to the Sun's, when earthshine runs.
-    thermal : bool
-        Whether thermal emission is computed.
-    """
-
-    scene: Scene
-    terms: xr.Dataset
-    shadowing: bool
-    merged: bool
-    steps: list[tuple[str, str]]
-    pre_integrate: bool = False
-    earthshine_ratio: float | None = None
-    thermal: bool = False
-
-    def __str__(self) -> str:
-        w = max(len(a) for a, _ in self.steps)
-        lines = [f"plan for scene {self.scene.name!r}:"]
-        lines += [f"  {a:<{w}}  {b}" for a, b in self.steps]
-        return "\n".join(lines)
-
-    def _repr_html_(self) -> str:  # pragma: no cover - Jupyter display
-        rows = "".join(f"<tr><td>{a}</td><td>{b}</td></tr>" for a, b in self.steps)
-        return f"<table><caption>plan for {self.scene.name}</caption>{rows}</table>"
+        """The compiled :class:`~sbrdf_xr.plan.Plan` of this scene (computed once, then cached)."""
+        if "plan" not in self._cache:
+            self._cache["plan"] = compile_plan(self)
+        return self._cache["plan"]
 
 
 # ----------------------------------------------------------- scene files
@@ -348,7 +459,9 @@ _SCENE_KEYS = {
     "name": str, "description": str, "spacecraft": str, "materials": dict,
     "attitude": dict, "phase_angles": list, "bisector": list, "plane_normal": list,
     "geometry": dict, "outputs": list, "effects": list, "method": str, "dtype": str,
-    "merge": bool, "shadow_density": int, "chunk": int, "bands": list, "band_extrapolate": str,
+    "merge": bool, "shadow_method": str, "shadow_density": int, "chunk": int,
+    "wavelength_stride": int, "band_integration": str, "table_theta_step": (int, float),
+    "evaluation": str, "kernel": str, "block_bytes": int, "size_limit": (int, float), "bands": list, "band_extrapolate": str,
     "earth_direction": list, "earth_albedo": (int, float), "earth_range_km": (int, float),
     "earth_phase_angle": (int, float), "temperature": (int, float, dict),
 }
@@ -403,8 +516,8 @@ def scene_from_dict(d: Mapping[str, Any]) -> Scene:
             if not isinstance(entry, str):
                 raise SceneError(f"[materials]: {mat!r} must name a catalog entry (a string)")
             materials[mat] = catalog.load(entry)
-    kw: dict[str, Any] = {k: d[k] for k in ("name", "description", "method", "dtype", "merge",
-                                               "shadow_density", "chunk", "earth_albedo", "band_extrapolate",
+    kw: dict[str, Any] = {k: d[k] for k in ("name", "description", *KNOBS, "merge", "size_limit",
+                                               "earth_albedo", "band_extrapolate",
                                                "earth_range_km", "earth_phase_angle",
                                                "temperature") if k in d}
     for k in ("outputs", "effects", "bands"):
@@ -490,7 +603,6 @@ def _canx1_rotation() -> Scene:
         attitude_angle=angles,
         phase_angles=[10.0],
         outputs=("spacecraft_sbrdf", "signal", "brdf", "area", "per_material"),
-        chunk=90,
         name="canx1-rotation",
         description="CanX-1 initially rotated 25 deg about +z, then 360 steps of 1 deg about -z; "
         "v_i and v_r 5 deg either side of +x (beta = 10 deg) (paper 000 section 4, Fig. 13)",

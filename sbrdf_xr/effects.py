@@ -1,0 +1,291 @@
+"""The effects a simulation can include, each declared once, and the outputs of a cube.
+
+Every effect is one :class:`Effect` entry of :data:`EFFECTS` (in the manner of
+flox's ``Aggregation`` table): what it needs from the scene, the source it adds
+(its direction and irradiance relative to the Sun), how a term contributes (a
+function run on every block), the outputs it fills, and the line it writes in
+the plan.  :mod:`sbrdf_xr.plan` resolves the entries a scene asks for and
+:mod:`sbrdf_xr.simulate` runs them generically; adding an effect is one entry
+here plus its tests.
+
+Every variable a cube can hold is one :class:`Output` of :data:`OUTPUTS`, with its
+dimensions and CF attributes, defined once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from . import _kernels, sources
+from ._names import BAND, MATERIAL, WAVELENGTH
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .plan import BlockInputs, Plan
+
+__all__ = ["EFFECTS", "OUTPUTS", "SPECTRAL_OUTPUTS", "Effect", "Output", "finish", "reflected"]
+
+
+@dataclass(frozen=True)
+class Output:
+    """One variable of a simulation cube.
+
+    Attributes
+    ----------
+    name : str
+        Variable name.
+    tail : tuple of str
+        Dimensions after the geometry dimensions (``wavelength``, ``band``,
+        ``material``).
+    spectral : bool
+        Its values have the dtype of the spectra (else float64).
+    units, long_name : str
+        CF attributes.
+    """
+
+    name: str
+    tail: tuple[str, ...]
+    spectral: bool
+    units: str
+    long_name: str
+
+    @property
+    def attrs(self) -> dict[str, str]:
+        """CF attributes."""
+        return {"units": self.units, "long_name": self.long_name}
+
+
+#: Every output variable a cube may hold.
+OUTPUTS: dict[str, Output] = {o.name: o for o in (
+    Output("spacecraft_sbrdf", (WAVELENGTH,), True, "sr-1",
+           "overall spacecraft spectral BRDF (paper 000 Eq. 4)"),
+    Output("signal", (WAVELENGTH,), True, "m2 sr-1",
+           "radiometric signal sum_j A_j cos(theta_i) cos(theta_r) f_r"),
+    Output("brdf", (), True, "sr-1 nm",
+           "broadband BRDF, sBRDF integrated over wavelength (paper 000 Eq. 2)"),
+    Output("area", (), False, "m2",
+           "contributing projected area sum_j A_j cos(theta_r) (paper 000 Eq. 4 denominator)"),
+    Output("signal_material", (MATERIAL, WAVELENGTH), True, "m2 sr-1",
+           "radiometric signal of each material's facets"),
+    Output("signal_earthshine", (WAVELENGTH,), True, "m2 sr-1",
+           "radiometric signal of the light reflected from a Lambertian Earth, per unit solar "
+           "irradiance"),
+    Output("thermal_intensity", (WAVELENGTH,), True, "W sr-1 nm-1",
+           "thermal emission intensity sum_j A_j cos(theta_r) epsilon(lambda, theta_r) B(lambda, T)"),
+    Output("band_signal", (BAND,), True, "m2 sr-1",
+           "solar-weighted band mean of the radiometric signal (photon counting)"),
+)}
+
+#: Scene output names and the cube variables they add (``per_material`` adds
+#: ``signal_material``).
+SCENE_OUTPUTS: dict[str, str] = {
+    "spacecraft_sbrdf": "spacecraft_sbrdf", "signal": "signal", "brdf": "brdf", "area": "area",
+    "per_material": "signal_material", "band_signal": "band_signal",
+}
+#: Scene outputs over wavelength: a scene asking for none of them (only band outputs)
+#: has its tables pre-integrated over the bands.
+SPECTRAL_OUTPUTS = ("spacecraft_sbrdf", "signal", "brdf", "per_material")
+
+
+# ------------------------------------------------------------- contributions
+
+
+def reflected(plan: Plan, block: BlockInputs, to_source: np.ndarray, fraction: np.ndarray | None,
+              per_material: bool) -> _kernels.FusedSums:
+    """Facet sums of light from a distant source in direction ``to_source`` (body frame).
+
+    Runs the kernel the plan chose (fused or numpy reference) or, with analytic
+    evaluation, each material's BRDF model.
+    """
+    t = plan.terms
+    if plan.knobs["evaluation"] == "analytic":
+        return _analytic_sums(plan, to_source, block.to_observer, fraction, per_material)
+    if plan.knobs["kernel"] == "fused":
+        return _kernels.fused_sums(to_source, block.to_observer, t.normal, t.area, t.material,
+                                   plan.tables, plan.knobs["method"], fraction, per_material)
+    g, n_wl = to_source.shape[0], plan.tables.values.shape[1]
+    dt = plan.tables.values.dtype
+    sig, pap = np.zeros((g, n_wl), dt), np.zeros((g, n_wl), dt)
+    area, lit = np.zeros(g), np.zeros(g)
+    pm = np.zeros((g, len(plan.materials), n_wl), dt) if per_material else None
+    for m in range(len(plan.materials)):
+        sel = t.material == m
+        values, grids, edges = plan.table(m)
+        r = _kernels.material_sums(to_source, block.to_observer, t.normal[sel], t.area[sel], values,
+                                   *grids, plan.knobs["method"],
+                                   None if fraction is None else fraction[:, sel], edges)
+        sig += r.signal
+        pap += r.paper
+        area += r.area
+        lit += r.lit_visible_area
+        if pm is not None:
+            pm[:, m] = r.signal
+    return _kernels.FusedSums(sig, pap, area, lit, pm)
+
+
+def _analytic_sums(plan: Plan, s: np.ndarray, o: np.ndarray, fraction: np.ndarray | None,
+                   per_material: bool) -> _kernels.FusedSums:
+    """The facet sums with every material evaluated by its BRDF model (no table)."""
+    t = plan.terms
+    wl = plan.wavelength
+    dt = np.dtype(plan.knobs["dtype"])
+    g = s.shape[0]
+    sig, pap = np.zeros((g, wl.size)), np.zeros((g, wl.size))
+    pm = np.zeros((g, len(plan.materials), wl.size)) if per_material else None
+    area, lit = np.zeros(g), np.zeros(g)
+    for j in range(t.normal.shape[0]):
+        n = t.normal[j]
+        ci, cr = s @ n, o @ n
+        on = (ci > 0) & (cr > 0)
+        if not on.any():
+            continue
+        eff = t.area[j] * (1.0 if fraction is None else fraction[on, j])
+        model, kw = plan.models[t.material[j]]
+        f = model.brdf(n, s[on], o[on], wl, **kw)
+        a2d = eff * cr[on]
+        area[on] += a2d
+        lit[on] += eff
+        contrib = (a2d * ci[on])[:, None] * f
+        sig[on] += contrib
+        pap[on] += a2d[:, None] * f
+        if pm is not None:
+            pm[on, t.material[j]] += contrib
+    if plan.pre_integrated:
+        sig, pap = sig @ plan.band_weights.T, pap @ plan.band_weights.T
+        pm = None if pm is None else pm @ plan.band_weights.T
+    return _kernels.FusedSums(sig.astype(dt), pap.astype(dt), area, lit,
+                              None if pm is None else pm.astype(dt))
+
+
+def _shadow_fraction(plan: Plan, to_source: np.ndarray, to_observer: np.ndarray) -> np.ndarray | None:
+    if not plan.shadowing:
+        return None
+    from .visibility import lit_visible_fraction
+
+    opts = dict(plan.shadow_options)
+    opts.pop("method")
+    frac = lit_visible_fraction(plan.spacecraft, to_source, to_observer, **opts)
+    return np.ascontiguousarray(np.asarray(frac)[:, plan.terms.facet])
+
+
+def _sunlight(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
+    frac = _shadow_fraction(plan, block.to_sun, block.to_observer)
+    r = reflected(plan, block, block.to_sun, frac, "signal_material" in plan.output_names)
+    out = {"signal": r.signal, "paper": r.paper, "area": r.area}
+    if r.per_material is not None:
+        out["signal_material"] = r.per_material
+    if block.sun_scale is not None:  # Earth's penumbra: the irradiance, not the geometry
+        out["signal"] = r.signal * block.sun_scale[:, None].astype(r.signal.dtype)
+        if r.per_material is not None:
+            out["signal_material"] = r.per_material * block.sun_scale[:, None, None].astype(r.signal.dtype)
+    return out
+
+
+def _earthshine(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
+    frac = _shadow_fraction(plan, block.to_earth, block.to_observer)
+    r = reflected(plan, block, block.to_earth, frac, False)
+    ratio = plan.effect_params["earthshine"]["ratio"]
+    return {"signal_earthshine": (ratio * r.signal).astype(r.signal.dtype)}
+
+
+def _thermal(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
+    """``sum_j A_j cos(theta_r) epsilon_j(lambda, theta_r) B(lambda, T_j)`` over the visible
+    terms [W sr-1 nm-1] (the emission term of paper 001's signature model)."""
+    t = plan.terms
+    p = plan.effect_params["thermal"]
+    o = block.to_observer
+    out = np.zeros((o.shape[0], plan.wavelength.size))
+    for m in range(len(plan.materials)):
+        sel = t.material == m
+        cos_r = o @ t.normal[sel].T  # (G, T_m)
+        vis = cos_r > 0
+        theta_r = np.degrees(np.arctan2(np.sqrt(np.clip(1 - cos_r**2, 0, None)), cos_r))
+        eps = sources.emissivity_at(p["emissivity"][m], p["theta"][m], np.where(vis, theta_r, 0.0))
+        w = np.where(vis, cos_r, 0.0) * t.area[sel]
+        out += np.einsum("gf,gfl->gl", w, eps) * p["radiance"][m]
+    return {"thermal_intensity": out.astype(np.dtype(plan.knobs["dtype"]))}
+
+
+# ------------------------------------------------------------------ registry
+
+
+@dataclass(frozen=True)
+class Effect:
+    """One effect a scene may ask for.
+
+    Attributes
+    ----------
+    name : str
+        Name used in ``Scene(effects=...)``.
+    needs : tuple of str
+        Scene inputs it requires (``"to_earth"``: Earth directions; ``"mesh"``: the
+        facets themselves rather than merged terms).
+    source : str or None
+        The light source it adds (``"sun"``, ``"earth"``, ``"facets"`` for emission),
+        or None for an effect that modifies others (shadowing, eclipse).
+    outputs : tuple of str
+        The :data:`OUTPUTS` it fills.
+    contribute : callable or None
+        ``contribute(plan, block) -> {name: array}`` on every block.
+    description : str
+        The plan line when it runs (details are added by the planner).
+    """
+
+    name: str
+    needs: tuple[str, ...]
+    source: str | None
+    outputs: tuple[str, ...]
+    contribute: Callable[[Plan, BlockInputs], Mapping[str, np.ndarray]] | None
+    description: str
+    params: Mapping[str, Any] = field(default_factory=dict)
+
+
+#: The effects, by name.
+EFFECTS: dict[str, Effect] = {e.name: e for e in (
+    Effect("sunlight", (), "sun", ("spacecraft_sbrdf", "signal", "brdf", "area", "signal_material",
+                                   "band_signal"), _sunlight,
+           "reflected sunlight: paper 000 Eqs. 3-4 and the radiometric signal"),
+    Effect("shadowing", ("mesh",), None, (), None,
+           "self-shadowing and self-occlusion of the facets"),
+    Effect("earthshine", ("to_earth",), "earth", ("signal_earthshine", "band_signal"), _earthshine,
+           "sunlight reflected by a Lambertian Earth, a second distant source"),
+    Effect("thermal", (), "facets", ("thermal_intensity",), _thermal,
+           "thermal emission epsilon(lambda, theta) B(lambda, T), epsilon = 1 - rho (Kirchhoff)"),
+    Effect("eclipse", ("sunlit_fraction",), None, (), None,
+           "the Earth's shadow: sunlight scaled by the sunlit fraction of the solar disc"),
+)}
+
+
+def finish(plan: Plan, sums: Mapping[str, np.ndarray], lead_shape: tuple[int, ...]) -> dict[str, np.ndarray]:
+    """The plan's outputs of one block from the effects' sums, shaped ``lead_shape + tail``.
+
+    ``spacecraft_sbrdf`` is paper 000 Eq. 4 (0 where no area contributes, the 0/0 of
+    Eq. 4), ``brdf`` its trapezoid integral over wavelength (Eq. 2), ``band_signal``
+    the band-weighted total signal (Sun plus Earth), or the pre-integrated sums.
+    """
+    names = plan.output_names
+    dt = np.dtype(plan.knobs["dtype"])
+    area = sums["area"]
+    out: dict[str, np.ndarray] = {}
+    if "area" in names:
+        out["area"] = area
+    if "spacecraft_sbrdf" in names or "brdf" in names:
+        safe = np.where(area > 0, area, 1.0)[:, None]
+        sbrdf = np.where(area[:, None] > 0, sums["paper"] / safe, 0.0).astype(dt)
+        if "spacecraft_sbrdf" in names:
+            out["spacecraft_sbrdf"] = sbrdf
+        if "brdf" in names:
+            wl = plan.wavelength
+            out["brdf"] = (np.trapezoid(sbrdf, wl, axis=-1) if wl.size > 1 else sbrdf[..., 0]).astype(dt)
+    for k in ("signal", "signal_material", "signal_earthshine", "thermal_intensity"):
+        if k in names:
+            out[k] = sums[k]
+    if "band_signal" in names:
+        total = sums["signal"]
+        if "signal_earthshine" in sums:
+            total = total + sums["signal_earthshine"]
+        out["band_signal"] = (total if plan.pre_integrated else total @ plan.band_weights.T).astype(dt)
+    return {k: v.reshape(*lead_shape, *v.shape[1:]) for k, v in out.items()}

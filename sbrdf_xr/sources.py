@@ -1,0 +1,148 @@
+"""Physics of the light sources besides the Sun's spectrum: Planck, earthshine, Kirchhoff.
+
+Pure numpy (no xarray, no I/O).  The Sun's spectral irradiance lives with the
+photometry (it is a data set); here are the closed forms the effects of a
+simulation need:
+
+* :func:`planck`: blackbody spectral radiance (thermal emission of the facets);
+* :func:`earthshine_irradiance_ratio`: light reflected by a Lambertian Earth onto the
+  spacecraft, relative to the Sun's;
+* :func:`kirchhoff_emissivity`: directional emissivity from directional-hemispherical
+  reflectance, and :func:`emissivity_at`, its linear interpolation in the emission
+  angle.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import constants
+
+__all__ = [
+    "EARTH_RADIUS_KM",
+    "earthshine_irradiance_ratio",
+    "emissivity_at",
+    "kirchhoff_emissivity",
+    "planck",
+]
+
+#: Earth's mean radius [km].
+EARTH_RADIUS_KM = 6371.0
+
+
+def planck(wavelength_nm: ArrayLike, temperature: float) -> NDArray[np.float64]:
+    """Blackbody spectral radiance ``B(lambda, T)`` [W m-2 sr-1 nm-1] (Planck's law).
+
+    ``B = 2 h c^2 / lambda^5 / (exp(h c / (lambda k T)) - 1)``, evaluated as
+    ``2 h c^2 / lambda^5 * e^-x / (1 - e^-x)`` with ``x = h c / (lambda k T)`` so
+    that it underflows to 0 instead of overflowing at short wavelengths.  Constants
+    from :mod:`scipy.constants` (CODATA, exact SI values of h, c and k).
+
+    Parameters
+    ----------
+    wavelength_nm : array_like
+        Vacuum wavelength [nm], > 0.
+    temperature : float
+        Temperature [K], > 0.
+
+    Returns
+    -------
+    ndarray
+        Radiance per nanometre of wavelength [W m-2 sr-1 nm-1].
+
+    Examples
+    --------
+    >>> from sbrdf_xr.sources import planck
+    >>> float(planck(10_000.0, 300.0))  # 10 um, 300 K: ~9.9 W m-2 sr-1 um-1
+    0.009924...
+    """
+    h, c, k = constants.h, constants.c, constants.k
+    lam = np.asarray(wavelength_nm, dtype=np.float64) * 1e-9
+    x = h * c / (lam * k * float(temperature))
+    with np.errstate(under="ignore", over="ignore"):
+        return 2.0 * h * c**2 / lam**5 * np.exp(-x) / -np.expm1(-x) * 1e-9
+
+
+def earthshine_irradiance_ratio(albedo: float, range_km: float, phase_angle_deg: float) -> float:
+    """Irradiance from a Lambertian Earth relative to the Sun's (same heliocentric distance).
+
+    A Lambertian sphere of radius ``R`` and Bond albedo ``a`` seen at phase angle
+    ``alpha`` from distance ``r`` gives ``E/E_sun = (2/3) a (R/r)^2 [(pi - alpha)
+    cos(alpha) + sin(alpha)] / pi`` (the diffuse-sphere phase law; Russell 1916,
+    Lester et al. 1979).  The Earth is then treated as a distant source from its
+    centre's direction: good when its angular radius ``asin(R/r)`` is small (8.7 deg
+    at GEO), rough in low orbit.
+
+    Parameters
+    ----------
+    albedo : float
+        Bond albedo [1].
+    range_km : float
+        Distance to the Earth's centre [km].
+    phase_angle_deg : float
+        Sun-Earth-spacecraft angle [degree].
+
+    Returns
+    -------
+    float
+        ``E_earth / E_sun`` [1].
+
+    Examples
+    --------
+    >>> from sbrdf_xr.sources import earthshine_irradiance_ratio
+    >>> round(earthshine_irradiance_ratio(0.3, 42164.0, 0.0), 5)  # full Earth from GEO
+    0.00457
+    """
+    a = np.radians(phase_angle_deg)
+    return float(2.0 / 3.0 * albedo * (EARTH_RADIUS_KM / range_km) ** 2
+                 * ((np.pi - a) * np.cos(a) + np.sin(a)) / np.pi)
+
+
+def kirchhoff_emissivity(reflectance: ArrayLike) -> NDArray[np.float64]:
+    """Directional emissivity ``epsilon(theta, lambda) = 1 - rho(theta, lambda)``.
+
+    Kirchhoff's law for an opaque surface in thermal equilibrium: the directional
+    emissivity equals the directional absorptance, one minus the
+    directional-hemispherical reflectance (paper 001 Eq. 1 and §2; by reciprocity
+    the reflectance for illumination from ``theta`` is that for emission into it).
+    Clipped to [0, 1] so that a table that does not conserve energy cannot emit
+    negatively.
+
+    Parameters
+    ----------
+    reflectance : array_like
+        Directional-hemispherical reflectance [1].
+
+    Returns
+    -------
+    ndarray
+        Emissivity [1].
+    """
+    return np.clip(1.0 - np.asarray(reflectance, dtype=np.float64), 0.0, 1.0)
+
+
+def emissivity_at(
+    emissivity: NDArray[np.floating], theta_grid: NDArray[np.floating], theta: ArrayLike
+) -> NDArray[np.float64]:
+    """Emissivity at emission angles ``theta``, linear in angle between the table's nodes.
+
+    Parameters
+    ----------
+    emissivity : ndarray, shape (n_theta, n_wavelength)
+        Emissivity on ``theta_grid`` [1].
+    theta_grid : ndarray, shape (n_theta,)
+        Strictly increasing emission angles [degree].
+    theta : array_like, shape (...)
+        Emission angles [degree]; clamped to the grid.
+
+    Returns
+    -------
+    ndarray, shape (..., n_wavelength)
+    """
+    grid = np.asarray(theta_grid, dtype=np.float64)
+    t = np.clip(np.asarray(theta, dtype=np.float64), grid[0], grid[-1])
+    if grid.size == 1:
+        return np.broadcast_to(emissivity[0], (*t.shape, emissivity.shape[-1])).copy()
+    i = np.clip(np.searchsorted(grid, t, side="right") - 1, 0, grid.size - 2)
+    w = ((t - grid[i]) / (grid[i + 1] - grid[i]))[..., None]
+    return (1.0 - w) * emissivity[i] + w * emissivity[i + 1]
