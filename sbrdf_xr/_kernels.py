@@ -29,6 +29,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numba
+import numba.typed
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
@@ -259,20 +260,20 @@ def _gather(values, rows, wn, nk, f, acc_s, acc_p, ws, wp):  # pragma: no cover 
 
 
 @numba.njit(nogil=True, cache=True)
-def _fused_sums(s, o, normals, areas, term_mat, frac, values, tgrid, t_off, dgrid, d_off,
-                pgrid, p_off, node_off, edges, method, tol, edge_tol,
+def _fused_sums(s, o, normals, areas, term_mat, frac, tables, tgrid, t_off, dgrid, d_off,
+                pgrid, p_off, edges, method, tol, edge_tol,
                 out_sig, out_pap, out_area, out_lit, out_pm):  # pragma: no cover - compiled
     n_geom = s.shape[0]
     n_term = normals.shape[0]
-    n_wl = values.shape[1]
+    n_wl = out_sig.shape[1]
     has_frac = frac.shape[0] > 0
     want_pm = out_pm.shape[0] > 0
-    f = np.empty(n_wl, dtype=values.dtype)
-    acc_s = np.empty(n_wl, dtype=values.dtype)
-    acc_p = np.empty(n_wl, dtype=values.dtype)
-    wbuf = np.empty(2, dtype=values.dtype)
+    f = np.empty(n_wl, dtype=out_sig.dtype)
+    acc_s = np.empty(n_wl, dtype=out_sig.dtype)
+    acc_p = np.empty(n_wl, dtype=out_sig.dtype)
+    wbuf = np.empty(2, dtype=out_sig.dtype)
     rows = np.empty(64, dtype=np.int64)
-    wn = np.empty(64, dtype=values.dtype)
+    wn = np.empty(64, dtype=out_sig.dtype)
     it = np.empty(4, dtype=np.int64)
     idt = np.empty(4, dtype=np.int64)
     iph = np.empty(4, dtype=np.int64)
@@ -352,11 +353,10 @@ def _fused_sums(s, o, normals, areas, term_mat, frac, values, tgrid, t_off, dgri
                     acc_p[:] = 0.0
                     any_lookup = True
                 # gather the K = kt * kd * kp nodes, then sum them in passes of 4 rows
-                base = node_off[m]
                 nk = 0
                 for a in range(kt):
                     for b in range(kd):
-                        row0 = base + (it[a] * nd + idt[b]) * npp
+                        row0 = (it[a] * nd + idt[b]) * npp
                         wab = wt[a] * wdt[b]
                         for c in range(kp):
                             rows[nk] = row0 + iph[c]
@@ -366,7 +366,7 @@ def _fused_sums(s, o, normals, areas, term_mat, frac, values, tgrid, t_off, dgri
                 wbuf[1] = a2d
                 ws = wbuf[0]
                 wp = wbuf[1]
-                _gather(values, rows, wn, nk, f, acc_s, acc_p, ws, wp)
+                _gather(tables[m], rows, wn, nk, f, acc_s, acc_p, ws, wp)
             if any_lookup:
                 if method == 2:
                     for k in range(n_wl):
@@ -386,22 +386,25 @@ def _fused_sums(s, o, normals, areas, term_mat, frac, values, tgrid, t_off, dgri
 
 
 class PackedTables(NamedTuple):
-    """Material tables packed for the fused kernel (one flat node x spectral array).
+    """Material tables as the fused kernel reads them.
 
-    Material ``m`` owns rows ``node_off[m]:node_off[m + 1]`` of ``values`` (its
-    ``(theta_i, delta_theta, phi)`` nodes in C order) and the slices ``t_off[m]:t_off[m + 1]``
-    (likewise ``d_off``, ``p_off``) of the concatenated grids.
+    ``values[m]`` is material ``m``'s table as a ``(n_nodes, L)`` view (its
+    ``(theta_i, delta_theta, phi)`` nodes in C order; no copy of a C-contiguous table in
+    the right dtype); its grids are the slices ``t_off[m]:t_off[m + 1]`` (likewise
+    ``d_off``, ``p_off``) of the concatenated grids.
     """
 
-    values: NDArray[np.floating]  #: (n_nodes, L) [sr-1]
+    values: tuple[NDArray[np.floating], ...]  #: per material (n_nodes, L) [sr-1]
     tgrid: NDArray[np.float64]
     t_off: NDArray[np.int64]
     dgrid: NDArray[np.float64]
     d_off: NDArray[np.int64]
     pgrid: NDArray[np.float64]
     p_off: NDArray[np.int64]
-    node_off: NDArray[np.int64]
     edges: NDArray[np.bool_]  #: (M, 3) zero beyond delta_theta min, max, phi max
+    shapes: tuple[tuple[int, int, int], ...]  #: (n_theta, n_delta_theta, n_phi) per material
+    n_spectral: int
+    dtype: np.dtype
 
 
 def pack_tables(
@@ -420,18 +423,19 @@ def pack_tables(
         off = np.concatenate([[0], np.cumsum([a.size for a in arrays])]).astype(np.int64)
         return np.ascontiguousarray(np.concatenate(arrays), dtype=np.float64), off
 
+    dt = np.dtype(dtype)
     if not tables:
         z = np.zeros(1, dtype=np.int64)
-        return PackedTables(np.zeros((0, n_spectral), dtype=dtype), np.zeros(0), z, np.zeros(0), z, np.zeros(0), z, z,
-                            np.zeros((0, 3), dtype=bool))
+        return PackedTables((), np.zeros(0), z, np.zeros(0), z, np.zeros(0), z,
+                            np.zeros((0, 3), dtype=bool), (), n_spectral, dt)
     n_wl = tables[0][0].shape[-1]
-    values = np.ascontiguousarray(np.concatenate([v.reshape(-1, n_wl) for v, *_ in tables]))
+    values = tuple(np.ascontiguousarray(v, dtype=dt).reshape(-1, n_wl) for v, *_ in tables)
     tgrid, t_off = cat([np.asarray(t[1]) for t in tables])
     dgrid, d_off = cat([np.asarray(t[2]) for t in tables])
     pgrid, p_off = cat([np.asarray(t[3]) for t in tables])
-    node_off = np.concatenate([[0], np.cumsum([v[..., 0].size for v, *_ in tables])]).astype(np.int64)
     edges = np.array([t[4] for t in tables], dtype=bool).reshape(-1, 3)
-    return PackedTables(values, tgrid, t_off, dgrid, d_off, pgrid, p_off, node_off, edges)
+    shapes = tuple(tuple(int(x) for x in v.shape[:3]) for v, *_ in tables)
+    return PackedTables(values, tgrid, t_off, dgrid, d_off, pgrid, p_off, edges, shapes, n_wl, dt)
 
 
 class FusedSums(NamedTuple):
@@ -480,7 +484,7 @@ def fused_sums(
     Returns
     -------
     FusedSums
-        The spectral sums in the dtype of ``tables.values`` (no promotion of float32);
+        The spectral sums in the dtype of the tables (no promotion of float32);
         ``area`` and ``lit_visible_area`` in float64.  For ``cubic`` each material's
         sums are clipped at 0 as in :func:`material_sums`.
     """
@@ -490,8 +494,8 @@ def fused_sums(
     s = np.ascontiguousarray(to_sun, dtype=np.float64)
     o = np.ascontiguousarray(to_observer, dtype=np.float64)
     g = s.shape[0]
-    n_wl = tables.values.shape[1]
-    dt = tables.values.dtype
+    n_wl = tables.n_spectral
+    dt = tables.dtype
     n_mat = tables.edges.shape[0]
     out_sig = np.zeros((g, n_wl), dtype=dt)
     out_pap = np.zeros((g, n_wl), dtype=dt)
@@ -501,10 +505,11 @@ def fused_sums(
     frac = (np.zeros((0, 0)) if fraction is None
             else np.ascontiguousarray(fraction, dtype=np.float64))
     if g and normals.shape[0]:
+        typed = numba.typed.List(tables.values)
         _fused_sums(s, o, np.ascontiguousarray(normals, dtype=np.float64),
-                    np.ascontiguousarray(areas, dtype=np.float64), tm, frac, tables.values,
+                    np.ascontiguousarray(areas, dtype=np.float64), tm, frac, typed,
                     tables.tgrid, tables.t_off, tables.dgrid, tables.d_off, tables.pgrid,
-                    tables.p_off, tables.node_off, tables.edges, METHOD_CODES[method],
+                    tables.p_off, tables.edges, METHOD_CODES[method],
                     normal_incidence_tolerance(np.float64), _lut.EDGE_TOL_DEG,
                     out_sig, out_pap, out_area, out_lit, out_pm)
     return FusedSums(out_sig, out_pap, out_area, out_lit, out_pm if per_material else None)

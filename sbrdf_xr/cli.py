@@ -72,7 +72,12 @@ def _cmd_info(args: argparse.Namespace) -> int:
 def _cmd_bench(args: argparse.Namespace) -> int:
     from . import bench
 
-    rows = bench.run(quick=args.quick)
+    if args.engine:
+        from .bench_engine import engine_rows
+
+        rows = engine_rows(quick=args.quick)
+    else:
+        rows = bench.run(quick=args.quick)
     print(bench.format_rows(rows))
     ds = bench.rows_to_dataset(rows)
     if args.output:
@@ -207,6 +212,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     pb = sub.add_parser("bench", help="accuracy/cost benchmarks (timings as ratios)")
     pb.add_argument("--quick", action="store_true", help="small problems, for a smoke run")
+    pb.add_argument("--engine", action="store_true",
+                    help="engine rows: end-to-end sweeps, scaling, cores, kernel throughput")
     pb.add_argument("-o", "--output", help="write the table to this netCDF file")
     pb.add_argument("--csv", help="write the table to this CSV file")
     pb.add_argument("--plot", help="draw the accuracy/time front to this PNG file")

@@ -106,8 +106,8 @@ def reflected(plan: Plan, block: BlockInputs, to_source: np.ndarray, fraction: n
     if plan.knobs["kernel"] == "fused":
         return _kernels.fused_sums(to_source, block.to_observer, t.normal, t.area, t.material,
                                    plan.tables, plan.knobs["method"], fraction, per_material)
-    g, n_wl = to_source.shape[0], plan.tables.values.shape[1]
-    dt = plan.tables.values.dtype
+    g, n_wl = to_source.shape[0], plan.tables.n_spectral
+    dt = plan.tables.dtype
     sig, pap = np.zeros((g, n_wl), dt), np.zeros((g, n_wl), dt)
     area, lit = np.zeros(g), np.zeros(g)
     pm = np.zeros((g, len(plan.materials), n_wl), dt) if per_material else None

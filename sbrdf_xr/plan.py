@@ -149,7 +149,6 @@ class Plan:
     terms: Terms
     materials: tuple[str, ...]
     tables: PackedTables
-    table_shapes: tuple[tuple[int, int, int], ...]
     wavelength: np.ndarray
     bands: tuple[str, ...]
     band_weights: np.ndarray | None
@@ -194,8 +193,7 @@ class Plan:
                                      tuple[bool, bool, bool]]:
         """Table ``m`` unpacked: values (n_theta, n_delta_theta, n_phi, L), grids, zero edges."""
         t = self.tables
-        shape = self.table_shapes[m]
-        values = t.values[t.node_off[m]:t.node_off[m + 1]].reshape(*shape, -1)
+        values = t.values[m].reshape(*t.shapes[m], -1)
         grids = (t.tgrid[t.t_off[m]:t.t_off[m + 1]], t.dgrid[t.d_off[m]:t.d_off[m + 1]],
                  t.pgrid[t.p_off[m]:t.p_off[m + 1]])
         return values, grids, tuple(bool(x) for x in t.edges[m])  # type: ignore[return-value]
@@ -439,7 +437,6 @@ def compile_plan(scene: Scene) -> Plan:
     if knobs["evaluation"] == "analytic":
         models = _models(scene, used)
         tables = pack_tables([], len(scene.bands) if pre else wl.size, dtype)
-        shapes: tuple[tuple[int, int, int], ...] = ()
         steps.append(("materials", f"{len(used)} materials ({', '.join(used)}) evaluated by their "
                       f"BRDF models (analytic, no table), {dtype.name}"))
     else:
@@ -447,14 +444,14 @@ def compile_plan(scene: Scene) -> Plan:
         packed = []
         for m in used:
             da = _table_on(scene.materials[m], wl, knobs["table_theta_step"])
-            values = np.asarray(da.values, dtype=np.float64)
+            values = np.asarray(da.values)
             if pre:
-                values = values @ bw.T
-            packed.append((values.astype(dtype), *(np.asarray(da[d].values, dtype=np.float64)
+                values = np.asarray(values, dtype=np.float64) @ bw.T
+            packed.append((values, *(np.asarray(da[d].values, dtype=np.float64)
                                                    for d in ("theta_i", "delta_theta", "phi")),
                            table_edges(scene.materials[m].attrs)))
         tables = pack_tables(packed, len(scene.bands) if pre else wl.size, dtype)
-        shapes = tuple(p[0].shape[:3] for p in packed)
+        del packed
         res = "" if knobs["table_theta_step"] is None else f", theta_i resampled every {knobs['table_theta_step']:g} deg"
         steps.append(("materials", f"{len(used)} tabulated materials ({', '.join(used)}), "
                       f"{knobs['method']} look-up, {dtype.name}, {knobs['kernel']} kernel{res}"))
@@ -585,7 +582,7 @@ def compile_plan(scene: Scene) -> Plan:
     }
     plan = Plan(
         name=scene.name, description=scene.description, spacecraft=scene.spacecraft, geometry=geo,
-        terms=terms, materials=tuple(used), tables=tables, table_shapes=shapes,
+        terms=terms, materials=tuple(used), tables=tables,
         wavelength=_readonly(wl), bands=tuple(scene.bands),
         band_weights=None if bw is None else _readonly(bw), band_coords=MappingProxyType(band_coords),
         pre_integrated=pre, shadowing=shadowing, merged=merged,

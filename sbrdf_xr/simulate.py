@@ -41,6 +41,7 @@ from __future__ import annotations
 import os
 import uuid
 from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
 from typing import Any
 
 import dask.array as dsa
@@ -237,10 +238,62 @@ def simulate(
     return _dataset(the_plan, arrays)
 
 
-def write(cube: xr.Dataset, path: str | os.PathLike[str], **kwargs: Any) -> Any:
-    """Write a cube: netCDF block by block (:func:`sbrdf_xr._writer.write_cube`), or, for a
-    path ending in ``.zarr``, a Zarr store whose blocks the Dask workers write themselves.
+def write(cube: xr.Dataset, path: str | os.PathLike[str], **kwargs: Any) -> Path:
+    """Write a cube: netCDF block by block, or a Zarr store for a path ending in ``.zarr``.
 
-    See :func:`sbrdf_xr._writer.write_cube` for the keyword arguments.
+    netCDF (the default): :func:`sbrdf_xr._writer.write_cube` (atomic, resumable, the
+    calling process writes; see it for the keyword arguments).  Zarr: every block is
+    computed *and written* by the Dask worker (or thread) that computes it, so adding
+    workers to a cluster speeds the whole sweep up; the store is written as
+    ``<path>.part`` and renamed when complete (keywords ``overwrite``, ``client``,
+    ``progress``).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
     """
+    if str(path).rstrip("/").endswith(".zarr"):
+        return _write_zarr(cube, Path(path), **kwargs)
     return write_cube(cube, path, **kwargs)
+
+
+def _write_zarr(cube: xr.Dataset, path: Path, *, overwrite: bool = False, client: Any = None,
+                progress: bool = False, resume: bool = False, scheduler: str | None = None) -> Path:
+    import shutil
+
+    from .errors import ValidationError
+
+    if resume:
+        raise ValidationError("resume: supported for netCDF cubes; a Zarr store is rewritten whole")
+    if scheduler is not None and client is None:
+        raise ValidationError("scheduler: for a Zarr store pass client= (a dask.distributed.Client)")
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{path} exists; pass --overwrite (overwrite=True) to replace it")
+    if path.exists() and not path.is_dir():
+        raise ValidationError(f"{path} exists and is not a Zarr store (a directory); not replaced")
+    part = path.with_name(path.name + ".part")
+    if part.exists():
+        shutil.rmtree(part)
+    ds = cube.copy()
+    for v in ds.variables.values():
+        v.encoding = {}
+    job = ds.to_zarr(part, mode="w", compute=False, consolidated=True, zarr_format=2)
+    if client is not None:
+        fut = client.compute(job)
+        if progress:
+            from distributed import progress as dist_progress
+
+            dist_progress(fut)
+        fut.result()
+    elif progress:
+        from dask.diagnostics import ProgressBar
+
+        with ProgressBar():
+            job.compute()
+    else:
+        job.compute()
+    if path.exists():
+        shutil.rmtree(path)
+    os.replace(part, path)
+    return path

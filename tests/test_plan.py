@@ -1,0 +1,171 @@
+"""Tests of sbrdf_xr.plan, sbrdf_xr.knobs and sbrdf_xr.effects: the plan is data."""
+
+from __future__ import annotations
+
+import dask
+import numpy as np
+import pytest
+import xarray as xr
+
+from sbrdf_xr import catalog, geometry, knobs
+from sbrdf_xr import testing as T
+from sbrdf_xr.effects import EFFECTS, OUTPUTS
+from sbrdf_xr.errors import SceneError
+from sbrdf_xr.plan import Plan
+from sbrdf_xr.scene import Scene
+from sbrdf_xr.simulate import simulate, write
+
+RTOL = 1e-12  # reordered float64 sums (see tests/test_kernels.py)
+
+
+class _RaiseIfComputes:
+    def __call__(self, dsk, keys, **kwargs):
+        raise AssertionError("graph building triggered a dask computation")
+
+
+def scene(**kw):
+    sc = T.cube_spacecraft(1.0, subdivisions=2)
+    table = kw.pop("table", None)
+    mats = {T.TEST_SPACECRAFT_MATERIAL: catalog.load("example-lobe") if table is None else table}
+    kw.setdefault("attitudes", geometry.uniform_attitudes(30, seed=4))
+    kw.setdefault("phase_angles", [20.0, 70.0])
+    return Scene(sc, materials=mats, **kw)
+
+
+def test_plan_fields_describe_what_runs():
+    p = scene().plan()
+    assert isinstance(p, Plan)
+    assert p.merged and not p.shadowing and p.effects == ("sunlight",)
+    assert p.terms.size == 6 and int(p.terms.n_facets.sum()) == 48
+    assert p.materials == (T.TEST_SPACECRAFT_MATERIAL,)
+    assert p.output_names == ("spacecraft_sbrdf", "signal", "brdf", "area")
+    out = {o.name: o for o in p.outputs}
+    assert out["signal"].dims == ("attitude", "phase_angle", "wavelength")
+    assert out["signal"].shape == (30, 2, p.wavelength.size)
+    assert out["signal"].attrs["units"] == "m2 sr-1" and out["area"].dtype == np.float64
+    assert p.knobs["method"] == "linear" and p.knobs["kernel"] == "fused"
+    assert p.estimate.n_geometries == 60 and p.estimate.output_bytes == sum(o.nbytes for o in p.outputs)
+    assert p.n_blocks == 1 and p.chunk == 30  # a small scene is one block
+    with pytest.raises(AttributeError):
+        p.chunk = 3  # frozen
+    assert not p.terms.normal.flags.writeable
+
+
+def test_plan_is_cached_and_options_make_a_new_one():
+    s = scene()
+    assert s.plan() is s.plan()
+    assert s.with_options(method="cubic").plan() is not s.plan()
+
+
+def test_band_only_scene_pre_integrates_and_equals_the_spectral_route():
+    s = scene(outputs=("band_signal", "area"), bands=("V", "R", "I"))
+    p = s.plan()
+    assert p.pre_integrated and p.tables.n_spectral == 3
+    assert p.output_names == ("band_signal", "area")
+    assert any("pre-integrated" in why for _, why in p.steps)
+    pre = simulate(s).compute()
+    spectral = simulate(s, band_integration="spectral").compute()
+    assert not spectral.attrs["plan"].count("pre-integrated over")
+    # linear look-up and a linear band integral commute: exact to rounding
+    np.testing.assert_allclose(pre.band_signal, spectral.band_signal, rtol=1e-11, atol=1e-18)
+
+
+def test_in_process_and_lazy_cubes_are_identical():
+    s = scene()
+    eager = simulate(s)
+    assert not any(isinstance(v.data, dask.array.Array) for v in eager.variables.values())
+    with dask.config.set(scheduler=_RaiseIfComputes()):
+        lazy = simulate(s, lazy=True)
+    assert lazy.signal.chunks is not None
+    xr.testing.assert_identical(eager, lazy.compute())
+    xr.testing.assert_identical(eager, simulate(s.plan()))
+
+
+def test_one_task_per_block_and_the_plan_once_in_the_graph():
+    s = scene(chunk=7)
+    cube = simulate(s)
+    graph = dict(cube.__dask_graph__())
+    blocks = [k for k in graph if isinstance(k, tuple) and str(k[0]).startswith("sbrdf-block-")]
+    plans = [k for k, v in graph.items() if isinstance(v, Plan)]
+    assert len(blocks) == 5 and len(plans) == 1  # 30 attitudes in blocks of 7
+
+
+def test_knob_table_and_presets():
+    assert set(knobs.PRESETS) == {"fast", "balanced", "reference"}
+    for preset in knobs.PRESETS.values():
+        for k, v in preset.items():
+            assert knobs.check_knob(k, v) == v
+    s = scene().with_options(preset="reference")
+    assert s.method == "cubic" and s.shadow_method == "exact"
+    assert "shadow_method" in knobs.knob_table()
+    with pytest.raises(SceneError, match="shadow_density: got 100000"):
+        scene(shadow_density=100_000)
+    with pytest.raises(SceneError, match="preset: unknown 'slow'"):
+        scene().with_options(preset="slow")
+    with pytest.raises(SceneError, match="kernel: got 'gpu'; allowed: fused, numpy"):
+        scene(kernel="gpu")
+
+
+def test_a_plan_beyond_reason_is_refused_before_anything_is_allocated():
+    # 1e6 attitudes x 2e5 "wavelengths" of a synthetic table: 3.2 TB of outputs
+    big = T.make_material(n_wavelength=3)
+    s = Scene(T.cube_spacecraft(), materials={T.TEST_SPACECRAFT_MATERIAL: big},
+              attitudes=geometry.uniform_attitudes(200, seed=1), phase_angles=np.linspace(1, 179, 5000),
+              outputs=("signal", "area"))
+    with pytest.raises(SceneError, match=r"beyond reason: .* raise the limits with size_limit"):
+        s.with_options(size_limit=1e-9).plan()
+    assert s.with_options(size_limit=1.0).plan().estimate.n_geometries == 1_000_000
+
+
+def test_wavelength_stride_and_table_resolution_knobs():
+    s = scene()
+    full = s.plan()
+    half = s.with_options(wavelength_stride=2).plan()
+    np.testing.assert_array_equal(half.wavelength, full.wavelength[::2])
+    coarse = s.with_options(table_theta_step=10.0).plan()
+    assert coarse.tables.shapes[0][0] == 10  # 0, 10, ..., 90
+    assert any("resampled every 10 deg" in why for _, why in coarse.steps)
+
+
+def test_analytic_evaluation_is_a_simulation_option():
+    """A Lambertian model against a Lambertian table: the same sums (the table is exact)."""
+    lam = catalog.load("lambertian-grey-50")
+    from sbrdf_xr import models
+
+    spec = models.model_material("lambert", lam.wavelength.values, rho=0.5, material="grey",
+                                 provenance="albedo 0.5, as the lambertian-grey-50 table")
+    s = scene(table=lam, models={T.TEST_SPACECRAFT_MATERIAL: spec})
+    a = simulate(s, evaluation="analytic")
+    t = simulate(s)
+    np.testing.assert_allclose(a.signal, t.signal, rtol=1e-6)
+
+
+def test_every_effect_and_output_is_declared_once_with_attrs():
+    for o in OUTPUTS.values():
+        assert o.units and o.long_name
+    for e in EFFECTS.values():
+        assert all(v in OUTPUTS for v in e.outputs)
+    s = scene(effects=("sunlight", "earthshine"))
+    cube = simulate(s)
+    for v in cube.data_vars:
+        assert cube[v].attrs == OUTPUTS[v].attrs
+
+
+def test_zarr_store_by_blocks_equals_netcdf(tmp_path):
+    pytest.importorskip("zarr")
+    cube = simulate(scene(chunk=8))
+    nc = write(cube, tmp_path / "c.nc")
+    zs = write(cube, tmp_path / "c.zarr")
+    assert not (tmp_path / "c.zarr.part").exists()
+    with xr.open_dataset(nc) as a, xr.open_zarr(zs) as b:
+        xr.testing.assert_identical(a.load(), b.load())
+    with pytest.raises(FileExistsError):
+        write(cube, tmp_path / "c.zarr")
+
+
+def test_simulate_refuses_a_plan_mixed_with_options():
+    s = scene()
+    with pytest.raises(SceneError, match="already compiled"):
+        simulate(s.plan(), method="cubic")
+    with pytest.raises(SceneError, match="not this scene's own plan"):
+        simulate(s, plan=scene(method="cubic").plan())
