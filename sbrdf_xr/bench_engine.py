@@ -105,8 +105,8 @@ def sweep_job(n: int, path: str, bands: bool = False, mode: str = "write", worke
 
 
 def _subprocess(n: int, bands: bool = False, mode: str = "write", workers: int = 0,
-                threads: int | None = None) -> dict[str, float]:
-    with tempfile.TemporaryDirectory(prefix="sbrdf-bench-") as tmp:
+                threads: int | None = None, where: str | None = None) -> dict[str, float]:
+    with tempfile.TemporaryDirectory(prefix="sbrdf-bench-", dir=where) as tmp:
         path = str(Path(tmp) / ("cube.zarr" if mode == "zarr" else "cube.nc"))
         env = dict(os.environ)
         if threads is not None:

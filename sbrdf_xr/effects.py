@@ -16,17 +16,30 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from . import _kernels, sources
 from ._names import BAND, MATERIAL, WAVELENGTH
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .plan import BlockInputs, Plan
+#: The compiled plan effects run on (:class:`sbrdf_xr.plan.Plan`, which imports this module).
+Plan = Any
 
-__all__ = ["EFFECTS", "OUTPUTS", "SPECTRAL_OUTPUTS", "Effect", "Output", "finish", "reflected"]
+
+@dataclass(frozen=True)
+class BlockInputs:
+    """Body-frame directions of one block of geometries, flattened to (G, 3)."""
+
+    to_sun: np.ndarray
+    to_observer: np.ndarray
+    to_earth: np.ndarray | None
+    sun_scale: np.ndarray | None  #: (G,) sunlit fraction of the solar disc, or None (1)
+    lead_shape: tuple[int, ...]  #: the block's geometry dimensions before flattening
+
+
+
+__all__ = ["EFFECTS", "OUTPUTS", "SPECTRAL_OUTPUTS", "BlockInputs", "Effect", "Output", "finish", "reflected"]
 
 
 @dataclass(frozen=True)

@@ -20,10 +20,11 @@ thermal emission is skipped where it is negligible.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -32,11 +33,11 @@ from . import __version__, sources
 from ._kernels import PackedTables, pack_tables
 from ._lut import table_edges
 from ._names import BAND, MATERIAL, WAVELENGTH
-from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS
+from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS, BlockInputs
 from .errors import SceneError, ValidationError
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .scene import Scene
+#: The scene being compiled (:class:`sbrdf_xr.scene.Scene`, which imports this module).
+Scene = Any
 
 __all__ = ["BlockInputs", "Estimate", "Plan", "PlannedOutput", "Terms", "compile_plan"]
 
@@ -45,6 +46,10 @@ THERMAL_NEGLIGIBLE = 1e-6
 #: Largest number of (geometry x term) dot products evaluated at once when
 #: searching for terms never lit and visible.
 _DROP_BLOCK = 2_000_000
+#: Default blocks: at least this many per core (load balance), of at least MIN_CHUNK
+#: geometries (task overhead), within the knob block_bytes (memory).
+BLOCKS_PER_CORE = 4
+MIN_CHUNK = 1024
 #: Plans whose outputs would exceed this many bytes are refused (override with the
 #: scene field ``size_limit``).
 SIZE_LIMIT_BYTES = 2 * 2**40
@@ -82,17 +87,6 @@ class Terms:
     def size(self) -> int:
         """Number of terms."""
         return int(self.area.size)
-
-
-@dataclass(frozen=True)
-class BlockInputs:
-    """Body-frame directions of one block of geometries, flattened to (G, 3)."""
-
-    to_sun: np.ndarray
-    to_observer: np.ndarray
-    to_earth: np.ndarray | None
-    sun_scale: np.ndarray | None  #: (G,) sunlit fraction of the solar disc, or None (1)
-    lead_shape: tuple[int, ...]  #: the block's geometry dimensions before flattening
 
 
 @dataclass(frozen=True)
@@ -541,7 +535,11 @@ def compile_plan(scene: Scene) -> Plan:
 
     # ---- blocks and estimate
     per_lead = sum(o.nbytes for o in outputs) / max(1, geo.n_lead)
-    chunk = knobs["chunk"] or max(1, min(geo.n_lead, int(knobs["block_bytes"] // max(1.0, per_lead))))
+    chunk = knobs["chunk"]
+    if chunk is None:  # within the memory budget, and enough blocks to keep every core busy
+        by_memory = int(knobs["block_bytes"] // max(1.0, per_lead))
+        by_cores = -(-geo.n_lead // (BLOCKS_PER_CORE * (os.cpu_count() or 1)))
+        chunk = max(1, min(by_memory, max(MIN_CHUNK, by_cores)))
     chunk = min(chunk, max(1, geo.n_lead))
     out_bytes = sum(o.nbytes for o in outputs)
     nodes = {"nearest": 1, "linear": 8, "cubic": 64}[knobs["method"]]

@@ -28,12 +28,12 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from . import geometry
-from ._names import ATTITUDE, GEOMETRY, PHASE_ANGLE, VECTOR, attrs
 from .effects import SCENE_OUTPUTS, SPECTRAL_OUTPUTS
 from .errors import SceneError, ValidationError
 from .knobs import KNOBS, PRESETS, apply_preset, check_knob
 from .material import validate_material
-from .plan import BlockInputs, Plan, compile_plan
+from .plan import Plan, compile_plan
+from .sweep import GridGeometry, PairGeometry
 
 __all__ = ["EFFECTS", "OUTPUTS", "PRESETS", "GridGeometry", "PairGeometry", "Scene",
            "builtin_scene", "builtin_scenes", "load_scene"]
@@ -44,8 +44,6 @@ OUTPUTS = tuple(SCENE_OUTPUTS)
 EFFECTS = ("sunlight", "shadowing", "earthshine", "thermal")
 _ = SPECTRAL_OUTPUTS  # re-exported
 
-#: Component names of the attitude quaternions (scalar last).
-QUATERNION_COMPONENTS = ("x", "y", "z", "w")
 
 _UNIT_TOL = 1e-6
 
@@ -64,140 +62,6 @@ def _unit_vectors(v: ArrayLike, name: str) -> np.ndarray:
             f"directions must be unit vectors (|length - 1| <= {_UNIT_TOL})"
         )
     return arr / norm[:, None]
-
-
-@dataclass(frozen=True)
-class GridGeometry:
-    """Attitudes x phase angles in an observation plane (paper 000 Figs. 12-13).
-
-    Sun and observer directions lie in the reference-frame plane of ``bisector`` and
-    ``plane_normal``, ``phase_angle / 2`` either side of the bisector; each attitude
-    (body -> reference quaternion) turns them into the body frame.
-    """
-
-    attitudes: np.ndarray  #: (n, 4) scalar-last quaternions
-    phase_angles: np.ndarray  #: (P,) [degree]
-    sun_ref: np.ndarray  #: (P, 3)
-    obs_ref: np.ndarray  #: (P, 3)
-    earth_ref: np.ndarray | None  #: (P, 3), with earthshine
-    attitude_angle: np.ndarray | None = None
-    sun_scale: None = None
-
-    @property
-    def dims(self) -> tuple[str, str]:
-        return (ATTITUDE, PHASE_ANGLE)
-
-    @property
-    def shape(self) -> tuple[int, int]:
-        return (len(self.attitudes), len(self.phase_angles))
-
-    @property
-    def n_lead(self) -> int:
-        return len(self.attitudes)
-
-    @property
-    def n_geometries(self) -> int:
-        return len(self.attitudes) * len(self.phase_angles)
-
-    @property
-    def attrs(self) -> dict[str, Any]:
-        return {}
-
-    def describe(self) -> str:
-        return (f"{self.n_lead} attitudes x {len(self.phase_angles)} phase angles = "
-                f"{self.n_geometries} geometries")
-
-    def block(self, sl: slice) -> BlockInputs:
-        """Body-frame directions of the attitudes in ``sl`` (flattened to (n * P, 3))."""
-        from scipy.spatial.transform import Rotation
-
-        q = self.attitudes[sl]  # unit quaternions, checked by the Scene
-        p = len(self.phase_angles)
-        refs = [self.sun_ref, self.obs_ref] + ([] if self.earth_ref is None else [self.earth_ref])
-        # v_body = R^T v for every attitude, as row vectors: v^T R
-        body = np.matmul(np.concatenate(refs)[None], Rotation.from_quat(q).as_matrix()) if len(q) else \
-            np.zeros((0, len(refs) * p, 3))
-        s, o = body[:, :p].reshape(-1, 3), body[:, p:2 * p].reshape(-1, 3)
-        e = None if self.earth_ref is None else body[:, 2 * p:].reshape(-1, 3)
-        return BlockInputs(s, o, e, None, (len(q), p))
-
-    def coords(self) -> dict[str, Any]:
-        """Coordinates of a cube over this geometry."""
-        b = self.block(slice(None))
-        s, o = b.to_sun.reshape(*self.shape, 3), b.to_observer.reshape(*self.shape, 3)
-        c: dict[str, Any] = {
-            ATTITUDE: (ATTITUDE, np.arange(self.n_lead), attrs("attitude")),
-            PHASE_ANGLE: (PHASE_ANGLE, np.asarray(self.phase_angles), attrs(PHASE_ANGLE)),
-            "quaternion": ((ATTITUDE, "component"), self.attitudes, attrs("quaternion")),
-            "component": ("component", list(QUATERNION_COMPONENTS), attrs("component")),
-            "to_sun": ((ATTITUDE, PHASE_ANGLE, VECTOR), s, attrs("to_sun")),
-            "to_observer": ((ATTITUDE, PHASE_ANGLE, VECTOR), o, attrs("to_observer")),
-        }
-        if self.attitude_angle is not None:
-            c["attitude_angle"] = (ATTITUDE, np.asarray(self.attitude_angle, dtype=np.float64),
-                                   attrs("attitude_angle"))
-        return c
-
-
-@dataclass(frozen=True)
-class PairGeometry:
-    """Explicit ``(to_sun, to_observer)`` pairs in the body frame, one per geometry.
-
-    ``dim`` names the dimension (``geometry``, or ``time`` for an observation);
-    ``sun_scale`` is the sunlit fraction of the solar disc per geometry (the Earth's
-    shadow), or None; ``extra_coords`` are further coordinates along ``dim``.
-    """
-
-    to_sun: np.ndarray
-    to_observer: np.ndarray
-    to_earth: np.ndarray | None = None
-    sun_scale: np.ndarray | None = None
-    dim: str = GEOMETRY
-    index: Any = None
-    extra_coords: Mapping[str, Any] = field(default_factory=dict)
-    extra_attrs: Mapping[str, Any] = field(default_factory=dict)
-
-    @property
-    def dims(self) -> tuple[str]:
-        return (self.dim,)
-
-    @property
-    def shape(self) -> tuple[int]:
-        return (len(self.to_sun),)
-
-    @property
-    def n_lead(self) -> int:
-        return len(self.to_sun)
-
-    @property
-    def n_geometries(self) -> int:
-        return len(self.to_sun)
-
-    @property
-    def attrs(self) -> dict[str, Any]:
-        return dict(self.extra_attrs)
-
-    def describe(self) -> str:
-        what = "times of an observation" if self.dim != GEOMETRY else "explicit (to_sun, to_observer) pairs"
-        return f"{self.n_lead} {what}"
-
-    def block(self, sl: slice) -> BlockInputs:
-        e = None if self.to_earth is None else self.to_earth[sl]
-        sc = None if self.sun_scale is None else self.sun_scale[sl]
-        s = self.to_sun[sl]
-        return BlockInputs(s, self.to_observer[sl], e, sc, (s.shape[0],))
-
-    def coords(self) -> dict[str, Any]:
-        d = self.dim
-        index = np.arange(self.n_lead) if self.index is None else self.index
-        c: dict[str, Any] = {
-            d: (d, index, attrs(d) if d == GEOMETRY else self.extra_coords.get(f"{d}_attrs", {})),
-            PHASE_ANGLE: (d, geometry.phase_angle(self.to_sun, self.to_observer), attrs(PHASE_ANGLE)),
-            "to_sun": ((d, VECTOR), self.to_sun, attrs("to_sun")),
-            "to_observer": ((d, VECTOR), self.to_observer, attrs("to_observer")),
-        }
-        c.update({k: v for k, v in self.extra_coords.items() if not k.endswith("_attrs")})
-        return c
 
 
 @dataclass(frozen=True)
