@@ -93,6 +93,9 @@ KNOBS: dict[str, Knob] = {k.name: k for k in (
     Knob("evaluation", "table", ("table", "analytic"), None,
          "table: look-up tables; analytic: each material's generating BRDF model (no table error, "
          "much slower)"),
+    Knob("tilt_nodes", 5, None, _positive_int(32),
+         "surface imperfections: Gauss-Hermite nodes per tangent axis of the normal-tilt "
+         "distribution (tilt_nodes**2 copies of every term)"),
     Knob("kernel", "fused", ("fused", "numpy"), None,
          "fused: the compiled one-pass kernel; numpy: the reference implementation (same sums)"),
     Knob("chunk", None, None, _optional_positive_int(10**9),

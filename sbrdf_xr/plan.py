@@ -255,6 +255,32 @@ def _terms(scene: Scene, shadowing: bool, steps: list[tuple[str, str]]) -> tuple
     return t, merge
 
 
+def _tilt(scene: Scene, raw: dict[str, np.ndarray], nodes: int,
+          steps: list[tuple[str, str]]) -> dict[str, np.ndarray]:
+    """Terms replaced by their tilted copies where the scene asks for surface imperfections."""
+    from .imperfections import tilt_quadrature, tilted_normals
+
+    st = scene.surface_tilt
+    sigma = np.array([float(st.get(m, 0.0)) if isinstance(st, Mapping) else float(st)
+                      for m in raw["material"].tolist()])
+    if not np.any(sigma > 0):
+        steps.append(("imperfections", "none: perfect CAD facets (surface_tilt = 0)"))
+        return raw
+    parts: list[dict[str, np.ndarray]] = []
+    for j in range(raw["area"].size):
+        t, w = tilt_quadrature(sigma[j], nodes)
+        part = {k: np.repeat(v[j:j + 1], w.size, axis=0) for k, v in raw.items()}
+        part["normal"] = tilted_normals(raw["normal"][j:j + 1], t)[0]
+        part["area"] = raw["area"][j] * w
+        parts.append(part)
+    out = {k: np.concatenate([p[k] for p in parts]) for k in raw}
+    what = (f"sigma {float(st):g} deg" if not isinstance(st, Mapping)
+            else ", ".join(f"{m} {float(v):g} deg" for m, v in st.items()))
+    steps.append(("imperfections", f"facet normals tilted by a Gaussian ({what}; paper 000 section 5), "
+                  f"{nodes}x{nodes} Gauss-Hermite copies per term: {raw['area'].size} -> {out['area'].size} terms"))
+    return out
+
+
 def _contributing(scene: Scene, normals: np.ndarray) -> np.ndarray:
     """Boolean per term: lit (by the Sun, or the Earth with earthshine) and visible for
     at least one geometry of the sweep; with thermal emission, visible is enough."""
@@ -401,6 +427,7 @@ def compile_plan(scene: Scene) -> Plan:
                           "clipping (non-convex body)"))
 
     raw, merged = _terms(scene, shadowing, steps)
+    raw = _tilt(scene, raw, knobs["tilt_nodes"], steps)
     keep = _contributing(scene, raw["normal"])
     if not keep.all():
         raw = {k: v[keep] for k, v in raw.items()}

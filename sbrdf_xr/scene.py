@@ -101,6 +101,11 @@ class Scene:
         Sampled shadowing: samples per facet side.
     wavelength_stride, band_integration, table_theta_step, evaluation, kernel, block_bytes
         The other numerical knobs (:data:`sbrdf_xr.knobs.KNOBS` says what each trades).
+    surface_tilt : float or mapping of str to float
+        Surface imperfections (paper 000 §5): standard deviation [degree] of each
+        tangent component of a Gaussian tilt of the facet normals, for all facets or
+        per material (:mod:`sbrdf_xr.imperfections`); 0, the default, is the perfect
+        CAD facet.  ``tilt_nodes`` sets the quadrature.
     chunk : int, optional
         Geometries per block along the attitude (or geometry) dimension; default from
         ``block_bytes``.  Given explicitly, :func:`~sbrdf_xr.simulate.simulate` always
@@ -157,6 +162,8 @@ class Scene:
     table_theta_step: float | None = None
     evaluation: str = "table"
     kernel: str = "fused"
+    tilt_nodes: int = 5
+    surface_tilt: float | Mapping[str, float] = 0.0
     chunk: int | None = None
     block_bytes: int = 32 * 2**20
     bands: Sequence[str] = ()
@@ -182,6 +189,10 @@ class Scene:
             raise SceneError(f"effects: unknown {bad}; allowed: {', '.join(EFFECTS)}")
         for k in KNOBS:
             check_knob(k, getattr(self, k))
+        tilts = self.surface_tilt.values() if isinstance(self.surface_tilt, Mapping) else [self.surface_tilt]
+        if any(isinstance(x, bool) or not isinstance(x, int | float) or not (np.isfinite(x) and 0 <= x <= 45)
+               for x in tilts):
+            raise SceneError(f"surface_tilt: expected tilts in [0, 45] degree, got {self.surface_tilt!r}")
         if not (isinstance(self.size_limit, int | float) and np.isfinite(self.size_limit)
                 and self.size_limit > 0):
             raise SceneError(f"size_limit: must be a positive factor, got {self.size_limit!r}")
@@ -325,7 +336,8 @@ _SCENE_KEYS = {
     "geometry": dict, "outputs": list, "effects": list, "method": str, "dtype": str,
     "merge": bool, "shadow_method": str, "shadow_density": int, "chunk": int,
     "wavelength_stride": int, "band_integration": str, "table_theta_step": (int, float),
-    "evaluation": str, "kernel": str, "block_bytes": int, "size_limit": (int, float), "bands": list, "band_extrapolate": str,
+    "evaluation": str, "kernel": str, "block_bytes": int, "size_limit": (int, float),
+    "tilt_nodes": int, "surface_tilt": (int, float, dict), "bands": list, "band_extrapolate": str,
     "earth_direction": list, "earth_albedo": (int, float), "earth_range_km": (int, float),
     "earth_phase_angle": (int, float), "temperature": (int, float, dict),
 }
@@ -380,7 +392,7 @@ def scene_from_dict(d: Mapping[str, Any]) -> Scene:
             if not isinstance(entry, str):
                 raise SceneError(f"[materials]: {mat!r} must name a catalog entry (a string)")
             materials[mat] = catalog.load(entry)
-    kw: dict[str, Any] = {k: d[k] for k in ("name", "description", *KNOBS, "merge", "size_limit",
+    kw: dict[str, Any] = {k: d[k] for k in ("name", "description", *KNOBS, "merge", "size_limit", "surface_tilt",
                                                "earth_albedo", "band_extrapolate",
                                                "earth_range_km", "earth_phase_angle",
                                                "temperature") if k in d}
