@@ -13,10 +13,10 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
-from sbrdf_xr.scene import builtin_scene  # noqa: E402
-from sbrdf_xr.simulate import simulate  # noqa: E402
+from sbrdf_xr.scene import builtin_scene
+from sbrdf_xr.simulate import simulate
 
 OUT = Path(__file__).parent / "img" / "canx1_imperfections.png"
 
