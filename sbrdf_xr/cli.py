@@ -102,8 +102,11 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     from .simulate import simulate, write
 
     scene = resolve_scene(args.scene)
+    changes = _knob_values(args.set or [])
     if args.preset:
-        scene = scene.with_options(preset=args.preset)
+        scene = scene.with_options(preset=args.preset, **changes)
+    elif changes:
+        scene = scene.with_options(**changes)
     plan = scene.plan()
     print(plan)
     if args.plan:
@@ -115,14 +118,43 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         client = Client(args.scheduler)
     try:
         cube = simulate(plan, client=client)
+        extra = {} if str(args.output).endswith(".zarr") else {"complevel": args.complevel}
         path = write(cube, args.output, overwrite=args.overwrite, resume=args.resume,
-                     client=client, progress=not args.quiet)
+                     client=client, progress=not args.quiet, **extra)
     finally:
         if client is not None:
             client.close()
     print(f"wrote {path}")
     if args.plot:
         _save_figure(path, args.plot)
+    return 0
+
+
+def _knob_values(items: list[str]) -> dict[str, object]:
+    """``NAME=VALUE`` strings as knob values (TOML syntax for the value, else a string)."""
+    import tomllib
+
+    from .errors import SceneError
+    from .knobs import KNOBS
+
+    out: dict[str, object] = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        name = name.strip()
+        if not sep or name not in KNOBS:
+            raise SceneError(f"--set {item!r}: expected NAME=VALUE with NAME one of {', '.join(KNOBS)}")
+        try:
+            value = tomllib.loads(f"v = {text.strip()}")["v"]
+        except tomllib.TOMLDecodeError:
+            value = text.strip()
+        out[name] = None if value == "none" else value
+    return out
+
+
+def _cmd_knobs(args: argparse.Namespace) -> int:
+    from .knobs import knob_table
+
+    print(knob_table())
     return 0
 
 
@@ -210,6 +242,9 @@ def build_parser() -> argparse.ArgumentParser:
     pi.add_argument("file", nargs="?")
     pi.set_defaults(func=_cmd_info)
 
+    pk = sub.add_parser("knobs", help="the numerical knobs, their defaults and the presets")
+    pk.set_defaults(func=_cmd_knobs)
+
     pb = sub.add_parser("bench", help="accuracy/cost benchmarks (timings as ratios)")
     pb.add_argument("--quick", action="store_true", help="small problems, for a smoke run")
     pb.add_argument("--engine", action="store_true",
@@ -224,6 +259,11 @@ def build_parser() -> argparse.ArgumentParser:
     psim.add_argument("-o", "--output", required=True, help="netCDF file to write")
     psim.add_argument("--scheduler", help="address of a dask.distributed scheduler (default: threads)")
     psim.add_argument("--preset", help="numerical preset: fast, balanced or reference")
+    psim.add_argument("--set", action="append", metavar="KNOB=VALUE",
+                      help="set a numerical knob (repeatable; 'sbrdf-xr knobs' lists them), e.g. "
+                           "--set method=cubic --set dtype=float32")
+    psim.add_argument("--complevel", type=int, default=4, choices=range(10), metavar="0-9",
+                      help="zlib compression level of the netCDF cube (default 4; 0: none, fastest)")
     psim.add_argument("--plot", help="also write the cube's figure to this PNG file")
     g = psim.add_mutually_exclusive_group()
     g.add_argument("--overwrite", action="store_true", help="replace an existing output file")
