@@ -594,7 +594,7 @@ class QuaternionSeries(AttitudeLaw):
         if missing:
             raise AttitudeError(f"quaternion_series: {path} lacks the columns {missing}; has {list(df.columns)}")
         tcol = df[time_column]
-        if np.issubdtype(tcol.dtype, np.number):
+        if pd.api.types.is_numeric_dtype(tcol):
             t = tcol.to_numpy(np.float64)
         else:
             t = pd.to_datetime(tcol, utc=True).dt.tz_localize(None).to_numpy("datetime64[ns]")
