@@ -487,20 +487,28 @@ class Tumble(AttitudeLaw):
         """
         return cls(spacecraft.inertia(density_kg_m3), omega_deg_s, initial, epoch)
 
-    def _rhs(self, t: float, y: np.ndarray) -> np.ndarray:
-        i = self.inertia
-        w = y[:3]
-        x, yq, z, s = y[3:]
-        dw = np.linalg.solve(i, -np.cross(w, i @ w))
-        # dq/dt = 1/2 q (x) (w, 0), scalar-last Hamilton product.
-        wx, wy, wz = w
-        dq = 0.5 * np.array([
-            s * wx + yq * wz - z * wy,
-            s * wy + z * wx - x * wz,
-            s * wz + x * wy - yq * wx,
-            -(x * wx + yq * wy + z * wz),
-        ])
-        return np.concatenate([dw, dq])
+    def _rhs_function(self):
+        """Right-hand side of Euler's equations and the kinematics, on plain floats (fast)."""
+        (a, b, c), (d, e, f), (g, h, k) = self.inertia.tolist()
+        (ia, ib, ic), (id_, ie, if_), (ig, ih, ik) = np.linalg.inv(self.inertia).tolist()
+
+        def rhs(t: float, y: np.ndarray) -> list[float]:
+            wx, wy, wz, x, yq, z, s = y.tolist()
+            lx, ly, lz = a * wx + b * wy + c * wz, d * wx + e * wy + f * wz, g * wx + h * wy + k * wz
+            # I dw/dt = -w x (I w) = (I w) x w
+            tx, ty, tz = ly * wz - lz * wy, lz * wx - lx * wz, lx * wy - ly * wx
+            return [
+                ia * tx + ib * ty + ic * tz,
+                id_ * tx + ie * ty + if_ * tz,
+                ig * tx + ih * ty + ik * tz,
+                # dq/dt = 1/2 q (x) (w, 0), scalar-last Hamilton product.
+                0.5 * (s * wx + yq * wz - z * wy),
+                0.5 * (s * wy + z * wx - x * wz),
+                0.5 * (s * wz + x * wy - yq * wx),
+                -0.5 * (x * wx + yq * wy + z * wz),
+            ]
+
+        return rhs
 
     def states(self, times: ArrayLike, context: Context | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Body angular velocity [rad s-1] and attitude at ``times``.
@@ -513,6 +521,7 @@ class Tumble(AttitudeLaw):
         from scipy.integrate import solve_ivp
 
         t = _seconds(times, self.epoch, context)
+        rhs = self._rhs_function()
         y0 = np.concatenate([np.radians(self.omega_deg_s), self.initial])
         out = np.empty((t.size, 7))
         scale = max(float(np.linalg.norm(y0[:3])), 1e-12)
@@ -526,7 +535,7 @@ class Tumble(AttitudeLaw):
             if np.all(tq == 0):
                 out[np.flatnonzero(sel)] = y0
                 continue
-            sol = solve_ivp(self._rhs, (0.0, float(tq[-1])), y0, method="DOP853", t_eval=tq,
+            sol = solve_ivp(rhs, (0.0, float(tq[-1])), y0, method="DOP853", t_eval=tq,
                             rtol=TUMBLE_RTOL, atol=atol)
             if not sol.success:  # pragma: no cover - smooth right-hand side
                 raise AttitudeError(f"tumble: integration failed: {sol.message}")
