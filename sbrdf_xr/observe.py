@@ -220,6 +220,21 @@ def tle_checksum(line: str) -> int:
     return (sum(int(c) for c in line[:68] if c.isdigit()) + line[:68].count("-")) % 10
 
 
+#: Numeric fields of the TLE lines: name, first and last column (0-based, end excluded).
+_TLE_FIELDS_1 = (("catalog number", 2, 7), ("epoch", 18, 32), ("mean motion derivative", 33, 43))
+_TLE_FIELDS_2 = (("catalog number", 2, 7), ("inclination", 8, 16), ("right ascension of the node", 17, 25),
+                 ("eccentricity", 26, 33), ("argument of perigee", 34, 42), ("mean anomaly", 43, 51),
+                 ("mean motion", 52, 63))
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
 def _check_tle(line1: Any, line2: Any) -> tuple[str, str]:
     lines = []
     for i, line in ((1, line1), (2, line2)):
@@ -236,6 +251,15 @@ def _check_tle(line1: Any, line2: Any) -> tuple[str, str]:
                 f"(digits summed, '-' counting 1, modulo 10): {line!r}"
             )
         lines.append(line)
+    for i, fields in ((1, _TLE_FIELDS_1), (2, _TLE_FIELDS_2)):
+        line = lines[i - 1]
+        for fname, lo, hi in fields:
+            text = line[lo:hi]
+            ok = text.strip().isdigit() if fname == "eccentricity" else _is_number(text)
+            if not ok:
+                raise ObservationError(
+                    f"TLE line {i}: field {fname!r} (columns {lo + 1}-{hi}) is {text!r}, not a number"
+                )
     if lines[0][2:7] != lines[1][2:7]:
         raise ObservationError(f"TLE: catalog numbers differ between the lines ({lines[0][2:7]!r}, {lines[1][2:7]!r})")
     return lines[0], lines[1]
@@ -336,10 +360,12 @@ class Orbit:
 
 
 def _check_model(sat: Any, label: str) -> None:
+    from sgp4.api import SGP4_ERRORS
+
     err = getattr(sat.model, "error", 0)
     if err:
         raise ObservationError(f"orbit {label}: SGP4 rejects the elements (error {err}: "
-                               f"{getattr(sat.model, 'error_message', '')})")
+                               f"{SGP4_ERRORS.get(err, 'unknown')})")
 
 
 # --------------------------------------------------------------------------- site
