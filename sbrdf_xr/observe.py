@@ -14,8 +14,10 @@ Frames and models
 * Ephemeris ``de421.bsp`` and Earth orientation (UT1-UTC and polar motion from
   ``finals2000A.all``) come from the ``skyfield-data`` package, loaded from its
   directory by a skyfield :class:`~skyfield.iokit.Loader`: nothing is downloaded.
-* The Sun direction is skyfield's apparent direction from the spacecraft (light time,
-  aberration by the spacecraft's barycentric velocity, deflection).  The observer
+* The Sun direction is the apparent direction from the spacecraft: skyfield's geocentric
+  apparent Sun (light time, aberration, deflection) on knots every 10 min, splined, moved
+  to the spacecraft and aberrated by its geocentric velocity (within 1 mas of skyfield's
+  ``(earth + satellite).at(t).observe(sun).apparent()``).  The observer
   direction is geometric (no light time: under 3 ms, a few arcseconds in LEO) and
   without refraction, as is skyfield's ``(satellite - site).at(t).altaz()``.
 * Nutation: IAU 2000B (skyfield ``iau2000b_radians``), within 1 milliarcsecond of IAU 2000A.
@@ -444,17 +446,23 @@ def disc_overlap_fraction(a: ArrayLike, b: ArrayLike, c: ArrayLike) -> NDArray[n
         In ``[0, 1]``.
     """
     a, b, c = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (a, b, c)))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        safe_c = np.where(c > 0, c, 1.0)
-        safe_a = np.where(a > 0, a, 1.0)
-        safe_b = np.where(b > 0, b, 1.0)
-        x1 = np.clip((c * c + a * a - b * b) / (2 * safe_a * safe_c), -1.0, 1.0)
-        x2 = np.clip((c * c + b * b - a * a) / (2 * safe_b * safe_c), -1.0, 1.0)
-        k = (-c + a + b) * (c + a - b) * (c - a + b) * (c + a + b)
-        area = a * a * np.arccos(x1) + b * b * np.arccos(x2) - 0.5 * np.sqrt(np.maximum(k, 0.0))
-        partial = 1.0 - area / (np.pi * safe_a * safe_a)
-    inside = np.minimum(a, b) ** 2 / np.where(a > 0, a * a, 1.0)  # covered fraction when nested
-    out = np.where(c >= a + b, 1.0, np.where(c <= np.abs(a - b), 1.0 - inside, partial))
+    # The lens of the two discs, written with atan2 (never arccos near +-1, which loses
+    # half the digits at the tangencies): the chord lies x1 = (c^2 + a^2 - b^2) / 2c from
+    # the centre of disc a and x2 = c - x1 from that of disc b, its half-length is
+    # y = sqrt(k) / 2c (Heron), and the area is a^2 atan2(y, x1) + b^2 atan2(y, x2) - c y.
+    # Each factor of Heron's product under its own square root, and x1 without c^2, so that
+    # nothing underflows for tiny separations of equal discs.
+    safe_c = np.where(c > 0, c, 1.0)
+    d = a - b
+    roots = [np.sqrt(np.maximum(f, 0.0)) for f in (a + b - c, c + d, c - d, a + b + c)]
+    y = roots[0] * roots[1] * roots[2] * roots[3] / (2 * safe_c)
+    x1 = 0.5 * (c + d * (a + b) / safe_c)
+    x2 = c - x1
+    area = a * a * np.arctan2(y, x1) + b * b * np.arctan2(y, x2) - c * y
+    safe_a2 = np.where(a > 0, a * a, 1.0)
+    partial = 1.0 - area / (np.pi * safe_a2)
+    nested = 1.0 - np.minimum(a, b) ** 2 / safe_a2  # the smaller disc inside the larger
+    out = np.where(c >= a + b, 1.0, np.where(c <= np.abs(a - b), nested, partial))
     out = np.where(a > 0, out, np.where(c >= b, 1.0, 0.0))
     return np.clip(out, 0.0, 1.0)
 
@@ -519,6 +527,42 @@ def airmass(elevation_deg: ArrayLike, model: str = "kastenyoung1989") -> NDArray
     zen = np.where(el >= 0, 90.0 - el, 90.0)
     am = np.asarray(get_relative_airmass(zen, model=model), dtype=np.float64)
     return np.where(el >= 0, am, np.nan)
+
+
+#: Spacing of the knots at which skyfield evaluates the geocentric Sun [s]; a cubic spline
+#: through them is exact to far below a millimetre (the Earth-Sun vector's fourth
+#: derivative is |r| (2 pi / yr)^4 ~ 2e-19 km s-4).
+SUN_KNOT_S = 600.0
+#: Speed of light [km s-1].
+C_KM_S = 299792.458
+
+
+def _sun_from_spacecraft(t64: np.ndarray, r: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Apparent position of the Sun from the spacecraft in the GCRS [km].
+
+    skyfield's geocentric apparent Sun (light time, aberration by the Earth's velocity,
+    deflection) on knots every :data:`SUN_KNOT_S`, cubic-spline interpolated, moved to the
+    spacecraft (``- r``) and aberrated by its geocentric velocity ``v`` to first order
+    (``u' = u + b - u (u.b)``, ``b = v/c``).  Against skyfield's own
+    ``(earth + satellite).at(t).observe(sun).apparent()`` the direction differs by the
+    cross term of the two aberrations, ``|v_earth| |v| / c^2 ~ 3e-9 rad`` (0.6 mas).
+    """
+    from scipy.interpolate import CubicSpline
+
+    _, eph = _skyfield()
+    secs = (t64 - t64[0]).astype(np.int64) / 1e9
+    span = float(secs[-1])
+    n_knots = max(4, int(np.ceil(span / SUN_KNOT_S)) + 1)
+    knots = np.linspace(-SUN_KNOT_S, span + SUN_KNOT_S, n_knots + 2)
+    tk = _skyfield_time(t64[0] + (knots * 1e9).astype("timedelta64[ns]"))
+    sun_k = eph["earth"].at(tk).observe(eph["sun"]).apparent().position.km.T
+    sun_geo = CubicSpline(knots, sun_k, axis=0)(secs)
+    rel = sun_geo - r
+    d = np.linalg.norm(rel, axis=1, keepdims=True)
+    u = rel / d
+    b = v / C_KM_S
+    u = u + b - u * np.einsum("ni,ni->n", u, b)[:, None]
+    return d * _unit(u)
 
 
 def _angle(u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -612,7 +656,6 @@ class Observation:
             return self._cache["state"]
         from skyfield.framelib import itrs
 
-        _, eph = _skyfield()
         t = _skyfield_time(self.times)
         sat = self.orbit.satellite
         geo = sat.at(t)
@@ -623,8 +666,7 @@ class Observation:
             msg = getattr(geo, "message", None)
             msg = msg[bad] if isinstance(msg, list | tuple | np.ndarray) else msg
             raise ObservationError(f"orbit {self.orbit.name!r}: SGP4 fails at {self.times[bad]}: {msg}")
-        earth, sun = eph["earth"], eph["sun"]
-        sun_rel = (earth + sat).at(t).observe(sun).apparent().position.km.T  # Sun from the spacecraft
+        sun_rel = _sun_from_spacecraft(self.times, r, v)
         site_r = self.site.position.at(t).position.km.T
         rot = itrs.rotation_at(t)  # GCRS -> ITRS, (3, 3, n)
         state = {"r": r, "v": v, "sun": sun_rel, "site": site_r, "itrs": rot}

@@ -36,10 +36,12 @@ REPO = Path(__file__).resolve().parent.parent
 # below anything photometry can see (1e-9 deg ~ 0.02 mm at 1000 km).
 ANGLE_TOL_DEG = 1e-9
 RANGE_TOL_KM = 1e-8
-# The Sun direction differs by the nutation model only through the satellite's GCRS
-# position (1 mas x 7000 km ~ 3 cm over 1 AU): far below 1e-6 arcsec; 1e-6 arcsec allowed.
-SUN_TOL_ARCSEC = 1e-6
-# Phase angle: 1 mas of nutation in the GCRS line of sight allows 3e-7 deg.
+# The Sun direction: geocentric apparent Sun splined and aberrated by the spacecraft's
+# geocentric velocity to first order, against skyfield's aberration by the summed
+# barycentric velocity: they differ by the cross term |v_earth| |v_sat| / c^2 ~ 3e-9 rad
+# (0.6 mas); 0.01 arcsec allowed.
+SUN_TOL_ARCSEC = 0.01
+# Phase angle: the same 0.6 mas plus 1 mas of nutation in the line of sight: 1e-6 deg.
 PHASE_TOL_DEG = 1e-6
 
 
@@ -62,6 +64,7 @@ def test_topocentric_angles_and_range_against_skyfield(canx1):
     d_el = np.abs(alt.degrees - g.elevation.values).max()
     d_az = np.abs((az.degrees - g.azimuth.values + 180.0) % 360.0 - 180.0).max()
     d_r = np.abs(dist.km - g.range.values).max()
+    print(f"elevation {d_el:.2e} deg, azimuth {d_az:.2e} deg, range {d_r:.2e} km")
     assert d_el < ANGLE_TOL_DEG and d_az < ANGLE_TOL_DEG and d_r < RANGE_TOL_KM, (d_el, d_az, d_r)
 
 
@@ -82,7 +85,10 @@ def test_sun_direction_and_phase_angle_against_skyfield(canx1):
         los = (site - sat).at(ti).position.km
         phase = np.degrees(np.arctan2(np.linalg.norm(np.cross(s, los)), s @ los))
         worst_phase = max(worst_phase, abs(phase - g.phase_angle.values[i]))
-        assert abs(np.linalg.norm(s) / observe.AU_KM - g.sun_distance.values[i]) < 1e-9
+        # Distances agree to 1e-8 au (1.5 km, 1e-8 relative): skyfield's aberrated vector
+        # is displaced by v tau across the line of sight, the distance is kept here.
+        assert abs(np.linalg.norm(s) / observe.AU_KM - g.sun_distance.values[i]) < 1e-8
+    print(f"Sun direction residual {worst_sun:.2e} arcsec, phase angle {worst_phase:.2e} deg")
     assert worst_sun < SUN_TOL_ARCSEC, worst_sun
     assert worst_phase < PHASE_TOL_DEG, worst_phase
     # The body-frame pair carries the same phase angle (rotations preserve angles).
@@ -135,6 +141,7 @@ def test_shadow_entry_cylindrical_closed_form(radius, beta_deg):
     n, t_pen, _ = circular_shadow_times(radius, beta_deg, 1e16, 0.0)
     x = np.sqrt(radius**2 - R_E**2)
     t_closed = np.arccos(-x / (radius * np.cos(np.radians(beta_deg)))) / n
+    print(f"r={radius} beta={beta_deg}: cylinder {t_pen - t_closed:.2e} s")
     assert abs(t_pen - t_closed) < 1e-3, t_pen - t_closed  # [s]
 
 
@@ -158,6 +165,7 @@ def test_shadow_entry_conical_closed_form(radius, beta_deg):
         out[kind] = np.arccos(-x / (radius * cb)) / n
     # Both within a millisecond (the root finder works to 1e-10 s; the fraction leaves 1
     # as the 3/2 power of the overlap depth, so eps = 1e-12 moves the root < 1e-6 s).
+    print(f"r={radius} beta={beta_deg}: penumbra {t_pen - out['pen']:.2e} s, umbra {t_umb - out['umb']:.2e} s")
     assert abs(t_pen - out["pen"]) < 1e-3, (t_pen - out["pen"])
     assert abs(t_umb - out["umb"]) < 1e-3, (t_umb - out["umb"])
     assert t_umb - t_pen > 1.0  # a real penumbra of seconds
