@@ -679,6 +679,13 @@ class Observation:
                 EpochGapWarning, stacklevel=2,
             )
 
+    def __repr__(self) -> str:
+        t = self.times
+        step = f", step {(t[1] - t[0]) / np.timedelta64(1, 's'):g} s" if t.size > 1 else ""
+        return (f"<Observation {self.name!r}: {self.orbit.name!r} from {self.site.name or 'site'} "
+                f"({self.site.latitude_deg:.4f}, {self.site.longitude_deg:.4f}, {self.site.height_m:g} m), "
+                f"{t.size} times {t[0]} .. {t[-1]}{step}, attitude {self.attitude!r}>")
+
     def _state(self) -> dict[str, np.ndarray]:
         """Inertial-frame (GCRS) vectors per time, from one vectorised skyfield pass."""
         if "state" in self._cache:
