@@ -5,6 +5,7 @@ The catalog directory holds ``index.toml``, one ``[[entry]]`` table per item::
     [[entry]]
     name = "lambertian-grey-50"          # unique, lower-case, used by load()
     kind = "material"                    # material | measurements | model | paint_parameters | spacecraft
+                                         # | orbit (a TLE file) | site (a table of a TOML file of sites)
     path = "materials/lambertian-grey-50.nc"   # relative to the catalog directory
     source = "synthetic"                 # measured | synthetic | model:<name>
     description = "..."                  # what it is
@@ -28,7 +29,7 @@ from .errors import CatalogError
 
 __all__ = ["CatalogEntry", "catalog_dir", "data_path", "entries", "entry", "load", "names"]
 
-KINDS = ("material", "measurements", "model", "paint_parameters", "spacecraft")
+KINDS = ("material", "measurements", "model", "paint_parameters", "spacecraft", "orbit", "site")
 SOURCES = ("measured", "synthetic")
 
 
@@ -142,7 +143,7 @@ def entries(kind: str | None = None) -> list[CatalogEntry]:
     Parameters
     ----------
     kind : str, optional
-        One of ``material``, ``measurements``, ``model``, ``paint_parameters``, ``spacecraft``.
+        One of :data:`KINDS`.
 
     Returns
     -------
@@ -200,7 +201,9 @@ def load(name: str) -> Any:
         A material ``DataArray`` for ``material``; a measurement ``Dataset`` for
         ``measurements``; a parameter ``Dataset`` for ``model`` (see
         :mod:`sbrdf_xr.models`) and ``paint_parameters``; a
-        :class:`~sbrdf_xr.spacecraft.Spacecraft` for ``spacecraft``.
+        :class:`~sbrdf_xr.spacecraft.Spacecraft` for ``spacecraft``; an
+        :class:`~sbrdf_xr.observe.Orbit` for ``orbit``; a :class:`~sbrdf_xr.observe.Site`
+        for ``site``.
     """
     e = entry(name)
     _import_loaders()
@@ -213,4 +216,4 @@ def load(name: str) -> Any:
 
 def _import_loaders() -> None:
     # Loaders live with the objects they build; importing registers them.
-    from . import material, models, spacecraft  # noqa: F401
+    from . import material, models, observe, spacecraft  # noqa: F401

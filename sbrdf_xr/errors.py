@@ -9,10 +9,14 @@ is allowed.  Warnings derive from :class:`SbrdfWarning` so users can filter them
 from __future__ import annotations
 
 __all__ = [
+    "AttitudeError",
     "CatalogError",
+    "EpochGapWarning",
     "MeshError",
     "MeshRepairWarning",
     "NonPhysicalWarning",
+    "NotObservableError",
+    "ObservationError",
     "SbrdfError",
     "SbrdfWarning",
     "SceneError",
@@ -40,6 +44,18 @@ class SceneError(ValidationError):
     """A scene definition that cannot be compiled into a plan."""
 
 
+class ObservationError(ValidationError):
+    """An orbit (TLE/OMM), site, time axis or observation definition that cannot be used."""
+
+
+class NotObservableError(ObservationError):
+    """An observation whose object is below the horizon, or in shadow, at every time."""
+
+
+class AttitudeError(ValidationError):
+    """An unknown attitude law or bad law parameters."""
+
+
 class SbrdfWarning(UserWarning):
     """Base class of the warnings issued by sbrdf_xr."""
 
@@ -50,3 +66,7 @@ class NonPhysicalWarning(SbrdfWarning):
 
 class MeshRepairWarning(SbrdfWarning):
     """A spacecraft mesh was repaired as documented in :mod:`sbrdf_xr.spacecraft`."""
+
+
+class EpochGapWarning(SbrdfWarning):
+    """Observation times far from the epoch of the orbital elements (SGP4 accuracy degrades)."""

@@ -723,6 +723,27 @@ class Spacecraft:
             self._cache["is_convex"] = bool(self.mesh.is_convex)
         return self._cache["is_convex"]
 
+    def inertia(self, density: float = 1.0) -> NDArray[np.float64]:
+        """Inertia tensor about the centre of mass of the closed body at uniform density.
+
+        Volume integrals over the closed surface (divergence theorem) by
+        :func:`trimesh.triangles.mass_properties`.
+
+        Parameters
+        ----------
+        density : float
+            Uniform density [kg m-3].
+
+        Returns
+        -------
+        ndarray, shape (3, 3)
+            Inertia tensor in the body frame [kg m2].
+        """
+        if not (np.isfinite(density) and density > 0):
+            raise ValidationError(f"density: must be a positive number [kg m-3], got {density!r}")
+        props = trimesh.triangles.mass_properties(self.mesh.triangles, density=float(density))
+        return np.asarray(props["inertia"], dtype=np.float64)
+
     def facets(self) -> xr.Dataset:
         """Facet table: normal, area, centroid and material of every facet.
 
