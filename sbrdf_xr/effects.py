@@ -36,6 +36,7 @@ class BlockInputs:
     to_earth: np.ndarray | None
     sun_scale: np.ndarray | None  #: (G,) sunlit fraction of the solar disc, or None (1)
     lead_shape: tuple[int, ...]  #: the block's geometry dimensions before flattening
+    earth_scale: np.ndarray | None = None  #: (G,) earthshine irradiance / the Sun's, or None
 
 
 
@@ -185,21 +186,41 @@ def _shadow_fraction(plan: Plan, to_source: np.ndarray, to_observer: np.ndarray)
 
 
 def _sunlight(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
+    """Reflected sunlight; in the Earth's umbra nothing is evaluated (the sums are 0), in
+    the penumbra the signal is scaled by the sunlit fraction of the solar disc."""
+    scale = block.sun_scale
+    if scale is not None and not np.all(scale > 0):
+        lit = np.flatnonzero(scale > 0)
+        sub = BlockInputs(block.to_sun[lit], block.to_observer[lit], None, scale[lit], (lit.size,))
+        part = _sunlight(plan, sub) if lit.size else None
+        g, n = block.to_sun.shape[0], plan.tables.n_spectral if plan.knobs["evaluation"] == "table" else (
+            len(plan.bands) if plan.pre_integrated else plan.wavelength.size)
+        dt = np.dtype(plan.knobs["dtype"])
+        out = {"signal": np.zeros((g, n), dt), "paper": np.zeros((g, n), dt), "area": np.zeros(g)}
+        if "signal_material" in plan.output_names:
+            out["signal_material"] = np.zeros((g, len(plan.materials), n), dt)
+        if part is not None:
+            for k in out:
+                out[k][lit] = part[k]
+        return out
     frac = _shadow_fraction(plan, block.to_sun, block.to_observer)
     r = reflected(plan, block, block.to_sun, frac, "signal_material" in plan.output_names)
     out = {"signal": r.signal, "paper": r.paper, "area": r.area}
     if r.per_material is not None:
         out["signal_material"] = r.per_material
-    if block.sun_scale is not None:  # Earth's penumbra: the irradiance, not the geometry
-        out["signal"] = r.signal * block.sun_scale[:, None].astype(r.signal.dtype)
+    if scale is not None:  # the Earth's penumbra scales the irradiance, not the geometry
+        sc = scale.astype(r.signal.dtype)
+        out["signal"] = r.signal * sc[:, None]
         if r.per_material is not None:
-            out["signal_material"] = r.per_material * block.sun_scale[:, None, None].astype(r.signal.dtype)
+            out["signal_material"] = r.per_material * sc[:, None, None]
     return out
 
 
 def _earthshine(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
     frac = _shadow_fraction(plan, block.to_earth, block.to_observer)
     r = reflected(plan, block, block.to_earth, frac, False)
+    if block.earth_scale is not None:  # per geometry (an observation's Earth distance and phase)
+        return {"signal_earthshine": (block.earth_scale[:, None] * r.signal).astype(r.signal.dtype)}
     ratio = plan.effect_params["earthshine"]["ratio"]
     return {"signal_earthshine": (ratio * r.signal).astype(r.signal.dtype)}
 

@@ -499,7 +499,14 @@ def compile_plan(scene: Scene) -> Plan:
         part = int(np.sum((geo.sun_scale > 0) & (geo.sun_scale < 1)))
         steps.append(("eclipse", f"Earth shadow: {dark} geometries in umbra skipped (no sunlight), "
                       f"{part} in penumbra scaled by the sunlit fraction of the solar disc"))
-    if "earthshine" in scene.effects:
+    if "earthshine" in scene.effects and getattr(geo, "earth_scale", None) is not None:
+        active.append("earthshine")
+        es = geo.earth_scale
+        params["earthshine"] = MappingProxyType({"ratio": float(np.max(es)) if es.size else 0.0})
+        steps.append(("earthshine", f"Lambertian Earth (albedo {scene.earth_albedo:g}) at the observation's "
+                      f"distance and phase at every time: irradiance {np.min(es):.3g}-{np.max(es):.3g} "
+                      "of the Sun's, a second distant source"))
+    elif "earthshine" in scene.effects:
         ratio = sources.earthshine_irradiance_ratio(scene.earth_albedo, scene.earth_range_km,
                                                     scene.earth_phase_angle)
         active.append("earthshine")

@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike
 
 from . import geometry
 from .effects import SCENE_OUTPUTS, SPECTRAL_OUTPUTS
-from .errors import SceneError, ValidationError
+from .errors import CatalogError, SceneError, ValidationError
 from .knobs import KNOBS, PRESETS, apply_preset, check_knob
 from .material import validate_material
 from .plan import Plan, compile_plan
@@ -83,6 +83,12 @@ class Scene:
         Observation plane in the reference frame (default: bisector +x, plane xy).
     to_sun, to_observer : array_like, shape (n, 3), optional
         Explicit body-frame geometry pairs instead of a grid.
+    observation : sbrdf_xr.observe.Observation, optional
+        A real pass (orbit, site, times, attitude law) instead of a grid or pairs: the
+        cube gets a ``time`` dimension with the observation's geometry as coordinates,
+        the Earth's shadow scales the sunlight, and earthshine (when asked) follows the
+        Earth's distance and phase at every time.  Its geometry is computed when the
+        scene is planned.
     attitude_angle : array_like, shape (n,), optional
         A label per attitude (for example the sweep angle [degree]).
     outputs : sequence of str
@@ -149,6 +155,7 @@ class Scene:
     plane_normal: tuple[float, float, float] = (0.0, 0.0, 1.0)
     to_sun: ArrayLike | None = None
     to_observer: ArrayLike | None = None
+    observation: Any = None
     attitude_angle: ArrayLike | None = None
     outputs: Sequence[str] = ("spacecraft_sbrdf", "signal", "brdf", "area")
     effects: Sequence[str] = ("sunlight",)
@@ -216,12 +223,19 @@ class Scene:
             raise SceneError(f"temperature: must be positive kelvin, got {self.temperature}")
         grid = self.attitudes is not None or self.phase_angles is not None
         explicit = self.to_sun is not None or self.to_observer is not None
-        if grid == explicit:
+        observed = self.observation is not None
+        if grid + explicit + observed != 1:
             raise SceneError(
-                "geometry: give either attitudes and phase_angles (a grid) or to_sun and "
-                "to_observer (explicit pairs), not both and not neither"
+                "geometry: give either attitudes and phase_angles (a grid), to_sun and "
+                "to_observer (explicit pairs) or an observation, not several and not neither"
             )
-        if grid:
+        if observed:
+            from .observe import Observation
+
+            if not isinstance(self.observation, Observation):
+                raise SceneError(f"observation: expected a sbrdf_xr.observe.Observation, got "
+                                 f"{type(self.observation).__name__}")
+        elif grid:
             if self.attitudes is None or self.phase_angles is None:
                 raise SceneError("geometry: a grid needs both attitudes and phase_angles")
             try:
@@ -277,6 +291,14 @@ class Scene:
     @cached_property
     def geometry(self) -> GridGeometry | PairGeometry:
         """The sweep's geometry (:class:`GridGeometry` or :class:`PairGeometry`)."""
+        if self.observation is not None:
+            from .errors import ObservationError
+
+            try:
+                g = self.observation.geometry()
+            except ObservationError as exc:
+                raise SceneError(f"observation: {exc}") from exc
+            return PairGeometry.from_observation(g, "earthshine" in self.effects, self.earth_albedo)
         if self.is_grid:
             s, o = geometry.observation_plane(self.phase_angles, self.bisector, self.plane_normal)
             e = None
@@ -301,7 +323,7 @@ class Scene:
     def earth_vectors(self, attitude_slice: slice | None = None) -> np.ndarray:
         """Unit vectors to the Earth in the body frame (shaped like :meth:`body_vectors`)."""
         if not self.is_grid:
-            return self.to_earth[attitude_slice or slice(None)]
+            return self.geometry.block(attitude_slice or slice(None)).to_earth
         q = self.attitudes if attitude_slice is None else self.attitudes[attitude_slice]
         e = geometry.normalize(self.earth_direction, "earth_direction")
         e = np.broadcast_to(e, (len(self.phase_angles), 3))
@@ -337,7 +359,7 @@ _SCENE_KEYS = {
     "merge": bool, "shadow_method": str, "shadow_density": int, "chunk": int,
     "wavelength_stride": int, "band_integration": str, "table_theta_step": (int, float),
     "evaluation": str, "kernel": str, "block_bytes": int, "size_limit": (int, float),
-    "tilt_nodes": int, "surface_tilt": (int, float, dict), "bands": list, "band_extrapolate": str,
+    "tilt_nodes": int, "surface_tilt": (int, float, dict), "observation": dict, "bands": list, "band_extrapolate": str,
     "earth_direction": list, "earth_albedo": (int, float), "earth_range_km": (int, float),
     "earth_phase_angle": (int, float), "temperature": (int, float, dict),
 }
@@ -373,8 +395,9 @@ def _attitudes_from_table(t: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray 
     raise SceneError(f"[attitude]: unknown kind {kind!r}; allowed: sweep, uniform, euler, quaternions")
 
 
-def scene_from_dict(d: Mapping[str, Any]) -> Scene:
-    """Build a scene from the contents of a scene file (see :func:`load_scene`)."""
+def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) -> Scene:
+    """Build a scene from the contents of a scene file (see :func:`load_scene`); relative
+    file names in it (an ``[observation]``'s quaternion series) are taken from ``base_dir``."""
     _check_keys(d, _SCENE_KEYS, "scene")
     from . import catalog
     from .spacecraft import Spacecraft
@@ -408,6 +431,16 @@ def scene_from_dict(d: Mapping[str, Any]) -> Scene:
         kw["to_sun"], kw["to_observer"] = g.get("to_sun"), g.get("to_observer")
         if "to_earth" in g:
             kw["to_earth"] = g["to_earth"]
+    if "observation" in d:
+        from .observe import observation_from_dict
+
+        if "attitude" in d or "geometry" in d or "phase_angles" in d:
+            raise SceneError("scene: an [observation] gives the geometry; leave out [attitude], "
+                             "[geometry] and phase_angles")
+        try:
+            kw["observation"] = observation_from_dict(d["observation"], base_dir)
+        except (ValidationError, CatalogError) as exc:
+            raise SceneError(f"[observation]: {exc}") from exc
     if "attitude" in d:
         kw["attitudes"], angles = _attitudes_from_table(d["attitude"])
         if angles is not None:
@@ -449,7 +482,7 @@ def load_scene(path: str | Path) -> Scene:
         d = tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path}: invalid TOML: {exc}") from exc
-    return scene_from_dict(d)
+    return scene_from_dict(d, path.parent)
 
 
 # --------------------------------------------------------- built-in scenes
@@ -485,7 +518,23 @@ def _canx1_rotation() -> Scene:
     )
 
 
-_BUILTIN = {"canx1-plusx-specular": _canx1_plusx_specular, "canx1-rotation": _canx1_rotation}
+def _canx1_pass() -> Scene:
+    from .observe import canx1_pass
+    from .spacecraft import canx1
+
+    return Scene(
+        canx1(),
+        observation=canx1_pass(),
+        outputs=("spacecraft_sbrdf", "signal", "brdf", "area", "band_signal"),
+        bands=("V", "R", "I"),
+        name="canx1-pass",
+        description="CanX-1 model on the shipped example elements over Mont Megantic, "
+        "2024-03-17 01:20-01:25 UTC at 1 s, spinning; leaves the Earth's shadow in the window",
+    )
+
+
+_BUILTIN = {"canx1-plusx-specular": _canx1_plusx_specular, "canx1-rotation": _canx1_rotation,
+            "canx1-pass": _canx1_pass}
 
 
 def builtin_scenes() -> list[str]:

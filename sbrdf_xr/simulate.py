@@ -255,7 +255,17 @@ def write(cube: xr.Dataset, path: str | os.PathLike[str], **kwargs: Any) -> Path
     """
     if str(path).rstrip("/").endswith(".zarr"):
         return _write_zarr(cube, Path(path), **kwargs)
-    return write_cube(cube, path, **kwargs)
+    return write_cube(_encode_times(cube), path, **kwargs)
+
+
+def _encode_times(cube: xr.Dataset) -> xr.Dataset:
+    """datetime64 coordinates as CF numbers with ``units`` and ``calendar`` (xarray's own
+    encoder, the one ``open_dataset`` decodes), for the netCDF writer."""
+    times = [k for k, v in cube.coords.items() if v.dtype.kind in "mM"]
+    if not times:
+        return cube
+    return cube.assign_coords({k: xr.conventions.encode_cf_variable(cube[k].variable, name=str(k))
+                               for k in times})
 
 
 def _write_zarr(cube: xr.Dataset, path: Path, *, overwrite: bool = False, client: Any = None,

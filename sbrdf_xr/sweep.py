@@ -115,6 +115,7 @@ class PairGeometry:
     to_observer: np.ndarray
     to_earth: np.ndarray | None = None
     sun_scale: np.ndarray | None = None
+    earth_scale: np.ndarray | None = None
     dim: str = GEOMETRY
     index: Any = None
     extra_coords: Mapping[str, Any] = field(default_factory=dict)
@@ -141,24 +142,49 @@ class PairGeometry:
         return dict(self.extra_attrs)
 
     def describe(self) -> str:
-        what = "times of an observation" if self.dim != GEOMETRY else "explicit (to_sun, to_observer) pairs"
-        return f"{self.n_lead} {what}"
+        if self.dim == GEOMETRY:
+            return f"{self.n_lead} explicit (to_sun, to_observer) pairs"
+        what = self.extra_attrs.get("observation", "an observation")
+        return (f"{self.n_lead} times of {what} ({self.extra_attrs.get('orbit_name', '')} from "
+                f"{self.extra_attrs.get('site_name', 'a site')})")
 
     def block(self, sl: slice) -> BlockInputs:
         e = None if self.to_earth is None else self.to_earth[sl]
         sc = None if self.sun_scale is None else self.sun_scale[sl]
+        es = None if self.earth_scale is None else self.earth_scale[sl]
         s = self.to_sun[sl]
-        return BlockInputs(s, self.to_observer[sl], e, sc, (s.shape[0],))
+        return BlockInputs(s, self.to_observer[sl], e, sc, (s.shape[0],), es)
 
     def coords(self) -> dict[str, Any]:
+        """Coordinates of a cube over these geometries (an observation adds its own)."""
         d = self.dim
-        index = np.arange(self.n_lead) if self.index is None else self.index
         c: dict[str, Any] = {
-            d: (d, index, attrs(d) if d == GEOMETRY else self.extra_coords.get(f"{d}_attrs", {})),
+            d: (d, np.arange(self.n_lead), attrs(GEOMETRY)) if self.index is None else self.index,
             PHASE_ANGLE: (d, geometry.phase_angle(self.to_sun, self.to_observer), attrs(PHASE_ANGLE)),
             "to_sun": ((d, VECTOR), self.to_sun, attrs("to_sun")),
             "to_observer": ((d, VECTOR), self.to_observer, attrs("to_observer")),
         }
-        c.update({k: v for k, v in self.extra_coords.items() if not k.endswith("_attrs")})
+        c.update(self.extra_coords)
         return c
+
+    @classmethod
+    def from_observation(cls, g: Any, with_earth: bool, earth_albedo: float = 0.3) -> PairGeometry:
+        """The geometry of an observation (:meth:`sbrdf_xr.observe.Observation.geometry`):
+        a ``time`` dimension, the sunlit fraction as the Sun's scale, and, with
+        earthshine, the Earth's irradiance per time from its distance and phase."""
+        from .sources import earthshine_irradiance_ratio
+
+        dim = "time"
+        extra = {str(k): g[k].variable for k in g.coords if k not in ("xyz", "component")}
+        extra["quaternion"] = g["quaternion"].variable
+        extra["component"] = g["component"].variable
+        earth_scale = None
+        if with_earth:
+            earth_scale = np.array([earthshine_irradiance_ratio(earth_albedo, r, a) for r, a in
+                                    zip(g["earth_distance"].values, g["earth_phase_angle"].values,
+                                        strict=True)])
+        return cls(np.ascontiguousarray(g["to_sun"].values), np.ascontiguousarray(g["to_observer"].values),
+                   np.ascontiguousarray(g["to_earth"].values) if with_earth else None,
+                   np.asarray(g["sunlit_fraction"].values, dtype=np.float64), earth_scale, dim,
+                   g[dim].variable, extra, dict(g.attrs))
 

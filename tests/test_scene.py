@@ -74,7 +74,7 @@ def test_bad_scene_files(tmp_path, text, match):
 
 
 def test_resolve_scene_names_and_files(tmp_path):
-    assert set(builtin_scenes()) == {"canx1-rotation", "canx1-plusx-specular"}
+    assert set(builtin_scenes()) == {"canx1-rotation", "canx1-plusx-specular", "canx1-pass"}
     with pytest.raises(SceneError, match="unknown scene 'nope'; built-in scenes"):
         resolve_scene("nope")
     with pytest.raises(SceneError, match="does not exist"):
