@@ -86,7 +86,7 @@ def test_toml_observation_scene(tmp_path):
 def test_observation_and_another_geometry_are_refused():
     with pytest.raises(SceneError, match="not several"):
         Scene(canx1(), observation=observe.canx1_pass(), to_sun=[[1.0, 0, 0]], to_observer=[[1.0, 0, 0]])
-    with pytest.raises(SceneError, match="expected a sbrdf_xr.observe.Observation"):
+    with pytest.raises(SceneError, match=r"expected a sbrdf_xr\.observe\.Observation"):
         Scene(canx1(), observation="canx1-pass")
 
 

@@ -154,7 +154,7 @@ def test_presets_and_float32():
         ({"attitudes": [[0, 0, 0, 1.0]]}, "needs both attitudes and phase_angles"),
         ({}, "give either attitudes and phase_angles"),
         ({"attitudes": [[0, 0, 0, 1.0]], "phase_angles": [10.0], "to_sun": [[1.0, 0, 0]],
-          "to_observer": [[1.0, 0, 0]]}, "not both"),
+          "to_observer": [[1.0, 0, 0]]}, "not several"),
     ],
 )
 def test_bad_scenes_raise_scene_errors(kw, match):
