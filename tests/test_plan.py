@@ -218,3 +218,15 @@ def test_surface_tilt_zero_is_exact_and_matches_monte_carlo_over_perturbed_facet
     # 5 standard errors (plus the quadrature's own small error, 1e-3 of the peak)
     assert np.all(np.abs(rough - mean) <= 5 * se + 1e-3 * np.abs(mean).max())
     assert "Gauss-Hermite" in simulate(s, surface_tilt=sigma).attrs["plan"]
+
+
+def test_workers_write_their_own_zarr_blocks_on_a_local_cluster(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    pytest.importorskip("zarr")
+    s = scene(chunk=6)
+    ref = simulate(s).compute()
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=":0") as cluster, distributed.Client(cluster) as client:
+        path = write(simulate(s, client=client), tmp_path / "c.zarr", client=client)
+    with xr.open_zarr(path) as back:
+        xr.testing.assert_identical(back.load(), ref)
