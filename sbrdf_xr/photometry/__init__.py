@@ -1,0 +1,115 @@
+"""Photometry: solar spectrum, filter bands, band signals, magnitudes, colours, light curves.
+
+The chain from a simulation cube to what a telescope measures:
+
+1. :func:`solar_spectrum` - the extraterrestrial Sun at 1 AU [W m-2 nm-1], the
+   ASTM G173-03 table shipped inside pvlib (no network).
+2. :func:`filters` - standard bandpasses shipped inside speclite (Bessell UBVRI,
+   SDSS ugriz, ...; short aliases in :data:`BAND_ALIASES`) and user bandpasses.
+3. :func:`band_weights` - the ``(band, wavelength)`` matrix ``W`` with the Sun and
+   the filter folded in, so that the band flux of any spectrum ``x`` sampled on a
+   wavelength grid is ``W @ x``; :func:`pre_integrate` applies it along
+   ``wavelength`` of any DataArray (material tables included).  Because the
+   simulated signal is a sum over facets that is linear in the material tables,
+   pre-integrating the tables and integrating the full-spectrum output give the same
+   band numbers to float rounding.
+4. :func:`band_signal` and :func:`magnitudes` from a cube; :func:`colour_indices`;
+   :func:`srgb` swatches; :func:`photometry` bundles them (``ds.sbrdf.photometry``).
+5. :func:`read_light_curve`, :func:`compare_light_curves`, :func:`plot_comparison`
+   for measured light curves.
+
+Conventions
+-----------
+Band-integrated flux of a spectral flux density ``f(lambda)`` [W m-2 nm-1] through a
+filter response ``T(lambda)`` is
+
+* photon counting (default): ``F = int f T lambda / (h c) dlambda`` [m-2 s-1], the
+  rate of detected photons, for responses that are photon-detection probabilities
+  (the speclite convention);
+* energy weighting: ``F = int f T dlambda`` [W m-2], for energy-response curves.
+
+The *band signal* of a cube is the solar-weighted band mean of its radiometric
+signal ``S(lambda)`` [m2 sr-1] (reflected intensity per unit solar irradiance)::
+
+    S_band = int E_sun T w S dlambda / int E_sun T w dlambda        [m2 sr-1]
+
+with ``w = lambda`` (photon) or ``1`` (energy).  It keeps the units of ``S``; a grey
+body of signal ``c`` has ``S_band = c`` exactly, in every band.  The reflected
+band flux at range ``d`` [m] from an object ``r`` AU from the Sun is
+``F = F_sun,band S_band / (d**2 r**2)``, hence the magnitude
+
+    m = m_sun,band(1 AU) + 5 log10(r / 1 AU) - 2.5 log10(S_band / d**2)
+
+where ``m_sun,band`` is the Sun's apparent magnitude at 1 AU in the same band,
+computed from the same solar spectrum and filter (:func:`sun_magnitudes`).
+
+Magnitudes are AB (Oke & Gunn 1983, ApJ 266, 713: a flat ``f_nu`` of 3631 Jy has
+magnitude 0 in every band)::
+
+    photon:  m_AB = -2.5 log10( int f_nu T dnu/nu / int 3631 Jy T dnu/nu )
+                  = -2.5 log10( int f_lambda T lambda dlambda / int f_AB,lambda T lambda dlambda )
+    energy:  m_AB = -2.5 log10( int f_lambda T dlambda / int f_AB,lambda T dlambda )
+
+with ``f_AB,lambda = 3631 Jy * c / lambda**2``.  The Vega system is not offered:
+neither speclite nor colour-science nor pvlib ships a Vega spectrum, and the
+package must work without the network.
+
+A body that reflects nothing (``S_band = 0``) has magnitude ``+inf`` (zero flux;
+computed without floating-point warnings); colour indices involving an infinite
+magnitude are NaN (the colour is undefined).  A negative band signal (possible only
+with noisy tables) gives a NaN magnitude.
+"""
+
+from .bands import (
+    BAND_ALIASES,
+    EXTRAPOLATIONS,
+    QUADRATURES,
+    WEIGHTINGS,
+    band_weights,
+    filters,
+    pre_integrate,
+    speclite_names,
+)
+from .colour import srgb
+from .lightcurves import (
+    LIGHT_CURVE_ABSCISSAE,
+    LIGHT_CURVE_COLUMNS,
+    compare_light_curves,
+    plot_comparison,
+    read_light_curve,
+)
+from .magnitude import band_signal, colour_indices, magnitudes, photometry, sun_magnitudes
+from .spectra import (
+    AB_ZERO_POINT_JY,
+    ab_reference_flux,
+    hat_integrals,
+    solar_spectrum,
+    trapezoid_weights,
+)
+
+__all__ = [
+    "AB_ZERO_POINT_JY",
+    "BAND_ALIASES",
+    "EXTRAPOLATIONS",
+    "LIGHT_CURVE_ABSCISSAE",
+    "LIGHT_CURVE_COLUMNS",
+    "QUADRATURES",
+    "WEIGHTINGS",
+    "ab_reference_flux",
+    "band_signal",
+    "band_weights",
+    "colour_indices",
+    "compare_light_curves",
+    "filters",
+    "hat_integrals",
+    "magnitudes",
+    "photometry",
+    "plot_comparison",
+    "pre_integrate",
+    "read_light_curve",
+    "solar_spectrum",
+    "speclite_names",
+    "srgb",
+    "sun_magnitudes",
+    "trapezoid_weights",
+]
