@@ -81,10 +81,15 @@ from .lightcurves import (
 from .magnitude import band_signal, colour_indices, magnitudes, photometry, sun_magnitudes
 from .spectra import (
     AB_ZERO_POINT_JY,
+    MAGNITUDE_SYSTEMS,
+    SOLAR_SPECTRA,
     ab_reference_flux,
+    check_system,
     hat_integrals,
+    reference_flux,
     solar_spectrum,
     trapezoid_weights,
+    vega_spectrum,
 )
 
 __all__ = [
@@ -93,11 +98,14 @@ __all__ = [
     "EXTRAPOLATIONS",
     "LIGHT_CURVE_ABSCISSAE",
     "LIGHT_CURVE_COLUMNS",
+    "MAGNITUDE_SYSTEMS",
     "QUADRATURES",
+    "SOLAR_SPECTRA",
     "WEIGHTINGS",
     "ab_reference_flux",
     "band_signal",
     "band_weights",
+    "check_system",
     "colour_indices",
     "compare_light_curves",
     "filters",
@@ -107,9 +115,11 @@ __all__ = [
     "plot_comparison",
     "pre_integrate",
     "read_light_curve",
+    "reference_flux",
     "solar_spectrum",
     "speclite_names",
     "srgb",
     "sun_magnitudes",
     "trapezoid_weights",
+    "vega_spectrum",
 ]

@@ -17,10 +17,11 @@ from numpy.typing import ArrayLike
 from .._names import BAND, WAVELENGTH, attrs
 from ..errors import ValidationError
 from .spectra import (
+    SOLAR_SPECTRA,
     _check_grid,
     _choose,
+    _illumination,
     _integral,
-    _solar_native,
     _solar_provenance,
     _weighting,
     hat_integrals,
@@ -248,16 +249,17 @@ def _coverage_error(band: _Band, lo: float, hi: float, what: str, extra: str = "
 
 
 def _band_rows(
-    bl: list[_Band], t: np.ndarray, weighting: str, quadrature: str, extrapolate: str | None
+    bl: list[_Band], t: np.ndarray, weighting: str, quadrature: str, extrapolate: str | None,
+    solar: str = "astm_g173", transmission: Any = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Unnormalised weights (n_band, n_t) and the full-band solar integrals (n_band,)."""
-    ws, es, _ = _solar_native()
+    ws, es = _illumination(solar, transmission)
     rows = np.zeros((len(bl), t.size))
     full = np.zeros(len(bl))
     for n, band in enumerate(bl):
         blo, bhi = band.support
         if blo < ws[0] or bhi > ws[-1]:
-            raise _coverage_error(band, ws[0], ws[-1], "solar spectrum (ASTM G173-03)")
+            raise _coverage_error(band, ws[0], ws[-1], f"solar spectrum ({solar})")
         if (t[0] > blo or t[-1] < bhi) and extrapolate is None:
             raise _coverage_error(
                 band, t[0], t[-1], "spectrum",
@@ -296,6 +298,8 @@ def band_weights(
     quadrature: str = "trapezoid",
     extrapolate: str | None = None,
     normalize: bool = False,
+    solar: str = "astm_g173",
+    transmission: xr.DataArray | None = None,
 ) -> xr.DataArray:
     """The ``(band, wavelength)`` matrix that band-integrates a spectrum under sunlight.
 
@@ -331,6 +335,12 @@ def band_weights(
         (computed with the same quadrature, continuing the Sun past the grid): then
         ``W @ x`` is the solar-weighted band mean of ``x`` in the units of ``x``, and
         ``W @ 1 = 1`` whenever the grid covers the band or ``extrapolate="constant"``.
+    solar : str
+        Solar spectrum, a key of :data:`~sbrdf_xr.photometry.SOLAR_SPECTRA`.
+    transmission : xarray.DataArray, optional
+        Atmospheric transmission over ``wavelength`` [1]
+        (:func:`sbrdf_xr.photometry.atmosphere.transmission`), folded into the weights
+        as ``E_sun * transmission``; default none (above the atmosphere).
 
     Returns
     -------
@@ -350,7 +360,8 @@ def band_weights(
     _choose(extrapolate, EXTRAPOLATIONS, "extrapolate")
     t = _check_grid(wavelength, "wavelength")
     bl = _resolve_bands(bands)
-    rows, full = _band_rows(bl, t, weighting, quadrature, extrapolate)
+    _choose(solar, SOLAR_SPECTRA, "solar")
+    rows, full = _band_rows(bl, t, weighting, quadrature, extrapolate, solar, transmission)
     if normalize:
         rows = rows / full[:, None]
         units = "1"
@@ -359,20 +370,27 @@ def band_weights(
     coords = _band_coords(bl)
     coords[WAVELENGTH] = (WAVELENGTH, t, attrs(WAVELENGTH))
     return xr.DataArray(rows, dims=(BAND, WAVELENGTH), coords=coords, name="band_weight",
-                        attrs=attrs("band_weight", units=units, **_method_attrs(weighting, quadrature, extrapolate),
+                        attrs=attrs("band_weight", units=units, **_method_attrs(weighting, quadrature, extrapolate, solar,
+                                                                              transmission),
                                     normalized=int(normalize)))
 
 
-def _method_attrs(weighting: str, quadrature: str, extrapolate: str | None) -> dict[str, str]:
-    return {
+def _method_attrs(weighting: str, quadrature: str, extrapolate: str | None, solar: str = "astm_g173",
+                  transmission: Any = None) -> dict[str, Any]:
+    out: dict[str, Any] = {
         "weighting": weighting,
         "weighting_description": WEIGHTINGS[weighting],
         "quadrature": quadrature,
         "quadrature_description": QUADRATURES[quadrature],
         "extrapolate": str(extrapolate),
         "extrapolate_description": EXTRAPOLATIONS[extrapolate],
-        **_solar_provenance(),
+        **_solar_provenance(solar),
     }
+    if transmission is not None:
+        out["atmosphere"] = str(transmission.attrs.get("model_description", "user transmission curve"))
+        if "airmass" in transmission.attrs:
+            out["airmass"] = float(transmission.attrs["airmass"])
+    return out
 
 
 def pre_integrate(
@@ -383,6 +401,8 @@ def pre_integrate(
     quadrature: str = "trapezoid",
     extrapolate: str | None = None,
     normalize: bool = True,
+    solar: str = "astm_g173",
+    transmission: xr.DataArray | None = None,
 ) -> xr.DataArray:
     """Apply :func:`band_weights` along ``wavelength`` of any DataArray.
 
@@ -394,7 +414,7 @@ def pre_integrate(
         [m2 sr-1], ... Dask-backed arrays stay lazy.
     bands : str, sequence, mapping or DataArray
         See :func:`filters`.
-    weighting, quadrature, extrapolate
+    weighting, quadrature, extrapolate, solar, transmission
         See :func:`band_weights`.
     normalize : bool, default True
         Solar-weighted band means (same units as ``table``); ``False`` gives band
@@ -412,7 +432,7 @@ def pre_integrate(
     if units != "nm":
         raise ValidationError(f"table: wavelength units must be 'nm', got {units!r}")
     w = band_weights(bands, table[WAVELENGTH].values, weighting=weighting, quadrature=quadrature,
-                     extrapolate=extrapolate, normalize=normalize)
+                     extrapolate=extrapolate, normalize=normalize, solar=solar, transmission=transmission)
     w = w.astype(np.result_type(table.dtype, np.float32))
     dims = [BAND if d == WAVELENGTH else d for d in table.dims]
     out = xr.dot(table, w.drop_vars(WAVELENGTH).assign_coords({WAVELENGTH: table[WAVELENGTH]}), dim=WAVELENGTH)

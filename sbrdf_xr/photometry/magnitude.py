@@ -21,59 +21,77 @@ from .bands import (
     pre_integrate,
 )
 from .spectra import (
+    MAGNITUDE_SYSTEMS,
     _choose,
+    _illumination,
     _integral,
-    _solar_native,
-    _solar_provenance,
     _weighting,
-    ab_reference_flux,
+    check_system,
+    reference_flux,
+    reference_nodes,
 )
 
 
-def sun_magnitudes(bands: Any, *, weighting: str = "photon", system: str = "AB") -> xr.DataArray:
+def sun_magnitudes(
+    bands: Any,
+    *,
+    weighting: str = "photon",
+    system: str = "AB",
+    solar: str = "astm_g173",
+    transmission: xr.DataArray | None = None,
+) -> xr.DataArray:
     """Apparent magnitudes of the Sun at 1 AU in each band.
 
-    ``m_sun = -2.5 log10( int E_sun T w dlambda / int f_AB T w dlambda )``, both
-    integrals on the union of the solar and filter nodes (native resolution).
+    ``m_sun = -2.5 log10( int E_sun A T w dlambda / int f_ref T w dlambda )``, both
+    integrals exact for the linear interpolants on the union of the solar, filter and
+    reference-spectrum nodes (native resolution); ``f_ref`` is the zero-magnitude
+    source of ``system`` (3631 Jy for AB, alpha Lyr for Vega) and ``A`` the
+    atmospheric transmission (1 above the atmosphere).
 
     Parameters
     ----------
     bands : str, sequence, mapping or DataArray
         See :func:`filters`.
     weighting : {"photon", "energy"}
-    system : {"AB"}
-        Only AB: no Vega spectrum ships with the dependencies.
+    system : {"AB", "Vega"}
+        Any case (:data:`~sbrdf_xr.photometry.MAGNITUDE_SYSTEMS`).
+    solar : str
+        Solar spectrum (:data:`~sbrdf_xr.photometry.SOLAR_SPECTRA`).
+    transmission : xarray.DataArray, optional
+        Atmospheric transmission over ``wavelength`` [1] applied to the sunlight (not
+        to the reference): the Sun observed through that atmosphere.
 
     Returns
     -------
     xarray.DataArray
-        ``sun_magnitude`` over ``band`` [mag].
+        ``sun_magnitude`` over ``band`` [1, magnitudes], attrs ``magnitude_system``.
     """
     _choose(weighting, WEIGHTINGS, "weighting")
-    _check_system(system)
-    ws, es, _ = _solar_native()
+    system = check_system(system)
+    ws, es = _illumination(solar, transmission)
+    vn = reference_nodes(system)
     bl = _resolve_bands(bands)
     out = np.zeros(len(bl))
     for n, band in enumerate(bl):
         blo, bhi = band.support
         if blo < ws[0] or bhi > ws[-1]:
-            raise _coverage_error(band, ws[0], ws[-1], "solar spectrum (ASTM G173-03)")
-        grid = np.unique(np.concatenate([[blo, bhi], ws[(ws > blo) & (ws < bhi)],
-                                         band.wavelength[(band.wavelength > blo) & (band.wavelength < bhi)]]))
+            raise _coverage_error(band, ws[0], ws[-1], f"solar spectrum ({solar})")
+
+        def inside(v: np.ndarray, lo: float = blo, hi: float = bhi) -> np.ndarray:
+            return v[(v > lo) & (v < hi)]
+
+        grid = np.unique(np.concatenate([[blo, bhi], inside(ws), inside(band.wavelength), inside(vn)]))
         tw = np.interp(grid, band.wavelength, band.response, left=0.0, right=0.0) * _weighting(grid, weighting)
         sun = _integral(grid, np.interp(grid, ws, es) * tw, blo, bhi)
-        ref = _integral(grid, ab_reference_flux(grid) * tw, blo, bhi)
+        ref = _integral(grid, reference_flux(system, grid) * tw, blo, bhi)
         out[n] = -2.5 * np.log10(sun / ref)
     return xr.DataArray(out, dims=(BAND,), coords=_band_coords(bl), name="sun_magnitude",
-                        attrs=attrs("sun_magnitude", magnitude_system=system, weighting=weighting,
-                                    **_solar_provenance()))
+                        attrs=attrs("sun_magnitude", **_system_attrs(system),
+                                    **_method_attrs(weighting, "linear", None, solar, transmission)))
 
 
-def _check_system(system: str) -> None:
-    if system != "AB":
-        raise ValidationError(
-            f"system: unknown {system!r}; allowed: 'AB' (Vega is not offered: no Vega spectrum ships "
-            "with speclite, colour-science or pvlib)")
+def _system_attrs(system: str) -> dict[str, str]:
+    return {"magnitude_system": system, "magnitude_system_description": MAGNITUDE_SYSTEMS[system]}
 
 
 # ------------------------------------------------------------ from a cube
@@ -101,6 +119,9 @@ def band_signal(
     weighting: str = "photon",
     quadrature: str = "trapezoid",
     extrapolate: str | None = None,
+    system: str = "AB",
+    solar: str = "astm_g173",
+    transmission: xr.DataArray | None = None,
 ) -> xr.DataArray:
     """Solar-weighted band mean of a cube's radiometric signal.
 
@@ -117,8 +138,10 @@ def band_signal(
         See :func:`filters`.
     variable : str
         Cube variable to integrate (``signal`` or ``signal_material``).
-    weighting, quadrature, extrapolate
+    weighting, quadrature, extrapolate, solar, transmission
         See :func:`band_weights`.
+    system : {"AB", "Vega"}
+        System of the Sun's magnitudes carried in the coordinate ``sun_magnitude``.
 
     Returns
     -------
@@ -128,11 +151,12 @@ def band_signal(
     """
     s = _signal_of(cube, variable)
     out = pre_integrate(s, bands, weighting=weighting, quadrature=quadrature, extrapolate=extrapolate,
-                        normalize=True)
-    sun = sun_magnitudes(bands, weighting=weighting)
+                        normalize=True, solar=solar, transmission=transmission)
+    sun = sun_magnitudes(bands, weighting=weighting, system=system, solar=solar, transmission=transmission)
     out = out.assign_coords(sun_magnitude=(BAND, sun.values, sun.attrs))
     out.name = "band_signal"
     out.attrs.update(attrs("band_signal", units=s.attrs.get("units", "m2 sr-1")))
+    out.attrs.update(_system_attrs(sun.attrs["magnitude_system"]))
     return out
 
 
@@ -154,10 +178,12 @@ def magnitudes(
     range_km: Any = None,
     *,
     system: str = "AB",
-    sun_distance_au: float = 1.0,
+    sun_distance_au: Any = 1.0,
     weighting: str = "photon",
     quadrature: str = "trapezoid",
     extrapolate: str | None = None,
+    solar: str = "astm_g173",
+    transmission: xr.DataArray | None = None,
 ) -> xr.DataArray:
     """Apparent magnitudes of the reflected sunlight.
 
@@ -174,33 +200,48 @@ def magnitudes(
         See :func:`filters`.
     range_km : float, array_like or DataArray
         Observer range [km], > 0; broadcast against the cube (a DataArray aligns by dims).
-    system : {"AB"}
-    sun_distance_au : float
-        Sun-object distance [AU].
-    weighting, quadrature, extrapolate
+    system : {"AB", "Vega"}
+        Magnitude system, any case (:data:`~sbrdf_xr.photometry.MAGNITUDE_SYSTEMS`);
+        recorded in the attribute ``magnitude_system``.  A :func:`band_signal` input
+        must have been made in the same system.
+    sun_distance_au : float, array_like or DataArray
+        Sun-object distance [AU], > 0 (e.g. :func:`sun_distance_au` of the
+        observation times); broadcast like ``range_km``.
+    weighting, quadrature, extrapolate, solar, transmission
         See :func:`band_weights`.
 
     Returns
     -------
     xarray.DataArray
-        ``magnitude`` [mag] over the cube's dims with ``band`` in place of ``wavelength``.
+        ``magnitude`` [1] over the cube's dims with ``band`` in place of ``wavelength``.
     """
-    _check_system(system)
+    system = check_system(system)
     if range_km is None:
-        raise ValidationError("range_km: the observer range [km] is required")
+        raise ValidationError("range_km: the observer range [km] is required (e.g. range_km=1000.0)")
     d = _range_m(range_km)
-    if not np.isfinite(sun_distance_au) or sun_distance_au <= 0:
-        raise ValidationError(f"sun_distance_au: must be finite and > 0, got {sun_distance_au}")
+    r = _positive(sun_distance_au, "sun_distance_au")
     if isinstance(cube, xr.DataArray) and BAND in cube.dims and "sun_magnitude" in cube.coords:
         sb = cube
+        have = sb.attrs.get("magnitude_system", sb["sun_magnitude"].attrs.get("magnitude_system", "AB"))
+        if have != system:
+            raise ValidationError(f"system: the band_signal was made in the {have} system, not {system}; "
+                                  f"pass system={have!r} or recompute band_signal(..., system={system!r})")
     else:
         if bands is None:
             raise ValidationError("bands: required unless a band_signal result is given")
-        sb = band_signal(cube, bands, weighting=weighting, quadrature=quadrature, extrapolate=extrapolate)
-    return _magnitudes_from(sb, d, sun_distance_au, system)
+        sb = band_signal(cube, bands, weighting=weighting, quadrature=quadrature, extrapolate=extrapolate,
+                         system=system, solar=solar, transmission=transmission)
+    return _magnitudes_from(sb, d, r, system)
 
 
-def _magnitudes_from(sb: xr.DataArray, d_m: Any, sun_distance_au: float, system: str) -> xr.DataArray:
+def _positive(value: Any, what: str) -> Any:
+    vals = np.asarray(value.values if isinstance(value, xr.DataArray) else value, dtype=np.float64)
+    if vals.size == 0 or not np.all(np.isfinite(vals)) or np.any(vals <= 0):
+        raise ValidationError(f"{what}: must be finite and > 0, got {vals.ravel()[:5].tolist()}")
+    return value.astype(np.float64) if isinstance(value, xr.DataArray) else vals
+
+
+def _magnitudes_from(sb: xr.DataArray, d_m: Any, sun_distance_au: Any, system: str) -> xr.DataArray:
     ratio = sb / d_m**2
     pos = ratio > 0
     safe = xr.where(pos, ratio, 1.0)
@@ -208,11 +249,12 @@ def _magnitudes_from(sb: xr.DataArray, d_m: Any, sun_distance_au: float, system:
     m = xr.where(pos, m, xr.where(ratio == 0, np.inf, np.nan))
     m = m.transpose(*sb.dims, ...)
     m.name = "magnitude"
-    m.attrs = attrs("magnitude", magnitude_system=system, weighting=sb.attrs.get("weighting", ""),
-                    sun_distance_au=float(sun_distance_au),
+    m.attrs = attrs("magnitude", **_system_attrs(system), weighting=sb.attrs.get("weighting", ""),
                     note="+inf where the band signal is 0 (nothing reflects toward the observer); "
                     "NaN where it is negative",
                     formula="m = m_sun,band(1 AU) + 5 log10(r/AU) - 2.5 log10(S_band / d^2), d in m")
+    if not isinstance(sun_distance_au, xr.DataArray) and np.ndim(sun_distance_au) == 0:
+        m.attrs["sun_distance_au"] = float(sun_distance_au)
     if not isinstance(d_m, xr.DataArray):
         d_arr = np.asarray(d_m)
         if d_arr.ndim == 0:
@@ -281,10 +323,12 @@ def photometry(
     *,
     pairs: Sequence[tuple[str, str]] | None = None,
     system: str = "AB",
-    sun_distance_au: float = 1.0,
+    sun_distance_au: Any = 1.0,
     weighting: str = "photon",
     quadrature: str = "trapezoid",
     extrapolate: str | None = None,
+    solar: str = "astm_g173",
+    transmission: xr.DataArray | None = None,
 ) -> xr.Dataset:
     """Band signal, magnitudes and colour indices of a cube, as one Dataset.
 
@@ -298,9 +342,11 @@ def photometry(
         there are two bands or more), with the cube's coordinates.
     """
     d = _range_m(range_km)
-    _check_system(system)
-    sb = band_signal(cube, bands, weighting=weighting, quadrature=quadrature, extrapolate=extrapolate)
-    m = _magnitudes_from(sb, d, sun_distance_au, system)
+    system = check_system(system)
+    r = _positive(sun_distance_au, "sun_distance_au")
+    sb = band_signal(cube, bands, weighting=weighting, quadrature=quadrature, extrapolate=extrapolate,
+                     system=system, solar=solar, transmission=transmission)
+    m = _magnitudes_from(sb, d, r, system)
     out = {"band_signal": sb, "magnitude": m}
     if sb.sizes[BAND] > 1 or pairs:
         out["colour_index"] = colour_indices(m, pairs)
@@ -312,11 +358,13 @@ def photometry(
         "source": src.get("source", "sbrdf_xr"),
         "history": f"sbrdf_xr.photometry(bands={[str(b) for b in sb[BAND].values]}, "
         f"range_km={np.asarray(range_km).tolist() if not isinstance(range_km, xr.DataArray) else 'DataArray'}, "
-        f"system={system}, weighting={weighting}, quadrature={quadrature}, extrapolate={extrapolate})",
-        "magnitude_system": system,
-        "sun_distance_au": float(sun_distance_au),
-        **_method_attrs(weighting, quadrature, extrapolate),
+        f"system={system}, weighting={weighting}, quadrature={quadrature}, extrapolate={extrapolate}, "
+        f"solar={solar})",
+        **_system_attrs(system),
+        **_method_attrs(weighting, quadrature, extrapolate, solar, transmission),
     }
+    if "sun_distance_au" in m.attrs:
+        ds.attrs["sun_distance_au"] = m.attrs["sun_distance_au"]
     if "range_km" in m.attrs:
         ds.attrs["range_km"] = m.attrs["range_km"]
     return ds
