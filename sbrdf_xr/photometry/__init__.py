@@ -60,6 +60,15 @@ magnitude are NaN (the colour is undefined).  A negative band signal (possible o
 with noisy tables) gives a NaN magnitude.
 """
 
+from . import atmosphere
+from .atmosphere import (
+    AIRMASS_MODELS,
+    airmass,
+    apply_extinction,
+    extinction_coefficients,
+    rayleigh_optical_depth,
+    transmission,
+)
 from .bands import (
     BAND_ALIASES,
     EXTRAPOLATIONS,
@@ -91,35 +100,56 @@ from .spectra import (
     trapezoid_weights,
     vega_spectrum,
 )
+from .standard import (
+    PHASE_FUNCTIONS,
+    at_resolution,
+    lambert_sphere_phase,
+    specular_sphere_phase,
+    standard_magnitude,
+    sun_distance_au,
+)
 
 __all__ = [
     "AB_ZERO_POINT_JY",
+    "AIRMASS_MODELS",
     "BAND_ALIASES",
     "EXTRAPOLATIONS",
     "LIGHT_CURVE_ABSCISSAE",
     "LIGHT_CURVE_COLUMNS",
     "MAGNITUDE_SYSTEMS",
+    "PHASE_FUNCTIONS",
     "QUADRATURES",
     "SOLAR_SPECTRA",
     "WEIGHTINGS",
     "ab_reference_flux",
+    "airmass",
+    "apply_extinction",
+    "at_resolution",
+    "atmosphere",
     "band_signal",
     "band_weights",
     "check_system",
     "colour_indices",
     "compare_light_curves",
+    "extinction_coefficients",
     "filters",
     "hat_integrals",
+    "lambert_sphere_phase",
     "magnitudes",
     "photometry",
     "plot_comparison",
     "pre_integrate",
+    "rayleigh_optical_depth",
     "read_light_curve",
     "reference_flux",
     "solar_spectrum",
     "speclite_names",
+    "specular_sphere_phase",
     "srgb",
+    "standard_magnitude",
+    "sun_distance_au",
     "sun_magnitudes",
+    "transmission",
     "trapezoid_weights",
     "vega_spectrum",
 ]
