@@ -80,14 +80,15 @@ from .bands import (
     speclite_names,
 )
 from .colour import srgb
-from .lightcurves import (
+from .lightcurves import compare_light_curves, plot_comparison
+from .magnitude import band_signal, colour_indices, magnitudes, photometry, sun_magnitudes
+from .measured import (
     LIGHT_CURVE_ABSCISSAE,
     LIGHT_CURVE_COLUMNS,
-    compare_light_curves,
-    plot_comparison,
+    LIGHT_CURVE_OPTIONAL,
+    TABLE_FORMATS,
     read_light_curve,
 )
-from .magnitude import band_signal, colour_indices, magnitudes, photometry, sun_magnitudes
 from .spectra import (
     AB_ZERO_POINT_JY,
     MAGNITUDE_SYSTEMS,
@@ -116,10 +117,12 @@ __all__ = [
     "EXTRAPOLATIONS",
     "LIGHT_CURVE_ABSCISSAE",
     "LIGHT_CURVE_COLUMNS",
+    "LIGHT_CURVE_OPTIONAL",
     "MAGNITUDE_SYSTEMS",
     "PHASE_FUNCTIONS",
     "QUADRATURES",
     "SOLAR_SPECTRA",
+    "TABLE_FORMATS",
     "WEIGHTINGS",
     "ab_reference_flux",
     "airmass",

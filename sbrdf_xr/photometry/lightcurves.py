@@ -2,10 +2,7 @@
 
 from __future__ import annotations
 
-import os
-from collections.abc import Sequence
 from itertools import pairwise
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -13,154 +10,8 @@ import xarray as xr
 
 from .._names import ATTITUDE, BAND, PHASE_ANGLE, attrs
 from ..errors import ValidationError
-from .bands import BAND_ALIASES, _canonical, speclite_names
-
-# -------------------------------------------------------------- light curves
-
-LIGHT_CURVE_COLUMNS = ("band", "magnitude", "uncertainty")
-LIGHT_CURVE_ABSCISSAE = ("time", "rotation_angle")
-
-
-def read_light_curve(path: str | os.PathLike[str], *, bands: Sequence[str] | None = None) -> xr.Dataset:
-    """Read a measured light curve from CSV or netCDF.
-
-    Schema (one observation per row; CSV with a header line, extra columns ignored):
-
-    ============== ========================================================================
-    column         meaning
-    ============== ========================================================================
-    time           observation time: seconds [s] (any origin) or ISO 8601 timestamps;
-                   **or** ``rotation_angle`` [degree], the body rotation angle (cumulative,
-                   may exceed 360).  Exactly one of the two; non-decreasing down the file.
-    band           band label: an alias (``B``, ``V``, ``g``, ...) or speclite filter name,
-                   or one of ``bands`` when given
-    magnitude      measured magnitude [mag]
-    uncertainty    1-sigma uncertainty of the magnitude [mag], > 0
-    ============== ========================================================================
-
-    A netCDF file holds the same names as variables along one dimension.
-
-    Parameters
-    ----------
-    path : str or path
-        ``.csv`` (or any text file) or ``.nc``.
-    bands : sequence of str, optional
-        Allowed band labels; default any alias or speclite filter name.
-
-    Returns
-    -------
-    xarray.Dataset
-        Over ``obs``: ``magnitude``, ``uncertainty`` [mag], coords ``band`` and ``time``
-        [s] (numeric times as given; ISO 8601 times as seconds since the first
-        observation, attr ``time_origin``) or ``rotation_angle`` [degree].
-
-    Raises
-    ------
-    ValidationError
-        Naming the file and the column or row: missing columns, both or neither of
-        time and rotation_angle, NaN or non-numeric values, non-positive uncertainty,
-        unknown bands, times or angles that decrease.
-    """
-    import pandas as pd
-
-    path = Path(path)
-    if not path.is_file():
-        raise ValidationError(f"light curve: file {path} does not exist")
-    if path.suffix.lower() in (".nc", ".nc4", ".netcdf"):
-        with xr.open_dataset(path, decode_times=True) as ds:
-            ds = ds.load()
-        if len(ds.dims) != 1:
-            raise ValidationError(f"{path}: expected variables along one dimension, got dims {dict(ds.sizes)}")
-        df = ds.reset_coords().to_dataframe().reset_index(drop=True)
-        where = "netCDF record {}"
-        offset = 0
-    else:
-        try:
-            df = pd.read_csv(path, skipinitialspace=True, dtype=str, keep_default_na=False)
-        except Exception as exc:  # pandas raises several types for malformed text
-            raise ValidationError(f"{path}: cannot be read as CSV with a header: {exc}") from exc
-        df.columns = [str(c).strip() for c in df.columns]
-        where = "row {} (line {} of the file)"
-        offset = 1
-    cols = list(df.columns)
-    missing = [c for c in LIGHT_CURVE_COLUMNS if c not in cols]
-    absc = [c for c in LIGHT_CURVE_ABSCISSAE if c in cols]
-    if missing:
-        raise ValidationError(f"{path}: missing column(s) {missing}; required: band, magnitude, uncertainty "
-                              f"and one of time, rotation_angle; found {cols}")
-    if len(absc) != 1:
-        raise ValidationError(f"{path}: need exactly one of the columns 'time' or 'rotation_angle', found "
-                              f"{absc or 'neither'}")
-    xname = absc[0]
-    if len(df) == 0:
-        raise ValidationError(f"{path}: no observations")
-
-    def row_name(k: int) -> str:
-        return where.format(k + 1, k + 1 + offset) if offset else where.format(k)
-
-    def numeric(col: str) -> np.ndarray:
-        v = pd.to_numeric(pd.Series(df[col]).astype(str).str.strip()
-                          if df[col].dtype == object else df[col], errors="coerce").to_numpy(dtype=np.float64)
-        bad = np.flatnonzero(~np.isfinite(v))
-        if bad.size:
-            raise ValidationError(f"{path}: {row_name(int(bad[0]))}, column {col!r}: value "
-                                  f"{df[col].iloc[bad[0]]!r} is not a finite number")
-        return v
-
-    mag = numeric("magnitude")
-    unc = numeric("uncertainty")
-    bad = np.flatnonzero(unc <= 0)
-    if bad.size:
-        raise ValidationError(f"{path}: {row_name(int(bad[0]))}, column 'uncertainty': must be > 0, got {unc[bad[0]]}")
-    x_attrs: dict[str, Any]
-    if xname == "time":
-        raw = df["time"]
-        if pd.api.types.is_datetime64_any_dtype(raw.dtype):
-            tt = pd.to_datetime(raw, utc=True)
-            x = None
-        else:
-            as_num = pd.to_numeric(raw.astype(str).str.strip(), errors="coerce")
-            if as_num.notna().all():
-                x = as_num.to_numpy(dtype=np.float64)
-                tt = None
-            else:
-                tt = pd.to_datetime(raw.astype(str).str.strip(), utc=True, errors="coerce", format="ISO8601")
-                x = None
-        if x is None:
-            nat = np.flatnonzero(tt.isna().to_numpy())
-            if nat.size:
-                raise ValidationError(f"{path}: {row_name(int(nat[0]))}, column 'time': value "
-                                      f"{raw.iloc[nat[0]]!r} is neither a number of seconds nor an ISO 8601 time")
-            origin = tt.iloc[0]
-            x = (tt - origin).dt.total_seconds().to_numpy(dtype=np.float64)
-            x_attrs = attrs("time_since_first", time_origin=origin.isoformat())
-        else:
-            x = numeric("time")
-            x_attrs = attrs("time_since_first", long_name="observation time",
-                            time_origin="as in the file (numeric seconds are kept unchanged)")
-    else:
-        x = numeric("rotation_angle")
-        x_attrs = attrs("rotation_angle")
-    back = np.flatnonzero(np.diff(x) < 0)
-    if back.size:
-        k = int(back[0]) + 1
-        raise ValidationError(f"{path}: {row_name(k)}, column {xname!r}: values must be non-decreasing "
-                              f"(sorted); it goes back from row {k} to row {k + 1}")
-    band = [str(b).strip() for b in df["band"].tolist()]
-    known = set(bands) if bands is not None else None
-    for k, b in enumerate(band):
-        ok = (b in known) if known is not None else (_canonical(b) in speclite_names())
-        if not ok:
-            allowed = sorted(known) if known is not None else f"aliases {list(BAND_ALIASES)} or speclite names"
-            raise ValidationError(f"{path}: {row_name(k)}, column 'band': unknown band {b!r}; allowed: {allowed}")
-    ds = xr.Dataset(
-        {"magnitude": ("obs", mag, attrs("magnitude", long_name="measured magnitude")),
-         "uncertainty": ("obs", unc, attrs("magnitude_uncertainty"))},
-        coords={"obs": ("obs", np.arange(mag.size), attrs("obs")),
-                BAND: ("obs", band, attrs(BAND)),
-                xname: ("obs", x, x_attrs)})
-    ds.attrs = {"source_file": str(path), "abscissa": xname}
-    return ds
+from .bands import _canonical
+from .measured import MIN_UNCERTAINTY
 
 
 def _periodic_model_flux(angles: np.ndarray, flux: np.ndarray, at: np.ndarray) -> np.ndarray:
@@ -176,6 +27,8 @@ def compare_light_curves(
     period_s: float | None = None,
     phase_angle: float | None = None,
     n_scan: int = 720,
+    epoch: Any = None,
+    extinction: Any = None,
 ) -> xr.Dataset:
     """Fit a simulated light curve to a measured one: magnitude and rotation-phase offsets.
 
@@ -186,7 +39,10 @@ def compare_light_curves(
     by a scan of ``n_scan`` equally spaced values over [0, 360) and a bounded Brent
     refinement within one scan step of the best; it is reported in [0, 360).
     Observations where the model reflects nothing (infinite magnitude) are excluded
-    and counted.
+    and counted.  Per-row geometry in ``measured`` enters the model: a ``range_km``
+    column adds ``5 log10(range / range_sim)`` (``range_sim`` the ``range_km``
+    attribute of the simulated magnitudes), an ``airmass`` column with ``extinction``
+    adds ``k_band X``; absolute times from several nights share one rotation phase.
 
     Parameters
     ----------
@@ -203,7 +59,12 @@ def compare_light_curves(
     phase_angle : float, optional
         Selects the simulated phase angle [degree] (nearest) when there are several.
     n_scan : int
-        Number of scan points.
+        Number of scan points, >= 1.
+    epoch : datetime64 or str, optional
+        Time of rotation angle 0 for absolute (UTC) times; default the first observation.
+    extinction : mapping or DataArray, optional
+        Extinction coefficients per band (:func:`~sbrdf_xr.photometry.apply_extinction`)
+        applied with the ``airmass`` column of ``measured``.
 
     Returns
     -------
@@ -220,18 +81,36 @@ def compare_light_curves(
 
     if not isinstance(measured, xr.Dataset) or "magnitude" not in measured or "uncertainty" not in measured:
         raise ValidationError("measured: expected a light-curve Dataset from read_light_curve")
+    if isinstance(n_scan, bool) or not isinstance(n_scan, int | np.integer) or n_scan < 1:
+        raise ValidationError(f"n_scan: must be an integer >= 1 (trial phase offsets over 360 degree), got {n_scan!r}")
     sim = _simulated_curve(simulated_mags, phase_angle)
+    have = str(measured.attrs.get("magnitude_system", measured["magnitude"].attrs.get("magnitude_system",
+                                                                                          "unstated")))
+    want = str(sim.attrs.get("magnitude_system", "unstated"))
+    if "unstated" not in (have, want) and have != want:
+        raise ValidationError(f"measured: magnitudes are in the {have} system but the simulation is in {want}; "
+                              f"simulate with system={have!r}")
     if "rotation_angle" in measured.coords:
         theta = np.asarray(measured["rotation_angle"].values, dtype=np.float64)
     elif "time" in measured.coords:
         if period_s is None or not np.isfinite(period_s) or period_s <= 0:
             raise ValidationError("period_s: the measured light curve is indexed by time; give the rotation "
                                   "period [s] (> 0) to convert it to rotation angle")
-        theta = 360.0 * np.asarray(measured["time"].values, dtype=np.float64) / period_s
+        tv = measured["time"].values
+        if np.issubdtype(tv.dtype, np.datetime64):
+            t0 = tv[0] if epoch is None else np.datetime64(epoch, "ns")
+            secs = (tv.astype("datetime64[ns]") - t0) / np.timedelta64(1, "s")
+        else:
+            secs = np.asarray(tv, dtype=np.float64)
+        theta = 360.0 * np.asarray(secs, dtype=np.float64) / period_s
     else:
         raise ValidationError("measured: needs a 'rotation_angle' or 'time' coordinate")
     m_obs = np.asarray(measured["magnitude"].values, dtype=np.float64)
     sig = np.asarray(measured["uncertainty"].values, dtype=np.float64)
+    bad = np.flatnonzero(~np.isfinite(sig) | (sig < MIN_UNCERTAINTY))
+    if bad.size:
+        raise ValidationError(f"measured: observation {int(bad[0])} has uncertainty {sig[bad[0]]:g}; must be "
+                              f"finite and >= {MIN_UNCERTAINTY:g} mag")
     sim_labels = [str(b) for b in sim[BAND].values]
     sim_filters = [str(f) for f in sim["filter"].values] if "filter" in sim.coords else sim_labels
     obs_band = [str(b) for b in measured[BAND].values]
@@ -249,6 +128,24 @@ def compare_light_curves(
     with np.errstate(over="ignore"):
         flux = np.where(np.isfinite(sim_m), 10.0 ** (-0.4 * np.where(np.isfinite(sim_m), sim_m, 0.0)), 0.0)
     w = 1.0 / sig**2
+    extra = np.zeros(theta.size)  # per-observation geometry terms of the model [mag]
+    if "range_km" in measured:
+        if "range_km" not in sim.attrs:
+            raise ValidationError("measured: has a range_km column but simulated_mags has no range_km "
+                                  "attribute (the range it was computed at); compute it at one range")
+        extra += 5.0 * np.log10(np.asarray(measured["range_km"].values, dtype=np.float64)
+                                / float(sim.attrs["range_km"]))
+    if extinction is not None:
+        if "airmass" not in measured:
+            raise ValidationError("extinction: the measured light curve has no airmass column")
+        from .atmosphere import apply_extinction
+
+        labels = sorted({str(b) for b in measured[BAND].values})
+        zero = xr.DataArray(np.zeros(len(labels)), dims=(BAND,), coords={BAND: labels})
+        k = apply_extinction(zero, 1.0, extinction)
+        kb = dict(zip(labels, k.values.tolist(), strict=True))
+        extra += np.array([kb[str(b)] for b in measured[BAND].values]) * np.asarray(
+            measured["airmass"].values, dtype=np.float64)
 
     def model(phi: float) -> tuple[np.ndarray, np.ndarray]:
         f = np.empty(theta.size)
@@ -257,7 +154,7 @@ def compare_light_curves(
             f[sel] = _periodic_model_flux(angles, flux[:, b], theta[sel] + phi)
         ok = f > 0
         mm = np.full(theta.size, np.inf)
-        mm[ok] = -2.5 * np.log10(f[ok])
+        mm[ok] = -2.5 * np.log10(f[ok]) + extra[ok]
         return mm, ok
 
     def fit(phi: float) -> tuple[float, float, np.ndarray, np.ndarray]:
@@ -295,6 +192,10 @@ def compare_light_curves(
         phi_alt, dchi_alt = np.nan, np.nan
     n_par = 2 if fit_phase else 1
     dof = int(ok.sum()) - n_par
+    if dof < 1:
+        raise ValidationError(f"measured: {int(ok.sum())} observation(s) where the model reflects light; fitting "
+                              f"{n_par} parameter(s) (magnitude{' and phase' if fit_phase else ''} offset) needs "
+                              f"at least {n_par + 1}")
     resid = np.where(ok, m_obs - (mm + dm), np.nan)
     labels_present = [lab for j, lab in enumerate(sim_labels) if np.any(col[ok] == j)]
     band_mean = []
