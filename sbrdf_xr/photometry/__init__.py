@@ -80,6 +80,7 @@ from .bands import (
     speclite_names,
 )
 from .colour import srgb
+from .files import cf_decode, cf_encode, open_photometry, to_netcdf
 from .lightcurves import compare_light_curves, plot_comparison
 from .magnitude import band_signal, colour_indices, magnitudes, photometry, sun_magnitudes
 from .measured import (
@@ -131,6 +132,8 @@ __all__ = [
     "atmosphere",
     "band_signal",
     "band_weights",
+    "cf_decode",
+    "cf_encode",
     "check_system",
     "colour_indices",
     "compare_light_curves",
@@ -139,6 +142,7 @@ __all__ = [
     "hat_integrals",
     "lambert_sphere_phase",
     "magnitudes",
+    "open_photometry",
     "photometry",
     "plot_comparison",
     "pre_integrate",
@@ -152,6 +156,7 @@ __all__ = [
     "standard_magnitude",
     "sun_distance_au",
     "sun_magnitudes",
+    "to_netcdf",
     "transmission",
     "trapezoid_weights",
     "vega_spectrum",

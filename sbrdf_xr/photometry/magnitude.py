@@ -295,8 +295,10 @@ def colour_indices(mags: xr.DataArray, pairs: Sequence[tuple[str, str]] | None =
     ci = xr.where(ok, xr.where(ok, first, 0.0) - xr.where(ok, second, 0.0), np.nan)
     names = [f"{a}-{b}" for a, b in pairs]
     ci = ci.assign_coords(colour=("colour", names, attrs("colour")),
-                          first=("colour", [labels[i] for i in idx[0]]),
-                          second=("colour", [labels[i] for i in idx[1]]))
+                          first=("colour", [labels[i] for i in idx[0]],
+                                 {"long_name": "band of the first magnitude of the colour index"}),
+                          second=("colour", [labels[i] for i in idx[1]],
+                                  {"long_name": "band of the magnitude subtracted in the colour index"}))
     dims = [("colour" if d == BAND else d) for d in mags.dims]
     ci = ci.transpose(*dims)
     ci.name = "colour_index"
