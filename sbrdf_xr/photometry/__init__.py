@@ -2,8 +2,11 @@
 
 The chain from a simulation cube to what a telescope measures:
 
-1. :func:`solar_spectrum` - the extraterrestrial Sun at 1 AU [W m-2 nm-1], the
-   ASTM G173-03 table shipped inside pvlib (no network).
+1. :func:`solar_spectrum` - the extraterrestrial Sun at 1 AU [W m-2 nm-1]: the
+   ASTM G173-03 table shipped inside pvlib by default, or (``solar=``) the CALSPEC
+   ``sun_reference_stis_001`` spectrum or the Kurucz 1993 solar model shipped inside
+   pyphot (:data:`SOLAR_SPECTRA`; no network).  :func:`vega_spectrum` - CALSPEC
+   ``alpha_lyr_stis_011``, also from pyphot.
 2. :func:`filters` - standard bandpasses shipped inside speclite (Bessell UBVRI,
    SDSS ugriz, ...; short aliases in :data:`BAND_ALIASES`) and user bandpasses.
 3. :func:`band_weights` - the ``(band, wavelength)`` matrix ``W`` with the Sun and
@@ -15,8 +18,16 @@ The chain from a simulation cube to what a telescope measures:
    band numbers to float rounding.
 4. :func:`band_signal` and :func:`magnitudes` from a cube; :func:`colour_indices`;
    :func:`srgb` swatches; :func:`photometry` bundles them (``ds.sbrdf.photometry``).
-5. :func:`read_light_curve`, :func:`compare_light_curves`, :func:`plot_comparison`
-   for measured light curves.
+5. :func:`read_light_curve` (CSV, ECSV, FITS, VOTable, netCDF; units, UTC times),
+   :func:`compare_light_curves`, :func:`plot_comparison` for measured light curves.
+6. :mod:`~sbrdf_xr.photometry.atmosphere` - air mass (:func:`airmass`, pvlib's
+   models), extinction (:func:`apply_extinction`, :func:`transmission` folded into
+   the band weights); :func:`standard_magnitude` (to a range, a phase angle, 1 AU),
+   :func:`sun_distance_au`, :func:`at_resolution` (a spectrograph's resolution).
+7. :func:`to_netcdf` / :func:`open_photometry` - CF-1.10 photometry files.
+
+Modules: ``spectra`` (reference spectra, quadrature), ``bands``, ``magnitude``,
+``atmosphere``, ``standard``, ``colour``, ``measured``, ``lightcurves``, ``files``.
 
 Conventions
 -----------
@@ -43,16 +54,51 @@ band flux at range ``d`` [m] from an object ``r`` AU from the Sun is
 where ``m_sun,band`` is the Sun's apparent magnitude at 1 AU in the same band,
 computed from the same solar spectrum and filter (:func:`sun_magnitudes`).
 
-Magnitudes are AB (Oke & Gunn 1983, ApJ 266, 713: a flat ``f_nu`` of 3631 Jy has
-magnitude 0 in every band)::
+Magnitude systems (``system=``, any case, recorded in the attribute
+``magnitude_system``; magnitudes have CF units ``"1"``):
 
-    photon:  m_AB = -2.5 log10( int f_nu T dnu/nu / int 3631 Jy T dnu/nu )
-                  = -2.5 log10( int f_lambda T lambda dlambda / int f_AB,lambda T lambda dlambda )
+* **AB** (default; Oke & Gunn 1983, ApJ 266, 713): a flat ``f_nu`` of 3631 Jy has
+  magnitude 0 in every band::
+
+    photon:  m_AB = -2.5 log10( int f_lambda T lambda dlambda / int f_AB,lambda T lambda dlambda )
     energy:  m_AB = -2.5 log10( int f_lambda T dlambda / int f_AB,lambda T dlambda )
 
-with ``f_AB,lambda = 3631 Jy * c / lambda**2``.  The Vega system is not offered:
-neither speclite nor colour-science nor pvlib ships a Vega spectrum, and the
-package must work without the network.
+  with ``f_AB,lambda = 3631 Jy * c / lambda**2``;
+* **Vega**: the same with ``f_AB`` replaced by the CALSPEC spectrum of alpha Lyr
+  (``alpha_lyr_stis_011``; Bohlin et al. 2020, AJ 160, 21), so Vega has magnitude 0
+  in every band (the synthetic-photometry convention of synphot's VEGAMAG and
+  pyphot).  The file ships inside the package pyphot (``pyphot/libs``); STScI
+  CALSPEC data are public.
+
+The Sun's magnitudes and colours (photon counting, ASTM G173-03; ``sun_magnitudes``)
+against published values:
+
+======  ========  =========  ================================================================
+colour  AB        Vega       published
+======  ========  =========  ================================================================
+V       -26.768   -26.774    -26.76 +- 0.02 Vega (Willmer 2018, ApJS 236, 47)
+B-V     0.525     0.651      0.653 +- 0.003 Vega (Ramirez et al. 2012, ApJ 752, 5)
+U-B     1.007     0.121      0.166 +- 0.022 Vega (Ramirez et al. 2012)
+V-R     0.194     0.391      0.356 +- 0.003 Vega, Cousins R (Ramirez et al. 2012)
+V-I     0.289     0.732      0.701 +- 0.003 Vega, Cousins I (Ramirez et al. 2012)
+g-r     0.476     0.733      0.44 +- 0.02 AB-like SDSS (Holmberg et al. 2006, MNRAS 367, 449);
+                             0.45 AB, synthetic (Willmer 2018, Table 3)
+r-i     0.115     0.336      0.11 +- 0.02 (Holmberg et al. 2006)
+i-z     0.030     0.187      0.03 +- 0.02 (Holmberg et al. 2006)
+======  ========  =========  ================================================================
+
+The Sun's g-r: 0.476 here (Doi et al. 2010 SDSS responses at air mass 1.3, AB).  The
+difference to the published 0.44 +- 0.02 is not in the integration, the solar
+spectrum or the AB convention: pyphot's independent code with its own SDSS curves
+gives 0.476 on the same Sun, the CALSPEC and Kurucz Suns 0.479 and 0.477, and the
+SDSS g and r are AB to 0.01.  The 0.44 is empirical - Johnson-Cousins colours of
+solar analogues transformed to SDSS (Holmberg et al. 2006) - and Willmer's
+synthetic value from his composite Sun is 0.45; without the atmosphere
+(``sdss2010noatm-*``) the synthetic value is 0.491 (the atmosphere at air mass 1.3
+dims g more than r).  Synthetic g-r thus depends on the filter realisation by
+0.02-0.04 mag, about the size of the empirical uncertainty; the tests hold it
+to 0.05 of the published value.  Likewise the synthetic V-R and V-I with the
+Bessell (1990) curves are 0.03 redder than Ramirez et al.'s solar-twin values.
 
 A body that reflects nothing (``S_band = 0``) has magnitude ``+inf`` (zero flux;
 computed without floating-point warnings); colour indices involving an infinite
