@@ -22,6 +22,7 @@ from .bands import (
 )
 from .spectra import (
     MAGNITUDE_SYSTEMS,
+    SOLAR_SPECTRA,
     _choose,
     _illumination,
     _integral,
@@ -362,6 +363,9 @@ def photometry(
         f"range_km={np.asarray(range_km).tolist() if not isinstance(range_km, xr.DataArray) else 'DataArray'}, "
         f"system={system}, weighting={weighting}, quadrature={quadrature}, extrapolate={extrapolate}, "
         f"solar={solar})",
+        "references": "AB: Oke & Gunn 1983, ApJ 266, 713; Vega: CALSPEC alpha_lyr_stis_011, Bohlin et al. "
+        "2020, AJ 160, 21; filters: speclite (Bessell 1990, PASP 102, 1181; Doi et al. 2010, AJ 139, 1628); "
+        f"Sun: {SOLAR_SPECTRA[solar]}",
         **_system_attrs(system),
         **_method_attrs(weighting, quadrature, extrapolate, solar, transmission),
     }
