@@ -6,6 +6,7 @@ import warnings
 
 import numpy as np
 import pytest
+import xarray as xr
 
 from sbrdf_xr import models
 from sbrdf_xr import photometry as P
@@ -181,3 +182,17 @@ def test_sun_g_minus_r_with_an_independent_code_and_filter_set():
     assert doi[0] - doi[1] == pytest.approx(0.476, abs=0.005)
     noatm = P.sun_magnitudes(["sdss2010noatm-g", "sdss2010noatm-r"]).values
     assert noatm[0] - noatm[1] == pytest.approx(0.491, abs=0.005)
+
+
+def test_the_real_sun_distance_enters_the_magnitude():
+    cube = _white_lambertian_cube()
+    m1 = P.magnitudes(cube, ["V"], 1000.0)
+    r = P.sun_distance_au(np.array(["2024-07-05T05:06"], dtype="datetime64[ns]"))  # aphelion
+    mr = P.magnitudes(cube, ["V"], 1000.0, sun_distance_au=float(r[0]))
+    np.testing.assert_allclose((mr - m1).values, 5 * np.log10(r[0]), rtol=1e-12)
+    assert mr.attrs["sun_distance_au"] == pytest.approx(1.0167, abs=1e-4)
+    per_geometry = xr.DataArray([1.0167], dims="geometry")
+    mg = P.magnitudes(cube, ["V"], 1000.0, sun_distance_au=per_geometry)
+    np.testing.assert_allclose(mg.values, m1.values + 5 * np.log10(1.0167), rtol=1e-12)
+    with pytest.raises(ValidationError, match="sun_distance_au: must be finite and > 0"):
+        P.magnitudes(cube, ["V"], 1000.0, sun_distance_au=0.0)
