@@ -98,11 +98,21 @@ ATTRS: dict[str, dict[str, str]] = {
     "solar_irradiance": {"units": "W m-2 nm-1", "long_name": "extraterrestrial solar spectral irradiance at 1 AU"},
     "band_weight": {"units": "1", "long_name": "band-integration weight (solar spectrum x filter x spectral weighting x quadrature weight)"},
     "band_signal": {"units": "m2 sr-1", "long_name": "solar-weighted band mean of the radiometric signal"},
-    "sun_magnitude": {"units": "mag", "long_name": "apparent magnitude of the Sun at 1 AU"},
-    "magnitude": {"units": "mag", "long_name": "apparent magnitude of the reflected sunlight"},
-    "magnitude_uncertainty": {"units": "mag", "long_name": "1-sigma magnitude uncertainty"},
+    # Magnitudes are dimensionless (UDUNITS has no "mag"): units "1", the system in the
+    # attribute magnitude_system.
+    "sun_magnitude": {"units": "1", "long_name": "apparent magnitude of the Sun at 1 AU"},
+    "magnitude": {"units": "1", "long_name": "apparent magnitude of the reflected sunlight"},
+    "magnitude_uncertainty": {"units": "1", "long_name": "1-sigma magnitude uncertainty"},
     "colour": {"units": "1", "long_name": "colour index (band pair)"},
-    "colour_index": {"units": "mag", "long_name": "colour index, difference of two band magnitudes"},
+    "colour_index": {"units": "1", "long_name": "colour index, difference of two band magnitudes"},
+    "vega_flux": {"units": "W m-2 nm-1", "long_name": "spectral flux density of alpha Lyr (Vega)"},
+    "airmass": {"units": "1", "long_name": "relative optical air mass"},
+    "elevation": {"units": DEGREE, "long_name": "apparent elevation of the object above the horizon"},
+    "transmission": {"units": "1", "long_name": "atmospheric transmission"},
+    "extinction_coefficient": {"units": "1", "long_name": "atmospheric extinction coefficient "
+                               "(magnitudes per unit air mass)"},
+    "range": {"units": "km", "long_name": "observer-object range"},
+    "time": {"long_name": "observation time (UTC)"},
     "srgb": {"units": "1", "long_name": "sRGB swatch of the reflected sunlight (display-normalised)"},
     "obs": {"units": "1", "long_name": "observation index"},
     "rotation_angle": {"units": DEGREE, "long_name": "body rotation angle"},
@@ -133,4 +143,61 @@ def attrs(name: str, **extra: Any) -> dict[str, Any]:
     """
     out = dict(ATTRS[name])
     out.update(extra)
+    return out
+
+
+#: Meanings of a boolean variable's two values, by variable name (CF flag_meanings).
+FLAG_MEANINGS: dict[str, str] = {"reference": "measured_point reference_point"}
+
+
+def cf_finish(ds: Any, *, history: str | None = None) -> Any:
+    """A copy of ``ds`` with the CF/ACDD basics a file needs, before it is written.
+
+    * global ``Conventions`` (CF-1.10), ``title`` (derived from the content when
+      missing), ``source`` (the package and version when missing), ``history`` (one
+      line appended: UTC time, package version, ``history`` or "written");
+    * attribute names with characters other than letters, digits and ``_`` (e.g. a
+      hyphen from a material name) rewritten with ``_`` (CF 2.3);
+    * boolean variables get ``flag_values = [0, 1]`` and ``flag_meanings`` (CF 3.5);
+    * a variable ``X`` with a standard uncertainty ``u_X`` (or ``uncertainty`` for
+      ``magnitude``) names it in ``ancillary_variables`` (CF 3.4).
+    """
+    import re
+    from datetime import UTC, datetime
+
+    import numpy as np
+
+    from . import __version__
+
+    out = ds.copy()
+    bad = re.compile(r"[^A-Za-z0-9_]")
+
+    def clean(a: dict[str, Any]) -> dict[str, Any]:
+        return {(bad.sub("_", k) if not k.startswith("_") else k): v for k, v in a.items()}
+
+    out.attrs = clean(dict(out.attrs))
+    for name in list(out.variables):
+        var = out[name]
+        var.attrs = clean(dict(var.attrs))
+        if var.dtype == bool:
+            var.attrs.setdefault("flag_values", np.array([0, 1], dtype=np.int8))
+            var.attrs.setdefault("flag_meanings", FLAG_MEANINGS.get(str(name), "false true"))
+        partner = f"u_{name}" if f"u_{name}" in out.variables else (
+            "uncertainty" if str(name) in ("magnitude", "measured_magnitude") and "uncertainty" in out.variables
+            else None)
+        if partner is not None:
+            have = str(var.attrs.get("ancillary_variables", "")).split()
+            if partner not in have:
+                var.attrs["ancillary_variables"] = " ".join([*have, partner])
+    a = out.attrs
+    a["Conventions"] = "CF-1.10"
+    if not a.get("title"):
+        who = a.get("material") or a.get("scene") or a.get("model") or ""
+        kind = ("sBRDF table" if SBRDF in out else "sBRDF measurement set" if MEASURED in out
+                else f"{a['model']} model parameters" if "model" in a else "sbrdf_xr dataset")
+        a["title"] = f"{kind} of {who}" if who else kind
+    a.setdefault("source", f"sbrdf_xr {__version__}")
+    stamp = datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
+    line = f"{stamp} sbrdf_xr {__version__}: {history or 'written'}"
+    a["history"] = f"{a['history']}\n{line}" if a.get("history") else line
     return out

@@ -45,6 +45,40 @@ class SbrdfDataArrayAccessor:
         """:func:`sbrdf_xr.material.to_netcdf` of this table."""
         return _material.to_netcdf(self._da, path, **kwargs)
 
+    @property
+    def plot(self) -> _Plotter:
+        """Figures of this array: ``da.sbrdf.plot.magnitudes()``, ``da.sbrdf.plot.lut_slice(30)``."""
+        return _Plotter(self._da, {"magnitudes": "magnitudes", "lut_slice": "lut_slice"})
+
+
+class _Plotter:
+    """Forwards to :mod:`sbrdf_xr.plot`; calling it draws the object's natural figure."""
+
+    def __init__(self, obj: Any, methods: dict[str, str]) -> None:
+        self._obj = obj
+        self._methods = methods
+
+    def __call__(self, **kwargs: Any) -> Any:
+        from . import plot as _plot
+
+        if isinstance(self._obj, xr.Dataset):
+            return _plot.plot_cube(self._obj, **kwargs)
+        if "band" in self._obj.dims:
+            return _plot.magnitudes(self._obj, **kwargs)
+        raise AttributeError("no natural figure for this array; use .lut_slice(theta_i) for a material table")
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("_") or name not in self._methods:
+            raise AttributeError(f"sbrdf.plot has no {name!r}; available: {sorted(self._methods)}")
+        from functools import partial
+
+        from . import plot as _plot
+
+        return partial(getattr(_plot, self._methods[name]), self._obj)
+
+    def __dir__(self) -> list[str]:
+        return sorted(self._methods)
+
 
 @xr.register_dataset_accessor("sbrdf")
 class SbrdfDatasetAccessor:
@@ -79,5 +113,12 @@ class SbrdfDatasetAccessor:
         from . import photometry as _phot
 
         return _phot.srgb(self._ds, **kwargs)
+
+    @property
+    def plot(self) -> _Plotter:
+        """Figures of this cube: ``ds.sbrdf.plot()`` (its natural figure), ``.light_curve()``,
+        ``.spectra()``, ``.colour_colour("B-V", "V-R")`` (a photometry Dataset)."""
+        return _Plotter(self._ds, {"light_curve": "light_curve", "spectra": "spectra",
+                                   "colour_colour": "colour_colour"})
 
 

@@ -9,7 +9,8 @@ Sub-commands::
     sbrdf-xr simulate SCENE -o CUBE.nc      run a scene (built-in name or TOML file) into a cube
              [--scheduler ADDR] [--preset NAME] [--plot FIG.png] [--overwrite | --resume] [--plan]
     sbrdf-xr plot CUBE.nc -o FIG.png        the cube's natural figure (light curve or spectra)
-    sbrdf-xr photometry CUBE.nc --bands B V R I --range-km 36000 [-o PHOT.nc] [--csv PHOT.csv]
+    sbrdf-xr photometry CUBE.nc [--bands V R I] [--range-km KM] [--colours V-R,R-I]
+             [--system ab|vega] [-o PHOT.nc] [--csv PHOT.csv]
 """
 
 from __future__ import annotations
@@ -177,21 +178,50 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cube_range_km(cube) -> float | None:
+    """The observer range a cube records [km] (attribute or scalar variable), if any."""
+    for name in ("range_km", "observer_range_km"):
+        if name in cube.attrs:
+            return float(cube.attrs[name])
+        if name in cube.variables and cube[name].ndim == 0:
+            return float(cube[name].values)
+    return None
+
+
+def _parse_colours(text: str | None) -> list[tuple[str, str]] | None:
+    if not text:
+        return None
+    pairs = []
+    for item in text.split(","):
+        a, sep, b = item.strip().partition("-")
+        if not sep or not a or not b:
+            raise SbrdfError(f"--colours: {item.strip()!r} is not a band pair like V-R (give e.g. V-R,R-I)")
+        pairs.append((a, b))
+    return pairs
+
+
 def _cmd_photometry(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     import numpy as np
     import xarray as xr
+    from tqdm.dask import TqdmCallback
 
     from . import photometry as phot
-    from .material import write_netcdf_atomic
 
-    with xr.open_dataset(args.cube) as cube:
-        cube = cube.load()
-    ds = phot.photometry(cube, args.bands, args.range_km, weighting=args.weighting,
-                         quadrature=args.quadrature, extrapolate=args.extrapolate)
-    print(f"photometry of {args.cube}: range {args.range_km:g} km, {ds.attrs['magnitude_system']} "
-          f"magnitudes, {args.weighting} weighting, solar spectrum ASTM G173-03 (pvlib)")
+    colours = _parse_colours(args.colours)
+    with xr.open_dataset(args.cube, chunks={}) as cube:
+        range_km = args.range_km if args.range_km is not None else _cube_range_km(cube)
+        if range_km is None:
+            raise SbrdfError(f"{args.cube} records no observer range; give it with --range-km KM "
+                             "(e.g. --range-km 36000 for a geostationary object)")
+        lazy = phot.photometry(cube, args.bands, range_km, pairs=colours, system=args.system,
+                               weighting=args.weighting, quadrature=args.quadrature,
+                               extrapolate=args.extrapolate, solar=args.solar)
+        with TqdmCallback(desc="photometry", disable=args.quiet):
+            ds = lazy.compute()
+    print(f"photometry of {args.cube}: range {range_km:g} km, {ds.attrs['magnitude_system']} "
+          f"magnitudes, {args.weighting} weighting, solar spectrum {args.solar}")
     print(f"{'band':<8} {'filter':<14} {'m_sun':>8} {'min':>8} {'median':>8} {'max':>8}")
     for b in ds.band.values:
         m = np.asarray(ds.magnitude.sel(band=b).values).ravel()
@@ -206,7 +236,7 @@ def _cmd_photometry(args: argparse.Namespace) -> int:
             med = f"{np.median(v):.3f}" if v.size else "nan"
             print(f"colour {c!s:<10} median {med} mag")
     if args.output:
-        write_netcdf_atomic(ds, args.output, overwrite=args.overwrite)
+        phot.to_netcdf(ds, args.output, overwrite=args.overwrite)
         print(f"wrote {args.output}")
     if args.csv:
         if Path(args.csv).exists() and not args.overwrite:
@@ -274,9 +304,16 @@ def build_parser() -> argparse.ArgumentParser:
 
     pph = sub.add_parser("photometry", help="band magnitudes and colours of a cube")
     pph.add_argument("cube", help="netCDF cube written by 'sbrdf-xr simulate'")
-    pph.add_argument("--bands", nargs="+", required=True,
-                     help="bands: aliases U B V R I u g r i z or speclite filter names")
-    pph.add_argument("--range-km", type=float, required=True, help="observer range [km]")
+    pph.add_argument("--bands", nargs="+", default=["V", "R", "I"],
+                     help="bands: aliases U B V R I u g r i z or speclite filter names (default V R I)")
+    pph.add_argument("--range-km", type=float,
+                     help="observer range [km] (default: the range the cube records, if any)")
+    pph.add_argument("--colours", help="colour indices as band pairs, e.g. V-R,R-I (default consecutive bands)")
+    pph.add_argument("--system", type=str.lower, choices=("ab", "vega"), default="ab",
+                     help="magnitude system (default ab)")
+    pph.add_argument("--solar", default="astm_g173",
+                     choices=("astm_g173", "calspec", "kurucz1993"), help="solar spectrum")
+    pph.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     pph.add_argument("--weighting", choices=("photon", "energy"), default="photon")
     pph.add_argument("--quadrature", choices=("trapezoid", "linear"), default="trapezoid")
     pph.add_argument("--extrapolate", choices=("zero", "constant"),

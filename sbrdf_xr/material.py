@@ -785,6 +785,9 @@ def write_netcdf_atomic(ds: xr.Dataset, path: str | os.PathLike[str], *, overwri
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".part", dir=path.parent)
     os.close(fd)
+    from ._names import cf_finish
+
+    ds = cf_finish(ds)  # Conventions, title, source, history, flags, ancillary links
     try:
         ds.to_netcdf(tmp, engine="netcdf4", encoding=_encoding(ds))
         umask = os.umask(0)
@@ -831,7 +834,10 @@ def open_measurements(path: str | os.PathLike[str]) -> xr.Dataset:
     with xr.open_dataset(path, engine="netcdf4") as ds:
         ds = ds.load()
     if "reference" in ds:
-        ds["reference"] = ds["reference"].astype(bool)
+        ref = ds["reference"].astype(bool)
+        for k in ("flag_values", "flag_meanings"):  # they describe the on-disk byte, not the bool
+            ref.attrs.pop(k, None)
+        ds["reference"] = ref
     return validate_measurements(ds)
 
 

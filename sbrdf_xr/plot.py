@@ -11,7 +11,21 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-__all__ = ["light_curve", "lut_slice", "plot_cube", "spectra"]
+__all__ = ["colour_colour", "light_curve", "lut_slice", "magnitudes", "plot_cube", "spectra"]
+
+#: Short axis labels of the package's variables (the long_name goes into titles and docs).
+SHORT_LABELS: dict[str, str] = {
+    "spacecraft_sbrdf": "overall sBRDF", "brdf": "broadband BRDF", "signal": "radiometric signal",
+    "signal_material": "signal per material", "band_signal": "band signal", "magnitude": "magnitude",
+    "standard_magnitude": "standard magnitude", "colour_index": "colour index",
+    "wavelength": "wavelength", "attitude_angle": "attitude angle", "phase_angle": "phase angle",
+    "rotation_angle": "rotation angle", "sbrdf": "sBRDF", "theta_i": "theta_i",
+    "delta_theta": "delta_theta", "phi": "phi",
+}
+_UNIT_TEXT = {"degree": "deg", "1": ""}
+#: Above this max/min ratio of positive data the y axis is logarithmic by default.
+LOG_RATIO = 30.0
+_STYLES = ("-", "--", "-.", ":")
 
 
 def _axes(ax: Any = None, **fig_kw: Any) -> tuple[Any, Any]:
@@ -24,10 +38,27 @@ def _axes(ax: Any = None, **fig_kw: Any) -> tuple[Any, Any]:
 
 
 def _label(da: xr.DataArray) -> str:
-    return f"{da.attrs.get('long_name', da.name)} [{da.attrs.get('units', '')}]"
+    """A short axis label with units: ``short name [units]`` (never the long_name)."""
+    name = SHORT_LABELS.get(str(da.name), str(da.name).replace("_", " "))
+    units = str(da.attrs.get("units", ""))
+    units = _UNIT_TEXT.get(units, units)
+    return f"{name} [{units}]" if units else name
 
 
-def light_curve(cube: xr.Dataset, variable: str = "brdf", ax: Any = None, log: bool = False) -> Any:
+def _value_label(coord: str, value: Any, units: str | None) -> str:
+    """``phase angle 5 deg`` for legends."""
+    u = _UNIT_TEXT.get(units or "", units or "")
+    name = SHORT_LABELS.get(coord, coord.replace("_", " "))
+    return f"{name} {float(value):g} {u}".rstrip()
+
+
+def _wants_log(values: Any) -> bool:
+    v = np.asarray(values, dtype=np.float64)
+    v = v[np.isfinite(v) & (v > 0)]
+    return bool(v.size) and float(v.max() / v.min()) > LOG_RATIO
+
+
+def light_curve(cube: xr.Dataset, variable: str = "brdf", ax: Any = None, log: bool | None = None) -> Any:
     """Broadband BRDF (paper 000 Fig. 18) or another scalar variable versus attitude.
 
     Parameters
@@ -37,8 +68,8 @@ def light_curve(cube: xr.Dataset, variable: str = "brdf", ax: Any = None, log: b
     variable : str, default "brdf"
         Variable without a spectral dimension.
     ax : matplotlib axes, optional
-    log : bool
-        Logarithmic y axis.
+    log : bool, optional
+        Logarithmic y axis; default when the data span more than :data:`LOG_RATIO`.
 
     Returns
     -------
@@ -47,18 +78,21 @@ def light_curve(cube: xr.Dataset, variable: str = "brdf", ax: Any = None, log: b
     fig, ax = _axes(ax)
     da = cube[variable]
     x = cube["attitude_angle"] if "attitude_angle" in cube.coords else cube["attitude"]
-    for beta in np.atleast_1d(cube["phase_angle"].values):
-        ax.plot(x.values, da.sel(phase_angle=beta).values, label=f"beta = {beta:g} deg", lw=1)
-    ax.set_xlabel(_label(x) if "units" in x.attrs else "attitude")
+    units = cube["phase_angle"].attrs.get("units", "degree")
+    for k, beta in enumerate(np.atleast_1d(cube["phase_angle"].values)):
+        ax.plot(x.values, da.sel(phase_angle=beta).values, _STYLES[k % len(_STYLES)], lw=1,
+                label=_value_label("phase_angle", beta, units))
+    ax.set_xlabel(_label(x) if "units" in x.attrs else "attitude [index]")
     ax.set_ylabel(_label(da))
-    if log:
+    if log or (log is None and _wants_log(da.values)):
         ax.set_yscale("log")
     ax.set_title(cube.attrs.get("scene", ""))
     ax.legend()
     return fig
 
 
-def spectra(cube: xr.Dataset, variable: str = "spacecraft_sbrdf", ax: Any = None, log: bool = False, **sel: Any) -> Any:
+def spectra(cube: xr.Dataset, variable: str = "spacecraft_sbrdf", ax: Any = None, log: bool | None = None,
+            **sel: Any) -> Any:
     """Spectra of a cube (paper 000 Figs. 14 and 16), one line per remaining geometry.
 
     Parameters
@@ -66,8 +100,8 @@ def spectra(cube: xr.Dataset, variable: str = "spacecraft_sbrdf", ax: Any = None
     cube : xarray.Dataset
     variable : str, default "spacecraft_sbrdf"
     ax : matplotlib axes, optional
-    log : bool
-        Logarithmic y axis (Fig. 16).
+    log : bool, optional
+        Logarithmic y axis (Fig. 16); default when the data span more than :data:`LOG_RATIO`.
     **sel
         Selections applied first (for example ``attitude=0``).
 
@@ -82,11 +116,12 @@ def spectra(cube: xr.Dataset, variable: str = "spacecraft_sbrdf", ax: Any = None
                if c in stacked.coords and stacked[c].size > 1 and "_line" in stacked[c].dims]
     for k in range(stacked.sizes["_line"]):
         line = stacked.isel(_line=k)
-        label = ", ".join(f"{c} = {line[c].values:g}" for c in varying)
-        ax.plot(line["wavelength"].values, line.values, lw=1, label=label or None)
+        label = ", ".join(_value_label(c, line[c].values, cube[c].attrs.get("units")) for c in varying)
+        ax.plot(line["wavelength"].values, line.values, _STYLES[(k // 10) % len(_STYLES)], lw=1,
+                label=label or None)
     ax.set_xlabel(_label(cube["wavelength"]))
     ax.set_ylabel(_label(cube[variable]))
-    if log:
+    if log or (log is None and _wants_log(da.values)):
         ax.set_yscale("log")
     if stacked.sizes["_line"] <= 12:
         ax.legend()
@@ -117,8 +152,108 @@ def lut_slice(material: xr.DataArray, theta_i: float, wavelength: float | None =
 
 
 def plot_cube(cube: xr.Dataset) -> Any:
-    """The natural figure of a cube: a light curve for attitude sweeps, spectra otherwise."""
+    """The natural figure of a cube: a light curve for attitude sweeps, spectra otherwise.
+
+    Axes are logarithmic where the data span more than :data:`LOG_RATIO` (a glinting
+    light curve spans 100x).
+    """
     if "attitude" in cube.dims and cube.sizes["attitude"] > 1 and "brdf" in cube:
         return light_curve(cube)
     var = "spacecraft_sbrdf" if "spacecraft_sbrdf" in cube else "signal"
     return spectra(cube, var)
+
+
+def _system_text(da: xr.DataArray) -> str:
+    """``(Vega, 1000 km)`` from a magnitude's attributes."""
+    sysname = da.attrs.get("magnitude_system")
+    rng = da.attrs.get("range_km")
+    parts = [str(sysname) if sysname else "", f"{rng:g} km" if rng else ""]
+    inner = ", ".join(p for p in parts if p)
+    return f"({inner})" if inner else ""
+
+
+def magnitudes(mags: xr.DataArray, ax: Any = None, x: str | None = None, **sel: Any) -> Any:
+    """Magnitudes per band against attitude (or rotation angle, or time), brighter up.
+
+    Parameters
+    ----------
+    mags : xarray.DataArray
+        Magnitudes over ``band`` and one other dimension (after ``sel``), e.g.
+        :func:`sbrdf_xr.photometry.magnitudes` of a rotation sweep.
+    ax : matplotlib axes, optional
+    x : str, optional
+        Coordinate for the x axis; default ``attitude_angle``, ``rotation_angle`` or
+        ``time``, whichever exists.
+    **sel
+        Selections applied first (e.g. ``phase_angle=10``).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = _axes(ax)
+    da = mags.sel(**sel) if sel else mags
+    if "phase_angle" in da.dims and da.sizes["phase_angle"] == 1:
+        da = da.isel(phase_angle=0)
+    other = [d for d in da.dims if d != "band"]
+    if len(other) != 1:
+        raise ValueError(f"magnitudes: expected dims (band, one more) after selection, got {da.dims}; "
+                         "select the others, e.g. phase_angle=10")
+    if x is None:
+        x = next((c for c in ("attitude_angle", "rotation_angle", "time") if c in da.coords), other[0])
+    xc = da[x]
+    for k, b in enumerate(da["band"].values):
+        ax.plot(xc.values, da.sel(band=b).values, _STYLES[(k // 10) % len(_STYLES)], lw=1, label=str(b))
+    ax.invert_yaxis()
+    ax.set_xlabel(_label(xc) if xc.dtype.kind != "M" else "time [UTC]")
+    ax.set_ylabel(" ".join(p for p in ("magnitude", _system_text(mags)) if p))
+    ax.legend(title="band", fontsize="small")
+    return fig
+
+
+def colour_colour(ds: xr.Dataset, x: str, y: str, ax: Any = None, sun: bool = True, c: str | None = None) -> Any:
+    """Colour-colour diagram of a photometry Dataset (one point per geometry/attitude).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        :func:`sbrdf_xr.photometry.photometry` output with ``colour_index``.
+    x, y : str
+        Colour labels, e.g. ``"B-V"`` and ``"V-R"`` (in ``ds.colour``).
+    ax : matplotlib axes, optional
+    sun : bool
+        Mark the Sun's colours (a spectrally flat reflector) from the ``sun_magnitude``
+        coordinate.
+    c : str, optional
+        Coordinate to colour the points by (default ``attitude_angle`` when present).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = _axes(ax, figsize=(5, 4.5))
+    ci = ds["colour_index"]
+    labels = [str(v) for v in ci["colour"].values]
+    for want in (x, y):
+        if want not in labels:
+            raise ValueError(f"colour_colour: colour {want!r} not in {labels}; compute it with pairs=...")
+    xv = ci.sel(colour=x).values.ravel()
+    yv = ci.sel(colour=y).values.ravel()
+    cname = c or ("attitude_angle" if "attitude_angle" in ci.coords else None)
+    if cname is not None:
+        cv = np.broadcast_to(ci[cname].values, ci.sel(colour=x).shape).ravel()
+        pts = ax.scatter(xv, yv, c=cv, s=12, cmap="viridis")
+        fig.colorbar(pts, ax=ax, label=_label(ci[cname]))
+    else:
+        ax.scatter(xv, yv, s=12)
+    if sun and "sun_magnitude" in ds.coords:
+        m = {str(b): float(v) for b, v in zip(ds["band"].values, ds["sun_magnitude"].values, strict=True)}
+        sx = [m[b] for b in x.split("-")]
+        sy = [m[b] for b in y.split("-")]
+        ax.plot(sx[0] - sx[1], sy[0] - sy[1], "*", ms=16, mfc="none", mec="orangered", mew=1.5, zorder=5,
+                label="Sun (a grey body)")
+        ax.legend(fontsize="small")
+    sysname = ci.attrs.get("magnitude_system", "")
+    ax.set_xlabel(f"{x} [{sysname} mag]" if sysname else x)
+    ax.set_ylabel(f"{y} [{sysname} mag]" if sysname else y)
+    return fig

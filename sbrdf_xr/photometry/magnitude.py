@@ -1,0 +1,376 @@
+"""Magnitudes and colour indices of the reflected sunlight, from a cube or a spectrum."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from itertools import pairwise
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from .._names import BAND, WAVELENGTH, attrs
+from ..errors import ValidationError
+from .bands import (
+    WEIGHTINGS,
+    _band_coords,
+    _canonical,
+    _coverage_error,
+    _method_attrs,
+    _resolve_bands,
+    pre_integrate,
+)
+from .spectra import (
+    MAGNITUDE_SYSTEMS,
+    SOLAR_SPECTRA,
+    _choose,
+    _illumination,
+    _integral,
+    _weighting,
+    check_system,
+    reference_flux,
+    reference_nodes,
+)
+
+
+def sun_magnitudes(
+    bands: Any,
+    *,
+    weighting: str = "photon",
+    system: str = "AB",
+    solar: str = "astm_g173",
+    transmission: xr.DataArray | None = None,
+) -> xr.DataArray:
+    """Apparent magnitudes of the Sun at 1 AU in each band.
+
+    ``m_sun = -2.5 log10( int E_sun A T w dlambda / int f_ref T w dlambda )``, both
+    integrals exact for the linear interpolants on the union of the solar, filter and
+    reference-spectrum nodes (native resolution); ``f_ref`` is the zero-magnitude
+    source of ``system`` (3631 Jy for AB, alpha Lyr for Vega) and ``A`` the
+    atmospheric transmission (1 above the atmosphere).
+
+    Parameters
+    ----------
+    bands : str, sequence, mapping or DataArray
+        See :func:`filters`.
+    weighting : {"photon", "energy"}
+    system : {"AB", "Vega"}
+        Any case (:data:`~sbrdf_xr.photometry.MAGNITUDE_SYSTEMS`).
+    solar : str
+        Solar spectrum (:data:`~sbrdf_xr.photometry.SOLAR_SPECTRA`).
+    transmission : xarray.DataArray, optional
+        Atmospheric transmission over ``wavelength`` [1] applied to the sunlight (not
+        to the reference): the Sun observed through that atmosphere.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``sun_magnitude`` over ``band`` [1, magnitudes], attrs ``magnitude_system``.
+    """
+    _choose(weighting, WEIGHTINGS, "weighting")
+    system = check_system(system)
+    ws, es = _illumination(solar, transmission)
+    vn = reference_nodes(system)
+    bl = _resolve_bands(bands)
+    out = np.zeros(len(bl))
+    for n, band in enumerate(bl):
+        blo, bhi = band.support
+        if blo < ws[0] or bhi > ws[-1]:
+            raise _coverage_error(band, ws[0], ws[-1], f"solar spectrum ({solar})")
+
+        def inside(v: np.ndarray, lo: float = blo, hi: float = bhi) -> np.ndarray:
+            return v[(v > lo) & (v < hi)]
+
+        grid = np.unique(np.concatenate([[blo, bhi], inside(ws), inside(band.wavelength), inside(vn)]))
+        tw = np.interp(grid, band.wavelength, band.response, left=0.0, right=0.0) * _weighting(grid, weighting)
+        sun = _integral(grid, np.interp(grid, ws, es) * tw, blo, bhi)
+        ref = _integral(grid, reference_flux(system, grid) * tw, blo, bhi)
+        out[n] = -2.5 * np.log10(sun / ref)
+    return xr.DataArray(out, dims=(BAND,), coords=_band_coords(bl), name="sun_magnitude",
+                        attrs=attrs("sun_magnitude", **_system_attrs(system),
+                                    **_method_attrs(weighting, "linear", None, solar, transmission)))
+
+
+def _system_attrs(system: str) -> dict[str, str]:
+    return {"magnitude_system": system, "magnitude_system_description": MAGNITUDE_SYSTEMS[system]}
+
+
+# ------------------------------------------------------------ from a cube
+
+
+def _signal_of(cube: xr.Dataset | xr.DataArray, variable: str = "signal") -> xr.DataArray:
+    if isinstance(cube, xr.Dataset):
+        if variable not in cube:
+            raise ValidationError(f"cube: no variable {variable!r}; has {sorted(map(str, cube.data_vars))}")
+        da = cube[variable]
+    elif isinstance(cube, xr.DataArray):
+        da = cube
+    else:
+        raise ValidationError(f"cube: expected an xarray Dataset or DataArray, got {type(cube).__name__}")
+    if WAVELENGTH not in da.dims:
+        raise ValidationError(f"cube: {da.name!r} has no '{WAVELENGTH}' dimension (dims {da.dims})")
+    return da
+
+
+def band_signal(
+    cube: xr.Dataset | xr.DataArray,
+    bands: Any,
+    *,
+    variable: str = "signal",
+    weighting: str = "photon",
+    quadrature: str = "trapezoid",
+    extrapolate: str | None = None,
+    system: str = "AB",
+    solar: str = "astm_g173",
+    transmission: xr.DataArray | None = None,
+) -> xr.DataArray:
+    """Solar-weighted band mean of a cube's radiometric signal.
+
+    ``S_band = int E_sun T w S dlambda / int E_sun T w dlambda`` [m2 sr-1] (module
+    docstring): the reflected band intensity per unit solar band irradiance.  Times
+    the Sun's band flux at the object and divided by the squared range it is the
+    observed band flux.
+
+    Parameters
+    ----------
+    cube : xarray.Dataset or DataArray
+        A simulation cube (its ``variable``) or a spectrum over ``wavelength``.
+    bands : str, sequence, mapping or DataArray
+        See :func:`filters`.
+    variable : str
+        Cube variable to integrate (``signal`` or ``signal_material``).
+    weighting, quadrature, extrapolate, solar, transmission
+        See :func:`band_weights`.
+    system : {"AB", "Vega"}
+        System of the Sun's magnitudes carried in the coordinate ``sun_magnitude``.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``band_signal`` with ``band`` in place of ``wavelength`` [m2 sr-1], lazy if the
+        cube is, with the Sun's band magnitudes as coordinate ``sun_magnitude``.
+    """
+    s = _signal_of(cube, variable)
+    out = pre_integrate(s, bands, weighting=weighting, quadrature=quadrature, extrapolate=extrapolate,
+                        normalize=True, solar=solar, transmission=transmission)
+    sun = sun_magnitudes(bands, weighting=weighting, system=system, solar=solar, transmission=transmission)
+    out = out.assign_coords(sun_magnitude=(BAND, sun.values, sun.attrs))
+    out.name = "band_signal"
+    out.attrs.update(attrs("band_signal", units=s.attrs.get("units", "m2 sr-1")))
+    out.attrs.update(_system_attrs(sun.attrs["magnitude_system"]))
+    return out
+
+
+def _range_m(range_km: Any) -> Any:
+    if isinstance(range_km, xr.DataArray):
+        vals = np.asarray(range_km.values, dtype=np.float64)
+        r = range_km.astype(np.float64) * 1e3
+    else:
+        vals = np.asarray(range_km, dtype=np.float64)
+        r = vals * 1e3
+    if vals.size == 0 or not np.all(np.isfinite(vals)) or np.any(vals <= 0):
+        raise ValidationError(f"range_km: must be finite and > 0 km, got {vals.ravel()[:5].tolist()}")
+    return r
+
+
+def magnitudes(
+    cube: xr.Dataset | xr.DataArray,
+    bands: Any = None,
+    range_km: Any = None,
+    *,
+    system: str = "AB",
+    sun_distance_au: Any = 1.0,
+    weighting: str = "photon",
+    quadrature: str = "trapezoid",
+    extrapolate: str | None = None,
+    solar: str = "astm_g173",
+    transmission: xr.DataArray | None = None,
+) -> xr.DataArray:
+    """Apparent magnitudes of the reflected sunlight.
+
+    ``m = m_sun,band + 5 log10(r / 1 AU) - 2.5 log10(S_band / d**2)`` with ``d`` the
+    observer range [m] (module docstring).  ``S_band = 0`` gives ``+inf`` (no
+    warning), a negative ``S_band`` gives NaN.
+
+    Parameters
+    ----------
+    cube : xarray.Dataset or DataArray
+        A cube (or spectrum over ``wavelength``), or a :func:`band_signal` result
+        (then ``bands`` is not needed).
+    bands : str, sequence, mapping or DataArray
+        See :func:`filters`.
+    range_km : float, array_like or DataArray
+        Observer range [km], > 0; broadcast against the cube (a DataArray aligns by dims).
+    system : {"AB", "Vega"}
+        Magnitude system, any case (:data:`~sbrdf_xr.photometry.MAGNITUDE_SYSTEMS`);
+        recorded in the attribute ``magnitude_system``.  A :func:`band_signal` input
+        must have been made in the same system.
+    sun_distance_au : float, array_like or DataArray
+        Sun-object distance [AU], > 0 (e.g. :func:`sun_distance_au` of the
+        observation times); broadcast like ``range_km``.
+    weighting, quadrature, extrapolate, solar, transmission
+        See :func:`band_weights`.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``magnitude`` [1] over the cube's dims with ``band`` in place of ``wavelength``.
+    """
+    system = check_system(system)
+    if range_km is None:
+        raise ValidationError("range_km: the observer range [km] is required (e.g. range_km=1000.0)")
+    d = _range_m(range_km)
+    r = _positive(sun_distance_au, "sun_distance_au")
+    if isinstance(cube, xr.DataArray) and BAND in cube.dims and "sun_magnitude" in cube.coords:
+        sb = cube
+        have = sb.attrs.get("magnitude_system", sb["sun_magnitude"].attrs.get("magnitude_system", "AB"))
+        if have != system:
+            raise ValidationError(f"system: the band_signal was made in the {have} system, not {system}; "
+                                  f"pass system={have!r} or recompute band_signal(..., system={system!r})")
+    else:
+        if bands is None:
+            raise ValidationError("bands: required unless a band_signal result is given")
+        sb = band_signal(cube, bands, weighting=weighting, quadrature=quadrature, extrapolate=extrapolate,
+                         system=system, solar=solar, transmission=transmission)
+    return _magnitudes_from(sb, d, r, system)
+
+
+def _positive(value: Any, what: str) -> Any:
+    vals = np.asarray(value.values if isinstance(value, xr.DataArray) else value, dtype=np.float64)
+    if vals.size == 0 or not np.all(np.isfinite(vals)) or np.any(vals <= 0):
+        raise ValidationError(f"{what}: must be finite and > 0, got {vals.ravel()[:5].tolist()}")
+    return value.astype(np.float64) if isinstance(value, xr.DataArray) else vals
+
+
+def _magnitudes_from(sb: xr.DataArray, d_m: Any, sun_distance_au: Any, system: str) -> xr.DataArray:
+    ratio = sb / d_m**2
+    pos = ratio > 0
+    safe = xr.where(pos, ratio, 1.0)
+    m = sb["sun_magnitude"] + 5.0 * np.log10(sun_distance_au) - 2.5 * np.log10(safe)
+    m = xr.where(pos, m, xr.where(ratio == 0, np.inf, np.nan))
+    m = m.transpose(*sb.dims, ...)
+    m.name = "magnitude"
+    m.attrs = attrs("magnitude", **_system_attrs(system), weighting=sb.attrs.get("weighting", ""),
+                    note="+inf where the band signal is 0 (nothing reflects toward the observer); "
+                    "NaN where it is negative",
+                    formula="m = m_sun,band(1 AU) + 5 log10(r/AU) - 2.5 log10(S_band / d^2), d in m")
+    if not isinstance(sun_distance_au, xr.DataArray) and np.ndim(sun_distance_au) == 0:
+        m.attrs["sun_distance_au"] = float(sun_distance_au)
+    if not isinstance(d_m, xr.DataArray):
+        d_arr = np.asarray(d_m)
+        if d_arr.ndim == 0:
+            m.attrs["range_km"] = float(d_arr) / 1e3
+    return m
+
+
+def colour_indices(mags: xr.DataArray, pairs: Sequence[tuple[str, str]] | None = None) -> xr.DataArray:
+    """Colour indices ``m_a - m_b`` of band pairs.
+
+    Parameters
+    ----------
+    mags : xarray.DataArray
+        Magnitudes over ``band`` (:func:`magnitudes`).
+    pairs : sequence of (str, str), optional
+        Band labels (aliases and speclite names are matched through the ``filter``
+        coordinate); default consecutive bands in the order given.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``colour_index`` [mag] with dim ``colour`` (labels ``"a-b"``) and coords
+        ``first``, ``second``; NaN where either magnitude is infinite or NaN.
+    """
+    if not isinstance(mags, xr.DataArray) or BAND not in mags.dims:
+        raise ValidationError("mags: expected a DataArray with a 'band' dimension")
+    labels = [str(b) for b in mags[BAND].values]
+    if pairs is None:
+        pairs = list(pairwise(labels))
+    if not pairs:
+        raise ValidationError("pairs: need at least two bands for a colour index")
+    idx = [_band_index(mags, a) for a, _ in pairs], [_band_index(mags, b) for _, b in pairs]
+    first = mags.isel({BAND: idx[0]})
+    second = mags.isel({BAND: idx[1]})
+    first = first.drop_vars([c for c in first.coords if BAND in first[c].dims]).rename({BAND: "colour"})
+    second = second.drop_vars([c for c in second.coords if BAND in second[c].dims]).rename({BAND: "colour"})
+    ok = np.isfinite(first) & np.isfinite(second)
+    ci = xr.where(ok, xr.where(ok, first, 0.0) - xr.where(ok, second, 0.0), np.nan)
+    names = [f"{a}-{b}" for a, b in pairs]
+    ci = ci.assign_coords(colour=("colour", names, attrs("colour")),
+                          first=("colour", [labels[i] for i in idx[0]],
+                                 {"long_name": "band of the first magnitude of the colour index"}),
+                          second=("colour", [labels[i] for i in idx[1]],
+                                  {"long_name": "band of the magnitude subtracted in the colour index"}))
+    dims = [("colour" if d == BAND else d) for d in mags.dims]
+    ci = ci.transpose(*dims)
+    ci.name = "colour_index"
+    ci.attrs = attrs("colour_index", magnitude_system=mags.attrs.get("magnitude_system", "AB"),
+                     note="NaN where either magnitude is infinite (nothing reflects) or NaN")
+    return ci
+
+
+def _band_index(mags: xr.DataArray, label: str) -> int:
+    labels = [str(b) for b in mags[BAND].values]
+    if label in labels:
+        return labels.index(label)
+    if "filter" in mags.coords:
+        filt = [str(f) for f in mags["filter"].values]
+        if _canonical(label) in filt:
+            return filt.index(_canonical(label))
+    raise ValidationError(f"pairs: band {label!r} is not among the bands {labels}")
+
+
+def photometry(
+    cube: xr.Dataset | xr.DataArray,
+    bands: Any,
+    range_km: Any,
+    *,
+    pairs: Sequence[tuple[str, str]] | None = None,
+    system: str = "AB",
+    sun_distance_au: Any = 1.0,
+    weighting: str = "photon",
+    quadrature: str = "trapezoid",
+    extrapolate: str | None = None,
+    solar: str = "astm_g173",
+    transmission: xr.DataArray | None = None,
+) -> xr.Dataset:
+    """Band signal, magnitudes and colour indices of a cube, as one Dataset.
+
+    Parameters are those of :func:`band_signal`, :func:`magnitudes` and
+    :func:`colour_indices`.  Also ``ds.sbrdf.photometry(bands=..., range_km=...)``.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``band_signal`` [m2 sr-1], ``magnitude`` [mag], ``colour_index`` [mag] (when
+        there are two bands or more), with the cube's coordinates.
+    """
+    d = _range_m(range_km)
+    system = check_system(system)
+    r = _positive(sun_distance_au, "sun_distance_au")
+    sb = band_signal(cube, bands, weighting=weighting, quadrature=quadrature, extrapolate=extrapolate,
+                     system=system, solar=solar, transmission=transmission)
+    m = _magnitudes_from(sb, d, r, system)
+    out = {"band_signal": sb, "magnitude": m}
+    if sb.sizes[BAND] > 1 or pairs:
+        out["colour_index"] = colour_indices(m, pairs)
+    ds = xr.Dataset(out)
+    src = cube.attrs if isinstance(cube, xr.Dataset) else {}
+    ds.attrs = {
+        "Conventions": "CF-1.10",
+        "title": f"sbrdf_xr photometry of {src.get('title', 'a spectrum')}",
+        "source": src.get("source", "sbrdf_xr"),
+        "history": f"sbrdf_xr.photometry(bands={[str(b) for b in sb[BAND].values]}, "
+        f"range_km={np.asarray(range_km).tolist() if not isinstance(range_km, xr.DataArray) else 'DataArray'}, "
+        f"system={system}, weighting={weighting}, quadrature={quadrature}, extrapolate={extrapolate}, "
+        f"solar={solar})",
+        "references": "AB: Oke & Gunn 1983, ApJ 266, 713; Vega: CALSPEC alpha_lyr_stis_011, Bohlin et al. "
+        "2020, AJ 160, 21; filters: speclite (Bessell 1990, PASP 102, 1181; Doi et al. 2010, AJ 139, 1628); "
+        f"Sun: {SOLAR_SPECTRA[solar]}",
+        **_system_attrs(system),
+        **_method_attrs(weighting, quadrature, extrapolate, solar, transmission),
+    }
+    if "sun_distance_au" in m.attrs:
+        ds.attrs["sun_distance_au"] = m.attrs["sun_distance_au"]
+    if "range_km" in m.attrs:
+        ds.attrs["range_km"] = m.attrs["range_km"]
+    return ds
