@@ -264,8 +264,12 @@ def _encode_times(cube: xr.Dataset) -> xr.Dataset:
     times = [k for k, v in cube.coords.items() if v.dtype.kind in "mM"]
     if not times:
         return cube
-    return cube.assign_coords({k: xr.conventions.encode_cf_variable(cube[k].variable, name=str(k))
-                               for k in times})
+    encoded = {}
+    for k in times:
+        v = xr.conventions.encode_cf_variable(cube[k].variable, name=str(k))
+        v.attrs.pop("_FillValue", None)  # CF 2.5.1: no fill value on a coordinate variable
+        encoded[k] = v
+    return cube.assign_coords(encoded)
 
 
 def _write_zarr(cube: xr.Dataset, path: Path, *, overwrite: bool = False, client: Any = None,
