@@ -19,9 +19,10 @@ Methods (:data:`METHODS`)
     clipped to the facet (Sutherland-Hodgman; convex against convex is exact), are united
     and the fraction is ``1 - area(union) / area(facet)``.  The union area is the
     inclusion-exclusion sum over the non-empty intersections of the convex shadows (each one
-    again a convex clip; an empty intersection prunes all its supersets); a facet with more
-    than :data:`MAX_SHADOWS` shadows, or past a work budget, is united by GEOS
-    (:func:`shapely.union_all`).  Candidate occluders come from a uniform grid over the
+    again a convex clip; an empty intersection prunes all its supersets); past 64 shadows or
+    a work budget it is summed over vertical slabs bounded by every vertex and edge
+    crossing (in each slab the covered length is linear in x); a facet with more than
+    :data:`MAX_SHADOWS` shadows is united by GEOS (:func:`shapely.union_all`).  Candidate occluders come from a uniform grid over the
     bounding boxes in the plane perpendicular to ``d`` (a facet whose box does not overlap,
     or that lies wholly behind the receiver along ``d``, cannot shadow it), so the cost grows
     nearly linearly with the number of facets.  Compiled with numba.
@@ -359,9 +360,11 @@ def _escape_masks(
 # Plain-array numba kernels (nogil, cached).  Polygons are (x, y) float arrays plus a count.
 
 _MAXV = 96  #: vertex capacity of one clipped polygon
-#: Shadow polygons per facet united by inclusion-exclusion; a facet with more goes to GEOS.
-MAX_SHADOWS = 24
-_MAXM = MAX_SHADOWS
+#: Shadow polygons per facet united by inclusion-exclusion (more, or past the work budget:
+#: vertical slabs).
+_MAXM = 64
+#: Shadow polygons per facet held by the compiled kernel; a facet with more goes to GEOS.
+MAX_SHADOWS = 1024
 _BUDGET = 20000  #: polygon intersections per facet before falling back to the GEOS union
 
 
@@ -464,10 +467,26 @@ def _hull(px, py, n, ox, oy, idx):
 
 
 @nb.njit(cache=True, nogil=True)
+def _bounds(px, py, n, out):
+    out[0] = out[2] = np.inf
+    out[1] = out[3] = -np.inf
+    for k in range(n):
+        out[0] = min(out[0], px[k])
+        out[1] = max(out[1], px[k])
+        out[2] = min(out[2], py[k])
+        out[3] = max(out[3], py[k])
+
+
+@nb.njit(cache=True, nogil=True)
 def _union_area(gx, gy, gn, m, tiny, stack_x, stack_y, stack_n, nxt, tx, ty):
     """Area of the union of m convex counter-clockwise polygons (gx[k], gy[k], gn[k]) by
     inclusion-exclusion over the non-empty intersections, depth first (an empty intersection
-    prunes every superset).  Returns (area, ok); ok is False past the work budget."""
+    prunes every superset; bounding boxes that do not overlap skip the clip).  Returns
+    (area, ok); ok is False past the work budget."""
+    box = np.empty((m, 4))
+    sbox = np.empty((m + 1, 4))
+    for k in range(m):
+        _bounds(gx[k], gy[k], gn[k], box[k])
     total = 0.0
     ops = 0
     for a in range(m):
@@ -476,6 +495,7 @@ def _union_area(gx, gy, gn, m, tiny, stack_x, stack_y, stack_n, nxt, tx, ty):
             stack_x[0, k] = gx[a, k]
             stack_y[0, k] = gy[a, k]
         stack_n[0] = n0
+        sbox[0] = box[a]
         total += _signed_area(gx[a], gy[a], n0)
         nxt[0] = a + 1
         d = 0
@@ -485,6 +505,9 @@ def _union_area(gx, gy, gn, m, tiny, stack_x, stack_y, stack_n, nxt, tx, ty):
                 continue
             b = nxt[d]
             nxt[d] += 1
+            if (box[b, 0] >= sbox[d, 1] or box[b, 1] <= sbox[d, 0]
+                    or box[b, 2] >= sbox[d, 3] or box[b, 3] <= sbox[d, 2]):
+                continue
             ops += 1
             if ops > _BUDGET:
                 return 0.0, False
@@ -499,9 +522,100 @@ def _union_area(gx, gy, gn, m, tiny, stack_x, stack_y, stack_n, nxt, tx, ty):
                 continue
             total += area if (d % 2 == 1) else -area  # subset size d + 2
             stack_n[d + 1] = nq
+            _bounds(stack_x[d + 1], stack_y[d + 1], nq, sbox[d + 1])
             nxt[d + 1] = b + 1
             d += 1
     return total, True
+
+
+@nb.njit(cache=True, nogil=True)
+def _union_area_slabs(gx, gy, gn, m):
+    """Area of the union of m convex polygons by vertical slabs.
+
+    The slab boundaries are every vertex abscissa and every abscissa where edges of two
+    polygons cross; inside a slab each polygon covers a y-interval whose ends move linearly
+    with x and never cross another end, so the length of the union of the intervals is
+    linear in x and its value at the slab's middle times the slab's width is the slab's
+    area, exactly.  O(E**2) for E edges in all: used past the inclusion-exclusion budget.
+    """
+    nv = 0
+    for k in range(m):
+        nv += gn[k]
+    ne = 0
+    xs = np.empty(0)
+    n_cross = 0
+    for sweep in range(2):  # count the crossings, then store them
+        if sweep == 1:
+            xs = np.empty(nv + n_cross)
+            for k in range(m):
+                for v in range(gn[k]):
+                    xs[ne] = gx[k, v]
+                    ne += 1
+        ne = 0 if sweep == 0 else ne
+        for k in range(m):
+            for v in range(gn[k]):
+                v1 = v + 1 if v + 1 < gn[k] else 0
+                ax, ay = gx[k, v], gy[k, v]
+                rx, ry = gx[k, v1] - ax, gy[k, v1] - ay
+                for q in range(k + 1, m):
+                    for w in range(gn[q]):
+                        w1 = w + 1 if w + 1 < gn[q] else 0
+                        bx, by = gx[q, w], gy[q, w]
+                        sx, sy = gx[q, w1] - bx, gy[q, w1] - by
+                        den = rx * sy - ry * sx
+                        if den == 0.0:
+                            continue  # parallel: their ends never swap inside a slab
+                        t = ((bx - ax) * sy - (by - ay) * sx) / den
+                        u = ((bx - ax) * ry - (by - ay) * rx) / den
+                        if 0.0 < t < 1.0 and 0.0 < u < 1.0:
+                            if sweep == 0:
+                                n_cross += 1
+                            else:
+                                xs[ne] = ax + t * rx
+                                ne += 1
+    xs = np.sort(xs[:ne])
+    lo = np.empty(m)
+    hi = np.empty(m)
+    total = 0.0
+    for e in range(ne - 1):
+        x0 = xs[e]
+        x1 = xs[e + 1]
+        if x1 <= x0:
+            continue
+        xm = 0.5 * (x0 + x1)
+        n_int = 0
+        for k in range(m):
+            ylo = np.inf
+            yhi = -np.inf
+            for v in range(gn[k]):
+                v1 = v + 1 if v + 1 < gn[k] else 0
+                xa, xb = gx[k, v], gx[k, v1]
+                if (xa < xm) != (xb < xm):
+                    y = gy[k, v] + (xm - xa) * (gy[k, v1] - gy[k, v]) / (xb - xa)
+                    ylo = min(ylo, y)
+                    yhi = max(yhi, y)
+            if yhi > ylo:
+                lo[n_int] = ylo
+                hi[n_int] = yhi
+                n_int += 1
+        if n_int == 0:
+            continue
+        order = np.argsort(lo[:n_int])
+        length = 0.0
+        cur_lo = lo[order[0]]
+        cur_hi = hi[order[0]]
+        for q in range(1, n_int):
+            a = lo[order[q]]
+            b = hi[order[q]]
+            if a > cur_hi:
+                length += cur_hi - cur_lo
+                cur_lo = a
+                cur_hi = b
+            elif b > cur_hi:
+                cur_hi = b
+        length += cur_hi - cur_lo
+        total += (x1 - x0) * length
+    return total
 
 
 @nb.njit(cache=True, nogil=True)
@@ -648,9 +762,9 @@ def _exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
     K = dirs.shape[1]
     nf = F.shape[0]
     frac = np.zeros((G, nf))
-    gx = np.empty((_MAXM, _MAXV))
-    gy = np.empty((_MAXM, _MAXV))
-    gn = np.empty(_MAXM, dtype=np.int64)
+    gx = np.empty((MAX_SHADOWS, 8))  # a shadow clipped to a triangle has at most 7 vertices
+    gy = np.empty((MAX_SHADOWS, 8))
+    gn = np.empty(MAX_SHADOWS, dtype=np.int64)
     stack_x = np.empty((_MAXM + 1, _MAXV))
     stack_y = np.empty((_MAXM + 1, _MAXV))
     stack_n = np.empty(_MAXM + 1, dtype=np.int64)
@@ -727,7 +841,7 @@ def _exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
                                                  cx, cy, eps_h, hh, px, py, qx, qy, tx, ty, idx)
                             if nq == 0:
                                 continue
-                            if m == _MAXM:
+                            if m == MAX_SHADOWS or nq > 8:
                                 too_many = True
                                 continue
                             for v in range(nq):
@@ -738,12 +852,17 @@ def _exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
             if m == 0:
                 frac[g, i] = 1.0
                 continue
+            if too_many:
+                frac[g, i] = np.nan
+                continue
             ok = False
             shadow = 0.0
-            if not too_many:
+            if m <= _MAXM:
                 shadow, ok = _union_area(gx, gy, gn, m, 1e-15 * area_t, stack_x, stack_y,
                                          stack_n, nxt, tx, ty)
-            frac[g, i] = min(1.0, max(0.0, 1.0 - shadow / area_t)) if ok else np.nan
+            if not ok:
+                shadow = _union_area_slabs(gx, gy, gn, m)
+            frac[g, i] = min(1.0, max(0.0, 1.0 - shadow / area_t))
     return frac
 
 
