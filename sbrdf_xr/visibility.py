@@ -697,40 +697,52 @@ def _view_grid(d, V, F, occluder):
 
 
 @nb.njit(cache=True, nogil=True)
-def _shadow_polygon(i, j, d, ndi, V, F, N, P0, E1, E2, cx, cy, eps_h, hh, px, py, qx, qy, tx,
-                    ty, idx):
-    """Shadow that facet j casts on facet i along d, clipped to facet i, in the plane frame of i
-    (written to qx, qy; counter-clockwise).  Returns its vertex count (0 if none)."""
+def _shadow_polygon(i, j, d0, d1, d2, ndi, V, F, N, P0, E1, E2, cx, cy, eps_h, hh, px, py, qx,
+                    qy, tx, ty, idx):
+    """Shadow that facet j casts on facet i along d = (d0, d1, d2), clipped to facet i, in
+    the plane frame of i (written to qx, qy; counter-clockwise).  Returns its vertex count (0
+    if none).  Scalar indexing only (array views cost more than the arithmetic here)."""
     hmax = -np.inf
     for v in range(3):
-        x = V[F[j, v]]
-        hh[v] = (N[i, 0] * (x[0] - P0[i, 0]) + N[i, 1] * (x[1] - P0[i, 1])
-                 + N[i, 2] * (x[2] - P0[i, 2]))
+        f = F[j, v]
+        hh[v] = (N[i, 0] * (V[f, 0] - P0[i, 0]) + N[i, 1] * (V[f, 1] - P0[i, 1])
+                 + N[i, 2] * (V[f, 2] - P0[i, 2]))
         hmax = max(hmax, hh[v])
     if hmax <= eps_h:
         return 0  # on or behind the plane of i
-    s1 = (E1[i, 0] * d[0] + E1[i, 1] * d[1] + E1[i, 2] * d[2]) / ndi
-    s2 = (E2[i, 0] * d[0] + E2[i, 1] * d[1] + E2[i, 2] * d[2]) / ndi
+    s1 = (E1[i, 0] * d0 + E1[i, 1] * d1 + E1[i, 2] * d2) / ndi
+    s2 = (E2[i, 0] * d0 + E2[i, 1] * d1 + E2[i, 2] * d2) / ndi
     n_p = 0
     for v in range(3):  # cut to h >= 0, project along d onto the plane: x - d h / N.d
         w = v + 1 if v < 2 else 0
-        xv = V[F[j, v]]
-        xw = V[F[j, w]]
+        fv = F[j, v]
+        fw = F[j, w]
         if hh[v] >= 0.0:
-            y0 = xv[0] - P0[i, 0]
-            y1 = xv[1] - P0[i, 1]
-            y2 = xv[2] - P0[i, 2]
+            y0 = V[fv, 0] - P0[i, 0]
+            y1 = V[fv, 1] - P0[i, 1]
+            y2 = V[fv, 2] - P0[i, 2]
             px[n_p] = E1[i, 0] * y0 + E1[i, 1] * y1 + E1[i, 2] * y2 - hh[v] * s1
             py[n_p] = E2[i, 0] * y0 + E2[i, 1] * y1 + E2[i, 2] * y2 - hh[v] * s2
             n_p += 1
         if (hh[v] >= 0.0) != (hh[w] >= 0.0):
             t = hh[v] / (hh[v] - hh[w])
-            y0 = xv[0] + t * (xw[0] - xv[0]) - P0[i, 0]
-            y1 = xv[1] + t * (xw[1] - xv[1]) - P0[i, 1]
-            y2 = xv[2] + t * (xw[2] - xv[2]) - P0[i, 2]
+            y0 = V[fv, 0] + t * (V[fw, 0] - V[fv, 0]) - P0[i, 0]
+            y1 = V[fv, 1] + t * (V[fw, 1] - V[fv, 1]) - P0[i, 1]
+            y2 = V[fv, 2] + t * (V[fw, 2] - V[fv, 2]) - P0[i, 2]
             px[n_p] = E1[i, 0] * y0 + E1[i, 1] * y1 + E1[i, 2] * y2
             py[n_p] = E2[i, 0] * y0 + E2[i, 1] * y1 + E2[i, 2] * y2
             n_p += 1
+    for e in range(3):  # all of it outside one edge of the facet: no overlap
+        e1 = e + 1 if e < 2 else 0
+        ex = cx[e1] - cx[e]
+        ey = cy[e1] - cy[e]
+        outside = True
+        for v in range(n_p):
+            if ex * (py[v] - cy[e]) - ey * (px[v] - cx[e]) > 0.0:
+                outside = False
+                break
+        if outside:
+            return 0
     if _signed_area(px, py, n_p) < 0.0:  # make it counter-clockwise
         for v in range(n_p // 2):
             px[v], px[n_p - 1 - v] = px[n_p - 1 - v], px[v]
@@ -819,6 +831,9 @@ def _exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
                 start = starts[k]
                 items = itemss[k]
                 ng = int(grid[4])
+                dk0 = dirs[g, k, 0]
+                dk1 = dirs[g, k, 1]
+                dk2 = dirs[g, k, 2]
                 c0 = int(np.floor((box[i, 0] - grid[0]) * grid[2]))
                 c1 = int(np.floor((box[i, 1] - grid[0]) * grid[2]))
                 r0 = int(np.floor((box[i, 2] - grid[1]) * grid[3]))
@@ -837,8 +852,9 @@ def _exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
                                     or box[j, 2] >= box[i, 3] or box[j, 3] <= box[i, 2]
                                     or box[j, 5] <= box[i, 4]):
                                 continue  # apart across d, or wholly behind i along d
-                            nq = _shadow_polygon(i, j, dirs[g, k], nd[k, i], V, F, N, P0, E1, E2,
-                                                 cx, cy, eps_h, hh, px, py, qx, qy, tx, ty, idx)
+                            nq = _shadow_polygon(i, j, dk0, dk1, dk2, nd[k, i], V, F, N, P0, E1,
+                                                 E2, cx, cy, eps_h, hh, px, py, qx, qy, tx, ty,
+                                                 idx)
                             if nq == 0:
                                 continue
                             if m == MAX_SHADOWS or nq > 8:
@@ -894,8 +910,8 @@ def _facet_shadows(i, dirs, V, F, N, P0, E1, E2, T2, watertight, eps_h):
             ndj = N[j, 0] * d[0] + N[j, 1] * d[1] + N[j, 2] * d[2]
             if (watertight and ndj >= 0.0) or ndj == 0.0:
                 continue
-            nq = _shadow_polygon(i, j, d, ndi, V, F, N, P0, E1, E2, cx, cy, eps_h, hh, px, py,
-                                 qx, qy, tx, ty, idx)
+            nq = _shadow_polygon(i, j, d[0], d[1], d[2], ndi, V, F, N, P0, E1, E2, cx, cy, eps_h,
+                                 hh, px, py, qx, qy, tx, ty, idx)
             if nq == 0:
                 continue
             if n + nq > xy.shape[0]:
