@@ -260,11 +260,15 @@ def canx1_sweep_rows(n_attitudes: int = 360, density: int = 4, repeat: int = 2) 
 
 
 def scaling_rows(subdivisions: Sequence[int] = (1, 2, 3, 4, 5), n_geometries: int = 6,
-                 repeat: int = 1, seed: int = 7) -> list[CostRow]:
+                 repeat: int = 1, seed: int = 7, compare_density: int | None = 4) -> list[CostRow]:
     """Exact-method time per geometry against the facet count, on CanX-1 with antennas
-    subdivided (732, 2928, 11712, 46848, 187392 facets); the last row's ``ratio`` is the
-    exponent ``b`` of the least-squares fit ``time ~ n_facets**b``, each row's the local
-    exponent from the previous row."""
+    subdivided (732, 2928, 11712, 46848, 187392 facets).
+
+    Each exact row's ``ratio`` is the local exponent from the previous count; the last
+    exact row's the exponent ``b`` of the least-squares fit ``time ~ n_facets**b`` over all
+    counts.  With ``compare_density``, a sampled row follows each exact row, its ``ratio``
+    its time over the exact time at that count (same run).
+    """
     s, o = geometries(n_geometries, seed)
     rows: list[CostRow] = []
     pts = []
@@ -277,12 +281,20 @@ def scaling_rows(subdivisions: Sequence[int] = (1, 2, 3, 4, 5), n_geometries: in
         pts.append((craft.n_facets, ms))
         rows.append(CostRow("exact", craft.name, craft.n_facets, n_geometries, ms, float(local),
                             "local exponent"))
+        if compare_density:
+            d = compare_density
+            lit_visible_fraction(craft, s[:1], o[:1], method="sampled", density=d)
+            _, ts = _timed(lambda craft=craft, d=d: lit_visible_fraction(
+                craft, s, o, method="sampled", density=d), repeat)
+            rows.append(CostRow(f"sampled density {d}", craft.name, craft.n_facets, n_geometries,
+                                1e3 * ts / n_geometries, ts / t, "exact at this facet count"))
     if len(pts) > 1:
         x, y = np.log([p[0] for p in pts]), np.log([p[1] for p in pts])
         b = float(np.polyfit(x, y, 1)[0])
-        last = rows[-1]
-        rows[-1] = CostRow(last.label, last.body, last.n_facets, last.n_geometries,
-                           last.ms_per_geometry, b, "fitted exponent over all rows")
+        last = max(i for i, r in enumerate(rows) if r.label == "exact")
+        r = rows[last]
+        rows[last] = CostRow(r.label, r.body, r.n_facets, r.n_geometries, r.ms_per_geometry, b,
+                             "fitted exponent over all counts")
     return rows
 
 
