@@ -243,3 +243,97 @@ def plate_with_fin_spacecraft(depth: float = 2.0, **section):
     """A plate ``[-1, 1] x [-0.1, 0]`` with a perpendicular fin ``[-0.05, 0.05] x [0, 1]`` (xy, [m]),
     extruded over z in [0, depth]; ``section`` overrides :func:`plate_with_fin_section`."""
     return _as_spacecraft(prism_mesh(plate_with_fin_section(**section), 0.0, depth), "plate-with-fin")
+
+
+# ---------------------------------------------------------------- non-convex shadowing bodies
+
+#: Cross-section in xz of :func:`bus_with_panel_spacecraft` [m]: a bus square
+#: [-0.5, 0.5] x [-0.5, 0.5], a flat boom [0.5, 1.3] x [-0.03, 0.03] and a panel
+#: [1.3, 1.34] x [-0.9, 0.9], counter-clockwise seen from +y.
+BUS_PANEL_SECTION = (
+    (-0.5, -0.5), (0.5, -0.5), (0.5, -0.03), (1.3, -0.03), (1.3, -0.9), (1.34, -0.9),
+    (1.34, 0.9), (1.3, 0.9), (1.3, 0.03), (0.5, 0.03), (0.5, 0.5), (-0.5, 0.5),
+)
+
+
+def bus_with_panel_spacecraft(depth: float = 1.0, subdivisions: int = 1):
+    """A bus with a solar panel on a boom: :data:`BUS_PANEL_SECTION` (xz) extruded over
+    y in [-depth/2, depth/2] [m], one closed surface.
+
+    The panel (1.8 m tall, 0.8 m beyond the bus) shadows the bus's +x face and the boom
+    when the Sun is toward +x; the boom shadows the panel's inner face.
+
+    Parameters
+    ----------
+    depth : float
+        Extent along y of bus, boom and panel [m].
+    subdivisions : int
+        1 + rounds of :meth:`trimesh.Trimesh.subdivide` (4x the facets each).
+    """
+    import trimesh
+
+    sec = np.asarray(BUS_PANEL_SECTION, dtype=float)
+    # the prism is built in (x, y', z') = (x, z, -y) and rotated so that the section is xz
+    mesh = prism_mesh(sec, -depth / 2, depth / 2)
+    mesh = trimesh.Trimesh(mesh.vertices[:, [0, 2, 1]] * [1.0, -1.0, 1.0], mesh.faces, process=False)
+    for _ in range(subdivisions - 1):
+        mesh = mesh.subdivide()
+    return _as_spacecraft(mesh, "bus-with-panel")
+
+
+#: Antennas of :func:`canx1_with_antennas`: (x, y) of the root [m] on the +Z face, half-width
+#: [m], length [m] and the standoff gap between the face and the antenna [m].
+CANX1_ANTENNAS = (((0.035, 0.035), (-0.035, 0.035), (-0.035, -0.035), (0.035, -0.035)),
+                  0.002, 0.08, 0.001)
+
+
+def canx1_with_antennas(subdivisions: int = 1, tilt: float = 30.0):
+    """CanX-1 (:func:`sbrdf_xr.spacecraft.canx1`) with four aluminium whip antennas.
+
+    Each antenna is a closed square rod (4 mm wide, 80 mm long) that rises from a point of
+    the +Z face, tilted by ``tilt`` degrees outward (away from the z axis), standing 1 mm off
+    the face (the surface stays a union of disjoint closed parts, so no facet is partly
+    buried).  The rods shadow the +Z face and each other's neighbourhood; the raised cells
+    shadow the side faces as in CanX-1.
+
+    Parameters
+    ----------
+    subdivisions : int
+        1 + rounds of :meth:`trimesh.Trimesh.subdivide` of the whole mesh (4x the facets
+        each: 732, 2928, 11712, 46848, ...).
+    tilt : float
+        Tilt of the rods from the +z axis [degree].
+
+    Returns
+    -------
+    sbrdf_xr.spacecraft.Spacecraft
+    """
+    import trimesh
+
+    from .spacecraft import Spacecraft, canx1
+
+    base = canx1()
+    roots, half, length, gap = CANX1_ANTENNAS
+    parts = [base.mesh]
+    labels = [base.facet_material]
+    t = np.radians(tilt)
+    for x, y in roots:
+        rod = trimesh.creation.box(extents=(2 * half, 2 * half, length))
+        rod.apply_translation((0.0, 0.0, length / 2))
+        outward = np.array([x, y, 0.0]) / np.hypot(x, y)
+        axis = np.cross([0.0, 0.0, 1.0], outward)
+        rod.apply_transform(trimesh.transformations.rotation_matrix(t, axis))
+        # lift so that the lowest vertex stands gap above the face z = 0.05
+        lift = 0.05 + gap - rod.vertices[:, 2].min()
+        rod.apply_translation((x, y, lift))
+        parts.append(rod)
+        labels.append(np.full(len(rod.faces), "aluminium-6061-t6"))
+    mesh = trimesh.Trimesh(np.vstack([p.vertices for p in parts]),
+                           np.vstack([p.faces + off for p, off in
+                                      zip(parts, np.cumsum([0] + [len(p.vertices) for p in parts[:-1]]), strict=True)]),
+                           process=False)
+    label = np.concatenate(labels)
+    for _ in range(subdivisions - 1):
+        mesh = mesh.subdivide()
+        label = np.repeat(label, 4)  # trimesh.subdivide keeps each face's 4 children together
+    return Spacecraft(mesh, label, name="canx1-antennas", colors=base.colors)
