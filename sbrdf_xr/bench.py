@@ -270,47 +270,33 @@ def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
         rows.append(BenchRow("materials: analytic generating models (ground truth)", t_an, "reference",
                              t_an / t_ref, "error column: the tabulated reference against them",
                              sweep=sweep_name, mmag_max=mx, mmag_median=med, rel_p99=p99, knob="materials"))
-    rows += shadow_density_rows(quick=quick, repeat=repeat)
+    rows += shadow_rows(quick=quick, repeat=repeat)
     return rows
 
 
-def shadow_density_rows(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
-    """Self-shadowing on CanX-1 (non-convex: raised cells) at several sampling densities.
-
-    Reference: density 8 (64 samples per facet); also the cost of shadowing against the
-    unshadowed evaluation of the same sweep.
+def shadow_rows(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
+    """Self-shadowing: the sampled method at several densities against the exact method
+    (polygon clipping) on the package's non-convex test bodies (an L prism, a plate with a
+    fin, a bus with a panel, CanX-1 with antennas), and the cost of both on a CanX-1 sweep
+    (:mod:`sbrdf_xr.shadow_bench`).  Errors are of the Lambertian signal against exact.
     """
-    from . import geometry
-    from .scene import builtin_scene
-    from .simulate import simulate
+    from . import shadow_bench
 
-    n = 60 if quick else 300
-    scene = builtin_scene("canx1-rotation").with_options(
-        attitudes=geometry.uniform_attitudes(n, seed=3), attitude_angle=None, phase_angles=[40.0],
-        outputs=("signal", "area"), chunk=n, name=f"random-{n}-shadowed")
-    densities = (1, 2, 4) if quick else (1, 2, 4, 8)
-    ref_d = 6 if quick else 12
-
-    def run_cube(**opts: Any) -> xr.Dataset:
-        return simulate(scene.with_options(**opts)).compute(scheduler="sync")
-
-    ref_opts = {"effects": ("sunlight", "shadowing"), "shadow_density": ref_d}
-    ref = run_cube(**ref_opts).signal
-    t_ref = best_time(lambda: run_cube(**ref_opts), 1)
     rows = []
-    for d in densities:
-        opts = {"effects": ("sunlight", "shadowing"), "shadow_density": d}
-        cube = run_cube(**opts)
-        t = best_time(lambda opts=opts: run_cube(**opts), repeat)
-        mx, med, p99 = _errors(cube.signal, ref)
-        rows.append(BenchRow(f"shadowing: density {d} ({d * d} samples/facet)", t,
-                             f"shadowing density {ref_d}", t / t_ref, sweep=scene.name, mmag_max=mx,
-                             mmag_median=med, rel_p99=p99, knob="shadowing"))
-    plain = run_cube()
-    t = best_time(lambda: run_cube(), repeat)
-    mx, med, p99 = _errors(plain.signal, ref)
-    rows.append(BenchRow("shadowing: off (convex assumption)", t, f"shadowing density {ref_d}", t / t_ref,
-                         sweep=scene.name, mmag_max=mx, mmag_median=med, rel_p99=p99, knob="shadowing"))
+    acc = shadow_bench.accuracy_rows(densities=(2, 4, 8) if quick else (2, 4, 8, 16, 32),
+                                     n_geometries=8 if quick else 18, repeat=repeat)
+    for r in acc:
+        mmag = 2500.0 * np.log10(1.0 + r.worst_rel_error)
+        med = 2500.0 * np.log10(1.0 + r.median_rel_error)
+        rows.append(BenchRow(f"shadowing: {r.label}", r.ms_per_geometry * 1e-3, "exact shadowing",
+                             r.time_ratio, f"worst {r.worst_rel_error:.2g}, median {r.median_rel_error:.2g} "
+                             f"relative ({r.bodies}; {r.n_geometries} geometries each)",
+                             sweep="shadowing, non-convex bodies", mmag_max=mmag, mmag_median=med,
+                             knob="shadowing"))
+    for c in shadow_bench.canx1_sweep_rows(n_attitudes=90 if quick else 360, repeat=repeat):
+        rows.append(BenchRow(f"shadowing cost: {c.label}", c.ms_per_geometry * 1e-3, c.ratio_to, c.ratio,
+                             f"{c.ms_per_geometry:.2f} ms per geometry, {c.n_facets} facets",
+                             sweep="shadowing, CanX-1 sweep", knob="shadowing"))
     return rows
 
 

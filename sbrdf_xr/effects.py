@@ -179,9 +179,7 @@ def _shadow_fraction(plan: Plan, to_source: np.ndarray, to_observer: np.ndarray)
         return None
     from .visibility import lit_visible_fraction
 
-    opts = dict(plan.shadow_options)
-    opts.pop("method")
-    frac = lit_visible_fraction(plan.spacecraft, to_source, to_observer, **opts)
+    frac = lit_visible_fraction(plan.spacecraft, to_source, to_observer, **plan.shadow_options)
     return np.ascontiguousarray(np.asarray(frac)[:, plan.terms.facet])
 
 

@@ -12,8 +12,10 @@ accuracy/cost table of ``sbrdf-xr bench`` (README): against ``reference``, linea
 look-up costs about a third of the time for glint errors of tens of mmag (median
 below 1 mmag); float32 adds about 0.001 mmag; the paper's nearest look-up saves
 little more time for about five times the error of linear, so no preset uses it.
-Shadowing in ``balanced`` and ``reference`` is area-exact (polygon clipping);
-``fast`` samples it.
+Shadowing is area-exact (polygon clipping) in every preset: on the package's non-convex
+bodies no sampled density up to 32 reaches 1% worst error, and on meshes below about
+5e4 facets exact clipping costs less than 4 x 4 samples per facet; sampling
+(``shadow_method="sampled"``) pays off only on larger meshes.
 """
 
 from __future__ import annotations
@@ -106,7 +108,7 @@ KNOBS: dict[str, Knob] = {k.name: k for k in (
 
 #: Presets: knob values chosen from the accuracy/cost table (see the module docstring).
 PRESETS: dict[str, dict[str, Any]] = {
-    "fast": {"method": "linear", "dtype": "float32", "shadow_method": "sampled", "shadow_density": 4},
+    "fast": {"method": "linear", "dtype": "float32", "shadow_method": "exact"},
     "balanced": {"method": "linear", "dtype": "float64", "shadow_method": "exact"},
     "reference": {"method": "cubic", "dtype": "float64", "shadow_method": "exact"},
 }
