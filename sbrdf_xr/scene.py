@@ -239,7 +239,7 @@ class Scene:
             raise SceneError(f"materials: no table for {missing}; given: {sorted(self.materials)}")
         for name, da in self.materials.items():
             try:
-                validate_material(da, check_values=False)
+                validate_material(da, check_values=True)
             except ValidationError as exc:
                 raise SceneError(f"material {name!r}: {exc}") from None
 

@@ -46,6 +46,7 @@ from ._lut import table_edges
 from ._names import ATTITUDE, BAND, PHASE_ANGLE, VECTOR, WAVELENGTH, attrs
 from ._writer import write_cube as write
 from .errors import SceneError
+from .fingerprint import scene_fingerprint
 from .scene import SPECTRAL_OUTPUTS, Plan, Scene, resolve_scene
 
 __all__ = ["compile_plan", "earthshine_irradiance_ratio", "planck", "simulate", "write"]
@@ -546,4 +547,5 @@ def simulate(
         **{f"material_provenance_{m}": p for m, p in provenance.items()},
         "note_sbrdf_zero_area": "spacecraft_sbrdf is 0 where area is 0 (no lit and visible facet; 0/0 of Eq. 4)",
     }
+    ds.attrs.update(scene_fingerprint(scene))
     return ds
