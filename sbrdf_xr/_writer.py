@@ -738,20 +738,23 @@ _SCHEMES = ("tcp", "tls", "ucx", "ws", "wss")
 
 def _check_address(address: Any) -> str:
     """``address`` as a ``scheme://host:port`` string, or :class:`ValidationError`."""
-    allowed = (
-        "allowed: None or 'threads' (in-process threads), 'synchronous', or the address of a "
-        "Dask scheduler such as 'tcp://127.0.0.1:8786'"
-    )
+    if _STYLE.get() == "cli":
+        allowed = "expected the address of a Dask scheduler such as 'tcp://127.0.0.1:8786'"
+        name = "--scheduler"
+    else:
+        allowed = ("allowed: None or 'threads' (in-process threads), 'synchronous', or the address "
+                   "of a Dask scheduler such as 'tcp://127.0.0.1:8786'")
+        name = "scheduler"
     if not isinstance(address, str) or not address.isprintable() or any(c.isspace() for c in address):
-        raise ValidationError(f"scheduler: got {address!r}; {allowed}")
+        raise ValidationError(f"{name}: got {address!r}; {allowed}")
     scheme, sep, rest = address.rpartition("://")
     if not sep:
         scheme, rest = "tcp", address
     host, colon, port = rest.rpartition(":")
     if scheme not in _SCHEMES or not colon or not host or not port.isdigit() or not 0 < int(port) < 65536:
-        raise ValidationError(f"scheduler: got {address!r}; {allowed} (port 1-65535)")
+        raise ValidationError(f"{name}: got {address!r}; {allowed} (port 1-65535)")
     if host.startswith("[") != host.endswith("]"):
-        raise ValidationError(f"scheduler: got {address!r}; {allowed}")
+        raise ValidationError(f"{name}: got {address!r}; {allowed}")
     return f"{scheme}://{host}:{port}"
 
 
@@ -862,6 +865,9 @@ _ERRNO_WORDS = {
     errno.EPERM: "operation not permitted",
     errno.EROFS: "read-only file system",
     errno.EIO: "input/output error",
+    errno.ENOENT: "no such file or directory",
+    errno.ENOTDIR: "not a directory",
+    errno.EISDIR: "is a directory",
 }
 _FIXES = {
     "no space left on device": "free some space",
