@@ -1308,6 +1308,8 @@ def write_cube(
     for every block: persist or compute them first.
     """
     path = Path(path)
+    if path.name in ("", ".", ".."):
+        raise ValidationError(f"path: {str(path)!r} names no file; give a file name for the cube")
     part = path.with_name(path.name + PART_SUFFIX)
     log = path.with_name(path.name + LOG_SUFFIX)
     plan = _plan(ds)

@@ -176,7 +176,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     finished = (args.resume and not args.overwrite and out.is_file()
                 and not out.with_name(out.name + PART_SUFFIX).exists())
     client = None
-    if args.scheduler:
+    if args.scheduler is not None:
         from ._writer import connect
 
         client = connect(args.scheduler)

@@ -520,23 +520,6 @@ def scene_from_dict(d: Mapping[str, Any]) -> Scene:
     from . import catalog
     from .spacecraft import Spacecraft
 
-    sc_name = d.get("spacecraft")
-    if sc_name is None:
-        raise SceneError("scene: key 'spacecraft' is required (a catalog name)")
-    sc = catalog.load(sc_name)
-    if not isinstance(sc, Spacecraft):
-        raise SceneError(f"spacecraft: catalog entry {sc_name!r} is not a spacecraft")
-    materials = None
-    if "materials" in d:
-        materials = {}
-        for mat, entry in d["materials"].items():
-            if not isinstance(entry, str):
-                raise SceneError(f"[materials]: {mat!r} must name a catalog entry (a string)")
-            table = catalog.load(entry)
-            if not isinstance(table, xr.DataArray):
-                raise SceneError(f"[materials]: {mat!r} = {entry!r} is a {type(table).__name__} "
-                                 "entry, not a material table")
-            materials[mat] = table
     kw: dict[str, Any] = {k: d[k] for k in ("name", "description", "method", "dtype", "merge",
                                                "band_extrapolate") if k in d}
     for k in ("earth_albedo", "earth_range_km", "earth_phase_angle"):
@@ -584,6 +567,24 @@ def scene_from_dict(d: Mapping[str, Any]) -> Scene:
         kw["phase_angles"] = _numbers(d["phase_angles"], "phase_angles")
     elif "phase_angles" in d:
         raise SceneError("scene: 'phase_angles' needs an [attitude] table")
+    # Catalog entries are loaded last, once every cheap check has passed.
+    sc_name = d.get("spacecraft")
+    if sc_name is None:
+        raise SceneError("scene: key 'spacecraft' is required (a catalog name)")
+    sc = catalog.load(sc_name)
+    if not isinstance(sc, Spacecraft):
+        raise SceneError(f"spacecraft: catalog entry {sc_name!r} is not a spacecraft")
+    materials = None
+    if "materials" in d:
+        materials = {}
+        for mat, entry in d["materials"].items():
+            if not isinstance(entry, str):
+                raise SceneError(f"[materials]: {mat!r} must name a catalog entry (a string)")
+            table = catalog.load(entry)
+            if not isinstance(table, xr.DataArray):
+                raise SceneError(f"[materials]: {mat!r} = {entry!r} is a {type(table).__name__} "
+                                 "entry, not a material table")
+            materials[mat] = table
     try:
         return Scene(sc, materials=materials, **kw)
     except SceneError:

@@ -69,11 +69,13 @@ def fault_table(request):
         rows = [o for k, o in TRIALS if kind in (k, "all")]
         lines.append(f"{kind:<28}{len(rows):>7}" + "".join(f"{rows.count(o):>22}" for o in OUTCOMES))
     reporter = request.config.pluginmanager.get_plugin("terminalreporter")
-    for line in ["", *lines]:
-        if reporter is not None:
-            reporter.write_line(line)
-        else:  # pragma: no cover
-            print(line)
+    capman = request.config.pluginmanager.getplugin("capturemanager")
+    with capman.global_and_fixture_disabled() if capman else contextlib.nullcontext():
+        for line in ["", *lines]:
+            if reporter is not None:
+                reporter.write_line(line)
+            else:  # pragma: no cover
+                print(line)
 
 
 def cube_24(**kw) -> xr.Dataset:
