@@ -68,8 +68,9 @@ def _unit_vectors(v: ArrayLike, name: str) -> np.ndarray:
         raise SceneError(f"{name}: needs at least one vector, got none")
     if not np.all(np.isfinite(arr)):
         raise SceneError(f"{name}: contains NaN or infinite components")
-    norm = np.linalg.norm(arr, axis=1)
-    bad = np.flatnonzero(np.abs(norm - 1.0) > _UNIT_TOL)
+    with np.errstate(over="ignore"):  # a huge component: length inf, refused below
+        norm = np.linalg.norm(arr, axis=1)
+    bad = np.flatnonzero(~(np.abs(norm - 1.0) <= _UNIT_TOL))
     if bad.size:
         raise SceneError(
             f"{name}: vector {bad[0]} {arr[bad[0]].tolist()} has length {norm[bad[0]]:.6g}; "
@@ -377,6 +378,8 @@ def _check_keys(table: Any, allowed: Mapping[str, Any], where: str) -> None:
 
 #: Most attitudes or geometry pairs a scene file may list or generate.
 MAX_SCENE_COUNT = 10_000_000
+#: Largest magnitude of a direction's component in a scene file (its length must not overflow).
+_MAX_COMPONENT = 1e100
 #: Largest shadow-sampling density a scene file may ask for (sub-facet samples per side).
 MAX_SHADOW_DENSITY = 64
 
@@ -435,6 +438,8 @@ def _vector(v: Any, where: str) -> tuple[float, float, float]:
     x = tuple(_number(c, f"{where}[{i}]") for i, c in enumerate(v))
     if not any(x):
         raise SceneError(f"{where}: the zero vector has no direction")
+    if max(map(abs, x)) > _MAX_COMPONENT:
+        raise SceneError(f"{where}: components must not exceed {_MAX_COMPONENT:g} in magnitude, got {list(x)}")
     return x  # type: ignore[return-value]
 
 
