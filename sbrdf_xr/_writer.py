@@ -17,7 +17,29 @@ Atomicity
     renamed (:func:`os.replace`) to ``path`` only after every block is written,
     flushed and ``fsync``-ed.  A cube is never half-written under its final name,
     and with ``overwrite=True`` the old file stays intact until the new one is
-    complete.
+    complete.  Only regular files are ever replaced: a FIFO, symbolic link, device
+    node or directory at ``path`` or at the ``.part`` is refused, overwrite or not.
+
+Lock (``<path>.lock``)
+    One writer per path: the lock file is created atomically (``O_CREAT |
+    O_EXCL``), holds the writer's pid, host and start time, and carries a ``flock``
+    for the life of the write; it is removed on every way out (success, error,
+    interrupt).  A second writer gets :class:`CubeLockedError` naming the holder.
+    A lock left by a writer that died on this host (its pid gone, its ``flock``
+    released by the kernel) is stale: it is removed with a logged message and the
+    write proceeds.  A lock from another host is never removed automatically.
+
+Durability
+    A block is reported (``on_block``, the sidecar) only after its data were
+    written, the file flushed (``nc.sync``) and ``fsync``-ed.  Before each block
+    the room it needs is checked (free space, ``RLIMIT_FSIZE``) and reserved
+    (``fallocate`` past the end of the file, where supported), so that a full disk
+    or a file-size limit stops the write *before* HDF5 writes anything: the
+    ``.part`` stays exactly as last synced and the error names the cause ("no
+    space left on device", "file size limit exceeded").  Should HDF5's own write
+    fail anyway, HDF5's descriptor is made read-only (nothing more reaches the
+    file) and the file is cut back to its last synced size and superblock; if it
+    then does not open, the message says that the ``.part`` was lost.
 
 Bookkeeping (``<path>.part.jsonl``)
     A sidecar JSON-lines file next to the ``.part``.  Line 1 is a header object::
@@ -42,8 +64,12 @@ Resume
     fingerprint equals the fingerprint of ``ds`` (same dims, sizes, chunking,
     variables, dtypes, attributes and coordinate values) and then computes only
     the blocks not listed.  The lazy values themselves are not hashed (that would
-    need computing them): resuming with a different computation of the same
-    structure is the caller's mistake.  Global attributes in
+    need computing them); instead cubes of :func:`sbrdf_xr.simulate.simulate`
+    carry the content fingerprint of their scene (:mod:`sbrdf_xr.fingerprint`:
+    table values, mesh, materials map, filters, settings, geometry, version) in
+    their global attributes, so a resume with other inputs is refused with a
+    message naming what changed.  ``resume=True`` with a finished ``path`` and no
+    ``.part`` checks that it is the same cube and does nothing.  Global attributes in
     :data:`VOLATILE_ATTRS` (``history`` and the ACDD dates) may change between
     runs; they are rewritten from ``ds`` on resume.
 
