@@ -223,7 +223,6 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 
 
 def _cmd_photometry(args: argparse.Namespace) -> int:
-    from pathlib import Path
 
     import numpy as np
     import xarray as xr
@@ -231,6 +230,9 @@ def _cmd_photometry(args: argparse.Namespace) -> int:
     from . import photometry as phot
     from .material import write_netcdf_atomic
 
+    for out in (args.output, args.csv):
+        if out and Path(out).exists() and not args.overwrite:
+            raise FileExistsError(f"{out} exists; pass --overwrite to replace it")
     cube = _open_cube(args.cube)
     ds = phot.photometry(cube, args.bands, args.range_km, weighting=args.weighting,
                          quadrature=args.quadrature, extrapolate=args.extrapolate)
@@ -253,8 +255,6 @@ def _cmd_photometry(args: argparse.Namespace) -> int:
         write_netcdf_atomic(ds, args.output, overwrite=args.overwrite)
         print(f"wrote {args.output}")
     if args.csv:
-        if Path(args.csv).exists() and not args.overwrite:
-            raise FileExistsError(f"{args.csv} exists; pass --overwrite to replace it")
         lead = set(ds.magnitude.dims) - {"band"}
         parts = [ds.magnitude.to_dataset(dim="band").rename({str(b): f"mag_{b}" for b in ds.band.values})]
         if "colour_index" in ds:
@@ -356,7 +356,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     handler.setFormatter(_OneLine())
     logger.addHandler(handler)
     level = logger.level
-    logger.setLevel(logging.INFO)
+    logger.setLevel(logging.WARNING)
     try:
         with command_line_messages():
             return int(args.func(args))
