@@ -1525,6 +1525,9 @@ def _write_locked(
         if nc is not None:
             with contextlib.suppress(Exception):
                 nc.close()
+        if fd >= 0:  # release room reserved past the end (the size is unchanged)
+            with contextlib.suppress(OSError):
+                os.ftruncate(fd, os.fstat(fd).st_size)
         for f in (fd, log_fd):
             if f >= 0:
                 os.close(f)

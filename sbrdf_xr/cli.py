@@ -223,7 +223,6 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 
 
 def _cmd_photometry(args: argparse.Namespace) -> int:
-
     import numpy as np
     import xarray as xr
 
