@@ -1509,6 +1509,13 @@ def _write_locked(
         head = f"writing {path} failed {where}after {len(done)} of {plan.n_blocks} blocks: {why}. "
         if lost is not None:
             raise CubeWriteError(f"{head}{part} could not be kept ({lost}); {_discard()}") from exc
+        if writing and good >= 0:
+            raise CubeWriteError(
+                f"{head}HDF5 failed in the middle of a block; {part} was cut back to its last "
+                f"synced state, with the blocks written so far. {_fix(why)[0].upper()}{_fix(why)[1:]} "
+                f"and {_again()}; should HDF5 fail again at the same block, the file cannot be "
+                f"continued: {_discard()}"
+            ) from exc
         raise CubeWriteError(
             f"{head}The blocks written so far are kept in {part}; {_fix(why)} and {_again()} "
             "to compute only the missing blocks"
