@@ -17,7 +17,29 @@ Atomicity
     renamed (:func:`os.replace`) to ``path`` only after every block is written,
     flushed and ``fsync``-ed.  A cube is never half-written under its final name,
     and with ``overwrite=True`` the old file stays intact until the new one is
-    complete.
+    complete.  Only regular files are ever replaced: a FIFO, symbolic link, device
+    node or directory at ``path`` or at the ``.part`` is refused, overwrite or not.
+
+Lock (``<path>.lock``)
+    One writer per path: the lock file is created atomically (``O_CREAT |
+    O_EXCL``), holds the writer's pid, host and start time, and carries a ``flock``
+    for the life of the write; it is removed on every way out (success, error,
+    interrupt).  A second writer gets :class:`CubeLockedError` naming the holder.
+    A lock left by a writer that died on this host (its pid gone, its ``flock``
+    released by the kernel) is stale: it is removed with a logged message and the
+    write proceeds.  A lock from another host is never removed automatically.
+
+Durability
+    A block is reported (``on_block``, the sidecar) only after its data were
+    written, the file flushed (``nc.sync``) and ``fsync``-ed.  Before each block
+    the room it needs is checked (free space, ``RLIMIT_FSIZE``) and reserved
+    (``fallocate`` past the end of the file, where supported), so that a full disk
+    or a file-size limit stops the write *before* HDF5 writes anything: the
+    ``.part`` stays exactly as last synced and the error names the cause ("no
+    space left on device", "file size limit exceeded").  Should HDF5's own write
+    fail anyway, HDF5's descriptor is made read-only (nothing more reaches the
+    file) and the file is cut back to its last synced size and superblock; if it
+    then does not open, the message says that the ``.part`` was lost.
 
 Bookkeeping (``<path>.part.jsonl``)
     A sidecar JSON-lines file next to the ``.part``.  Line 1 is a header object::
@@ -42,8 +64,12 @@ Resume
     fingerprint equals the fingerprint of ``ds`` (same dims, sizes, chunking,
     variables, dtypes, attributes and coordinate values) and then computes only
     the blocks not listed.  The lazy values themselves are not hashed (that would
-    need computing them): resuming with a different computation of the same
-    structure is the caller's mistake.  Global attributes in
+    need computing them); instead cubes of :func:`sbrdf_xr.simulate.simulate`
+    carry the content fingerprint of their scene (:mod:`sbrdf_xr.fingerprint`:
+    table values, mesh, materials map, filters, settings, geometry, version) in
+    their global attributes, so a resume with other inputs is refused with a
+    message naming what changed.  ``resume=True`` with a finished ``path`` and no
+    ``.part`` checks that it is the same cube and does nothing.  Global attributes in
     :data:`VOLATILE_ATTRS` (``history`` and the ACDD dates) may change between
     runs; they are rewritten from ``ds`` on resume.
 
@@ -70,11 +96,17 @@ Encoding
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import dataclasses
+import datetime
+import errno
 import hashlib
 import json
+import logging
 import math
 import os
+import socket
+import stat
 import sys
 import time
 from collections import deque
@@ -90,21 +122,31 @@ import numpy as np
 import xarray as xr
 from dask.system import CPU_COUNT
 
+from . import fingerprint as _fingerprint
 from .errors import SbrdfError, ValidationError
 
 __all__ = [
+    "LOCK_SUFFIX",
     "LOG_SUFFIX",
     "PART_SUFFIX",
     "VOLATILE_ATTRS",
     "BlockWritten",
+    "CubeLockedError",
     "CubeWriteError",
+    "SchedulerError",
+    "command_line_messages",
+    "connect",
     "write_cube",
 ]
+
+_log = logging.getLogger("sbrdf_xr.write_cube")
 
 #: Suffix of the temporary file the cube is written to before the final rename.
 PART_SUFFIX = ".part"
 #: Suffix of the bookkeeping sidecar (JSON lines) of an unfinished cube.
 LOG_SUFFIX = ".part.jsonl"
+#: Suffix of the exclusive writer lock held while a cube is being written.
+LOCK_SUFFIX = ".lock"
 #: Global attributes that may change between an interrupted run and its resume.
 VOLATILE_ATTRS = frozenset(
     {"history", "date_created", "date_modified", "date_issued", "date_metadata_modified"}
@@ -121,6 +163,54 @@ _THREAD_NAMES = ("threads", "threading")
 
 class CubeWriteError(SbrdfError):
     """A cube could not be written, or an unfinished ``.part`` cannot be resumed."""
+
+
+class CubeLockedError(CubeWriteError):
+    """Another writer holds the lock of this cube (``<path>.lock``)."""
+
+
+class SchedulerError(SbrdfError):
+    """A Dask scheduler address that is malformed or cannot be reached."""
+
+
+#: Free space [byte] kept beyond a block's raw size for HDF5 metadata (chunk index,
+#: object headers, superblock) written with it.
+_SPACE_MARGIN = 256 * 2**10
+#: Whether each block's room on the file system is checked before it is written.
+_CHECK_SPACE = True
+#: Bytes at the start of a ``.part`` (the HDF5 superblock) saved after each sync.
+_HEAD_BYTES = 4096
+#: Seconds a lock file without readable content counts as being created, not stale.
+_LOCK_GRACE = 10.0
+
+_STYLE: contextvars.ContextVar[str] = contextvars.ContextVar("sbrdf_xr_option_style", default="python")
+
+
+@contextlib.contextmanager
+def command_line_messages() -> Any:
+    """Within this context, messages name command-line options (``--resume``), not arguments."""
+    token = _STYLE.set("cli")
+    try:
+        yield
+    finally:
+        _STYLE.reset(token)
+
+
+def _opt(name: str) -> str:
+    """``--resume`` on the command line, ``resume=True`` in Python."""
+    return f"--{name}" if _STYLE.get() == "cli" else f"{name}=True"
+
+
+def _discard() -> str:
+    if _STYLE.get() == "cli":
+        return "run again with --overwrite (without --resume) to discard it and start again"
+    return "pass overwrite=True, resume=False to discard it and start again"
+
+
+def _again() -> str:
+    if _STYLE.get() == "cli":
+        return "run the same command again with --resume"
+    return "call write_cube again with resume=True"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -283,6 +373,11 @@ def _plan(ds: xr.Dataset) -> _Plan:
             "or rechunk them alike"
         ) from exc
     _check_attrs("global attributes", ds.attrs)
+    if not ds.data_vars:
+        raise ValidationError("ds: the cube has no data variables; there is nothing to write")
+    empty = [f"{d!s} (size 0)" for d, n in ds.sizes.items() if n == 0]
+    if empty:
+        raise ValidationError(f"ds: the cube is empty along {', '.join(empty)}; there is nothing to write")
     lazy: list[_Lazy] = []
     variables: list[dict[str, Any]] = []
     for name, var in ds.variables.items():
@@ -335,8 +430,15 @@ def _plan(ds: xr.Dataset) -> _Plan:
 
 
 def _difference(old: Mapping[str, Any], new: Mapping[str, Any]) -> str:
-    """First difference between two ``structure`` records, in words."""
+    """First difference between two ``structure`` records, in words.
+
+    Differences of the content fingerprint (:mod:`sbrdf_xr.fingerprint`) come first,
+    naming every part that changed (a material table, the mesh, a setting, ...).
+    """
     new = json.loads(json.dumps(new))  # compare like with like (tuples become lists)
+    changed = _fingerprint.changes(old.get("attrs", {}), new.get("attrs", {}))
+    if changed:
+        return "; ".join(changed)
     if old.get("dims") != new.get("dims"):
         return f"dims and sizes differ: {old.get('dims')} in the .part, {new.get('dims')} now"
     if old.get("chunks") != new.get("chunks"):
@@ -350,8 +452,10 @@ def _difference(old: Mapping[str, Any], new: Mapping[str, Any]) -> str:
             if ov[name].get(key) != nv[name].get(key):
                 what = "values" if key == "sha256" else key
                 return f"{what} of {name!r} differ"
-    if old.get("attrs") != new.get("attrs"):
-        return "global attributes differ"
+    oa, na = old.get("attrs", {}), new.get("attrs", {})
+    keys = sorted(k for k in set(oa) | set(na) if oa.get(k) != na.get(k))
+    if keys:
+        return f"global attribute{'s' if len(keys) > 1 else ''} {', '.join(map(repr, keys[:5]))} differ"
     return "the file format version differs"
 
 
@@ -479,8 +583,8 @@ def _open_part(part: Path, ds: xr.Dataset, plan: _Plan) -> netCDF4.Dataset:
         nc = netCDF4.Dataset(part, mode="a")
     except OSError as exc:
         raise CubeWriteError(
-            f"{part} cannot be opened ({exc}); it was probably damaged by a crash while "
-            "writing. Pass overwrite=True, resume=False to discard it and start again"
+            f"{part} cannot be opened ({exc}); it was probably damaged while being "
+            f"written. {_discard()[0].upper()}{_discard()[1:]}"
         ) from exc
     try:
         for dim, size in ds.sizes.items():
@@ -506,18 +610,20 @@ def _read_log(log: Path, part: Path) -> tuple[dict[str, Any], set[int]]:
     if not log.exists():
         raise CubeWriteError(
             f"{part} has no bookkeeping file {log.name}, so which blocks it holds is unknown; "
-            "pass overwrite=True, resume=False to discard it and start again"
+            f"{_discard()}"
         )
-    with open(log, encoding="utf-8") as f:
-        lines = f.read().split("\n")
+    try:
+        with open(log, encoding="utf-8") as f:
+            lines = f.read().split("\n")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise CubeWriteError(f"{log}: cannot be read ({exc}); {_discard()}") from exc
     try:
         header = json.loads(lines[0])
         if header.get("format") != _FORMAT:
             raise ValueError(f"format {header.get('format')!r}")
     except (ValueError, AttributeError) as exc:
         raise CubeWriteError(
-            f"{log}: not a write_cube bookkeeping file ({exc}); pass overwrite=True, "
-            "resume=False to discard the unfinished cube and start again"
+            f"{log}: not a write_cube bookkeeping file ({exc}); {_discard()}"
         ) from exc
     done: set[int] = set()
     for line in lines[1:-1]:  # the last element follows the last newline: empty or torn
@@ -661,22 +767,70 @@ def _runner(client: Any, scheduler: str | None) -> _SyncRunner | _ThreadRunner |
         return _ThreadRunner(max(1, int(n)))
     if scheduler in _SYNC_NAMES:
         return _SyncRunner()
-    if not isinstance(scheduler, str) or ":" not in scheduler:
-        raise ValidationError(
-            f"scheduler: got {scheduler!r}; allowed: None or 'threads' (in-process threads), "
-            "'synchronous', or the address of a Dask scheduler such as 'tcp://127.0.0.1:8786'"
-        )
+    return _DistributedRunner(connect(scheduler), owned=True)
+
+
+_SCHEMES = ("tcp", "tls", "ucx", "ws", "wss")
+
+
+def _check_address(address: Any) -> str:
+    """``address`` as a ``scheme://host:port`` string, or :class:`ValidationError`."""
+    if _STYLE.get() == "cli":
+        allowed = "expected the address of a Dask scheduler such as 'tcp://127.0.0.1:8786'"
+        name = "--scheduler"
+    else:
+        allowed = ("allowed: None or 'threads' (in-process threads), 'synchronous', or the address "
+                   "of a Dask scheduler such as 'tcp://127.0.0.1:8786'")
+        name = "scheduler"
+    if not isinstance(address, str) or not address.isprintable() or any(c.isspace() for c in address):
+        raise ValidationError(f"{name}: got {address!r}; {allowed}")
+    scheme, sep, rest = address.rpartition("://")
+    if not sep:
+        scheme, rest = "tcp", address
+    host, colon, port = rest.rpartition(":")
+    if scheme not in _SCHEMES or not colon or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise ValidationError(f"{name}: got {address!r}; {allowed} (port 1-65535)")
+    if host.startswith("[") != host.endswith("]"):
+        raise ValidationError(f"{name}: got {address!r}; {allowed}")
+    return f"{scheme}://{host}:{port}"
+
+
+def connect(address: str, timeout: float | str | None = None) -> Any:
+    """A :class:`distributed.Client` connected to the scheduler at ``address``.
+
+    Parameters
+    ----------
+    address : str
+        ``tcp://host:port`` (or ``host:port``; schemes ``tcp``, ``tls``, ``ucx``,
+        ``ws``, ``wss``).
+    timeout : float or str, optional
+        Seconds (or a Dask time string) to wait for the scheduler; default the Dask
+        setting ``distributed.comm.timeouts.connect``.
+
+    Raises
+    ------
+    ValidationError
+        A malformed address.
+    SchedulerError
+        No scheduler answers at that address in time, or ``distributed`` is missing.
+    """
+    address = _check_address(address)
     try:
         from distributed import Client
     except ImportError as exc:  # pragma: no cover - distributed is a test dependency
-        raise ValidationError(
-            f"scheduler={scheduler!r} needs the 'distributed' package (pip install sbrdf-xr[distributed])"
+        raise SchedulerError(
+            f"scheduler {address!r} needs the 'distributed' package (pip install sbrdf-xr[distributed])"
         ) from exc
+    if timeout is None:
+        timeout = dask.config.get("distributed.comm.timeouts.connect", "30s")
     try:
-        c = Client(scheduler, set_as_default=False, timeout="30s")
-    except OSError as exc:
-        raise CubeWriteError(f"cannot connect to the Dask scheduler at {scheduler}: {exc}") from exc
-    return _DistributedRunner(c, owned=True)
+        return Client(address, set_as_default=False, timeout=timeout)
+    except (OSError, ValueError, TypeError) as exc:
+        what = "timed out" if isinstance(exc, TimeoutError) else type(exc).__name__
+        raise SchedulerError(
+            f"cannot connect to the Dask scheduler at {address} ({what}: {exc}); start one with "
+            "'dask scheduler --host 127.0.0.1' or check the address"
+        ) from exc
 
 
 # ------------------------------------------------------------------ progress
@@ -728,21 +882,372 @@ def _progress(enabled: bool, total: int, initial: int, desc: str) -> Any:
 # -------------------------------------------------------------------- write
 
 
-def _check_destination(path: Path, part: Path, log: Path, overwrite: bool, resume: bool) -> bool:
-    """Apply the overwrite/resume rules before anything is touched; True to resume."""
-    if path.is_dir():
-        raise CubeWriteError(f"{path} is a directory; give a file name for the cube")
-    if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True to replace it")
-    if part.exists():
-        if resume:
-            return True
-        if not overwrite:
-            raise FileExistsError(
-                f"{part} exists: an unfinished write of {path.name}. Pass resume=True to "
-                "continue it, or overwrite=True to discard it and start again"
+def _reason(exc: BaseException, part: Path | None = None) -> str:
+    """The cause of an I/O failure in words ("no space left on device", ...)."""
+    code = getattr(exc, "errno", None)
+    words = _ERRNO_WORDS.get(code) if isinstance(code, int) else None
+    if words is None and part is not None:
+        words = _diagnose(part)
+    if words is None:
+        return f"{type(exc).__name__}: {exc}"
+    detail = getattr(exc, "strerror", None) if isinstance(exc, _NoRoom) else None
+    return f"{words} ({detail})" if detail else words
+
+
+_ERRNO_WORDS = {
+    errno.ENOSPC: "no space left on device",
+    errno.EFBIG: "file size limit exceeded",
+    errno.EDQUOT: "disk quota exceeded",
+    errno.EACCES: "permission denied",
+    errno.EPERM: "operation not permitted",
+    errno.EROFS: "read-only file system",
+    errno.EIO: "input/output error",
+    errno.ENOENT: "no such file or directory",
+    errno.ENOTDIR: "not a directory",
+    errno.EISDIR: "is a directory",
+}
+_FIXES = {
+    "no space left on device": "free some space",
+    "file size limit exceeded": "raise the file size limit (ulimit -f)",
+    "disk quota exceeded": "free some space within your quota",
+}
+
+
+def _fix(reason: str) -> str:
+    return next((v for k, v in _FIXES.items() if reason.startswith(k)), "fix the cause")
+
+
+def _diagnose(part: Path) -> str | None:
+    """Why a write into ``part`` may have failed when HDF5 does not say (it reports "HDF error")."""
+    try:
+        st = os.statvfs(part.parent)
+        free = (st.f_bfree if os.geteuid() == 0 else st.f_bavail) * st.f_frsize
+        if free < _SPACE_MARGIN:
+            return "no space left on device"
+    except (OSError, AttributeError):
+        pass
+    limit = _file_size_limit()
+    with contextlib.suppress(OSError):
+        if limit is not None and part.stat().st_size + _SPACE_MARGIN > limit:
+            return "file size limit exceeded"
+    return None
+
+
+def _file_size_limit() -> int | None:
+    try:
+        import resource
+    except ImportError:  # pragma: no cover - not on POSIX
+        return None
+    soft, _ = resource.getrlimit(resource.RLIMIT_FSIZE)
+    return None if soft == resource.RLIM_INFINITY else int(soft)
+
+
+class _NoRoom(OSError):
+    """Raised before a write that would not fit: nothing was written."""
+
+
+def _mib(n: float) -> str:
+    return f"{n / 2**20:.1f} MiB"
+
+
+def _check_room(part: Path, need: int) -> None:
+    """Refuse, before writing, ``need`` bytes (plus metadata) that would not fit."""
+    if not _CHECK_SPACE:
+        return
+    need = int(need) + _SPACE_MARGIN
+    try:
+        st = os.statvfs(part.parent)
+    except (OSError, AttributeError):  # pragma: no cover - not on POSIX
+        st = None
+    if st is not None:
+        free = (st.f_bfree if os.geteuid() == 0 else st.f_bavail) * st.f_frsize
+        if free < need:
+            raise _NoRoom(errno.ENOSPC, f"about {_mib(need)} needed, {_mib(free)} free on {part.parent}")
+    limit = _file_size_limit()
+    if limit is not None:
+        size = part.stat().st_size if part.exists() else 0
+        if size + need > limit:
+            raise _NoRoom(errno.EFBIG, f"{part.name} would grow from {_mib(size)} past the limit "
+                          f"of {_mib(limit)}")
+
+
+_FALLOC_FL_KEEP_SIZE = 1
+
+
+def _fallocate_fn() -> Any:
+    try:
+        import ctypes
+        import ctypes.util
+
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+        fn = libc.fallocate
+    except (OSError, AttributeError):  # pragma: no cover - not glibc
+        return None
+    fn.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_int64, ctypes.c_int64]
+    fn.restype = ctypes.c_int
+    return fn
+
+
+_FALLOCATE = _fallocate_fn() if sys.platform.startswith("linux") else None
+
+
+def _reserve(fd: int, nbytes: int) -> None:
+    """Reserve ``nbytes`` of disk beyond the end of the file open as ``fd`` (size unchanged).
+
+    HDF5 appends each block at the end of the file; with the room already allocated
+    a full disk is found here, before HDF5 writes anything, instead of in the middle
+    of HDF5's flush.  File systems without ``fallocate`` skip the reservation.
+    """
+    if _FALLOCATE is None or not _CHECK_SPACE:
+        return
+    import ctypes
+
+    size = os.fstat(fd).st_size
+    if _FALLOCATE(fd, _FALLOC_FL_KEEP_SIZE, size, int(nbytes) + _SPACE_MARGIN) != 0:
+        code = ctypes.get_errno()
+        if code in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
+            raise _NoRoom(code, f"reserving {_mib(int(nbytes) + _SPACE_MARGIN)} for the next block failed")
+
+
+def _block_bytes(plan: _Plan) -> int:
+    """Largest raw size of one block [byte] (what a block may add to the file, uncompressed)."""
+    total = 0
+    for v in plan.lazy:
+        shape = [max(plan.chunks[d]) if d in plan.chunks else n
+                 for d, n in zip(v.dims, v.data.shape, strict=True)]
+        total += math.prod(shape) * v.data.dtype.itemsize
+    return total
+
+
+# --------------------------------------------------------------------- lock
+
+
+def _pid_alive(pid: Any) -> bool:
+    if not isinstance(pid, int) or pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    except (OverflowError, OSError):
+        return False
+    return True
+
+
+def _try_flock(fd: int) -> bool | None:
+    """True if this process now holds ``flock`` on ``fd``, False if another holds it, None if unsupported."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not on POSIX
+        return None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return False
+    except OSError:
+        return None
+    return True
+
+
+_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+
+
+class _Lock:
+    """Exclusive writer lock of one cube: ``<path>.lock``.
+
+    Taken by creating the file atomically (``O_CREAT | O_EXCL``), holding ``flock`` on
+    it for the life of the write, and recording the holder's pid, host and start
+    time inside.  A lock left by a writer that died (SIGKILL, power loss) is stale:
+    on the same host its pid is no longer running and nobody holds its ``flock``;
+    it is then removed with a logged message.  A lock from another host is never
+    removed automatically (its pid cannot be checked from here).
+    """
+
+    def __init__(self, path: Path, target: Path) -> None:
+        self.path, self.target = path, target
+        self.fd = -1
+        self.ino = -1
+
+    def acquire(self) -> None:
+        for _ in range(8):
+            try:
+                fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_EXCL | _NOFOLLOW, 0o644)
+            except FileExistsError:
+                self._clear_stale()
+                continue
+            except OSError as exc:
+                raise CubeWriteError(f"cannot write {self.target}: creating the lock {self.path} "
+                                     f"failed: {_reason(exc)}") from exc
+            try:
+                for _ in range(50):  # a stale-lock check may hold it for an instant
+                    if _try_flock(fd) is not False:
+                        break
+                    time.sleep(0.01)
+                info = {"pid": os.getpid(), "host": socket.gethostname(), "cube": str(self.target),
+                        "started": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")}
+                os.write(fd, (json.dumps(info) + "\n").encode())
+                os.fsync(fd)
+                self.ino = os.fstat(fd).st_ino
+            except BaseException as exc:
+                os.close(fd)
+                with contextlib.suppress(OSError):
+                    os.unlink(self.path)
+                if isinstance(exc, OSError):
+                    raise CubeWriteError(f"cannot write {self.target}: writing the lock {self.path} "
+                                         f"failed: {_reason(exc, self.path)}") from exc
+                raise
+            self.fd = fd
+            return
+        raise CubeLockedError(f"{self.target}: the lock {self.path} keeps being taken by other writers")
+
+    def _locked(self, info: Mapping[str, Any] | None) -> CubeLockedError:
+        who = (f"pid {info.get('pid')} on host {info.get('host')}, started {info.get('started')}"
+               if info else "a writer that is starting")
+        return CubeLockedError(
+            f"{self.target} is being written by another writer ({who}; lock {self.path}); "
+            "wait for it to finish or stop it, or write to another file"
+        )
+
+    def _clear_stale(self) -> None:
+        try:
+            fd = os.open(self.path, os.O_RDWR | _NOFOLLOW)
+        except FileNotFoundError:
+            return
+        except OSError as exc:
+            raise CubeLockedError(
+                f"{self.path} exists and cannot be used as a lock ({_reason(exc)}); "
+                f"remove it if no writer of {self.target} is running"
+            ) from exc
+        try:
+            held = _try_flock(fd)
+            st = os.fstat(fd)
+            raw = os.pread(fd, 4096, 0) if hasattr(os, "pread") else b""
+            try:
+                info = json.loads(raw.decode())
+                info = info if isinstance(info, dict) else None
+            except (ValueError, UnicodeDecodeError):
+                info = None
+            if held is False:
+                raise self._locked(info)
+            if info is None:
+                if time.time() - st.st_mtime < _LOCK_GRACE:
+                    raise self._locked(None)
+                why = "it names no owner"
+            else:
+                pid, host = info.get("pid"), info.get("host")
+                if host != socket.gethostname():
+                    raise CubeLockedError(
+                        f"{self.target} is locked by pid {pid} on host {host} (started "
+                        f"{info.get('started')}); whether that writer still runs cannot be checked "
+                        f"from {socket.gethostname()}. If it does not, remove {self.path} and try again"
+                    )
+                if held is None and _pid_alive(pid):
+                    raise self._locked(info)
+                why = (f"its writer, pid {pid} started {info.get('started')}, is no longer running"
+                       if not _pid_alive(pid) else f"pid {pid} no longer holds it")
+            try:
+                same = os.stat(self.path, follow_symlinks=False).st_ino == st.st_ino
+            except FileNotFoundError:
+                return
+            if same:
+                os.unlink(self.path)
+                _log.warning("removed the stale lock %s: %s (an interrupted write)", self.path, why)
+        finally:
+            os.close(fd)
+
+    def release(self) -> None:
+        if self.fd < 0:
+            return
+        try:
+            with contextlib.suppress(OSError):
+                if os.stat(self.path, follow_symlinks=False).st_ino == self.ino:
+                    os.unlink(self.path)
+        finally:
+            os.close(self.fd)
+            self.fd = -1
+
+
+# -------------------------------------------------------------------- write
+
+
+def _file_kind(p: Path) -> str | None:
+    """None if nothing is at ``p``, ``"file"`` for a regular file, else what it is."""
+    try:
+        mode = os.lstat(p).st_mode
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+    if stat.S_ISREG(mode):
+        return "file"
+    kinds = ((stat.S_ISDIR, "a directory"), (stat.S_ISLNK, "a symbolic link"),
+             (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+             (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+    return next((name for test, name in kinds if test(mode)), "not a regular file")
+
+
+def _check_destination(path: Path, part: Path, log: Path, overwrite: bool, resume: bool) -> str:
+    """Apply the overwrite/resume rules before anything is touched.
+
+    Returns ``"new"`` (start afresh), ``"resume"`` (continue the ``.part``) or
+    ``"finished"`` (``resume`` with a finished cube and no ``.part``).
+    """
+    for p in (path, part, log):
+        kind = _file_kind(p)
+        if kind not in (None, "file"):
+            raise CubeWriteError(
+                f"{p} is {kind}, not a regular file; cubes replace only regular files, even with "
+                f"{_opt('overwrite')}. Remove it or choose another output"
             )
-    return False
+    has_path, has_part = _file_kind(path) == "file", _file_kind(part) == "file"
+    if has_part and resume:
+        if has_path and not overwrite:
+            raise FileExistsError(
+                f"{path} exists and {part} holds an unfinished write of it: pass {_opt('resume')} "
+                f"with {_opt('overwrite')} to finish it and replace {path.name}, or remove one of them"
+            )
+        return "resume"
+    if has_path and resume and not overwrite:
+        return "finished"
+    if has_path and not overwrite:
+        raise FileExistsError(f"{path} exists; pass {_opt('overwrite')} to replace it")
+    if has_part and not overwrite:
+        raise FileExistsError(
+            f"{part} exists: an unfinished write of {path.name}. Pass {_opt('resume')} to "
+            f"continue it, or {_opt('overwrite')} to discard it and start again"
+        )
+    return "new"
+
+
+def _check_finished(path: Path, ds: xr.Dataset) -> None:
+    """``resume`` of a finished cube: a no-op if it is this cube, else an error."""
+    try:
+        with netCDF4.Dataset(path) as nc:
+            dims = {str(d): len(v) for d, v in nc.dimensions.items()}
+            names = set(map(str, nc.variables))
+            attrs = {k: nc.getncattr(k) for k in nc.ncattrs()}
+    except OSError as exc:
+        raise CubeWriteError(
+            f"{path} exists and is not a readable netCDF cube ({exc}); pass {_opt('overwrite')} "
+            "to replace it"
+        ) from exc
+    want = {str(d): int(n) for d, n in ds.sizes.items()}
+    problems = _fingerprint.changes(attrs, ds.attrs)
+    if dims != want:
+        problems.append(f"dims and sizes differ: {dims} in the file, {want} now")
+    if names != set(map(str, ds.variables)):
+        problems.append(f"variables differ: {sorted(names)} in the file, {sorted(map(str, ds.variables))} now")
+    if not problems:
+        for k, v in ds.attrs.items():
+            if k not in VOLATILE_ATTRS and isinstance(v, str) and attrs.get(k) != v:
+                problems.append(f"global attribute {k!r} differs")
+                break
+    if problems:
+        raise CubeWriteError(
+            f"{path} is a finished cube of other inputs ({'; '.join(problems)}); nothing was resumed. "
+            f"Pass {_opt('overwrite')} to replace it"
+        )
+    _log.info("%s is already complete; there is nothing to resume", path)
 
 
 def write_cube(
@@ -762,8 +1267,8 @@ def write_cube(
 
     The file is written as ``<path>.part`` and renamed to ``path`` when complete;
     the blocks already written are recorded in ``<path>.part.jsonl`` so that an
-    interrupted write can be resumed (see the module documentation for the
-    format).
+    interrupted write can be resumed, and ``<path>.lock`` is held meanwhile so that
+    no two writers share a path (see the module documentation).
 
     Parameters
     ----------
@@ -775,10 +1280,13 @@ def write_cube(
         Destination file.
     overwrite : bool, default False
         Replace an existing ``path`` (kept intact until the new cube is
-        complete) and discard an unfinished ``.part`` when not resuming.
+        complete) and discard an unfinished ``.part`` when not resuming.  Only a
+        regular file is ever replaced.
     resume : bool, default False
-        Continue an unfinished ``<path>.part`` of the same cube, computing only
-        the missing blocks; without a ``.part`` the write starts afresh.
+        Continue an unfinished ``<path>.part`` of the same cube (same content
+        fingerprint), computing only the missing blocks; without a ``.part`` the
+        write starts afresh, and with a finished ``path`` of the same cube it does
+        nothing.
     client : distributed.Client, optional
         Compute the blocks on this cluster (left open).
     scheduler : str, optional
@@ -797,7 +1305,7 @@ def write_cube(
         them uncompressed.
     on_block : callable, optional
         Called with a :class:`BlockWritten` in the writing thread after each
-        block is committed (written, flushed and recorded).
+        block is committed (written, flushed, synced and recorded).
 
     Returns
     -------
@@ -812,12 +1320,23 @@ def write_cube(
         touched.
     ValidationError
         ``ds`` cannot be written (inconsistent chunks, unsupported dtypes or
-        attributes) or the arguments are invalid.  Nothing is touched.
+        attributes, no data variables or a dimension of size 0) or the arguments
+        are invalid.  Nothing is touched.
+    CubeLockedError
+        Another writer holds ``<path>.lock``.  Nothing is touched.
+    SchedulerError
+        ``scheduler`` cannot be reached.
     CubeWriteError
-        A ``.part`` that does not belong to this cube or cannot be read
-        (``resume=True``; it is left untouched), or a block computation or write
-        that failed: the blocks written so far stay in the ``.part`` and
-        ``resume=True`` continues from them.  The original exception is chained.
+        Something other than a regular file at ``path`` (a FIFO, symlink, device,
+        directory); a ``.part`` that belongs to another cube (its fingerprint
+        differs: the message names what changed) or cannot be read (it is left
+        untouched); a finished ``path`` of another cube with ``resume``; or a
+        block computation or write that failed.  A write that fails for lack of
+        room (disk full, file size limit) is refused before the block is written
+        when that can be foreseen, and the file is cut back to its last synced
+        state otherwise: the message names the cause, the blocks written so far
+        stay in the ``.part`` and ``resume=True`` continues from them.  The
+        original exception is chained.
 
     Notes
     -----
@@ -826,6 +1345,8 @@ def write_cube(
     for every block: persist or compute them first.
     """
     path = Path(path)
+    if path.name in ("", ".", ".."):
+        raise ValidationError(f"path: {str(path)!r} names no file; give a file name for the cube")
     part = path.with_name(path.name + PART_SUFFIX)
     log = path.with_name(path.name + LOG_SUFFIX)
     plan = _plan(ds)
@@ -835,7 +1356,37 @@ def write_cube(
         raise ValidationError(f"max_in_flight: must be an integer >= 1, got {max_in_flight!r}")
     if not 0 <= int(complevel) <= 9:
         raise ValidationError(f"complevel: must be 0 (no compression) to 9, got {complevel!r}")
-    resuming = _check_destination(path, part, log, overwrite, resume)
+    if client is not None and scheduler is not None:
+        raise ValidationError("pass either client or scheduler, not both")
+    if scheduler is not None and scheduler not in _THREAD_NAMES + _SYNC_NAMES:
+        _check_address(scheduler)
+    if _file_kind(path.parent) is None:
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise CubeWriteError(f"cannot write {path}: creating {path.parent} failed: "
+                                 f"{_reason(exc)}") from exc
+    lock = _Lock(path.with_name(path.name + LOCK_SUFFIX), path)
+    lock.acquire()
+    try:
+        return _write_locked(ds, path, part, log, plan, overwrite=overwrite, resume=resume,
+                             client=client, scheduler=scheduler, max_in_flight=max_in_flight,
+                             progress=progress, complevel=complevel, on_block=on_block)
+    finally:
+        lock.release()
+
+
+def _write_locked(
+    ds: xr.Dataset, path: Path, part: Path, log: Path, plan: _Plan, *, overwrite: bool,
+    resume: bool, client: Any, scheduler: str | None, max_in_flight: int | None, progress: bool,
+    complevel: int, on_block: Callable[[BlockWritten], None] | None,
+) -> Path:
+    """:func:`write_cube` once the lock is held."""
+    state = _check_destination(path, part, log, overwrite, resume)
+    if state == "finished":
+        _check_finished(path, ds)
+        return path
+    resuming = state == "resume"
     done: set[int] = set()
     if resuming:
         header, done = _read_log(log, part)
@@ -843,7 +1394,7 @@ def write_cube(
             why = _difference(header.get("structure", {}), plan.structure)
             raise CubeWriteError(
                 f"{part} belongs to a different cube ({why}); it was left untouched. "
-                "Resume with the same cube, or pass overwrite=True, resume=False to discard it"
+                f"Resume with the same inputs, or {_discard()}"
             )
         done = {k for k in done if 0 <= k < plan.n_blocks}
 
@@ -851,18 +1402,37 @@ def write_cube(
     nc: netCDF4.Dataset | None = None
     try:
         if resuming:
-            nc = _open_part(part, ds, plan)
+            size0 = part.stat().st_size
+            try:
+                _check_room(part, _block_bytes(plan))
+                nc = _open_part(part, ds, plan)
+            except CubeWriteError:
+                raise
+            except Exception as exc:
+                if not isinstance(exc, _NoRoom):
+                    with contextlib.suppress(OSError):
+                        os.truncate(part, size0)  # undo a half-written attribute update
+                why = _reason(exc, part)
+                raise CubeWriteError(
+                    f"cannot resume {path}: {why}. The {len(done)} of {plan.n_blocks} blocks "
+                    f"written so far are kept in {part}; {_fix(why)} and {_again()}"
+                ) from exc
         else:
             log.unlink(missing_ok=True)
             part.unlink(missing_ok=True)
-            path.parent.mkdir(parents=True, exist_ok=True)
             try:
+                _check_room(part, 0)
                 nc = _create(part, ds, plan, complevel)
                 _write_header(log, plan)
-            except BaseException:
+            except BaseException as exc:
                 if nc is not None:
-                    nc.close()
+                    with contextlib.suppress(Exception):
+                        nc.close()
                 part.unlink(missing_ok=True)  # nothing recorded yet: nothing lost
+                log.unlink(missing_ok=True)
+                if isinstance(exc, Exception) and not isinstance(exc, SbrdfError):
+                    raise CubeWriteError(f"cannot write {path}: creating {part} failed: "
+                                         f"{_reason(exc, part)}") from exc
                 raise
     except BaseException:
         runner.close()
@@ -871,10 +1441,15 @@ def write_cube(
     bar: Any = _NoProgress()
     fd = log_fd = -1
     k = -1
+    writing = False
+    good, head = -1, b""
     try:
-        fd = os.open(part, os.O_RDONLY)
+        writing = True
+        fd = os.open(part, os.O_RDWR)
         os.fsync(fd)
+        good, head = os.fstat(fd).st_size, os.pread(fd, _HEAD_BYTES, 0)
         log_fd = os.open(log, os.O_WRONLY | os.O_APPEND)
+        writing = False
         limit = int(max_in_flight or 2 * runner.n_workers)
         todo = iter([b for b in range(plan.n_blocks) if b not in done])
         kinds = {str(n): _storage_kind(n, v.dtype) for n, v in ds.variables.items()}
@@ -895,7 +1470,12 @@ def write_cube(
             arrays = runner.result(handle)
             if k in done:  # a block is written exactly once
                 continue
-            for (name, region, _), values in zip(pieces.pop(k), arrays, strict=True):
+            block = pieces.pop(k)
+            nbytes = sum(np.asarray(a).nbytes for a in arrays)
+            _check_room(part, nbytes)
+            _reserve(fd, nbytes)
+            writing = True
+            for (name, region, _), values in zip(block, arrays, strict=True):
                 expected = tuple(s.stop - s.start for s in region)
                 if np.shape(values) != expected:
                     raise CubeWriteError(
@@ -906,6 +1486,8 @@ def write_cube(
             del arrays
             nc.sync()
             os.fsync(fd)
+            good, head = os.fstat(fd).st_size, os.pread(fd, _HEAD_BYTES, 0)
+            writing = False
             os.write(log_fd, (json.dumps({"block": k}) + "\n").encode())
             os.fsync(log_fd)
             done.add(k)
@@ -913,22 +1495,46 @@ def write_cube(
             if on_block is not None:
                 on_block(BlockWritten(k, plan.slices(k), len(done), plan.n_blocks, runner.pending))
             k = -1
+        writing = True
         nc.close()
         nc = None
+        os.ftruncate(fd, os.fstat(fd).st_size)  # release room reserved past the end
         os.fsync(fd)
+        writing = False
+        for p in (path, part):
+            kind = _file_kind(p)
+            if kind not in (None, "file"):
+                raise CubeWriteError(f"{p} became {kind} during the write; it was not replaced")
         os.replace(part, path)
     except Exception as exc:
         where = f"at block {k} ({_describe(plan.slices(k))}) " if k >= 0 else ""
+        why = _reason(exc, part) if isinstance(exc, OSError) or writing else f"{type(exc).__name__}: {exc}"
+        lost = None
+        if writing and good >= 0:  # an I/O failure: cut the file back to its last synced state
+            _fence(part)
+            if nc is not None:
+                with contextlib.suppress(Exception):
+                    nc.close()
+                nc = None
+            lost = _cut_back(part, good, head)
+        head = f"writing {path} failed {where}after {len(done)} of {plan.n_blocks} blocks: {why}. "
+        if lost is not None:
+            raise CubeWriteError(f"{head}{part} could not be kept ({lost}); {_discard()}") from exc
+        if writing and good >= 0:
+            raise CubeWriteError(
+                f"{head}HDF5 failed in the middle of a block; {part} was cut back to its last "
+                f"synced state, with the blocks written so far. {_fix(why)[0].upper()}{_fix(why)[1:]} "
+                f"and {_again()}; should HDF5 fail again at the same block, the file cannot be "
+                f"continued: {_discard()}"
+            ) from exc
         raise CubeWriteError(
-            f"writing {path} failed {where}after {len(done)} of {plan.n_blocks} blocks: "
-            f"{type(exc).__name__}: {exc}. The blocks written so far are kept in {part}; "
-            "fix the cause and call write_cube again with resume=True to compute only the "
-            "missing blocks"
+            f"{head}The blocks written so far are kept in {part}; {_fix(why)} and {_again()} "
+            "to compute only the missing blocks"
         ) from exc
     except BaseException as exc:
         exc.add_note(
             f"write_cube: {len(done)} of {plan.n_blocks} blocks of {path} are kept in {part}; "
-            "call write_cube again with resume=True to finish it"
+            f"{_again()} to finish it"
         )
         raise
     finally:
@@ -937,12 +1543,87 @@ def write_cube(
         if nc is not None:
             with contextlib.suppress(Exception):
                 nc.close()
+        if fd >= 0:  # release room reserved past the end (the size is unchanged)
+            with contextlib.suppress(OSError):
+                os.ftruncate(fd, os.fstat(fd).st_size)
         for f in (fd, log_fd):
             if f >= 0:
                 os.close(f)
     log.unlink(missing_ok=True)
     _fsync_dir(path.parent)
     return path
+
+
+def _fence(part: Path) -> None:
+    """Make every read-write descriptor of ``part`` in this process read-only.
+
+    After a failed write HDF5 still holds dirty metadata of the failed block; were it
+    flushed (on close, or at exit), it would overwrite the last synced state in place
+    and point it at data that never reached the disk.  Replacing HDF5's descriptor by
+    a read-only one on the same file makes those writes fail harmlessly, so the file
+    can be cut back to its last synced size.  (Linux: descriptors found in /proc.)
+    """
+    fds = Path("/proc/self/fd")
+    if not fds.is_dir():  # pragma: no cover - not Linux
+        return
+    try:
+        ino = part.stat().st_ino
+    except OSError:
+        return
+    ro = -1
+    try:
+        for entry in list(fds.iterdir()):
+            with contextlib.suppress(OSError, ValueError):
+                n = int(entry.name)
+                st = os.fstat(n)
+                if st.st_ino != ino or not stat.S_ISREG(st.st_mode):
+                    continue
+                flags = Path(f"/proc/self/fdinfo/{n}").read_text().split("flags:")[1].split()[0]
+                if int(flags, 8) & os.O_ACCMODE == os.O_RDONLY:
+                    continue
+                if ro < 0:
+                    ro = os.open(part, os.O_RDONLY)
+                os.dup2(ro, n)
+    finally:
+        if ro >= 0:
+            os.close(ro)
+
+
+def _cut_back(part: Path, size: int, head: bytes) -> str | None:
+    """Restore ``part`` to its last synced state: its ``size`` and its first bytes ``head``.
+
+    HDF5 rewrites its superblock (at the start of the file, holding the end-of-file
+    address) in place when a write fails; the rest of the synced file is untouched
+    (blocks are appended).  Returns None if the file then opens, else why not.
+    """
+    try:
+        if part.stat().st_size > size:
+            os.truncate(part, size)
+        fd = os.open(part, os.O_WRONLY)
+        try:
+            os.pwrite(fd, head, 0)
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+    except OSError as exc:
+        return str(exc)
+    return _check_opens(part)
+
+
+def _check_opens(part: Path) -> str | None:
+    """None if ``part`` opens as netCDF in a fresh process (this one's HDF5 may still hold it)."""
+    import subprocess
+
+    code = "import sys, netCDF4; netCDF4.Dataset(sys.argv[1]).close()"
+    try:
+        r = subprocess.run([sys.executable, "-c", code, str(part)], capture_output=True, text=True,
+                           timeout=120, env={**os.environ, "HDF5_USE_FILE_LOCKING": "FALSE"})
+    except (OSError, subprocess.SubprocessError) as exc:
+        return f"it could not be checked: {exc}"
+    if r.returncode:
+        lines = r.stderr.strip().splitlines()
+        return lines[-1] if lines else f"exit status {r.returncode}"
+    return None
 
 
 def _describe(slices: Mapping[str, slice]) -> str:

@@ -16,14 +16,85 @@ Sub-commands::
 from __future__ import annotations
 
 import argparse
+import logging
+import signal
 import sys
 import textwrap
 from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
 
 from . import __version__, catalog
-from .errors import SbrdfError
+from ._writer import LOG_SUFFIX, PART_SUFFIX, command_line_messages
+from .errors import SbrdfError, ValidationError
 
 __all__ = ["main"]
+
+
+def escape(text: Any, newlines: bool = False) -> str:
+    """``text`` with control and other non-printable characters written as escapes.
+
+    Attributes of files and catalog entries are printed through this, so that a
+    terminal escape sequence in a file prints as ``\\x1b[...`` instead of acting on the
+    terminal.  Newlines and tabs are kept unless ``newlines`` is true.
+    """
+    keep = "" if newlines else "\n\t"
+    return "".join(c if c.isprintable() or c in keep else repr(c)[1:-1] for c in str(text))
+
+
+def _escaped_attrs(obj: Any) -> Any:
+    """A shallow copy of a Dataset/DataArray whose attributes (and names) print safely."""
+    import xarray as xr
+
+    def clean(attrs: dict[Any, Any]) -> dict[str, Any]:
+        return {escape(k, True): escape(v, True) if isinstance(v, str) else v for k, v in attrs.items()}
+
+    if isinstance(obj, xr.Dataset):
+        out = obj.copy()
+        out.attrs = clean(obj.attrs)
+        for name in out.variables:
+            out[name].attrs = clean(obj[name].attrs)
+        return out.rename({n: escape(n, True) for n in out.variables if escape(n, True) != n})
+    if isinstance(obj, xr.DataArray):
+        out = obj.copy()
+        out.attrs = clean(obj.attrs)
+        for c in out.coords:
+            out[c].attrs = clean(obj[c].attrs)
+        return out
+    return obj
+
+
+def _open_dataset(path: str) -> Any:
+    """Open a netCDF file, turning "not netCDF" into a :class:`ValidationError`."""
+    import xarray as xr
+
+    p = Path(path)
+    if not p.exists():
+        raise FileNotFoundError(f"{path}: no such file")
+    if not p.is_file():
+        raise ValidationError(f"{path}: not a file")
+    try:
+        return xr.open_dataset(p)
+    except (OSError, ValueError, TypeError, KeyError, RuntimeError) as exc:
+        why = "unrecognised format" if "did not find a match" in str(exc) else f"{type(exc).__name__}: {exc}"
+        raise ValidationError(f"{path}: not a readable netCDF file ({why})") from None
+
+
+def _open_cube(path: str) -> Any:
+    """A loaded simulation cube, or :class:`ValidationError` naming what is missing."""
+    with _open_dataset(path) as ds:
+        spectral = [v for v in ("spacecraft_sbrdf", "signal") if v in ds and "wavelength" in ds[v].dims]
+        curve = "brdf" in ds and "attitude" in ds.dims and "phase_angle" in ds.coords
+        if not spectral and not curve:
+            names = ", ".join(map(str, list(ds.data_vars)[:8])) or "none"
+            raise ValidationError(
+                f"{path}: not a simulation cube of 'sbrdf-xr simulate' (it needs 'spacecraft_sbrdf' "
+                f"or 'signal' over wavelength, or 'brdf' over attitude; its variables: {escape(names, True)})"
+            )
+        try:
+            return ds.load()
+        except (OSError, ValueError, RuntimeError) as exc:
+            raise ValidationError(f"{path}: cannot be read ({exc})") from None
 
 
 def _cmd_catalog_list(args: argparse.Namespace) -> int:
@@ -39,23 +110,21 @@ def _cmd_catalog_list(args: argparse.Namespace) -> int:
 
 def _cmd_catalog_show(args: argparse.Namespace) -> int:
     e = catalog.entry(args.name)
-    print(f"name:        {e.name}\nkind:        {e.kind}\nsource:      {e.source}")
-    print(f"file:        {e.file}")
-    print("description: " + textwrap.fill(e.description, 88, subsequent_indent=" " * 13))
-    print("provenance:  " + textwrap.fill(e.provenance, 88, subsequent_indent=" " * 13))
+    print(escape(f"name:        {e.name}\nkind:        {e.kind}\nsource:      {e.source}"))
+    print(escape(f"file:        {e.file}"))
+    print("description: " + textwrap.fill(escape(e.description, True), 88, subsequent_indent=" " * 13))
+    print("provenance:  " + textwrap.fill(escape(e.provenance, True), 88, subsequent_indent=" " * 13))
     for k, v in e.extra.items():
-        print(f"{k + ':':<13}{v}")
+        print(escape(f"{escape(k, True) + ':':<13}{escape(v, True)}"))
     print()
-    print(catalog.load(e.name))
+    print(escape(_escaped_attrs(catalog.load(e.name))))
     return 0
 
 
 def _cmd_info(args: argparse.Namespace) -> int:
     if args.file:
-        import xarray as xr
-
-        with xr.open_dataset(args.file) as ds:
-            print(ds)
+        with _open_dataset(args.file) as ds:
+            print(escape(_escaped_attrs(ds)))
         return 0
     import dask
     import numpy
@@ -112,20 +181,28 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     print(plan)
     if args.plan:
         return 0
+    out = Path(args.output)
+    finished = (args.resume and not args.overwrite and out.is_file()
+                and not out.with_name(out.name + PART_SUFFIX).exists())
     client = None
-    if args.scheduler:
-        from distributed import Client
+    if args.scheduler is not None:
+        from ._writer import connect
 
-        client = Client(args.scheduler)
+        client = connect(args.scheduler)
+    if hasattr(signal, "SIGXFSZ"):  # past a file size limit, fail the write (named) instead of dying
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
     try:
         cube = simulate(plan, client=client)
-        extra = {} if str(args.output).endswith(".zarr") else {"complevel": args.complevel}
-        path = write(cube, args.output, overwrite=args.overwrite, resume=args.resume,
+        extra = {} if str(out).endswith(".zarr") else {"complevel": args.complevel}
+        path = write(cube, out, overwrite=args.overwrite, resume=args.resume,
                      client=client, progress=not args.quiet, **extra)
     finally:
         if client is not None:
             client.close()
-    print(f"wrote {path}")
+    if finished:
+        print(f"{path} is already complete; nothing to resume")
+    else:
+        print(f"wrote {path}")
     if args.plot:
         _save_figure(path, args.plot)
     return 0
@@ -163,13 +240,18 @@ def _save_figure(cube_path: str, figure_path: str) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
-    import xarray as xr
 
     from .plot import plot_cube
 
-    with xr.open_dataset(cube_path) as cube:
-        fig = plot_cube(cube.load())
-    fig.savefig(figure_path, dpi=120)
+    cube = _open_cube(cube_path)
+    try:
+        fig = plot_cube(cube)
+    except (KeyError, ValueError, IndexError) as exc:
+        raise ValidationError(f"{cube_path}: cannot be drawn ({type(exc).__name__}: {exc})") from None
+    try:
+        fig.savefig(figure_path, dpi=120)
+    except ValueError as exc:  # an unknown image format
+        raise ValidationError(f"{figure_path}: {exc}") from None
     print(f"wrote {figure_path}")
 
 
@@ -201,14 +283,19 @@ def _parse_colours(text: str | None) -> list[tuple[str, str]] | None:
 
 
 def _cmd_photometry(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     import numpy as np
     import xarray as xr
     from tqdm.dask import TqdmCallback
 
     from . import photometry as phot
 
+    for out in (args.output, args.csv):
+        if out and Path(out).exists() and not args.overwrite:
+            raise FileExistsError(f"{out} exists; pass --overwrite to replace it")
+    with _open_dataset(args.cube) as probe:
+        if not any(v in probe and "wavelength" in probe[v].dims for v in ("signal", "spacecraft_sbrdf")):
+            raise ValidationError(f"{args.cube}: not a spectral simulation cube of 'sbrdf-xr simulate' "
+                                  "(it needs 'signal' or 'spacecraft_sbrdf' over wavelength)")
     colours = _parse_colours(args.colours)
     with xr.open_dataset(args.cube, chunks={}) as cube:
         range_km = args.range_km if args.range_km is not None else _cube_range_km(cube)
@@ -239,8 +326,6 @@ def _cmd_photometry(args: argparse.Namespace) -> int:
         phot.to_netcdf(ds, args.output, overwrite=args.overwrite)
         print(f"wrote {args.output}")
     if args.csv:
-        if Path(args.csv).exists() and not args.overwrite:
-            raise FileExistsError(f"{args.csv} exists; pass --overwrite to replace it")
         lead = set(ds.magnitude.dims) - {"band"}
         parts = [ds.magnitude.to_dataset(dim="band").rename({str(b): f"mag_{b}" for b in ds.band.values})]
         if "colour_index" in ds:
@@ -295,9 +380,11 @@ def build_parser() -> argparse.ArgumentParser:
     psim.add_argument("--complevel", type=int, default=4, choices=range(10), metavar="0-9",
                       help="zlib compression level of the netCDF cube (default 4; 0: none, fastest)")
     psim.add_argument("--plot", help="also write the cube's figure to this PNG file")
-    g = psim.add_mutually_exclusive_group()
-    g.add_argument("--overwrite", action="store_true", help="replace an existing output file")
-    g.add_argument("--resume", action="store_true", help="resume an interrupted run from its .part file")
+    psim.add_argument("--overwrite", action="store_true",
+                      help="replace an existing output file (a regular file only)")
+    psim.add_argument("--resume", action="store_true",
+                      help="resume an interrupted run from its .part file (with --overwrite: and "
+                      "replace the existing output); a finished output of the same scene is left as is")
     psim.add_argument("--plan", action="store_true", help="print the plan and stop")
     psim.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     psim.set_defaults(func=_cmd_simulate)
@@ -330,14 +417,50 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+class _OneLine(logging.Formatter):
+    def format(self, record: logging.LogRecord) -> str:
+        return "sbrdf-xr: " + escape(record.getMessage(), True)
+
+
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split("\n")).strip() or type(exc).__name__
+    if isinstance(exc, OSError) and exc.filename and str(exc.filename) not in text:
+        text = f"{exc.filename}: {text}"
+    return escape(text, True)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``sbrdf-xr``; returns the exit status."""
+    """Entry point of ``sbrdf-xr``; returns the exit status.
+
+    Usage errors end in argparse's usage message (exit status 2); every error of the
+    package (:class:`~sbrdf_xr.errors.SbrdfError`) and of the operating system
+    (:class:`OSError`: missing files, permissions, a full disk) in one line
+    ``sbrdf-xr: error: ...`` on stderr and exit status 2; an interrupt in exit status
+    130.  Messages name command-line options (``--overwrite``, ``--resume``).
+    """
     args = build_parser().parse_args(argv)
+    logger = logging.getLogger("sbrdf_xr")
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(_OneLine())
+    logger.addHandler(handler)
+    level = logger.level
+    logger.setLevel(logging.WARNING)
     try:
-        return int(args.func(args))
-    except (SbrdfError, FileExistsError, FileNotFoundError) as exc:
-        print(f"sbrdf-xr: error: {exc}", file=sys.stderr)
+        with command_line_messages():
+            return int(args.func(args))
+    except (SbrdfError, OSError) as exc:
+        print(f"sbrdf-xr: error: {_one_line(exc)}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        out = getattr(args, "output", None)
+        hint = ""
+        if out and Path(str(out) + LOG_SUFFIX).exists():
+            hint = f"; the blocks written so far are kept in {out}{PART_SUFFIX}: run again with --resume"
+        print(f"sbrdf-xr: interrupted{hint}", file=sys.stderr)
+        return 130
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(level)
 
 
 if __name__ == "__main__":  # pragma: no cover

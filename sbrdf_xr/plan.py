@@ -35,6 +35,7 @@ from ._lut import table_edges
 from ._names import BAND, MATERIAL, WAVELENGTH
 from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS, BlockInputs
 from .errors import SceneError, ValidationError
+from .fingerprint import scene_fingerprint
 
 #: The scene being compiled (:class:`sbrdf_xr.scene.Scene`, which imports this module).
 Scene = Any
@@ -611,6 +612,7 @@ def compile_plan(scene: Scene) -> Plan:
         **{f"material_provenance_{m.replace('-', '_')}": p for m, p in provenance.items()},
         "note_sbrdf_zero_area": "spacecraft_sbrdf is 0 where area is 0 (no lit and visible facet; 0/0 of Eq. 4)",
         **geo.attrs,
+        **scene_fingerprint(scene),  # checked when an interrupted write is resumed
     }
     plan = Plan(
         name=scene.name, description=scene.description, spacecraft=scene.spacecraft, geometry=geo,

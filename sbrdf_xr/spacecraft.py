@@ -822,7 +822,10 @@ class Spacecraft:
             [np.bincount(term, weights=area * normals[:, k], minlength=n_terms) for k in range(3)],
             axis=1,
         )
-        t_normal /= np.linalg.norm(t_normal, axis=1, keepdims=True)
+        norm = np.linalg.norm(t_normal, axis=1, keepdims=True)
+        # A term of zero-area facets only (no normal) keeps a zero normal: it faces
+        # nothing and contributes nothing, without 0/0.
+        t_normal = np.divide(t_normal, norm, out=np.zeros_like(t_normal), where=norm > 0)
         n_facets = np.bincount(term, minlength=n_terms)
         t_material = mat_names[mat_code.reshape(-1)[np.asarray(first)[order]]]
         return xr.Dataset(
