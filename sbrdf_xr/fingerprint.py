@@ -88,6 +88,8 @@ def _json(value: Any) -> str:
 def _array_sha(a: Any) -> str:
     arr = np.ascontiguousarray(np.asarray(a))
     h = hashlib.sha256(f"{arr.dtype.str}{arr.shape}".encode())
+    if arr.dtype.kind in "mM":  # datetimes and durations: their integer counts
+        arr = arr.view(np.int64)
     if arr.dtype.kind in "OUS":
         h.update(json.dumps([str(x) for x in arr.ravel().tolist()]).encode())
     else:

@@ -54,7 +54,7 @@ def test_bench_quick_runs_and_reports_ratios(capsys, tmp_path):
     assert main(["bench", "--quick", "--csv", str(csv), "-o", str(nc), "--plot", str(png)]) == 0
     out = capsys.readouterr().out
     assert "sbrdf_xr linear look-up kernel" in out and "xarray .interp (linear)" in out
-    assert "lookup method: linear" in out and "band pre-integration" in out and "shadowing: density" in out
+    assert "lookup method: linear" in out and "band pre-integration" in out and "shadowing: sampled density" in out
     ds = xr.open_dataset(nc)
     # The reference row is its own baseline; float32 changes magnitudes by far less than 1 mmag.
     ref = [c for c in ds.case.values if c.startswith("reference")]
