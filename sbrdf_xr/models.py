@@ -28,13 +28,13 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from . import brdf as _brdf
-from ._names import WAVELENGTH, attrs
+from ._names import DELTA_THETA, PHI, THETA_I, WAVELENGTH, attrs
 from .catalog import CatalogEntry, register_loader
 from .errors import ValidationError
 from .material import new_material, write_netcdf_atomic
 
-__all__ = ["PARAM_ATTRS", "fit_robertson_sandford", "measure", "model_material", "open_model", "render", "spectra",
-           "spectrum_function", "to_netcdf"]
+__all__ = ["PARAM_ATTRS", "fit_robertson_sandford", "measure", "model_material", "open_model", "render",
+           "render_values", "spectra", "spectrum_function", "to_netcdf"]
 
 PARAM_ATTRS: dict[str, dict[str, str]] = {
     "rho": {"units": "1", "long_name": "Lambertian albedo"},
@@ -171,13 +171,68 @@ def render(
     ti = np.arange(0.0, 91.0) if theta_i is None else np.asarray(theta_i, dtype=np.float64)
     dt = np.arange(-180.0, 91.0, 3.0) if delta_theta is None else np.asarray(delta_theta, dtype=np.float64)
     ph = np.arange(0.0, 91.0, 3.0) if phi is None else np.asarray(phi, dtype=np.float64)
-    vals = mod.render_grid(ti, dt, ph, wl, **kw)
+    for name, g in ((THETA_I, ti), (DELTA_THETA, dt), (PHI, ph)):
+        if g.ndim != 1 or g.size == 0:
+            raise ValidationError(f"{name}: expected a non-empty 1-D grid [degree], got shape {g.shape}")
+    vals = render_values(mod, ti, dt, ph, wl, kw)
+    # Where the grid stops inside the hemisphere the model goes on: hold the edge
+    # (exact for a Lambertian surface) rather than drop to zero.
+    edges = {"edge_delta_theta_min": "zero" if dt[0] <= -180.0 else "hold",
+             "edge_delta_theta_max": "zero" if dt[-1] >= 90.0 else "hold",
+             "edge_phi_max": "zero" if ph[-1] >= 90.0 else "hold"}
+    blend = min(float(ti[1] - ti[0]), 1.0) if ti.size > 1 and ti[0] == 0.0 else 0.0
     return new_material(
         vals.astype(dtype), ti, dt, ph, wl,
         material=spec.attrs["material"], source=spec.attrs["source"],
         provenance=f"{spec.attrs.get('provenance', '')}; rendered by sbrdf_xr.models.render",
-        model=spec.attrs["model"],
+        model=spec.attrs["model"], normal_incidence="symmetric", normal_incidence_blend=blend,
+        **edges,
     )
+
+
+#: Nodes are evaluated at least this far inside the lit and visible hemisphere [degree].
+HORIZON_MARGIN_DEG = 1e-6
+#: A ``theta_i = 90`` row is evaluated this far from grazing incidence [degree]: the
+#: specular peak of a microfacet model diverges as both directions graze, and a
+#: table node carries a value for the whole cell around it.
+GRAZING_MARGIN_DEG = 0.5
+
+
+def render_values(mod: Any, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, wl: np.ndarray,
+                  kw: dict[str, Any]) -> np.ndarray:
+    """A model's sBRDF on the outer product of 1-D grids, every node inside the hemisphere.
+
+    A node whose geometry is not lit and visible (``theta_i`` = 90 deg, the observer
+    at or below the horizon: ``|theta_i + delta_theta| >= 90`` or ``phi >= 90``)
+    carries the model's limit from inside the hemisphere: it is evaluated at the
+    nearest lit and visible geometry, :data:`HORIZON_MARGIN_DEG` inside the horizon
+    and :data:`GRAZING_MARGIN_DEG` from grazing incidence.  Interpolating
+    between such a node and a visible one then never blends in a zero that the
+    physics does not have (a Lambertian surface renders to ``rho / pi`` at every node).
+
+    Parameters
+    ----------
+    mod : module
+        A model of :data:`sbrdf_xr.brdf.MODELS`.
+    ti, dt, ph : ndarray, 1-D
+        Grids [degree].
+    wl : ndarray
+        Wavelengths [nm].
+    kw : dict
+        The model's parameters.
+
+    Returns
+    -------
+    ndarray, shape (n_ti, n_dt, n_phi, n_wl)
+        sBRDF [sr-1].
+    """
+    m = HORIZON_MARGIN_DEG
+    t3, d3, p3 = np.meshgrid(np.asarray(ti, float), np.asarray(dt, float), np.asarray(ph, float),
+                             indexing="ij")
+    t_c = np.minimum(t3, 90.0 - GRAZING_MARGIN_DEG)
+    r_c = np.clip(t3 + d3, -(90.0 - m), 90.0 - m)
+    p_c = np.minimum(p3, 90.0 - m)
+    return mod.brdf_angles(t_c, r_c - t_c, p_c, wl, **kw)
 
 
 def measure(spec: xr.Dataset, theta_i: Sequence[float], **kwargs: Any) -> xr.Dataset:
@@ -230,11 +285,11 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
     xarray.Dataset
         The fitted model material.
     """
-    from ._names import DELTA_THETA, MEASURED, PHI, SAMPLE, THETA_I
+    from ._names import MEASURED, SAMPLE
     from .brdf import robertson_sandford as rs
     from .material import _reference, validate_measurements
 
-    ds = validate_measurements(measurements)
+    ds = validate_measurements(measurements, duplicates="mean")
     wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
     spectra = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64)
     fit = rs.fit_robertson_sandford(ds[THETA_I].values, ds[DELTA_THETA].values, ds[PHI].values,
