@@ -309,7 +309,6 @@ def test_below_noise_model_fill_keeps_the_floor_and_the_measurements():
                                  roughness=0.1, n=1.5, k=0.0, rho_d=0.05)
     meas = models.measure(spec, (10.0, 25.0, 40.0, 55.0, 70.0))
     assert meas.reference.any()
-    paper = M.build_lut(meas, check_energy=False)
     # The theta_i = 90 row of a glossy table is not resolved by its grid (the lobe meets
     # the horizon between 5-degree nodes): build_lut says so, naming the row.
     with pytest.warns(NonPhysicalWarning, match=r"theta_i = \[90.0\] deg"):
