@@ -619,7 +619,8 @@ def build_lut(
     model carries the angular trend); above the largest, with
     ``extrapolation="model"``, it goes to one over ``blend`` degrees (the model alone
     near grazing, where a lobe meets the horizon and the measured ratio does not
-    carry over).
+    carry over), and a row whose directional-hemispherical reflectance exceeds the
+    model's is scaled down to it (grazing extrapolation bounded by the model).
 
     Parameters
     ----------
@@ -772,6 +773,8 @@ def build_lut(
             w = _blend_weights(ti_out, -np.inf, measured_ti[-1], blend)[:, None, None, None]
             r_lut = (1.0 - w) * r_lut + w
         lut = _model_rows(fit_model, ti_out, dt_grid, phi_grid, wl) * r_lut
+        if extrapolation == "model":
+            _bound_grazing_rows(lut, ti_out, dt_grid, phi_grid, wl, fit_model, measured_ti[-1])
     if extrapolation == "model" or below_noise == "model":
         extra = {"extrapolation_model": fit_model.attrs.get("model", ""),
                  "extrapolation_model_provenance": fit_model.attrs.get("provenance", "")}
@@ -832,6 +835,26 @@ BELOW_NOISE = ("zero", "model")
 ENERGY_TOL = 1e-6
 #: Largest step of the nodes that extend a table's grids to the horizon [degree].
 EXTENSION_STEP = 5.0
+
+
+def _bound_grazing_rows(
+    lut: np.ndarray, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, wl: np.ndarray,
+    model: xr.Dataset, above: float,
+) -> None:
+    """Scale every row above the measured incidence angles whose reflectance exceeds the
+    model's (in place), so that grazing extrapolation never creates energy: a glossy
+    lobe meeting the horizon between grid nodes is overestimated by interpolation."""
+    from . import models
+
+    rows = np.flatnonzero(ti > above)
+    if rows.size == 0:
+        return
+    mod, _, kw = models._params(_model_for(model, wl))
+    rho_m = mod.directional_hemispherical_reflectance(np.minimum(ti[rows], 90.0), wl, **kw)
+    rho_t = _lut.hemispherical_reflectance_kernel(lut, ti, dt, ph, ti[rows], "linear",
+                                                  zero_edges=(True, True, True))
+    scale = np.where(rho_t > rho_m, rho_m / np.maximum(rho_t, 1e-300), 1.0)
+    lut[rows] *= scale[:, None, None, :]
 
 
 def _lut_edges(edges: dict[str, str]) -> tuple[bool, bool, bool]:
