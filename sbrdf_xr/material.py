@@ -56,6 +56,7 @@ __all__ = [
     "hemispherical_reflectance",
     "lambertian",
     "lookup",
+    "lookup_anisotropic",
     "new_material",
     "open_material",
     "open_measurements",
@@ -369,6 +370,64 @@ def lookup(
     out.name = SBRDF
     out.attrs = attrs(SBRDF, material=material.attrs.get("material", ""), lookup_method=method)
     return out
+
+
+def lookup_anisotropic(
+    material: xr.DataArray,
+    theta_i: ArrayLike,
+    delta_theta: ArrayLike,
+    phi: ArrayLike,
+    psi: ArrayLike,
+    method: str = "linear",
+) -> np.ndarray:
+    """Spectra of an anisotropic table (dims ``(theta_i, delta_theta, phi, psi, wavelength)``).
+
+    The reference look-up of the layout of :func:`sbrdf_xr.models.render_anisotropic`:
+    every ``psi`` slice is looked up as an isotropic table (:func:`lookup`, with the
+    table's edges; ``method`` in the three table angles) and the slices are
+    interpolated linearly in ``psi``, which is periodic with period 180 deg (a grid
+    that ends at 180 wraps onto its start; otherwise ``psi`` is clamped to the grid).
+
+    Parameters
+    ----------
+    material : xarray.DataArray
+        Anisotropic table.
+    theta_i, delta_theta, phi, psi : array_like
+        Angles [degree], broadcast together (``psi`` from
+        :func:`sbrdf_xr.brdf.anisotropic.illumination_azimuth`).
+    method : {"nearest", "linear", "cubic"}
+        Look-up method in ``(theta_i, delta_theta, phi)``.
+
+    Returns
+    -------
+    ndarray, shape broadcast + (n_wavelength,)
+        sBRDF [sr-1].
+    """
+    from ._names import ANISO_LUT_DIMS, PSI
+
+    _lut.check_method(method)
+    if not isinstance(material, xr.DataArray) or set(material.dims) != set(ANISO_LUT_DIMS):
+        raise ValidationError(f"material: an anisotropic table has dims {ANISO_LUT_DIMS}, "
+                              f"got {getattr(material, 'dims', type(material).__name__)}")
+    material = material.transpose(*ANISO_LUT_DIMS)
+    ti, dt, ph, ps = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi, psi)))
+    grid = np.asarray(material[PSI].values, dtype=np.float64)
+    x = np.mod(ps, 180.0)
+    if grid[-1] < 180.0:
+        x = np.clip(x, grid[0], grid[-1])
+    idx, w = _lut.axis_weights(grid, x.ravel(), "linear")
+    grids = [np.asarray(material[d].values) for d in ANGLE_DIMS]
+    values = np.asarray(material.values)
+    out = np.zeros((x.size, material.sizes[WAVELENGTH]))
+    edges = _lut.table_edges(material.attrs)
+    for k in range(grid.size):
+        wk = np.where(idx == k, w, 0.0).sum(axis=1)
+        sel = np.flatnonzero(wk > 0)
+        if sel.size:
+            spec = _lut.lookup_kernel(values[:, :, :, k, :], *grids, ti.ravel()[sel], dt.ravel()[sel],
+                                      ph.ravel()[sel], method, zero_edges=edges)
+            out[sel] += wk[sel, None] * spec
+    return out.reshape(*ti.shape, -1).astype(values.dtype, copy=False)
 
 
 def _lookup_core(

@@ -28,13 +28,13 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from . import brdf as _brdf
-from ._names import DELTA_THETA, PHI, THETA_I, WAVELENGTH, attrs
+from ._names import ANISO_LUT_DIMS, DELTA_THETA, PER_SR, PHI, PSI, SBRDF, THETA_I, WAVELENGTH, attrs
 from .catalog import CatalogEntry, register_loader
 from .errors import ValidationError
 from .material import new_material, write_netcdf_atomic
 
 __all__ = ["PARAM_ATTRS", "fit_robertson_sandford", "measure", "model_material", "open_model", "render",
-           "render_values", "spectra", "spectrum_function", "to_netcdf"]
+           "render_anisotropic", "render_values", "spectra", "spectrum_function", "to_netcdf"]
 
 PARAM_ATTRS: dict[str, dict[str, str]] = {
     "rho": {"units": "1", "long_name": "Lambertian albedo"},
@@ -49,6 +49,8 @@ PARAM_ATTRS: dict[str, dict[str, str]] = {
     "layer_n": {"units": "1", "long_name": "thin-film layer refractive index (ambient side first)"},
     "layer_k": {"units": "1", "long_name": "thin-film layer extinction coefficient"},
     "layer_thickness": {"units": "nm", "long_name": "thin-film layer thickness"},
+    "alpha_x": {"units": "1", "long_name": "GGX roughness along the facet tangent"},
+    "alpha_y": {"units": "1", "long_name": "GGX roughness across the facet tangent"},
 }
 
 
@@ -115,7 +117,16 @@ def _params(spec: xr.Dataset) -> tuple[Any, np.ndarray, dict[str, Any]]:
     return mod, wl, kw
 
 
-def spectra(spec: xr.Dataset, theta_i: ArrayLike, delta_theta: ArrayLike, phi: ArrayLike) -> np.ndarray:
+def _isotropic(mod: Any, spec: xr.Dataset) -> None:
+    if getattr(mod, "ANISOTROPIC", False):
+        raise ValidationError(
+            f"model {spec.attrs['model']!r} is anisotropic: it needs the azimuth psi of the "
+            "illumination plane from the facet tangent (render_anisotropic, spectra(..., psi=...))"
+        )
+
+
+def spectra(spec: xr.Dataset, theta_i: ArrayLike, delta_theta: ArrayLike, phi: ArrayLike,
+            psi: ArrayLike | None = None) -> np.ndarray:
     """The model's spectra at paper-000 angles.
 
     Parameters
@@ -124,6 +135,9 @@ def spectra(spec: xr.Dataset, theta_i: ArrayLike, delta_theta: ArrayLike, phi: A
         A model material.
     theta_i, delta_theta, phi : array_like
         Angles [degree], broadcast together.
+    psi : array_like, optional
+        Azimuth of the illumination plane from the facet tangent [degree]: required by
+        the anisotropic models (:data:`sbrdf_xr.brdf.ANISOTROPIC_MODELS`).
 
     Returns
     -------
@@ -131,6 +145,9 @@ def spectra(spec: xr.Dataset, theta_i: ArrayLike, delta_theta: ArrayLike, phi: A
         sBRDF [sr-1].
     """
     mod, wl, kw = _params(spec)
+    if psi is not None and getattr(mod, "ANISOTROPIC", False):
+        return mod.brdf_angles(theta_i, delta_theta, phi, wl, psi=psi, **kw)
+    _isotropic(mod, spec)
     return mod.brdf_angles(theta_i, delta_theta, phi, wl, **kw)
 
 
@@ -174,6 +191,7 @@ def render(
     for name, g in ((THETA_I, ti), (DELTA_THETA, dt), (PHI, ph)):
         if g.ndim != 1 or g.size == 0:
             raise ValidationError(f"{name}: expected a non-empty 1-D grid [degree], got shape {g.shape}")
+    _isotropic(mod, spec)
     vals = render_values(mod, ti, dt, ph, wl, kw)
     # Where the grid stops inside the hemisphere the model goes on: hold the edge
     # (exact for a Lambertian surface) rather than drop to zero.
@@ -188,6 +206,65 @@ def render(
         model=spec.attrs["model"], normal_incidence="symmetric", normal_incidence_blend=blend,
         **edges,
     )
+
+
+def render_anisotropic(
+    spec: xr.Dataset,
+    theta_i: ArrayLike,
+    delta_theta: ArrayLike,
+    phi: ArrayLike,
+    psi: ArrayLike,
+    dtype: type | np.dtype = np.float64,
+) -> xr.DataArray:
+    """Render an anisotropic model material to a table with a ``psi`` axis.
+
+    Layout: a ``DataArray`` named ``sbrdf`` with dims ``(theta_i, delta_theta, phi,
+    psi, wavelength)`` (:data:`sbrdf_xr._names.ANISO_LUT_DIMS`), every ``psi`` slice an
+    isotropic table on the same grids (same attributes, edges and below-horizon
+    treatment as :func:`render`).  ``psi`` [degree] is the azimuth of the
+    illumination plane from the facet tangent, in ``[0, 180]`` (periodic:
+    ``psi = 180`` is ``psi = 0``; :func:`sbrdf_xr.brdf.anisotropic.illumination_azimuth`
+    gives it for a geometry).  Look-up: :func:`sbrdf_xr.material.lookup_anisotropic`.
+
+    Parameters
+    ----------
+    spec : xarray.Dataset
+        A model material of an anisotropic model.
+    theta_i, delta_theta, phi, psi : array_like
+        1-D grids [degree].
+    dtype : numpy dtype
+
+    Returns
+    -------
+    xarray.DataArray
+    """
+    mod, wl, kw = _params(spec)
+    if not getattr(mod, "ANISOTROPIC", False):
+        raise ValidationError(f"model {spec.attrs['model']!r} is isotropic: use render")
+    grids = [np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi, psi)]
+    for name, g in zip((THETA_I, DELTA_THETA, PHI, PSI), grids, strict=True):
+        if g.ndim != 1 or g.size == 0 or np.any(np.diff(g) <= 0):
+            raise ValidationError(f"{name}: expected a non-empty, strictly increasing 1-D grid [degree]")
+    ps = grids[3]
+    if ps[0] < 0 or ps[-1] > 180:
+        raise ValidationError(f"psi: must lie in [0, 180] degree, got [{ps[0]}, {ps[-1]}]")
+    m = HORIZON_MARGIN_DEG
+    t4, d4, p4, s4 = np.meshgrid(*grids, indexing="ij")
+    t_c = np.minimum(t4, 90.0 - GRAZING_MARGIN_DEG)
+    r_c = np.clip(t4 + d4, -(90.0 - m), 90.0 - m)
+    vals = mod.brdf_angles(t_c, r_c - t_c, np.minimum(p4, 90.0 - m), wl, psi=s4, **kw)
+    dt, ph = grids[1], grids[2]
+    a = attrs(SBRDF, material=spec.attrs["material"], source=spec.attrs["source"],
+              provenance=f"{spec.attrs.get('provenance', '')}; rendered by sbrdf_xr.models.render_anisotropic",
+              model=spec.attrs["model"],
+              edge_delta_theta_min="zero" if dt[0] <= -180.0 else "hold",
+              edge_delta_theta_max="zero" if dt[-1] >= 90.0 else "hold",
+              edge_phi_max="zero" if ph[-1] >= 90.0 else "hold")
+    coords = {n: (n, g, attrs(n)) for n, g in zip((THETA_I, DELTA_THETA, PHI, PSI), grids, strict=True)}
+    coords[WAVELENGTH] = (WAVELENGTH, wl, attrs(WAVELENGTH))
+    out = xr.DataArray(vals.astype(dtype), dims=ANISO_LUT_DIMS, coords=coords, name=SBRDF, attrs=a)
+    assert out.attrs["units"] == PER_SR
+    return out
 
 
 #: Nodes are evaluated at least this far inside the lit and visible hemisphere [degree].
