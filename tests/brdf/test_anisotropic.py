@@ -136,3 +136,26 @@ def test_registry_lists_the_anisotropic_model():
     assert get_model("anisotropic_microfacet") is A
     with pytest.raises(ValidationError, match="anisotropic_microfacet"):
         get_model("nope")
+
+
+def test_brushed_aluminium_example_glints_along_the_brushing():
+    from sbrdf_xr import catalog
+
+    spec = catalog.load("brushed-aluminium-model")
+    ti, dt, ph, ps = (np.array([30.0, 40.0, 50.0]), np.arange(-30.0, 31.0, 2.0),
+                      np.arange(0.0, 31.0, 2.0), np.array([0.0, 45.0, 90.0, 135.0, 180.0]))
+    tab = models.render_anisotropic(spec, ti, dt, ph, ps)
+    # Brushing along the illumination plane (psi = 0): smooth along the plane, rough
+    # across it, so the glint is narrow in delta_theta and spread in phi; brushing
+    # across the plane (psi = 90): the opposite.
+    row = tab.sel(theta_i=40.0, wavelength=tab.wavelength[0])
+    peak = row.sel(delta_theta=0.0, phi=0.0)
+    spread_phi = row.sel(delta_theta=0.0, phi=10.0) / peak
+    spread_dt = row.sel(delta_theta=10.0, phi=0.0) / peak
+    assert float(spread_phi.sel(psi=0.0)) > 5 * float(spread_phi.sel(psi=90.0))
+    assert float(spread_dt.sel(psi=90.0)) > 5 * float(spread_dt.sel(psi=0.0))
+    np.testing.assert_allclose(tab.sel(psi=0.0), tab.sel(psi=180.0), rtol=1e-12)
+    rho = A.directional_hemispherical_reflectance([0.0, 45.0, 80.0], spec.wavelength.values,
+                                                  psi=[0.0, 45.0, 90.0],
+                                                  **{k: spec[k].values for k in A.PARAMS})
+    assert np.all((rho > 0.5) & (rho <= 1.0))
