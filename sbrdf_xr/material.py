@@ -342,6 +342,11 @@ def lookup(
     edge as a measured point (attribute ``edge_* = "hold"``, set by
     :func:`build_lut` where the apparatus stopped before the noise): then the edge
     value is held.  Whether a facet is lit and visible is the caller's business.
+    A table with ``normal_incidence = "symmetric"`` (the default of :func:`build_lut`
+    and of :func:`sbrdf_xr.models.render`) blends, below ``normal_incidence_blend``
+    degrees, towards its ``theta_i = 0`` profile at the observer's polar angle, so
+    the look-up does not depend on the Sun's azimuth as ``theta_i -> 0``
+    (:func:`sbrdf_xr._lut.lookup_matrix`).
     """
     _lut.check_method(method)
     material = validate_material(material, check_values=False)
