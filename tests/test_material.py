@@ -421,3 +421,19 @@ def test_normal_incidence_row_is_the_azimuthal_average(meas_symmetric):
     b = M.lookup(lut, 0.0, 0.0, tr).values
     np.testing.assert_allclose(a, b, rtol=1e-12)
     assert np.all(np.isfinite(row.values))
+
+
+SHIPPED = ["aluminium-6061-t6", "tjpv-cell", "white-paint-a276", "aluminium-6061-t6-paper",
+           "tjpv-cell-paper", "white-paint-a276-paper", "example-lobe", "lambertian-grey-50"]
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+@settings(max_examples=10, deadline=None)
+@given(theta_r=st.floats(0.0, 85.0), obs_az=st.floats(0.0, 2 * np.pi),
+       dtype=st.sampled_from([np.float64, np.float32]))
+def test_shipped_tables_do_not_jump_at_normal_incidence(name, theta_r, obs_az, dtype):
+    from sbrdf_xr import catalog
+
+    table = catalog.load(name)
+    spread = _sun_azimuth_spread(table, theta_r, obs_az, dtype)
+    assert spread <= (1e-3 if dtype == np.float64 else 5e-3)
