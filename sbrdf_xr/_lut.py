@@ -209,12 +209,15 @@ def lookup_matrix(
     ``f = w g(theta_r) + (1 - w) T(theta_i, delta_theta, phi)``
 
     with ``w = normal_incidence_weight(theta_i, b)``, ``T`` the interpolation above,
-    ``theta_r = observer_polar_angle(theta_i, delta_theta, phi)``, and ``g`` the
+    ``gamma = observer_polar_angle(0, delta_theta, phi)`` the angle between the
+    observer and the specular direction (``cos gamma = cos(phi) cos(delta_theta)``;
+    the observer's polar angle ``theta_r`` at normal incidence, and it keeps the
+    profile centred on specular across the blend, as a lobe is), and ``g`` the
     table's ``theta_i = 0`` row interpolated (with ``method``) along its in-plane
-    profile: the mean of the row at ``(delta_theta, phi) = (+theta_r, 0)`` and
-    ``(-theta_r, 0)``, of whichever of the two is inside the table (or beyond a held
-    edge), zero if neither is.  ``g`` does not depend on the Sun's azimuth, so the
-    look-up is continuous as the Sun crosses a facet normal.
+    profile: the mean of the row at ``(delta_theta, phi) = (+gamma, 0)`` and
+    ``(-gamma, 0)``, of whichever of the two is inside the table (or beyond a held
+    edge), zero if neither is.  At ``theta_i = 0`` ``g`` does not depend on the Sun's
+    azimuth, so the look-up is continuous as the Sun crosses a facet normal.
 
     Returns
     -------
@@ -259,7 +262,9 @@ def lookup_matrix(
     if wn is None:
         return m
     rows = np.flatnonzero(wn > 0)
-    tr = observer_polar_angle(ti[rows], dt[rows], ph[rows])
+    # The angle from the specular direction (theta_r itself at normal incidence): the
+    # profile stays centred on specular across the blend, as a lobe does.
+    tr = observer_polar_angle(0.0, dt[rows], ph[rows])
     valid = [(tr <= delta_theta_grid[-1] + EDGE_TOL_DEG) | (not z_hi),
              (-tr >= delta_theta_grid[0] - EDGE_TOL_DEG) | (not z_lo)]
     n_valid = valid[0].astype(float) + valid[1].astype(float)
