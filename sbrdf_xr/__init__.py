@@ -12,7 +12,14 @@ from __future__ import annotations
 __version__ = "0.1.0"
 
 from . import accessors, catalog, errors, geometry, material  # noqa: F401
-from .material import build_lut, hemispherical_reflectance, lookup, open_material
+from .material import (
+    build_lut,
+    constant_material,
+    hemispherical_reflectance,
+    lambertian,
+    lookup,
+    open_material,
+)
 from .scene import Scene, builtin_scene, load_scene
 from .simulate import simulate, write
 from .spacecraft import Spacecraft, canx1, load_spacecraft
@@ -25,9 +32,11 @@ __all__ = [
     "builtin_scene",
     "canx1",
     "catalog",
+    "constant_material",
     "errors",
     "geometry",
     "hemispherical_reflectance",
+    "lambertian",
     "load_scene",
     "load_spacecraft",
     "lookup",

@@ -21,8 +21,10 @@ __all__ = [
     "hemispherical_reflectance_kernel",
     "lookup_kernel",
     "lookup_matrix",
+    "normal_incidence_weight",
     "smoothing_spline_matrix",
     "table_edges",
+    "table_normal_blend",
 ]
 
 #: Look-up methods and the number of grid nodes each uses per axis.
@@ -44,6 +46,45 @@ def table_edges(attrs: dict) -> tuple[bool, bool, bool]:
     """
     return tuple(attrs.get(k, "zero") != "hold"
                  for k in ("edge_delta_theta_min", "edge_delta_theta_max", "edge_phi_max"))  # type: ignore[return-value]
+
+
+def table_normal_blend(attrs: dict) -> float:
+    """``normal_blend`` of a table from its attributes [degree] (0: none, the paper's look-up).
+
+    :func:`sbrdf_xr.material.build_lut` (``normal_incidence="symmetric"``, its
+    default) and :func:`sbrdf_xr.models.render` record it as
+    ``normal_incidence_blend``; see :func:`lookup_matrix`.
+    """
+    if attrs.get("normal_incidence", "paper") != "symmetric":
+        return 0.0
+    return float(attrs.get("normal_incidence_blend", 0.0))
+
+
+def normal_incidence_weight(theta_i: ArrayLike, blend: float) -> NDArray[np.float64]:
+    """Weight of the normal-incidence profile in a look-up: ``1 - smoothstep(theta_i / blend)``.
+
+    One at ``theta_i = 0``, zero from ``theta_i = blend`` on, with zero slope at both
+    ends (so the look-up stays smooth in ``theta_i``); ``1 - 3 x**2 + 2 x**3`` with
+    ``x = theta_i / blend``.  Zero everywhere for ``blend <= 0``.
+    """
+    ti = np.asarray(theta_i, dtype=np.float64)
+    if not blend > 0:
+        return np.zeros(ti.shape)
+    x = np.clip(ti / blend, 0.0, 1.0)
+    return 1.0 - x * x * (3.0 - 2.0 * x)
+
+
+def observer_polar_angle(theta_i: ArrayLike, delta_theta: ArrayLike, phi: ArrayLike) -> NDArray[np.float64]:
+    """Observer polar angle ``theta_r`` [degree] from paper-000 angles [degree].
+
+    ``cos theta_r = cos(phi) cos(theta_i + delta_theta)`` and
+    ``sin^2 theta_r = sin^2 phi + cos^2 phi sin^2(theta_i + delta_theta)`` (an arctan2
+    of the two: accurate at ``theta_r`` -> 0).
+    """
+    t = np.radians(np.asarray(theta_i, dtype=np.float64) + np.asarray(delta_theta, dtype=np.float64))
+    p = np.radians(np.asarray(phi, dtype=np.float64))
+    cp = np.cos(p)
+    return np.degrees(np.arctan2(np.hypot(np.sin(p), cp * np.sin(t)), np.abs(cp * np.cos(t))))
 
 
 def check_method(method: str) -> str:
@@ -121,6 +162,7 @@ def lookup_matrix(
     method: str = "linear",
     weights: ArrayLike | None = None,
     zero_edges: tuple[bool, bool, bool] = (True, True, True),
+    normal_blend: float = 0.0,
 ) -> sp.csr_matrix:
     """Sparse matrix mapping look-up-table nodes to query geometries.
 
@@ -154,6 +196,28 @@ def lookup_matrix(
         Whether the table is zero beyond its smallest ``delta_theta``, its largest
         ``delta_theta`` and its largest ``phi`` (reference points), or holds the
         edge values there (:func:`table_edges`).
+    normal_blend : float, default 0
+        Width [degree] of the normal-incidence blend (:func:`table_normal_blend`);
+        0 switches it off.
+
+    Normal incidence
+    ----------------
+    At ``theta_i = 0`` the illumination plane is undefined, so a physical sBRDF
+    depends on the observer through its polar angle ``theta_r`` only.  With
+    ``normal_blend = b > 0`` (and ``theta_grid[0] == 0``) a query is
+
+    ``f = w g(theta_r) + (1 - w) T(theta_i, delta_theta, phi)``
+
+    with ``w = normal_incidence_weight(theta_i, b)``, ``T`` the interpolation above,
+    ``gamma = observer_polar_angle(0, delta_theta, phi)`` the angle between the
+    observer and the specular direction (``cos gamma = cos(phi) cos(delta_theta)``;
+    the observer's polar angle ``theta_r`` at normal incidence, and it keeps the
+    profile centred on specular across the blend, as a lobe is), and ``g`` the
+    table's ``theta_i = 0`` row interpolated (with ``method``) along its in-plane
+    profile: the mean of the row at ``(delta_theta, phi) = (+gamma, 0)`` and
+    ``(-gamma, 0)``, of whichever of the two is inside the table (or beyond a held
+    edge), zero if neither is.  At ``theta_i = 0`` ``g`` does not depend on the Sun's
+    azimuth, so the look-up is continuous as the Sun crosses a facet normal.
 
     Returns
     -------
@@ -181,13 +245,44 @@ def lookup_matrix(
     scale = np.where(outside, 0.0, 1.0)
     if weights is not None:
         scale = scale * arrays[3]
+    wn = None
+    if normal_blend > 0 and theta_grid[0] == 0.0:
+        wn = normal_incidence_weight(ti, normal_blend)
+        if not np.any(wn > 0):
+            wn = None
+    if wn is not None:
+        scale = scale * (1.0 - wn)
     k = int(np.prod(w.shape[1:]))
     w = (w * scale[:, None, None, None]).reshape(q, k)
     n_nodes = theta_grid.size * ndt * nph
-    return sp.csr_matrix(
+    m = sp.csr_matrix(
         (w.ravel(), idx.reshape(q, k).ravel(), np.arange(0, q * k + 1, k)),
         shape=(q, n_nodes),
     )
+    if wn is None:
+        return m
+    rows = np.flatnonzero(wn > 0)
+    # The angle from the specular direction (theta_r itself at normal incidence): the
+    # profile stays centred on specular across the blend, as a lobe does.
+    tr = observer_polar_angle(0.0, dt[rows], ph[rows])
+    valid = [(tr <= delta_theta_grid[-1] + EDGE_TOL_DEG) | (not z_hi),
+             (-tr >= delta_theta_grid[0] - EDGE_TOL_DEG) | (not z_lo)]
+    n_valid = valid[0].astype(float) + valid[1].astype(float)
+    base = wn[rows] * np.divide(1.0, n_valid, out=np.zeros_like(n_valid), where=n_valid > 0)
+    if weights is not None:
+        base = base * arrays[3][rows]
+    iph0, wph0 = axis_weights(phi_grid, np.zeros(1), method)
+    data, cols, rr = [], [], []
+    for sign, ok in zip((1.0, -1.0), valid, strict=True):
+        i1, w1 = axis_weights(delta_theta_grid, sign * tr, method)
+        ww = (base * ok)[:, None, None] * w1[:, :, None] * wph0[0][None, None, :]
+        cc = i1[:, :, None] * nph + iph0[0][None, None, :]
+        data.append(ww.ravel())
+        cols.append(cc.ravel())
+        rr.append(np.repeat(rows, ww.shape[1] * ww.shape[2]))
+    g = sp.csr_matrix((np.concatenate(data), (np.concatenate(rr), np.concatenate(cols))),
+                      shape=(q, n_nodes))
+    return m + g
 
 
 def lookup_kernel(
@@ -200,6 +295,7 @@ def lookup_kernel(
     phi: ArrayLike,
     method: str = "linear",
     zero_edges: tuple[bool, bool, bool] = (True, True, True),
+    normal_blend: float = 0.0,
 ) -> NDArray[np.floating]:
     """Spectra of a look-up table at arbitrary geometries (paper 000 §3.4).
 
@@ -217,6 +313,8 @@ def lookup_kernel(
         non-negative.
     zero_edges : tuple of 3 bool
         See :func:`lookup_matrix`.
+    normal_blend : float, default 0
+        See :func:`lookup_matrix` [degree].
 
     Returns
     -------
@@ -226,7 +324,7 @@ def lookup_kernel(
     """
     shape = np.broadcast_shapes(np.shape(theta_i), np.shape(delta_theta), np.shape(phi))
     m = lookup_matrix(theta_grid, delta_theta_grid, phi_grid, theta_i, delta_theta, phi, method,
-                      zero_edges=zero_edges)
+                      zero_edges=zero_edges, normal_blend=normal_blend)
     v2 = values.reshape(-1, values.shape[-1])
     if v2.dtype != np.float64:
         m = m.astype(v2.dtype)
@@ -380,6 +478,7 @@ def hemispherical_reflectance_kernel(
     theta_i: ArrayLike | None = None,
     method: str = "linear",
     zero_edges: tuple[bool, bool, bool] = (True, True, True),
+    normal_blend: float = 0.0,
 ) -> NDArray[np.float64]:
     """Directional-hemispherical reflectance of a look-up table by quadrature.
 
@@ -409,6 +508,8 @@ def hemispherical_reflectance_kernel(
     zero_edges : tuple of 3 bool
         See :func:`lookup_matrix`; a held edge extends the integral to the horizon
         (and to ``phi`` = 90 deg).
+    normal_blend : float, default 0
+        See :func:`lookup_matrix` [degree].
 
     Returns
     -------
@@ -422,11 +523,15 @@ def hemispherical_reflectance_kernel(
     phi_breaks = np.asarray(phi_grid, dtype=np.float64)
     if not z_phi and phi_breaks[-1] < 90.0:
         phi_breaks = np.append(phi_breaks, 90.0)
-    phi_nodes, phi_w = _gauss_nodes(phi_breaks)
+    phi_full = phi_breaks if phi_breaks[-1] >= 90.0 else np.append(phi_breaks, 90.0)
     out = np.empty((ti_all.size, values.shape[-1]))
     for k, ti in enumerate(ti_all):
-        lo = -90.0 if not z_lo else max(-90.0, ti + delta_theta_grid[0])
-        hi = 90.0 if not z_hi else min(90.0, ti + delta_theta_grid[-1])
+        # The normal-incidence profile reaches beyond the table's extents: integrate the
+        # whole hemisphere where it has weight.
+        whole = normal_blend > 0 and ti < normal_blend and theta_grid[0] == 0.0
+        phi_nodes, phi_w = _gauss_nodes(phi_full if whole else phi_breaks)
+        lo = -90.0 if (not z_lo or whole) else max(-90.0, ti + delta_theta_grid[0])
+        hi = 90.0 if (not z_hi or whole) else min(90.0, ti + delta_theta_grid[-1])
         if hi <= lo:
             out[k] = 0.0
             continue
@@ -436,7 +541,7 @@ def hemispherical_reflectance_kernel(
         tt, pp = np.meshgrid(t_nodes, phi_nodes, indexing="ij")
         ww = (np.outer(t_w, phi_w) * np.cos(np.radians(pp)) ** 2 * np.cos(np.radians(tt)))
         m = lookup_matrix(theta_grid, delta_theta_grid, phi_grid, ti, tt - ti, pp, method,
-                          weights=ww, zero_edges=zero_edges)
+                          weights=ww, zero_edges=zero_edges, normal_blend=normal_blend)
         spectra = np.asarray(m.sum(axis=0)) @ values.reshape(-1, values.shape[-1]).astype(np.float64)
         out[k] = 2.0 * np.radians(1.0) ** 2 * spectra.ravel()
     return out

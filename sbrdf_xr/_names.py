@@ -13,6 +13,8 @@ from typing import Any
 THETA_I = "theta_i"
 DELTA_THETA = "delta_theta"
 PHI = "phi"
+#: Azimuth of the illumination plane from a facet tangent (anisotropic materials).
+PSI = "psi"
 WAVELENGTH = "wavelength"
 ATTITUDE = "attitude"
 PHASE_ANGLE = "phase_angle"
@@ -27,6 +29,9 @@ VECTOR = "xyz"
 LUT_DIMS: tuple[str, str, str, str] = (THETA_I, DELTA_THETA, PHI, WAVELENGTH)
 #: Angular dimensions of a look-up table, in order.
 ANGLE_DIMS: tuple[str, str, str] = (THETA_I, DELTA_THETA, PHI)
+#: Dimensions of an anisotropic material table, in order (``psi`` before the spectrum,
+#: so that every ``psi`` slice is an isotropic table).
+ANISO_LUT_DIMS: tuple[str, str, str, str, str] = (THETA_I, DELTA_THETA, PHI, PSI, WAVELENGTH)
 
 #: Name of the DataArray holding a material's sBRDF.
 SBRDF = "sbrdf"
@@ -47,6 +52,7 @@ ATTRS: dict[str, dict[str, str]] = {
         "long_name": "difference-in-polar angle from the specular direction (signed)",
     },
     PHI: {"units": DEGREE, "long_name": "angle of the reflection direction from the illumination plane"},
+    PSI: {"units": DEGREE, "long_name": "azimuth of the illumination plane from the facet tangent"},
     WAVELENGTH: {
         "units": NM,
         "long_name": "vacuum wavelength",

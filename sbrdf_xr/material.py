@@ -52,8 +52,11 @@ from .errors import NonPhysicalWarning, ValidationError
 __all__ = [
     "LOOKUP_METHODS",
     "build_lut",
+    "constant_material",
     "hemispherical_reflectance",
+    "lambertian",
     "lookup",
+    "lookup_anisotropic",
     "new_material",
     "open_material",
     "open_measurements",
@@ -202,6 +205,92 @@ def new_material(
     return validate_material(da)
 
 
+#: Grids of a constant table: two nodes per axis spanning every lit-and-visible geometry.
+_CONSTANT_GRIDS = (np.array([0.0, 90.0]), np.array([-180.0, 90.0]), np.array([0.0, 90.0]))
+
+
+def constant_material(
+    value: ArrayLike,
+    wavelength: ArrayLike,
+    *,
+    material: str,
+    provenance: str = "",
+    source: str = "synthetic",
+    **parameters: Any,
+) -> xr.DataArray:
+    """A table whose sBRDF is the same spectrum at every geometry.
+
+    Two nodes per angular axis spanning the whole lit-and-visible hemisphere
+    (``theta_i`` 0-90, ``delta_theta`` -180..90, ``phi`` 0-90 deg), all equal, so every
+    look-up method (``nearest``, ``linear``, ``cubic``: weights that sum to one)
+    returns ``value`` exactly at every geometry.
+
+    Parameters
+    ----------
+    value : array_like, scalar or shape (n_wavelength,)
+        sBRDF [sr-1], >= 0.
+    wavelength : array_like
+        Strictly increasing wavelengths [nm] (a scalar gives a one-wavelength table).
+    material : str
+        Name.
+    provenance, source : str
+        Attributes (see :func:`new_material`).
+    **parameters
+        Further attributes.
+
+    Returns
+    -------
+    xarray.DataArray
+    """
+    wl = np.atleast_1d(np.asarray(wavelength, dtype=np.float64))
+    v = np.asarray(value, dtype=np.float64)
+    if v.ndim > 1 or (v.ndim == 1 and v.size not in (1, wl.size)):
+        raise ValidationError(
+            f"value: expected a scalar or one value per wavelength ({wl.size}), got shape {v.shape}"
+        )
+    spec = np.broadcast_to(v, wl.shape)
+    grids = _CONSTANT_GRIDS
+    vals = np.broadcast_to(spec, (2, 2, 2, wl.size)).copy()
+    return new_material(vals, *grids, wl, material=material, source=source,
+                        provenance=provenance or "constant sBRDF at every geometry",
+                        normal_incidence="symmetric", normal_incidence_blend=0.0, **parameters)
+
+
+def lambertian(albedo: ArrayLike, wavelength: ArrayLike, *, material: str | None = None) -> xr.DataArray:
+    """An ideal Lambertian (perfectly diffuse) material: ``f_r = albedo / pi`` everywhere.
+
+    Exact for every look-up method (:func:`constant_material`); its
+    directional-hemispherical reflectance is ``albedo`` at every incidence angle
+    (paper 001 §2: a perfectly diffuse, 100 % reflecting sample has a BRDF of
+    ``1/pi`` sr-1).
+
+    Parameters
+    ----------
+    albedo : array_like, scalar or shape (n_wavelength,)
+        Directional-hemispherical reflectance [1], ``0 <= albedo <= 1``.
+    wavelength : array_like
+        Wavelengths [nm].
+    material : str, optional
+        Name; default ``lambertian-<albedo>`` for a scalar albedo, ``lambertian``
+        otherwise.
+
+    Returns
+    -------
+    xarray.DataArray
+    """
+    from .brdf import lambert
+
+    wl = np.atleast_1d(np.asarray(wavelength, dtype=np.float64))
+    rho = lambert.check_params(wl, rho=albedo)["rho"]
+    scalar = np.ndim(albedo) == 0
+    name = material or (f"lambertian-{float(albedo):g}" if scalar else "lambertian")
+    return constant_material(
+        rho / np.pi, wl, material=name, source="model:lambert",
+        provenance=f"ideal Lambertian reflector, f_r = albedo / pi ({'albedo ' + format(float(albedo), 'g') if scalar else 'spectral albedo'})",
+        model="lambert", albedo=float(albedo) if scalar else rho,
+    )
+
+
 def _attr_value(v: Any) -> Any:
     """netCDF-storable form of an attribute value (bools and containers as JSON)."""
     if isinstance(v, bool) or v is None or isinstance(v, dict):
@@ -253,6 +342,11 @@ def lookup(
     edge as a measured point (attribute ``edge_* = "hold"``, set by
     :func:`build_lut` where the apparatus stopped before the noise): then the edge
     value is held.  Whether a facet is lit and visible is the caller's business.
+    A table with ``normal_incidence = "symmetric"`` (the default of :func:`build_lut`
+    and of :func:`sbrdf_xr.models.render`) blends, below ``normal_incidence_blend``
+    degrees, towards its ``theta_i = 0`` profile at the observer's polar angle, so
+    the look-up does not depend on the Sun's azimuth as ``theta_i -> 0``
+    (:func:`sbrdf_xr._lut.lookup_matrix`).
     """
     _lut.check_method(method)
     material = validate_material(material, check_values=False)
@@ -270,7 +364,8 @@ def lookup(
         _lookup_core,
         *angles,
         kwargs={"values": values, "theta_grid": grids[0], "delta_theta_grid": grids[1],
-                "phi_grid": grids[2], "method": method, "zero_edges": _lut.table_edges(material.attrs)},
+                "phi_grid": grids[2], "method": method, "zero_edges": _lut.table_edges(material.attrs),
+                "normal_blend": _lut.table_normal_blend(material.attrs)},
         output_core_dims=[[WAVELENGTH]],
         dask="parallelized",
         output_dtypes=[values.dtype],
@@ -280,6 +375,64 @@ def lookup(
     out.name = SBRDF
     out.attrs = attrs(SBRDF, material=material.attrs.get("material", ""), lookup_method=method)
     return out
+
+
+def lookup_anisotropic(
+    material: xr.DataArray,
+    theta_i: ArrayLike,
+    delta_theta: ArrayLike,
+    phi: ArrayLike,
+    psi: ArrayLike,
+    method: str = "linear",
+) -> np.ndarray:
+    """Spectra of an anisotropic table (dims ``(theta_i, delta_theta, phi, psi, wavelength)``).
+
+    The reference look-up of the layout of :func:`sbrdf_xr.models.render_anisotropic`:
+    every ``psi`` slice is looked up as an isotropic table (:func:`lookup`, with the
+    table's edges; ``method`` in the three table angles) and the slices are
+    interpolated linearly in ``psi``, which is periodic with period 180 deg (a grid
+    that ends at 180 wraps onto its start; otherwise ``psi`` is clamped to the grid).
+
+    Parameters
+    ----------
+    material : xarray.DataArray
+        Anisotropic table.
+    theta_i, delta_theta, phi, psi : array_like
+        Angles [degree], broadcast together (``psi`` from
+        :func:`sbrdf_xr.brdf.anisotropic.illumination_azimuth`).
+    method : {"nearest", "linear", "cubic"}
+        Look-up method in ``(theta_i, delta_theta, phi)``.
+
+    Returns
+    -------
+    ndarray, shape broadcast + (n_wavelength,)
+        sBRDF [sr-1].
+    """
+    from ._names import ANISO_LUT_DIMS, PSI
+
+    _lut.check_method(method)
+    if not isinstance(material, xr.DataArray) or set(material.dims) != set(ANISO_LUT_DIMS):
+        raise ValidationError(f"material: an anisotropic table has dims {ANISO_LUT_DIMS}, "
+                              f"got {getattr(material, 'dims', type(material).__name__)}")
+    material = material.transpose(*ANISO_LUT_DIMS)
+    ti, dt, ph, ps = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi, psi)))
+    grid = np.asarray(material[PSI].values, dtype=np.float64)
+    x = np.mod(ps, 180.0)
+    if grid[-1] < 180.0:
+        x = np.clip(x, grid[0], grid[-1])
+    idx, w = _lut.axis_weights(grid, x.ravel(), "linear")
+    grids = [np.asarray(material[d].values) for d in ANGLE_DIMS]
+    values = np.asarray(material.values)
+    out = np.zeros((x.size, material.sizes[WAVELENGTH]))
+    edges = _lut.table_edges(material.attrs)
+    for k in range(grid.size):
+        wk = np.where(idx == k, w, 0.0).sum(axis=1)
+        sel = np.flatnonzero(wk > 0)
+        if sel.size:
+            spec = _lut.lookup_kernel(values[:, :, :, k, :], *grids, ti.ravel()[sel], dt.ravel()[sel],
+                                      ph.ravel()[sel], method, zero_edges=edges)
+            out[sel] += wk[sel, None] * spec
+    return out.reshape(*ti.shape, -1).astype(values.dtype, copy=False)
 
 
 def _lookup_core(
@@ -292,7 +445,44 @@ def _lookup_core(
 # ----------------------------------------------------------- measurements
 
 
-def validate_measurements(ds: xr.Dataset) -> xr.Dataset:
+#: Policies for repeated measurement geometries (:func:`validate_measurements`).
+DUPLICATES = ("error", "mean")
+
+
+def _geometry_groups(ds: xr.Dataset) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Group samples by geometry (angles equal to 1e-9 degree): the group of every sample,
+    the first sample of every group and the group sizes."""
+    key = np.stack([np.round(np.asarray(ds[d].values, dtype=np.float64), 9)
+                    for d in (THETA_I, DELTA_THETA, PHI)], axis=1)
+    _, first, groups, counts = np.unique(key, axis=0, return_index=True, return_inverse=True,
+                                         return_counts=True)
+    return groups.ravel(), first, counts
+
+
+def _average_duplicates(ds: xr.Dataset) -> xr.Dataset:
+    """One sample per geometry: the mean spectrum of its measured (non-reference) repeats;
+    a reference point only if every repeat is one."""
+    groups, first, counts = _geometry_groups(ds)
+    if np.all(counts == 1):
+        return ds
+    ref = _reference(ds)
+    spectra = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64)
+    n_meas = np.bincount(groups, weights=(~ref).astype(float), minlength=first.size)
+    total = np.zeros((first.size, spectra.shape[1]))
+    np.add.at(total, groups[~ref], spectra[~ref])
+    mean = total / np.maximum(n_meas, 1.0)[:, None]
+    order = np.sort(first)
+    pos = np.searchsorted(order, first)  # group -> position of its first sample
+    out = ds.isel({SAMPLE: order}).copy()
+    out[MEASURED] = ((SAMPLE, WAVELENGTH), np.empty((order.size, spectra.shape[1])), ds[MEASURED].attrs)
+    out[MEASURED].values[pos] = mean
+    out["reference"] = (SAMPLE, np.zeros(order.size, dtype=bool), attrs("reference"))
+    out["reference"].values[pos] = n_meas == 0
+    out.attrs["duplicates"] = f"mean of repeated geometries ({int(np.sum(counts > 1))} averaged)"
+    return out
+
+
+def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Dataset:
     """Check a goniospectrometer measurement set.
 
     Schema: dims ``sample`` and ``wavelength``; a data variable ``measured_sbrdf``
@@ -306,6 +496,9 @@ def validate_measurements(ds: xr.Dataset) -> xr.Dataset:
     ----------
     ds : xarray.Dataset
         Candidate measurement set.
+    duplicates : {"error", "mean"}, default "error"
+        A geometry measured more than once is an error naming it (``"error"``),
+        or allowed (``"mean"``: :func:`build_lut` averages the repeats).
 
     Returns
     -------
@@ -347,6 +540,20 @@ def validate_measurements(ds: xr.Dataset) -> xr.Dataset:
         raise ValidationError("theta_i: measured incidence angles must lie in [0, 90) degree")
     if np.any(ds[PHI].values < 0):
         raise ValidationError("phi: must be >= 0 (unsigned angle from the illumination plane)")
+    if duplicates not in DUPLICATES:
+        raise ValidationError(f"duplicates: got {duplicates!r}; allowed: {', '.join(DUPLICATES)}")
+    groups, first, counts = _geometry_groups(ds)
+    if duplicates == "error" and np.any(counts > 1):
+        dup = np.flatnonzero(counts > 1)
+        k = int(first[dup[0]])
+        where = np.flatnonzero(groups == dup[0])
+        raise ValidationError(
+            f"measurements: {int(np.sum(counts[dup]))} of {ds.sizes[SAMPLE]} samples repeat "
+            f"{dup.size} geometr{'y' if dup.size == 1 else 'ies'} (first: theta_i = "
+            f"{float(ds[THETA_I].values[k])}, delta_theta = {float(ds[DELTA_THETA].values[k])}, "
+            f"phi = {float(ds[PHI].values[k])} deg in samples {where[:10].tolist()}); a geometry must be "
+            "measured once, or pass duplicates='mean' to average the repeats"
+        )
     ref = _reference(ds)
     v = np.asarray(da.transpose(SAMPLE, WAVELENGTH).values)[~ref]
     if not np.all(np.isfinite(v)):
@@ -430,8 +637,11 @@ def build_lut(
     dtype: type | np.dtype = np.float64,
     blend: float = 10.0,
     model: xr.Dataset | None = None,
-    normal_incidence: str = "paper",
+    normal_incidence: str = "symmetric",
     blend_normal: float = 5.0,
+    below_noise: str = "zero",
+    duplicates: str = "error",
+    check_energy: bool = True,
 ) -> xr.DataArray:
     """Look-up table from sparse measurements, by the construction of paper 000 §3.2.
 
@@ -457,6 +667,24 @@ def build_lut(
     Values are clipped at zero after step 3 (a smoothing spline can undershoot,
     and a BRDF cannot be negative).  Everything is vectorised: each step is one
     linear operator applied to all wavelengths at once.
+
+    ``below_noise="model"`` (beyond the paper) keeps the diffuse floor and the lobe's
+    tails that the instrument cannot see: the same three steps interpolate the
+    *ratio* of every measured spectrum to a fitted model (``model``), with every
+    edge held and the reference points left out, and the table is the model
+    rendered on the grid times that ratio.  Below-noise geometries (the reference
+    points and everything beyond each incidence angle's extents, out to the
+    horizon: the grids are extended to ``delta_theta`` -180..90 and ``phi`` 90 deg
+    in steps of at most 5 deg) then carry the model scaled by the nearest measured
+    ratio instead of zero, the ratio equals the measured one at the measured
+    geometries, and between them the lobe keeps the model's shape (a needle lobe is
+    not flattened by linear interpolation between samples a quarter of its extent
+    apart).  Below the smallest measured incidence angle the ratio is held (the
+    model carries the angular trend); above the largest, with
+    ``extrapolation="model"``, it goes to one over ``blend`` degrees (the model alone
+    near grazing, where a lobe meets the horizon and the measured ratio does not
+    carry over), and a row whose directional-hemispherical reflectance exceeds the
+    model's is scaled down to it (grazing extrapolation bounded by the model).
 
     Parameters
     ----------
@@ -485,21 +713,40 @@ def build_lut(
         ``model`` (beyond the paper) fits the Robertson-Sandford model (paper 001)
         to the measurements (:func:`sbrdf_xr.brdf.robertson_sandford.fit_robertson_sandford`)
         and lets it fill the unmeasurable range, blended into the linearly
-        extrapolated spline over ``blend`` degrees with a smoothstep weight.
+        extrapolated spline over ``blend`` degrees with a smoothstep weight.  With
+        ``below_noise="model"`` the model carries the table everywhere and this
+        only chooses how the ratio continues: held (``constant``, ``model``) or as
+        the spline says.
     blend : float, default 10
         Width of the blend zone of ``extrapolation="model"`` [degree].
     model : xarray.Dataset, optional
-        The model material that fills the unmeasurable range with
-        ``extrapolation="model"`` (:mod:`sbrdf_xr.models`); default: a
-        Robertson-Sandford fit to the measurements
-        (:func:`sbrdf_xr.models.fit_robertson_sandford`, a few seconds).
-    normal_incidence : {"paper", "symmetric"}, default "paper"
+        The model material of ``extrapolation="model"`` and ``below_noise="model"``
+        (:mod:`sbrdf_xr.models`); default: a Robertson-Sandford fit to the
+        measurements (:func:`sbrdf_xr.models.fit_robertson_sandford`, a few seconds).
+    normal_incidence : {"symmetric", "paper"}, default "symmetric"
         ``symmetric`` enforces what physics requires at ``theta_i = 0``: no
-        dependence on the undefined illumination plane (the row becomes a function
-        of the observer's polar angle only), blended into the rows below
-        ``blend_normal`` degrees.  ``paper`` leaves the row as extrapolated.
+        dependence on the undefined illumination plane.  The ``theta_i = 0`` row
+        becomes its own azimuthal average (for every node, the mean over the
+        illumination-plane azimuth of the row at the same observer polar angle
+        ``theta_r``, by 64-point Gauss-Legendre quadrature), and the table records
+        ``normal_incidence_blend = blend_normal``: look-ups below that angle blend
+        towards the row's in-plane profile at ``theta_r``
+        (:func:`sbrdf_xr._lut.lookup_matrix`), so the look-up is independent of the
+        Sun's azimuth as ``theta_i -> 0``.  ``paper`` leaves the row as extrapolated.
     blend_normal : float, default 5
         Width of that blend [degree].
+    below_noise : {"zero", "model"}, default "zero"
+        ``zero`` is the paper's: reference points and everything beyond an
+        incidence angle's extents are zero.  ``model``: see above.
+    duplicates : {"error", "mean"}, default "error"
+        A geometry measured more than once is an error (:func:`validate_measurements`)
+        or its repeats are averaged (``mean``: the mean of the measured repeats; a
+        reference point only if all repeats are).
+    check_energy : bool, default True
+        Compute the table's directional-hemispherical reflectance every 5 deg of
+        ``theta_i`` (and at the last row) and issue a
+        :class:`~sbrdf_xr.errors.NonPhysicalWarning` naming the incidence angle and
+        wavelength where it exceeds 1.
     material : str, optional
         Name; default the ``material`` attribute of ``measurements``.
     dtype : numpy dtype, default float64
@@ -515,13 +762,23 @@ def build_lut(
     ------
     ValidationError
         For an invalid measurement set, fewer than two measured incidence angles,
-        no measured extent in ``phi`` or ``delta_theta``.
+        no measured extent in ``phi`` or ``delta_theta``, repeated geometries with
+        ``duplicates="error"``.
     """
-    ds = validate_measurements(measurements)
+    ds = validate_measurements(measurements, duplicates=duplicates)
+    if duplicates == "mean":
+        ds = _average_duplicates(ds)
+    if extrapolation not in EXTRAPOLATIONS:
+        raise ValidationError(f"extrapolation: got {extrapolation!r}; allowed: {', '.join(EXTRAPOLATIONS)}")
+    if normal_incidence not in ("paper", "symmetric"):
+        raise ValidationError(f"normal_incidence: got {normal_incidence!r}; allowed: symmetric, paper")
+    if below_noise not in BELOW_NOISE:
+        raise ValidationError(f"below_noise: got {below_noise!r}; allowed: {', '.join(BELOW_NOISE)}")
     ref = _reference(ds)
     ti_s = np.asarray(ds[THETA_I].values, dtype=np.float64)
     dt_s = np.asarray(ds[DELTA_THETA].values, dtype=np.float64)
     ph_s = np.asarray(ds[PHI].values, dtype=np.float64)
+    wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
     spectra = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64).copy()
     spectra[ref] = 0.0
     measured_ti = np.unique(ti_s)
@@ -531,88 +788,74 @@ def build_lut(
         )
     phi_grid = paper_phi_grid(ph_s.max(), n_phi)
     dt_grid = paper_delta_theta_grid(dt_s.min(), dt_s.max(), n_delta_theta)
-    # Table edges: zero beyond them if the extreme samples are reference points.
-    edges = {
-        "edge_delta_theta_min": "zero" if np.all(ref[dt_s == dt_s.min()]) else "hold",
-        "edge_delta_theta_max": "zero" if np.all(ref[dt_s == dt_s.max()]) else "hold",
-        "edge_phi_max": "zero" if np.all(ref[ph_s == ph_s.max()]) else "hold",
-    }
     ti_out = np.arange(0.0, 91.0) if theta_i is None else np.asarray(theta_i, dtype=np.float64)
     _check_coord("theta_i", ti_out)
-
-    n_wl = spectra.shape[1]
-    per_theta = np.zeros((measured_ti.size, dt_grid.size, phi_grid.size, n_wl))
-    for a, t in enumerate(measured_ti):
-        in_t = np.flatnonzero(ti_s == t)
-        rows = np.unique(dt_s[in_t])
-        # Step 1: phi interpolation within every delta_theta row of this theta_i.
-        row_vals = np.zeros((rows.size, phi_grid.size, n_wl))
-        row_ref = np.zeros(rows.size, dtype=bool)
-        row_n = np.zeros(rows.size, dtype=int)
-        for r, d in enumerate(rows):
-            sel = in_t[dt_s[in_t] == d]
-            edge = sel[np.argmax(ph_s[sel])]
-            # A row measured at phi = 0 only (the in-plane delta_theta extents of the
-            # scheme) says nothing about phi > 0: it is not held out of the plane.
-            hold = sel.size > 1 and not ref[edge]
-            w = _interp_weights(ph_s[sel], phi_grid, hold_hi=hold)  # (n_phi, n_sel)
-            row_vals[r] = w @ spectra[sel]
-            row_ref[r] = bool(np.all(ref[sel]))
-            row_n[r] = sel.size
-        # A measured (apparatus-limited) in-plane extent borrows the phi profile of the
-        # nearest fully measured row, scaled to its own in-plane value.
-        full = np.flatnonzero(row_n > 1)
-        for r in np.flatnonzero((row_n == 1) & ~row_ref):
-            if full.size == 0:
-                break
-            adj = full[np.argmin(np.abs(full - r))]
-            base = row_vals[adj, 0]
-            scale = np.divide(row_vals[r, 0], base, out=np.zeros_like(base), where=base > 0)
-            row_vals[r, 1:] = row_vals[adj, 1:] * scale
-        # Step 2: delta_theta interpolation for every grid phi.
-        if rows.size == 1:
-            raise ValidationError(
-                f"delta_theta: theta_i = {t} has measurements at a single delta_theta; need >= 2"
-            )
-        w = _interp_weights(rows, dt_grid, hold_lo=not row_ref[0], hold_hi=not row_ref[-1])
-        per_theta[a] = np.einsum("dr,rpl->dpl", w, row_vals)
-
     lam = _lut.csaps_default_lambda(measured_ti) if smoothing == "csaps" else float(smoothing)
-    if extrapolation not in EXTRAPOLATIONS:
-        raise ValidationError(f"extrapolation: got {extrapolation!r}; allowed: {', '.join(EXTRAPOLATIONS)}")
-    spline_mode = "linear" if extrapolation == "model" else extrapolation
-    e = _lut.smoothing_spline_matrix(measured_ti, ti_out, lam, spline_mode)
-    lut = np.tensordot(e, per_theta, axes=(1, 0))
-    np.maximum(lut, 0.0, out=lut)
     extra: dict[str, Any] = {}
-    if extrapolation == "model":
-        if model is None:
-            from .models import fit_robertson_sandford
+    fit_model = model
+    if (extrapolation == "model" or below_noise == "model") and fit_model is None:
+        from .models import fit_robertson_sandford
 
-            model = fit_robertson_sandford(ds)
-        w = _blend_weights(ti_out, measured_ti[0], measured_ti[-1], blend)
-        rows = np.flatnonzero(w > 0)
-        if rows.size:
-            filled = _model_rows(model, ti_out[rows], dt_grid, phi_grid,
-                                 np.asarray(ds[WAVELENGTH].values, dtype=np.float64))
-            wr = w[rows][:, None, None, None]
-            lut[rows] = (1.0 - wr) * lut[rows] + wr * filled
-        extra = {"extrapolation_model": model.attrs.get("model", ""), "blend_width": blend,
-                 "extrapolation_model_provenance": model.attrs.get("provenance", "")}
-    if normal_incidence not in ("paper", "symmetric"):
-        raise ValidationError(f"normal_incidence: got {normal_incidence!r}; allowed: paper, symmetric")
-    if normal_incidence == "symmetric":
-        lut = _symmetric_normal_incidence(lut, ti_out, dt_grid, phi_grid, blend_normal)
-        extra["normal_incidence_blend"] = blend_normal
+        fit_model = fit_robertson_sandford(ds)
+
+    if below_noise == "zero":
+        # Table edges: zero beyond them if the extreme samples are reference points.
+        edges = {
+            "edge_delta_theta_min": "zero" if np.all(ref[dt_s == dt_s.min()]) else "hold",
+            "edge_delta_theta_max": "zero" if np.all(ref[dt_s == dt_s.max()]) else "hold",
+            "edge_phi_max": "zero" if np.all(ref[ph_s == ph_s.max()]) else "hold",
+        }
+        per_theta = _per_theta(measured_ti, ti_s, dt_s, ph_s, spectra, ref, dt_grid, phi_grid)
+        spline_mode = "linear" if extrapolation == "model" else extrapolation
+        e = _lut.smoothing_spline_matrix(measured_ti, ti_out, lam, spline_mode)
+        lut = np.tensordot(e, per_theta, axes=(1, 0))
+        np.maximum(lut, 0.0, out=lut)
+        if extrapolation == "model":
+            w = _blend_weights(ti_out, measured_ti[0], measured_ti[-1], blend)
+            rows = np.flatnonzero(w > 0)
+            if rows.size:
+                filled = _model_rows(fit_model, ti_out[rows], dt_grid, phi_grid, wl)
+                wr = w[rows][:, None, None, None]
+                lut[rows] = (1.0 - wr) * lut[rows] + wr * filled
+    else:
+        dt_grid = _extend(dt_grid, -180.0, 90.0)
+        phi_grid = _extend(phi_grid, phi_grid[0], 90.0)
+        # Beyond -180/90 and phi = 90 lies the far side of the horizon: nothing to hold.
+        edges = {"edge_delta_theta_min": "zero", "edge_delta_theta_max": "zero", "edge_phi_max": "zero"}
+        truth_s = _model_at(fit_model, ti_s, dt_s, ph_s, wl)
+        ok = ~ref
+        ratio = np.divide(spectra, truth_s, out=np.ones_like(spectra), where=truth_s > 0)
+        per_theta = _per_theta(measured_ti, ti_s[ok], dt_s[ok], ph_s[ok], ratio[ok],
+                               np.zeros(int(ok.sum()), dtype=bool), dt_grid, phi_grid, hold_all=True)
+        spline_mode = "constant" if extrapolation == "model" else extrapolation
+        e = _lut.smoothing_spline_matrix(measured_ti, ti_out, lam, spline_mode)
+        r_lut = np.tensordot(e, per_theta, axes=(1, 0))
+        np.maximum(r_lut, 0.0, out=r_lut)
+        if extrapolation == "model":
+            # Towards grazing incidence the measured ratio does not carry over (the
+            # lobe meets the horizon): the model alone, reached over ``blend`` degrees.
+            w = _blend_weights(ti_out, -np.inf, measured_ti[-1], blend)[:, None, None, None]
+            r_lut = (1.0 - w) * r_lut + w
+        lut = _model_rows(fit_model, ti_out, dt_grid, phi_grid, wl) * r_lut
+        if extrapolation == "model":
+            _bound_grazing_rows(lut, ti_out, dt_grid, phi_grid, wl, fit_model, measured_ti[-1])
+    if extrapolation == "model" or below_noise == "model":
+        extra = {"extrapolation_model": fit_model.attrs.get("model", ""),
+                 "extrapolation_model_provenance": fit_model.attrs.get("provenance", "")}
+        if extrapolation == "model" and below_noise == "zero":
+            extra["blend_width"] = blend
+    if normal_incidence == "symmetric" and ti_out[0] == 0.0:
+        lut[0] = _azimuthal_average(lut[0], dt_grid, phi_grid, _lut_edges(edges))
+        extra["normal_incidence_blend"] = float(blend_normal)
 
     name = material or ds.attrs.get("material", "unnamed")
     prov = ds.attrs.get("provenance", "")
-    return new_material(
+    out = new_material(
         lut.astype(dtype),
         ti_out,
         dt_grid,
         phi_grid,
-        ds[WAVELENGTH].values,
+        wl,
         material=name,
         source=ds.attrs.get("source", "measured"),
         provenance=(prov + "; " if prov else "") + "look-up table built by sbrdf_xr.build_lut "
@@ -623,15 +866,126 @@ def build_lut(
         smoothing_lambda=lam,
         extrapolation=extrapolation,
         normal_incidence=normal_incidence,
+        below_noise=below_noise,
         measured_theta_i=measured_ti,
         n_measurements=int(ds.sizes[SAMPLE]),
         **edges,
         **extra,
     )
+    if check_energy:
+        check_ti = np.unique(np.concatenate([ti_out[::5], ti_out[-1:]]))
+        rho = hemispherical_reflectance(out, check_ti, warn=False).values
+        if np.any(rho > 1.0 + ENERGY_TOL):
+            bad = np.argwhere(rho > 1.0 + ENERGY_TOL)
+            worst = np.unravel_index(np.argmax(rho), rho.shape)
+            tis = sorted({float(check_ti[b[0]]) for b in bad})
+            warnings.warn(
+                f"build_lut: the table of {name!r} does not conserve energy: its directional-"
+                f"hemispherical reflectance exceeds 1 at theta_i = {tis} deg (worst "
+                f"{rho[worst]:.3f} at theta_i = {check_ti[worst[0]]} deg, wavelength = "
+                f"{wl[worst[1]]} nm); consider below_noise='model' or extrapolation='model'",
+                NonPhysicalWarning,
+                stacklevel=2,
+            )
+    return out
 
 
 #: Extrapolation policies of :func:`build_lut` beyond the measured incidence angles.
 EXTRAPOLATIONS = ("cubic", "linear", "constant", "model")
+#: Below-noise policies of :func:`build_lut`.
+BELOW_NOISE = ("zero", "model")
+#: Reflectance above ``1 + ENERGY_TOL`` is reported by :func:`build_lut` (the
+#: quadrature of a float32 table is good to ~1e-7).
+ENERGY_TOL = 1e-6
+#: Largest step of the nodes that extend a table's grids to the horizon [degree].
+EXTENSION_STEP = 5.0
+
+
+def _bound_grazing_rows(
+    lut: np.ndarray, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, wl: np.ndarray,
+    model: xr.Dataset, above: float,
+) -> None:
+    """Scale every row above the measured incidence angles whose reflectance exceeds the
+    model's (in place), so that grazing extrapolation never creates energy: a glossy
+    lobe meeting the horizon between grid nodes is overestimated by interpolation."""
+    from . import models
+
+    rows = np.flatnonzero(ti > above)
+    if rows.size == 0:
+        return
+    mod, _, kw = models._params(_model_for(model, wl))
+    rho_m = mod.directional_hemispherical_reflectance(np.minimum(ti[rows], 90.0), wl, **kw)
+    rho_t = _lut.hemispherical_reflectance_kernel(lut, ti, dt, ph, ti[rows], "linear",
+                                                  zero_edges=(True, True, True))
+    scale = np.where(rho_t > rho_m, rho_m / np.maximum(rho_t, 1e-300), 1.0)
+    lut[rows] *= scale[:, None, None, :]
+
+
+def _lut_edges(edges: dict[str, str]) -> tuple[bool, bool, bool]:
+    return _lut.table_edges(edges)
+
+
+def _extend(grid: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """``grid`` with nodes at most :data:`EXTENSION_STEP` apart added out to ``[lo, hi]``."""
+    parts = [grid]
+    if grid[0] > lo:
+        n = int(np.ceil((grid[0] - lo) / EXTENSION_STEP))
+        parts.insert(0, np.linspace(lo, grid[0], n + 1)[:-1])
+    if grid[-1] < hi:
+        n = int(np.ceil((hi - grid[-1]) / EXTENSION_STEP))
+        parts.append(np.linspace(grid[-1], hi, n + 1)[1:])
+    return np.concatenate(parts)
+
+
+def _per_theta(
+    measured_ti: np.ndarray, ti_s: np.ndarray, dt_s: np.ndarray, ph_s: np.ndarray,
+    spectra: np.ndarray, ref: np.ndarray, dt_grid: np.ndarray, phi_grid: np.ndarray,
+    *, hold_all: bool = False,
+) -> np.ndarray:
+    """Steps 1 and 2 of the construction: every measured incidence angle on the grid.
+
+    ``hold_all`` holds every edge (for interpolating ratios, which have no zero
+    reference points).
+    """
+    n_wl = spectra.shape[1]
+    per_theta = np.zeros((measured_ti.size, dt_grid.size, phi_grid.size, n_wl))
+    for a, t in enumerate(measured_ti):
+        in_t = np.flatnonzero(ti_s == t)
+        rows = np.unique(dt_s[in_t])
+        if rows.size < (1 if hold_all else 2):
+            raise ValidationError(
+                f"delta_theta: theta_i = {t} has measurements at a single delta_theta; need >= 2"
+            )
+        # Step 1: phi interpolation within every delta_theta row of this theta_i.
+        row_vals = np.zeros((rows.size, phi_grid.size, n_wl))
+        row_ref = np.zeros(rows.size, dtype=bool)
+        row_n = np.zeros(rows.size, dtype=int)
+        for r, d in enumerate(rows):
+            sel = in_t[dt_s[in_t] == d]
+            edge = sel[np.argmax(ph_s[sel])]
+            # A row measured at phi = 0 only (the in-plane delta_theta extents of the
+            # scheme) says nothing about phi > 0: it is not held out of the plane.
+            hold = hold_all or (sel.size > 1 and not ref[edge])
+            w = _interp_weights(ph_s[sel], phi_grid, hold_lo=hold_all, hold_hi=hold)  # (n_phi, n_sel)
+            row_vals[r] = w @ spectra[sel]
+            row_ref[r] = bool(np.all(ref[sel]))
+            row_n[r] = sel.size
+        if not hold_all:
+            # A measured (apparatus-limited) in-plane extent borrows the phi profile of the
+            # nearest fully measured row, scaled to its own in-plane value.
+            full = np.flatnonzero(row_n > 1)
+            for r in np.flatnonzero((row_n == 1) & ~row_ref):
+                if full.size == 0:
+                    break
+                adj = full[np.argmin(np.abs(full - r))]
+                base = row_vals[adj, 0]
+                scale = np.divide(row_vals[r, 0], base, out=np.zeros_like(base), where=base > 0)
+                row_vals[r, 1:] = row_vals[adj, 1:] * scale
+        # Step 2: delta_theta interpolation for every grid phi.
+        w = _interp_weights(rows, dt_grid, hold_lo=hold_all or not row_ref[0],
+                            hold_hi=hold_all or not row_ref[-1])
+        per_theta[a] = np.einsum("dr,rpl->dpl", w, row_vals)
+    return per_theta
 
 
 def _blend_weights(ti: np.ndarray, lo: float, hi: float, width: float) -> np.ndarray:
@@ -642,55 +996,57 @@ def _blend_weights(ti: np.ndarray, lo: float, hi: float, width: float) -> np.nda
     return x * x * (3.0 - 2.0 * x)
 
 
+def _model_for(model: xr.Dataset, wl: np.ndarray) -> xr.Dataset:
+    if not np.array_equal(np.asarray(model[WAVELENGTH].values), wl):
+        model = model.interp({WAVELENGTH: wl})
+    return model
+
+
 def _model_rows(
     model: xr.Dataset, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, wl: np.ndarray
 ) -> np.ndarray:
-    """A model material rendered on the table grid (rows ``ti``) at wavelengths ``wl``."""
+    """A model material rendered on the table grid (rows ``ti``) at wavelengths ``wl``
+    (below-horizon nodes carry the limit from the hemisphere, :func:`sbrdf_xr.models.render`)."""
     from . import models
 
-    if not np.array_equal(np.asarray(model[WAVELENGTH].values), wl):
-        model = model.interp({WAVELENGTH: wl})
-    mod, _, kw = models._params(model)
-    return mod.render_grid(ti, dt, ph, wl, **kw)
+    mod, _, kw = models._params(_model_for(model, wl))
+    return models.render_values(mod, ti, dt, ph, wl, kw)
 
 
-def _symmetric_normal_incidence(
-    lut: np.ndarray, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, blend: float
+def _model_at(
+    model: xr.Dataset, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, wl: np.ndarray
 ) -> np.ndarray:
-    """Make the theta_i = 0 row independent of the (undefined) illumination plane.
+    """A model material's spectra at sample geometries (1-D angle arrays)."""
+    from . import models
 
-    At normal incidence the sBRDF can depend on the observer only through its polar
-    angle ``theta_r`` (``cos theta_r = cos(phi) cos(delta_theta)``).  The in-plane
-    profile ``g(theta_r)`` is the mean of the table's ``theta_i = 0`` row at
-    ``delta_theta = +theta_r`` and ``-theta_r`` (one side where the other is beyond
-    the measured extent), and the row becomes ``g(theta_r(delta_theta, phi))``.
-    Rows ``0 < theta_i < blend`` are blended linearly towards the spline's, so the
-    table stays continuous.
+    return models.spectra(_model_for(model, wl), ti, dt, ph)
+
+
+#: Gauss-Legendre nodes of the azimuthal average at normal incidence.
+_N_AZIMUTH = 64
+
+
+def _azimuthal_average(
+    row: np.ndarray, dt: np.ndarray, ph: np.ndarray, zero_edges: tuple[bool, bool, bool]
+) -> np.ndarray:
+    """The ``theta_i = 0`` row replaced by its average over the illumination-plane azimuth.
+
+    At normal incidence an observer at polar angle ``theta_r`` and azimuth ``psi``
+    from the (arbitrary) plane has ``delta_theta = atan2(sin theta_r cos psi,
+    cos theta_r)`` and ``phi = asin(sin theta_r |sin psi|)``; every node of the
+    row becomes the mean over ``psi`` in ``[0, pi]`` of the linearly interpolated
+    row along the contour of its own ``theta_r``.
     """
-    if ti[0] != 0.0:
-        return lut
-    out = lut.copy()
-    row = lut[0, :, 0, :]  # (n_dt, n_wl) in the plane
-    trg = np.radians(np.abs(dt))
-    tr = np.degrees(np.arccos(np.clip(np.cos(np.radians(ph))[None, :] * np.cos(trg)[:, None], -1, 1)))
-
-    def side(sign: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        xs = sign * x
-        inside = (xs >= dt[0]) & (xs <= dt[-1])
-        idx, w = _lut.axis_weights(dt, xs, "linear")
-        vals = w[..., 0, None] * row[idx[..., 0]] + w[..., 1, None] * row[idx[..., 1]]
-        return vals, inside
-
-    flat = tr.ravel()
-    vp, ip = side(1.0, flat)
-    vm, im = side(-1.0, flat)
-    n = ip.astype(float) + im.astype(float)
-    g = (vp * ip[:, None] + vm * im[:, None]) / np.maximum(n, 1.0)[:, None]
-    sym = g.reshape(dt.size, ph.size, -1)
-    w = np.clip(1.0 - ti / blend, 0.0, 1.0) if blend > 0 else (ti == 0).astype(float)
-    for k in np.flatnonzero(w > 0):
-        out[k] = w[k] * sym + (1.0 - w[k]) * lut[k]
-    return out
+    x, w = np.polynomial.legendre.leggauss(_N_AZIMUTH)
+    psi = 0.5 * np.pi * (x + 1.0)
+    w = w / 2.0  # mean over [0, pi]: the weights sum to 1
+    tr = np.radians(_lut.observer_polar_angle(0.0, dt[:, None], ph[None, :]))  # (n_dt, n_phi)
+    c_dt = np.degrees(np.arctan2(np.sin(tr)[..., None] * np.cos(psi), np.cos(tr)[..., None]))
+    c_ph = np.degrees(np.arcsin(np.clip(np.sin(tr)[..., None] * np.sin(psi), 0.0, 1.0)))
+    table = np.stack([row, row])
+    vals = _lut.lookup_kernel(table, np.array([0.0, 1.0]), dt, ph, 0.0, c_dt, c_ph, "linear",
+                              zero_edges=zero_edges)  # (n_dt, n_phi, n_psi, n_wl)
+    return np.einsum("dpql,q->dpl", vals, w)
 
 
 # ------------------------------------------------------------- reflectance
@@ -730,7 +1086,8 @@ def hemispherical_reflectance(
     grids = [np.asarray(material[d].values) for d in ANGLE_DIMS]
     ti = grids[0] if theta_i is None else np.atleast_1d(np.asarray(theta_i, dtype=np.float64))
     rho = _lut.hemispherical_reflectance_kernel(np.asarray(material.values), *grids, ti, method,
-                                                zero_edges=_lut.table_edges(material.attrs))
+                                                zero_edges=_lut.table_edges(material.attrs),
+                                                normal_blend=_lut.table_normal_blend(material.attrs))
     out = xr.DataArray(
         rho,
         dims=(THETA_I, WAVELENGTH),
@@ -812,7 +1169,7 @@ def to_netcdf(
     if isinstance(obj, xr.DataArray):
         obj = validate_material(obj).to_dataset()
     else:
-        validate_measurements(obj)
+        validate_measurements(obj, duplicates="mean")
     obj = obj.copy()
     obj.attrs.setdefault("Conventions", "CF-1.10")
     return write_netcdf_atomic(obj, path, overwrite=overwrite)
@@ -838,7 +1195,7 @@ def open_measurements(path: str | os.PathLike[str]) -> xr.Dataset:
         for k in ("flag_values", "flag_meanings"):  # they describe the on-disk byte, not the bool
             ref.attrs.pop(k, None)
         ds["reference"] = ref
-    return validate_measurements(ds)
+    return validate_measurements(ds, duplicates="mean")
 
 
 @register_loader("material")

@@ -28,13 +28,13 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from . import brdf as _brdf
-from ._names import WAVELENGTH, attrs
+from ._names import ANISO_LUT_DIMS, DELTA_THETA, PHI, PSI, SBRDF, THETA_I, WAVELENGTH, attrs
 from .catalog import CatalogEntry, register_loader
 from .errors import ValidationError
 from .material import new_material, write_netcdf_atomic
 
-__all__ = ["PARAM_ATTRS", "fit_robertson_sandford", "measure", "model_material", "open_model", "render", "spectra",
-           "spectrum_function", "to_netcdf"]
+__all__ = ["PARAM_ATTRS", "fit_robertson_sandford", "measure", "model_material", "open_model", "render",
+           "render_anisotropic", "render_values", "spectra", "spectrum_function", "to_netcdf"]
 
 PARAM_ATTRS: dict[str, dict[str, str]] = {
     "rho": {"units": "1", "long_name": "Lambertian albedo"},
@@ -49,6 +49,8 @@ PARAM_ATTRS: dict[str, dict[str, str]] = {
     "layer_n": {"units": "1", "long_name": "thin-film layer refractive index (ambient side first)"},
     "layer_k": {"units": "1", "long_name": "thin-film layer extinction coefficient"},
     "layer_thickness": {"units": "nm", "long_name": "thin-film layer thickness"},
+    "alpha_x": {"units": "1", "long_name": "GGX roughness along the facet tangent"},
+    "alpha_y": {"units": "1", "long_name": "GGX roughness across the facet tangent"},
 }
 
 
@@ -115,7 +117,16 @@ def _params(spec: xr.Dataset) -> tuple[Any, np.ndarray, dict[str, Any]]:
     return mod, wl, kw
 
 
-def spectra(spec: xr.Dataset, theta_i: ArrayLike, delta_theta: ArrayLike, phi: ArrayLike) -> np.ndarray:
+def _isotropic(mod: Any, spec: xr.Dataset) -> None:
+    if getattr(mod, "ANISOTROPIC", False):
+        raise ValidationError(
+            f"model {spec.attrs['model']!r} is anisotropic: it needs the azimuth psi of the "
+            "illumination plane from the facet tangent (render_anisotropic, spectra(..., psi=...))"
+        )
+
+
+def spectra(spec: xr.Dataset, theta_i: ArrayLike, delta_theta: ArrayLike, phi: ArrayLike,
+            psi: ArrayLike | None = None) -> np.ndarray:
     """The model's spectra at paper-000 angles.
 
     Parameters
@@ -124,6 +135,9 @@ def spectra(spec: xr.Dataset, theta_i: ArrayLike, delta_theta: ArrayLike, phi: A
         A model material.
     theta_i, delta_theta, phi : array_like
         Angles [degree], broadcast together.
+    psi : array_like, optional
+        Azimuth of the illumination plane from the facet tangent [degree]: required by
+        the anisotropic models (:data:`sbrdf_xr.brdf.ANISOTROPIC_MODELS`).
 
     Returns
     -------
@@ -131,6 +145,9 @@ def spectra(spec: xr.Dataset, theta_i: ArrayLike, delta_theta: ArrayLike, phi: A
         sBRDF [sr-1].
     """
     mod, wl, kw = _params(spec)
+    if psi is not None and getattr(mod, "ANISOTROPIC", False):
+        return mod.brdf_angles(theta_i, delta_theta, phi, wl, psi=psi, **kw)
+    _isotropic(mod, spec)
     return mod.brdf_angles(theta_i, delta_theta, phi, wl, **kw)
 
 
@@ -171,13 +188,127 @@ def render(
     ti = np.arange(0.0, 91.0) if theta_i is None else np.asarray(theta_i, dtype=np.float64)
     dt = np.arange(-180.0, 91.0, 3.0) if delta_theta is None else np.asarray(delta_theta, dtype=np.float64)
     ph = np.arange(0.0, 91.0, 3.0) if phi is None else np.asarray(phi, dtype=np.float64)
-    vals = mod.render_grid(ti, dt, ph, wl, **kw)
+    for name, g in ((THETA_I, ti), (DELTA_THETA, dt), (PHI, ph)):
+        if g.ndim != 1 or g.size == 0:
+            raise ValidationError(f"{name}: expected a non-empty 1-D grid [degree], got shape {g.shape}")
+    _isotropic(mod, spec)
+    vals = render_values(mod, ti, dt, ph, wl, kw)
+    # Where the grid stops inside the hemisphere the model goes on: hold the edge
+    # (exact for a Lambertian surface) rather than drop to zero.
+    edges = {"edge_delta_theta_min": "zero" if dt[0] <= -180.0 else "hold",
+             "edge_delta_theta_max": "zero" if dt[-1] >= 90.0 else "hold",
+             "edge_phi_max": "zero" if ph[-1] >= 90.0 else "hold"}
+    blend = min(float(ti[1] - ti[0]), 1.0) if ti.size > 1 and ti[0] == 0.0 else 0.0
     return new_material(
         vals.astype(dtype), ti, dt, ph, wl,
         material=spec.attrs["material"], source=spec.attrs["source"],
         provenance=f"{spec.attrs.get('provenance', '')}; rendered by sbrdf_xr.models.render",
-        model=spec.attrs["model"],
+        model=spec.attrs["model"], normal_incidence="symmetric", normal_incidence_blend=blend,
+        **edges,
     )
+
+
+def render_anisotropic(
+    spec: xr.Dataset,
+    theta_i: ArrayLike,
+    delta_theta: ArrayLike,
+    phi: ArrayLike,
+    psi: ArrayLike,
+    dtype: type | np.dtype = np.float64,
+) -> xr.DataArray:
+    """Render an anisotropic model material to a table with a ``psi`` axis.
+
+    Layout: a ``DataArray`` named ``sbrdf`` with dims ``(theta_i, delta_theta, phi,
+    psi, wavelength)`` (:data:`sbrdf_xr._names.ANISO_LUT_DIMS`), every ``psi`` slice an
+    isotropic table on the same grids (same attributes, edges and below-horizon
+    treatment as :func:`render`).  ``psi`` [degree] is the azimuth of the
+    illumination plane from the facet tangent, in ``[0, 180]`` (periodic:
+    ``psi = 180`` is ``psi = 0``; :func:`sbrdf_xr.brdf.anisotropic.illumination_azimuth`
+    gives it for a geometry).  Look-up: :func:`sbrdf_xr.material.lookup_anisotropic`.
+
+    Parameters
+    ----------
+    spec : xarray.Dataset
+        A model material of an anisotropic model.
+    theta_i, delta_theta, phi, psi : array_like
+        1-D grids [degree].
+    dtype : numpy dtype
+
+    Returns
+    -------
+    xarray.DataArray
+    """
+    mod, wl, kw = _params(spec)
+    if not getattr(mod, "ANISOTROPIC", False):
+        raise ValidationError(f"model {spec.attrs['model']!r} is isotropic: use render")
+    grids = [np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi, psi)]
+    for name, g in zip((THETA_I, DELTA_THETA, PHI, PSI), grids, strict=True):
+        if g.ndim != 1 or g.size == 0 or np.any(np.diff(g) <= 0):
+            raise ValidationError(f"{name}: expected a non-empty, strictly increasing 1-D grid [degree]")
+    ps = grids[3]
+    if ps[0] < 0 or ps[-1] > 180:
+        raise ValidationError(f"psi: must lie in [0, 180] degree, got [{ps[0]}, {ps[-1]}]")
+    m = HORIZON_MARGIN_DEG
+    t4, d4, p4, s4 = np.meshgrid(*grids, indexing="ij")
+    t_c = np.minimum(t4, 90.0 - GRAZING_MARGIN_DEG)
+    r_c = np.clip(t4 + d4, -(90.0 - m), 90.0 - m)
+    vals = mod.brdf_angles(t_c, r_c - t_c, np.minimum(p4, 90.0 - m), wl, psi=s4, **kw)
+    dt, ph = grids[1], grids[2]
+    a = attrs(SBRDF, material=spec.attrs["material"], source=spec.attrs["source"],
+              provenance=f"{spec.attrs.get('provenance', '')}; rendered by sbrdf_xr.models.render_anisotropic",
+              model=spec.attrs["model"],
+              edge_delta_theta_min="zero" if dt[0] <= -180.0 else "hold",
+              edge_delta_theta_max="zero" if dt[-1] >= 90.0 else "hold",
+              edge_phi_max="zero" if ph[-1] >= 90.0 else "hold")
+    coords = {n: (n, g, attrs(n)) for n, g in zip((THETA_I, DELTA_THETA, PHI, PSI), grids, strict=True)}
+    coords[WAVELENGTH] = (WAVELENGTH, wl, attrs(WAVELENGTH))
+    out = xr.DataArray(vals.astype(dtype), dims=ANISO_LUT_DIMS, coords=coords, name=SBRDF, attrs=a)
+    return out
+
+
+#: Nodes are evaluated at least this far inside the lit and visible hemisphere [degree].
+HORIZON_MARGIN_DEG = 1e-6
+#: A ``theta_i = 90`` row is evaluated this far from grazing incidence [degree]: the
+#: specular peak of a microfacet model diverges as both directions graze, and a
+#: table node carries a value for the whole cell around it.
+GRAZING_MARGIN_DEG = 0.5
+
+
+def render_values(mod: Any, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, wl: np.ndarray,
+                  kw: dict[str, Any]) -> np.ndarray:
+    """A model's sBRDF on the outer product of 1-D grids, every node inside the hemisphere.
+
+    A node whose geometry is not lit and visible (``theta_i`` = 90 deg, the observer
+    at or below the horizon: ``|theta_i + delta_theta| >= 90`` or ``phi >= 90``)
+    carries the model's limit from inside the hemisphere: it is evaluated at the
+    nearest lit and visible geometry, :data:`HORIZON_MARGIN_DEG` inside the horizon
+    and :data:`GRAZING_MARGIN_DEG` from grazing incidence.  Interpolating
+    between such a node and a visible one then never blends in a zero that the
+    physics does not have (a Lambertian surface renders to ``rho / pi`` at every node).
+
+    Parameters
+    ----------
+    mod : module
+        A model of :data:`sbrdf_xr.brdf.MODELS`.
+    ti, dt, ph : ndarray, 1-D
+        Grids [degree].
+    wl : ndarray
+        Wavelengths [nm].
+    kw : dict
+        The model's parameters.
+
+    Returns
+    -------
+    ndarray, shape (n_ti, n_dt, n_phi, n_wl)
+        sBRDF [sr-1].
+    """
+    m = HORIZON_MARGIN_DEG
+    t3, d3, p3 = np.meshgrid(np.asarray(ti, float), np.asarray(dt, float), np.asarray(ph, float),
+                             indexing="ij")
+    t_c = np.minimum(t3, 90.0 - GRAZING_MARGIN_DEG)
+    r_c = np.clip(t3 + d3, -(90.0 - m), 90.0 - m)
+    p_c = np.minimum(p3, 90.0 - m)
+    return mod.brdf_angles(t_c, r_c - t_c, p_c, wl, **kw)
 
 
 def measure(spec: xr.Dataset, theta_i: Sequence[float], **kwargs: Any) -> xr.Dataset:
@@ -230,11 +361,11 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
     xarray.Dataset
         The fitted model material.
     """
-    from ._names import DELTA_THETA, MEASURED, PHI, SAMPLE, THETA_I
+    from ._names import MEASURED, SAMPLE
     from .brdf import robertson_sandford as rs
     from .material import _reference, validate_measurements
 
-    ds = validate_measurements(measurements)
+    ds = validate_measurements(measurements, duplicates="mean")
     wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
     spectra = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64)
     fit = rs.fit_robertson_sandford(ds[THETA_I].values, ds[DELTA_THETA].values, ds[PHI].values,

@@ -588,8 +588,9 @@ def _clean(
 
 def load_spacecraft(
     path_or_mesh: str | Path | trimesh.Trimesh | trimesh.Scene,
-    material_map: Mapping[Any, str] | str | Path,
+    material_map: Mapping[Any, str] | str | Path | None = None,
     *,
+    material: str | None = None,
     length_unit: str = "m",
     repair: bool = False,
     name: str | None = None,
@@ -610,6 +611,9 @@ def load_spacecraft(
         ``"#rrggbb"``) or names (material, group, node or mesh names, or values of
         ``face_property``); a path reads a TOML map (:func:`read_material_map`).  Names are
         tried first, then colours.
+    material : str, optional
+        Instead of ``material_map``: the one material of every facet (a one-material
+        body; the mesh needs no colours or labels).
     length_unit : str
         Length unit of the file's coordinates (see :data:`LENGTH_UNITS`); converted to
         metres.  CAD exports are often in ``"mm"``.
@@ -641,12 +645,30 @@ def load_spacecraft(
         If ``path_or_mesh`` is a path that does not exist.
     """
     factor = length_factor(length_unit)
-    colours, name_map = _normalise_map(material_map, known_materials)
+    if (material_map is None) == (material is None):
+        raise ValidationError(
+            "load_spacecraft: give exactly one of material_map (facet label -> material) and "
+            f"material (one material for every facet); got material_map={material_map!r}, "
+            f"material={material!r}"
+        )
+    if material is not None:
+        if not isinstance(material, str) or not material.strip():
+            raise ValidationError(f"material: expected a non-empty material name, got {material!r}")
+        if known_materials is not None and material not in set(known_materials):
+            raise ValidationError(
+                f"material: {material!r} does not exist; known materials: {sorted(set(known_materials))}"
+            )
+        colours, name_map = {}, {}
+    else:
+        colours, name_map = _normalise_map(material_map, known_materials)
     labelled, default_name = _read(path_or_mesh, face_property, file_type)
     vertices, faces, rgb, names = labelled.arrays()
     if len(faces) == 0:
         raise MeshError("the mesh is empty: it has no facets")
-    material = _label_faces(labelled, rgb, names, colours, name_map)
+    if material is not None:
+        material = np.full(len(faces), material, dtype=object)
+    else:
+        material = _label_faces(labelled, rgb, names, colours, name_map)
     with np.errstate(invalid="ignore", over="ignore"):
         vertices = vertices * factor
     mesh, material = _clean(vertices, faces, material, repair)

@@ -7,6 +7,8 @@ import dask.array as dsa
 import numpy as np
 import pytest
 import xarray as xr
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import sbrdf_xr  # noqa: F401  (registers the accessors)
 from sbrdf_xr import material as M
@@ -122,6 +124,11 @@ def meas():
     return testing.make_measurements(n_wavelength=31)
 
 
+@pytest.fixture(scope="module")
+def meas_symmetric():
+    return M.build_lut(testing.make_measurements(n_wavelength=31))
+
+
 def test_paper_grids():
     np.testing.assert_allclose(M.paper_phi_grid(2.5), np.linspace(0, 2.5, 21))
     g = M.paper_delta_theta_grid(-46.0, 51.0)
@@ -144,7 +151,9 @@ def test_reference_points_make_the_edges_zero_and_measured_extents_are_held():
     # A narrow lobe on no floor: every extent is where the signal is in the noise.
     narrow = testing.make_measurements(n_wavelength=7, width=3.0, diffuse=0.0)
     assert int(narrow.reference.sum()) == 45
-    lut = M.build_lut(narrow)
+    # (the paper's normal incidence: the symmetric default averages the theta_i = 0 row
+    # over azimuth, which carries lobe values onto its phi edge)
+    lut = M.build_lut(narrow, normal_incidence="paper")
     np.testing.assert_array_equal(lut.isel(phi=-1), 0.0)
     np.testing.assert_array_equal(lut.isel(delta_theta=[0, -1]), 0.0)
     # A diffuse floor above the noise: the apparatus limits come first, the extents are
@@ -154,7 +163,7 @@ def test_reference_points_make_the_edges_zero_and_measured_extents_are_held():
     np.testing.assert_array_equal(beyond, 0.0)
     floor = testing.make_measurements(n_wavelength=7, width=3.0, diffuse=0.2)
     assert not floor.reference.any()
-    lut = M.build_lut(floor)
+    lut = M.build_lut(floor, check_energy=False)  # (a 0.2 sr-1 floor under a lobe: rho > 1)
     assert lut.attrs["edge_delta_theta_min"] == lut.attrs["edge_phi_max"] == "hold"
     # Beyond a held edge the look-up holds the edge value instead of dropping to zero.
     edge = M.lookup(lut, 70.0, float(lut.delta_theta[0]), 10.0)
@@ -192,7 +201,7 @@ def test_build_lut_error_against_truth_is_small_inside_the_measured_range(meas):
 
 def test_build_lut_options_and_dtype(meas):
     lut = M.build_lut(meas, n_phi=11, n_delta_theta=11, theta_i=np.arange(0, 91, 5.0),
-                      extrapolation="constant", dtype=np.float32)
+                      extrapolation="constant", dtype=np.float32, normal_incidence="paper")
     assert lut.dtype == np.float32 and lut.sizes["phi"] == 11 and lut.sizes["delta_theta"] == 11
     # Constant extrapolation below 10 deg: rows equal the 10-degree row of the spline.
     np.testing.assert_allclose(lut.sel(theta_i=0.0), lut.sel(theta_i=5.0), rtol=1e-6)
@@ -262,3 +271,171 @@ def test_netcdf_never_overwrites_by_accident(tmp_path):
         M.to_netcdf(lut * 2, path)
     assert path.read_bytes() == before
     assert not list(tmp_path.glob("*.part"))
+
+
+# ------------------------------------------------------- repeated geometries
+
+
+def test_repeated_geometries_are_a_named_error_or_averaged(meas):
+    # One sample repeated with a 3x spectrum: an error naming the geometry, or the mean.
+    rep = xr.concat([meas, meas.isel(sample=[5])], dim="sample")
+    rep["measured_sbrdf"].values[-1] *= 3.0
+    with pytest.raises(ValidationError, match=r"repeat 1 geometry .* samples \[5, 150\].*duplicates='mean'"):
+        M.build_lut(rep)
+    avg = M.build_lut(rep, duplicates="mean", check_energy=False)
+    fixed = meas.copy(deep=True)
+    fixed["measured_sbrdf"].values[5] *= 2.0  # mean of 1x and 3x
+    np.testing.assert_allclose(avg, M.build_lut(fixed, check_energy=False), rtol=1e-12, atol=1e-15)
+    # Every sample duplicated: the error is about the input, not NaN in the output.
+    both = xr.concat([meas, meas], dim="sample")
+    with pytest.raises(ValidationError, match="150 geometries"):
+        M.build_lut(both)
+    np.testing.assert_allclose(M.build_lut(both, duplicates="mean", check_energy=False),
+                               M.build_lut(meas, check_energy=False), rtol=1e-12, atol=1e-15)
+    with pytest.raises(ValidationError, match="duplicates: got 'sum'"):
+        M.build_lut(meas, duplicates="sum")
+
+
+# ----------------------------------------------------------- below the noise
+
+
+def test_below_noise_model_fill_keeps_the_floor_and_the_measurements():
+    # A glossy dielectric whose diffuse floor is below the noise: the paper zeroes the
+    # floor beyond the extents; below_noise="model" fills it from the model.  With the
+    # generating model as the "fit" (no noise, so every measured/model ratio is 1) the
+    # filled table is the model on the grid: the look-up error is interpolation only.
+    from sbrdf_xr import models
+
+    wl = np.linspace(450.0, 1000.0, 4)
+    spec = models.model_material("microfacet", wl, material="gloss", provenance="test",
+                                 roughness=0.1, n=1.5, k=0.0, rho_d=0.05)
+    meas = models.measure(spec, (10.0, 25.0, 40.0, 55.0, 70.0))
+    assert meas.reference.any()
+    # The theta_i = 90 row of a glossy table is not resolved by its grid (the lobe meets
+    # the horizon between 5-degree nodes): build_lut says so, naming the row.
+    with pytest.warns(NonPhysicalWarning, match=r"theta_i = \[90.0\] deg"):
+        filled = M.build_lut(meas, below_noise="model", model=spec, extrapolation="constant")
+    assert filled.attrs["below_noise"] == "model"
+    assert filled.delta_theta.values[0] == -180.0 and filled.delta_theta.values[-1] == 90.0
+    assert filled.phi.values[-1] == 90.0
+    far = (40.0, -60.0, 30.0)
+    truth = models.spectra(spec, *far)
+    # (linear interpolation of the smooth floor and tail on 5-degree nodes: < 1 %)
+    np.testing.assert_allclose(M.lookup(filled, *far), truth, rtol=0.01)
+    # At the measured geometries (not grid nodes) the filled table is the model
+    # interpolated on the grid: within the linear-interpolation error of the lobe
+    # (nodes ~1 deg apart on a lobe of alpha = 0.1: up to 16 %).
+    sel = ((meas.theta_i == 40.0) & ~meas.reference).values
+    got = M.lookup(filled, meas.theta_i.values[sel], meas.delta_theta.values[sel], meas.phi.values[sel])
+    np.testing.assert_allclose(got, meas.measured_sbrdf.values[sel], rtol=0.2)
+    # Energy: the filled table keeps the model's reflectance (interpolation: 2 %).
+    rho_m = models._params(spec)[0].directional_hemispherical_reflectance(
+        [20.0, 40.0, 60.0], wl, **models._params(spec)[2])
+    np.testing.assert_allclose(M.hemispherical_reflectance(filled, [20.0, 40.0, 60.0]), rho_m, rtol=0.02)
+    with pytest.raises(ValidationError, match="below_noise"):
+        M.build_lut(meas, below_noise="floor")
+
+
+def test_build_lut_warns_where_a_table_creates_energy():
+    # A measured floor of 0.5 sr-1 everywhere: reflectance pi * 0.5 > 1 at every angle.
+    wl = np.array([500.0, 600.0])
+    meas = testing.make_measurements(n_wavelength=2)
+    meas["measured_sbrdf"].values[:] = 0.5
+    meas["reference"].values[:] = False
+    with pytest.warns(NonPhysicalWarning, match=r"does not conserve energy.*theta_i = \[0.0"):
+        M.build_lut(meas)
+    del wl
+
+
+# ---------------------------------------------------------- simple materials
+
+
+@pytest.mark.parametrize("method", ["nearest", "linear", "cubic"])
+def test_lambertian_material_is_exact_everywhere(method):
+    wl = np.array([400.0, 550.0, 700.0])
+    rng = np.random.default_rng(3)
+    s = rng.standard_normal((4000, 3))
+    o = rng.standard_normal((4000, 3))
+    s[:, 2], o[:, 2] = np.abs(s[:, 2]), np.abs(o[:, 2])
+    from sbrdf_xr import geometry
+
+    a = geometry.facet_angles(np.array([0.0, 0.0, 1.0]), s, o)
+    for albedo in (0.3, np.array([0.1, 0.5, 0.9])):
+        lam = M.lambertian(albedo, wl)
+        got = M.lookup(lam, a.theta_i, a.delta_theta, a.phi, method=method).values
+        np.testing.assert_allclose(got, np.broadcast_to(np.asarray(albedo) / np.pi, got.shape),
+                                   rtol=1e-12)
+        rho = M.hemispherical_reflectance(lam, [0.0, 45.0, 89.0])
+        # Gauss-Legendre on the constant integrand: ~1e-13
+        np.testing.assert_allclose(rho, np.broadcast_to(albedo, rho.shape), rtol=1e-10)
+    const = M.constant_material([0.1, 0.2, 0.3], wl, material="c")
+    np.testing.assert_allclose(M.lookup(const, 89.9, -179.0, 89.9, method=method), [0.1, 0.2, 0.3],
+                               rtol=1e-12)
+    with pytest.raises(ValidationError, match="rho"):
+        M.lambertian(1.5, wl)
+    with pytest.raises(ValidationError, match="value: expected"):
+        M.constant_material([0.1, 0.2], wl, material="c")
+
+
+# ----------------------------------------------------------- normal incidence
+
+
+def _sun_azimuth_spread(table, theta_r, obs_az, dtype, ti_deg=1e-6, n_az=48):
+    from sbrdf_xr import geometry
+
+    ti = np.radians(ti_deg)
+    th = np.radians(theta_r)
+    o = np.array([np.sin(th) * np.cos(obs_az), np.sin(th) * np.sin(obs_az), np.cos(th)], dtype=dtype)
+    az = np.linspace(0.0, 2 * np.pi, n_az, endpoint=False)
+    s = np.stack([np.sin(ti) * np.cos(az), np.sin(ti) * np.sin(az), np.full(n_az, np.cos(ti))], -1)
+    a = geometry.facet_angles(np.array([0, 0, 1], dtype=dtype), s.astype(dtype), o[None, :])
+    v = M.lookup(table, a.theta_i, a.delta_theta, a.phi).values.astype(np.float64)
+    ref = v.max(axis=0)
+    ok = ref > 1e-9
+    return float(np.max((v.max(axis=0) - v.min(axis=0))[ok] / ref[ok])) if ok.any() else 0.0
+
+
+@settings(max_examples=25, deadline=None)
+@given(theta_r=st.floats(0.0, 85.0), obs_az=st.floats(0.0, 2 * np.pi),
+       dtype=st.sampled_from([np.float64, np.float32]))
+def test_normal_incidence_lookup_does_not_depend_on_the_sun_azimuth(meas_symmetric, theta_r, obs_az, dtype):
+    # theta_i = 1e-6 deg: the look-up is the theta_i = 0 row's profile at the observer's
+    # polar angle (weight 1 - 3e-13), the same for every Sun azimuth.  float32 angles
+    # carry ~1e-7 relative rounding; the bounds are the 0.1 % and 0.5 %.
+    spread = _sun_azimuth_spread(meas_symmetric, theta_r, obs_az, dtype)
+    assert spread <= (1e-3 if dtype == np.float64 else 5e-3)
+
+
+def test_normal_incidence_of_the_paper_construction_does_depend_on_the_sun_azimuth(meas):
+    lut = M.build_lut(meas, normal_incidence="paper")
+    assert max(_sun_azimuth_spread(lut, tr, 0.3, np.float64) for tr in (5.0, 15.0, 30.0)) > 0.01
+
+
+def test_normal_incidence_row_is_the_azimuthal_average(meas_symmetric):
+    lut = meas_symmetric
+    assert lut.attrs["normal_incidence"] == "symmetric" and lut.attrs["normal_incidence_blend"] == 5.0
+    row = lut.isel(theta_i=0)
+    # A function of theta_r only: equal at (dt, 0) and (0, phi) for the same theta_r
+    # where both are nodes of the symmetric part (linear interpolation of that function
+    # along the contour: ~1 % on this grid).
+    tr = float(lut.phi[4])
+    a = M.lookup(lut, 0.0, tr, 0.0).values
+    b = M.lookup(lut, 0.0, 0.0, tr).values
+    np.testing.assert_allclose(a, b, rtol=1e-12)
+    assert np.all(np.isfinite(row.values))
+
+
+SHIPPED = ["aluminium-6061-t6", "tjpv-cell", "white-paint-a276", "aluminium-6061-t6-paper",
+           "tjpv-cell-paper", "white-paint-a276-paper", "example-lobe", "lambertian-grey-50"]
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+@settings(max_examples=10, deadline=None)
+@given(theta_r=st.floats(0.0, 85.0), obs_az=st.floats(0.0, 2 * np.pi),
+       dtype=st.sampled_from([np.float64, np.float32]))
+def test_shipped_tables_do_not_jump_at_normal_incidence(name, theta_r, obs_az, dtype):
+    from sbrdf_xr import catalog
+
+    table = catalog.load(name)
+    spread = _sun_azimuth_spread(table, theta_r, obs_az, dtype)
+    assert spread <= (1e-3 if dtype == np.float64 else 5e-3)

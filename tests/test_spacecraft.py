@@ -310,6 +310,20 @@ def test_load_stl_without_colours_is_unmapped(tmp_path):
         sc.load_spacecraft(tmp_path / "plain.stl", BOX_MAP)
 
 
+def test_one_material_body_needs_no_labels(tmp_path):
+    box = trimesh.creation.box()
+    box.export(tmp_path / "plain.stl")
+    craft = sc.load_spacecraft(tmp_path / "plain.stl", material=PAINT)
+    assert craft.facet_material.tolist() == [PAINT] * 12
+    np.testing.assert_allclose(craft.mesh.area, 6.0, rtol=1e-6)
+    with pytest.raises(ValidationError, match="exactly one of material_map"):
+        sc.load_spacecraft(tmp_path / "plain.stl")
+    with pytest.raises(ValidationError, match="exactly one of material_map"):
+        sc.load_spacecraft(tmp_path / "plain.stl", BOX_MAP, material=PAINT)
+    with pytest.raises(ValidationError, match="does not exist"):
+        sc.load_spacecraft(tmp_path / "plain.stl", material="unobtainium", known_materials=[PAINT])
+
+
 def test_load_obj_material_groups(tmp_path):
     box = trimesh.creation.box()
     lines = ["mtllib box.mtl"] + [f"v {x} {y} {z}" for x, y, z in box.vertices]

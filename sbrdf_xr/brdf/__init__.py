@@ -15,6 +15,14 @@ Models
 ``"microfacet"``
     Cook–Torrance / Walter et al. 2007 GGX microfacet model with exact Fresnel terms
     (:mod:`~sbrdf_xr.brdf.microfacet`, :mod:`~sbrdf_xr.brdf.optics`).
+
+Anisotropic models (:data:`ANISOTROPIC_MODELS`) take the facet tangent as well: their
+``brdf`` has a ``tangent`` keyword, ``brdf_angles`` a ``psi`` keyword and
+``render_grid`` a ``psi`` grid (a table with an extra ``psi`` axis).
+
+``"anisotropic_microfacet"``
+    Anisotropic GGX with Smith masking (:mod:`~sbrdf_xr.brdf.anisotropic`), for brushed
+    metals; equal to ``"microfacet"`` when ``alpha_x = alpha_y``.
 """
 
 from __future__ import annotations
@@ -22,15 +30,20 @@ from __future__ import annotations
 from types import ModuleType
 
 from ..errors import ValidationError
-from . import lambert, microfacet, optics, robertson_sandford
+from . import anisotropic, lambert, microfacet, optics, robertson_sandford
 
-__all__ = ["MODELS", "get_model", "lambert", "microfacet", "optics", "robertson_sandford"]
+__all__ = ["ANISOTROPIC_MODELS", "MODELS", "anisotropic", "get_model", "lambert", "microfacet", "optics",
+           "robertson_sandford"]
 
 #: Registry of the analytic models: name -> module implementing the common interface.
 MODELS: dict[str, ModuleType] = {
     "lambert": lambert,
     "robertson_sandford": robertson_sandford,
     "microfacet": microfacet,
+}
+#: Registry of the anisotropic models (their tables have a ``psi`` axis).
+ANISOTROPIC_MODELS: dict[str, ModuleType] = {
+    "anisotropic_microfacet": anisotropic,
 }
 
 
@@ -40,7 +53,7 @@ def get_model(name: str) -> ModuleType:
     Parameters
     ----------
     name : str
-        One of the keys of :data:`MODELS`.
+        One of the keys of :data:`MODELS` or :data:`ANISOTROPIC_MODELS`.
 
     Returns
     -------
@@ -53,8 +66,11 @@ def get_model(name: str) -> ModuleType:
     ValidationError
         If ``name`` is not a registered model; the message lists the valid names.
     """
+    if isinstance(name, str) and name in ANISOTROPIC_MODELS:
+        return ANISOTROPIC_MODELS[name]
     if not isinstance(name, str) or name not in MODELS:
         raise ValidationError(
-            f"model: got {name!r}; valid model names are {sorted(MODELS)}"
+            f"model: got {name!r}; valid model names are {sorted(MODELS)} and the anisotropic "
+            f"{sorted(ANISOTROPIC_MODELS)}"
         )
     return MODELS[name]

@@ -222,10 +222,15 @@ def _e2_h_norm(cos_i: np.ndarray, e: np.ndarray) -> np.ndarray:
     """``e^2 H(theta_i)`` (Eq. 18) in its cancellation-free form."""
     a = (1.0 - e) * (1.0 + e) * cos_i
     s = np.hypot(a, 2.0 * e)
-    pos = a >= 0
-    # A >= 0: (S + A)^2 / (4 S);  A < 0: 4 e^4 / (S (S - A)^2)   (both times e^2 H)
+    # A >= 0: (S + A)^2 / (4 S);  A < 0: 4 e^4 / (S (S - A)^2)   (both times e^2 H).
+    # Both branches are written with |A|, so neither denominator can vanish where the
+    # other branch is selected (S - A -> 0 for needle lobes, e -> 0, with A > 0).  S = 0
+    # only for e = 0 at grazing incidence, where the limit of e^2 H (= e) is 0.
+    b = np.abs(a)
     e2 = e * e
-    return np.where(pos, (s + a) ** 2 / (4.0 * s), 4.0 * e2 * e2 / (s * (s - a) ** 2))
+    s_safe = np.where(s > 0, s, 1.0)
+    sb2 = (s_safe + b) ** 2
+    return np.where(s > 0, np.where(a >= 0, sb2 / (4.0 * s_safe), 4.0 * e2 * e2 / (s_safe * sb2)), 0.0)
 
 
 def normalisation_H(theta_i: ArrayLike, e: ArrayLike) -> NDArray[np.float64]:

@@ -469,3 +469,31 @@ def test_fit_rejects_too_few_samples():
         rs.fit_robertson_sandford(ti, dt, ph, WL, y, reference=ref)
     with pytest.raises(ValidationError, match="sbrdf"):
         rs.fit_robertson_sandford(ti, dt, ph, WL, y[:, :2])
+
+
+@pytest.mark.parametrize("e", [1e-12, 1e-10, 1e-9])
+def test_needle_lobe_evaluates_without_warnings(e):
+    # e <= 1e-9 once hit a 1/0 in the unselected branch of Eq. 18's cancellation-free
+    # form (S - A -> 0 for A > 0); pytest turns RuntimeWarning into errors.  Values: the
+    # peak is rho_s / (4 pi e^2 cos^2 theta_i) to O(e^2) (the needle-lobe limit above).
+    p = {"rho_D": 0.0, "epsilon": 0.5, "b": 0.0, "e": e}
+    ti = np.array([0.0, 30.0, 60.0, 89.0])
+    f = rs.brdf_angles(ti, 0.0, 0.0, WL[:1], cutoff=False, **p)[:, 0]
+    np.testing.assert_allclose(f, 0.5 / (4 * np.pi * e**2 * np.cos(np.radians(ti)) ** 2), rtol=1e-9)
+    off = rs.brdf_angles(ti, 5.0, 0.0, WL[:1], **{**p, "b": 0.1})
+    assert np.all(np.isfinite(off)) and np.all(off >= 0)
+    # Without the cut-off the hemispherical reflectance is 1 - epsilon (Eq. 11).
+    rho = rs.directional_hemispherical_reflectance(ti, WL[:1], cutoff=False, **p)
+    np.testing.assert_allclose(rho, 0.5, rtol=1e-12)
+    h = rs.normalisation_H(ti, e)
+    assert np.all(np.isfinite(h)) and np.all(h > 0)
+
+
+def test_zero_lobe_width_is_a_named_error_and_its_normalisation_limit_is_finite():
+    # e = 0 is a Dirac lobe, outside the model's domain (a named error, no warning);
+    # the normalisation's cancellation-free core e^2 H tends to cos(theta_i) as e -> 0
+    # (Eq. 18) and to 0 at grazing incidence, without dividing by zero.
+    with pytest.raises(ValidationError, match="e: got"):
+        rs.brdf_angles(30.0, 0.0, 0.0, WL, rho_D=0.1, epsilon=0.5, b=0.1, e=0.0)
+    ci = np.cos(np.radians([0.0, 30.0, 60.0, 90.0]))
+    np.testing.assert_allclose(rs._e2_h_norm(ci, np.zeros(4)), ci, atol=1e-15)
