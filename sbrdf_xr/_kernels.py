@@ -26,7 +26,7 @@ the outputs, in the table's dtype (float32 stays float32).
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numba
 import numba.typed
@@ -62,6 +62,7 @@ def material_sums(
     method: str = "linear",
     fraction: NDArray[np.floating] | None = None,
     zero_edges: tuple[bool, bool, bool] = (True, True, True),
+    normal_blend: float = 0.0,
 ) -> MaterialSums:
     """Facet sums of paper 000 Eqs. 3-4 and the radiometric signal for one material.
 
@@ -84,6 +85,8 @@ def material_sums(
         and self-occlusion); default 1.
     zero_edges : tuple of 3 bool
         The table's out-of-range policy (:func:`sbrdf_xr._lut.lookup_matrix`).
+    normal_blend : float
+        The table's normal-incidence blend [degree] (:func:`sbrdf_xr._lut.table_normal_blend`).
 
     Returns
     -------
@@ -109,7 +112,7 @@ def material_sums(
     m = _lut.lookup_matrix(
         theta_grid, delta_theta_grid, phi_grid,
         ang.theta_i.ravel()[rows], ang.delta_theta.ravel()[rows], ang.phi.ravel()[rows], method,
-        zero_edges=zero_edges,
+        zero_edges=zero_edges, normal_blend=normal_blend,
     ).tocoo()
     geom = rows[m.row] // f
     v2 = values.reshape(-1, n_wl)
@@ -261,7 +264,7 @@ def _gather(values, rows, wn, nk, f, acc_s, acc_p, ws, wp):  # pragma: no cover 
 
 @numba.njit(nogil=True, cache=True)
 def _fused_sums(s, o, normals, areas, term_mat, frac, tables, tgrid, t_off, dgrid, d_off,
-                pgrid, p_off, edges, method, tol, edge_tol,
+                pgrid, p_off, edges, blend, method, tol, edge_tol,
                 out_sig, out_pap, out_area, out_lit, out_pm):  # pragma: no cover - compiled
     n_geom = s.shape[0]
     n_term = normals.shape[0]
@@ -272,8 +275,8 @@ def _fused_sums(s, o, normals, areas, term_mat, frac, tables, tgrid, t_off, dgri
     acc_s = np.empty(n_wl, dtype=out_sig.dtype)
     acc_p = np.empty(n_wl, dtype=out_sig.dtype)
     wbuf = np.empty(2, dtype=out_sig.dtype)
-    rows = np.empty(64, dtype=np.int64)
-    wn = np.empty(64, dtype=out_sig.dtype)
+    rows = np.empty(96, dtype=np.int64)
+    wn = np.empty(96, dtype=out_sig.dtype)
     it = np.empty(4, dtype=np.int64)
     idt = np.empty(4, dtype=np.int64)
     iph = np.empty(4, dtype=np.int64)
@@ -339,29 +342,60 @@ def _fused_sums(s, o, normals, areas, term_mat, frac, tables, tgrid, t_off, dgri
                 nd = d_off[m + 1] - d0
                 p0 = p_off[m]
                 npp = p_off[m + 1] - p0
-                if ((edges[m, 0] and dt < dgrid[d0] - edge_tol)
-                        or (edges[m, 1] and dt > dgrid[d0 + nd - 1] + edge_tol)
-                        or (edges[m, 2] and phi > pgrid[p0 + npp - 1] + edge_tol)):
-                    continue
                 t0 = t_off[m]
                 nt = t_off[m + 1] - t0
-                kt = _axis(tgrid, t0, nt, ti, method, it, wt)
-                kd = _axis(dgrid, d0, nd, dt, method, idt, wdt)
-                kp = _axis(pgrid, p0, npp, phi, method, iph, wph)
+                outside = ((edges[m, 0] and dt < dgrid[d0] - edge_tol)
+                           or (edges[m, 1] and dt > dgrid[d0 + nd - 1] + edge_tol)
+                           or (edges[m, 2] and phi > pgrid[p0 + npp - 1] + edge_tol))
+                # normal-incidence blend (_lut.lookup_matrix): weight of the theta_i = 0 profile
+                w_n = 0.0
+                b_m = blend[m]
+                if b_m > 0.0 and tgrid[t0] == 0.0 and ti < b_m:
+                    x = ti / b_m
+                    if x < 0.0:
+                        x = 0.0
+                    w_n = 1.0 - x * x * (3.0 - 2.0 * x)
+                nk = 0
+                if not outside and w_n < 1.0:
+                    kt = _axis(tgrid, t0, nt, ti, method, it, wt)
+                    kd = _axis(dgrid, d0, nd, dt, method, idt, wdt)
+                    kp = _axis(pgrid, p0, npp, phi, method, iph, wph)
+                    for a in range(kt):
+                        for b in range(kd):
+                            row0 = (it[a] * nd + idt[b]) * npp
+                            wab = wt[a] * wdt[b] * (1.0 - w_n)
+                            for c in range(kp):
+                                rows[nk] = row0 + iph[c]
+                                wn[nk] = wab * wph[c]
+                                nk += 1
+                if w_n > 0.0:
+                    # the theta_i = 0 row along its in-plane profile at +-gamma, the angle from
+                    # the specular direction (_lut.observer_polar_angle(0, dt, phi))
+                    pr = phi / _RAD2DEG
+                    tr = dt / _RAD2DEG
+                    cp = np.cos(pr)
+                    gam = np.arctan2(np.hypot(np.sin(pr), cp * np.sin(tr)), abs(cp * np.cos(tr))) * _RAD2DEG
+                    ok_hi = (gam <= dgrid[d0 + nd - 1] + edge_tol) or not edges[m, 1]
+                    ok_lo = (-gam >= dgrid[d0] - edge_tol) or not edges[m, 0]
+                    n_ok = (1 if ok_hi else 0) + (1 if ok_lo else 0)
+                    if n_ok > 0:
+                        base_w = w_n / n_ok
+                        kp = _axis(pgrid, p0, npp, 0.0, method, iph, wph)
+                        for side in range(2):
+                            if (side == 0 and not ok_hi) or (side == 1 and not ok_lo):
+                                continue
+                            kd = _axis(dgrid, d0, nd, gam if side == 0 else -gam, method, idt, wdt)
+                            for b in range(kd):
+                                for c in range(kp):
+                                    rows[nk] = idt[b] * npp + iph[c]
+                                    wn[nk] = base_w * wdt[b] * wph[c]
+                                    nk += 1
+                if nk == 0:
+                    continue
                 if not any_lookup:
                     acc_s[:] = 0.0
                     acc_p[:] = 0.0
                     any_lookup = True
-                # gather the K = kt * kd * kp nodes, then sum them in passes of 4 rows
-                nk = 0
-                for a in range(kt):
-                    for b in range(kd):
-                        row0 = (it[a] * nd + idt[b]) * npp
-                        wab = wt[a] * wdt[b]
-                        for c in range(kp):
-                            rows[nk] = row0 + iph[c]
-                            wn[nk] = wab * wph[c]
-                            nk += 1
                 wbuf[0] = a2d * ns
                 wbuf[1] = a2d
                 ws = wbuf[0]
@@ -402,18 +436,19 @@ class PackedTables(NamedTuple):
     pgrid: NDArray[np.float64]
     p_off: NDArray[np.int64]
     edges: NDArray[np.bool_]  #: (M, 3) zero beyond delta_theta min, max, phi max
+    blend: NDArray[np.float64]  #: (M,) normal-incidence blend [degree] (0: none)
     shapes: tuple[tuple[int, int, int], ...]  #: (n_theta, n_delta_theta, n_phi) per material
     n_spectral: int
     dtype: np.dtype
 
 
 def pack_tables(
-    tables: list[tuple[NDArray[np.floating], NDArray[np.floating], NDArray[np.floating],
-                       NDArray[np.floating], tuple[bool, bool, bool]]],
+    tables: list[tuple[Any, ...]],
     n_spectral: int = 1,
     dtype: np.dtype | str = np.float64,
 ) -> PackedTables:
-    """Pack ``(values, theta_grid, delta_theta_grid, phi_grid, zero_edges)`` per material.
+    """Pack ``(values, theta_grid, delta_theta_grid, phi_grid, zero_edges[, normal_blend])``
+    per material.
 
     ``values`` has shape ``(n_theta, n_delta_theta, n_phi, L)``; every table has the
     same ``L`` and dtype.  ``n_spectral`` and ``dtype`` shape an empty packing (no
@@ -427,15 +462,16 @@ def pack_tables(
     if not tables:
         z = np.zeros(1, dtype=np.int64)
         return PackedTables((), np.zeros(0), z, np.zeros(0), z, np.zeros(0), z,
-                            np.zeros((0, 3), dtype=bool), (), n_spectral, dt)
+                            np.zeros((0, 3), dtype=bool), np.zeros(0), (), n_spectral, dt)
     n_wl = tables[0][0].shape[-1]
     values = tuple(np.ascontiguousarray(v, dtype=dt).reshape(-1, n_wl) for v, *_ in tables)
     tgrid, t_off = cat([np.asarray(t[1]) for t in tables])
     dgrid, d_off = cat([np.asarray(t[2]) for t in tables])
     pgrid, p_off = cat([np.asarray(t[3]) for t in tables])
     edges = np.array([t[4] for t in tables], dtype=bool).reshape(-1, 3)
+    blend = np.array([float(t[5]) if len(t) > 5 else 0.0 for t in tables], dtype=np.float64)
     shapes = tuple(tuple(int(x) for x in v.shape[:3]) for v, *_ in tables)
-    return PackedTables(values, tgrid, t_off, dgrid, d_off, pgrid, p_off, edges, shapes, n_wl, dt)
+    return PackedTables(values, tgrid, t_off, dgrid, d_off, pgrid, p_off, edges, blend, shapes, n_wl, dt)
 
 
 class FusedSums(NamedTuple):
@@ -509,7 +545,7 @@ def fused_sums(
         _fused_sums(s, o, np.ascontiguousarray(normals, dtype=np.float64),
                     np.ascontiguousarray(areas, dtype=np.float64), tm, frac, typed,
                     tables.tgrid, tables.t_off, tables.dgrid, tables.d_off, tables.pgrid,
-                    tables.p_off, tables.edges, METHOD_CODES[method],
+                    tables.p_off, tables.edges, tables.blend, METHOD_CODES[method],
                     normal_incidence_tolerance(np.float64), _lut.EDGE_TOL_DEG,
                     out_sig, out_pap, out_area, out_lit, out_pm)
     return FusedSums(out_sig, out_pap, out_area, out_lit, out_pm if per_material else None)

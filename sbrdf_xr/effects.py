@@ -127,10 +127,10 @@ def reflected(plan: Plan, block: BlockInputs, to_source: np.ndarray, fraction: n
     pm = np.zeros((g, len(plan.materials), n_wl), dt) if per_material else None
     for m in range(len(plan.materials)):
         sel = t.material == m
-        values, grids, edges = plan.table(m)
+        values, grids, edges, blend = plan.table(m)
         r = _kernels.material_sums(to_source, block.to_observer, t.normal[sel], t.area[sel], values,
                                    *grids, plan.knobs["method"],
-                                   None if fraction is None else fraction[:, sel], edges)
+                                   None if fraction is None else fraction[:, sel], edges, blend)
         sig += r.signal
         pap += r.paper
         area += r.area

@@ -31,7 +31,7 @@ import xarray as xr
 
 from . import __version__, sources
 from ._kernels import PackedTables, pack_tables
-from ._lut import table_edges
+from ._lut import table_edges, table_normal_blend
 from ._names import BAND, MATERIAL, WAVELENGTH
 from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS, BlockInputs
 from .errors import SceneError, ValidationError
@@ -185,13 +185,14 @@ class Plan:
         return slice(k * self.chunk, min((k + 1) * self.chunk, self.n_lead))
 
     def table(self, m: int) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray],
-                                     tuple[bool, bool, bool]]:
-        """Table ``m`` unpacked: values (n_theta, n_delta_theta, n_phi, L), grids, zero edges."""
+                                     tuple[bool, bool, bool], float]:
+        """Table ``m`` unpacked: values (n_theta, n_delta_theta, n_phi, L), grids, zero edges,
+        normal-incidence blend [degree]."""
         t = self.tables
         values = t.values[m].reshape(*t.shapes[m], -1)
         grids = (t.tgrid[t.t_off[m]:t.t_off[m + 1]], t.dgrid[t.d_off[m]:t.d_off[m + 1]],
                  t.pgrid[t.p_off[m]:t.p_off[m + 1]])
-        return values, grids, tuple(bool(x) for x in t.edges[m])  # type: ignore[return-value]
+        return values, grids, tuple(bool(x) for x in t.edges[m]), float(t.blend[m])  # type: ignore[return-value]
 
     @property
     def spectral_axis(self) -> np.ndarray:
@@ -471,7 +472,8 @@ def compile_plan(scene: Scene) -> Plan:
                 values = np.asarray(values, dtype=np.float64) @ bw.T
             packed.append((values, *(np.asarray(da[d].values, dtype=np.float64)
                                                    for d in ("theta_i", "delta_theta", "phi")),
-                           table_edges(scene.materials[m].attrs)))
+                           table_edges(scene.materials[m].attrs),
+                           table_normal_blend(scene.materials[m].attrs)))
         tables = pack_tables(packed, len(scene.bands) if pre else wl.size, dtype)
         del packed
         res = "" if knobs["table_theta_step"] is None else f", theta_i resampled every {knobs['table_theta_step']:g} deg"

@@ -40,7 +40,8 @@ def _tables(seed: int, n_mat: int, dtype: str, edges=None):
         pg[0] = 0.0
         v = rng.uniform(0, 2, (nt, nd, npp, 5)).astype(dtype)
         e = tuple(bool(x) for x in rng.integers(0, 2, 3)) if edges is None else edges
-        out.append((v, tg, dg, pg, e))
+        blend = float(rng.choice([0.0, 5.0, 20.0]))
+        out.append((v, tg, dg, pg, e, blend))
     return out
 
 
@@ -56,10 +57,10 @@ def _compare(s, o, normals, areas, mat, tables, method, dtype, fraction=None):
     sig = np.zeros_like(got.signal, dtype=np.float64)
     pap = np.zeros_like(sig)
     area = np.zeros(s.shape[0])
-    for m, (v, tg, dg, pg, e) in enumerate(tables):
+    for m, (v, tg, dg, pg, e, blend) in enumerate(tables):
         sel = mat == m
         r = material_sums(s, o, normals[sel], areas[sel], v, tg, dg, pg, method,
-                          None if fraction is None else fraction[:, sel], e)
+                          None if fraction is None else fraction[:, sel], e, blend)
         scale = max(np.abs(r.signal).max(), 1e-300)
         np.testing.assert_allclose(got.per_material[:, m], r.signal, rtol=0,
                                    atol=RTOL[dtype] * scale)
