@@ -112,8 +112,14 @@ def _table_sha(da: Any) -> str:
         c = da.coords[name]
         parts += [name, _json(list(map(str, c.dims))), _array_sha(np.asarray(c.values)),
                   _json(dict(c.attrs))]
-    parts.append(_json(dict(da.attrs)))
+    # when and by what a file was written says nothing about its values
+    parts.append(_json({k: v for k, v in da.attrs.items() if k not in _VOLATILE_TABLE_ATTRS}))
     return _sha(*parts)
+
+
+#: Table attributes that record when a file was written, not what it holds.
+_VOLATILE_TABLE_ATTRS = frozenset({"history", "date_created", "date_modified", "date_issued",
+                                   "date_metadata_modified"})
 
 
 def _attr_suffixes(names: list[str]) -> dict[str, str]:

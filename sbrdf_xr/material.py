@@ -1210,12 +1210,20 @@ def _load_material_entry(e: CatalogEntry) -> xr.DataArray:
 
 @functools.lru_cache(maxsize=16)
 def _built_material(name: str, measurements: str, options: tuple[tuple[str, Any], ...]) -> xr.DataArray:
-    from .catalog import load
+    from ._cache import cached_table
+    from .catalog import entry, load
 
     kw = dict(options)
-    if "fit" in kw:  # a model entry that fills the unmeasurable range
-        kw["model"] = load(kw.pop("fit"))
-    return build_lut(load(measurements), material=name, **kw)
+    inputs = [entry(measurements).file] + ([entry(kw["fit"]).file] if "fit" in kw else [])
+
+    def build() -> xr.DataArray:
+        opts = dict(kw)
+        if "fit" in opts:  # a model entry that fills the unmeasurable range
+            opts["model"] = load(opts.pop("fit"))
+        return build_lut(load(measurements), material=name, **opts)
+
+    return cached_table(name, inputs, repr(options), build,
+                        lambda da, path: to_netcdf(da, path, overwrite=True), open_material)
 
 
 @register_loader("measurements")
