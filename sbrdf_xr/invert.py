@@ -46,8 +46,8 @@ from scipy.optimize import least_squares, nnls
 from . import _kernels
 from .errors import InversionError
 
-__all__ = ["benchmark_spin_search", "fibonacci_sphere", "fit_spin", "light_curve_fluxes",
-           "material_areas", "spin_model", "unmix"]
+__all__ = ["band_terms", "benchmark_spin_search", "fibonacci_sphere", "fit_spin", "light_curve_fluxes",
+           "magnitudes_to_signal", "material_areas", "read_spectrum", "spin_model", "unmix"]
 
 MATERIAL = "material"
 #: Default |correlation| between two materials' estimates above which they are degenerate.
@@ -264,7 +264,7 @@ def unmix(
     elif select == "greedy":
         results, chosen, best = {}, (), None
         while len(chosen) < kmax:
-            trial = {tuple(sorted(chosen + (j,))): None for j in range(k) if j not in chosen}
+            trial = {tuple(sorted((*chosen, j))): None for j in range(k) if j not in chosen}
             for c in trial:
                 results[c] = score(c)
             cand = min(trial, key=lambda c: results[c][crit])
@@ -281,7 +281,7 @@ def unmix(
     x = np.zeros(k)
     x[cols] = xs
     sub = aw[:, cols]
-    cov_s, sig_s = _covariance(sub, xs > 0)
+    _cov_s, sig_s = _covariance(sub, xs > 0)
     sig = np.full(k, np.nan)
     sig[cols] = sig_s
     # Correlations from the unconstrained covariance of the selected columns: it says
@@ -436,7 +436,7 @@ def light_curve_fluxes(light_curve: xr.Dataset, bands: Sequence[str] | None = No
     ``obs``: ``magnitude``, ``uncertainty`` [mag], coords ``band``, ``time`` [s]) or the
     same with ``flux`` and ``flux_uncertainty`` instead of magnitudes.
     """
-    if not isinstance(light_curve, xr.Dataset) or "time" not in light_curve.coords and "time" not in light_curve:
+    if not isinstance(light_curve, xr.Dataset) or ("time" not in light_curve.coords and "time" not in light_curve):
         raise InversionError("light curve: expected a Dataset with a time coordinate [s] (read_light_curve)")
     t = np.asarray(light_curve["time"].values, dtype=np.float64)
     band = np.asarray(light_curve["band"].values).astype(str)
@@ -528,6 +528,15 @@ class _Problem:
         mdl = self.model(_vec(p[0], p[1])[None, :], np.array([p[2]]), np.array([p[3]]))
         return ((self.y - self.scales(mdl) * mdl) / self.sigma)[0]
 
+    def at_mean_directions(self) -> _Problem:
+        """The same problem with the Sun and observer fixed at their mean directions."""
+        other = object.__new__(_Problem)
+        other.__dict__.update(self.__dict__)
+        for key in ("s", "o"):
+            m = getattr(self, key).mean(0)
+            setattr(other, key, np.broadcast_to(m / np.linalg.norm(m), getattr(self, key).shape))
+        return other
+
     @property
     def n_scales(self) -> int:
         return 1 if self.offset == "common" else self.n_bands
@@ -539,7 +548,7 @@ def _search(prob: _Problem, axes: np.ndarray, periods: np.ndarray, phases: np.nd
     ia, ip, iq = np.meshgrid(np.arange(len(axes)), np.arange(len(periods)), np.arange(len(phases)), indexing="ij")
     ia, ip, iq = ia.ravel(), ip.ravel(), iq.ravel()
     out = np.empty(ia.size)
-    edges = list(range(0, ia.size, chunk)) + [ia.size]
+    edges = [*list(range(0, ia.size, chunk)), ia.size]
 
     def run(j: int) -> None:
         sl = slice(edges[j], edges[j + 1])
@@ -609,6 +618,32 @@ def _refine(prob: _Problem, p0: np.ndarray) -> tuple[np.ndarray, np.ndarray, flo
     return p, sig, float(2 * res.cost)
 
 
+def _alternatives(prob: _Problem, best: np.ndarray, n_phases: int,
+                  refine: bool) -> dict[str, tuple[np.ndarray, Any, float]]:
+    """The classical ambiguous solutions of a spin state, each searched in phase and refined.
+
+    ``antipode``: the opposite axis (the reversed sense of rotation); ``mirror``: the axial
+    vector mirrored through the mean scattering plane (the plane of the Sun and observer
+    directions), ``-M n``, which for a body equal to its mirror image and fixed directions
+    gives the same light curve (Kaasalainen & Lamberg 2006, Inverse Problems 22, 749);
+    ``half_period`` and ``double_period``.
+    """
+    axis = _vec(best[0], best[1])
+    nplane = np.cross(prob.s.mean(0), prob.o.mean(0))
+    nplane = nplane / np.linalg.norm(nplane) if np.linalg.norm(nplane) > 1e-9 else np.array([0.0, 0, 1])
+    mirror = -(axis - 2 * np.dot(axis, nplane) * nplane)
+    alts = {"antipode": (-axis, best[2]), "mirror": (mirror, best[2]),
+            "half_period": (axis, best[2] / 2), "double_period": (axis, best[2] * 2)}
+    dense = np.arange(4 * int(n_phases)) * 90.0 / int(n_phases)
+    out = {}
+    for name, (ax, per) in alts.items():
+        c2 = prob.chi2(np.repeat(ax[None, :], dense.size, 0), np.full(dense.size, per), dense)
+        lo, la = _lonlat(ax)
+        q0 = np.array([lo, la, per, dense[np.argmin(c2)]])
+        out[name] = _refine(prob, q0) if refine else (q0, None, float(c2.min()))
+    return out
+
+
 def _axis_angle(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.degrees(np.arccos(np.clip(np.dot(a, b), -1, 1))))
 
@@ -626,6 +661,7 @@ def fit_spin(
     offset: str = "band",
     materials: Mapping[str, xr.DataArray] | None = None,
     refine: bool = True,
+    n_starts: int = 5,
     method: str = "shift",
     n_threads: int | None = None,
 ) -> xr.Dataset:
@@ -665,11 +701,13 @@ def fit_spin(
         physical scale, e.g. magnitudes in one system).
     refine : bool
         Refine the best candidates by least squares.
+    n_starts : int
+        Refinements started from the best grid state of the ``n_starts`` best axes.
     method : {"shift", "direct"}
-        Search: with fixed directions, ``shift`` evaluates the kernel once per axis on a
-        dense spin-angle grid (0.5 degree) and reads every (period, phase) from it;
-        ``direct`` (always used when the directions change with time) runs every
-        candidate at every time through the kernel.
+        Search: ``shift`` evaluates the kernel once per axis on a dense spin-angle grid
+        (0.5 degree) and reads every (period, phase) from it, exact for fixed directions
+        and, when they move, at their mean directions (the refinement is exact);
+        ``direct`` runs every candidate at every time through the kernel.
     n_threads : int, optional
         Threads of the search (default: every core).
 
@@ -697,29 +735,36 @@ def fit_spin(
     phases = np.arange(int(n_phases)) * 360.0 / int(n_phases)
     t0 = time.perf_counter()
     fixed = bool(np.allclose(prob.s, prob.s[0]) and np.allclose(prob.o, prob.o[0]))
-    grid = (_search_shift if fixed and method == "shift" else _search)(prob, axes, periods, phases, n_threads)
+    if method == "shift":
+        # with moving directions the search reads the model at the mean directions (an
+        # approximation for the global search only; the refinement uses the exact ones)
+        search_prob = prob if fixed else prob.at_mean_directions()
+        grid = _search_shift(search_prob, axes, periods, phases, n_threads)
+    else:
+        grid = _search(prob, axes, periods, phases, n_threads)
     t_search = time.perf_counter() - t0
     ia, ip, iq = np.unravel_index(np.argmin(grid), grid.shape)
     lon0, lat0 = _lonlat(axes[ia])
     p0 = np.array([lon0, lat0, periods[ip], phases[iq]])
-    best, sig, chi2 = _refine(prob, p0) if refine else (p0, np.full(4, np.nan), float(grid[ia, ip, iq]))
+    if refine:
+        # multi-start: the best grid state of each of the n_starts best axes
+        best, sig, chi2 = _refine(prob, p0)
+        per_axis = grid.reshape(len(axes), -1)
+        for i in np.argsort(per_axis.min(axis=1))[1:max(1, int(n_starts))]:
+            jp, jq = np.unravel_index(np.argmin(per_axis[i]), grid.shape[1:])
+            lo, la = _lonlat(axes[i])
+            q, sq, c = _refine(prob, np.array([lo, la, periods[jp], phases[jq]]))
+            if c < chi2:
+                best, sig, chi2 = q, sq, c
+        # an alternative better than the first refinement becomes the solution (once)
+        for q, _, c in _alternatives(prob, best, n_phases, refine).values():
+            if c < chi2 - 1e-9:
+                best, sig, chi2 = _refine(prob, q)
+    else:
+        best, sig, chi2 = p0, np.full(4, np.nan), float(grid[ia, ip, iq])
     best_axis = _vec(best[0], best[1])
-    # alternatives: antipode (reversed sense), mirror through the mean scattering plane,
-    # half and double period; each is searched in phase and refined.
-    smean, omean = prob.s.mean(0), prob.o.mean(0)
-    nplane = np.cross(smean, omean)
-    nplane = nplane / np.linalg.norm(nplane) if np.linalg.norm(nplane) > 1e-9 else np.array([0.0, 0, 1])
-    mirror = best_axis - 2 * np.dot(best_axis, nplane) * nplane
-    alts = {"antipode": (-best_axis, best[2]), "mirror": (mirror, best[2]),
-            "half_period": (best_axis, best[2] / 2), "double_period": (best_axis, best[2] * 2)}
-    rows = []
-    dense = np.arange(4 * int(n_phases)) * 90.0 / int(n_phases)
-    for name, (ax, per) in alts.items():
-        c2 = prob.chi2(np.repeat(ax[None, :], dense.size, 0), np.full(dense.size, per), dense)
-        lo, la = _lonlat(ax)
-        q0 = np.array([lo, la, per, dense[np.argmin(c2)]])
-        q, _, c = _refine(prob, q0) if refine else (q0, None, float(c2.min()))
-        rows.append((name, q, c, _axis_angle(_vec(q[0], q[1]), best_axis)))
+    rows = [(name, q, c, _axis_angle(_vec(q[0], q[1]), best_axis))
+            for name, (q, _, c) in _alternatives(prob, best, n_phases, refine).items()]
     dof = prob.y.size - n_par
     chi_map = grid.min(axis=(1, 2))
     mlon, mlat = _lonlat(axes)
@@ -752,7 +797,7 @@ def fit_spin(
                                       "long_name": "angle between the solution's axis and the best axis"})
     ds.attrs = {"axis_body": str(list(np.asarray(axis_body, float))), "offset": offset,
                 "n_candidates": int(grid.size), "search_seconds": t_search,
-                "search_method": method if fixed else "direct",
+                "search_method": method, "fixed_directions": int(fixed),
                 "n_values": int(prob.y.size), "bands": ", ".join(lc["labels"])}
     return ds
 
@@ -766,12 +811,15 @@ def benchmark_spin_search(
     bands: Sequence[str] = ("V", "R", "I"),
     n_threads: int | None = None,
     spacecraft: Any = None,
-) -> list[dict[str, float]]:
-    """Wall time of the spin-state search (every candidate through the kernel).
+    methods: Sequence[str] = ("direct", "shift"),
+) -> list[dict[str, Any]]:
+    """Wall time of the spin-state search of :func:`fit_spin`.
 
-    A synthetic light curve of ``n_samples`` times in each band; the candidates are
-    Fibonacci axes x 10 periods x 10 phases (``n/100`` axes).  Returns one row per size:
-    ``candidates``, ``samples``, ``bands``, ``seconds``, ``per_candidate_ms``.
+    A synthetic light curve of ``n_samples`` times in each band at fixed directions; the
+    candidates are Fibonacci axes x 10 periods x 10 phases (``n/100`` axes).  ``direct``
+    runs every candidate at every time through the kernel; ``shift`` evaluates the kernel
+    once per axis on the spin-angle grid.  Returns one row per method and size:
+    ``method``, ``candidates``, ``samples``, ``bands``, ``seconds``, ``per_candidate_ms``.
     """
     from .spacecraft import canx1
 
@@ -787,12 +835,77 @@ def benchmark_spin_search(
     phases = np.arange(10) * 36.0
     _search(prob, fibonacci_sphere(2), periods[:1], phases[:1], n_threads)  # compile, warm caches
     rows = []
-    for n in n_candidates:
-        axes = fibonacci_sphere(max(1, int(n) // 100))
-        t0 = time.perf_counter()
-        _search(prob, axes, periods, phases, n_threads)
-        dt = time.perf_counter() - t0
-        nc = len(axes) * 100
-        rows.append({"candidates": nc, "samples": n_samples, "bands": nb, "seconds": dt,
-                     "per_candidate_ms": 1e3 * dt / nc})
+    for method in methods:
+        run = {"direct": _search, "shift": _search_shift}[method]
+        for n in n_candidates:
+            axes = fibonacci_sphere(max(1, int(n) // 100))
+            t0 = time.perf_counter()
+            run(prob, axes, periods, phases, n_threads)
+            dt = time.perf_counter() - t0
+            nc = len(axes) * 100
+            rows.append({"method": method, "candidates": nc, "samples": n_samples, "bands": nb,
+                         "seconds": dt, "per_candidate_ms": 1e3 * dt / nc})
     return rows
+
+
+# ------------------------------------------------------------------------------ measured data
+
+
+def band_terms(per_material: xr.DataArray, bands: Sequence[str]) -> xr.DataArray:
+    """Per-material band signals [m2 sr-1]: the solar-weighted band means of ``signal_material``
+    (:func:`sbrdf_xr.photometry.band_weights` normalised), ``wavelength`` replaced by ``band``."""
+    from .photometry import band_weights
+
+    w = band_weights(list(bands), per_material["wavelength"].values, normalize=True)
+    out = xr.dot(per_material, w.rename({"wavelength": "_wl"}).assign_coords(_wl=per_material["wavelength"].values)
+                 .rename({"_wl": "wavelength"}), dim="wavelength")
+    out.attrs = {"units": "m2 sr-1", "long_name": "band signal of each material"}
+    return out
+
+
+def magnitudes_to_signal(light_curve: xr.Dataset, range_km: float) -> tuple[xr.DataArray, xr.DataArray]:
+    """Band signal [m2 sr-1] and its uncertainty from measured magnitudes (one per band).
+
+    Inverts :func:`sbrdf_xr.photometry.magnitudes` at 1 AU:
+    ``S = d**2 10**(-0.4 (m - m_sun))``, ``sigma_S = S ln(10)/2.5 sigma_m``.
+    """
+    from .photometry import sun_magnitudes
+
+    if not np.isfinite(range_km) or range_km <= 0:
+        raise InversionError(f"range_km: must be finite and > 0, got {range_km}")
+    bands = [str(b) for b in light_curve["band"].values]
+    if len(set(bands)) != len(bands):
+        raise InversionError(f"magnitudes: one value per band expected (a spectrum in bands), got bands {bands}")
+    msun = sun_magnitudes(bands).values
+    m = np.asarray(light_curve["magnitude"].values, dtype=np.float64)
+    s = (range_km * 1e3) ** 2 * 10 ** (-0.4 * (m - msun))
+    sig = s * _LN10_2P5 * np.asarray(light_curve["uncertainty"].values, dtype=np.float64)
+    coords = {"band": bands}
+    return (xr.DataArray(s, dims="band", coords=coords, attrs={"units": "m2 sr-1", "long_name": "band signal"}),
+            xr.DataArray(sig, dims="band", coords=coords, attrs={"units": "m2 sr-1",
+                                                                   "long_name": "uncertainty of the band signal"}))
+
+
+def read_spectrum(path: str | os.PathLike[str]) -> tuple[xr.DataArray, xr.DataArray]:
+    """A measured spectrum from CSV or netCDF: columns ``wavelength`` [nm], ``signal``
+    [m2 sr-1] and ``uncertainty`` (same units, > 0)."""
+    from pathlib import Path
+
+    import pandas as pd
+
+    path = Path(path)
+    if not path.is_file():
+        raise InversionError(f"spectrum: file {path} does not exist")
+    if path.suffix.lower() in (".nc", ".nc4"):
+        with xr.open_dataset(path) as ds:
+            df = ds.load().reset_coords().to_dataframe().reset_index()
+    else:
+        df = pd.read_csv(path, skipinitialspace=True)
+        df.columns = [str(c).strip() for c in df.columns]
+    missing = [c for c in ("wavelength", "signal", "uncertainty") if c not in df.columns]
+    if missing:
+        raise InversionError(f"{path}: missing columns {missing}; needs wavelength, signal, uncertainty")
+    wl = df["wavelength"].to_numpy(dtype=np.float64)
+    y = xr.DataArray(df["signal"].to_numpy(dtype=np.float64), dims="wavelength", coords={"wavelength": wl},
+                     attrs={"units": "m2 sr-1", "long_name": "measured signal"})
+    return y, y.copy(data=df["uncertainty"].to_numpy(dtype=np.float64))
