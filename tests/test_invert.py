@@ -185,3 +185,58 @@ def test_fit_spin_bad_input(sc):
     lc["flux_uncertainty"] = lc["flux"] * 0.1
     with pytest.raises(InversionError, match="parameters"):
         invert.fit_spin(lc, sc, to_sun=[1, 0, 0], to_observer=[0, 1, 0], periods=[10.0])
+
+
+def test_cli_unmix_spectrum_and_bands(per_material, tmp_path, capsys):
+    import pandas as pd
+
+    from sbrdf_xr.cli import main
+    from sbrdf_xr.photometry import sun_magnitudes
+    from sbrdf_xr.simulate import write
+
+    cube = xr.Dataset({"signal_material": per_material})
+    write(cube, tmp_path / "cube.nc")
+    truth = per_material.isel(geometry=0).sum("material")
+    y, sigma = _noisy(truth, 0.01, 9)
+    pd.DataFrame({"wavelength": truth.wavelength.values, "signal": y.values,
+                  "uncertainty": sigma.values}).to_csv(tmp_path / "spec.csv", index=False)
+    out = tmp_path / "unmix.nc"
+    assert main(["invert", "unmix", str(tmp_path / "spec.csv"), "--cube", str(tmp_path / "cube.nc"),
+                 "--isel", "geometry=0", "--select", "none", "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "white-paint-a276" in text and out.exists()
+    r = xr.open_dataset(out)
+    np.testing.assert_allclose(r["scale"].values, 1.0, atol=4 * r["scale_uncertainty"].values.max())
+    # band magnitudes of all four geometries' total at 1000 km, as a light-curve file
+    sb = invert.band_terms(per_material.isel(geometry=0), BANDS).sum("material")
+    mags = sun_magnitudes(list(BANDS)).values - 2.5 * np.log10(sb.values / 1e6**2)
+    pd.DataFrame({"time": [0.0] * 3, "band": BANDS, "magnitude": mags,
+                  "uncertainty": 0.01}).to_csv(tmp_path / "mags.csv", index=False)
+    assert main(["invert", "unmix", str(tmp_path / "mags.csv"), "--cube", str(tmp_path / "cube.nc"),
+                 "--isel", "geometry=0", "--range-km", "1000", "--select", "greedy"]) == 0
+    assert "chi2" in capsys.readouterr().out
+    # no range for magnitudes: a named error, exit status 2
+    assert main(["invert", "unmix", str(tmp_path / "mags.csv"), "--cube", str(tmp_path / "cube.nc"),
+                 "--isel", "geometry=0"]) == 2
+    assert "--range-km" in capsys.readouterr().err
+
+
+def test_cli_spin(sc, tmp_path, capsys):
+    import pandas as pd
+
+    from sbrdf_xr.cli import main
+
+    axis_body = np.array([1.0, 2.0, 3.0]) / np.sqrt(14.0)
+    times = np.linspace(0.0, 60.0, 90)
+    lc = _spin_curve(sc, axis_body, invert._vec(40.0, 25.0), 30.0, 50.0, times, np.array([1.0, 0, 0]),
+                     np.array([np.cos(0.7), np.sin(0.7), 0.0]), 0.02, 3)
+    f = lc["flux"].values
+    pd.DataFrame({"time": lc.time.values, "band": lc.band.values, "magnitude": -2.5 * np.log10(f),
+                  "uncertainty": 0.02 / invert._LN10_2P5}).to_csv(tmp_path / "lc.csv", index=False)
+    out = tmp_path / "spin.nc"
+    assert main(["invert", "spin", str(tmp_path / "lc.csv"), "--to-sun", "1", "0", "0", "--to-observer",
+                 str(np.cos(0.7)), str(np.sin(0.7)), "0", "--periods", "28.5", "31.5", "21",
+                 "--axis-body", "1", "2", "3", "--n-axes", "200", "-o", str(out)]) == 0
+    assert "period" in capsys.readouterr().out
+    r = xr.open_dataset(out)
+    assert abs(float(r["period"]) - 30.0) < 0.15  # 0.5 %
