@@ -295,6 +295,8 @@ def unmix(
     cand_full = np.linalg.pinv(aw.T @ aw)
     dc = np.sqrt(np.clip(np.diag(cand_full), 1e-300, None))
     cand_corr = cand_full / np.outer(dc, dc)
+    out_of_model = ~np.isin(np.arange(k), cols)
+    sig[out_of_model] = dc[out_of_model]  # left out: its sigma with every candidate fitted
     sv = np.linalg.svd(aw, compute_uv=False)
     cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else np.inf
     degenerate = [f"{names[i]} / {names[j]} (correlation {cand_corr[i, j]:+.3f})"
@@ -305,7 +307,8 @@ def unmix(
     ds["scale"] = (MATERIAL, x, {"units": "1", "long_name": "effective area scale factor of the material "
                                  "(1: its area as simulated)"})
     ds["scale_uncertainty"] = (MATERIAL, sig, {"units": "1", "long_name": "1-sigma uncertainty of the scale "
-                                               "factor (active set: (A^T W A)^-1; at the bound: unconstrained)"})
+                                               "factor (active set: (A^T W A)^-1; at the bound: unconstrained; left out of the "
+                                               "chosen model: with every candidate fitted)"})
     ds["selected"] = (MATERIAL, np.isin(np.arange(k), cols) & (x > 0),
                       {"units": "1", "long_name": "material present in the chosen model"})
     ds["correlation"] = ((MATERIAL, "material_b"), corr,
