@@ -14,6 +14,7 @@ import xarray as xr
 
 from sbrdf_xr import geometry, invert
 from sbrdf_xr.errors import InversionError
+from sbrdf_xr.invert import _spin
 from sbrdf_xr.scene import Scene
 from sbrdf_xr.simulate import simulate
 from sbrdf_xr.spacecraft import canx1
@@ -126,7 +127,7 @@ def test_fit_spin_recovers_truth(sc, period):
     # A cube has isotropic inertia: a spin about a generic body axis is torque-free and
     # breaks the cube's symmetries (about a face normal the period would be ambiguous).
     axis_body = np.array([1.0, 2.0, 3.0]) / np.sqrt(14.0)
-    truth = invert._vec(40.0, 25.0)
+    truth = invert.axis_vector(40.0, 25.0)
     times = np.linspace(0.0, 2 * period, 100)  # two rotations
     s_in = np.array([1.0, 0.0, 0.0])
     # the observer moves 30 -> 50 deg in azimuth and 0 -> 15 deg in elevation: with fixed
@@ -138,7 +139,7 @@ def test_fit_spin_recovers_truth(sc, period):
     periods = period * np.linspace(0.95, 1.05, 21)
     r = invert.fit_spin(lc, sc, to_sun=s_in, to_observer=o_in, periods=periods, axis_body=axis_body,
                         n_axes=200, n_phases=36)
-    assert invert._axis_angle(r["axis_vector"].values, truth) < 5.0
+    assert invert.axis_separation(r["axis_vector"].values, truth) < 5.0
     assert abs(float(r["period"]) / period - 1) < 0.005
     assert 0.5 < float(r["reduced_chi2"]) < 2.0
     assert r.sizes["axis"] == 200 and np.isfinite(r["chi2_map"]).all()
@@ -150,15 +151,15 @@ def test_fit_spin_recovers_truth(sc, period):
 def test_fixed_geometry_mirror_ambiguity(sc):
     """With fixed directions the mirror pole -M n fits as well as the truth (zero gap)."""
     axis_body = np.array([1.0, 2.0, 3.0]) / np.sqrt(14.0)
-    truth = invert._vec(40.0, 25.0)
+    truth = invert.axis_vector(40.0, 25.0)
     s_in, o_in = np.array([1.0, 0.0, 0.0]), np.array([np.cos(0.7), np.sin(0.7), 0.0])
     times = np.linspace(0.0, 60.0, 80)
     lc = _spin_curve(sc, axis_body, truth, 30.0, 50.0, times, s_in, o_in, 0.02, 2)
     r = invert.fit_spin(lc, sc, to_sun=s_in, to_observer=o_in, periods=30.0 * np.linspace(0.97, 1.03, 7),
                         axis_body=axis_body, n_axes=200, n_phases=36)
-    both = [r["axis_vector"].values, invert._vec(float(r["solution_axis_longitude"].sel(solution="mirror")),
+    both = [r["axis_vector"].values, invert.axis_vector(float(r["solution_axis_longitude"].sel(solution="mirror")),
                                                  float(r["solution_axis_latitude"].sel(solution="mirror")))]
-    assert min(invert._axis_angle(v, truth) for v in both) < 5.0
+    assert min(invert.axis_separation(v, truth) for v in both) < 5.0
     assert abs(float(r["chi2_gap"].sel(solution="mirror"))) < 1e-3 * float(r["chi2"])
 
 
@@ -167,11 +168,11 @@ def test_search_paths_agree(sc):
     axis_body = np.array([1.0, 2.0, 3.0]) / np.sqrt(14.0)
     s_in, o_in = np.array([1.0, 0, 0]), np.array([0.0, 1.0, 0])
     times = np.linspace(0.0, 60.0, 40)
-    lc = _spin_curve(sc, axis_body, invert._vec(10.0, 60.0), 30.0, 0.0, times, s_in, o_in, 0.02, 1)
-    prob = invert._Problem(invert.light_curve_fluxes(lc), invert._Kernel(sc, BANDS), s_in, o_in, axis_body, "band")
+    lc = _spin_curve(sc, axis_body, invert.axis_vector(10.0, 60.0), 30.0, 0.0, times, s_in, o_in, 0.02, 1)
+    prob = _spin._Problem(invert.light_curve_fluxes(lc), _spin._Kernel(sc, BANDS), s_in, o_in, axis_body, "band")
     axes, periods, phases = invert.fibonacci_sphere(5), np.array([29.0, 30.0]), np.array([0.0, 90.0])
-    a = invert._search(prob, axes, periods, phases, 1)
-    b = invert._search_shift(prob, axes, periods, phases, 1, n_angles=7200)
+    a = _spin._search(prob, axes, periods, phases, 1)
+    b = _spin._search_shift(prob, axes, periods, phases, 1, n_angles=7200)
     # 0.05 degree angle grid with linear interpolation: chi-square within 2 %
     np.testing.assert_allclose(b, a, rtol=0.02)
 
@@ -228,11 +229,11 @@ def test_cli_spin(sc, tmp_path, capsys):
 
     axis_body = np.array([1.0, 2.0, 3.0]) / np.sqrt(14.0)
     times = np.linspace(0.0, 60.0, 90)
-    lc = _spin_curve(sc, axis_body, invert._vec(40.0, 25.0), 30.0, 50.0, times, np.array([1.0, 0, 0]),
+    lc = _spin_curve(sc, axis_body, invert.axis_vector(40.0, 25.0), 30.0, 50.0, times, np.array([1.0, 0, 0]),
                      np.array([np.cos(0.7), np.sin(0.7), 0.0]), 0.02, 3)
     f = lc["flux"].values
     pd.DataFrame({"time": lc.time.values, "band": lc.band.values, "magnitude": -2.5 * np.log10(f),
-                  "uncertainty": 0.02 / invert._LN10_2P5}).to_csv(tmp_path / "lc.csv", index=False)
+                  "uncertainty": 0.02 / _spin._LN10_2P5}).to_csv(tmp_path / "lc.csv", index=False)
     out = tmp_path / "spin.nc"
     assert main(["invert", "spin", str(tmp_path / "lc.csv"), "--to-sun", "1", "0", "0", "--to-observer",
                  str(np.cos(0.7)), str(np.sin(0.7)), "0", "--periods", "28.5", "31.5", "21",
