@@ -11,6 +11,9 @@ Sub-commands::
     sbrdf-xr plot CUBE.nc -o FIG.png        the cube's natural figure (light curve or spectra)
     sbrdf-xr photometry CUBE.nc [--bands V R I] [--range-km KM] [--colours V-R,R-I]
              [--system ab|vega] [-o PHOT.nc] [--csv PHOT.csv]
+    sbrdf-xr invert unmix MEASURED --cube CUBE.nc [--range-km R] [-o OUT.nc]   material areas
+    sbrdf-xr invert spin CURVE --spacecraft canx1 --to-sun X Y Z --to-observer X Y Z
+             --periods MIN MAX N [-o OUT.nc]                                      spin state
 """
 
 from __future__ import annotations
@@ -338,6 +341,59 @@ def _cmd_photometry(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_invert(args: argparse.Namespace) -> int:
+    import numpy as np
+    import xarray as xr
+
+    from . import invert
+    from .errors import InversionError
+    from .material import write_netcdf_atomic
+    from .photometry import read_light_curve
+
+    if args.invert_command == "unmix":
+        with xr.open_dataset(args.cube) as cube:
+            terms = cube.load()["signal_material"] if "signal_material" in cube else None
+        if terms is None:
+            raise InversionError(f"{args.cube}: no signal_material; simulate with the per_material output")
+        for item in args.isel or []:
+            dim, _, idx = item.partition("=")
+            terms = terms.isel({dim: int(idx)})
+        try:
+            y, sigma = invert.read_spectrum(args.measured)
+        except InversionError:
+            lc = read_light_curve(args.measured)
+            if args.range_km is None:
+                raise InversionError("--range-km: needed to turn measured magnitudes into signal") from None
+            y, sigma = invert.magnitudes_to_signal(lc, args.range_km)
+            terms = invert.band_terms(terms, [str(b) for b in y.band.values])
+        ds = invert.unmix(y, terms, sigma, select=None if args.select == "none" else args.select,
+                          criterion=args.criterion)
+        print(f"unmix {args.measured}: chi2 {float(ds.chi2):.4g}, reduced {float(ds.reduced_chi2):.4g}, "
+              f"{args.criterion} selection: {ds.attrs['selected_materials']}")
+        for m in ds.material.values:
+            print(f"  {m!s:<24} scale {float(ds.scale.sel(material=m)):.4f} "
+                  f"+- {float(ds.scale_uncertainty.sel(material=m)):.4f}")
+        print(f"  degenerate: {ds.attrs['degenerate']}")
+    else:
+        from .spacecraft import canx1, load_spacecraft
+
+        sc = canx1() if args.spacecraft == "canx1" else load_spacecraft(args.spacecraft)
+        lo, hi, n = args.periods
+        ds = invert.fit_spin(read_light_curve(args.measured), sc, to_sun=args.to_sun, to_observer=args.to_observer,
+                             periods=np.linspace(lo, hi, int(n)), axis_body=args.axis_body, n_axes=args.n_axes,
+                             n_phases=args.n_phases, offset=args.offset)
+        print(f"spin fit of {args.measured}: {ds.attrs['n_candidates']} candidates in "
+              f"{ds.attrs['search_seconds']:.1f} s; chi2 {float(ds.chi2):.4g}, reduced {float(ds.reduced_chi2):.4g}")
+        for k in ("axis_longitude", "axis_latitude", "period", "phase"):
+            print(f"  {k:<15} {float(ds[k]):10.4f} +- {float(ds[k + '_uncertainty']):.4f} {ds[k].attrs['units']}")
+        for sname in ds.solution.values:
+            print(f"  alternative {sname!s:<14} chi2 gap {float(ds.chi2_gap.sel(solution=sname)):10.2f}")
+    if args.output:
+        write_netcdf_atomic(ds, args.output, overwrite=args.overwrite)
+        print(f"wrote {args.output}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``sbrdf-xr``."""
     p = argparse.ArgumentParser(prog="sbrdf-xr", description="Spectral BRDF simulation of unresolved spacecraft.")
@@ -409,6 +465,32 @@ def build_parser() -> argparse.ArgumentParser:
     pph.add_argument("--csv", help="write magnitudes and colour indices to this CSV file")
     pph.add_argument("--overwrite", action="store_true", help="replace existing output files")
     pph.set_defaults(func=_cmd_photometry)
+
+    pinv = sub.add_parser("invert", help="materials or spin state from measured data")
+    isub = pinv.add_subparsers(dest="invert_command", required=True)
+    pu = isub.add_parser("unmix", help="material areas from a measured spectrum or band magnitudes")
+    pu.add_argument("measured", help="spectrum CSV/netCDF (wavelength, signal, uncertainty) or a light-curve "
+                    "file of band magnitudes (read_light_curve format, one row per band)")
+    pu.add_argument("--cube", required=True, help="netCDF cube with signal_material at the measured geometry")
+    pu.add_argument("--isel", action="append", metavar="DIM=INDEX", help="select the geometry in the cube")
+    pu.add_argument("--range-km", type=float, help="observer range [km] (band magnitudes)")
+    pu.add_argument("--select", choices=("all", "greedy", "none"), default="all")
+    pu.add_argument("--criterion", choices=("bic", "aic"), default="bic")
+    pspin = isub.add_parser("spin", help="spin axis, period and phase from a colour light curve")
+    pspin.add_argument("measured", help="light curve CSV/netCDF (read_light_curve format, times in s)")
+    pspin.add_argument("--spacecraft", default="canx1", help="canx1 or a mesh file")
+    pspin.add_argument("--to-sun", type=float, nargs=3, required=True, help="inertial direction to the Sun")
+    pspin.add_argument("--to-observer", type=float, nargs=3, required=True, help="inertial direction to the observer")
+    pspin.add_argument("--periods", type=float, nargs=3, required=True, metavar=("MIN", "MAX", "N"),
+                       help="candidate periods [s]")
+    pspin.add_argument("--axis-body", type=float, nargs=3, default=(0.0, 0.0, 1.0), help="body spin axis")
+    pspin.add_argument("--n-axes", type=int, default=300)
+    pspin.add_argument("--n-phases", type=int, default=36)
+    pspin.add_argument("--offset", choices=("band", "common"), default="band")
+    for q in (pu, pspin):
+        q.add_argument("-o", "--output", help="write the result Dataset to this netCDF file")
+        q.add_argument("--overwrite", action="store_true", help="replace an existing output file")
+        q.set_defaults(func=_cmd_invert)
 
     pp = sub.add_parser("plot", help="draw a cube's figure")
     pp.add_argument("cube")

@@ -12,6 +12,7 @@ __all__ = [
     "AttitudeError",
     "CatalogError",
     "EpochGapWarning",
+    "InversionError",
     "MeshError",
     "MeshRepairWarning",
     "NonPhysicalWarning",
@@ -54,6 +55,10 @@ class NotObservableError(ObservationError):
 
 class AttitudeError(ValidationError):
     """An unknown attitude law or bad law parameters."""
+
+
+class InversionError(ValidationError):
+    """Measured data, uncertainties or a model library that an inversion cannot use."""
 
 
 class SbrdfWarning(UserWarning):

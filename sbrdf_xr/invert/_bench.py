@@ -1,0 +1,60 @@
+"""Timing of the spin-state search."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from ._spin import _Kernel, _Problem, _search, _search_shift, fibonacci_sphere, light_curve_fluxes
+
+__all__ = ["benchmark_spin_search"]
+
+
+# ------------------------------------------------------------------------------ benchmark
+
+
+def benchmark_spin_search(
+    n_candidates: Sequence[int] = (2500, 5000, 10000),
+    n_samples: int = 300,
+    bands: Sequence[str] = ("V", "R", "I"),
+    n_threads: int | None = None,
+    spacecraft: Any = None,
+    methods: Sequence[str] = ("direct", "shift"),
+) -> list[dict[str, Any]]:
+    """Wall time of the spin-state search of :func:`fit_spin`.
+
+    A synthetic light curve of ``n_samples`` times in each band at fixed directions; the
+    candidates are Fibonacci axes x 10 periods x 10 phases (``n/100`` axes).  ``direct``
+    runs every candidate at every time through the kernel; ``shift`` evaluates the kernel
+    once per axis on the spin-angle grid.  Returns one row per method and size:
+    ``method``, ``candidates``, ``samples``, ``bands``, ``seconds``, ``per_candidate_ms``.
+    """
+    from ..spacecraft import canx1
+
+    sc = spacecraft if spacecraft is not None else canx1()
+    t = np.linspace(0.0, 300.0, n_samples)
+    nb = len(bands)
+    lc = xr.Dataset({"flux": ("obs", np.ones(n_samples * nb)), "flux_uncertainty": ("obs", np.full(n_samples * nb, 0.02))},
+                    coords={"time": ("obs", np.repeat(t, nb)), "band": ("obs", np.tile(list(bands), n_samples))})
+    data = light_curve_fluxes(lc)
+    kern = _Kernel(sc, list(bands))
+    prob = _Problem(data, kern, [1.0, 0, 0], [np.cos(0.5), np.sin(0.5), 0.0], np.array([0.0, 0, 1]), "band")
+    periods = np.linspace(20.0, 40.0, 10)
+    phases = np.arange(10) * 36.0
+    _search(prob, fibonacci_sphere(2), periods[:1], phases[:1], n_threads)  # compile, warm caches
+    rows = []
+    for method in methods:
+        run = {"direct": _search, "shift": _search_shift}[method]
+        for n in n_candidates:
+            axes = fibonacci_sphere(max(1, int(n) // 100))
+            t0 = time.perf_counter()
+            run(prob, axes, periods, phases, n_threads)
+            dt = time.perf_counter() - t0
+            nc = len(axes) * 100
+            rows.append({"method": method, "candidates": nc, "samples": n_samples, "bands": nb,
+                         "seconds": dt, "per_candidate_ms": 1e3 * dt / nc})
+    return rows
