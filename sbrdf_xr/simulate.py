@@ -39,6 +39,7 @@ declares every variable and its attributes.
 from __future__ import annotations
 
 import os
+import threading
 import uuid
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -103,9 +104,22 @@ def _in_process(plan: Plan, n_threads: int | None = None) -> dict[str, np.ndarra
     if workers == 1:
         return run_block(plan, slice(0, n))
     edges = np.linspace(0, n, workers + 1).astype(int)
-    with ThreadPoolExecutor(workers, thread_name_prefix="sbrdf_xr") as pool:
-        parts = list(pool.map(lambda i: run_block(plan, slice(edges[i], edges[i + 1])), range(workers)))
+    parts = list(_pool(workers).map(lambda i: run_block(plan, slice(edges[i], edges[i + 1])),
+                                    range(workers)))
     return {k: np.concatenate([p[k] for p in parts], axis=0) for k in parts[0]}
+
+
+_POOLS: dict[int, ThreadPoolExecutor] = {}
+_POOL_LOCK = threading.Lock()
+
+
+def _pool(workers: int) -> ThreadPoolExecutor:
+    """A thread pool kept for the life of the process (starting threads per call would cost
+    more than a small scene's whole kernel)."""
+    with _POOL_LOCK:
+        if workers not in _POOLS:
+            _POOLS[workers] = ThreadPoolExecutor(workers, thread_name_prefix="sbrdf_xr")
+        return _POOLS[workers]
 
 
 def _lazy(plan: Plan, client: Any = None) -> dict[str, dsa.Array]:
