@@ -29,9 +29,9 @@ from numpy.typing import ArrayLike
 
 from . import brdf as _brdf
 from ._names import ANISO_LUT_DIMS, DELTA_THETA, PHI, PSI, SBRDF, THETA_I, WAVELENGTH, attrs
-from .catalog import CatalogEntry, register_loader
 from .errors import ValidationError
-from .material import new_material, write_netcdf_atomic
+from .material_io import write_netcdf_atomic
+from .material_schema import new_material
 
 __all__ = ["PARAM_ATTRS", "fit_robertson_sandford", "measure", "model_material", "open_model", "render",
            "render_anisotropic", "render_values", "spectra", "spectrum_function", "to_netcdf"]
@@ -363,7 +363,7 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
     """
     from ._names import MEASURED, SAMPLE
     from .brdf import robertson_sandford as rs
-    from .material import _reference, validate_measurements
+    from .material_schema import _reference, validate_measurements
 
     ds = validate_measurements(measurements, duplicates="mean")
     wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
@@ -400,14 +400,3 @@ def open_model(path: str | os.PathLike[str]) -> xr.Dataset:
         ds = ds.load()
     _params(ds)
     return ds
-
-
-@register_loader("model")
-def _load_model_entry(e: CatalogEntry) -> xr.Dataset:
-    return open_model(e.file)
-
-
-@register_loader("paint_parameters")
-def _load_paint_parameters(e: CatalogEntry) -> xr.Dataset:
-    with xr.open_dataset(e.file, engine="netcdf4") as ds:
-        return ds.load()

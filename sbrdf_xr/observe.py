@@ -51,10 +51,16 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike, NDArray
 
+from . import _catalog_index
 from . import attitude as _att
-from . import catalog
 from ._names import VECTOR
-from .errors import AttitudeError, EpochGapWarning, NotObservableError, ObservationError
+from .errors import (
+    AttitudeError,
+    CatalogError,
+    EpochGapWarning,
+    NotObservableError,
+    ObservationError,
+)
 from .geometry import rotation_matrices
 
 __all__ = [
@@ -71,6 +77,8 @@ __all__ = [
     "bench_geometry",
     "canx1_pass",
     "disc_overlap_fraction",
+    "load_orbit_entry",
+    "load_site_entry",
     "observation_from_dict",
     "sunlit_fraction",
     "times",
@@ -386,10 +394,10 @@ class Orbit:
     @classmethod
     def from_catalog(cls, name: str) -> Orbit:
         """A shipped orbit (catalog kind ``orbit``)."""
-        obj = catalog.load(name)
-        if not isinstance(obj, Orbit):
-            raise ObservationError(f"catalog entry {name!r} is a {catalog.entry(name).kind}, not an orbit")
-        return obj
+        e = _catalog_index.entry(name)
+        if e.kind != "orbit":
+            raise ObservationError(f"catalog entry {name!r} is a {e.kind}, not an orbit")
+        return load_orbit_entry(e)
 
     @property
     def epoch(self) -> np.datetime64:
@@ -446,10 +454,10 @@ class Site:
     @classmethod
     def from_catalog(cls, name: str) -> Site:
         """A shipped observatory (catalog kind ``site``)."""
-        obj = catalog.load(name)
-        if not isinstance(obj, Site):
-            raise ObservationError(f"catalog entry {name!r} is a {catalog.entry(name).kind}, not a site")
-        return obj
+        e = _catalog_index.entry(name)
+        if e.kind != "site":
+            raise ObservationError(f"catalog entry {name!r} is a {e.kind}, not a site")
+        return load_site_entry(e)
 
     @property
     def position(self) -> Any:
@@ -919,8 +927,7 @@ def observation_from_dict(table: Mapping[str, Any], base_dir: str | Path | None 
 # --------------------------------------------------------------------------- catalog
 
 
-@catalog.register_loader("orbit")
-def _load_orbit(entry: catalog.CatalogEntry) -> Orbit:
+def load_orbit_entry(entry: _catalog_index.CatalogEntry) -> Orbit:
     """A ``kind = "orbit"`` entry: a 2- or 3-line TLE file."""
     lines = [ln.rstrip() for ln in entry.file.read_text(encoding="utf-8").splitlines() if ln.strip()]
     if len(lines) == 3:
@@ -928,17 +935,16 @@ def _load_orbit(entry: catalog.CatalogEntry) -> Orbit:
     elif len(lines) == 2:
         name, l1, l2 = entry.name, lines[0], lines[1]
     else:
-        raise catalog.CatalogError(f"orbit entry {entry.name!r}: {entry.path} must hold 2 or 3 lines, has {len(lines)}")
+        raise CatalogError(f"orbit entry {entry.name!r}: {entry.path} must hold 2 or 3 lines, has {len(lines)}")
     return Orbit.from_tle(l1, l2, name, provenance=entry.provenance)
 
 
-@catalog.register_loader("site")
-def _load_site(entry: catalog.CatalogEntry) -> Site:
+def load_site_entry(entry: _catalog_index.CatalogEntry) -> Site:
     """A ``kind = "site"`` entry: the table of that name in a TOML file of sites."""
     sites = tomllib.loads(entry.file.read_text(encoding="utf-8"))
     key = entry.extra.get("key", entry.name)
     if key not in sites:
-        raise catalog.CatalogError(f"site entry {entry.name!r}: {entry.path} has no table [{key}]")
+        raise CatalogError(f"site entry {entry.name!r}: {entry.path} has no table [{key}]")
     return Site(name=entry.name, **sites[key])
 
 

@@ -59,9 +59,9 @@ import trimesh
 import xarray as xr
 from numpy.typing import NDArray
 
-from . import catalog
+from . import _catalog_index
 from ._names import FACET, MATERIAL, VECTOR, attrs
-from .errors import MeshError, MeshRepairWarning, ValidationError
+from .errors import CatalogError, MeshError, MeshRepairWarning, ValidationError
 
 __all__ = [
     "CANX1_MATERIALS",
@@ -955,8 +955,7 @@ class Spacecraft:
 # --------------------------------------------------------------------------- catalog
 
 
-@catalog.register_loader("spacecraft")
-def load_catalog_entry(entry: catalog.CatalogEntry) -> Spacecraft:
+def load_catalog_entry(entry: _catalog_index.CatalogEntry) -> Spacecraft:
     """Load a ``kind = "spacecraft"`` catalog entry.
 
     The entry's ``path`` is the mesh; extra fields: ``material_map`` (path of the TOML map,
@@ -966,12 +965,12 @@ def load_catalog_entry(entry: catalog.CatalogEntry) -> Spacecraft:
     try:
         map_file = entry.extra["material_map"]
     except KeyError:
-        raise catalog.CatalogError(
+        raise CatalogError(
             f"spacecraft entry {entry.name!r} lacks the field 'material_map'"
         ) from None
     return load_spacecraft(
         entry.file,
-        read_material_map(catalog.data_path(map_file)),
+        read_material_map(_catalog_index.data_path(map_file)),
         length_unit=entry.extra.get("length_unit", "m"),
         name=entry.name,
         face_property=entry.extra.get("face_property"),
@@ -993,4 +992,4 @@ def canx1() -> Spacecraft:
     Spacecraft
         Materials ``aluminium-6061-t6``, ``tjpv-cell``, ``white-paint-a276``.
     """
-    return load_catalog_entry(catalog.entry("canx1"))
+    return load_catalog_entry(_catalog_index.entry("canx1"))
