@@ -951,7 +951,7 @@ def load_site_entry(entry: _catalog_index.CatalogEntry) -> Site:
 # --------------------------------------------------------------------------- examples
 
 #: The built-in example: orbit and site catalog entries and the pass window (UTC), found
-#: with :mod:`sbrdf_xr._build_observe`: the site in astronomical darkness (Sun below
+#: with ``tools/build_observe.py``: the site in astronomical darkness (Sun below
 #: -25 deg), the spacecraft between 27 and 76 deg elevation, leaving the Earth's shadow
 #: in the first minute (penumbra 01:20:46-01:21:00) and sunlit for the remaining four.
 CANX1_PASS = {

@@ -985,7 +985,7 @@ def canx1() -> Spacecraft:
     (side by side along y on +-X, stacked along z on +-Y), aluminium 6061-T6 frame rails along
     the side-face borders (5 mm on +-X, 10 mm vertical rails on +-Y, so the Y sides carry more
     aluminium) and white paint elsewhere; 684 facets (paper: 698).  Built by
-    :mod:`sbrdf_xr._build_canx1`, shipped as ``catalogs/spacecraft/canx1.ply``.
+    ``tools/build_canx1.py``, shipped as ``catalogs/spacecraft/canx1.ply``.
 
     Returns
     -------
