@@ -37,6 +37,15 @@ from ._names import (
     WAVELENGTH,
     attrs,
 )
+from .construction import (
+    azimuthal_average,
+    blend_weights,
+    extend_grid,
+    lut_edges,
+    paper_delta_theta_grid,
+    paper_phi_grid,
+    per_theta_tables,
+)
 from .errors import NonPhysicalWarning, ValidationError
 from .material_io import open_material, open_measurements, to_netcdf, write_netcdf_atomic
 from .material_schema import (
@@ -72,7 +81,6 @@ __all__ = [
 ]
 
 LOOKUP_METHODS = tuple(_lut.LOOKUP_METHODS)
-
 
 
 def lookup(
@@ -212,59 +220,6 @@ def _lookup_core(
 
 
 # ----------------------------------------------------------- measurements
-
-
-
-def paper_phi_grid(phi_max: float, n: int = 21) -> np.ndarray:
-    """Uniform ``phi`` grid of paper 000 §3.2: ``n`` points from 0 to ``phi_max`` [degree]."""
-    if not phi_max > 0:
-        raise ValidationError(f"phi_max: must be > 0 degree, got {phi_max}")
-    return np.linspace(0.0, float(phi_max), n)
-
-
-def paper_delta_theta_grid(dt_min: float, dt_max: float, n: int = 21) -> np.ndarray:
-    """``delta_theta`` grid of paper 000 §3.2: 0 at the median, ``dt_min/10`` and
-    ``dt_max/10`` steps on either side (for ``n = 21``) [degree]."""
-    if not (dt_min < 0 < dt_max):
-        raise ValidationError(
-            f"delta_theta: measured extent must straddle specular (min < 0 < max), got [{dt_min}, {dt_max}]"
-        )
-    if n < 3 or n % 2 == 0:
-        raise ValidationError(f"n_delta_theta: must be odd and >= 3, got {n}")
-    half = n // 2
-    return np.concatenate([np.linspace(dt_min, 0.0, half + 1)[:-1], np.linspace(0.0, dt_max, half + 1)])
-
-
-def _interp_weights(
-    x_data: np.ndarray, x_out: np.ndarray, hold_lo: bool = False, hold_hi: bool = False
-) -> np.ndarray:
-    """Matrix (len(x_out), len(x_data)) of linear interpolation.
-
-    Outside the data the result is zero (the edge is a reference point, where the
-    signal is in the noise), or the edge value where ``hold_lo``/``hold_hi`` says the
-    edge is a measured point that only the apparatus kept from going further.
-    """
-    order = np.argsort(x_data, kind="stable")
-    xs = x_data[order]
-    w = np.zeros((x_out.size, x_data.size))
-    lo = x_out < xs[0] - _lut.EDGE_TOL_DEG
-    hi = x_out > xs[-1] + _lut.EDGE_TOL_DEG
-    rows = np.arange(x_out.size)
-    if xs.size == 1:
-        hit = ~lo & ~hi
-    else:
-        idx, wt = _lut.axis_weights(xs, x_out, "linear")
-        hit = np.zeros(x_out.size, dtype=bool)
-        inside = ~lo & ~hi
-        for k in range(2):
-            np.add.at(w, (rows[inside], order[idx[inside, k]]), wt[inside, k])
-    if xs.size == 1:
-        w[hit, order[0]] = 1.0
-    if hold_lo:
-        w[lo, order[0]] = 1.0
-    if hold_hi:
-        w[hi, order[-1]] = 1.0
-    return w
 
 
 def build_lut(
@@ -445,27 +400,27 @@ def build_lut(
             "edge_delta_theta_max": "zero" if np.all(ref[dt_s == dt_s.max()]) else "hold",
             "edge_phi_max": "zero" if np.all(ref[ph_s == ph_s.max()]) else "hold",
         }
-        per_theta = _per_theta(measured_ti, ti_s, dt_s, ph_s, spectra, ref, dt_grid, phi_grid)
+        per_theta = per_theta_tables(measured_ti, ti_s, dt_s, ph_s, spectra, ref, dt_grid, phi_grid)
         spline_mode = "linear" if extrapolation == "model" else extrapolation
         e = _lut.smoothing_spline_matrix(measured_ti, ti_out, lam, spline_mode)
         lut = np.tensordot(e, per_theta, axes=(1, 0))
         np.maximum(lut, 0.0, out=lut)
         if extrapolation == "model":
-            w = _blend_weights(ti_out, measured_ti[0], measured_ti[-1], blend)
+            w = blend_weights(ti_out, measured_ti[0], measured_ti[-1], blend)
             rows = np.flatnonzero(w > 0)
             if rows.size:
                 filled = _model_rows(fit_model, ti_out[rows], dt_grid, phi_grid, wl)
                 wr = w[rows][:, None, None, None]
                 lut[rows] = (1.0 - wr) * lut[rows] + wr * filled
     else:
-        dt_grid = _extend(dt_grid, -180.0, 90.0)
-        phi_grid = _extend(phi_grid, phi_grid[0], 90.0)
+        dt_grid = extend_grid(dt_grid, -180.0, 90.0)
+        phi_grid = extend_grid(phi_grid, phi_grid[0], 90.0)
         # Beyond -180/90 and phi = 90 lies the far side of the horizon: nothing to hold.
         edges = {"edge_delta_theta_min": "zero", "edge_delta_theta_max": "zero", "edge_phi_max": "zero"}
         truth_s = _model_at(fit_model, ti_s, dt_s, ph_s, wl)
         ok = ~ref
         ratio = np.divide(spectra, truth_s, out=np.ones_like(spectra), where=truth_s > 0)
-        per_theta = _per_theta(measured_ti, ti_s[ok], dt_s[ok], ph_s[ok], ratio[ok],
+        per_theta = per_theta_tables(measured_ti, ti_s[ok], dt_s[ok], ph_s[ok], ratio[ok],
                                np.zeros(int(ok.sum()), dtype=bool), dt_grid, phi_grid, hold_all=True)
         spline_mode = "constant" if extrapolation == "model" else extrapolation
         e = _lut.smoothing_spline_matrix(measured_ti, ti_out, lam, spline_mode)
@@ -474,7 +429,7 @@ def build_lut(
         if extrapolation == "model":
             # Towards grazing incidence the measured ratio does not carry over (the
             # lobe meets the horizon): the model alone, reached over ``blend`` degrees.
-            w = _blend_weights(ti_out, -np.inf, measured_ti[-1], blend)[:, None, None, None]
+            w = blend_weights(ti_out, -np.inf, measured_ti[-1], blend)[:, None, None, None]
             r_lut = (1.0 - w) * r_lut + w
         lut = _model_rows(fit_model, ti_out, dt_grid, phi_grid, wl) * r_lut
         if extrapolation == "model":
@@ -485,7 +440,7 @@ def build_lut(
         if extrapolation == "model" and below_noise == "zero":
             extra["blend_width"] = blend
     if normal_incidence == "symmetric" and ti_out[0] == 0.0:
-        lut[0] = _azimuthal_average(lut[0], dt_grid, phi_grid, _lut_edges(edges))
+        lut[0] = azimuthal_average(lut[0], dt_grid, phi_grid, lut_edges(edges))
         extra["normal_incidence_blend"] = float(blend_normal)
 
     name = material or ds.attrs.get("material", "unnamed")
@@ -537,8 +492,6 @@ BELOW_NOISE = ("zero", "model")
 #: Reflectance above ``1 + ENERGY_TOL`` is reported by :func:`build_lut` (the
 #: quadrature of a float32 table is good to ~1e-7).
 ENERGY_TOL = 1e-6
-#: Largest step of the nodes that extend a table's grids to the horizon [degree].
-EXTENSION_STEP = 5.0
 
 
 def _bound_grazing_rows(
@@ -557,81 +510,6 @@ def _bound_grazing_rows(
                                                   zero_edges=(True, True, True))
     scale = np.where(rho_t > rho_m, rho_m / np.maximum(rho_t, 1e-300), 1.0)
     lut[rows] *= scale[:, None, None, :]
-
-
-def _lut_edges(edges: dict[str, str]) -> tuple[bool, bool, bool]:
-    return _lut.table_edges(edges)
-
-
-def _extend(grid: np.ndarray, lo: float, hi: float) -> np.ndarray:
-    """``grid`` with nodes at most :data:`EXTENSION_STEP` apart added out to ``[lo, hi]``."""
-    parts = [grid]
-    if grid[0] > lo:
-        n = int(np.ceil((grid[0] - lo) / EXTENSION_STEP))
-        parts.insert(0, np.linspace(lo, grid[0], n + 1)[:-1])
-    if grid[-1] < hi:
-        n = int(np.ceil((hi - grid[-1]) / EXTENSION_STEP))
-        parts.append(np.linspace(grid[-1], hi, n + 1)[1:])
-    return np.concatenate(parts)
-
-
-def _per_theta(
-    measured_ti: np.ndarray, ti_s: np.ndarray, dt_s: np.ndarray, ph_s: np.ndarray,
-    spectra: np.ndarray, ref: np.ndarray, dt_grid: np.ndarray, phi_grid: np.ndarray,
-    *, hold_all: bool = False,
-) -> np.ndarray:
-    """Steps 1 and 2 of the construction: every measured incidence angle on the grid.
-
-    ``hold_all`` holds every edge (for interpolating ratios, which have no zero
-    reference points).
-    """
-    n_wl = spectra.shape[1]
-    per_theta = np.zeros((measured_ti.size, dt_grid.size, phi_grid.size, n_wl))
-    for a, t in enumerate(measured_ti):
-        in_t = np.flatnonzero(ti_s == t)
-        rows = np.unique(dt_s[in_t])
-        if rows.size < (1 if hold_all else 2):
-            raise ValidationError(
-                f"delta_theta: theta_i = {t} has measurements at a single delta_theta; need >= 2"
-            )
-        # Step 1: phi interpolation within every delta_theta row of this theta_i.
-        row_vals = np.zeros((rows.size, phi_grid.size, n_wl))
-        row_ref = np.zeros(rows.size, dtype=bool)
-        row_n = np.zeros(rows.size, dtype=int)
-        for r, d in enumerate(rows):
-            sel = in_t[dt_s[in_t] == d]
-            edge = sel[np.argmax(ph_s[sel])]
-            # A row measured at phi = 0 only (the in-plane delta_theta extents of the
-            # scheme) says nothing about phi > 0: it is not held out of the plane.
-            hold = hold_all or (sel.size > 1 and not ref[edge])
-            w = _interp_weights(ph_s[sel], phi_grid, hold_lo=hold_all, hold_hi=hold)  # (n_phi, n_sel)
-            row_vals[r] = w @ spectra[sel]
-            row_ref[r] = bool(np.all(ref[sel]))
-            row_n[r] = sel.size
-        if not hold_all:
-            # A measured (apparatus-limited) in-plane extent borrows the phi profile of the
-            # nearest fully measured row, scaled to its own in-plane value.
-            full = np.flatnonzero(row_n > 1)
-            for r in np.flatnonzero((row_n == 1) & ~row_ref):
-                if full.size == 0:
-                    break
-                adj = full[np.argmin(np.abs(full - r))]
-                base = row_vals[adj, 0]
-                scale = np.divide(row_vals[r, 0], base, out=np.zeros_like(base), where=base > 0)
-                row_vals[r, 1:] = row_vals[adj, 1:] * scale
-        # Step 2: delta_theta interpolation for every grid phi.
-        w = _interp_weights(rows, dt_grid, hold_lo=hold_all or not row_ref[0],
-                            hold_hi=hold_all or not row_ref[-1])
-        per_theta[a] = np.einsum("dr,rpl->dpl", w, row_vals)
-    return per_theta
-
-
-def _blend_weights(ti: np.ndarray, lo: float, hi: float, width: float) -> np.ndarray:
-    """Weight of the fitted model: 0 inside [lo, hi], rising smoothly to 1 over ``width``
-    degrees outside (a cubic smoothstep, so the table stays continuous in theta_i)."""
-    d = np.maximum(lo - ti, 0.0) + np.maximum(ti - hi, 0.0)
-    x = np.clip(d / width, 0.0, 1.0) if width > 0 else (d > 0).astype(float)
-    return x * x * (3.0 - 2.0 * x)
 
 
 def _model_for(model: xr.Dataset, wl: np.ndarray) -> xr.Dataset:
@@ -654,33 +532,6 @@ def _model_at(
 ) -> np.ndarray:
     """A model material's spectra at sample geometries (1-D angle arrays)."""
     return models.spectra(_model_for(model, wl), ti, dt, ph)
-
-
-#: Gauss-Legendre nodes of the azimuthal average at normal incidence.
-_N_AZIMUTH = 64
-
-
-def _azimuthal_average(
-    row: np.ndarray, dt: np.ndarray, ph: np.ndarray, zero_edges: tuple[bool, bool, bool]
-) -> np.ndarray:
-    """The ``theta_i = 0`` row replaced by its average over the illumination-plane azimuth.
-
-    At normal incidence an observer at polar angle ``theta_r`` and azimuth ``psi``
-    from the (arbitrary) plane has ``delta_theta = atan2(sin theta_r cos psi,
-    cos theta_r)`` and ``phi = asin(sin theta_r |sin psi|)``; every node of the
-    row becomes the mean over ``psi`` in ``[0, pi]`` of the linearly interpolated
-    row along the contour of its own ``theta_r``.
-    """
-    x, w = np.polynomial.legendre.leggauss(_N_AZIMUTH)
-    psi = 0.5 * np.pi * (x + 1.0)
-    w = w / 2.0  # mean over [0, pi]: the weights sum to 1
-    tr = np.radians(_lut.observer_polar_angle(0.0, dt[:, None], ph[None, :]))  # (n_dt, n_phi)
-    c_dt = np.degrees(np.arctan2(np.sin(tr)[..., None] * np.cos(psi), np.cos(tr)[..., None]))
-    c_ph = np.degrees(np.arcsin(np.clip(np.sin(tr)[..., None] * np.sin(psi), 0.0, 1.0)))
-    table = np.stack([row, row])
-    vals = _lut.lookup_kernel(table, np.array([0.0, 1.0]), dt, ph, 0.0, c_dt, c_ph, "linear",
-                              zero_edges=zero_edges)  # (n_dt, n_phi, n_psi, n_wl)
-    return np.einsum("dpql,q->dpl", vals, w)
 
 
 # ------------------------------------------------------------- reflectance

@@ -9,7 +9,7 @@ not run).
 * L0, kernels and names: ``_version``, ``_names``, ``errors``, ``geometry``, ``_lut``, ``_kernels``,
   ``sources``, ``brdf`` (and its models), ``imperfections``, ``knobs``, ``_catalog_index``
   (where the shipped files are; it loads nothing).
-* L1, the domain: ``material_schema``, ``material_io``, ``models``, ``material``,
+* L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``models``, ``material``,
   ``goniometer``, ``spacecraft``, ``visibility``, ``attitude``, ``observe``, ``photometry``
   (and its modules), ``fingerprint``.
 * L2: ``catalog`` (knows every kind's loader in L1).
@@ -33,7 +33,7 @@ PACKAGE = Path(__file__).resolve().parent.parent / "sbrdf_xr"
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("_version", "_names", "errors", "geometry", "_lut", "_kernels", "sources", "brdf", "imperfections",
      "knobs", "_catalog_index"),
-    ("material_schema", "material_io", "models", "material", "goniometer", "spacecraft",
+    ("material_schema", "material_io", "construction", "models", "material", "goniometer", "spacecraft",
      "visibility", "attitude", "observe", "photometry", "fingerprint"),
     ("catalog",),
     ("effects", "plan", "sweep", "scene"),
@@ -107,7 +107,7 @@ def layer_of(mod: str) -> int:
         for i, layer in enumerate(LAYERS):
             if name in layer:
                 return i
-        if not name:
+        if not name or "." not in name:
             raise KeyError(mod)
         name = name.rpartition(".")[0]
 
@@ -158,6 +158,8 @@ def against_flow(graph: dict[str, set[str]]) -> list[str]:
 
 
 def test_every_module_has_a_layer():
+    with pytest.raises(KeyError):
+        layer_of("a_new_module")
     missing = []
     for mod in import_graph():
         try:
