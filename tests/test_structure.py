@@ -8,9 +8,9 @@ not run).
 
 * L0, kernels and names: ``_version``, ``_names``, ``errors``, ``geometry``, ``_lut``, ``_kernels``,
   ``sources``, ``brdf`` (and its models), ``imperfections``, ``knobs``, ``_catalog_index``
-  (where the shipped files are; it loads nothing).
+  (where the shipped files are; it loads nothing), ``_shadow_kernels``.
 * L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``models``, ``material``,
-  ``goniometer``, ``spacecraft``, ``visibility``, ``attitude``, ``observe``, ``photometry``
+  ``goniometer``, ``mesh_io``, ``spacecraft``, ``visibility``, ``attitude``, ``orbits``, ``observe``, ``photometry``
   (and its modules), ``fingerprint``.
 * L2: ``catalog`` (knows every kind's loader in L1).
 * L3, the scene and its plan: ``effects``, ``plan``, ``sweep``, ``scene``.
@@ -32,9 +32,9 @@ PACKAGE = Path(__file__).resolve().parent.parent / "sbrdf_xr"
 
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("_version", "_names", "errors", "geometry", "_lut", "_kernels", "sources", "brdf", "imperfections",
-     "knobs", "_catalog_index"),
-    ("material_schema", "material_io", "construction", "models", "material", "goniometer", "spacecraft",
-     "visibility", "attitude", "observe", "photometry", "fingerprint"),
+     "knobs", "_catalog_index", "_shadow_kernels"),
+    ("material_schema", "material_io", "construction", "models", "material", "goniometer", "mesh_io", "spacecraft",
+     "visibility", "attitude", "orbits", "observe", "photometry", "fingerprint"),
     ("catalog",),
     ("effects", "plan", "sweep", "scene"),
     ("simulate", "_writer"),
