@@ -308,7 +308,7 @@ def build_lut(
         pieces, as the paper's spline evaluation did (the source of the
         discontinuities its §4.2 reports); ``linear`` and ``constant`` are milder.
         ``model`` (beyond the paper) fits the Robertson-Sandford model (paper 001)
-        to the measurements (:func:`sbrdf_xr.brdf.robertson_sandford.fit_robertson_sandford`)
+        to the measurements (:func:`sbrdf_xr.brdf.robertson_sandford_fit.fit_robertson_sandford`)
         and lets it fill the unmeasurable range, blended into the linearly
         extrapolated spline over ``blend`` degrees with a smoothstep weight.  With
         ``below_noise="model"`` the model carries the table everywhere and this

@@ -341,7 +341,7 @@ def measure(spec: xr.Dataset, theta_i: Sequence[float], **kwargs: Any) -> xr.Dat
 def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Dataset:
     """Fit the Robertson-Sandford model (paper 001) to a measurement set.
 
-    Wraps :func:`sbrdf_xr.brdf.robertson_sandford.fit_robertson_sandford`
+    Wraps :func:`sbrdf_xr.brdf.robertson_sandford_fit.fit_robertson_sandford`
     (log-residual least squares; ``rho_D`` and ``epsilon`` per wavelength, shared
     ``b`` and ``e``) and returns a model material with the standard uncertainties
     as variables ``u_rho_D``, ``u_epsilon``, ``u_b``, ``u_e`` and the reduced
@@ -363,12 +363,13 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
     """
     from ._names import MEASURED, SAMPLE
     from .brdf import robertson_sandford as rs
+    from .brdf import robertson_sandford_fit
     from .material_schema import _reference, validate_measurements
 
     ds = validate_measurements(measurements, duplicates="mean")
     wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
     spectra = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64)
-    fit = rs.fit_robertson_sandford(ds[THETA_I].values, ds[DELTA_THETA].values, ds[PHI].values,
+    fit = robertson_sandford_fit.fit_robertson_sandford(ds[THETA_I].values, ds[DELTA_THETA].values, ds[PHI].values,
                                     wl, spectra, reference=_reference(ds), **kwargs)
     p = {k: np.asarray(fit[k], dtype=np.float64) for k in rs.PARAMS}
     g_b = float(rs.normalisation_G(p["b"]))
