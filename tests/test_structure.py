@@ -6,15 +6,17 @@ layer either).  Imports are read from the source with :mod:`ast`, at module leve
 inside functions alike; only those under ``if TYPE_CHECKING:`` are left out (they do
 not run).
 
-* L0, kernels and names: ``_version``, ``_names``, ``errors``, ``geometry``, ``_lut``, ``_kernels``,
-  ``sources``, ``brdf`` (and its models), ``imperfections``, ``knobs``, ``_catalog_index``
-  (where the shipped files are; it loads nothing), ``_shadow_kernels``.
-* L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``models``, ``material``,
-  ``goniometer``, ``mesh_io``, ``spacecraft``, ``visibility``, ``attitude``, ``orbits``, ``observe``, ``photometry``
-  (and its modules), ``fingerprint``.
+* L0, kernels and names: ``_version``, ``_names``, ``errors``, ``geometry``, ``_lut``,
+  ``_kernels``, ``sources``, ``brdf`` (and its models), ``imperfections``, ``knobs``,
+  ``_catalog_index`` (where the shipped files are; it loads nothing), ``_shadow_kernels``.
+* L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``models``,
+  ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``visibility``,
+  ``attitude_frames``, ``attitude``, ``orbits``, ``observe``, ``photometry`` (and its
+  modules), ``fingerprint``.
 * L2: ``catalog`` (knows every kind's loader in L1).
-* L3, the scene and its plan: ``effects``, ``plan``, ``sweep``, ``scene``.
-* L4, the cube: ``simulate``, ``_writer``.
+* L3, the scene and its plan: ``effects``, ``plan``, ``sweep``, ``scene_model`` (the
+  :class:`Scene`), ``scene_io`` (scene files, built-in scenes), ``scene`` (re-exports both).
+* L4, the cube: ``simulate``, ``_writer`` and its parts ``_write_common``, ``_runners``, ``_lock``.
 * L5, users of everything: ``bench``, ``bench_engine``, ``shadow_bench``, ``plot``,
   ``accessors``, ``cli``, ``testing`` and the package's ``__init__``.
 
@@ -31,13 +33,14 @@ import pytest
 PACKAGE = Path(__file__).resolve().parent.parent / "sbrdf_xr"
 
 LAYERS: tuple[tuple[str, ...], ...] = (
-    ("_version", "_names", "errors", "geometry", "_lut", "_kernels", "sources", "brdf", "imperfections",
-     "knobs", "_catalog_index", "_shadow_kernels"),
-    ("material_schema", "material_io", "construction", "models", "material", "goniometer", "mesh_io", "spacecraft",
-     "visibility", "attitude", "orbits", "observe", "photometry", "fingerprint"),
+    ("_version", "_names", "errors", "geometry", "_lut", "_kernels", "sources", "brdf",
+     "imperfections", "knobs", "_catalog_index", "_shadow_kernels"),
+    ("material_schema", "material_io", "construction", "models", "material", "goniometer",
+     "mesh_io", "spacecraft", "visibility", "attitude_frames", "attitude", "orbits", "observe",
+     "photometry", "fingerprint"),
     ("catalog",),
-    ("effects", "plan", "sweep", "scene"),
-    ("simulate", "_writer"),
+    ("effects", "plan", "sweep", "scene_model", "scene_io", "scene"),
+    ("simulate", "_writer", "_write_common", "_runners", "_lock"),
     ("bench", "bench_engine", "shadow_bench", "plot", "accessors", "cli", "testing", ""),
 )
 
