@@ -8,7 +8,8 @@ not run).
 
 * L0, kernels and names: ``_version``, ``_names``, ``errors``, ``geometry``, ``_lut``,
   ``_kernels``, ``sources``, ``brdf`` (and its models), ``imperfections``, ``knobs``,
-  ``_catalog_index`` (where the shipped files are; it loads nothing), ``_shadow_kernels``.
+  ``_catalog_index`` (where the shipped files are; it loads nothing), ``_shadow_kernels``,
+  ``_cache`` (tables built on load, cached on disk).
 * L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``models``,
   ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``visibility``,
   ``attitude_frames``, ``attitude``, ``orbits``, ``observe``, ``photometry`` (and its
@@ -17,7 +18,8 @@ not run).
 * L3, the scene and its plan: ``effects``, ``plan``, ``sweep``, ``scene_model`` (the
   :class:`Scene`), ``scene_io`` (scene files, built-in scenes), ``scene`` (re-exports both).
 * L4, the cube: ``simulate``, ``_writer`` and its parts ``_write_common``, ``_runners``, ``_lock``.
-* L5, users of everything: ``bench``, ``bench_engine``, ``shadow_bench``, ``plot``,
+* L5, users of everything: ``invert`` (and its modules), ``bench``, ``bench_engine``,
+  ``shadow_bench``, ``plot``,
   ``accessors``, ``cli``, ``testing`` and the package's ``__init__``.
 
 A new module must be given a layer here.
@@ -34,14 +36,14 @@ PACKAGE = Path(__file__).resolve().parent.parent / "sbrdf_xr"
 
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("_version", "_names", "errors", "geometry", "_lut", "_kernels", "sources", "brdf",
-     "imperfections", "knobs", "_catalog_index", "_shadow_kernels"),
+     "imperfections", "knobs", "_catalog_index", "_shadow_kernels", "_cache"),
     ("material_schema", "material_io", "construction", "models", "material", "goniometer",
      "mesh_io", "spacecraft", "visibility", "attitude_frames", "attitude", "orbits", "observe",
      "photometry", "fingerprint"),
     ("catalog",),
     ("effects", "plan", "sweep", "scene_model", "scene_io", "scene"),
     ("simulate", "_writer", "_write_common", "_runners", "_lock"),
-    ("bench", "bench_engine", "shadow_bench", "plot", "accessors", "cli", "testing", ""),
+    ("invert", "bench", "bench_engine", "shadow_bench", "plot", "accessors", "cli", "testing", ""),
 )
 
 
