@@ -9,9 +9,8 @@ points: :func:`build_lut` and :func:`lookup` (materials), :func:`load_spacecraft
 
 from __future__ import annotations
 
-__version__ = "0.1.0"
-
 from . import accessors, catalog, errors, geometry, material  # noqa: F401
+from ._version import __version__
 from .material import (
     build_lut,
     constant_material,

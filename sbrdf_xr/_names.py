@@ -173,7 +173,7 @@ def cf_finish(ds: Any, *, history: str | None = None) -> Any:
 
     import numpy as np
 
-    from . import __version__
+    from ._version import __version__
 
     out = ds.copy()
     bad = re.compile(r"[^A-Za-z0-9_]")

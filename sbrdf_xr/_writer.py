@@ -96,33 +96,55 @@ Encoding
 from __future__ import annotations
 
 import contextlib
-import contextvars
 import dataclasses
-import datetime
 import errno
 import hashlib
 import json
-import logging
 import math
 import os
-import socket
 import stat
 import sys
 import time
-from collections import deque
 from collections.abc import Callable, Hashable, Mapping
-from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from pathlib import Path
 from typing import Any
 
-import dask
 import dask.array as da
 import netCDF4
 import numpy as np
 import xarray as xr
-from dask.system import CPU_COUNT
 
 from . import fingerprint as _fingerprint
+from ._lock import (
+    _Lock,
+)
+from ._runners import (
+    _check_address,
+    _runner,
+    connect,
+)
+from ._write_common import (
+    _SPACE_MARGIN,
+    _SYNC_NAMES,
+    _THREAD_NAMES,
+    LOCK_SUFFIX,
+    LOG_SUFFIX,
+    PART_SUFFIX,
+    BlockWritten,
+    CubeLockedError,
+    CubeWriteError,
+    SchedulerError,
+    _again,
+    _discard,
+    _file_size_limit,
+    _fix,
+    _log,
+    _mib,
+    _NoRoom,
+    _opt,
+    _reason,
+    command_line_messages,
+)
 from .errors import SbrdfError, ValidationError
 
 __all__ = [
@@ -139,14 +161,7 @@ __all__ = [
     "write_cube",
 ]
 
-_log = logging.getLogger("sbrdf_xr.write_cube")
 
-#: Suffix of the temporary file the cube is written to before the final rename.
-PART_SUFFIX = ".part"
-#: Suffix of the bookkeeping sidecar (JSON lines) of an unfinished cube.
-LOG_SUFFIX = ".part.jsonl"
-#: Suffix of the exclusive writer lock held while a cube is being written.
-LOCK_SUFFIX = ".lock"
 #: Global attributes that may change between an interrupted run and its resume.
 VOLATILE_ATTRS = frozenset(
     {"history", "date_created", "date_modified", "date_issued", "date_metadata_modified"}
@@ -157,85 +172,12 @@ _FORMAT_VERSION = 1
 #: Largest HDF5 chunk of a streamed variable [byte]; larger Dask chunks are split.
 _HDF5_CHUNK_BYTES = 8 * 2**20
 _NUMERIC_KINDS = "iuf"
-_SYNC_NAMES = ("sync", "synchronous", "single-threaded")
-_THREAD_NAMES = ("threads", "threading")
 
 
-class CubeWriteError(SbrdfError):
-    """A cube could not be written, or an unfinished ``.part`` cannot be resumed."""
-
-
-class CubeLockedError(CubeWriteError):
-    """Another writer holds the lock of this cube (``<path>.lock``)."""
-
-
-class SchedulerError(SbrdfError):
-    """A Dask scheduler address that is malformed or cannot be reached."""
-
-
-#: Free space [byte] kept beyond a block's raw size for HDF5 metadata (chunk index,
-#: object headers, superblock) written with it.
-_SPACE_MARGIN = 256 * 2**10
 #: Whether each block's room on the file system is checked before it is written.
 _CHECK_SPACE = True
 #: Bytes at the start of a ``.part`` (the HDF5 superblock) saved after each sync.
 _HEAD_BYTES = 4096
-#: Seconds a lock file without readable content counts as being created, not stale.
-_LOCK_GRACE = 10.0
-
-_STYLE: contextvars.ContextVar[str] = contextvars.ContextVar("sbrdf_xr_option_style", default="python")
-
-
-@contextlib.contextmanager
-def command_line_messages() -> Any:
-    """Within this context, messages name command-line options (``--resume``), not arguments."""
-    token = _STYLE.set("cli")
-    try:
-        yield
-    finally:
-        _STYLE.reset(token)
-
-
-def _opt(name: str) -> str:
-    """``--resume`` on the command line, ``resume=True`` in Python."""
-    return f"--{name}" if _STYLE.get() == "cli" else f"{name}=True"
-
-
-def _discard() -> str:
-    if _STYLE.get() == "cli":
-        return "run again with --overwrite (without --resume) to discard it and start again"
-    return "pass overwrite=True, resume=False to discard it and start again"
-
-
-def _again() -> str:
-    if _STYLE.get() == "cli":
-        return "run the same command again with --resume"
-    return "call write_cube again with resume=True"
-
-
-@dataclasses.dataclass(frozen=True)
-class BlockWritten:
-    """What :func:`write_cube` passes to ``on_block`` after each block is committed.
-
-    Attributes
-    ----------
-    index : int
-        Block number (C order over the grid of chunks).
-    slices : dict of str to slice
-        Position of the block along each chunked dimension.
-    n_written : int
-        Blocks committed so far, including those of an earlier, resumed run.
-    n_blocks : int
-        Blocks in the cube.
-    in_flight : int
-        Blocks submitted for computation but not yet written, after this one.
-    """
-
-    index: int
-    slices: dict[str, slice]
-    n_written: int
-    n_blocks: int
-    in_flight: int
 
 
 # ------------------------------------------------------------------ planning
@@ -663,176 +605,6 @@ def _fsync_dir(directory: Path) -> None:
 # ------------------------------------------------------------------ runners
 
 
-class _SyncRunner:
-    """Compute each block in the calling thread when its result is asked for."""
-
-    def __init__(self) -> None:
-        self.queue: deque[tuple[int, Any]] = deque()
-        self.n_workers = 1
-
-    @property
-    def pending(self) -> int:
-        return len(self.queue)
-
-    def submit(self, k: int, task: tuple[dict[Any, Any], Any]) -> None:
-        self.queue.append((k, task))
-
-    def next_done(self) -> tuple[int, Any]:
-        return self.queue.popleft()
-
-    def result(self, task: tuple[dict[Any, Any], Any]) -> tuple[np.ndarray, ...]:
-        return dask.get(*task)
-
-    def close(self) -> None:
-        self.queue.clear()
-
-
-class _ThreadRunner:
-    """A pool of threads, each computing whole blocks with Dask's synchronous scheduler."""
-
-    def __init__(self, n_threads: int) -> None:
-        self.n_workers = n_threads
-        self.pool = ThreadPoolExecutor(n_threads, thread_name_prefix="write_cube")
-        self.futures: dict[Future[Any], int] = {}
-
-    @property
-    def pending(self) -> int:
-        return len(self.futures)
-
-    def submit(self, k: int, task: tuple[dict[Any, Any], Any]) -> None:
-        self.futures[self.pool.submit(dask.get, *task)] = k
-
-    def next_done(self) -> tuple[int, Future[Any]]:
-        done, _ = wait(self.futures, return_when=FIRST_COMPLETED)
-        fut = min(done, key=self.futures.__getitem__)
-        return self.futures.pop(fut), fut
-
-    def result(self, fut: Future[Any]) -> tuple[np.ndarray, ...]:
-        return fut.result()
-
-    def close(self) -> None:
-        self.pool.shutdown(wait=True, cancel_futures=True)
-        self.futures.clear()
-
-
-class _DistributedRunner:
-    """Blocks submitted to a Dask cluster; results gathered by the writing process."""
-
-    def __init__(self, client: Any, owned: bool) -> None:
-        from distributed import as_completed
-
-        self.client = client
-        self.owned = owned
-        self.done = as_completed(loop=client.loop)
-        self.futures: dict[str, tuple[int, Any]] = {}
-        self.n_workers = max(1, sum(client.nthreads().values()))
-
-    @property
-    def pending(self) -> int:
-        return len(self.futures)
-
-    def submit(self, k: int, task: tuple[dict[Any, Any], Any]) -> None:
-        fut = self.client.get(task[0], task[1], sync=False)
-        self.futures[fut.key] = (k, fut)
-        self.done.add(fut)
-
-    def next_done(self) -> tuple[int, Any]:
-        fut = next(self.done)
-        k, _ = self.futures.pop(fut.key)
-        return k, fut
-
-    def result(self, fut: Any) -> tuple[np.ndarray, ...]:
-        try:
-            return fut.result()
-        finally:
-            fut.release()
-
-    def close(self) -> None:
-        with contextlib.suppress(Exception):
-            self.done.clear()
-            if self.futures:
-                self.client.cancel([f for _, f in self.futures.values()])
-        self.futures.clear()
-        if self.owned:
-            self.client.close()
-
-
-def _runner(client: Any, scheduler: str | None) -> _SyncRunner | _ThreadRunner | _DistributedRunner:
-    if client is not None and scheduler is not None:
-        raise ValidationError("pass either client or scheduler, not both")
-    if client is not None:
-        return _DistributedRunner(client, owned=False)
-    if scheduler is None or scheduler in _THREAD_NAMES:
-        n = dask.config.get("num_workers", None) or CPU_COUNT
-        return _ThreadRunner(max(1, int(n)))
-    if scheduler in _SYNC_NAMES:
-        return _SyncRunner()
-    return _DistributedRunner(connect(scheduler), owned=True)
-
-
-_SCHEMES = ("tcp", "tls", "ucx", "ws", "wss")
-
-
-def _check_address(address: Any) -> str:
-    """``address`` as a ``scheme://host:port`` string, or :class:`ValidationError`."""
-    if _STYLE.get() == "cli":
-        allowed = "expected the address of a Dask scheduler such as 'tcp://127.0.0.1:8786'"
-        name = "--scheduler"
-    else:
-        allowed = ("allowed: None or 'threads' (in-process threads), 'synchronous', or the address "
-                   "of a Dask scheduler such as 'tcp://127.0.0.1:8786'")
-        name = "scheduler"
-    if not isinstance(address, str) or not address.isprintable() or any(c.isspace() for c in address):
-        raise ValidationError(f"{name}: got {address!r}; {allowed}")
-    scheme, sep, rest = address.rpartition("://")
-    if not sep:
-        scheme, rest = "tcp", address
-    host, colon, port = rest.rpartition(":")
-    if scheme not in _SCHEMES or not colon or not host or not port.isdigit() or not 0 < int(port) < 65536:
-        raise ValidationError(f"{name}: got {address!r}; {allowed} (port 1-65535)")
-    if host.startswith("[") != host.endswith("]"):
-        raise ValidationError(f"{name}: got {address!r}; {allowed}")
-    return f"{scheme}://{host}:{port}"
-
-
-def connect(address: str, timeout: float | str | None = None) -> Any:
-    """A :class:`distributed.Client` connected to the scheduler at ``address``.
-
-    Parameters
-    ----------
-    address : str
-        ``tcp://host:port`` (or ``host:port``; schemes ``tcp``, ``tls``, ``ucx``,
-        ``ws``, ``wss``).
-    timeout : float or str, optional
-        Seconds (or a Dask time string) to wait for the scheduler; default the Dask
-        setting ``distributed.comm.timeouts.connect``.
-
-    Raises
-    ------
-    ValidationError
-        A malformed address.
-    SchedulerError
-        No scheduler answers at that address in time, or ``distributed`` is missing.
-    """
-    address = _check_address(address)
-    try:
-        from distributed import Client
-    except ImportError as exc:  # pragma: no cover - distributed is a test dependency
-        raise SchedulerError(
-            f"scheduler {address!r} needs the 'distributed' package (pip install sbrdf-xr[distributed])"
-        ) from exc
-    if timeout is None:
-        timeout = dask.config.get("distributed.comm.timeouts.connect", "30s")
-    try:
-        return Client(address, set_as_default=False, timeout=timeout)
-    except (OSError, ValueError, TypeError) as exc:
-        what = "timed out" if isinstance(exc, TimeoutError) else type(exc).__name__
-        raise SchedulerError(
-            f"cannot connect to the Dask scheduler at {address} ({what}: {exc}); start one with "
-            "'dask scheduler --host 127.0.0.1' or check the address"
-        ) from exc
-
-
 # ------------------------------------------------------------------ progress
 
 
@@ -880,74 +652,6 @@ def _progress(enabled: bool, total: int, initial: int, desc: str) -> Any:
 
 
 # -------------------------------------------------------------------- write
-
-
-def _reason(exc: BaseException, part: Path | None = None) -> str:
-    """The cause of an I/O failure in words ("no space left on device", ...)."""
-    code = getattr(exc, "errno", None)
-    words = _ERRNO_WORDS.get(code) if isinstance(code, int) else None
-    if words is None and part is not None:
-        words = _diagnose(part)
-    if words is None:
-        return f"{type(exc).__name__}: {exc}"
-    detail = getattr(exc, "strerror", None) if isinstance(exc, _NoRoom) else None
-    return f"{words} ({detail})" if detail else words
-
-
-_ERRNO_WORDS = {
-    errno.ENOSPC: "no space left on device",
-    errno.EFBIG: "file size limit exceeded",
-    errno.EDQUOT: "disk quota exceeded",
-    errno.EACCES: "permission denied",
-    errno.EPERM: "operation not permitted",
-    errno.EROFS: "read-only file system",
-    errno.EIO: "input/output error",
-    errno.ENOENT: "no such file or directory",
-    errno.ENOTDIR: "not a directory",
-    errno.EISDIR: "is a directory",
-}
-_FIXES = {
-    "no space left on device": "free some space",
-    "file size limit exceeded": "raise the file size limit (ulimit -f)",
-    "disk quota exceeded": "free some space within your quota",
-}
-
-
-def _fix(reason: str) -> str:
-    return next((v for k, v in _FIXES.items() if reason.startswith(k)), "fix the cause")
-
-
-def _diagnose(part: Path) -> str | None:
-    """Why a write into ``part`` may have failed when HDF5 does not say (it reports "HDF error")."""
-    try:
-        st = os.statvfs(part.parent)
-        free = (st.f_bfree if os.geteuid() == 0 else st.f_bavail) * st.f_frsize
-        if free < _SPACE_MARGIN:
-            return "no space left on device"
-    except (OSError, AttributeError):
-        pass
-    limit = _file_size_limit()
-    with contextlib.suppress(OSError):
-        if limit is not None and part.stat().st_size + _SPACE_MARGIN > limit:
-            return "file size limit exceeded"
-    return None
-
-
-def _file_size_limit() -> int | None:
-    try:
-        import resource
-    except ImportError:  # pragma: no cover - not on POSIX
-        return None
-    soft, _ = resource.getrlimit(resource.RLIMIT_FSIZE)
-    return None if soft == resource.RLIM_INFINITY else int(soft)
-
-
-class _NoRoom(OSError):
-    """Raised before a write that would not fit: nothing was written."""
-
-
-def _mib(n: float) -> str:
-    return f"{n / 2**20:.1f} MiB"
 
 
 def _check_room(part: Path, need: int) -> None:
@@ -1020,153 +724,6 @@ def _block_bytes(plan: _Plan) -> int:
 
 
 # --------------------------------------------------------------------- lock
-
-
-def _pid_alive(pid: Any) -> bool:
-    if not isinstance(pid, int) or pid <= 0:
-        return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    except (OverflowError, OSError):
-        return False
-    return True
-
-
-def _try_flock(fd: int) -> bool | None:
-    """True if this process now holds ``flock`` on ``fd``, False if another holds it, None if unsupported."""
-    try:
-        import fcntl
-    except ImportError:  # pragma: no cover - not on POSIX
-        return None
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        return False
-    except OSError:
-        return None
-    return True
-
-
-_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
-
-
-class _Lock:
-    """Exclusive writer lock of one cube: ``<path>.lock``.
-
-    Taken by creating the file atomically (``O_CREAT | O_EXCL``), holding ``flock`` on
-    it for the life of the write, and recording the holder's pid, host and start
-    time inside.  A lock left by a writer that died (SIGKILL, power loss) is stale:
-    on the same host its pid is no longer running and nobody holds its ``flock``;
-    it is then removed with a logged message.  A lock from another host is never
-    removed automatically (its pid cannot be checked from here).
-    """
-
-    def __init__(self, path: Path, target: Path) -> None:
-        self.path, self.target = path, target
-        self.fd = -1
-        self.ino = -1
-
-    def acquire(self) -> None:
-        for _ in range(8):
-            try:
-                fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_EXCL | _NOFOLLOW, 0o644)
-            except FileExistsError:
-                self._clear_stale()
-                continue
-            except OSError as exc:
-                raise CubeWriteError(f"cannot write {self.target}: creating the lock {self.path} "
-                                     f"failed: {_reason(exc)}") from exc
-            try:
-                for _ in range(50):  # a stale-lock check may hold it for an instant
-                    if _try_flock(fd) is not False:
-                        break
-                    time.sleep(0.01)
-                info = {"pid": os.getpid(), "host": socket.gethostname(), "cube": str(self.target),
-                        "started": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")}
-                os.write(fd, (json.dumps(info) + "\n").encode())
-                os.fsync(fd)
-                self.ino = os.fstat(fd).st_ino
-            except BaseException as exc:
-                os.close(fd)
-                with contextlib.suppress(OSError):
-                    os.unlink(self.path)
-                if isinstance(exc, OSError):
-                    raise CubeWriteError(f"cannot write {self.target}: writing the lock {self.path} "
-                                         f"failed: {_reason(exc, self.path)}") from exc
-                raise
-            self.fd = fd
-            return
-        raise CubeLockedError(f"{self.target}: the lock {self.path} keeps being taken by other writers")
-
-    def _locked(self, info: Mapping[str, Any] | None) -> CubeLockedError:
-        who = (f"pid {info.get('pid')} on host {info.get('host')}, started {info.get('started')}"
-               if info else "a writer that is starting")
-        return CubeLockedError(
-            f"{self.target} is being written by another writer ({who}; lock {self.path}); "
-            "wait for it to finish or stop it, or write to another file"
-        )
-
-    def _clear_stale(self) -> None:
-        try:
-            fd = os.open(self.path, os.O_RDWR | _NOFOLLOW)
-        except FileNotFoundError:
-            return
-        except OSError as exc:
-            raise CubeLockedError(
-                f"{self.path} exists and cannot be used as a lock ({_reason(exc)}); "
-                f"remove it if no writer of {self.target} is running"
-            ) from exc
-        try:
-            held = _try_flock(fd)
-            st = os.fstat(fd)
-            raw = os.pread(fd, 4096, 0) if hasattr(os, "pread") else b""
-            try:
-                info = json.loads(raw.decode())
-                info = info if isinstance(info, dict) else None
-            except (ValueError, UnicodeDecodeError):
-                info = None
-            if held is False:
-                raise self._locked(info)
-            if info is None:
-                if time.time() - st.st_mtime < _LOCK_GRACE:
-                    raise self._locked(None)
-                why = "it names no owner"
-            else:
-                pid, host = info.get("pid"), info.get("host")
-                if host != socket.gethostname():
-                    raise CubeLockedError(
-                        f"{self.target} is locked by pid {pid} on host {host} (started "
-                        f"{info.get('started')}); whether that writer still runs cannot be checked "
-                        f"from {socket.gethostname()}. If it does not, remove {self.path} and try again"
-                    )
-                if held is None and _pid_alive(pid):
-                    raise self._locked(info)
-                why = (f"its writer, pid {pid} started {info.get('started')}, is no longer running"
-                       if not _pid_alive(pid) else f"pid {pid} no longer holds it")
-            try:
-                same = os.stat(self.path, follow_symlinks=False).st_ino == st.st_ino
-            except FileNotFoundError:
-                return
-            if same:
-                os.unlink(self.path)
-                _log.warning("removed the stale lock %s: %s (an interrupted write)", self.path, why)
-        finally:
-            os.close(fd)
-
-    def release(self) -> None:
-        if self.fd < 0:
-            return
-        try:
-            with contextlib.suppress(OSError):
-                if os.stat(self.path, follow_symlinks=False).st_ino == self.ino:
-                    os.unlink(self.path)
-        finally:
-            os.close(self.fd)
-            self.fd = -1
 
 
 # -------------------------------------------------------------------- write

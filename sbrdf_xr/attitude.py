@@ -41,7 +41,18 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation, Slerp
 
-from .errors import AttitudeError, ValidationError
+from .attitude_frames import (
+    NS_PER_S,
+    Context,
+    axis_vector,
+    check_epoch,
+    check_quaternion,
+    context_fields,
+    perpendicular_pair,
+    seconds_since,
+    triad,
+)
+from .errors import AttitudeError
 from .geometry import check_quaternions
 
 __all__ = [
@@ -63,164 +74,8 @@ __all__ = [
 #: Relative tolerance of the tumble integration (scipy ``solve_ivp``, DOP853).
 TUMBLE_RTOL = 1e-12
 
-#: Body axes by name.
-_AXES = {
-    "x": (1.0, 0.0, 0.0),
-    "y": (0.0, 1.0, 0.0),
-    "z": (0.0, 0.0, 1.0),
-}
-
-_NS_PER_S = 1e9
-
 
 # --------------------------------------------------------------------------- helpers
-
-
-def _axis(spec: str | ArrayLike, name: str) -> NDArray[np.float64]:
-    """A unit vector from ``"+x"``, ``"-z"``, ``"y"`` or three components."""
-    if isinstance(spec, str):
-        s = spec.strip().lower()
-        sign = -1.0 if s.startswith("-") else 1.0
-        key = s.lstrip("+-")
-        if key not in _AXES:
-            raise AttitudeError(f"{name}: got {spec!r}; allowed: +x, -x, +y, -y, +z, -z or 3 components")
-        return sign * np.asarray(_AXES[key])
-    try:
-        v = np.asarray(spec, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise AttitudeError(f"{name}: got {spec!r}; expected an axis name or 3 numbers") from None
-    n = np.linalg.norm(v) if v.shape == (3,) else 0.0
-    if v.shape != (3,) or not np.all(np.isfinite(v)) or n == 0:
-        raise AttitudeError(f"{name}: got {spec!r}; expected 3 finite components, not all zero")
-    return v / n
-
-
-def _quaternion(q: ArrayLike, name: str) -> NDArray[np.float64]:
-    try:
-        arr = check_quaternions(q)
-    except ValidationError as exc:
-        raise AttitudeError(f"{name}: {exc}") from None
-    if arr.shape != (4,):
-        raise AttitudeError(f"{name}: expected one quaternion of 4 components, got shape {arr.shape}")
-    return arr
-
-
-def _unit_rows(v: np.ndarray) -> np.ndarray:
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
-
-
-def triad(
-    body_primary: ArrayLike,
-    body_secondary: ArrayLike,
-    ref_primary: ArrayLike,
-    ref_secondary: ArrayLike,
-) -> NDArray[np.float64]:
-    """Rotations taking a body primary axis onto a reference direction (TRIAD).
-
-    ``R b1 = r1`` exactly, and ``R b2`` is the unit vector nearest ``r2`` that is
-    perpendicular to ``r1`` (Black 1964, the TRIAD algorithm).
-
-    Parameters
-    ----------
-    body_primary, body_secondary : array_like, shape (3,)
-        Perpendicular body axes [1].
-    ref_primary, ref_secondary : array_like, shape (n, 3)
-        Reference-frame directions [1]; ``ref_secondary`` must not be parallel to
-        ``ref_primary``.
-
-    Returns
-    -------
-    ndarray, shape (n, 4)
-        Scalar-last unit quaternions, body -> reference.
-    """
-    b1 = np.asarray(body_primary, float)
-    b2 = np.asarray(body_secondary, float)
-    r1 = _unit_rows(np.atleast_2d(np.asarray(ref_primary, float)))
-    r2 = np.atleast_2d(np.asarray(ref_secondary, float))
-    r2 = r2 - np.einsum("ni,ni->n", r2, r1)[:, None] * r1
-    norm = np.linalg.norm(r2, axis=-1)
-    bad = np.flatnonzero(norm < 1e-9 * np.linalg.norm(np.atleast_2d(ref_secondary), axis=-1).max())
-    if bad.size:
-        raise AttitudeError(
-            f"secondary direction parallel to the primary direction at time index {int(bad[0])}; "
-            "choose another secondary target"
-        )
-    r2 = r2 / norm[:, None]
-    m_body = np.stack([b1, b2, np.cross(b1, b2)], axis=-1)  # columns
-    m_ref = np.stack([r1, r2, np.cross(r1, r2)], axis=-1)  # (n, 3, 3) columns
-    return Rotation.from_matrix(m_ref @ m_body.T).as_quat().reshape(-1, 4)
-
-
-def _perpendicular_pair(primary: ArrayLike, secondary: ArrayLike, names: str) -> tuple[np.ndarray, np.ndarray]:
-    a, b = primary, secondary
-    if abs(float(np.dot(a, b))) > 1e-9:
-        raise AttitudeError(f"{names}: the two body axes must be perpendicular, got {a.tolist()} and {b.tolist()}")
-    return a, b
-
-
-@dataclass(frozen=True)
-class Context:
-    """What orbit-following laws need: the spacecraft's state and the Sun, per time.
-
-    Parameters
-    ----------
-    epoch : numpy.datetime64
-        Time origin of float times (UTC).
-    position_km : array_like, shape (n, 3)
-        Geocentric position of the spacecraft in the inertial frame [km].
-    velocity_km_s : array_like, shape (n, 3)
-        Its velocity [km s-1].
-    sun_km : array_like, shape (n, 3)
-        Position of the Sun relative to the spacecraft [km].
-    """
-
-    epoch: np.datetime64 | None = None
-    position_km: NDArray[np.float64] | None = None
-    velocity_km_s: NDArray[np.float64] | None = None
-    sun_km: NDArray[np.float64] | None = None
-
-
-def _seconds(times: ArrayLike, epoch: np.datetime64 | None, context: Context | None) -> NDArray[np.float64]:
-    """Float seconds of ``times`` from the law's epoch (see the module docstring)."""
-    t = np.atleast_1d(np.asarray(times))
-    if t.ndim != 1:
-        raise AttitudeError(f"times: expected a 1-D array, got shape {t.shape}")
-    if np.issubdtype(t.dtype, np.datetime64):
-        t = t.astype("datetime64[ns]")
-        origin = epoch if epoch is not None else (
-            context.epoch if context is not None and context.epoch is not None else t[0]
-        )
-        return (t - np.datetime64(origin, "ns")).astype(np.int64) / _NS_PER_S
-    if not np.issubdtype(t.dtype, np.number):
-        raise AttitudeError(f"times: expected datetime64 or seconds, got dtype {t.dtype}")
-    t = t.astype(np.float64)
-    if epoch is not None and context is not None and context.epoch is not None:
-        t = t + (np.datetime64(context.epoch, "ns") - np.datetime64(epoch, "ns")).astype(np.int64) / _NS_PER_S
-    return t
-
-
-def _need(context: Context | None, n: int, law: str, *fields: str) -> list[np.ndarray]:
-    if context is None:
-        raise AttitudeError(f"{law}: needs an orbit context ({', '.join(fields)}); use it inside an Observation")
-    out = []
-    for f in fields:
-        v = getattr(context, f)
-        if v is None:
-            raise AttitudeError(f"{law}: the context lacks {f}")
-        v = np.asarray(v, dtype=np.float64)
-        if v.shape != (n, 3):
-            raise AttitudeError(f"{law}: context {f} has shape {v.shape}, expected ({n}, 3)")
-        out.append(v)
-    return out
-
-
-def _epoch(epoch: Any) -> np.datetime64 | None:
-    if epoch is None:
-        return None
-    try:
-        return np.datetime64(epoch, "ns")
-    except (TypeError, ValueError):
-        raise AttitudeError(f"epoch: got {epoch!r}; expected a UTC time (ISO 8601 or datetime64)") from None
 
 
 # --------------------------------------------------------------------------- laws
@@ -263,7 +118,7 @@ class Inertial(AttitudeLaw):
     q: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "q", tuple(_quaternion(self.q, "inertial q").tolist()))
+        object.__setattr__(self, "q", tuple(check_quaternion(self.q, "inertial q").tolist()))
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         n = np.atleast_1d(np.asarray(times)).shape[0]
@@ -295,13 +150,13 @@ class Nadir(AttitudeLaw):
     def __post_init__(self) -> None:
         if not np.isfinite(self.yaw_deg):
             raise AttitudeError(f"nadir yaw_deg: must be finite, got {self.yaw_deg}")
-        a, b = _perpendicular_pair(_axis(self.nadir_axis, "nadir_axis"),
-                                   _axis(self.velocity_axis, "velocity_axis"), "nadir")
+        a, b = perpendicular_pair(axis_vector(self.nadir_axis, "nadir_axis"),
+                                   axis_vector(self.velocity_axis, "velocity_axis"), "nadir")
         object.__setattr__(self, "_axes", (a, b))
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         n = np.atleast_1d(np.asarray(times)).shape[0]
-        r, v = _need(context, n, "nadir", "position_km", "velocity_km_s")
+        r, v = context_fields(context, n, "nadir", "position_km", "velocity_km_s")
         a, b = self._axes  # type: ignore[attr-defined]
         q = triad(a, b, -r, v)
         if self.yaw_deg:
@@ -334,7 +189,7 @@ class SunPointing(AttitudeLaw):
     secondary_target: Any = "orbit_normal"
 
     def __post_init__(self) -> None:
-        a, b = _perpendicular_pair(_axis(self.axis, "axis"), _axis(self.secondary_axis, "secondary_axis"),
+        a, b = perpendicular_pair(axis_vector(self.axis, "axis"), axis_vector(self.secondary_axis, "secondary_axis"),
                                    "sun_pointing")
         tgt = self.secondary_target
         if isinstance(tgt, str):
@@ -344,15 +199,15 @@ class SunPointing(AttitudeLaw):
                     "or 3 components"
                 )
         else:
-            tgt = _axis(tgt, "secondary_target")
+            tgt = axis_vector(tgt, "secondary_target")
         object.__setattr__(self, "_axes", (a, b, tgt))
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         n = np.atleast_1d(np.asarray(times)).shape[0]
         a, b, tgt = self._axes  # type: ignore[attr-defined]
-        (sun,) = _need(context, n, "sun_pointing", "sun_km")
+        (sun,) = context_fields(context, n, "sun_pointing", "sun_km")
         if isinstance(tgt, str) and tgt != "north":
-            r, v = _need(context, n, "sun_pointing", "position_km", "velocity_km_s")
+            r, v = context_fields(context, n, "sun_pointing", "position_km", "velocity_km_s")
             target = {"orbit_normal": np.cross(r, v), "nadir": -r, "velocity": v}[tgt]
         else:
             target = np.tile([0.0, 0.0, 1.0] if isinstance(tgt, str) else tgt, (n, 1))
@@ -395,13 +250,13 @@ class Spin(AttitudeLaw):
             val = getattr(self, name)
             if not isinstance(val, int | float | np.floating | np.integer) or not np.isfinite(val):
                 raise AttitudeError(f"spin {name}: must be a finite number [degree], got {val!r}")
-        object.__setattr__(self, "_axis_vec", _axis(self.axis_body, "axis_body"))
+        object.__setattr__(self, "_axis_vec", axis_vector(self.axis_body, "axis_body"))
         object.__setattr__(self, "initial", _law_or_quaternion(self.initial, "initial"))
-        object.__setattr__(self, "epoch", _epoch(self.epoch))
+        object.__setattr__(self, "epoch", check_epoch(self.epoch))
 
     def angles(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         """Spin angle ``phase + rate t`` at ``times`` [degree]."""
-        return self.phase_deg + self.rate_deg_s * _seconds(times, self.epoch, context)
+        return self.phase_deg + self.rate_deg_s * seconds_since(times, self.epoch, context)
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         ang = np.radians(self.angles(times, context))
@@ -468,8 +323,8 @@ class Tumble(AttitudeLaw):
         if w.shape != (3,) or not np.all(np.isfinite(w)):
             raise AttitudeError(f"tumble omega_deg_s: expected 3 finite body rates [degree s-1], got {self.omega_deg_s!r}")
         object.__setattr__(self, "omega_deg_s", w)
-        object.__setattr__(self, "initial", _quaternion(self.initial, "tumble initial"))
-        object.__setattr__(self, "epoch", _epoch(self.epoch))
+        object.__setattr__(self, "initial", check_quaternion(self.initial, "tumble initial"))
+        object.__setattr__(self, "epoch", check_epoch(self.epoch))
 
     @classmethod
     def from_spacecraft(cls, spacecraft: Any, density_kg_m3: float, omega_deg_s: ArrayLike,
@@ -520,7 +375,7 @@ class Tumble(AttitudeLaw):
         """
         from scipy.integrate import solve_ivp
 
-        t = _seconds(times, self.epoch, context)
+        t = seconds_since(times, self.epoch, context)
         rhs = self._rhs_function()
         y0 = np.concatenate([np.radians(self.omega_deg_s), self.initial])
         out = np.empty((t.size, 7))
@@ -576,11 +431,11 @@ class QuaternionSeries(AttitudeLaw):
                 f"quaternion_series: need >= 2 times and as many quaternions (n, 4); got times "
                 f"{t.shape} and quaternions {None if q is None else q.shape}"
             )
-        epoch = _epoch(self.epoch)
+        epoch = check_epoch(self.epoch)
         if np.issubdtype(t.dtype, np.datetime64):
             t = t.astype("datetime64[ns]")
             epoch = t[0] if epoch is None else epoch
-            secs = (t - epoch).astype(np.int64) / _NS_PER_S
+            secs = (t - epoch).astype(np.int64) / NS_PER_S
         else:
             secs = t.astype(np.float64)
         if not np.all(np.diff(secs) > 0):
@@ -627,7 +482,7 @@ class QuaternionSeries(AttitudeLaw):
         return cls(da[da.dims[0]].values, da.values)
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
-        t = _seconds(times, self.epoch, context)
+        t = seconds_since(times, self.epoch, context)
         lo, hi = self._secs[0], self._secs[-1]  # type: ignore[attr-defined]
         if t.min() < lo or t.max() > hi:
             raise AttitudeError(

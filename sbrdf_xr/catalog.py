@@ -12,179 +12,93 @@ The catalog directory holds ``index.toml``, one ``[[entry]]`` table per item::
     provenance = "..."                   # where its numbers come from
 
 In a source checkout the directory is the top-level ``catalogs/``; an installed
-package carries a copy at ``sbrdf_xr/catalogs`` (see ``pyproject.toml``).  This
-module and :mod:`sbrdf_xr.cli` are the only places that read catalog files.
+package carries a copy at ``sbrdf_xr/catalogs`` (see ``pyproject.toml``).
+
+The catalog sits above the domain modules: it imports them and maps every kind to
+the function that builds its object from an entry (:data:`LOADERS`); none of them
+imports it (they read an entry's file given the entry, from
+:mod:`sbrdf_xr._catalog_index`).
 """
 
 from __future__ import annotations
 
-import tomllib
+import functools
 from collections.abc import Callable
-from dataclasses import dataclass
-from functools import cache
-from pathlib import Path
 from typing import Any
 
+import xarray as xr
+
+from . import material, models, observe, spacecraft
+from ._cache import cached_table
+from ._catalog_index import (
+    KINDS,
+    SOURCES,
+    CatalogEntry,
+    _index,  # noqa: F401  (re-exported: tools clear its cache after writing the index)
+    catalog_dir,
+    data_path,
+    entries,
+    entry,
+    names,
+)
 from .errors import CatalogError
 
-__all__ = ["CatalogEntry", "catalog_dir", "data_path", "entries", "entry", "load", "names"]
-
-KINDS = ("material", "measurements", "model", "paint_parameters", "spacecraft", "orbit", "site")
-SOURCES = ("measured", "synthetic")
-
-
-@dataclass(frozen=True)
-class CatalogEntry:
-    """One item of the catalog index.
-
-    Attributes
-    ----------
-    name, kind, path, source, description, provenance : str
-        Fields of the ``[[entry]]`` table (see the module docstring).
-    extra : dict
-        Any further fields of the table (for example the material of a model).
-    """
-
-    name: str
-    kind: str
-    path: str
-    source: str
-    description: str
-    provenance: str
-    extra: dict[str, Any]
-
-    @property
-    def file(self) -> Path:
-        """Absolute path of the entry's file."""
-        return data_path(self.path)
+__all__ = [
+    "KINDS",
+    "LOADERS",
+    "SOURCES",
+    "CatalogEntry",
+    "catalog_dir",
+    "data_path",
+    "entries",
+    "entry",
+    "load",
+    "names",
+]
 
 
-@cache
-def catalog_dir() -> Path:
-    """Directory holding the catalogs (installed copy first, then the source tree).
-
-    Returns
-    -------
-    pathlib.Path
-        Directory that contains ``index.toml``.
-
-    Raises
-    ------
-    CatalogError
-        If no catalog directory can be found.
-    """
-    here = Path(__file__).resolve().parent
-    for candidate in (here / "catalogs", here.parent / "catalogs"):
-        if (candidate / "index.toml").is_file():
-            return candidate
-    raise CatalogError(
-        f"no catalogs/index.toml found next to {here} or in its parent; "
-        "reinstall the package with 'pip install .'"
-    )
+def _load_material(e: CatalogEntry) -> xr.DataArray:
+    """A table file, or (``build_from`` set) a table built from a measurement entry."""
+    source = e.extra.get("build_from")
+    if source is None:
+        return material.open_material(e.file)
+    options = tuple(sorted(e.extra.get("build", {}).items()))
+    return _built_material(e.name, source, options).copy(deep=True)
 
 
-def data_path(relative: str | Path) -> Path:
-    """Absolute path of a file inside the catalog directory.
+@functools.lru_cache(maxsize=16)
+def _built_material(name: str, measurements: str, options: tuple[tuple[str, Any], ...]) -> xr.DataArray:
+    """A table built from a measurement entry, through the disk cache (:mod:`sbrdf_xr._cache`)."""
+    kw = dict(options)
+    inputs = [entry(measurements).file] + ([entry(kw["fit"]).file] if "fit" in kw else [])
 
-    Parameters
-    ----------
-    relative : str or Path
-        Path relative to the catalog directory.
+    def build() -> xr.DataArray:
+        opts = dict(kw)
+        if "fit" in opts:  # a model entry that fills the unmeasurable range
+            opts["model"] = load(opts.pop("fit"))
+        return material.build_lut(load(measurements), material=name, **opts)
 
-    Returns
-    -------
-    pathlib.Path
-        The absolute path.
-
-    Raises
-    ------
-    CatalogError
-        If the file does not exist.
-    """
-    path = catalog_dir() / relative
-    if not path.is_file():
-        raise CatalogError(f"catalog file {relative!s} does not exist in {catalog_dir()}")
-    return path
+    return cached_table(name, inputs, repr(options), build,
+                        lambda da, path: material.to_netcdf(da, path, overwrite=True),
+                        material.open_material)
 
 
-@cache
-def _index() -> tuple[CatalogEntry, ...]:
-    path = catalog_dir() / "index.toml"
-    try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:  # pragma: no cover - shipped file is tested
-        raise CatalogError(f"{path}: invalid TOML: {exc}") from exc
-    out = []
-    required = ("name", "kind", "path", "source", "description", "provenance")
-    for i, item in enumerate(raw.get("entry", [])):
-        missing = [k for k in required if k not in item]
-        if missing:
-            raise CatalogError(f"{path}: entry {i} lacks the field(s) {missing}")
-        if item["kind"] not in KINDS:
-            raise CatalogError(f"{path}: entry {item['name']!r} has kind {item['kind']!r}; allowed: {KINDS}")
-        src = item["source"]
-        if src not in SOURCES and not src.startswith("model:"):
-            raise CatalogError(
-                f"{path}: entry {item['name']!r} has source {src!r}; allowed: measured, synthetic, model:<name>"
-            )
-        extra = {k: v for k, v in item.items() if k not in required}
-        out.append(CatalogEntry(*(item[k] for k in required), extra=extra))
-    seen: set[str] = set()
-    for e in out:
-        if e.name in seen:
-            raise CatalogError(f"{path}: duplicate entry name {e.name!r}")
-        seen.add(e.name)
-    return tuple(out)
-
-
-def entries(kind: str | None = None) -> list[CatalogEntry]:
-    """All catalog entries, optionally of one kind.
-
-    Parameters
-    ----------
-    kind : str, optional
-        One of :data:`KINDS`.
-
-    Returns
-    -------
-    list of CatalogEntry
-    """
-    if kind is not None and kind not in KINDS:
-        raise CatalogError(f"unknown catalog kind {kind!r}; allowed: {', '.join(KINDS)}")
-    return [e for e in _index() if kind is None or e.kind == kind]
-
-
-def names(kind: str | None = None) -> list[str]:
-    """Names of the catalog entries, optionally of one kind."""
-    return [e.name for e in entries(kind)]
-
-
-def entry(name: str) -> CatalogEntry:
-    """The catalog entry called ``name``.
-
-    Raises
-    ------
-    CatalogError
-        If there is no such entry; the message lists the known names.
-    """
-    for e in _index():
-        if e.name == name:
-            return e
-    raise CatalogError(f"no catalog entry named {name!r}; known: {', '.join(names())}")
+def _load_paint_parameters(e: CatalogEntry) -> xr.Dataset:
+    with xr.open_dataset(e.file, engine="netcdf4") as ds:
+        return ds.load()
 
 
 #: Loader per kind: takes the entry, returns the loaded object.
-_LOADERS: dict[str, Callable[[CatalogEntry], Any]] = {}
-
-
-def register_loader(kind: str) -> Callable[[Callable[[CatalogEntry], Any]], Callable[[CatalogEntry], Any]]:
-    """Decorator registering the loader of one catalog kind (used inside the package)."""
-
-    def deco(func: Callable[[CatalogEntry], Any]) -> Callable[[CatalogEntry], Any]:
-        _LOADERS[kind] = func
-        return func
-
-    return deco
+LOADERS: dict[str, Callable[[CatalogEntry], Any]] = {
+    "material": _load_material,
+    "measurements": lambda e: material.open_measurements(e.file),
+    "model": lambda e: models.open_model(e.file),
+    "paint_parameters": _load_paint_parameters,
+    "spacecraft": spacecraft.load_catalog_entry,
+    "orbit": observe.load_orbit_entry,
+    "site": observe.load_site_entry,
+}
+assert set(LOADERS) == set(KINDS)
 
 
 def load(name: str) -> Any:
@@ -206,14 +120,8 @@ def load(name: str) -> Any:
         for ``site``.
     """
     e = entry(name)
-    _import_loaders()
     try:
-        loader = _LOADERS[e.kind]
-    except KeyError:  # pragma: no cover - every kind has a loader
+        loader = LOADERS[e.kind]
+    except KeyError:  # pragma: no cover - every kind has a loader (asserted above)
         raise CatalogError(f"no loader for catalog kind {e.kind!r}") from None
     return loader(e)
-
-
-def _import_loaders() -> None:
-    # Loaders live with the objects they build; importing registers them.
-    from . import material, models, observe, spacecraft  # noqa: F401

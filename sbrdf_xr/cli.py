@@ -27,7 +27,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from . import __version__, catalog
+from . import catalog
+from ._version import __version__
 from ._writer import LOG_SUFFIX, PART_SUFFIX, command_line_messages
 from .errors import SbrdfError, ValidationError
 

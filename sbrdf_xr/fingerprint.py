@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from . import __version__
+from ._version import __version__
 
 __all__ = ["PREFIX", "changes", "scene_fingerprint"]
 

@@ -18,27 +18,18 @@ This module wraps the pure-numpy kernels of :mod:`sbrdf_xr._lut`:
 
 from __future__ import annotations
 
-import functools
-import json
-import os
-import tempfile
 import warnings
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from . import _lut
+from . import _lut, models
 from ._names import (
     ANGLE_DIMS,
-    DEGREE,
     DELTA_THETA,
-    LUT_DIMS,
     MEASURED,
-    NM,
-    PER_SR,
     PHI,
     SAMPLE,
     SBRDF,
@@ -46,8 +37,29 @@ from ._names import (
     WAVELENGTH,
     attrs,
 )
-from .catalog import CatalogEntry, register_loader
+from .construction import (
+    azimuthal_average,
+    blend_weights,
+    extend_grid,
+    lut_edges,
+    paper_delta_theta_grid,
+    paper_phi_grid,
+    per_theta_tables,
+)
 from .errors import NonPhysicalWarning, ValidationError
+from .material_io import open_material, open_measurements, to_netcdf, write_netcdf_atomic
+from .material_schema import (
+    DUPLICATES,  # noqa: F401  (re-exported)
+    SOURCES,  # noqa: F401  (re-exported)
+    _average_duplicates,
+    _check_coord,
+    _reference,
+    constant_material,
+    lambertian,
+    new_material,
+    validate_material,
+    validate_measurements,
+)
 
 __all__ = [
     "LOOKUP_METHODS",
@@ -65,245 +77,10 @@ __all__ = [
     "to_netcdf",
     "validate_material",
     "validate_measurements",
+    "write_netcdf_atomic",
 ]
 
 LOOKUP_METHODS = tuple(_lut.LOOKUP_METHODS)
-SOURCES = ("measured", "synthetic")
-_UNITS = {THETA_I: DEGREE, DELTA_THETA: DEGREE, PHI: DEGREE, WAVELENGTH: NM}
-
-
-# ------------------------------------------------------------------ schema
-
-
-def _check_source(source: str) -> None:
-    if source not in SOURCES and not str(source).startswith("model:"):
-        raise ValidationError(
-            f"source: got {source!r}; allowed: 'measured', 'synthetic' or 'model:<name>'"
-        )
-
-
-def _check_coord(name: str, values: np.ndarray, *, strict: bool = True) -> None:
-    if values.ndim != 1:
-        raise ValidationError(f"{name}: coordinate must be 1-D, got shape {values.shape}")
-    if values.size == 0:
-        raise ValidationError(f"{name}: coordinate is empty")
-    if not np.issubdtype(values.dtype, np.number) or not np.all(np.isfinite(values)):
-        raise ValidationError(f"{name}: coordinate must be finite numbers")
-    if strict and np.any(np.diff(values) <= 0):
-        bad = int(np.flatnonzero(np.diff(values) <= 0)[0])
-        raise ValidationError(
-            f"{name}: coordinate must be strictly increasing; "
-            f"{values[bad]!r} is followed by {values[bad + 1]!r} at index {bad + 1}"
-        )
-
-
-def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.DataArray:
-    """Check that ``da`` is a valid material look-up table.
-
-    Parameters
-    ----------
-    da : xarray.DataArray
-        Candidate table.
-    check_values : bool, default True
-        Also check that every value is finite and non-negative (loads the values;
-        tables are small).
-
-    Returns
-    -------
-    xarray.DataArray
-        ``da`` with its dims in the canonical order ``(theta_i, delta_theta, phi,
-        wavelength)`` (a transpose, never a change of values).
-
-    Raises
-    ------
-    ValidationError
-        Naming the first problem found: wrong type or dims, missing or
-        non-monotonic coordinates, wrong units, angles out of their domain, NaN or
-        negative values.
-    """
-    if not isinstance(da, xr.DataArray):
-        raise ValidationError(f"material: expected an xarray.DataArray, got {type(da).__name__}")
-    if set(da.dims) != set(LUT_DIMS) or len(da.dims) != len(LUT_DIMS):
-        raise ValidationError(f"material: dims must be {LUT_DIMS}, got {da.dims}")
-    da = da.transpose(*LUT_DIMS)
-    for dim in LUT_DIMS:
-        if dim not in da.coords:
-            raise ValidationError(f"{dim}: coordinate is missing")
-        _check_coord(dim, np.asarray(da[dim].values))
-        units = da[dim].attrs.get("units")
-        if units != _UNITS[dim]:
-            raise ValidationError(f"{dim}: units must be {_UNITS[dim]!r}, got {units!r}")
-    if da.attrs.get("units") != PER_SR:
-        raise ValidationError(f"sbrdf: units must be {PER_SR!r}, got {da.attrs.get('units')!r}")
-    ti = da[THETA_I].values
-    if ti[0] < 0 or ti[-1] > 90:
-        raise ValidationError(f"theta_i: must lie in [0, 90] degree, got [{ti[0]}, {ti[-1]}]")
-    ph = da[PHI].values
-    if ph[0] < 0 or ph[-1] > 90:
-        raise ValidationError(f"phi: must lie in [0, 90] degree, got [{ph[0]}, {ph[-1]}]")
-    if da[WAVELENGTH].values[0] <= 0:
-        raise ValidationError("wavelength: must be positive")
-    if "source" in da.attrs:
-        _check_source(da.attrs["source"])
-    if check_values:
-        v = np.asarray(da.values)
-        if not np.all(np.isfinite(v)):
-            raise ValidationError(f"sbrdf: contains {int(np.sum(~np.isfinite(v)))} NaN or infinite values")
-        if np.any(v < 0):
-            raise ValidationError(
-                f"sbrdf: contains {int(np.sum(v < 0))} negative values (min {v.min():.3g}); a BRDF is >= 0"
-            )
-    return da
-
-
-def new_material(
-    values: ArrayLike,
-    theta_i: ArrayLike,
-    delta_theta: ArrayLike,
-    phi: ArrayLike,
-    wavelength: ArrayLike,
-    *,
-    material: str,
-    source: str,
-    provenance: str,
-    **parameters: Any,
-) -> xr.DataArray:
-    """Build a validated material ``DataArray`` from plain arrays.
-
-    Parameters
-    ----------
-    values : array_like, shape (n_theta_i, n_delta_theta, n_phi, n_wavelength)
-        sBRDF [sr-1].
-    theta_i, delta_theta, phi : array_like
-        Strictly increasing coordinates [degree].
-    wavelength : array_like
-        Strictly increasing vacuum wavelengths [nm].
-    material : str
-        Material name.
-    source : str
-        ``measured``, ``synthetic`` or ``model:<name>``.
-    provenance : str
-        Where the numbers come from.
-    **parameters
-        Construction parameters stored as attributes (numbers, strings, or
-        sequences of numbers; anything else is stored as JSON text).
-
-    Returns
-    -------
-    xarray.DataArray
-    """
-    _check_source(source)
-    coords = {
-        THETA_I: (THETA_I, np.asarray(theta_i, dtype=np.float64), attrs(THETA_I)),
-        DELTA_THETA: (DELTA_THETA, np.asarray(delta_theta, dtype=np.float64), attrs(DELTA_THETA)),
-        PHI: (PHI, np.asarray(phi, dtype=np.float64), attrs(PHI)),
-        WAVELENGTH: (WAVELENGTH, np.asarray(wavelength, dtype=np.float64), attrs(WAVELENGTH)),
-    }
-    a = attrs(SBRDF, material=material, source=source, provenance=provenance)
-    a.update({k: _attr_value(v) for k, v in parameters.items()})
-    da = xr.DataArray(np.asarray(values), dims=LUT_DIMS, coords=coords, name=SBRDF, attrs=a)
-    return validate_material(da)
-
-
-#: Grids of a constant table: two nodes per axis spanning every lit-and-visible geometry.
-_CONSTANT_GRIDS = (np.array([0.0, 90.0]), np.array([-180.0, 90.0]), np.array([0.0, 90.0]))
-
-
-def constant_material(
-    value: ArrayLike,
-    wavelength: ArrayLike,
-    *,
-    material: str,
-    provenance: str = "",
-    source: str = "synthetic",
-    **parameters: Any,
-) -> xr.DataArray:
-    """A table whose sBRDF is the same spectrum at every geometry.
-
-    Two nodes per angular axis spanning the whole lit-and-visible hemisphere
-    (``theta_i`` 0-90, ``delta_theta`` -180..90, ``phi`` 0-90 deg), all equal, so every
-    look-up method (``nearest``, ``linear``, ``cubic``: weights that sum to one)
-    returns ``value`` exactly at every geometry.
-
-    Parameters
-    ----------
-    value : array_like, scalar or shape (n_wavelength,)
-        sBRDF [sr-1], >= 0.
-    wavelength : array_like
-        Strictly increasing wavelengths [nm] (a scalar gives a one-wavelength table).
-    material : str
-        Name.
-    provenance, source : str
-        Attributes (see :func:`new_material`).
-    **parameters
-        Further attributes.
-
-    Returns
-    -------
-    xarray.DataArray
-    """
-    wl = np.atleast_1d(np.asarray(wavelength, dtype=np.float64))
-    v = np.asarray(value, dtype=np.float64)
-    if v.ndim > 1 or (v.ndim == 1 and v.size not in (1, wl.size)):
-        raise ValidationError(
-            f"value: expected a scalar or one value per wavelength ({wl.size}), got shape {v.shape}"
-        )
-    spec = np.broadcast_to(v, wl.shape)
-    grids = _CONSTANT_GRIDS
-    vals = np.broadcast_to(spec, (2, 2, 2, wl.size)).copy()
-    return new_material(vals, *grids, wl, material=material, source=source,
-                        provenance=provenance or "constant sBRDF at every geometry",
-                        normal_incidence="symmetric", normal_incidence_blend=0.0, **parameters)
-
-
-def lambertian(albedo: ArrayLike, wavelength: ArrayLike, *, material: str | None = None) -> xr.DataArray:
-    """An ideal Lambertian (perfectly diffuse) material: ``f_r = albedo / pi`` everywhere.
-
-    Exact for every look-up method (:func:`constant_material`); its
-    directional-hemispherical reflectance is ``albedo`` at every incidence angle
-    (paper 001 §2: a perfectly diffuse, 100 % reflecting sample has a BRDF of
-    ``1/pi`` sr-1).
-
-    Parameters
-    ----------
-    albedo : array_like, scalar or shape (n_wavelength,)
-        Directional-hemispherical reflectance [1], ``0 <= albedo <= 1``.
-    wavelength : array_like
-        Wavelengths [nm].
-    material : str, optional
-        Name; default ``lambertian-<albedo>`` for a scalar albedo, ``lambertian``
-        otherwise.
-
-    Returns
-    -------
-    xarray.DataArray
-    """
-    from .brdf import lambert
-
-    wl = np.atleast_1d(np.asarray(wavelength, dtype=np.float64))
-    rho = lambert.check_params(wl, rho=albedo)["rho"]
-    scalar = np.ndim(albedo) == 0
-    name = material or (f"lambertian-{float(albedo):g}" if scalar else "lambertian")
-    return constant_material(
-        rho / np.pi, wl, material=name, source="model:lambert",
-        provenance=f"ideal Lambertian reflector, f_r = albedo / pi ({'albedo ' + format(float(albedo), 'g') if scalar else 'spectral albedo'})",
-        model="lambert", albedo=float(albedo) if scalar else rho,
-    )
-
-
-def _attr_value(v: Any) -> Any:
-    """netCDF-storable form of an attribute value (bools and containers as JSON)."""
-    if isinstance(v, bool) or v is None or isinstance(v, dict):
-        return json.dumps(v)
-    if isinstance(v, str | int | float | np.number):
-        return v
-    arr = np.asarray(v)
-    if arr.ndim == 1 and np.issubdtype(arr.dtype, np.number):
-        return arr
-    return json.dumps(v, default=str)
-
-
-# ------------------------------------------------------------------ lookup
 
 
 def lookup(
@@ -445,186 +222,6 @@ def _lookup_core(
 # ----------------------------------------------------------- measurements
 
 
-#: Policies for repeated measurement geometries (:func:`validate_measurements`).
-DUPLICATES = ("error", "mean")
-
-
-def _geometry_groups(ds: xr.Dataset) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Group samples by geometry (angles equal to 1e-9 degree): the group of every sample,
-    the first sample of every group and the group sizes."""
-    key = np.stack([np.round(np.asarray(ds[d].values, dtype=np.float64), 9)
-                    for d in (THETA_I, DELTA_THETA, PHI)], axis=1)
-    _, first, groups, counts = np.unique(key, axis=0, return_index=True, return_inverse=True,
-                                         return_counts=True)
-    return groups.ravel(), first, counts
-
-
-def _average_duplicates(ds: xr.Dataset) -> xr.Dataset:
-    """One sample per geometry: the mean spectrum of its measured (non-reference) repeats;
-    a reference point only if every repeat is one."""
-    groups, first, counts = _geometry_groups(ds)
-    if np.all(counts == 1):
-        return ds
-    ref = _reference(ds)
-    spectra = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64)
-    n_meas = np.bincount(groups, weights=(~ref).astype(float), minlength=first.size)
-    total = np.zeros((first.size, spectra.shape[1]))
-    np.add.at(total, groups[~ref], spectra[~ref])
-    mean = total / np.maximum(n_meas, 1.0)[:, None]
-    order = np.sort(first)
-    pos = np.searchsorted(order, first)  # group -> position of its first sample
-    out = ds.isel({SAMPLE: order}).copy()
-    out[MEASURED] = ((SAMPLE, WAVELENGTH), np.empty((order.size, spectra.shape[1])), ds[MEASURED].attrs)
-    out[MEASURED].values[pos] = mean
-    out["reference"] = (SAMPLE, np.zeros(order.size, dtype=bool), attrs("reference"))
-    out["reference"].values[pos] = n_meas == 0
-    out.attrs["duplicates"] = f"mean of repeated geometries ({int(np.sum(counts > 1))} averaged)"
-    return out
-
-
-def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Dataset:
-    """Check a goniospectrometer measurement set.
-
-    Schema: dims ``sample`` and ``wavelength``; a data variable ``measured_sbrdf``
-    ``(sample, wavelength)`` [sr-1]; coordinates ``theta_i``, ``delta_theta``,
-    ``phi`` over ``sample`` [degree] and ``wavelength`` [nm]; an optional boolean
-    ``reference`` over ``sample`` marking the reference points of paper 000 §3.1
-    (where the reflectance is indistinguishable from noise and is taken as zero;
-    their spectra are ignored and treated as zero).
-
-    Parameters
-    ----------
-    ds : xarray.Dataset
-        Candidate measurement set.
-    duplicates : {"error", "mean"}, default "error"
-        A geometry measured more than once is an error naming it (``"error"``),
-        or allowed (``"mean"``: :func:`build_lut` averages the repeats).
-
-    Returns
-    -------
-    xarray.Dataset
-        ``ds`` unchanged.
-
-    Raises
-    ------
-    ValidationError
-        Naming the first problem found.
-    """
-    if not isinstance(ds, xr.Dataset):
-        raise ValidationError(f"measurements: expected an xarray.Dataset, got {type(ds).__name__}")
-    if MEASURED not in ds:
-        raise ValidationError(f"measurements: lacks the data variable {MEASURED!r}")
-    da = ds[MEASURED]
-    if set(da.dims) != {SAMPLE, WAVELENGTH}:
-        raise ValidationError(f"{MEASURED}: dims must be ('sample', 'wavelength'), got {da.dims}")
-    if da.attrs.get("units") != PER_SR:
-        raise ValidationError(f"{MEASURED}: units must be {PER_SR!r}, got {da.attrs.get('units')!r}")
-    if ds.sizes[SAMPLE] == 0:
-        raise ValidationError("measurements: the set is empty (no samples)")
-    for name in (THETA_I, DELTA_THETA, PHI):
-        if name not in ds.coords and name not in ds:
-            raise ValidationError(f"{name}: coordinate over 'sample' is missing")
-        c = ds[name]
-        if c.dims != (SAMPLE,):
-            raise ValidationError(f"{name}: must be over ('sample',), got {c.dims}")
-        _check_coord(name, np.asarray(c.values), strict=False)
-        if c.attrs.get("units") != DEGREE:
-            raise ValidationError(f"{name}: units must be 'degree', got {c.attrs.get('units')!r}")
-    if WAVELENGTH not in ds.coords:
-        raise ValidationError("wavelength: coordinate is missing")
-    _check_coord(WAVELENGTH, np.asarray(ds[WAVELENGTH].values))
-    if ds[WAVELENGTH].attrs.get("units") != NM:
-        raise ValidationError(f"wavelength: units must be 'nm', got {ds[WAVELENGTH].attrs.get('units')!r}")
-    ti = ds[THETA_I].values
-    if np.any((ti < 0) | (ti >= 90)):
-        raise ValidationError("theta_i: measured incidence angles must lie in [0, 90) degree")
-    if np.any(ds[PHI].values < 0):
-        raise ValidationError("phi: must be >= 0 (unsigned angle from the illumination plane)")
-    if duplicates not in DUPLICATES:
-        raise ValidationError(f"duplicates: got {duplicates!r}; allowed: {', '.join(DUPLICATES)}")
-    groups, first, counts = _geometry_groups(ds)
-    if duplicates == "error" and np.any(counts > 1):
-        dup = np.flatnonzero(counts > 1)
-        k = int(first[dup[0]])
-        where = np.flatnonzero(groups == dup[0])
-        raise ValidationError(
-            f"measurements: {int(np.sum(counts[dup]))} of {ds.sizes[SAMPLE]} samples repeat "
-            f"{dup.size} geometr{'y' if dup.size == 1 else 'ies'} (first: theta_i = "
-            f"{float(ds[THETA_I].values[k])}, delta_theta = {float(ds[DELTA_THETA].values[k])}, "
-            f"phi = {float(ds[PHI].values[k])} deg in samples {where[:10].tolist()}); a geometry must be "
-            "measured once, or pass duplicates='mean' to average the repeats"
-        )
-    ref = _reference(ds)
-    v = np.asarray(da.transpose(SAMPLE, WAVELENGTH).values)[~ref]
-    if not np.all(np.isfinite(v)):
-        bad = np.flatnonzero(~np.all(np.isfinite(np.asarray(da.transpose(SAMPLE, WAVELENGTH).values)), axis=1) & ~ref)
-        raise ValidationError(f"{MEASURED}: NaN or infinite values in sample(s) {bad[:10].tolist()}")
-    if np.any(v < 0):
-        raise ValidationError(f"{MEASURED}: contains negative values; a BRDF is >= 0")
-    return ds
-
-
-def _reference(ds: xr.Dataset) -> np.ndarray:
-    if "reference" in ds:
-        ref = np.asarray(ds["reference"].values)
-        if ref.dtype != bool:
-            ref = ref.astype(bool)
-        return ref
-    return np.zeros(ds.sizes[SAMPLE], dtype=bool)
-
-
-def paper_phi_grid(phi_max: float, n: int = 21) -> np.ndarray:
-    """Uniform ``phi`` grid of paper 000 §3.2: ``n`` points from 0 to ``phi_max`` [degree]."""
-    if not phi_max > 0:
-        raise ValidationError(f"phi_max: must be > 0 degree, got {phi_max}")
-    return np.linspace(0.0, float(phi_max), n)
-
-
-def paper_delta_theta_grid(dt_min: float, dt_max: float, n: int = 21) -> np.ndarray:
-    """``delta_theta`` grid of paper 000 §3.2: 0 at the median, ``dt_min/10`` and
-    ``dt_max/10`` steps on either side (for ``n = 21``) [degree]."""
-    if not (dt_min < 0 < dt_max):
-        raise ValidationError(
-            f"delta_theta: measured extent must straddle specular (min < 0 < max), got [{dt_min}, {dt_max}]"
-        )
-    if n < 3 or n % 2 == 0:
-        raise ValidationError(f"n_delta_theta: must be odd and >= 3, got {n}")
-    half = n // 2
-    return np.concatenate([np.linspace(dt_min, 0.0, half + 1)[:-1], np.linspace(0.0, dt_max, half + 1)])
-
-
-def _interp_weights(
-    x_data: np.ndarray, x_out: np.ndarray, hold_lo: bool = False, hold_hi: bool = False
-) -> np.ndarray:
-    """Matrix (len(x_out), len(x_data)) of linear interpolation.
-
-    Outside the data the result is zero (the edge is a reference point, where the
-    signal is in the noise), or the edge value where ``hold_lo``/``hold_hi`` says the
-    edge is a measured point that only the apparatus kept from going further.
-    """
-    order = np.argsort(x_data, kind="stable")
-    xs = x_data[order]
-    w = np.zeros((x_out.size, x_data.size))
-    lo = x_out < xs[0] - _lut.EDGE_TOL_DEG
-    hi = x_out > xs[-1] + _lut.EDGE_TOL_DEG
-    rows = np.arange(x_out.size)
-    if xs.size == 1:
-        hit = ~lo & ~hi
-    else:
-        idx, wt = _lut.axis_weights(xs, x_out, "linear")
-        hit = np.zeros(x_out.size, dtype=bool)
-        inside = ~lo & ~hi
-        for k in range(2):
-            np.add.at(w, (rows[inside], order[idx[inside, k]]), wt[inside, k])
-    if xs.size == 1:
-        w[hit, order[0]] = 1.0
-    if hold_lo:
-        w[lo, order[0]] = 1.0
-    if hold_hi:
-        w[hi, order[-1]] = 1.0
-    return w
-
-
 def build_lut(
     measurements: xr.Dataset,
     *,
@@ -711,7 +308,7 @@ def build_lut(
         pieces, as the paper's spline evaluation did (the source of the
         discontinuities its §4.2 reports); ``linear`` and ``constant`` are milder.
         ``model`` (beyond the paper) fits the Robertson-Sandford model (paper 001)
-        to the measurements (:func:`sbrdf_xr.brdf.robertson_sandford.fit_robertson_sandford`)
+        to the measurements (:func:`sbrdf_xr.brdf.robertson_sandford_fit.fit_robertson_sandford`)
         and lets it fill the unmeasurable range, blended into the linearly
         extrapolated spline over ``blend`` degrees with a smoothstep weight.  With
         ``below_noise="model"`` the model carries the table everywhere and this
@@ -794,9 +391,7 @@ def build_lut(
     extra: dict[str, Any] = {}
     fit_model = model
     if (extrapolation == "model" or below_noise == "model") and fit_model is None:
-        from .models import fit_robertson_sandford
-
-        fit_model = fit_robertson_sandford(ds)
+        fit_model = models.fit_robertson_sandford(ds)
 
     if below_noise == "zero":
         # Table edges: zero beyond them if the extreme samples are reference points.
@@ -805,27 +400,27 @@ def build_lut(
             "edge_delta_theta_max": "zero" if np.all(ref[dt_s == dt_s.max()]) else "hold",
             "edge_phi_max": "zero" if np.all(ref[ph_s == ph_s.max()]) else "hold",
         }
-        per_theta = _per_theta(measured_ti, ti_s, dt_s, ph_s, spectra, ref, dt_grid, phi_grid)
+        per_theta = per_theta_tables(measured_ti, ti_s, dt_s, ph_s, spectra, ref, dt_grid, phi_grid)
         spline_mode = "linear" if extrapolation == "model" else extrapolation
         e = _lut.smoothing_spline_matrix(measured_ti, ti_out, lam, spline_mode)
         lut = np.tensordot(e, per_theta, axes=(1, 0))
         np.maximum(lut, 0.0, out=lut)
         if extrapolation == "model":
-            w = _blend_weights(ti_out, measured_ti[0], measured_ti[-1], blend)
+            w = blend_weights(ti_out, measured_ti[0], measured_ti[-1], blend)
             rows = np.flatnonzero(w > 0)
             if rows.size:
                 filled = _model_rows(fit_model, ti_out[rows], dt_grid, phi_grid, wl)
                 wr = w[rows][:, None, None, None]
                 lut[rows] = (1.0 - wr) * lut[rows] + wr * filled
     else:
-        dt_grid = _extend(dt_grid, -180.0, 90.0)
-        phi_grid = _extend(phi_grid, phi_grid[0], 90.0)
+        dt_grid = extend_grid(dt_grid, -180.0, 90.0)
+        phi_grid = extend_grid(phi_grid, phi_grid[0], 90.0)
         # Beyond -180/90 and phi = 90 lies the far side of the horizon: nothing to hold.
         edges = {"edge_delta_theta_min": "zero", "edge_delta_theta_max": "zero", "edge_phi_max": "zero"}
         truth_s = _model_at(fit_model, ti_s, dt_s, ph_s, wl)
         ok = ~ref
         ratio = np.divide(spectra, truth_s, out=np.ones_like(spectra), where=truth_s > 0)
-        per_theta = _per_theta(measured_ti, ti_s[ok], dt_s[ok], ph_s[ok], ratio[ok],
+        per_theta = per_theta_tables(measured_ti, ti_s[ok], dt_s[ok], ph_s[ok], ratio[ok],
                                np.zeros(int(ok.sum()), dtype=bool), dt_grid, phi_grid, hold_all=True)
         spline_mode = "constant" if extrapolation == "model" else extrapolation
         e = _lut.smoothing_spline_matrix(measured_ti, ti_out, lam, spline_mode)
@@ -834,7 +429,7 @@ def build_lut(
         if extrapolation == "model":
             # Towards grazing incidence the measured ratio does not carry over (the
             # lobe meets the horizon): the model alone, reached over ``blend`` degrees.
-            w = _blend_weights(ti_out, -np.inf, measured_ti[-1], blend)[:, None, None, None]
+            w = blend_weights(ti_out, -np.inf, measured_ti[-1], blend)[:, None, None, None]
             r_lut = (1.0 - w) * r_lut + w
         lut = _model_rows(fit_model, ti_out, dt_grid, phi_grid, wl) * r_lut
         if extrapolation == "model":
@@ -845,7 +440,7 @@ def build_lut(
         if extrapolation == "model" and below_noise == "zero":
             extra["blend_width"] = blend
     if normal_incidence == "symmetric" and ti_out[0] == 0.0:
-        lut[0] = _azimuthal_average(lut[0], dt_grid, phi_grid, _lut_edges(edges))
+        lut[0] = azimuthal_average(lut[0], dt_grid, phi_grid, lut_edges(edges))
         extra["normal_incidence_blend"] = float(blend_normal)
 
     name = material or ds.attrs.get("material", "unnamed")
@@ -897,8 +492,6 @@ BELOW_NOISE = ("zero", "model")
 #: Reflectance above ``1 + ENERGY_TOL`` is reported by :func:`build_lut` (the
 #: quadrature of a float32 table is good to ~1e-7).
 ENERGY_TOL = 1e-6
-#: Largest step of the nodes that extend a table's grids to the horizon [degree].
-EXTENSION_STEP = 5.0
 
 
 def _bound_grazing_rows(
@@ -908,8 +501,6 @@ def _bound_grazing_rows(
     """Scale every row above the measured incidence angles whose reflectance exceeds the
     model's (in place), so that grazing extrapolation never creates energy: a glossy
     lobe meeting the horizon between grid nodes is overestimated by interpolation."""
-    from . import models
-
     rows = np.flatnonzero(ti > above)
     if rows.size == 0:
         return
@@ -919,81 +510,6 @@ def _bound_grazing_rows(
                                                   zero_edges=(True, True, True))
     scale = np.where(rho_t > rho_m, rho_m / np.maximum(rho_t, 1e-300), 1.0)
     lut[rows] *= scale[:, None, None, :]
-
-
-def _lut_edges(edges: dict[str, str]) -> tuple[bool, bool, bool]:
-    return _lut.table_edges(edges)
-
-
-def _extend(grid: np.ndarray, lo: float, hi: float) -> np.ndarray:
-    """``grid`` with nodes at most :data:`EXTENSION_STEP` apart added out to ``[lo, hi]``."""
-    parts = [grid]
-    if grid[0] > lo:
-        n = int(np.ceil((grid[0] - lo) / EXTENSION_STEP))
-        parts.insert(0, np.linspace(lo, grid[0], n + 1)[:-1])
-    if grid[-1] < hi:
-        n = int(np.ceil((hi - grid[-1]) / EXTENSION_STEP))
-        parts.append(np.linspace(grid[-1], hi, n + 1)[1:])
-    return np.concatenate(parts)
-
-
-def _per_theta(
-    measured_ti: np.ndarray, ti_s: np.ndarray, dt_s: np.ndarray, ph_s: np.ndarray,
-    spectra: np.ndarray, ref: np.ndarray, dt_grid: np.ndarray, phi_grid: np.ndarray,
-    *, hold_all: bool = False,
-) -> np.ndarray:
-    """Steps 1 and 2 of the construction: every measured incidence angle on the grid.
-
-    ``hold_all`` holds every edge (for interpolating ratios, which have no zero
-    reference points).
-    """
-    n_wl = spectra.shape[1]
-    per_theta = np.zeros((measured_ti.size, dt_grid.size, phi_grid.size, n_wl))
-    for a, t in enumerate(measured_ti):
-        in_t = np.flatnonzero(ti_s == t)
-        rows = np.unique(dt_s[in_t])
-        if rows.size < (1 if hold_all else 2):
-            raise ValidationError(
-                f"delta_theta: theta_i = {t} has measurements at a single delta_theta; need >= 2"
-            )
-        # Step 1: phi interpolation within every delta_theta row of this theta_i.
-        row_vals = np.zeros((rows.size, phi_grid.size, n_wl))
-        row_ref = np.zeros(rows.size, dtype=bool)
-        row_n = np.zeros(rows.size, dtype=int)
-        for r, d in enumerate(rows):
-            sel = in_t[dt_s[in_t] == d]
-            edge = sel[np.argmax(ph_s[sel])]
-            # A row measured at phi = 0 only (the in-plane delta_theta extents of the
-            # scheme) says nothing about phi > 0: it is not held out of the plane.
-            hold = hold_all or (sel.size > 1 and not ref[edge])
-            w = _interp_weights(ph_s[sel], phi_grid, hold_lo=hold_all, hold_hi=hold)  # (n_phi, n_sel)
-            row_vals[r] = w @ spectra[sel]
-            row_ref[r] = bool(np.all(ref[sel]))
-            row_n[r] = sel.size
-        if not hold_all:
-            # A measured (apparatus-limited) in-plane extent borrows the phi profile of the
-            # nearest fully measured row, scaled to its own in-plane value.
-            full = np.flatnonzero(row_n > 1)
-            for r in np.flatnonzero((row_n == 1) & ~row_ref):
-                if full.size == 0:
-                    break
-                adj = full[np.argmin(np.abs(full - r))]
-                base = row_vals[adj, 0]
-                scale = np.divide(row_vals[r, 0], base, out=np.zeros_like(base), where=base > 0)
-                row_vals[r, 1:] = row_vals[adj, 1:] * scale
-        # Step 2: delta_theta interpolation for every grid phi.
-        w = _interp_weights(rows, dt_grid, hold_lo=hold_all or not row_ref[0],
-                            hold_hi=hold_all or not row_ref[-1])
-        per_theta[a] = np.einsum("dr,rpl->dpl", w, row_vals)
-    return per_theta
-
-
-def _blend_weights(ti: np.ndarray, lo: float, hi: float, width: float) -> np.ndarray:
-    """Weight of the fitted model: 0 inside [lo, hi], rising smoothly to 1 over ``width``
-    degrees outside (a cubic smoothstep, so the table stays continuous in theta_i)."""
-    d = np.maximum(lo - ti, 0.0) + np.maximum(ti - hi, 0.0)
-    x = np.clip(d / width, 0.0, 1.0) if width > 0 else (d > 0).astype(float)
-    return x * x * (3.0 - 2.0 * x)
 
 
 def _model_for(model: xr.Dataset, wl: np.ndarray) -> xr.Dataset:
@@ -1007,8 +523,6 @@ def _model_rows(
 ) -> np.ndarray:
     """A model material rendered on the table grid (rows ``ti``) at wavelengths ``wl``
     (below-horizon nodes carry the limit from the hemisphere, :func:`sbrdf_xr.models.render`)."""
-    from . import models
-
     mod, _, kw = models._params(_model_for(model, wl))
     return models.render_values(mod, ti, dt, ph, wl, kw)
 
@@ -1017,36 +531,7 @@ def _model_at(
     model: xr.Dataset, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, wl: np.ndarray
 ) -> np.ndarray:
     """A model material's spectra at sample geometries (1-D angle arrays)."""
-    from . import models
-
     return models.spectra(_model_for(model, wl), ti, dt, ph)
-
-
-#: Gauss-Legendre nodes of the azimuthal average at normal incidence.
-_N_AZIMUTH = 64
-
-
-def _azimuthal_average(
-    row: np.ndarray, dt: np.ndarray, ph: np.ndarray, zero_edges: tuple[bool, bool, bool]
-) -> np.ndarray:
-    """The ``theta_i = 0`` row replaced by its average over the illumination-plane azimuth.
-
-    At normal incidence an observer at polar angle ``theta_r`` and azimuth ``psi``
-    from the (arbitrary) plane has ``delta_theta = atan2(sin theta_r cos psi,
-    cos theta_r)`` and ``phi = asin(sin theta_r |sin psi|)``; every node of the
-    row becomes the mean over ``psi`` in ``[0, pi]`` of the linearly interpolated
-    row along the contour of its own ``theta_r``.
-    """
-    x, w = np.polynomial.legendre.leggauss(_N_AZIMUTH)
-    psi = 0.5 * np.pi * (x + 1.0)
-    w = w / 2.0  # mean over [0, pi]: the weights sum to 1
-    tr = np.radians(_lut.observer_polar_angle(0.0, dt[:, None], ph[None, :]))  # (n_dt, n_phi)
-    c_dt = np.degrees(np.arctan2(np.sin(tr)[..., None] * np.cos(psi), np.cos(tr)[..., None]))
-    c_ph = np.degrees(np.arcsin(np.clip(np.sin(tr)[..., None] * np.sin(psi), 0.0, 1.0)))
-    table = np.stack([row, row])
-    vals = _lut.lookup_kernel(table, np.array([0.0, 1.0]), dt, ph, 0.0, c_dt, c_ph, "linear",
-                              zero_edges=zero_edges)  # (n_dt, n_phi, n_psi, n_wl)
-    return np.einsum("dpql,q->dpl", vals, w)
 
 
 # ------------------------------------------------------------- reflectance
@@ -1107,125 +592,3 @@ def hemispherical_reflectance(
     return out
 
 
-# --------------------------------------------------------------------- I/O
-
-
-def _encoding(obj: xr.Dataset) -> dict[str, dict[str, Any]]:
-    """No fill values anywhere; lossless zlib compression of the data variables."""
-    enc: dict[str, dict[str, Any]] = {name: {"_FillValue": None} for name in list(obj.variables)}
-    for name, var in obj.data_vars.items():
-        if var.ndim and np.issubdtype(var.dtype, np.floating):
-            enc[name].update(zlib=True, complevel=4, shuffle=True)
-    return enc
-
-
-def write_netcdf_atomic(ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
-    """Write ``ds`` to ``path`` atomically (temporary file, then rename).
-
-    Parameters
-    ----------
-    ds : xarray.Dataset
-        Dataset to write.
-    path : path-like
-        Destination.
-    overwrite : bool, default False
-        Replace an existing file; otherwise an existing file is an error and is left
-        untouched.
-
-    Returns
-    -------
-    pathlib.Path
-    """
-    path = Path(path)
-    if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True to replace it")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".part", dir=path.parent)
-    os.close(fd)
-    from ._names import cf_finish
-
-    ds = cf_finish(ds)  # Conventions, title, source, history, flags, ancillary links
-    try:
-        ds.to_netcdf(tmp, engine="netcdf4", encoding=_encoding(ds))
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
-
-
-def to_netcdf(
-    obj: xr.DataArray | xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False
-) -> Path:
-    """Write a material table or a measurement set to netCDF, losslessly and atomically.
-
-    Values, coordinates and attributes survive :func:`open_material` /
-    :func:`open_measurements` exactly (no fill values are added; float64 stays
-    float64).
-    """
-    if isinstance(obj, xr.DataArray):
-        obj = validate_material(obj).to_dataset()
-    else:
-        validate_measurements(obj, duplicates="mean")
-    obj = obj.copy()
-    obj.attrs.setdefault("Conventions", "CF-1.10")
-    return write_netcdf_atomic(obj, path, overwrite=overwrite)
-
-
-def open_material(path: str | os.PathLike[str]) -> xr.DataArray:
-    """Read a material table written by :func:`to_netcdf` (loaded into memory)."""
-    with xr.open_dataset(path, engine="netcdf4") as ds:
-        ds = ds.load()
-    if SBRDF not in ds:
-        raise ValidationError(f"{path}: no 'sbrdf' variable; not a material table")
-    da = ds[SBRDF]
-    da.attrs = {**{k: v for k, v in ds.attrs.items() if k != "Conventions"}, **da.attrs}
-    return validate_material(da)
-
-
-def open_measurements(path: str | os.PathLike[str]) -> xr.Dataset:
-    """Read a measurement set written by :func:`to_netcdf` (loaded into memory)."""
-    with xr.open_dataset(path, engine="netcdf4") as ds:
-        ds = ds.load()
-    if "reference" in ds:
-        ref = ds["reference"].astype(bool)
-        for k in ("flag_values", "flag_meanings"):  # they describe the on-disk byte, not the bool
-            ref.attrs.pop(k, None)
-        ds["reference"] = ref
-    return validate_measurements(ds, duplicates="mean")
-
-
-@register_loader("material")
-def _load_material_entry(e: CatalogEntry) -> xr.DataArray:
-    """A table file, or (``build_from`` set) a table built from a measurement entry."""
-    source = e.extra.get("build_from")
-    if source is None:
-        return open_material(e.file)
-    options = tuple(sorted(e.extra.get("build", {}).items()))
-    return _built_material(e.name, source, options).copy(deep=True)
-
-
-@functools.lru_cache(maxsize=16)
-def _built_material(name: str, measurements: str, options: tuple[tuple[str, Any], ...]) -> xr.DataArray:
-    from ._cache import cached_table
-    from .catalog import entry, load
-
-    kw = dict(options)
-    inputs = [entry(measurements).file] + ([entry(kw["fit"]).file] if "fit" in kw else [])
-
-    def build() -> xr.DataArray:
-        opts = dict(kw)
-        if "fit" in opts:  # a model entry that fills the unmeasurable range
-            opts["model"] = load(opts.pop("fit"))
-        return build_lut(load(measurements), material=name, **opts)
-
-    return cached_table(name, inputs, repr(options), build,
-                        lambda da, path: to_netcdf(da, path, overwrite=True), open_material)
-
-
-@register_loader("measurements")
-def _load_measurements_entry(e: CatalogEntry) -> xr.Dataset:
-    return open_measurements(e.file)

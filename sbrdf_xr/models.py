@@ -29,9 +29,9 @@ from numpy.typing import ArrayLike
 
 from . import brdf as _brdf
 from ._names import ANISO_LUT_DIMS, DELTA_THETA, PHI, PSI, SBRDF, THETA_I, WAVELENGTH, attrs
-from .catalog import CatalogEntry, register_loader
 from .errors import ValidationError
-from .material import new_material, write_netcdf_atomic
+from .material_io import write_netcdf_atomic
+from .material_schema import new_material
 
 __all__ = ["PARAM_ATTRS", "fit_robertson_sandford", "measure", "model_material", "open_model", "render",
            "render_anisotropic", "render_values", "spectra", "spectrum_function", "to_netcdf"]
@@ -341,7 +341,7 @@ def measure(spec: xr.Dataset, theta_i: Sequence[float], **kwargs: Any) -> xr.Dat
 def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Dataset:
     """Fit the Robertson-Sandford model (paper 001) to a measurement set.
 
-    Wraps :func:`sbrdf_xr.brdf.robertson_sandford.fit_robertson_sandford`
+    Wraps :func:`sbrdf_xr.brdf.robertson_sandford_fit.fit_robertson_sandford`
     (log-residual least squares; ``rho_D`` and ``epsilon`` per wavelength, shared
     ``b`` and ``e``) and returns a model material with the standard uncertainties
     as variables ``u_rho_D``, ``u_epsilon``, ``u_b``, ``u_e`` and the reduced
@@ -363,12 +363,13 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
     """
     from ._names import MEASURED, SAMPLE
     from .brdf import robertson_sandford as rs
-    from .material import _reference, validate_measurements
+    from .brdf import robertson_sandford_fit
+    from .material_schema import _reference, validate_measurements
 
     ds = validate_measurements(measurements, duplicates="mean")
     wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
     spectra = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64)
-    fit = rs.fit_robertson_sandford(ds[THETA_I].values, ds[DELTA_THETA].values, ds[PHI].values,
+    fit = robertson_sandford_fit.fit_robertson_sandford(ds[THETA_I].values, ds[DELTA_THETA].values, ds[PHI].values,
                                     wl, spectra, reference=_reference(ds), **kwargs)
     p = {k: np.asarray(fit[k], dtype=np.float64) for k in rs.PARAMS}
     g_b = float(rs.normalisation_G(p["b"]))
@@ -400,14 +401,3 @@ def open_model(path: str | os.PathLike[str]) -> xr.Dataset:
         ds = ds.load()
     _params(ds)
     return ds
-
-
-@register_loader("model")
-def _load_model_entry(e: CatalogEntry) -> xr.Dataset:
-    return open_model(e.file)
-
-
-@register_loader("paint_parameters")
-def _load_paint_parameters(e: CatalogEntry) -> xr.Dataset:
-    with xr.open_dataset(e.file, engine="netcdf4") as ds:
-        return ds.load()

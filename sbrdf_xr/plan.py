@@ -29,10 +29,11 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from . import __version__, sources
+from . import sources
 from ._kernels import PackedTables, pack_tables
 from ._lut import table_edges, table_normal_blend
 from ._names import BAND, MATERIAL, WAVELENGTH
+from ._version import __version__
 from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS, BlockInputs
 from .errors import SceneError, ValidationError
 from .fingerprint import scene_fingerprint

@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 from scipy.optimize import brentq
 
 from sbrdf_xr import attitude as att
-from sbrdf_xr import catalog, geometry, observe
+from sbrdf_xr import catalog, geometry, observe, orbits
 from sbrdf_xr.errors import (
     AttitudeError,
     EpochGapWarning,
@@ -52,7 +52,7 @@ def canx1():
 
 
 def skyfield_times(t64):
-    ts, _ = observe._skyfield()
+    ts, _ = orbits.skyfield_data()
     py = [dt.datetime.fromisoformat(str(x)[:26]).replace(tzinfo=dt.UTC) for x in t64]
     return ts.from_datetimes(py), py
 
@@ -82,12 +82,12 @@ def test_gcrs_state_against_skyfield_per_time_evaluation(canx1):
 
 def test_sun_direction_and_phase_angle_against_skyfield(canx1):
     obs, g = canx1
-    _, eph = observe._skyfield()
+    _, eph = orbits.skyfield_data()
     sat, site = obs.orbit.satellite, obs.site.position
     rot = geometry.rotation_matrices(g.quaternion.values)
     sun_ref = np.einsum("nij,nj->ni", rot, g.to_sun.values)  # back to the GCRS
     _, py = skyfield_times(g.time.values)
-    ts, _ = observe._skyfield()
+    ts, _ = orbits.skyfield_data()
     worst_sun = worst_phase = 0.0
     for i in range(0, g.sizes["time"], 20):  # one scalar skyfield evaluation per time
         ti = ts.from_datetime(py[i])
@@ -112,7 +112,7 @@ def test_shadow_boundary_brackets_skyfield_is_sunlit(canx1):
     # skyfield's is_sunlit is a point Sun with a spherical Earth: its switch must fall in
     # our penumbra, where the disc is about half covered.
     obs, g = canx1
-    _, eph = observe._skyfield()
+    _, eph = orbits.skyfield_data()
     t, _ = skyfield_times(g.time.values)
     lit = obs.orbit.satellite.at(t).is_sunlit(eph)
     switch = np.flatnonzero(np.diff(lit.astype(int)))

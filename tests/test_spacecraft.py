@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import importlib.util
 import warnings
+from pathlib import Path
 
 import matplotlib
 import numpy as np
@@ -11,10 +13,22 @@ import trimesh
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from sbrdf_xr import _build_canx1, catalog
+from sbrdf_xr import catalog
 from sbrdf_xr import spacecraft as sc
 from sbrdf_xr.errors import MeshError, ValidationError
 from sbrdf_xr.testing import cube_spacecraft, l_shaped_spacecraft
+
+
+def _tool(name: str):
+    """A build script of ``tools/`` (not part of the package), imported by path."""
+    path = Path(__file__).resolve().parent.parent / "tools" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(f"tools_{name}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+_build_canx1 = _tool("build_canx1")
 
 matplotlib.use("Agg")
 

@@ -11,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from shapely.geometry import MultiPoint, Polygon
 
+from sbrdf_xr import _shadow_kernels as sk
 from sbrdf_xr import spacecraft as sc
 from sbrdf_xr import visibility as vis
 from sbrdf_xr.errors import ValidationError
@@ -530,13 +531,13 @@ def test_union_kernels_against_geos(m):
     for _ in range(20):
         gx, gy, gn, polys = _random_convex_polygons(rng, m)
         ref = shapely.union_all(polys).area
-        assert vis._union_area_slabs(gx, gy, gn, m) == pytest.approx(ref, rel=1e-12)
+        assert sk._union_area_slabs(gx, gy, gn, m) == pytest.approx(ref, rel=1e-12)
         if m <= 12:  # inclusion-exclusion of heavily overlapping sets is exponential
-            buf = vis._MAXM + 1
-            area, ok = vis._union_area(gx, gy, gn, m, 0.0, np.zeros((buf, vis._MAXV)),
-                                       np.zeros((buf, vis._MAXV)), np.zeros(buf, np.int64),
-                                       np.zeros(buf, np.int64), np.zeros(vis._MAXV),
-                                       np.zeros(vis._MAXV))
+            buf = sk._MAXM + 1
+            area, ok = sk._union_area(gx, gy, gn, m, 0.0, np.zeros((buf, sk._MAXV)),
+                                      np.zeros((buf, sk._MAXV)), np.zeros(buf, np.int64),
+                                      np.zeros(buf, np.int64), np.zeros(sk._MAXV),
+                                      np.zeros(sk._MAXV))
             assert ok and area == pytest.approx(ref, rel=1e-12)
 
 

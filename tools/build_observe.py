@@ -1,6 +1,6 @@
 """Build the example orbit of the catalog and find the window of the built-in pass.
 
-Run ``python -m sbrdf_xr._build_observe`` to write ``catalogs/observe/canx1-example.tle``
+Run ``python tools/build_observe.py`` to write ``catalogs/observe/canx1-example.tle``
 and print the passes of the window search (the chosen one is ``observe.CANX1_PASS``).
 
 The elements are illustrative mean elements in the TLE format of NORAD 27847 (CanX-1,
@@ -58,7 +58,7 @@ def example_tle(elements: dict[str, float] = ELEMENTS) -> tuple[str, str]:
 def find_passes(orbit, site, start: str, stop: str, step_s: float = 5.0,
                 min_elevation_deg: float = 20.0, max_sun_elevation_deg: float = -18.0) -> list[dict]:
     """Passes above ``min_elevation_deg`` with the site dark and the shadow boundary crossed."""
-    from . import observe
+    from sbrdf_xr import observe
 
     t = observe.times(start, stop, step_s)
     obs = observe.Observation(orbit, site, t, None)
@@ -78,7 +78,7 @@ def find_passes(orbit, site, start: str, stop: str, step_s: float = 5.0,
 
 
 def main() -> None:
-    from . import catalog, observe
+    from sbrdf_xr import catalog, observe
 
     l1, l2 = example_tle()
     path = Path(__file__).resolve().parent.parent / "catalogs" / "observe" / "canx1-example.tle"

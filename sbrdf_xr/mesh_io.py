@@ -1,0 +1,512 @@
+"""Reading spacecraft meshes: five formats, length units, material maps, checks and repairs.
+
+:func:`sbrdf_xr.spacecraft.load_spacecraft` reads a mesh with :func:`read_mesh`
+(STL, OBJ, PLY, glTF/GLB or a trimesh object), labels its facets with
+:func:`label_faces`, checks (and optionally repairs) it with :func:`clean_mesh` and
+builds the :class:`~sbrdf_xr.spacecraft.Spacecraft` from the result.
+"""
+
+from __future__ import annotations
+
+import tomllib
+import warnings
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import trimesh
+
+from .errors import MeshError, MeshRepairWarning, ValidationError
+
+#: Length units accepted by :func:`load_spacecraft` and their size in metres [m].
+LENGTH_UNITS: dict[str, float] = {
+    "m": 1.0,
+    "meter": 1.0,
+    "metre": 1.0,
+    "km": 1.0e3,
+    "cm": 1.0e-2,
+    "centimeter": 1.0e-2,
+    "centimetre": 1.0e-2,
+    "mm": 1.0e-3,
+    "millimeter": 1.0e-3,
+    "millimetre": 1.0e-3,
+    "um": 1.0e-6,
+    "micrometer": 1.0e-6,
+    "micrometre": 1.0e-6,
+    "in": 0.0254,
+    "inch": 0.0254,
+    "ft": 0.3048,
+    "foot": 0.3048,
+}
+
+
+#: Facets whose area is at most this factor times the squared bounding-box diagonal are
+#: zero-area (about a 1e-7 relative edge length).
+ZERO_AREA_FACTOR = 1.0e-14
+
+
+#: Component tolerance below which two unit normals are the same in :meth:`Spacecraft.merged`.
+NORMAL_TOLERANCE = 1.0e-9
+
+
+#: Vertices whose coordinates agree after rounding to this step are one vertex [m].
+MERGE_DISTANCE = 1.0e-8
+
+
+Color = tuple[int, int, int]
+
+
+def length_factor(length_unit: str) -> float:
+    """Size of one ``length_unit`` in metres.
+
+    Parameters
+    ----------
+    length_unit : str
+        A key of :data:`LENGTH_UNITS` (case-insensitive), e.g. ``"m"``, ``"mm"``, ``"in"``.
+
+    Returns
+    -------
+    float
+        Metres per unit [m].
+
+    Raises
+    ------
+    ValidationError
+        If the unit is not a known length unit.
+    """
+    key = length_unit.strip().lower() if isinstance(length_unit, str) else None
+    if key not in LENGTH_UNITS:
+        raise ValidationError(
+            f"length_unit: got {length_unit!r}, which is not a length unit; "
+            f"allowed: {', '.join(LENGTH_UNITS)}"
+        )
+    return LENGTH_UNITS[key]
+
+
+def read_material_map(path: str | Path) -> dict[Any, str]:
+    """Read a facet-label -> material map from a TOML file.
+
+    The file holds one ``[[material]]`` table per material::
+
+        [[material]]
+        name = "aluminium-6061-t6"   # material name
+        rgb = [255, 0, 0]            # optional: facet colour(s), 0-255
+        labels = ["alu", 3]          # optional: material/group names or face-property values
+
+    ``rgb`` may also be a list of colours.
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML file.
+
+    Returns
+    -------
+    dict
+        ``{(r, g, b): name, label: name, ...}`` as accepted by :func:`load_spacecraft`.
+
+    Raises
+    ------
+    ValidationError
+        If the file is not valid TOML or a table lacks ``name`` or has no key.
+    """
+    path = Path(path)
+    try:
+        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        raise ValidationError(f"material map {path}: cannot be read as TOML: {exc}") from exc
+    out: dict[Any, str] = {}
+    tables = raw.get("material")
+    if not isinstance(tables, list) or not tables:
+        raise ValidationError(f"material map {path}: expected [[material]] tables, found none")
+    for i, table in enumerate(tables):
+        name = table.get("name")
+        if not isinstance(name, str) or not name:
+            raise ValidationError(f"material map {path}: table {i} lacks a 'name' string")
+        rgb = table.get("rgb", [])
+        colours = [rgb] if rgb and not isinstance(rgb[0], list) else rgb
+        keys = [tuple(c) for c in colours] + list(table.get("labels", []))
+        if not keys:
+            raise ValidationError(
+                f"material map {path}: material {name!r} has neither 'rgb' nor 'labels'"
+            )
+        for k in keys:
+            out[k] = name
+    return out
+
+
+def _as_color(key: Any) -> Color | None:
+    """The RGB colour a map key stands for, or None if it is a name."""
+    if isinstance(key, str):
+        k = key.strip()
+        if len(k) == 7 and k.startswith("#"):
+            try:
+                return (int(k[1:3], 16), int(k[3:5], 16), int(k[5:7], 16))
+            except ValueError:
+                return None
+        return None
+    if isinstance(key, bool | int | np.integer):
+        return None
+    arr = np.asarray(key)
+    if arr.shape != (3,) or not np.issubdtype(arr.dtype, np.number):
+        raise ValidationError(
+            f"material_map: key {key!r} is neither a colour (3 integers 0-255) nor a name"
+        )
+    if (
+        not np.all(np.isfinite(arr))
+        or np.any(arr != np.round(arr))
+        or arr.min() < 0
+        or arr.max() > 255
+    ):
+        raise ValidationError(f"material_map: colour key {key!r} must be 3 integers in 0-255")
+    return (int(arr[0]), int(arr[1]), int(arr[2]))
+
+
+def normalise_map(
+    material_map: Mapping[Any, str] | str | Path, known_materials: Iterable[str] | None
+) -> tuple[dict[Color, str], dict[str, str]]:
+    if isinstance(material_map, str | Path):
+        material_map = read_material_map(material_map)
+    if not isinstance(material_map, Mapping) or not material_map:
+        raise ValidationError(
+            f"material_map: expected a non-empty mapping of colour or name -> material, got {material_map!r}"
+        )
+    colours: dict[Color, str] = {}
+    names: dict[str, str] = {}
+    for key, value in material_map.items():
+        if not isinstance(value, str) or not value.strip():
+            raise ValidationError(
+                f"material_map: key {key!r} maps to {value!r}; material names are non-empty strings"
+            )
+        colour = _as_color(key)
+        if colour is not None:
+            colours[colour] = value
+        else:
+            names[str(key)] = value
+    if known_materials is not None:
+        known = set(known_materials)
+        unknown = sorted({*colours.values(), *names.values()} - known)
+        if unknown:
+            raise ValidationError(
+                f"material_map: names material(s) {unknown} that do not exist; "
+                f"known materials: {sorted(known)}"
+            )
+    return colours, names
+
+
+class _Labelled:
+    """Vertices, facets and per-facet label candidates read from a file or trimesh object."""
+
+    def __init__(self) -> None:
+        self.vertices: list[np.ndarray] = []
+        self.faces: list[np.ndarray] = []
+        self.rgb: list[np.ndarray] = []  # (n, 3) int, -1 where unknown
+        self.names: list[list[np.ndarray]] = []  # per part: candidate name arrays (object)
+        self.rgb_bits = 8
+        self.offset = 0
+
+    def add(
+        self, vertices: np.ndarray, faces: np.ndarray, rgb: np.ndarray | None, names: list[Any]
+    ) -> None:
+        n = len(faces)
+        self.vertices.append(np.asarray(vertices, dtype=np.float64).reshape(-1, 3))
+        self.faces.append(np.asarray(faces, dtype=np.int64).reshape(-1, 3) + self.offset)
+        self.offset += len(self.vertices[-1])
+        self.rgb.append(
+            np.full((n, 3), -1, np.int64) if rgb is None else np.asarray(rgb, np.int64)[:, :3]
+        )
+        cands = []
+        for nm in names:  # keep positions aligned across parts: None -> all-None candidate
+            if nm is None or np.ndim(nm) == 0:
+                cands.append(np.full(n, nm, dtype=object))
+            else:
+                cands.append(np.asarray(nm).astype(str).astype(object))
+        self.names.append(cands)
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[np.ndarray]]:
+        if not self.faces:
+            return np.zeros((0, 3)), np.zeros((0, 3), np.int64), np.zeros((0, 3), np.int64), []
+        n_cand = max(len(c) for c in self.names)
+        cands = []
+        for k in range(n_cand):
+            parts = [
+                c[k] if k < len(c) else np.full(len(f), None, object)
+                for c, f in zip(self.names, self.faces, strict=True)
+            ]
+            cands.append(np.concatenate(parts))
+        return (
+            np.concatenate(self.vertices),
+            np.concatenate(self.faces),
+            np.concatenate(self.rgb),
+            cands,
+        )
+
+
+def _face_property(mesh: trimesh.Trimesh, prop: str) -> np.ndarray:
+    """Values of a face property (PLY element property or trimesh face attribute)."""
+    if prop in getattr(mesh, "face_attributes", {}):
+        vals = np.asarray(mesh.face_attributes[prop])
+    else:
+        raw = mesh.metadata.get("_ply_raw", {}).get("face", {}).get("data")
+        if isinstance(raw, dict) and prop in raw:
+            vals = np.asarray(raw[prop])
+        elif isinstance(raw, np.ndarray) and raw.dtype.names and prop in raw.dtype.names:
+            vals = np.asarray(raw[prop])
+        else:
+            available = sorted(set(getattr(mesh, "face_attributes", {})) | _ply_face_props(raw))
+            raise MeshError(
+                f"face_property: the mesh has no face property {prop!r}; available: {available}"
+            )
+    return vals.reshape(len(mesh.faces), -1)[:, 0]
+
+
+def _ply_face_props(raw: Any) -> set[str]:
+    if isinstance(raw, dict):
+        return set(raw) - {"vertex_indices"}
+    if isinstance(raw, np.ndarray) and raw.dtype.names:
+        return set(raw.dtype.names) - {"vertex_indices"}
+    return set()
+
+
+def _visual_labels(mesh: trimesh.Trimesh) -> tuple[np.ndarray | None, str | None]:
+    """Per-face colours and the material name carried by a mesh's visual."""
+    visual = getattr(mesh, "visual", None)
+    kind = getattr(visual, "kind", None)
+    if kind in ("face", "vertex"):
+        return np.asarray(visual.face_colors)[:, :3], None
+    material = getattr(visual, "material", None)
+    if material is not None:
+        name = getattr(material, "name", None)
+        try:
+            colour = np.asarray(material.main_color)[:3]
+        except Exception:  # pragma: no cover - exotic materials
+            colour = None
+        rgb = None if colour is None else np.tile(colour, (len(mesh.faces), 1))
+        return rgb, name
+    return None, None
+
+
+def _stl_colors(mesh: trimesh.Trimesh) -> np.ndarray | None:
+    """Decode VisCAM/SolidView 15-bit facet colours of a binary STL (5 bits per channel)."""
+    attr = getattr(mesh, "face_attributes", {}).get("stl")
+    if attr is None:
+        return None
+    a = np.asarray(attr, dtype=np.uint16).reshape(-1)
+    valid = (a & 0x8000) != 0
+    if not valid.any():
+        return None
+    rgb = np.stack([(a >> 10) & 31, (a >> 5) & 31, a & 31], axis=1).astype(np.int64)
+    rgb[~valid] = -1
+    return rgb
+
+
+def read_mesh(
+    path_or_mesh: Any, face_property: str | None, file_type: str | None
+) -> tuple[_Labelled, str | None]:
+    """Read a mesh source into labelled arrays; return them and a default name."""
+    out = _Labelled()
+    default_name = None
+    obj = path_or_mesh
+    if isinstance(obj, str | Path):
+        path = Path(obj)
+        if not path.is_file():
+            raise FileNotFoundError(f"mesh file {path} does not exist")
+        default_name = path.stem
+        try:
+            obj = trimesh.load(path, file_type=file_type, process=False)
+        except Exception as exc:
+            raise MeshError(
+                f"{path}: could not be read as a mesh ({type(exc).__name__}: {exc}); "
+                "expected a format trimesh reads (STL, OBJ, PLY, glTF/GLB, OFF, ...)"
+            ) from exc
+    if isinstance(obj, trimesh.Scene):
+        if not obj.geometry:
+            raise MeshError("the mesh source is an empty scene: it holds no geometry")
+        for node in obj.graph.nodes_geometry:
+            transform, geom_name = obj.graph[node]
+            geom = obj.geometry[geom_name]
+            if not isinstance(geom, trimesh.Trimesh):
+                continue
+            rgb, mat_name = _visual_labels(geom)
+            prop = _face_property(geom, face_property) if face_property else None
+            verts = trimesh.transform_points(np.asarray(geom.vertices, dtype=np.float64), transform)
+            out.add(verts, geom.faces, rgb, [prop, mat_name, geom_name, node])
+        if not out.faces:
+            raise MeshError(
+                "the mesh source holds no triangle mesh (only "
+                f"{sorted({type(g).__name__ for g in obj.geometry.values()})})"
+            )
+        return out, default_name
+    if not isinstance(obj, trimesh.Trimesh):
+        raise MeshError(
+            f"expected a triangle mesh (a file trimesh reads, a trimesh.Trimesh or trimesh.Scene), "
+            f"got {type(obj).__name__}"
+        )
+    rgb, mat_name = _visual_labels(obj)
+    stl = _stl_colors(obj)
+    if stl is not None:
+        rgb = stl
+        out.rgb_bits = 5
+    prop = _face_property(obj, face_property) if face_property else None
+    out.add(obj.vertices, obj.faces, rgb, [prop, mat_name])
+    return out, default_name or obj.metadata.get("name")
+
+
+def label_faces(
+    labelled: _Labelled,
+    rgb: np.ndarray,
+    names: list[np.ndarray],
+    colours: dict[Color, str],
+    name_map: dict[str, str],
+) -> np.ndarray:
+    """Material name of every face; MeshError listing the labels that are not in the map."""
+    n = len(rgb)
+    material = np.full(n, None, dtype=object)
+    for cand in names:
+        todo = np.flatnonzero(np.equal(material, None) & ~np.equal(cand, None))
+        if len(todo) == 0:
+            continue
+        uniq, inv = np.unique(cand[todo].astype(str), return_inverse=True)
+        lookup = np.array([name_map.get(u) for u in uniq], dtype=object)
+        material[todo] = lookup[inv]
+    todo = np.flatnonzero(np.equal(material, None))
+    unmapped_colours: list[Color] = []
+    if len(todo) and colours:
+        have = todo[(rgb[todo] >= 0).all(axis=1)]
+        if len(have):
+            keys = np.array(list(colours), dtype=np.int64)
+            if labelled.rgb_bits == 5:
+                keys = np.round(keys * 31 / 255).astype(np.int64)
+            uniq, inv = np.unique(rgb[have], axis=0, return_inverse=True)
+            lookup = np.full(len(uniq), None, dtype=object)
+            values = list(colours.values())
+            for i, u in enumerate(uniq):  # loop over distinct colours (few), not facets
+                match = np.flatnonzero((keys == u).all(axis=1))
+                if len(match):
+                    lookup[i] = values[match[0]]
+                else:
+                    c = u if labelled.rgb_bits == 8 else np.round(u * 255 / 31)
+                    unmapped_colours.append((int(c[0]), int(c[1]), int(c[2])))
+            material[have] = lookup[inv.reshape(-1)]
+    missing = np.flatnonzero(np.equal(material, None))
+    if len(missing):
+        labels: list[Any] = list(dict.fromkeys(unmapped_colours))
+        for cand in names:
+            labels += [v for v in dict.fromkeys(cand[missing]) if v is not None]
+        if not labels and not (rgb[missing] >= 0).all(axis=1).any():
+            what = "no colour and no name matching the map"
+        else:
+            what = f"label(s) {labels[:10]}{' ...' if len(labels) > 10 else ''}"
+        raise MeshError(
+            f"material_map: {len(missing)} of {n} facets are unmapped: {what}; "
+            f"the map has colours {sorted(colours)} and names {sorted(name_map)}"
+        )
+    return material.astype(str)
+
+
+def _problem(repair: bool, message: str, fix: str) -> None:
+    if not repair:
+        raise MeshError(f"{message}; pass repair=True to {fix}")
+    warnings.warn(f"{message}: repaired ({fix})", MeshRepairWarning, stacklevel=4)
+
+
+def clean_mesh(
+    vertices: np.ndarray, faces: np.ndarray, material: np.ndarray, repair: bool
+) -> tuple[trimesh.Trimesh, np.ndarray]:
+    """Run checks/repairs 1-7 of the module docstring."""
+    if len(faces) == 0:
+        raise MeshError("the mesh is empty: it has no facets")
+    if faces.min() < 0 or faces.max() >= len(vertices):
+        raise MeshError(f"facets index vertices outside 0..{len(vertices) - 1}")
+    # 1. non-finite vertices
+    bad_v = ~np.isfinite(vertices).all(axis=1)
+    if bad_v.any():
+        bad_f = bad_v[faces].any(axis=1)
+        _problem(
+            repair,
+            f"{int(bad_v.sum())} vertices are not finite (NaN or inf), used by {int(bad_f.sum())} facets",
+            "remove them and their facets",
+        )
+        vertices = np.where(bad_v[:, None], 0.0, vertices)
+        faces, material = faces[~bad_f], material[~bad_f]
+        if len(faces) == 0:
+            raise MeshError("the mesh is empty after removing facets with non-finite vertices")
+    # 2. merge coincident vertices (not a repair: STL has no shared vertices)
+    mesh = trimesh.Trimesh(vertices, faces, process=False, validate=False)
+    digits = round(-np.log10(MERGE_DISTANCE))
+    mesh.merge_vertices(merge_tex=True, merge_norm=True, digits_vertex=digits)
+    mesh.remove_unreferenced_vertices()
+    faces = np.asarray(mesh.faces)
+    vertices = np.asarray(mesh.vertices)
+    # 3. zero-area facets
+    scale = float(np.linalg.norm(np.ptp(vertices, axis=0)))
+    tri = vertices[faces]
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    repeated = (
+        (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 0] == faces[:, 2])
+    )
+    zero = repeated | (area <= ZERO_AREA_FACTOR * scale**2)
+    if zero.any():
+        _problem(
+            repair,
+            f"{int(zero.sum())} of {len(faces)} facets have zero area (first: {np.flatnonzero(zero)[:5].tolist()})",
+            "remove them",
+        )
+        faces, material = faces[~zero], material[~zero]
+        if len(faces) == 0:
+            raise MeshError("the mesh is empty after removing zero-area facets")
+    # 4. duplicate facets
+    _, first = np.unique(np.sort(faces, axis=1), axis=0, return_index=True)
+    if len(first) < len(faces):
+        keep = np.zeros(len(faces), bool)
+        keep[first] = True
+        _problem(
+            repair,
+            f"{len(faces) - len(first)} facets duplicate another facet (first: {np.flatnonzero(~keep)[:5].tolist()})",
+            "keep the first of each set of duplicates",
+        )
+        faces, material = faces[keep], material[keep]
+    mesh = trimesh.Trimesh(vertices, faces, process=False, validate=False)
+    # 5. open surface
+    if not mesh.is_watertight:
+        n_open = len(trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1))
+        _problem(
+            repair,
+            f"the surface is not closed ({n_open} edges belong to a single facet, or edges are shared by more than two)",
+            "fill the holes with trimesh.repair.fill_holes",
+        )
+        n_before = len(mesh.faces)
+        old_centres = mesh.triangles_center.copy()
+        trimesh.repair.fill_holes(mesh)
+        if not mesh.is_watertight:
+            raise MeshError(
+                "the surface is not closed and trimesh.repair.fill_holes could not close it"
+            )
+        if len(mesh.faces) > n_before:
+            from scipy.spatial import cKDTree
+
+            _, nearest = cKDTree(old_centres).query(mesh.triangles_center[n_before:])
+            material = np.concatenate([material, material[nearest]])
+    # 6. winding
+    if not mesh.is_winding_consistent:
+        _problem(
+            repair,
+            "the facets are not consistently wound",
+            "reorient them with trimesh.repair.fix_winding",
+        )
+        trimesh.repair.fix_winding(mesh)
+    # 7. inside-out bodies
+    probe = mesh.copy()
+    trimesh.repair.fix_inversion(probe, multibody=True)
+    flipped = (np.asarray(probe.faces) != np.asarray(mesh.faces)).any(axis=1)
+    if flipped.any():
+        _problem(
+            repair,
+            f"{int(flipped.sum())} facets belong to inside-out bodies (negative volume, normals pointing inwards)",
+            "flip them",
+        )
+        mesh = probe
+    return trimesh.Trimesh(
+        np.asarray(mesh.vertices), np.asarray(mesh.faces), process=False
+    ), material

@@ -1,0 +1,424 @@
+"""Scene files and built-in scenes: the TOML schema of a scene, its checks, the named scenes.
+
+:func:`load_scene` reads a TOML file, :func:`scene_from_dict` a parsed table,
+:func:`builtin_scene` builds a named scene and :func:`resolve_scene` accepts any of the
+three.  All are re-exported from :mod:`sbrdf_xr.scene`.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from . import geometry
+from .errors import CatalogError, SceneError, ValidationError
+from .knobs import KNOBS
+from .scene_model import Scene
+
+_SCENE_KEYS = {
+    "name": str, "description": str, "spacecraft": str, "materials": dict,
+    "attitude": dict, "phase_angles": list, "bisector": list, "plane_normal": list,
+    "geometry": dict, "outputs": list, "effects": list, "method": str, "dtype": str,
+    "merge": bool, "shadow_method": str, "shadow_density": int, "chunk": int,
+    "wavelength_stride": int, "band_integration": str, "table_theta_step": (int, float),
+    "evaluation": str, "kernel": str, "block_bytes": int, "size_limit": (int, float),
+    "tilt_nodes": int, "surface_tilt": (int, float, dict), "observation": dict, "bands": list, "band_extrapolate": str,
+    "earth_direction": list, "earth_albedo": (int, float), "earth_range_km": (int, float),
+    "earth_phase_angle": (int, float), "temperature": (int, float, dict),
+}
+
+
+_ATTITUDE_KEYS = {"kind": str, "axis": list, "start": (int, float), "stop": (int, float),
+                  "step": (int, float), "initial_axis": list, "initial_angle": (int, float),
+                  "n": int, "seed": int, "sequence": str, "angles": list, "quaternions": list}
+
+
+def _check_keys(table: Any, allowed: Mapping[str, Any], where: str) -> None:
+    if not isinstance(table, Mapping):
+        raise SceneError(f"{where}: expected a table of keys, got {type(table).__name__}")
+    for k, v in table.items():
+        if k not in allowed:
+            raise SceneError(f"{where}: unknown key {k!r}; allowed: {', '.join(sorted(allowed))}")
+        types = allowed[k]
+        if not isinstance(v, types) or (isinstance(v, bool) and types in (int, (int, float))):
+            names = " or ".join(t.__name__ for t in (types if isinstance(types, tuple) else (types,)))
+            raise SceneError(f"{where}: key {k!r} has type {type(v).__name__} ({_show(v)}); "
+                             f"expected {names}")
+
+
+#: Most attitudes or geometry pairs a scene file may list or generate.
+MAX_SCENE_COUNT = 10_000_000
+
+
+#: Largest magnitude of a direction's component in a scene file (its length must not overflow).
+_MAX_COMPONENT = 1e100
+
+
+#: Largest shadow-sampling density a scene file may ask for (sub-facet samples per side).
+MAX_SHADOW_DENSITY = 64
+
+
+def _show(v: Any) -> str:
+    text = repr(v)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _is_number(x: Any) -> bool:
+    return isinstance(x, int | float) and not isinstance(x, bool)
+
+
+def _number(v: Any, where: str) -> float:
+    """A finite number from a scene file."""
+    if not _is_number(v):
+        raise SceneError(f"{where}: expected a number, got {_show(v)} ({type(v).__name__})")
+    try:
+        x = float(v)
+    except OverflowError:
+        raise SceneError(f"{where}: {_show(v)} is too large") from None
+    if not np.isfinite(x):
+        raise SceneError(f"{where}: must be finite, got {x}")
+    return x
+
+
+def _numbers(v: Any, where: str, *, allow_empty: bool = False) -> np.ndarray:
+    """A flat list of finite numbers from a scene file."""
+    if not isinstance(v, list):
+        raise SceneError(f"{where}: expected a list of numbers, got {_show(v)}")
+    if not v and not allow_empty:
+        raise SceneError(f"{where}: the list is empty; give at least one value")
+    if len(v) > MAX_SCENE_COUNT:
+        raise SceneError(f"{where}: {len(v)} values; at most {MAX_SCENE_COUNT} are allowed")
+    return np.array([_number(x, f"{where}[{i}]") for i, x in enumerate(v)], dtype=np.float64)
+
+
+def _rows(v: Any, width: int, where: str) -> np.ndarray:
+    """A non-empty list of rows of ``width`` finite numbers (vectors, quaternions)."""
+    if not isinstance(v, list) or not v:
+        raise SceneError(f"{where}: expected a non-empty list of [{', '.join(['x'] * width)}] rows, "
+                         f"got {_show(v)}")
+    if len(v) > MAX_SCENE_COUNT:
+        raise SceneError(f"{where}: {len(v)} rows; at most {MAX_SCENE_COUNT} are allowed")
+    out = np.empty((len(v), width))
+    for i, row in enumerate(v):
+        if not isinstance(row, list) or len(row) != width:
+            raise SceneError(f"{where}[{i}]: expected {width} numbers, got {_show(row)}")
+        out[i] = [_number(x, f"{where}[{i}][{j}]") for j, x in enumerate(row)]
+    return out
+
+
+def _vector(v: Any, where: str) -> tuple[float, float, float]:
+    if not isinstance(v, list) or len(v) != 3:
+        raise SceneError(f"{where}: expected a vector of 3 numbers, got {_show(v)}")
+    x = tuple(_number(c, f"{where}[{i}]") for i, c in enumerate(v))
+    if not any(x):
+        raise SceneError(f"{where}: the zero vector has no direction")
+    if max(map(abs, x)) > _MAX_COMPONENT:
+        raise SceneError(f"{where}: components must not exceed {_MAX_COMPONENT:g} in magnitude, got {list(x)}")
+    return x  # type: ignore[return-value]
+
+
+def _strings(v: Any, where: str, *, allow_empty: bool = True) -> tuple[str, ...]:
+    if not isinstance(v, list) or not all(isinstance(x, str) for x in v):
+        raise SceneError(f"{where}: expected a list of strings, got {_show(v)}")
+    if not v and not allow_empty:
+        raise SceneError(f"{where}: the list is empty; give at least one")
+    return tuple(v)
+
+
+def _count(v: Any, where: str) -> int:
+    if not isinstance(v, int) or isinstance(v, bool) or not 1 <= v <= MAX_SCENE_COUNT:
+        raise SceneError(f"{where}: expected an integer from 1 to {MAX_SCENE_COUNT}, got {_show(v)}")
+    return int(v)
+
+
+def _attitudes_from_table(t: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray | None]:
+    _check_keys(t, _ATTITUDE_KEYS, "[attitude]")
+    kind = t.get("kind", "sweep")
+    try:
+        if kind == "sweep":
+            if "stop" not in t:
+                raise SceneError("[attitude]: a sweep needs 'stop' (and optionally 'start' and 'step') [degree]")
+            start = _number(t.get("start", 0.0), "[attitude] start")
+            stop = _number(t["stop"], "[attitude] stop")
+            step = _number(t.get("step", 1.0), "[attitude] step")
+            if step == 0:
+                raise SceneError("[attitude] step: must not be 0")
+            n = int(np.ceil((stop - start) / step))
+            if n < 1:
+                raise SceneError(f"[attitude]: a sweep from {start:g} to {stop:g} (excluded) in steps of "
+                                 f"{step:g} degree has no attitude; stop must lie beyond start in the "
+                                 "direction of step")
+            if n > MAX_SCENE_COUNT:
+                raise SceneError(f"[attitude]: the sweep has {n} attitudes; at most {MAX_SCENE_COUNT} are allowed")
+            angles = np.arange(start, stop, step)
+            initial = None
+            if "initial_axis" in t:
+                initial = geometry.axis_rotation(_vector(t["initial_axis"], "[attitude] initial_axis"),
+                                                 _number(t.get("initial_angle", 0.0), "[attitude] initial_angle"))
+            axis = _vector(t.get("axis", [0, 0, 1]), "[attitude] axis")
+            return geometry.rotation_sweep(axis, angles, initial), angles
+        if kind == "uniform":
+            if "n" not in t:
+                raise SceneError("[attitude]: kind 'uniform' needs 'n' (the number of attitudes)")
+            seed = t.get("seed", 0)
+            if not 0 <= seed < 2**63:
+                raise SceneError(f"[attitude] seed: expected an integer from 0 to 2**63 - 1, got {seed}")
+            return geometry.uniform_attitudes(_count(t["n"], "[attitude] n"), seed), None
+        if kind == "euler":
+            if "sequence" not in t or "angles" not in t:
+                raise SceneError("[attitude]: kind 'euler' needs 'sequence' (e.g. 'zyx') and 'angles' [degree]")
+            seq, ang = t["sequence"], t["angles"]
+            if ang and all(isinstance(a, list) for a in ang):
+                angles = _rows(ang, len(seq), "[attitude] angles")
+            else:
+                angles = _numbers(ang, "[attitude] angles")
+            return geometry.euler_attitudes(seq, angles), None
+        if kind == "quaternions":
+            if "quaternions" not in t:
+                raise SceneError("[attitude]: kind 'quaternions' needs 'quaternions' (rows of x, y, z, w)")
+            return geometry.check_quaternions(_rows(t["quaternions"], 4, "[attitude] quaternions")), None
+    except SceneError:
+        raise
+    except (ValidationError, ValueError, TypeError) as exc:
+        raise SceneError(f"[attitude]: {exc}") from None
+    raise SceneError(f"[attitude]: unknown kind {kind!r}; allowed: sweep, uniform, euler, quaternions")
+
+
+def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) -> Scene:
+    """Build a scene from the contents of a scene file (see :func:`load_scene`); relative
+    file names in it (an ``[observation]``'s quaternion series) are taken from ``base_dir``.
+
+    Raises
+    ------
+    SceneError
+        For every key that is unknown, of the wrong type, out of its domain, empty where
+        something is needed (``phase_angles``, ``outputs``), or larger than
+        :data:`MAX_SCENE_COUNT`; :class:`~sbrdf_xr.errors.CatalogError` for catalog names
+        that do not exist.
+    """
+    _check_keys(d, _SCENE_KEYS, "scene")
+    from . import catalog
+    from .spacecraft import Spacecraft
+
+    kw: dict[str, Any] = {k: d[k] for k in ("name", "description", "method", "dtype", "merge",
+                                               "band_extrapolate") if k in d}
+    # the other numerical knobs (checked by the Scene against the knob table)
+    kw.update({k: d[k] for k in KNOBS if k in d and k not in kw and k not in ("chunk", "shadow_density")})
+    if "size_limit" in d:
+        kw["size_limit"] = _number(d["size_limit"], "size_limit")
+    if "surface_tilt" in d:
+        st = d["surface_tilt"]
+        kw["surface_tilt"] = ({str(m): _number(x, f"surface_tilt.{m}") for m, x in st.items()}
+                              if isinstance(st, Mapping) else _number(st, "surface_tilt"))
+    for k in ("earth_albedo", "earth_range_km", "earth_phase_angle"):
+        if k in d:
+            kw[k] = _number(d[k], k)
+    if "chunk" in d:
+        kw["chunk"] = _count(d["chunk"], "chunk")
+    if "shadow_density" in d:
+        sd = d["shadow_density"]
+        if not 1 <= sd <= MAX_SHADOW_DENSITY:
+            raise SceneError(f"shadow_density: expected an integer from 1 to {MAX_SHADOW_DENSITY}, got {sd}")
+        kw["shadow_density"] = sd
+    if "temperature" in d:
+        t = d["temperature"]
+        if isinstance(t, Mapping):
+            kw["temperature"] = {str(m): _number(x, f"temperature.{m}") for m, x in t.items()}
+        else:
+            kw["temperature"] = _number(t, "temperature")
+    if "outputs" in d:
+        kw["outputs"] = _strings(d["outputs"], "outputs", allow_empty=False)
+    for k in ("effects", "bands"):
+        if k in d:
+            kw[k] = _strings(d[k], k)
+    for k in ("bisector", "plane_normal", "earth_direction"):
+        if k in d:
+            kw[k] = _vector(d[k], k)
+    if "geometry" in d:
+        g = d["geometry"]
+        _check_keys(g, {"to_sun": list, "to_observer": list, "to_earth": list}, "[geometry]")
+        for k in ("to_sun", "to_observer"):
+            if k not in g:
+                raise SceneError(f"[geometry]: key {k!r} is required (rows of 3 numbers)")
+            kw[k] = _rows(g[k], 3, f"[geometry] {k}")
+        if "to_earth" in g:
+            kw["to_earth"] = _rows(g["to_earth"], 3, "[geometry] to_earth")
+    if "observation" in d:
+        from .observe import observation_from_dict
+
+        if "attitude" in d or "geometry" in d or "phase_angles" in d:
+            raise SceneError("scene: an [observation] gives the geometry; leave out [attitude], "
+                             "[geometry] and phase_angles")
+        try:
+            kw["observation"] = observation_from_dict(d["observation"], base_dir)
+        except (ValidationError, CatalogError) as exc:
+            raise SceneError(f"[observation]: {exc}") from exc
+    if "attitude" in d:
+        if "geometry" in d:
+            raise SceneError("scene: give either an [attitude] table (with phase_angles) or a "
+                             "[geometry] table, not both")
+        if "phase_angles" not in d:
+            raise SceneError("scene: an [attitude] table needs 'phase_angles' [degree]")
+        kw["attitudes"], angles = _attitudes_from_table(d["attitude"])
+        if angles is not None:
+            kw["attitude_angle"] = angles
+        kw["phase_angles"] = _numbers(d["phase_angles"], "phase_angles")
+    elif "phase_angles" in d:
+        raise SceneError("scene: 'phase_angles' needs an [attitude] table")
+    # Catalog entries are loaded last, once every cheap check has passed.
+    sc_name = d.get("spacecraft")
+    if sc_name is None:
+        raise SceneError("scene: key 'spacecraft' is required (a catalog name)")
+    sc = catalog.load(sc_name)
+    if not isinstance(sc, Spacecraft):
+        raise SceneError(f"spacecraft: catalog entry {sc_name!r} is not a spacecraft")
+    materials = None
+    if "materials" in d:
+        materials = {}
+        for mat, entry in d["materials"].items():
+            if not isinstance(entry, str):
+                raise SceneError(f"[materials]: {mat!r} must name a catalog entry (a string)")
+            table = catalog.load(entry)
+            if not isinstance(table, xr.DataArray):
+                raise SceneError(f"[materials]: {mat!r} = {entry!r} is a {type(table).__name__} "
+                                 "entry, not a material table")
+            materials[mat] = table
+    try:
+        return Scene(sc, materials=materials, **kw)
+    except SceneError:
+        raise
+    except (ValidationError, ValueError, TypeError) as exc:  # a check deeper in the package
+        raise SceneError(f"scene: {exc}") from None
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Load a scene from a TOML file.
+
+    Example file::
+
+        name = "my-rotation"
+        spacecraft = "canx1"              # a catalog entry
+        phase_angles = [10.0]             # degree
+        outputs = ["spacecraft_sbrdf", "signal", "brdf", "area"]
+        effects = ["sunlight"]
+        method = "linear"
+
+        [attitude]                        # or [geometry] with to_sun / to_observer lists
+        kind = "sweep"                    # sweep | uniform | euler | quaternions
+        axis = [0, 0, -1]
+        start = 0
+        stop = 360
+        step = 1
+        initial_axis = [0, 0, 1]
+        initial_angle = 25
+
+        [materials]                       # optional: material name -> catalog entry
+        "white-paint-a276" = "white-paint-a276"
+
+    Unknown keys and wrong types raise :class:`~sbrdf_xr.errors.SceneError`.
+    """
+    path = Path(path)
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise SceneError(f"scene file {path}: cannot be read ({exc.strerror or exc})") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"scene file {path}: not UTF-8 text (byte 0x{raw[exc.start]:02x} at offset "
+                         f"{exc.start}); TOML files are UTF-8") from None
+    try:
+        d = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path}: invalid TOML: {exc}") from None
+    except RecursionError:
+        raise SceneError(f"{path}: invalid TOML: nested too deeply") from None
+    return scene_from_dict(d, path.parent)
+
+
+def _canx1_plusx_specular() -> Scene:
+    from .spacecraft import canx1
+
+    return Scene(
+        canx1(),
+        attitudes=geometry.axis_rotation([0, 0, 1], [0.0]),
+        phase_angles=[5.0, 30.0, 60.0, 90.0],
+        outputs=("spacecraft_sbrdf", "signal", "brdf", "area", "per_material"),
+        name="canx1-plusx-specular",
+        description="CanX-1 +X side at specular geometry in the xy-plane, beta = 5, 30, 60, 90 deg "
+        "(paper 000 section 4, Fig. 12)",
+    )
+
+
+def _canx1_rotation() -> Scene:
+    from .spacecraft import canx1
+
+    angles = np.arange(360.0)
+    return Scene(
+        canx1(),
+        attitudes=geometry.rotation_sweep([0, 0, -1], angles, geometry.axis_rotation([0, 0, 1], 25.0)),
+        attitude_angle=angles,
+        phase_angles=[10.0],
+        outputs=("spacecraft_sbrdf", "signal", "brdf", "area", "per_material"),
+        name="canx1-rotation",
+        description="CanX-1 initially rotated 25 deg about +z, then 360 steps of 1 deg about -z; "
+        "v_i and v_r 5 deg either side of +x (beta = 10 deg) (paper 000 section 4, Fig. 13)",
+    )
+
+
+def _canx1_pass() -> Scene:
+    from .observe import canx1_pass
+    from .spacecraft import canx1
+
+    return Scene(
+        canx1(),
+        observation=canx1_pass(),
+        outputs=("spacecraft_sbrdf", "signal", "brdf", "area", "band_signal"),
+        bands=("V", "R", "I"),
+        name="canx1-pass",
+        description="CanX-1 model on the shipped example elements over Mont Megantic, "
+        "2024-03-17 01:20-01:25 UTC at 1 s, spinning; leaves the Earth's shadow in the window",
+    )
+
+
+_BUILTIN = {"canx1-plusx-specular": _canx1_plusx_specular, "canx1-rotation": _canx1_rotation,
+            "canx1-pass": _canx1_pass}
+
+
+def builtin_scenes() -> list[str]:
+    """Names of the built-in scenes."""
+    return list(_BUILTIN)
+
+
+def builtin_scene(name: str) -> Scene:
+    """A built-in scene by name (see :func:`builtin_scenes`)."""
+    try:
+        return _BUILTIN[name]()
+    except KeyError:
+        raise SceneError(f"unknown scene {name!r}; built-in scenes: {', '.join(_BUILTIN)}") from None
+
+
+def resolve_scene(spec: str | Path | Scene) -> Scene:
+    """A scene from a Scene, a built-in name or a TOML file path."""
+    if isinstance(spec, Scene):
+        return spec
+    if not isinstance(spec, str | Path):
+        raise SceneError(f"scene: expected a Scene, a built-in scene name or a TOML file path, "
+                         f"got {type(spec).__name__}")
+    if str(spec) in _BUILTIN:
+        return builtin_scene(str(spec))
+    if "\0" in str(spec):
+        raise SceneError(f"unknown scene {str(spec)!r}: a name or path cannot contain a NUL character")
+    path = Path(spec)
+    if path.suffix == ".toml" or path.exists():
+        if path.is_dir():
+            raise SceneError(f"scene file {path} is a directory")
+        if not path.exists():
+            raise SceneError(f"scene file {path} does not exist")
+        return load_scene(path)
+    raise SceneError(f"unknown scene {str(spec)!r}; built-in scenes: {', '.join(_BUILTIN)}, or a .toml file")

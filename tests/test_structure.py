@@ -1,0 +1,213 @@
+"""The package's imports flow one way.
+
+The modules of ``sbrdf_xr`` stand in layers, lowest first; a module imports only from
+its own layer or lower ones, and no set of modules imports itself round (within a
+layer either).  Imports are read from the source with :mod:`ast`, at module level and
+inside functions alike; only those under ``if TYPE_CHECKING:`` are left out (they do
+not run).
+
+* L0, kernels and names: ``_version``, ``_names``, ``errors``, ``geometry``, ``_lut``,
+  ``_kernels``, ``sources``, ``brdf`` (and its models), ``imperfections``, ``knobs``,
+  ``_catalog_index`` (where the shipped files are; it loads nothing), ``_shadow_kernels``,
+  ``_cache`` (tables built on load, cached on disk).
+* L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``models``,
+  ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``visibility``,
+  ``attitude_frames``, ``attitude``, ``orbits``, ``observe``, ``photometry`` (and its
+  modules), ``fingerprint``.
+* L2: ``catalog`` (knows every kind's loader in L1).
+* L3, the scene and its plan: ``effects``, ``plan``, ``sweep``, ``scene_model`` (the
+  :class:`Scene`), ``scene_io`` (scene files, built-in scenes), ``scene`` (re-exports both).
+* L4, the cube: ``simulate``, ``_writer`` and its parts ``_write_common``, ``_runners``, ``_lock``.
+* L5, users of everything: ``invert`` (and its modules), ``bench``, ``bench_engine``,
+  ``shadow_bench``, ``plot``,
+  ``accessors``, ``cli``, ``testing`` and the package's ``__init__``.
+
+A new module must be given a layer here.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parent.parent / "sbrdf_xr"
+
+LAYERS: tuple[tuple[str, ...], ...] = (
+    ("_version", "_names", "errors", "geometry", "_lut", "_kernels", "sources", "brdf",
+     "imperfections", "knobs", "_catalog_index", "_shadow_kernels", "_cache"),
+    ("material_schema", "material_io", "construction", "models", "material", "goniometer",
+     "mesh_io", "spacecraft", "visibility", "attitude_frames", "attitude", "orbits", "observe",
+     "photometry", "fingerprint"),
+    ("catalog",),
+    ("effects", "plan", "sweep", "scene_model", "scene_io", "scene"),
+    ("simulate", "_writer", "_write_common", "_runners", "_lock"),
+    ("invert", "bench", "bench_engine", "shadow_bench", "plot", "accessors", "cli", "testing", ""),
+)
+
+
+def _module_name(path: Path, root: Path) -> str:
+    parts = path.relative_to(root).with_suffix("").parts
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(parts)
+
+
+def _type_checking_nodes(tree: ast.AST) -> set[int]:
+    """ids of the nodes under ``if TYPE_CHECKING:`` (or ``typing.TYPE_CHECKING``)."""
+    skip: set[int] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If):
+            t = node.test
+            name = t.id if isinstance(t, ast.Name) else t.attr if isinstance(t, ast.Attribute) else None
+            if name == "TYPE_CHECKING":
+                for child in node.body:
+                    skip.update(id(n) for n in ast.walk(child))
+    return skip
+
+
+def import_graph(root: Path = PACKAGE) -> dict[str, set[str]]:
+    """Module -> the package modules it imports (names relative to the package, ``""`` for it)."""
+    files = {_module_name(p, root): p for p in root.rglob("*.py")}
+    graph: dict[str, set[str]] = {}
+    for mod, path in files.items():
+        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+        skip = _type_checking_nodes(tree)
+        pkg = mod.split(".") if path.name == "__init__.py" else mod.split(".")[:-1]
+        if mod == "":
+            pkg = []
+        deps: set[str] = set()
+        for node in ast.walk(tree):
+            if id(node) in skip:
+                continue
+            targets: list[str] = []
+            if isinstance(node, ast.Import):
+                targets = [a.name.removeprefix("sbrdf_xr").lstrip(".") for a in node.names
+                           if a.name == "sbrdf_xr" or a.name.startswith("sbrdf_xr.")]
+            elif isinstance(node, ast.ImportFrom):
+                if node.level:
+                    base_parts = pkg[: len(pkg) - node.level + 1] + ([node.module] if node.module else [])
+                    base = ".".join(base_parts)
+                elif node.module and (node.module == "sbrdf_xr" or node.module.startswith("sbrdf_xr.")):
+                    base = node.module.removeprefix("sbrdf_xr").lstrip(".")
+                else:
+                    continue
+                for a in node.names:
+                    sub = f"{base}.{a.name}" if base else a.name
+                    targets.append(sub if sub in files else base)
+            for t in targets:
+                while t and t not in files:
+                    t = t.rpartition(".")[0]
+                if t != mod:
+                    deps.add(t)
+        graph[mod] = deps
+    return graph
+
+
+def layer_of(mod: str) -> int:
+    """Layer of a module: that of its entry, or of its package's (``brdf.lambert`` -> ``brdf``)."""
+    name = mod
+    while True:
+        for i, layer in enumerate(LAYERS):
+            if name in layer:
+                return i
+        if not name or "." not in name:
+            raise KeyError(mod)
+        name = name.rpartition(".")[0]
+
+
+def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components with more than one module (Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    out: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in sorted(graph.get(v, ())):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def against_flow(graph: dict[str, set[str]]) -> list[str]:
+    """Imports of a module from a higher layer, as ``"a (L1) -> b (L2)"``."""
+    bad = []
+    for mod, deps in sorted(graph.items()):
+        for dep in sorted(deps):
+            if layer_of(dep) > layer_of(mod):
+                bad.append(f"{mod or 'sbrdf_xr'} (L{layer_of(mod)}) -> {dep or 'sbrdf_xr'} (L{layer_of(dep)})")
+    return bad
+
+
+def test_every_module_has_a_layer():
+    with pytest.raises(KeyError):
+        layer_of("a_new_module")
+    missing = []
+    for mod in import_graph():
+        try:
+            layer_of(mod)
+        except KeyError:
+            missing.append(mod)
+    assert not missing, f"modules without a layer in tests/test_structure.py: {missing}"
+
+
+def test_no_import_cycles():
+    found = cycles(import_graph())
+    assert not found, "import cycles: " + "; ".join(" <-> ".join(c) for c in found)
+
+
+def test_no_imports_against_the_flow():
+    bad = against_flow(import_graph())
+    assert not bad, "imports against the flow:\n" + "\n".join(bad)
+
+
+def test_the_checks_catch_a_catalog_import_in_material(tmp_path):
+    """The reading of the imports sees a function-level ``from .catalog import`` in material."""
+    import shutil
+
+    copy = tmp_path / "sbrdf_xr"
+    shutil.copytree(PACKAGE, copy, ignore=shutil.ignore_patterns("__pycache__", "catalogs"))
+    mat = copy / "material.py"
+    mat.write_text(mat.read_text(encoding="utf-8")
+                   + "\n\ndef _f():\n    from .catalog import load\n\n    return load\n", encoding="utf-8")
+    graph = import_graph(copy)
+    assert "material (L1) -> catalog (L2)" in against_flow(graph)
+    assert any({"material", "catalog"} <= set(c) for c in cycles(graph))
+
+
+def test_type_checking_imports_are_left_out(tmp_path):
+    pkg = tmp_path / "sbrdf_xr"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "errors.py").write_text("from typing import TYPE_CHECKING\n\nif TYPE_CHECKING:\n"
+                                   "    from .catalog import CatalogEntry\n")
+    (pkg / "catalog.py").write_text("from .errors import CatalogError\n")
+    assert import_graph(pkg) == {"": set(), "errors": set(), "catalog": {"errors"}}
+
+
+@pytest.mark.parametrize("mod", ["material", "models", "spacecraft", "observe"])
+def test_domain_modules_do_not_import_the_catalog(mod):
+    assert "catalog" not in import_graph()[mod]
