@@ -78,9 +78,18 @@ def _built_material(name: str, measurements: str, options: tuple[tuple[str, Any]
             opts["model"] = load(opts.pop("fit"))
         return material.build_lut(load(measurements), material=name, **opts)
 
+    def read(path: Any) -> xr.DataArray:
+        da = material.open_material(path)
+        for k in _FILE_ATTRS:  # what writing a file adds, not what the build made
+            da.attrs.pop(k, None)
+        return da
+
     return cached_table(name, inputs, repr(options), build,
-                        lambda da, path: material.to_netcdf(da, path, overwrite=True),
-                        material.open_material)
+                        lambda da, path: material.to_netcdf(da, path, overwrite=True), read)
+
+
+#: Attributes the netCDF writer adds to a file (CF/ACDD basics) that a built table lacks.
+_FILE_ATTRS = ("title", "history")
 
 
 def _load_paint_parameters(e: CatalogEntry) -> xr.Dataset:
