@@ -25,21 +25,39 @@ def main() -> None:
     cube = simulate(builtin_scene("canx1-pass"))
     mags = magnitudes(cube.signal, ["V", "R", "I"], range_km=cube["range"])  # the cube's own range
     t = cube.time.values
-    fig, (ax, el) = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True,
-                                 gridspec_kw={"height_ratios": [3, 1]})
+    fig, (ax, el) = plt.subplots(
+        2, 1, figsize=(9, 5.5), sharex=True, gridspec_kw={"height_ratios": [3, 1]}
+    )
     f = cube.sunlit_fraction.values
     for a in (ax, el):
-        a.fill_between(t, 0, 1, where=f == 0, transform=a.get_xaxis_transform(), color="0.85",
-                       label="umbra" if a is ax else None)
-        a.fill_between(t, 0, 1, where=(f > 0) & (f < 1), transform=a.get_xaxis_transform(),
-                       color="khaki", label="penumbra" if a is ax else None)
+        a.fill_between(
+            t,
+            0,
+            1,
+            where=f == 0,
+            transform=a.get_xaxis_transform(),
+            color="0.85",
+            label="umbra" if a is ax else None,
+        )
+        a.fill_between(
+            t,
+            0,
+            1,
+            where=(f > 0) & (f < 1),
+            transform=a.get_xaxis_transform(),
+            color="khaki",
+            label="penumbra" if a is ax else None,
+        )
     for band, colour in (("V", "tab:green"), ("R", "tab:red"), ("I", "darkred")):
         m = mags.sel(band=band).values
         ax.plot(t, np.where(np.isfinite(m), m, np.nan), color=colour, lw=1, label=band)
     ax.invert_yaxis()
     ax.set_ylabel("AB magnitude")
-    ax.set_title(f"{cube.attrs['scene']}: CanX-1 model, {cube.attrs['orbit_name']} from "
-                 f"{cube.attrs['site_name']} (spinning)", fontsize=10)
+    ax.set_title(
+        f"{cube.attrs['scene']}: CanX-1 model, {cube.attrs['orbit_name']} from "
+        f"{cube.attrs['site_name']} (spinning)",
+        fontsize=10,
+    )
     ax.legend(fontsize=8, ncol=5, loc="lower right")
     el.plot(t, cube.elevation, color="k", lw=1)
     el.set_ylabel("elevation [degree]")

@@ -51,10 +51,14 @@ def _file_digest(path: Path) -> str:
     return h.hexdigest()
 
 
-def cached_table(name: str, inputs: Iterable[Path], options: str,
-                 build: Callable[[], xr.DataArray],
-                 write: Callable[[xr.DataArray, Path], object],
-                 read: Callable[[Path], xr.DataArray]) -> xr.DataArray:
+def cached_table(
+    name: str,
+    inputs: Iterable[Path],
+    options: str,
+    build: Callable[[], xr.DataArray],
+    write: Callable[[xr.DataArray, Path], object],
+    read: Callable[[Path], xr.DataArray],
+) -> xr.DataArray:
     """The table ``build()`` would give, from the cache when it is there.
 
     The table returned is always the one read back from the cache file (when the cache
@@ -64,8 +68,9 @@ def cached_table(name: str, inputs: Iterable[Path], options: str,
     d = cache_dir()
     if d is None:
         return build()
-    key = hashlib.sha256("\n".join([name, options, source_digest(),
-                                    *(_file_digest(p) for p in inputs)]).encode()).hexdigest()[:32]
+    key = hashlib.sha256(
+        "\n".join([name, options, source_digest(), *(_file_digest(p) for p in inputs)]).encode()
+    ).hexdigest()[:32]
     path = d / f"{name}-{key}.nc"
     if path.is_file():
         try:

@@ -27,7 +27,16 @@ from typing import Any
 
 from .errors import CatalogError
 
-__all__ = ["KINDS", "SOURCES", "CatalogEntry", "catalog_dir", "data_path", "entries", "entry", "names"]
+__all__ = [
+    "KINDS",
+    "SOURCES",
+    "CatalogEntry",
+    "catalog_dir",
+    "data_path",
+    "entries",
+    "entry",
+    "names",
+]
 
 KINDS = ("material", "measurements", "model", "paint_parameters", "spacecraft", "orbit", "site")
 SOURCES = ("measured", "synthetic")
@@ -121,7 +130,9 @@ def _index() -> tuple[CatalogEntry, ...]:
         if missing:
             raise CatalogError(f"{path}: entry {i} lacks the field(s) {missing}")
         if item["kind"] not in KINDS:
-            raise CatalogError(f"{path}: entry {item['name']!r} has kind {item['kind']!r}; allowed: {KINDS}")
+            raise CatalogError(
+                f"{path}: entry {item['name']!r} has kind {item['kind']!r}; allowed: {KINDS}"
+            )
         src = item["source"]
         if src not in SOURCES and not src.startswith("model:"):
             raise CatalogError(

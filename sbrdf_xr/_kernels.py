@@ -37,8 +37,15 @@ from numpy.typing import NDArray
 from . import _lut
 from .geometry import facet_angles, normal_incidence_tolerance
 
-__all__ = ["METHOD_CODES", "FusedSums", "MaterialSums", "PackedTables", "fused_sums",
-           "material_sums", "pack_tables"]
+__all__ = [
+    "METHOD_CODES",
+    "FusedSums",
+    "MaterialSums",
+    "PackedTables",
+    "fused_sums",
+    "material_sums",
+    "pack_tables",
+]
 
 
 class MaterialSums(NamedTuple):
@@ -99,7 +106,9 @@ def material_sums(
     if f == 0 or g == 0:
         z = np.zeros((g, n_wl), dtype=out_dtype)
         return MaterialSums(z, z.copy(), np.zeros(g), np.zeros(g))
-    ang = facet_angles(normals[None, :, :], to_sun[:, None, :], to_observer[:, None, :], check=False)
+    ang = facet_angles(
+        normals[None, :, :], to_sun[:, None, :], to_observer[:, None, :], check=False
+    )
     cos_i = np.einsum("fk,gk->gf", normals, to_sun)
     cos_r = np.einsum("fk,gk->gf", normals, to_observer)
     contributing = ang.lit & ang.visible
@@ -110,9 +119,15 @@ def material_sums(
     w_signal = a2d * cos_i
     rows = np.flatnonzero(contributing.ravel())
     m = _lut.lookup_matrix(
-        theta_grid, delta_theta_grid, phi_grid,
-        ang.theta_i.ravel()[rows], ang.delta_theta.ravel()[rows], ang.phi.ravel()[rows], method,
-        zero_edges=zero_edges, normal_blend=normal_blend,
+        theta_grid,
+        delta_theta_grid,
+        phi_grid,
+        ang.theta_i.ravel()[rows],
+        ang.delta_theta.ravel()[rows],
+        ang.phi.ravel()[rows],
+        method,
+        zero_edges=zero_edges,
+        normal_blend=normal_blend,
     ).tocoo()
     geom = rows[m.row] // f
     v2 = values.reshape(-1, n_wl)
@@ -150,8 +165,9 @@ _RAD2DEG = 180.0 / np.pi
 
 
 @numba.njit(nogil=True, cache=True, inline="always")
-def _axis(grid: np.ndarray, lo: int, n: int, x: float, method: int,
-          idx: np.ndarray, w: np.ndarray) -> int:  # pragma: no cover - compiled
+def _axis(
+    grid: np.ndarray, lo: int, n: int, x: float, method: int, idx: np.ndarray, w: np.ndarray
+) -> int:  # pragma: no cover - compiled
     """Node indices and weights along one axis (``_lut.axis_weights``); returns the count."""
     g0 = grid[lo]
     g1 = grid[lo + n - 1]
@@ -223,21 +239,29 @@ def _gather(values, rows, wn, nk, f, acc_s, acc_p, ws, wp):  # pragma: no cover 
             w0, w1, w2, w3 = wn[n], wn[n + 1], wn[n + 2], wn[n + 3]
             if last and not started:
                 for k in range(n_wl):
-                    v = (w0 * values[r0, k] + w1 * values[r1, k]) + (w2 * values[r2, k] + w3 * values[r3, k])
+                    v = (w0 * values[r0, k] + w1 * values[r1, k]) + (
+                        w2 * values[r2, k] + w3 * values[r3, k]
+                    )
                     acc_s[k] += ws * v
                     acc_p[k] += wp * v
             elif last:
                 for k in range(n_wl):
-                    v = f[k] + ((w0 * values[r0, k] + w1 * values[r1, k])
-                                + (w2 * values[r2, k] + w3 * values[r3, k]))
+                    v = f[k] + (
+                        (w0 * values[r0, k] + w1 * values[r1, k])
+                        + (w2 * values[r2, k] + w3 * values[r3, k])
+                    )
                     acc_s[k] += ws * v
                     acc_p[k] += wp * v
             elif not started:
                 for k in range(n_wl):
-                    f[k] = (w0 * values[r0, k] + w1 * values[r1, k]) + (w2 * values[r2, k] + w3 * values[r3, k])
+                    f[k] = (w0 * values[r0, k] + w1 * values[r1, k]) + (
+                        w2 * values[r2, k] + w3 * values[r3, k]
+                    )
             else:
                 for k in range(n_wl):
-                    f[k] += (w0 * values[r0, k] + w1 * values[r1, k]) + (w2 * values[r2, k] + w3 * values[r3, k])
+                    f[k] += (w0 * values[r0, k] + w1 * values[r1, k]) + (
+                        w2 * values[r2, k] + w3 * values[r3, k]
+                    )
             n += 4
         else:
             r0 = rows[n]
@@ -263,9 +287,31 @@ def _gather(values, rows, wn, nk, f, acc_s, acc_p, ws, wp):  # pragma: no cover 
 
 
 @numba.njit(nogil=True, cache=True)
-def _fused_sums(s, o, normals, areas, term_mat, frac, tables, tgrid, t_off, dgrid, d_off,
-                pgrid, p_off, edges, blend, method, tol, edge_tol,
-                out_sig, out_pap, out_area, out_lit, out_pm):  # pragma: no cover - compiled
+def _fused_sums(
+    s,
+    o,
+    normals,
+    areas,
+    term_mat,
+    frac,
+    tables,
+    tgrid,
+    t_off,
+    dgrid,
+    d_off,
+    pgrid,
+    p_off,
+    edges,
+    blend,
+    method,
+    tol,
+    edge_tol,
+    out_sig,
+    out_pap,
+    out_area,
+    out_lit,
+    out_pm,
+):  # pragma: no cover - compiled
     n_geom = s.shape[0]
     n_term = normals.shape[0]
     n_wl = out_sig.shape[1]
@@ -344,9 +390,11 @@ def _fused_sums(s, o, normals, areas, term_mat, frac, tables, tgrid, t_off, dgri
                 npp = p_off[m + 1] - p0
                 t0 = t_off[m]
                 nt = t_off[m + 1] - t0
-                outside = ((edges[m, 0] and dt < dgrid[d0] - edge_tol)
-                           or (edges[m, 1] and dt > dgrid[d0 + nd - 1] + edge_tol)
-                           or (edges[m, 2] and phi > pgrid[p0 + npp - 1] + edge_tol))
+                outside = (
+                    (edges[m, 0] and dt < dgrid[d0] - edge_tol)
+                    or (edges[m, 1] and dt > dgrid[d0 + nd - 1] + edge_tol)
+                    or (edges[m, 2] and phi > pgrid[p0 + npp - 1] + edge_tol)
+                )
                 # normal-incidence blend (_lut.lookup_matrix): weight of the theta_i = 0 profile
                 w_n = 0.0
                 b_m = blend[m]
@@ -374,7 +422,10 @@ def _fused_sums(s, o, normals, areas, term_mat, frac, tables, tgrid, t_off, dgri
                     pr = phi / _RAD2DEG
                     tr = dt / _RAD2DEG
                     cp = np.cos(pr)
-                    gam = np.arctan2(np.hypot(np.sin(pr), cp * np.sin(tr)), abs(cp * np.cos(tr))) * _RAD2DEG
+                    gam = (
+                        np.arctan2(np.hypot(np.sin(pr), cp * np.sin(tr)), abs(cp * np.cos(tr)))
+                        * _RAD2DEG
+                    )
                     ok_hi = (gam <= dgrid[d0 + nd - 1] + edge_tol) or not edges[m, 1]
                     ok_lo = (-gam >= dgrid[d0] - edge_tol) or not edges[m, 0]
                     n_ok = (1 if ok_hi else 0) + (1 if ok_lo else 0)
@@ -454,6 +505,7 @@ def pack_tables(
     same ``L`` and dtype.  ``n_spectral`` and ``dtype`` shape an empty packing (no
     tables).
     """
+
     def cat(arrays: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         off = np.concatenate([[0], np.cumsum([a.size for a in arrays])]).astype(np.int64)
         return np.ascontiguousarray(np.concatenate(arrays), dtype=np.float64), off
@@ -461,8 +513,20 @@ def pack_tables(
     dt = np.dtype(dtype)
     if not tables:
         z = np.zeros(1, dtype=np.int64)
-        return PackedTables((), np.zeros(0), z, np.zeros(0), z, np.zeros(0), z,
-                            np.zeros((0, 3), dtype=bool), np.zeros(0), (), n_spectral, dt)
+        return PackedTables(
+            (),
+            np.zeros(0),
+            z,
+            np.zeros(0),
+            z,
+            np.zeros(0),
+            z,
+            np.zeros((0, 3), dtype=bool),
+            np.zeros(0),
+            (),
+            n_spectral,
+            dt,
+        )
     n_wl = tables[0][0].shape[-1]
     values = tuple(np.ascontiguousarray(v, dtype=dt).reshape(-1, n_wl) for v, *_ in tables)
     tgrid, t_off = cat([np.asarray(t[1]) for t in tables])
@@ -471,7 +535,9 @@ def pack_tables(
     edges = np.array([t[4] for t in tables], dtype=bool).reshape(-1, 3)
     blend = np.array([float(t[5]) if len(t) > 5 else 0.0 for t in tables], dtype=np.float64)
     shapes = tuple(tuple(int(x) for x in v.shape[:3]) for v, *_ in tables)
-    return PackedTables(values, tgrid, t_off, dgrid, d_off, pgrid, p_off, edges, blend, shapes, n_wl, dt)
+    return PackedTables(
+        values, tgrid, t_off, dgrid, d_off, pgrid, p_off, edges, blend, shapes, n_wl, dt
+    )
 
 
 class FusedSums(NamedTuple):
@@ -538,14 +604,34 @@ def fused_sums(
     out_area = np.zeros(g)
     out_lit = np.zeros(g)
     out_pm = np.zeros((g, n_mat, n_wl) if per_material else (0, 0, 0), dtype=dt)
-    frac = (np.zeros((0, 0)) if fraction is None
-            else np.ascontiguousarray(fraction, dtype=np.float64))
+    frac = (
+        np.zeros((0, 0)) if fraction is None else np.ascontiguousarray(fraction, dtype=np.float64)
+    )
     if g and normals.shape[0]:
         typed = numba.typed.List(tables.values)
-        _fused_sums(s, o, np.ascontiguousarray(normals, dtype=np.float64),
-                    np.ascontiguousarray(areas, dtype=np.float64), tm, frac, typed,
-                    tables.tgrid, tables.t_off, tables.dgrid, tables.d_off, tables.pgrid,
-                    tables.p_off, tables.edges, tables.blend, METHOD_CODES[method],
-                    normal_incidence_tolerance(np.float64), _lut.EDGE_TOL_DEG,
-                    out_sig, out_pap, out_area, out_lit, out_pm)
+        _fused_sums(
+            s,
+            o,
+            np.ascontiguousarray(normals, dtype=np.float64),
+            np.ascontiguousarray(areas, dtype=np.float64),
+            tm,
+            frac,
+            typed,
+            tables.tgrid,
+            tables.t_off,
+            tables.dgrid,
+            tables.d_off,
+            tables.pgrid,
+            tables.p_off,
+            tables.edges,
+            tables.blend,
+            METHOD_CODES[method],
+            normal_incidence_tolerance(np.float64),
+            _lut.EDGE_TOL_DEG,
+            out_sig,
+            out_pap,
+            out_area,
+            out_lit,
+            out_pm,
+        )
     return FusedSums(out_sig, out_pap, out_area, out_lit, out_pm if per_material else None)

@@ -77,15 +77,21 @@ class _Lock:
                 self._clear_stale()
                 continue
             except OSError as exc:
-                raise CubeWriteError(f"cannot write {self.target}: creating the lock {self.path} "
-                                     f"failed: {_reason(exc)}") from exc
+                raise CubeWriteError(
+                    f"cannot write {self.target}: creating the lock {self.path} "
+                    f"failed: {_reason(exc)}"
+                ) from exc
             try:
                 for _ in range(50):  # a stale-lock check may hold it for an instant
                     if _try_flock(fd) is not False:
                         break
                     time.sleep(0.01)
-                info = {"pid": os.getpid(), "host": socket.gethostname(), "cube": str(self.target),
-                        "started": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")}
+                info = {
+                    "pid": os.getpid(),
+                    "host": socket.gethostname(),
+                    "cube": str(self.target),
+                    "started": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
+                }
                 os.write(fd, (json.dumps(info) + "\n").encode())
                 os.fsync(fd)
                 self.ino = os.fstat(fd).st_ino
@@ -94,16 +100,23 @@ class _Lock:
                 with contextlib.suppress(OSError):
                     os.unlink(self.path)
                 if isinstance(exc, OSError):
-                    raise CubeWriteError(f"cannot write {self.target}: writing the lock {self.path} "
-                                         f"failed: {_reason(exc, self.path)}") from exc
+                    raise CubeWriteError(
+                        f"cannot write {self.target}: writing the lock {self.path} "
+                        f"failed: {_reason(exc, self.path)}"
+                    ) from exc
                 raise
             self.fd = fd
             return
-        raise CubeLockedError(f"{self.target}: the lock {self.path} keeps being taken by other writers")
+        raise CubeLockedError(
+            f"{self.target}: the lock {self.path} keeps being taken by other writers"
+        )
 
     def _locked(self, info: Mapping[str, Any] | None) -> CubeLockedError:
-        who = (f"pid {info.get('pid')} on host {info.get('host')}, started {info.get('started')}"
-               if info else "a writer that is starting")
+        who = (
+            f"pid {info.get('pid')} on host {info.get('host')}, started {info.get('started')}"
+            if info
+            else "a writer that is starting"
+        )
         return CubeLockedError(
             f"{self.target} is being written by another writer ({who}; lock {self.path}); "
             "wait for it to finish or stop it, or write to another file"
@@ -144,8 +157,11 @@ class _Lock:
                     )
                 if held is None and _pid_alive(pid):
                     raise self._locked(info)
-                why = (f"its writer, pid {pid} started {info.get('started')}, is no longer running"
-                       if not _pid_alive(pid) else f"pid {pid} no longer holds it")
+                why = (
+                    f"its writer, pid {pid} started {info.get('started')}, is no longer running"
+                    if not _pid_alive(pid)
+                    else f"pid {pid} no longer holds it"
+                )
             try:
                 same = os.stat(self.path, follow_symlinks=False).st_ino == st.st_ino
             except FileNotFoundError:

@@ -44,8 +44,10 @@ def table_edges(attrs: dict) -> tuple[bool, bool, bool]:
     ``edge_delta_theta_max`` and ``edge_phi_max`` as ``"zero"`` (a reference point)
     or ``"hold"`` (a measured point where the apparatus stopped).
     """
-    return tuple(attrs.get(k, "zero") != "hold"
-                 for k in ("edge_delta_theta_min", "edge_delta_theta_max", "edge_phi_max"))  # type: ignore[return-value]
+    return tuple(
+        attrs.get(k, "zero") != "hold"
+        for k in ("edge_delta_theta_min", "edge_delta_theta_max", "edge_phi_max")
+    )  # type: ignore[return-value]
 
 
 def table_normal_blend(attrs: dict) -> float:
@@ -74,14 +76,18 @@ def normal_incidence_weight(theta_i: ArrayLike, blend: float) -> NDArray[np.floa
     return 1.0 - x * x * (3.0 - 2.0 * x)
 
 
-def observer_polar_angle(theta_i: ArrayLike, delta_theta: ArrayLike, phi: ArrayLike) -> NDArray[np.float64]:
+def observer_polar_angle(
+    theta_i: ArrayLike, delta_theta: ArrayLike, phi: ArrayLike
+) -> NDArray[np.float64]:
     """Observer polar angle ``theta_r`` [degree] from paper-000 angles [degree].
 
     ``cos theta_r = cos(phi) cos(theta_i + delta_theta)`` and
     ``sin^2 theta_r = sin^2 phi + cos^2 phi sin^2(theta_i + delta_theta)`` (an arctan2
     of the two: accurate at ``theta_r`` -> 0).
     """
-    t = np.radians(np.asarray(theta_i, dtype=np.float64) + np.asarray(delta_theta, dtype=np.float64))
+    t = np.radians(
+        np.asarray(theta_i, dtype=np.float64) + np.asarray(delta_theta, dtype=np.float64)
+    )
     p = np.radians(np.asarray(phi, dtype=np.float64))
     cp = np.cos(p)
     return np.degrees(np.arctan2(np.hypot(np.sin(p), cp * np.sin(t)), np.abs(cp * np.cos(t))))
@@ -234,7 +240,7 @@ def lookup_matrix(
     idt, wdt = axis_weights(delta_theta_grid, dt, method)
     iph, wph = axis_weights(phi_grid, ph, method)
     ndt, nph = delta_theta_grid.size, phi_grid.size
-    idx = ((it[:, :, None, None] * ndt + idt[:, None, :, None]) * nph + iph[:, None, None, :])
+    idx = (it[:, :, None, None] * ndt + idt[:, None, :, None]) * nph + iph[:, None, None, :]
     w = wt[:, :, None, None] * wdt[:, None, :, None] * wph[:, None, None, :]
     z_lo, z_hi, z_phi = zero_edges
     outside = (
@@ -265,8 +271,10 @@ def lookup_matrix(
     # The angle from the specular direction (theta_r itself at normal incidence): the
     # profile stays centred on specular across the blend, as a lobe does.
     tr = observer_polar_angle(0.0, dt[rows], ph[rows])
-    valid = [(tr <= delta_theta_grid[-1] + EDGE_TOL_DEG) | (not z_hi),
-             (-tr >= delta_theta_grid[0] - EDGE_TOL_DEG) | (not z_lo)]
+    valid = [
+        (tr <= delta_theta_grid[-1] + EDGE_TOL_DEG) | (not z_hi),
+        (-tr >= delta_theta_grid[0] - EDGE_TOL_DEG) | (not z_lo),
+    ]
     n_valid = valid[0].astype(float) + valid[1].astype(float)
     base = wn[rows] * np.divide(1.0, n_valid, out=np.zeros_like(n_valid), where=n_valid > 0)
     if weights is not None:
@@ -280,8 +288,9 @@ def lookup_matrix(
         data.append(ww.ravel())
         cols.append(cc.ravel())
         rr.append(np.repeat(rows, ww.shape[1] * ww.shape[2]))
-    g = sp.csr_matrix((np.concatenate(data), (np.concatenate(rr), np.concatenate(cols))),
-                      shape=(q, n_nodes))
+    g = sp.csr_matrix(
+        (np.concatenate(data), (np.concatenate(rr), np.concatenate(cols))), shape=(q, n_nodes)
+    )
     return m + g
 
 
@@ -323,8 +332,17 @@ def lookup_kernel(
         :func:`lookup_matrix`.
     """
     shape = np.broadcast_shapes(np.shape(theta_i), np.shape(delta_theta), np.shape(phi))
-    m = lookup_matrix(theta_grid, delta_theta_grid, phi_grid, theta_i, delta_theta, phi, method,
-                      zero_edges=zero_edges, normal_blend=normal_blend)
+    m = lookup_matrix(
+        theta_grid,
+        delta_theta_grid,
+        phi_grid,
+        theta_i,
+        delta_theta,
+        phi,
+        method,
+        zero_edges=zero_edges,
+        normal_blend=normal_blend,
+    )
     v2 = values.reshape(-1, values.shape[-1])
     if v2.dtype != np.float64:
         m = m.astype(v2.dtype)
@@ -407,8 +425,7 @@ def smoothing_spline_matrix(
     hj = h[j][:, None]
     a = (x[j + 1][:, None] - xo[:, None]) / hj
     b = (xo[:, None] - x[j][:, None]) / hj
-    e = (a * f[j] + b * f[j + 1]
-         + ((a**3 - a) * c[j] + (b**3 - b) * c[j + 1]) * hj**2 / 6.0)
+    e = a * f[j] + b * f[j + 1] + ((a**3 - a) * c[j] + (b**3 - b) * c[j + 1]) * hj**2 / 6.0
     if extrapolation != "cubic":
         lo, hi = xo < x[0], xo > x[-1]
         slope0 = (f[1] - f[0]) / h[0] - h[0] * (2 * c[0] + c[1]) / 6.0
@@ -461,7 +478,10 @@ def _gauss_nodes(breaks: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDAr
     each interval split into pieces no wider than :data:`_MAX_STEP_DEG`."""
     pieces = np.maximum(np.ceil(np.diff(breaks) / _MAX_STEP_DEG).astype(int), 1)
     breaks = np.concatenate(
-        [np.linspace(a, b, k + 1)[:-1] for a, b, k in zip(breaks[:-1], breaks[1:], pieces, strict=True)]
+        [
+            np.linspace(a, b, k + 1)[:-1]
+            for a, b, k in zip(breaks[:-1], breaks[1:], pieces, strict=True)
+        ]
         + [breaks[-1:]]
     )
     a, b = breaks[:-1, None], breaks[1:, None]
@@ -539,9 +559,21 @@ def hemispherical_reflectance_kernel(
         breaks = np.unique(np.concatenate([[lo, hi], inner[(inner > lo) & (inner < hi)]]))
         t_nodes, t_w = _gauss_nodes(breaks)
         tt, pp = np.meshgrid(t_nodes, phi_nodes, indexing="ij")
-        ww = (np.outer(t_w, phi_w) * np.cos(np.radians(pp)) ** 2 * np.cos(np.radians(tt)))
-        m = lookup_matrix(theta_grid, delta_theta_grid, phi_grid, ti, tt - ti, pp, method,
-                          weights=ww, zero_edges=zero_edges, normal_blend=normal_blend)
-        spectra = np.asarray(m.sum(axis=0)) @ values.reshape(-1, values.shape[-1]).astype(np.float64)
+        ww = np.outer(t_w, phi_w) * np.cos(np.radians(pp)) ** 2 * np.cos(np.radians(tt))
+        m = lookup_matrix(
+            theta_grid,
+            delta_theta_grid,
+            phi_grid,
+            ti,
+            tt - ti,
+            pp,
+            method,
+            weights=ww,
+            zero_edges=zero_edges,
+            normal_blend=normal_blend,
+        )
+        spectra = np.asarray(m.sum(axis=0)) @ values.reshape(-1, values.shape[-1]).astype(
+            np.float64
+        )
         out[k] = 2.0 * np.radians(1.0) ** 2 * spectra.ravel()
     return out

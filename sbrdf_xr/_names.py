@@ -51,15 +51,24 @@ ATTRS: dict[str, dict[str, str]] = {
         "units": DEGREE,
         "long_name": "difference-in-polar angle from the specular direction (signed)",
     },
-    PHI: {"units": DEGREE, "long_name": "angle of the reflection direction from the illumination plane"},
+    PHI: {
+        "units": DEGREE,
+        "long_name": "angle of the reflection direction from the illumination plane",
+    },
     PSI: {"units": DEGREE, "long_name": "azimuth of the illumination plane from the facet tangent"},
     WAVELENGTH: {
         "units": NM,
         "long_name": "vacuum wavelength",
         "standard_name": "radiation_wavelength",
     },
-    SBRDF: {"units": PER_SR, "long_name": "spectral bidirectional reflectance distribution function"},
-    MEASURED: {"units": PER_SR, "long_name": "measured spectral bidirectional reflectance distribution function"},
+    SBRDF: {
+        "units": PER_SR,
+        "long_name": "spectral bidirectional reflectance distribution function",
+    },
+    MEASURED: {
+        "units": PER_SR,
+        "long_name": "measured spectral bidirectional reflectance distribution function",
+    },
     "theta_r": {"units": DEGREE, "long_name": "reflection polar angle from the facet normal"},
     "phi_i": {"units": DEGREE, "long_name": "illumination azimuth angle"},
     "phi_r": {"units": DEGREE, "long_name": "reflection azimuth angle"},
@@ -101,9 +110,18 @@ ATTRS: dict[str, dict[str, str]] = {
     "filter": {"units": "1", "long_name": "filter curve (speclite name, or user:<label>)"},
     "filter_source": {"units": "1", "long_name": "file and reference of the filter curve"},
     "filter_response": {"units": "1", "long_name": "filter response"},
-    "solar_irradiance": {"units": "W m-2 nm-1", "long_name": "extraterrestrial solar spectral irradiance at 1 AU"},
-    "band_weight": {"units": "1", "long_name": "band-integration weight (solar spectrum x filter x spectral weighting x quadrature weight)"},
-    "band_signal": {"units": "m2 sr-1", "long_name": "solar-weighted band mean of the radiometric signal"},
+    "solar_irradiance": {
+        "units": "W m-2 nm-1",
+        "long_name": "extraterrestrial solar spectral irradiance at 1 AU",
+    },
+    "band_weight": {
+        "units": "1",
+        "long_name": "band-integration weight (solar spectrum x filter x spectral weighting x quadrature weight)",
+    },
+    "band_signal": {
+        "units": "m2 sr-1",
+        "long_name": "solar-weighted band mean of the radiometric signal",
+    },
     # Magnitudes are dimensionless (UDUNITS has no "mag"): units "1", the system in the
     # attribute magnitude_system.
     "sun_magnitude": {"units": "1", "long_name": "apparent magnitude of the Sun at 1 AU"},
@@ -113,19 +131,30 @@ ATTRS: dict[str, dict[str, str]] = {
     "colour_index": {"units": "1", "long_name": "colour index, difference of two band magnitudes"},
     "vega_flux": {"units": "W m-2 nm-1", "long_name": "spectral flux density of alpha Lyr (Vega)"},
     "airmass": {"units": "1", "long_name": "relative optical air mass"},
-    "elevation": {"units": DEGREE, "long_name": "apparent elevation of the object above the horizon"},
+    "elevation": {
+        "units": DEGREE,
+        "long_name": "apparent elevation of the object above the horizon",
+    },
     "transmission": {"units": "1", "long_name": "atmospheric transmission"},
-    "extinction_coefficient": {"units": "1", "long_name": "atmospheric extinction coefficient "
-                               "(magnitudes per unit air mass)"},
+    "extinction_coefficient": {
+        "units": "1",
+        "long_name": "atmospheric extinction coefficient (magnitudes per unit air mass)",
+    },
     "range": {"units": "km", "long_name": "observer-object range"},
     "time": {"long_name": "observation time (UTC)"},
-    "srgb": {"units": "1", "long_name": "sRGB swatch of the reflected sunlight (display-normalised)"},
+    "srgb": {
+        "units": "1",
+        "long_name": "sRGB swatch of the reflected sunlight (display-normalised)",
+    },
     "obs": {"units": "1", "long_name": "observation index"},
     "rotation_angle": {"units": DEGREE, "long_name": "body rotation angle"},
     # --- simulation cubes ---
     ATTITUDE: {"units": "1", "long_name": "attitude index"},
     "attitude_angle": {"units": DEGREE, "long_name": "rotation angle of the attitude sweep"},
-    "quaternion": {"units": "1", "long_name": "attitude quaternion, body to reference frame, scalar last (x, y, z, w)"},
+    "quaternion": {
+        "units": "1",
+        "long_name": "attitude quaternion, body to reference frame, scalar last (x, y, z, w)",
+    },
     "component": {"units": "1", "long_name": "quaternion component"},
     GEOMETRY: {"units": "1", "long_name": "geometry index"},
     "time_since_first": {"units": "s", "long_name": "time since the first observation"},
@@ -188,9 +217,16 @@ def cf_finish(ds: Any, *, history: str | None = None) -> Any:
         if var.dtype == bool:
             var.attrs.setdefault("flag_values", np.array([0, 1], dtype=np.int8))
             var.attrs.setdefault("flag_meanings", FLAG_MEANINGS.get(str(name), "false true"))
-        partner = f"u_{name}" if f"u_{name}" in out.variables else (
-            "uncertainty" if str(name) in ("magnitude", "measured_magnitude") and "uncertainty" in out.variables
-            else None)
+        partner = (
+            f"u_{name}"
+            if f"u_{name}" in out.variables
+            else (
+                "uncertainty"
+                if str(name) in ("magnitude", "measured_magnitude")
+                and "uncertainty" in out.variables
+                else None
+            )
+        )
         if partner is not None:
             have = str(var.attrs.get("ancillary_variables", "")).split()
             if partner not in have:
@@ -199,8 +235,15 @@ def cf_finish(ds: Any, *, history: str | None = None) -> Any:
     a["Conventions"] = "CF-1.10"
     if not a.get("title"):
         who = a.get("material") or a.get("scene") or a.get("model") or ""
-        kind = ("sBRDF table" if SBRDF in out else "sBRDF measurement set" if MEASURED in out
-                else f"{a['model']} model parameters" if "model" in a else "sbrdf_xr dataset")
+        kind = (
+            "sBRDF table"
+            if SBRDF in out
+            else "sBRDF measurement set"
+            if MEASURED in out
+            else f"{a['model']} model parameters"
+            if "model" in a
+            else "sbrdf_xr dataset"
+        )
         a["title"] = f"{kind} of {who}" if who else kind
     a.setdefault("source", f"sbrdf_xr {__version__}")
     stamp = datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ")

@@ -136,16 +136,28 @@ def _check_address(address: Any) -> str:
         allowed = "expected the address of a Dask scheduler such as 'tcp://127.0.0.1:8786'"
         name = "--scheduler"
     else:
-        allowed = ("allowed: None or 'threads' (in-process threads), 'synchronous', or the address "
-                   "of a Dask scheduler such as 'tcp://127.0.0.1:8786'")
+        allowed = (
+            "allowed: None or 'threads' (in-process threads), 'synchronous', or the address "
+            "of a Dask scheduler such as 'tcp://127.0.0.1:8786'"
+        )
         name = "scheduler"
-    if not isinstance(address, str) or not address.isprintable() or any(c.isspace() for c in address):
+    if (
+        not isinstance(address, str)
+        or not address.isprintable()
+        or any(c.isspace() for c in address)
+    ):
         raise ValidationError(f"{name}: got {address!r}; {allowed}")
     scheme, sep, rest = address.rpartition("://")
     if not sep:
         scheme, rest = "tcp", address
     host, colon, port = rest.rpartition(":")
-    if scheme not in _SCHEMES or not colon or not host or not port.isdigit() or not 0 < int(port) < 65536:
+    if (
+        scheme not in _SCHEMES
+        or not colon
+        or not host
+        or not port.isdigit()
+        or not 0 < int(port) < 65536
+    ):
         raise ValidationError(f"{name}: got {address!r}; {allowed} (port 1-65535)")
     if host.startswith("[") != host.endswith("]"):
         raise ValidationError(f"{name}: got {address!r}; {allowed}")

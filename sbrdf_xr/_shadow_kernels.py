@@ -99,8 +99,14 @@ def _hull(px, py, n, ox, oy, idx):
     m = 0
     for k in range(n):  # lower chain
         v = idx[k]
-        while m >= 2 and ((ox[m - 1] - ox[m - 2]) * (py[v] - oy[m - 2])
-                          - (oy[m - 1] - oy[m - 2]) * (px[v] - ox[m - 2])) <= 0.0:
+        while (
+            m >= 2
+            and (
+                (ox[m - 1] - ox[m - 2]) * (py[v] - oy[m - 2])
+                - (oy[m - 1] - oy[m - 2]) * (px[v] - ox[m - 2])
+            )
+            <= 0.0
+        ):
             m -= 1
         ox[m] = px[v]
         oy[m] = py[v]
@@ -108,8 +114,14 @@ def _hull(px, py, n, ox, oy, idx):
     low = m + 1
     for k in range(n - 2, -1, -1):  # upper chain
         v = idx[k]
-        while m >= low and ((ox[m - 1] - ox[m - 2]) * (py[v] - oy[m - 2])
-                            - (oy[m - 1] - oy[m - 2]) * (px[v] - ox[m - 2])) <= 0.0:
+        while (
+            m >= low
+            and (
+                (ox[m - 1] - ox[m - 2]) * (py[v] - oy[m - 2])
+                - (oy[m - 1] - oy[m - 2]) * (px[v] - ox[m - 2])
+            )
+            <= 0.0
+        ):
             m -= 1
         ox[m] = px[v]
         oy[m] = py[v]
@@ -156,14 +168,28 @@ def _union_area(gx, gy, gn, m, tiny, stack_x, stack_y, stack_n, nxt, tx, ty):
                 continue
             b = nxt[d]
             nxt[d] += 1
-            if (box[b, 0] >= sbox[d, 1] or box[b, 1] <= sbox[d, 0]
-                    or box[b, 2] >= sbox[d, 3] or box[b, 3] <= sbox[d, 2]):
+            if (
+                box[b, 0] >= sbox[d, 1]
+                or box[b, 1] <= sbox[d, 0]
+                or box[b, 2] >= sbox[d, 3]
+                or box[b, 3] <= sbox[d, 2]
+            ):
                 continue
             ops += 1
             if ops > _BUDGET:
                 return 0.0, False
-            nq = _clip(stack_x[d], stack_y[d], stack_n[d], gx[b], gy[b], gn[b],
-                       stack_x[d + 1], stack_y[d + 1], tx, ty)
+            nq = _clip(
+                stack_x[d],
+                stack_y[d],
+                stack_n[d],
+                gx[b],
+                gy[b],
+                gn[b],
+                stack_x[d + 1],
+                stack_y[d + 1],
+                tx,
+                ty,
+            )
             if nq < 0:
                 return 0.0, False
             if nq < 3:
@@ -347,16 +373,20 @@ def _view_grid(d, V, F, occluder):
 
 
 @nb.njit(cache=True, nogil=True)
-def _shadow_polygon(i, j, d0, d1, d2, ndi, V, F, N, P0, E1, E2, cx, cy, eps_h, hh, px, py, qx,
-                    qy, tx, ty, idx):
+def _shadow_polygon(
+    i, j, d0, d1, d2, ndi, V, F, N, P0, E1, E2, cx, cy, eps_h, hh, px, py, qx, qy, tx, ty, idx
+):
     """Shadow that facet j casts on facet i along d = (d0, d1, d2), clipped to facet i, in
     the plane frame of i (written to qx, qy; counter-clockwise).  Returns its vertex count (0
     if none).  Scalar indexing only (array views cost more than the arithmetic here)."""
     hmax = -np.inf
     for v in range(3):
         f = F[j, v]
-        hh[v] = (N[i, 0] * (V[f, 0] - P0[i, 0]) + N[i, 1] * (V[f, 1] - P0[i, 1])
-                 + N[i, 2] * (V[f, 2] - P0[i, 2]))
+        hh[v] = (
+            N[i, 0] * (V[f, 0] - P0[i, 0])
+            + N[i, 1] * (V[f, 1] - P0[i, 1])
+            + N[i, 2] * (V[f, 2] - P0[i, 2])
+        )
         hmax = max(hmax, hh[v])
     if hmax <= eps_h:
         return 0  # on or behind the plane of i
@@ -446,7 +476,9 @@ def exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
     for g in range(G):
         for k in range(K):
             for f in range(nf):
-                nd[k, f] = N[f, 0] * dirs[g, k, 0] + N[f, 1] * dirs[g, k, 1] + N[f, 2] * dirs[g, k, 2]
+                nd[k, f] = (
+                    N[f, 0] * dirs[g, k, 0] + N[f, 1] * dirs[g, k, 1] + N[f, 2] * dirs[g, k, 2]
+                )
                 stamp[k, f] = -1
         boxes = []
         grids = []
@@ -498,13 +530,39 @@ def exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
                             if j == i or stamp[k, j] == i:
                                 continue
                             stamp[k, j] = i
-                            if (box[j, 0] >= box[i, 1] or box[j, 1] <= box[i, 0]
-                                    or box[j, 2] >= box[i, 3] or box[j, 3] <= box[i, 2]
-                                    or box[j, 5] <= box[i, 4]):
+                            if (
+                                box[j, 0] >= box[i, 1]
+                                or box[j, 1] <= box[i, 0]
+                                or box[j, 2] >= box[i, 3]
+                                or box[j, 3] <= box[i, 2]
+                                or box[j, 5] <= box[i, 4]
+                            ):
                                 continue  # apart across d, or wholly behind i along d
-                            nq = _shadow_polygon(i, j, dk0, dk1, dk2, nd[k, i], V, F, N, P0, E1,
-                                                 E2, cx, cy, eps_h, hh, px, py, qx, qy, tx, ty,
-                                                 idx)
+                            nq = _shadow_polygon(
+                                i,
+                                j,
+                                dk0,
+                                dk1,
+                                dk2,
+                                nd[k, i],
+                                V,
+                                F,
+                                N,
+                                P0,
+                                E1,
+                                E2,
+                                cx,
+                                cy,
+                                eps_h,
+                                hh,
+                                px,
+                                py,
+                                qx,
+                                qy,
+                                tx,
+                                ty,
+                                idx,
+                            )
                             if nq == 0:
                                 continue
                             if m == MAX_SHADOWS or nq > 8:
@@ -524,8 +582,9 @@ def exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
             ok = False
             shadow = 0.0
             if m <= _MAXM:
-                shadow, ok = _union_area(gx, gy, gn, m, 1e-15 * area_t, stack_x, stack_y,
-                                         stack_n, nxt, tx, ty)
+                shadow, ok = _union_area(
+                    gx, gy, gn, m, 1e-15 * area_t, stack_x, stack_y, stack_n, nxt, tx, ty
+                )
             if not ok:
                 shadow = _union_area_slabs(gx, gy, gn, m)
             frac[g, i] = min(1.0, max(0.0, 1.0 - shadow / area_t))
@@ -560,8 +619,31 @@ def facet_shadows(i, dirs, V, F, N, P0, E1, E2, T2, watertight, eps_h):
             ndj = N[j, 0] * d[0] + N[j, 1] * d[1] + N[j, 2] * d[2]
             if (watertight and ndj >= 0.0) or ndj == 0.0:
                 continue
-            nq = _shadow_polygon(i, j, d[0], d[1], d[2], ndi, V, F, N, P0, E1, E2, cx, cy, eps_h,
-                                 hh, px, py, qx, qy, tx, ty, idx)
+            nq = _shadow_polygon(
+                i,
+                j,
+                d[0],
+                d[1],
+                d[2],
+                ndi,
+                V,
+                F,
+                N,
+                P0,
+                E1,
+                E2,
+                cx,
+                cy,
+                eps_h,
+                hh,
+                px,
+                py,
+                qx,
+                qy,
+                tx,
+                ty,
+                idx,
+            )
             if nq == 0:
                 continue
             if n + nq > xy.shape[0]:

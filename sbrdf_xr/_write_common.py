@@ -55,7 +55,9 @@ _SPACE_MARGIN = 256 * 2**10
 _LOCK_GRACE = 10.0
 
 
-_STYLE: contextvars.ContextVar[str] = contextvars.ContextVar("sbrdf_xr_option_style", default="python")
+_STYLE: contextvars.ContextVar[str] = contextvars.ContextVar(
+    "sbrdf_xr_option_style", default="python"
+)
 
 
 @contextlib.contextmanager

@@ -251,7 +251,9 @@ def _storage_kind(name: Hashable, dtype: np.dtype) -> str:
     """``numeric``, ``bool`` or ``str``; anything else is an error."""
     if dtype.kind in _NUMERIC_KINDS and dtype.itemsize in (1, 2, 4, 8):
         if dtype.kind == "f" and dtype.itemsize < 4:
-            raise ValidationError(f"{name}: dtype {dtype} cannot be stored in netCDF; cast to float32")
+            raise ValidationError(
+                f"{name}: dtype {dtype} cannot be stored in netCDF; cast to float32"
+            )
         return "numeric"
     if dtype.kind == "b":
         return "bool"
@@ -319,7 +321,9 @@ def _plan(ds: xr.Dataset) -> _Plan:
         raise ValidationError("ds: the cube has no data variables; there is nothing to write")
     empty = [f"{d!s} (size 0)" for d, n in ds.sizes.items() if n == 0]
     if empty:
-        raise ValidationError(f"ds: the cube is empty along {', '.join(empty)}; there is nothing to write")
+        raise ValidationError(
+            f"ds: the cube is empty along {', '.join(empty)}; there is nothing to write"
+        )
     lazy: list[_Lazy] = []
     variables: list[dict[str, Any]] = []
     for name, var in ds.variables.items():
@@ -355,9 +359,7 @@ def _plan(ds: xr.Dataset) -> _Plan:
         "dims": [[str(d), int(n)] for d, n in ds.sizes.items()],
         "chunks": [[d, list(chunks[d])] for d in block_dims],  # in block-numbering order
         "variables": sorted(variables, key=lambda v: v["name"]),
-        "attrs": {
-            k: _attr_json(v) for k, v in ds.attrs.items() if k not in VOLATILE_ATTRS
-        },
+        "attrs": {k: _attr_json(v) for k, v in ds.attrs.items() if k not in VOLATILE_ATTRS},
     }
     text = json.dumps(structure, sort_keys=True, allow_nan=True, separators=(",", ":"))
     return _Plan(
@@ -533,7 +535,9 @@ def _open_part(part: Path, ds: xr.Dataset, plan: _Plan) -> netCDF4.Dataset:
             if str(dim) not in nc.dimensions or len(nc.dimensions[str(dim)]) != size:
                 raise CubeWriteError(f"{part}: dimension {dim!r} is missing or has another size")
         for name, var in ds.variables.items():
-            if name not in nc.variables or nc.variables[name].dimensions != tuple(map(str, var.dims)):
+            if name not in nc.variables or nc.variables[name].dimensions != tuple(
+                map(str, var.dims)
+            ):
                 raise CubeWriteError(f"{part}: variable {name!r} is missing or has other dims")
             _tune(nc.variables[name], isinstance(var.data, da.Array))
         _set_global_attrs(nc, ds, _coordinates_attrs(ds)[1])
@@ -666,13 +670,17 @@ def _check_room(part: Path, need: int) -> None:
     if st is not None:
         free = (st.f_bfree if os.geteuid() == 0 else st.f_bavail) * st.f_frsize
         if free < need:
-            raise _NoRoom(errno.ENOSPC, f"about {_mib(need)} needed, {_mib(free)} free on {part.parent}")
+            raise _NoRoom(
+                errno.ENOSPC, f"about {_mib(need)} needed, {_mib(free)} free on {part.parent}"
+            )
     limit = _file_size_limit()
     if limit is not None:
         size = part.stat().st_size if part.exists() else 0
         if size + need > limit:
-            raise _NoRoom(errno.EFBIG, f"{part.name} would grow from {_mib(size)} past the limit "
-                          f"of {_mib(limit)}")
+            raise _NoRoom(
+                errno.EFBIG,
+                f"{part.name} would grow from {_mib(size)} past the limit of {_mib(limit)}",
+            )
 
 
 _FALLOC_FL_KEEP_SIZE = 1
@@ -710,15 +718,19 @@ def _reserve(fd: int, nbytes: int) -> None:
     if _FALLOCATE(fd, _FALLOC_FL_KEEP_SIZE, size, int(nbytes) + _SPACE_MARGIN) != 0:
         code = ctypes.get_errno()
         if code in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
-            raise _NoRoom(code, f"reserving {_mib(int(nbytes) + _SPACE_MARGIN)} for the next block failed")
+            raise _NoRoom(
+                code, f"reserving {_mib(int(nbytes) + _SPACE_MARGIN)} for the next block failed"
+            )
 
 
 def _block_bytes(plan: _Plan) -> int:
     """Largest raw size of one block [byte] (what a block may add to the file, uncompressed)."""
     total = 0
     for v in plan.lazy:
-        shape = [max(plan.chunks[d]) if d in plan.chunks else n
-                 for d, n in zip(v.dims, v.data.shape, strict=True)]
+        shape = [
+            max(plan.chunks[d]) if d in plan.chunks else n
+            for d, n in zip(v.dims, v.data.shape, strict=True)
+        ]
         total += math.prod(shape) * v.data.dtype.itemsize
     return total
 
@@ -737,9 +749,14 @@ def _file_kind(p: Path) -> str | None:
         return None
     if stat.S_ISREG(mode):
         return "file"
-    kinds = ((stat.S_ISDIR, "a directory"), (stat.S_ISLNK, "a symbolic link"),
-             (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
-             (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+    kinds = (
+        (stat.S_ISDIR, "a directory"),
+        (stat.S_ISLNK, "a symbolic link"),
+        (stat.S_ISFIFO, "a FIFO (named pipe)"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISSOCK, "a socket"),
+    )
     return next((name for test, name in kinds if test(mode)), "not a regular file")
 
 
@@ -793,7 +810,9 @@ def _check_finished(path: Path, ds: xr.Dataset) -> None:
     if dims != want:
         problems.append(f"dims and sizes differ: {dims} in the file, {want} now")
     if names != set(map(str, ds.variables)):
-        problems.append(f"variables differ: {sorted(names)} in the file, {sorted(map(str, ds.variables))} now")
+        problems.append(
+            f"variables differ: {sorted(names)} in the file, {sorted(map(str, ds.variables))} now"
+        )
     if not problems:
         for k, v in ds.attrs.items():
             if k not in VOLATILE_ATTRS and isinstance(v, str) and attrs.get(k) != v:
@@ -921,22 +940,46 @@ def write_cube(
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
-            raise CubeWriteError(f"cannot write {path}: creating {path.parent} failed: "
-                                 f"{_reason(exc)}") from exc
+            raise CubeWriteError(
+                f"cannot write {path}: creating {path.parent} failed: {_reason(exc)}"
+            ) from exc
     lock = _Lock(path.with_name(path.name + LOCK_SUFFIX), path)
     lock.acquire()
     try:
-        return _write_locked(ds, path, part, log, plan, overwrite=overwrite, resume=resume,
-                             client=client, scheduler=scheduler, max_in_flight=max_in_flight,
-                             progress=progress, complevel=complevel, on_block=on_block)
+        return _write_locked(
+            ds,
+            path,
+            part,
+            log,
+            plan,
+            overwrite=overwrite,
+            resume=resume,
+            client=client,
+            scheduler=scheduler,
+            max_in_flight=max_in_flight,
+            progress=progress,
+            complevel=complevel,
+            on_block=on_block,
+        )
     finally:
         lock.release()
 
 
 def _write_locked(
-    ds: xr.Dataset, path: Path, part: Path, log: Path, plan: _Plan, *, overwrite: bool,
-    resume: bool, client: Any, scheduler: str | None, max_in_flight: int | None, progress: bool,
-    complevel: int, on_block: Callable[[BlockWritten], None] | None,
+    ds: xr.Dataset,
+    path: Path,
+    part: Path,
+    log: Path,
+    plan: _Plan,
+    *,
+    overwrite: bool,
+    resume: bool,
+    client: Any,
+    scheduler: str | None,
+    max_in_flight: int | None,
+    progress: bool,
+    complevel: int,
+    on_block: Callable[[BlockWritten], None] | None,
 ) -> Path:
     """:func:`write_cube` once the lock is held."""
     state = _check_destination(path, part, log, overwrite, resume)
@@ -988,8 +1031,9 @@ def _write_locked(
                 part.unlink(missing_ok=True)  # nothing recorded yet: nothing lost
                 log.unlink(missing_ok=True)
                 if isinstance(exc, Exception) and not isinstance(exc, SbrdfError):
-                    raise CubeWriteError(f"cannot write {path}: creating {part} failed: "
-                                         f"{_reason(exc, part)}") from exc
+                    raise CubeWriteError(
+                        f"cannot write {path}: creating {part} failed: {_reason(exc, part)}"
+                    ) from exc
                 raise
     except BaseException:
         runner.close()
@@ -1065,7 +1109,11 @@ def _write_locked(
         os.replace(part, path)
     except Exception as exc:
         where = f"at block {k} ({_describe(plan.slices(k))}) " if k >= 0 else ""
-        why = _reason(exc, part) if isinstance(exc, OSError) or writing else f"{type(exc).__name__}: {exc}"
+        why = (
+            _reason(exc, part)
+            if isinstance(exc, OSError) or writing
+            else f"{type(exc).__name__}: {exc}"
+        )
         lost = None
         if writing and good >= 0:  # an I/O failure: cut the file back to its last synced state
             _fence(part)
@@ -1173,8 +1221,13 @@ def _check_opens(part: Path) -> str | None:
 
     code = "import sys, netCDF4; netCDF4.Dataset(sys.argv[1]).close()"
     try:
-        r = subprocess.run([sys.executable, "-c", code, str(part)], capture_output=True, text=True,
-                           timeout=120, env={**os.environ, "HDF5_USE_FILE_LOCKING": "FALSE"})
+        r = subprocess.run(
+            [sys.executable, "-c", code, str(part)],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            env={**os.environ, "HDF5_USE_FILE_LOCKING": "FALSE"},
+        )
     except (OSError, subprocess.SubprocessError) as exc:
         return f"it could not be checked: {exc}"
     if r.returncode:
@@ -1185,4 +1238,3 @@ def _check_opens(part: Path) -> str | None:
 
 def _describe(slices: Mapping[str, slice]) -> str:
     return ", ".join(f"{d}[{s.start}:{s.stop}]" for d, s in slices.items())
-

@@ -37,7 +37,9 @@ class SbrdfDataArrayAccessor:
         """:func:`sbrdf_xr.material.lookup` on this table."""
         return _material.lookup(self._da, theta_i, delta_theta, phi, method=method)
 
-    def hemispherical_reflectance(self, theta_i: ArrayLike | None = None, **kwargs: Any) -> xr.DataArray:
+    def hemispherical_reflectance(
+        self, theta_i: ArrayLike | None = None, **kwargs: Any
+    ) -> xr.DataArray:
         """:func:`sbrdf_xr.material.hemispherical_reflectance` of this table."""
         return _material.hemispherical_reflectance(self._da, theta_i, **kwargs)
 
@@ -65,7 +67,9 @@ class _Plotter:
             return _plot.plot_cube(self._obj, **kwargs)
         if "band" in self._obj.dims:
             return _plot.magnitudes(self._obj, **kwargs)
-        raise AttributeError("no natural figure for this array; use .lut_slice(theta_i) for a material table")
+        raise AttributeError(
+            "no natural figure for this array; use .lut_slice(theta_i) for a material table"
+        )
 
     def __getattr__(self, name: str) -> Any:
         if name.startswith("_") or name not in self._methods:
@@ -118,7 +122,7 @@ class SbrdfDatasetAccessor:
     def plot(self) -> _Plotter:
         """Figures of this cube: ``ds.sbrdf.plot()`` (its natural figure), ``.light_curve()``,
         ``.spectra()``, ``.colour_colour("B-V", "V-R")`` (a photometry Dataset)."""
-        return _Plotter(self._ds, {"light_curve": "light_curve", "spectra": "spectra",
-                                   "colour_colour": "colour_colour"})
-
-
+        return _Plotter(
+            self._ds,
+            {"light_curve": "light_curve", "spectra": "spectra", "colour_colour": "colour_colour"},
+        )

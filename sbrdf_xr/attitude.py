@@ -150,8 +150,11 @@ class Nadir(AttitudeLaw):
     def __post_init__(self) -> None:
         if not np.isfinite(self.yaw_deg):
             raise AttitudeError(f"nadir yaw_deg: must be finite, got {self.yaw_deg}")
-        a, b = perpendicular_pair(axis_vector(self.nadir_axis, "nadir_axis"),
-                                   axis_vector(self.velocity_axis, "velocity_axis"), "nadir")
+        a, b = perpendicular_pair(
+            axis_vector(self.nadir_axis, "nadir_axis"),
+            axis_vector(self.velocity_axis, "velocity_axis"),
+            "nadir",
+        )
         object.__setattr__(self, "_axes", (a, b))
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
@@ -189,8 +192,11 @@ class SunPointing(AttitudeLaw):
     secondary_target: Any = "orbit_normal"
 
     def __post_init__(self) -> None:
-        a, b = perpendicular_pair(axis_vector(self.axis, "axis"), axis_vector(self.secondary_axis, "secondary_axis"),
-                                   "sun_pointing")
+        a, b = perpendicular_pair(
+            axis_vector(self.axis, "axis"),
+            axis_vector(self.secondary_axis, "secondary_axis"),
+            "sun_pointing",
+        )
         tgt = self.secondary_target
         if isinstance(tgt, str):
             if tgt not in _SECONDARY_TARGETS:
@@ -269,16 +275,22 @@ def _inertia(value: ArrayLike) -> NDArray[np.float64]:
     try:
         arr = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
-        raise AttitudeError(f"tumble inertia: got {value!r}; expected 3 principal moments or a 3x3 tensor") from None
+        raise AttitudeError(
+            f"tumble inertia: got {value!r}; expected 3 principal moments or a 3x3 tensor"
+        ) from None
     if arr.shape == (3,):
         arr = np.diag(arr)
     if arr.shape != (3, 3) or not np.all(np.isfinite(arr)):
-        raise AttitudeError(f"tumble inertia: expected 3 principal moments or a finite 3x3 tensor [kg m2], got shape {arr.shape}")
+        raise AttitudeError(
+            f"tumble inertia: expected 3 principal moments or a finite 3x3 tensor [kg m2], got shape {arr.shape}"
+        )
     if not np.allclose(arr, arr.T, rtol=1e-9, atol=1e-12 * np.abs(arr).max()):
         raise AttitudeError("tumble inertia: the tensor must be symmetric")
     moments = np.linalg.eigvalsh(arr)
     if moments[0] <= 0:
-        raise AttitudeError(f"tumble inertia: principal moments must be positive, got {moments.tolist()}")
+        raise AttitudeError(
+            f"tumble inertia: principal moments must be positive, got {moments.tolist()}"
+        )
     if moments[0] + moments[1] < moments[2] * (1 - 1e-9):
         raise AttitudeError(
             f"tumble inertia: principal moments {moments.tolist()} break the triangle inequality "
@@ -321,14 +333,22 @@ class Tumble(AttitudeLaw):
         object.__setattr__(self, "inertia", _inertia(self.inertia))
         w = np.asarray(self.omega_deg_s, dtype=np.float64)
         if w.shape != (3,) or not np.all(np.isfinite(w)):
-            raise AttitudeError(f"tumble omega_deg_s: expected 3 finite body rates [degree s-1], got {self.omega_deg_s!r}")
+            raise AttitudeError(
+                f"tumble omega_deg_s: expected 3 finite body rates [degree s-1], got {self.omega_deg_s!r}"
+            )
         object.__setattr__(self, "omega_deg_s", w)
         object.__setattr__(self, "initial", check_quaternion(self.initial, "tumble initial"))
         object.__setattr__(self, "epoch", check_epoch(self.epoch))
 
     @classmethod
-    def from_spacecraft(cls, spacecraft: Any, density_kg_m3: float, omega_deg_s: ArrayLike,
-                        initial: ArrayLike = (0.0, 0.0, 0.0, 1.0), epoch: Any = None) -> Tumble:
+    def from_spacecraft(
+        cls,
+        spacecraft: Any,
+        density_kg_m3: float,
+        omega_deg_s: ArrayLike,
+        initial: ArrayLike = (0.0, 0.0, 0.0, 1.0),
+        epoch: Any = None,
+    ) -> Tumble:
         """A tumble of a spacecraft filled at uniform density (``spacecraft.inertia``).
 
         Parameters
@@ -349,7 +369,11 @@ class Tumble(AttitudeLaw):
 
         def rhs(t: float, y: np.ndarray) -> list[float]:
             wx, wy, wz, x, yq, z, s = y.tolist()
-            lx, ly, lz = a * wx + b * wy + c * wz, d * wx + e * wy + f * wz, g * wx + h * wy + k * wz
+            lx, ly, lz = (
+                a * wx + b * wy + c * wz,
+                d * wx + e * wy + f * wz,
+                g * wx + h * wy + k * wz,
+            )
             # I dw/dt = -w x (I w) = (I w) x w
             tx, ty, tz = ly * wz - lz * wy, lz * wx - lx * wz, lx * wy - ly * wx
             return [
@@ -365,7 +389,9 @@ class Tumble(AttitudeLaw):
 
         return rhs
 
-    def states(self, times: ArrayLike, context: Context | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def states(
+        self, times: ArrayLike, context: Context | None = None
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Body angular velocity [rad s-1] and attitude at ``times``.
 
         Returns
@@ -390,8 +416,15 @@ class Tumble(AttitudeLaw):
             if np.all(tq == 0):
                 out[np.flatnonzero(sel)] = y0
                 continue
-            sol = solve_ivp(rhs, (0.0, float(tq[-1])), y0, method="DOP853", t_eval=tq,
-                            rtol=TUMBLE_RTOL, atol=atol)
+            sol = solve_ivp(
+                rhs,
+                (0.0, float(tq[-1])),
+                y0,
+                method="DOP853",
+                t_eval=tq,
+                rtol=TUMBLE_RTOL,
+                atol=atol,
+            )
             if not sol.success:  # pragma: no cover - smooth right-hand side
                 raise AttitudeError(f"tumble: integration failed: {sol.message}")
             idx = np.flatnonzero(sel)[order]
@@ -445,8 +478,13 @@ class QuaternionSeries(AttitudeLaw):
         object.__setattr__(self, "_slerp", Slerp(secs, Rotation.from_quat(q)))
 
     @classmethod
-    def from_csv(cls, path: str | Path, time_column: str = "time",
-                 columns: Sequence[str] = ("qx", "qy", "qz", "qw"), epoch: Any = None) -> QuaternionSeries:
+    def from_csv(
+        cls,
+        path: str | Path,
+        time_column: str = "time",
+        columns: Sequence[str] = ("qx", "qy", "qz", "qw"),
+        epoch: Any = None,
+    ) -> QuaternionSeries:
         """Read a CSV with a time column (ISO 8601 UTC, or seconds) and scalar-last quaternion columns."""
         import pandas as pd
 
@@ -456,7 +494,9 @@ class QuaternionSeries(AttitudeLaw):
             raise AttitudeError(f"quaternion_series: cannot read {path}: {exc}") from None
         missing = [c for c in (time_column, *columns) if c not in df.columns]
         if missing:
-            raise AttitudeError(f"quaternion_series: {path} lacks the columns {missing}; has {list(df.columns)}")
+            raise AttitudeError(
+                f"quaternion_series: {path} lacks the columns {missing}; has {list(df.columns)}"
+            )
         tcol = df[time_column]
         if pd.api.types.is_numeric_dtype(tcol):
             t = tcol.to_numpy(np.float64)
@@ -476,7 +516,9 @@ class QuaternionSeries(AttitudeLaw):
             with xr.open_dataset(path) as ds:
                 da = ds[variable].load()
         except (OSError, KeyError, ValueError) as exc:
-            raise AttitudeError(f"quaternion_series: cannot read {variable!r} from {path}: {exc}") from None
+            raise AttitudeError(
+                f"quaternion_series: cannot read {variable!r} from {path}: {exc}"
+            ) from None
         if "component" in da.dims:
             da = da.transpose(..., "component").sel(component=["x", "y", "z", "w"])
         return cls(da[da.dims[0]].values, da.values)
@@ -502,7 +544,9 @@ class Composed(AttitudeLaw):
     def __post_init__(self) -> None:
         for name in ("outer", "inner"):
             if not isinstance(getattr(self, name), AttitudeLaw):
-                raise AttitudeError(f"compose {name}: expected an attitude law, got {type(getattr(self, name)).__name__}")
+                raise AttitudeError(
+                    f"compose {name}: expected an attitude law, got {type(getattr(self, name)).__name__}"
+                )
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         a = Rotation.from_quat(self.outer.quaternions(times, context))
@@ -524,7 +568,10 @@ LAWS: dict[str, tuple[type[AttitudeLaw], tuple[str, ...]]] = {
     "sun_pointing": (SunPointing, ("axis", "secondary_axis", "secondary_target")),
     "spin": (Spin, ("axis_body", "rate_deg_s", "phase_deg", "initial", "epoch")),
     "tumble": (Tumble, ("inertia", "omega_deg_s", "initial", "epoch")),
-    "quaternion_series": (QuaternionSeries, ("path", "time_column", "columns", "variable", "epoch")),
+    "quaternion_series": (
+        QuaternionSeries,
+        ("path", "time_column", "columns", "variable", "epoch"),
+    ),
     "compose": (Composed, ("outer", "inner")),
 }
 
@@ -548,7 +595,9 @@ def law_from_dict(table: Mapping[str, Any]) -> AttitudeLaw:
         For an unknown law or parameter, or bad parameter values.
     """
     if not isinstance(table, Mapping) or "law" not in table:
-        raise AttitudeError(f"attitude: expected a table with a 'law' key (one of {', '.join(LAWS)}), got {table!r}")
+        raise AttitudeError(
+            f"attitude: expected a table with a 'law' key (one of {', '.join(LAWS)}), got {table!r}"
+        )
     name = table["law"]
     if name not in LAWS:
         raise AttitudeError(f"attitude: unknown law {name!r}; allowed: {', '.join(LAWS)}")
@@ -556,7 +605,9 @@ def law_from_dict(table: Mapping[str, Any]) -> AttitudeLaw:
     params = {k: v for k, v in table.items() if k != "law"}
     bad = sorted(set(params) - set(allowed))
     if bad:
-        raise AttitudeError(f"attitude law {name!r}: unknown parameter(s) {bad}; allowed: {', '.join(allowed)}")
+        raise AttitudeError(
+            f"attitude law {name!r}: unknown parameter(s) {bad}; allowed: {', '.join(allowed)}"
+        )
     if name == "compose":
         missing = [k for k in ("outer", "inner") if k not in params]
         if missing:
@@ -571,7 +622,9 @@ def law_from_dict(table: Mapping[str, Any]) -> AttitudeLaw:
             if "columns" in params:
                 kw["columns"] = tuple(params["columns"])
             return QuaternionSeries.from_csv(path, **kw)
-        return QuaternionSeries.from_netcdf(path, **({"variable": params["variable"]} if "variable" in params else {}))
+        return QuaternionSeries.from_netcdf(
+            path, **({"variable": params["variable"]} if "variable" in params else {})
+        )
     try:
         return cls(**params)
     except TypeError as exc:

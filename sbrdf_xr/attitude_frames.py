@@ -35,7 +35,9 @@ def axis_vector(spec: str | ArrayLike, name: str) -> NDArray[np.float64]:
         sign = -1.0 if s.startswith("-") else 1.0
         key = s.lstrip("+-")
         if key not in _AXES:
-            raise AttitudeError(f"{name}: got {spec!r}; allowed: +x, -x, +y, -y, +z, -z or 3 components")
+            raise AttitudeError(
+                f"{name}: got {spec!r}; allowed: +x, -x, +y, -y, +z, -z or 3 components"
+            )
         return sign * np.asarray(_AXES[key])
     try:
         v = np.asarray(spec, dtype=np.float64)
@@ -53,7 +55,9 @@ def check_quaternion(q: ArrayLike, name: str) -> NDArray[np.float64]:
     except ValidationError as exc:
         raise AttitudeError(f"{name}: {exc}") from None
     if arr.shape != (4,):
-        raise AttitudeError(f"{name}: expected one quaternion of 4 components, got shape {arr.shape}")
+        raise AttitudeError(
+            f"{name}: expected one quaternion of 4 components, got shape {arr.shape}"
+        )
     return arr
 
 
@@ -103,10 +107,14 @@ def triad(
     return Rotation.from_matrix(m_ref @ m_body.T).as_quat().reshape(-1, 4)
 
 
-def perpendicular_pair(primary: ArrayLike, secondary: ArrayLike, names: str) -> tuple[np.ndarray, np.ndarray]:
+def perpendicular_pair(
+    primary: ArrayLike, secondary: ArrayLike, names: str
+) -> tuple[np.ndarray, np.ndarray]:
     a, b = primary, secondary
     if abs(float(np.dot(a, b))) > 1e-9:
-        raise AttitudeError(f"{names}: the two body axes must be perpendicular, got {a.tolist()} and {b.tolist()}")
+        raise AttitudeError(
+            f"{names}: the two body axes must be perpendicular, got {a.tolist()} and {b.tolist()}"
+        )
     return a, b
 
 
@@ -132,28 +140,38 @@ class Context:
     sun_km: NDArray[np.float64] | None = None
 
 
-def seconds_since(times: ArrayLike, epoch: np.datetime64 | None, context: Context | None) -> NDArray[np.float64]:
+def seconds_since(
+    times: ArrayLike, epoch: np.datetime64 | None, context: Context | None
+) -> NDArray[np.float64]:
     """Float seconds of ``times`` from the law's epoch (see the module docstring)."""
     t = np.atleast_1d(np.asarray(times))
     if t.ndim != 1:
         raise AttitudeError(f"times: expected a 1-D array, got shape {t.shape}")
     if np.issubdtype(t.dtype, np.datetime64):
         t = t.astype("datetime64[ns]")
-        origin = epoch if epoch is not None else (
-            context.epoch if context is not None and context.epoch is not None else t[0]
+        origin = (
+            epoch
+            if epoch is not None
+            else (context.epoch if context is not None and context.epoch is not None else t[0])
         )
         return (t - np.datetime64(origin, "ns")).astype(np.int64) / NS_PER_S
     if not np.issubdtype(t.dtype, np.number):
         raise AttitudeError(f"times: expected datetime64 or seconds, got dtype {t.dtype}")
     t = t.astype(np.float64)
     if epoch is not None and context is not None and context.epoch is not None:
-        t = t + (np.datetime64(context.epoch, "ns") - np.datetime64(epoch, "ns")).astype(np.int64) / NS_PER_S
+        t = (
+            t
+            + (np.datetime64(context.epoch, "ns") - np.datetime64(epoch, "ns")).astype(np.int64)
+            / NS_PER_S
+        )
     return t
 
 
 def context_fields(context: Context | None, n: int, law: str, *fields: str) -> list[np.ndarray]:
     if context is None:
-        raise AttitudeError(f"{law}: needs an orbit context ({', '.join(fields)}); use it inside an Observation")
+        raise AttitudeError(
+            f"{law}: needs an orbit context ({', '.join(fields)}); use it inside an Observation"
+        )
     out = []
     for f in fields:
         v = getattr(context, f)
@@ -172,4 +190,6 @@ def check_epoch(epoch: Any) -> np.datetime64 | None:
     try:
         return np.datetime64(epoch, "ns")
     except (TypeError, ValueError):
-        raise AttitudeError(f"epoch: got {epoch!r}; expected a UTC time (ISO 8601 or datetime64)") from None
+        raise AttitudeError(
+            f"epoch: got {epoch!r}; expected a UTC time (ISO 8601 or datetime64)"
+        ) from None

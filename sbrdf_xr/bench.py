@@ -114,12 +114,21 @@ def bench_build_lut(n_wavelength: int = 131, repeat: int = 3) -> list[BenchRow]:
     ds = _example_measurements(n_wavelength)
     t_build = best_time(lambda: material.build_lut(ds), repeat)
     n_meas = int((~ds.reference).sum())
-    return [BenchRow(f"build_lut ({ds.sizes['sample']} samples, {n_meas} measured, {n_wavelength} wl)",
-                     t_build, "itself", 1.0, f"{t_build * 1e3:.0f} ms for the 91 x 21 x 21 x {n_wavelength} table",
-                     sweep="tables")]
+    return [
+        BenchRow(
+            f"build_lut ({ds.sizes['sample']} samples, {n_meas} measured, {n_wavelength} wl)",
+            t_build,
+            "itself",
+            1.0,
+            f"{t_build * 1e3:.0f} ms for the 91 x 21 x 21 x {n_wavelength} table",
+            sweep="tables",
+        )
+    ]
 
 
-def bench_lookup(n_geometries: int = 20000, n_wavelength: int = 131, repeat: int = 3) -> list[BenchRow]:
+def bench_lookup(
+    n_geometries: int = 20000, n_wavelength: int = 131, repeat: int = 3
+) -> list[BenchRow]:
     """Spectra per second of the ``linear`` look-up against ``xarray.DataArray.interp``.
 
     Both interpolate multilinearly the same paper-sized table at the same random
@@ -145,10 +154,22 @@ def bench_lookup(n_geometries: int = 20000, n_wavelength: int = 131, repeat: int
     err = float(np.max(np.abs(a - b) / np.maximum(np.abs(b), 1e-300)))
     t_ours, t_xr = best_time(ours, repeat), best_time(xr_interp, repeat)
     return [
-        BenchRow("sbrdf_xr linear look-up kernel", t_ours, "xarray .interp (linear)", t_ours / t_xr,
-                 f"{n_geometries / t_ours:,.0f} spectra/s; max rel diff {err:.1e}", sweep="tables"),
-        BenchRow("xarray .interp (linear)", t_xr, "xarray .interp (linear)", 1.0,
-                 f"{n_geometries / t_xr:,.0f} spectra/s", sweep="tables"),
+        BenchRow(
+            "sbrdf_xr linear look-up kernel",
+            t_ours,
+            "xarray .interp (linear)",
+            t_ours / t_xr,
+            f"{n_geometries / t_ours:,.0f} spectra/s; max rel diff {err:.1e}",
+            sweep="tables",
+        ),
+        BenchRow(
+            "xarray .interp (linear)",
+            t_xr,
+            "xarray .interp (linear)",
+            1.0,
+            f"{n_geometries / t_xr:,.0f} spectra/s",
+            sweep="tables",
+        ),
     ]
 
 
@@ -162,8 +183,9 @@ def _paper_tables(**build: Any) -> dict[str, xr.DataArray]:
     for m in CANX1_MATERIALS:
         meas = catalog.load(f"{m}-measurements")
         shipped = {k: v for k, v in catalog.entry(m).extra.get("build", {}).items() if k != "fit"}
-        out[m] = material.build_lut(meas, model=catalog.load(f"{m}-fit"), material=m,
-                                    **{**shipped, **build})
+        out[m] = material.build_lut(
+            meas, model=catalog.load(f"{m}-fit"), material=m, **{**shipped, **build}
+        )
     return out
 
 
@@ -183,7 +205,11 @@ def _errors(test: xr.DataArray, ref: xr.DataArray) -> tuple[float, float, float]
     """(max mmag, median mmag, p99 relative spectral error) of ``test`` against ``ref``."""
     if "wavelength" in test.dims:
         mt, mr = _band_mags(test), _band_mags(ref)
-        t_sp = test.interp(wavelength=ref.wavelength) if test.sizes["wavelength"] != ref.sizes["wavelength"] else test
+        t_sp = (
+            test.interp(wavelength=ref.wavelength)
+            if test.sizes["wavelength"] != ref.sizes["wavelength"]
+            else test
+        )
         rel = np.abs(t_sp.values - ref.values) / np.maximum(np.abs(ref.values), 1e-300)
         keep_sp = np.abs(ref.values) > 1e-3 * np.abs(ref.values).max()
         p99 = float(np.percentile(rel[keep_sp], 99))
@@ -217,15 +243,25 @@ def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
 
     rot = builtin_scene("canx1-rotation")
     n_big = 400 if quick else 5000
-    big = rot.with_options(attitudes=geometry.uniform_attitudes(n_big, seed=7), attitude_angle=None,
-                           phase_angles=[10.0, 45.0, 90.0], chunk=500, name=f"random-{n_big}x3")
+    big = rot.with_options(
+        attitudes=geometry.uniform_attitudes(n_big, seed=7),
+        attitude_angle=None,
+        phase_angles=[10.0, 45.0, 90.0],
+        chunk=500,
+        name=f"random-{n_big}x3",
+    )
     sweeps = {"canx1-rotation": rot} if quick else {"canx1-rotation": rot, big.name: big}
     if quick:
         sweeps[big.name] = big
     rows: list[BenchRow] = []
     base_tables = _paper_tables()
-    reference = {"method": "cubic", "dtype": "float64", "merge": True, "materials": base_tables,
-                 "outputs": ("signal", "area")}
+    reference = {
+        "method": "cubic",
+        "dtype": "float64",
+        "merge": True,
+        "materials": base_tables,
+        "outputs": ("signal", "area"),
+    }
 
     def run_cube(scene: Any, **opts: Any) -> xr.Dataset:
         return simulate(scene.with_options(**opts)).compute(scheduler="sync")
@@ -241,16 +277,35 @@ def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
             ("precision", "float32", {"dtype": "float32"}),
             ("wavelength", "10 nm sampling", {"materials": _subsample_wavelengths(base_tables, 2)}),
             ("wavelength", "20 nm sampling", {"materials": _subsample_wavelengths(base_tables, 4)}),
-            ("wavelength", "band pre-integration (V, R, I)",
-             {"outputs": ("band_signal", "area"), "bands": BANDS}),
+            (
+                "wavelength",
+                "band pre-integration (V, R, I)",
+                {"outputs": ("band_signal", "area"), "bands": BANDS},
+            ),
             ("facets", "not merged (684 facets)", {"merge": False}),
         ]
         if not quick:
             knobs += [
-                ("table", "theta_i every 2 deg", {"materials": _paper_tables(theta_i=np.arange(0.0, 91.0, 2.0))}),
-                ("table", "theta_i every 5 deg", {"materials": _paper_tables(theta_i=np.arange(0.0, 91.0, 5.0))}),
-                ("table", "11 x 11 delta_theta x phi", {"materials": _paper_tables(n_phi=11, n_delta_theta=11)}),
-                ("table", "41 x 41 delta_theta x phi", {"materials": _paper_tables(n_phi=41, n_delta_theta=41)}),
+                (
+                    "table",
+                    "theta_i every 2 deg",
+                    {"materials": _paper_tables(theta_i=np.arange(0.0, 91.0, 2.0))},
+                ),
+                (
+                    "table",
+                    "theta_i every 5 deg",
+                    {"materials": _paper_tables(theta_i=np.arange(0.0, 91.0, 5.0))},
+                ),
+                (
+                    "table",
+                    "11 x 11 delta_theta x phi",
+                    {"materials": _paper_tables(n_phi=11, n_delta_theta=11)},
+                ),
+                (
+                    "table",
+                    "41 x 41 delta_theta x phi",
+                    {"materials": _paper_tables(n_phi=41, n_delta_theta=41)},
+                ),
             ]
         for knob, setting, opts in knobs:
             cfg = {**reference, **opts}
@@ -261,17 +316,39 @@ def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
                 t = best_time(lambda sweep=sweep, cfg=cfg: run_cube(sweep, **cfg), repeat)
             test = cube.band_signal if "band_signal" in cube else cube.signal
             mx, med, p99 = _errors(test, ref)
-            rows.append(BenchRow(f"{knob}: {setting}", t, "reference", t / t_ref, sweep=sweep_name,
-                                 mmag_max=mx, mmag_median=med, rel_p99=p99, knob=knob))
+            rows.append(
+                BenchRow(
+                    f"{knob}: {setting}",
+                    t,
+                    "reference",
+                    t / t_ref,
+                    sweep=sweep_name,
+                    mmag_max=mx,
+                    mmag_median=med,
+                    rel_p99=p99,
+                    knob=knob,
+                )
+            )
         # Tabulated vs analytic: the table method's own error, against the generating models
         # (the simulation option evaluation="analytic", each material's catalog model).
         an_cfg = {**reference, "evaluation": "analytic"}
         an = run_cube(sweep, **an_cfg).signal
         t_an = best_time(lambda sweep=sweep, an_cfg=an_cfg: run_cube(sweep, **an_cfg), 1)
         mx, med, p99 = _errors(ref, an)
-        rows.append(BenchRow("materials: analytic generating models (ground truth)", t_an, "reference",
-                             t_an / t_ref, "error column: the tabulated reference against them",
-                             sweep=sweep_name, mmag_max=mx, mmag_median=med, rel_p99=p99, knob="materials"))
+        rows.append(
+            BenchRow(
+                "materials: analytic generating models (ground truth)",
+                t_an,
+                "reference",
+                t_an / t_ref,
+                "error column: the tabulated reference against them",
+                sweep=sweep_name,
+                mmag_max=mx,
+                mmag_median=med,
+                rel_p99=p99,
+                knob="materials",
+            )
+        )
     rows += shadow_rows(quick=quick, repeat=repeat)
     return rows
 
@@ -285,20 +362,40 @@ def shadow_rows(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
     from . import shadow_bench
 
     rows = []
-    acc = shadow_bench.accuracy_rows(densities=(2, 4, 8) if quick else (2, 4, 8, 16, 32),
-                                     n_geometries=8 if quick else 18, repeat=repeat)
+    acc = shadow_bench.accuracy_rows(
+        densities=(2, 4, 8) if quick else (2, 4, 8, 16, 32),
+        n_geometries=8 if quick else 18,
+        repeat=repeat,
+    )
     for r in acc:
         mmag = 2500.0 * np.log10(1.0 + r.worst_rel_error)
         med = 2500.0 * np.log10(1.0 + r.median_rel_error)
-        rows.append(BenchRow(f"shadowing: {r.label}", r.ms_per_geometry * 1e-3, "exact shadowing",
-                             r.time_ratio, f"worst {r.worst_rel_error:.2g}, median {r.median_rel_error:.2g} "
-                             f"relative ({r.bodies}; {r.n_geometries} geometries each)",
-                             sweep="shadowing, non-convex bodies", mmag_max=mmag, mmag_median=med,
-                             knob="shadowing"))
+        rows.append(
+            BenchRow(
+                f"shadowing: {r.label}",
+                r.ms_per_geometry * 1e-3,
+                "exact shadowing",
+                r.time_ratio,
+                f"worst {r.worst_rel_error:.2g}, median {r.median_rel_error:.2g} "
+                f"relative ({r.bodies}; {r.n_geometries} geometries each)",
+                sweep="shadowing, non-convex bodies",
+                mmag_max=mmag,
+                mmag_median=med,
+                knob="shadowing",
+            )
+        )
     for c in shadow_bench.canx1_sweep_rows(n_attitudes=90 if quick else 360, repeat=repeat):
-        rows.append(BenchRow(f"shadowing cost: {c.label}", c.ms_per_geometry * 1e-3, c.ratio_to, c.ratio,
-                             f"{c.ms_per_geometry:.2f} ms per geometry, {c.n_facets} facets",
-                             sweep="shadowing, CanX-1 sweep", knob="shadowing"))
+        rows.append(
+            BenchRow(
+                f"shadowing cost: {c.label}",
+                c.ms_per_geometry * 1e-3,
+                c.ratio_to,
+                c.ratio,
+                f"{c.ms_per_geometry:.2f} ms per geometry, {c.n_facets} facets",
+                sweep="shadowing, CanX-1 sweep",
+                knob="shadowing",
+            )
+        )
     return rows
 
 
@@ -320,7 +417,9 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
     from .scene import builtin_scene
     from .simulate import simulate
 
-    scene = builtin_scene("canx1-rotation").with_options(outputs=("signal", "area"), method="linear")
+    scene = builtin_scene("canx1-rotation").with_options(
+        outputs=("signal", "area"), method="linear"
+    )
     facets = scene.spacecraft.facets()
     s, o = scene.body_vectors()
     s2, o2 = s.reshape(-1, 3), o.reshape(-1, 3)
@@ -336,8 +435,12 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
             ok = ang.lit & ang.visible
             if not ok.any():
                 continue
-            spec = material.lookup(tables[str(facets.material.values[j])], ang.theta_i[ok],
-                                   ang.delta_theta[ok], ang.phi[ok]).values
+            spec = material.lookup(
+                tables[str(facets.material.values[j])],
+                ang.theta_i[ok],
+                ang.delta_theta[ok],
+                ang.phi[ok],
+            ).values
             w = facets.area.values[j] * (s2[ok] @ n) * (o2[ok] @ n)
             out[ok] += w[:, None] * spec
         return out
@@ -355,30 +458,59 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
     big = np.ones(2**25)  # 256 MiB
     t_copy = best_time(lambda: big.copy(), 2)
     bandwidth = 2 * big.nbytes / t_copy  # read + write
-    limit = bandwidth / (8 * n_wl * 8)  # 8 gathered rows of n_wl float64 per geometry-facet, no cache reuse
+    limit = bandwidth / (
+        8 * n_wl * 8
+    )  # 8 gathered rows of n_wl float64 per geometry-facet, no cache reuse
     a = np.random.default_rng(0).random((1024, 1024))
     t_mm = best_time(lambda: a @ a, 2)
     flops = 2 * 1024**3 / t_mm  # dense matmul rate of this machine (BLAS, all cores)
     compute_limit = flops / (2 * 8 * n_wl)  # 8 multiply-adds per wavelength per pair
     rows = [
-        BenchRow("per-facet numpy loop (baseline)", t_base, "per-facet loop", 1.0,
-                 f"{work / t_base:,.0f} geometry-facet-spectra/s", sweep="canx1-rotation"),
-        BenchRow("simulate, facets not merged", t_unmerged, "per-facet loop", t_unmerged / t_base,
-                 f"{work / t_unmerged:,.0f} g-f-spectra/s; speed-up {t_base / t_unmerged:.1f}x; "
-                 f"agrees to {agree2:.1e}", sweep="canx1-rotation"),
-        BenchRow("simulate, merged (684 facets -> 20 terms)", t_merged, "per-facet loop", t_merged / t_base,
-                 f"{work / t_merged:,.0f} facet-equivalent g-f-spectra/s; speed-up {t_base / t_merged:.1f}x; "
-                 f"agrees to {agree:.1e}", sweep="canx1-rotation"),
-        BenchRow("DRAM-bandwidth estimate (no cache reuse)", work / limit, "per-facet loop",
-                 (work / limit) / t_base,
-                 f"{limit:,.0f} g-f-spectra/s at {bandwidth / 1e9:.1f} GB/s (measured copy), 8 x {n_wl} "
-                 f"float64 gathered per pair; the unmerged kernel reaches {(work / t_unmerged) / limit:.0%} "
-                 "of it (neighbouring geometries reuse table rows from cache)", sweep="canx1-rotation"),
-        BenchRow("arithmetic estimate (dense-matmul rate)", work / compute_limit, "per-facet loop",
-                 (work / compute_limit) / t_base,
-                 f"{compute_limit:,.0f} g-f-spectra/s at {flops / 1e9:.1f} GFLOP/s, 16 x {n_wl} flops per "
-                 f"pair; the unmerged kernel reaches {(work / t_unmerged) / compute_limit:.0%} of it",
-                 sweep="canx1-rotation"),
+        BenchRow(
+            "per-facet numpy loop (baseline)",
+            t_base,
+            "per-facet loop",
+            1.0,
+            f"{work / t_base:,.0f} geometry-facet-spectra/s",
+            sweep="canx1-rotation",
+        ),
+        BenchRow(
+            "simulate, facets not merged",
+            t_unmerged,
+            "per-facet loop",
+            t_unmerged / t_base,
+            f"{work / t_unmerged:,.0f} g-f-spectra/s; speed-up {t_base / t_unmerged:.1f}x; "
+            f"agrees to {agree2:.1e}",
+            sweep="canx1-rotation",
+        ),
+        BenchRow(
+            "simulate, merged (684 facets -> 20 terms)",
+            t_merged,
+            "per-facet loop",
+            t_merged / t_base,
+            f"{work / t_merged:,.0f} facet-equivalent g-f-spectra/s; speed-up {t_base / t_merged:.1f}x; "
+            f"agrees to {agree:.1e}",
+            sweep="canx1-rotation",
+        ),
+        BenchRow(
+            "DRAM-bandwidth estimate (no cache reuse)",
+            work / limit,
+            "per-facet loop",
+            (work / limit) / t_base,
+            f"{limit:,.0f} g-f-spectra/s at {bandwidth / 1e9:.1f} GB/s (measured copy), 8 x {n_wl} "
+            f"float64 gathered per pair; the unmerged kernel reaches {(work / t_unmerged) / limit:.0%} "
+            "of it (neighbouring geometries reuse table rows from cache)",
+            sweep="canx1-rotation",
+        ),
+        BenchRow(
+            "arithmetic estimate (dense-matmul rate)",
+            work / compute_limit,
+            "per-facet loop",
+            (work / compute_limit) / t_base,
+            f"{compute_limit:,.0f} g-f-spectra/s at {flops / 1e9:.1f} GFLOP/s, 16 x {n_wl} flops per "
+            f"pair; the unmerged kernel reaches {(work / t_unmerged) / compute_limit:.0%} of it",
+            sweep="canx1-rotation",
+        ),
     ]
     return rows
 
@@ -394,10 +526,16 @@ def format_rows(rows: list[BenchRow]) -> str:
     for r in rows:
         if r.sweep != sweep:
             sweep = r.sweep
-            out += ["", f"[{sweep}]",
-                    f"{'case':<{w}}  {'time/baseline':>13}  {'mmag max':>9}  {'mmag med':>9}  {'rel p99':>8}  notes"]
-        err = (f"{r.mmag_max:>9.3g}  {r.mmag_median:>9.3g}  {r.rel_p99:>8.2g}" if np.isfinite(r.mmag_max)
-               else f"{'':>9}  {'':>9}  {'':>8}")
+            out += [
+                "",
+                f"[{sweep}]",
+                f"{'case':<{w}}  {'time/baseline':>13}  {'mmag max':>9}  {'mmag med':>9}  {'rel p99':>8}  notes",
+            ]
+        err = (
+            f"{r.mmag_max:>9.3g}  {r.mmag_median:>9.3g}  {r.rel_p99:>8.2g}"
+            if np.isfinite(r.mmag_max)
+            else f"{'':>9}  {'':>9}  {'':>8}"
+        )
         note = r.extra or f"vs {r.baseline}"
         out.append(f"{r.name:<{w}}  {r.ratio:>12.3g}x  {err}  {note}")
     return "\n".join(out).lstrip("\n")
@@ -405,16 +543,33 @@ def format_rows(rows: list[BenchRow]) -> str:
 
 def rows_to_dataset(rows: list[BenchRow]) -> xr.Dataset:
     """The rows as a labelled Dataset over ``case`` (for netCDF or CSV)."""
+
     def col(name: str) -> list[Any]:
         return [getattr(r, name) for r in rows]
 
     return xr.Dataset(
         {
             "seconds": ("case", col("seconds"), {"units": "s", "long_name": "best wall time"}),
-            "time_ratio": ("case", col("ratio"), {"units": "1", "long_name": "wall time / baseline wall time"}),
-            "mmag_max": ("case", col("mmag_max"), {"units": "mmag", "long_name": "largest band magnitude error"}),
-            "mmag_median": ("case", col("mmag_median"), {"units": "mmag", "long_name": "median band magnitude error"}),
-            "rel_p99": ("case", col("rel_p99"), {"units": "1", "long_name": "99th percentile relative spectral error"}),
+            "time_ratio": (
+                "case",
+                col("ratio"),
+                {"units": "1", "long_name": "wall time / baseline wall time"},
+            ),
+            "mmag_max": (
+                "case",
+                col("mmag_max"),
+                {"units": "mmag", "long_name": "largest band magnitude error"},
+            ),
+            "mmag_median": (
+                "case",
+                col("mmag_median"),
+                {"units": "mmag", "long_name": "median band magnitude error"},
+            ),
+            "rel_p99": (
+                "case",
+                col("rel_p99"),
+                {"units": "1", "long_name": "99th percentile relative spectral error"},
+            ),
             "baseline": ("case", col("baseline"), {"long_name": "baseline of the time ratio"}),
             "sweep": ("case", col("sweep"), {"long_name": "sweep"}),
             "notes": ("case", col("extra"), {"long_name": "notes"}),

@@ -46,14 +46,19 @@ def _sweep_scene(n: int, bands: bool = False) -> Any:
     from .scene import builtin_scene
 
     scene = builtin_scene("canx1-rotation").with_options(
-        attitudes=geometry.uniform_attitudes(n, seed=11), attitude_angle=None,
-        outputs=("spacecraft_sbrdf", "signal", "brdf", "area"), name=f"random-{n}")
+        attitudes=geometry.uniform_attitudes(n, seed=11),
+        attitude_angle=None,
+        outputs=("spacecraft_sbrdf", "signal", "brdf", "area"),
+        name=f"random-{n}",
+    )
     if bands:
         scene = scene.with_options(outputs=("band_signal", "area"), bands=("V", "R", "I"))
     return scene
 
 
-def sweep_job(n: int, path: str, bands: bool = False, mode: str = "write", workers: int = 0) -> dict[str, float]:
+def sweep_job(
+    n: int, path: str, bands: bool = False, mode: str = "write", workers: int = 0
+) -> dict[str, float]:
     """Run one sweep in this process (the subprocess side of :func:`engine_rows`).
 
     ``mode``: ``write`` (netCDF at default settings), ``kernel`` (the bare fused
@@ -79,8 +84,15 @@ def sweep_job(n: int, path: str, bands: bool = False, mode: str = "write", worke
 
         def one(sl: slice) -> None:
             b = plan.geometry.block(sl)
-            fused_sums(b.to_sun, b.to_observer, t.normal, t.area, t.material, plan.tables,
-                       plan.knobs["method"])
+            fused_sums(
+                b.to_sun,
+                b.to_observer,
+                t.normal,
+                t.area,
+                t.material,
+                plan.tables,
+                plan.knobs["method"],
+            )
 
         t0 = time.perf_counter()
         with ThreadPoolExecutor(_n_threads()) as pool:
@@ -89,9 +101,16 @@ def sweep_job(n: int, path: str, bands: bool = False, mode: str = "write", worke
     elif mode == "zarr":
         from distributed import Client, LocalCluster
 
-        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                          dashboard_address=None, env={"SBRDF_XR_NUM_THREADS": "1"}) as cluster, \
-                Client(cluster) as client:
+        with (
+            LocalCluster(
+                n_workers=workers,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+                env={"SBRDF_XR_NUM_THREADS": "1"},
+            ) as cluster,
+            Client(cluster) as client,
+        ):
             client.run(lambda: run_block(plan, slice(0, 8)))  # compile on the workers
             t0 = time.perf_counter()
             write(simulate(plan, client=client), path, overwrite=True, client=client)
@@ -104,18 +123,31 @@ def sweep_job(n: int, path: str, bands: bool = False, mode: str = "write", worke
     return {"seconds": seconds, "rss": float(rss), "blocks": float(plan.n_blocks)}
 
 
-def _subprocess(n: int, bands: bool = False, mode: str = "write", workers: int = 0,
-                threads: int | None = None, where: str | None = None) -> dict[str, float]:
+def _subprocess(
+    n: int,
+    bands: bool = False,
+    mode: str = "write",
+    workers: int = 0,
+    threads: int | None = None,
+    where: str | None = None,
+) -> dict[str, float]:
     with tempfile.TemporaryDirectory(prefix="sbrdf-bench-", dir=where) as tmp:
         path = str(Path(tmp) / ("cube.zarr" if mode == "zarr" else "cube.nc"))
         env = dict(os.environ)
         if threads is not None:
-            env.update(SBRDF_XR_NUM_THREADS=str(threads), DASK_NUM_WORKERS=str(threads),
-                       NUMBA_NUM_THREADS=str(threads), OMP_NUM_THREADS=str(threads))
-        code = ("import json, sys; from sbrdf_xr.bench_engine import sweep_job; "
-                f"print(json.dumps(sweep_job({n}, {path!r}, {bands}, {mode!r}, {workers})))")
-        out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
-                             check=False)
+            env.update(
+                SBRDF_XR_NUM_THREADS=str(threads),
+                DASK_NUM_WORKERS=str(threads),
+                NUMBA_NUM_THREADS=str(threads),
+                OMP_NUM_THREADS=str(threads),
+            )
+        code = (
+            "import json, sys; from sbrdf_xr.bench_engine import sweep_job; "
+            f"print(json.dumps(sweep_job({n}, {path!r}, {bands}, {mode!r}, {workers})))"
+        )
+        out = subprocess.run(
+            [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=False
+        )
         if out.returncode:
             raise RuntimeError(f"benchmark subprocess failed: {out.stderr[-2000:]}")
         return json.loads(out.stdout.strip().splitlines()[-1])
@@ -152,15 +184,27 @@ def kernel_rows(repeat: int = 3) -> list[BenchRow]:
     pairs = b.to_sun.shape[0] * t.size
     lit = int(np.sum((b.to_sun @ t.normal.T > 0) & (b.to_observer @ t.normal.T > 0)))
     rate = _matmul_rate(1)
-    ceiling = rate / (2 * 8 * n_wl)  # 8 weighted table rows of n_wl multiply-adds per facet-spectrum
+    ceiling = rate / (
+        2 * 8 * n_wl
+    )  # 8 weighted table rows of n_wl multiply-adds per facet-spectrum
     return [
-        BenchRow("kernel: numpy reference (sparse matrix)", t_numpy, "numpy reference", 1.0,
-                 f"{lit / t_numpy:,.0f} facet-spectra/s ({pairs} pairs, {lit} lit and seen)",
-                 sweep="kernel, canx1-rotation unmerged, linear, 141 nm, 1 thread"),
-        BenchRow("kernel: fused (numba)", t_fused, "numpy reference", t_fused / t_numpy,
-                 f"{lit / t_fused:,.0f} facet-spectra/s = {(lit / t_fused) / ceiling:.0%} of the "
-                 f"dense-matmul ceiling ({ceiling:,.0f}/s at {rate / 1e9:.1f} GFLOP/s, 1 thread)",
-                 sweep="kernel, canx1-rotation unmerged, linear, 141 nm, 1 thread"),
+        BenchRow(
+            "kernel: numpy reference (sparse matrix)",
+            t_numpy,
+            "numpy reference",
+            1.0,
+            f"{lit / t_numpy:,.0f} facet-spectra/s ({pairs} pairs, {lit} lit and seen)",
+            sweep="kernel, canx1-rotation unmerged, linear, 141 nm, 1 thread",
+        ),
+        BenchRow(
+            "kernel: fused (numba)",
+            t_fused,
+            "numpy reference",
+            t_fused / t_numpy,
+            f"{lit / t_fused:,.0f} facet-spectra/s = {(lit / t_fused) / ceiling:.0%} of the "
+            f"dense-matmul ceiling ({ceiling:,.0f}/s at {rate / 1e9:.1f} GFLOP/s, 1 thread)",
+            sweep="kernel, canx1-rotation unmerged, linear, 141 nm, 1 thread",
+        ),
     ]
 
 
@@ -177,11 +221,26 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
     simulate(one).compute()
     t_one = best_time(lambda: simulate(one).compute(), repeat, number=20)
     sweep = "end to end, warm"
-    rows.append(BenchRow("canx1-rotation, full spectrum, per attitude-spectrum", t_rot / 360,
-                         "canx1-rotation total", 1 / 360, f"{t_rot / 360 * 1e6:.1f} us per attitude "
-                         f"({t_rot * 1e3:.1f} ms for 360 x 141)", sweep=sweep))
-    rows.append(BenchRow("single geometry, simulate(scene).compute()", t_one, "canx1-rotation total",
-                         t_one / t_rot, f"{t_one * 1e3:.2f} ms", sweep=sweep))
+    rows.append(
+        BenchRow(
+            "canx1-rotation, full spectrum, per attitude-spectrum",
+            t_rot / 360,
+            "canx1-rotation total",
+            1 / 360,
+            f"{t_rot / 360 * 1e6:.1f} us per attitude ({t_rot * 1e3:.1f} ms for 360 x 141)",
+            sweep=sweep,
+        )
+    )
+    rows.append(
+        BenchRow(
+            "single geometry, simulate(scene).compute()",
+            t_one,
+            "canx1-rotation total",
+            t_one / t_rot,
+            f"{t_one * 1e3:.2f} ms",
+            sweep=sweep,
+        )
+    )
 
     sizes = _SIZES_QUICK if quick else _SIZES
     results = {n: _subprocess(n) for n in sizes}
@@ -190,29 +249,61 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
     prev = None
     for n in sizes:
         r, k = results[n], kernels[n]
-        exp = "" if prev is None else (
-            f"; exponent {np.log(r['seconds'] / results[prev]['seconds']) / np.log(n / prev):.3f} "
-            f"from {prev:.0e}")
-        rows.append(BenchRow(f"{n:.0e} attitudes, write", r["seconds"], "bare kernel, same geometries",
-                             r["seconds"] / k["seconds"],
-                             f"{r['seconds']:.2f} s in {int(r['blocks'])} blocks, peak RSS "
-                             f"{r['rss'] / 2**30:.2f} GiB{exp}", sweep=sw))
+        exp = (
+            ""
+            if prev is None
+            else (
+                f"; exponent {np.log(r['seconds'] / results[prev]['seconds']) / np.log(n / prev):.3f} "
+                f"from {prev:.0e}"
+            )
+        )
+        rows.append(
+            BenchRow(
+                f"{n:.0e} attitudes, write",
+                r["seconds"],
+                "bare kernel, same geometries",
+                r["seconds"] / k["seconds"],
+                f"{r['seconds']:.2f} s in {int(r['blocks'])} blocks, peak RSS "
+                f"{r['rss'] / 2**30:.2f} GiB{exp}",
+                sweep=sw,
+            )
+        )
         prev = n
     n5 = 100_000
     band = _subprocess(n5, bands=True)
-    rows.append(BenchRow("band-only (V, R, I), 1e5 attitudes, write", band["seconds"],
-                         "full spectrum, same sweep", band["seconds"] / results[n5]["seconds"],
-                         f"{results[n5]['seconds'] / band['seconds']:.1f}x faster", sweep=sw))
+    rows.append(
+        BenchRow(
+            "band-only (V, R, I), 1e5 attitudes, write",
+            band["seconds"],
+            "full spectrum, same sweep",
+            band["seconds"] / results[n5]["seconds"],
+            f"{results[n5]['seconds'] / band['seconds']:.1f}x faster",
+            sweep=sw,
+        )
+    )
     single = _subprocess(n5, threads=1)
-    rows.append(BenchRow("1e5 attitudes, one core (one thread everywhere)", single["seconds"],
-                         "two cores", single["seconds"] / results[n5]["seconds"],
-                         f"two cores are {single['seconds'] / results[n5]['seconds']:.2f}x one core",
-                         sweep=sw))
+    rows.append(
+        BenchRow(
+            "1e5 attitudes, one core (one thread everywhere)",
+            single["seconds"],
+            "two cores",
+            single["seconds"] / results[n5]["seconds"],
+            f"two cores are {single['seconds'] / results[n5]['seconds']:.2f}x one core",
+            sweep=sw,
+        )
+    )
     if not quick:
         z1 = _subprocess(n5, mode="zarr", workers=1)
         z2 = _subprocess(n5, mode="zarr", workers=2)
-        rows.append(BenchRow("1e5 attitudes, LocalCluster, 1 process worker, Zarr by blocks",
-                             z1["seconds"], "2 process workers", z1["seconds"] / z2["seconds"],
-                             f"2 workers are {z1['seconds'] / z2['seconds']:.2f}x one worker", sweep=sw))
+        rows.append(
+            BenchRow(
+                "1e5 attitudes, LocalCluster, 1 process worker, Zarr by blocks",
+                z1["seconds"],
+                "2 process workers",
+                z1["seconds"] / z2["seconds"],
+                f"2 workers are {z1['seconds'] / z2['seconds']:.2f}x one worker",
+                sweep=sw,
+            )
+        )
     rows += kernel_rows(repeat)
     return rows

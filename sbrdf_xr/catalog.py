@@ -67,7 +67,9 @@ def _load_material(e: CatalogEntry) -> xr.DataArray:
 
 
 @functools.lru_cache(maxsize=16)
-def _built_material(name: str, measurements: str, options: tuple[tuple[str, Any], ...]) -> xr.DataArray:
+def _built_material(
+    name: str, measurements: str, options: tuple[tuple[str, Any], ...]
+) -> xr.DataArray:
     """A table built from a measurement entry, through the disk cache (:mod:`sbrdf_xr._cache`)."""
     kw = dict(options)
     inputs = [entry(measurements).file] + ([entry(kw["fit"]).file] if "fit" in kw else [])
@@ -84,8 +86,14 @@ def _built_material(name: str, measurements: str, options: tuple[tuple[str, Any]
             da.attrs.pop(k, None)
         return da
 
-    return cached_table(name, inputs, repr(options), build,
-                        lambda da, path: material.to_netcdf(da, path, overwrite=True), read)
+    return cached_table(
+        name,
+        inputs,
+        repr(options),
+        build,
+        lambda da, path: material.to_netcdf(da, path, overwrite=True),
+        read,
+    )
 
 
 #: Attributes the netCDF writer adds to a file (CF/ACDD basics) that a built table lacks.

@@ -51,7 +51,9 @@ def _escaped_attrs(obj: Any) -> Any:
     import xarray as xr
 
     def clean(attrs: dict[Any, Any]) -> dict[str, Any]:
-        return {escape(k, True): escape(v, True) if isinstance(v, str) else v for k, v in attrs.items()}
+        return {
+            escape(k, True): escape(v, True) if isinstance(v, str) else v for k, v in attrs.items()
+        }
 
     if isinstance(obj, xr.Dataset):
         out = obj.copy()
@@ -80,14 +82,20 @@ def _open_dataset(path: str) -> Any:
     try:
         return xr.open_dataset(p)
     except (OSError, ValueError, TypeError, KeyError, RuntimeError) as exc:
-        why = "unrecognised format" if "did not find a match" in str(exc) else f"{type(exc).__name__}: {exc}"
+        why = (
+            "unrecognised format"
+            if "did not find a match" in str(exc)
+            else f"{type(exc).__name__}: {exc}"
+        )
         raise ValidationError(f"{path}: not a readable netCDF file ({why})") from None
 
 
 def _open_cube(path: str) -> Any:
     """A loaded simulation cube, or :class:`ValidationError` naming what is missing."""
     with _open_dataset(path) as ds:
-        spectral = [v for v in ("spacecraft_sbrdf", "signal") if v in ds and "wavelength" in ds[v].dims]
+        spectral = [
+            v for v in ("spacecraft_sbrdf", "signal") if v in ds and "wavelength" in ds[v].dims
+        ]
         curve = "brdf" in ds and "attitude" in ds.dims and "phase_angle" in ds.coords
         if not spectral and not curve:
             names = ", ".join(map(str, list(ds.data_vars)[:8])) or "none"
@@ -116,8 +124,12 @@ def _cmd_catalog_show(args: argparse.Namespace) -> int:
     e = catalog.entry(args.name)
     print(escape(f"name:        {e.name}\nkind:        {e.kind}\nsource:      {e.source}"))
     print(escape(f"file:        {e.file}"))
-    print("description: " + textwrap.fill(escape(e.description, True), 88, subsequent_indent=" " * 13))
-    print("provenance:  " + textwrap.fill(escape(e.provenance, True), 88, subsequent_indent=" " * 13))
+    print(
+        "description: " + textwrap.fill(escape(e.description, True), 88, subsequent_indent=" " * 13)
+    )
+    print(
+        "provenance:  " + textwrap.fill(escape(e.provenance, True), 88, subsequent_indent=" " * 13)
+    )
     for k, v in e.extra.items():
         print(escape(f"{escape(k, True) + ':':<13}{escape(v, True)}"))
     print()
@@ -186,20 +198,33 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     if args.plan:
         return 0
     out = Path(args.output)
-    finished = (args.resume and not args.overwrite and out.is_file()
-                and not out.with_name(out.name + PART_SUFFIX).exists())
+    finished = (
+        args.resume
+        and not args.overwrite
+        and out.is_file()
+        and not out.with_name(out.name + PART_SUFFIX).exists()
+    )
     client = None
     if args.scheduler is not None:
         from ._writer import connect
 
         client = connect(args.scheduler)
-    if hasattr(signal, "SIGXFSZ"):  # past a file size limit, fail the write (named) instead of dying
+    if hasattr(
+        signal, "SIGXFSZ"
+    ):  # past a file size limit, fail the write (named) instead of dying
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
     try:
         cube = simulate(plan, client=client)
         extra = {} if str(out).endswith(".zarr") else {"complevel": args.complevel}
-        path = write(cube, out, overwrite=args.overwrite, resume=args.resume,
-                     client=client, progress=not args.quiet, **extra)
+        path = write(
+            cube,
+            out,
+            overwrite=args.overwrite,
+            resume=args.resume,
+            client=client,
+            progress=not args.quiet,
+            **extra,
+        )
     finally:
         if client is not None:
             client.close()
@@ -224,7 +249,9 @@ def _knob_values(items: list[str]) -> dict[str, object]:
         name, sep, text = item.partition("=")
         name = name.strip()
         if not sep or name not in KNOBS:
-            raise SceneError(f"--set {item!r}: expected NAME=VALUE with NAME one of {', '.join(KNOBS)}")
+            raise SceneError(
+                f"--set {item!r}: expected NAME=VALUE with NAME one of {', '.join(KNOBS)}"
+            )
         try:
             value = tomllib.loads(f"v = {text.strip()}")["v"]
         except tomllib.TOMLDecodeError:
@@ -251,7 +278,9 @@ def _save_figure(cube_path: str, figure_path: str) -> None:
     try:
         fig = plot_cube(cube)
     except (KeyError, ValueError, IndexError) as exc:
-        raise ValidationError(f"{cube_path}: cannot be drawn ({type(exc).__name__}: {exc})") from None
+        raise ValidationError(
+            f"{cube_path}: cannot be drawn ({type(exc).__name__}: {exc})"
+        ) from None
     try:
         fig.savefig(figure_path, dpi=120)
     except ValueError as exc:  # an unknown image format
@@ -281,7 +310,9 @@ def _parse_colours(text: str | None) -> list[tuple[str, str]] | None:
     for item in text.split(","):
         a, sep, b = item.strip().partition("-")
         if not sep or not a or not b:
-            raise SbrdfError(f"--colours: {item.strip()!r} is not a band pair like V-R (give e.g. V-R,R-I)")
+            raise SbrdfError(
+                f"--colours: {item.strip()!r} is not a band pair like V-R (give e.g. V-R,R-I)"
+            )
         pairs.append((a, b))
     return pairs
 
@@ -297,29 +328,50 @@ def _cmd_photometry(args: argparse.Namespace) -> int:
         if out and Path(out).exists() and not args.overwrite:
             raise FileExistsError(f"{out} exists; pass --overwrite to replace it")
     with _open_dataset(args.cube) as probe:
-        if not any(v in probe and "wavelength" in probe[v].dims for v in ("signal", "spacecraft_sbrdf")):
-            raise ValidationError(f"{args.cube}: not a spectral simulation cube of 'sbrdf-xr simulate' "
-                                  "(it needs 'signal' or 'spacecraft_sbrdf' over wavelength)")
+        if not any(
+            v in probe and "wavelength" in probe[v].dims for v in ("signal", "spacecraft_sbrdf")
+        ):
+            raise ValidationError(
+                f"{args.cube}: not a spectral simulation cube of 'sbrdf-xr simulate' "
+                "(it needs 'signal' or 'spacecraft_sbrdf' over wavelength)"
+            )
     colours = _parse_colours(args.colours)
     with xr.open_dataset(args.cube, chunks={}) as cube:
         range_km = args.range_km if args.range_km is not None else _cube_range_km(cube)
         if range_km is None:
-            raise SbrdfError(f"{args.cube} records no observer range; give it with --range-km KM "
-                             "(e.g. --range-km 36000 for a geostationary object)")
-        lazy = phot.photometry(cube, args.bands, range_km, pairs=colours, system=args.system,
-                               weighting=args.weighting, quadrature=args.quadrature,
-                               extrapolate=args.extrapolate, solar=args.solar)
+            raise SbrdfError(
+                f"{args.cube} records no observer range; give it with --range-km KM "
+                "(e.g. --range-km 36000 for a geostationary object)"
+            )
+        lazy = phot.photometry(
+            cube,
+            args.bands,
+            range_km,
+            pairs=colours,
+            system=args.system,
+            weighting=args.weighting,
+            quadrature=args.quadrature,
+            extrapolate=args.extrapolate,
+            solar=args.solar,
+        )
         with TqdmCallback(desc="photometry", disable=args.quiet):
             ds = lazy.compute()
-    print(f"photometry of {args.cube}: range {range_km:g} km, {ds.attrs['magnitude_system']} "
-          f"magnitudes, {args.weighting} weighting, solar spectrum {args.solar}")
+    print(
+        f"photometry of {args.cube}: range {range_km:g} km, {ds.attrs['magnitude_system']} "
+        f"magnitudes, {args.weighting} weighting, solar spectrum {args.solar}"
+    )
     print(f"{'band':<8} {'filter':<14} {'m_sun':>8} {'min':>8} {'median':>8} {'max':>8}")
     for b in ds.band.values:
         m = np.asarray(ds.magnitude.sel(band=b).values).ravel()
         fin = m[np.isfinite(m)]
-        stats = (f"{fin.min():8.3f} {np.median(fin):8.3f} {fin.max():8.3f}" if fin.size
-                 else f"{'inf':>8} {'inf':>8} {'inf':>8}")
-        print(f"{b!s:<8} {ds.filter.sel(band=b).item()!s:<14} {float(ds.sun_magnitude.sel(band=b)):8.3f} {stats}")
+        stats = (
+            f"{fin.min():8.3f} {np.median(fin):8.3f} {fin.max():8.3f}"
+            if fin.size
+            else f"{'inf':>8} {'inf':>8} {'inf':>8}"
+        )
+        print(
+            f"{b!s:<8} {ds.filter.sel(band=b).item()!s:<14} {float(ds.sun_magnitude.sel(band=b)):8.3f} {stats}"
+        )
     if "colour_index" in ds:
         for c in ds.colour.values:
             v = np.asarray(ds.colour_index.sel(colour=c).values).ravel()
@@ -331,12 +383,16 @@ def _cmd_photometry(args: argparse.Namespace) -> int:
         print(f"wrote {args.output}")
     if args.csv:
         lead = set(ds.magnitude.dims) - {"band"}
-        parts = [ds.magnitude.to_dataset(dim="band").rename({str(b): f"mag_{b}" for b in ds.band.values})]
+        parts = [
+            ds.magnitude.to_dataset(dim="band").rename({str(b): f"mag_{b}" for b in ds.band.values})
+        ]
         if "colour_index" in ds:
             parts.append(ds.colour_index.to_dataset(dim="colour"))
         wide = xr.merge(parts, compat="override")
-        wide = wide.drop_vars([c for c in wide.coords if not set(wide[c].dims) <= lead or c in ("band", "colour")],
-                              errors="ignore")
+        wide = wide.drop_vars(
+            [c for c in wide.coords if not set(wide[c].dims) <= lead or c in ("band", "colour")],
+            errors="ignore",
+        )
         wide.to_dataframe().to_csv(args.csv)
         print(f"wrote {args.csv}")
     return 0
@@ -355,7 +411,9 @@ def _cmd_invert(args: argparse.Namespace) -> int:
         with xr.open_dataset(args.cube) as cube:
             terms = cube.load()["signal_material"] if "signal_material" in cube else None
         if terms is None:
-            raise InversionError(f"{args.cube}: no signal_material; simulate with the per_material output")
+            raise InversionError(
+                f"{args.cube}: no signal_material; simulate with the per_material output"
+            )
         for item in args.isel or []:
             dim, _, idx = item.partition("=")
             terms = terms.isel({dim: int(idx)})
@@ -364,31 +422,56 @@ def _cmd_invert(args: argparse.Namespace) -> int:
         except InversionError:
             lc = read_light_curve(args.measured)
             if args.range_km is None:
-                raise InversionError("--range-km: needed to turn measured magnitudes into signal") from None
+                raise InversionError(
+                    "--range-km: needed to turn measured magnitudes into signal"
+                ) from None
             y, sigma = invert.magnitudes_to_signal(lc, args.range_km)
             terms = invert.band_terms(terms, [str(b) for b in y.band.values])
-        ds = invert.unmix(y, terms, sigma, select=None if args.select == "none" else args.select,
-                          criterion=args.criterion)
-        print(f"unmix {args.measured}: chi2 {float(ds.chi2):.4g}, reduced {float(ds.reduced_chi2):.4g}, "
-              f"{args.criterion} selection: {ds.attrs['selected_materials']}")
+        ds = invert.unmix(
+            y,
+            terms,
+            sigma,
+            select=None if args.select == "none" else args.select,
+            criterion=args.criterion,
+        )
+        print(
+            f"unmix {args.measured}: chi2 {float(ds.chi2):.4g}, reduced {float(ds.reduced_chi2):.4g}, "
+            f"{args.criterion} selection: {ds.attrs['selected_materials']}"
+        )
         for m in ds.material.values:
-            print(f"  {m!s:<24} scale {float(ds.scale.sel(material=m)):.4f} "
-                  f"+- {float(ds.scale_uncertainty.sel(material=m)):.4f}")
+            print(
+                f"  {m!s:<24} scale {float(ds.scale.sel(material=m)):.4f} "
+                f"+- {float(ds.scale_uncertainty.sel(material=m)):.4f}"
+            )
         print(f"  degenerate: {ds.attrs['degenerate']}")
     else:
         from .spacecraft import canx1, load_spacecraft
 
         sc = canx1() if args.spacecraft == "canx1" else load_spacecraft(args.spacecraft)
         lo, hi, n = args.periods
-        ds = invert.fit_spin(read_light_curve(args.measured), sc, to_sun=args.to_sun, to_observer=args.to_observer,
-                             periods=np.linspace(lo, hi, int(n)), axis_body=args.axis_body, n_axes=args.n_axes,
-                             n_phases=args.n_phases, offset=args.offset)
-        print(f"spin fit of {args.measured}: {ds.attrs['n_candidates']} candidates in "
-              f"{ds.attrs['search_seconds']:.1f} s; chi2 {float(ds.chi2):.4g}, reduced {float(ds.reduced_chi2):.4g}")
+        ds = invert.fit_spin(
+            read_light_curve(args.measured),
+            sc,
+            to_sun=args.to_sun,
+            to_observer=args.to_observer,
+            periods=np.linspace(lo, hi, int(n)),
+            axis_body=args.axis_body,
+            n_axes=args.n_axes,
+            n_phases=args.n_phases,
+            offset=args.offset,
+        )
+        print(
+            f"spin fit of {args.measured}: {ds.attrs['n_candidates']} candidates in "
+            f"{ds.attrs['search_seconds']:.1f} s; chi2 {float(ds.chi2):.4g}, reduced {float(ds.reduced_chi2):.4g}"
+        )
         for k in ("axis_longitude", "axis_latitude", "period", "phase"):
-            print(f"  {k:<15} {float(ds[k]):10.4f} +- {float(ds[k + '_uncertainty']):.4f} {ds[k].attrs['units']}")
+            print(
+                f"  {k:<15} {float(ds[k]):10.4f} +- {float(ds[k + '_uncertainty']):.4f} {ds[k].attrs['units']}"
+            )
         for sname in ds.solution.values:
-            print(f"  alternative {sname!s:<14} chi2 gap {float(ds.chi2_gap.sel(solution=sname)):10.2f}")
+            print(
+                f"  alternative {sname!s:<14} chi2 gap {float(ds.chi2_gap.sel(solution=sname)):10.2f}"
+            )
     if args.output:
         write_netcdf_atomic(ds, args.output, overwrite=args.overwrite)
         print(f"wrote {args.output}")
@@ -397,7 +480,9 @@ def _cmd_invert(args: argparse.Namespace) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``sbrdf-xr``."""
-    p = argparse.ArgumentParser(prog="sbrdf-xr", description="Spectral BRDF simulation of unresolved spacecraft.")
+    p = argparse.ArgumentParser(
+        prog="sbrdf-xr", description="Spectral BRDF simulation of unresolved spacecraft."
+    )
     p.add_argument("--version", action="version", version=f"sbrdf_xr {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
 
@@ -419,49 +504,93 @@ def build_parser() -> argparse.ArgumentParser:
 
     pb = sub.add_parser("bench", help="accuracy/cost benchmarks (timings as ratios)")
     pb.add_argument("--quick", action="store_true", help="small problems, for a smoke run")
-    pb.add_argument("--engine", action="store_true",
-                    help="engine rows: end-to-end sweeps, scaling, cores, kernel throughput")
+    pb.add_argument(
+        "--engine",
+        action="store_true",
+        help="engine rows: end-to-end sweeps, scaling, cores, kernel throughput",
+    )
     pb.add_argument("-o", "--output", help="write the table to this netCDF file")
     pb.add_argument("--csv", help="write the table to this CSV file")
     pb.add_argument("--plot", help="draw the accuracy/time front to this PNG file")
     pb.set_defaults(func=_cmd_bench)
 
     psim = sub.add_parser("simulate", help="run a scene into a netCDF cube")
-    psim.add_argument("scene", help="built-in scene name (canx1-rotation, canx1-plusx-specular) or a TOML file")
+    psim.add_argument(
+        "scene", help="built-in scene name (canx1-rotation, canx1-plusx-specular) or a TOML file"
+    )
     psim.add_argument("-o", "--output", required=True, help="netCDF file to write")
-    psim.add_argument("--scheduler", help="address of a dask.distributed scheduler (default: threads)")
+    psim.add_argument(
+        "--scheduler", help="address of a dask.distributed scheduler (default: threads)"
+    )
     psim.add_argument("--preset", help="numerical preset: fast, balanced or reference")
-    psim.add_argument("--set", action="append", metavar="KNOB=VALUE",
-                      help="set a numerical knob (repeatable; 'sbrdf-xr knobs' lists them), e.g. "
-                           "--set method=cubic --set dtype=float32")
-    psim.add_argument("--complevel", type=int, default=4, choices=range(10), metavar="0-9",
-                      help="zlib compression level of the netCDF cube (default 4; 0: none, fastest)")
+    psim.add_argument(
+        "--set",
+        action="append",
+        metavar="KNOB=VALUE",
+        help="set a numerical knob (repeatable; 'sbrdf-xr knobs' lists them), e.g. "
+        "--set method=cubic --set dtype=float32",
+    )
+    psim.add_argument(
+        "--complevel",
+        type=int,
+        default=4,
+        choices=range(10),
+        metavar="0-9",
+        help="zlib compression level of the netCDF cube (default 4; 0: none, fastest)",
+    )
     psim.add_argument("--plot", help="also write the cube's figure to this PNG file")
-    psim.add_argument("--overwrite", action="store_true",
-                      help="replace an existing output file (a regular file only)")
-    psim.add_argument("--resume", action="store_true",
-                      help="resume an interrupted run from its .part file (with --overwrite: and "
-                      "replace the existing output); a finished output of the same scene is left as is")
+    psim.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace an existing output file (a regular file only)",
+    )
+    psim.add_argument(
+        "--resume",
+        action="store_true",
+        help="resume an interrupted run from its .part file (with --overwrite: and "
+        "replace the existing output); a finished output of the same scene is left as is",
+    )
     psim.add_argument("--plan", action="store_true", help="print the plan and stop")
     psim.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     psim.set_defaults(func=_cmd_simulate)
 
     pph = sub.add_parser("photometry", help="band magnitudes and colours of a cube")
     pph.add_argument("cube", help="netCDF cube written by 'sbrdf-xr simulate'")
-    pph.add_argument("--bands", nargs="+", default=["V", "R", "I"],
-                     help="bands: aliases U B V R I u g r i z or speclite filter names (default V R I)")
-    pph.add_argument("--range-km", type=float,
-                     help="observer range [km] (default: the range the cube records, if any)")
-    pph.add_argument("--colours", help="colour indices as band pairs, e.g. V-R,R-I (default consecutive bands)")
-    pph.add_argument("--system", type=str.lower, choices=("ab", "vega"), default="ab",
-                     help="magnitude system (default ab)")
-    pph.add_argument("--solar", default="astm_g173",
-                     choices=("astm_g173", "calspec", "kurucz1993"), help="solar spectrum")
+    pph.add_argument(
+        "--bands",
+        nargs="+",
+        default=["V", "R", "I"],
+        help="bands: aliases U B V R I u g r i z or speclite filter names (default V R I)",
+    )
+    pph.add_argument(
+        "--range-km",
+        type=float,
+        help="observer range [km] (default: the range the cube records, if any)",
+    )
+    pph.add_argument(
+        "--colours", help="colour indices as band pairs, e.g. V-R,R-I (default consecutive bands)"
+    )
+    pph.add_argument(
+        "--system",
+        type=str.lower,
+        choices=("ab", "vega"),
+        default="ab",
+        help="magnitude system (default ab)",
+    )
+    pph.add_argument(
+        "--solar",
+        default="astm_g173",
+        choices=("astm_g173", "calspec", "kurucz1993"),
+        help="solar spectrum",
+    )
     pph.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     pph.add_argument("--weighting", choices=("photon", "energy"), default="photon")
     pph.add_argument("--quadrature", choices=("trapezoid", "linear"), default="trapezoid")
-    pph.add_argument("--extrapolate", choices=("zero", "constant"),
-                     help="continue spectra past their grid into bands they do not cover")
+    pph.add_argument(
+        "--extrapolate",
+        choices=("zero", "constant"),
+        help="continue spectra past their grid into bands they do not cover",
+    )
     pph.add_argument("-o", "--output", help="write the photometry Dataset to this netCDF file")
     pph.add_argument("--csv", help="write magnitudes and colour indices to this CSV file")
     pph.add_argument("--overwrite", action="store_true", help="replace existing output files")
@@ -470,21 +599,46 @@ def build_parser() -> argparse.ArgumentParser:
     pinv = sub.add_parser("invert", help="materials or spin state from measured data")
     isub = pinv.add_subparsers(dest="invert_command", required=True)
     pu = isub.add_parser("unmix", help="material areas from a measured spectrum or band magnitudes")
-    pu.add_argument("measured", help="spectrum CSV/netCDF (wavelength, signal, uncertainty) or a light-curve "
-                    "file of band magnitudes (read_light_curve format, one row per band)")
-    pu.add_argument("--cube", required=True, help="netCDF cube with signal_material at the measured geometry")
-    pu.add_argument("--isel", action="append", metavar="DIM=INDEX", help="select the geometry in the cube")
+    pu.add_argument(
+        "measured",
+        help="spectrum CSV/netCDF (wavelength, signal, uncertainty) or a light-curve "
+        "file of band magnitudes (read_light_curve format, one row per band)",
+    )
+    pu.add_argument(
+        "--cube", required=True, help="netCDF cube with signal_material at the measured geometry"
+    )
+    pu.add_argument(
+        "--isel", action="append", metavar="DIM=INDEX", help="select the geometry in the cube"
+    )
     pu.add_argument("--range-km", type=float, help="observer range [km] (band magnitudes)")
     pu.add_argument("--select", choices=("all", "greedy", "none"), default="all")
     pu.add_argument("--criterion", choices=("bic", "aic"), default="bic")
     pspin = isub.add_parser("spin", help="spin axis, period and phase from a colour light curve")
-    pspin.add_argument("measured", help="light curve CSV/netCDF (read_light_curve format, times in s)")
+    pspin.add_argument(
+        "measured", help="light curve CSV/netCDF (read_light_curve format, times in s)"
+    )
     pspin.add_argument("--spacecraft", default="canx1", help="canx1 or a mesh file")
-    pspin.add_argument("--to-sun", type=float, nargs=3, required=True, help="inertial direction to the Sun")
-    pspin.add_argument("--to-observer", type=float, nargs=3, required=True, help="inertial direction to the observer")
-    pspin.add_argument("--periods", type=float, nargs=3, required=True, metavar=("MIN", "MAX", "N"),
-                       help="candidate periods [s]")
-    pspin.add_argument("--axis-body", type=float, nargs=3, default=(0.0, 0.0, 1.0), help="body spin axis")
+    pspin.add_argument(
+        "--to-sun", type=float, nargs=3, required=True, help="inertial direction to the Sun"
+    )
+    pspin.add_argument(
+        "--to-observer",
+        type=float,
+        nargs=3,
+        required=True,
+        help="inertial direction to the observer",
+    )
+    pspin.add_argument(
+        "--periods",
+        type=float,
+        nargs=3,
+        required=True,
+        metavar=("MIN", "MAX", "N"),
+        help="candidate periods [s]",
+    )
+    pspin.add_argument(
+        "--axis-body", type=float, nargs=3, default=(0.0, 0.0, 1.0), help="body spin axis"
+    )
     pspin.add_argument("--n-axes", type=int, default=300)
     pspin.add_argument("--n-phases", type=int, default=36)
     pspin.add_argument("--offset", choices=("band", "common"), default="band")

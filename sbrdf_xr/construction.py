@@ -32,7 +32,9 @@ def paper_delta_theta_grid(dt_min: float, dt_max: float, n: int = 21) -> np.ndar
     if n < 3 or n % 2 == 0:
         raise ValidationError(f"n_delta_theta: must be odd and >= 3, got {n}")
     half = n // 2
-    return np.concatenate([np.linspace(dt_min, 0.0, half + 1)[:-1], np.linspace(0.0, dt_max, half + 1)])
+    return np.concatenate(
+        [np.linspace(dt_min, 0.0, half + 1)[:-1], np.linspace(0.0, dt_max, half + 1)]
+    )
 
 
 def interp_weights(
@@ -88,9 +90,16 @@ def extend_grid(grid: np.ndarray, lo: float, hi: float) -> np.ndarray:
 
 
 def per_theta_tables(
-    measured_ti: np.ndarray, ti_s: np.ndarray, dt_s: np.ndarray, ph_s: np.ndarray,
-    spectra: np.ndarray, ref: np.ndarray, dt_grid: np.ndarray, phi_grid: np.ndarray,
-    *, hold_all: bool = False,
+    measured_ti: np.ndarray,
+    ti_s: np.ndarray,
+    dt_s: np.ndarray,
+    ph_s: np.ndarray,
+    spectra: np.ndarray,
+    ref: np.ndarray,
+    dt_grid: np.ndarray,
+    phi_grid: np.ndarray,
+    *,
+    hold_all: bool = False,
 ) -> np.ndarray:
     """Steps 1 and 2 of the construction: every measured incidence angle on the grid.
 
@@ -116,7 +125,9 @@ def per_theta_tables(
             # A row measured at phi = 0 only (the in-plane delta_theta extents of the
             # scheme) says nothing about phi > 0: it is not held out of the plane.
             hold = hold_all or (sel.size > 1 and not ref[edge])
-            w = interp_weights(ph_s[sel], phi_grid, hold_lo=hold_all, hold_hi=hold)  # (n_phi, n_sel)
+            w = interp_weights(
+                ph_s[sel], phi_grid, hold_lo=hold_all, hold_hi=hold
+            )  # (n_phi, n_sel)
             row_vals[r] = w @ spectra[sel]
             row_ref[r] = bool(np.all(ref[sel]))
             row_n[r] = sel.size
@@ -132,8 +143,9 @@ def per_theta_tables(
                 scale = np.divide(row_vals[r, 0], base, out=np.zeros_like(base), where=base > 0)
                 row_vals[r, 1:] = row_vals[adj, 1:] * scale
         # Step 2: delta_theta interpolation for every grid phi.
-        w = interp_weights(rows, dt_grid, hold_lo=hold_all or not row_ref[0],
-                            hold_hi=hold_all or not row_ref[-1])
+        w = interp_weights(
+            rows, dt_grid, hold_lo=hold_all or not row_ref[0], hold_hi=hold_all or not row_ref[-1]
+        )
         per_theta[a] = np.einsum("dr,rpl->dpl", w, row_vals)
     return per_theta
 
@@ -168,6 +180,7 @@ def azimuthal_average(
     c_dt = np.degrees(np.arctan2(np.sin(tr)[..., None] * np.cos(psi), np.cos(tr)[..., None]))
     c_ph = np.degrees(np.arcsin(np.clip(np.sin(tr)[..., None] * np.sin(psi), 0.0, 1.0)))
     table = np.stack([row, row])
-    vals = _lut.lookup_kernel(table, np.array([0.0, 1.0]), dt, ph, 0.0, c_dt, c_ph, "linear",
-                              zero_edges=zero_edges)  # (n_dt, n_phi, n_psi, n_wl)
+    vals = _lut.lookup_kernel(
+        table, np.array([0.0, 1.0]), dt, ph, 0.0, c_dt, c_ph, "linear", zero_edges=zero_edges
+    )  # (n_dt, n_phi, n_psi, n_wl)
     return np.einsum("dpql,q->dpl", vals, w)

@@ -39,8 +39,16 @@ class BlockInputs:
     earth_scale: np.ndarray | None = None  #: (G,) earthshine irradiance / the Sun's, or None
 
 
-
-__all__ = ["EFFECTS", "OUTPUTS", "SPECTRAL_OUTPUTS", "BlockInputs", "Effect", "Output", "finish", "reflected"]
+__all__ = [
+    "EFFECTS",
+    "OUTPUTS",
+    "SPECTRAL_OUTPUTS",
+    "BlockInputs",
+    "Effect",
+    "Output",
+    "finish",
+    "reflected",
+]
 
 
 @dataclass(frozen=True)
@@ -73,31 +81,78 @@ class Output:
 
 
 #: Every output variable a cube may hold.
-OUTPUTS: dict[str, Output] = {o.name: o for o in (
-    Output("spacecraft_sbrdf", (WAVELENGTH,), True, "sr-1",
-           "overall spacecraft spectral BRDF (paper 000 Eq. 4)"),
-    Output("signal", (WAVELENGTH,), True, "m2 sr-1",
-           "radiometric signal sum_j A_j cos(theta_i) cos(theta_r) f_r"),
-    Output("brdf", (), True, "sr-1 nm",
-           "broadband BRDF, sBRDF integrated over wavelength (paper 000 Eq. 2)"),
-    Output("area", (), False, "m2",
-           "contributing projected area sum_j A_j cos(theta_r) (paper 000 Eq. 4 denominator)"),
-    Output("signal_material", (MATERIAL, WAVELENGTH), True, "m2 sr-1",
-           "radiometric signal of each material's facets"),
-    Output("signal_earthshine", (WAVELENGTH,), True, "m2 sr-1",
-           "radiometric signal of the light reflected from a Lambertian Earth, per unit solar "
-           "irradiance"),
-    Output("thermal_intensity", (WAVELENGTH,), True, "W sr-1 nm-1",
-           "thermal emission intensity sum_j A_j cos(theta_r) epsilon(lambda, theta_r) B(lambda, T)"),
-    Output("band_signal", (BAND,), True, "m2 sr-1",
-           "solar-weighted band mean of the radiometric signal (photon counting)"),
-)}
+OUTPUTS: dict[str, Output] = {
+    o.name: o
+    for o in (
+        Output(
+            "spacecraft_sbrdf",
+            (WAVELENGTH,),
+            True,
+            "sr-1",
+            "overall spacecraft spectral BRDF (paper 000 Eq. 4)",
+        ),
+        Output(
+            "signal",
+            (WAVELENGTH,),
+            True,
+            "m2 sr-1",
+            "radiometric signal sum_j A_j cos(theta_i) cos(theta_r) f_r",
+        ),
+        Output(
+            "brdf",
+            (),
+            True,
+            "sr-1 nm",
+            "broadband BRDF, sBRDF integrated over wavelength (paper 000 Eq. 2)",
+        ),
+        Output(
+            "area",
+            (),
+            False,
+            "m2",
+            "contributing projected area sum_j A_j cos(theta_r) (paper 000 Eq. 4 denominator)",
+        ),
+        Output(
+            "signal_material",
+            (MATERIAL, WAVELENGTH),
+            True,
+            "m2 sr-1",
+            "radiometric signal of each material's facets",
+        ),
+        Output(
+            "signal_earthshine",
+            (WAVELENGTH,),
+            True,
+            "m2 sr-1",
+            "radiometric signal of the light reflected from a Lambertian Earth, per unit solar "
+            "irradiance",
+        ),
+        Output(
+            "thermal_intensity",
+            (WAVELENGTH,),
+            True,
+            "W sr-1 nm-1",
+            "thermal emission intensity sum_j A_j cos(theta_r) epsilon(lambda, theta_r) B(lambda, T)",
+        ),
+        Output(
+            "band_signal",
+            (BAND,),
+            True,
+            "m2 sr-1",
+            "solar-weighted band mean of the radiometric signal (photon counting)",
+        ),
+    )
+}
 
 #: Scene output names and the cube variables they add (``per_material`` adds
 #: ``signal_material``).
 SCENE_OUTPUTS: dict[str, str] = {
-    "spacecraft_sbrdf": "spacecraft_sbrdf", "signal": "signal", "brdf": "brdf", "area": "area",
-    "per_material": "signal_material", "band_signal": "band_signal",
+    "spacecraft_sbrdf": "spacecraft_sbrdf",
+    "signal": "signal",
+    "brdf": "brdf",
+    "area": "area",
+    "per_material": "signal_material",
+    "band_signal": "band_signal",
 }
 #: Scene outputs over wavelength: a scene asking for none of them (only band outputs)
 #: has its tables pre-integrated over the bands.
@@ -107,8 +162,13 @@ SPECTRAL_OUTPUTS = ("spacecraft_sbrdf", "signal", "brdf", "per_material")
 # ------------------------------------------------------------- contributions
 
 
-def reflected(plan: Plan, block: BlockInputs, to_source: np.ndarray, fraction: np.ndarray | None,
-              per_material: bool) -> _kernels.FusedSums:
+def reflected(
+    plan: Plan,
+    block: BlockInputs,
+    to_source: np.ndarray,
+    fraction: np.ndarray | None,
+    per_material: bool,
+) -> _kernels.FusedSums:
     """Facet sums of light from a distant source in direction ``to_source`` (body frame).
 
     Runs the kernel the plan chose (fused or numpy reference) or, with analytic
@@ -118,8 +178,17 @@ def reflected(plan: Plan, block: BlockInputs, to_source: np.ndarray, fraction: n
     if plan.knobs["evaluation"] == "analytic":
         return _analytic_sums(plan, to_source, block.to_observer, fraction, per_material)
     if plan.knobs["kernel"] == "fused":
-        return _kernels.fused_sums(to_source, block.to_observer, t.normal, t.area, t.material,
-                                   plan.tables, plan.knobs["method"], fraction, per_material)
+        return _kernels.fused_sums(
+            to_source,
+            block.to_observer,
+            t.normal,
+            t.area,
+            t.material,
+            plan.tables,
+            plan.knobs["method"],
+            fraction,
+            per_material,
+        )
     g, n_wl = to_source.shape[0], plan.tables.n_spectral
     dt = plan.tables.dtype
     sig, pap = np.zeros((g, n_wl), dt), np.zeros((g, n_wl), dt)
@@ -128,9 +197,18 @@ def reflected(plan: Plan, block: BlockInputs, to_source: np.ndarray, fraction: n
     for m in range(len(plan.materials)):
         sel = t.material == m
         values, grids, edges, blend = plan.table(m)
-        r = _kernels.material_sums(to_source, block.to_observer, t.normal[sel], t.area[sel], values,
-                                   *grids, plan.knobs["method"],
-                                   None if fraction is None else fraction[:, sel], edges, blend)
+        r = _kernels.material_sums(
+            to_source,
+            block.to_observer,
+            t.normal[sel],
+            t.area[sel],
+            values,
+            *grids,
+            plan.knobs["method"],
+            None if fraction is None else fraction[:, sel],
+            edges,
+            blend,
+        )
         sig += r.signal
         pap += r.paper
         area += r.area
@@ -140,8 +218,9 @@ def reflected(plan: Plan, block: BlockInputs, to_source: np.ndarray, fraction: n
     return _kernels.FusedSums(sig, pap, area, lit, pm)
 
 
-def _analytic_sums(plan: Plan, s: np.ndarray, o: np.ndarray, fraction: np.ndarray | None,
-                   per_material: bool) -> _kernels.FusedSums:
+def _analytic_sums(
+    plan: Plan, s: np.ndarray, o: np.ndarray, fraction: np.ndarray | None, per_material: bool
+) -> _kernels.FusedSums:
     """The facet sums with every material evaluated by its BRDF model (no table)."""
     t = plan.terms
     wl = plan.wavelength
@@ -170,11 +249,14 @@ def _analytic_sums(plan: Plan, s: np.ndarray, o: np.ndarray, fraction: np.ndarra
     if plan.pre_integrated:
         sig, pap = sig @ plan.band_weights.T, pap @ plan.band_weights.T
         pm = None if pm is None else pm @ plan.band_weights.T
-    return _kernels.FusedSums(sig.astype(dt), pap.astype(dt), area, lit,
-                              None if pm is None else pm.astype(dt))
+    return _kernels.FusedSums(
+        sig.astype(dt), pap.astype(dt), area, lit, None if pm is None else pm.astype(dt)
+    )
 
 
-def _shadow_fraction(plan: Plan, to_source: np.ndarray, to_observer: np.ndarray) -> np.ndarray | None:
+def _shadow_fraction(
+    plan: Plan, to_source: np.ndarray, to_observer: np.ndarray
+) -> np.ndarray | None:
     if not plan.shadowing:
         return None
     from .visibility import lit_visible_fraction
@@ -191,8 +273,12 @@ def _sunlight(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
         lit = np.flatnonzero(scale > 0)
         sub = BlockInputs(block.to_sun[lit], block.to_observer[lit], None, scale[lit], (lit.size,))
         part = _sunlight(plan, sub) if lit.size else None
-        g, n = block.to_sun.shape[0], plan.tables.n_spectral if plan.knobs["evaluation"] == "table" else (
-            len(plan.bands) if plan.pre_integrated else plan.wavelength.size)
+        g, n = (
+            block.to_sun.shape[0],
+            plan.tables.n_spectral
+            if plan.knobs["evaluation"] == "table"
+            else (len(plan.bands) if plan.pre_integrated else plan.wavelength.size),
+        )
         dt = np.dtype(plan.knobs["dtype"])
         out = {"signal": np.zeros((g, n), dt), "paper": np.zeros((g, n), dt), "area": np.zeros(g)}
         if "signal_material" in plan.output_names:
@@ -276,22 +362,56 @@ class Effect:
 
 
 #: The effects, by name.
-EFFECTS: dict[str, Effect] = {e.name: e for e in (
-    Effect("sunlight", (), "sun", ("spacecraft_sbrdf", "signal", "brdf", "area", "signal_material",
-                                   "band_signal"), _sunlight,
-           "reflected sunlight: paper 000 Eqs. 3-4 and the radiometric signal"),
-    Effect("shadowing", ("mesh",), None, (), None,
-           "self-shadowing and self-occlusion of the facets"),
-    Effect("earthshine", ("to_earth",), "earth", ("signal_earthshine", "band_signal"), _earthshine,
-           "sunlight reflected by a Lambertian Earth, a second distant source"),
-    Effect("thermal", (), "facets", ("thermal_intensity",), _thermal,
-           "thermal emission epsilon(lambda, theta) B(lambda, T), epsilon = 1 - rho (Kirchhoff)"),
-    Effect("eclipse", ("sunlit_fraction",), None, (), None,
-           "the Earth's shadow: sunlight scaled by the sunlit fraction of the solar disc"),
-)}
+EFFECTS: dict[str, Effect] = {
+    e.name: e
+    for e in (
+        Effect(
+            "sunlight",
+            (),
+            "sun",
+            ("spacecraft_sbrdf", "signal", "brdf", "area", "signal_material", "band_signal"),
+            _sunlight,
+            "reflected sunlight: paper 000 Eqs. 3-4 and the radiometric signal",
+        ),
+        Effect(
+            "shadowing",
+            ("mesh",),
+            None,
+            (),
+            None,
+            "self-shadowing and self-occlusion of the facets",
+        ),
+        Effect(
+            "earthshine",
+            ("to_earth",),
+            "earth",
+            ("signal_earthshine", "band_signal"),
+            _earthshine,
+            "sunlight reflected by a Lambertian Earth, a second distant source",
+        ),
+        Effect(
+            "thermal",
+            (),
+            "facets",
+            ("thermal_intensity",),
+            _thermal,
+            "thermal emission epsilon(lambda, theta) B(lambda, T), epsilon = 1 - rho (Kirchhoff)",
+        ),
+        Effect(
+            "eclipse",
+            ("sunlit_fraction",),
+            None,
+            (),
+            None,
+            "the Earth's shadow: sunlight scaled by the sunlit fraction of the solar disc",
+        ),
+    )
+}
 
 
-def finish(plan: Plan, sums: Mapping[str, np.ndarray], lead_shape: tuple[int, ...]) -> dict[str, np.ndarray]:
+def finish(
+    plan: Plan, sums: Mapping[str, np.ndarray], lead_shape: tuple[int, ...]
+) -> dict[str, np.ndarray]:
     """The plan's outputs of one block from the effects' sums, shaped ``lead_shape + tail``.
 
     ``spacecraft_sbrdf`` is paper 000 Eq. 4 (0 where no area contributes, the 0/0 of
@@ -311,7 +431,9 @@ def finish(plan: Plan, sums: Mapping[str, np.ndarray], lead_shape: tuple[int, ..
             out["spacecraft_sbrdf"] = sbrdf
         if "brdf" in names:
             wl = plan.wavelength
-            out["brdf"] = (np.trapezoid(sbrdf, wl, axis=-1) if wl.size > 1 else sbrdf[..., 0]).astype(dt)
+            out["brdf"] = (
+                np.trapezoid(sbrdf, wl, axis=-1) if wl.size > 1 else sbrdf[..., 0]
+            ).astype(dt)
     for k in ("signal", "signal_material", "signal_earthshine", "thermal_intensity"):
         if k in names:
             out[k] = sums[k]
@@ -319,5 +441,7 @@ def finish(plan: Plan, sums: Mapping[str, np.ndarray], lead_shape: tuple[int, ..
         total = sums["signal"]
         if "signal_earthshine" in sums:
             total = total + sums["signal_earthshine"]
-        out["band_signal"] = (total if plan.pre_integrated else total @ plan.band_weights.T).astype(dt)
+        out["band_signal"] = (total if plan.pre_integrated else total @ plan.band_weights.T).astype(
+            dt
+        )
     return {k: v.reshape(*lead_shape, *v.shape[1:]) for k, v in out.items()}

@@ -45,8 +45,17 @@ _MATERIAL = f"{PREFIX}_material_"
 _NAMES = f"{PREFIX}_material_names"
 _KNOBS_JSON = f"{PREFIX}_knobs_json"
 #: Scene fields that are geometry (hashed together) rather than knobs.
-_GEOMETRY_FIELDS = ("attitudes", "phase_angles", "bisector", "plane_normal", "to_sun",
-                    "to_observer", "to_earth", "attitude_angle", "observation")
+_GEOMETRY_FIELDS = (
+    "attitudes",
+    "phase_angles",
+    "bisector",
+    "plane_normal",
+    "to_sun",
+    "to_observer",
+    "to_earth",
+    "attitude_angle",
+    "observation",
+)
 #: Scene fields hashed on their own, or labels that do not change any value.
 _OTHER_FIELDS = ("spacecraft", "materials", "name", "description", "_checked", "_cache")
 #: What each single-hash part stands for, in messages.
@@ -110,16 +119,21 @@ def _table_sha(da: Any) -> str:
     parts = [_array_sha(np.asarray(da.values)), _json(list(map(str, da.dims)))]
     for name in sorted(map(str, da.coords)):
         c = da.coords[name]
-        parts += [name, _json(list(map(str, c.dims))), _array_sha(np.asarray(c.values)),
-                  _json(dict(c.attrs))]
+        parts += [
+            name,
+            _json(list(map(str, c.dims))),
+            _array_sha(np.asarray(c.values)),
+            _json(dict(c.attrs)),
+        ]
     # when and by what a file was written says nothing about its values
     parts.append(_json({k: v for k, v in da.attrs.items() if k not in _VOLATILE_TABLE_ATTRS}))
     return _sha(*parts)
 
 
 #: Table attributes that record when a file was written, not what it holds.
-_VOLATILE_TABLE_ATTRS = frozenset({"history", "date_created", "date_modified", "date_issued",
-                                   "date_metadata_modified"})
+_VOLATILE_TABLE_ATTRS = frozenset(
+    {"history", "date_created", "date_modified", "date_issued", "date_metadata_modified"}
+)
 
 
 def _attr_suffixes(names: list[str]) -> dict[str, str]:
@@ -128,8 +142,10 @@ def _attr_suffixes(names: list[str]) -> dict[str, str]:
     counts: dict[str, int] = {}
     for s in clean.values():
         counts[s] = counts.get(s, 0) + 1
-    return {n: s if counts[s] == 1 else f"{s}_{hashlib.sha256(n.encode()).hexdigest()[:8]}"
-            for n, s in clean.items()}
+    return {
+        n: s if counts[s] == 1 else f"{s}_{hashlib.sha256(n.encode()).hexdigest()[:8]}"
+        for n, s in clean.items()
+    }
 
 
 def _filters_sha(bands: Any) -> str:
@@ -138,16 +154,21 @@ def _filters_sha(bands: Any) -> str:
     from .photometry import filters
 
     f = filters(list(bands))
-    return _sha(_array_sha(f.values), *(_array_sha(np.asarray(f[c].values)) for c in sorted(map(str, f.coords))))
+    return _sha(
+        _array_sha(f.values),
+        *(_array_sha(np.asarray(f[c].values)) for c in sorted(map(str, f.coords))),
+    )
 
 
 def _mesh_sha(spacecraft: Any) -> str:
     mesh = getattr(spacecraft, "mesh", None)
     if mesh is None:
         return _sha(f"{type(spacecraft).__name__}:{spacecraft!r}")
-    return _sha(_array_sha(np.asarray(mesh.vertices, dtype=np.float64)),
-                _array_sha(np.asarray(mesh.faces, dtype=np.int64)),
-                _array_sha(np.asarray(spacecraft.facet_material, dtype=str)))
+    return _sha(
+        _array_sha(np.asarray(mesh.vertices, dtype=np.float64)),
+        _array_sha(np.asarray(mesh.faces, dtype=np.int64)),
+        _array_sha(np.asarray(spacecraft.facet_material, dtype=str)),
+    )
 
 
 def scene_fingerprint(scene: Any) -> dict[str, str]:
@@ -175,16 +196,27 @@ def scene_fingerprint(scene: Any) -> dict[str, str]:
     for n in names:
         out[_MATERIAL + suffix[n]] = _table_sha(materials[n])
     out[_NAMES] = json.dumps({suffix[n]: n for n in names}, sort_keys=True)
-    out[f"{PREFIX}_materials"] = _sha(_json({
-        n: {"material": materials[n].attrs.get("material"), "source": materials[n].attrs.get("source"),
-            "name": materials[n].name} for n in names}))
+    out[f"{PREFIX}_materials"] = _sha(
+        _json(
+            {
+                n: {
+                    "material": materials[n].attrs.get("material"),
+                    "source": materials[n].attrs.get("source"),
+                    "name": materials[n].name,
+                }
+                for n in names
+            }
+        )
+    )
     out[f"{PREFIX}_mesh"] = _mesh_sha(scene.spacecraft)
     out[f"{PREFIX}_filters"] = _filters_sha(getattr(scene, "bands", ()))
     fields = [f.name for f in dataclasses.fields(scene)]
     knobs = {f: getattr(scene, f) for f in fields if f not in _GEOMETRY_FIELDS + _OTHER_FIELDS}
     out[_KNOBS_JSON] = _json(knobs)
     out[f"{PREFIX}_knobs"] = _sha(out[_KNOBS_JSON])
-    out[f"{PREFIX}_geometry"] = _sha(*(f"{f}={_json(getattr(scene, f, None))}" for f in _GEOMETRY_FIELDS))
+    out[f"{PREFIX}_geometry"] = _sha(
+        *(f"{f}={_json(getattr(scene, f, None))}" for f in _GEOMETRY_FIELDS)
+    )
     out[f"{PREFIX}_package"] = _sha(f"sbrdf_xr {__version__}")
     out[PREFIX] = _sha(*(f"{k}={v}" for k, v in sorted(out.items())))
     return {PREFIX: out.pop(PREFIX), **dict(sorted(out.items()))}
@@ -223,7 +255,7 @@ def changes(old: Mapping[str, Any], new: Mapping[str, Any]) -> list[str]:
     names = {**_names(old), **_names(new)}
     keys = sorted({k for k in (*old, *new) if k.startswith(_MATERIAL) and k != _NAMES})
     for k in keys:
-        label = names.get(k[len(_MATERIAL):], k[len(_MATERIAL):])
+        label = names.get(k[len(_MATERIAL) :], k[len(_MATERIAL) :])
         if k not in old:
             out.append(f"material {label!r}: added")
         elif k not in new:
@@ -235,7 +267,9 @@ def changes(old: Mapping[str, Any], new: Mapping[str, Any]) -> list[str]:
         if old.get(k) == new.get(k):
             continue
         if part == "knobs":
-            out.append(_knob_changes(old.get(_KNOBS_JSON), new.get(_KNOBS_JSON)) or f"{what} changed")
+            out.append(
+                _knob_changes(old.get(_KNOBS_JSON), new.get(_KNOBS_JSON)) or f"{what} changed"
+            )
         else:
             out.append(f"{what} changed")
     return out or ["the content fingerprint changed"]

@@ -225,8 +225,9 @@ def facet_angles(
     else:
         n, s, o = (np.asarray(a) for a in (normal, to_sun, to_observer))
     dtype = _float_dtype(n, s, o)
-    n, s, o = np.broadcast_arrays(n.astype(dtype, copy=False), s.astype(dtype, copy=False),
-                                  o.astype(dtype, copy=False))
+    n, s, o = np.broadcast_arrays(
+        n.astype(dtype, copy=False), s.astype(dtype, copy=False), o.astype(dtype, copy=False)
+    )
 
     ns = _dot(n, s)
     no = _dot(n, o)

@@ -36,7 +36,10 @@ __all__ = ["PAPER_THETA_I", "measure", "paper_scheme", "scheme_extents"]
 
 #: Incidence angles [degree] used in the examples: aluminium was measured from 30
 #: deg, the solar cell and the paint from 10 deg (paper 000 §4.2).
-PAPER_THETA_I = {"aluminium": (30.0, 40.0, 50.0, 60.0, 70.0), "default": (10.0, 25.0, 40.0, 55.0, 70.0)}
+PAPER_THETA_I = {
+    "aluminium": (30.0, 40.0, 50.0, 60.0, 70.0),
+    "default": (10.0, 25.0, 40.0, 55.0, 70.0),
+}
 
 #: Table 1's fractions of the extents along the rows and columns.
 ROW_FRACTIONS_FAR = (0.75, 0.5, 0.25)
@@ -81,15 +84,20 @@ def paper_scheme(
     if phi_max.shape != (7,):
         raise ValidationError(f"phi_max: need one extent per row (7), got shape {phi_max.shape}")
     if not (dt_min < 0 < dt_max):
-        raise ValidationError(f"delta_theta extents must satisfy min < 0 < max, got {dt_min}, {dt_max}")
-    rows = np.array([f * dt_max for f in ROW_FRACTIONS_FAR] + [0.0]
-                    + [f * dt_min for f in ROW_FRACTIONS_NEAR])
+        raise ValidationError(
+            f"delta_theta extents must satisfy min < 0 < max, got {dt_min}, {dt_max}"
+        )
+    rows = np.array(
+        [f * dt_max for f in ROW_FRACTIONS_FAR] + [0.0] + [f * dt_min for f in ROW_FRACTIONS_NEAR]
+    )
     cols = np.asarray(COLUMN_FRACTIONS)
     dt = np.concatenate([np.repeat(rows, cols.size), [dt_max, dt_min]])
     ph = np.concatenate([(phi_max[:, None] * cols).ravel(), [0.0, 0.0]])
     flags = np.ones(9, dtype=bool) if in_noise is None else np.asarray(in_noise, dtype=bool)
     if flags.shape != (9,):
-        raise ValidationError(f"in_noise: need 9 flags (7 phi extents, dt_max, dt_min), got {flags.shape}")
+        raise ValidationError(
+            f"in_noise: need 9 flags (7 phi extents, dt_max, dt_min), got {flags.shape}"
+        )
     ref = np.concatenate([((cols == 1.0)[None, :] & flags[:7, None]).ravel(), flags[7:]])
     return dt, ph, ref
 
@@ -152,6 +160,7 @@ def scheme_extents(
         is where the signal fell into the noise (a reference point, zero) rather
         than an apparatus limit (a measured point).
     """
+
     def band(ti: float, dt: np.ndarray, ph: np.ndarray) -> np.ndarray:
         return np.mean(func(np.full(dt.shape, ti), dt, ph), axis=-1)
 
@@ -163,10 +172,13 @@ def scheme_extents(
         )
     dt_max, ref_max = _walk_out(lambda x: band(theta_i, x, 0 * x), far_limit, noise_floor, step)
     dt_min, ref_min = _walk_out(lambda x: band(theta_i, x, 0 * x), near_limit, noise_floor, step)
-    rows = np.array([f * dt_max for f in ROW_FRACTIONS_FAR] + [0.0]
-                    + [f * dt_min for f in ROW_FRACTIONS_NEAR])
-    walks = [_walk_out(lambda x, d=d: band(theta_i, np.full(x.shape, d), x), max_phi, noise_floor, step)
-             for d in rows]
+    rows = np.array(
+        [f * dt_max for f in ROW_FRACTIONS_FAR] + [0.0] + [f * dt_min for f in ROW_FRACTIONS_NEAR]
+    )
+    walks = [
+        _walk_out(lambda x, d=d: band(theta_i, np.full(x.shape, d), x), max_phi, noise_floor, step)
+        for d in rows
+    ]
     phi_max = np.array([w[0] for w in walks])
     in_noise = np.array([w[1] for w in walks] + [ref_max, ref_min])
     return dt_min, dt_max, phi_max, in_noise
@@ -231,10 +243,14 @@ def measure(
     if not 0 < dynamic_range < 1:
         raise ValidationError(f"dynamic_range: must lie in (0, 1), got {dynamic_range}")
     specular = np.mean(func(tis, np.zeros_like(tis), np.zeros_like(tis)), axis=-1)
-    floors = np.full(tis.shape, noise_floor) if noise_floor is not None else dynamic_range * specular
+    floors = (
+        np.full(tis.shape, noise_floor) if noise_floor is not None else dynamic_range * specular
+    )
     ti_all, dt_all, ph_all, ref_all = [], [], [], []
     for t, floor in zip(tis, floors, strict=True):
-        dt_min, dt_max, phi_max, in_noise = scheme_extents(func, float(t), noise_floor=float(floor), **limits)
+        dt_min, dt_max, phi_max, in_noise = scheme_extents(
+            func, float(t), noise_floor=float(floor), **limits
+        )
         dt, ph, ref = paper_scheme(float(t), dt_min, dt_max, phi_max, in_noise)
         ti_all.append(np.full(dt.shape, t))
         dt_all.append(dt)

@@ -53,7 +53,9 @@ def tilt_quadrature(sigma_deg: float, n: int) -> tuple[NDArray[np.float64], NDAr
     if not (np.isfinite(sigma_deg) and sigma_deg >= 0):
         raise ValidationError(f"sigma: expected a finite tilt >= 0 degree, got {sigma_deg!r}")
     if isinstance(n, bool) or int(n) != n or n < 1:
-        raise ValidationError(f"n: expected an integer >= 1 of quadrature nodes per axis, got {n!r}")
+        raise ValidationError(
+            f"n: expected an integer >= 1 of quadrature nodes per axis, got {n!r}"
+        )
     if sigma_deg == 0 or n == 1:
         return np.zeros((1, 2)), np.ones(1)
     x, w = np.polynomial.hermite.hermgauss(int(n))

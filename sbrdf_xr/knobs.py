@@ -59,6 +59,7 @@ def _positive_int(limit: int) -> Callable[[Any], str | None]:
         if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= limit:
             return f"expected an integer from 1 to {limit}"
         return None
+
     return check
 
 
@@ -76,35 +77,98 @@ def _optional_step(v: Any) -> str | None:
 
 
 #: The knob table (one entry a knob).
-KNOBS: dict[str, Knob] = {k.name: k for k in (
-    Knob("method", "linear", ("nearest", "linear", "cubic"), None,
-         "look-up interpolation order: nearest (the paper's) < linear < cubic in accuracy and cost"),
-    Knob("dtype", "float64", ("float32", "float64"), None,
-         "precision of the spectra (geometry is always float64)"),
-    Knob("wavelength_stride", 1, None, _positive_int(1000),
-         "use every n-th wavelength of the materials' common grid"),
-    Knob("band_integration", "auto", ("auto", "spectral"), None,
-         "auto: band-only scenes pre-integrate the tables over the bands (exact for nearest "
-         "and linear); spectral: integrate the spectral signal instead"),
-    Knob("shadow_method", "exact", ("exact", "sampled"), None,
-         "self-shadowing and occlusion: exact polygon clipping, or sub-facet ray sampling"),
-    Knob("shadow_density", 4, None, _positive_int(64),
-         "sampled shadowing: samples per facet side (density**2 per facet)"),
-    Knob("table_theta_step", None, None, _optional_step,
-         "resample the tables' theta_i axis to this step [degree] (None: as given)"),
-    Knob("evaluation", "table", ("table", "analytic"), None,
-         "table: look-up tables; analytic: each material's generating BRDF model (no table error, "
-         "much slower)"),
-    Knob("tilt_nodes", 5, None, _positive_int(32),
-         "surface imperfections: Gauss-Hermite nodes per tangent axis of the normal-tilt "
-         "distribution (tilt_nodes**2 copies of every term)"),
-    Knob("kernel", "fused", ("fused", "numpy"), None,
-         "fused: the compiled one-pass kernel; numpy: the reference implementation (same sums)"),
-    Knob("chunk", None, None, _optional_positive_int(10**9),
-         "geometries per block (None: from the memory budget)"),
-    Knob("block_bytes", 32 * 2**20, None, _positive_int(2**34),
-         "memory budget of one block's outputs [byte], sets the default chunk"),
-)}
+KNOBS: dict[str, Knob] = {
+    k.name: k
+    for k in (
+        Knob(
+            "method",
+            "linear",
+            ("nearest", "linear", "cubic"),
+            None,
+            "look-up interpolation order: nearest (the paper's) < linear < cubic in accuracy and cost",
+        ),
+        Knob(
+            "dtype",
+            "float64",
+            ("float32", "float64"),
+            None,
+            "precision of the spectra (geometry is always float64)",
+        ),
+        Knob(
+            "wavelength_stride",
+            1,
+            None,
+            _positive_int(1000),
+            "use every n-th wavelength of the materials' common grid",
+        ),
+        Knob(
+            "band_integration",
+            "auto",
+            ("auto", "spectral"),
+            None,
+            "auto: band-only scenes pre-integrate the tables over the bands (exact for nearest "
+            "and linear); spectral: integrate the spectral signal instead",
+        ),
+        Knob(
+            "shadow_method",
+            "exact",
+            ("exact", "sampled"),
+            None,
+            "self-shadowing and occlusion: exact polygon clipping, or sub-facet ray sampling",
+        ),
+        Knob(
+            "shadow_density",
+            4,
+            None,
+            _positive_int(64),
+            "sampled shadowing: samples per facet side (density**2 per facet)",
+        ),
+        Knob(
+            "table_theta_step",
+            None,
+            None,
+            _optional_step,
+            "resample the tables' theta_i axis to this step [degree] (None: as given)",
+        ),
+        Knob(
+            "evaluation",
+            "table",
+            ("table", "analytic"),
+            None,
+            "table: look-up tables; analytic: each material's generating BRDF model (no table error, "
+            "much slower)",
+        ),
+        Knob(
+            "tilt_nodes",
+            5,
+            None,
+            _positive_int(32),
+            "surface imperfections: Gauss-Hermite nodes per tangent axis of the normal-tilt "
+            "distribution (tilt_nodes**2 copies of every term)",
+        ),
+        Knob(
+            "kernel",
+            "fused",
+            ("fused", "numpy"),
+            None,
+            "fused: the compiled one-pass kernel; numpy: the reference implementation (same sums)",
+        ),
+        Knob(
+            "chunk",
+            None,
+            None,
+            _optional_positive_int(10**9),
+            "geometries per block (None: from the memory budget)",
+        ),
+        Knob(
+            "block_bytes",
+            32 * 2**20,
+            None,
+            _positive_int(2**34),
+            "memory budget of one block's outputs [byte], sets the default chunk",
+        ),
+    )
+}
 
 #: Presets: knob values chosen from the accuracy/cost table (see the module docstring).
 PRESETS: dict[str, dict[str, Any]] = {

@@ -140,9 +140,15 @@ def lookup(
     out = xr.apply_ufunc(
         _lookup_core,
         *angles,
-        kwargs={"values": values, "theta_grid": grids[0], "delta_theta_grid": grids[1],
-                "phi_grid": grids[2], "method": method, "zero_edges": _lut.table_edges(material.attrs),
-                "normal_blend": _lut.table_normal_blend(material.attrs)},
+        kwargs={
+            "values": values,
+            "theta_grid": grids[0],
+            "delta_theta_grid": grids[1],
+            "phi_grid": grids[2],
+            "method": method,
+            "zero_edges": _lut.table_edges(material.attrs),
+            "normal_blend": _lut.table_normal_blend(material.attrs),
+        },
         output_core_dims=[[WAVELENGTH]],
         dask="parallelized",
         output_dtypes=[values.dtype],
@@ -189,10 +195,14 @@ def lookup_anisotropic(
 
     _lut.check_method(method)
     if not isinstance(material, xr.DataArray) or set(material.dims) != set(ANISO_LUT_DIMS):
-        raise ValidationError(f"material: an anisotropic table has dims {ANISO_LUT_DIMS}, "
-                              f"got {getattr(material, 'dims', type(material).__name__)}")
+        raise ValidationError(
+            f"material: an anisotropic table has dims {ANISO_LUT_DIMS}, "
+            f"got {getattr(material, 'dims', type(material).__name__)}"
+        )
     material = material.transpose(*ANISO_LUT_DIMS)
-    ti, dt, ph, ps = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi, psi)))
+    ti, dt, ph, ps = np.broadcast_arrays(
+        *(np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi, psi))
+    )
     grid = np.asarray(material[PSI].values, dtype=np.float64)
     x = np.mod(ps, 180.0)
     if grid[-1] < 180.0:
@@ -206,8 +216,15 @@ def lookup_anisotropic(
         wk = np.where(idx == k, w, 0.0).sum(axis=1)
         sel = np.flatnonzero(wk > 0)
         if sel.size:
-            spec = _lut.lookup_kernel(values[:, :, :, k, :], *grids, ti.ravel()[sel], dt.ravel()[sel],
-                                      ph.ravel()[sel], method, zero_edges=edges)
+            spec = _lut.lookup_kernel(
+                values[:, :, :, k, :],
+                *grids,
+                ti.ravel()[sel],
+                dt.ravel()[sel],
+                ph.ravel()[sel],
+                method,
+                zero_edges=edges,
+            )
             out[sel] += wk[sel, None] * spec
     return out.reshape(*ti.shape, -1).astype(values.dtype, copy=False)
 
@@ -366,11 +383,17 @@ def build_lut(
     if duplicates == "mean":
         ds = _average_duplicates(ds)
     if extrapolation not in EXTRAPOLATIONS:
-        raise ValidationError(f"extrapolation: got {extrapolation!r}; allowed: {', '.join(EXTRAPOLATIONS)}")
+        raise ValidationError(
+            f"extrapolation: got {extrapolation!r}; allowed: {', '.join(EXTRAPOLATIONS)}"
+        )
     if normal_incidence not in ("paper", "symmetric"):
-        raise ValidationError(f"normal_incidence: got {normal_incidence!r}; allowed: symmetric, paper")
+        raise ValidationError(
+            f"normal_incidence: got {normal_incidence!r}; allowed: symmetric, paper"
+        )
     if below_noise not in BELOW_NOISE:
-        raise ValidationError(f"below_noise: got {below_noise!r}; allowed: {', '.join(BELOW_NOISE)}")
+        raise ValidationError(
+            f"below_noise: got {below_noise!r}; allowed: {', '.join(BELOW_NOISE)}"
+        )
     ref = _reference(ds)
     ti_s = np.asarray(ds[THETA_I].values, dtype=np.float64)
     dt_s = np.asarray(ds[DELTA_THETA].values, dtype=np.float64)
@@ -416,12 +439,25 @@ def build_lut(
         dt_grid = extend_grid(dt_grid, -180.0, 90.0)
         phi_grid = extend_grid(phi_grid, phi_grid[0], 90.0)
         # Beyond -180/90 and phi = 90 lies the far side of the horizon: nothing to hold.
-        edges = {"edge_delta_theta_min": "zero", "edge_delta_theta_max": "zero", "edge_phi_max": "zero"}
+        edges = {
+            "edge_delta_theta_min": "zero",
+            "edge_delta_theta_max": "zero",
+            "edge_phi_max": "zero",
+        }
         truth_s = _model_at(fit_model, ti_s, dt_s, ph_s, wl)
         ok = ~ref
         ratio = np.divide(spectra, truth_s, out=np.ones_like(spectra), where=truth_s > 0)
-        per_theta = per_theta_tables(measured_ti, ti_s[ok], dt_s[ok], ph_s[ok], ratio[ok],
-                               np.zeros(int(ok.sum()), dtype=bool), dt_grid, phi_grid, hold_all=True)
+        per_theta = per_theta_tables(
+            measured_ti,
+            ti_s[ok],
+            dt_s[ok],
+            ph_s[ok],
+            ratio[ok],
+            np.zeros(int(ok.sum()), dtype=bool),
+            dt_grid,
+            phi_grid,
+            hold_all=True,
+        )
         spline_mode = "constant" if extrapolation == "model" else extrapolation
         e = _lut.smoothing_spline_matrix(measured_ti, ti_out, lam, spline_mode)
         r_lut = np.tensordot(e, per_theta, axes=(1, 0))
@@ -435,8 +471,10 @@ def build_lut(
         if extrapolation == "model":
             _bound_grazing_rows(lut, ti_out, dt_grid, phi_grid, wl, fit_model, measured_ti[-1])
     if extrapolation == "model" or below_noise == "model":
-        extra = {"extrapolation_model": fit_model.attrs.get("model", ""),
-                 "extrapolation_model_provenance": fit_model.attrs.get("provenance", "")}
+        extra = {
+            "extrapolation_model": fit_model.attrs.get("model", ""),
+            "extrapolation_model_provenance": fit_model.attrs.get("provenance", ""),
+        }
         if extrapolation == "model" and below_noise == "zero":
             extra["blend_width"] = blend
     if normal_incidence == "symmetric" and ti_out[0] == 0.0:
@@ -495,8 +533,13 @@ ENERGY_TOL = 1e-6
 
 
 def _bound_grazing_rows(
-    lut: np.ndarray, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, wl: np.ndarray,
-    model: xr.Dataset, above: float,
+    lut: np.ndarray,
+    ti: np.ndarray,
+    dt: np.ndarray,
+    ph: np.ndarray,
+    wl: np.ndarray,
+    model: xr.Dataset,
+    above: float,
 ) -> None:
     """Scale every row above the measured incidence angles whose reflectance exceeds the
     model's (in place), so that grazing extrapolation never creates energy: a glossy
@@ -506,8 +549,9 @@ def _bound_grazing_rows(
         return
     mod, _, kw = models._params(_model_for(model, wl))
     rho_m = mod.directional_hemispherical_reflectance(np.minimum(ti[rows], 90.0), wl, **kw)
-    rho_t = _lut.hemispherical_reflectance_kernel(lut, ti, dt, ph, ti[rows], "linear",
-                                                  zero_edges=(True, True, True))
+    rho_t = _lut.hemispherical_reflectance_kernel(
+        lut, ti, dt, ph, ti[rows], "linear", zero_edges=(True, True, True)
+    )
     scale = np.where(rho_t > rho_m, rho_m / np.maximum(rho_t, 1e-300), 1.0)
     lut[rows] *= scale[:, None, None, :]
 
@@ -570,9 +614,14 @@ def hemispherical_reflectance(
     material = validate_material(material, check_values=False)
     grids = [np.asarray(material[d].values) for d in ANGLE_DIMS]
     ti = grids[0] if theta_i is None else np.atleast_1d(np.asarray(theta_i, dtype=np.float64))
-    rho = _lut.hemispherical_reflectance_kernel(np.asarray(material.values), *grids, ti, method,
-                                                zero_edges=_lut.table_edges(material.attrs),
-                                                normal_blend=_lut.table_normal_blend(material.attrs))
+    rho = _lut.hemispherical_reflectance_kernel(
+        np.asarray(material.values),
+        *grids,
+        ti,
+        method,
+        zero_edges=_lut.table_edges(material.attrs),
+        normal_blend=_lut.table_normal_blend(material.attrs),
+    )
     out = xr.DataArray(
         rho,
         dims=(THETA_I, WAVELENGTH),
@@ -590,5 +639,3 @@ def hemispherical_reflectance(
             stacklevel=2,
         )
     return out
-
-

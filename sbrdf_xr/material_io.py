@@ -29,7 +29,9 @@ def _encoding(obj: xr.Dataset) -> dict[str, dict[str, Any]]:
     return enc
 
 
-def write_netcdf_atomic(ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
+def write_netcdf_atomic(
+    ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False
+) -> Path:
     """Write ``ds`` to ``path`` atomically (temporary file, then rename).
 
     Parameters
@@ -106,4 +108,3 @@ def open_measurements(path: str | os.PathLike[str]) -> xr.Dataset:
             ref.attrs.pop(k, None)
         ds["reference"] = ref
     return validate_measurements(ds, duplicates="mean")
-

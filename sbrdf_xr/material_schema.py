@@ -121,7 +121,9 @@ def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.Data
     if check_values:
         v = np.asarray(da.values)
         if not np.all(np.isfinite(v)):
-            raise ValidationError(f"sbrdf: contains {int(np.sum(~np.isfinite(v)))} NaN or infinite values")
+            raise ValidationError(
+                f"sbrdf: contains {int(np.sum(~np.isfinite(v)))} NaN or infinite values"
+            )
         if np.any(v < 0):
             raise ValidationError(
                 f"sbrdf: contains {int(np.sum(v < 0))} negative values (min {v.min():.3g}); a BRDF is >= 0"
@@ -224,12 +226,22 @@ def constant_material(
     spec = np.broadcast_to(v, wl.shape)
     grids = _CONSTANT_GRIDS
     vals = np.broadcast_to(spec, (2, 2, 2, wl.size)).copy()
-    return new_material(vals, *grids, wl, material=material, source=source,
-                        provenance=provenance or "constant sBRDF at every geometry",
-                        normal_incidence="symmetric", normal_incidence_blend=0.0, **parameters)
+    return new_material(
+        vals,
+        *grids,
+        wl,
+        material=material,
+        source=source,
+        provenance=provenance or "constant sBRDF at every geometry",
+        normal_incidence="symmetric",
+        normal_incidence_blend=0.0,
+        **parameters,
+    )
 
 
-def lambertian(albedo: ArrayLike, wavelength: ArrayLike, *, material: str | None = None) -> xr.DataArray:
+def lambertian(
+    albedo: ArrayLike, wavelength: ArrayLike, *, material: str | None = None
+) -> xr.DataArray:
     """An ideal Lambertian (perfectly diffuse) material: ``f_r = albedo / pi`` everywhere.
 
     Exact for every look-up method (:func:`constant_material`); its
@@ -258,9 +270,13 @@ def lambertian(albedo: ArrayLike, wavelength: ArrayLike, *, material: str | None
     scalar = np.ndim(albedo) == 0
     name = material or (f"lambertian-{float(albedo):g}" if scalar else "lambertian")
     return constant_material(
-        rho / np.pi, wl, material=name, source="model:lambert",
+        rho / np.pi,
+        wl,
+        material=name,
+        source="model:lambert",
         provenance=f"ideal Lambertian reflector, f_r = albedo / pi ({'albedo ' + format(float(albedo), 'g') if scalar else 'spectral albedo'})",
-        model="lambert", albedo=float(albedo) if scalar else rho,
+        model="lambert",
+        albedo=float(albedo) if scalar else rho,
     )
 
 
@@ -279,9 +295,6 @@ def _attr_value(v: Any) -> Any:
 # ------------------------------------------------------------------ lookup
 
 
-
-
-
 #: Policies for repeated measurement geometries (:func:`validate_measurements`).
 DUPLICATES = ("error", "mean")
 
@@ -289,10 +302,16 @@ DUPLICATES = ("error", "mean")
 def _geometry_groups(ds: xr.Dataset) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Group samples by geometry (angles equal to 1e-9 degree): the group of every sample,
     the first sample of every group and the group sizes."""
-    key = np.stack([np.round(np.asarray(ds[d].values, dtype=np.float64), 9)
-                    for d in (THETA_I, DELTA_THETA, PHI)], axis=1)
-    _, first, groups, counts = np.unique(key, axis=0, return_index=True, return_inverse=True,
-                                         return_counts=True)
+    key = np.stack(
+        [
+            np.round(np.asarray(ds[d].values, dtype=np.float64), 9)
+            for d in (THETA_I, DELTA_THETA, PHI)
+        ],
+        axis=1,
+    )
+    _, first, groups, counts = np.unique(
+        key, axis=0, return_index=True, return_inverse=True, return_counts=True
+    )
     return groups.ravel(), first, counts
 
 
@@ -311,7 +330,11 @@ def _average_duplicates(ds: xr.Dataset) -> xr.Dataset:
     order = np.sort(first)
     pos = np.searchsorted(order, first)  # group -> position of its first sample
     out = ds.isel({SAMPLE: order}).copy()
-    out[MEASURED] = ((SAMPLE, WAVELENGTH), np.empty((order.size, spectra.shape[1])), ds[MEASURED].attrs)
+    out[MEASURED] = (
+        (SAMPLE, WAVELENGTH),
+        np.empty((order.size, spectra.shape[1])),
+        ds[MEASURED].attrs,
+    )
     out[MEASURED].values[pos] = mean
     out["reference"] = (SAMPLE, np.zeros(order.size, dtype=bool), attrs("reference"))
     out["reference"].values[pos] = n_meas == 0
@@ -355,7 +378,9 @@ def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Da
     if set(da.dims) != {SAMPLE, WAVELENGTH}:
         raise ValidationError(f"{MEASURED}: dims must be ('sample', 'wavelength'), got {da.dims}")
     if da.attrs.get("units") != PER_SR:
-        raise ValidationError(f"{MEASURED}: units must be {PER_SR!r}, got {da.attrs.get('units')!r}")
+        raise ValidationError(
+            f"{MEASURED}: units must be {PER_SR!r}, got {da.attrs.get('units')!r}"
+        )
     if ds.sizes[SAMPLE] == 0:
         raise ValidationError("measurements: the set is empty (no samples)")
     for name in (THETA_I, DELTA_THETA, PHI):
@@ -371,7 +396,9 @@ def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Da
         raise ValidationError("wavelength: coordinate is missing")
     _check_coord(WAVELENGTH, np.asarray(ds[WAVELENGTH].values))
     if ds[WAVELENGTH].attrs.get("units") != NM:
-        raise ValidationError(f"wavelength: units must be 'nm', got {ds[WAVELENGTH].attrs.get('units')!r}")
+        raise ValidationError(
+            f"wavelength: units must be 'nm', got {ds[WAVELENGTH].attrs.get('units')!r}"
+        )
     ti = ds[THETA_I].values
     if np.any((ti < 0) | (ti >= 90)):
         raise ValidationError("theta_i: measured incidence angles must lie in [0, 90) degree")
@@ -394,8 +421,12 @@ def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Da
     ref = _reference(ds)
     v = np.asarray(da.transpose(SAMPLE, WAVELENGTH).values)[~ref]
     if not np.all(np.isfinite(v)):
-        bad = np.flatnonzero(~np.all(np.isfinite(np.asarray(da.transpose(SAMPLE, WAVELENGTH).values)), axis=1) & ~ref)
-        raise ValidationError(f"{MEASURED}: NaN or infinite values in sample(s) {bad[:10].tolist()}")
+        bad = np.flatnonzero(
+            ~np.all(np.isfinite(np.asarray(da.transpose(SAMPLE, WAVELENGTH).values)), axis=1) & ~ref
+        )
+        raise ValidationError(
+            f"{MEASURED}: NaN or infinite values in sample(s) {bad[:10].tolist()}"
+        )
     if np.any(v < 0):
         raise ValidationError(f"{MEASURED}: contains negative values; a BRDF is >= 0")
     return ds
@@ -408,4 +439,3 @@ def _reference(ds: xr.Dataset) -> np.ndarray:
             ref = ref.astype(bool)
         return ref
     return np.zeros(ds.sizes[SAMPLE], dtype=bool)
-

@@ -33,13 +33,27 @@ from .errors import ValidationError
 from .material_io import write_netcdf_atomic
 from .material_schema import new_material
 
-__all__ = ["PARAM_ATTRS", "fit_robertson_sandford", "measure", "model_material", "open_model", "render",
-           "render_anisotropic", "render_values", "spectra", "spectrum_function", "to_netcdf"]
+__all__ = [
+    "PARAM_ATTRS",
+    "fit_robertson_sandford",
+    "measure",
+    "model_material",
+    "open_model",
+    "render",
+    "render_anisotropic",
+    "render_values",
+    "spectra",
+    "spectrum_function",
+    "to_netcdf",
+]
 
 PARAM_ATTRS: dict[str, dict[str, str]] = {
     "rho": {"units": "1", "long_name": "Lambertian albedo"},
     "rho_D": {"units": "1", "long_name": "diffuse spectral reflectance (Robertson-Sandford rho_D)"},
-    "epsilon": {"units": "1", "long_name": "spectral hemispherical emissivity (Robertson-Sandford)"},
+    "epsilon": {
+        "units": "1",
+        "long_name": "spectral hemispherical emissivity (Robertson-Sandford)",
+    },
     "b": {"units": "1", "long_name": "grazing-angle parameter (Robertson-Sandford b)"},
     "e": {"units": "1", "long_name": "specular lobe width (Robertson-Sandford e)"},
     "roughness": {"units": "1", "long_name": "GGX roughness alpha"},
@@ -87,21 +101,38 @@ def model_material(
     mod = _brdf.get_model(model)
     wl = np.asarray(wavelength, dtype=np.float64)
     checked = mod.check_params(wl, **params)
-    data = {k: (WAVELENGTH, np.asarray(v, dtype=np.float64), PARAM_ATTRS.get(k, {"units": "1", "long_name": k}))
-            for k, v in checked.items()}
+    data = {
+        k: (
+            WAVELENGTH,
+            np.asarray(v, dtype=np.float64),
+            PARAM_ATTRS.get(k, {"units": "1", "long_name": k}),
+        )
+        for k, v in checked.items()
+    }
     if layers:
         if model != "microfacet":
-            raise ValidationError(f"layers: only the microfacet model has a thin-film stack, not {model!r}")
-        idx = np.stack([np.broadcast_to(np.asarray(n, dtype=np.complex128), wl.shape) for n, _ in layers])
+            raise ValidationError(
+                f"layers: only the microfacet model has a thin-film stack, not {model!r}"
+            )
+        idx = np.stack(
+            [np.broadcast_to(np.asarray(n, dtype=np.complex128), wl.shape) for n, _ in layers]
+        )
         data["layer_n"] = (("layer", WAVELENGTH), idx.real, PARAM_ATTRS["layer_n"])
         data["layer_k"] = (("layer", WAVELENGTH), idx.imag, PARAM_ATTRS["layer_k"])
         thick = np.array([float(t) for _, t in layers])
         if np.any(thick < 0) or not np.all(np.isfinite(thick)):
-            raise ValidationError(f"layers: thicknesses must be finite and >= 0 nm, got {thick.tolist()}")
+            raise ValidationError(
+                f"layers: thicknesses must be finite and >= 0 nm, got {thick.tolist()}"
+            )
         data["layer_thickness"] = ("layer", thick, PARAM_ATTRS["layer_thickness"])
     ds = xr.Dataset(data, coords={WAVELENGTH: (WAVELENGTH, wl, attrs(WAVELENGTH))})
-    ds.attrs = {"model": model, "material": material, "source": f"model:{model}",
-                "provenance": provenance, "Conventions": "CF-1.10"}
+    ds.attrs = {
+        "model": model,
+        "material": material,
+        "source": f"model:{model}",
+        "provenance": provenance,
+        "Conventions": "CF-1.10",
+    }
     return ds
 
 
@@ -125,8 +156,13 @@ def _isotropic(mod: Any, spec: xr.Dataset) -> None:
         )
 
 
-def spectra(spec: xr.Dataset, theta_i: ArrayLike, delta_theta: ArrayLike, phi: ArrayLike,
-            psi: ArrayLike | None = None) -> np.ndarray:
+def spectra(
+    spec: xr.Dataset,
+    theta_i: ArrayLike,
+    delta_theta: ArrayLike,
+    phi: ArrayLike,
+    psi: ArrayLike | None = None,
+) -> np.ndarray:
     """The model's spectra at paper-000 angles.
 
     Parameters
@@ -186,24 +222,39 @@ def render(
     """
     mod, wl, kw = _params(spec)
     ti = np.arange(0.0, 91.0) if theta_i is None else np.asarray(theta_i, dtype=np.float64)
-    dt = np.arange(-180.0, 91.0, 3.0) if delta_theta is None else np.asarray(delta_theta, dtype=np.float64)
+    dt = (
+        np.arange(-180.0, 91.0, 3.0)
+        if delta_theta is None
+        else np.asarray(delta_theta, dtype=np.float64)
+    )
     ph = np.arange(0.0, 91.0, 3.0) if phi is None else np.asarray(phi, dtype=np.float64)
     for name, g in ((THETA_I, ti), (DELTA_THETA, dt), (PHI, ph)):
         if g.ndim != 1 or g.size == 0:
-            raise ValidationError(f"{name}: expected a non-empty 1-D grid [degree], got shape {g.shape}")
+            raise ValidationError(
+                f"{name}: expected a non-empty 1-D grid [degree], got shape {g.shape}"
+            )
     _isotropic(mod, spec)
     vals = render_values(mod, ti, dt, ph, wl, kw)
     # Where the grid stops inside the hemisphere the model goes on: hold the edge
     # (exact for a Lambertian surface) rather than drop to zero.
-    edges = {"edge_delta_theta_min": "zero" if dt[0] <= -180.0 else "hold",
-             "edge_delta_theta_max": "zero" if dt[-1] >= 90.0 else "hold",
-             "edge_phi_max": "zero" if ph[-1] >= 90.0 else "hold"}
+    edges = {
+        "edge_delta_theta_min": "zero" if dt[0] <= -180.0 else "hold",
+        "edge_delta_theta_max": "zero" if dt[-1] >= 90.0 else "hold",
+        "edge_phi_max": "zero" if ph[-1] >= 90.0 else "hold",
+    }
     blend = min(float(ti[1] - ti[0]), 1.0) if ti.size > 1 and ti[0] == 0.0 else 0.0
     return new_material(
-        vals.astype(dtype), ti, dt, ph, wl,
-        material=spec.attrs["material"], source=spec.attrs["source"],
+        vals.astype(dtype),
+        ti,
+        dt,
+        ph,
+        wl,
+        material=spec.attrs["material"],
+        source=spec.attrs["source"],
         provenance=f"{spec.attrs.get('provenance', '')}; rendered by sbrdf_xr.models.render",
-        model=spec.attrs["model"], normal_incidence="symmetric", normal_incidence_blend=blend,
+        model=spec.attrs["model"],
+        normal_incidence="symmetric",
+        normal_incidence_blend=blend,
         **edges,
     )
 
@@ -244,7 +295,9 @@ def render_anisotropic(
     grids = [np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi, psi)]
     for name, g in zip((THETA_I, DELTA_THETA, PHI, PSI), grids, strict=True):
         if g.ndim != 1 or g.size == 0 or np.any(np.diff(g) <= 0):
-            raise ValidationError(f"{name}: expected a non-empty, strictly increasing 1-D grid [degree]")
+            raise ValidationError(
+                f"{name}: expected a non-empty, strictly increasing 1-D grid [degree]"
+            )
     ps = grids[3]
     if ps[0] < 0 or ps[-1] > 180:
         raise ValidationError(f"psi: must lie in [0, 180] degree, got [{ps[0]}, {ps[-1]}]")
@@ -254,13 +307,19 @@ def render_anisotropic(
     r_c = np.clip(t4 + d4, -(90.0 - m), 90.0 - m)
     vals = mod.brdf_angles(t_c, r_c - t_c, np.minimum(p4, 90.0 - m), wl, psi=s4, **kw)
     dt, ph = grids[1], grids[2]
-    a = attrs(SBRDF, material=spec.attrs["material"], source=spec.attrs["source"],
-              provenance=f"{spec.attrs.get('provenance', '')}; rendered by sbrdf_xr.models.render_anisotropic",
-              model=spec.attrs["model"],
-              edge_delta_theta_min="zero" if dt[0] <= -180.0 else "hold",
-              edge_delta_theta_max="zero" if dt[-1] >= 90.0 else "hold",
-              edge_phi_max="zero" if ph[-1] >= 90.0 else "hold")
-    coords = {n: (n, g, attrs(n)) for n, g in zip((THETA_I, DELTA_THETA, PHI, PSI), grids, strict=True)}
+    a = attrs(
+        SBRDF,
+        material=spec.attrs["material"],
+        source=spec.attrs["source"],
+        provenance=f"{spec.attrs.get('provenance', '')}; rendered by sbrdf_xr.models.render_anisotropic",
+        model=spec.attrs["model"],
+        edge_delta_theta_min="zero" if dt[0] <= -180.0 else "hold",
+        edge_delta_theta_max="zero" if dt[-1] >= 90.0 else "hold",
+        edge_phi_max="zero" if ph[-1] >= 90.0 else "hold",
+    )
+    coords = {
+        n: (n, g, attrs(n)) for n, g in zip((THETA_I, DELTA_THETA, PHI, PSI), grids, strict=True)
+    }
     coords[WAVELENGTH] = (WAVELENGTH, wl, attrs(WAVELENGTH))
     out = xr.DataArray(vals.astype(dtype), dims=ANISO_LUT_DIMS, coords=coords, name=SBRDF, attrs=a)
     return out
@@ -274,8 +333,9 @@ HORIZON_MARGIN_DEG = 1e-6
 GRAZING_MARGIN_DEG = 0.5
 
 
-def render_values(mod: Any, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, wl: np.ndarray,
-                  kw: dict[str, Any]) -> np.ndarray:
+def render_values(
+    mod: Any, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, wl: np.ndarray, kw: dict[str, Any]
+) -> np.ndarray:
     """A model's sBRDF on the outer product of 1-D grids, every node inside the hemisphere.
 
     A node whose geometry is not lit and visible (``theta_i`` = 90 deg, the observer
@@ -303,8 +363,9 @@ def render_values(mod: Any, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, wl: 
         sBRDF [sr-1].
     """
     m = HORIZON_MARGIN_DEG
-    t3, d3, p3 = np.meshgrid(np.asarray(ti, float), np.asarray(dt, float), np.asarray(ph, float),
-                             indexing="ij")
+    t3, d3, p3 = np.meshgrid(
+        np.asarray(ti, float), np.asarray(dt, float), np.asarray(ph, float), indexing="ij"
+    )
     t_c = np.minimum(t3, 90.0 - GRAZING_MARGIN_DEG)
     r_c = np.clip(t3 + d3, -(90.0 - m), 90.0 - m)
     p_c = np.minimum(p3, 90.0 - m)
@@ -332,10 +393,19 @@ def measure(spec: xr.Dataset, theta_i: Sequence[float], **kwargs: Any) -> xr.Dat
     from .goniometer import measure as _measure
 
     wl = np.asarray(spec[WAVELENGTH].values)
-    prov = (f"virtual goniospectrometer measurement of model {spec.attrs['model']!r} "
-            f"({spec.attrs.get('provenance', '')})")
-    return _measure(spectrum_function(spec), wl, theta_i, material=spec.attrs["material"],
-                    source="synthetic", provenance=prov, **kwargs)
+    prov = (
+        f"virtual goniospectrometer measurement of model {spec.attrs['model']!r} "
+        f"({spec.attrs.get('provenance', '')})"
+    )
+    return _measure(
+        spectrum_function(spec),
+        wl,
+        theta_i,
+        material=spec.attrs["material"],
+        source="synthetic",
+        provenance=prov,
+        **kwargs,
+    )
 
 
 def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Dataset:
@@ -369,21 +439,36 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
     ds = validate_measurements(measurements, duplicates="mean")
     wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
     spectra = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64)
-    fit = robertson_sandford_fit.fit_robertson_sandford(ds[THETA_I].values, ds[DELTA_THETA].values, ds[PHI].values,
-                                    wl, spectra, reference=_reference(ds), **kwargs)
+    fit = robertson_sandford_fit.fit_robertson_sandford(
+        ds[THETA_I].values,
+        ds[DELTA_THETA].values,
+        ds[PHI].values,
+        wl,
+        spectra,
+        reference=_reference(ds),
+        **kwargs,
+    )
     p = {k: np.asarray(fit[k], dtype=np.float64) for k in rs.PARAMS}
     g_b = float(rs.normalisation_G(p["b"]))
-    p["epsilon"] = np.minimum(np.broadcast_to(p["epsilon"], wl.shape), np.maximum(g_b - p["rho_D"], 0.0))
+    p["epsilon"] = np.minimum(
+        np.broadcast_to(p["epsilon"], wl.shape), np.maximum(g_b - p["rho_D"], 0.0)
+    )
     name = ds.attrs.get("material", "unnamed")
     out = model_material(
-        "robertson_sandford", wl, material=name,
+        "robertson_sandford",
+        wl,
+        material=name,
         provenance=f"Robertson-Sandford fit to the measurements of {name} "
         f"(reduced chi-square {fit['chi2_reduced']:.3g}, {fit['n_used']} residuals)",
         **p,
     )
     for k in rs.PARAMS:
         u = np.broadcast_to(np.asarray(fit[f"u_{k}"], dtype=np.float64), wl.shape)
-        out[f"u_{k}"] = (WAVELENGTH, np.array(u), {"units": "1", "long_name": f"standard uncertainty of {k}"})
+        out[f"u_{k}"] = (
+            WAVELENGTH,
+            np.array(u),
+            {"units": "1", "long_name": f"standard uncertainty of {k}"},
+        )
     out.attrs["chi2_reduced"] = float(fit["chi2_reduced"])
     out.attrs["source"] = "model:robertson_sandford"
     return out

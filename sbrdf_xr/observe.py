@@ -113,19 +113,46 @@ ATTRS: dict[str, dict[str, str]] = {
     COMPONENT: {"units": "1", "long_name": "quaternion component (scalar last)"},
     "to_sun": {"units": "1", "long_name": "unit vector toward the Sun in the body frame"},
     "to_observer": {"units": "1", "long_name": "unit vector toward the observer in the body frame"},
-    "to_earth": {"units": "1", "long_name": "unit vector toward the Earth's centre in the body frame"},
+    "to_earth": {
+        "units": "1",
+        "long_name": "unit vector toward the Earth's centre in the body frame",
+    },
     "quaternion": {"units": "1", "long_name": "attitude quaternion, body to GCRS, scalar last"},
     "range": {"units": "km", "long_name": "distance from the observer to the spacecraft"},
-    "elevation": {"units": "degree", "long_name": "elevation of the spacecraft above the observer's geodetic horizon"},
-    "azimuth": {"units": "degree", "long_name": "azimuth of the spacecraft from north through east"},
-    "phase_angle": {"units": "degree", "long_name": "angle between the Sun and observer directions"},
-    "solar_elongation": {"units": "degree", "long_name": "angle between the Sun and the spacecraft seen by the observer"},
+    "elevation": {
+        "units": "degree",
+        "long_name": "elevation of the spacecraft above the observer's geodetic horizon",
+    },
+    "azimuth": {
+        "units": "degree",
+        "long_name": "azimuth of the spacecraft from north through east",
+    },
+    "phase_angle": {
+        "units": "degree",
+        "long_name": "angle between the Sun and observer directions",
+    },
+    "solar_elongation": {
+        "units": "degree",
+        "long_name": "angle between the Sun and the spacecraft seen by the observer",
+    },
     "sun_distance": {"units": "au", "long_name": "distance from the spacecraft to the Sun"},
-    "sunlit_fraction": {"units": "1", "long_name": "fraction of the solar disc seen from the spacecraft not hidden by the Earth"},
+    "sunlit_fraction": {
+        "units": "1",
+        "long_name": "fraction of the solar disc seen from the spacecraft not hidden by the Earth",
+    },
     "airmass": {"units": "1", "long_name": "relative airmass along the line of sight"},
-    "earth_distance": {"units": "km", "long_name": "distance from the spacecraft to the Earth's centre"},
-    "earth_phase_angle": {"units": "degree", "long_name": "Sun-Earth-spacecraft angle seen from the Earth's centre"},
-    "site_sun_elevation": {"units": "degree", "long_name": "elevation of the Sun above the observer's horizon"},
+    "earth_distance": {
+        "units": "km",
+        "long_name": "distance from the spacecraft to the Earth's centre",
+    },
+    "earth_phase_angle": {
+        "units": "degree",
+        "long_name": "Sun-Earth-spacecraft angle seen from the Earth's centre",
+    },
+    "site_sun_elevation": {
+        "units": "degree",
+        "long_name": "elevation of the Sun above the observer's horizon",
+    },
     VECTOR: {"units": "1", "long_name": "Cartesian component in the spacecraft body frame"},
 }
 
@@ -173,7 +200,9 @@ def _sun_from_spacecraft(t64: np.ndarray, r: np.ndarray, v: np.ndarray) -> np.nd
 
 def _angle(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Angle between rows [degree], by atan2."""
-    return np.degrees(np.arctan2(np.linalg.norm(np.cross(u, v), axis=-1), np.einsum("ni,ni->n", u, v)))
+    return np.degrees(
+        np.arctan2(np.linalg.norm(np.cross(u, v), axis=-1), np.einsum("ni,ni->n", u, v))
+    )
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -193,7 +222,9 @@ def _as_law(value: Any) -> _att.AttitudeLaw:
     try:
         return _att.Inertial(value)
     except AttitudeError:
-        raise AttitudeError(f"attitude: expected an attitude law, a table or a quaternion, got {value!r}") from None
+        raise AttitudeError(
+            f"attitude: expected an attitude law, a table or a quaternion, got {value!r}"
+        ) from None
 
 
 UNOBSERVABLE = ("raise", "empty", "keep")
@@ -243,9 +274,13 @@ class Observation:
         object.__setattr__(self, "times", t)
         object.__setattr__(self, "attitude", _as_law(self.attitude))
         if self.airmass_model not in AIRMASS_MODELS:
-            raise ObservationError(f"airmass_model: got {self.airmass_model!r}; allowed: {', '.join(AIRMASS_MODELS)}")
+            raise ObservationError(
+                f"airmass_model: got {self.airmass_model!r}; allowed: {', '.join(AIRMASS_MODELS)}"
+            )
         if not -90.0 <= float(self.min_elevation_deg) <= 90.0:
-            raise ObservationError(f"min_elevation_deg: must lie in [-90, 90], got {self.min_elevation_deg}")
+            raise ObservationError(
+                f"min_elevation_deg: must lie in [-90, 90], got {self.min_elevation_deg}"
+            )
         epoch = self.orbit.epoch
         gap = np.abs(t[[0, -1]] - epoch).max().astype(np.int64) / 86400e9
         if gap > EPOCH_GAP_DAYS:
@@ -253,15 +288,18 @@ class Observation:
                 f"observation times {t[0]} .. {t[-1]} reach {gap:.1f} days from the epoch {epoch} of the "
                 f"elements of {self.orbit.name!r} (more than {EPOCH_GAP_DAYS:g} days): SGP4 errors grow "
                 "by about 1-3 km per day in LEO; use elements nearer the observation",
-                EpochGapWarning, stacklevel=2,
+                EpochGapWarning,
+                stacklevel=2,
             )
 
     def __repr__(self) -> str:
         t = self.times
         step = f", step {(t[1] - t[0]) / np.timedelta64(1, 's'):g} s" if t.size > 1 else ""
-        return (f"<Observation {self.name!r}: {self.orbit.name!r} from {self.site.name or 'site'} "
-                f"({self.site.latitude_deg:.4f}, {self.site.longitude_deg:.4f}, {self.site.height_m:g} m), "
-                f"{t.size} times {t[0]} .. {t[-1]}{step}, attitude {self.attitude!r}>")
+        return (
+            f"<Observation {self.name!r}: {self.orbit.name!r} from {self.site.name or 'site'} "
+            f"({self.site.latitude_deg:.4f}, {self.site.longitude_deg:.4f}, {self.site.height_m:g} m), "
+            f"{t.size} times {t[0]} .. {t[-1]}{step}, attitude {self.attitude!r}>"
+        )
 
     def _state(self) -> dict[str, np.ndarray]:
         """Inertial-frame (GCRS) vectors per time, from one vectorised skyfield pass."""
@@ -278,7 +316,9 @@ class Observation:
             bad = int(np.flatnonzero(~np.isfinite(r).all(axis=1))[0])
             msg = getattr(geo, "message", None)
             msg = msg[bad] if isinstance(msg, list | tuple | np.ndarray) else msg
-            raise ObservationError(f"orbit {self.orbit.name!r}: SGP4 fails at {self.times[bad]}: {msg}")
+            raise ObservationError(
+                f"orbit {self.orbit.name!r}: SGP4 fails at {self.times[bad]}: {msg}"
+            )
         sun_rel = _sun_from_spacecraft(self.times, r, v)
         site_r = self.site.position.at(t).position.km.T
         rot = itrs.rotation_at(t)  # GCRS -> ITRS, (3, 3, n)
@@ -289,13 +329,17 @@ class Observation:
     def context(self) -> _att.Context:
         """The :class:`~sbrdf_xr.attitude.Context` the attitude law sees."""
         st = self._state()
-        return _att.Context(epoch=self.times[0], position_km=st["r"], velocity_km_s=st["v"], sun_km=st["sun"])
+        return _att.Context(
+            epoch=self.times[0], position_km=st["r"], velocity_km_s=st["v"], sun_km=st["sun"]
+        )
 
     def quaternions(self) -> NDArray[np.float64]:
         """Attitudes (body -> GCRS) at the observation times, sign-continuous; (n, 4)."""
         q = np.asarray(self.attitude.quaternions(self.times, self.context()), dtype=np.float64)
         if q.shape != (self.times.size, 4):
-            raise AttitudeError(f"attitude law returned shape {q.shape}, expected ({self.times.size}, 4)")
+            raise AttitudeError(
+                f"attitude law returned shape {q.shape}, expected ({self.times.size}, 4)"
+            )
         # Flip signs so consecutive quaternions are in the same hemisphere (same rotations).
         if q.shape[0] > 1:
             flips = np.concatenate([[False], np.einsum("ni,ni->n", q[1:], q[:-1]) < 0])
@@ -327,7 +371,9 @@ class Observation:
             ``site_name`` and the frames and models used.
         """
         if on_unobservable not in UNOBSERVABLE:
-            raise ObservationError(f"on_unobservable: got {on_unobservable!r}; allowed: {', '.join(UNOBSERVABLE)}")
+            raise ObservationError(
+                f"on_unobservable: got {on_unobservable!r}; allowed: {', '.join(UNOBSERVABLE)}"
+            )
         st = self._state()
         r, sun, site_r, rot = st["r"], st["sun"], st["site"], st["itrs"]
         los = site_r - r  # spacecraft -> observer, GCRS
@@ -343,7 +389,9 @@ class Observation:
         azimuth = np.mod(np.degrees(np.arctan2(e, n_)), 360.0)
         sun_site = sun + r - site_r  # Sun from the observer
         sun_site_itrs = np.einsum("ijn,nj->ni", rot, sun_site)
-        sun_el = np.degrees(np.arctan2(sun_site_itrs @ up, np.hypot(sun_site_itrs @ east, sun_site_itrs @ north)))
+        sun_el = np.degrees(
+            np.arctan2(sun_site_itrs @ up, np.hypot(sun_site_itrs @ east, sun_site_itrs @ north))
+        )
         sunlit = sunlit_fraction(r, sun)
         phase = _angle(sun, los)
         elong = _angle(sun_site, -los)
@@ -352,28 +400,42 @@ class Observation:
         reasons = []
         if np.all(elevation < self.min_elevation_deg):
             i = int(np.argmax(elevation))
-            reasons.append(f"below {self.min_elevation_deg:g} deg elevation at every time "
-                           f"(highest {elevation[i]:.2f} deg at {self.times[i]})")
+            reasons.append(
+                f"below {self.min_elevation_deg:g} deg elevation at every time "
+                f"(highest {elevation[i]:.2f} deg at {self.times[i]})"
+            )
         if np.all(sunlit == 0):
-            reasons.append(f"in the Earth's umbra at every time {self.times[0]} .. {self.times[-1]}")
+            reasons.append(
+                f"in the Earth's umbra at every time {self.times[0]} .. {self.times[-1]}"
+            )
         if reasons and on_unobservable == "raise":
-            raise NotObservableError(f"observation {self.name!r} of {self.orbit.name!r} from "
-                                     f"{self.site.name or 'the site'}: " + "; ".join(reasons))
+            raise NotObservableError(
+                f"observation {self.name!r} of {self.orbit.name!r} from "
+                f"{self.site.name or 'the site'}: " + "; ".join(reasons)
+            )
 
         q = self.quaternions()
         rt = np.swapaxes(rotation_matrices(q), -1, -2)  # GCRS -> body
-        body = {name: np.einsum("nij,nj->ni", rt, _unit(vec))
-                for name, vec in (("to_sun", sun), ("to_observer", los), ("to_earth", -r))}
+        body = {
+            name: np.einsum("nij,nj->ni", rt, _unit(vec))
+            for name, vec in (("to_sun", sun), ("to_observer", los), ("to_earth", -r))
+        }
         coords = {
             TIME: (TIME, np.asarray(self.times), ATTRS[TIME]),
             VECTOR: (VECTOR, ["x", "y", "z"], ATTRS[VECTOR]),
             COMPONENT: (COMPONENT, ["x", "y", "z", "w"], ATTRS[COMPONENT]),
         }
         per_time = {
-            "range": rng, "elevation": elevation, "azimuth": azimuth, "phase_angle": phase,
-            "solar_elongation": elong, "sun_distance": np.linalg.norm(sun, axis=1) / AU_KM,
-            "sunlit_fraction": sunlit, "airmass": airmass(elevation, self.airmass_model),
-            "earth_distance": np.linalg.norm(r, axis=1), "earth_phase_angle": earth_phase,
+            "range": rng,
+            "elevation": elevation,
+            "azimuth": azimuth,
+            "phase_angle": phase,
+            "solar_elongation": elong,
+            "sun_distance": np.linalg.norm(sun, axis=1) / AU_KM,
+            "sunlit_fraction": sunlit,
+            "airmass": airmass(elevation, self.airmass_model),
+            "earth_distance": np.linalg.norm(r, axis=1),
+            "earth_phase_angle": earth_phase,
             "site_sun_elevation": sun_el,
         }
         for k, val in per_time.items():
@@ -381,8 +443,9 @@ class Observation:
         data = {k: ((TIME, VECTOR), val, ATTRS[k]) for k, val in body.items()}
         data["quaternion"] = ((TIME, COMPONENT), q, ATTRS["quaternion"])
         ds = xr.Dataset(data, coords=coords, attrs=self._attrs())
-        ds[TIME].encoding.update(units="seconds since 1970-01-01 00:00:00", calendar="standard",
-                                 dtype="float64")
+        ds[TIME].encoding.update(
+            units="seconds since 1970-01-01 00:00:00", calendar="standard", dtype="float64"
+        )
         if reasons and on_unobservable == "empty":
             ds = ds.isel({TIME: slice(0, 0)})
             ds.attrs["unobservable"] = "; ".join(reasons)
@@ -408,12 +471,14 @@ class Observation:
             "propagator": f"SGP4 (sgp4 via skyfield {skyfield.__version__})",
             "ephemeris": f"de421.bsp and finals2000A.all from skyfield-data {getattr(skyfield_data, '__version__', '')}".strip(),
             "shadow_model": f"spherical Earth R = {EARTH_RADIUS_KM} km, solar disc R = {SUN_RADIUS_KM} km, "
-                            "exact disc-overlap area (Montenbruck & Gill 2000, 3.4.2)",
+            "exact disc-overlap area (Montenbruck & Gill 2000, 3.4.2)",
             "airmass_model": self.airmass_model,
         }
 
 
-def observation_from_dict(table: Mapping[str, Any], base_dir: str | Path | None = None) -> Observation:
+def observation_from_dict(
+    table: Mapping[str, Any], base_dir: str | Path | None = None
+) -> Observation:
     """An :class:`Observation` from a TOML ``[observation]`` table.
 
     Keys: the orbit as ``orbit`` (a catalog name), ``tle = [line1, line2]`` (or
@@ -434,13 +499,29 @@ def observation_from_dict(table: Mapping[str, Any], base_dir: str | Path | None 
         law = "nadir"
         yaw_deg = 0.0
     """
-    allowed = {"orbit", "tle", "tle_line1", "tle_line2", "omm", "name", "site", "start", "stop", "step_s",
-               "times", "attitude", "airmass_model", "min_elevation_deg"}
+    allowed = {
+        "orbit",
+        "tle",
+        "tle_line1",
+        "tle_line2",
+        "omm",
+        "name",
+        "site",
+        "start",
+        "stop",
+        "step_s",
+        "times",
+        "attitude",
+        "airmass_model",
+        "min_elevation_deg",
+    }
     if not isinstance(table, Mapping):
         raise ObservationError(f"[observation]: expected a table, got {type(table).__name__}")
     bad = sorted(set(table) - allowed)
     if bad:
-        raise ObservationError(f"[observation]: unknown key(s) {bad}; allowed: {', '.join(sorted(allowed))}")
+        raise ObservationError(
+            f"[observation]: unknown key(s) {bad}; allowed: {', '.join(sorted(allowed))}"
+        )
     base = Path(base_dir) if base_dir is not None else Path.cwd()
 
     def resolve(p: str) -> Path:
@@ -449,7 +530,9 @@ def observation_from_dict(table: Mapping[str, Any], base_dir: str | Path | None 
 
     orbit_keys = [k for k in ("orbit", "tle", "tle_line1", "omm") if k in table]
     if len(orbit_keys) != 1:
-        raise ObservationError(f"[observation]: give exactly one of orbit, tle, tle_line1/tle_line2, omm; got {orbit_keys}")
+        raise ObservationError(
+            f"[observation]: give exactly one of orbit, tle, tle_line1/tle_line2, omm; got {orbit_keys}"
+        )
     if "orbit" in table:
         orbit = Orbit.from_catalog(table["orbit"])
     elif "tle" in table:
@@ -471,10 +554,14 @@ def observation_from_dict(table: Mapping[str, Any], base_dir: str | Path | None 
     elif isinstance(site_v, Mapping):
         extra = sorted(set(site_v) - {"latitude_deg", "longitude_deg", "height_m", "name"})
         if extra or not {"latitude_deg", "longitude_deg"} <= set(site_v):
-            raise ObservationError(f"[observation] site: needs latitude_deg, longitude_deg (and optional height_m, name); got {sorted(site_v)}")
+            raise ObservationError(
+                f"[observation] site: needs latitude_deg, longitude_deg (and optional height_m, name); got {sorted(site_v)}"
+            )
         site = Site(**site_v)
     else:
-        raise ObservationError(f"[observation] site: expected a catalog name or a table, got {site_v!r}")
+        raise ObservationError(
+            f"[observation] site: expected a catalog name or a table, got {site_v!r}"
+        )
 
     if "times" in table:
         if any(k in table for k in ("start", "stop", "step_s")):
@@ -483,7 +570,9 @@ def observation_from_dict(table: Mapping[str, Any], base_dir: str | Path | None 
     else:
         missing = [k for k in ("start", "stop") if k not in table]
         if missing:
-            raise ObservationError(f"[observation]: needs times or start and stop (missing {missing})")
+            raise ObservationError(
+                f"[observation]: needs times or start and stop (missing {missing})"
+            )
         t = times(table["start"], table["stop"], float(table.get("step_s", 1.0)))
 
     att = table.get("attitude")
@@ -513,8 +602,12 @@ CANX1_PASS = {
 
 def canx1_attitude() -> _att.AttitudeLaw:
     """Attitude of the built-in pass: a slow spin about a tilted body axis from a fixed start."""
-    return _att.Spin(axis_body=(0.3, 0.4, 0.866), rate_deg_s=4.0, phase_deg=0.0,
-                     initial=_att.Inertial((0.2, -0.1, 0.3, 0.92736185)))
+    return _att.Spin(
+        axis_body=(0.3, 0.4, 0.866),
+        rate_deg_s=4.0,
+        phase_deg=0.0,
+        initial=_att.Inertial((0.2, -0.1, 0.3, 0.92736185)),
+    )
 
 
 def canx1_pass(attitude: _att.AttitudeLaw | None = None) -> Observation:
@@ -530,9 +623,13 @@ def canx1_pass(attitude: _att.AttitudeLaw | None = None) -> Observation:
     Observation
     """
     p = CANX1_PASS
-    return Observation(Orbit.from_catalog(p["orbit"]), Site.from_catalog(p["site"]),
-                       times(p["start"], p["stop"], p["step_s"]),
-                       attitude if attitude is not None else canx1_attitude(), name="canx1-pass")
+    return Observation(
+        Orbit.from_catalog(p["orbit"]),
+        Site.from_catalog(p["site"]),
+        times(p["start"], p["stop"], p["step_s"]),
+        attitude if attitude is not None else canx1_attitude(),
+        name="canx1-pass",
+    )
 
 
 def bench_geometry(n_times: int = 3600, step_s: float = 1.0, repeats: int = 3) -> dict[str, float]:
@@ -561,5 +658,9 @@ def bench_geometry(n_times: int = 3600, step_s: float = 1.0, repeats: int = 3) -
         start = _time.perf_counter()
         obs.geometry(on_unobservable="keep")
         best = min(best, _time.perf_counter() - start)
-    return {"n_times": float(n_times), "first_call_seconds": first, "seconds": best,
-            "seconds_per_time": best / n_times}
+    return {
+        "n_times": float(n_times),
+        "first_call_seconds": first,
+        "seconds": best,
+        "seconds_per_time": best / n_times,
+    }

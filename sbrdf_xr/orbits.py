@@ -45,8 +45,16 @@ EPOCH_GAP_DAYS = 7.0
 
 
 #: Relative airmass models of :func:`pvlib.atmosphere.get_relative_airmass`.
-AIRMASS_MODELS = ("simple", "kasten1966", "youngirvine1967", "kastenyoung1989", "gueymard1993",
-                  "young1994", "pickering2002", "gueymard2003")
+AIRMASS_MODELS = (
+    "simple",
+    "kasten1966",
+    "youngirvine1967",
+    "kastenyoung1989",
+    "gueymard1993",
+    "young1994",
+    "pickering2002",
+    "gueymard2003",
+)
 
 
 _NS = np.dtype("datetime64[ns]")
@@ -94,8 +102,14 @@ def skyfield_utc(t64: np.ndarray) -> Any:
     month = day.astype("datetime64[M]")
     year = month.astype("datetime64[Y]")
     sec = (t64 - day).astype(np.int64) / 1e9
-    return ts.utc(year.astype(np.int64) + 1970, month.astype(np.int64) % 12 + 1,
-                  (day - month).astype(np.int64) + 1, 0, 0, sec)
+    return ts.utc(
+        year.astype(np.int64) + 1970,
+        month.astype(np.int64) % 12 + 1,
+        (day - month).astype(np.int64) + 1,
+        0,
+        0,
+        sec,
+    )
 
 
 def skyfield_time(t64: np.ndarray) -> Any:
@@ -132,7 +146,9 @@ def to_datetime64(value: Any, name: str) -> np.datetime64:
     try:
         out = np.datetime64(value, "ns")
     except (TypeError, ValueError):
-        raise ObservationError(f"{name}: got {value!r}; expected a UTC time (ISO 8601, datetime or datetime64)") from None
+        raise ObservationError(
+            f"{name}: got {value!r}; expected a UTC time (ISO 8601, datetime or datetime64)"
+        ) from None
     if np.isnat(out):
         raise ObservationError(f"{name}: got NaT")
     return out
@@ -190,9 +206,15 @@ def tle_checksum(line: str) -> int:
 _TLE_FIELDS_1 = (("catalog number", 2, 7), ("epoch", 18, 32), ("mean motion derivative", 33, 43))
 
 
-_TLE_FIELDS_2 = (("catalog number", 2, 7), ("inclination", 8, 16), ("right ascension of the node", 17, 25),
-                 ("eccentricity", 26, 33), ("argument of perigee", 34, 42), ("mean anomaly", 43, 51),
-                 ("mean motion", 52, 63))
+_TLE_FIELDS_2 = (
+    ("catalog number", 2, 7),
+    ("inclination", 8, 16),
+    ("right ascension of the node", 17, 25),
+    ("eccentricity", 26, 33),
+    ("argument of perigee", 34, 42),
+    ("mean anomaly", 43, 51),
+    ("mean motion", 52, 63),
+)
 
 
 def _is_number(text: str) -> bool:
@@ -210,7 +232,9 @@ def _check_tle(line1: Any, line2: Any) -> tuple[str, str]:
             raise ObservationError(f"TLE line {i}: expected a string, got {type(line).__name__}")
         line = line.rstrip()
         if len(line) != 69:
-            raise ObservationError(f"TLE line {i}: has {len(line)} characters; a TLE line has 69: {line!r}")
+            raise ObservationError(
+                f"TLE line {i}: has {len(line)} characters; a TLE line has 69: {line!r}"
+            )
         if line[0] != str(i) or line[1] != " ":
             raise ObservationError(f"TLE line {i}: must start with '{i} ', got {line[:2]!r}")
         if not line[68].isdigit() or int(line[68]) != tle_checksum(line):
@@ -229,7 +253,9 @@ def _check_tle(line1: Any, line2: Any) -> tuple[str, str]:
                     f"TLE line {i}: field {fname!r} (columns {lo + 1}-{hi}) is {text!r}, not a number"
                 )
     if lines[0][2:7] != lines[1][2:7]:
-        raise ObservationError(f"TLE: catalog numbers differ between the lines ({lines[0][2:7]!r}, {lines[1][2:7]!r})")
+        raise ObservationError(
+            f"TLE: catalog numbers differ between the lines ({lines[0][2:7]!r}, {lines[1][2:7]!r})"
+        )
     return lines[0], lines[1]
 
 
@@ -255,7 +281,9 @@ class Orbit:
     provenance: str = ""
 
     @classmethod
-    def from_tle(cls, line1: str, line2: str, name: str | None = None, provenance: str = "") -> Orbit:
+    def from_tle(
+        cls, line1: str, line2: str, name: str | None = None, provenance: str = ""
+    ) -> Orbit:
         """Orbit from the two lines of a TLE.
 
         Raises
@@ -308,7 +336,9 @@ class Orbit:
         try:
             sat = EarthSatellite.from_omm(ts, fields)
         except (KeyError, ValueError, TypeError) as exc:
-            raise ObservationError(f"OMM: missing or bad field: {exc!r}; fields given: {sorted(fields)}") from None
+            raise ObservationError(
+                f"OMM: missing or bad field: {exc!r}; fields given: {sorted(fields)}"
+            ) from None
         _check_model(sat, fields.get("OBJECT_NAME", "OMM"))
         l1, l2 = exporter.export_tle(sat.model)
         return cls(sat, l1, l2, str(fields.get("OBJECT_NAME", "")), provenance)
@@ -332,8 +362,10 @@ def _check_model(sat: Any, label: str) -> None:
 
     err = getattr(sat.model, "error", 0)
     if err:
-        raise ObservationError(f"orbit {label}: SGP4 rejects the elements (error {err}: "
-                               f"{SGP4_ERRORS.get(err, 'unknown')})")
+        raise ObservationError(
+            f"orbit {label}: SGP4 rejects the elements (error {err}: "
+            f"{SGP4_ERRORS.get(err, 'unknown')})"
+        )
 
 
 @dataclass(frozen=True)
@@ -357,7 +389,11 @@ class Site:
     name: str = ""
 
     def __post_init__(self) -> None:
-        checks = (("latitude_deg", -90.0, 90.0), ("longitude_deg", -180.0, 360.0), ("height_m", -500.0, 9000.0))
+        checks = (
+            ("latitude_deg", -90.0, 90.0),
+            ("longitude_deg", -180.0, 360.0),
+            ("height_m", -500.0, 9000.0),
+        )
         for attr, lo, hi in checks:
             v = getattr(self, attr)
             try:
@@ -480,7 +516,9 @@ def airmass(elevation_deg: ArrayLike, model: str = "kastenyoung1989") -> NDArray
         Relative airmass [1].
     """
     if model not in AIRMASS_MODELS:
-        raise ObservationError(f"airmass_model: got {model!r}; allowed: {', '.join(AIRMASS_MODELS)}")
+        raise ObservationError(
+            f"airmass_model: got {model!r}; allowed: {', '.join(AIRMASS_MODELS)}"
+        )
     from pvlib.atmosphere import get_relative_airmass
 
     el = np.asarray(elevation_deg, dtype=np.float64)
@@ -491,13 +529,17 @@ def airmass(elevation_deg: ArrayLike, model: str = "kastenyoung1989") -> NDArray
 
 def load_orbit_entry(entry: _catalog_index.CatalogEntry) -> Orbit:
     """A ``kind = "orbit"`` entry: a 2- or 3-line TLE file."""
-    lines = [ln.rstrip() for ln in entry.file.read_text(encoding="utf-8").splitlines() if ln.strip()]
+    lines = [
+        ln.rstrip() for ln in entry.file.read_text(encoding="utf-8").splitlines() if ln.strip()
+    ]
     if len(lines) == 3:
         name, l1, l2 = lines[0].removeprefix("0 ").strip(), lines[1], lines[2]
     elif len(lines) == 2:
         name, l1, l2 = entry.name, lines[0], lines[1]
     else:
-        raise CatalogError(f"orbit entry {entry.name!r}: {entry.path} must hold 2 or 3 lines, has {len(lines)}")
+        raise CatalogError(
+            f"orbit entry {entry.name!r}: {entry.path} must hold 2 or 3 lines, has {len(lines)}"
+        )
     return Orbit.from_tle(l1, l2, name, provenance=entry.provenance)
 
 

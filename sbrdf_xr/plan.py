@@ -185,14 +185,20 @@ class Plan:
         """Slice of the first dimension covered by block ``k``."""
         return slice(k * self.chunk, min((k + 1) * self.chunk, self.n_lead))
 
-    def table(self, m: int) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray],
-                                     tuple[bool, bool, bool], float]:
+    def table(
+        self, m: int
+    ) -> tuple[
+        np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray], tuple[bool, bool, bool], float
+    ]:
         """Table ``m`` unpacked: values (n_theta, n_delta_theta, n_phi, L), grids, zero edges,
         normal-incidence blend [degree]."""
         t = self.tables
         values = t.values[m].reshape(*t.shapes[m], -1)
-        grids = (t.tgrid[t.t_off[m]:t.t_off[m + 1]], t.dgrid[t.d_off[m]:t.d_off[m + 1]],
-                 t.pgrid[t.p_off[m]:t.p_off[m + 1]])
+        grids = (
+            t.tgrid[t.t_off[m] : t.t_off[m + 1]],
+            t.dgrid[t.d_off[m] : t.d_off[m + 1]],
+            t.pgrid[t.p_off[m] : t.p_off[m + 1]],
+        )
         return values, grids, tuple(bool(x) for x in t.edges[m]), float(t.blend[m])  # type: ignore[return-value]
 
     @property
@@ -212,8 +218,10 @@ class Plan:
     def _repr_html_(self) -> str:  # pragma: no cover - Jupyter display
         import html
 
-        rows = "".join(f"<tr><td>{html.escape(a)}</td><td style='text-align:left'>"
-                       f"{html.escape(b)}</td></tr>" for a, b in self.steps)
+        rows = "".join(
+            f"<tr><td>{html.escape(a)}</td><td style='text-align:left'>{html.escape(b)}</td></tr>"
+            for a, b in self.steps
+        )
         return f"<table><caption>plan for {html.escape(self.name)}</caption>{rows}</table>"
 
     @classmethod
@@ -231,12 +239,16 @@ def _readonly(a: np.ndarray) -> np.ndarray:
     return a
 
 
-def _terms(scene: Scene, shadowing: bool, steps: list[tuple[str, str]]) -> tuple[dict[str, np.ndarray], bool]:
+def _terms(
+    scene: Scene, shadowing: bool, steps: list[tuple[str, str]]
+) -> tuple[dict[str, np.ndarray], bool]:
     sc = scene.spacecraft
     may_merge = not shadowing
     merge = may_merge if scene.merge is None else bool(scene.merge)
     if merge and not may_merge:
-        raise SceneError("merge: facets cannot be merged while self-shadowing is on (a per-facet effect)")
+        raise SceneError(
+            "merge: facets cannot be merged while self-shadowing is on (a per-facet effect)"
+        )
     f = sc.facets()
     n_fac = f.sizes["facet"]
     if merge:
@@ -244,43 +256,69 @@ def _terms(scene: Scene, shadowing: bool, steps: list[tuple[str, str]]) -> tuple
         term_of = np.asarray(m["facet_term"].values)
         first = np.full(m.sizes["term"], n_fac, dtype=np.int64)
         np.minimum.at(first, term_of, np.arange(n_fac))
-        t = {"normal": np.asarray(m["normal"].values), "area": np.asarray(m["area"].values),
-             "material": np.asarray(m[MATERIAL].values), "facet": first,
-             "n_facets": np.asarray(m["n_facets"].values)}
-        steps.append(("facets", f"{n_fac} facets -> {m.sizes['term']} terms, merged by "
-                      "(normal, material): exact for flat facets, no per-facet effect is on"))
+        t = {
+            "normal": np.asarray(m["normal"].values),
+            "area": np.asarray(m["area"].values),
+            "material": np.asarray(m[MATERIAL].values),
+            "facet": first,
+            "n_facets": np.asarray(m["n_facets"].values),
+        }
+        steps.append(
+            (
+                "facets",
+                f"{n_fac} facets -> {m.sizes['term']} terms, merged by "
+                "(normal, material): exact for flat facets, no per-facet effect is on",
+            )
+        )
     else:
         why = "self-shadowing is per facet" if shadowing else "merging disabled by the scene"
-        t = {"normal": np.asarray(f["normal"].values), "area": np.asarray(f["area"].values),
-             "material": np.asarray(f[MATERIAL].values), "facet": np.arange(n_fac),
-             "n_facets": np.ones(n_fac, dtype=np.int64)}
+        t = {
+            "normal": np.asarray(f["normal"].values),
+            "area": np.asarray(f["area"].values),
+            "material": np.asarray(f[MATERIAL].values),
+            "facet": np.arange(n_fac),
+            "n_facets": np.ones(n_fac, dtype=np.int64),
+        }
         steps.append(("facets", f"{n_fac} facets evaluated one by one ({why})"))
     return t, merge
 
 
-def _tilt(scene: Scene, raw: dict[str, np.ndarray], nodes: int,
-          steps: list[tuple[str, str]]) -> dict[str, np.ndarray]:
+def _tilt(
+    scene: Scene, raw: dict[str, np.ndarray], nodes: int, steps: list[tuple[str, str]]
+) -> dict[str, np.ndarray]:
     """Terms replaced by their tilted copies where the scene asks for surface imperfections."""
     from .imperfections import tilt_quadrature, tilted_normals
 
     st = scene.surface_tilt
-    sigma = np.array([float(st.get(m, 0.0)) if isinstance(st, Mapping) else float(st)
-                      for m in raw["material"].tolist()])
+    sigma = np.array(
+        [
+            float(st.get(m, 0.0)) if isinstance(st, Mapping) else float(st)
+            for m in raw["material"].tolist()
+        ]
+    )
     if not np.any(sigma > 0):
         steps.append(("imperfections", "none: perfect CAD facets (surface_tilt = 0)"))
         return raw
     parts: list[dict[str, np.ndarray]] = []
     for j in range(raw["area"].size):
         t, w = tilt_quadrature(sigma[j], nodes)
-        part = {k: np.repeat(v[j:j + 1], w.size, axis=0) for k, v in raw.items()}
-        part["normal"] = tilted_normals(raw["normal"][j:j + 1], t)[0]
+        part = {k: np.repeat(v[j : j + 1], w.size, axis=0) for k, v in raw.items()}
+        part["normal"] = tilted_normals(raw["normal"][j : j + 1], t)[0]
         part["area"] = raw["area"][j] * w
         parts.append(part)
     out = {k: np.concatenate([p[k] for p in parts]) for k in raw}
-    what = (f"sigma {float(st):g} deg" if not isinstance(st, Mapping)
-            else ", ".join(f"{m} {float(v):g} deg" for m, v in st.items()))
-    steps.append(("imperfections", f"facet normals tilted by a Gaussian ({what}; paper 000 section 5), "
-                  f"{nodes}x{nodes} Gauss-Hermite copies per term: {raw['area'].size} -> {out['area'].size} terms"))
+    what = (
+        f"sigma {float(st):g} deg"
+        if not isinstance(st, Mapping)
+        else ", ".join(f"{m} {float(v):g} deg" for m, v in st.items())
+    )
+    steps.append(
+        (
+            "imperfections",
+            f"facet normals tilted by a Gaussian ({what}; paper 000 section 5), "
+            f"{nodes}x{nodes} Gauss-Hermite copies per term: {raw['area'].size} -> {out['area'].size} terms",
+        )
+    )
     return out
 
 
@@ -325,7 +363,9 @@ def _band_weights(scene: Scene, wl: np.ndarray) -> xr.DataArray:
     from .photometry import band_weights
 
     try:
-        return band_weights(list(scene.bands), wl, normalize=True, extrapolate=scene.band_extrapolate)
+        return band_weights(
+            list(scene.bands), wl, normalize=True, extrapolate=scene.band_extrapolate
+        )
     except ValidationError as exc:
         raise SceneError(f"bands: {exc} (scene field band_extrapolate)") from None
 
@@ -423,19 +463,33 @@ def compile_plan(scene: Scene) -> Plan:
         shadow_options = {"method": knobs["shadow_method"]}
         if knobs["shadow_method"] == "sampled":
             shadow_options["density"] = knobs["shadow_density"]
-            steps.append(("shadowing", f"sampled self-shadowing and self-occlusion, "
-                          f"{knobs['shadow_density']}**2 samples per facet (non-convex body)"))
+            steps.append(
+                (
+                    "shadowing",
+                    f"sampled self-shadowing and self-occlusion, "
+                    f"{knobs['shadow_density']}**2 samples per facet (non-convex body)",
+                )
+            )
         else:
-            steps.append(("shadowing", "exact self-shadowing and self-occlusion by polygon "
-                          "clipping (non-convex body)"))
+            steps.append(
+                (
+                    "shadowing",
+                    "exact self-shadowing and self-occlusion by polygon clipping (non-convex body)",
+                )
+            )
 
     raw, merged = _terms(scene, shadowing, steps)
     raw = _tilt(scene, raw, knobs["tilt_nodes"], steps)
     keep = _contributing(scene, raw["normal"])
     if not keep.all():
         raw = {k: v[keep] for k, v in raw.items()}
-        steps.append(("drop", f"{int((~keep).sum())} terms that never contribute (lit and visible) "
-                      "in this sweep are dropped"))
+        steps.append(
+            (
+                "drop",
+                f"{int((~keep).sum())} terms that never contribute (lit and visible) "
+                "in this sweep are dropped",
+            )
+        )
     else:
         steps.append(("drop", "none: every term contributes somewhere in the sweep"))
 
@@ -443,12 +497,16 @@ def compile_plan(scene: Scene) -> Plan:
     index = {m: i for i, m in enumerate(used)}
     code = np.array([index[m] for m in raw["material"].tolist()], dtype=np.int64)
     order = np.argsort(code, kind="stable")
-    terms = Terms(*(_readonly(a[order]) for a in (raw["normal"], raw["area"], code, raw["facet"],
-                                                   raw["n_facets"])))
+    terms = Terms(
+        *(
+            _readonly(a[order])
+            for a in (raw["normal"], raw["area"], code, raw["facet"], raw["n_facets"])
+        )
+    )
 
     # ---- spectral axis
     wl_full = _common_wavelength(scene, used or list(scene.materials))
-    wl = wl_full[::knobs["wavelength_stride"]]
+    wl = wl_full[:: knobs["wavelength_stride"]]
     bw = None
     band_coords: dict[str, Any] = {}
     if scene.bands:
@@ -461,8 +519,13 @@ def compile_plan(scene: Scene) -> Plan:
     if knobs["evaluation"] == "analytic":
         models = _models(scene, used)
         tables = pack_tables([], len(scene.bands) if pre else wl.size, dtype)
-        steps.append(("materials", f"{len(used)} materials ({', '.join(used)}) evaluated by their "
-                      f"BRDF models (analytic, no table), {dtype.name}"))
+        steps.append(
+            (
+                "materials",
+                f"{len(used)} materials ({', '.join(used)}) evaluated by their "
+                f"BRDF models (analytic, no table), {dtype.name}",
+            )
+        )
     else:
         models = {}
         packed = []
@@ -471,25 +534,52 @@ def compile_plan(scene: Scene) -> Plan:
             values = np.asarray(da.values)
             if pre:
                 values = np.asarray(values, dtype=np.float64) @ bw.T
-            packed.append((values, *(np.asarray(da[d].values, dtype=np.float64)
-                                                   for d in ("theta_i", "delta_theta", "phi")),
-                           table_edges(scene.materials[m].attrs),
-                           table_normal_blend(scene.materials[m].attrs)))
+            packed.append(
+                (
+                    values,
+                    *(
+                        np.asarray(da[d].values, dtype=np.float64)
+                        for d in ("theta_i", "delta_theta", "phi")
+                    ),
+                    table_edges(scene.materials[m].attrs),
+                    table_normal_blend(scene.materials[m].attrs),
+                )
+            )
         tables = pack_tables(packed, len(scene.bands) if pre else wl.size, dtype)
         del packed
-        res = "" if knobs["table_theta_step"] is None else f", theta_i resampled every {knobs['table_theta_step']:g} deg"
-        steps.append(("materials", f"{len(used)} tabulated materials ({', '.join(used)}), "
-                      f"{knobs['method']} look-up, {dtype.name}, {knobs['kernel']} kernel{res}"))
+        res = (
+            ""
+            if knobs["table_theta_step"] is None
+            else f", theta_i resampled every {knobs['table_theta_step']:g} deg"
+        )
+        steps.append(
+            (
+                "materials",
+                f"{len(used)} tabulated materials ({', '.join(used)}), "
+                f"{knobs['method']} look-up, {dtype.name}, {knobs['kernel']} kernel{res}",
+            )
+        )
     stride = "" if knobs["wavelength_stride"] == 1 else f" (every {knobs['wavelength_stride']}th)"
     if not scene.bands:
         steps.append(("bands", "skipped: no band output requested"))
     elif pre:
-        steps.append(("bands", f"tables pre-integrated over {', '.join(scene.bands)} (filter x Sun, photon "
-                      "counting) before the sweep: exact, the facet sum is linear in f_r; the sweep "
-                      f"evaluates {len(scene.bands)} values per look-up instead of {wl.size}"))
+        steps.append(
+            (
+                "bands",
+                f"tables pre-integrated over {', '.join(scene.bands)} (filter x Sun, photon "
+                "counting) before the sweep: exact, the facet sum is linear in f_r; the sweep "
+                f"evaluates {len(scene.bands)} values per look-up instead of {wl.size}",
+            )
+        )
     else:
-        why = "spectral outputs are requested too" if spectral_asked else "band_integration = 'spectral'"
-        steps.append(("bands", f"{', '.join(scene.bands)} integrated from the spectral signal ({why})"))
+        why = (
+            "spectral outputs are requested too"
+            if spectral_asked
+            else "band_integration = 'spectral'"
+        )
+        steps.append(
+            ("bands", f"{', '.join(scene.bands)} integrated from the spectral signal ({why})")
+        )
     steps.append(("wavelength", f"{wl.size} wavelengths {wl[0]:g}-{wl[-1]:g} nm{stride}"))
 
     # ---- effects
@@ -501,23 +591,39 @@ def compile_plan(scene: Scene) -> Plan:
         active.append("eclipse")
         dark = int(np.sum(geo.sun_scale <= 0))
         part = int(np.sum((geo.sun_scale > 0) & (geo.sun_scale < 1)))
-        steps.append(("eclipse", f"Earth shadow: {dark} geometries in umbra skipped (no sunlight), "
-                      f"{part} in penumbra scaled by the sunlit fraction of the solar disc"))
+        steps.append(
+            (
+                "eclipse",
+                f"Earth shadow: {dark} geometries in umbra skipped (no sunlight), "
+                f"{part} in penumbra scaled by the sunlit fraction of the solar disc",
+            )
+        )
     if "earthshine" in scene.effects and getattr(geo, "earth_scale", None) is not None:
         active.append("earthshine")
         es = geo.earth_scale
         params["earthshine"] = MappingProxyType({"ratio": float(np.max(es)) if es.size else 0.0})
-        steps.append(("earthshine", f"Lambertian Earth (albedo {scene.earth_albedo:g}) at the observation's "
-                      f"distance and phase at every time: irradiance {np.min(es):.3g}-{np.max(es):.3g} "
-                      "of the Sun's, a second distant source"))
+        steps.append(
+            (
+                "earthshine",
+                f"Lambertian Earth (albedo {scene.earth_albedo:g}) at the observation's "
+                f"distance and phase at every time: irradiance {np.min(es):.3g}-{np.max(es):.3g} "
+                "of the Sun's, a second distant source",
+            )
+        )
     elif "earthshine" in scene.effects:
-        ratio = sources.earthshine_irradiance_ratio(scene.earth_albedo, scene.earth_range_km,
-                                                    scene.earth_phase_angle)
+        ratio = sources.earthshine_irradiance_ratio(
+            scene.earth_albedo, scene.earth_range_km, scene.earth_phase_angle
+        )
         active.append("earthshine")
         params["earthshine"] = MappingProxyType({"ratio": ratio})
-        steps.append(("earthshine", f"Lambertian Earth (albedo {scene.earth_albedo:g}, range "
-                      f"{scene.earth_range_km:g} km, phase {scene.earth_phase_angle:g} deg): irradiance "
-                      f"{ratio:.3g} of the Sun's, a second distant source"))
+        steps.append(
+            (
+                "earthshine",
+                f"Lambertian Earth (albedo {scene.earth_albedo:g}, range "
+                f"{scene.earth_range_km:g} km, phase {scene.earth_phase_angle:g} deg): irradiance "
+                f"{ratio:.3g} of the Sun's, a second distant source",
+            )
+        )
     else:
         steps.append(("earthshine", "skipped: not requested"))
     if "thermal" not in scene.effects:
@@ -525,12 +631,22 @@ def compile_plan(scene: Scene) -> Plan:
     else:
         worst = _thermal_to_reflected(scene, wl)
         if worst < THERMAL_NEGLIGIBLE:
-            steps.append(("thermal", f"skipped: negligible, at most {worst:.1e} of reflected sunlight "
-                          f"at {wl[0]:g}-{wl[-1]:g} nm"))
+            steps.append(
+                (
+                    "thermal",
+                    f"skipped: negligible, at most {worst:.1e} of reflected sunlight "
+                    f"at {wl[0]:g}-{wl[-1]:g} nm",
+                )
+            )
         elif pre:
-            steps.append(("thermal", f"skipped: up to {worst:.1e} of reflected sunlight, but only band "
-                          "outputs of reflected light are asked for; add the 'signal' output for "
-                          "thermal_intensity"))
+            steps.append(
+                (
+                    "thermal",
+                    f"skipped: up to {worst:.1e} of reflected sunlight, but only band "
+                    "outputs of reflected light are asked for; add the 'signal' output for "
+                    "thermal_intensity",
+                )
+            )
         else:
             from .material import hemispherical_reflectance
 
@@ -543,11 +659,17 @@ def compile_plan(scene: Scene) -> Plan:
                 eps.append(_readonly(sources.kirchhoff_emissivity(rho)))
                 thetas.append(_readonly(th))
                 rad.append(_readonly(sources.planck(wl, _temperature(scene, m))))
-            params["thermal"] = MappingProxyType({"emissivity": tuple(eps), "theta": tuple(thetas),
-                                                  "radiance": tuple(rad)})
-            steps.append(("thermal", "epsilon(lambda, theta) B(lambda, T) per term, epsilon = 1 - rho "
-                          "(Kirchhoff) from each table's hemispherical reflectance at its theta_i nodes, "
-                          f"linear in the emission angle; up to {worst:.1e} of reflected sunlight"))
+            params["thermal"] = MappingProxyType(
+                {"emissivity": tuple(eps), "theta": tuple(thetas), "radiance": tuple(rad)}
+            )
+            steps.append(
+                (
+                    "thermal",
+                    "epsilon(lambda, theta) B(lambda, T) per term, epsilon = 1 - rho "
+                    "(Kirchhoff) from each table's hemispherical reflectance at its theta_i nodes, "
+                    f"linear in the emission angle; up to {worst:.1e} of reflected sunlight",
+                )
+            )
 
     # ---- outputs
     names = []
@@ -566,9 +688,15 @@ def compile_plan(scene: Scene) -> Plan:
     for v in names:
         spec = OUTPUTS[v]
         dt = dtype if spec.spectral else np.dtype(np.float64)
-        outputs.append(PlannedOutput(v, (*lead_dims, *spec.tail),
-                                     (*lead_shape, *(sizes[d] for d in spec.tail)), dt,
-                                     MappingProxyType(spec.attrs)))
+        outputs.append(
+            PlannedOutput(
+                v,
+                (*lead_dims, *spec.tail),
+                (*lead_shape, *(sizes[d] for d in spec.tail)),
+                dt,
+                MappingProxyType(spec.attrs),
+            )
+        )
     steps.append(("outputs", ", ".join(names)))
 
     # ---- blocks and estimate
@@ -594,8 +722,13 @@ def compile_plan(scene: Scene) -> Plan:
             "or raise the limits with size_limit (a factor, default 1) if you mean it"
         )
     n_blocks = max(1, -(-geo.n_lead // chunk)) if geo.n_lead else 0
-    steps.append(("blocks", f"{n_blocks} blocks of {chunk} {lead_dims[0]}s, {_describe_bytes(per_lead * chunk)} "
-                  f"each; {_describe_bytes(out_bytes)} of outputs, at most {work:.3g} multiply-adds"))
+    steps.append(
+        (
+            "blocks",
+            f"{n_blocks} blocks of {chunk} {lead_dims[0]}s, {_describe_bytes(per_lead * chunk)} "
+            f"each; {_describe_bytes(out_bytes)} of outputs, at most {work:.3g} multiply-adds",
+        )
+    )
 
     provenance = {m: scene.materials[m].attrs.get("provenance", "") for m in used}
     attrs = {
@@ -604,12 +737,16 @@ def compile_plan(scene: Scene) -> Plan:
         "source": f"sbrdf_xr {__version__}",
         "history": f"sbrdf_xr.simulate(scene={scene.name!r}, method={knobs['method']}, dtype={dtype.name})",
         "references": "Bedard et al., A novel approach to modeling spacecraft spectral reflectance; "
-                      "Sandford, Infrared reflectance properties of aircraft paints",
+        "Sandford, Infrared reflectance properties of aircraft paints",
         "scene": scene.name,
         "scene_description": scene.description,
         "spacecraft": getattr(scene.spacecraft, "name", ""),
         "lookup_method": knobs["method"],
-        **{f"knob_{k}": ("none" if v is None else v) for k, v in knobs.items() if k != "block_bytes"},
+        **{
+            f"knob_{k}": ("none" if v is None else v)
+            for k, v in knobs.items()
+            if k != "block_bytes"
+        },
         "effects": ", ".join(active),
         "plan": "",
         **{f"material_provenance_{m.replace('-', '_')}": p for m, p in provenance.items()},
@@ -618,15 +755,30 @@ def compile_plan(scene: Scene) -> Plan:
         **scene_fingerprint(scene),  # checked when an interrupted write is resumed
     }
     plan = Plan(
-        name=scene.name, description=scene.description, spacecraft=scene.spacecraft, geometry=geo,
-        terms=terms, materials=tuple(used), tables=tables,
-        wavelength=_readonly(wl), bands=tuple(scene.bands),
-        band_weights=None if bw is None else _readonly(bw), band_coords=MappingProxyType(band_coords),
-        pre_integrated=pre, shadowing=shadowing, merged=merged,
-        shadow_options=MappingProxyType(shadow_options), effects=tuple(active),
-        effect_params=MappingProxyType(params), models=MappingProxyType(models),
-        knobs=MappingProxyType(knobs), outputs=tuple(outputs), chunk=int(chunk), estimate=est,
-        steps=tuple(steps), attrs=MappingProxyType(attrs),
+        name=scene.name,
+        description=scene.description,
+        spacecraft=scene.spacecraft,
+        geometry=geo,
+        terms=terms,
+        materials=tuple(used),
+        tables=tables,
+        wavelength=_readonly(wl),
+        bands=tuple(scene.bands),
+        band_weights=None if bw is None else _readonly(bw),
+        band_coords=MappingProxyType(band_coords),
+        pre_integrated=pre,
+        shadowing=shadowing,
+        merged=merged,
+        shadow_options=MappingProxyType(shadow_options),
+        effects=tuple(active),
+        effect_params=MappingProxyType(params),
+        models=MappingProxyType(models),
+        knobs=MappingProxyType(knobs),
+        outputs=tuple(outputs),
+        chunk=int(chunk),
+        estimate=est,
+        steps=tuple(steps),
+        attrs=MappingProxyType(attrs),
     )
     attrs["plan"] = str(plan)
     return plan

@@ -15,12 +15,22 @@ __all__ = ["colour_colour", "light_curve", "lut_slice", "magnitudes", "plot_cube
 
 #: Short axis labels of the package's variables (the long_name goes into titles and docs).
 SHORT_LABELS: dict[str, str] = {
-    "spacecraft_sbrdf": "overall sBRDF", "brdf": "broadband BRDF", "signal": "radiometric signal",
-    "signal_material": "signal per material", "band_signal": "band signal", "magnitude": "magnitude",
-    "standard_magnitude": "standard magnitude", "colour_index": "colour index",
-    "wavelength": "wavelength", "attitude_angle": "attitude angle", "phase_angle": "phase angle",
-    "rotation_angle": "rotation angle", "sbrdf": "sBRDF", "theta_i": "theta_i",
-    "delta_theta": "delta_theta", "phi": "phi",
+    "spacecraft_sbrdf": "overall sBRDF",
+    "brdf": "broadband BRDF",
+    "signal": "radiometric signal",
+    "signal_material": "signal per material",
+    "band_signal": "band signal",
+    "magnitude": "magnitude",
+    "standard_magnitude": "standard magnitude",
+    "colour_index": "colour index",
+    "wavelength": "wavelength",
+    "attitude_angle": "attitude angle",
+    "phase_angle": "phase angle",
+    "rotation_angle": "rotation angle",
+    "sbrdf": "sBRDF",
+    "theta_i": "theta_i",
+    "delta_theta": "delta_theta",
+    "phi": "phi",
 }
 _UNIT_TEXT = {"degree": "deg", "1": ""}
 #: Above this max/min ratio of positive data the y axis is logarithmic by default.
@@ -58,7 +68,9 @@ def _wants_log(values: Any) -> bool:
     return bool(v.size) and float(v.max() / v.min()) > LOG_RATIO
 
 
-def light_curve(cube: xr.Dataset, variable: str = "brdf", ax: Any = None, log: bool | None = None) -> Any:
+def light_curve(
+    cube: xr.Dataset, variable: str = "brdf", ax: Any = None, log: bool | None = None
+) -> Any:
     """Broadband BRDF (paper 000 Fig. 18) or another scalar variable versus attitude.
 
     Parameters
@@ -80,8 +92,13 @@ def light_curve(cube: xr.Dataset, variable: str = "brdf", ax: Any = None, log: b
     x = cube["attitude_angle"] if "attitude_angle" in cube.coords else cube["attitude"]
     units = cube["phase_angle"].attrs.get("units", "degree")
     for k, beta in enumerate(np.atleast_1d(cube["phase_angle"].values)):
-        ax.plot(x.values, da.sel(phase_angle=beta).values, _STYLES[k % len(_STYLES)], lw=1,
-                label=_value_label("phase_angle", beta, units))
+        ax.plot(
+            x.values,
+            da.sel(phase_angle=beta).values,
+            _STYLES[k % len(_STYLES)],
+            lw=1,
+            label=_value_label("phase_angle", beta, units),
+        )
     ax.set_xlabel(_label(x) if "units" in x.attrs else "attitude [index]")
     ax.set_ylabel(_label(da))
     if log or (log is None and _wants_log(da.values)):
@@ -91,8 +108,13 @@ def light_curve(cube: xr.Dataset, variable: str = "brdf", ax: Any = None, log: b
     return fig
 
 
-def spectra(cube: xr.Dataset, variable: str = "spacecraft_sbrdf", ax: Any = None, log: bool | None = None,
-            **sel: Any) -> Any:
+def spectra(
+    cube: xr.Dataset,
+    variable: str = "spacecraft_sbrdf",
+    ax: Any = None,
+    log: bool | None = None,
+    **sel: Any,
+) -> Any:
     """Spectra of a cube (paper 000 Figs. 14 and 16), one line per remaining geometry.
 
     Parameters
@@ -111,14 +133,28 @@ def spectra(cube: xr.Dataset, variable: str = "spacecraft_sbrdf", ax: Any = None
     """
     fig, ax = _axes(ax)
     da = cube[variable].sel(**sel) if sel else cube[variable]
-    stacked = da.stack(_line=[d for d in da.dims if d != "wavelength"]) if da.ndim > 1 else da.expand_dims(_line=[0])
-    varying = [c for c in ("attitude_angle", "attitude", "geometry", "phase_angle")
-               if c in stacked.coords and stacked[c].size > 1 and "_line" in stacked[c].dims]
+    stacked = (
+        da.stack(_line=[d for d in da.dims if d != "wavelength"])
+        if da.ndim > 1
+        else da.expand_dims(_line=[0])
+    )
+    varying = [
+        c
+        for c in ("attitude_angle", "attitude", "geometry", "phase_angle")
+        if c in stacked.coords and stacked[c].size > 1 and "_line" in stacked[c].dims
+    ]
     for k in range(stacked.sizes["_line"]):
         line = stacked.isel(_line=k)
-        label = ", ".join(_value_label(c, line[c].values, cube[c].attrs.get("units")) for c in varying)
-        ax.plot(line["wavelength"].values, line.values, _STYLES[(k // 10) % len(_STYLES)], lw=1,
-                label=label or None)
+        label = ", ".join(
+            _value_label(c, line[c].values, cube[c].attrs.get("units")) for c in varying
+        )
+        ax.plot(
+            line["wavelength"].values,
+            line.values,
+            _STYLES[(k // 10) % len(_STYLES)],
+            lw=1,
+            label=label or None,
+        )
     ax.set_xlabel(_label(cube["wavelength"]))
     ax.set_ylabel(_label(cube[variable]))
     if log or (log is None and _wants_log(da.values)):
@@ -128,7 +164,9 @@ def spectra(cube: xr.Dataset, variable: str = "spacecraft_sbrdf", ax: Any = None
     return fig
 
 
-def lut_slice(material: xr.DataArray, theta_i: float, wavelength: float | None = None, ax: Any = None) -> Any:
+def lut_slice(
+    material: xr.DataArray, theta_i: float, wavelength: float | None = None, ax: Any = None
+) -> Any:
     """A slice of a material table over (delta_theta, phi) (paper 000 Figs. 8-9).
 
     Without ``wavelength`` the table is integrated over wavelength (the broadband
@@ -142,8 +180,12 @@ def lut_slice(material: xr.DataArray, theta_i: float, wavelength: float | None =
     else:
         da = da.sel(wavelength=wavelength, method="nearest")
         title = f"sBRDF at {float(da.wavelength):g} nm, theta_i = {float(da.theta_i):g} deg [sr-1]"
-    m = ax.pcolormesh(da["delta_theta"].values, da["phi"].values, da.transpose("phi", "delta_theta").values,
-                      shading="nearest")
+    m = ax.pcolormesh(
+        da["delta_theta"].values,
+        da["phi"].values,
+        da.transpose("phi", "delta_theta").values,
+        shading="nearest",
+    )
     fig.colorbar(m, ax=ax)
     ax.set_xlabel(_label(material["delta_theta"]))
     ax.set_ylabel(_label(material["phi"]))
@@ -197,13 +239,19 @@ def magnitudes(mags: xr.DataArray, ax: Any = None, x: str | None = None, **sel: 
         da = da.isel(phase_angle=0)
     other = [d for d in da.dims if d != "band"]
     if len(other) != 1:
-        raise ValueError(f"magnitudes: expected dims (band, one more) after selection, got {da.dims}; "
-                         "select the others, e.g. phase_angle=10")
+        raise ValueError(
+            f"magnitudes: expected dims (band, one more) after selection, got {da.dims}; "
+            "select the others, e.g. phase_angle=10"
+        )
     if x is None:
-        x = next((c for c in ("attitude_angle", "rotation_angle", "time") if c in da.coords), other[0])
+        x = next(
+            (c for c in ("attitude_angle", "rotation_angle", "time") if c in da.coords), other[0]
+        )
     xc = da[x]
     for k, b in enumerate(da["band"].values):
-        ax.plot(xc.values, da.sel(band=b).values, _STYLES[(k // 10) % len(_STYLES)], lw=1, label=str(b))
+        ax.plot(
+            xc.values, da.sel(band=b).values, _STYLES[(k // 10) % len(_STYLES)], lw=1, label=str(b)
+        )
     ax.invert_yaxis()
     ax.set_xlabel(_label(xc) if xc.dtype.kind != "M" else "time [UTC]")
     ax.set_ylabel(" ".join(p for p in ("magnitude", _system_text(mags)) if p))
@@ -211,7 +259,9 @@ def magnitudes(mags: xr.DataArray, ax: Any = None, x: str | None = None, **sel: 
     return fig
 
 
-def colour_colour(ds: xr.Dataset, x: str, y: str, ax: Any = None, sun: bool = True, c: str | None = None) -> Any:
+def colour_colour(
+    ds: xr.Dataset, x: str, y: str, ax: Any = None, sun: bool = True, c: str | None = None
+) -> Any:
     """Colour-colour diagram of a photometry Dataset (one point per geometry/attitude).
 
     Parameters
@@ -236,7 +286,9 @@ def colour_colour(ds: xr.Dataset, x: str, y: str, ax: Any = None, sun: bool = Tr
     labels = [str(v) for v in ci["colour"].values]
     for want in (x, y):
         if want not in labels:
-            raise ValueError(f"colour_colour: colour {want!r} not in {labels}; compute it with pairs=...")
+            raise ValueError(
+                f"colour_colour: colour {want!r} not in {labels}; compute it with pairs=..."
+            )
     xv = ci.sel(colour=x).values.ravel()
     yv = ci.sel(colour=y).values.ravel()
     cname = c or ("attitude_angle" if "attitude_angle" in ci.coords else None)
@@ -247,11 +299,23 @@ def colour_colour(ds: xr.Dataset, x: str, y: str, ax: Any = None, sun: bool = Tr
     else:
         ax.scatter(xv, yv, s=12)
     if sun and "sun_magnitude" in ds.coords:
-        m = {str(b): float(v) for b, v in zip(ds["band"].values, ds["sun_magnitude"].values, strict=True)}
+        m = {
+            str(b): float(v)
+            for b, v in zip(ds["band"].values, ds["sun_magnitude"].values, strict=True)
+        }
         sx = [m[b] for b in x.split("-")]
         sy = [m[b] for b in y.split("-")]
-        ax.plot(sx[0] - sx[1], sy[0] - sy[1], "*", ms=16, mfc="none", mec="orangered", mew=1.5, zorder=5,
-                label="Sun (a grey body)")
+        ax.plot(
+            sx[0] - sx[1],
+            sy[0] - sy[1],
+            "*",
+            ms=16,
+            mfc="none",
+            mec="orangered",
+            mew=1.5,
+            zorder=5,
+            label="Sun (a grey body)",
+        )
         ax.legend(fontsize="small")
     sysname = ci.attrs.get("magnitude_system", "")
     ax.set_xlabel(f"{x} [{sysname} mag]" if sysname else x)

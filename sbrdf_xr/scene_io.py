@@ -21,21 +21,57 @@ from .knobs import KNOBS
 from .scene_model import Scene
 
 _SCENE_KEYS = {
-    "name": str, "description": str, "spacecraft": str, "materials": dict,
-    "attitude": dict, "phase_angles": list, "bisector": list, "plane_normal": list,
-    "geometry": dict, "outputs": list, "effects": list, "method": str, "dtype": str,
-    "merge": bool, "shadow_method": str, "shadow_density": int, "chunk": int,
-    "wavelength_stride": int, "band_integration": str, "table_theta_step": (int, float),
-    "evaluation": str, "kernel": str, "block_bytes": int, "size_limit": (int, float),
-    "tilt_nodes": int, "surface_tilt": (int, float, dict), "observation": dict, "bands": list, "band_extrapolate": str,
-    "earth_direction": list, "earth_albedo": (int, float), "earth_range_km": (int, float),
-    "earth_phase_angle": (int, float), "temperature": (int, float, dict),
+    "name": str,
+    "description": str,
+    "spacecraft": str,
+    "materials": dict,
+    "attitude": dict,
+    "phase_angles": list,
+    "bisector": list,
+    "plane_normal": list,
+    "geometry": dict,
+    "outputs": list,
+    "effects": list,
+    "method": str,
+    "dtype": str,
+    "merge": bool,
+    "shadow_method": str,
+    "shadow_density": int,
+    "chunk": int,
+    "wavelength_stride": int,
+    "band_integration": str,
+    "table_theta_step": (int, float),
+    "evaluation": str,
+    "kernel": str,
+    "block_bytes": int,
+    "size_limit": (int, float),
+    "tilt_nodes": int,
+    "surface_tilt": (int, float, dict),
+    "observation": dict,
+    "bands": list,
+    "band_extrapolate": str,
+    "earth_direction": list,
+    "earth_albedo": (int, float),
+    "earth_range_km": (int, float),
+    "earth_phase_angle": (int, float),
+    "temperature": (int, float, dict),
 }
 
 
-_ATTITUDE_KEYS = {"kind": str, "axis": list, "start": (int, float), "stop": (int, float),
-                  "step": (int, float), "initial_axis": list, "initial_angle": (int, float),
-                  "n": int, "seed": int, "sequence": str, "angles": list, "quaternions": list}
+_ATTITUDE_KEYS = {
+    "kind": str,
+    "axis": list,
+    "start": (int, float),
+    "stop": (int, float),
+    "step": (int, float),
+    "initial_axis": list,
+    "initial_angle": (int, float),
+    "n": int,
+    "seed": int,
+    "sequence": str,
+    "angles": list,
+    "quaternions": list,
+}
 
 
 def _check_keys(table: Any, allowed: Mapping[str, Any], where: str) -> None:
@@ -46,9 +82,12 @@ def _check_keys(table: Any, allowed: Mapping[str, Any], where: str) -> None:
             raise SceneError(f"{where}: unknown key {k!r}; allowed: {', '.join(sorted(allowed))}")
         types = allowed[k]
         if not isinstance(v, types) or (isinstance(v, bool) and types in (int, (int, float))):
-            names = " or ".join(t.__name__ for t in (types if isinstance(types, tuple) else (types,)))
-            raise SceneError(f"{where}: key {k!r} has type {type(v).__name__} ({_show(v)}); "
-                             f"expected {names}")
+            names = " or ".join(
+                t.__name__ for t in (types if isinstance(types, tuple) else (types,))
+            )
+            raise SceneError(
+                f"{where}: key {k!r} has type {type(v).__name__} ({_show(v)}); expected {names}"
+            )
 
 
 #: Most attitudes or geometry pairs a scene file may list or generate.
@@ -99,8 +138,10 @@ def _numbers(v: Any, where: str, *, allow_empty: bool = False) -> np.ndarray:
 def _rows(v: Any, width: int, where: str) -> np.ndarray:
     """A non-empty list of rows of ``width`` finite numbers (vectors, quaternions)."""
     if not isinstance(v, list) or not v:
-        raise SceneError(f"{where}: expected a non-empty list of [{', '.join(['x'] * width)}] rows, "
-                         f"got {_show(v)}")
+        raise SceneError(
+            f"{where}: expected a non-empty list of [{', '.join(['x'] * width)}] rows, "
+            f"got {_show(v)}"
+        )
     if len(v) > MAX_SCENE_COUNT:
         raise SceneError(f"{where}: {len(v)} rows; at most {MAX_SCENE_COUNT} are allowed")
     out = np.empty((len(v), width))
@@ -118,7 +159,9 @@ def _vector(v: Any, where: str) -> tuple[float, float, float]:
     if not any(x):
         raise SceneError(f"{where}: the zero vector has no direction")
     if max(map(abs, x)) > _MAX_COMPONENT:
-        raise SceneError(f"{where}: components must not exceed {_MAX_COMPONENT:g} in magnitude, got {list(x)}")
+        raise SceneError(
+            f"{where}: components must not exceed {_MAX_COMPONENT:g} in magnitude, got {list(x)}"
+        )
     return x  # type: ignore[return-value]
 
 
@@ -132,7 +175,9 @@ def _strings(v: Any, where: str, *, allow_empty: bool = True) -> tuple[str, ...]
 
 def _count(v: Any, where: str) -> int:
     if not isinstance(v, int) or isinstance(v, bool) or not 1 <= v <= MAX_SCENE_COUNT:
-        raise SceneError(f"{where}: expected an integer from 1 to {MAX_SCENE_COUNT}, got {_show(v)}")
+        raise SceneError(
+            f"{where}: expected an integer from 1 to {MAX_SCENE_COUNT}, got {_show(v)}"
+        )
     return int(v)
 
 
@@ -142,7 +187,9 @@ def _attitudes_from_table(t: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray 
     try:
         if kind == "sweep":
             if "stop" not in t:
-                raise SceneError("[attitude]: a sweep needs 'stop' (and optionally 'start' and 'step') [degree]")
+                raise SceneError(
+                    "[attitude]: a sweep needs 'stop' (and optionally 'start' and 'step') [degree]"
+                )
             start = _number(t.get("start", 0.0), "[attitude] start")
             stop = _number(t["stop"], "[attitude] stop")
             step = _number(t.get("step", 1.0), "[attitude] step")
@@ -150,16 +197,22 @@ def _attitudes_from_table(t: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray 
                 raise SceneError("[attitude] step: must not be 0")
             n = int(np.ceil((stop - start) / step))
             if n < 1:
-                raise SceneError(f"[attitude]: a sweep from {start:g} to {stop:g} (excluded) in steps of "
-                                 f"{step:g} degree has no attitude; stop must lie beyond start in the "
-                                 "direction of step")
+                raise SceneError(
+                    f"[attitude]: a sweep from {start:g} to {stop:g} (excluded) in steps of "
+                    f"{step:g} degree has no attitude; stop must lie beyond start in the "
+                    "direction of step"
+                )
             if n > MAX_SCENE_COUNT:
-                raise SceneError(f"[attitude]: the sweep has {n} attitudes; at most {MAX_SCENE_COUNT} are allowed")
+                raise SceneError(
+                    f"[attitude]: the sweep has {n} attitudes; at most {MAX_SCENE_COUNT} are allowed"
+                )
             angles = np.arange(start, stop, step)
             initial = None
             if "initial_axis" in t:
-                initial = geometry.axis_rotation(_vector(t["initial_axis"], "[attitude] initial_axis"),
-                                                 _number(t.get("initial_angle", 0.0), "[attitude] initial_angle"))
+                initial = geometry.axis_rotation(
+                    _vector(t["initial_axis"], "[attitude] initial_axis"),
+                    _number(t.get("initial_angle", 0.0), "[attitude] initial_angle"),
+                )
             axis = _vector(t.get("axis", [0, 0, 1]), "[attitude] axis")
             return geometry.rotation_sweep(axis, angles, initial), angles
         if kind == "uniform":
@@ -167,11 +220,15 @@ def _attitudes_from_table(t: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray 
                 raise SceneError("[attitude]: kind 'uniform' needs 'n' (the number of attitudes)")
             seed = t.get("seed", 0)
             if not 0 <= seed < 2**63:
-                raise SceneError(f"[attitude] seed: expected an integer from 0 to 2**63 - 1, got {seed}")
+                raise SceneError(
+                    f"[attitude] seed: expected an integer from 0 to 2**63 - 1, got {seed}"
+                )
             return geometry.uniform_attitudes(_count(t["n"], "[attitude] n"), seed), None
         if kind == "euler":
             if "sequence" not in t or "angles" not in t:
-                raise SceneError("[attitude]: kind 'euler' needs 'sequence' (e.g. 'zyx') and 'angles' [degree]")
+                raise SceneError(
+                    "[attitude]: kind 'euler' needs 'sequence' (e.g. 'zyx') and 'angles' [degree]"
+                )
             seq, ang = t["sequence"], t["angles"]
             if ang and all(isinstance(a, list) for a in ang):
                 angles = _rows(ang, len(seq), "[attitude] angles")
@@ -180,13 +237,19 @@ def _attitudes_from_table(t: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray 
             return geometry.euler_attitudes(seq, angles), None
         if kind == "quaternions":
             if "quaternions" not in t:
-                raise SceneError("[attitude]: kind 'quaternions' needs 'quaternions' (rows of x, y, z, w)")
-            return geometry.check_quaternions(_rows(t["quaternions"], 4, "[attitude] quaternions")), None
+                raise SceneError(
+                    "[attitude]: kind 'quaternions' needs 'quaternions' (rows of x, y, z, w)"
+                )
+            return geometry.check_quaternions(
+                _rows(t["quaternions"], 4, "[attitude] quaternions")
+            ), None
     except SceneError:
         raise
     except (ValidationError, ValueError, TypeError) as exc:
         raise SceneError(f"[attitude]: {exc}") from None
-    raise SceneError(f"[attitude]: unknown kind {kind!r}; allowed: sweep, uniform, euler, quaternions")
+    raise SceneError(
+        f"[attitude]: unknown kind {kind!r}; allowed: sweep, uniform, euler, quaternions"
+    )
 
 
 def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) -> Scene:
@@ -205,16 +268,24 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
     from . import catalog
     from .spacecraft import Spacecraft
 
-    kw: dict[str, Any] = {k: d[k] for k in ("name", "description", "method", "dtype", "merge",
-                                               "band_extrapolate") if k in d}
+    kw: dict[str, Any] = {
+        k: d[k]
+        for k in ("name", "description", "method", "dtype", "merge", "band_extrapolate")
+        if k in d
+    }
     # the other numerical knobs (checked by the Scene against the knob table)
-    kw.update({k: d[k] for k in KNOBS if k in d and k not in kw and k not in ("chunk", "shadow_density")})
+    kw.update(
+        {k: d[k] for k in KNOBS if k in d and k not in kw and k not in ("chunk", "shadow_density")}
+    )
     if "size_limit" in d:
         kw["size_limit"] = _number(d["size_limit"], "size_limit")
     if "surface_tilt" in d:
         st = d["surface_tilt"]
-        kw["surface_tilt"] = ({str(m): _number(x, f"surface_tilt.{m}") for m, x in st.items()}
-                              if isinstance(st, Mapping) else _number(st, "surface_tilt"))
+        kw["surface_tilt"] = (
+            {str(m): _number(x, f"surface_tilt.{m}") for m, x in st.items()}
+            if isinstance(st, Mapping)
+            else _number(st, "surface_tilt")
+        )
     for k in ("earth_albedo", "earth_range_km", "earth_phase_angle"):
         if k in d:
             kw[k] = _number(d[k], k)
@@ -223,7 +294,9 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
     if "shadow_density" in d:
         sd = d["shadow_density"]
         if not 1 <= sd <= MAX_SHADOW_DENSITY:
-            raise SceneError(f"shadow_density: expected an integer from 1 to {MAX_SHADOW_DENSITY}, got {sd}")
+            raise SceneError(
+                f"shadow_density: expected an integer from 1 to {MAX_SHADOW_DENSITY}, got {sd}"
+            )
         kw["shadow_density"] = sd
     if "temperature" in d:
         t = d["temperature"]
@@ -252,16 +325,20 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
         from .observe import observation_from_dict
 
         if "attitude" in d or "geometry" in d or "phase_angles" in d:
-            raise SceneError("scene: an [observation] gives the geometry; leave out [attitude], "
-                             "[geometry] and phase_angles")
+            raise SceneError(
+                "scene: an [observation] gives the geometry; leave out [attitude], "
+                "[geometry] and phase_angles"
+            )
         try:
             kw["observation"] = observation_from_dict(d["observation"], base_dir)
         except (ValidationError, CatalogError) as exc:
             raise SceneError(f"[observation]: {exc}") from exc
     if "attitude" in d:
         if "geometry" in d:
-            raise SceneError("scene: give either an [attitude] table (with phase_angles) or a "
-                             "[geometry] table, not both")
+            raise SceneError(
+                "scene: give either an [attitude] table (with phase_angles) or a "
+                "[geometry] table, not both"
+            )
         if "phase_angles" not in d:
             raise SceneError("scene: an [attitude] table needs 'phase_angles' [degree]")
         kw["attitudes"], angles = _attitudes_from_table(d["attitude"])
@@ -285,8 +362,10 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
                 raise SceneError(f"[materials]: {mat!r} must name a catalog entry (a string)")
             table = catalog.load(entry)
             if not isinstance(table, xr.DataArray):
-                raise SceneError(f"[materials]: {mat!r} = {entry!r} is a {type(table).__name__} "
-                                 "entry, not a material table")
+                raise SceneError(
+                    f"[materials]: {mat!r} = {entry!r} is a {type(table).__name__} "
+                    "entry, not a material table"
+                )
             materials[mat] = table
     try:
         return Scene(sc, materials=materials, **kw)
@@ -330,8 +409,10 @@ def load_scene(path: str | Path) -> Scene:
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise SceneError(f"scene file {path}: not UTF-8 text (byte 0x{raw[exc.start]:02x} at offset "
-                         f"{exc.start}); TOML files are UTF-8") from None
+        raise SceneError(
+            f"scene file {path}: not UTF-8 text (byte 0x{raw[exc.start]:02x} at offset "
+            f"{exc.start}); TOML files are UTF-8"
+        ) from None
     try:
         d = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -361,7 +442,9 @@ def _canx1_rotation() -> Scene:
     angles = np.arange(360.0)
     return Scene(
         canx1(),
-        attitudes=geometry.rotation_sweep([0, 0, -1], angles, geometry.axis_rotation([0, 0, 1], 25.0)),
+        attitudes=geometry.rotation_sweep(
+            [0, 0, -1], angles, geometry.axis_rotation([0, 0, 1], 25.0)
+        ),
         attitude_angle=angles,
         phase_angles=[10.0],
         outputs=("spacecraft_sbrdf", "signal", "brdf", "area", "per_material"),
@@ -386,8 +469,11 @@ def _canx1_pass() -> Scene:
     )
 
 
-_BUILTIN = {"canx1-plusx-specular": _canx1_plusx_specular, "canx1-rotation": _canx1_rotation,
-            "canx1-pass": _canx1_pass}
+_BUILTIN = {
+    "canx1-plusx-specular": _canx1_plusx_specular,
+    "canx1-rotation": _canx1_rotation,
+    "canx1-pass": _canx1_pass,
+}
 
 
 def builtin_scenes() -> list[str]:
@@ -400,7 +486,9 @@ def builtin_scene(name: str) -> Scene:
     try:
         return _BUILTIN[name]()
     except KeyError:
-        raise SceneError(f"unknown scene {name!r}; built-in scenes: {', '.join(_BUILTIN)}") from None
+        raise SceneError(
+            f"unknown scene {name!r}; built-in scenes: {', '.join(_BUILTIN)}"
+        ) from None
 
 
 def resolve_scene(spec: str | Path | Scene) -> Scene:
@@ -408,12 +496,16 @@ def resolve_scene(spec: str | Path | Scene) -> Scene:
     if isinstance(spec, Scene):
         return spec
     if not isinstance(spec, str | Path):
-        raise SceneError(f"scene: expected a Scene, a built-in scene name or a TOML file path, "
-                         f"got {type(spec).__name__}")
+        raise SceneError(
+            f"scene: expected a Scene, a built-in scene name or a TOML file path, "
+            f"got {type(spec).__name__}"
+        )
     if str(spec) in _BUILTIN:
         return builtin_scene(str(spec))
     if "\0" in str(spec):
-        raise SceneError(f"unknown scene {str(spec)!r}: a name or path cannot contain a NUL character")
+        raise SceneError(
+            f"unknown scene {str(spec)!r}: a name or path cannot contain a NUL character"
+        )
     path = Path(spec)
     if path.suffix == ".toml" or path.exists():
         if path.is_dir():
@@ -421,4 +513,6 @@ def resolve_scene(spec: str | Path | Scene) -> Scene:
         if not path.exists():
             raise SceneError(f"scene file {path} does not exist")
         return load_scene(path)
-    raise SceneError(f"unknown scene {str(spec)!r}; built-in scenes: {', '.join(_BUILTIN)}, or a .toml file")
+    raise SceneError(
+        f"unknown scene {str(spec)!r}; built-in scenes: {', '.join(_BUILTIN)}, or a .toml file"
+    )

@@ -185,15 +185,30 @@ class Scene:
             raise SceneError(f"effects: unknown {bad}; allowed: {', '.join(EFFECTS)}")
         for k in KNOBS:
             check_knob(k, getattr(self, k))
-        tilts = self.surface_tilt.values() if isinstance(self.surface_tilt, Mapping) else [self.surface_tilt]
-        if any(isinstance(x, bool) or not isinstance(x, int | float) or not (np.isfinite(x) and 0 <= x <= 45)
-               for x in tilts):
-            raise SceneError(f"surface_tilt: expected tilts in [0, 45] degree, got {self.surface_tilt!r}")
-        if not (isinstance(self.size_limit, int | float) and np.isfinite(self.size_limit)
-                and self.size_limit > 0):
+        tilts = (
+            self.surface_tilt.values()
+            if isinstance(self.surface_tilt, Mapping)
+            else [self.surface_tilt]
+        )
+        if any(
+            isinstance(x, bool)
+            or not isinstance(x, int | float)
+            or not (np.isfinite(x) and 0 <= x <= 45)
+            for x in tilts
+        ):
+            raise SceneError(
+                f"surface_tilt: expected tilts in [0, 45] degree, got {self.surface_tilt!r}"
+            )
+        if not (
+            isinstance(self.size_limit, int | float)
+            and np.isfinite(self.size_limit)
+            and self.size_limit > 0
+        ):
             raise SceneError(f"size_limit: must be a positive factor, got {self.size_limit!r}")
         if "band_signal" in self.outputs and not self.bands:
-            raise SceneError("bands: the band_signal output needs at least one band (e.g. bands=('B', 'V'))")
+            raise SceneError(
+                "bands: the band_signal output needs at least one band (e.g. bands=('B', 'V'))"
+            )
         if self.bands:
             from .photometry import filters
 
@@ -204,10 +219,18 @@ class Scene:
         if not 0.0 <= self.earth_albedo <= 1.0:
             raise SceneError(f"earth_albedo: must lie in [0, 1], got {self.earth_albedo}")
         if not self.earth_range_km > 6371.0:
-            raise SceneError(f"earth_range_km: must exceed the Earth's radius (6371 km), got {self.earth_range_km}")
+            raise SceneError(
+                f"earth_range_km: must exceed the Earth's radius (6371 km), got {self.earth_range_km}"
+            )
         if not 0.0 <= self.earth_phase_angle <= 180.0:
-            raise SceneError(f"earth_phase_angle: must lie in [0, 180] degree, got {self.earth_phase_angle}")
-        temps = self.temperature.values() if isinstance(self.temperature, Mapping) else [self.temperature]
+            raise SceneError(
+                f"earth_phase_angle: must lie in [0, 180] degree, got {self.earth_phase_angle}"
+            )
+        temps = (
+            self.temperature.values()
+            if isinstance(self.temperature, Mapping)
+            else [self.temperature]
+        )
         if any(not (np.isfinite(x) and x > 0) for x in temps):
             raise SceneError(f"temperature: must be positive kelvin, got {self.temperature}")
         grid = self.attitudes is not None or self.phase_angles is not None
@@ -222,8 +245,10 @@ class Scene:
             from .observe import Observation
 
             if not isinstance(self.observation, Observation):
-                raise SceneError(f"observation: expected a sbrdf_xr.observe.Observation, got "
-                                 f"{type(self.observation).__name__}")
+                raise SceneError(
+                    f"observation: expected a sbrdf_xr.observe.Observation, got "
+                    f"{type(self.observation).__name__}"
+                )
         elif grid:
             if self.attitudes is None or self.phase_angles is None:
                 raise SceneError("geometry: a grid needs both attitudes and phase_angles")
@@ -252,11 +277,15 @@ class Scene:
                     raise SceneError(f"to_earth {e.shape} and to_sun {s.shape} differ in shape")
                 object.__setattr__(self, "to_earth", e)
             elif "earthshine" in self.effects:
-                raise SceneError("to_earth: explicit geometry with earthshine needs body-frame to_earth vectors")
+                raise SceneError(
+                    "to_earth: explicit geometry with earthshine needs body-frame to_earth vectors"
+                )
         if self.materials is None:
             from . import catalog
 
-            object.__setattr__(self, "materials", {m: catalog.load(m) for m in self.spacecraft.materials})
+            object.__setattr__(
+                self, "materials", {m: catalog.load(m) for m in self.spacecraft.materials}
+            )
         missing = [m for m in self.spacecraft.materials if m not in self.materials]
         if missing:
             raise SceneError(f"materials: no table for {missing}; given: {sorted(self.materials)}")
@@ -343,5 +372,3 @@ class Scene:
 
 
 # --------------------------------------------------------- built-in scenes
-
-

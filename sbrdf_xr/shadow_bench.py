@@ -128,13 +128,15 @@ def geometries(n: int = 18, seed: int = 7) -> tuple[np.ndarray, np.ndarray]:
     b = np.cross(s, a)
     phase = np.radians(rng.uniform(5.0, 120.0, n))
     az = rng.uniform(0.0, 2 * np.pi, n)
-    o = (np.cos(phase)[:, None] * s
-         + np.sin(phase)[:, None] * (np.cos(az)[:, None] * a + np.sin(az)[:, None] * b))
+    o = np.cos(phase)[:, None] * s + np.sin(phase)[:, None] * (
+        np.cos(az)[:, None] * a + np.sin(az)[:, None] * b
+    )
     return s, o
 
 
-def lambertian_signal(craft: Spacecraft, s: np.ndarray, o: np.ndarray,
-                      fraction: np.ndarray | None) -> np.ndarray:
+def lambertian_signal(
+    craft: Spacecraft, s: np.ndarray, o: np.ndarray, fraction: np.ndarray | None
+) -> np.ndarray:
     """``sum_j A_j (N_j.s)+ (N_j.o)+ f_j`` per geometry [m2] (paper 000 Eq. 3 with a constant
     sBRDF of 1 sr-1); ``fraction`` None means 1 (no shadowing)."""
     n = np.asarray(craft.mesh.face_normals)
@@ -201,19 +203,34 @@ def accuracy_rows(
 
     def row(lbl: str, method: str, density: int, t: float, errs: list[np.ndarray]) -> ShadowRow:
         e = np.concatenate(errs)
-        return ShadowRow(lbl, method, density, label, n_used, 1e3 * t / len(s),
-                         t / exact_t, float(e.max()), float(np.median(e)))
+        return ShadowRow(
+            lbl,
+            method,
+            density,
+            label,
+            n_used,
+            1e3 * t / len(s),
+            t / exact_t,
+            float(e.max()),
+            float(np.median(e)),
+        )
 
     rows = [row("exact", "exact", 0, exact_t, [np.zeros(1)])]
-    errs = [np.abs(lambertian_signal(c, s, o, None) - ref[n])[keep[n]] / ref[n][keep[n]]
-            for n, c in crafts.items()]
+    errs = [
+        np.abs(lambertian_signal(c, s, o, None) - ref[n])[keep[n]] / ref[n][keep[n]]
+        for n, c in crafts.items()
+    ]
     rows.append(row("off (no shadowing)", "off", 0, 0.0, errs))
     for d in densities:
         total = 0.0
         errs = []
         for name, craft in crafts.items():
-            f, t = _timed(lambda craft=craft, d=d: lit_visible_fraction(
-                craft, s, o, method="sampled", density=d), repeat)
+            f, t = _timed(
+                lambda craft=craft, d=d: lit_visible_fraction(
+                    craft, s, o, method="sampled", density=d
+                ),
+                repeat,
+            )
             total += t
             sig = lambertian_signal(craft, s, o, f)
             errs.append(np.abs(sig - ref[name])[keep[name]] / ref[name][keep[name]])
@@ -244,23 +261,43 @@ def canx1_sweep_rows(n_attitudes: int = 360, density: int = 4, repeat: int = 2) 
     lit_visible_fraction(craft, s[:2], o[:2])
     lit_visible_fraction(craft, s[:2], o[:2], method="sampled", density=density)
     fe, te = _timed(lambda: lit_visible_fraction(craft, s, o), repeat)
-    fs, ts = _timed(lambda: lit_visible_fraction(craft, s, o, method="sampled", density=density),
-                    repeat)
+    fs, ts = _timed(
+        lambda: lit_visible_fraction(craft, s, o, method="sampled", density=density), repeat
+    )
     se, ss, s0 = (lambertian_signal(craft, s, o, f) for f in (fe, fs, None))
     err = float(np.max(np.abs(ss - se) / se))
     off = float(np.max(np.abs(s0 - se) / se))
     n = craft.n_facets
     return [
         CostRow("exact", craft.name, n, n_attitudes, 1e3 * te / n_attitudes, 1.0, "exact"),
-        CostRow(f"sampled density {density}", craft.name, n, n_attitudes, 1e3 * ts / n_attitudes,
-                ts / te, f"exact (worst signal error {err:.2e})"),
-        CostRow("off (no shadowing)", craft.name, n, n_attitudes, 0.0, off,
-                "largest |S_off - S_exact| / S_exact"),
+        CostRow(
+            f"sampled density {density}",
+            craft.name,
+            n,
+            n_attitudes,
+            1e3 * ts / n_attitudes,
+            ts / te,
+            f"exact (worst signal error {err:.2e})",
+        ),
+        CostRow(
+            "off (no shadowing)",
+            craft.name,
+            n,
+            n_attitudes,
+            0.0,
+            off,
+            "largest |S_off - S_exact| / S_exact",
+        ),
     ]
 
 
-def scaling_rows(subdivisions: Sequence[int] = (1, 2, 3, 4, 5), n_geometries: int = 6,
-                 repeat: int = 1, seed: int = 7, compare_density: int | None = 4) -> list[CostRow]:
+def scaling_rows(
+    subdivisions: Sequence[int] = (1, 2, 3, 4, 5),
+    n_geometries: int = 6,
+    repeat: int = 1,
+    seed: int = 7,
+    compare_density: int | None = 4,
+) -> list[CostRow]:
     """Exact-method time per geometry against the facet count, on CanX-1 with antennas
     subdivided (732, 2928, 11712, 46848, 187392 facets).
 
@@ -279,22 +316,51 @@ def scaling_rows(subdivisions: Sequence[int] = (1, 2, 3, 4, 5), n_geometries: in
         ms = 1e3 * t / n_geometries
         local = (np.log(ms / pts[-1][1]) / np.log(craft.n_facets / pts[-1][0])) if pts else np.nan
         pts.append((craft.n_facets, ms))
-        rows.append(CostRow("exact", craft.name, craft.n_facets, n_geometries, ms, float(local),
-                            "local exponent"))
+        rows.append(
+            CostRow(
+                "exact",
+                craft.name,
+                craft.n_facets,
+                n_geometries,
+                ms,
+                float(local),
+                "local exponent",
+            )
+        )
         if compare_density:
             d = compare_density
             lit_visible_fraction(craft, s[:1], o[:1], method="sampled", density=d)
-            _, ts = _timed(lambda craft=craft, d=d: lit_visible_fraction(
-                craft, s, o, method="sampled", density=d), repeat)
-            rows.append(CostRow(f"sampled density {d}", craft.name, craft.n_facets, n_geometries,
-                                1e3 * ts / n_geometries, ts / t, "exact at this facet count"))
+            _, ts = _timed(
+                lambda craft=craft, d=d: lit_visible_fraction(
+                    craft, s, o, method="sampled", density=d
+                ),
+                repeat,
+            )
+            rows.append(
+                CostRow(
+                    f"sampled density {d}",
+                    craft.name,
+                    craft.n_facets,
+                    n_geometries,
+                    1e3 * ts / n_geometries,
+                    ts / t,
+                    "exact at this facet count",
+                )
+            )
     if len(pts) > 1:
         x, y = np.log([p[0] for p in pts]), np.log([p[1] for p in pts])
         b = float(np.polyfit(x, y, 1)[0])
         last = max(i for i, r in enumerate(rows) if r.label == "exact")
         r = rows[last]
-        rows[last] = CostRow(r.label, r.body, r.n_facets, r.n_geometries, r.ms_per_geometry, b,
-                             "fitted exponent over all counts")
+        rows[last] = CostRow(
+            r.label,
+            r.body,
+            r.n_facets,
+            r.n_geometries,
+            r.ms_per_geometry,
+            b,
+            "fitted exponent over all counts",
+        )
     return rows
 
 

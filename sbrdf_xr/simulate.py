@@ -104,8 +104,9 @@ def _in_process(plan: Plan, n_threads: int | None = None) -> dict[str, np.ndarra
     if workers == 1:
         return run_block(plan, slice(0, n))
     edges = np.linspace(0, n, workers + 1).astype(int)
-    parts = list(_pool(workers).map(lambda i: run_block(plan, slice(edges[i], edges[i + 1])),
-                                    range(workers)))
+    parts = list(
+        _pool(workers).map(lambda i: run_block(plan, slice(edges[i], edges[i + 1])), range(workers))
+    )
     return {k: np.concatenate([p[k] for p in parts], axis=0) for k in parts[0]}
 
 
@@ -147,8 +148,10 @@ def _lazy(plan: Plan, client: Any = None) -> dict[str, dsa.Array]:
         name = f"sbrdf-{o.name}-{token}"
         rest = (0,) * (len(o.shape) - 1)
         layer = {(name, k, *rest): (_pick, (block_name, k), o.name) for k in range(nb)}
-        graph = HighLevelGraph(layers={block_name: block_layer, name: layer},
-                               dependencies={block_name: set(), name: {block_name}})
+        graph = HighLevelGraph(
+            layers={block_name: block_layer, name: layer},
+            dependencies={block_name: set(), name: {block_name}},
+        )
         chunks = (lead, *((s,) for s in o.shape[1:]))
         out[o.name] = dsa.Array(graph, name, chunks, dtype=o.dtype)
     return out
@@ -185,7 +188,9 @@ def _dataset(plan: Plan, arrays: dict[str, Any]) -> xr.Dataset:
     variables = dict(t.variables)
     for o in plan.outputs:
         variables[o.name] = xr.Variable(o.dims, arrays[o.name], attrs=dict(o.attrs))
-    return xr.Dataset._construct_direct(variables, set(t.coords), None, dict(t.attrs), dict(t.xindexes))
+    return xr.Dataset._construct_direct(
+        variables, set(t.coords), None, dict(t.attrs), dict(t.xindexes)
+    )
 
 
 def simulate(
@@ -228,8 +233,10 @@ def simulate(
     """
     if isinstance(scene, Plan):
         if plan is not None or options:
-            raise SceneError("simulate(plan): a plan is already compiled; change the scene and "
-                             "plan it again instead of passing options")
+            raise SceneError(
+                "simulate(plan): a plan is already compiled; change the scene and "
+                "plan it again instead of passing options"
+            )
         the_plan = scene
     else:
         sc = resolve_scene(scene)
@@ -239,15 +246,23 @@ def simulate(
             sc = sc.with_options(**options)
         the_plan = sc.plan()
         if plan is not None and plan is not the_plan:
-            raise SceneError("simulate(scene, plan): the plan is not this scene's own plan "
-                             "(scene.plan()); pass the plan alone: simulate(plan)")
+            raise SceneError(
+                "simulate(scene, plan): the plan is not this scene's own plan "
+                "(scene.plan()); pass the plan alone: simulate(plan)"
+            )
     if lazy is None:
-        lazy = client is not None or the_plan.knobs["chunk"] is not None or the_plan.estimate.output_bytes > IN_PROCESS_BYTES
+        lazy = (
+            client is not None
+            or the_plan.knobs["chunk"] is not None
+            or the_plan.estimate.output_bytes > IN_PROCESS_BYTES
+        )
     if lazy:
         arrays: dict[str, Any] = _lazy(the_plan, client)
     else:
         if client is not None:
-            raise SceneError("simulate: lazy=False computes in this process; it cannot use a client")
+            raise SceneError(
+                "simulate: lazy=False computes in this process; it cannot use a client"
+            )
         arrays = _in_process(the_plan)
     return _dataset(the_plan, arrays)
 
@@ -286,8 +301,16 @@ def _encode_times(cube: xr.Dataset) -> xr.Dataset:
     return cube.assign_coords(encoded)
 
 
-def _write_zarr(cube: xr.Dataset, path: Path, *, overwrite: bool = False, client: Any = None,
-                progress: bool = False, resume: bool = False, scheduler: str | None = None) -> Path:
+def _write_zarr(
+    cube: xr.Dataset,
+    path: Path,
+    *,
+    overwrite: bool = False,
+    client: Any = None,
+    progress: bool = False,
+    resume: bool = False,
+    scheduler: str | None = None,
+) -> Path:
     import shutil
 
     from .errors import ValidationError
@@ -295,7 +318,9 @@ def _write_zarr(cube: xr.Dataset, path: Path, *, overwrite: bool = False, client
     if resume:
         raise ValidationError("resume: supported for netCDF cubes; a Zarr store is rewritten whole")
     if scheduler is not None and client is None:
-        raise ValidationError("scheduler: for a Zarr store pass client= (a dask.distributed.Client)")
+        raise ValidationError(
+            "scheduler: for a Zarr store pass client= (a dask.distributed.Client)"
+        )
     if path.exists() and not overwrite:
         raise FileExistsError(f"{path} exists; pass --overwrite (overwrite=True) to replace it")
     if path.exists() and not path.is_dir():

@@ -94,8 +94,14 @@ def earthshine_irradiance_ratio(albedo: float, range_km: float, phase_angle_deg:
     0.00457
     """
     a = np.radians(phase_angle_deg)
-    return float(2.0 / 3.0 * albedo * (EARTH_RADIUS_KM / range_km) ** 2
-                 * ((np.pi - a) * np.cos(a) + np.sin(a)) / np.pi)
+    return float(
+        2.0
+        / 3.0
+        * albedo
+        * (EARTH_RADIUS_KM / range_km) ** 2
+        * ((np.pi - a) * np.cos(a) + np.sin(a))
+        / np.pi
+    )
 
 
 def kirchhoff_emissivity(reflectance: ArrayLike) -> NDArray[np.float64]:

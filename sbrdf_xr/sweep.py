@@ -69,8 +69,10 @@ class GridGeometry:
         return {}
 
     def describe(self) -> str:
-        return (f"{self.n_lead} attitudes x {len(self.phase_angles)} phase angles = "
-                f"{self.n_geometries} geometries")
+        return (
+            f"{self.n_lead} attitudes x {len(self.phase_angles)} phase angles = "
+            f"{self.n_geometries} geometries"
+        )
 
     def block(self, sl: slice) -> BlockInputs:
         """Body-frame directions of the attitudes in ``sl`` (flattened to (n * P, 3))."""
@@ -78,10 +80,13 @@ class GridGeometry:
         p = len(self.phase_angles)
         refs = [self.sun_ref, self.obs_ref] + ([] if self.earth_ref is None else [self.earth_ref])
         # v_body = R^T v for every attitude, as row vectors: v^T R
-        body = np.matmul(np.concatenate(refs)[None], Rotation.from_quat(q).as_matrix()) if len(q) else \
-            np.zeros((0, len(refs) * p, 3))
-        s, o = body[:, :p].reshape(-1, 3), body[:, p:2 * p].reshape(-1, 3)
-        e = None if self.earth_ref is None else body[:, 2 * p:].reshape(-1, 3)
+        body = (
+            np.matmul(np.concatenate(refs)[None], Rotation.from_quat(q).as_matrix())
+            if len(q)
+            else np.zeros((0, len(refs) * p, 3))
+        )
+        s, o = body[:, :p].reshape(-1, 3), body[:, p : 2 * p].reshape(-1, 3)
+        e = None if self.earth_ref is None else body[:, 2 * p :].reshape(-1, 3)
         return BlockInputs(s, o, e, None, (len(q), p))
 
     def coords(self) -> dict[str, Any]:
@@ -97,8 +102,11 @@ class GridGeometry:
             "to_observer": ((ATTITUDE, PHASE_ANGLE, VECTOR), o, attrs("to_observer")),
         }
         if self.attitude_angle is not None:
-            c["attitude_angle"] = (ATTITUDE, np.asarray(self.attitude_angle, dtype=np.float64),
-                                   attrs("attitude_angle"))
+            c["attitude_angle"] = (
+                ATTITUDE,
+                np.asarray(self.attitude_angle, dtype=np.float64),
+                attrs("attitude_angle"),
+            )
         return c
 
 
@@ -145,8 +153,10 @@ class PairGeometry:
         if self.dim == GEOMETRY:
             return f"{self.n_lead} explicit (to_sun, to_observer) pairs"
         what = self.extra_attrs.get("observation", "an observation")
-        return (f"{self.n_lead} times of {what} ({self.extra_attrs.get('orbit_name', '')} from "
-                f"{self.extra_attrs.get('site_name', 'a site')})")
+        return (
+            f"{self.n_lead} times of {what} ({self.extra_attrs.get('orbit_name', '')} from "
+            f"{self.extra_attrs.get('site_name', 'a site')})"
+        )
 
     def block(self, sl: slice) -> BlockInputs:
         e = None if self.to_earth is None else self.to_earth[sl]
@@ -160,7 +170,11 @@ class PairGeometry:
         d = self.dim
         c: dict[str, Any] = {
             d: (d, np.arange(self.n_lead), attrs(GEOMETRY)) if self.index is None else self.index,
-            PHASE_ANGLE: (d, geometry.phase_angle(self.to_sun, self.to_observer), attrs(PHASE_ANGLE)),
+            PHASE_ANGLE: (
+                d,
+                geometry.phase_angle(self.to_sun, self.to_observer),
+                attrs(PHASE_ANGLE),
+            ),
             "to_sun": ((d, VECTOR), self.to_sun, attrs("to_sun")),
             "to_observer": ((d, VECTOR), self.to_observer, attrs("to_observer")),
         }
@@ -180,11 +194,22 @@ class PairGeometry:
         extra["component"] = g["component"].variable
         earth_scale = None
         if with_earth:
-            earth_scale = np.array([earthshine_irradiance_ratio(earth_albedo, r, a) for r, a in
-                                    zip(g["earth_distance"].values, g["earth_phase_angle"].values,
-                                        strict=True)])
-        return cls(np.ascontiguousarray(g["to_sun"].values), np.ascontiguousarray(g["to_observer"].values),
-                   np.ascontiguousarray(g["to_earth"].values) if with_earth else None,
-                   np.asarray(g["sunlit_fraction"].values, dtype=np.float64), earth_scale, dim,
-                   g[dim].variable, extra, dict(g.attrs))
-
+            earth_scale = np.array(
+                [
+                    earthshine_irradiance_ratio(earth_albedo, r, a)
+                    for r, a in zip(
+                        g["earth_distance"].values, g["earth_phase_angle"].values, strict=True
+                    )
+                ]
+            )
+        return cls(
+            np.ascontiguousarray(g["to_sun"].values),
+            np.ascontiguousarray(g["to_observer"].values),
+            np.ascontiguousarray(g["to_earth"].values) if with_earth else None,
+            np.asarray(g["sunlit_fraction"].values, dtype=np.float64),
+            earth_scale,
+            dim,
+            g[dim].variable,
+            extra,
+            dict(g.attrs),
+        )

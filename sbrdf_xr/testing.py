@@ -77,9 +77,15 @@ def make_measurements(
     from .goniometer import measure
 
     wl = np.linspace(400.0, 1100.0, n_wavelength)
-    return measure(lobe_function(wl, **kwargs), wl, theta_i, noise=noise,
-                   noise_floor=0.05, material="test-lobe",
-                   provenance="sbrdf_xr.testing.lobe_function")
+    return measure(
+        lobe_function(wl, **kwargs),
+        wl,
+        theta_i,
+        noise=noise,
+        noise_floor=0.05,
+        material="test-lobe",
+        provenance="sbrdf_xr.testing.lobe_function",
+    )
 
 
 def make_material(
@@ -120,8 +126,17 @@ def make_material(
         vals = lobe_function(wl)(*(a.ravel() for a in g)).reshape(ti.size, dt.size, ph.size, -1)
     else:
         vals = np.full((ti.size, dt.size, ph.size, wl.size), value)
-    return new_material(vals.astype(dtype), ti, dt, ph, wl, material="test-material",
-                        source="synthetic", provenance="sbrdf_xr.testing.make_material")
+    return new_material(
+        vals.astype(dtype),
+        ti,
+        dt,
+        ph,
+        wl,
+        material="test-material",
+        source="synthetic",
+        provenance="sbrdf_xr.testing.make_material",
+    )
+
 
 # ---------------------------------------------------------------- spacecraft
 # (section owned by the spacecraft/visibility issue: cube, L-shaped body, plate with a fin)
@@ -145,7 +160,9 @@ def _ear_clip(polygon: np.ndarray) -> np.ndarray:
             if cross(a, b, c) <= 0:
                 continue  # reflex or collinear corner
             inside = any(
-                cross(a, b, polygon[j]) >= 0 and cross(b, c, polygon[j]) >= 0 and cross(c, a, polygon[j]) >= 0
+                cross(a, b, polygon[j]) >= 0
+                and cross(b, c, polygon[j]) >= 0
+                and cross(c, a, polygon[j]) >= 0
                 for j in idx
                 if j not in (i0, i1, i2)
             )
@@ -178,7 +195,9 @@ def prism_mesh(polygon_xy, z0: float, z1: float):
 
     p = np.asarray(polygon_xy, dtype=float)
     n = len(p)
-    vertices = np.vstack([np.column_stack([p, np.full(n, z0)]), np.column_stack([p, np.full(n, z1)])])
+    vertices = np.vstack(
+        [np.column_stack([p, np.full(n, z0)]), np.column_stack([p, np.full(n, z1)])]
+    )
     cap = _ear_clip(p)
     faces = [cap[:, ::-1], cap + n]  # bottom faces -z, top faces +z
     i = np.arange(n)
@@ -232,8 +251,12 @@ def l_shaped_spacecraft(depth: float = 2.0):
     return _as_spacecraft(prism_mesh(L_SECTION, 0.0, depth), "l-shape")
 
 
-def plate_with_fin_section(half_width: float = 1.0, thickness: float = 0.1, fin_height: float = 1.0,
-                           fin_thickness: float = 0.1) -> np.ndarray:
+def plate_with_fin_section(
+    half_width: float = 1.0,
+    thickness: float = 0.1,
+    fin_height: float = 1.0,
+    fin_thickness: float = 0.1,
+) -> np.ndarray:
     """Cross-section in xy of :func:`plate_with_fin_spacecraft` (counter-clockwise) [m]."""
     w, t, h, f = half_width, thickness, fin_height, fin_thickness / 2
     return np.array([(-w, -t), (w, -t), (w, 0.0), (f, 0.0), (f, h), (-f, h), (-f, 0.0), (-w, 0.0)])
@@ -242,7 +265,9 @@ def plate_with_fin_section(half_width: float = 1.0, thickness: float = 0.1, fin_
 def plate_with_fin_spacecraft(depth: float = 2.0, **section):
     """A plate ``[-1, 1] x [-0.1, 0]`` with a perpendicular fin ``[-0.05, 0.05] x [0, 1]`` (xy, [m]),
     extruded over z in [0, depth]; ``section`` overrides :func:`plate_with_fin_section`."""
-    return _as_spacecraft(prism_mesh(plate_with_fin_section(**section), 0.0, depth), "plate-with-fin")
+    return _as_spacecraft(
+        prism_mesh(plate_with_fin_section(**section), 0.0, depth), "plate-with-fin"
+    )
 
 
 # ---------------------------------------------------------------- non-convex shadowing bodies
@@ -251,8 +276,18 @@ def plate_with_fin_spacecraft(depth: float = 2.0, **section):
 #: [-0.5, 0.5] x [-0.5, 0.5], a flat boom [0.5, 1.3] x [-0.03, 0.03] and a panel
 #: [1.3, 1.34] x [-0.9, 0.9], counter-clockwise seen from +y.
 BUS_PANEL_SECTION = (
-    (-0.5, -0.5), (0.5, -0.5), (0.5, -0.03), (1.3, -0.03), (1.3, -0.9), (1.34, -0.9),
-    (1.34, 0.9), (1.3, 0.9), (1.3, 0.03), (0.5, 0.03), (0.5, 0.5), (-0.5, 0.5),
+    (-0.5, -0.5),
+    (0.5, -0.5),
+    (0.5, -0.03),
+    (1.3, -0.03),
+    (1.3, -0.9),
+    (1.34, -0.9),
+    (1.34, 0.9),
+    (1.3, 0.9),
+    (1.3, 0.03),
+    (0.5, 0.03),
+    (0.5, 0.5),
+    (-0.5, 0.5),
 )
 
 
@@ -275,7 +310,9 @@ def bus_with_panel_spacecraft(depth: float = 1.0, subdivisions: int = 1):
     sec = np.asarray(BUS_PANEL_SECTION, dtype=float)
     # the prism is built in (x, y', z') = (x, z, -y) and rotated so that the section is xz
     mesh = prism_mesh(sec, -depth / 2, depth / 2)
-    mesh = trimesh.Trimesh(mesh.vertices[:, [0, 2, 1]] * [1.0, -1.0, 1.0], mesh.faces, process=False)
+    mesh = trimesh.Trimesh(
+        mesh.vertices[:, [0, 2, 1]] * [1.0, -1.0, 1.0], mesh.faces, process=False
+    )
     for _ in range(subdivisions - 1):
         mesh = mesh.subdivide()
     return _as_spacecraft(mesh, "bus-with-panel")
@@ -283,8 +320,12 @@ def bus_with_panel_spacecraft(depth: float = 1.0, subdivisions: int = 1):
 
 #: Antennas of :func:`canx1_with_antennas`: (x, y) of the root [m] on the +Z face, half-width
 #: [m], length [m] and the standoff gap between the face and the antenna [m].
-CANX1_ANTENNAS = (((0.035, 0.035), (-0.035, 0.035), (-0.035, -0.035), (0.035, -0.035)),
-                  0.002, 0.08, 0.001)
+CANX1_ANTENNAS = (
+    ((0.035, 0.035), (-0.035, 0.035), (-0.035, -0.035), (0.035, -0.035)),
+    0.002,
+    0.08,
+    0.001,
+)
 
 
 def canx1_with_antennas(subdivisions: int = 1, tilt: float = 30.0):
@@ -328,10 +369,18 @@ def canx1_with_antennas(subdivisions: int = 1, tilt: float = 30.0):
         rod.apply_translation((x, y, lift))
         parts.append(rod)
         labels.append(np.full(len(rod.faces), "aluminium-6061-t6"))
-    mesh = trimesh.Trimesh(np.vstack([p.vertices for p in parts]),
-                           np.vstack([p.faces + off for p, off in
-                                      zip(parts, np.cumsum([0] + [len(p.vertices) for p in parts[:-1]]), strict=True)]),
-                           process=False)
+    mesh = trimesh.Trimesh(
+        np.vstack([p.vertices for p in parts]),
+        np.vstack(
+            [
+                p.faces + off
+                for p, off in zip(
+                    parts, np.cumsum([0] + [len(p.vertices) for p in parts[:-1]]), strict=True
+                )
+            ]
+        ),
+        process=False,
+    )
     label = np.concatenate(labels)
     for _ in range(subdivisions - 1):
         mesh = mesh.subdivide()

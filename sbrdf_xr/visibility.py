@@ -383,8 +383,15 @@ def _plane_frames(mesh: trimesh.Trimesh, cache: dict[str, Any]) -> dict[str, Any
     tol = PLANE_TOLERANCE * float(mesh.scale)
     receiver = ok & ~_supporting(mesh, cache, tol)
     frames = {
-        "V": V, "F": F, "N": N, "P0": np.ascontiguousarray(tri[:, 0]), "E1": E1, "E2": E2,
-        "T2": np.ascontiguousarray(T2), "receiver": receiver, "eps": tol,
+        "V": V,
+        "F": F,
+        "N": N,
+        "P0": np.ascontiguousarray(tri[:, 0]),
+        "E1": E1,
+        "E2": E2,
+        "T2": np.ascontiguousarray(T2),
+        "receiver": receiver,
+        "eps": tol,
         "watertight": bool(mesh.is_watertight) and bool(mesh.is_winding_consistent),
     }
     cache["exact:frames"] = frames
@@ -395,9 +402,19 @@ def _geos_fraction(frames: dict[str, Any], i: int, dirs: np.ndarray) -> float:
     """Fraction of facet i left by the GEOS union of its shadows (the kernel's fallback)."""
     import shapely
 
-    xy, start = facet_shadows(i, dirs, frames["V"], frames["F"], frames["N"], frames["P0"],
-                               frames["E1"], frames["E2"], frames["T2"], frames["watertight"],
-                               frames["eps"])
+    xy, start = facet_shadows(
+        i,
+        dirs,
+        frames["V"],
+        frames["F"],
+        frames["N"],
+        frames["P0"],
+        frames["E1"],
+        frames["E2"],
+        frames["T2"],
+        frames["watertight"],
+        frames["eps"],
+    )
     tri = shapely.Polygon(frames["T2"][i])
     rings = [xy[a:b] for a, b in itertools.pairwise(start)]
     shadow = shapely.union_all([shapely.Polygon(r) for r in rings])
@@ -417,9 +434,19 @@ def _exact(
     dirs = np.ascontiguousarray(np.stack(directions, axis=1), dtype=np.float64)  # (G, K, 3)
     if not frames["receiver"].any():
         return front.astype(np.float64)
-    frac = exact_kernel(frames["V"], frames["F"], frames["N"], frames["P0"], frames["E1"],
-                         frames["E2"], frames["T2"], frames["receiver"], dirs,
-                         frames["watertight"], frames["eps"])
+    frac = exact_kernel(
+        frames["V"],
+        frames["F"],
+        frames["N"],
+        frames["P0"],
+        frames["E1"],
+        frames["E2"],
+        frames["T2"],
+        frames["receiver"],
+        dirs,
+        frames["watertight"],
+        frames["eps"],
+    )
     for g, i in np.argwhere(np.isnan(frac)):
         frac[g, i] = _geos_fraction(frames, int(i), dirs[g])
     # a facet facing a direction per the stored normals but not per its winding (or
@@ -508,7 +535,9 @@ def lit_fraction(
         unavailable engine.
     """
     d, shape = _directions(directions, "directions")
-    f, _ = _fractions(spacecraft, [d], method, density, engine, offset, convex_shortcut, seed, False)
+    f, _ = _fractions(
+        spacecraft, [d], method, density, engine, offset, convex_shortcut, seed, False
+    )
     return f.reshape(*shape, -1)
 
 
@@ -528,8 +557,16 @@ def visible_fraction(
     Identical to :func:`lit_fraction` with observer directions in place of Sun directions
     (occlusion toward a distant observer is shadowing by a light at the observer).
     """
-    return lit_fraction(spacecraft, directions, method=method, density=density, engine=engine,
-                        offset=offset, convex_shortcut=convex_shortcut, seed=seed)
+    return lit_fraction(
+        spacecraft,
+        directions,
+        method=method,
+        density=density,
+        engine=engine,
+        offset=offset,
+        convex_shortcut=convex_shortcut,
+        seed=seed,
+    )
 
 
 def lit_visible_fraction(
@@ -577,8 +614,9 @@ def lit_visible_fraction(
     )
     ds, shape = _directions(s, "to_sun")
     do, _ = _directions(o, "to_observer")
-    f, err = _fractions(spacecraft, [ds, do], method, density, engine, offset, convex_shortcut,
-                        seed, return_error)
+    f, err = _fractions(
+        spacecraft, [ds, do], method, density, engine, offset, convex_shortcut, seed, return_error
+    )
     if return_error:
         return f.reshape(*shape, -1), err.reshape(*shape, -1)
     return f.reshape(*shape, -1)
@@ -628,8 +666,12 @@ def facet_visibility(
     else:
         masks = _escape_masks(spacecraft, [ds, do], density, engine, offset, True, seed)
         lit, vis, joint = masks[0].mean(-1), masks[1].mean(-1), (masks[0] & masks[1]).mean(-1)
-        extra = {"density": _density(density), "samples_per_facet": samples_per_facet(density),
-                 "engine": _engine_name(engine), "seed": seed}
+        extra = {
+            "density": _density(density),
+            "samples_per_facet": samples_per_facet(density),
+            "engine": _engine_name(engine),
+            "seed": seed,
+        }
     dims = (GEOMETRY, FACET)
     return xr.Dataset(
         {

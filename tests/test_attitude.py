@@ -20,7 +20,9 @@ QTOL = 1e-12
 
 
 def same_rotation(q1, q2, atol=QTOL):
-    np.testing.assert_allclose(geometry.rotation_matrices(q1), geometry.rotation_matrices(q2), atol=atol)
+    np.testing.assert_allclose(
+        geometry.rotation_matrices(q1), geometry.rotation_matrices(q2), atol=atol
+    )
 
 
 def circular_context(n=50, radius=7000.0, incl_deg=60.0, span_s=3000.0):
@@ -34,7 +36,12 @@ def circular_context(n=50, radius=7000.0, incl_deg=60.0, span_s=3000.0):
     r = radius * (np.cos(w * t)[:, None] * u + np.sin(w * t)[:, None] * v)
     vel = radius * w * (-np.sin(w * t)[:, None] * u + np.cos(w * t)[:, None] * v)
     sun = np.tile([1.5e8, 2.0e7, 1.0e7], (n, 1)) - r
-    ctx = att.Context(epoch=np.datetime64("2024-01-01T00:00:00", "ns"), position_km=r, velocity_km_s=vel, sun_km=sun)
+    ctx = att.Context(
+        epoch=np.datetime64("2024-01-01T00:00:00", "ns"),
+        position_km=r,
+        velocity_km_s=vel,
+        sun_km=sun,
+    )
     return t, ctx
 
 
@@ -74,7 +81,9 @@ def test_spin_datetime_times_and_epoch():
 def test_tumble_conserves_energy_and_momentum():
     # A general (non-diagonal) tensor and a rate near the intermediate axis: the hard case.
     inertia = np.array([[3.0, 0.2, -0.1], [0.2, 2.0, 0.15], [-0.1, 0.15, 1.2]])
-    tumble = att.Tumble(inertia, omega_deg_s=(0.5, 20.0, 3.0), initial=geometry.axis_rotation([1, 1, 0], 30))
+    tumble = att.Tumble(
+        inertia, omega_deg_s=(0.5, 20.0, 3.0), initial=geometry.axis_rotation([1, 1, 0], 30)
+    )
     t = np.linspace(-600.0, 3600.0, 801)
     w, q = tumble.states(t)
     energy = 0.5 * np.einsum("ni,ij,nj->n", w, inertia, w)
@@ -97,7 +106,9 @@ def test_tumble_axisymmetric_closed_form():
     t = np.linspace(0.0, 500.0, 101)
     w, _ = tumble.states(t)
     lam = (i3 - i1) / i1 * w0[2]
-    expected = np.stack([w0[0] * np.cos(lam * t), w0[0] * np.sin(lam * t), np.full_like(t, w0[2])], axis=1)
+    expected = np.stack(
+        [w0[0] * np.cos(lam * t), w0[0] * np.sin(lam * t), np.full_like(t, w0[2])], axis=1
+    )
     np.testing.assert_allclose(w, expected, atol=1e-10 * np.linalg.norm(w0))
     # Spin about a principal axis of a symmetric body is a pure spin.
     pure = att.Tumble((i1, i1, i3), omega_deg_s=(0, 0, 6.0))
@@ -135,11 +146,15 @@ def test_nadir_keeps_the_nadir_axis_on_the_geocentre():
         rot = geometry.rotation_matrices(law.quaternions(t, ctx))
         nadir = -ctx.position_km / np.linalg.norm(ctx.position_km, axis=1, keepdims=True)
         got = rot @ np.asarray(axis, float)
-        angle = np.arctan2(np.linalg.norm(np.cross(got, nadir), axis=1), np.einsum("ni,ni->n", got, nadir))
+        angle = np.arctan2(
+            np.linalg.norm(np.cross(got, nadir), axis=1), np.einsum("ni,ni->n", got, nadir)
+        )
         assert angle.max() < 1e-9  # the requirement [rad]
         if vel_axis is not None:
             v = ctx.velocity_km_s / np.linalg.norm(ctx.velocity_km_s, axis=1, keepdims=True)
-            np.testing.assert_allclose(rot @ np.asarray(vel_axis, float), v, atol=1e-12)  # circular: v perpendicular to r
+            np.testing.assert_allclose(
+                rot @ np.asarray(vel_axis, float), v, atol=1e-12
+            )  # circular: v perpendicular to r
     # The yaw turns the velocity axis about the nadir by the yaw angle.
     q0 = att.Nadir().quaternions(t, ctx)
     q1 = att.Nadir(yaw_deg=30.0).quaternions(t, ctx)
@@ -166,11 +181,20 @@ def test_sun_pointing_axis_and_secondary_constraint():
     # The secondary axis lies in the plane of the Sun and the orbit normal, on its side.
     h = np.cross(ctx.position_km, ctx.velocity_km_s)
     z = rot @ [0, 0, 1.0]
-    np.testing.assert_allclose(np.einsum("ni,ni->n", z, np.cross(sun, h)), 0.0, atol=1e-9 * np.linalg.norm(h, axis=1).max())
+    np.testing.assert_allclose(
+        np.einsum("ni,ni->n", z, np.cross(sun, h)), 0.0, atol=1e-9 * np.linalg.norm(h, axis=1).max()
+    )
     assert np.all(np.einsum("ni,ni->n", z, h) > 0)
     with pytest.raises(AttitudeError, match="parallel"):
-        att.SunPointing(secondary_target=ctx.sun_km[0]).quaternions(t[:1], att.Context(
-            epoch=ctx.epoch, position_km=ctx.position_km[:1], velocity_km_s=ctx.velocity_km_s[:1], sun_km=ctx.sun_km[:1]))
+        att.SunPointing(secondary_target=ctx.sun_km[0]).quaternions(
+            t[:1],
+            att.Context(
+                epoch=ctx.epoch,
+                position_km=ctx.position_km[:1],
+                velocity_km_s=ctx.velocity_km_s[:1],
+                sun_km=ctx.sun_km[:1],
+            ),
+        )
     with pytest.raises(AttitudeError, match="secondary_target"):
         att.SunPointing(secondary_target="moon")
 
@@ -180,7 +204,9 @@ def test_composition_forms_agree():
     spin = att.Spin("+z", rate_deg_s=5.0, phase_deg=10.0)
     a = (att.Nadir(yaw_deg=5.0) * spin).quaternions(t, ctx)
     b = att.compose(att.Nadir(yaw_deg=5.0), spin).quaternions(t, ctx)
-    c = att.Spin("+z", rate_deg_s=5.0, phase_deg=10.0, initial=att.Nadir(yaw_deg=5.0)).quaternions(t, ctx)
+    c = att.Spin("+z", rate_deg_s=5.0, phase_deg=10.0, initial=att.Nadir(yaw_deg=5.0)).quaternions(
+        t, ctx
+    )
     same_rotation(a, b)
     same_rotation(a, c)
     # A nadir-pointer spinning about its nadir axis keeps it on the geocentre.
@@ -201,7 +227,10 @@ def test_quaternion_series_slerp_and_range(tmp_path):
         series.quaternions(t0 + np.array([25]) * np.timedelta64(1, "s"))
     # CSV round trip with ISO times.
     path = tmp_path / "att.csv"
-    rows = ["time,qx,qy,qz,qw"] + [f"{np.datetime_as_string(a)}Z,{b[0]},{b[1]},{b[2]},{b[3]}" for a, b in zip(ts, q, strict=True)]
+    rows = ["time,qx,qy,qz,qw"] + [
+        f"{np.datetime_as_string(a)}Z,{b[0]},{b[1]},{b[2]},{b[3]}"
+        for a, b in zip(ts, q, strict=True)
+    ]
     path.write_text("\n".join(rows) + "\n")
     from_csv = att.law_from_dict({"law": "quaternion_series", "path": str(path)})
     same_rotation(from_csv.quaternions(query), series.quaternions(query))

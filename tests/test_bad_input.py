@@ -40,7 +40,9 @@ BASE = {
     "outputs": ["spacecraft_sbrdf", "signal", "brdf", "area"],
     "chunk": 4,
     "attitude": {"kind": "sweep", "axis": [0, 0, 1], "start": 0, "stop": 20, "step": 5},
-    "materials": {m: "lambertian-grey-50" for m in ("aluminium-6061-t6", "tjpv-cell", "white-paint-a276")},
+    "materials": {
+        m: "lambertian-grey-50" for m in ("aluminium-6061-t6", "tjpv-cell", "white-paint-a276")
+    },
 }
 
 
@@ -82,8 +84,12 @@ def toml_value(v) -> str:
 
 def toml_text(d: dict) -> str:
     plain = [f"{json.dumps(k)} = {toml_value(v)}" for k, v in d.items() if not isinstance(v, dict)]
-    tables = [f"\n[{json.dumps(k)}]\n" + "\n".join(f"{json.dumps(a)} = {toml_value(b)}" for a, b in v.items())
-              for k, v in d.items() if isinstance(v, dict)]
+    tables = [
+        f"\n[{json.dumps(k)}]\n"
+        + "\n".join(f"{json.dumps(a)} = {toml_value(b)}" for a, b in v.items())
+        for k, v in d.items()
+        if isinstance(v, dict)
+    ]
     return "\n".join(plain) + "\n" + "\n".join(tables) + "\n"
 
 
@@ -98,16 +104,60 @@ bad_values = st.one_of(
     scalars,
     st.lists(scalars, max_size=4),
     st.lists(st.lists(scalars, max_size=4), max_size=3),  # nested, ragged, strings in numbers
-    st.sampled_from([[], [[]], [[1, 2, 3], [4, 5]], [[0, 0, 1, 0], [1, 0]], [1, [2]], [float("nan")] * 3,
-                     [0, 0, 0], [[0, 0, 0]], [[1e308, 1e308, 1e308]], ["1", "2", "3"]]),
+    st.sampled_from(
+        [
+            [],
+            [[]],
+            [[1, 2, 3], [4, 5]],
+            [[0, 0, 1, 0], [1, 0]],
+            [1, [2]],
+            [float("nan")] * 3,
+            [0, 0, 0],
+            [[0, 0, 0]],
+            [[1e308, 1e308, 1e308]],
+            ["1", "2", "3"],
+        ]
+    ),
     st.dictionaries(st.text(max_size=4), scalars, max_size=2),
 )
-TOP_KEYS = ["name", "description", "spacecraft", "materials", "phase_angles", "bisector",
-            "plane_normal", "outputs", "effects", "method", "dtype", "merge", "shadow_density",
-            "chunk", "bands", "band_extrapolate", "earth_direction", "earth_albedo", "earth_range_km",
-            "earth_phase_angle", "temperature", "unknown_key"]
-ATTITUDE_KEYS = ["kind", "axis", "start", "stop", "step", "initial_axis", "initial_angle", "n", "seed",
-                 "sequence", "angles", "quaternions"]
+TOP_KEYS = [
+    "name",
+    "description",
+    "spacecraft",
+    "materials",
+    "phase_angles",
+    "bisector",
+    "plane_normal",
+    "outputs",
+    "effects",
+    "method",
+    "dtype",
+    "merge",
+    "shadow_density",
+    "chunk",
+    "bands",
+    "band_extrapolate",
+    "earth_direction",
+    "earth_albedo",
+    "earth_range_km",
+    "earth_phase_angle",
+    "temperature",
+    "unknown_key",
+]
+ATTITUDE_KEYS = [
+    "kind",
+    "axis",
+    "start",
+    "stop",
+    "step",
+    "initial_axis",
+    "initial_angle",
+    "n",
+    "seed",
+    "sequence",
+    "angles",
+    "quaternions",
+]
 KINDS = ["sweep", "uniform", "euler", "quaternions", "spiral"]
 
 
@@ -120,12 +170,16 @@ def bad_scenes(draw) -> dict:
     elif where == "attitude":
         kind = draw(st.sampled_from(KINDS))
         d["attitude"] = {"kind": kind, **({"stop": 10} if kind == "sweep" else {})}
-        for key in draw(st.lists(st.sampled_from(ATTITUDE_KEYS), min_size=1, max_size=3, unique=True)):
+        for key in draw(
+            st.lists(st.sampled_from(ATTITUDE_KEYS), min_size=1, max_size=3, unique=True)
+        ):
             d["attitude"][key] = draw(bad_values)
     elif where == "geometry":
         del d["attitude"], d["phase_angles"]
         d["geometry"] = {"to_sun": [[1.0, 0.0, 0.0]], "to_observer": [[0.0, 1.0, 0.0]]}
-        d["geometry"][draw(st.sampled_from(["to_sun", "to_observer", "to_earth"]))] = draw(bad_values)
+        d["geometry"][draw(st.sampled_from(["to_sun", "to_observer", "to_earth"]))] = draw(
+            bad_values
+        )
     else:  # a required or paired key missing
         key = draw(st.sampled_from(["spacecraft", "phase_angles", "attitude", "stop"]))
         if key == "stop":
@@ -156,8 +210,12 @@ def check_scene_file(path: Path, suite: str) -> None:
     COUNTS[f"{suite}:accepted"] += 1
 
 
-@settings(max_examples=300, deadline=None, database=None,
-          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@settings(
+    max_examples=300,
+    deadline=None,
+    database=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
 @given(d=bad_scenes())
 def test_scene_files_give_named_errors(tmp_path, d):
     path = tmp_path / "scene.toml"
@@ -168,8 +226,12 @@ def test_scene_files_give_named_errors(tmp_path, d):
     check_scene_file(path, "scene TOML")
 
 
-@settings(max_examples=40, deadline=None, database=None,
-          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(
+    max_examples=40,
+    deadline=None,
+    database=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
 @given(junk=st.binary(min_size=1, max_size=40), at=st.integers(0, 200))
 def test_scene_file_bytes_give_named_errors(tmp_path, junk, at):
     """Arbitrary bytes (non-UTF-8 among them) spliced into a valid scene file."""
@@ -190,9 +252,18 @@ def test_scene_file_bytes_give_named_errors(tmp_path, junk, at):
         ({"attitude": {"stop": 10, "step": -1}}, "has no attitude"),
         ({"attitude": {"stop": 1e12, "step": 1e-3}}, "at most"),
         ({"attitude": {"kind": "uniform", "n": 10**15}}, "from 1 to"),
-        ({"attitude": {"kind": "quaternions", "quaternions": [[0, 0, 0, 1], [0, 1]]}}, r"quaternions\[1\]"),
-        ({"attitude": {"kind": "quaternions", "quaternions": [[0, 0, "0", 1]]}}, "expected a number"),
-        ({"attitude": {"kind": "euler", "sequence": "zyx", "angles": [[1, 2, 3], [4]]}}, r"angles\[1\]"),
+        (
+            {"attitude": {"kind": "quaternions", "quaternions": [[0, 0, 0, 1], [0, 1]]}},
+            r"quaternions\[1\]",
+        ),
+        (
+            {"attitude": {"kind": "quaternions", "quaternions": [[0, 0, "0", 1]]}},
+            "expected a number",
+        ),
+        (
+            {"attitude": {"kind": "euler", "sequence": "zyx", "angles": [[1, 2, 3], [4]]}},
+            r"angles\[1\]",
+        ),
         ({"phase_angles": [[10.0], [20.0]]}, "expected a number"),
         ({"phase_angles": []}, "phase_angles: the list is empty"),
         ({"outputs": []}, "outputs: the list is empty"),
@@ -251,7 +322,12 @@ def test_nan_and_negative_tables_are_refused():
     grey = catalog.load("lambertian-grey-50")
     for bad, match in ((grey.where(grey.theta_i != 10), "NaN"), (grey - 1.0, "negative")):
         with pytest.raises(SceneError, match=match):
-            Scene(sc, materials={m: bad for m in sc.materials}, attitudes=[[0, 0, 0, 1]], phase_angles=[10.0])
+            Scene(
+                sc,
+                materials={m: bad for m in sc.materials},
+                attitudes=[[0, 0, 0, 1]],
+                phase_angles=[10.0],
+            )
 
 
 def test_zero_area_facet_does_not_warn():
@@ -288,10 +364,24 @@ def files(tmp_path_factory):
 
 addresses = st.one_of(
     st.text(max_size=20),
-    st.sampled_from(["bogus", "tcp://", "tcp://127.0.0.1", "tcp://127.0.0.1:0", "tcp://127.0.0.1:99999",
-                     "tcp://127.0.0.1:-5", "http://127.0.0.1:8786", "tcp://[::1:8786", ":8786",
-                     "tcp://127.0.0.1:8786/path", "tcp://127.0.0.1: 8786", "tcp://bad host:1",
-                     "tcp://127.0.0.1:1", "inproc://x"]),
+    st.sampled_from(
+        [
+            "bogus",
+            "tcp://",
+            "tcp://127.0.0.1",
+            "tcp://127.0.0.1:0",
+            "tcp://127.0.0.1:99999",
+            "tcp://127.0.0.1:-5",
+            "http://127.0.0.1:8786",
+            "tcp://[::1:8786",
+            ":8786",
+            "tcp://127.0.0.1:8786/path",
+            "tcp://127.0.0.1: 8786",
+            "tcp://bad host:1",
+            "tcp://127.0.0.1:1",
+            "inproc://x",
+        ]
+    ),
 )
 
 
@@ -319,36 +409,92 @@ def run_cli(argv: list[str], suite: str, capsys) -> None:
     COUNTS[f"{suite}:named errors"] += 1
 
 
-@settings(max_examples=40, deadline=None, database=None,
-          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(
+    max_examples=40,
+    deadline=None,
+    database=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
 @given(address=addresses)
 def test_bad_scheduler_addresses(files, address, capsys):
     out = files / "never.nc"
     with dask.config.set({"distributed.comm.timeouts.connect": "2s"}):
-        run_cli(["simulate", str(files / "scene.toml"), "-o", str(out), "-q", "--scheduler", address],
-                "CLI scheduler", capsys)
+        run_cli(
+            ["simulate", str(files / "scene.toml"), "-o", str(out), "-q", "--scheduler", address],
+            "CLI scheduler",
+            capsys,
+        )
     assert not out.exists()
 
 
-OUTPUTS = ["/proc/sbrdf/x.nc", "/proc/x.nc", "/dev/null", "{d}/adir.nc", "{d}/file.txt/x.nc", "{d}/",
-           "/sys/x.nc", ""]
-NON_CUBES = ["text.nc", "empty.nc", "binary.nc", "hdf5.nc", "material.nc", "adir.nc", "missing.nc",
-             "file.txt", "scene.toml"]
+OUTPUTS = [
+    "/proc/sbrdf/x.nc",
+    "/proc/x.nc",
+    "/dev/null",
+    "{d}/adir.nc",
+    "{d}/file.txt/x.nc",
+    "{d}/",
+    "/sys/x.nc",
+    "",
+]
+NON_CUBES = [
+    "text.nc",
+    "empty.nc",
+    "binary.nc",
+    "hdf5.nc",
+    "material.nc",
+    "adir.nc",
+    "missing.nc",
+    "file.txt",
+    "scene.toml",
+]
 
 
-@settings(max_examples=60, deadline=None, database=None,
-          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(
+    max_examples=60,
+    deadline=None,
+    database=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
 @given(
     argv=st.one_of(
-        st.tuples(st.just("simulate"), st.just("{d}/scene.toml"), st.just("-o"), st.sampled_from(OUTPUTS)),
+        st.tuples(
+            st.just("simulate"), st.just("{d}/scene.toml"), st.just("-o"), st.sampled_from(OUTPUTS)
+        ),
         st.tuples(st.just("info"), st.sampled_from(NON_CUBES)),
-        st.tuples(st.just("plot"), st.sampled_from(NON_CUBES), st.just("-o"), st.just("{d}/fig.png")),
+        st.tuples(
+            st.just("plot"), st.sampled_from(NON_CUBES), st.just("-o"), st.just("{d}/fig.png")
+        ),
         st.tuples(st.just("plot"), st.just("{d}/text.nc"), st.just("-o"), st.sampled_from(OUTPUTS)),
-        st.tuples(st.just("photometry"), st.sampled_from(NON_CUBES), st.just("--bands"), st.just("V"),
-                  st.just("--range-km"), st.sampled_from(["36000", "nan", "-1", "x"])),
+        st.tuples(
+            st.just("photometry"),
+            st.sampled_from(NON_CUBES),
+            st.just("--bands"),
+            st.just("V"),
+            st.just("--range-km"),
+            st.sampled_from(["36000", "nan", "-1", "x"]),
+        ),
         st.tuples(st.just("catalog"), st.just("show"), st.text(max_size=12)),
-        st.lists(st.sampled_from(["simulate", "info", "plot", "-o", "--resume", "--overwrite", "x.nc",
-                                  "--plan", "--preset", "warp", "catalog", "show", "--bands"]), max_size=5),
+        st.lists(
+            st.sampled_from(
+                [
+                    "simulate",
+                    "info",
+                    "plot",
+                    "-o",
+                    "--resume",
+                    "--overwrite",
+                    "x.nc",
+                    "--plan",
+                    "--preset",
+                    "warp",
+                    "catalog",
+                    "show",
+                    "--bands",
+                ]
+            ),
+            max_size=5,
+        ),
     )
 )
 def test_bad_command_lines(files, argv, capsys):
@@ -364,8 +510,10 @@ def test_bad_command_lines(files, argv, capsys):
 def test_info_escapes_control_characters(tmp_path, capsys):
     import xarray as xr
 
-    ds = xr.Dataset({"v": ("x", [1.0], {"units": "1", "long_name": "bell\x07 and \x1b[2J clear"})},
-                    attrs={"title": "\x1b]0;pwned\x07\x1b[31mred\nfake line"})
+    ds = xr.Dataset(
+        {"v": ("x", [1.0], {"units": "1", "long_name": "bell\x07 and \x1b[2J clear"})},
+        attrs={"title": "\x1b]0;pwned\x07\x1b[31mred\nfake line"},
+    )
     ds.to_netcdf(tmp_path / "evil.nc")
     assert main(["info", str(tmp_path / "evil.nc")]) == 0
     out = capsys.readouterr().out
@@ -386,8 +534,20 @@ def test_catalog_show_escapes_control_characters(tmp_path, capsys, monkeypatch):
 
 def test_unreachable_scheduler_is_one_line(files, capsys):
     with dask.config.set({"distributed.comm.timeouts.connect": "1s"}):
-        assert main(["simulate", str(files / "scene.toml"), "-o", str(files / "n.nc"), "-q",
-                     "--scheduler", "tcp://127.0.0.1:9"]) == 2
+        assert (
+            main(
+                [
+                    "simulate",
+                    str(files / "scene.toml"),
+                    "-o",
+                    str(files / "n.nc"),
+                    "-q",
+                    "--scheduler",
+                    "tcp://127.0.0.1:9",
+                ]
+            )
+            == 2
+        )
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "cannot connect to the Dask scheduler at tcp://127.0.0.1:9" in err[0]
 

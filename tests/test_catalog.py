@@ -51,10 +51,18 @@ def test_built_entry_equals_build_lut_of_its_measurements_and_is_a_copy():
 def test_installed_package_finds_its_catalogs_from_any_directory(tmp_path):
     """After `pip install .` the catalogs ship inside the package (not editable)."""
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
-    code = ("import sbrdf_xr, sbrdf_xr.catalog as c; print(sbrdf_xr.__file__); "
-            "print(c.catalog_dir()); print(len(c.names()))")
-    res = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env,
-                         capture_output=True, text=True, check=False)
+    code = (
+        "import sbrdf_xr, sbrdf_xr.catalog as c; print(sbrdf_xr.__file__); "
+        "print(c.catalog_dir()); print(len(c.names()))"
+    )
+    res = subprocess.run(
+        [sys.executable, "-c", code],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     if res.returncode != 0 and "No module named 'sbrdf_xr'" in res.stderr:
         pytest.skip("sbrdf_xr is not installed in this interpreter (source-tree run)")
     assert res.returncode == 0, res.stderr

@@ -54,7 +54,11 @@ def test_bench_quick_runs_and_reports_ratios(capsys, tmp_path):
     assert main(["bench", "--quick", "--csv", str(csv), "-o", str(nc), "--plot", str(png)]) == 0
     out = capsys.readouterr().out
     assert "sbrdf_xr linear look-up kernel" in out and "xarray .interp (linear)" in out
-    assert "lookup method: linear" in out and "band pre-integration" in out and "shadowing: sampled density" in out
+    assert (
+        "lookup method: linear" in out
+        and "band pre-integration" in out
+        and "shadowing: sampled density" in out
+    )
     ds = xr.open_dataset(nc)
     # The reference row is its own baseline; float32 changes magnitudes by far less than 1 mmag.
     ref = [c for c in ds.case.values if c.startswith("reference")]
@@ -62,6 +66,8 @@ def test_bench_quick_runs_and_reports_ratios(capsys, tmp_path):
     f32 = ds.mmag_max.sel(case="precision: float32").values
     assert np.all(f32 < 0.1)
     # The analytic generating models differ from the tabulated reference (the table method's error).
-    assert np.all(ds.mmag_max.sel(case="materials: analytic generating models (ground truth)").values > 1)
+    assert np.all(
+        ds.mmag_max.sel(case="materials: analytic generating models (ground truth)").values > 1
+    )
     ds.close()
     assert csv.stat().st_size > 0 and png.stat().st_size > 0

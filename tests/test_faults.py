@@ -67,7 +67,9 @@ def fault_table(request):
     lines = [f"{'fault-injection trials':<28}{'trials':>7}" + "".join(f"{o:>22}" for o in OUTCOMES)]
     for kind in [*kinds, "all"]:
         rows = [o for k, o in TRIALS if kind in (k, "all")]
-        lines.append(f"{kind:<28}{len(rows):>7}" + "".join(f"{rows.count(o):>22}" for o in OUTCOMES))
+        lines.append(
+            f"{kind:<28}{len(rows):>7}" + "".join(f"{rows.count(o):>22}" for o in OUTCOMES)
+        )
     reporter = request.config.pluginmanager.get_plugin("terminalreporter")
     capman = request.config.pluginmanager.getplugin("capturemanager")
     with capman.global_and_fixture_disabled() if capman else contextlib.nullcontext():
@@ -140,8 +142,12 @@ def writer(tmp_path: Path, **args) -> subprocess.Popen:
     script = tmp_path / "writer.py"
     if not script.exists():
         script.write_text(WRITER.format(repo=str(REPO), tests=str(TESTS)))
-    return subprocess.Popen([sys.executable, str(script), json.dumps(args)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(
+        [sys.executable, str(script), json.dumps(args)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
 
 
 def result(proc: subprocess.Popen) -> dict:
@@ -223,8 +229,9 @@ def test_file_size_limit(tmp_path, reference, check_space):
             assert not check_space, r
             continue
         # Still "full": resuming is refused with the cause, not a traceback.
-        again = result(writer(path.parent, path=str(path), limit=limit, resume=True,
-                              check_space=check_space))
+        again = result(
+            writer(path.parent, path=str(path), limit=limit, resume=True, check_space=check_space)
+        )
         assert not again["ok"] and again["named"], again
         assert "file size limit exceeded" in again["message"], again
         # Space freed: resume finishes the cube from the blocks kept.
@@ -253,7 +260,9 @@ def test_two_writers_on_one_path(tmp_path, reference):
     first = writer(tmp_path, path=str(path), overwrite=True, delay=0.4)  # about 5 s
     deadline = time.monotonic() + TIMEOUT
     while len(recorded(path)) < 2:
-        assert first.poll() is None and time.monotonic() < deadline, "the first writer did not start"
+        assert first.poll() is None and time.monotonic() < deadline, (
+            "the first writer did not start"
+        )
         time.sleep(0.01)
     lock = json.loads(path.with_name(path.name + LOCK_SUFFIX).read_text())
     assert lock["pid"] == first.pid and lock["host"] == socket.gethostname() and lock["started"]
@@ -271,22 +280,34 @@ def test_two_writers_on_one_path(tmp_path, reference):
 
 def test_stale_lock_of_a_dead_writer_is_removed_with_a_message(tmp_path, caplog):
     path = tmp_path / "cube.nc"
-    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
-                          capture_output=True, text=True, check=True)
+    dead = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     pid = int(dead.stdout)
     lock = path.with_name(path.name + LOCK_SUFFIX)
-    lock.write_text(json.dumps({"pid": pid, "host": socket.gethostname(), "started": "2026-01-01T00:00:00+00:00"}))
+    lock.write_text(
+        json.dumps(
+            {"pid": pid, "host": socket.gethostname(), "started": "2026-01-01T00:00:00+00:00"}
+        )
+    )
     with caplog.at_level(logging.WARNING, logger="sbrdf_xr.write_cube"):
         write_cube(make_cube(), path)
-    assert any(f"pid {pid}" in r.getMessage() and "no longer running" in r.getMessage()
-               for r in caplog.records)
+    assert any(
+        f"pid {pid}" in r.getMessage() and "no longer running" in r.getMessage()
+        for r in caplog.records
+    )
     assert not lock.exists()
 
 
 def test_lock_of_another_host_is_left_alone(tmp_path):
     path = tmp_path / "cube.nc"
     lock = path.with_name(path.name + LOCK_SUFFIX)
-    lock.write_text(json.dumps({"pid": 1, "host": "elsewhere.example", "started": "2026-01-01T00:00:00+00:00"}))
+    lock.write_text(
+        json.dumps({"pid": 1, "host": "elsewhere.example", "started": "2026-01-01T00:00:00+00:00"})
+    )
     with pytest.raises(CubeLockedError, match=r"elsewhere\.example.*remove"):
         write_cube(make_cube(), path)
     assert lock.exists() and not path.exists()
@@ -343,8 +364,11 @@ def _device(p: Path) -> None:
         pytest.skip("creating a device node needs privileges")
 
 
-@pytest.mark.parametrize("make", [_fifo, _symlink, _dangling, _directory, _device],
-                         ids=["fifo", "symlink", "dangling-symlink", "directory", "device"])
+@pytest.mark.parametrize(
+    "make",
+    [_fifo, _symlink, _dangling, _directory, _device],
+    ids=["fifo", "symlink", "dangling-symlink", "directory", "device"],
+)
 @pytest.mark.parametrize("which", ["path", "part"])
 def test_overwrite_replaces_only_regular_files(tmp_path, make, which):
     path = tmp_path / "cube.nc"
@@ -436,8 +460,12 @@ def test_resume_after_a_changed_table_is_refused(tmp_path, capsys):
     path = tmp_path / "cube.nc"
     script = tmp_path / "killer.py"
     script.write_text(KILLER.format(repo=str(REPO)))
-    proc = subprocess.run([sys.executable, str(script), str(scene), str(path)], timeout=TIMEOUT,
-                          capture_output=True, text=True)
+    proc = subprocess.run(
+        [sys.executable, str(script), str(scene), str(path)],
+        timeout=TIMEOUT,
+        capture_output=True,
+        text=True,
+    )
     assert proc.returncode == -signal.SIGKILL, proc.stderr[-2000:]
     assert sorted(recorded(path)) == list(range(8)) and not path.exists()
     part, log = (path.with_name(path.name + s) for s in (PART_SUFFIX, LOG_SUFFIX))

@@ -146,8 +146,14 @@ def test_normal_incidence_is_finite_and_continuous(theta_i_deg):
     s = np.array([np.sin(t), 0.0, np.cos(t)])
     # Observers all around the normal at 30 deg, and one along the normal.
     az = np.radians(np.arange(0, 360, 15.0))
-    o = np.stack([np.sin(np.radians(30)) * np.cos(az), np.sin(np.radians(30)) * np.sin(az),
-                  np.full_like(az, np.cos(np.radians(30)))], -1)
+    o = np.stack(
+        [
+            np.sin(np.radians(30)) * np.cos(az),
+            np.sin(np.radians(30)) * np.sin(az),
+            np.full_like(az, np.cos(np.radians(30))),
+        ],
+        -1,
+    )
     o = np.vstack([o, n])
     a = _no_warnings(g.facet_angles, n, s, o)
     for x in a[:3]:
@@ -272,9 +278,13 @@ def test_rotation_sweep_of_the_paper_rotation_scenario():
     sb = g.to_body_frame(q, s)
     ob = g.to_body_frame(q, o)
     # At 25 deg of rotation the body +x axis points along the bisector (+x): +X glints.
-    np.testing.assert_allclose((sb[1] + ob[1]) / np.linalg.norm(sb[1] + ob[1]), [1, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(
+        (sb[1] + ob[1]) / np.linalg.norm(sb[1] + ob[1]), [1, 0, 0], atol=1e-12
+    )
     # 90 deg later the bisector is along body +y.
-    np.testing.assert_allclose((sb[2] + ob[2]) / np.linalg.norm(sb[2] + ob[2]), [0, 1, 0], atol=1e-12)
+    np.testing.assert_allclose(
+        (sb[2] + ob[2]) / np.linalg.norm(sb[2] + ob[2]), [0, 1, 0], atol=1e-12
+    )
     assert g.phase_angle(sb, ob) == pytest.approx(np.full(3, 10.0))
 
 
@@ -307,5 +317,8 @@ def test_quaternions_that_are_not_rotations_are_rejected(q):
 def test_compose_matches_matrix_product():
     a = g.axis_rotation([1, 2, 3], 40.0)
     b = g.axis_rotation([0, 1, 0], -70.0)
-    np.testing.assert_allclose(g.rotation_matrices(g.compose(a, b)),
-                               g.rotation_matrices(a) @ g.rotation_matrices(b), atol=1e-12)
+    np.testing.assert_allclose(
+        g.rotation_matrices(g.compose(a, b)),
+        g.rotation_matrices(a) @ g.rotation_matrices(b),
+        atol=1e-12,
+    )

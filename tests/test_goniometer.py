@@ -55,7 +55,11 @@ def test_measure_noise_and_references():
 
 @pytest.mark.parametrize(
     ("kw", "match"),
-    [({"noise": -0.1}, "noise"), ({"noise_floor": 0.0}, "noise_floor"), ({"dynamic_range": 2.0}, "dynamic_range")],
+    [
+        ({"noise": -0.1}, "noise"),
+        ({"noise_floor": 0.0}, "noise_floor"),
+        ({"dynamic_range": 2.0}, "dynamic_range"),
+    ],
 )
 def test_measure_bad_input(kw, match):
     wl = np.linspace(400, 1100, 5)

@@ -59,11 +59,24 @@ def _compare(s, o, normals, areas, mat, tables, method, dtype, fraction=None):
     area = np.zeros(s.shape[0])
     for m, (v, tg, dg, pg, e, blend) in enumerate(tables):
         sel = mat == m
-        r = material_sums(s, o, normals[sel], areas[sel], v, tg, dg, pg, method,
-                          None if fraction is None else fraction[:, sel], e, blend)
+        r = material_sums(
+            s,
+            o,
+            normals[sel],
+            areas[sel],
+            v,
+            tg,
+            dg,
+            pg,
+            method,
+            None if fraction is None else fraction[:, sel],
+            e,
+            blend,
+        )
         scale = max(np.abs(r.signal).max(), 1e-300)
-        np.testing.assert_allclose(got.per_material[:, m], r.signal, rtol=0,
-                                   atol=RTOL[dtype] * scale)
+        np.testing.assert_allclose(
+            got.per_material[:, m], r.signal, rtol=0, atol=RTOL[dtype] * scale
+        )
         sig += r.signal
         pap += r.paper
         area += r.area
@@ -74,10 +87,16 @@ def _compare(s, o, normals, areas, mat, tables, method, dtype, fraction=None):
 
 
 @settings(max_examples=40, deadline=None)
-@given(seed=st.integers(0, 2**31 - 1), method=st.sampled_from(["nearest", "linear", "cubic"]),
-       dtype=st.sampled_from(["float64", "float32"]), n_mat=st.integers(1, 3),
-       shadowed=st.booleans())
-def test_fused_kernel_equals_the_numpy_reference_on_random_scenes(seed, method, dtype, n_mat, shadowed):
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    method=st.sampled_from(["nearest", "linear", "cubic"]),
+    dtype=st.sampled_from(["float64", "float32"]),
+    n_mat=st.integers(1, 3),
+    shadowed=st.booleans(),
+)
+def test_fused_kernel_equals_the_numpy_reference_on_random_scenes(
+    seed, method, dtype, n_mat, shadowed
+):
     rng = np.random.default_rng(seed)
     tables = _tables(seed, n_mat, dtype)
     n_terms, n_geom = int(rng.integers(1, 30)), int(rng.integers(1, 40))
@@ -85,7 +104,9 @@ def test_fused_kernel_equals_the_numpy_reference_on_random_scenes(seed, method, 
     areas = rng.uniform(0, 2, n_terms)
     mat = np.sort(rng.integers(0, n_mat, n_terms))
     frac = rng.uniform(0, 1, (n_geom, n_terms)) if shadowed else None
-    _compare(_unit(rng, n_geom), _unit(rng, n_geom), normals, areas, mat, tables, method, dtype, frac)
+    _compare(
+        _unit(rng, n_geom), _unit(rng, n_geom), normals, areas, mat, tables, method, dtype, frac
+    )
 
 
 @pytest.mark.parametrize("dtype", ["float64", "float32"])
@@ -97,13 +118,25 @@ def test_hard_geometries(method, dtype):
     areas = np.array([1.0, 0.0, 2.0, 0.5])  # a zero-area facet
     tiny = 1e-9
     pairs = []
-    for ti, dt, ph in [(0.0, 0.0, 0.0), (0.0, 30.0, 10.0), (1e-12, 5.0, 0.0), (40.0, 0.0, 0.0),
-                       (60.0, -60.0, 0.0), (89.999, 0.0, 0.0), (30.0, 59.9999, 0.0), (45.0, -3.0, 80.0)]:
+    for ti, dt, ph in [
+        (0.0, 0.0, 0.0),
+        (0.0, 30.0, 10.0),
+        (1e-12, 5.0, 0.0),
+        (40.0, 0.0, 0.0),
+        (60.0, -60.0, 0.0),
+        (89.999, 0.0, 0.0),
+        (30.0, 59.9999, 0.0),
+        (45.0, -3.0, 80.0),
+    ]:
         _, s, o = geometry.facet_vectors(ti, dt, ph)
         pairs.append((s, o))
     z = np.array([0.0, 0.0, 1.0])
-    pairs += [(z, z), (z, -z), (np.array([np.sin(tiny), 0, np.cos(tiny)]), z),
-              (np.array([1.0, 0, 0]), np.array([-1.0, 0, 0]))]
+    pairs += [
+        (z, z),
+        (z, -z),
+        (np.array([np.sin(tiny), 0, np.cos(tiny)]), z),
+        (np.array([1.0, 0, 0]), np.array([-1.0, 0, 0])),
+    ]
     s = np.array([p[0] for p in pairs])
     o = np.array([p[1] for p in pairs])
     tables = _tables(3, 2, dtype, edges=(True, True, True))
@@ -128,7 +161,8 @@ def test_merged_canx1_terms_match_on_a_rotation():
     from sbrdf_xr.simulate import simulate
 
     scene = builtin_scene("canx1-rotation").with_options(
-        attitudes=geometry.rotation_sweep([0, 0, 1], np.arange(0, 360, 10.0)), attitude_angle=None)
+        attitudes=geometry.rotation_sweep([0, 0, 1], np.arange(0, 360, 10.0)), attitude_angle=None
+    )
     fused = simulate(scene).compute()
     ref = simulate(scene, kernel="numpy").compute()
     for v in ("signal", "spacecraft_sbrdf", "signal_material", "area"):
@@ -139,8 +173,15 @@ def test_merged_canx1_terms_match_on_a_rotation():
 def test_unsorted_materials_are_refused():
     tables = _tables(1, 2, "float64")
     with pytest.raises(ValueError, match="contiguous"):
-        fused_sums(np.eye(3)[:1], np.eye(3)[:1], np.eye(3)[:2], np.ones(2), np.array([1, 0]),
-                   pack_tables(tables, 5), "linear")
+        fused_sums(
+            np.eye(3)[:1],
+            np.eye(3)[:1],
+            np.eye(3)[:2],
+            np.ones(2),
+            np.array([1, 0]),
+            pack_tables(tables, 5),
+            "linear",
+        )
 
 
 def test_cube_spacecraft_through_both_kernels():
@@ -149,9 +190,16 @@ def test_cube_spacecraft_through_both_kernels():
     from sbrdf_xr.simulate import simulate
 
     sc = T.cube_spacecraft(1.0, subdivisions=2)
-    scene = Scene(sc, materials={T.TEST_SPACECRAFT_MATERIAL: catalog.load("example-lobe")},
-                  attitudes=geometry.uniform_attitudes(25, seed=2), phase_angles=[0.0, 30.0, 179.9],
-                  method="cubic", merge=False)
+    scene = Scene(
+        sc,
+        materials={T.TEST_SPACECRAFT_MATERIAL: catalog.load("example-lobe")},
+        attitudes=geometry.uniform_attitudes(25, seed=2),
+        phase_angles=[0.0, 30.0, 179.9],
+        method="cubic",
+        merge=False,
+    )
     a = simulate(scene).compute()
     b = simulate(scene, kernel="numpy").compute()
-    np.testing.assert_allclose(a.signal, b.signal, rtol=0, atol=1e-12 * float(np.abs(b.signal).max()))
+    np.testing.assert_allclose(
+        a.signal, b.signal, rtol=0, atol=1e-12 * float(np.abs(b.signal).max())
+    )

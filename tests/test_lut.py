@@ -103,7 +103,9 @@ def test_weighted_lookup_matrix_sums_weighted_spectra():
 
 @settings(max_examples=200, deadline=None)
 @given(
-    ti=st.floats(-10, 100), dt=st.floats(-60, 50), ph=st.floats(0, 10),
+    ti=st.floats(-10, 100),
+    dt=st.floats(-60, 50),
+    ph=st.floats(0, 10),
     method=st.sampled_from(["nearest", "linear", "cubic"]),
 )
 def test_lookup_is_finite_nonnegative_and_bounded(ti, dt, ph, method):
@@ -199,4 +201,6 @@ def test_hemispherical_reflectance_of_narrow_band_matches_closed_form():
 def test_empty_query_gives_empty_results():
     m = _lut.lookup_matrix(TI, DT, PH, np.array([]), np.array([]), np.array([]))
     assert m.shape == (0, TI.size * DT.size * PH.size)
-    assert _lut.lookup_kernel(table(), TI, DT, PH, np.array([]), np.array([]), np.array([])).shape == (0, 3)
+    assert _lut.lookup_kernel(
+        table(), TI, DT, PH, np.array([]), np.array([]), np.array([])
+    ).shape == (0, 3)

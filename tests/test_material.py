@@ -42,7 +42,10 @@ def test_new_material_carries_cf_attributes():
         (lambda d: d.isel(wavelength=0), "dims must be"),
         (lambda d: d.assign_attrs(units="1"), "sbrdf: units"),
         (lambda d: d.assign_coords(phi=d.phi.assign_attrs(units="rad")), "phi: units"),
-        (lambda d: d.isel(delta_theta=slice(None, None, -1)), "delta_theta: coordinate must be strictly increasing"),
+        (
+            lambda d: d.isel(delta_theta=slice(None, None, -1)),
+            "delta_theta: coordinate must be strictly increasing",
+        ),
         (lambda d: d.where(d.theta_i != 30), "NaN"),
         (lambda d: d - 10.0, "negative"),
         (lambda d: d.assign_coords(theta_i=d.theta_i + 5), r"theta_i: must lie in \[0, 90\]"),
@@ -84,7 +87,9 @@ def test_lookup_wrapper_labels_and_matches_xarray_interp():
     assert out.dims == ("geom", "wavelength")
     assert out.attrs["units"] == "sr-1" and out.attrs["lookup_method"] == "linear"
     np.testing.assert_array_equal(out.wavelength, da.wavelength)
-    ref = da.interp(theta_i=ti, delta_theta=dt, phi=ph, method="linear").transpose("geom", "wavelength")
+    ref = da.interp(theta_i=ti, delta_theta=dt, phi=ph, method="linear").transpose(
+        "geom", "wavelength"
+    )
     np.testing.assert_allclose(out.values, ref.values, rtol=1e-12)
 
 
@@ -200,8 +205,15 @@ def test_build_lut_error_against_truth_is_small_inside_the_measured_range(meas):
 
 
 def test_build_lut_options_and_dtype(meas):
-    lut = M.build_lut(meas, n_phi=11, n_delta_theta=11, theta_i=np.arange(0, 91, 5.0),
-                      extrapolation="constant", dtype=np.float32, normal_incidence="paper")
+    lut = M.build_lut(
+        meas,
+        n_phi=11,
+        n_delta_theta=11,
+        theta_i=np.arange(0, 91, 5.0),
+        extrapolation="constant",
+        dtype=np.float32,
+        normal_incidence="paper",
+    )
     assert lut.dtype == np.float32 and lut.sizes["phi"] == 11 and lut.sizes["delta_theta"] == 11
     # Constant extrapolation below 10 deg: rows equal the 10-degree row of the spline.
     np.testing.assert_allclose(lut.sel(theta_i=0.0), lut.sel(theta_i=5.0), rtol=1e-6)
@@ -212,9 +224,16 @@ def test_build_lut_options_and_dtype(meas):
     [
         (lambda d: d.isel(sample=slice(0, 0)), "empty"),
         (lambda d: d.isel(sample=d.theta_i == 10.0), "need measurements at >= 2 incidence angles"),
-        (lambda d: d.assign(measured_sbrdf=d.measured_sbrdf.where(d.sample != 1).assign_attrs(units="sr-1")),
-         r"NaN or infinite values in sample\(s\) \[1\]"),
-        (lambda d: d.assign(measured_sbrdf=(d.measured_sbrdf - 5).assign_attrs(units="sr-1")), "negative"),
+        (
+            lambda d: d.assign(
+                measured_sbrdf=d.measured_sbrdf.where(d.sample != 1).assign_attrs(units="sr-1")
+            ),
+            r"NaN or infinite values in sample\(s\) \[1\]",
+        ),
+        (
+            lambda d: d.assign(measured_sbrdf=(d.measured_sbrdf - 5).assign_attrs(units="sr-1")),
+            "negative",
+        ),
         (lambda d: d.assign_coords(phi=d.phi.assign_attrs(units="rad")), "phi: units"),
         (lambda d: d.drop_vars("delta_theta"), "delta_theta: coordinate over 'sample' is missing"),
         (lambda d: d.rename(measured_sbrdf="brdf"), "lacks the data variable 'measured_sbrdf'"),
@@ -235,8 +254,11 @@ def test_single_row_incidence_angle_is_rejected(meas):
 
 
 def test_hemispherical_reflectance_wrapper_and_warning():
-    full = dict(theta_i=np.array([0.0, 45.0, 90.0]), delta_theta=np.array([-180.0, 0.0, 90.0]),
-                phi=np.array([0.0, 45.0, 90.0]))
+    full = dict(
+        theta_i=np.array([0.0, 45.0, 90.0]),
+        delta_theta=np.array([-180.0, 0.0, 90.0]),
+        phi=np.array([0.0, 45.0, 90.0]),
+    )
     lam = testing.make_material(value=0.5 / np.pi, **full)
     rho = lam.sbrdf.hemispherical_reflectance()
     assert rho.dims == ("theta_i", "wavelength") and rho.attrs["units"] == "1"
@@ -280,7 +302,9 @@ def test_repeated_geometries_are_a_named_error_or_averaged(meas):
     # One sample repeated with a 3x spectrum: an error naming the geometry, or the mean.
     rep = xr.concat([meas, meas.isel(sample=[5])], dim="sample")
     rep["measured_sbrdf"].values[-1] *= 3.0
-    with pytest.raises(ValidationError, match=r"repeat 1 geometry .* samples \[5, 150\].*duplicates='mean'"):
+    with pytest.raises(
+        ValidationError, match=r"repeat 1 geometry .* samples \[5, 150\].*duplicates='mean'"
+    ):
         M.build_lut(rep)
     avg = M.build_lut(rep, duplicates="mean", check_energy=False)
     fixed = meas.copy(deep=True)
@@ -290,8 +314,12 @@ def test_repeated_geometries_are_a_named_error_or_averaged(meas):
     both = xr.concat([meas, meas], dim="sample")
     with pytest.raises(ValidationError, match="150 geometries"):
         M.build_lut(both)
-    np.testing.assert_allclose(M.build_lut(both, duplicates="mean", check_energy=False),
-                               M.build_lut(meas, check_energy=False), rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(
+        M.build_lut(both, duplicates="mean", check_energy=False),
+        M.build_lut(meas, check_energy=False),
+        rtol=1e-12,
+        atol=1e-15,
+    )
     with pytest.raises(ValidationError, match="duplicates: got 'sum'"):
         M.build_lut(meas, duplicates="sum")
 
@@ -307,8 +335,16 @@ def test_below_noise_model_fill_keeps_the_floor_and_the_measurements():
     from sbrdf_xr import models
 
     wl = np.linspace(450.0, 1000.0, 4)
-    spec = models.model_material("microfacet", wl, material="gloss", provenance="test",
-                                 roughness=0.1, n=1.5, k=0.0, rho_d=0.05)
+    spec = models.model_material(
+        "microfacet",
+        wl,
+        material="gloss",
+        provenance="test",
+        roughness=0.1,
+        n=1.5,
+        k=0.0,
+        rho_d=0.05,
+    )
     meas = models.measure(spec, (10.0, 25.0, 40.0, 55.0, 70.0))
     assert meas.reference.any()
     # The theta_i = 90 row of a glossy table is not resolved by its grid (the lobe meets
@@ -326,12 +362,17 @@ def test_below_noise_model_fill_keeps_the_floor_and_the_measurements():
     # interpolated on the grid: within the linear-interpolation error of the lobe
     # (nodes ~1 deg apart on a lobe of alpha = 0.1: up to 16 %).
     sel = ((meas.theta_i == 40.0) & ~meas.reference).values
-    got = M.lookup(filled, meas.theta_i.values[sel], meas.delta_theta.values[sel], meas.phi.values[sel])
+    got = M.lookup(
+        filled, meas.theta_i.values[sel], meas.delta_theta.values[sel], meas.phi.values[sel]
+    )
     np.testing.assert_allclose(got, meas.measured_sbrdf.values[sel], rtol=0.2)
     # Energy: the filled table keeps the model's reflectance (interpolation: 2 %).
     rho_m = models._params(spec)[0].directional_hemispherical_reflectance(
-        [20.0, 40.0, 60.0], wl, **models._params(spec)[2])
-    np.testing.assert_allclose(M.hemispherical_reflectance(filled, [20.0, 40.0, 60.0]), rho_m, rtol=0.02)
+        [20.0, 40.0, 60.0], wl, **models._params(spec)[2]
+    )
+    np.testing.assert_allclose(
+        M.hemispherical_reflectance(filled, [20.0, 40.0, 60.0]), rho_m, rtol=0.02
+    )
     with pytest.raises(ValidationError, match="below_noise"):
         M.build_lut(meas, below_noise="floor")
 
@@ -363,14 +404,16 @@ def test_lambertian_material_is_exact_everywhere(method):
     for albedo in (0.3, np.array([0.1, 0.5, 0.9])):
         lam = M.lambertian(albedo, wl)
         got = M.lookup(lam, a.theta_i, a.delta_theta, a.phi, method=method).values
-        np.testing.assert_allclose(got, np.broadcast_to(np.asarray(albedo) / np.pi, got.shape),
-                                   rtol=1e-12)
+        np.testing.assert_allclose(
+            got, np.broadcast_to(np.asarray(albedo) / np.pi, got.shape), rtol=1e-12
+        )
         rho = M.hemispherical_reflectance(lam, [0.0, 45.0, 89.0])
         # Gauss-Legendre on the constant integrand: ~1e-13
         np.testing.assert_allclose(rho, np.broadcast_to(albedo, rho.shape), rtol=1e-10)
     const = M.constant_material([0.1, 0.2, 0.3], wl, material="c")
-    np.testing.assert_allclose(M.lookup(const, 89.9, -179.0, 89.9, method=method), [0.1, 0.2, 0.3],
-                               rtol=1e-12)
+    np.testing.assert_allclose(
+        M.lookup(const, 89.9, -179.0, 89.9, method=method), [0.1, 0.2, 0.3], rtol=1e-12
+    )
     with pytest.raises(ValidationError, match="rho"):
         M.lambertian(1.5, wl)
     with pytest.raises(ValidationError, match="value: expected"):
@@ -385,7 +428,9 @@ def _sun_azimuth_spread(table, theta_r, obs_az, dtype, ti_deg=1e-6, n_az=48):
 
     ti = np.radians(ti_deg)
     th = np.radians(theta_r)
-    o = np.array([np.sin(th) * np.cos(obs_az), np.sin(th) * np.sin(obs_az), np.cos(th)], dtype=dtype)
+    o = np.array(
+        [np.sin(th) * np.cos(obs_az), np.sin(th) * np.sin(obs_az), np.cos(th)], dtype=dtype
+    )
     az = np.linspace(0.0, 2 * np.pi, n_az, endpoint=False)
     s = np.stack([np.sin(ti) * np.cos(az), np.sin(ti) * np.sin(az), np.full(n_az, np.cos(ti))], -1)
     a = geometry.facet_angles(np.array([0, 0, 1], dtype=dtype), s.astype(dtype), o[None, :])
@@ -396,9 +441,14 @@ def _sun_azimuth_spread(table, theta_r, obs_az, dtype, ti_deg=1e-6, n_az=48):
 
 
 @settings(max_examples=25, deadline=None)
-@given(theta_r=st.floats(0.0, 85.0), obs_az=st.floats(0.0, 2 * np.pi),
-       dtype=st.sampled_from([np.float64, np.float32]))
-def test_normal_incidence_lookup_does_not_depend_on_the_sun_azimuth(meas_symmetric, theta_r, obs_az, dtype):
+@given(
+    theta_r=st.floats(0.0, 85.0),
+    obs_az=st.floats(0.0, 2 * np.pi),
+    dtype=st.sampled_from([np.float64, np.float32]),
+)
+def test_normal_incidence_lookup_does_not_depend_on_the_sun_azimuth(
+    meas_symmetric, theta_r, obs_az, dtype
+):
     # theta_i = 1e-6 deg: the look-up is the theta_i = 0 row's profile at the observer's
     # polar angle (weight 1 - 3e-13), the same for every Sun azimuth.  float32 angles
     # carry ~1e-7 relative rounding; the bounds are the 0.1 % and 0.5 %.
@@ -413,7 +463,9 @@ def test_normal_incidence_of_the_paper_construction_does_depend_on_the_sun_azimu
 
 def test_normal_incidence_row_is_the_azimuthal_average(meas_symmetric):
     lut = meas_symmetric
-    assert lut.attrs["normal_incidence"] == "symmetric" and lut.attrs["normal_incidence_blend"] == 5.0
+    assert (
+        lut.attrs["normal_incidence"] == "symmetric" and lut.attrs["normal_incidence_blend"] == 5.0
+    )
     row = lut.isel(theta_i=0)
     # A function of theta_r only: equal at (dt, 0) and (0, phi) for the same theta_r
     # where both are nodes of the symmetric part (linear interpolation of that function
@@ -425,14 +477,25 @@ def test_normal_incidence_row_is_the_azimuthal_average(meas_symmetric):
     assert np.all(np.isfinite(row.values))
 
 
-SHIPPED = ["aluminium-6061-t6", "tjpv-cell", "white-paint-a276", "aluminium-6061-t6-paper",
-           "tjpv-cell-paper", "white-paint-a276-paper", "example-lobe", "lambertian-grey-50"]
+SHIPPED = [
+    "aluminium-6061-t6",
+    "tjpv-cell",
+    "white-paint-a276",
+    "aluminium-6061-t6-paper",
+    "tjpv-cell-paper",
+    "white-paint-a276-paper",
+    "example-lobe",
+    "lambertian-grey-50",
+]
 
 
 @pytest.mark.parametrize("name", SHIPPED)
 @settings(max_examples=10, deadline=None)
-@given(theta_r=st.floats(0.0, 85.0), obs_az=st.floats(0.0, 2 * np.pi),
-       dtype=st.sampled_from([np.float64, np.float32]))
+@given(
+    theta_r=st.floats(0.0, 85.0),
+    obs_az=st.floats(0.0, 2 * np.pi),
+    dtype=st.sampled_from([np.float64, np.float32]),
+)
 def test_shipped_tables_do_not_jump_at_normal_incidence(name, theta_r, obs_az, dtype):
     from sbrdf_xr import catalog
 

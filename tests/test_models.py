@@ -25,7 +25,9 @@ def test_render_equals_direct_evaluation_and_conserves_energy():
     n = 50
     rng = np.random.default_rng(0)
     ti = rng.choice([0.0, 30.0, 60.0], n)
-    dt = rng.choice(lut.delta_theta.values[(lut.delta_theta.values >= -90) & (lut.delta_theta.values <= 30)], n)
+    dt = rng.choice(
+        lut.delta_theta.values[(lut.delta_theta.values >= -90) & (lut.delta_theta.values <= 30)], n
+    )
     ph = rng.choice(lut.phi.values[lut.phi.values <= 60], n)  # table nodes: exact
     got, want = material.lookup(lut, ti, dt, ph).values, models.spectra(spec, ti, dt, ph)
     np.testing.assert_allclose(got[ti > 0], want[ti > 0], rtol=1e-12)
@@ -46,8 +48,12 @@ def test_render_equals_direct_evaluation_and_conserves_energy():
 
 @pytest.mark.parametrize(
     ("kw", "match"),
-    [({"b": -0.1}, "b"), ({"e": 0.0}, "e"), ({"rho_D": 0.95}, "rho_D \\+ epsilon"),
-     ({"rho_D": -np.ones(15)}, "rho_D")],
+    [
+        ({"b": -0.1}, "b"),
+        ({"e": 0.0}, "e"),
+        ({"rho_D": 0.95}, "rho_D \\+ epsilon"),
+        ({"rho_D": -np.ones(15)}, "rho_D"),
+    ],
 )
 def test_parameters_out_of_domain(kw, match):
     with pytest.raises(ValidationError, match=match):
@@ -56,17 +62,29 @@ def test_parameters_out_of_domain(kw, match):
 
 def test_layers_only_for_microfacet_and_round_trip(tmp_path):
     with pytest.raises(ValidationError, match="only the microfacet"):
-        models.model_material("lambert", WL, material="x", provenance="t", layers=[(1.5, 100.0)], rho=0.5)
+        models.model_material(
+            "lambert", WL, material="x", provenance="t", layers=[(1.5, 100.0)], rho=0.5
+        )
     al = optics.aluminium_index(WL)
-    spec = models.model_material("microfacet", WL, material="c", provenance="t",
-                                 layers=[(optics.silica_index(WL), 120.0)],
-                                 roughness=0.1, n=al.real, k=al.imag, rho_d=0.01)
+    spec = models.model_material(
+        "microfacet",
+        WL,
+        material="c",
+        provenance="t",
+        layers=[(optics.silica_index(WL), 120.0)],
+        roughness=0.1,
+        n=al.real,
+        k=al.imag,
+        rho_d=0.01,
+    )
     path = models.to_netcdf(spec, tmp_path / "m.nc")
     back = models.open_model(path)
     # the writer adds the file-level ACDD attributes title and history (CF/ACDD basics)
     assert back.attrs.pop("title") and back.attrs.pop("history")
     xr.testing.assert_identical(back, spec)
-    np.testing.assert_allclose(models.spectra(back, 30.0, 0.0, 0.0), models.spectra(spec, 30.0, 0.0, 0.0))
+    np.testing.assert_allclose(
+        models.spectra(back, 30.0, 0.0, 0.0), models.spectra(spec, 30.0, 0.0, 0.0)
+    )
 
 
 def test_unknown_model_name():
@@ -93,7 +111,10 @@ def test_canx1_catalog_models_show_their_spectral_features():
     cell = catalog.load("tjpv-cell-model")
     wl = cell.wavelength.values
     band = (wl >= 620) & (wl <= 780)
-    minima = [wl[band][np.argmin(models.spectra(cell, t, 0.0, 0.0)[band])] for t in (2.5, 15.0, 30.0, 45.0)]
+    minima = [
+        wl[band][np.argmin(models.spectra(cell, t, 0.0, 0.0)[band])]
+        for t in (2.5, 15.0, 30.0, 45.0)
+    ]
     # the anti-reflection minimum moves to shorter wavelengths with angle: 715, 710, 695, 675 nm
     assert minima == sorted(minima, reverse=True) and minima[-1] <= minima[0] - 30
     paint_ = catalog.load("white-paint-a276-model")
@@ -106,9 +127,17 @@ def test_canx1_catalog_models_show_their_spectral_features():
     "grid",
     [
         {},  # the default, whole hemisphere in 3-degree steps
-        {"theta_i": [0.0, 45.0, 90.0], "delta_theta": [-180.0, -100.0, 0.0, 90.0], "phi": [0.0, 80.0, 90.0]},
+        {
+            "theta_i": [0.0, 45.0, 90.0],
+            "delta_theta": [-180.0, -100.0, 0.0, 90.0],
+            "phi": [0.0, 80.0, 90.0],
+        },
         {"theta_i": [0.0, 30.0, 60.0, 90.0], "delta_theta": [-20.0, 0.0, 25.0], "phi": [0.0, 10.0]},
-        {"theta_i": [10.0, 70.0], "delta_theta": [-50.0, -7.0, 3.0, 40.0], "phi": [0.0, 33.0, 89.0]},
+        {
+            "theta_i": [10.0, 70.0],
+            "delta_theta": [-50.0, -7.0, 3.0, 40.0],
+            "phi": [0.0, 33.0, 89.0],
+        },
     ],
 )
 def test_lambert_renders_exactly_on_any_grid(grid, method):

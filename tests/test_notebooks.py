@@ -39,13 +39,23 @@ def _kernel_environment(tmp_path_factory):
     jupyter = tmp_path_factory.mktemp("jupyter")
     spec = jupyter / "kernels" / "python3"
     spec.mkdir(parents=True)
-    (spec / "kernel.json").write_text(json.dumps({
-        "argv": [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"],
-        "display_name": "Python 3 (pytest)", "language": "python",
-    }))
+    (spec / "kernel.json").write_text(
+        json.dumps(
+            {
+                "argv": [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"],
+                "display_name": "Python 3 (pytest)",
+                "language": "python",
+            }
+        )
+    )
     with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("JUPYTER_PATH", os.pathsep.join(p for p in (str(jupyter), os.environ.get("JUPYTER_PATH")) if p))
-        mp.setenv("PYTHONPATH", os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH")) if p))
+        mp.setenv(
+            "JUPYTER_PATH",
+            os.pathsep.join(p for p in (str(jupyter), os.environ.get("JUPYTER_PATH")) if p),
+        )
+        mp.setenv(
+            "PYTHONPATH", os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH")) if p)
+        )
         mp.setenv("MPLBACKEND", "module://matplotlib_inline.backend_inline")
         yield
 
@@ -61,13 +71,24 @@ def test_notebook_runs(path, tmp_path):
     nb = nbformat.read(copy, as_version=4)
     workdir = tmp_path / "cwd"
     workdir.mkdir()
-    client = nbclient.NotebookClient(nb, timeout=CELL_TIMEOUT, kernel_name="python3",
-                                     resources={"metadata": {"path": str(workdir)}})
+    client = nbclient.NotebookClient(
+        nb,
+        timeout=CELL_TIMEOUT,
+        kernel_name="python3",
+        resources={"metadata": {"path": str(workdir)}},
+    )
     try:
         client.execute()
-    except nbclient.exceptions.CellExecutionError as exc:  # show the failing cell, not the kernel stack
+    except (
+        nbclient.exceptions.CellExecutionError
+    ) as exc:  # show the failing cell, not the kernel stack
         pytest.fail(f"{path.name}: a cell failed\n{exc}", pytrace=False)
-    errors = [o for cell in nb.cells if cell.cell_type == "code" for o in cell.get("outputs", [])
-              if o.get("output_type") == "error"]
+    errors = [
+        o
+        for cell in nb.cells
+        if cell.cell_type == "code"
+        for o in cell.get("outputs", [])
+        if o.get("output_type") == "error"
+    ]
     assert not errors, f"{path.name}: error outputs {[(e['ename'], e['evalue']) for e in errors]}"
     assert not list(workdir.iterdir()), f"{path.name} left files in its working directory"

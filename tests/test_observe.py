@@ -93,7 +93,11 @@ def test_sun_direction_and_phase_angle_against_skyfield(canx1):
         ti = ts.from_datetime(py[i])
         s = (eph["earth"] + sat).at(ti).observe(eph["sun"]).apparent().position.km
         su = s / np.linalg.norm(s)
-        worst_sun = max(worst_sun, 3600 * np.degrees(np.arctan2(np.linalg.norm(np.cross(su, sun_ref[i])), su @ sun_ref[i])))
+        worst_sun = max(
+            worst_sun,
+            3600
+            * np.degrees(np.arctan2(np.linalg.norm(np.cross(su, sun_ref[i])), su @ sun_ref[i])),
+        )
         los = (site - sat).at(ti).position.km
         phase = np.degrees(np.arctan2(np.linalg.norm(np.cross(s, los)), s @ los))
         worst_phase = max(worst_phase, abs(phase - g.phase_angle.values[i]))
@@ -104,8 +108,11 @@ def test_sun_direction_and_phase_angle_against_skyfield(canx1):
     assert worst_sun < SUN_TOL_ARCSEC, worst_sun
     assert worst_phase < PHASE_TOL_DEG, worst_phase
     # The body-frame pair carries the same phase angle (rotations preserve angles).
-    np.testing.assert_allclose(geometry.phase_angle(g.to_sun.values, g.to_observer.values),
-                               g.phase_angle.values, atol=1e-10)
+    np.testing.assert_allclose(
+        geometry.phase_angle(g.to_sun.values, g.to_observer.values),
+        g.phase_angle.values,
+        atol=1e-10,
+    )
 
 
 def test_shadow_boundary_brackets_skyfield_is_sunlit(canx1):
@@ -143,11 +150,17 @@ def circular_shadow_times(radius, beta_deg, sun_distance, sun_radius):
     t_cyl = np.arccos(-x_cyl / (radius * np.cos(beta))) / n
     eps = 1e-12
     t_pen = brentq(lambda t: frac(t) - (1 - eps), t_cyl - 60, t_cyl + 1e-9, xtol=1e-10)
-    t_umb = brentq(lambda t: frac(t) - eps, t_cyl - 1e-9, t_cyl + 60, xtol=1e-10) if sun_radius > 0 else t_pen
+    t_umb = (
+        brentq(lambda t: frac(t) - eps, t_cyl - 1e-9, t_cyl + 60, xtol=1e-10)
+        if sun_radius > 0
+        else t_pen
+    )
     return n, t_pen, t_umb
 
 
-@pytest.mark.parametrize("radius,beta_deg", [(6378.137 + 500, 0.0), (6378.137 + 820, 35.0), (26560.0, 10.0)])
+@pytest.mark.parametrize(
+    "radius,beta_deg", [(6378.137 + 500, 0.0), (6378.137 + 820, 35.0), (26560.0, 10.0)]
+)
 def test_shadow_entry_cylindrical_closed_form(radius, beta_deg):
     # Point Sun at a practically infinite distance: the cylinder rho = R_E, x > 0.
     n, t_pen, _ = circular_shadow_times(radius, beta_deg, 1e16, 0.0)
@@ -157,7 +170,9 @@ def test_shadow_entry_cylindrical_closed_form(radius, beta_deg):
     assert abs(t_pen - t_closed) < 1e-3, t_pen - t_closed  # [s]
 
 
-@pytest.mark.parametrize("radius,beta_deg", [(6378.137 + 500, 0.0), (6378.137 + 820, 35.0), (26560.0, 10.0)])
+@pytest.mark.parametrize(
+    "radius,beta_deg", [(6378.137 + 500, 0.0), (6378.137 + 820, 35.0), (26560.0, 10.0)]
+)
 def test_shadow_entry_conical_closed_form(radius, beta_deg):
     # Penumbra: the internal tangent cone of Earth and Sun, apex d_p sunward of the Earth,
     # sin f_p = (R_S + R_E)/D; umbra: the external cone, apex d_u behind the Earth,
@@ -168,7 +183,10 @@ def test_shadow_entry_conical_closed_form(radius, beta_deg):
     n, t_pen, t_umb = circular_shadow_times(radius, beta_deg, d_sun, R_S)
     cb = np.cos(np.radians(beta_deg))
     out = {}
-    for kind, sin_f, d, sign in (("pen", (R_S + R_E) / d_sun, None, +1), ("umb", (R_S - R_E) / d_sun, None, -1)):
+    for kind, sin_f, d, sign in (
+        ("pen", (R_S + R_E) / d_sun, None, +1),
+        ("umb", (R_S - R_E) / d_sun, None, -1),
+    ):
         d = R_E / sin_f
         tau2 = np.tan(np.arcsin(sin_f)) ** 2
         # (1 + tau2) x^2 + 2 sign tau2 d x + tau2 d^2 - r^2 = 0
@@ -177,9 +195,11 @@ def test_shadow_entry_conical_closed_form(radius, beta_deg):
         out[kind] = np.arccos(-x / (radius * cb)) / n
     # Both within a millisecond (the root finder works to 1e-10 s; the fraction leaves 1
     # as the 3/2 power of the overlap depth, so eps = 1e-12 moves the root < 1e-6 s).
-    print(f"r={radius} beta={beta_deg}: penumbra {t_pen - out['pen']:.2e} s, umbra {t_umb - out['umb']:.2e} s")
-    assert abs(t_pen - out["pen"]) < 1e-3, (t_pen - out["pen"])
-    assert abs(t_umb - out["umb"]) < 1e-3, (t_umb - out["umb"])
+    print(
+        f"r={radius} beta={beta_deg}: penumbra {t_pen - out['pen']:.2e} s, umbra {t_umb - out['umb']:.2e} s"
+    )
+    assert abs(t_pen - out["pen"]) < 1e-3, t_pen - out["pen"]
+    assert abs(t_umb - out["umb"]) < 1e-3, t_umb - out["umb"]
     assert t_umb - t_pen > 1.0  # a real penumbra of seconds
 
 
@@ -215,7 +235,9 @@ def test_disc_overlap_against_shapely_polygons(a, ratio, u):
 
 
 def test_point_sun_is_a_step():
-    np.testing.assert_array_equal(observe.disc_overlap_fraction(0.0, 0.1, [0.05, 0.1, 0.2]), [0.0, 1.0, 1.0])
+    np.testing.assert_array_equal(
+        observe.disc_overlap_fraction(0.0, 0.1, [0.05, 0.1, 0.2]), [0.0, 1.0, 1.0]
+    )
 
 
 # ----------------------------------------------------------------- observation outputs
@@ -224,7 +246,14 @@ def test_point_sun_is_a_step():
 def test_canx1_pass_geometry(canx1):
     _, g = canx1
     assert g.sizes["time"] == 301 and g.time.dtype == np.dtype("datetime64[ns]")
-    for key in ("tle_line1", "tle_line2", "site_latitude", "site_longitude", "site_height", "site_name"):
+    for key in (
+        "tle_line1",
+        "tle_line2",
+        "site_latitude",
+        "site_longitude",
+        "site_height",
+        "site_name",
+    ):
         assert key in g.attrs
     assert g.attrs["tle_line1"].startswith("1 27847U") and g.attrs["site_name"] == "mont-megantic"
     assert g.attrs["site_latitude"] == pytest.approx(45.4555)
@@ -259,17 +288,26 @@ def test_geometry_round_trips_through_netcdf(canx1, tmp_path):
     path = tmp_path / "geometry.nc"
     g.to_netcdf(path)
     with xr.open_dataset(path, decode_times=False) as raw:
-        assert raw.time.attrs["units"].startswith("seconds since") and raw.time.attrs["standard_name"] == "time"
+        assert (
+            raw.time.attrs["units"].startswith("seconds since")
+            and raw.time.attrs["standard_name"] == "time"
+        )
     with xr.open_dataset(path) as back:
         np.testing.assert_array_equal(back.time.values, g.time.values)
         xr.testing.assert_allclose(back.load(), g)
     series = att.QuaternionSeries.from_netcdf(path)
-    np.testing.assert_allclose(np.abs(np.einsum("ni,ni->n", series.quaternions(g.time.values), g.quaternion.values)), 1.0, atol=1e-12)
+    np.testing.assert_allclose(
+        np.abs(np.einsum("ni,ni->n", series.quaternions(g.time.values), g.quaternion.values)),
+        1.0,
+        atol=1e-12,
+    )
 
 
 def test_nadir_observation_points_at_the_geocentre(canx1):
     obs, _ = canx1
-    nadir = observe.Observation(obs.orbit, obs.site, obs.times, att.Nadir(yaw_deg=20.0, nadir_axis="+z"))
+    nadir = observe.Observation(
+        obs.orbit, obs.site, obs.times, att.Nadir(yaw_deg=20.0, nadir_axis="+z")
+    )
     to_earth = nadir.geometry().to_earth.values
     angle = np.arctan2(np.hypot(to_earth[:, 0], to_earth[:, 1]), to_earth[:, 2])
     assert angle.max() < 1e-9  # [rad]
@@ -296,8 +334,12 @@ def test_observation_from_toml_table():
     # Explicit TLE lines and site coordinates.
     e = catalog.entry("canx1-example")
     lines = e.file.read_text().splitlines()
-    table = {"tle": lines[1:3], "site": {"latitude_deg": 45.4555, "longitude_deg": -71.1526, "height_m": 1114.0},
-             "times": ["2024-03-17T01:21:00", "2024-03-17T01:22:00"], "attitude": {"law": "nadir"}}
+    table = {
+        "tle": lines[1:3],
+        "site": {"latitude_deg": 45.4555, "longitude_deg": -71.1526, "height_m": 1114.0},
+        "times": ["2024-03-17T01:21:00", "2024-03-17T01:22:00"],
+        "attitude": {"law": "nadir"},
+    }
     g = observe.observation_from_dict(table).geometry()
     assert g.sizes["time"] == 2
     with pytest.raises(ObservationError, match="unknown key"):
@@ -318,9 +360,15 @@ def test_omm_gives_the_same_orbit(tmp_path):
     path.write_text(json.dumps([fields]))
     for source in (fields, path):
         omm = observe.Orbit.from_omm(source)
-        a = observe.Observation(tle, observe.Site(45, -71), t, None, min_elevation_deg=-90).geometry(on_unobservable="keep")
-        b = observe.Observation(omm, observe.Site(45, -71), t, None, min_elevation_deg=-90).geometry(on_unobservable="keep")
-        np.testing.assert_allclose(a.range.values, b.range.values, atol=1e-6)  # same elements: < 1 mm
+        a = observe.Observation(
+            tle, observe.Site(45, -71), t, None, min_elevation_deg=-90
+        ).geometry(on_unobservable="keep")
+        b = observe.Observation(
+            omm, observe.Site(45, -71), t, None, min_elevation_deg=-90
+        ).geometry(on_unobservable="keep")
+        np.testing.assert_allclose(
+            a.range.values, b.range.values, atol=1e-6
+        )  # same elements: < 1 mm
     with pytest.raises(ObservationError, match="OMM"):
         observe.Orbit.from_omm({"OBJECT_NAME": "X"})
 
@@ -363,7 +411,9 @@ def test_malformed_tles_raise_named_errors():
         observe.Orbit.from_tle(l1, "3" + l2[1:])
     with pytest.raises(ObservationError, match="catalog numbers differ"):
         observe.Orbit.from_tle(l1, with_checksum(l2[:2] + "27848" + l2[7:]))
-    with pytest.raises(ObservationError, match="field 'eccentricity' \\(columns 27-33\\) is '00X2000'"):
+    with pytest.raises(
+        ObservationError, match="field 'eccentricity' \\(columns 27-33\\) is '00X2000'"
+    ):
         observe.Orbit.from_tle(l1, with_checksum(l2[:26] + "00X2000" + l2[33:]))
     with pytest.raises(ObservationError, match="SGP4 rejects the elements"):  # mean motion 0
         observe.Orbit.from_tle(l1, with_checksum(l2[:52] + " 0.00000000" + l2[63:]))
@@ -395,13 +445,17 @@ def test_times_far_from_the_epoch_warn(canx1):
 
 def test_unobservable_windows(canx1):
     obs, _ = canx1
-    below = observe.Observation(obs.orbit, obs.site, observe.times("2024-03-17T02:20", "2024-03-17T02:21", 1.0))
+    below = observe.Observation(
+        obs.orbit, obs.site, observe.times("2024-03-17T02:20", "2024-03-17T02:21", 1.0)
+    )
     with pytest.raises(NotObservableError, match="below 0 deg elevation at every time"):
         below.geometry()
     empty = below.geometry(on_unobservable="empty")
     assert empty.sizes["time"] == 0 and "below" in empty.attrs["unobservable"]
     assert below.geometry(on_unobservable="keep").sizes["time"] == 61
-    dark = observe.Observation(obs.orbit, obs.site, observe.times("2024-03-17T01:19:00", "2024-03-17T01:20:00", 1.0))
+    dark = observe.Observation(
+        obs.orbit, obs.site, observe.times("2024-03-17T01:19:00", "2024-03-17T01:20:00", 1.0)
+    )
     with pytest.raises(NotObservableError, match="umbra at every time"):
         dark.geometry()
     with pytest.raises(ObservationError, match="on_unobservable"):
@@ -428,9 +482,14 @@ def test_no_network_is_needed(tmp_path):
         "g = observe.canx1_pass().geometry()\n"
         "print(g.sizes['time'])\n"
     )
-    res = subprocess.run([sys.executable, "-W", "error::RuntimeWarning", "-c", code], cwd=tmp_path,
-                         capture_output=True, text=True, check=False,
-                         env={"PYTHONPATH": str(REPO), "PATH": "/usr/bin:/bin", "HOME": str(tmp_path)})
+    res = subprocess.run(
+        [sys.executable, "-W", "error::RuntimeWarning", "-c", code],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        check=False,
+        env={"PYTHONPATH": str(REPO), "PATH": "/usr/bin:/bin", "HOME": str(tmp_path)},
+    )
     assert res.returncode == 0, res.stderr
     assert res.stdout.strip() == "301"
     assert not list(tmp_path.glob("*.bsp")) and not list(tmp_path.glob("finals*"))

@@ -42,7 +42,9 @@ def test_rotation_cube_is_labelled_and_finite(rotation):
         assert np.all(np.isfinite(rotation[name].values)), name
         assert rotation[name].attrs["units"] and rotation[name].attrs["long_name"]
     assert rotation.sizes["attitude"] == 360
-    np.testing.assert_allclose(geometry.phase_angle(rotation.to_sun.values, rotation.to_observer.values), 10.0)
+    np.testing.assert_allclose(
+        geometry.phase_angle(rotation.to_sun.values, rotation.to_observer.values), 10.0
+    )
 
 
 def test_plusx_cell_features_move_to_shorter_wavelengths_as_beta_grows(plusx):
@@ -65,11 +67,14 @@ def test_plusx_cell_features_move_to_shorter_wavelengths_as_beta_grows(plusx):
 def test_aluminium_feature_appears_off_specular():
     """Fig. 16: off specular the aluminium's ~800 nm absorption shows in the sBRDF."""
     scene = builtin_scene("canx1-plusx-specular").with_options(
-        attitudes=geometry.axis_rotation([0, 0, 1], [0.0, 6.0, 10.0]), phase_angles=[30.0])
+        attitudes=geometry.axis_rotation([0, 0, 1], [0.0, 6.0, 10.0]), phase_angles=[30.0]
+    )
     cube = simulate(scene).compute()
     wl = cube.wavelength.values
     band = (wl >= 700) & (wl <= 950)
-    alu = cube.signal_material.sel(material="aluminium-6061-t6") / cube.signal_material.sum("material")
+    alu = cube.signal_material.sel(material="aluminium-6061-t6") / cube.signal_material.sum(
+        "material"
+    )
     at_specular, off = alu.isel(attitude=0, phase_angle=0), alu.isel(attitude=[1, 2], phase_angle=0)
     assert float(at_specular.mean()) < 0.3 < float(off.mean("wavelength").min())
     for k in (1, 2):

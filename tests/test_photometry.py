@@ -40,8 +40,12 @@ class _RaiseIfComputes:
 
 def lambert_table(rho: float, wl: np.ndarray = WL):
     spec = models.model_material("lambert", wl, rho=rho, material="test-lambert", provenance="test")
-    return models.render(spec, theta_i=np.arange(0.0, 91.0, 15.0),
-                         delta_theta=np.arange(-180.0, 91.0, 30.0), phi=np.arange(0.0, 91.0, 15.0))
+    return models.render(
+        spec,
+        theta_i=np.arange(0.0, 91.0, 15.0),
+        delta_theta=np.arange(-180.0, 91.0, 30.0),
+        phi=np.arange(0.0, 91.0, 15.0),
+    )
 
 
 def explicit_scene(table, n: int = 6, seed: int = 0, **kw):
@@ -75,7 +79,9 @@ def test_solar_spectrum_is_pvlib_astm_g173_and_resamples_conservatively():
     ref = get_reference_spectra(wl)["extraterrestrial"].to_numpy()
     np.testing.assert_allclose(P.solar_spectrum(wl, method="linear").values, ref, rtol=1e-12)
     # ASTM G173-03 AM0 integrates to 1347.9 W m-2 over 280-4000 nm (the table's stated total).
-    assert float(np.trapezoid(native.values, native.wavelength.values)) == pytest.approx(1347.9, abs=0.1)
+    assert float(np.trapezoid(native.values, native.wavelength.values)) == pytest.approx(
+        1347.9, abs=0.1
+    )
     # Conservative resampling: the trapezoid integral on a 10 nm grid equals the native one
     # over the same range (exactly for the piecewise-linear native table).
     grid = np.arange(400.0, 1101.0, 10.0)
@@ -137,7 +143,9 @@ def test_sun_colours_agree_with_published_solar_colours():
 
 
 def test_filters_aliases_user_bandpasses_and_unknown_names():
-    f = P.filters(["B", "sdss2010-r", ("flat", ([500.0, 510.0, 600.0, 610.0], [0.0, 1.0, 1.0, 0.0]))])
+    f = P.filters(
+        ["B", "sdss2010-r", ("flat", ([500.0, 510.0, 600.0, 610.0], [0.0, 1.0, 1.0, 0.0]))]
+    )
     assert f.dims == ("band", "wavelength")
     assert f.band.values.tolist() == ["B", "sdss2010-r", "flat"]
     assert f["filter"].values.tolist() == ["bessell-B", "sdss2010-r", "user:flat"]
@@ -145,8 +153,9 @@ def test_filters_aliases_user_bandpasses_and_unknown_names():
     assert f.sel(band="flat").interp(wavelength=550.0).item() == pytest.approx(1.0)
     # Bessell (1990) V peaks at 530 nm with response 1 (speclite file normalised to max 1).
     assert float(P.filters("V").sel(wavelength=530.0).squeeze()) == 1.0
-    da = xr.DataArray([0.0, 1.0, 0.0], dims="wavelength", coords={"wavelength": [500.0, 550.0, 600.0]},
-                      name="tri")
+    da = xr.DataArray(
+        [0.0, 1.0, 0.0], dims="wavelength", coords={"wavelength": [500.0, 550.0, 600.0]}, name="tri"
+    )
     assert P.filters(da).band.values.tolist() == ["tri"]
     with pytest.raises(ValidationError, match=r"unknown 'Q'.*alias"):
         P.filters(["Q"])
@@ -171,7 +180,9 @@ def test_band_weights_quadratures_weightings_and_units():
     for k, band in enumerate(["V", "r"]):
         f = P.filters(band)
         tr = np.interp(fine, f.wavelength.values, f.values[0], left=0.0, right=0.0)
-        ref = np.trapezoid(e * tr * fine * 1e-9 / (6.62607015e-34 * 299792458.0) * np.interp(fine, grid, x), fine)
+        ref = np.trapezoid(
+            e * tr * fine * 1e-9 / (6.62607015e-34 * 299792458.0) * np.interp(fine, grid, x), fine
+        )
         # 'linear' integrates E T w at native (<= 1 nm) resolution: 1e-5 relative
         assert float(wl.values[k] @ x) == pytest.approx(ref, rel=1e-5)
         # 'trapezoid' on 10 nm nodes: the filter's curvature over 10 nm, ~1e-3 relative
@@ -187,7 +198,9 @@ def test_band_weights_quadratures_weightings_and_units():
 
 def test_spectrum_not_covering_a_band_raises_unless_extrapolated():
     grid = np.arange(400.0, 1001.0, 10.0)  # Bessell B starts at 360 nm, SDSS z ends at 1114 nm
-    with pytest.raises(ValidationError, match=r"band 'B' \(bessell-B\).*360-560 nm.*400-1000 nm.*extrapolate"):
+    with pytest.raises(
+        ValidationError, match=r"band 'B' \(bessell-B\).*360-560 nm.*400-1000 nm.*extrapolate"
+    ):
         P.band_weights(["V", "B"], grid)
     with pytest.raises(ValidationError, match="band 'z'"):
         P.band_weights("z", grid)
@@ -216,7 +229,9 @@ def test_white_lambertian_reflects_the_suns_colours(white_cube):
     diff = (ds.colour_index - sun_ci).where(lit)
     assert float(np.abs(diff).max()) < EXACT_MAG
     m_v = float(ds.magnitude.sel(band="V").isel(geometry=0))
-    assert m_v == pytest.approx(float(sun.sel(band="V")) - 2.5 * np.log10(1.0 / np.pi / 1e12), abs=1e-9)
+    assert m_v == pytest.approx(
+        float(sun.sel(band="V")) - 2.5 * np.log10(1.0 / np.pi / 1e12), abs=1e-9
+    )
     flux = P.pre_integrate(white_cube.signal, ["V"], normalize=False)
     assert flux.attrs["units"] == "m2 sr-1 m-2 s-1"  # photons s-1 sr-1 at 1 AU
     for name in ("band_signal", "magnitude", "colour_index"):
@@ -231,7 +246,9 @@ def test_grey_albedo_shifts_every_band_by_minus_2p5_log10_a(white_cube, albedo):
     ma = P.magnitudes(grey, ALL_BANDS, 500.0)
     lit = np.isfinite(m1)
     assert int(lit.sum()) > 0
-    np.testing.assert_allclose((ma - m1).values[lit.values], -2.5 * np.log10(albedo), rtol=0, atol=EXACT_MAG)
+    np.testing.assert_allclose(
+        (ma - m1).values[lit.values], -2.5 * np.log10(albedo), rtol=0, atol=EXACT_MAG
+    )
 
 
 def _sphere(subdivisions: int):
@@ -265,12 +282,16 @@ def test_lambertian_sphere_follows_the_diffuse_sphere_phase_law():
     exact = 2.0 * rho / (3.0 * np.pi) * ((np.pi - alpha) * np.cos(alpha) + np.sin(alpha))
     errors = []
     for sub in (3, 4, 5):
-        ds = simulate(Scene(_sphere(sub), materials={"grey": grey}, to_sun=s, to_observer=o)).compute()
+        ds = simulate(
+            Scene(_sphere(sub), materials={"grey": grey}, to_sun=s, to_observer=o)
+        ).compute()
         errors.append(np.abs(ds.signal.isel(wavelength=0).values / exact - 1.0).max())
         # A grey sphere's band signal is its signal (band mean of a flat spectrum).
         if sub == 5:
             sb = P.band_signal(ds, ["V", "I"])
-            np.testing.assert_allclose(sb.values, ds.signal.isel(wavelength=[0, 0]).values, rtol=1e-12)
+            np.testing.assert_allclose(
+                sb.values, ds.signal.isel(wavelength=[0, 0]).values, rtol=1e-12
+            )
     assert errors[-1] < 2e-3
     assert errors[0] / errors[1] > 3.0 and errors[1] / errors[2] > 3.0
 
@@ -285,7 +306,9 @@ def test_band_pre_integration_equals_integrating_the_full_spectrum_canx1():
     kw = {"extrapolate": "constant"}  # B starts at 360 nm, the tables at 400 nm
     angles = np.arange(0.0, 360.0, 20.0)
     q = geometry.rotation_sweep([0, 0, -1], angles, geometry.axis_rotation([0, 0, 1], 25.0))
-    scene = Scene(sc, materials=tables, attitudes=q, attitude_angle=angles, phase_angles=[10.0, 70.0])
+    scene = Scene(
+        sc, materials=tables, attitudes=q, attitude_angle=angles, phase_angles=[10.0, 70.0]
+    )
     full = simulate(scene).compute()
     expected = P.band_signal(full, bands, **kw)
     pseudo = {}
@@ -293,13 +316,19 @@ def test_band_pre_integration_equals_integrating_the_full_spectrum_canx1():
         b = P.pre_integrate(t, bands, **kw)
         assert b.dims == ("theta_i", "delta_theta", "phi", "band") and b.attrs["units"] == "sr-1"
         # run the band table through the simulation as if 'band' were a wavelength axis
-        pseudo[m] = b.drop_vars(["band", "filter", "filter_source"]).rename(band="wavelength").assign_coords(
-            wavelength=("wavelength", np.arange(1.0, len(bands) + 1.0), {"units": "nm"}))
+        pseudo[m] = (
+            b.drop_vars(["band", "filter", "filter_source"])
+            .rename(band="wavelength")
+            .assign_coords(
+                wavelength=("wavelength", np.arange(1.0, len(bands) + 1.0), {"units": "nm"})
+            )
+        )
     banded = simulate(scene.with_options(materials=pseudo)).compute()
     got = banded.signal.values
     assert np.all(expected.values > 0)
-    np.testing.assert_allclose(got, expected.transpose("attitude", "phase_angle", "band").values,
-                               rtol=RTOL_LINEAR, atol=0)
+    np.testing.assert_allclose(
+        got, expected.transpose("attitude", "phase_angle", "band").values, rtol=RTOL_LINEAR, atol=0
+    )
 
 
 def test_band_signal_stays_lazy_and_equals_eager():
@@ -316,8 +345,11 @@ def test_nothing_reflected_is_infinite_magnitude_without_warnings():
     s = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
     o = np.array([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])  # forward scatter, then back-scatter
     sc = T.cube_spacecraft(1.0)
-    ds = simulate(Scene(sc, materials={T.TEST_SPACECRAFT_MATERIAL: lambert_table(0.5)}, to_sun=s,
-                        to_observer=o)).compute()
+    ds = simulate(
+        Scene(
+            sc, materials={T.TEST_SPACECRAFT_MATERIAL: lambert_table(0.5)}, to_sun=s, to_observer=o
+        )
+    ).compute()
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         ph = ds.sbrdf.photometry(["B", "V"], 100.0)
@@ -338,9 +370,12 @@ def test_range_broadcasts_and_accessor_forwards(white_cube):
     m = P.magnitudes(white_cube, ["V"], r)
     d = m.isel(geometry=0, band=0)
     assert float(d.sel(range=1000.0) - d.sel(range=100.0)) == pytest.approx(5.0, abs=1e-12)
-    xr.testing.assert_identical(white_cube.sbrdf.photometry(["V", "R"], 10.0),
-                                P.photometry(white_cube, ["V", "R"], 10.0))
-    ci = P.colour_indices(P.magnitudes(white_cube, ["B", "V", "R"], 10.0), pairs=[("B", "R"), ("bessell-V", "R")])
+    xr.testing.assert_identical(
+        white_cube.sbrdf.photometry(["V", "R"], 10.0), P.photometry(white_cube, ["V", "R"], 10.0)
+    )
+    ci = P.colour_indices(
+        P.magnitudes(white_cube, ["B", "V", "R"], 10.0), pairs=[("B", "R"), ("bessell-V", "R")]
+    )
     assert ci.colour.values.tolist() == ["B-R", "bessell-V-R"]
     with pytest.raises(ValidationError, match="band 'g' is not among"):
         P.colour_indices(P.magnitudes(white_cube, ["B", "V"], 10.0), pairs=[("g", "V")])
@@ -376,15 +411,36 @@ def test_cli_photometry_writes_netcdf_and_csv(tmp_path, white_cube, capsys):
 
     cube = write_netcdf_atomic(white_cube, tmp_path / "cube.nc")
     out, csv = tmp_path / "phot.nc", tmp_path / "phot.csv"
-    assert main(["photometry", str(cube), "--bands", "B", "V", "R", "I", "--range-km", "36000",
-                 "-o", str(out), "--csv", str(csv)]) == 0
+    assert (
+        main(
+            [
+                "photometry",
+                str(cube),
+                "--bands",
+                "B",
+                "V",
+                "R",
+                "I",
+                "--range-km",
+                "36000",
+                "-o",
+                str(out),
+                "--csv",
+                str(csv),
+            ]
+        )
+        == 0
+    )
     text = capsys.readouterr().out
     assert "bessell-V" in text and "B-V" in text and f"wrote {out}" in text
     with xr.open_dataset(out) as ph:
-        np.testing.assert_allclose(ph.magnitude.values, P.magnitudes(white_cube, ["B", "V", "R", "I"],
-                                                                        36000.0).values)
+        np.testing.assert_allclose(
+            ph.magnitude.values, P.magnitudes(white_cube, ["B", "V", "R", "I"], 36000.0).values
+        )
     df = pd.read_csv(csv)
-    assert {"mag_B", "mag_V", "B-V", "V-R"} <= set(df.columns) and len(df) == white_cube.sizes["geometry"]
+    assert {"mag_B", "mag_V", "B-V", "V-R"} <= set(df.columns) and len(df) == white_cube.sizes[
+        "geometry"
+    ]
     assert main(["photometry", str(cube), "--bands", "Q", "--range-km", "1"]) == 2
     assert "unknown 'Q'" in capsys.readouterr().err
 
@@ -397,9 +453,16 @@ def _sim_curve(step: float = 1.0) -> xr.DataArray:
     th = np.deg2rad(ang)
     base = 12.0 + 0.8 * np.sin(th) + 0.3 * np.cos(2 * th + 1.0)
     m = np.stack([base + 0.6, base], axis=1)
-    return xr.DataArray(m, dims=("attitude", "band"),
-                        coords={"attitude": np.arange(ang.size), "attitude_angle": ("attitude", ang),
-                                "band": ["B", "V"]}, name="magnitude")
+    return xr.DataArray(
+        m,
+        dims=("attitude", "band"),
+        coords={
+            "attitude": np.arange(ang.size),
+            "attitude_angle": ("attitude", ang),
+            "band": ["B", "V"],
+        },
+        name="magnitude",
+    )
 
 
 def _sim_at(sim: xr.DataArray, band: str, theta: np.ndarray) -> np.ndarray:
@@ -415,10 +478,14 @@ def _write_curve(path, phi0=47.3, dm0=1.234, sigma=0.01, extra_b=0.0, seed=3, n=
     rng = np.random.default_rng(seed)
     theta = np.sort(rng.uniform(0.0, 720.0, n))
     band = rng.choice(["B", "V"], n)
-    mag = np.array([_sim_at(None, b, np.array([t + phi0]))[0] for b, t in zip(band, theta, strict=True)])
+    mag = np.array(
+        [_sim_at(None, b, np.array([t + phi0]))[0] for b, t in zip(band, theta, strict=True)]
+    )
     mag = mag + dm0 + np.where(band == "B", extra_b, 0.0) + rng.normal(0.0, sigma, n)
     col = {"time": theta / 360.0 * 600.0} if time else {"rotation_angle": theta}
-    pd.DataFrame({**col, "band": band, "magnitude": mag, "uncertainty": sigma}).to_csv(path, index=False)
+    pd.DataFrame({**col, "band": band, "magnitude": mag, "uncertainty": sigma}).to_csv(
+        path, index=False
+    )
     return path
 
 
@@ -433,7 +500,9 @@ def test_light_curve_fit_recovers_injected_offsets(tmp_path):
     assert float(res.magnitude_offset) == pytest.approx(1.234 + 0.025, abs=0.01)
     assert float(res.colour_index_difference.sel(colour="B-V")) == pytest.approx(0.05, abs=0.005)
     assert res.degrees_of_freedom == 298
-    clean = P.compare_light_curves(P.read_light_curve(_write_curve(tmp_path / "c.csv")), _sim_curve())
+    clean = P.compare_light_curves(
+        P.read_light_curve(_write_curve(tmp_path / "c.csv")), _sim_curve()
+    )
     # 300 points of 0.01 mag on a curve of slope ~0.8 mag/rad: sigma(phase) ~ 0.03 deg,
     # sigma(offset) ~ 0.0006 mag; bounds at ~3 sigma.  chi2/dof of 298 dof: 1 +- 0.08 (1 sigma).
     assert float(clean.phase_offset) == pytest.approx(47.3, abs=0.1)
@@ -449,14 +518,21 @@ def test_light_curve_without_phase_fit_is_the_weighted_mean(tmp_path):
     sig = np.linspace(0.01, 0.2, 50)  # unequal uncertainties: weighted != plain mean
     lc["uncertainty"] = ("obs", sig, lc.uncertainty.attrs)
     res = P.compare_light_curves(lc, _sim_curve(0.5), fit_phase=False)
-    model = np.array([_sim_at(None, b, np.array([t]))[0]
-                      for b, t in zip(lc.band.values, lc.rotation_angle.values, strict=True)])
+    model = np.array(
+        [
+            _sim_at(None, b, np.array([t]))[0]
+            for b, t in zip(lc.band.values, lc.rotation_angle.values, strict=True)
+        ]
+    )
     r = lc.magnitude.values - model
     # 0.5 deg sampling, linear in flux: interpolation error < 2e-5 mag
-    assert float(res.magnitude_offset) == pytest.approx(np.sum(r / sig**2) / np.sum(1 / sig**2), abs=2e-5)
+    assert float(res.magnitude_offset) == pytest.approx(
+        np.sum(r / sig**2) / np.sum(1 / sig**2), abs=2e-5
+    )
     assert abs(np.mean(r) - np.sum(r / sig**2) / np.sum(1 / sig**2)) > 1e-3  # the test can tell
-    assert float(res.chi_square) == pytest.approx(np.sum(((r - float(res.magnitude_offset)) / sig) ** 2),
-                                                  rel=1e-3)
+    assert float(res.chi_square) == pytest.approx(
+        np.sum(((r - float(res.magnitude_offset)) / sig) ** 2), rel=1e-3
+    )
     assert float(res.phase_offset) == 0.0 and int(res.degrees_of_freedom) == 49
 
 
@@ -478,7 +554,9 @@ def test_light_curve_by_time_needs_a_period_and_netcdf_reads(tmp_path):
 def test_plot_comparison_returns_a_figure(tmp_path):
     from matplotlib.figure import Figure
 
-    res = P.compare_light_curves(P.read_light_curve(_write_curve(tmp_path / "lc.csv", n=60)), _sim_curve())
+    res = P.compare_light_curves(
+        P.read_light_curve(_write_curve(tmp_path / "lc.csv", n=60)), _sim_curve()
+    )
     fig = P.plot_comparison(res)
     assert isinstance(fig, Figure) and len(fig.axes) == 2
     fig.savefig(tmp_path / "cmp.png")
@@ -488,16 +566,34 @@ def test_plot_comparison_returns_a_figure(tmp_path):
     ("text", "match"),
     [
         ("rotation_angle,band,magnitude\n0,V,12.0\n", r"missing column\(s\) \['uncertainty'\]"),
-        ("band,magnitude,uncertainty\nV,12.0,0.1\n", "exactly one of the columns 'time' or 'rotation_angle'"),
-        ("rotation_angle,band,magnitude,uncertainty\n0,V,12.0,0.1\n5,Q,12.0,0.1\n",
-         r"row 2 \(line 3 of the file\), column 'band': unknown band 'Q'"),
-        ("rotation_angle,band,magnitude,uncertainty\n0,V,12.0,0.1\n5,V,nan,0.1\n",
-         r"row 2 \(line 3 of the file\), column 'magnitude'.*not a finite number"),
-        ("rotation_angle,band,magnitude,uncertainty\n0,V,12.0,0.1\n5,V,,0.1\n", "row 2.*'magnitude'"),
-        ("time,band,magnitude,uncertainty\n10,V,12.0,0.1\n20,V,12.1,0.1\n15,V,12.0,0.1\n",
-         r"row 3 \(line 4 of the file\), column 'time': values must be non-decreasing"),
-        ("rotation_angle,band,magnitude,uncertainty\n0,V,12.0,0\n", "column 'uncertainty': must be > 0"),
-        ("time,band,magnitude,uncertainty\nyesterday,V,12.0,0.1\n", "neither a number of seconds nor an ISO"),
+        (
+            "band,magnitude,uncertainty\nV,12.0,0.1\n",
+            "exactly one of the columns 'time' or 'rotation_angle'",
+        ),
+        (
+            "rotation_angle,band,magnitude,uncertainty\n0,V,12.0,0.1\n5,Q,12.0,0.1\n",
+            r"row 2 \(line 3 of the file\), column 'band': unknown band 'Q'",
+        ),
+        (
+            "rotation_angle,band,magnitude,uncertainty\n0,V,12.0,0.1\n5,V,nan,0.1\n",
+            r"row 2 \(line 3 of the file\), column 'magnitude'.*not a finite number",
+        ),
+        (
+            "rotation_angle,band,magnitude,uncertainty\n0,V,12.0,0.1\n5,V,,0.1\n",
+            "row 2.*'magnitude'",
+        ),
+        (
+            "time,band,magnitude,uncertainty\n10,V,12.0,0.1\n20,V,12.1,0.1\n15,V,12.0,0.1\n",
+            r"row 3 \(line 4 of the file\), column 'time': values must be non-decreasing",
+        ),
+        (
+            "rotation_angle,band,magnitude,uncertainty\n0,V,12.0,0\n",
+            "column 'uncertainty': must be > 0",
+        ),
+        (
+            "time,band,magnitude,uncertainty\nyesterday,V,12.0,0.1\n",
+            "neither a number of seconds nor an ISO",
+        ),
     ],
 )
 def test_bad_light_curve_files(tmp_path, text, match):
@@ -509,14 +605,18 @@ def test_bad_light_curve_files(tmp_path, text, match):
 
 def test_light_curve_iso_times_and_band_whitelist(tmp_path):
     path = tmp_path / "iso.csv"
-    path.write_text("time,band,magnitude,uncertainty\n2024-01-01T00:00:00Z,V,12,0.1\n"
-                    "2024-01-01T00:01:00Z,my-band,12,0.1\n")
+    path.write_text(
+        "time,band,magnitude,uncertainty\n2024-01-01T00:00:00Z,V,12,0.1\n"
+        "2024-01-01T00:01:00Z,my-band,12,0.1\n"
+    )
     with pytest.raises(ValidationError, match="unknown band 'my-band'"):
         P.read_light_curve(path)
     lc = P.read_light_curve(path, bands=["V", "my-band"])
     assert lc.time.dtype == np.dtype("datetime64[ns]")  # absolute UTC times are kept
-    np.testing.assert_array_equal(lc.time.values, np.array(["2024-01-01T00:00:00", "2024-01-01T00:01:00"],
-                                                           dtype="datetime64[ns]"))
+    np.testing.assert_array_equal(
+        lc.time.values,
+        np.array(["2024-01-01T00:00:00", "2024-01-01T00:01:00"], dtype="datetime64[ns]"),
+    )
     with pytest.raises(ValidationError, match="does not have"):
         P.compare_light_curves(lc, _sim_curve(), period_s=600.0)
 
@@ -528,21 +628,35 @@ def test_light_curve_fit_reports_the_half_turn_ambiguity_of_a_symmetric_body(tmp
     ang = np.arange(0.0, 360.0, 1.0)
     th = np.deg2rad(ang)
     sym = 12.0 + 0.5 * np.cos(2 * th) + 0.2 * np.sin(4 * th)
-    sim = xr.DataArray(np.stack([sym, sym], 1), dims=("attitude", "band"),
-                       coords={"attitude": np.arange(ang.size), "attitude_angle": ("attitude", ang),
-                               "band": ["B", "V"]})
+    sim = xr.DataArray(
+        np.stack([sym, sym], 1),
+        dims=("attitude", "band"),
+        coords={
+            "attitude": np.arange(ang.size),
+            "attitude_angle": ("attitude", ang),
+            "band": ["B", "V"],
+        },
+    )
     rng = np.random.default_rng(1)
     theta = np.sort(rng.uniform(0, 360, 200))
     band = rng.choice(["B", "V"], 200)
     mag = 12.0 + 0.5 * np.cos(2 * np.deg2rad(theta + 20)) + 0.2 * np.sin(4 * np.deg2rad(theta + 20))
     path = tmp_path / "sym.csv"
-    pd.DataFrame({"rotation_angle": theta, "band": band, "magnitude": mag + rng.normal(0, 0.01, 200),
-                  "uncertainty": 0.01}).to_csv(path, index=False)
+    pd.DataFrame(
+        {
+            "rotation_angle": theta,
+            "band": band,
+            "magnitude": mag + rng.normal(0, 0.01, 200),
+            "uncertainty": 0.01,
+        }
+    ).to_csv(path, index=False)
     res = P.compare_light_curves(P.read_light_curve(path), sim)
     best = float(res.phase_offset)
     assert min(abs(best - 20.0), abs(best - 200.0)) < 0.5
     alt = float(res.alternative_phase_offset)
     assert abs(((alt - best) % 360) - 180) < 1.0  # the other minimum is half a turn away ...
     assert float(res.alternative_delta_chi_square) < 4.0  # ... and not distinguished
-    asym = P.compare_light_curves(P.read_light_curve(_write_curve(tmp_path / "a.csv")), _sim_curve())
+    asym = P.compare_light_curves(
+        P.read_light_curve(_write_curve(tmp_path / "a.csv")), _sim_curve()
+    )
     assert float(asym.alternative_delta_chi_square) > 100.0

@@ -13,8 +13,13 @@ from sbrdf_xr.errors import ValidationError
 
 
 def _mags(values=(10.0, 11.0, 12.0)):
-    return xr.DataArray(np.array(values), dims="band", coords={"band": ["B", "V", "R"][: len(values)]},
-                        name="magnitude", attrs={"units": "1", "long_name": "m", "magnitude_system": "Vega"})
+    return xr.DataArray(
+        np.array(values),
+        dims="band",
+        coords={"band": ["B", "V", "R"][: len(values)]},
+        name="magnitude",
+        attrs={"units": "1", "long_name": "m", "magnitude_system": "Vega"},
+    )
 
 
 def test_airmass_wraps_pvlib_models_and_refuses_the_horizon():
@@ -22,13 +27,20 @@ def test_airmass_wraps_pvlib_models_and_refuses_the_horizon():
 
     el = np.array([90.0, 60.0, 30.0, 10.0])
     for model in P.AIRMASS_MODELS:
-        np.testing.assert_array_equal(P.airmass(el, model=model),
-                                      get_relative_airmass(90.0 - el, model=model))
+        np.testing.assert_array_equal(
+            P.airmass(el, model=model), get_relative_airmass(90.0 - el, model=model)
+        )
     assert P.airmass(30.0, model="simple") == pytest.approx(2.0, rel=1e-12)  # sec 60 deg
     da = xr.DataArray([45.0, 60.0], dims="obs", name="elevation")
     x = P.airmass(da)
-    assert x.dims == ("obs",) and x.attrs["units"] == "1" and x.attrs["airmass_model"] == "kastenyoung1989"
-    with pytest.raises(ValidationError, match=r"elevation: must be finite and in \(0, 90\].*first is -5"):
+    assert (
+        x.dims == ("obs",)
+        and x.attrs["units"] == "1"
+        and x.attrs["airmass_model"] == "kastenyoung1989"
+    )
+    with pytest.raises(
+        ValidationError, match=r"elevation: must be finite and in \(0, 90\].*first is -5"
+    ):
         P.airmass([10.0, -5.0])
     with pytest.raises(ValidationError, match="airmass model: unknown 'bogus'; allowed: 'simple'"):
         P.airmass(10.0, model="bogus")
@@ -41,7 +53,9 @@ def test_extinction_law_is_exact(x, kb, kv, kr):
     m1 = P.apply_extinction(_mags(), 1.0, k)
     mx = P.apply_extinction(_mags(), x, k)
     # m(X) - m(1) = k (X - 1): one multiply-add per value, so to a few ulps of m ~ 10
-    np.testing.assert_allclose(mx.values - m1.values, np.array([kb, kv, kr]) * (x - 1.0), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        mx.values - m1.values, np.array([kb, kv, kr]) * (x - 1.0), rtol=0, atol=1e-12
+    )
     assert mx.attrs["airmass"] == x and mx.attrs["magnitude_system"] == "Vega"
 
 
@@ -61,8 +75,12 @@ def test_spectral_transmission_through_the_band_weights():
     wl = P.solar_spectrum().wavelength.values
     # Transmission 1 changes nothing (the same integrals)
     one = xr.DataArray(np.ones(wl.size), dims="wavelength", coords={"wavelength": wl})
-    np.testing.assert_allclose(P.sun_magnitudes(["B", "V"], transmission=one).values,
-                               P.sun_magnitudes(["B", "V"]).values, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        P.sun_magnitudes(["B", "V"], transmission=one).values,
+        P.sun_magnitudes(["B", "V"]).values,
+        rtol=0,
+        atol=1e-12,
+    )
     # A grey transmission a dims every band by -2.5 log10 a exactly
     grey = one * 0.5
     d = P.sun_magnitudes(["B", "V"], transmission=grey) - P.sun_magnitudes(["B", "V"])
@@ -78,7 +96,9 @@ def test_spectral_transmission_through_the_band_weights():
     w = P.band_weights(["V"], np.arange(400.0, 800.0, 1.0), normalize=True, transmission=t2)
     assert float(w.sum()) == pytest.approx(1.0, rel=1e-12)
     assert w.attrs["airmass"] == 2.0 and "Rayleigh" in w.attrs["atmosphere"]
-    with pytest.raises(ValidationError, match=r"transmission: values must be finite and in \[0, 1\]"):
+    with pytest.raises(
+        ValidationError, match=r"transmission: values must be finite and in \[0, 1\]"
+    ):
         P.sun_magnitudes(["V"], transmission=one * 2.0)
 
 
@@ -86,7 +106,8 @@ def test_rayleigh_optical_depth_closed_form():
     # Hansen & Travis 1974: tau_R(550 nm) = 0.0975 at sea level; scales with pressure
     assert float(P.rayleigh_optical_depth([550.0])[0]) == pytest.approx(0.0975, abs=0.0005)
     assert float(P.rayleigh_optical_depth([550.0], 506.625)[0]) == pytest.approx(
-        0.5 * float(P.rayleigh_optical_depth([550.0])[0]), rel=1e-14)
+        0.5 * float(P.rayleigh_optical_depth([550.0])[0]), rel=1e-14
+    )
 
 
 def test_standard_magnitude_to_range_and_phase():
@@ -96,9 +117,13 @@ def test_standard_magnitude_to_range_and_phase():
     assert s.attrs["standard_range_km"] == 1000.0 and s.attrs["magnitude_system"] == "Vega"
     # Lambert sphere: Phi(90) = 1/pi exactly; at 90 deg normalised to 0 deg: -2.5 log10 pi brighter
     s0 = P.standard_magnitude(m, 1000.0, phase_angle=90.0, to_phase_angle=0.0)
-    np.testing.assert_allclose(s0.values, m.values + 2.5 * np.log10(1.0 / np.pi), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        s0.values, m.values + 2.5 * np.log10(1.0 / np.pi), rtol=0, atol=1e-12
+    )
     assert s0.attrs["phase_function"] == "lambert_sphere"
-    sp = P.standard_magnitude(m, 1000.0, phase_angle=90.0, to_phase_angle=0.0, phase_function="specular_sphere")
+    sp = P.standard_magnitude(
+        m, 1000.0, phase_angle=90.0, to_phase_angle=0.0, phase_function="specular_sphere"
+    )
     np.testing.assert_allclose(sp.values, m.values, atol=1e-12)
     s1 = P.standard_magnitude(m, 1000.0, sun_distance_au=1.1)
     np.testing.assert_allclose(s1.values, m.values - 5 * np.log10(1.1), atol=1e-12)
@@ -126,7 +151,8 @@ def test_lambert_sphere_phase_function_is_the_quadrature_of_lambert_discs():
 
     for alpha in (30.0, 90.0, 150.0):
         assert brightness(alpha) / brightness(0.0) == pytest.approx(
-            float(P.lambert_sphere_phase(alpha)), abs=2e-4)
+            float(P.lambert_sphere_phase(alpha)), abs=2e-4
+        )
 
 
 def test_sun_distance_at_perihelion_and_aphelion():
@@ -139,8 +165,13 @@ def test_sun_distance_at_perihelion_and_aphelion():
 
 
 def _emission(wl, centre=600.0, sigma=0.5):
-    return xr.DataArray(np.exp(-0.5 * ((wl - centre) / sigma) ** 2), dims="wavelength",
-                        coords={"wavelength": wl}, name="x", attrs={"units": "1", "long_name": "test"})
+    return xr.DataArray(
+        np.exp(-0.5 * ((wl - centre) / sigma) ** 2),
+        dims="wavelength",
+        coords={"wavelength": wl},
+        name="x",
+        attrs={"units": "1", "long_name": "test"},
+    )
 
 
 def test_at_resolution_conserves_flux_and_widens_lines_in_quadrature():
@@ -159,12 +190,15 @@ def test_at_resolution_conserves_flux_and_widens_lines_in_quadrature():
     assert mean == pytest.approx(600.0, abs=1e-6)
     # a continuum that reaches the ends loses the half-kernel past each end (documented)
     flat = x * 0.0 + 1.0
-    lost = np.trapezoid(flat.values, wl) - np.trapezoid(P.at_resolution(flat, fwhm_nm=2.0).values, wl)
+    lost = np.trapezoid(flat.values, wl) - np.trapezoid(
+        P.at_resolution(flat, fwhm_nm=2.0).values, wl
+    )
     assert lost == pytest.approx(2 * s / np.sqrt(2 * np.pi), rel=1e-2)
     # resolving power R: FWHM lambda/R; R = 600/2 gives the same line as FWHM 2 nm near 600 nm
     z = P.at_resolution(x, resolving_power=300.0)
     assert float(z.sel(wavelength=600.0, method="nearest")) == pytest.approx(
-        float(y.sel(wavelength=600.0, method="nearest")), abs=2e-3)
+        float(y.sel(wavelength=600.0, method="nearest")), abs=2e-3
+    )
     # onto a coarser grid, still flux-conserving
     coarse = np.arange(500.0, 700.01, 1.0)
     c = P.at_resolution(x, fwhm_nm=2.0, wavelength=coarse)

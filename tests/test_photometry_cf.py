@@ -16,7 +16,9 @@ from sbrdf_xr.simulate import simulate
 
 pytest.importorskip("compliance_checker")
 
-CATALOG_MATERIALS = sorted((Path(__file__).resolve().parents[1] / "catalogs" / "materials").glob("*.nc"))
+CATALOG_MATERIALS = sorted(
+    (Path(__file__).resolve().parents[1] / "catalogs" / "materials").glob("*.nc")
+)
 # table4-paints.nc has a string coordinate variable 'sample(sample)'; compliance-checker
 # 6.1's monotonicity check raises on strings instead of reporting (no error or warning).
 CHECKER_RAISES_ON_STRING_COORDINATES = {"table4-paints.nc"}
@@ -45,7 +47,9 @@ def cf_report(path: Path) -> tuple[list[str], list[str], list[str]]:
             v = r.value
             failed = (v[0] < v[1]) if isinstance(v, tuple) else not v
             if failed:
-                (errors if r.weight == 3 else warnings if r.weight == 2 else []).append(f"{r.name}: {r.msgs}")
+                (errors if r.weight == 3 else warnings if r.weight == 2 else []).append(
+                    f"{r.name}: {r.msgs}"
+                )
             walk(r.children or [])
 
     walk(groups)
@@ -55,10 +59,18 @@ def cf_report(path: Path) -> tuple[list[str], list[str], list[str]]:
 def _scene():
     wl = np.arange(290.0, 1201.0, 10.0)
     spec = models.model_material("lambert", wl, rho=0.5, material="white", provenance="test")
-    table = models.render(spec, theta_i=np.arange(0.0, 91.0, 15.0),
-                          delta_theta=np.arange(-180.0, 91.0, 30.0), phi=np.arange(0.0, 91.0, 15.0))
-    scene = Scene(T.cube_spacecraft(1.0), materials={T.TEST_SPACECRAFT_MATERIAL: table},
-                  to_sun=[[1.0, 0.0, 0.0], [0.6, 0.8, 0.0]], to_observer=[[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    table = models.render(
+        spec,
+        theta_i=np.arange(0.0, 91.0, 15.0),
+        delta_theta=np.arange(-180.0, 91.0, 30.0),
+        phi=np.arange(0.0, 91.0, 15.0),
+    )
+    scene = Scene(
+        T.cube_spacecraft(1.0),
+        materials={T.TEST_SPACECRAFT_MATERIAL: table},
+        to_sun=[[1.0, 0.0, 0.0], [0.6, 0.8, 0.0]],
+        to_observer=[[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]],
+    )
     return scene
 
 
@@ -89,21 +101,29 @@ def test_photometry_file_is_cf_clean(tmp_path, system):
     with xr.open_dataset(path) as raw:
         for name, var in raw.variables.items():
             assert var.attrs.get("long_name"), name
-        assert raw.magnitude.attrs["units"] == "1" and raw.magnitude.attrs["magnitude_system"] == system
+        assert (
+            raw.magnitude.attrs["units"] == "1"
+            and raw.magnitude.attrs["magnitude_system"] == system
+        )
         assert _attribute_names_are_cf(raw) == []
         for a in ("title", "source", "history", "Conventions"):
             assert raw.attrs[a]
     back = P.open_photometry(path)
     xr.testing.assert_equal(back.magnitude, ds.magnitude)
-    assert back.band.values.tolist() == ["B", "V", "R"] and back.colour.values.tolist() == ["B-V", "V-R"]
+    assert back.band.values.tolist() == ["B", "V", "R"] and back.colour.values.tolist() == [
+        "B-V",
+        "V-R",
+    ]
 
 
 def test_written_material_files_are_cf_clean(tmp_path):
     import xarray as xr
 
-    paths = [material.to_netcdf(catalog.load("lambertian-grey-50"), tmp_path / "table.nc"),
-             material.to_netcdf(catalog.load("white-paint-a276-measurements"), tmp_path / "meas.nc"),
-             models.to_netcdf(catalog.load("white-paint-a276-fit"), tmp_path / "fit.nc")]
+    paths = [
+        material.to_netcdf(catalog.load("lambertian-grey-50"), tmp_path / "table.nc"),
+        material.to_netcdf(catalog.load("white-paint-a276-measurements"), tmp_path / "meas.nc"),
+        models.to_netcdf(catalog.load("white-paint-a276-fit"), tmp_path / "fit.nc"),
+    ]
     for path in paths:
         assert cf_report(path) == ([], [], []), path.name
     with xr.open_dataset(tmp_path / "meas.nc", decode_cf=False) as raw:
@@ -118,13 +138,19 @@ def test_written_material_files_are_cf_clean(tmp_path):
 def test_shipped_material_files_are_cf_clean(path):
     errors, warnings, raised = cf_report(path)
     assert (errors, warnings) == ([], [])
-    assert raised == (["check_coordinate_variables_strict_monotonicity"]
-                      if path.name in CHECKER_RAISES_ON_STRING_COORDINATES else [])
+    assert raised == (
+        ["check_coordinate_variables_strict_monotonicity"]
+        if path.name in CHECKER_RAISES_ON_STRING_COORDINATES
+        else []
+    )
 
 
-@pytest.mark.xfail(strict=True, reason="cubes keep string dimension coordinates (xyz, component, "
-                   "material, band) for label-based selection; compliance-checker 6.1 raises in its "
-                   "monotonicity check on them instead of reporting")
+@pytest.mark.xfail(
+    strict=True,
+    reason="cubes keep string dimension coordinates (xyz, component, "
+    "material, band) for label-based selection; compliance-checker 6.1 raises in its "
+    "monotonicity check on them instead of reporting",
+)
 def test_cube_file_is_cf_clean(tmp_path):
     from sbrdf_xr import write
 

@@ -15,8 +15,18 @@ from sbrdf_xr.errors import ValidationError
 from sbrdf_xr.scene import Scene
 from sbrdf_xr.simulate import simulate
 
-BANDS = ["bessell-U", "bessell-B", "bessell-V", "bessell-R", "bessell-I",
-         "sdss2010-u", "sdss2010-g", "sdss2010-r", "sdss2010-i", "sdss2010-z"]
+BANDS = [
+    "bessell-U",
+    "bessell-B",
+    "bessell-V",
+    "bessell-R",
+    "bessell-I",
+    "sdss2010-u",
+    "sdss2010-g",
+    "sdss2010-r",
+    "sdss2010-i",
+    "sdss2010-z",
+]
 # Both sides integrate the same linear interpolants; speclite uses the trapezoid rule on
 # the spectrum's nodes with the filter resampled at 1 A, so the difference is the
 # quadrature error of that rule (measured <= 0.2 mmag): 1 mmag is the requirement.
@@ -38,8 +48,13 @@ def _fine_speclite(names):
     for name in names:
         f = sf.load_filter(name)
         w = np.arange(f.wavelength[0], f.wavelength[-1] + 0.01, 1.0)
-        out.append(sf.FilterResponse(w * u.AA, np.interp(w, f.wavelength, f.response),
-                                     meta={"group_name": "fine", "band_name": name.replace("-", "_")}))
+        out.append(
+            sf.FilterResponse(
+                w * u.AA,
+                np.interp(w, f.wavelength, f.response),
+                meta={"group_name": "fine", "band_name": name.replace("-", "_")},
+            )
+        )
     return sf.FilterSequence(out)
 
 
@@ -70,8 +85,14 @@ def test_sun_vega_magnitudes_match_pyphot():
     for k, name in enumerate(BANDS):
         f = sf.load_filter(name)
         w = np.arange(f.wavelength[0], f.wavelength[-1] + 0.01, 1.0)
-        pf = Filter(w, np.interp(w, f.wavelength, f.response), name=name, dtype="photon", unit="AA",
-                    vega="stis_011")
+        pf = Filter(
+            w,
+            np.interp(w, f.wavelength, f.response),
+            name=name,
+            dtype="photon",
+            unit="AA",
+            vega="stis_011",
+        )
         m = -2.5 * np.log10(pf.get_flux(wl_a, flam).value / pf.Vega_zero_flux.value)
         assert ours.values[k] == pytest.approx(m, abs=MMAG), name
     assert ours.attrs["magnitude_system"] == "Vega"
@@ -102,11 +123,19 @@ def test_vega_has_magnitude_zero_on_its_own_system():
 def _white_lambertian_cube():
     wl = np.arange(290.0, 1201.0, 5.0)
     spec = models.model_material("lambert", wl, rho=1.0, material="white", provenance="test")
-    table = models.render(spec, theta_i=np.arange(0.0, 91.0, 15.0),
-                          delta_theta=np.arange(-180.0, 91.0, 30.0), phi=np.arange(0.0, 91.0, 15.0))
+    table = models.render(
+        spec,
+        theta_i=np.arange(0.0, 91.0, 15.0),
+        delta_theta=np.arange(-180.0, 91.0, 30.0),
+        phi=np.arange(0.0, 91.0, 15.0),
+    )
     sc = T.cube_spacecraft(1.0)
-    scene = Scene(sc, materials={T.TEST_SPACECRAFT_MATERIAL: table},
-                  to_sun=[[1.0, 0.0, 0.0]], to_observer=[[1.0, 0.0, 0.0]])
+    scene = Scene(
+        sc,
+        materials={T.TEST_SPACECRAFT_MATERIAL: table},
+        to_sun=[[1.0, 0.0, 0.0]],
+        to_observer=[[1.0, 0.0, 0.0]],
+    )
     return simulate(scene).compute()
 
 

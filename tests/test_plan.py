@@ -44,7 +44,9 @@ def test_plan_fields_describe_what_runs():
     assert out["signal"].shape == (30, 2, p.wavelength.size)
     assert out["signal"].attrs["units"] == "m2 sr-1" and out["area"].dtype == np.float64
     assert p.knobs["method"] == "linear" and p.knobs["kernel"] == "fused"
-    assert p.estimate.n_geometries == 60 and p.estimate.output_bytes == sum(o.nbytes for o in p.outputs)
+    assert p.estimate.n_geometries == 60 and p.estimate.output_bytes == sum(
+        o.nbytes for o in p.outputs
+    )
     assert p.n_blocks == 1 and p.chunk == 30  # a small scene is one block
     with pytest.raises(AttributeError):
         p.chunk = 3  # frozen
@@ -109,9 +111,13 @@ def test_knob_table_and_presets():
 def test_a_plan_beyond_reason_is_refused_before_anything_is_allocated():
     # 1e6 attitudes x 2e5 "wavelengths" of a synthetic table: 3.2 TB of outputs
     big = T.make_material(n_wavelength=3)
-    s = Scene(T.cube_spacecraft(), materials={T.TEST_SPACECRAFT_MATERIAL: big},
-              attitudes=geometry.uniform_attitudes(200, seed=1), phase_angles=np.linspace(1, 179, 5000),
-              outputs=("signal", "area"))
+    s = Scene(
+        T.cube_spacecraft(),
+        materials={T.TEST_SPACECRAFT_MATERIAL: big},
+        attitudes=geometry.uniform_attitudes(200, seed=1),
+        phase_angles=np.linspace(1, 179, 5000),
+        outputs=("signal", "area"),
+    )
     with pytest.raises(SceneError, match=r"beyond reason: .* raise the limits with size_limit"):
         s.with_options(size_limit=1e-9).plan()
     assert s.with_options(size_limit=1.0).plan().estimate.n_geometries == 1_000_000
@@ -132,8 +138,13 @@ def test_analytic_evaluation_is_a_simulation_option():
     lam = catalog.load("lambertian-grey-50")
     from sbrdf_xr import models
 
-    spec = models.model_material("lambert", lam.wavelength.values, rho=0.5, material="grey",
-                                 provenance="albedo 0.5, as the lambertian-grey-50 table")
+    spec = models.model_material(
+        "lambert",
+        lam.wavelength.values,
+        rho=0.5,
+        material="grey",
+        provenance="albedo 0.5, as the lambertian-grey-50 table",
+    )
     s = scene(table=lam, models={T.TEST_SPACECRAFT_MATERIAL: spec})
     a = simulate(s, evaluation="analytic")
     t = simulate(s)
@@ -179,12 +190,17 @@ def test_tilt_quadrature_is_the_gaussian_expectation():
     sig = np.radians(3.0)
     t, w = tilt_quadrature(3.0, 4)
     np.testing.assert_allclose(w @ t, 0.0, atol=1e-15)
-    np.testing.assert_allclose((w[:, None, None] * t[:, :, None] * t[:, None, :]).sum(0),
-                               sig**2 * np.eye(2), rtol=1e-12, atol=1e-18)
+    np.testing.assert_allclose(
+        (w[:, None, None] * t[:, :, None] * t[:, None, :]).sum(0),
+        sig**2 * np.eye(2),
+        rtol=1e-12,
+        atol=1e-18,
+    )
     np.testing.assert_allclose(w @ ((t**2).sum(1) ** 2), 8 * sig**4, rtol=1e-12)
     n = tilted_normals(np.array([[0.0, 0.0, 1.0]]), t)[0]
-    np.testing.assert_allclose(np.degrees(np.arccos(np.clip(n[:, 2], -1, 1))), np.degrees(np.hypot(*t.T)),
-                               rtol=1e-9)
+    np.testing.assert_allclose(
+        np.degrees(np.arccos(np.clip(n[:, 2], -1, 1))), np.degrees(np.hypot(*t.T)), rtol=1e-9
+    )
     t0, w0 = tilt_quadrature(0.0, 7)
     assert t0.shape == (1, 2) and w0[0] == 1.0
 
@@ -195,8 +211,12 @@ def test_surface_tilt_zero_is_exact_and_matches_monte_carlo_over_perturbed_facet
     from sbrdf_xr._kernels import fused_sums
 
     lobe = catalog.load("example-lobe")
-    s = scene(table=lobe, attitudes=geometry.uniform_attitudes(12, seed=8), phase_angles=[8.0, 40.0],
-              merge=False)
+    s = scene(
+        table=lobe,
+        attitudes=geometry.uniform_attitudes(12, seed=8),
+        phase_angles=[8.0, 40.0],
+        merge=False,
+    )
     flat = simulate(s)
     same = simulate(s, surface_tilt=0.0, tilt_nodes=9)
     xr.testing.assert_identical(flat.signal, same.signal)
@@ -211,8 +231,11 @@ def test_surface_tilt_zero_is_exact_and_matches_monte_carlo_over_perturbed_facet
     for _ in range(400):
         tilt = rng.normal(0.0, np.radians(sigma), (p.terms.size, 1, 2))
         nrm = tilted_normals(p.terms.normal, tilt)[:, 0]
-        draws.append(fused_sums(b.to_sun, b.to_observer, nrm, p.terms.area, p.terms.material,
-                                p.tables, "linear").signal)
+        draws.append(
+            fused_sums(
+                b.to_sun, b.to_observer, nrm, p.terms.area, p.terms.material, p.tables, "linear"
+            ).signal
+        )
     draws = np.array(draws).reshape(400, *rough.shape)
     mean, se = draws.mean(0), draws.std(0) / np.sqrt(400)
     # 5 standard errors (plus the quadrature's own small error, 1e-3 of the peak)
@@ -225,8 +248,12 @@ def test_workers_write_their_own_zarr_blocks_on_a_local_cluster(tmp_path):
     pytest.importorskip("zarr")
     s = scene(chunk=6)
     ref = simulate(s).compute()
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=":0") as cluster, distributed.Client(cluster) as client:
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
         path = write(simulate(s, client=client), tmp_path / "c.zarr", client=client)
     with xr.open_zarr(path) as back:
         xr.testing.assert_identical(back.load(), ref)

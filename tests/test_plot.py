@@ -28,12 +28,19 @@ def sweep():
 
     wl = np.arange(400.0, 1101.0, 10.0)
     spec = models.model_material("lambert", wl, rho=0.5, material="grey", provenance="test")
-    table = models.render(spec, theta_i=np.arange(0.0, 91.0, 15.0),
-                          delta_theta=np.arange(-180.0, 91.0, 30.0), phi=np.arange(0.0, 91.0, 15.0))
-    scene = Scene(T.cube_spacecraft(1.0), materials={T.TEST_SPACECRAFT_MATERIAL: table},
-                  attitudes=geometry.axis_rotation([0, 0, 1], np.arange(0.0, 360.0, 10.0)),
-                  attitude_angle=np.arange(0.0, 360.0, 10.0),
-                  phase_angles=[10.0, 60.0])
+    table = models.render(
+        spec,
+        theta_i=np.arange(0.0, 91.0, 15.0),
+        delta_theta=np.arange(-180.0, 91.0, 30.0),
+        phi=np.arange(0.0, 91.0, 15.0),
+    )
+    scene = Scene(
+        T.cube_spacecraft(1.0),
+        materials={T.TEST_SPACECRAFT_MATERIAL: table},
+        attitudes=geometry.axis_rotation([0, 0, 1], np.arange(0.0, 360.0, 10.0)),
+        attitude_angle=np.arange(0.0, 360.0, 10.0),
+        phase_angles=[10.0, 60.0],
+    )
     return simulate(scene).compute()
 
 
@@ -43,7 +50,11 @@ def _labels(fig):
 
 
 def test_cube_figures_have_short_labels_with_units(sweep):
-    for fig in (plot.light_curve(sweep), plot.spectra(sweep, "signal", attitude=0), plot.plot_cube(sweep)):
+    for fig in (
+        plot.light_curve(sweep),
+        plot.spectra(sweep, "signal", attitude=0),
+        plot.plot_cube(sweep),
+    ):
         for text in _labels(fig):
             assert 0 < len(text) <= MAX_LABEL and "[" in text, text
         legend = fig.axes[0].get_legend()
@@ -52,10 +63,19 @@ def test_cube_figures_have_short_labels_with_units(sweep):
 
 
 def test_log_axis_where_the_range_is_large():
-    ds = xr.Dataset({"brdf": (("attitude", "phase_angle"), np.array([[1.0], [200.0], [3.0]]),
-                              {"units": "sr-1 nm", "long_name": "x"})},
-                    coords={"attitude_angle": ("attitude", [0.0, 10.0, 20.0], {"units": "degree"}),
-                            "phase_angle": ("phase_angle", [5.0], {"units": "degree"})})
+    ds = xr.Dataset(
+        {
+            "brdf": (
+                ("attitude", "phase_angle"),
+                np.array([[1.0], [200.0], [3.0]]),
+                {"units": "sr-1 nm", "long_name": "x"},
+            )
+        },
+        coords={
+            "attitude_angle": ("attitude", [0.0, 10.0, 20.0], {"units": "degree"}),
+            "phase_angle": ("phase_angle", [5.0], {"units": "degree"}),
+        },
+    )
     assert plot.light_curve(ds).axes[0].get_yscale() == "log"
     flat = ds.copy()
     flat["brdf"] = flat.brdf.copy(data=np.array([[1.0], [2.0], [3.0]]))
@@ -67,7 +87,11 @@ def test_magnitudes_per_band_brighter_up_and_the_accessor(sweep):
     mags = P.magnitudes(sweep, ["V", "R", "I"], 1000.0, system="vega")
     fig = plot.magnitudes(mags, phase_angle=10.0)
     ax = fig.axes[0]
-    assert ax.yaxis_inverted() and [t.get_text() for t in ax.get_legend().get_texts()] == ["V", "R", "I"]
+    assert ax.yaxis_inverted() and [t.get_text() for t in ax.get_legend().get_texts()] == [
+        "V",
+        "R",
+        "I",
+    ]
     assert ax.get_ylabel() == "magnitude (Vega, 1000 km)"
     with pytest.raises(ValueError, match="select the others"):
         plot.magnitudes(mags)
@@ -86,7 +110,9 @@ def test_colour_colour_marks_the_sun(sweep):
     assert ax.get_xlabel() == "V-R [Vega mag]" and ax.get_ylabel() == "R-I [Vega mag]"
     sun = next(line for line in ax.get_lines() if line.get_label().startswith("Sun"))
     sm = P.sun_magnitudes(["V", "R", "I"], system="vega").values
-    assert sun.get_xdata()[0] == pytest.approx(sm[0] - sm[1]) and sun.get_ydata()[0] == pytest.approx(sm[1] - sm[2])
+    assert sun.get_xdata()[0] == pytest.approx(sm[0] - sm[1]) and sun.get_ydata()[
+        0
+    ] == pytest.approx(sm[1] - sm[2])
     # a grey body has the Sun's colours: every point sits on the star
     ci = ph.colour_index
     finite = np.isfinite(ci.sel(colour="V-R").values)

@@ -15,7 +15,8 @@ GREY = """
 "white-paint-a276" = "lambertian-grey-50"
 """
 
-ROTATION = """
+ROTATION = (
+    """
 name = "toml-rotation"
 spacecraft = "canx1"
 phase_angles = [10.0, 20.0]
@@ -31,7 +32,9 @@ stop = 360
 step = 2
 initial_axis = [0, 0, 1]
 initial_angle = 25
-""" + GREY
+"""
+    + GREY
+)
 
 
 def write(tmp_path, text, name="s.toml"):
@@ -49,7 +52,10 @@ def test_toml_scene_round_trip(tmp_path):
 
 
 def test_toml_explicit_geometry(tmp_path):
-    text = 'spacecraft = "canx1"\n[geometry]\nto_sun = [[1.0, 0.0, 0.0]]\nto_observer = [[0.0, 1.0, 0.0]]\n' + GREY
+    text = (
+        'spacecraft = "canx1"\n[geometry]\nto_sun = [[1.0, 0.0, 0.0]]\nto_observer = [[0.0, 1.0, 0.0]]\n'
+        + GREY
+    )
     scene = load_scene(write(tmp_path, text))
     assert not scene.is_grid and scene.n_geometries == 1
 
@@ -60,12 +66,23 @@ def test_toml_explicit_geometry(tmp_path):
         (ROTATION.replace('method = "nearest"', 'methdo = "nearest"'), "unknown key 'methdo'"),
         (ROTATION.replace("chunk = 50", 'chunk = "fifty"'), "key 'chunk' has type str"),
         (ROTATION.replace('kind = "sweep"', 'kind = "tumble"'), "unknown kind 'tumble'"),
-        (ROTATION.replace('outputs = ["spacecraft_sbrdf", "signal", "brdf", "area"]', 'outputs = ["spacecraft_sbrdf", "smell"]'),
-         "outputs: unknown"),
-        (ROTATION.replace('spacecraft = "canx1"', 'spacecraft = "lambertian-grey-50"'), "not a spacecraft"),
+        (
+            ROTATION.replace(
+                'outputs = ["spacecraft_sbrdf", "signal", "brdf", "area"]',
+                'outputs = ["spacecraft_sbrdf", "smell"]',
+            ),
+            "outputs: unknown",
+        ),
+        (
+            ROTATION.replace('spacecraft = "canx1"', 'spacecraft = "lambertian-grey-50"'),
+            "not a spacecraft",
+        ),
         ("this is = not toml", "invalid TOML"),
-        ('spacecraft = "canx1"\n[geometry]\nto_sun = [[2.0, 0.0, 0.0]]\nto_observer = [[0.0, 1.0, 0.0]]\n'
-         + GREY, "unit vectors"),
+        (
+            'spacecraft = "canx1"\n[geometry]\nto_sun = [[2.0, 0.0, 0.0]]\nto_observer = [[0.0, 1.0, 0.0]]\n'
+            + GREY,
+            "unit vectors",
+        ),
     ],
 )
 def test_bad_scene_files(tmp_path, text, match):

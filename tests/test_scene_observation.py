@@ -56,9 +56,18 @@ def test_umbra_is_skipped_and_the_penumbra_scales_the_sunlight(cube):
     # Penumbra: the same geometry in full sunlight, times the sunlit fraction.
     g = observe.canx1_pass().geometry()
     pen = np.flatnonzero((f > 0) & (f < 1))
-    full = simulate(Scene(canx1(), to_sun=g.to_sun.values[pen], to_observer=g.to_observer.values[pen],
-                          outputs=("signal", "area", "band_signal"), bands=("V", "R", "I")))
-    np.testing.assert_allclose(cube.signal.values[pen], f[pen, None] * full.signal.values, rtol=1e-12)
+    full = simulate(
+        Scene(
+            canx1(),
+            to_sun=g.to_sun.values[pen],
+            to_observer=g.to_observer.values[pen],
+            outputs=("signal", "area", "band_signal"),
+            bands=("V", "R", "I"),
+        )
+    )
+    np.testing.assert_allclose(
+        cube.signal.values[pen], f[pen, None] * full.signal.values, rtol=1e-12
+    )
     np.testing.assert_allclose(cube.area.values[pen], full.area.values, rtol=1e-12)
 
 
@@ -78,21 +87,27 @@ def test_toml_observation_scene(tmp_path):
     p.write_text(bad)
     with pytest.raises(SceneError, match=r"\[observation\]"):
         load_scene(p)
-    p.write_text(PASS_TOML + "\n[attitude]\nkind = \"uniform\"\nn = 3\n")
+    p.write_text(PASS_TOML + '\n[attitude]\nkind = "uniform"\nn = 3\n')
     with pytest.raises(SceneError, match="an \\[observation\\] gives the geometry"):
         load_scene(p)
 
 
 def test_observation_and_another_geometry_are_refused():
     with pytest.raises(SceneError, match="not several"):
-        Scene(canx1(), observation=observe.canx1_pass(), to_sun=[[1.0, 0, 0]], to_observer=[[1.0, 0, 0]])
+        Scene(
+            canx1(),
+            observation=observe.canx1_pass(),
+            to_sun=[[1.0, 0, 0]],
+            to_observer=[[1.0, 0, 0]],
+        )
     with pytest.raises(SceneError, match=r"expected a sbrdf_xr\.observe\.Observation"):
         Scene(canx1(), observation="canx1-pass")
 
 
 def test_earthshine_follows_the_earth_at_every_time():
-    scene = builtin_scene("canx1-pass").with_options(effects=("sunlight", "earthshine"),
-                                                      outputs=("signal", "area"))
+    scene = builtin_scene("canx1-pass").with_options(
+        effects=("sunlight", "earthshine"), outputs=("signal", "area")
+    )
     c = simulate(scene)
     assert "signal_earthshine" in c and np.all(np.isfinite(c.signal_earthshine))
     assert (c.signal_earthshine.values > 0).any()

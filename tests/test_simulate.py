@@ -100,8 +100,11 @@ def test_simulate_builds_a_lazy_graph():
 
 
 def test_plan_says_what_runs_and_why():
-    scene = cube_scene(attitudes=geometry.rotation_sweep([0, 0, 1], np.arange(0, 360, 30.0)),
-                       phase_angles=[20.0], effects=("sunlight", "shadowing"))
+    scene = cube_scene(
+        attitudes=geometry.rotation_sweep([0, 0, 1], np.arange(0, 360, 30.0)),
+        phase_angles=[20.0],
+        effects=("sunlight", "shadowing"),
+    )
     plan = scene.plan()
     text = str(plan)
     assert "skipped: the body is convex" in text
@@ -114,9 +117,15 @@ def test_plan_says_what_runs_and_why():
 def test_shadowing_on_a_non_convex_body_runs_per_facet():
     sc = T.l_shaped_spacecraft()
     s = np.array([[2.0, -1.0, 0.0]]) / np.sqrt(5.0)
-    scene = Scene(sc, materials={T.TEST_SPACECRAFT_MATERIAL: grey()},
-                  to_sun=s, to_observer=[[1.0, 0.0, 0.0]],
-                  effects=("sunlight", "shadowing"), shadow_method="sampled", shadow_density=6)
+    scene = Scene(
+        sc,
+        materials={T.TEST_SPACECRAFT_MATERIAL: grey()},
+        to_sun=s,
+        to_observer=[[1.0, 0.0, 0.0]],
+        effects=("sunlight", "shadowing"),
+        shadow_method="sampled",
+        shadow_density=6,
+    )
     plan = compile_plan(scene)
     assert plan.shadowing and not plan.merged
     assert "sampled self-shadowing" in str(plan)
@@ -153,8 +162,15 @@ def test_presets_and_float32():
         ({"attitudes": [[0, 0, 0, 2.0]], "phase_angles": [10.0]}, "quaternion"),
         ({"attitudes": [[0, 0, 0, 1.0]]}, "needs both attitudes and phase_angles"),
         ({}, "give either attitudes and phase_angles"),
-        ({"attitudes": [[0, 0, 0, 1.0]], "phase_angles": [10.0], "to_sun": [[1.0, 0, 0]],
-          "to_observer": [[1.0, 0, 0]]}, "not several"),
+        (
+            {
+                "attitudes": [[0, 0, 0, 1.0]],
+                "phase_angles": [10.0],
+                "to_sun": [[1.0, 0, 0]],
+                "to_observer": [[1.0, 0, 0]],
+            },
+            "not several",
+        ),
     ],
 )
 def test_bad_scenes_raise_scene_errors(kw, match):
@@ -177,7 +193,9 @@ def test_band_pre_integration_equals_spectral_path():
     common = dict(attitudes=q, phase_angles=[20.0, 70.0], bands=("V", "R", "I"))
     pre = cube_scene(outputs=("band_signal", "area"), **common)
     spectral = cube_scene(outputs=("signal", "band_signal", "area"), **common)
-    assert "pre-integrated" in str(pre.plan()) and "from the spectral signal" in str(spectral.plan())
+    assert "pre-integrated" in str(pre.plan()) and "from the spectral signal" in str(
+        spectral.plan()
+    )
     a = simulate(pre).compute()
     b = simulate(spectral).compute()
     assert "wavelength" not in a.dims and a.band_signal.dims == ("attitude", "phase_angle", "band")
@@ -188,10 +206,16 @@ def test_band_pre_integration_equals_spectral_path():
 
 def test_bands_outside_the_material_wavelengths_need_an_explicit_extrapolation():
     with pytest.raises(SceneError, match="bands: band 'U'"):
-        cube_scene(to_sun=[[1.0, 0, 0]], to_observer=[[1.0, 0, 0]], outputs=("band_signal",),
-                   bands=("U",)).plan()
-    scene = cube_scene(to_sun=[[1.0, 0, 0]], to_observer=[[1.0, 0, 0]], outputs=("band_signal",),
-                       bands=("U",), band_extrapolate="constant")
+        cube_scene(
+            to_sun=[[1.0, 0, 0]], to_observer=[[1.0, 0, 0]], outputs=("band_signal",), bands=("U",)
+        ).plan()
+    scene = cube_scene(
+        to_sun=[[1.0, 0, 0]],
+        to_observer=[[1.0, 0, 0]],
+        outputs=("band_signal",),
+        bands=("U",),
+        band_extrapolate="constant",
+    )
     assert np.isfinite(simulate(scene).compute().band_signal).all()
 
 
@@ -203,13 +227,26 @@ def test_earthshine_is_a_second_lambertian_source():
     s = np.array([[1.0, 0.0, 0.0]])
     o = np.array([[0.0, 1.0, 0.0]])
     e = np.array([[0.0, 0.6, 0.8]])
-    es = simulate(cube_scene(to_sun=s, to_observer=o, to_earth=e, effects=("sunlight", "earthshine"),
-                             earth_albedo=0.3, earth_range_km=42164.0, earth_phase_angle=60.0)).compute()
+    es = simulate(
+        cube_scene(
+            to_sun=s,
+            to_observer=o,
+            to_earth=e,
+            effects=("sunlight", "earthshine"),
+            earth_albedo=0.3,
+            earth_range_km=42164.0,
+            earth_phase_angle=60.0,
+        )
+    ).compute()
     ratio = earthshine_irradiance_ratio(0.3, 42164.0, 60.0)
     a = np.radians(60.0)
-    assert ratio == pytest.approx(2 / 3 * 0.3 * (6371 / 42164) ** 2 * ((np.pi - a) * np.cos(a) + np.sin(a)) / np.pi)
+    assert ratio == pytest.approx(
+        2 / 3 * 0.3 * (6371 / 42164) ** 2 * ((np.pi - a) * np.cos(a) + np.sin(a)) / np.pi
+    )
     # faces +y (cos_e 0.6, cos_r 1) and +z (cos_e 0.8, cos_r 0) -> only +y counts
-    np.testing.assert_allclose(es.signal_earthshine.isel(wavelength=0), ratio * 0.5 / np.pi * 0.6, rtol=1e-6)
+    np.testing.assert_allclose(
+        es.signal_earthshine.isel(wavelength=0), ratio * 0.5 / np.pi * 0.6, rtol=1e-6
+    )
     assert float(es.signal.isel(wavelength=0, geometry=0)) == 0.0  # the Sun lights +x, unseen
     with pytest.raises(SceneError, match="to_earth"):
         cube_scene(to_sun=s, to_observer=o, effects=("sunlight", "earthshine"))
@@ -241,11 +278,19 @@ def test_simulation_on_a_local_cluster_equals_the_threaded_run(tmp_path):
     distributed = pytest.importorskip("distributed")
     from sbrdf_xr.simulate import write
 
-    scene = cube_scene(table=catalog.load("example-lobe"), attitudes=geometry.uniform_attitudes(40, seed=9),
-                       phase_angles=[15.0, 60.0], chunk=10)
+    scene = cube_scene(
+        table=catalog.load("example-lobe"),
+        attitudes=geometry.uniform_attitudes(40, seed=9),
+        phase_angles=[15.0, 60.0],
+        chunk=10,
+    )
     threaded = write(simulate(scene), tmp_path / "threads.nc")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=":0") as cluster, distributed.Client(cluster) as client:
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
         cube = simulate(scene, client=client)
         on_cluster = write(cube, tmp_path / "cluster.nc", client=client)
     with xr.open_dataset(threaded) as a, xr.open_dataset(on_cluster) as b:
@@ -255,14 +300,19 @@ def test_simulation_on_a_local_cluster_equals_the_threaded_run(tmp_path):
 def test_materials_without_common_wavelengths_are_rejected():
     sc = T.cube_spacecraft()
     short = T.make_material(n_wavelength=3).assign_coords(
-        wavelength=np.array([2000.0, 2100.0, 2200.0]))
+        wavelength=np.array([2000.0, 2100.0, 2200.0])
+    )
     short.wavelength.attrs.update(units="nm", long_name="vacuum wavelength")
     other = T.make_material(n_wavelength=3)
     from sbrdf_xr.spacecraft import load_spacecraft
 
     mesh = sc.mesh.copy()
-    mesh.visual.face_colors = np.where(np.arange(len(mesh.faces))[:, None] < 6, [255, 0, 0, 255], [0, 0, 255, 255])
+    mesh.visual.face_colors = np.where(
+        np.arange(len(mesh.faces))[:, None] < 6, [255, 0, 0, 255], [0, 0, 255, 255]
+    )
     two = load_spacecraft(mesh, {(255, 0, 0): "a", (0, 0, 255): "b"})
-    scene = Scene(two, materials={"a": short, "b": other}, to_sun=[[1.0, 0, 0]], to_observer=[[0.0, 0, 1.0]])
+    scene = Scene(
+        two, materials={"a": short, "b": other}, to_sun=[[1.0, 0, 0]], to_observer=[[0.0, 0, 1.0]]
+    )
     with pytest.raises(SceneError, match="no wavelengths in common"):
         simulate(scene)

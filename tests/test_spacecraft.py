@@ -79,7 +79,9 @@ def test_canx1_geometry(canx1):
 def side_area(craft, material, axis, sign):
     """Area of the facets of a material facing a side, projected onto that side [m2]."""
     n = craft.mesh.face_normals
-    on_side = craft.mesh.triangles_center[:, axis] * sign >= 0.05 - 1e-9  # not the cell walls of other sides
+    on_side = (
+        craft.mesh.triangles_center[:, axis] * sign >= 0.05 - 1e-9
+    )  # not the cell walls of other sides
     sel = (craft.facet_material == material) & (n[:, axis] * sign > 0.5) & on_side
     return (craft.mesh.area_faces[sel] * np.abs(n[sel, axis])).sum()
 
@@ -107,7 +109,11 @@ def test_canx1_cell_layout(canx1):
     tilt = np.radians(_build_canx1.Y_CELL_TILT)
     for axis, spread_axis in ((0, 1), (1, 2)):
         for sign in (1, -1):
-            top = (canx1.facet_material == CELL) & (n[:, axis] * sign > 0.99) & (c[:, axis] * sign > 0.0502)
+            top = (
+                (canx1.facet_material == CELL)
+                & (n[:, axis] * sign > 0.99)
+                & (c[:, axis] * sign > 0.0502)
+            )
             if axis == 0:
                 # equal normals up to the rounding of trimesh's normalisation (1 ulp), one term
                 np.testing.assert_allclose(

@@ -35,11 +35,38 @@ import pytest
 PACKAGE = Path(__file__).resolve().parent.parent / "sbrdf_xr"
 
 LAYERS: tuple[tuple[str, ...], ...] = (
-    ("_version", "_names", "errors", "geometry", "_lut", "_kernels", "sources", "brdf",
-     "imperfections", "knobs", "_catalog_index", "_shadow_kernels", "_cache"),
-    ("material_schema", "material_io", "construction", "models", "material", "goniometer",
-     "mesh_io", "spacecraft", "visibility", "attitude_frames", "attitude", "orbits", "observe",
-     "photometry", "fingerprint"),
+    (
+        "_version",
+        "_names",
+        "errors",
+        "geometry",
+        "_lut",
+        "_kernels",
+        "sources",
+        "brdf",
+        "imperfections",
+        "knobs",
+        "_catalog_index",
+        "_shadow_kernels",
+        "_cache",
+    ),
+    (
+        "material_schema",
+        "material_io",
+        "construction",
+        "models",
+        "material",
+        "goniometer",
+        "mesh_io",
+        "spacecraft",
+        "visibility",
+        "attitude_frames",
+        "attitude",
+        "orbits",
+        "observe",
+        "photometry",
+        "fingerprint",
+    ),
     ("catalog",),
     ("effects", "plan", "sweep", "scene_model", "scene_io", "scene"),
     ("simulate", "_writer", "_write_common", "_runners", "_lock"),
@@ -60,7 +87,13 @@ def _type_checking_nodes(tree: ast.AST) -> set[int]:
     for node in ast.walk(tree):
         if isinstance(node, ast.If):
             t = node.test
-            name = t.id if isinstance(t, ast.Name) else t.attr if isinstance(t, ast.Attribute) else None
+            name = (
+                t.id
+                if isinstance(t, ast.Name)
+                else t.attr
+                if isinstance(t, ast.Attribute)
+                else None
+            )
             if name == "TYPE_CHECKING":
                 for child in node.body:
                     skip.update(id(n) for n in ast.walk(child))
@@ -83,13 +116,20 @@ def import_graph(root: Path = PACKAGE) -> dict[str, set[str]]:
                 continue
             targets: list[str] = []
             if isinstance(node, ast.Import):
-                targets = [a.name.removeprefix("sbrdf_xr").lstrip(".") for a in node.names
-                           if a.name == "sbrdf_xr" or a.name.startswith("sbrdf_xr.")]
+                targets = [
+                    a.name.removeprefix("sbrdf_xr").lstrip(".")
+                    for a in node.names
+                    if a.name == "sbrdf_xr" or a.name.startswith("sbrdf_xr.")
+                ]
             elif isinstance(node, ast.ImportFrom):
                 if node.level:
-                    base_parts = pkg[: len(pkg) - node.level + 1] + ([node.module] if node.module else [])
+                    base_parts = pkg[: len(pkg) - node.level + 1] + (
+                        [node.module] if node.module else []
+                    )
                     base = ".".join(base_parts)
-                elif node.module and (node.module == "sbrdf_xr" or node.module.startswith("sbrdf_xr.")):
+                elif node.module and (
+                    node.module == "sbrdf_xr" or node.module.startswith("sbrdf_xr.")
+                ):
                     base = node.module.removeprefix("sbrdf_xr").lstrip(".")
                 else:
                     continue
@@ -158,7 +198,9 @@ def against_flow(graph: dict[str, set[str]]) -> list[str]:
     for mod, deps in sorted(graph.items()):
         for dep in sorted(deps):
             if layer_of(dep) > layer_of(mod):
-                bad.append(f"{mod or 'sbrdf_xr'} (L{layer_of(mod)}) -> {dep or 'sbrdf_xr'} (L{layer_of(dep)})")
+                bad.append(
+                    f"{mod or 'sbrdf_xr'} (L{layer_of(mod)}) -> {dep or 'sbrdf_xr'} (L{layer_of(dep)})"
+                )
     return bad
 
 
@@ -191,8 +233,11 @@ def test_the_checks_catch_a_catalog_import_in_material(tmp_path):
     copy = tmp_path / "sbrdf_xr"
     shutil.copytree(PACKAGE, copy, ignore=shutil.ignore_patterns("__pycache__", "catalogs"))
     mat = copy / "material.py"
-    mat.write_text(mat.read_text(encoding="utf-8")
-                   + "\n\ndef _f():\n    from .catalog import load\n\n    return load\n", encoding="utf-8")
+    mat.write_text(
+        mat.read_text(encoding="utf-8")
+        + "\n\ndef _f():\n    from .catalog import load\n\n    return load\n",
+        encoding="utf-8",
+    )
     graph = import_graph(copy)
     assert "material (L1) -> catalog (L2)" in against_flow(graph)
     assert any({"material", "catalog"} <= set(c) for c in cycles(graph))
@@ -202,8 +247,10 @@ def test_type_checking_imports_are_left_out(tmp_path):
     pkg = tmp_path / "sbrdf_xr"
     pkg.mkdir()
     (pkg / "__init__.py").write_text("")
-    (pkg / "errors.py").write_text("from typing import TYPE_CHECKING\n\nif TYPE_CHECKING:\n"
-                                   "    from .catalog import CatalogEntry\n")
+    (pkg / "errors.py").write_text(
+        "from typing import TYPE_CHECKING\n\nif TYPE_CHECKING:\n"
+        "    from .catalog import CatalogEntry\n"
+    )
     (pkg / "catalog.py").write_text("from .errors import CatalogError\n")
     assert import_graph(pkg) == {"": set(), "errors": set(), "catalog": {"errors"}}
 

@@ -104,7 +104,9 @@ def reference_fraction(craft, i: int, directions) -> float:
         # affine map from the view plane to the facet-plane coordinates
         src = np.column_stack([tri @ view, np.ones(3)])
         m = np.linalg.solve(src, tri[:, keep])
-        shadows.append(shapely.transform(inside, lambda xy, m=m: np.column_stack([xy, np.ones(len(xy))]) @ m))
+        shadows.append(
+            shapely.transform(inside, lambda xy, m=m: np.column_stack([xy, np.ones(len(xy))]) @ m)
+        )
     if not shadows:
         return 1.0
     return 1.0 - shapely.intersection(shapely.union_all(shadows), facet).area / facet.area
@@ -222,9 +224,11 @@ def test_bus_with_panel_closed_form():
 
 # ----------------------------------------------------------------------------- properties
 
-unit = st.tuples(*[st.floats(-1, 1, allow_nan=False)] * 3).filter(
-    lambda v: 0.05 < np.linalg.norm(v)
-).map(lambda v: np.array(v) / np.linalg.norm(v))
+unit = (
+    st.tuples(*[st.floats(-1, 1, allow_nan=False)] * 3)
+    .filter(lambda v: 0.05 < np.linalg.norm(v))
+    .map(lambda v: np.array(v) / np.linalg.norm(v))
+)
 
 
 @settings(max_examples=40)
@@ -259,8 +263,9 @@ def test_exactly_one_on_convex_body(s, o, subdivisions):
 
 
 @settings(max_examples=25)
-@given(name=st.sampled_from(sorted(NONCONVEX)), s=unit, o=unit,
-       step=st.tuples(*[st.floats(-1, 1)] * 3))
+@given(
+    name=st.sampled_from(sorted(NONCONVEX)), s=unit, o=unit, step=st.tuples(*[st.floats(-1, 1)] * 3)
+)
 def test_signal_continuous_as_the_sun_moves(name, s, o, step):
     """The Lambertian signal S = sum A (N.s)+ (N.o)+ f is Lipschitz in the Sun direction
     (shadow edges move linearly; a facet's 1/N.s blow-up is tamed by its N.s factor): a
@@ -377,8 +382,9 @@ def test_engines_when_no_ray_hits(engine):
         f = vis.lit_fraction(craft, d, method="sampled", density=3, engine=engine)
         np.testing.assert_array_equal(f, (craft.mesh.face_normals @ d > 0) * 1.0)
         np.testing.assert_array_equal(f, vis.lit_fraction(craft, d))
-    f = vis.lit_visible_fraction(craft, MISS_ALL[0], MISS_ALL[1], method="sampled", density=2,
-                                 engine=engine)
+    f = vis.lit_visible_fraction(
+        craft, MISS_ALL[0], MISS_ALL[1], method="sampled", density=2, engine=engine
+    )
     np.testing.assert_array_equal(f, vis.lit_visible_fraction(craft, MISS_ALL[0], MISS_ALL[1]))
 
 
@@ -470,7 +476,9 @@ def test_facet_visibility_dataset_and_joint_fraction(method):
 def test_output_shapes():
     craft = l_shaped_spacecraft()
     for method in vis.METHODS:
-        assert vis.lit_fraction(craft, [0, 1, 0], method=method, density=1).shape == (craft.n_facets,)
+        assert vis.lit_fraction(craft, [0, 1, 0], method=method, density=1).shape == (
+            craft.n_facets,
+        )
         d = random_directions(6, 8).reshape(2, 3, 3)
         assert vis.lit_fraction(craft, d, method=method).shape == (2, 3, craft.n_facets)
         assert vis.lit_fraction(craft.mesh, [0, 1, 0], method=method, density="fast").shape == (
@@ -534,10 +542,19 @@ def test_union_kernels_against_geos(m):
         assert sk._union_area_slabs(gx, gy, gn, m) == pytest.approx(ref, rel=1e-12)
         if m <= 12:  # inclusion-exclusion of heavily overlapping sets is exponential
             buf = sk._MAXM + 1
-            area, ok = sk._union_area(gx, gy, gn, m, 0.0, np.zeros((buf, sk._MAXV)),
-                                      np.zeros((buf, sk._MAXV)), np.zeros(buf, np.int64),
-                                      np.zeros(buf, np.int64), np.zeros(sk._MAXV),
-                                      np.zeros(sk._MAXV))
+            area, ok = sk._union_area(
+                gx,
+                gy,
+                gn,
+                m,
+                0.0,
+                np.zeros((buf, sk._MAXV)),
+                np.zeros((buf, sk._MAXV)),
+                np.zeros(buf, np.int64),
+                np.zeros(buf, np.int64),
+                np.zeros(sk._MAXV),
+                np.zeros(sk._MAXV),
+            )
             assert ok and area == pytest.approx(ref, rel=1e-12)
 
 
@@ -547,7 +564,9 @@ def test_exact_on_finely_meshed_body_against_reference():
     craft = canx1_with_antennas(subdivisions=2)
     s, o = np.array([[0.5, 0.2, 0.8]]), np.array([[0.2, 0.6, 0.75]])
     joint = vis.lit_visible_fraction(craft, s, o)[0]
-    partial = np.flatnonzero((joint > 0) & (joint < 1) & (craft.mesh.triangles_center[:, 2] > 0.0499))
+    partial = np.flatnonzero(
+        (joint > 0) & (joint < 1) & (craft.mesh.triangles_center[:, 2] > 0.0499)
+    )
     assert len(partial) >= 10
     for i in np.random.default_rng(24).choice(partial, 12, replace=False):
         ref = reference_fraction(craft, i, [s[0], o[0]])

@@ -97,7 +97,11 @@ def make_cube(
     to_sun = rng.standard_normal((n_attitude, n_phase, 3))
     to_sun /= np.linalg.norm(to_sun, axis=-1, keepdims=True)
     if spectral == "wavelength":
-        spec = {"units": "nm", "long_name": "vacuum wavelength", "standard_name": "radiation_wavelength"}
+        spec = {
+            "units": "nm",
+            "long_name": "vacuum wavelength",
+            "standard_name": "radiation_wavelength",
+        }
         spec_values = np.linspace(350.0, 1000.0, n_wavelength)
     else:
         spec = {"units": "1", "long_name": "photometric band"}
@@ -117,7 +121,11 @@ def make_cube(
             ),
         },
         coords={
-            "attitude": ("attitude", np.arange(n_attitude), {"units": "1", "long_name": "attitude index"}),
+            "attitude": (
+                "attitude",
+                np.arange(n_attitude),
+                {"units": "1", "long_name": "attitude index"},
+            ),
             "phase_angle": (
                 "phase_angle",
                 np.linspace(0.0, 170.0, n_phase),
@@ -143,7 +151,9 @@ def make_cube(
     )
 
 
-def make_geometry_cube(n_geometry: int = 50, n_wavelength: int = 30, chunk: int = 8, **kw) -> xr.Dataset:
+def make_geometry_cube(
+    n_geometry: int = 50, n_wavelength: int = 30, chunk: int = 8, **kw
+) -> xr.Dataset:
     """Lazy cube over (geometry, wavelength)."""
     ch = (da.core.normalize_chunks(chunk, (n_geometry,))[0], (n_wavelength,))
     return xr.Dataset(
@@ -240,7 +250,11 @@ def test_on_block_reports_every_block_once(tmp_path):
     assert [e.n_written for e in events] == list(range(1, 10))
     assert all(e.n_blocks == 9 and e.in_flight <= 2 for e in events)
     first = next(e for e in events if e.index == 0)
-    assert first.slices == {"attitude": slice(0, 5), "phase_angle": slice(0, 4), "wavelength": slice(0, 40)}
+    assert first.slices == {
+        "attitude": slice(0, 5),
+        "phase_angle": slice(0, 4),
+        "wavelength": slice(0, 40),
+    }
 
 
 def test_progress_bar_tqdm_and_plain(tmp_path, capsys, monkeypatch):
@@ -450,7 +464,12 @@ def test_blocks_in_flight_are_bounded(tmp_path, max_in_flight):
     _COUNTS.update(started=0, written=0, worst=0)
     chunks = ((2,) * 10, (2,) * 5, (8,))
     ds = xr.Dataset(
-        {"v": (("attitude", "phase_angle", "wavelength"), da.map_blocks(counting_block, chunks=chunks, dtype="f8", meta=np.array((), "f8")))}
+        {
+            "v": (
+                ("attitude", "phase_angle", "wavelength"),
+                da.map_blocks(counting_block, chunks=chunks, dtype="f8", meta=np.array((), "f8")),
+            )
+        }
     )
 
     def written(event: BlockWritten) -> None:
@@ -573,16 +592,29 @@ def dask_cluster(tmp_path):
     try:
         start(
             "distributed.cli.dask_scheduler",
-            "--host", "127.0.0.1", "--port", "0", "--scheduler-file", str(sfile),
+            "--host",
+            "127.0.0.1",
+            "--port",
+            "0",
+            "--scheduler-file",
+            str(sfile),
         )
         _wait_for(lambda: sfile.exists() and sfile.stat().st_size > 0, "the scheduler file")
         address = json.loads(sfile.read_text())["address"]
         workers = [
             start(
                 "distributed.cli.dask_worker",
-                "--scheduler-file", str(sfile), "--nthreads", "1", "--no-nanny",
-                "--host", "127.0.0.1", "--local-directory", str(tmp_path / "dask"),
-                "--death-timeout", "60",
+                "--scheduler-file",
+                str(sfile),
+                "--nthreads",
+                "1",
+                "--no-nanny",
+                "--host",
+                "127.0.0.1",
+                "--local-directory",
+                str(tmp_path / "dask"),
+                "--death-timeout",
+                "60",
             )
             for _ in range(2)
         ]

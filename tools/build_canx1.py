@@ -150,8 +150,12 @@ def build() -> tuple[np.ndarray, np.ndarray, list[str]]:
                         return height(u, vm) if raised else 0.0
 
                     b.quad(
-                        [point(u0, v0, h(u0)), point(u1, v0, h(u1)), point(u1, v1, h(u1)),
-                         point(u0, v1, h(u0))],
+                        [
+                            point(u0, v0, h(u0)),
+                            point(u1, v0, h(u1)),
+                            point(u1, v1, h(u1)),
+                            point(u0, v1, h(u0)),
+                        ],
                         normal,
                         material,
                     )

@@ -43,10 +43,19 @@ def example_tle(elements: dict[str, float] = ELEMENTS) -> tuple[str, str]:
     days_1950 = (epoch - np.datetime64("1949-12-31T00:00:00", "ns")).astype(np.int64) / 86400e9
     sat = Satrec()
     sat.sgp4init(
-        WGS72, "i", int(e["satnum"]), days_1950, e["bstar"],
-        e["ndot"] * 2 * math.pi / 1440.0**2, 0.0, e["eccentricity"], math.radians(e["argp_deg"]),
-        math.radians(e["inclination_deg"]), math.radians(e["mean_anomaly_deg"]),
-        e["mean_motion_rev_day"] * 2 * math.pi / 1440.0, math.radians(e["raan_deg"]),
+        WGS72,
+        "i",
+        int(e["satnum"]),
+        days_1950,
+        e["bstar"],
+        e["ndot"] * 2 * math.pi / 1440.0**2,
+        0.0,
+        e["eccentricity"],
+        math.radians(e["argp_deg"]),
+        math.radians(e["inclination_deg"]),
+        math.radians(e["mean_anomaly_deg"]),
+        e["mean_motion_rev_day"] * 2 * math.pi / 1440.0,
+        math.radians(e["raan_deg"]),
     )
     sat.classification = "U"
     sat.intldesg = "03031H"
@@ -55,8 +64,15 @@ def example_tle(elements: dict[str, float] = ELEMENTS) -> tuple[str, str]:
     return exporter.export_tle(sat)
 
 
-def find_passes(orbit, site, start: str, stop: str, step_s: float = 5.0,
-                min_elevation_deg: float = 20.0, max_sun_elevation_deg: float = -18.0) -> list[dict]:
+def find_passes(
+    orbit,
+    site,
+    start: str,
+    stop: str,
+    step_s: float = 5.0,
+    min_elevation_deg: float = 20.0,
+    max_sun_elevation_deg: float = -18.0,
+) -> list[dict]:
     """Passes above ``min_elevation_deg`` with the site dark and the shadow boundary crossed."""
     from sbrdf_xr import observe
 
@@ -69,11 +85,18 @@ def find_passes(orbit, site, start: str, stop: str, step_s: float = 5.0,
     edges = np.flatnonzero(np.diff(np.concatenate([[0], up.astype(int), [0]])))
     for i0, i1 in zip(edges[::2], edges[1::2], strict=True):
         frac = g["sunlit_fraction"].values[i0:i1]
-        out.append({
-            "start": str(t[i0]), "stop": str(t[i1 - 1]), "max_elevation": float(el[i0:i1].max()),
-            "sunlit_min": float(frac.min()), "sunlit_max": float(frac.max()),
-            "shadow_edge": str(t[i0 + int(np.argmin(np.abs(frac - 0.5)))]) if frac.min() < 0.5 < frac.max() else "",
-        })
+        out.append(
+            {
+                "start": str(t[i0]),
+                "stop": str(t[i1 - 1]),
+                "max_elevation": float(el[i0:i1].max()),
+                "sunlit_min": float(frac.min()),
+                "sunlit_max": float(frac.max()),
+                "shadow_edge": str(t[i0 + int(np.argmin(np.abs(frac - 0.5)))])
+                if frac.min() < 0.5 < frac.max()
+                else "",
+            }
+        )
     return out
 
 

@@ -32,8 +32,16 @@ from types import ModuleType
 from ..errors import ValidationError
 from . import anisotropic, lambert, microfacet, optics, robertson_sandford
 
-__all__ = ["ANISOTROPIC_MODELS", "MODELS", "anisotropic", "get_model", "lambert", "microfacet", "optics",
-           "robertson_sandford"]
+__all__ = [
+    "ANISOTROPIC_MODELS",
+    "MODELS",
+    "anisotropic",
+    "get_model",
+    "lambert",
+    "microfacet",
+    "optics",
+    "robertson_sandford",
+]
 
 #: Registry of the analytic models: name -> module implementing the common interface.
 MODELS: dict[str, ModuleType] = {

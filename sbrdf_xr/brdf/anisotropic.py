@@ -100,8 +100,12 @@ def check_params(wavelength: ArrayLike, **params: Any) -> dict[str, NDArray[np.f
     _check_names(params, PARAMS, "anisotropic_microfacet")
     m = wl.size
     return {
-        "alpha_x": _band_param("alpha_x", params["alpha_x"], m, lower=ROUGHNESS_MIN, upper=ROUGHNESS_MAX),
-        "alpha_y": _band_param("alpha_y", params["alpha_y"], m, lower=ROUGHNESS_MIN, upper=ROUGHNESS_MAX),
+        "alpha_x": _band_param(
+            "alpha_x", params["alpha_x"], m, lower=ROUGHNESS_MIN, upper=ROUGHNESS_MAX
+        ),
+        "alpha_y": _band_param(
+            "alpha_y", params["alpha_y"], m, lower=ROUGHNESS_MIN, upper=ROUGHNESS_MAX
+        ),
         "n": _band_param("n", params["n"], m, lower=0.0, lower_open=True),
         "k": _band_param("k", params["k"], m, lower=0.0),
         "rho_d": _band_param("rho_d", params["rho_d"], m, lower=0.0, upper=1.0),
@@ -243,9 +247,14 @@ def illumination_azimuth(
     o_t = o - np.einsum("...k,...k->...", o, n)[..., None] * n
     ls = np.linalg.norm(s_t, axis=-1, keepdims=True)
     lo = np.linalg.norm(o_t, axis=-1, keepdims=True)
-    e_f = np.where(ls > tol, -s_t / np.where(ls > tol, ls, 1.0),
-                   np.where(lo > tol, o_t / np.where(lo > tol, lo, 1.0), t))
-    psi = np.degrees(np.arctan2(np.einsum("...k,...k->...", e_f, b), np.einsum("...k,...k->...", e_f, t)))
+    e_f = np.where(
+        ls > tol,
+        -s_t / np.where(ls > tol, ls, 1.0),
+        np.where(lo > tol, o_t / np.where(lo > tol, lo, 1.0), t),
+    )
+    psi = np.degrees(
+        np.arctan2(np.einsum("...k,...k->...", e_f, b), np.einsum("...k,...k->...", e_f, t))
+    )
     p = np.cross(n, e_f)
     psi = np.where(np.einsum("...k,...k->...", o, p) < 0, -psi, psi)
     return np.mod(psi, 180.0)  # t and -t are the same tangent
@@ -282,8 +291,9 @@ def render_grid(
     ndarray, shape (n_ti, n_dt, n_phi, n_psi, n_wl)
         BRDF [sr-1].
     """
-    g = np.meshgrid(*(np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi, psi)),
-                    indexing="ij")
+    g = np.meshgrid(
+        *(np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi, psi)), indexing="ij"
+    )
     return brdf_angles(g[0], g[1], g[2], wavelength, psi=g[3], **params)
 
 

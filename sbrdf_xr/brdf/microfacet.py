@@ -153,7 +153,11 @@ def _fresnel(
 
 
 def _specular_parts(
-    n: np.ndarray, s: np.ndarray, o: np.ndarray, cos_i: np.ndarray, cos_r: np.ndarray,
+    n: np.ndarray,
+    s: np.ndarray,
+    o: np.ndarray,
+    cos_i: np.ndarray,
+    cos_r: np.ndarray,
     roughness: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(D G2 / (4 N.s N.o))`` (…, n_wl) and ``h.s`` (…) for unit vectors."""
@@ -188,8 +192,13 @@ def specular_factor(
         [sr-1]; zero where unlit or unseen.  Its hemispherical integral (the
         "white furnace" albedo) is <= 1 and -> 1 for smooth surfaces.
     """
-    a = _band_param("roughness", roughness, np.atleast_1d(roughness).size,
-                    lower=ROUGHNESS_MIN, upper=ROUGHNESS_MAX)
+    a = _band_param(
+        "roughness",
+        roughness,
+        np.atleast_1d(roughness).size,
+        lower=ROUGHNESS_MIN,
+        upper=ROUGHNESS_MAX,
+    )
     n, s, o, cos_i, cos_r, mask, dtype = _facet_frame(normal, to_sun, to_observer)
     geo, _ = _specular_parts(n, s, o, cos_i, cos_r, a)
     return _cast_out(np.where(mask[..., None], geo, 0.0), dtype)
@@ -294,8 +303,7 @@ def render_grid(
     ndarray, shape (n_ti, n_dt, n_phi, n_wl)
         BRDF [sr-1].
     """
-    return _render_grid(brdf_angles, theta_i, delta_theta, phi, wavelength, layers=layers,
-                        **params)
+    return _render_grid(brdf_angles, theta_i, delta_theta, phi, wavelength, layers=layers, **params)
 
 
 def _half_vector_pieces(

@@ -368,7 +368,9 @@ def _stack_reflectance(
     """Stack reflectance for cosines ``c`` whose last axis is 1 or aligned with wavelength."""
     wl = np.atleast_1d(np.asarray(wavelength, dtype=np.float64))
     if wl.ndim != 1 or not np.all(np.isfinite(wl)) or np.any(wl <= 0):
-        raise ValidationError(f"wavelength: expected a 1-D array of positive values [nm], got {wl!r}")
+        raise ValidationError(
+            f"wavelength: expected a 1-D array of positive values [nm], got {wl!r}"
+        )
     n_wl = wl.size
     if not (np.isfinite(ambient) and ambient > 0):
         raise ValidationError(f"ambient: got {ambient!r}; allowed domain is ambient > 0 [1]")

@@ -230,7 +230,9 @@ def _e2_h_norm(cos_i: np.ndarray, e: np.ndarray) -> np.ndarray:
     e2 = e * e
     s_safe = np.where(s > 0, s, 1.0)
     sb2 = (s_safe + b) ** 2
-    return np.where(s > 0, np.where(a >= 0, sb2 / (4.0 * s_safe), 4.0 * e2 * e2 / (s_safe * sb2)), 0.0)
+    return np.where(
+        s > 0, np.where(a >= 0, sb2 / (4.0 * s_safe), 4.0 * e2 * e2 / (s_safe * sb2)), 0.0
+    )
 
 
 def normalisation_H(theta_i: ArrayLike, e: ArrayLike) -> NDArray[np.float64]:
@@ -658,9 +660,7 @@ def render_grid(
     ndarray, shape (n_ti, n_dt, n_phi, n_wl)
         BRDF [sr-1].
     """
-    return _render_grid(
-        brdf_angles, theta_i, delta_theta, phi, wavelength, cutoff=cutoff, **params
-    )
+    return _render_grid(brdf_angles, theta_i, delta_theta, phi, wavelength, cutoff=cutoff, **params)
 
 
 # --------------------------------------------------------------------------

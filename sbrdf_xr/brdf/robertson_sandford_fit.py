@@ -217,7 +217,9 @@ def fit_robertson_sandford(
     s_idx, l_idx = np.nonzero(use)  # residual order of resid() (row-major over samples)
     n_res = s_idx.size
     rows = np.repeat(np.arange(n_res), 4)
-    cols = np.stack([l_idx, n_wl + l_idx, np.full(n_res, 2 * n_wl), np.full(n_res, 2 * n_wl + 1)], 1).ravel()
+    cols = np.stack(
+        [l_idx, n_wl + l_idx, np.full(n_res, 2 * n_wl), np.full(n_res, 2 * n_wl + 1)], 1
+    ).ravel()
 
     def jac(x: np.ndarray) -> sparse.csr_matrix:
         """Sparse Jacobian: a residual at wavelength l depends on rho_D[l], epsilon[l], b, ln e."""
@@ -234,12 +236,24 @@ def fit_robertson_sandford(
             fp = model(*unpack(xp))[0]
             fm = model(*unpack(xm))[0]
             shared.append((np.log(fp) - np.log(fm)) / (2 * step))
-        vals = np.stack([d_rho[use], d_eps[use], shared[0][use], shared[1][use]], 1) / sig[use][:, None]
+        vals = (
+            np.stack([d_rho[use], d_eps[use], shared[0][use], shared[1][use]], 1)
+            / sig[use][:, None]
+        )
         return sparse.csr_matrix((vals.ravel(), (rows, cols)), shape=(n_res, 2 * n_wl + 2))
 
     sol = optimize.least_squares(
-        resid, x0, jac=jac, bounds=(lower, upper), method="trf", x_scale="jac",
-        tr_solver="lsmr", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=500,
+        resid,
+        x0,
+        jac=jac,
+        bounds=(lower, upper),
+        method="trf",
+        x_scale="jac",
+        tr_solver="lsmr",
+        xtol=1e-12,
+        ftol=1e-12,
+        gtol=1e-12,
+        max_nfev=500,
     )
     n_par = 2 * n_wl + 2
     chi2 = float(np.sum(sol.fun**2))

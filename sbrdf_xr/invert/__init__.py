@@ -35,16 +35,28 @@ from ..errors import InversionError
 from ._bench import benchmark_spin_search
 from ._data import band_terms, magnitudes_to_signal, read_spectrum
 from ._spin import (
-           axis_separation,
-           axis_vector,
-           fibonacci_sphere,
-           fit_spin,
-           light_curve_fluxes,
-           spin_model,
+    axis_separation,
+    axis_vector,
+    fibonacci_sphere,
+    fit_spin,
+    light_curve_fluxes,
+    spin_model,
 )
 from ._unmix import DEGENERACY_THRESHOLD, material_areas, unmix
 
-__all__ = ["DEGENERACY_THRESHOLD", "InversionError", "axis_separation", "axis_vector", "band_terms",
-           "benchmark_spin_search", "fibonacci_sphere",
-           "fit_spin", "light_curve_fluxes", "magnitudes_to_signal", "material_areas", "read_spectrum",
-           "spin_model", "unmix"]
+__all__ = [
+    "DEGENERACY_THRESHOLD",
+    "InversionError",
+    "axis_separation",
+    "axis_vector",
+    "band_terms",
+    "benchmark_spin_search",
+    "fibonacci_sphere",
+    "fit_spin",
+    "light_curve_fluxes",
+    "magnitudes_to_signal",
+    "material_areas",
+    "read_spectrum",
+    "spin_model",
+    "unmix",
+]

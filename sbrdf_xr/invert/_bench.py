@@ -38,11 +38,21 @@ def benchmark_spin_search(
     sc = spacecraft if spacecraft is not None else canx1()
     t = np.linspace(0.0, 300.0, n_samples)
     nb = len(bands)
-    lc = xr.Dataset({"flux": ("obs", np.ones(n_samples * nb)), "flux_uncertainty": ("obs", np.full(n_samples * nb, 0.02))},
-                    coords={"time": ("obs", np.repeat(t, nb)), "band": ("obs", np.tile(list(bands), n_samples))})
+    lc = xr.Dataset(
+        {
+            "flux": ("obs", np.ones(n_samples * nb)),
+            "flux_uncertainty": ("obs", np.full(n_samples * nb, 0.02)),
+        },
+        coords={
+            "time": ("obs", np.repeat(t, nb)),
+            "band": ("obs", np.tile(list(bands), n_samples)),
+        },
+    )
     data = light_curve_fluxes(lc)
     kern = _Kernel(sc, list(bands))
-    prob = _Problem(data, kern, [1.0, 0, 0], [np.cos(0.5), np.sin(0.5), 0.0], np.array([0.0, 0, 1]), "band")
+    prob = _Problem(
+        data, kern, [1.0, 0, 0], [np.cos(0.5), np.sin(0.5), 0.0], np.array([0.0, 0, 1]), "band"
+    )
     periods = np.linspace(20.0, 40.0, 10)
     phases = np.arange(10) * 36.0
     _search(prob, fibonacci_sphere(2), periods[:1], phases[:1], n_threads)  # compile, warm caches
@@ -55,6 +65,14 @@ def benchmark_spin_search(
             run(prob, axes, periods, phases, n_threads)
             dt = time.perf_counter() - t0
             nc = len(axes) * 100
-            rows.append({"method": method, "candidates": nc, "samples": n_samples, "bands": nb,
-                         "seconds": dt, "per_candidate_ms": 1e3 * dt / nc})
+            rows.append(
+                {
+                    "method": method,
+                    "candidates": nc,
+                    "samples": n_samples,
+                    "bands": nb,
+                    "seconds": dt,
+                    "per_candidate_ms": 1e3 * dt / nc,
+                }
+            )
     return rows

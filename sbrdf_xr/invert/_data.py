@@ -23,13 +23,20 @@ def band_terms(per_material: xr.DataArray, bands: Sequence[str]) -> xr.DataArray
     from ..photometry import band_weights
 
     w = band_weights(list(bands), per_material["wavelength"].values, normalize=True)
-    out = xr.dot(per_material, w.rename({"wavelength": "_wl"}).assign_coords(_wl=per_material["wavelength"].values)
-                 .rename({"_wl": "wavelength"}), dim="wavelength")
+    out = xr.dot(
+        per_material,
+        w.rename({"wavelength": "_wl"})
+        .assign_coords(_wl=per_material["wavelength"].values)
+        .rename({"_wl": "wavelength"}),
+        dim="wavelength",
+    )
     out.attrs = {"units": "m2 sr-1", "long_name": "band signal of each material"}
     return out
 
 
-def magnitudes_to_signal(light_curve: xr.Dataset, range_km: float) -> tuple[xr.DataArray, xr.DataArray]:
+def magnitudes_to_signal(
+    light_curve: xr.Dataset, range_km: float
+) -> tuple[xr.DataArray, xr.DataArray]:
     """Band signal [m2 sr-1] and its uncertainty from measured magnitudes (one per band).
 
     Inverts :func:`sbrdf_xr.photometry.magnitudes` at 1 AU:
@@ -41,15 +48,25 @@ def magnitudes_to_signal(light_curve: xr.Dataset, range_km: float) -> tuple[xr.D
         raise InversionError(f"range_km: must be finite and > 0, got {range_km}")
     bands = [str(b) for b in light_curve["band"].values]
     if len(set(bands)) != len(bands):
-        raise InversionError(f"magnitudes: one value per band expected (a spectrum in bands), got bands {bands}")
+        raise InversionError(
+            f"magnitudes: one value per band expected (a spectrum in bands), got bands {bands}"
+        )
     msun = sun_magnitudes(bands).values
     m = np.asarray(light_curve["magnitude"].values, dtype=np.float64)
     s = (range_km * 1e3) ** 2 * 10 ** (-0.4 * (m - msun))
     sig = s * _LN10_2P5 * np.asarray(light_curve["uncertainty"].values, dtype=np.float64)
     coords = {"band": bands}
-    return (xr.DataArray(s, dims="band", coords=coords, attrs={"units": "m2 sr-1", "long_name": "band signal"}),
-            xr.DataArray(sig, dims="band", coords=coords, attrs={"units": "m2 sr-1",
-                                                                   "long_name": "uncertainty of the band signal"}))
+    return (
+        xr.DataArray(
+            s, dims="band", coords=coords, attrs={"units": "m2 sr-1", "long_name": "band signal"}
+        ),
+        xr.DataArray(
+            sig,
+            dims="band",
+            coords=coords,
+            attrs={"units": "m2 sr-1", "long_name": "uncertainty of the band signal"},
+        ),
+    )
 
 
 def read_spectrum(path: str | os.PathLike[str]) -> tuple[xr.DataArray, xr.DataArray]:
@@ -70,8 +87,14 @@ def read_spectrum(path: str | os.PathLike[str]) -> tuple[xr.DataArray, xr.DataAr
         df.columns = [str(c).strip() for c in df.columns]
     missing = [c for c in ("wavelength", "signal", "uncertainty") if c not in df.columns]
     if missing:
-        raise InversionError(f"{path}: missing columns {missing}; needs wavelength, signal, uncertainty")
+        raise InversionError(
+            f"{path}: missing columns {missing}; needs wavelength, signal, uncertainty"
+        )
     wl = df["wavelength"].to_numpy(dtype=np.float64)
-    y = xr.DataArray(df["signal"].to_numpy(dtype=np.float64), dims="wavelength", coords={"wavelength": wl},
-                     attrs={"units": "m2 sr-1", "long_name": "measured signal"})
+    y = xr.DataArray(
+        df["signal"].to_numpy(dtype=np.float64),
+        dims="wavelength",
+        coords={"wavelength": wl},
+        attrs={"units": "m2 sr-1", "long_name": "measured signal"},
+    )
     return y, y.copy(data=df["uncertainty"].to_numpy(dtype=np.float64))

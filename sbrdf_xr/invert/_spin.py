@@ -16,7 +16,14 @@ from scipy.optimize import least_squares
 from .. import _kernels
 from ..errors import InversionError
 
-__all__ = ["axis_separation", "axis_vector", "fibonacci_sphere", "fit_spin", "light_curve_fluxes", "spin_model"]
+__all__ = [
+    "axis_separation",
+    "axis_vector",
+    "fibonacci_sphere",
+    "fit_spin",
+    "light_curve_fluxes",
+    "spin_model",
+]
 
 _LN10_2P5 = np.log(10.0) / 2.5
 
@@ -35,8 +42,10 @@ def fibonacci_sphere(n: int) -> np.ndarray:
 
 
 def _lonlat(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    return (np.degrees(np.arctan2(v[..., 1], v[..., 0])) % 360.0,
-            np.degrees(np.arcsin(np.clip(v[..., 2], -1, 1))))
+    return (
+        np.degrees(np.arctan2(v[..., 1], v[..., 0])) % 360.0,
+        np.degrees(np.arcsin(np.clip(v[..., 2], -1, 1))),
+    )
 
 
 def _vec(lon: Any, lat: Any) -> np.ndarray:
@@ -69,8 +78,12 @@ def spin_model(axis_body: ArrayLike, axis: ArrayLike, period_s: float, phase_deg
 
     m = _align_matrices(np.asarray(axis_body, float), np.asarray(axis, float)[None, :])[0]
     q = Rotation.from_matrix(m).as_quat()
-    return Spin(axis_body=np.asarray(axis_body, float), rate_deg_s=360.0 / float(period_s),
-                phase_deg=float(phase_deg), initial=q)
+    return Spin(
+        axis_body=np.asarray(axis_body, float),
+        rate_deg_s=360.0 / float(period_s),
+        phase_deg=float(phase_deg),
+        initial=q,
+    )
 
 
 def _body_vectors(v: np.ndarray, align: np.ndarray, k: np.ndarray, angle: np.ndarray) -> np.ndarray:
@@ -86,13 +99,25 @@ def _body_vectors(v: np.ndarray, align: np.ndarray, k: np.ndarray, angle: np.nda
 class _Kernel:
     """Band signal of a spacecraft for body-frame geometries, on pre-integrated tables."""
 
-    def __init__(self, spacecraft: Any, bands: Sequence[str], materials: Mapping[str, Any] | None = None,
-                 method: str = "linear") -> None:
+    def __init__(
+        self,
+        spacecraft: Any,
+        bands: Sequence[str],
+        materials: Mapping[str, Any] | None = None,
+        method: str = "linear",
+    ) -> None:
         from ..scene import Scene
 
         f = fibonacci_sphere(256)
-        scene = Scene(spacecraft, materials=materials, to_sun=f, to_observer=f,
-                      outputs=("band_signal", "area"), bands=tuple(bands), method=method)
+        scene = Scene(
+            spacecraft,
+            materials=materials,
+            to_sun=f,
+            to_observer=f,
+            outputs=("band_signal", "area"),
+            bands=tuple(bands),
+            method=method,
+        )
         self.plan = plan = scene.plan()
         if not plan.pre_integrated:
             raise InversionError("spin fit: the band tables could not be pre-integrated")
@@ -101,20 +126,35 @@ class _Kernel:
 
     def __call__(self, s: np.ndarray, o: np.ndarray) -> np.ndarray:
         t = self.plan.terms
-        r = _kernels.fused_sums(s.reshape(-1, 3), o.reshape(-1, 3), t.normal, t.area, t.material,
-                                self.plan.tables, self.method, None, False)
+        r = _kernels.fused_sums(
+            s.reshape(-1, 3),
+            o.reshape(-1, 3),
+            t.normal,
+            t.area,
+            t.material,
+            self.plan.tables,
+            self.method,
+            None,
+            False,
+        )
         return np.asarray(r.signal, dtype=np.float64).reshape(*s.shape[:-1], len(self.bands))
 
 
-def light_curve_fluxes(light_curve: xr.Dataset, bands: Sequence[str] | None = None) -> dict[str, np.ndarray]:
+def light_curve_fluxes(
+    light_curve: xr.Dataset, bands: Sequence[str] | None = None
+) -> dict[str, np.ndarray]:
     """Times [s], band index, relative flux and its uncertainty from a light curve.
 
     ``light_curve`` is what :func:`sbrdf_xr.photometry.read_light_curve` returns (over
     ``obs``: ``magnitude``, ``uncertainty`` [mag], coords ``band``, ``time`` [s]) or the
     same with ``flux`` and ``flux_uncertainty`` instead of magnitudes.
     """
-    if not isinstance(light_curve, xr.Dataset) or ("time" not in light_curve.coords and "time" not in light_curve):
-        raise InversionError("light curve: expected a Dataset with a time coordinate [s] (read_light_curve)")
+    if not isinstance(light_curve, xr.Dataset) or (
+        "time" not in light_curve.coords and "time" not in light_curve
+    ):
+        raise InversionError(
+            "light curve: expected a Dataset with a time coordinate [s] (read_light_curve)"
+        )
     t = np.asarray(light_curve["time"].values, dtype=np.float64)
     band = np.asarray(light_curve["band"].values).astype(str)
     labels = list(dict.fromkeys(band)) if bands is None else [str(b) for b in bands]
@@ -132,15 +172,24 @@ def light_curve_fluxes(light_curve: xr.Dataset, bands: Sequence[str] | None = No
         f = 10 ** (-0.4 * (m - np.nanmedian(m)))
         sf = f * _LN10_2P5 * sm
     else:
-        raise InversionError(f"light curve: needs magnitude/uncertainty or flux/flux_uncertainty, got "
-                             f"{list(light_curve.data_vars)}")
+        raise InversionError(
+            f"light curve: needs magnitude/uncertainty or flux/flux_uncertainty, got "
+            f"{list(light_curve.data_vars)}"
+        )
     bad = ~(np.isfinite(sf) & (sf > 0))
     if bad.any():
-        raise InversionError(f"light curve: {int(bad.sum())} uncertainties that are not finite and > 0")
+        raise InversionError(
+            f"light curve: {int(bad.sum())} uncertainties that are not finite and > 0"
+        )
     if not np.all(np.isfinite(t)) or not np.all(np.isfinite(f)):
         raise InversionError("light curve: times and values must be finite")
-    return {"time": t, "band": np.array([labels.index(b) for b in band]), "flux": f, "sigma": sf,
-            "labels": np.array(labels)}
+    return {
+        "time": t,
+        "band": np.array([labels.index(b) for b in band]),
+        "flux": f,
+        "sigma": sf,
+        "labels": np.array(labels),
+    }
 
 
 def _directions(v: Any, n_t: int, name: str) -> np.ndarray:
@@ -148,7 +197,9 @@ def _directions(v: Any, n_t: int, name: str) -> np.ndarray:
     if arr.shape == (3,):
         arr = np.broadcast_to(arr, (n_t, 3))
     if arr.shape != (n_t, 3):
-        raise InversionError(f"{name}: expected shape (3,) or ({n_t}, 3) (one per distinct time), got {arr.shape}")
+        raise InversionError(
+            f"{name}: expected shape (3,) or ({n_t}, 3) (one per distinct time), got {arr.shape}"
+        )
     nrm = np.linalg.norm(arr, axis=-1)
     if not np.all(nrm > 0):
         raise InversionError(f"{name}: zero-length direction")
@@ -158,8 +209,15 @@ def _directions(v: Any, n_t: int, name: str) -> np.ndarray:
 class _Problem:
     """A light curve, its geometry and the model: chi-square of spin states."""
 
-    def __init__(self, lc: dict[str, np.ndarray], kernel: _Kernel, to_sun: Any, to_observer: Any,
-                 axis_body: np.ndarray, offset: str) -> None:
+    def __init__(
+        self,
+        lc: dict[str, np.ndarray],
+        kernel: _Kernel,
+        to_sun: Any,
+        to_observer: Any,
+        axis_body: np.ndarray,
+        offset: str,
+    ) -> None:
         self.times, self.t_index = np.unique(lc["time"], return_inverse=True)
         self.band = lc["band"]
         self.y, self.sigma = lc["flux"], lc["sigma"]
@@ -169,7 +227,9 @@ class _Problem:
         self.o = _directions(to_observer, self.times.size, "to_observer")
         self.k = axis_body / np.linalg.norm(axis_body)
         if offset not in ("band", "common"):
-            raise InversionError(f"offset: {offset!r}; allowed 'band' (a free scale per band), 'common'")
+            raise InversionError(
+                f"offset: {offset!r}; allowed 'band' (a free scale per band), 'common'"
+            )
         self.offset = offset
         self.n_bands = len(lc["labels"])
 
@@ -219,10 +279,18 @@ class _Problem:
         return 1 if self.offset == "common" else self.n_bands
 
 
-def _search(prob: _Problem, axes: np.ndarray, periods: np.ndarray, phases: np.ndarray,
-            n_threads: int | None, chunk: int = 256) -> np.ndarray:
+def _search(
+    prob: _Problem,
+    axes: np.ndarray,
+    periods: np.ndarray,
+    phases: np.ndarray,
+    n_threads: int | None,
+    chunk: int = 256,
+) -> np.ndarray:
     """Chi-square over the grid (axes, periods, phases), threads over chunks of candidates."""
-    ia, ip, iq = np.meshgrid(np.arange(len(axes)), np.arange(len(periods)), np.arange(len(phases)), indexing="ij")
+    ia, ip, iq = np.meshgrid(
+        np.arange(len(axes)), np.arange(len(periods)), np.arange(len(phases)), indexing="ij"
+    )
     ia, ip, iq = ia.ravel(), ip.ravel(), iq.ravel()
     out = np.empty(ia.size)
     edges = [*list(range(0, ia.size, chunk)), ia.size]
@@ -241,8 +309,14 @@ def _search(prob: _Problem, axes: np.ndarray, periods: np.ndarray, phases: np.nd
     return out.reshape(len(axes), len(periods), len(phases))
 
 
-def _search_shift(prob: _Problem, axes: np.ndarray, periods: np.ndarray, phases: np.ndarray,
-                  n_threads: int | None, n_angles: int = 720) -> np.ndarray:
+def _search_shift(
+    prob: _Problem,
+    axes: np.ndarray,
+    periods: np.ndarray,
+    phases: np.ndarray,
+    n_threads: int | None,
+    n_angles: int = 720,
+) -> np.ndarray:
     """The same grid for fixed directions: the model depends on the spin angle only, so it
     is evaluated once per axis on ``n_angles`` angles and every (period, phase) reads it
     by linear interpolation at ``phase + 360 t / P``."""
@@ -252,9 +326,12 @@ def _search_shift(prob: _Problem, axes: np.ndarray, periods: np.ndarray, phases:
     t = prob.times[prob.t_index]
 
     def run(i: int) -> None:
-        align = _align_matrices(prob.k, axes[i:i + 1])
+        align = _align_matrices(prob.k, axes[i : i + 1])
         ang = np.radians(grid_ang)[None, :]
-        f = prob.kernel(_body_vectors(prob.s[:1], align, prob.k, ang), _body_vectors(prob.o[:1], align, prob.k, ang))[0]
+        f = prob.kernel(
+            _body_vectors(prob.s[:1], align, prob.k, ang),
+            _body_vectors(prob.o[:1], align, prob.k, ang),
+        )[0]
         f = np.concatenate([f, f[:1]], axis=0)  # (n_angles + 1, B), periodic
         theta = (phases[None, :, None] + 360.0 * t[None, None, :] / periods[:, None, None]) % 360.0
         x = theta / step
@@ -279,7 +356,9 @@ def _refine(prob: _Problem, p0: np.ndarray) -> tuple[np.ndarray, np.ndarray, flo
     """Local least squares from ``p0`` (lon, lat, period, phase); parameters, sigma, chi2."""
     span = max(float(np.ptp(prob.times)), 1e-9)
     xs = np.array([1.0, 1.0, p0[2] ** 2 / (360.0 * span), 1.0])
-    res = least_squares(prob.residuals, p0, x_scale=xs, diff_step=1e-6, method="lm" if prob.y.size > 4 else "trf")
+    res = least_squares(
+        prob.residuals, p0, x_scale=xs, diff_step=1e-6, method="lm" if prob.y.size > 4 else "trf"
+    )
     j = res.jac
     try:
         cov = np.linalg.inv(j.T @ j)
@@ -295,8 +374,9 @@ def _refine(prob: _Problem, p0: np.ndarray) -> tuple[np.ndarray, np.ndarray, flo
     return p, sig, float(2 * res.cost)
 
 
-def _alternatives(prob: _Problem, best: np.ndarray, n_phases: int,
-                  refine: bool) -> dict[str, tuple[np.ndarray, Any, float]]:
+def _alternatives(
+    prob: _Problem, best: np.ndarray, n_phases: int, refine: bool
+) -> dict[str, tuple[np.ndarray, Any, float]]:
     """The classical ambiguous solutions of a spin state, each searched in phase and refined.
 
     ``antipode``: the opposite axis (the reversed sense of rotation); ``mirror``: the axial
@@ -307,10 +387,16 @@ def _alternatives(prob: _Problem, best: np.ndarray, n_phases: int,
     """
     axis = _vec(best[0], best[1])
     nplane = np.cross(prob.s.mean(0), prob.o.mean(0))
-    nplane = nplane / np.linalg.norm(nplane) if np.linalg.norm(nplane) > 1e-9 else np.array([0.0, 0, 1])
+    nplane = (
+        nplane / np.linalg.norm(nplane) if np.linalg.norm(nplane) > 1e-9 else np.array([0.0, 0, 1])
+    )
     mirror = -(axis - 2 * np.dot(axis, nplane) * nplane)
-    alts = {"antipode": (-axis, best[2]), "mirror": (mirror, best[2]),
-            "half_period": (axis, best[2] / 2), "double_period": (axis, best[2] * 2)}
+    alts = {
+        "antipode": (-axis, best[2]),
+        "mirror": (mirror, best[2]),
+        "half_period": (axis, best[2] / 2),
+        "double_period": (axis, best[2] * 2),
+    }
     dense = np.arange(4 * int(n_phases)) * 90.0 / int(n_phases)
     out = {}
     for name, (ax, per) in alts.items():
@@ -407,7 +493,9 @@ def fit_spin(
         raise InversionError("periods: must be finite and > 0 [s]")
     n_par = 4 + prob.n_scales
     if prob.y.size <= n_par:
-        raise InversionError(f"light curve: {prob.y.size} values for {n_par} parameters; need more values")
+        raise InversionError(
+            f"light curve: {prob.y.size} values for {n_par} parameters; need more values"
+        )
     axes = fibonacci_sphere(int(n_axes))
     phases = np.arange(int(n_phases)) * 360.0 / int(n_phases)
     t0 = time.perf_counter()
@@ -427,7 +515,7 @@ def fit_spin(
         # multi-start: the best grid state of each of the n_starts best axes
         best, sig, chi2 = _refine(prob, p0)
         per_axis = grid.reshape(len(axes), -1)
-        for i in np.argsort(per_axis.min(axis=1))[1:max(1, int(n_starts))]:
+        for i in np.argsort(per_axis.min(axis=1))[1 : max(1, int(n_starts))]:
             jp, jq = np.unravel_index(np.argmin(per_axis[i]), grid.shape[1:])
             lo, la = _lonlat(axes[i])
             q, sq, c = _refine(prob, np.array([lo, la, periods[jp], phases[jq]]))
@@ -440,42 +528,109 @@ def fit_spin(
     else:
         best, sig, chi2 = p0, np.full(4, np.nan), float(grid[ia, ip, iq])
     best_axis = _vec(best[0], best[1])
-    rows = [(name, q, c, _axis_angle(_vec(q[0], q[1]), best_axis))
-            for name, (q, _, c) in _alternatives(prob, best, n_phases, refine).items()]
+    rows = [
+        (name, q, c, _axis_angle(_vec(q[0], q[1]), best_axis))
+        for name, (q, _, c) in _alternatives(prob, best, n_phases, refine).items()
+    ]
     dof = prob.y.size - n_par
     chi_map = grid.min(axis=(1, 2))
     mlon, mlat = _lonlat(axes)
-    ds = xr.Dataset(coords={
-        "axis": ("axis", np.arange(len(axes)), {"long_name": "candidate axis index", "units": "1"}),
-        "axis_longitude_grid": ("axis", mlon, {"long_name": "longitude of the candidate axis", "units": "degree"}),
-        "axis_latitude_grid": ("axis", mlat, {"long_name": "latitude of the candidate axis", "units": "degree"}),
-        "solution": ("solution", [r[0] for r in rows], {"long_name": "alternative solution", "units": "1"})})
-    meta = {"axis_longitude": ("degree", "longitude of the inertial spin axis"),
-            "axis_latitude": ("degree", "latitude of the inertial spin axis"),
-            "period": ("s", "spin period"), "phase": ("degree", "spin angle at t = 0")}
+    ds = xr.Dataset(
+        coords={
+            "axis": (
+                "axis",
+                np.arange(len(axes)),
+                {"long_name": "candidate axis index", "units": "1"},
+            ),
+            "axis_longitude_grid": (
+                "axis",
+                mlon,
+                {"long_name": "longitude of the candidate axis", "units": "degree"},
+            ),
+            "axis_latitude_grid": (
+                "axis",
+                mlat,
+                {"long_name": "latitude of the candidate axis", "units": "degree"},
+            ),
+            "solution": (
+                "solution",
+                [r[0] for r in rows],
+                {"long_name": "alternative solution", "units": "1"},
+            ),
+        }
+    )
+    meta = {
+        "axis_longitude": ("degree", "longitude of the inertial spin axis"),
+        "axis_latitude": ("degree", "latitude of the inertial spin axis"),
+        "period": ("s", "spin period"),
+        "phase": ("degree", "spin angle at t = 0"),
+    }
     for j, (key, (u, ln)) in enumerate(meta.items()):
         ds[key] = ((), float(best[j]), {"units": u, "long_name": ln})
-        ds[key + "_uncertainty"] = ((), float(sig[j]), {"units": u, "long_name": f"1-sigma uncertainty of {ln} "
-                                                        "(Jacobian of the refinement)"})
-    ds["axis_vector"] = (("xyz",), best_axis, {"units": "1", "long_name": "unit vector of the inertial spin axis"})
+        ds[key + "_uncertainty"] = (
+            (),
+            float(sig[j]),
+            {"units": u, "long_name": f"1-sigma uncertainty of {ln} (Jacobian of the refinement)"},
+        )
+    ds["axis_vector"] = (
+        ("xyz",),
+        best_axis,
+        {"units": "1", "long_name": "unit vector of the inertial spin axis"},
+    )
     ds["chi2"] = ((), chi2, {"units": "1", "long_name": "chi-square of the best spin state"})
-    ds["reduced_chi2"] = ((), chi2 / dof, {"units": "1", "long_name": "chi-square per degree of freedom"})
-    ds["chi2_map"] = ("axis", chi_map, {"units": "1", "long_name": "chi-square of the axis, minimised over "
-                                        "period and phase on the grid"})
-    ds["solution_chi2"] = ("solution", [r[2] for r in rows], {"units": "1", "long_name": "chi-square"})
-    ds["chi2_gap"] = ("solution", [r[2] - chi2 for r in rows],
-                      {"units": "1", "long_name": "chi-square above the best solution"})
-    ds["solution_period"] = ("solution", [r[1][2] for r in rows], {"units": "s", "long_name": "spin period"})
-    ds["solution_axis_longitude"] = ("solution", [r[1][0] for r in rows], {"units": "degree",
-                                     "long_name": "longitude of the spin axis"})
-    ds["solution_axis_latitude"] = ("solution", [r[1][1] for r in rows], {"units": "degree",
-                                    "long_name": "latitude of the spin axis"})
-    ds["solution_axis_separation"] = ("solution", [r[3] for r in rows], {"units": "degree",
-                                      "long_name": "angle between the solution's axis and the best axis"})
-    ds.attrs = {"axis_body": str(list(np.asarray(axis_body, float))), "offset": offset,
-                "n_candidates": int(grid.size), "search_seconds": t_search,
-                "search_method": method, "fixed_directions": int(fixed),
-                "n_values": int(prob.y.size), "bands": ", ".join(lc["labels"])}
+    ds["reduced_chi2"] = (
+        (),
+        chi2 / dof,
+        {"units": "1", "long_name": "chi-square per degree of freedom"},
+    )
+    ds["chi2_map"] = (
+        "axis",
+        chi_map,
+        {
+            "units": "1",
+            "long_name": "chi-square of the axis, minimised over period and phase on the grid",
+        },
+    )
+    ds["solution_chi2"] = (
+        "solution",
+        [r[2] for r in rows],
+        {"units": "1", "long_name": "chi-square"},
+    )
+    ds["chi2_gap"] = (
+        "solution",
+        [r[2] - chi2 for r in rows],
+        {"units": "1", "long_name": "chi-square above the best solution"},
+    )
+    ds["solution_period"] = (
+        "solution",
+        [r[1][2] for r in rows],
+        {"units": "s", "long_name": "spin period"},
+    )
+    ds["solution_axis_longitude"] = (
+        "solution",
+        [r[1][0] for r in rows],
+        {"units": "degree", "long_name": "longitude of the spin axis"},
+    )
+    ds["solution_axis_latitude"] = (
+        "solution",
+        [r[1][1] for r in rows],
+        {"units": "degree", "long_name": "latitude of the spin axis"},
+    )
+    ds["solution_axis_separation"] = (
+        "solution",
+        [r[3] for r in rows],
+        {"units": "degree", "long_name": "angle between the solution's axis and the best axis"},
+    )
+    ds.attrs = {
+        "axis_body": str(list(np.asarray(axis_body, float))),
+        "offset": offset,
+        "n_candidates": int(grid.size),
+        "search_seconds": t_search,
+        "search_method": method,
+        "fixed_directions": int(fixed),
+        "n_values": int(prob.y.size),
+        "bands": ", ".join(lc["labels"]),
+    }
     return ds
 
 

@@ -34,8 +34,10 @@ def _library(simulated: Any) -> xr.DataArray:
     """Per-material terms as one DataArray with a ``material`` dimension."""
     if isinstance(simulated, xr.Dataset):
         if "signal_material" not in simulated:
-            raise InversionError("simulated: a Dataset needs the variable signal_material "
-                                 f"(simulate with outputs=(..., 'per_material')); got {list(simulated.data_vars)}")
+            raise InversionError(
+                "simulated: a Dataset needs the variable signal_material "
+                f"(simulate with outputs=(..., 'per_material')); got {list(simulated.data_vars)}"
+            )
         simulated = simulated["signal_material"]
     if isinstance(simulated, Mapping):
         items = list(simulated.items())
@@ -50,12 +52,17 @@ def _library(simulated: Any) -> xr.DataArray:
                     if a is None or b is None or a.shape != b.shape or not np.array_equal(a, b):
                         raise InversionError(
                             f"candidate library: {name!r} has {dim} {_describe(b)}, {ref_name!r} has "
-                            f"{_describe(a)}; every candidate must be on the same {dim} grid")
-        simulated = xr.concat([da for _, da in items], dim=xr.DataArray(
-            [str(k) for k, _ in items], dims=MATERIAL, name=MATERIAL))
+                            f"{_describe(a)}; every candidate must be on the same {dim} grid"
+                        )
+        simulated = xr.concat(
+            [da for _, da in items],
+            dim=xr.DataArray([str(k) for k, _ in items], dims=MATERIAL, name=MATERIAL),
+        )
     if not isinstance(simulated, xr.DataArray) or MATERIAL not in simulated.dims:
-        raise InversionError("simulated: expected a DataArray with a material dimension "
-                             "(signal_material), a Dataset holding one, or a mapping of name to DataArray")
+        raise InversionError(
+            "simulated: expected a DataArray with a material dimension "
+            "(signal_material), a Dataset holding one, or a mapping of name to DataArray"
+        )
     return simulated
 
 
@@ -70,7 +77,9 @@ def _describe(grid: np.ndarray | None) -> str:
 def _spectral_dim(da: xr.DataArray, what: str) -> str:
     dims = [d for d in ("wavelength", "band") if d in da.dims]
     if len(dims) != 1:
-        raise InversionError(f"{what}: expected exactly one of the dimensions wavelength or band, got {da.dims}")
+        raise InversionError(
+            f"{what}: expected exactly one of the dimensions wavelength or band, got {da.dims}"
+        )
     return dims[0]
 
 
@@ -78,37 +87,55 @@ def _align(measured: xr.DataArray, lib: xr.DataArray) -> xr.DataArray:
     """The library on the measured spectral grid (linear interpolation in wavelength)."""
     dim = _spectral_dim(measured, "measured")
     if dim not in lib.dims:
-        raise InversionError(f"measured is over {dim} but the simulation is over {_spectral_dim(lib, 'simulated')}")
+        raise InversionError(
+            f"measured is over {dim} but the simulation is over {_spectral_dim(lib, 'simulated')}"
+        )
     if dim == "band":
         have = [str(b) for b in lib["band"].values]
         missing = [str(b) for b in measured["band"].values if str(b) not in have]
         if missing:
-            raise InversionError(f"measured bands {missing} are not among the simulated bands {have}")
+            raise InversionError(
+                f"measured bands {missing} are not among the simulated bands {have}"
+            )
         return lib.sel(band=measured["band"].values)
     wl, mw = lib["wavelength"].values, measured["wavelength"].values
     lo, hi = float(wl.min()), float(wl.max())
     out = mw[(mw < lo - 1e-9) | (mw > hi + 1e-9)]
     if out.size:
-        raise InversionError(f"measured wavelengths {out.min():g}..{out.max():g} nm lie outside the simulated "
-                             f"range {lo:g}..{hi:g} nm")
+        raise InversionError(
+            f"measured wavelengths {out.min():g}..{out.max():g} nm lie outside the simulated "
+            f"range {lo:g}..{hi:g} nm"
+        )
     if wl.shape == mw.shape and np.allclose(wl, mw):
         return lib.assign_coords(wavelength=mw)
     return lib.interp(wavelength=mw)
 
 
-def _design(measured: xr.DataArray, uncertainty: Any, lib: xr.DataArray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _design(
+    measured: xr.DataArray, uncertainty: Any, lib: xr.DataArray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Rows (every sample and wavelength) of ``A``, ``y`` and ``sigma``."""
     if not isinstance(measured, xr.DataArray):
-        raise InversionError(f"measured: expected a DataArray over wavelength or band, got {type(measured).__name__}")
+        raise InversionError(
+            f"measured: expected a DataArray over wavelength or band, got {type(measured).__name__}"
+        )
     lib = _align(measured, lib)
-    sigma = (uncertainty if isinstance(uncertainty, xr.DataArray)
-             else xr.DataArray(np.broadcast_to(np.asarray(uncertainty, dtype=np.float64), measured.shape),
-                               dims=measured.dims, coords=measured.coords))
+    sigma = (
+        uncertainty
+        if isinstance(uncertainty, xr.DataArray)
+        else xr.DataArray(
+            np.broadcast_to(np.asarray(uncertainty, dtype=np.float64), measured.shape),
+            dims=measured.dims,
+            coords=measured.coords,
+        )
+    )
     y, sigma = xr.broadcast(measured, sigma)
     extra = [d for d in lib.dims if d not in y.dims and d != MATERIAL]
     if extra:
-        raise InversionError(f"simulated has dimensions {extra} that measured lacks; select one geometry "
-                             "or give measurements over them")
+        raise InversionError(
+            f"simulated has dimensions {extra} that measured lacks; select one geometry "
+            "or give measurements over them"
+        )
     sample_dims = list(y.dims)
     a = lib.transpose(*[d for d in sample_dims if d in lib.dims], MATERIAL)
     a = a.broadcast_like(y).transpose(*sample_dims, MATERIAL)
@@ -117,8 +144,10 @@ def _design(measured: xr.DataArray, uncertainty: Any, lib: xr.DataArray) -> tupl
         raise InversionError(f"measured: {int((~np.isfinite(yv)).sum())} NaN or infinite values")
     bad = ~(np.isfinite(sv) & (sv > 0))
     if bad.any():
-        raise InversionError(f"uncertainty: must be finite and > 0, got {int(bad.sum())} values that are not "
-                             f"(e.g. {sv[bad][0]!r})")
+        raise InversionError(
+            f"uncertainty: must be finite and > 0, got {int(bad.sum())} values that are not "
+            f"(e.g. {sv[bad][0]!r})"
+        )
     av = a.values.reshape(-1, lib.sizes[MATERIAL]).astype(np.float64)
     if not np.all(np.isfinite(av)):
         raise InversionError("simulated: per-material terms contain NaN or infinite values")
@@ -206,8 +235,10 @@ def unmix(
     a, y, s = _design(measured, uncertainty, lib)
     n, k = a.shape
     if n < k:
-        raise InversionError(f"measured: {n} samples for {k} material parameters; need at least as many samples "
-                             "as parameters")
+        raise InversionError(
+            f"measured: {n} samples for {k} material parameters; need at least as many samples "
+            "as parameters"
+        )
     if criterion not in ("aic", "bic"):
         raise InversionError(f"criterion: {criterion!r}; allowed 'aic', 'bic'")
     if select not in ("all", "greedy", None):
@@ -264,49 +295,108 @@ def unmix(
     sig[out_of_model] = dc[out_of_model]  # left out: its sigma with every candidate fitted
     sv = np.linalg.svd(aw, compute_uv=False)
     cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else np.inf
-    degenerate = [f"{names[i]} / {names[j]} (correlation {cand_corr[i, j]:+.3f})"
-                  for i in range(k) for j in range(i + 1, k) if abs(cand_corr[i, j]) > degeneracy_threshold]
+    degenerate = [
+        f"{names[i]} / {names[j]} (correlation {cand_corr[i, j]:+.3f})"
+        for i in range(k)
+        for j in range(i + 1, k)
+        if abs(cand_corr[i, j]) > degeneracy_threshold
+    ]
     dof = n - int((xs > 0).sum())
-    ds = xr.Dataset(coords={MATERIAL: (MATERIAL, names, {"long_name": "material", "units": "1"}),
-                            "material_b": ("material_b", names, {"long_name": "material", "units": "1"})})
-    ds["scale"] = (MATERIAL, x, {"units": "1", "long_name": "effective area scale factor of the material "
-                                 "(1: its area as simulated)"})
-    ds["scale_uncertainty"] = (MATERIAL, sig, {"units": "1", "long_name": "1-sigma uncertainty of the scale "
-                                               "factor (active set: (A^T W A)^-1; at the bound: unconstrained; left out of the "
-                                               "chosen model: with every candidate fitted)"})
-    ds["selected"] = (MATERIAL, np.isin(np.arange(k), cols) & (x > 0),
-                      {"units": "1", "long_name": "material present in the chosen model"})
-    ds["correlation"] = ((MATERIAL, "material_b"), corr,
-                         {"units": "1", "long_name": "correlation of the scale factors in the chosen model"})
-    ds["candidate_correlation"] = ((MATERIAL, "material_b"), cand_corr,
-                                   {"units": "1", "long_name": "correlation of the scale factors with every "
-                                    "candidate fitted (unconstrained)"})
+    ds = xr.Dataset(
+        coords={
+            MATERIAL: (MATERIAL, names, {"long_name": "material", "units": "1"}),
+            "material_b": ("material_b", names, {"long_name": "material", "units": "1"}),
+        }
+    )
+    ds["scale"] = (
+        MATERIAL,
+        x,
+        {
+            "units": "1",
+            "long_name": "effective area scale factor of the material (1: its area as simulated)",
+        },
+    )
+    ds["scale_uncertainty"] = (
+        MATERIAL,
+        sig,
+        {
+            "units": "1",
+            "long_name": "1-sigma uncertainty of the scale "
+            "factor (active set: (A^T W A)^-1; at the bound: unconstrained; left out of the "
+            "chosen model: with every candidate fitted)",
+        },
+    )
+    ds["selected"] = (
+        MATERIAL,
+        np.isin(np.arange(k), cols) & (x > 0),
+        {"units": "1", "long_name": "material present in the chosen model"},
+    )
+    ds["correlation"] = (
+        (MATERIAL, "material_b"),
+        corr,
+        {"units": "1", "long_name": "correlation of the scale factors in the chosen model"},
+    )
+    ds["candidate_correlation"] = (
+        (MATERIAL, "material_b"),
+        cand_corr,
+        {
+            "units": "1",
+            "long_name": "correlation of the scale factors with every "
+            "candidate fitted (unconstrained)",
+        },
+    )
     if areas is not None:
         missing = [m for m in names if m not in areas]
         if missing:
             raise InversionError(f"areas: no area for {missing}; have {sorted(areas)}")
         nominal = np.array([float(areas[m]) for m in names])
-        ds["area"] = (MATERIAL, x * nominal, {"units": "m2", "long_name": "effective area of the material"})
-        ds["area_uncertainty"] = (MATERIAL, sig * nominal, {"units": "m2", "long_name": "1-sigma uncertainty of "
-                                                            "the effective area"})
+        ds["area"] = (
+            MATERIAL,
+            x * nominal,
+            {"units": "m2", "long_name": "effective area of the material"},
+        )
+        ds["area_uncertainty"] = (
+            MATERIAL,
+            sig * nominal,
+            {"units": "m2", "long_name": "1-sigma uncertainty of the effective area"},
+        )
         tot = float((x * nominal).sum())
-        ds["area_fraction"] = (MATERIAL, x * nominal / tot if tot > 0 else np.zeros(k),
-                               {"units": "1", "long_name": "fraction of the total effective area"})
-    scal = {"chi2": (chi2, "chi-square of the chosen model"),
-            "reduced_chi2": (chi2 / dof if dof > 0 else np.nan, "chi-square per degree of freedom"),
-            "aic": (aic, "Akaike information criterion chi2 + 2k"),
-            "bic": (bic, "Bayesian information criterion chi2 + k ln n"),
-            "condition_number": (cond, "condition number of the weighted design matrix of all candidates")}
+        ds["area_fraction"] = (
+            MATERIAL,
+            x * nominal / tot if tot > 0 else np.zeros(k),
+            {"units": "1", "long_name": "fraction of the total effective area"},
+        )
+    scal = {
+        "chi2": (chi2, "chi-square of the chosen model"),
+        "reduced_chi2": (chi2 / dof if dof > 0 else np.nan, "chi-square per degree of freedom"),
+        "aic": (aic, "Akaike information criterion chi2 + 2k"),
+        "bic": (bic, "Bayesian information criterion chi2 + k ln n"),
+        "condition_number": (
+            cond,
+            "condition number of the weighted design matrix of all candidates",
+        ),
+    }
     for key, (val, ln) in scal.items():
         ds[key] = ((), float(val), {"units": "1", "long_name": ln})
     ds["n_samples"] = ((), n, {"units": "1", "long_name": "number of measured values"})
-    ds = ds.assign_coords(subset=("subset", [t[0] for t in table], {"long_name": "materials fitted",
-                                                                      "units": "1"}))
+    ds = ds.assign_coords(
+        subset=("subset", [t[0] for t in table], {"long_name": "materials fitted", "units": "1"})
+    )
     for j, key in enumerate(("subset_chi2", "subset_aic", "subset_bic"), start=1):
-        ds[key] = ("subset", np.array([t[j] for t in table]), {"units": "1", "long_name": f"{key[7:]} of the subset"})
-    ds.attrs = {"selected_materials": ", ".join(names[j] for j in cols if x[j] > 0),
-                "criterion": criterion, "selection": str(select),
-                "degenerate": "; ".join(degenerate) if degenerate else "none",
-                "degeneracy_note": (f"the data cannot tell apart: {'; '.join(degenerate)}" if degenerate
-                                    else f"no pair of candidates correlated beyond {degeneracy_threshold}")}
+        ds[key] = (
+            "subset",
+            np.array([t[j] for t in table]),
+            {"units": "1", "long_name": f"{key[7:]} of the subset"},
+        )
+    ds.attrs = {
+        "selected_materials": ", ".join(names[j] for j in cols if x[j] > 0),
+        "criterion": criterion,
+        "selection": str(select),
+        "degenerate": "; ".join(degenerate) if degenerate else "none",
+        "degeneracy_note": (
+            f"the data cannot tell apart: {'; '.join(degenerate)}"
+            if degenerate
+            else f"no pair of candidates correlated beyond {degeneracy_threshold}"
+        ),
+    }
     return ds

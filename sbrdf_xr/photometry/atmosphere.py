@@ -79,12 +79,21 @@ def airmass(elevation: ArrayLike | xr.DataArray, model: str = "kastenyoung1989")
     bad = ~np.isfinite(el) | (el <= 0.0) | (el > 90.0)
     if np.any(bad):
         first = el.ravel()[np.flatnonzero(bad.ravel())[0]]
-        raise ValidationError(f"elevation: must be finite and in (0, 90] degree (above the horizon); "
-                              f"{int(bad.sum())} value(s) are not, the first is {first}")
+        raise ValidationError(
+            f"elevation: must be finite and in (0, 90] degree (above the horizon); "
+            f"{int(bad.sum())} value(s) are not, the first is {first}"
+        )
     x = np.asarray(get_relative_airmass(90.0 - el, model=model), dtype=np.float64)
     if isinstance(elevation, xr.DataArray):
-        return elevation.copy(data=x).rename("airmass").assign_attrs(
-            attrs("airmass", airmass_model=model, airmass_model_description=AIRMASS_MODELS[model]))
+        return (
+            elevation.copy(data=x)
+            .rename("airmass")
+            .assign_attrs(
+                attrs(
+                    "airmass", airmass_model=model, airmass_model_description=AIRMASS_MODELS[model]
+                )
+            )
+        )
     return float(x) if x.ndim == 0 else x
 
 
@@ -114,20 +123,33 @@ def apply_extinction(mags: xr.DataArray, airmass: Any, coefficients: Any) -> xr.
         raise ValidationError("mags: expected a DataArray with a 'band' dimension")
     labels = [str(b) for b in mags[BAND].values]
     if isinstance(coefficients, xr.DataArray):
-        have = {str(b): float(v) for b, v in zip(coefficients[BAND].values, coefficients.values, strict=True)}
+        have = {
+            str(b): float(v)
+            for b, v in zip(coefficients[BAND].values, coefficients.values, strict=True)
+        }
     elif isinstance(coefficients, dict):
         have = {str(b): float(v) for b, v in coefficients.items()}
     else:
-        raise ValidationError(f"coefficients: expected a mapping band -> k or a DataArray over band, "
-                              f"got {type(coefficients).__name__}")
+        raise ValidationError(
+            f"coefficients: expected a mapping band -> k or a DataArray over band, "
+            f"got {type(coefficients).__name__}"
+        )
     missing = [b for b in labels if b not in have]
     if missing:
-        raise ValidationError(f"coefficients: no extinction coefficient for band(s) {missing}; "
-                              f"given for {sorted(have)}")
+        raise ValidationError(
+            f"coefficients: no extinction coefficient for band(s) {missing}; "
+            f"given for {sorted(have)}"
+        )
     k = np.array([have[b] for b in labels])
     if not np.all(np.isfinite(k)) or np.any(k < 0):
-        raise ValidationError(f"coefficients: must be finite and >= 0, got {dict(zip(labels, k, strict=True))}")
-    x = airmass.astype(np.float64) if isinstance(airmass, xr.DataArray) else np.asarray(airmass, dtype=np.float64)
+        raise ValidationError(
+            f"coefficients: must be finite and >= 0, got {dict(zip(labels, k, strict=True))}"
+        )
+    x = (
+        airmass.astype(np.float64)
+        if isinstance(airmass, xr.DataArray)
+        else np.asarray(airmass, dtype=np.float64)
+    )
     xv = _values(airmass)
     if xv.size == 0 or not np.all(np.isfinite(xv)) or np.any(xv < 1.0):
         raise ValidationError(f"airmass: must be finite and >= 1, got {xv.ravel()[:5].tolist()}")
@@ -136,14 +158,18 @@ def apply_extinction(mags: xr.DataArray, airmass: Any, coefficients: Any) -> xr.
     out = out.transpose(*mags.dims, ...)
     out.name = mags.name
     out.attrs = dict(mags.attrs)
-    out.attrs["extinction_coefficients"] = ", ".join(f"{b}: {v:g}" for b, v in zip(labels, k, strict=True))
+    out.attrs["extinction_coefficients"] = ", ".join(
+        f"{b}: {v:g}" for b, v in zip(labels, k, strict=True)
+    )
     out.attrs["extinction"] = "first-order law m(X) = m + k X"
     if xv.ndim == 0:
         out.attrs["airmass"] = float(xv)
     return out
 
 
-def rayleigh_optical_depth(wavelength: ArrayLike, pressure_hpa: float = SEA_LEVEL_HPA) -> np.ndarray:
+def rayleigh_optical_depth(
+    wavelength: ArrayLike, pressure_hpa: float = SEA_LEVEL_HPA
+) -> np.ndarray:
     """Rayleigh-scattering optical depth of the atmosphere at the zenith.
 
     ``tau_R = 0.008569 l**-4 (1 + 0.0113 l**-2 + 0.00013 l**-4) P / 1013.25 hPa`` with
@@ -162,7 +188,13 @@ def rayleigh_optical_depth(wavelength: ArrayLike, pressure_hpa: float = SEA_LEVE
         [1]
     """
     lam = np.asarray(wavelength, dtype=np.float64) / 1000.0
-    return 0.008569 * lam**-4 * (1.0 + 0.0113 * lam**-2 + 0.00013 * lam**-4) * pressure_hpa / SEA_LEVEL_HPA
+    return (
+        0.008569
+        * lam**-4
+        * (1.0 + 0.0113 * lam**-2 + 0.00013 * lam**-4)
+        * pressure_hpa
+        / SEA_LEVEL_HPA
+    )
 
 
 def transmission(
@@ -201,22 +233,35 @@ def transmission(
         ``model_description``; pass it as ``transmission=`` to the band functions.
     """
     wl = _check_grid(wavelength, "wavelength")
-    for name, v, lo in (("airmass", airmass, 1.0), ("pressure_hpa", pressure_hpa, 0.0),
-                        ("aerosol_optical_depth", aerosol_optical_depth, 0.0)):
+    for name, v, lo in (
+        ("airmass", airmass, 1.0),
+        ("pressure_hpa", pressure_hpa, 0.0),
+        ("aerosol_optical_depth", aerosol_optical_depth, 0.0),
+    ):
         if not np.isfinite(v) or v < lo:
             raise ValidationError(f"{name}: must be finite and >= {lo:g}, got {v}")
     if not np.isfinite(angstrom_exponent):
         raise ValidationError(f"angstrom_exponent: must be finite, got {angstrom_exponent}")
-    tau = rayleigh_optical_depth(wl, pressure_hpa) + aerosol_optical_depth * (wl / 550.0) ** -angstrom_exponent
-    desc = (f"Rayleigh (Hansen & Travis 1974, P = {pressure_hpa:g} hPa) + Angstrom aerosols "
-            f"(tau_550 = {aerosol_optical_depth:g}, alpha = {angstrom_exponent:g}) at air mass {airmass:g}")
-    return xr.DataArray(np.exp(-tau * airmass), dims=(WAVELENGTH,),
-                        coords={WAVELENGTH: (WAVELENGTH, wl, attrs(WAVELENGTH))}, name="transmission",
-                        attrs=attrs("transmission", airmass=float(airmass), model_description=desc))
+    tau = (
+        rayleigh_optical_depth(wl, pressure_hpa)
+        + aerosol_optical_depth * (wl / 550.0) ** -angstrom_exponent
+    )
+    desc = (
+        f"Rayleigh (Hansen & Travis 1974, P = {pressure_hpa:g} hPa) + Angstrom aerosols "
+        f"(tau_550 = {aerosol_optical_depth:g}, alpha = {angstrom_exponent:g}) at air mass {airmass:g}"
+    )
+    return xr.DataArray(
+        np.exp(-tau * airmass),
+        dims=(WAVELENGTH,),
+        coords={WAVELENGTH: (WAVELENGTH, wl, attrs(WAVELENGTH))},
+        name="transmission",
+        attrs=attrs("transmission", airmass=float(airmass), model_description=desc),
+    )
 
 
-def extinction_coefficients(bands: Any, *, system: str = "AB", solar: str = "astm_g173",
-                            **atmosphere: Any) -> xr.DataArray:
+def extinction_coefficients(
+    bands: Any, *, system: str = "AB", solar: str = "astm_g173", **atmosphere: Any
+) -> xr.DataArray:
     """Extinction coefficients ``k`` of a solar-coloured source for :func:`transmission`.
 
     ``k_band = m_sun(X = 1) - m_sun(above the atmosphere)``, the band integral of the
@@ -244,6 +289,9 @@ def extinction_coefficients(bands: Any, *, system: str = "AB", solar: str = "ast
     above = sun_magnitudes(bands, system=system, solar=solar)
     through = sun_magnitudes(bands, system=system, solar=solar, transmission=t)
     k = (through - above).rename("extinction_coefficient")
-    k.attrs = attrs("extinction_coefficient", model_description=t.attrs["model_description"].replace(
-        " at air mass 1", ""), solar_spectrum=solar)
+    k.attrs = attrs(
+        "extinction_coefficient",
+        model_description=t.attrs["model_description"].replace(" at air mass 1", ""),
+        solar_spectrum=solar,
+    )
     return k

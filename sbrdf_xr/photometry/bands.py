@@ -32,8 +32,16 @@ from .spectra import (
 #: 1628) reference responses through airmass 1.3 (the ``sdss2010noatm-*`` curves,
 #: without the atmosphere, are available by their full name).
 BAND_ALIASES: dict[str, str] = {
-    "U": "bessell-U", "B": "bessell-B", "V": "bessell-V", "R": "bessell-R", "I": "bessell-I",
-    "u": "sdss2010-u", "g": "sdss2010-g", "r": "sdss2010-r", "i": "sdss2010-i", "z": "sdss2010-z",
+    "U": "bessell-U",
+    "B": "bessell-B",
+    "V": "bessell-V",
+    "R": "bessell-R",
+    "I": "bessell-I",
+    "u": "sdss2010-u",
+    "g": "sdss2010-g",
+    "r": "sdss2010-r",
+    "i": "sdss2010-i",
+    "z": "sdss2010-z",
 }
 
 #: Spectral weightings of the band integral: name -> description.
@@ -78,8 +86,6 @@ class _Band:
         return float(lo), float(hi)
 
 
-
-
 def _speclite_dir() -> Path:
     return Path(str(resources.files("speclite") / "data" / "filters"))
 
@@ -97,13 +103,16 @@ def _speclite_band(name: str) -> tuple[np.ndarray, np.ndarray, str]:
         raise ValidationError(
             f"band: unknown {name!r}; use an alias ({', '.join(BAND_ALIASES)}) or a speclite "
             f"filter name (e.g. {', '.join(speclite_names()[:6])}, ...; see "
-            "sbrdf_xr.photometry.speclite_names())")
+            "sbrdf_xr.photometry.speclite_names())"
+        )
     f = speclite.filters.load_filter(name)
     wl = np.asarray(f.wavelength, dtype=np.float64) / 10.0  # speclite stores Angstrom
     resp = np.asarray(f.response, dtype=np.float64)
     desc = " ".join(str(f.meta.get("description", "")).split())
-    src = (f"speclite {_pkg_version('speclite')} file speclite/data/filters/{name}.ecsv "
-           f"({f.meta.get('url', '')}; airmass {f.meta.get('airmass', '?')}): {desc[:160]}")
+    src = (
+        f"speclite {_pkg_version('speclite')} file speclite/data/filters/{name}.ecsv "
+        f"({f.meta.get('url', '')}; airmass {f.meta.get('airmass', '?')}): {desc[:160]}"
+    )
     wl.setflags(write=False)
     resp.setflags(write=False)
     return wl, resp, src
@@ -116,8 +125,10 @@ def _canonical(name: str) -> str:
 def _user_band(label: str, spec: Any) -> _Band:
     if isinstance(spec, xr.DataArray):
         if spec.dims != (WAVELENGTH,) or WAVELENGTH not in spec.coords:
-            raise ValidationError(f"band {label!r}: a bandpass DataArray needs the single dim "
-                                  f"'{WAVELENGTH}' with its coordinate, got dims {spec.dims}")
+            raise ValidationError(
+                f"band {label!r}: a bandpass DataArray needs the single dim "
+                f"'{WAVELENGTH}' with its coordinate, got dims {spec.dims}"
+            )
         units = spec[WAVELENGTH].attrs.get("units", "nm")
         if units != "nm":
             raise ValidationError(f"band {label!r}: wavelength units must be 'nm', got {units!r}")
@@ -127,16 +138,21 @@ def _user_band(label: str, spec: Any) -> _Band:
         try:
             wl, resp = spec
         except (TypeError, ValueError):
-            raise ValidationError(f"band {label!r}: expected a DataArray or a (wavelength, response) "
-                                  f"pair, got {type(spec).__name__}") from None
+            raise ValidationError(
+                f"band {label!r}: expected a DataArray or a (wavelength, response) "
+                f"pair, got {type(spec).__name__}"
+            ) from None
         src = "user-supplied bandpass"
     wl = _check_grid(wl, f"band {label!r} wavelength")
     resp = np.asarray(resp, dtype=np.float64)
     if resp.shape != wl.shape:
-        raise ValidationError(f"band {label!r}: response shape {resp.shape} differs from wavelength {wl.shape}")
+        raise ValidationError(
+            f"band {label!r}: response shape {resp.shape} differs from wavelength {wl.shape}"
+        )
     if wl.size < 2 or not np.all(np.isfinite(resp)) or np.any(resp < 0) or not np.any(resp > 0):
-        raise ValidationError(f"band {label!r}: response must have >= 2 finite, non-negative values, "
-                              "not all zero")
+        raise ValidationError(
+            f"band {label!r}: response must have >= 2 finite, non-negative values, not all zero"
+        )
     return _Band(label, f"user:{label}", wl, resp, str(src))
 
 
@@ -148,14 +164,20 @@ def _resolve_bands(bands: Any) -> list[_Band]:
     elif isinstance(bands, xr.DataArray):
         if BAND in bands.dims:
             if set(bands.dims) != {BAND, WAVELENGTH}:
-                raise ValidationError(f"bands: a filter DataArray must have dims (band, wavelength), got {bands.dims}")
+                raise ValidationError(
+                    f"bands: a filter DataArray must have dims (band, wavelength), got {bands.dims}"
+                )
             b = bands.transpose(BAND, WAVELENGTH)
             out = []
             for k, lab in enumerate(b[BAND].values.tolist()):
                 row = b.isel({BAND: k}).drop_vars(BAND)
                 band = _user_band(str(lab), row)
                 filt = str(b["filter"].values[k]) if "filter" in b.coords else band.filter
-                src = str(b["filter_source"].values[k]) if "filter_source" in b.coords else band.source
+                src = (
+                    str(b["filter_source"].values[k])
+                    if "filter_source" in b.coords
+                    else band.source
+                )
                 out.append(_Band(band.label, filt, band.wavelength, band.response, src))
             return _unique(out)
         items = [(str(bands.name or "user"), bands)]
@@ -170,8 +192,10 @@ def _resolve_bands(bands: Any) -> list[_Band]:
             elif isinstance(it, tuple) and len(it) == 2 and isinstance(it[0], str):
                 items.append(it)
             else:
-                raise ValidationError(f"bands: cannot interpret {type(it).__name__} {it!r}; give a band "
-                                      "name, a (name, bandpass) pair or a named DataArray")
+                raise ValidationError(
+                    f"bands: cannot interpret {type(it).__name__} {it!r}; give a band "
+                    "name, a (name, bandpass) pair or a named DataArray"
+                )
     else:
         raise ValidationError(f"bands: expected names or bandpasses, got {type(bands).__name__}")
     if not items:
@@ -235,22 +259,37 @@ def filters(bands: Any, wavelength: ArrayLike | None = None) -> xr.DataArray:
     resp = np.stack([np.interp(wl, b.wavelength, b.response, left=0.0, right=0.0) for b in bl])
     coords = _band_coords(bl)
     coords[WAVELENGTH] = (WAVELENGTH, wl, attrs(WAVELENGTH))
-    return xr.DataArray(resp, dims=(BAND, WAVELENGTH), coords=coords, name="filter_response",
-                        attrs=attrs("filter_response",
-                                    response_convention="as shipped; speclite responses are photon-"
-                                    "detection probabilities (photon-counting integrals use T lambda)"))
+    return xr.DataArray(
+        resp,
+        dims=(BAND, WAVELENGTH),
+        coords=coords,
+        name="filter_response",
+        attrs=attrs(
+            "filter_response",
+            response_convention="as shipped; speclite responses are photon-"
+            "detection probabilities (photon-counting integrals use T lambda)",
+        ),
+    )
 
 
-def _coverage_error(band: _Band, lo: float, hi: float, what: str, extra: str = "") -> ValidationError:
+def _coverage_error(
+    band: _Band, lo: float, hi: float, what: str, extra: str = ""
+) -> ValidationError:
     blo, bhi = band.support
     return ValidationError(
         f"band {band.label!r} ({band.filter}) has non-zero response over {blo:g}-{bhi:g} nm but the "
-        f"{what} covers only {lo:g}-{hi:g} nm{extra}")
+        f"{what} covers only {lo:g}-{hi:g} nm{extra}"
+    )
 
 
 def _band_rows(
-    bl: list[_Band], t: np.ndarray, weighting: str, quadrature: str, extrapolate: str | None,
-    solar: str = "astm_g173", transmission: Any = None,
+    bl: list[_Band],
+    t: np.ndarray,
+    weighting: str,
+    quadrature: str,
+    extrapolate: str | None,
+    solar: str = "astm_g173",
+    transmission: Any = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Unnormalised weights (n_band, n_t) and the full-band solar integrals (n_band,)."""
     ws, es = _illumination(solar, transmission)
@@ -262,17 +301,28 @@ def _band_rows(
             raise _coverage_error(band, ws[0], ws[-1], f"solar spectrum ({solar})")
         if (t[0] > blo or t[-1] < bhi) and extrapolate is None:
             raise _coverage_error(
-                band, t[0], t[-1], "spectrum",
-                "; pass extrapolate='zero' or 'constant' to continue the spectrum past its grid")
+                band,
+                t[0],
+                t[-1],
+                "spectrum",
+                "; pass extrapolate='zero' or 'constant' to continue the spectrum past its grid",
+            )
         inside = lambda v, lo=blo, hi=bhi: v[(v > lo) & (v < hi)]  # noqa: E731
-        g_grid = np.unique(np.concatenate([[blo, bhi], inside(ws), inside(band.wavelength), inside(t)]))
-        g = (np.interp(g_grid, ws, es) * np.interp(g_grid, band.wavelength, band.response, left=0.0, right=0.0)
-             * _weighting(g_grid, weighting))
+        g_grid = np.unique(
+            np.concatenate([[blo, bhi], inside(ws), inside(band.wavelength), inside(t)])
+        )
+        g = (
+            np.interp(g_grid, ws, es)
+            * np.interp(g_grid, band.wavelength, band.response, left=0.0, right=0.0)
+            * _weighting(g_grid, weighting)
+        )
         if t.size == 1:
             if t[0] < blo or t[0] > bhi:
                 raise _coverage_error(band, t[0], t[0], "spectrum")
             below, above, row = 0.0, 0.0, np.zeros(1)
-            below = float(_integral(g_grid, g, g_grid[0], g_grid[-1]))  # all of it: constant spectrum
+            below = float(
+                _integral(g_grid, g, g_grid[0], g_grid[-1])
+            )  # all of it: constant spectrum
         else:
             below = float(_integral(g_grid, g, g_grid[0], t[0]))
             above = float(_integral(g_grid, g, t[-1], g_grid[-1]))
@@ -280,7 +330,11 @@ def _band_rows(
                 row = hat_integrals(g_grid, g, t)
             else:
                 e_hat = hat_integrals(ws, es, t)  # = trapezoid weight x conservative solar average
-                row = e_hat * np.interp(t, band.wavelength, band.response, left=0.0, right=0.0) * _weighting(t, weighting)
+                row = (
+                    e_hat
+                    * np.interp(t, band.wavelength, band.response, left=0.0, right=0.0)
+                    * _weighting(t, weighting)
+                )
         full[n] = row.sum() + below + above
         if extrapolate == "constant" or t.size == 1:
             row = row.copy()
@@ -369,14 +423,27 @@ def band_weights(
         units = "m-2 s-1" if weighting == "photon" else "W m-2"
     coords = _band_coords(bl)
     coords[WAVELENGTH] = (WAVELENGTH, t, attrs(WAVELENGTH))
-    return xr.DataArray(rows, dims=(BAND, WAVELENGTH), coords=coords, name="band_weight",
-                        attrs=attrs("band_weight", units=units, **_method_attrs(weighting, quadrature, extrapolate, solar,
-                                                                              transmission),
-                                    normalized=int(normalize)))
+    return xr.DataArray(
+        rows,
+        dims=(BAND, WAVELENGTH),
+        coords=coords,
+        name="band_weight",
+        attrs=attrs(
+            "band_weight",
+            units=units,
+            **_method_attrs(weighting, quadrature, extrapolate, solar, transmission),
+            normalized=int(normalize),
+        ),
+    )
 
 
-def _method_attrs(weighting: str, quadrature: str, extrapolate: str | None, solar: str = "astm_g173",
-                  transmission: Any = None) -> dict[str, Any]:
+def _method_attrs(
+    weighting: str,
+    quadrature: str,
+    extrapolate: str | None,
+    solar: str = "astm_g173",
+    transmission: Any = None,
+) -> dict[str, Any]:
     out: dict[str, Any] = {
         "weighting": weighting,
         "weighting_description": WEIGHTINGS[weighting],
@@ -387,7 +454,9 @@ def _method_attrs(weighting: str, quadrature: str, extrapolate: str | None, sola
         **_solar_provenance(solar),
     }
     if transmission is not None:
-        out["atmosphere"] = str(transmission.attrs.get("model_description", "user transmission curve"))
+        out["atmosphere"] = str(
+            transmission.attrs.get("model_description", "user transmission curve")
+        )
         if "airmass" in transmission.attrs:
             out["airmass"] = float(transmission.attrs["airmass"])
     return out
@@ -426,16 +495,34 @@ def pre_integrate(
         Same dims with ``band`` in place of ``wavelength``, same name and attrs
         (``units`` multiplied by the weight units when not normalised).
     """
-    if not isinstance(table, xr.DataArray) or WAVELENGTH not in table.dims or WAVELENGTH not in table.coords:
-        raise ValidationError(f"table: expected a DataArray with a '{WAVELENGTH}' dimension and coordinate")
+    if (
+        not isinstance(table, xr.DataArray)
+        or WAVELENGTH not in table.dims
+        or WAVELENGTH not in table.coords
+    ):
+        raise ValidationError(
+            f"table: expected a DataArray with a '{WAVELENGTH}' dimension and coordinate"
+        )
     units = table[WAVELENGTH].attrs.get("units", "nm")
     if units != "nm":
         raise ValidationError(f"table: wavelength units must be 'nm', got {units!r}")
-    w = band_weights(bands, table[WAVELENGTH].values, weighting=weighting, quadrature=quadrature,
-                     extrapolate=extrapolate, normalize=normalize, solar=solar, transmission=transmission)
+    w = band_weights(
+        bands,
+        table[WAVELENGTH].values,
+        weighting=weighting,
+        quadrature=quadrature,
+        extrapolate=extrapolate,
+        normalize=normalize,
+        solar=solar,
+        transmission=transmission,
+    )
     w = w.astype(np.result_type(table.dtype, np.float32))
     dims = [BAND if d == WAVELENGTH else d for d in table.dims]
-    out = xr.dot(table, w.drop_vars(WAVELENGTH).assign_coords({WAVELENGTH: table[WAVELENGTH]}), dim=WAVELENGTH)
+    out = xr.dot(
+        table,
+        w.drop_vars(WAVELENGTH).assign_coords({WAVELENGTH: table[WAVELENGTH]}),
+        dim=WAVELENGTH,
+    )
     out = out.transpose(*dims)
     out.name = table.name
     out.attrs = dict(table.attrs)
@@ -443,9 +530,9 @@ def pre_integrate(
         tu = table.attrs.get("units", "1")
         out.attrs["units"] = w.attrs["units"] if tu == "1" else f"{tu} {w.attrs['units']}"
     out.attrs.update({k: v for k, v in w.attrs.items() if k not in ("units", "long_name")})
-    out.attrs["band_integration"] = ("solar-weighted band mean" if normalize
-                                     else "band flux at 1 AU per unit of the spectrum")
+    out.attrs["band_integration"] = (
+        "solar-weighted band mean" if normalize else "band flux at 1 AU per unit of the spectrum"
+    )
     for c in ("filter", "filter_source"):
         out = out.assign_coords({c: w[c]})
     return out
-

@@ -87,27 +87,53 @@ def srgb(
     sun = solar_spectrum(grid, method="average").values
     cmfs = colour.MSDS_CMFS[_CMFS].copy().align(shape)  # 1931 CMFs at their 5 nm nodes (no warning)
     ill = colour.SpectralDistribution(sun, grid, name="ASTM G173-03 AM0")
-    xyz = colour.msds_to_XYZ(vals, cmfs=cmfs, illuminant=ill, method="Integration", shape=shape) / 100.0
+    xyz = (
+        colour.msds_to_XYZ(vals, cmfs=cmfs, illuminant=ill, method="Integration", shape=shape)
+        / 100.0
+    )
     d65 = colour.CCS_ILLUMINANTS[_CMFS]["D65"]
     if white == "sun":
-        xyz_w = colour.msds_to_XYZ(np.ones((1, grid.size)), cmfs=cmfs, illuminant=ill,
-                                   method="Integration", shape=shape)[0] / 100.0
-        rgb = colour.XYZ_to_sRGB(xyz, illuminant=colour.XYZ_to_xy(xyz_w),
-                                 chromatic_adaptation_transform="CAT02", apply_cctf_encoding=False)
+        xyz_w = (
+            colour.msds_to_XYZ(
+                np.ones((1, grid.size)),
+                cmfs=cmfs,
+                illuminant=ill,
+                method="Integration",
+                shape=shape,
+            )[0]
+            / 100.0
+        )
+        rgb = colour.XYZ_to_sRGB(
+            xyz,
+            illuminant=colour.XYZ_to_xy(xyz_w),
+            chromatic_adaptation_transform="CAT02",
+            apply_cctf_encoding=False,
+        )
     else:
-        rgb = colour.XYZ_to_sRGB(xyz, illuminant=d65, chromatic_adaptation_transform=None,
-                                 apply_cctf_encoding=False)
+        rgb = colour.XYZ_to_sRGB(
+            xyz, illuminant=d65, chromatic_adaptation_transform=None, apply_cctf_encoding=False
+        )
     rgb = np.clip(np.asarray(rgb, dtype=np.float64), 0.0, None)
     if normalise == "each":
         scale = rgb.max(axis=-1, keepdims=True)
     else:
         scale = np.full((*rgb.shape[:-1], 1), rgb.max() if rgb.size else 0.0)
     rgb = np.divide(rgb, scale, out=np.zeros_like(rgb), where=scale > 0)
-    enc = np.asarray(colour.cctf_encoding(np.clip(rgb, 0.0, 1.0), function="sRGB"), dtype=np.float64)
+    enc = np.asarray(
+        colour.cctf_encoding(np.clip(rgb, 0.0, 1.0), function="sRGB"), dtype=np.float64
+    )
     coords = {k: v for k, v in s.coords.items() if WAVELENGTH not in v.dims}
     coords["rgb"] = ("rgb", ["R", "G", "B"])
-    return xr.DataArray(enc, dims=(*other, "rgb"), coords=coords, name="srgb",
-                        attrs=attrs("srgb", white=white, normalise=normalise,
-                                    colorimetry=f"{_CMFS}, CIE XYZ -> sRGB (IEC 61966-2-1) by colour-science "
-                                    f"{_pkg_version('colour-science')}; illuminant: ASTM G173-03 AM0 Sun"))
-
+    return xr.DataArray(
+        enc,
+        dims=(*other, "rgb"),
+        coords=coords,
+        name="srgb",
+        attrs=attrs(
+            "srgb",
+            white=white,
+            normalise=normalise,
+            colorimetry=f"{_CMFS}, CIE XYZ -> sRGB (IEC 61966-2-1) by colour-science "
+            f"{_pkg_version('colour-science')}; illuminant: ASTM G173-03 AM0 Sun",
+        ),
+    )

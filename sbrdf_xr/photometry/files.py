@@ -59,8 +59,9 @@ def to_netcdf(ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool =
     enc = cf_encode(ds)
     for name in enc.variables:
         if enc[name].dtype.kind == "f" and not np.all(np.isfinite(enc[name].values)):
-            enc[name].attrs.setdefault("comment", "+inf where nothing reflects toward the observer; "
-                                       "NaN where undefined")
+            enc[name].attrs.setdefault(
+                "comment", "+inf where nothing reflects toward the observer; NaN where undefined"
+            )
     return write_netcdf_atomic(enc, path, overwrite=overwrite)
 
 

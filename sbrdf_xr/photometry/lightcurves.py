@@ -79,23 +79,36 @@ def compare_light_curves(
     """
     from scipy.optimize import minimize_scalar
 
-    if not isinstance(measured, xr.Dataset) or "magnitude" not in measured or "uncertainty" not in measured:
+    if (
+        not isinstance(measured, xr.Dataset)
+        or "magnitude" not in measured
+        or "uncertainty" not in measured
+    ):
         raise ValidationError("measured: expected a light-curve Dataset from read_light_curve")
     if isinstance(n_scan, bool) or not isinstance(n_scan, int | np.integer) or n_scan < 1:
-        raise ValidationError(f"n_scan: must be an integer >= 1 (trial phase offsets over 360 degree), got {n_scan!r}")
+        raise ValidationError(
+            f"n_scan: must be an integer >= 1 (trial phase offsets over 360 degree), got {n_scan!r}"
+        )
     sim = _simulated_curve(simulated_mags, phase_angle)
-    have = str(measured.attrs.get("magnitude_system", measured["magnitude"].attrs.get("magnitude_system",
-                                                                                          "unstated")))
+    have = str(
+        measured.attrs.get(
+            "magnitude_system", measured["magnitude"].attrs.get("magnitude_system", "unstated")
+        )
+    )
     want = str(sim.attrs.get("magnitude_system", "unstated"))
     if "unstated" not in (have, want) and have != want:
-        raise ValidationError(f"measured: magnitudes are in the {have} system but the simulation is in {want}; "
-                              f"simulate with system={have!r}")
+        raise ValidationError(
+            f"measured: magnitudes are in the {have} system but the simulation is in {want}; "
+            f"simulate with system={have!r}"
+        )
     if "rotation_angle" in measured.coords:
         theta = np.asarray(measured["rotation_angle"].values, dtype=np.float64)
     elif "time" in measured.coords:
         if period_s is None or not np.isfinite(period_s) or period_s <= 0:
-            raise ValidationError("period_s: the measured light curve is indexed by time; give the rotation "
-                                  "period [s] (> 0) to convert it to rotation angle")
+            raise ValidationError(
+                "period_s: the measured light curve is indexed by time; give the rotation "
+                "period [s] (> 0) to convert it to rotation angle"
+            )
         tv = measured["time"].values
         if np.issubdtype(tv.dtype, np.datetime64):
             t0 = tv[0] if epoch is None else np.datetime64(epoch, "ns")
@@ -109,8 +122,10 @@ def compare_light_curves(
     sig = np.asarray(measured["uncertainty"].values, dtype=np.float64)
     bad = np.flatnonzero(~np.isfinite(sig) | (sig < MIN_UNCERTAINTY))
     if bad.size:
-        raise ValidationError(f"measured: observation {int(bad[0])} has uncertainty {sig[bad[0]]:g}; must be "
-                              f"finite and >= {MIN_UNCERTAINTY:g} mag")
+        raise ValidationError(
+            f"measured: observation {int(bad[0])} has uncertainty {sig[bad[0]]:g}; must be "
+            f"finite and >= {MIN_UNCERTAINTY:g} mag"
+        )
     sim_labels = [str(b) for b in sim[BAND].values]
     sim_filters = [str(f) for f in sim["filter"].values] if "filter" in sim.coords else sim_labels
     obs_band = [str(b) for b in measured[BAND].values]
@@ -121,20 +136,27 @@ def compare_light_curves(
         elif _canonical(b) in sim_filters:
             col[k] = sim_filters.index(_canonical(b))
         else:
-            raise ValidationError(f"measured: observation {k} is in band {b!r}, which the simulation does "
-                                  f"not have (bands {sim_labels})")
+            raise ValidationError(
+                f"measured: observation {k} is in band {b!r}, which the simulation does "
+                f"not have (bands {sim_labels})"
+            )
     angles = np.asarray(sim["attitude_angle"].values, dtype=np.float64)
     sim_m = np.asarray(sim.transpose(ATTITUDE, BAND).values, dtype=np.float64)
     with np.errstate(over="ignore"):
-        flux = np.where(np.isfinite(sim_m), 10.0 ** (-0.4 * np.where(np.isfinite(sim_m), sim_m, 0.0)), 0.0)
+        flux = np.where(
+            np.isfinite(sim_m), 10.0 ** (-0.4 * np.where(np.isfinite(sim_m), sim_m, 0.0)), 0.0
+        )
     w = 1.0 / sig**2
     extra = np.zeros(theta.size)  # per-observation geometry terms of the model [mag]
     if "range_km" in measured:
         if "range_km" not in sim.attrs:
-            raise ValidationError("measured: has a range_km column but simulated_mags has no range_km "
-                                  "attribute (the range it was computed at); compute it at one range")
-        extra += 5.0 * np.log10(np.asarray(measured["range_km"].values, dtype=np.float64)
-                                / float(sim.attrs["range_km"]))
+            raise ValidationError(
+                "measured: has a range_km column but simulated_mags has no range_km "
+                "attribute (the range it was computed at); compute it at one range"
+            )
+        extra += 5.0 * np.log10(
+            np.asarray(measured["range_km"].values, dtype=np.float64) / float(sim.attrs["range_km"])
+        )
     if extinction is not None:
         if "airmass" not in measured:
             raise ValidationError("extinction: the measured light curve has no airmass column")
@@ -145,7 +167,8 @@ def compare_light_curves(
         k = apply_extinction(zero, 1.0, extinction)
         kb = dict(zip(labels, k.values.tolist(), strict=True))
         extra += np.array([kb[str(b)] for b in measured[BAND].values]) * np.asarray(
-            measured["airmass"].values, dtype=np.float64)
+            measured["airmass"].values, dtype=np.float64
+        )
 
     def model(phi: float) -> tuple[np.ndarray, np.ndarray]:
         f = np.empty(theta.size)
@@ -169,11 +192,17 @@ def compare_light_curves(
     if fit_phase:
         chi_scan = np.array([fit(p)[0] for p in scan])
         if not np.isfinite(chi_scan).any():
-            raise ValidationError("simulated_mags: the model reflects nothing at any measured angle")
+            raise ValidationError(
+                "simulated_mags: the model reflects nothing at any measured angle"
+            )
         k = int(np.nanargmin(chi_scan))
         step = 360.0 / n_scan
-        res = minimize_scalar(lambda p: fit(p)[0], bounds=(scan[k] - step, scan[k] + step), method="bounded",
-                              options={"xatol": 1e-7})
+        res = minimize_scalar(
+            lambda p: fit(p)[0],
+            bounds=(scan[k] - step, scan[k] + step),
+            method="bounded",
+            options={"xatol": 1e-7},
+        )
         phi = float(res.x) if res.fun <= chi_scan[k] else float(scan[k])
         phi = float(np.mod(phi, 360.0))
     else:
@@ -193,9 +222,11 @@ def compare_light_curves(
     n_par = 2 if fit_phase else 1
     dof = int(ok.sum()) - n_par
     if dof < 1:
-        raise ValidationError(f"measured: {int(ok.sum())} observation(s) where the model reflects light; fitting "
-                              f"{n_par} parameter(s) (magnitude{' and phase' if fit_phase else ''} offset) needs "
-                              f"at least {n_par + 1}")
+        raise ValidationError(
+            f"measured: {int(ok.sum())} observation(s) where the model reflects light; fitting "
+            f"{n_par} parameter(s) (magnitude{' and phase' if fit_phase else ''} offset) needs "
+            f"at least {n_par + 1}"
+        )
     resid = np.where(ok, m_obs - (mm + dm), np.nan)
     labels_present = [lab for j, lab in enumerate(sim_labels) if np.any(col[ok] == j)]
     band_mean = []
@@ -204,73 +235,166 @@ def compare_light_curves(
         band_mean.append(float(np.sum(w[sel] * resid[sel]) / np.sum(w[sel])))
     colours = [f"{a}-{b}" for a, b in pairwise(labels_present)]
     ci_diff = [band_mean[i] - band_mean[i + 1] for i in range(len(colours))]
-    obs_coords = {("obs_band" if k == BAND else k): v for k, v in measured.coords.items()
-                  if v.dims == ("obs",)}
+    obs_coords = {
+        ("obs_band" if k == BAND else k): v
+        for k, v in measured.coords.items()
+        if v.dims == ("obs",)
+    }
     ds = xr.Dataset(
         {
-            "measured_magnitude": ("obs", m_obs, attrs("magnitude", long_name="measured magnitude")),
+            "measured_magnitude": (
+                "obs",
+                m_obs,
+                attrs("magnitude", long_name="measured magnitude"),
+            ),
             "uncertainty": ("obs", sig, attrs("magnitude_uncertainty")),
-            "model_magnitude": ("obs", np.where(ok, mm + dm, np.inf),
-                                attrs("magnitude", long_name="simulated magnitude with the fitted offsets")),
-            "residual": ("obs", resid, attrs("magnitude", long_name="measured minus fitted simulated magnitude")),
-            "normalized_residual": ("obs", resid / sig, {"units": "1", "long_name": "residual / uncertainty"}),
-            "model_rotation_angle": ("obs", np.mod(theta + phi, 360.0),
-                                     attrs("rotation_angle", long_name="simulated rotation angle matched to "
-                                           "each observation (measured angle + phase offset, mod 360)")),
-            "magnitude_offset": ((), dm, attrs("magnitude", long_name="fitted magnitude offset (measured - "
-                                                "simulated), analytic weighted mean")),
-            "magnitude_offset_uncertainty": ((), float(1.0 / np.sqrt(np.sum(w[ok]))),
-                                             attrs("magnitude", long_name="1-sigma uncertainty of the "
-                                                   "magnitude offset")),
-            "phase_offset": ((), phi, attrs("rotation_angle", long_name="fitted rotation-phase offset "
-                                            "(simulated angle = measured angle + offset), in [0, 360)")),
+            "model_magnitude": (
+                "obs",
+                np.where(ok, mm + dm, np.inf),
+                attrs("magnitude", long_name="simulated magnitude with the fitted offsets"),
+            ),
+            "residual": (
+                "obs",
+                resid,
+                attrs("magnitude", long_name="measured minus fitted simulated magnitude"),
+            ),
+            "normalized_residual": (
+                "obs",
+                resid / sig,
+                {"units": "1", "long_name": "residual / uncertainty"},
+            ),
+            "model_rotation_angle": (
+                "obs",
+                np.mod(theta + phi, 360.0),
+                attrs(
+                    "rotation_angle",
+                    long_name="simulated rotation angle matched to "
+                    "each observation (measured angle + phase offset, mod 360)",
+                ),
+            ),
+            "magnitude_offset": (
+                (),
+                dm,
+                attrs(
+                    "magnitude",
+                    long_name="fitted magnitude offset (measured - "
+                    "simulated), analytic weighted mean",
+                ),
+            ),
+            "magnitude_offset_uncertainty": (
+                (),
+                float(1.0 / np.sqrt(np.sum(w[ok]))),
+                attrs("magnitude", long_name="1-sigma uncertainty of the magnitude offset"),
+            ),
+            "phase_offset": (
+                (),
+                phi,
+                attrs(
+                    "rotation_angle",
+                    long_name="fitted rotation-phase offset "
+                    "(simulated angle = measured angle + offset), in [0, 360)",
+                ),
+            ),
             "chi_square": ((), chi2, {"units": "1", "long_name": "chi-square of the fit"}),
-            "alternative_phase_offset": ((), phi_alt, attrs("rotation_angle", long_name="best phase offset more "
-                                                            "than 30 deg from the fitted one (scan resolution)")),
-            "alternative_delta_chi_square": ((), dchi_alt, {"units": "1", "long_name": "chi-square at the "
-                                                            "alternative phase minus the best; below ~4 the two "
-                                                            "phases are not distinguished at 2 sigma"}),
-            "degrees_of_freedom": ((), dof, {"units": "1", "long_name": "observations used minus fitted "
-                                             "parameters"}),
-            "reduced_chi_square": ((), chi2 / dof if dof > 0 else np.nan,
-                                   {"units": "1", "long_name": "chi-square per degree of freedom"}),
-            "n_excluded": ((), int((~ok).sum()), {"units": "1", "long_name": "observations where the model "
-                                                  "reflects nothing (excluded)"}),
-            "band_mean_residual": (BAND, np.array(band_mean),
-                                   attrs("magnitude", long_name="weighted mean residual per band after the "
-                                         "common offset")),
-            "colour_index_difference": ("colour", np.array(ci_diff),
-                                        attrs("colour_index", long_name="measured minus simulated colour index")),
-            "chi_square_scan": ("phase_scan", chi_scan, {"units": "1", "long_name": "chi-square versus "
-                                                         "trial phase offset"}),
+            "alternative_phase_offset": (
+                (),
+                phi_alt,
+                attrs(
+                    "rotation_angle",
+                    long_name="best phase offset more "
+                    "than 30 deg from the fitted one (scan resolution)",
+                ),
+            ),
+            "alternative_delta_chi_square": (
+                (),
+                dchi_alt,
+                {
+                    "units": "1",
+                    "long_name": "chi-square at the "
+                    "alternative phase minus the best; below ~4 the two "
+                    "phases are not distinguished at 2 sigma",
+                },
+            ),
+            "degrees_of_freedom": (
+                (),
+                dof,
+                {"units": "1", "long_name": "observations used minus fitted parameters"},
+            ),
+            "reduced_chi_square": (
+                (),
+                chi2 / dof if dof > 0 else np.nan,
+                {"units": "1", "long_name": "chi-square per degree of freedom"},
+            ),
+            "n_excluded": (
+                (),
+                int((~ok).sum()),
+                {
+                    "units": "1",
+                    "long_name": "observations where the model reflects nothing (excluded)",
+                },
+            ),
+            "band_mean_residual": (
+                BAND,
+                np.array(band_mean),
+                attrs(
+                    "magnitude", long_name="weighted mean residual per band after the common offset"
+                ),
+            ),
+            "colour_index_difference": (
+                "colour",
+                np.array(ci_diff),
+                attrs("colour_index", long_name="measured minus simulated colour index"),
+            ),
+            "chi_square_scan": (
+                "phase_scan",
+                chi_scan,
+                {"units": "1", "long_name": "chi-square versus trial phase offset"},
+            ),
         },
-        coords={**obs_coords, BAND: (BAND, labels_present, attrs(BAND)),
-                "colour": ("colour", colours, attrs("colour")),
-                "phase_scan": ("phase_scan", scan, attrs("rotation_angle", long_name="trial phase offset"))},
+        coords={
+            **obs_coords,
+            BAND: (BAND, labels_present, attrs(BAND)),
+            "colour": ("colour", colours, attrs("colour")),
+            "phase_scan": (
+                "phase_scan",
+                scan,
+                attrs("rotation_angle", long_name="trial phase offset"),
+            ),
+        },
     )
-    ds.attrs = {"fit_phase": int(fit_phase), "title": "comparison of a measured and a simulated light curve",
-                "model": "m_meas(theta) = m_sim(theta + phase_offset) + magnitude_offset",
-                "abscissa": "rotation_angle" if "rotation_angle" in measured.coords
-                else f"time converted with period_s = {period_s}"}
+    ds.attrs = {
+        "fit_phase": int(fit_phase),
+        "title": "comparison of a measured and a simulated light curve",
+        "model": "m_meas(theta) = m_sim(theta + phase_offset) + magnitude_offset",
+        "abscissa": "rotation_angle"
+        if "rotation_angle" in measured.coords
+        else f"time converted with period_s = {period_s}",
+    }
     return ds
 
 
 def _simulated_curve(sim: xr.DataArray, phase_angle: float | None) -> xr.DataArray:
     if not isinstance(sim, xr.DataArray) or BAND not in sim.dims:
-        raise ValidationError("simulated_mags: expected magnitudes over (attitude, band) from magnitudes()")
+        raise ValidationError(
+            "simulated_mags: expected magnitudes over (attitude, band) from magnitudes()"
+        )
     if PHASE_ANGLE in sim.dims:
         if phase_angle is not None:
             sim = sim.sel({PHASE_ANGLE: phase_angle}, method="nearest")
         elif sim.sizes[PHASE_ANGLE] == 1:
             sim = sim.isel({PHASE_ANGLE: 0})
         else:
-            raise ValidationError(f"phase_angle: the simulation has {sim.sizes[PHASE_ANGLE]} phase angles "
-                                  f"{sim[PHASE_ANGLE].values.tolist()}; choose one")
+            raise ValidationError(
+                f"phase_angle: the simulation has {sim.sizes[PHASE_ANGLE]} phase angles "
+                f"{sim[PHASE_ANGLE].values.tolist()}; choose one"
+            )
     extra = [d for d in sim.dims if d not in (ATTITUDE, BAND)]
     if ATTITUDE not in sim.dims or extra:
         raise ValidationError(f"simulated_mags: expected dims (attitude, band), got {sim.dims}")
     if "attitude_angle" not in sim.coords:
-        raise ValidationError("simulated_mags: needs the 'attitude_angle' coordinate of a rotation sweep")
+        raise ValidationError(
+            "simulated_mags: needs the 'attitude_angle' coordinate of a rotation sweep"
+        )
     ang = np.mod(np.asarray(sim["attitude_angle"].values, dtype=np.float64), 360.0)
     if np.unique(ang).size != ang.size:
         raise ValidationError("simulated_mags: attitude angles repeat modulo 360 degree")
@@ -299,10 +423,21 @@ def plot_comparison(comparison: xr.Dataset, *, title: str | None = None) -> Any:
     for b in bands:
         sel = obs_band == b
         order = np.argsort(x[sel])
-        line = ax.errorbar(x[sel], comparison["measured_magnitude"].values[sel],
-                           comparison["uncertainty"].values[sel], fmt="o", ms=3, label=f"{b} measured")
-        ax.plot(x[sel][order], comparison["model_magnitude"].values[sel][order], "-",
-                color=line[0].get_color(), label=f"{b} simulated")
+        line = ax.errorbar(
+            x[sel],
+            comparison["measured_magnitude"].values[sel],
+            comparison["uncertainty"].values[sel],
+            fmt="o",
+            ms=3,
+            label=f"{b} measured",
+        )
+        ax.plot(
+            x[sel][order],
+            comparison["model_magnitude"].values[sel][order],
+            "-",
+            color=line[0].get_color(),
+            label=f"{b} simulated",
+        )
         axr.plot(x[sel], comparison["residual"].values[sel], "o", ms=3, color=line[0].get_color())
     ax.invert_yaxis()
     ax.set_ylabel("magnitude [mag]")
@@ -310,8 +445,12 @@ def plot_comparison(comparison: xr.Dataset, *, title: str | None = None) -> Any:
     axr.axhline(0.0, color="k", lw=0.8)
     axr.set_xlabel("simulated rotation angle [degree]")
     axr.set_ylabel("residual [mag]")
-    ax.set_title(title or (f"offset {float(comparison.magnitude_offset):.3f} mag, phase "
-                           f"{float(comparison.phase_offset):.2f} deg, reduced chi2 "
-                           f"{float(comparison.reduced_chi_square):.2f}"))
+    ax.set_title(
+        title
+        or (
+            f"offset {float(comparison.magnitude_offset):.3f} mag, phase "
+            f"{float(comparison.phase_offset):.2f} deg, reduced chi2 "
+            f"{float(comparison.reduced_chi_square):.2f}"
+        )
+    )
     return fig
-

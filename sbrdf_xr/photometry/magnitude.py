@@ -81,14 +81,26 @@ def sun_magnitudes(
         def inside(v: np.ndarray, lo: float = blo, hi: float = bhi) -> np.ndarray:
             return v[(v > lo) & (v < hi)]
 
-        grid = np.unique(np.concatenate([[blo, bhi], inside(ws), inside(band.wavelength), inside(vn)]))
-        tw = np.interp(grid, band.wavelength, band.response, left=0.0, right=0.0) * _weighting(grid, weighting)
+        grid = np.unique(
+            np.concatenate([[blo, bhi], inside(ws), inside(band.wavelength), inside(vn)])
+        )
+        tw = np.interp(grid, band.wavelength, band.response, left=0.0, right=0.0) * _weighting(
+            grid, weighting
+        )
         sun = _integral(grid, np.interp(grid, ws, es) * tw, blo, bhi)
         ref = _integral(grid, reference_flux(system, grid) * tw, blo, bhi)
         out[n] = -2.5 * np.log10(sun / ref)
-    return xr.DataArray(out, dims=(BAND,), coords=_band_coords(bl), name="sun_magnitude",
-                        attrs=attrs("sun_magnitude", **_system_attrs(system),
-                                    **_method_attrs(weighting, "linear", None, solar, transmission)))
+    return xr.DataArray(
+        out,
+        dims=(BAND,),
+        coords=_band_coords(bl),
+        name="sun_magnitude",
+        attrs=attrs(
+            "sun_magnitude",
+            **_system_attrs(system),
+            **_method_attrs(weighting, "linear", None, solar, transmission),
+        ),
+    )
 
 
 def _system_attrs(system: str) -> dict[str, str]:
@@ -101,12 +113,16 @@ def _system_attrs(system: str) -> dict[str, str]:
 def _signal_of(cube: xr.Dataset | xr.DataArray, variable: str = "signal") -> xr.DataArray:
     if isinstance(cube, xr.Dataset):
         if variable not in cube:
-            raise ValidationError(f"cube: no variable {variable!r}; has {sorted(map(str, cube.data_vars))}")
+            raise ValidationError(
+                f"cube: no variable {variable!r}; has {sorted(map(str, cube.data_vars))}"
+            )
         da = cube[variable]
     elif isinstance(cube, xr.DataArray):
         da = cube
     else:
-        raise ValidationError(f"cube: expected an xarray Dataset or DataArray, got {type(cube).__name__}")
+        raise ValidationError(
+            f"cube: expected an xarray Dataset or DataArray, got {type(cube).__name__}"
+        )
     if WAVELENGTH not in da.dims:
         raise ValidationError(f"cube: {da.name!r} has no '{WAVELENGTH}' dimension (dims {da.dims})")
     return da
@@ -151,9 +167,19 @@ def band_signal(
         cube is, with the Sun's band magnitudes as coordinate ``sun_magnitude``.
     """
     s = _signal_of(cube, variable)
-    out = pre_integrate(s, bands, weighting=weighting, quadrature=quadrature, extrapolate=extrapolate,
-                        normalize=True, solar=solar, transmission=transmission)
-    sun = sun_magnitudes(bands, weighting=weighting, system=system, solar=solar, transmission=transmission)
+    out = pre_integrate(
+        s,
+        bands,
+        weighting=weighting,
+        quadrature=quadrature,
+        extrapolate=extrapolate,
+        normalize=True,
+        solar=solar,
+        transmission=transmission,
+    )
+    sun = sun_magnitudes(
+        bands, weighting=weighting, system=system, solar=solar, transmission=transmission
+    )
     out = out.assign_coords(sun_magnitude=(BAND, sun.values, sun.attrs))
     out.name = "band_signal"
     out.attrs.update(attrs("band_signal", units=s.attrs.get("units", "m2 sr-1")))
@@ -169,7 +195,9 @@ def _range_m(range_km: Any) -> Any:
         vals = np.asarray(range_km, dtype=np.float64)
         r = vals * 1e3
     if vals.size == 0 or not np.all(np.isfinite(vals)) or np.any(vals <= 0):
-        raise ValidationError(f"range_km: must be finite and > 0 km, got {vals.ravel()[:5].tolist()}")
+        raise ValidationError(
+            f"range_km: must be finite and > 0 km, got {vals.ravel()[:5].tolist()}"
+        )
     return r
 
 
@@ -218,20 +246,34 @@ def magnitudes(
     """
     system = check_system(system)
     if range_km is None:
-        raise ValidationError("range_km: the observer range [km] is required (e.g. range_km=1000.0)")
+        raise ValidationError(
+            "range_km: the observer range [km] is required (e.g. range_km=1000.0)"
+        )
     d = _range_m(range_km)
     r = _positive(sun_distance_au, "sun_distance_au")
     if isinstance(cube, xr.DataArray) and BAND in cube.dims and "sun_magnitude" in cube.coords:
         sb = cube
-        have = sb.attrs.get("magnitude_system", sb["sun_magnitude"].attrs.get("magnitude_system", "AB"))
+        have = sb.attrs.get(
+            "magnitude_system", sb["sun_magnitude"].attrs.get("magnitude_system", "AB")
+        )
         if have != system:
-            raise ValidationError(f"system: the band_signal was made in the {have} system, not {system}; "
-                                  f"pass system={have!r} or recompute band_signal(..., system={system!r})")
+            raise ValidationError(
+                f"system: the band_signal was made in the {have} system, not {system}; "
+                f"pass system={have!r} or recompute band_signal(..., system={system!r})"
+            )
     else:
         if bands is None:
             raise ValidationError("bands: required unless a band_signal result is given")
-        sb = band_signal(cube, bands, weighting=weighting, quadrature=quadrature, extrapolate=extrapolate,
-                         system=system, solar=solar, transmission=transmission)
+        sb = band_signal(
+            cube,
+            bands,
+            weighting=weighting,
+            quadrature=quadrature,
+            extrapolate=extrapolate,
+            system=system,
+            solar=solar,
+            transmission=transmission,
+        )
     return _magnitudes_from(sb, d, r, system)
 
 
@@ -250,10 +292,14 @@ def _magnitudes_from(sb: xr.DataArray, d_m: Any, sun_distance_au: Any, system: s
     m = xr.where(pos, m, xr.where(ratio == 0, np.inf, np.nan))
     m = m.transpose(*sb.dims, ...)
     m.name = "magnitude"
-    m.attrs = attrs("magnitude", **_system_attrs(system), weighting=sb.attrs.get("weighting", ""),
-                    note="+inf where the band signal is 0 (nothing reflects toward the observer); "
-                    "NaN where it is negative",
-                    formula="m = m_sun,band(1 AU) + 5 log10(r/AU) - 2.5 log10(S_band / d^2), d in m")
+    m.attrs = attrs(
+        "magnitude",
+        **_system_attrs(system),
+        weighting=sb.attrs.get("weighting", ""),
+        note="+inf where the band signal is 0 (nothing reflects toward the observer); "
+        "NaN where it is negative",
+        formula="m = m_sun,band(1 AU) + 5 log10(r/AU) - 2.5 log10(S_band / d^2), d in m",
+    )
     if not isinstance(sun_distance_au, xr.DataArray) and np.ndim(sun_distance_au) == 0:
         m.attrs["sun_distance_au"] = float(sun_distance_au)
     if not isinstance(d_m, xr.DataArray):
@@ -263,7 +309,9 @@ def _magnitudes_from(sb: xr.DataArray, d_m: Any, sun_distance_au: Any, system: s
     return m
 
 
-def colour_indices(mags: xr.DataArray, pairs: Sequence[tuple[str, str]] | None = None) -> xr.DataArray:
+def colour_indices(
+    mags: xr.DataArray, pairs: Sequence[tuple[str, str]] | None = None
+) -> xr.DataArray:
     """Colour indices ``m_a - m_b`` of band pairs.
 
     Parameters
@@ -290,21 +338,36 @@ def colour_indices(mags: xr.DataArray, pairs: Sequence[tuple[str, str]] | None =
     idx = [_band_index(mags, a) for a, _ in pairs], [_band_index(mags, b) for _, b in pairs]
     first = mags.isel({BAND: idx[0]})
     second = mags.isel({BAND: idx[1]})
-    first = first.drop_vars([c for c in first.coords if BAND in first[c].dims]).rename({BAND: "colour"})
-    second = second.drop_vars([c for c in second.coords if BAND in second[c].dims]).rename({BAND: "colour"})
+    first = first.drop_vars([c for c in first.coords if BAND in first[c].dims]).rename(
+        {BAND: "colour"}
+    )
+    second = second.drop_vars([c for c in second.coords if BAND in second[c].dims]).rename(
+        {BAND: "colour"}
+    )
     ok = np.isfinite(first) & np.isfinite(second)
     ci = xr.where(ok, xr.where(ok, first, 0.0) - xr.where(ok, second, 0.0), np.nan)
     names = [f"{a}-{b}" for a, b in pairs]
-    ci = ci.assign_coords(colour=("colour", names, attrs("colour")),
-                          first=("colour", [labels[i] for i in idx[0]],
-                                 {"long_name": "band of the first magnitude of the colour index"}),
-                          second=("colour", [labels[i] for i in idx[1]],
-                                  {"long_name": "band of the magnitude subtracted in the colour index"}))
+    ci = ci.assign_coords(
+        colour=("colour", names, attrs("colour")),
+        first=(
+            "colour",
+            [labels[i] for i in idx[0]],
+            {"long_name": "band of the first magnitude of the colour index"},
+        ),
+        second=(
+            "colour",
+            [labels[i] for i in idx[1]],
+            {"long_name": "band of the magnitude subtracted in the colour index"},
+        ),
+    )
     dims = [("colour" if d == BAND else d) for d in mags.dims]
     ci = ci.transpose(*dims)
     ci.name = "colour_index"
-    ci.attrs = attrs("colour_index", magnitude_system=mags.attrs.get("magnitude_system", "AB"),
-                     note="NaN where either magnitude is infinite (nothing reflects) or NaN")
+    ci.attrs = attrs(
+        "colour_index",
+        magnitude_system=mags.attrs.get("magnitude_system", "AB"),
+        note="NaN where either magnitude is infinite (nothing reflects) or NaN",
+    )
     return ci
 
 
@@ -347,8 +410,16 @@ def photometry(
     d = _range_m(range_km)
     system = check_system(system)
     r = _positive(sun_distance_au, "sun_distance_au")
-    sb = band_signal(cube, bands, weighting=weighting, quadrature=quadrature, extrapolate=extrapolate,
-                     system=system, solar=solar, transmission=transmission)
+    sb = band_signal(
+        cube,
+        bands,
+        weighting=weighting,
+        quadrature=quadrature,
+        extrapolate=extrapolate,
+        system=system,
+        solar=solar,
+        transmission=transmission,
+    )
     m = _magnitudes_from(sb, d, r, system)
     out = {"band_signal": sb, "magnitude": m}
     if sb.sizes[BAND] > 1 or pairs:

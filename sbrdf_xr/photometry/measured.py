@@ -24,11 +24,21 @@ from .spectra import MAGNITUDE_SYSTEMS, check_system
 LIGHT_CURVE_COLUMNS = ("band", "magnitude", "uncertainty")
 LIGHT_CURVE_ABSCISSAE = ("time", "rotation_angle")
 #: Optional per-row columns: name -> (unit they are converted to, attribute table key).
-LIGHT_CURVE_OPTIONAL = {"range_km": ("km", "range"), "phase_angle": ("deg", "phase_angle"),
-                        "airmass": ("", "airmass")}
+LIGHT_CURVE_OPTIONAL = {
+    "range_km": ("km", "range"),
+    "phase_angle": ("deg", "phase_angle"),
+    "airmass": ("", "airmass"),
+}
 #: Suffix -> astropy Table format.
-TABLE_FORMATS = {".ecsv": "ascii.ecsv", ".fits": "fits", ".fit": "fits", ".fits.gz": "fits",
-                 ".vot": "votable", ".votable": "votable", ".xml": "votable"}
+TABLE_FORMATS = {
+    ".ecsv": "ascii.ecsv",
+    ".fits": "fits",
+    ".fit": "fits",
+    ".fits.gz": "fits",
+    ".vot": "votable",
+    ".votable": "votable",
+    ".xml": "votable",
+}
 #: Uncertainties below this [mag] are refused: no photometry is that precise, and their
 #: weights 1/sigma**2 would overflow the fit.
 MIN_UNCERTAINTY = 1e-6
@@ -54,13 +64,23 @@ def _from_astropy(path: Path, fmt: str) -> tuple[Any, dict[str, Any], dict[str, 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # VOTable/FITS readers warn about vendor keywords
             # astropy_native: FITS time columns come back as Time (with their scale)
-            tab = Table.read(path, format=fmt, **({"astropy_native": True} if fmt == "fits" else {}))
+            tab = Table.read(
+                path, format=fmt, **({"astropy_native": True} if fmt == "fits" else {})
+            )
     except Exception as exc:  # astropy raises many types for malformed files
         raise ValidationError(f"{path}: cannot be read as {fmt}: {exc}") from exc
     cols: dict[str, Any] = {}
     units: dict[str, Any] = {}
-    want = {"magnitude": "mag", "uncertainty": "mag", "rotation_angle": "deg", "time": "s",
-            "range_km": "km", "range": "km", "phase_angle": "deg", "airmass": ""}
+    want = {
+        "magnitude": "mag",
+        "uncertainty": "mag",
+        "rotation_angle": "deg",
+        "time": "s",
+        "range_km": "km",
+        "range": "km",
+        "phase_angle": "deg",
+        "airmass": "",
+    }
     for name in tab.colnames:
         col = tab[name]
         key = name.strip()
@@ -71,9 +91,13 @@ def _from_astropy(path: Path, fmt: str) -> tuple[Any, dict[str, Any], dict[str, 
             units[key] = "utc"
             continue
         if getattr(col, "ndim", 1) != 1:
-            raise ValidationError(f"{path}: column {key!r} is not one value per row (shape {col.shape})")
+            raise ValidationError(
+                f"{path}: column {key!r} is not one value per row (shape {col.shape})"
+            )
         unit = getattr(col, "unit", None)
-        data = np.ma.filled(np.ma.asarray(col), np.nan) if col.dtype.kind in "fiu" else np.asarray(col)
+        data = (
+            np.ma.filled(np.ma.asarray(col), np.nan) if col.dtype.kind in "fiu" else np.asarray(col)
+        )
         if key in want and unit is not None and col.dtype.kind in "fiu":
             target = want[key]
             try:
@@ -82,19 +106,24 @@ def _from_astropy(path: Path, fmt: str) -> tuple[Any, dict[str, Any], dict[str, 
                         raise u.UnitConversionError(str(unit))
                     data = np.asarray(data, dtype=np.float64)
                 else:
-                    data = (np.asarray(data, dtype=np.float64) * unit).to_value(u.Unit(target) if target else
-                                                                               u.dimensionless_unscaled)
+                    data = (np.asarray(data, dtype=np.float64) * unit).to_value(
+                        u.Unit(target) if target else u.dimensionless_unscaled
+                    )
             except (u.UnitConversionError, u.UnitsError, ValueError, TypeError):
-                raise ValidationError(f"{path}: column {key!r} has unit {unit!s}, which cannot be converted "
-                                      f"to {target or 'a dimensionless number'}") from None
+                raise ValidationError(
+                    f"{path}: column {key!r} has unit {unit!s}, which cannot be converted "
+                    f"to {target or 'a dimensionless number'}"
+                ) from None
             units[key] = target
         elif col.dtype.kind in "SU" or col.dtype == object:
             data = [str(v.decode() if isinstance(v, bytes) else v) for v in data]
         cols[key] = data
     if "range" in cols and "range_km" not in cols:
         if units.get("range") != "km":
-            raise ValidationError(f"{path}: column 'range' has no length unit; give one (e.g. km) or name "
-                                  "the column 'range_km'")
+            raise ValidationError(
+                f"{path}: column 'range' has no length unit; give one (e.g. km) or name "
+                "the column 'range_km'"
+            )
         cols["range_km"] = cols.pop("range")
     meta = {str(k).lower(): v for k, v in tab.meta.items() if isinstance(v, str | int | float)}
     return pd.DataFrame(cols), units, meta
@@ -176,7 +205,9 @@ def read_light_curve(
         except Exception as exc:  # netCDF4/HDF raise several types
             raise ValidationError(f"{path}: cannot be read as netCDF: {exc}") from exc
         if len(ds.dims) != 1:
-            raise ValidationError(f"{path}: expected variables along one dimension, got dims {dict(ds.sizes)}")
+            raise ValidationError(
+                f"{path}: expected variables along one dimension, got dims {dict(ds.sizes)}"
+            )
         meta = {str(k).lower(): v for k, v in ds.attrs.items()}
         df = ds.reset_coords().to_dataframe().reset_index(drop=True)
         for c in df.columns:
@@ -199,34 +230,54 @@ def read_light_curve(
     return _validate(path, df, units, meta, where, offset, bands, system, time_scale)
 
 
-def _validate(path: Path, df: Any, units: dict[str, Any], meta: dict[str, Any], where: str, offset: int,
-              bands: Sequence[str] | None, system: str | None, time_scale: str | None) -> xr.Dataset:
+def _validate(
+    path: Path,
+    df: Any,
+    units: dict[str, Any],
+    meta: dict[str, Any],
+    where: str,
+    offset: int,
+    bands: Sequence[str] | None,
+    system: str | None,
+    time_scale: str | None,
+) -> xr.Dataset:
     import pandas as pd
 
     cols = list(df.columns)
     missing = [c for c in LIGHT_CURVE_COLUMNS if c not in cols]
     absc = [c for c in LIGHT_CURVE_ABSCISSAE if c in cols]
     if missing:
-        raise ValidationError(f"{path}: missing column(s) {missing}; required: band, magnitude, uncertainty "
-                              f"and one of time, rotation_angle; found {cols}")
+        raise ValidationError(
+            f"{path}: missing column(s) {missing}; required: band, magnitude, uncertainty "
+            f"and one of time, rotation_angle; found {cols}"
+        )
     if len(absc) != 1:
-        raise ValidationError(f"{path}: need exactly one of the columns 'time' or 'rotation_angle', found "
-                              f"{absc or 'neither'}")
+        raise ValidationError(
+            f"{path}: need exactly one of the columns 'time' or 'rotation_angle', found "
+            f"{absc or 'neither'}"
+        )
     xname = absc[0]
     if len(df) == 0:
         raise ValidationError(f"{path}: no observations")
 
     def row_name(k: int) -> str:
-        return where.format(k + 1, k + 1 + offset) if offset else where.format(k + 1 if "row" in where else k)
+        return (
+            where.format(k + 1, k + 1 + offset)
+            if offset
+            else where.format(k + 1 if "row" in where else k)
+        )
 
     def numeric(col: str) -> np.ndarray:
         raw = df[col]
-        v = pd.to_numeric(pd.Series(raw).astype(str).str.strip() if raw.dtype == object else raw,
-                          errors="coerce").to_numpy(dtype=np.float64)
+        v = pd.to_numeric(
+            pd.Series(raw).astype(str).str.strip() if raw.dtype == object else raw, errors="coerce"
+        ).to_numpy(dtype=np.float64)
         bad = np.flatnonzero(~np.isfinite(v))
         if bad.size:
-            raise ValidationError(f"{path}: {row_name(int(bad[0]))}, column {col!r}: value "
-                                  f"{raw.iloc[bad[0]]!r} is not a finite number")
+            raise ValidationError(
+                f"{path}: {row_name(int(bad[0]))}, column {col!r}: value "
+                f"{raw.iloc[bad[0]]!r} is not a finite number"
+            )
         return v
 
     mag = numeric("magnitude")
@@ -234,8 +285,14 @@ def _validate(path: Path, df: Any, units: dict[str, Any], meta: dict[str, Any], 
     bad = np.flatnonzero(unc < MIN_UNCERTAINTY)
     if bad.size:
         k = int(bad[0])
-        rule = "must be > 0" if unc[k] <= 0 else f"must be >= {MIN_UNCERTAINTY:g} mag (no photometry is that precise)"
-        raise ValidationError(f"{path}: {row_name(k)}, column 'uncertainty': {rule}, got {unc[k]:g}")
+        rule = (
+            "must be > 0"
+            if unc[k] <= 0
+            else f"must be >= {MIN_UNCERTAINTY:g} mag (no photometry is that precise)"
+        )
+        raise ValidationError(
+            f"{path}: {row_name(k)}, column 'uncertainty': {rule}, got {unc[k]:g}"
+        )
     scale = time_scale if time_scale is not None else meta.get("time_scale")
     if scale is not None and str(scale).lower() != "utc":
         raise ValidationError(f"time_scale: only 'utc' is accepted, got {scale!r}")
@@ -245,22 +302,28 @@ def _validate(path: Path, df: Any, units: dict[str, Any], meta: dict[str, Any], 
         as_num = pd.to_numeric(raw, errors="coerce")
         if units.get("time") != "utc" and as_num.notna().all():
             x = as_num.to_numpy(dtype=np.float64)
-            x_attrs = attrs("time_since_first", long_name="observation time",
-                            time_origin="as in the file (numeric seconds are kept unchanged)")
+            x_attrs = attrs(
+                "time_since_first",
+                long_name="observation time",
+                time_origin="as in the file (numeric seconds are kept unchanged)",
+            )
             order = x
         else:
             tt = pd.to_datetime(raw, utc=True, errors="coerce", format="ISO8601")
             nat = np.flatnonzero(tt.isna().to_numpy())
             if nat.size:
-                raise ValidationError(f"{path}: {row_name(int(nat[0]))}, column 'time': value "
-                                      f"{raw.iloc[nat[0]]!r} is neither a number of seconds nor an ISO 8601 time")
+                raise ValidationError(
+                    f"{path}: {row_name(int(nat[0]))}, column 'time': value "
+                    f"{raw.iloc[nat[0]]!r} is neither a number of seconds nor an ISO 8601 time"
+                )
             naive = [k for k, v in enumerate(raw) if not _TZ.search(v)]
             if naive and scale is None:
                 k = naive[0]
                 raise ValidationError(
                     f"{path}: {row_name(k)}, column 'time': {raw.iloc[k]!r} has no time zone and cannot be "
                     "read as UTC; write it as ISO 8601 with 'Z' or an offset (2024-01-01T00:00:00Z), or "
-                    "pass time_scale='utc' (table metadata time_scale: utc)")
+                    "pass time_scale='utc' (table metadata time_scale: utc)"
+                )
             x = tt.dt.tz_convert("UTC").dt.tz_localize(None).to_numpy(dtype="datetime64[ns]")
             x_attrs = attrs("time", standard_name="time")
             order = (x - x[0]) / np.timedelta64(1, "s")
@@ -271,40 +334,79 @@ def _validate(path: Path, df: Any, units: dict[str, Any], meta: dict[str, Any], 
     back = np.flatnonzero(np.diff(order) < 0)
     if back.size:
         k = int(back[0]) + 1
-        raise ValidationError(f"{path}: {row_name(k)}, column {xname!r}: values must be non-decreasing "
-                              f"(sorted); it goes back from the previous row")
+        raise ValidationError(
+            f"{path}: {row_name(k)}, column {xname!r}: values must be non-decreasing "
+            f"(sorted); it goes back from the previous row"
+        )
     band = [str(b).strip() for b in df["band"].tolist()]
     known = set(bands) if bands is not None else None
     for k, b in enumerate(band):
         ok = (b in known) if known is not None else (_canonical(b) in speclite_names())
         if not ok:
-            allowed = sorted(known) if known is not None else f"aliases {list(BAND_ALIASES)} or speclite names"
-            raise ValidationError(f"{path}: {row_name(k)}, column 'band': unknown band {b!r}; allowed: {allowed}")
+            allowed = (
+                sorted(known)
+                if known is not None
+                else f"aliases {list(BAND_ALIASES)} or speclite names"
+            )
+            raise ValidationError(
+                f"{path}: {row_name(k)}, column 'band': unknown band {b!r}; allowed: {allowed}"
+            )
     stated = _stated_system(path, df, meta, row_name)
     if system is not None:
         system = check_system(system)
         if stated is not None and stated != system:
-            raise ValidationError(f"{path}: the table states the {stated} system, not system={system!r}")
+            raise ValidationError(
+                f"{path}: the table states the {stated} system, not system={system!r}"
+            )
     mag_system = stated or system or "unstated"
-    mag_attrs = attrs("magnitude", long_name="measured magnitude", magnitude_system=mag_system,
-                      ancillary_variables="uncertainty")
-    data: dict[str, Any] = {"magnitude": ("obs", mag, mag_attrs),
-                            "uncertainty": ("obs", unc, attrs("magnitude_uncertainty",
-                                                              magnitude_system=mag_system))}
+    mag_attrs = attrs(
+        "magnitude",
+        long_name="measured magnitude",
+        magnitude_system=mag_system,
+        ancillary_variables="uncertainty",
+    )
+    data: dict[str, Any] = {
+        "magnitude": ("obs", mag, mag_attrs),
+        "uncertainty": ("obs", unc, attrs("magnitude_uncertainty", magnitude_system=mag_system)),
+    }
     for name, (_unit, key) in LIGHT_CURVE_OPTIONAL.items():
         if name in df.columns:
             v = numeric(name)
-            lo_ok = (v > 0) if name == "range_km" else (v >= 1.0) if name == "airmass" else (v >= 0) & (v <= 180)
+            lo_ok = (
+                (v > 0)
+                if name == "range_km"
+                else (v >= 1.0)
+                if name == "airmass"
+                else (v >= 0) & (v <= 180)
+            )
             bad = np.flatnonzero(~lo_ok)
             if bad.size:
                 k = int(bad[0])
-                rule = {"range_km": "> 0 km", "airmass": ">= 1", "phase_angle": "in [0, 180] degree"}[name]
-                raise ValidationError(f"{path}: {row_name(k)}, column {name!r}: must be {rule}, got {v[k]:g}")
+                rule = {
+                    "range_km": "> 0 km",
+                    "airmass": ">= 1",
+                    "phase_angle": "in [0, 180] degree",
+                }[name]
+                raise ValidationError(
+                    f"{path}: {row_name(k)}, column {name!r}: must be {rule}, got {v[k]:g}"
+                )
             data[name] = ("obs", v, attrs(key))
-    ds = xr.Dataset(data, coords={"obs": ("obs", np.arange(mag.size), attrs("obs")),
-                                  BAND: ("obs", band, attrs(BAND)), xname: ("obs", x, x_attrs)})
-    ds.attrs = {"source_file": str(path), "abscissa": xname, "magnitude_system": mag_system,
-                "magnitude_system_description": MAGNITUDE_SYSTEMS.get(mag_system, "not stated in the table")}
+    ds = xr.Dataset(
+        data,
+        coords={
+            "obs": ("obs", np.arange(mag.size), attrs("obs")),
+            BAND: ("obs", band, attrs(BAND)),
+            xname: ("obs", x, x_attrs),
+        },
+    )
+    ds.attrs = {
+        "source_file": str(path),
+        "abscissa": xname,
+        "magnitude_system": mag_system,
+        "magnitude_system_description": MAGNITUDE_SYSTEMS.get(
+            mag_system, "not stated in the table"
+        ),
+    }
     return ds
 
 
@@ -322,11 +424,15 @@ def _stated_system(path: Path, df: Any, meta: dict[str, Any], row_name: Any) -> 
             try:
                 canon = check_system(v)
             except ValidationError:
-                raise ValidationError(f"{path}: {row_name(k)}, column 'system': unknown {v!r}; allowed: "
-                                      f"{', '.join(MAGNITUDE_SYSTEMS)}") from None
+                raise ValidationError(
+                    f"{path}: {row_name(k)}, column 'system': unknown {v!r}; allowed: "
+                    f"{', '.join(MAGNITUDE_SYSTEMS)}"
+                ) from None
             if found is None:
                 found = canon
             elif canon != found:
-                raise ValidationError(f"{path}: {row_name(k)}, column 'system': {v!r} differs from {found!r} "
-                                      "above; a light curve must be in one magnitude system (convert first)")
+                raise ValidationError(
+                    f"{path}: {row_name(k)}, column 'system': {v!r} differs from {found!r} "
+                    "above; a light curve must be in one magnitude system (convert first)"
+                )
     return found

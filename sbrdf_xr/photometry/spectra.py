@@ -46,6 +46,7 @@ MAGNITUDE_SYSTEMS: dict[str, str] = {
     "magnitude 0 in every band",
 }
 
+
 def _choose(name: Any, table: Mapping[Any, str], what: str) -> Any:
     if name not in table:
         allowed = ", ".join(repr(k) for k in table)
@@ -140,7 +141,9 @@ def _check_grid(wavelength: ArrayLike, what: str) -> np.ndarray:
         raise ValidationError(f"{what}: wavelengths must be finite and > 0 nm")
     if np.any(np.diff(wl) <= 0):
         k = int(np.flatnonzero(np.diff(wl) <= 0)[0])
-        raise ValidationError(f"{what}: must be strictly increasing; {wl[k]:g} nm is followed by {wl[k + 1]:g} nm")
+        raise ValidationError(
+            f"{what}: must be strictly increasing; {wl[k]:g} nm is followed by {wl[k + 1]:g} nm"
+        )
     return wl
 
 
@@ -195,8 +198,9 @@ def _solar_native(solar: str = "astm_g173") -> tuple[np.ndarray, np.ndarray, str
         wl, e = data[:, 0], data[:, 1]
         src = f"pvlib/data/{_SOLAR_FILE} (pvlib {_pkg_version('pvlib')}), column {_SOLAR_COLUMN!r}"
     else:
-        wl, e, src = _read_calspec({"calspec": "sun_reference_stis_001.fits",
-                                    "kurucz1993": "sun_kurucz93.fits"}[solar])
+        wl, e, src = _read_calspec(
+            {"calspec": "sun_reference_stis_001.fits", "kurucz1993": "sun_kurucz93.fits"}[solar]
+        )
         if solar == "kurucz1993":  # the model grid is coarse far out; keep 100 nm - 30 um
             keep = (wl >= 100.0) & (wl <= 30_000.0)
             wl, e = wl[keep], e[keep]
@@ -224,8 +228,10 @@ def _illumination(solar: str, transmission: Any = None) -> tuple[np.ndarray, np.
     if transmission is None:
         return ws, es
     if not isinstance(transmission, xr.DataArray) or transmission.dims != (WAVELENGTH,):
-        raise ValidationError("transmission: expected a DataArray over 'wavelength' only "
-                              "(sbrdf_xr.photometry.atmosphere.transmission)")
+        raise ValidationError(
+            "transmission: expected a DataArray over 'wavelength' only "
+            "(sbrdf_xr.photometry.atmosphere.transmission)"
+        )
     tw = _check_grid(transmission[WAVELENGTH].values, "transmission wavelength")
     tv = np.asarray(transmission.values, dtype=np.float64)
     if not np.all(np.isfinite(tv)) or np.any(tv < 0) or np.any(tv > 1):
@@ -268,12 +274,18 @@ def vega_spectrum(wavelength: ArrayLike | None = None) -> xr.DataArray:
     else:
         wl = _check_grid(wavelength, "wavelength")
         if wl[0] < wl0[0] or wl[-1] > wl0[-1]:
-            raise ValidationError(f"wavelength: {wl[0]:g}-{wl[-1]:g} nm is outside the Vega spectrum "
-                                  f"({wl0[0]:g}-{wl0[-1]:g} nm)")
+            raise ValidationError(
+                f"wavelength: {wl[0]:g}-{wl[-1]:g} nm is outside the Vega spectrum "
+                f"({wl0[0]:g}-{wl0[-1]:g} nm)"
+            )
         f = np.interp(wl, wl0, f0)
-    return xr.DataArray(f, dims=(WAVELENGTH,), coords={WAVELENGTH: (WAVELENGTH, wl, attrs(WAVELENGTH))},
-                        name="vega_flux", attrs=attrs("vega_flux", source_file=src,
-                                                      references="Bohlin et al. 2020, AJ 160, 21"))
+    return xr.DataArray(
+        f,
+        dims=(WAVELENGTH,),
+        coords={WAVELENGTH: (WAVELENGTH, wl, attrs(WAVELENGTH))},
+        name="vega_flux",
+        attrs=attrs("vega_flux", source_file=src, references="Bohlin et al. 2020, AJ 160, 21"),
+    )
 
 
 def check_system(system: str) -> str:
@@ -281,8 +293,10 @@ def check_system(system: str) -> str:
     canon = {k.lower(): k for k in MAGNITUDE_SYSTEMS}
     key = system.lower() if isinstance(system, str) else system
     if key not in canon:
-        raise ValidationError(f"system: unknown {system!r}; allowed: "
-                              f"{', '.join(repr(k) for k in MAGNITUDE_SYSTEMS)} (any case)")
+        raise ValidationError(
+            f"system: unknown {system!r}; allowed: "
+            f"{', '.join(repr(k) for k in MAGNITUDE_SYSTEMS)} (any case)"
+        )
     return canon[key]
 
 
@@ -297,7 +311,9 @@ def reference_flux(system: str, wavelength: ArrayLike) -> np.ndarray:
         return ab_reference_flux(wl)
     wv, fv, _ = _vega_native()
     if wl.min() < wv[0] or wl.max() > wv[-1]:  # pragma: no cover - Vega spans 90 nm - 300 um
-        raise ValidationError(f"wavelength: {wl.min():g}-{wl.max():g} nm is outside the Vega spectrum")
+        raise ValidationError(
+            f"wavelength: {wl.min():g}-{wl.max():g} nm is outside the Vega spectrum"
+        )
     return np.interp(wl, wv, fv)
 
 
@@ -346,7 +362,8 @@ def solar_spectrum(
         if wl[0] < wl0[0] or wl[-1] > wl0[-1]:
             raise ValidationError(
                 f"wavelength: {wl[0]:g}-{wl[-1]:g} nm is outside the solar spectrum "
-                f"({wl0[0]:g}-{wl0[-1]:g} nm)")
+                f"({wl0[0]:g}-{wl0[-1]:g} nm)"
+            )
         if method == "linear" or wl.size == 1:
             e = np.interp(wl, wl0, e0)
             how = "linear interpolation of the native table"
@@ -354,8 +371,12 @@ def solar_spectrum(
             e = hat_integrals(wl0, e0, wl) / trapezoid_weights(wl)
             how = "conservative hat-weighted average of the native table (trapezoid-integral preserving)"
     return xr.DataArray(
-        e, dims=(WAVELENGTH,), coords={WAVELENGTH: (WAVELENGTH, wl, attrs(WAVELENGTH))},
-        name="solar_irradiance", attrs=attrs("solar_irradiance", resampling=how, **_solar_provenance(solar)))
+        e,
+        dims=(WAVELENGTH,),
+        coords={WAVELENGTH: (WAVELENGTH, wl, attrs(WAVELENGTH))},
+        name="solar_irradiance",
+        attrs=attrs("solar_irradiance", resampling=how, **_solar_provenance(solar)),
+    )
 
 
 def ab_reference_flux(wavelength: ArrayLike) -> np.ndarray:
@@ -375,4 +396,3 @@ def ab_reference_flux(wavelength: ArrayLike) -> np.ndarray:
     """
     lam_m = np.asarray(wavelength, dtype=np.float64) * 1e-9
     return AB_ZERO_POINT_JY * _JY * _C_M_S / lam_m**2 * 1e-9
-

@@ -106,7 +106,11 @@ def standard_magnitude(
         raise ValidationError(f"mags: expected a DataArray, got {type(mags).__name__}")
     _positive(range_km, "range_km")
     _positive(to_range_km, "to_range_km")
-    d = range_km.astype(np.float64) if isinstance(range_km, xr.DataArray) else np.asarray(range_km, dtype=np.float64)
+    d = (
+        range_km.astype(np.float64)
+        if isinstance(range_km, xr.DataArray)
+        else np.asarray(range_km, dtype=np.float64)
+    )
     out = mags - 5.0 * np.log10(d / float(to_range_km))
     how = [f"range {to_range_km:g} km"]
     if to_phase_angle is not None:
@@ -114,33 +118,51 @@ def standard_magnitude(
         fn, desc = PHASE_FUNCTIONS[phase_function]
         if phase_angle is None:
             if "phase_angle" not in mags.coords:
-                raise ValidationError("phase_angle: give the phase angle of each magnitude [degree] "
-                                      "(mags has no 'phase_angle' coordinate)")
+                raise ValidationError(
+                    "phase_angle: give the phase angle of each magnitude [degree] "
+                    "(mags has no 'phase_angle' coordinate)"
+                )
             phase_angle = mags["phase_angle"]
-        a = phase_angle.astype(np.float64) if isinstance(phase_angle, xr.DataArray) else np.asarray(
-            phase_angle, dtype=np.float64)
+        a = (
+            phase_angle.astype(np.float64)
+            if isinstance(phase_angle, xr.DataArray)
+            else np.asarray(phase_angle, dtype=np.float64)
+        )
         av = np.asarray(a.values if isinstance(a, xr.DataArray) else a)
-        for what, v in (("phase_angle", av), ("to_phase_angle", np.asarray(to_phase_angle, dtype=np.float64))):
+        for what, v in (
+            ("phase_angle", av),
+            ("to_phase_angle", np.asarray(to_phase_angle, dtype=np.float64)),
+        ):
             if not np.all(np.isfinite(v)) or np.any(v < 0) or np.any(v > 180):
-                raise ValidationError(f"{what}: must be in [0, 180] degree, got {v.ravel()[:5].tolist()}")
+                raise ValidationError(
+                    f"{what}: must be in [0, 180] degree, got {v.ravel()[:5].tolist()}"
+                )
         p0 = float(fn(to_phase_angle))
         pa = fn(av) if not isinstance(a, xr.DataArray) else a.copy(data=fn(av))
         if p0 <= 1e-12 or np.any(np.asarray(fn(av)) <= 1e-12):  # sin(pi) is 1e-16, not 0
-            raise ValidationError(f"phase_function {phase_function!r} is zero at the given phase angles "
-                                  "(a Lambert sphere is dark at 180 degree); choose other angles")
+            raise ValidationError(
+                f"phase_function {phase_function!r} is zero at the given phase angles "
+                "(a Lambert sphere is dark at 180 degree); choose other angles"
+            )
         out = out + 2.5 * np.log10(pa / p0)
         how.append(f"phase angle {to_phase_angle:g} deg with the {desc} phase function")
     if sun_distance_au is not None:
         _positive(sun_distance_au, "sun_distance_au")
-        r = sun_distance_au if isinstance(sun_distance_au, xr.DataArray) else np.asarray(sun_distance_au)
+        r = (
+            sun_distance_au
+            if isinstance(sun_distance_au, xr.DataArray)
+            else np.asarray(sun_distance_au)
+        )
         out = out - 5.0 * np.log10(r)
         how.append("Sun-object distance 1 AU")
     out = out.transpose(*mags.dims, ...)
     out.name = "standard_magnitude"
-    out.attrs = {**{k: v for k, v in mags.attrs.items() if k not in ("long_name", "range_km")},
-                 **attrs("magnitude", long_name="standard magnitude of the reflected sunlight"),
-                 "standardisation": "normalised to " + ", ".join(how),
-                 "standard_range_km": float(to_range_km)}
+    out.attrs = {
+        **{k: v for k, v in mags.attrs.items() if k not in ("long_name", "range_km")},
+        **attrs("magnitude", long_name="standard magnitude of the reflected sunlight"),
+        "standardisation": "normalised to " + ", ".join(how),
+        "standard_range_km": float(to_range_km),
+    }
     if to_phase_angle is not None:
         out.attrs["standard_phase_angle"] = float(to_phase_angle)
         out.attrs["phase_function"] = phase_function
@@ -170,15 +192,23 @@ def sun_distance_au(time: Any) -> Any:
     try:
         t64 = np.asarray(t, dtype="datetime64[ns]")
     except (TypeError, ValueError) as exc:
-        raise ValidationError(f"time: expected UTC datetime64 values or ISO 8601 strings, got {t!r}") from exc
+        raise ValidationError(
+            f"time: expected UTC datetime64 values or ISO 8601 strings, got {t!r}"
+        ) from exc
     if np.any(np.isnat(t64)):
         raise ValidationError("time: NaT (missing) times")
     n = (t64 - np.datetime64("2000-01-01T12:00:00", "ns")) / np.timedelta64(1, "D")
     g = np.radians(357.529 + 0.98560028 * n)
     r = 1.00014 - 0.01671 * np.cos(g) - 0.00014 * np.cos(2.0 * g)
     if isinstance(time, xr.DataArray):
-        return time.copy(data=r).rename("sun_distance").assign_attrs(
-            units="au", long_name="Sun-object distance (Sun-Earth, Astronomical Almanac low precision)")
+        return (
+            time.copy(data=r)
+            .rename("sun_distance")
+            .assign_attrs(
+                units="au",
+                long_name="Sun-object distance (Sun-Earth, Astronomical Almanac low precision)",
+            )
+        )
     return float(r) if np.ndim(r) == 0 else r
 
 
@@ -218,7 +248,9 @@ def at_resolution(
     from scipy.special import ndtr
 
     if not isinstance(spectrum, xr.DataArray) or WAVELENGTH not in spectrum.dims:
-        raise ValidationError("spectrum: expected a DataArray with a 'wavelength' dimension and coordinate")
+        raise ValidationError(
+            "spectrum: expected a DataArray with a 'wavelength' dimension and coordinate"
+        )
     if (resolving_power is None) == (fwhm_nm is None):
         raise ValidationError("give exactly one of resolving_power (lambda / FWHM) and fwhm_nm")
     x = _check_grid(spectrum[WAVELENGTH].values, "spectrum wavelength")
@@ -239,7 +271,9 @@ def at_resolution(
     m = np.diff(cdf, axis=0) * trapezoid_weights(x)[None, :] / trapezoid_weights(t)[:, None]
     mat = xr.DataArray(m, dims=("_out", WAVELENGTH), coords={WAVELENGTH: spectrum[WAVELENGTH]})
     out = xr.dot(spectrum, mat, dim=WAVELENGTH).rename({"_out": WAVELENGTH})
-    out = out.assign_coords({WAVELENGTH: (WAVELENGTH, t, spectrum[WAVELENGTH].attrs or attrs(WAVELENGTH))})
+    out = out.assign_coords(
+        {WAVELENGTH: (WAVELENGTH, t, spectrum[WAVELENGTH].attrs or attrs(WAVELENGTH))}
+    )
     out = out.transpose(*spectrum.dims)
     out.name = spectrum.name
     out.attrs = {**spectrum.attrs, "spectral_resolution": how + " (flux-conserving)"}

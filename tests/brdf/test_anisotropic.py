@@ -61,8 +61,12 @@ def test_reflectance_quadrature_matches_the_isotropic_one():
 
 
 @settings(max_examples=15, deadline=None)
-@given(ax=st.floats(0.02, 1.0), ay=st.floats(0.02, 1.0), ti=st.floats(0.0, 85.0),
-       psi=st.floats(0.0, 180.0))
+@given(
+    ax=st.floats(0.02, 1.0),
+    ay=st.floats(0.02, 1.0),
+    ti=st.floats(0.0, 85.0),
+    psi=st.floats(0.0, 180.0),
+)
 def test_energy_is_bounded_by_one(ax, ay, ti, psi):
     # A near-perfect conductor (k = 1e3: F = 1 - 4e-6) and no diffuse term: the
     # "white furnace" albedo, <= 1 (masking loses energy), quadrature to 1e-3.
@@ -90,42 +94,82 @@ def test_angles_psi_and_vectors_agree():
 
 def test_tangent_along_the_normal_is_an_error():
     with pytest.raises(ValidationError, match="tangent"):
-        A.brdf(Z, [0.3, 0, 1], [-0.3, 0, 1], WL, tangent=[0, 0, 2.0], alpha_x=0.1, alpha_y=0.2, **METAL)
+        A.brdf(
+            Z, [0.3, 0, 1], [-0.3, 0, 1], WL, tangent=[0, 0, 2.0], alpha_x=0.1, alpha_y=0.2, **METAL
+        )
 
 
 def brushed():
-    return models.model_material("anisotropic_microfacet", WL, material="brushed", provenance="test",
-                                 alpha_x=0.05, alpha_y=0.3, **METAL)
+    return models.model_material(
+        "anisotropic_microfacet",
+        WL,
+        material="brushed",
+        provenance="test",
+        alpha_x=0.05,
+        alpha_y=0.3,
+        **METAL,
+    )
 
 
 def test_psi_table_layout_and_lookup():
     spec = brushed()
-    ti, dt, ph, ps = (np.arange(0.0, 91.0, 10.0), np.arange(-180.0, 91.0, 5.0),
-                      np.arange(0.0, 91.0, 5.0), np.arange(0.0, 181.0, 15.0))
+    ti, dt, ph, ps = (
+        np.arange(0.0, 91.0, 10.0),
+        np.arange(-180.0, 91.0, 5.0),
+        np.arange(0.0, 91.0, 5.0),
+        np.arange(0.0, 181.0, 15.0),
+    )
     tab = models.render_anisotropic(spec, ti, dt, ph, ps)
     assert tab.dims == ("theta_i", "delta_theta", "phi", "psi", "wavelength")
     assert tab.psi.attrs["units"] == "degree" and tab.attrs["units"] == "sr-1"
     # At nodes the look-up is the model; psi = 180 wraps onto 0.
-    q = (np.array([30.0, 50.0, 60.0]), np.array([-5.0, 10.0, 0.0]), np.array([5.0, 0.0, 20.0]),
-         np.array([45.0, 90.0, 180.0]))
-    np.testing.assert_allclose(material.lookup_anisotropic(tab, *q), models.spectra(spec, *q), rtol=1e-12)
-    np.testing.assert_allclose(material.lookup_anisotropic(tab, 30.0, -5.0, 5.0, 195.0),
-                               material.lookup_anisotropic(tab, 30.0, -5.0, 5.0, 15.0), rtol=1e-13)
+    q = (
+        np.array([30.0, 50.0, 60.0]),
+        np.array([-5.0, 10.0, 0.0]),
+        np.array([5.0, 0.0, 20.0]),
+        np.array([45.0, 90.0, 180.0]),
+    )
+    np.testing.assert_allclose(
+        material.lookup_anisotropic(tab, *q), models.spectra(spec, *q), rtol=1e-12
+    )
+    np.testing.assert_allclose(
+        material.lookup_anisotropic(tab, 30.0, -5.0, 5.0, 195.0),
+        material.lookup_anisotropic(tab, 30.0, -5.0, 5.0, 15.0),
+        rtol=1e-13,
+    )
     # Brushed: off the plane the glint depends on the tangent's azimuth.
     off = material.lookup_anisotropic(tab, 40.0, 0.0, 10.0, np.array([0.0, 90.0]))
     assert off[0, 0] > 3 * off[1, 0] or off[1, 0] > 3 * off[0, 0]
     with pytest.raises(ValidationError, match="anisotropic"):
         models.render(spec)
     with pytest.raises(ValidationError, match="isotropic"):
-        models.render_anisotropic(models.model_material("lambert", WL, material="l", provenance="t", rho=0.5),
-                                  ti, dt, ph, ps)
+        models.render_anisotropic(
+            models.model_material("lambert", WL, material="l", provenance="t", rho=0.5),
+            ti,
+            dt,
+            ph,
+            ps,
+        )
 
 
 def test_equal_roughness_psi_table_is_the_isotropic_table():
-    a = models.model_material("anisotropic_microfacet", WL, material="iso", provenance="test",
-                              alpha_x=0.2, alpha_y=0.2, **METAL)
-    i = models.model_material("microfacet", WL, material="iso", provenance="test", roughness=0.2, **METAL)
-    ti, dt, ph = np.arange(0.0, 91.0, 15.0), np.arange(-180.0, 91.0, 15.0), np.arange(0.0, 91.0, 15.0)
+    a = models.model_material(
+        "anisotropic_microfacet",
+        WL,
+        material="iso",
+        provenance="test",
+        alpha_x=0.2,
+        alpha_y=0.2,
+        **METAL,
+    )
+    i = models.model_material(
+        "microfacet", WL, material="iso", provenance="test", roughness=0.2, **METAL
+    )
+    ti, dt, ph = (
+        np.arange(0.0, 91.0, 15.0),
+        np.arange(-180.0, 91.0, 15.0),
+        np.arange(0.0, 91.0, 15.0),
+    )
     tab = models.render_anisotropic(a, ti, dt, ph, [0.0, 60.0, 120.0])
     iso = models.render(i, ti, dt, ph)
     for k in range(3):
@@ -142,8 +186,12 @@ def test_brushed_aluminium_example_glints_along_the_brushing():
     from sbrdf_xr import catalog
 
     spec = catalog.load("brushed-aluminium-model")
-    ti, dt, ph, ps = (np.array([30.0, 40.0, 50.0]), np.arange(-30.0, 31.0, 2.0),
-                      np.arange(0.0, 31.0, 2.0), np.array([0.0, 45.0, 90.0, 135.0, 180.0]))
+    ti, dt, ph, ps = (
+        np.array([30.0, 40.0, 50.0]),
+        np.arange(-30.0, 31.0, 2.0),
+        np.arange(0.0, 31.0, 2.0),
+        np.array([0.0, 45.0, 90.0, 135.0, 180.0]),
+    )
     tab = models.render_anisotropic(spec, ti, dt, ph, ps)
     # Brushing along the illumination plane (psi = 0): smooth along the plane, rough
     # across it, so the glint is narrow in delta_theta and spread in phi; brushing
@@ -155,7 +203,10 @@ def test_brushed_aluminium_example_glints_along_the_brushing():
     assert float(spread_phi.sel(psi=0.0)) > 5 * float(spread_phi.sel(psi=90.0))
     assert float(spread_dt.sel(psi=90.0)) > 5 * float(spread_dt.sel(psi=0.0))
     np.testing.assert_allclose(tab.sel(psi=0.0), tab.sel(psi=180.0), rtol=1e-12)
-    rho = A.directional_hemispherical_reflectance([0.0, 45.0, 80.0], spec.wavelength.values,
-                                                  psi=[0.0, 45.0, 90.0],
-                                                  **{k: spec[k].values for k in A.PARAMS})
+    rho = A.directional_hemispherical_reflectance(
+        [0.0, 45.0, 80.0],
+        spec.wavelength.values,
+        psi=[0.0, 45.0, 90.0],
+        **{k: spec[k].values for k in A.PARAMS},
+    )
     assert np.all((rho > 0.5) & (rho <= 1.0))

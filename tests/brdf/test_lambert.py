@@ -57,8 +57,11 @@ def test_shapes_dtype_and_grid():
 
 
 @settings(max_examples=100, deadline=None)
-@given(st.lists(st.floats(-1, 1), min_size=6, max_size=6).filter(
-    lambda v: sum(x * x for x in v[:3]) > 1e-6 and sum(x * x for x in v[3:]) > 1e-6))
+@given(
+    st.lists(st.floats(-1, 1), min_size=6, max_size=6).filter(
+        lambda v: sum(x * x for x in v[:3]) > 1e-6 and sum(x * x for x in v[3:]) > 1e-6
+    )
+)
 def test_property_finite_nonnegative(v):
     f = lambert.brdf(Z, v[:3], v[3:], WL, rho=RHO)
     assert np.all(np.isfinite(f)) and np.all(f >= 0)

@@ -54,8 +54,9 @@ def glint_nodes(theta_i, alpha, n_phi=128, n_x=128):
     tail_w = 0.5 * th_max[:, None] * wt
     th = np.concatenate([core_th, tail_th], axis=1)
     wth = np.concatenate([core_w, tail_w], axis=1)
-    h = np.stack([np.sin(th) * np.cos(phi)[:, None], np.sin(th) * np.sin(phi)[:, None],
-                  np.cos(th)], axis=-1)
+    h = np.stack(
+        [np.sin(th) * np.cos(phi)[:, None], np.sin(th) * np.sin(phi)[:, None], np.cos(th)], axis=-1
+    )
     hs = h @ s
     o = 2 * hs[..., None] * h - s
     return s, o, wphi[:, None] * wth * 4 * hs * np.sin(th) * o[..., 2]
@@ -83,8 +84,11 @@ def test_white_furnace_closed_form_rough_normal_incidence():
 @pytest.mark.parametrize("theta_i", [0.0, 40.0, 75.0])
 @pytest.mark.parametrize(
     "params",
-    [GLASS, {"roughness": [0.02, 0.1, 0.5], "n": 1.2, "k": 7.0, "rho_d": 0.05},
-     {"roughness": 0.3, "n": 3.5, "k": 0.2, "rho_d": [0.0, 0.05, 0.2]}],
+    [
+        GLASS,
+        {"roughness": [0.02, 0.1, 0.5], "n": 1.2, "k": 7.0, "rho_d": 0.05},
+        {"roughness": 0.3, "n": 3.5, "k": 0.2, "rho_d": [0.0, 0.05, 0.2]},
+    ],
 )
 def test_hemispherical_reflectance_equals_brdf_quadrature(theta_i, params):
     alphas = np.broadcast_to(params["roughness"], WL.shape)
@@ -97,13 +101,17 @@ def test_hemispherical_reflectance_equals_brdf_quadrature(theta_i, params):
     full = mf.directional_hemispherical_reflectance(theta_i, WL, **params)
     np.testing.assert_allclose(
         full - mf.directional_hemispherical_reflectance(theta_i, WL, **{**params, "rho_d": 0.0}),
-        np.broadcast_to(params["rho_d"], WL.shape), rtol=1e-12, atol=1e-15)
+        np.broadcast_to(params["rho_d"], WL.shape),
+        rtol=1e-12,
+        atol=1e-15,
+    )
     assert np.all(full <= 1.0)
 
 
 def test_index_one_has_no_specular_reflection():
-    r = mf.directional_hemispherical_reflectance([0.0, 45.0], WL, roughness=0.2, n=1.0, k=0.0,
-                                                 rho_d=0.3)
+    r = mf.directional_hemispherical_reflectance(
+        [0.0, 45.0], WL, roughness=0.2, n=1.0, k=0.0, rho_d=0.3
+    )
     np.testing.assert_allclose(r, 0.3, atol=1e-12)
 
 
@@ -120,26 +128,40 @@ def test_coating_with_zero_thickness_equals_bare_and_coating_changes_colour():
     p = {"roughness": 0.1, "n": 3.5, "k": 0.1, "rho_d": 0.0}
     s, o = [0.5, 0.0, 1.0], [-0.45, 0.05, 1.0]
     bare = mf.brdf(Z, s, o, WL, **p)
-    np.testing.assert_allclose(mf.brdf(Z, s, o, WL, layers=[(2.4, 0.0)], **p), bare,
-                               rtol=1e-12)
+    np.testing.assert_allclose(mf.brdf(Z, s, o, WL, layers=[(2.4, 0.0)], **p), bare, rtol=1e-12)
     coated = mf.brdf(Z, s, o, WL, layers=[(1.87, 600 / (4 * 1.87))], **p)
     assert np.all(coated < bare)
 
 
 @st.composite
 def directions(draw):
-    special = [(0.0, 0.0, 1.0), (1.0, 0.0, 1e-9), (0.0, 1.0, 1e-300), (1e-12, 0.0, 1.0),
-               (-1.0, 1e-12, 1e-8), (0.0, 0.0, -1.0)]
-    return draw(st.one_of(
-        st.tuples(*[st.floats(-1, 1, allow_subnormal=False)] * 3).filter(
-            lambda v: v[0] ** 2 + v[1] ** 2 + v[2] ** 2 > 1e-6),
-        st.sampled_from(special)))
+    special = [
+        (0.0, 0.0, 1.0),
+        (1.0, 0.0, 1e-9),
+        (0.0, 1.0, 1e-300),
+        (1e-12, 0.0, 1.0),
+        (-1.0, 1e-12, 1e-8),
+        (0.0, 0.0, -1.0),
+    ]
+    return draw(
+        st.one_of(
+            st.tuples(*[st.floats(-1, 1, allow_subnormal=False)] * 3).filter(
+                lambda v: v[0] ** 2 + v[1] ** 2 + v[2] ** 2 > 1e-6
+            ),
+            st.sampled_from(special),
+        )
+    )
 
 
 @settings(max_examples=300, deadline=None)
-@given(s=directions(), o=directions(), log_a=st.floats(-4, 0),
-       dtype=st.sampled_from([np.float32, np.float64]), k=st.floats(0, 10),
-       coated=st.booleans())
+@given(
+    s=directions(),
+    o=directions(),
+    log_a=st.floats(-4, 0),
+    dtype=st.sampled_from([np.float32, np.float64]),
+    k=st.floats(0, 10),
+    coated=st.booleans(),
+)
 def test_property_finite_nonnegative(s, o, log_a, dtype, k, coated):
     s = np.array(s, dtype=dtype)
     o = np.array(o, dtype=dtype)
@@ -163,14 +185,24 @@ def test_property_reciprocity(s, o, log_a):
     su = np.asarray(s) / np.linalg.norm(s)
     ou = np.asarray(o) / np.linalg.norm(o)
     # (capped at 1: beyond that the comparison says nothing, and rtol * |b| could overflow)
-    rtol = min(1.0, max(TOL_RECIPROCITY, 1e3 * np.finfo(float).eps / max(np.linalg.norm(su + ou), 1e-300)))
+    rtol = min(
+        1.0, max(TOL_RECIPROCITY, 1e3 * np.finfo(float).eps / max(np.linalg.norm(su + ou), 1e-300))
+    )
     np.testing.assert_allclose(a, b, rtol=rtol)
 
 
 def test_normal_and_grazing_incidence_are_finite():
     for a in (1e-4, 0.3):
-        f = mf.brdf_angles([0.0, 0.0, 89.999, 90.0 - 1e-9], [0.0, 60.0, 0.0, 0.0], 0.0, WL,
-                           roughness=a, n=1.5, k=0.0, rho_d=0.0)
+        f = mf.brdf_angles(
+            [0.0, 0.0, 89.999, 90.0 - 1e-9],
+            [0.0, 60.0, 0.0, 0.0],
+            0.0,
+            WL,
+            roughness=a,
+            n=1.5,
+            k=0.0,
+            rho_d=0.0,
+        )
         assert np.all(np.isfinite(f)) and np.all(f >= 0)
     r = mf.directional_hemispherical_reflectance([0.0, 89.99, 90.0], WL, **GLASS)
     assert np.all(np.isfinite(r)) and np.all((r >= 0) & (r <= 1))
@@ -178,8 +210,13 @@ def test_normal_and_grazing_incidence_are_finite():
 
 @pytest.mark.parametrize(
     ("update", "name"),
-    [({"roughness": 0.0}, "roughness"), ({"n": -1.0}, "n"), ({"k": -0.1}, "k"),
-     ({"rho_d": 1.5}, "rho_d"), ({"n": [1.5, 1.5]}, "n")],
+    [
+        ({"roughness": 0.0}, "roughness"),
+        ({"n": -1.0}, "n"),
+        ({"k": -0.1}, "k"),
+        ({"rho_d": 1.5}, "rho_d"),
+        ({"n": [1.5, 1.5]}, "n"),
+    ],
 )
 def test_validation(update, name):
     with pytest.raises(ValidationError, match=name):

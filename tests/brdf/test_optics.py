@@ -36,8 +36,9 @@ def test_dielectric_against_textbook_real_snell():
     tt = np.arcsin(np.sin(ti) / n)
     rs = (np.cos(ti) - n * np.cos(tt)) / (np.cos(ti) + n * np.cos(tt))
     rp = (n * np.cos(ti) - np.cos(tt)) / (n * np.cos(ti) + np.cos(tt))
-    np.testing.assert_allclose(optics.fresnel_conductor(np.cos(ti), n), 0.5 * (rs**2 + rp**2),
-                               rtol=1e-10, atol=1e-15)
+    np.testing.assert_allclose(
+        optics.fresnel_conductor(np.cos(ti), n), 0.5 * (rs**2 + rp**2), rtol=1e-10, atol=1e-15
+    )
     # Brewster angle: p vanishes, R = R_s / 2
     tb = np.arctan(n)
     tt = np.arcsin(np.sin(tb) / n)
@@ -52,11 +53,13 @@ def test_stack_without_layers_or_with_zero_thickness_equals_bare_substrate():
     c = np.array([1.0, 0.8, 0.3, 1e-3, 0.0])
     sub = optics.aluminium_index(WL)
     bare = optics.fresnel_conductor(c[:, None], sub)
-    np.testing.assert_allclose(optics.fresnel_thin_film_stack(c, WL, [], sub), bare,
-                               rtol=TOL_EXACT, atol=1e-15)
+    np.testing.assert_allclose(
+        optics.fresnel_thin_film_stack(c, WL, [], sub), bare, rtol=TOL_EXACT, atol=1e-15
+    )
     layers = [(2.4, 0.0), (optics.gaas_index(WL), 0.0), (1.46 + 0.1j, 0.0)]
-    np.testing.assert_allclose(optics.fresnel_thin_film_stack(c, WL, layers, sub), bare,
-                               rtol=TOL_EXACT, atol=1e-15)
+    np.testing.assert_allclose(
+        optics.fresnel_thin_film_stack(c, WL, layers, sub), bare, rtol=TOL_EXACT, atol=1e-15
+    )
 
 
 def _airy(cos_t, wl, n1, d, n2):
@@ -82,8 +85,9 @@ def test_single_layer_matches_airy_formula(cos_t):
     sub = optics.gaas_index(WL)
     for n1, d in ((2.4, 70.0), (1.65 + 0.05j, 300.0), (optics.aluminium_index(WL), 12.0)):
         stack = optics.fresnel_thin_film_stack(cos_t, WL, [(n1, d)], sub)
-        np.testing.assert_allclose(stack, _airy(cos_t, WL, np.asarray(n1), d, sub),
-                                   rtol=1e-10, atol=1e-14)
+        np.testing.assert_allclose(
+            stack, _airy(cos_t, WL, np.asarray(n1), d, sub), rtol=1e-10, atol=1e-14
+        )
 
 
 def test_quarter_wave_layer_cancels_reflection():
@@ -100,9 +104,10 @@ def test_interference_minimum_moves_blue_with_angle():
     sub = optics.gaas_index(wl)
     n1 = 2.0
     layers = [(n1, 600.0 / (4 * n1))]
-    mins = [wl[np.argmin(optics.fresnel_thin_film_stack(np.cos(np.radians(t)), wl, layers,
-                                                        sub))]
-            for t in (0.0, 30.0, 50.0, 65.0)]
+    mins = [
+        wl[np.argmin(optics.fresnel_thin_film_stack(np.cos(np.radians(t)), wl, layers, sub))]
+        for t in (0.0, 30.0, 50.0, 65.0)
+    ]
     assert np.all(np.diff(mins) < 0)
     # phase-thickness scaling: lambda_min ~ cos(theta_1) (+ dispersion of GaAs)
     cos1 = np.sqrt(1 - (np.sin(np.radians(50.0)) / n1) ** 2)
@@ -111,10 +116,10 @@ def test_interference_minimum_moves_blue_with_angle():
 
 def test_thick_absorbing_layer_no_overflow():
     sub = 1.46
-    r = optics.fresnel_thin_film_stack(np.array([1.0, 0.5, 0.0]), WL,
-                                       [(optics.aluminium_index(WL), 1e5)], sub)
-    bare = optics.fresnel_conductor(np.array([1.0, 0.5, 0.0])[:, None],
-                                    optics.aluminium_index(WL))
+    r = optics.fresnel_thin_film_stack(
+        np.array([1.0, 0.5, 0.0]), WL, [(optics.aluminium_index(WL), 1e5)], sub
+    )
+    bare = optics.fresnel_conductor(np.array([1.0, 0.5, 0.0])[:, None], optics.aluminium_index(WL))
     assert np.all(np.isfinite(r))
     np.testing.assert_allclose(r, bare, rtol=1e-12)
 
@@ -136,9 +141,12 @@ def test_aluminium_reflectance_visible_and_800nm_dip():
 def test_gaas_model_against_skauli_2003():
     wl_um = np.array([1.0, 1.3, 1.5, 2.0])
     # Skauli et al., J. Appl. Phys. 94, 6447 (2003), 22 C (valid 0.97-17 um)
-    eps = (5.372514 + 5.466742 * wl_um**2 / (wl_um**2 - 0.4431307**2)
-           + 0.02429960 * wl_um**2 / (wl_um**2 - 0.8746453**2)
-           + 1.957522 * wl_um**2 / (wl_um**2 - 36.9166**2))
+    eps = (
+        5.372514
+        + 5.466742 * wl_um**2 / (wl_um**2 - 0.4431307**2)
+        + 0.02429960 * wl_um**2 / (wl_um**2 - 0.8746453**2)
+        + 1.957522 * wl_um**2 / (wl_um**2 - 36.9166**2)
+    )
     n = optics.gaas_index(wl_um * 1000)
     np.testing.assert_allclose(n.real, np.sqrt(eps), rtol=TOL_GAAS)
     assert np.all(n.imag == 0)  # transparent below the gap (871 nm)

@@ -37,8 +37,14 @@ def test_get_model_rejects_unknown_name_and_lists_valid_ones():
 @pytest.mark.parametrize("name", sorted(MODELS))
 def test_interface_members(name):
     model = get_model(name)
-    for attr in ("PARAMS", "check_params", "brdf", "brdf_angles", "render_grid",
-                 "directional_hemispherical_reflectance"):
+    for attr in (
+        "PARAMS",
+        "check_params",
+        "brdf",
+        "brdf_angles",
+        "render_grid",
+        "directional_hemispherical_reflectance",
+    ):
         assert hasattr(model, attr)
     checked = model.check_params(WL, **PARAMS[name])
     assert tuple(checked) == model.PARAMS
@@ -67,8 +73,12 @@ def test_zero_when_unlit_or_unseen(name):
     s_lit = np.array([0.3, 0.0, 1.0])
     o_seen = np.array([-0.3, 0.1, 1.0])
     assert np.all(model.brdf(n, s_lit, o_seen, WL, **PARAMS[name]) > 0)
-    for s, o in ((np.array([0.3, 0, -1.0]), o_seen), (s_lit, np.array([-0.3, 0, -1.0])),
-                 (np.array([1.0, 0, 0]), o_seen), (s_lit, np.array([0, 1.0, 0]))):
+    for s, o in (
+        (np.array([0.3, 0, -1.0]), o_seen),
+        (s_lit, np.array([-0.3, 0, -1.0])),
+        (np.array([1.0, 0, 0]), o_seen),
+        (s_lit, np.array([0, 1.0, 0])),
+    ):
         assert np.all(model.brdf(n, s, o, WL, **PARAMS[name]) == 0)
     # and from angles: unlit (theta_i >= 90) or unseen (theta_i + delta_theta >= 90)
     assert np.all(model.brdf_angles([95.0, 40.0], [0.0, 55.0], 0.0, WL, **PARAMS[name]) == 0)
@@ -77,7 +87,8 @@ def test_zero_when_unlit_or_unseen(name):
 @pytest.mark.parametrize("name", sorted(MODELS))
 def test_hemispherical_reflectance_shape_and_bounds(name):
     model = get_model(name)
-    r = model.directional_hemispherical_reflectance(np.array([[0.0, 30.0], [60.0, 85.0]]), WL,
-                                                    **PARAMS[name])
+    r = model.directional_hemispherical_reflectance(
+        np.array([[0.0, 30.0], [60.0, 85.0]]), WL, **PARAMS[name]
+    )
     assert r.shape == (2, 2, 3)
     assert np.all((r >= 0) & (r <= 1))

@@ -59,8 +59,9 @@ def glint_nodes(theta_i: float, e: float, n_phi: int = 128, n_x: int = 128):
     alpha = np.arctan(e * tx)
     dalpha = e * (1 + tx**2) / (1 + (e * tx) ** 2)
     h = np.stack(
-        [np.sin(alpha) * np.cos(phi)[:, None], np.sin(alpha) * np.sin(phi)[:, None],
-         np.cos(alpha)], axis=-1)
+        [np.sin(alpha) * np.cos(phi)[:, None], np.sin(alpha) * np.sin(phi)[:, None], np.cos(alpha)],
+        axis=-1,
+    )
     hs = h @ s
     o = 2 * hs[..., None] * h - s
     w = wphi[:, None] * wx * 4 * hs * np.sin(alpha) * dalpha * o[..., 2]
@@ -95,8 +96,27 @@ def _g_quad(b: float) -> float:
 
 
 @pytest.mark.parametrize(
-    "b", [0.0, 1e-9, 1e-3, 0.08, 0.12, 0.5, 0.7, 0.71, 1 - 1e-3, 1 - 1e-9, 1.0, 1 + 1e-9,
-          1 + 1e-3, 1.2, 1.3, 2.0, 5.0, 30.0],
+    "b",
+    [
+        0.0,
+        1e-9,
+        1e-3,
+        0.08,
+        0.12,
+        0.5,
+        0.7,
+        0.71,
+        1 - 1e-3,
+        1 - 1e-9,
+        1.0,
+        1 + 1e-9,
+        1 + 1e-3,
+        1.2,
+        1.3,
+        2.0,
+        5.0,
+        30.0,
+    ],
 )
 def test_G_closed_form_equals_quadrature(b):
     assert rs.normalisation_G(b) == pytest.approx(_g_quad(b), rel=TOL_CLOSED_FORM, abs=0)
@@ -129,8 +149,9 @@ def _h_quad(theta_i: float, e: float) -> float:
     def f(phi):
         beta = np.arctan2(np.cos(phi) * np.sin(ti), np.cos(ti))
         xm = np.arctan2(np.tan(0.5 * (beta + 0.5 * np.pi)), e)
-        return (np.cos(ti) * np.sin(xm) ** 2 / 2
-                + e * np.cos(phi) * np.sin(ti) * (xm / 2 - np.sin(2 * xm) / 4))
+        return np.cos(ti) * np.sin(xm) ** 2 / 2 + e * np.cos(phi) * np.sin(ti) * (
+            xm / 2 - np.sin(2 * xm) / 4
+        )
 
     v = integrate.quad(f, 0, np.pi, points=[np.pi / 2], epsabs=0, epsrel=1e-13, limit=500)[0]
     return 2 * v / np.pi
@@ -145,8 +166,10 @@ def test_H_closed_form_equals_quadrature(theta_i, e):
 
 def _eq18_as_printed(theta_i, e):
     c = np.cos(np.radians(theta_i))
-    return (1 / (2 * e**2)) * ((1 - e**2) * c + (2 * e**2 + (1 - e**2) ** 2 * c**2)
-                               / np.sqrt((1 - e**2) ** 2 * c**2 + 4 * e**2))
+    return (1 / (2 * e**2)) * (
+        (1 - e**2) * c
+        + (2 * e**2 + (1 - e**2) ** 2 * c**2) / np.sqrt((1 - e**2) ** 2 * c**2 + 4 * e**2)
+    )
 
 
 @pytest.mark.parametrize(("theta_i", "e"), [(0, 0.5), (40, 0.3), (75, 1.0), (30, 0.7)])
@@ -195,10 +218,12 @@ def test_hemispherical_integral_equals_one_minus_emissivity(params, theta_i):
     expected = 1 - rs.directional_emissivity(theta_i, wl, **params)
     assert diffuse + spec == pytest.approx(expected, rel=TOL_HEMISPHERE)
     # and each part separately (Eq. 13 -> rho_D g/G, Eq. 15 -> rho_s)
-    assert diffuse == pytest.approx(rs.diffuse_reflectance(theta_i, wl, **params),
-                                    rel=TOL_HEMISPHERE, abs=1e-15)
-    assert spec == pytest.approx(rs.specular_reflectance(theta_i, wl, **params),
-                                 rel=TOL_HEMISPHERE, abs=1e-15)
+    assert diffuse == pytest.approx(
+        rs.diffuse_reflectance(theta_i, wl, **params), rel=TOL_HEMISPHERE, abs=1e-15
+    )
+    assert spec == pytest.approx(
+        rs.specular_reflectance(theta_i, wl, **params), rel=TOL_HEMISPHERE, abs=1e-15
+    )
     no_cut = rs.directional_hemispherical_reflectance(theta_i, wl, cutoff=False, **params)
     assert no_cut == pytest.approx(expected, rel=1e-14)
 
@@ -241,8 +266,9 @@ def test_cutoff_loss_by_independent_quadrature():
         h = 1.0 / (e**2 * g[2] ** 2 + g[0] ** 2 + g[1] ** 2) ** 2
         return np.sin(thr) * h * (1 - rs.cutoff_factor(np.degrees(thr), b))
 
-    lost = integrate.dblquad(f, np.radians(80), np.pi / 2, 0, 2 * np.pi, epsabs=1e-12,
-                             epsrel=1e-9)[0] / (4 * np.pi * h_norm)
+    lost = integrate.dblquad(f, np.radians(80), np.pi / 2, 0, 2 * np.pi, epsabs=1e-12, epsrel=1e-9)[
+        0
+    ] / (4 * np.pi * h_norm)
     rho_s = rs.specular_reflectance(ti, WL[:1], **p)[0]
     no_cut = rs.directional_hemispherical_reflectance(ti, WL[:1], cutoff=False, **p)[0]
     cut = rs.directional_hemispherical_reflectance(ti, WL[:1], **p)[0]
@@ -253,8 +279,10 @@ def test_cutoff_loss_documented_values():
     """The cut-off removes little below 60 deg and more toward grazing (module notes)."""
     ti = np.array([0.0, 60.0, 80.0, 89.0])
     for p, at60, at80 in ((AFGL01, 0.0145, 0.0925), (AFGL10, 1.6e-4, 0.026)):
-        lost = (rs.directional_hemispherical_reflectance(ti, WL[:1], cutoff=False, **p)
-                - rs.directional_hemispherical_reflectance(ti, WL[:1], **p))[:, 0]
+        lost = (
+            rs.directional_hemispherical_reflectance(ti, WL[:1], cutoff=False, **p)
+            - rs.directional_hemispherical_reflectance(ti, WL[:1], **p)
+        )[:, 0]
         frac = lost / rs.specular_reflectance(ti, WL[:1], **p)[:, 0]
         assert np.all(np.diff(frac) > 0)
         assert frac[1] < at60 and frac[2] < at80 and frac[2] > 0.5 * at80
@@ -333,13 +361,23 @@ def test_diffuse_reciprocity():
 
 @st.composite
 def directions(draw):
-    special = [(0.0, 0.0, 1.0), (1.0, 0.0, 0.0), (1.0, 0.0, 1e-9), (0.0, -1.0, 1e-300),
-               (1e-12, 0.0, 1.0), (-1.0, 1e-12, 1e-8), (0.0, 0.0, -1.0)]
-    return draw(st.one_of(
-        st.tuples(*[st.floats(-1, 1, allow_subnormal=False)] * 3).filter(
-            lambda v: v[0] ** 2 + v[1] ** 2 + v[2] ** 2 > 1e-6),
-        st.sampled_from(special),
-    ))
+    special = [
+        (0.0, 0.0, 1.0),
+        (1.0, 0.0, 0.0),
+        (1.0, 0.0, 1e-9),
+        (0.0, -1.0, 1e-300),
+        (1e-12, 0.0, 1.0),
+        (-1.0, 1e-12, 1e-8),
+        (0.0, 0.0, -1.0),
+    ]
+    return draw(
+        st.one_of(
+            st.tuples(*[st.floats(-1, 1, allow_subnormal=False)] * 3).filter(
+                lambda v: v[0] ** 2 + v[1] ** 2 + v[2] ** 2 > 1e-6
+            ),
+            st.sampled_from(special),
+        )
+    )
 
 
 @st.composite
@@ -353,9 +391,14 @@ def rs_params(draw):
 
 
 @settings(max_examples=300, deadline=None)
-@given(s=directions(), o=directions(), p=rs_params(),
-       dtype=st.sampled_from([np.float32, np.float64]), cutoff=st.booleans(),
-       forward=st.booleans())
+@given(
+    s=directions(),
+    o=directions(),
+    p=rs_params(),
+    dtype=st.sampled_from([np.float32, np.float64]),
+    cutoff=st.booleans(),
+    forward=st.booleans(),
+)
 def test_property_finite_nonnegative(s, o, p, dtype, cutoff, forward):
     s = np.array(s, dtype=dtype)
     o = -s if forward else np.array(o, dtype=dtype)  # phase angle 180 deg included
@@ -388,22 +431,33 @@ def test_shapes_and_broadcasting():
     o = np.stack([[0.1, 0.2, 1.0]] * 5)[:, None, :]  # (5, 1, 3)
     f = rs.brdf(Z, s, o, WL, **AFGL01)
     assert f.shape == (5, 4, 3)
-    p = {"rho_D": [0.05, 0.07, 0.1], "epsilon": [0.8, 0.85, 0.8], "b": [0.1, 0.12, 0.14],
-         "e": [0.1, 0.12, 0.14]}
+    p = {
+        "rho_D": [0.05, 0.07, 0.1],
+        "epsilon": [0.8, 0.85, 0.8],
+        "b": [0.1, 0.12, 0.14],
+        "e": [0.1, 0.12, 0.14],
+    }
     f2 = rs.brdf(Z, s, o, WL, **p)
     for k in range(3):
         single = {name: v[k] for name, v in p.items()}
-        np.testing.assert_allclose(f2[..., k], rs.brdf(Z, s, o, WL[k:k + 1], **single)[..., 0],
-                                   rtol=1e-14)
+        np.testing.assert_allclose(
+            f2[..., k], rs.brdf(Z, s, o, WL[k : k + 1], **single)[..., 0], rtol=1e-14
+        )
     dhr = rs.directional_hemispherical_reflectance(np.array([[10.0, 20.0], [30.0, 89.0]]), WL, **p)
     assert dhr.shape == (2, 2, 3)
 
 
 @pytest.mark.parametrize(
     ("update", "name"),
-    [({"rho_D": -0.1}, "rho_D"), ({"e": 0.0}, "e"), ({"b": -1.0}, "b"),
-     ({"epsilon": 1.2}, "epsilon"), ({"epsilon": [0.8, np.nan, 0.8]}, "epsilon"),
-     ({"rho_D": [0.1, 0.1]}, "rho_D"), ({"rho_D": 0.5, "epsilon": 0.49, "b": 0.5}, "G(b)")],
+    [
+        ({"rho_D": -0.1}, "rho_D"),
+        ({"e": 0.0}, "e"),
+        ({"b": -1.0}, "b"),
+        ({"epsilon": 1.2}, "epsilon"),
+        ({"epsilon": [0.8, np.nan, 0.8]}, "epsilon"),
+        ({"rho_D": [0.1, 0.1]}, "rho_D"),
+        ({"rho_D": 0.5, "epsilon": 0.49, "b": 0.5}, "G(b)"),
+    ],
 )
 def test_validation_errors(update, name):
     with pytest.raises(ValidationError, match=name.replace("(", r"\(").replace(")", r"\)")):

@@ -16,10 +16,15 @@ WL = np.array([500.0, 1000.0, 4000.0])  # [nm]
 
 
 def _synthetic(noise: float, seed: int = 7):
-    truth = {"rho_D": np.array([0.05, 0.07, 0.10]), "epsilon": np.array([0.85, 0.80, 0.70]),
-             "b": 0.12, "e": 0.12}
-    ti, dt, ph = np.meshgrid([10.0, 25.0, 40.0, 55.0, 70.0], np.linspace(-30, 30, 10),
-                             [0.0, 10.0, 40.0], indexing="ij")
+    truth = {
+        "rho_D": np.array([0.05, 0.07, 0.10]),
+        "epsilon": np.array([0.85, 0.80, 0.70]),
+        "b": 0.12,
+        "e": 0.12,
+    }
+    ti, dt, ph = np.meshgrid(
+        [10.0, 25.0, 40.0, 55.0, 70.0], np.linspace(-30, 30, 10), [0.0, 10.0, 40.0], indexing="ij"
+    )
     ti, dt, ph = ti.ravel(), dt.ravel(), ph.ravel()
     f = rs.brdf_angles(ti, dt, ph, WL, **truth)
     rng = np.random.default_rng(seed)
