@@ -166,9 +166,24 @@ _RAD2DEG = 180.0 / np.pi
 
 @numba.njit(nogil=True, cache=True, inline="always")
 def _axis(
-    grid: np.ndarray, lo: int, n: int, x: float, method: int, idx: np.ndarray, w: np.ndarray
+    grid: np.ndarray,
+    lo: int,
+    n: int,
+    x: float,
+    method: int,
+    idx: np.ndarray,
+    w: np.ndarray,
+    bmap: np.ndarray,
+    blo: int,
+    nb: int,
+    binv: float,
 ) -> int:  # pragma: no cover - compiled
-    """Node indices and weights along one axis (``_lut.axis_weights``); returns the count."""
+    """Node indices and weights along one axis (``_lut.axis_weights``); returns the count.
+
+    The cell is found from the axis' bucket map (:func:`_bucket_map`) and corrected by
+    comparisons with the nodes, so it is exactly ``searchsorted(grid, x, "right") - 1``
+    without a binary search's unpredictable branches.
+    """
     g0 = grid[lo]
     g1 = grid[lo + n - 1]
     if x < g0:
@@ -180,17 +195,17 @@ def _axis(
         w[0] = 1.0
         return 1
     # searchsorted(grid, x, side="right") - 1, clipped to [0, n - 2]
-    a, b = 0, n
-    while a < b:
-        mid = (a + b) // 2
-        if grid[lo + mid] <= x:
-            a = mid + 1
-        else:
-            b = mid
-    i = a - 1
-    if i < 0:
-        i = 0
-    elif i > n - 2:
+    kb = int((x - g0) * binv)
+    if kb < 0:
+        kb = 0
+    elif kb > nb - 1:
+        kb = nb - 1
+    i = bmap[blo + kb]
+    while i < n - 1 and grid[lo + i + 1] <= x:
+        i += 1
+    while i > 0 and grid[lo + i] > x:
+        i -= 1
+    if i > n - 2:
         i = n - 2
     t = (x - grid[lo + i]) / (grid[lo + i + 1] - grid[lo + i])
     if method == 0:
@@ -303,6 +318,9 @@ def _fused_sums(
     p_off,
     edges,
     blend,
+    bmap,
+    b_off,
+    binv,
     method,
     tol,
     edge_tol,
@@ -329,6 +347,7 @@ def _fused_sums(
     wt = np.empty(4)
     wdt = np.empty(4)
     wph = np.empty(4)
+    bt, bd, bp = bmap[0], bmap[1], bmap[2]
     for g in range(n_geom):
         sx, sy, sz = s[g, 0], s[g, 1], s[g, 2]
         ox, oy, oz = o[g, 0], o[g, 1], o[g, 2]
@@ -390,6 +409,9 @@ def _fused_sums(
                 npp = p_off[m + 1] - p0
                 t0 = t_off[m]
                 nt = t_off[m + 1] - t0
+                bt0, nbt, bit = b_off[0, m], b_off[0, m + 1] - b_off[0, m], binv[0, m]
+                bd0, nbd, bid = b_off[1, m], b_off[1, m + 1] - b_off[1, m], binv[1, m]
+                bp0, nbp, bip = b_off[2, m], b_off[2, m + 1] - b_off[2, m], binv[2, m]
                 outside = (
                     (edges[m, 0] and dt < dgrid[d0] - edge_tol)
                     or (edges[m, 1] and dt > dgrid[d0 + nd - 1] + edge_tol)
@@ -405,9 +427,9 @@ def _fused_sums(
                     w_n = 1.0 - x * x * (3.0 - 2.0 * x)
                 nk = 0
                 if not outside and w_n < 1.0:
-                    kt = _axis(tgrid, t0, nt, ti, method, it, wt)
-                    kd = _axis(dgrid, d0, nd, dt, method, idt, wdt)
-                    kp = _axis(pgrid, p0, npp, phi, method, iph, wph)
+                    kt = _axis(tgrid, t0, nt, ti, method, it, wt, bt, bt0, nbt, bit)
+                    kd = _axis(dgrid, d0, nd, dt, method, idt, wdt, bd, bd0, nbd, bid)
+                    kp = _axis(pgrid, p0, npp, phi, method, iph, wph, bp, bp0, nbp, bip)
                     for a in range(kt):
                         for b in range(kd):
                             row0 = (it[a] * nd + idt[b]) * npp
@@ -431,11 +453,23 @@ def _fused_sums(
                     n_ok = (1 if ok_hi else 0) + (1 if ok_lo else 0)
                     if n_ok > 0:
                         base_w = w_n / n_ok
-                        kp = _axis(pgrid, p0, npp, 0.0, method, iph, wph)
+                        kp = _axis(pgrid, p0, npp, 0.0, method, iph, wph, bp, bp0, nbp, bip)
                         for side in range(2):
                             if (side == 0 and not ok_hi) or (side == 1 and not ok_lo):
                                 continue
-                            kd = _axis(dgrid, d0, nd, gam if side == 0 else -gam, method, idt, wdt)
+                            kd = _axis(
+                                dgrid,
+                                d0,
+                                nd,
+                                gam if side == 0 else -gam,
+                                method,
+                                idt,
+                                wdt,
+                                bd,
+                                bd0,
+                                nbd,
+                                bid,
+                            )
                             for b in range(kd):
                                 for c in range(kp):
                                     rows[nk] = idt[b] * npp + iph[c]
@@ -470,6 +504,31 @@ def _fused_sums(
         out_lit[g] = lit_g
 
 
+#: Most buckets of an axis' bucket map (a grid with very uneven spacing gets fewer
+#: buckets than nodes' spacing asks for, and a short scan within a bucket).
+_MAX_BUCKETS = 4096
+
+
+def _bucket_map(grid: np.ndarray) -> tuple[np.ndarray, float]:
+    """Uniform buckets over ``grid`` and the cell at each bucket's start.
+
+    Bucket ``k`` starts at ``grid[0] + k / inv``; ``map[k]`` is
+    ``searchsorted(grid, start, "right") - 1``.  The bucket width is the smallest node
+    spacing (at most :data:`_MAX_BUCKETS` buckets), so a bucket holds at most one node
+    and :func:`_axis` needs at most one correcting step.
+    """
+    g = np.asarray(grid, dtype=np.float64)
+    if g.size < 2 or g[-1] <= g[0]:
+        return np.zeros(1, dtype=np.int64), 0.0
+    span = g[-1] - g[0]
+    width = max(float(np.min(np.diff(g))), span / _MAX_BUCKETS)
+    nb = int(np.ceil(span / width)) + 1
+    inv = 1.0 / width
+    starts = g[0] + np.arange(nb) / inv
+    bmap = np.clip(np.searchsorted(g, starts, side="right") - 1, 0, g.size - 1)
+    return bmap.astype(np.int64), inv
+
+
 class PackedTables(NamedTuple):
     """Material tables as the fused kernel reads them.
 
@@ -491,6 +550,11 @@ class PackedTables(NamedTuple):
     shapes: tuple[tuple[int, int, int], ...]  #: (n_theta, n_delta_theta, n_phi) per material
     n_spectral: int
     dtype: np.dtype
+    #: bucket maps of the (theta_i, delta_theta, phi) axes (:func:`_bucket_map`): the
+    #: concatenated maps (3, total), offsets (3, M + 1) and inverse widths (3, M)
+    bmap: NDArray[np.int64] = np.zeros((3, 1), dtype=np.int64)
+    b_off: NDArray[np.int64] = np.zeros((3, 1), dtype=np.int64)
+    binv: NDArray[np.float64] = np.zeros((3, 0))
 
 
 def pack_tables(
@@ -535,8 +599,32 @@ def pack_tables(
     edges = np.array([t[4] for t in tables], dtype=bool).reshape(-1, 3)
     blend = np.array([float(t[5]) if len(t) > 5 else 0.0 for t in tables], dtype=np.float64)
     shapes = tuple(tuple(int(x) for x in v.shape[:3]) for v, *_ in tables)
+    maps = [[_bucket_map(np.asarray(t[1 + a])) for t in tables] for a in range(3)]
+    lengths = [[m.size for m, _ in axis] for axis in maps]
+    width = max(sum(n) for n in lengths)
+    bmap = np.zeros((3, width), dtype=np.int64)
+    b_off = np.zeros((3, len(tables) + 1), dtype=np.int64)
+    binv = np.zeros((3, len(tables)))
+    for a, axis in enumerate(maps):
+        b_off[a, 1:] = np.cumsum(lengths[a])
+        bmap[a, : b_off[a, -1]] = np.concatenate([m for m, _ in axis])
+        binv[a] = [inv for _, inv in axis]
     return PackedTables(
-        values, tgrid, t_off, dgrid, d_off, pgrid, p_off, edges, blend, shapes, n_wl, dt
+        values,
+        tgrid,
+        t_off,
+        dgrid,
+        d_off,
+        pgrid,
+        p_off,
+        edges,
+        blend,
+        shapes,
+        n_wl,
+        dt,
+        bmap,
+        b_off,
+        binv,
     )
 
 
@@ -625,6 +713,9 @@ def fused_sums(
             tables.p_off,
             tables.edges,
             tables.blend,
+            tables.bmap,
+            tables.b_off,
+            tables.binv,
             METHOD_CODES[method],
             normal_incidence_tolerance(np.float64),
             _lut.EDGE_TOL_DEG,

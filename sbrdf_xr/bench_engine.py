@@ -12,8 +12,9 @@ absolute claim:
   over the same geometries, and the peak resident memory;
 * band-only (V, R, I) against full spectrum on the 1e5 sweep;
 * two cores against one (one thread everywhere: ``SBRDF_XR_NUM_THREADS=1`` and one
-  writer thread), and two process workers against one on a ``LocalCluster`` writing
-  a Zarr store by blocks;
+  writer thread), written and computed only (every output, nothing written), and
+  two process workers against one on a ``LocalCluster`` writing a Zarr store by
+  blocks;
 * kernel throughput (facet-spectra per second, linear, 141 wavelengths, unmerged)
   against the dense-matmul arithmetic rate of this machine and against the numpy
   reference kernel.
@@ -62,8 +63,10 @@ def sweep_job(
     """Run one sweep in this process (the subprocess side of :func:`engine_rows`).
 
     ``mode``: ``write`` (netCDF at default settings), ``kernel`` (the bare fused
-    kernel over the same geometries and threads, outputs discarded), ``zarr``
-    (a LocalCluster of ``workers`` single-threaded processes writing a Zarr store).
+    kernel over the same geometries and threads, outputs discarded), ``compute``
+    (every block's outputs computed in full, :func:`~sbrdf_xr.simulate.run_block`,
+    on the same threads, nothing written), ``zarr`` (a LocalCluster of ``workers``
+    single-threaded processes writing a Zarr store).
     Returns seconds (after planning and a warm-up of the compiled kernel) and the
     peak RSS [byte].
     """
@@ -74,7 +77,7 @@ def sweep_job(
     scene = _sweep_scene(n, bands)
     plan = scene.plan()
     run_block(plan, slice(0, min(8, n)))  # load the compiled kernel
-    if mode == "kernel":
+    if mode in ("kernel", "compute"):
         from concurrent.futures import ThreadPoolExecutor
 
         from ._kernels import fused_sums
@@ -83,6 +86,9 @@ def sweep_job(
         blocks = [plan.block_slice(k) for k in range(plan.n_blocks)]
 
         def one(sl: slice) -> None:
+            if mode == "compute":
+                run_block(plan, sl)
+                return
             b = plan.geometry.block(sl)
             fused_sums(
                 b.to_sun,
@@ -216,10 +222,11 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
     rows: list[BenchRow] = []
     rot = builtin_scene("canx1-rotation")
     simulate(rot).compute()
-    t_rot = best_time(lambda: simulate(rot).compute(), repeat)
+    # many repeats: the best of a few short calls is at the mercy of the machine's load
+    t_rot = best_time(lambda: simulate(rot).compute(), max(repeat, 20))
     one = rot.with_options(attitudes=rot.attitudes[:1], attitude_angle=None)
     simulate(one).compute()
-    t_one = best_time(lambda: simulate(one).compute(), repeat, number=20)
+    t_one = best_time(lambda: simulate(one).compute(), max(repeat, 5), number=20)
     sweep = "end to end, warm"
     rows.append(
         BenchRow(
@@ -292,12 +299,28 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
             sweep=sw,
         )
     )
+    c2 = _subprocess(n5, mode="compute")
+    c1 = _subprocess(n5, mode="compute", threads=1)
+    rows.append(
+        BenchRow(
+            "1e5 attitudes computed, nothing written, one core",
+            c1["seconds"],
+            "two cores",
+            c1["seconds"] / c2["seconds"],
+            f"two cores are {c1['seconds'] / c2['seconds']:.2f}x one core "
+            f"({c2['seconds']:.2f} s against {c1['seconds']:.2f} s)",
+            sweep="compute only, default settings, 141 wavelengths",
+        )
+    )
     if not quick:
-        z1 = _subprocess(n5, mode="zarr", workers=1)
-        z2 = _subprocess(n5, mode="zarr", workers=2)
+        # 1e6: each worker first receives the plan with its tables (about 240 MB), a fixed
+        # cost that a 1e5 sweep (seconds) cannot amortise
+        n6 = _SIZES[-1]
+        z1 = _subprocess(n6, mode="zarr", workers=1)
+        z2 = _subprocess(n6, mode="zarr", workers=2)
         rows.append(
             BenchRow(
-                "1e5 attitudes, LocalCluster, 1 process worker, Zarr by blocks",
+                f"{n6:.0e} attitudes, LocalCluster, 1 process worker, Zarr by blocks",
                 z1["seconds"],
                 "2 process workers",
                 z1["seconds"] / z2["seconds"],

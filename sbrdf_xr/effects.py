@@ -409,6 +409,21 @@ EFFECTS: dict[str, Effect] = {
 }
 
 
+def _trapezoid_weights(plan: Plan) -> np.ndarray:
+    """Weights ``w`` with ``y @ w`` the trapezoid integral of ``y`` over the wavelength grid
+    (paper 000 Eq. 2); a single wavelength has weight 1.  Made once per plan."""
+    w = plan.cache.get("trapezoid_weights")
+    if w is None:
+        wl = np.asarray(plan.wavelength, dtype=np.float64)
+        w = np.ones(1) if wl.size == 1 else np.zeros(wl.size)
+        if wl.size > 1:
+            half = np.diff(wl) / 2
+            w[:-1] += half
+            w[1:] += half
+        plan.cache["trapezoid_weights"] = w
+    return w
+
+
 def finish(
     plan: Plan, sums: Mapping[str, np.ndarray], lead_shape: tuple[int, ...]
 ) -> dict[str, np.ndarray]:
@@ -425,15 +440,18 @@ def finish(
     if "area" in names:
         out["area"] = area
     if "spacecraft_sbrdf" in names or "brdf" in names:
-        safe = np.where(area > 0, area, 1.0)[:, None]
-        sbrdf = np.where(area[:, None] > 0, sums["paper"] / safe, 0.0).astype(dt)
+        paper = sums["paper"]
+        # Eq. 4 in place where the kernel's buffer allows it (no block-sized temporaries);
+        # where no area contributes the paper sum is 0 already and stays so
+        if paper.dtype == dt and paper.flags.c_contiguous and paper.flags.writeable:
+            sbrdf = paper
+        else:
+            sbrdf = np.zeros(paper.shape, dt)
+        np.divide(paper, area[:, None], out=sbrdf, where=area[:, None] > 0)
         if "spacecraft_sbrdf" in names:
             out["spacecraft_sbrdf"] = sbrdf
         if "brdf" in names:
-            wl = plan.wavelength
-            out["brdf"] = (
-                np.trapezoid(sbrdf, wl, axis=-1) if wl.size > 1 else sbrdf[..., 0]
-            ).astype(dt)
+            out["brdf"] = (sbrdf @ _trapezoid_weights(plan)).astype(dt)
     for k in ("signal", "signal_material", "signal_earthshine", "thermal_intensity"):
         if k in names:
             out[k] = sums[k]

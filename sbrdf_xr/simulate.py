@@ -104,9 +104,14 @@ def _in_process(plan: Plan, n_threads: int | None = None) -> dict[str, np.ndarra
     if workers == 1:
         return run_block(plan, slice(0, n))
     edges = np.linspace(0, n, workers + 1).astype(int)
-    parts = list(
-        _pool(workers).map(lambda i: run_block(plan, slice(edges[i], edges[i + 1])), range(workers))
-    )
+    pool = _pool(workers - 1)  # the calling thread computes the first part itself
+    futures = [
+        pool.submit(run_block, plan, slice(edges[i], edges[i + 1])) for i in range(1, workers)
+    ]
+    try:
+        parts = [run_block(plan, slice(edges[0], edges[1]))]
+    finally:
+        parts += [f.result() for f in futures]
     return {k: np.concatenate([p[k] for p in parts], axis=0) for k in parts[0]}
 
 

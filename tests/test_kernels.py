@@ -203,3 +203,37 @@ def test_cube_spacecraft_through_both_kernels():
     np.testing.assert_allclose(
         a.signal, b.signal, rtol=0, atol=1e-12 * float(np.abs(b.signal).max())
     )
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.lists(st.floats(-200, 200, allow_nan=False, allow_infinity=False), min_size=1, max_size=40),
+    st.lists(st.floats(-250, 250, allow_nan=False, allow_infinity=False), max_size=30),
+    st.integers(0, 2),
+)
+def test_bucket_map_finds_the_same_cell_as_searchsorted(nodes, xs, method):
+    """The kernel's axis look-up (bucket map + correcting steps) is exactly the clipped
+    ``searchsorted(grid, x, "right") - 1`` of ``_lut.axis_weights``, also at nodes,
+    between nodes closer than the bucket width and outside the grid."""
+    from sbrdf_xr._kernels import _axis, _bucket_map
+
+    # nodes at least 1e-6 degree apart (table grids are; closer nodes make the cubic
+    # Lagrange weights themselves overflow, whatever finds the cell)
+    grid = np.unique(np.round(np.asarray(nodes, dtype=float), 6))
+    n = grid.size
+    bmap, inv = _bucket_map(grid)
+    probes = np.concatenate([np.asarray(xs, dtype=float), grid, np.nextafter(grid, -np.inf)])
+    idx, w = np.zeros(4, dtype=np.int64), np.zeros(4)
+    for x in probes:
+        k = _axis(grid, 0, n, x, method, idx, w, bmap, 0, bmap.size, inv)
+        if n == 1:
+            assert (k, idx[0]) == (1, 0)
+            continue
+        xc = min(max(x, grid[0]), grid[-1])
+        i = int(np.clip(np.searchsorted(grid, xc, side="right") - 1, 0, n - 2))
+        if method == 1:
+            assert (idx[0], idx[1]) == (i, i + 1)
+        elif method == 0:
+            t = (xc - grid[i]) / (grid[i + 1] - grid[i])
+            assert idx[0] == (i + 1 if t >= 0.5 else i)
+        assert np.isclose(w[:k].sum(), 1.0, rtol=1e-9, atol=1e-9)
