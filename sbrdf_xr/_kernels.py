@@ -26,16 +26,17 @@ the outputs, in the table's dtype (float32 stays float32).
 
 from __future__ import annotations
 
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
 import numba
 import numba.typed
 import numpy as np
-import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from . import _lut
-from .geometry import facet_angles, normal_incidence_tolerance
+from ._packed_tables import PackedTables, pack_tables
+from ._reference_kernel import MaterialSums, material_sums
+from .geometry import normal_incidence_tolerance
 
 __all__ = [
     "METHOD_CODES",
@@ -46,107 +47,6 @@ __all__ = [
     "material_sums",
     "pack_tables",
 ]
-
-
-class MaterialSums(NamedTuple):
-    """Sums over the facets of one material for a block of geometries."""
-
-    signal: NDArray[np.floating]  #: (G, L) [m2 sr-1]
-    paper: NDArray[np.floating]  #: (G, L) [m2 sr-1]
-    area: NDArray[np.float64]  #: (G,) [m2]
-    lit_visible_area: NDArray[np.float64]  #: (G,) [m2], sum of A_j c_j over contributing facets
-
-
-def material_sums(
-    to_sun: NDArray[np.floating],
-    to_observer: NDArray[np.floating],
-    normals: NDArray[np.floating],
-    areas: NDArray[np.floating],
-    values: NDArray[np.floating],
-    theta_grid: NDArray[np.floating],
-    delta_theta_grid: NDArray[np.floating],
-    phi_grid: NDArray[np.floating],
-    method: str = "linear",
-    fraction: NDArray[np.floating] | None = None,
-    zero_edges: tuple[bool, bool, bool] = (True, True, True),
-    normal_blend: float = 0.0,
-) -> MaterialSums:
-    """Facet sums of paper 000 Eqs. 3-4 and the radiometric signal for one material.
-
-    Parameters
-    ----------
-    to_sun, to_observer : ndarray, shape (G, 3)
-        Unit vectors to the Sun and the observer in the body frame [1].
-    normals : ndarray, shape (F, 3)
-        Unit facet normals [1].
-    areas : ndarray, shape (F,)
-        Facet areas [m2].
-    values : ndarray, shape (n_theta, n_delta_theta, n_phi, L)
-        The material's table [sr-1].
-    theta_grid, delta_theta_grid, phi_grid : ndarray
-        Table coordinates [degree].
-    method : {"nearest", "linear", "cubic"}
-        Look-up method.
-    fraction : ndarray, shape (G, F), optional
-        Fraction of each facet's area that is lit and visible [1] (self-shadowing
-        and self-occlusion); default 1.
-    zero_edges : tuple of 3 bool
-        The table's out-of-range policy (:func:`sbrdf_xr._lut.lookup_matrix`).
-    normal_blend : float
-        The table's normal-incidence blend [degree] (:func:`sbrdf_xr._lut.table_normal_blend`).
-
-    Returns
-    -------
-    MaterialSums
-        ``signal`` and ``paper`` in the dtype of ``values``; ``area`` in float64.
-    """
-    g, f = to_sun.shape[0], normals.shape[0]
-    n_wl = values.shape[-1]
-    out_dtype = values.dtype
-    if f == 0 or g == 0:
-        z = np.zeros((g, n_wl), dtype=out_dtype)
-        return MaterialSums(z, z.copy(), np.zeros(g), np.zeros(g))
-    ang = facet_angles(
-        normals[None, :, :], to_sun[:, None, :], to_observer[:, None, :], check=False
-    )
-    cos_i = np.einsum("fk,gk->gf", normals, to_sun)
-    cos_r = np.einsum("fk,gk->gf", normals, to_observer)
-    contributing = ang.lit & ang.visible
-    eff_area = np.where(contributing, areas[None, :], 0.0)
-    if fraction is not None:
-        eff_area = eff_area * fraction
-    a2d = eff_area * cos_r
-    w_signal = a2d * cos_i
-    rows = np.flatnonzero(contributing.ravel())
-    m = _lut.lookup_matrix(
-        theta_grid,
-        delta_theta_grid,
-        phi_grid,
-        ang.theta_i.ravel()[rows],
-        ang.delta_theta.ravel()[rows],
-        ang.phi.ravel()[rows],
-        method,
-        zero_edges=zero_edges,
-        normal_blend=normal_blend,
-    ).tocoo()
-    geom = rows[m.row] // f
-    v2 = values.reshape(-1, n_wl)
-    mats = []
-    for w in (w_signal, a2d):
-        data = m.data * w.ravel()[rows][m.row]
-        mats.append(sp.csr_matrix((data, (geom, m.col)), shape=(g, m.shape[1])))
-    stacked = sp.vstack(mats, format="csr")
-    if v2.dtype != np.float64:
-        stacked = stacked.astype(v2.dtype)
-    res = np.asarray(stacked @ v2)
-    if method == "cubic":
-        np.maximum(res, 0, out=res)
-    return MaterialSums(
-        res[:g].astype(out_dtype, copy=False),
-        res[g:].astype(out_dtype, copy=False),
-        a2d.sum(axis=1),
-        eff_area.sum(axis=1),
-    )
 
 
 # ---------------------------------------------------------------- fused kernel
@@ -180,7 +80,7 @@ def _axis(
 ) -> int:  # pragma: no cover - compiled
     """Node indices and weights along one axis (``_lut.axis_weights``); returns the count.
 
-    The cell is found from the axis' bucket map (:func:`_bucket_map`) and corrected by
+    The cell is found from the axis' bucket map (:func:`bucket_map`) and corrected by
     comparisons with the nodes, so it is exactly ``searchsorted(grid, x, "right") - 1``
     without a binary search's unpredictable branches.
     """
@@ -502,130 +402,6 @@ def _fused_sums(
             t = stop
         out_area[g] = area_g
         out_lit[g] = lit_g
-
-
-#: Most buckets of an axis' bucket map (a grid with very uneven spacing gets fewer
-#: buckets than nodes' spacing asks for, and a short scan within a bucket).
-_MAX_BUCKETS = 4096
-
-
-def _bucket_map(grid: np.ndarray) -> tuple[np.ndarray, float]:
-    """Uniform buckets over ``grid`` and the cell at each bucket's start.
-
-    Bucket ``k`` starts at ``grid[0] + k / inv``; ``map[k]`` is
-    ``searchsorted(grid, start, "right") - 1``.  The bucket width is the smallest node
-    spacing (at most :data:`_MAX_BUCKETS` buckets), so a bucket holds at most one node
-    and :func:`_axis` needs at most one correcting step.
-    """
-    g = np.asarray(grid, dtype=np.float64)
-    if g.size < 2 or g[-1] <= g[0]:
-        return np.zeros(1, dtype=np.int64), 0.0
-    span = g[-1] - g[0]
-    width = max(float(np.min(np.diff(g))), span / _MAX_BUCKETS)
-    nb = int(np.ceil(span / width)) + 1
-    inv = 1.0 / width
-    starts = g[0] + np.arange(nb) / inv
-    bmap = np.clip(np.searchsorted(g, starts, side="right") - 1, 0, g.size - 1)
-    return bmap.astype(np.int64), inv
-
-
-class PackedTables(NamedTuple):
-    """Material tables as the fused kernel reads them.
-
-    ``values[m]`` is material ``m``'s table as a ``(n_nodes, L)`` view (its
-    ``(theta_i, delta_theta, phi)`` nodes in C order; no copy of a C-contiguous table in
-    the right dtype); its grids are the slices ``t_off[m]:t_off[m + 1]`` (likewise
-    ``d_off``, ``p_off``) of the concatenated grids.
-    """
-
-    values: tuple[NDArray[np.floating], ...]  #: per material (n_nodes, L) [sr-1]
-    tgrid: NDArray[np.float64]
-    t_off: NDArray[np.int64]
-    dgrid: NDArray[np.float64]
-    d_off: NDArray[np.int64]
-    pgrid: NDArray[np.float64]
-    p_off: NDArray[np.int64]
-    edges: NDArray[np.bool_]  #: (M, 3) zero beyond delta_theta min, max, phi max
-    blend: NDArray[np.float64]  #: (M,) normal-incidence blend [degree] (0: none)
-    shapes: tuple[tuple[int, int, int], ...]  #: (n_theta, n_delta_theta, n_phi) per material
-    n_spectral: int
-    dtype: np.dtype
-    #: bucket maps of the (theta_i, delta_theta, phi) axes (:func:`_bucket_map`): the
-    #: concatenated maps (3, total), offsets (3, M + 1) and inverse widths (3, M)
-    bmap: NDArray[np.int64] = np.zeros((3, 1), dtype=np.int64)
-    b_off: NDArray[np.int64] = np.zeros((3, 1), dtype=np.int64)
-    binv: NDArray[np.float64] = np.zeros((3, 0))
-
-
-def pack_tables(
-    tables: list[tuple[Any, ...]],
-    n_spectral: int = 1,
-    dtype: np.dtype | str = np.float64,
-) -> PackedTables:
-    """Pack ``(values, theta_grid, delta_theta_grid, phi_grid, zero_edges[, normal_blend])``
-    per material.
-
-    ``values`` has shape ``(n_theta, n_delta_theta, n_phi, L)``; every table has the
-    same ``L`` and dtype.  ``n_spectral`` and ``dtype`` shape an empty packing (no
-    tables).
-    """
-
-    def cat(arrays: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-        off = np.concatenate([[0], np.cumsum([a.size for a in arrays])]).astype(np.int64)
-        return np.ascontiguousarray(np.concatenate(arrays), dtype=np.float64), off
-
-    dt = np.dtype(dtype)
-    if not tables:
-        z = np.zeros(1, dtype=np.int64)
-        return PackedTables(
-            (),
-            np.zeros(0),
-            z,
-            np.zeros(0),
-            z,
-            np.zeros(0),
-            z,
-            np.zeros((0, 3), dtype=bool),
-            np.zeros(0),
-            (),
-            n_spectral,
-            dt,
-        )
-    n_wl = tables[0][0].shape[-1]
-    values = tuple(np.ascontiguousarray(v, dtype=dt).reshape(-1, n_wl) for v, *_ in tables)
-    tgrid, t_off = cat([np.asarray(t[1]) for t in tables])
-    dgrid, d_off = cat([np.asarray(t[2]) for t in tables])
-    pgrid, p_off = cat([np.asarray(t[3]) for t in tables])
-    edges = np.array([t[4] for t in tables], dtype=bool).reshape(-1, 3)
-    blend = np.array([float(t[5]) if len(t) > 5 else 0.0 for t in tables], dtype=np.float64)
-    shapes = tuple(tuple(int(x) for x in v.shape[:3]) for v, *_ in tables)
-    maps = [[_bucket_map(np.asarray(t[1 + a])) for t in tables] for a in range(3)]
-    lengths = [[m.size for m, _ in axis] for axis in maps]
-    width = max(sum(n) for n in lengths)
-    bmap = np.zeros((3, width), dtype=np.int64)
-    b_off = np.zeros((3, len(tables) + 1), dtype=np.int64)
-    binv = np.zeros((3, len(tables)))
-    for a, axis in enumerate(maps):
-        b_off[a, 1:] = np.cumsum(lengths[a])
-        bmap[a, : b_off[a, -1]] = np.concatenate([m for m, _ in axis])
-        binv[a] = [inv for _, inv in axis]
-    return PackedTables(
-        values,
-        tgrid,
-        t_off,
-        dgrid,
-        d_off,
-        pgrid,
-        p_off,
-        edges,
-        blend,
-        shapes,
-        n_wl,
-        dt,
-        bmap,
-        b_off,
-        binv,
-    )
 
 
 class FusedSums(NamedTuple):

@@ -27,15 +27,25 @@ from types import MappingProxyType
 from typing import Any
 
 import numpy as np
-import xarray as xr
 
-from . import sources
 from ._kernels import PackedTables, pack_tables
 from ._lut import table_edges, table_normal_blend
 from ._names import BAND, MATERIAL, WAVELENGTH
+from ._plan_stages import (
+    band_weights_of,
+    common_wavelength,
+    contributing_terms,
+    describe_bytes,
+    effect_stage,
+    facet_terms,
+    material_models,
+    readonly,
+    table_on,
+    tilted_terms,
+)
 from ._version import __version__
 from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS, BlockInputs
-from .errors import SceneError, ValidationError
+from .errors import SceneError
 from .fingerprint import scene_fingerprint
 
 #: The scene being compiled (:class:`sbrdf_xr.scene.Scene`, which imports this module).
@@ -43,11 +53,6 @@ Scene = Any
 
 __all__ = ["BlockInputs", "Estimate", "Plan", "PlannedOutput", "Terms", "compile_plan"]
 
-#: Thermal emission below this fraction of the reflected sunlight is not computed.
-THERMAL_NEGLIGIBLE = 1e-6
-#: Largest number of (geometry x term) dot products evaluated at once when
-#: searching for terms never lit and visible.
-_DROP_BLOCK = 2_000_000
 #: Default blocks: at least this many per core (load balance), of at least MIN_CHUNK
 #: geometries (task overhead), within the knob block_bytes (memory).
 BLOCKS_PER_CORE = 4
@@ -233,200 +238,6 @@ class Plan:
 # ------------------------------------------------------------------ compiler
 
 
-def _readonly(a: np.ndarray) -> np.ndarray:
-    a = np.ascontiguousarray(a)
-    a.flags.writeable = False
-    return a
-
-
-def _terms(
-    scene: Scene, shadowing: bool, steps: list[tuple[str, str]]
-) -> tuple[dict[str, np.ndarray], bool]:
-    sc = scene.spacecraft
-    may_merge = not shadowing
-    merge = may_merge if scene.merge is None else bool(scene.merge)
-    if merge and not may_merge:
-        raise SceneError(
-            "merge: facets cannot be merged while self-shadowing is on (a per-facet effect)"
-        )
-    f = sc.facets()
-    n_fac = f.sizes["facet"]
-    if merge:
-        m = sc.merged()
-        term_of = np.asarray(m["facet_term"].values)
-        first = np.full(m.sizes["term"], n_fac, dtype=np.int64)
-        np.minimum.at(first, term_of, np.arange(n_fac))
-        t = {
-            "normal": np.asarray(m["normal"].values),
-            "area": np.asarray(m["area"].values),
-            "material": np.asarray(m[MATERIAL].values),
-            "facet": first,
-            "n_facets": np.asarray(m["n_facets"].values),
-        }
-        steps.append(
-            (
-                "facets",
-                f"{n_fac} facets -> {m.sizes['term']} terms, merged by "
-                "(normal, material): exact for flat facets, no per-facet effect is on",
-            )
-        )
-    else:
-        why = "self-shadowing is per facet" if shadowing else "merging disabled by the scene"
-        t = {
-            "normal": np.asarray(f["normal"].values),
-            "area": np.asarray(f["area"].values),
-            "material": np.asarray(f[MATERIAL].values),
-            "facet": np.arange(n_fac),
-            "n_facets": np.ones(n_fac, dtype=np.int64),
-        }
-        steps.append(("facets", f"{n_fac} facets evaluated one by one ({why})"))
-    return t, merge
-
-
-def _tilt(
-    scene: Scene, raw: dict[str, np.ndarray], nodes: int, steps: list[tuple[str, str]]
-) -> dict[str, np.ndarray]:
-    """Terms replaced by their tilted copies where the scene asks for surface imperfections."""
-    from .imperfections import tilt_quadrature, tilted_normals
-
-    st = scene.surface_tilt
-    sigma = np.array(
-        [
-            float(st.get(m, 0.0)) if isinstance(st, Mapping) else float(st)
-            for m in raw["material"].tolist()
-        ]
-    )
-    if not np.any(sigma > 0):
-        steps.append(("imperfections", "none: perfect CAD facets (surface_tilt = 0)"))
-        return raw
-    parts: list[dict[str, np.ndarray]] = []
-    for j in range(raw["area"].size):
-        t, w = tilt_quadrature(sigma[j], nodes)
-        part = {k: np.repeat(v[j : j + 1], w.size, axis=0) for k, v in raw.items()}
-        part["normal"] = tilted_normals(raw["normal"][j : j + 1], t)[0]
-        part["area"] = raw["area"][j] * w
-        parts.append(part)
-    out = {k: np.concatenate([p[k] for p in parts]) for k in raw}
-    what = (
-        f"sigma {float(st):g} deg"
-        if not isinstance(st, Mapping)
-        else ", ".join(f"{m} {float(v):g} deg" for m, v in st.items())
-    )
-    steps.append(
-        (
-            "imperfections",
-            f"facet normals tilted by a Gaussian ({what}; paper 000 section 5), "
-            f"{nodes}x{nodes} Gauss-Hermite copies per term: {raw['area'].size} -> {out['area'].size} terms",
-        )
-    )
-    return out
-
-
-def _contributing(scene: Scene, normals: np.ndarray) -> np.ndarray:
-    """Boolean per term: lit (by the Sun, or the Earth with earthshine) and visible for
-    at least one geometry of the sweep; with thermal emission, visible is enough."""
-    geo = scene.geometry
-    keep = np.zeros(len(normals), dtype=bool)
-    per = max(1, geo.n_geometries // max(1, geo.n_lead))
-    step = max(1, _DROP_BLOCK // max(1, per * len(normals)))
-    thermal = "thermal" in scene.effects
-    for start in range(0, geo.n_lead, step):
-        b = geo.block(slice(start, start + step))
-        visible = b.to_observer @ normals.T > 0
-        if thermal:
-            lit = True
-        else:
-            lit = b.to_sun @ normals.T > 0
-            if b.sun_scale is not None:
-                lit = lit & (b.sun_scale > 0)[:, None]
-            if "earthshine" in scene.effects and b.to_earth is not None:
-                lit = lit | (b.to_earth @ normals.T > 0)
-        keep |= (visible & lit).any(axis=0)
-        if keep.all():
-            break
-    return keep
-
-
-def _common_wavelength(scene: Scene, used: list[str]) -> np.ndarray:
-    wl = np.asarray(scene.materials[used[0]][WAVELENGTH].values) if used else np.array([550.0])
-    for m in used[1:]:
-        other = np.asarray(scene.materials[m][WAVELENGTH].values)
-        if other.shape != wl.shape or not np.allclose(other, wl, rtol=0, atol=1e-9):
-            lo, hi = max(wl[0], other[0]), min(wl[-1], other[-1])
-            if lo >= hi:
-                raise SceneError(f"materials {used[0]!r} and {m!r} have no wavelengths in common")
-            wl = wl[(wl >= lo) & (wl <= hi)]
-    return wl
-
-
-def _band_weights(scene: Scene, wl: np.ndarray) -> xr.DataArray:
-    from .photometry import band_weights
-
-    try:
-        return band_weights(
-            list(scene.bands), wl, normalize=True, extrapolate=scene.band_extrapolate
-        )
-    except ValidationError as exc:
-        raise SceneError(f"bands: {exc} (scene field band_extrapolate)") from None
-
-
-def _table_on(da: xr.DataArray, wl: np.ndarray, theta_step: float | None) -> xr.DataArray:
-    if not np.array_equal(da[WAVELENGTH].values, wl):
-        da = da.interp({WAVELENGTH: wl})
-    if theta_step is not None:
-        ti = da["theta_i"].values
-        new = np.arange(ti[0], ti[-1] + 1e-9, float(theta_step))
-        if new[-1] < ti[-1]:
-            new = np.append(new, ti[-1])
-        da = da.interp(theta_i=new)
-    return da
-
-
-def _temperature(scene: Scene, material: str) -> float:
-    t = scene.temperature
-    return float(t.get(material, 300.0)) if isinstance(t, Mapping) else float(t)
-
-
-def _thermal_to_reflected(scene: Scene, wl: np.ndarray) -> float:
-    """Largest ratio of blackbody radiance (emissivity 1) to the radiance of a white
-    Lambertian surface in sunlight, E_sun / pi, over the scene's wavelengths."""
-    from .photometry import solar_spectrum
-
-    e_sun = solar_spectrum(wl).values
-    b = np.max([sources.planck(wl, _temperature(scene, m)) for m in scene.materials], axis=0)
-    return float(np.max(b / np.maximum(e_sun / np.pi, 1e-300)))
-
-
-def _models(scene: Scene, used: list[str]) -> dict[int, tuple[Any, Mapping[str, Any]]]:
-    """BRDF model and parameters of every material, for analytic evaluation."""
-    from . import models as models_mod
-
-    given = dict(scene.models or {})
-    out = {}
-    for m, name in enumerate(used):
-        spec = given.get(name)
-        if spec is None:
-            from . import catalog
-
-            try:
-                spec = catalog.load(f"{name}-model")
-            except Exception as exc:
-                raise SceneError(
-                    f"evaluation='analytic': material {name!r} has no model; give "
-                    f"Scene(models={{{name!r}: ...}}) or a catalog entry '{name}-model' ({exc})"
-                ) from None
-        mod, _, kw = models_mod._params(spec)
-        out[m] = (mod, MappingProxyType(dict(kw)))
-    return out
-
-
-def _describe_bytes(n: float) -> str:
-    for unit, scale in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
-        if n >= scale:
-            return f"{n / scale:.3g} {unit}"
-    return f"{n:.0f} B"
-
-
 def compile_plan(scene: Scene) -> Plan:
     """Compile a scene into its :class:`Plan` (see the module docstring).
 
@@ -478,9 +289,9 @@ def compile_plan(scene: Scene) -> Plan:
                 )
             )
 
-    raw, merged = _terms(scene, shadowing, steps)
-    raw = _tilt(scene, raw, knobs["tilt_nodes"], steps)
-    keep = _contributing(scene, raw["normal"])
+    raw, merged = facet_terms(scene, shadowing, steps)
+    raw = tilted_terms(scene, raw, knobs["tilt_nodes"], steps)
+    keep = contributing_terms(scene, raw["normal"])
     if not keep.all():
         raw = {k: v[keep] for k, v in raw.items()}
         steps.append(
@@ -499,25 +310,25 @@ def compile_plan(scene: Scene) -> Plan:
     order = np.argsort(code, kind="stable")
     terms = Terms(
         *(
-            _readonly(a[order])
+            readonly(a[order])
             for a in (raw["normal"], raw["area"], code, raw["facet"], raw["n_facets"])
         )
     )
 
     # ---- spectral axis
-    wl_full = _common_wavelength(scene, used or list(scene.materials))
+    wl_full = common_wavelength(scene, used or list(scene.materials))
     wl = wl_full[:: knobs["wavelength_stride"]]
     bw = None
     band_coords: dict[str, Any] = {}
     if scene.bands:
-        w = _band_weights(scene, wl)
+        w = band_weights_of(scene, wl)
         bw = np.asarray(w.values)
         band_coords = {c: w[c] for c in w.coords if BAND in w[c].dims}
     spectral_asked = any(o in SPECTRAL_OUTPUTS for o in scene.outputs)
     pre = bool(scene.bands) and not spectral_asked and knobs["band_integration"] == "auto"
     dtype = np.dtype(knobs["dtype"])
     if knobs["evaluation"] == "analytic":
-        models = _models(scene, used)
+        models = material_models(scene, used)
         tables = pack_tables([], len(scene.bands) if pre else wl.size, dtype)
         steps.append(
             (
@@ -530,7 +341,7 @@ def compile_plan(scene: Scene) -> Plan:
         models = {}
         packed = []
         for m in used:
-            da = _table_on(scene.materials[m], wl, knobs["table_theta_step"])
+            da = table_on(scene.materials[m], wl, knobs["table_theta_step"])
             values = np.asarray(da.values)
             if pre:
                 values = np.asarray(values, dtype=np.float64) @ bw.T
@@ -583,93 +394,7 @@ def compile_plan(scene: Scene) -> Plan:
     steps.append(("wavelength", f"{wl.size} wavelengths {wl[0]:g}-{wl[-1]:g} nm{stride}"))
 
     # ---- effects
-    active = ["sunlight"]
-    params: dict[str, dict[str, Any]] = {}
-    if shadowing:
-        active.append("shadowing")
-    if geo.sun_scale is not None:
-        active.append("eclipse")
-        dark = int(np.sum(geo.sun_scale <= 0))
-        part = int(np.sum((geo.sun_scale > 0) & (geo.sun_scale < 1)))
-        steps.append(
-            (
-                "eclipse",
-                f"Earth shadow: {dark} geometries in umbra skipped (no sunlight), "
-                f"{part} in penumbra scaled by the sunlit fraction of the solar disc",
-            )
-        )
-    if "earthshine" in scene.effects and getattr(geo, "earth_scale", None) is not None:
-        active.append("earthshine")
-        es = geo.earth_scale
-        params["earthshine"] = MappingProxyType({"ratio": float(np.max(es)) if es.size else 0.0})
-        steps.append(
-            (
-                "earthshine",
-                f"Lambertian Earth (albedo {scene.earth_albedo:g}) at the observation's "
-                f"distance and phase at every time: irradiance {np.min(es):.3g}-{np.max(es):.3g} "
-                "of the Sun's, a second distant source",
-            )
-        )
-    elif "earthshine" in scene.effects:
-        ratio = sources.earthshine_irradiance_ratio(
-            scene.earth_albedo, scene.earth_range_km, scene.earth_phase_angle
-        )
-        active.append("earthshine")
-        params["earthshine"] = MappingProxyType({"ratio": ratio})
-        steps.append(
-            (
-                "earthshine",
-                f"Lambertian Earth (albedo {scene.earth_albedo:g}, range "
-                f"{scene.earth_range_km:g} km, phase {scene.earth_phase_angle:g} deg): irradiance "
-                f"{ratio:.3g} of the Sun's, a second distant source",
-            )
-        )
-    else:
-        steps.append(("earthshine", "skipped: not requested"))
-    if "thermal" not in scene.effects:
-        steps.append(("thermal", "skipped: not requested"))
-    else:
-        worst = _thermal_to_reflected(scene, wl)
-        if worst < THERMAL_NEGLIGIBLE:
-            steps.append(
-                (
-                    "thermal",
-                    f"skipped: negligible, at most {worst:.1e} of reflected sunlight "
-                    f"at {wl[0]:g}-{wl[-1]:g} nm",
-                )
-            )
-        elif pre:
-            steps.append(
-                (
-                    "thermal",
-                    f"skipped: up to {worst:.1e} of reflected sunlight, but only band "
-                    "outputs of reflected light are asked for; add the 'signal' output for "
-                    "thermal_intensity",
-                )
-            )
-        else:
-            from .material import hemispherical_reflectance
-
-            active.append("thermal")
-            eps, thetas, rad = [], [], []
-            for m in used:
-                da = _table_on(scene.materials[m], wl, None)
-                th = np.asarray(da["theta_i"].values, dtype=np.float64)
-                rho = hemispherical_reflectance(da, th, warn=False).values
-                eps.append(_readonly(sources.kirchhoff_emissivity(rho)))
-                thetas.append(_readonly(th))
-                rad.append(_readonly(sources.planck(wl, _temperature(scene, m))))
-            params["thermal"] = MappingProxyType(
-                {"emissivity": tuple(eps), "theta": tuple(thetas), "radiance": tuple(rad)}
-            )
-            steps.append(
-                (
-                    "thermal",
-                    "epsilon(lambda, theta) B(lambda, T) per term, epsilon = 1 - rho "
-                    "(Kirchhoff) from each table's hemispherical reflectance at its theta_i nodes, "
-                    f"linear in the emission angle; up to {worst:.1e} of reflected sunlight",
-                )
-            )
+    active, params = effect_stage(scene, wl, used, pre, shadowing, steps)
 
     # ---- outputs
     names = []
@@ -717,7 +442,7 @@ def compile_plan(scene: Scene) -> Plan:
     if out_bytes > limit * SIZE_LIMIT_BYTES or work > limit * WORK_LIMIT:
         raise SceneError(
             f"scene {scene.name!r} is beyond reason: {geo.n_geometries:.3g} geometries x {terms.size} terms "
-            f"would write {_describe_bytes(out_bytes)} (limit {_describe_bytes(limit * SIZE_LIMIT_BYTES)}) "
+            f"would write {describe_bytes(out_bytes)} (limit {describe_bytes(limit * SIZE_LIMIT_BYTES)}) "
             f"and take up to {work:.3g} multiply-adds (limit {limit * WORK_LIMIT:.3g}); reduce the sweep, "
             "or raise the limits with size_limit (a factor, default 1) if you mean it"
         )
@@ -725,8 +450,8 @@ def compile_plan(scene: Scene) -> Plan:
     steps.append(
         (
             "blocks",
-            f"{n_blocks} blocks of {chunk} {lead_dims[0]}s, {_describe_bytes(per_lead * chunk)} "
-            f"each; {_describe_bytes(out_bytes)} of outputs, at most {work:.3g} multiply-adds",
+            f"{n_blocks} blocks of {chunk} {lead_dims[0]}s, {describe_bytes(per_lead * chunk)} "
+            f"each; {describe_bytes(out_bytes)} of outputs, at most {work:.3g} multiply-adds",
         )
     )
 
@@ -762,9 +487,9 @@ def compile_plan(scene: Scene) -> Plan:
         terms=terms,
         materials=tuple(used),
         tables=tables,
-        wavelength=_readonly(wl),
+        wavelength=readonly(wl),
         bands=tuple(scene.bands),
-        band_weights=None if bw is None else _readonly(bw),
+        band_weights=None if bw is None else readonly(bw),
         band_coords=MappingProxyType(band_coords),
         pre_integrated=pre,
         shadowing=shadowing,

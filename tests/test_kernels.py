@@ -215,13 +215,14 @@ def test_bucket_map_finds_the_same_cell_as_searchsorted(nodes, xs, method):
     """The kernel's axis look-up (bucket map + correcting steps) is exactly the clipped
     ``searchsorted(grid, x, "right") - 1`` of ``_lut.axis_weights``, also at nodes,
     between nodes closer than the bucket width and outside the grid."""
-    from sbrdf_xr._kernels import _axis, _bucket_map
+    from sbrdf_xr._kernels import _axis
+    from sbrdf_xr._packed_tables import bucket_map
 
     # nodes at least 1e-6 degree apart (table grids are; closer nodes make the cubic
     # Lagrange weights themselves overflow, whatever finds the cell)
     grid = np.unique(np.round(np.asarray(nodes, dtype=float), 6))
     n = grid.size
-    bmap, inv = _bucket_map(grid)
+    bmap, inv = bucket_map(grid)
     probes = np.concatenate([np.asarray(xs, dtype=float), grid, np.nextafter(grid, -np.inf)])
     idx, w = np.zeros(4, dtype=np.int64), np.zeros(4)
     for x in probes:

@@ -42,6 +42,8 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "geometry",
         "_lut",
         "_kernels",
+        "_packed_tables",
+        "_reference_kernel",
         "sources",
         "brdf",
         "imperfections",
@@ -68,7 +70,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "fingerprint",
     ),
     ("catalog",),
-    ("effects", "plan", "sweep", "scene_model", "scene_io", "scene"),
+    ("effects", "plan", "_plan_stages", "sweep", "scene_model", "scene_io", "scene"),
     ("simulate", "_writer", "_write_common", "_runners", "_lock"),
     ("invert", "bench", "bench_engine", "shadow_bench", "plot", "accessors", "cli", "testing", ""),
 )
