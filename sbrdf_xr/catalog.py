@@ -63,7 +63,10 @@ def _load_material(e: CatalogEntry) -> xr.DataArray:
     if source is None:
         return material.open_material(e.file)
     options = tuple(sorted(e.extra.get("build", {}).items()))
-    return _built_material(e.name, source, options).copy(deep=True)
+    # a new DataArray (its own attrs) over the one built table, whose values are read-only:
+    # every load in a process shares them (a copy each would double the resident tables);
+    # ``.copy()`` gives a writable table
+    return _built_material(e.name, source, options).copy(deep=False)
 
 
 @functools.lru_cache(maxsize=16)
@@ -86,7 +89,7 @@ def _built_material(
             da.attrs.pop(k, None)
         return da
 
-    return cached_table(
+    da = cached_table(
         name,
         inputs,
         repr(options),
@@ -94,6 +97,8 @@ def _built_material(
         lambda da, path: material.to_netcdf(da, path, overwrite=True),
         read,
     )
+    da.values.flags.writeable = False
+    return da
 
 
 #: Attributes the netCDF writer adds to a file (CF/ACDD basics) that a built table lacks.
@@ -134,7 +139,9 @@ def load(name: str) -> Any:
         :mod:`sbrdf_xr.models`) and ``paint_parameters``; a
         :class:`~sbrdf_xr.spacecraft.Spacecraft` for ``spacecraft``; an
         :class:`~sbrdf_xr.observe.Orbit` for ``orbit``; a :class:`~sbrdf_xr.observe.Site`
-        for ``site``.
+        for ``site``.  A material built from measurements on load shares its values
+        with every other load of it in the process: they are read-only (``.copy()``
+        gives a writable table); its attributes are each load's own.
     """
     e = entry(name)
     try:

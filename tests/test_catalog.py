@@ -40,12 +40,21 @@ def test_lambertian_reference_integrates_to_its_albedo():
     np.testing.assert_allclose(rho.values, 0.5, rtol=1e-6)  # float32 table: 1e-7 relative
 
 
-def test_built_entry_equals_build_lut_of_its_measurements_and_is_a_copy():
+def test_built_entry_equals_build_lut_of_its_measurements_and_is_read_only():
+    """Loads share one built table (no second copy in memory): its values cannot be
+    changed in place, its attrs are each load's own, and ``.copy()`` is writable."""
     built = catalog.load("example-lobe")
     direct = material.build_lut(catalog.load("example-lobe-measurements"), material="example-lobe")
     xr.testing.assert_identical(built, direct)
-    built[...] = 0.0
-    assert float(catalog.load("example-lobe").max()) > 0  # the cache was not modified
+    with pytest.raises(ValueError, match="copy"):
+        built[...] = 0.0
+    built.attrs["provenance"] = "changed"
+    mine = built.copy()
+    mine[...] = 0.0
+    again = catalog.load("example-lobe")
+    assert float(again.max()) > 0  # the shared table was not modified
+    assert again.attrs.get("provenance") != "changed"
+    assert np.shares_memory(again.values, built.values)
 
 
 def test_installed_package_finds_its_catalogs_from_any_directory(tmp_path):
