@@ -135,6 +135,24 @@ def load(name: str) -> Any:
         :class:`~sbrdf_xr.spacecraft.Spacecraft` for ``spacecraft``; an
         :class:`~sbrdf_xr.observe.Orbit` for ``orbit``; a :class:`~sbrdf_xr.observe.Site`
         for ``site``.
+
+    Examples
+    --------
+    A shipped table: an ideal Lambertian grey of albedo 0.5, ``f_r = 0.5 / pi``:
+
+    >>> from sbrdf_xr import catalog
+    >>> grey = catalog.load("lambertian-grey-50")
+    >>> grey.dims
+    ('theta_i', 'delta_theta', 'phi', 'wavelength')
+    >>> grey.attrs["source"], round(float(grey.max()), 6), round(float(grey.min()), 6)
+    ('synthetic', 0.159155, 0.159155)
+
+    A spacecraft and an observing site:
+
+    >>> catalog.load("canx1")  # doctest: +ELLIPSIS
+    <Spacecraft 'canx1': 684 facets, materials ['aluminium-6061-t6', 'tjpv-cell', ...] m>
+    >>> catalog.load("mont-megantic").latitude_deg
+    45.4555
     """
     e = entry(name)
     try:
