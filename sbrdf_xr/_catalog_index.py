@@ -52,6 +52,13 @@ class CatalogEntry:
         Fields of the ``[[entry]]`` table (see the module docstring).
     extra : dict
         Any further fields of the table (for example the material of a model).
+
+    Examples
+    --------
+    >>> from sbrdf_xr import catalog
+    >>> e = catalog.entry("canx1")
+    >>> e.kind, e.path, e.file.name
+    ('spacecraft', 'spacecraft/canx1.ply', 'canx1.ply')
     """
 
     name: str
@@ -81,6 +88,12 @@ def catalog_dir() -> Path:
     ------
     CatalogError
         If no catalog directory can be found.
+
+    Examples
+    --------
+    >>> from sbrdf_xr import catalog
+    >>> (catalog.catalog_dir() / "index.toml").is_file()
+    True
     """
     here = Path(__file__).resolve().parent
     for candidate in (here / "catalogs", here.parent / "catalogs"):
@@ -109,6 +122,16 @@ def data_path(relative: str | Path) -> Path:
     ------
     CatalogError
         If the file does not exist.
+
+    Examples
+    --------
+    >>> from sbrdf_xr import catalog
+    >>> catalog.data_path("spacecraft/canx1.ply").name
+    'canx1.ply'
+    >>> catalog.data_path("spacecraft/nothing.ply")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.CatalogError: catalog file spacecraft/nothing.ply does not exist in ...
     """
     path = catalog_dir() / relative
     if not path.is_file():
@@ -159,6 +182,14 @@ def entries(kind: str | None = None) -> list[CatalogEntry]:
     Returns
     -------
     list of CatalogEntry
+
+    Examples
+    --------
+    >>> from sbrdf_xr import catalog
+    >>> [e.name for e in catalog.entries("spacecraft")]
+    ['canx1']
+    >>> catalog.entries("material")[0].kind
+    'material'
     """
     if kind is not None and kind not in KINDS:
         raise CatalogError(f"unknown catalog kind {kind!r}; allowed: {', '.join(KINDS)}")
@@ -166,7 +197,16 @@ def entries(kind: str | None = None) -> list[CatalogEntry]:
 
 
 def names(kind: str | None = None) -> list[str]:
-    """Names of the catalog entries, optionally of one kind."""
+    """Names of the catalog entries, optionally of one kind.
+
+    Examples
+    --------
+    >>> from sbrdf_xr import catalog
+    >>> "lambertian-grey-50" in catalog.names("material")
+    True
+    >>> catalog.names("site")[:2]
+    ['mont-megantic', 'dominion-astrophysical']
+    """
     return [e.name for e in entries(kind)]
 
 
@@ -177,6 +217,17 @@ def entry(name: str) -> CatalogEntry:
     ------
     CatalogError
         If there is no such entry; the message lists the known names.
+
+    Examples
+    --------
+    >>> from sbrdf_xr import catalog
+    >>> e = catalog.entry("lambertian-grey-50")
+    >>> e.kind, e.source
+    ('material', 'synthetic')
+    >>> catalog.entry("lambertian-grey-51")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.CatalogError: no catalog entry named 'lambertian-grey-51'; known: ...
     """
     for e in _index():
         if e.name == name:

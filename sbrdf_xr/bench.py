@@ -70,6 +70,13 @@ class BenchRow:
         Which sweep.
     mmag_max, mmag_median, rel_p99 : float
         Error against the reference (NaN when not applicable).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench import BenchRow
+    >>> row = BenchRow("lookup method: linear", 0.6, "reference", 0.3, mmag_max=12.0)
+    >>> row.ratio, row.mmag_max, row.rel_p99
+    (0.3, 12.0, nan)
     """
 
     name: str
@@ -85,7 +92,16 @@ class BenchRow:
 
 
 def best_time(func: Callable[[], object], repeat: int = 3, number: int = 1) -> float:
-    """Best of ``repeat`` wall times of ``number`` calls of ``func`` after a warm-up [s per call]."""
+    """Best of ``repeat`` wall times of ``number`` calls of ``func`` after a warm-up [s per call].
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench import best_time
+    >>> calls = []
+    >>> t = best_time(lambda: calls.append(1), repeat=3, number=2)
+    >>> len(calls), 0.0 <= t < 1.0  # one warm-up call, then 3 x 2 timed calls
+    (7, True)
+    """
     func()
     best = np.inf
     for _ in range(repeat):
@@ -110,6 +126,19 @@ def bench_build_lut(n_wavelength: int = 131, repeat: int = 3) -> list[BenchRow]:
     5 incidence angles x 30 geometries (105 measured spectra, 45 reference points)
     at ``n_wavelength`` wavelengths into the paper's 91 x 21 x 21 x n_wavelength
     table.  It is its own baseline: the row states the time.
+
+    Examples
+    --------
+    Even at one wavelength the two builds (warm-up and timing) of the 91 x 21 x 21 table
+    take about a second, so the call is not run here:
+
+    >>> import inspect
+    >>> from sbrdf_xr.bench import bench_build_lut
+    >>> list(inspect.signature(bench_build_lut).parameters)
+    ['n_wavelength', 'repeat']
+    >>> rows = bench_build_lut(n_wavelength=3, repeat=1)  # doctest: +SKIP
+    >>> rows[0].name, rows[0].baseline  # doctest: +SKIP
+    ('build_lut (150 samples, 105 measured, 3 wl)', 'itself')
     """
     ds = _example_measurements(n_wavelength)
     t_build = best_time(lambda: material.build_lut(ds), repeat)
@@ -133,6 +162,18 @@ def bench_lookup(
 
     Both interpolate multilinearly the same paper-sized table at the same random
     geometries (inside the table); the row notes their largest relative difference.
+
+    Examples
+    --------
+    The call builds a paper-sized table first (about a second), so it is not run here:
+
+    >>> import inspect
+    >>> from sbrdf_xr.bench import bench_lookup
+    >>> list(inspect.signature(bench_lookup).parameters)
+    ['n_geometries', 'n_wavelength', 'repeat']
+    >>> rows = bench_lookup(n_geometries=10, n_wavelength=3, repeat=1)  # doctest: +SKIP
+    >>> [r.name for r in rows]  # doctest: +SKIP
+    ['sbrdf_xr linear look-up kernel', 'xarray .interp (linear)']
     """
     lut = material.build_lut(_example_measurements(n_wavelength))
     rng = np.random.default_rng(0)
@@ -236,6 +277,20 @@ def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
     Returns
     -------
     list of BenchRow
+
+    Examples
+    --------
+    The table rebuilds the CanX-1 tables and runs minutes even with ``quick``; it is
+    not run here:
+
+    >>> import inspect
+    >>> from sbrdf_xr.bench import accuracy_cost, format_rows
+    >>> list(inspect.signature(accuracy_cost).parameters)
+    ['quick', 'repeat']
+    >>> rows = accuracy_cost(quick=True, repeat=1)  # doctest: +SKIP
+    >>> rows[0].name  # doctest: +SKIP
+    'reference: cubic look-up, 1-deg theta_i, 21x21, 5 nm, merged, float64'
+    >>> print(format_rows(rows))  # doctest: +SKIP
     """
     from . import geometry
     from .scene import builtin_scene
@@ -358,6 +413,17 @@ def shadow_rows(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
     (polygon clipping) on the package's non-convex test bodies (an L prism, a plate with a
     fin, a bus with a panel, CanX-1 with antennas), and the cost of both on a CanX-1 sweep
     (:mod:`sbrdf_xr.shadow_bench`).  Errors are of the Lambertian signal against exact.
+
+    Examples
+    --------
+    Even ``quick`` takes over a second (four bodies, three densities, a CanX-1 sweep);
+    :func:`sbrdf_xr.shadow_bench.accuracy_rows` runs the same comparison on one body
+    in milliseconds.  Not run here:
+
+    >>> from sbrdf_xr.bench import shadow_rows
+    >>> rows = shadow_rows(quick=True, repeat=1)  # doctest: +SKIP
+    >>> [r.name for r in rows][:2]  # doctest: +SKIP
+    ['shadowing: exact', 'shadowing: off (no shadowing)']
     """
     from . import shadow_bench
 
@@ -412,6 +478,19 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
     The machine limit is estimated from the bytes each geometry-facet must gather
     (8 table rows of the spectrum) and a measured memory bandwidth (a large
     ``numpy`` copy).
+
+    Examples
+    --------
+    The comparison runs on the CanX-1 rotation with its measured tables (seconds to
+    build) and a per-facet loop of many seconds; it is not run here:
+
+    >>> import inspect
+    >>> from sbrdf_xr.bench import kernel_throughput
+    >>> list(inspect.signature(kernel_throughput).parameters)
+    ['repeat']
+    >>> rows = kernel_throughput(repeat=1)  # doctest: +SKIP
+    >>> rows[0].name  # doctest: +SKIP
+    'per-facet numpy loop (baseline)'
     """
     from . import geometry
     from .scene import builtin_scene
@@ -519,7 +598,24 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
 
 
 def format_rows(rows: list[BenchRow]) -> str:
-    """A plain-text table of benchmark rows (time as a ratio to the row's baseline)."""
+    """A plain-text table of benchmark rows (time as a ratio to the row's baseline).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench import BenchRow
+    >>> rows = [
+    ...     BenchRow("reference", 2.0, "reference", 1.0, sweep="demo",
+    ...              mmag_max=0.0, mmag_median=0.0, rel_p99=0.0),
+    ...     BenchRow("lookup method: linear", 0.6, "reference", 0.3, sweep="demo",
+    ...              mmag_max=12.0, mmag_median=0.4, rel_p99=0.01),
+    ... ]
+    >>> from sbrdf_xr.bench import format_rows
+    >>> print(format_rows(rows))
+    [demo]
+    case                   time/baseline   mmag max   mmag med   rel p99  notes
+    reference                         1x          0          0         0  vs reference
+    lookup method: linear           0.3x         12        0.4      0.01  vs reference
+    """
     w = max(len(r.name) for r in rows)
     out = []
     sweep = None
@@ -542,7 +638,24 @@ def format_rows(rows: list[BenchRow]) -> str:
 
 
 def rows_to_dataset(rows: list[BenchRow]) -> xr.Dataset:
-    """The rows as a labelled Dataset over ``case`` (for netCDF or CSV)."""
+    """The rows as a labelled Dataset over ``case`` (for netCDF or CSV).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench import BenchRow
+    >>> rows = [
+    ...     BenchRow("reference", 2.0, "reference", 1.0, sweep="demo",
+    ...              mmag_max=0.0, mmag_median=0.0, rel_p99=0.0),
+    ...     BenchRow("lookup method: linear", 0.6, "reference", 0.3, sweep="demo",
+    ...              mmag_max=12.0, mmag_median=0.4, rel_p99=0.01),
+    ... ]
+    >>> from sbrdf_xr.bench import rows_to_dataset
+    >>> ds = rows_to_dataset(rows)
+    >>> ds.case.values.tolist(), ds.time_ratio.values.tolist()
+    (['reference', 'lookup method: linear'], [1.0, 0.3])
+    >>> ds.mmag_max.attrs["units"]
+    'mmag'
+    """
 
     def col(name: str) -> list[Any]:
         return [getattr(r, name) for r in rows]
@@ -580,7 +693,25 @@ def rows_to_dataset(rows: list[BenchRow]) -> xr.Dataset:
 
 
 def plot_front(rows: list[BenchRow], ax: Any = None) -> Any:
-    """The accuracy/time front: worst band error against relative time, per sweep."""
+    """The accuracy/time front: worst band error against relative time, per sweep.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench import BenchRow
+    >>> rows = [
+    ...     BenchRow("reference", 2.0, "reference", 1.0, sweep="demo",
+    ...              mmag_max=0.0, mmag_median=0.0, rel_p99=0.0),
+    ...     BenchRow("lookup method: linear", 0.6, "reference", 0.3, sweep="demo",
+    ...              mmag_max=12.0, mmag_median=0.4, rel_p99=0.01),
+    ... ]
+    >>> import matplotlib.pyplot as plt
+    >>> from sbrdf_xr.bench import plot_front
+    >>> fig = plot_front(rows)
+    >>> ax = fig.axes[0]
+    >>> ax.get_xscale(), ax.get_yscale(), ax.get_xlabel()
+    ('log', 'log', 'wall time / reference wall time')
+    >>> plt.close(fig)
+    """
     import matplotlib.pyplot as plt
 
     if ax is None:
@@ -601,7 +732,18 @@ def plot_front(rows: list[BenchRow], ax: Any = None) -> Any:
 
 
 def run(quick: bool = False) -> list[BenchRow]:
-    """All benchmarks (``quick``: smaller problems, a smoke run)."""
+    """All benchmarks (``quick``: smaller problems, a smoke run).
+
+    Examples
+    --------
+    Minutes even with ``quick`` (``sbrdf-xr bench --quick`` runs it); not run here:
+
+    >>> from sbrdf_xr.bench import format_rows, run
+    >>> rows = run(quick=True)  # doctest: +SKIP
+    >>> rows[0].name  # doctest: +SKIP
+    'build_lut (150 samples, 105 measured, 131 wl)'
+    >>> print(format_rows(rows))  # doctest: +SKIP
+    """
     rows = bench_build_lut(repeat=1 if quick else 3)
     rows += bench_lookup(n_geometries=2000 if quick else 20000, repeat=1 if quick else 3)
     rows += accuracy_cost(quick=quick, repeat=1 if quick else 2)

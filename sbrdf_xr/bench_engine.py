@@ -69,6 +69,18 @@ def sweep_job(
     single-threaded processes writing a Zarr store).
     Returns seconds (after planning and a warm-up of the compiled kernel) and the
     peak RSS [byte].
+
+    Examples
+    --------
+    Every sweep is CanX-1 with its measured tables (seconds to build on first use), so
+    the call is not run here:
+
+    >>> import inspect
+    >>> from sbrdf_xr.bench_engine import sweep_job
+    >>> list(inspect.signature(sweep_job).parameters)
+    ['n', 'path', 'bands', 'mode', 'workers']
+    >>> sorted(sweep_job(1000, "cube.nc"))  # doctest: +SKIP
+    ['blocks', 'rss', 'seconds']
     """
     import resource
 
@@ -170,7 +182,19 @@ def _matmul_rate(threads: int = 1) -> float:
 
 
 def kernel_rows(repeat: int = 3) -> list[BenchRow]:
-    """Kernel throughput (linear, 141 wavelengths, unmerged CanX-1 rotation, one thread)."""
+    """Kernel throughput (linear, 141 wavelengths, unmerged CanX-1 rotation, one thread).
+
+    Examples
+    --------
+    The rows time the CanX-1 rotation with its measured tables; not run here:
+
+    >>> import inspect
+    >>> from sbrdf_xr.bench_engine import kernel_rows
+    >>> list(inspect.signature(kernel_rows).parameters)
+    ['repeat']
+    >>> [r.name for r in kernel_rows(repeat=1)]  # doctest: +SKIP
+    ['kernel: numpy reference (sparse matrix)', 'kernel: fused (numba)']
+    """
     from ._kernels import fused_sums
     from .scene import builtin_scene
     from .simulate import run_block
@@ -215,7 +239,21 @@ def kernel_rows(repeat: int = 3) -> list[BenchRow]:
 
 
 def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
-    """All engine rows (see the module docstring); ``quick`` leaves out 1e6 and the cluster."""
+    """All engine rows (see the module docstring); ``quick`` leaves out 1e6 and the cluster.
+
+    Examples
+    --------
+    Minutes even with ``quick`` (sweeps of 1e4 and 1e5 attitudes in fresh processes;
+    ``sbrdf-xr bench --engine`` runs it); not run here:
+
+    >>> import inspect
+    >>> from sbrdf_xr.bench_engine import engine_rows
+    >>> list(inspect.signature(engine_rows).parameters)
+    ['quick', 'repeat']
+    >>> rows = engine_rows(quick=True, repeat=1)  # doctest: +SKIP
+    >>> rows[0].name  # doctest: +SKIP
+    'canx1-rotation, full spectrum, per attitude-spectrum'
+    """
     from .scene import builtin_scene
     from .simulate import simulate
 

@@ -142,6 +142,24 @@ def load(name: str) -> Any:
         for ``site``.  A material built from measurements on load shares its values
         with every other load of it in the process: they are read-only (``.copy()``
         gives a writable table); its attributes are each load's own.
+
+    Examples
+    --------
+    A shipped table: an ideal Lambertian grey of albedo 0.5, ``f_r = 0.5 / pi``:
+
+    >>> from sbrdf_xr import catalog
+    >>> grey = catalog.load("lambertian-grey-50")
+    >>> grey.dims
+    ('theta_i', 'delta_theta', 'phi', 'wavelength')
+    >>> grey.attrs["source"], round(float(grey.max()), 6), round(float(grey.min()), 6)
+    ('synthetic', 0.159155, 0.159155)
+
+    A spacecraft and an observing site:
+
+    >>> catalog.load("canx1")  # doctest: +ELLIPSIS
+    <Spacecraft 'canx1': 684 facets, materials ['aluminium-6061-t6', 'tjpv-cell', ...] m>
+    >>> catalog.load("mont-megantic").latitude_deg
+    45.4555
     """
     e = entry(name)
     try:

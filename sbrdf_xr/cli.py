@@ -41,6 +41,14 @@ def escape(text: Any, newlines: bool = False) -> str:
     Attributes of files and catalog entries are printed through this, so that a
     terminal escape sequence in a file prints as ``\\x1b[...`` instead of acting on the
     terminal.  Newlines and tabs are kept unless ``newlines`` is true.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.cli import escape
+    >>> print(escape("red " + chr(27) + "[31mtext"))  # the terminal's escape character
+    red \\x1b[31mtext
+    >>> print(escape("two" + chr(10) + "lines", newlines=True))
+    two\\nlines
     """
     keep = "" if newlines else "\n\t"
     return "".join(c if c.isprintable() or c in keep else repr(c)[1:-1] for c in str(text))
@@ -479,7 +487,17 @@ def _cmd_invert(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of ``sbrdf-xr``."""
+    """The argument parser of ``sbrdf-xr``.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.cli import build_parser
+    >>> args = build_parser().parse_args(
+    ...     ["simulate", "canx1-rotation", "-o", "cube.nc", "--preset", "fast"]
+    ... )
+    >>> args.command, args.scene, args.output, args.preset, args.complevel
+    ('simulate', 'canx1-rotation', 'cube.nc', 'fast', 4)
+    """
     p = argparse.ArgumentParser(
         prog="sbrdf-xr", description="Spectral BRDF simulation of unresolved spacecraft."
     )
@@ -674,6 +692,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     (:class:`OSError`: missing files, permissions, a full disk) in one line
     ``sbrdf-xr: error: ...`` on stderr and exit status 2; an interrupt in exit status
     130.  Messages name command-line options (``--overwrite``, ``--resume``).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.cli import main
+    >>> main(["knobs"])  # doctest: +ELLIPSIS
+    knob               default     fast / balanced / reference   trades
+    method             linear      linear / linear / cubic       look-up interpolation order: ...
+    ...
+    block_bytes        33554432    - / - / -                     memory budget of one block's ...
+    0
+    >>> main(["catalog", "list", "--kind", "spacecraft"])  # doctest: +ELLIPSIS
+    name   kind              source        description
+    canx1  spacecraft        synthetic     CanX-1 Engineering Model-like 10 cm cube ...
+    <BLANKLINE>
+    1 entries in ...catalogs
+    0
     """
     args = build_parser().parse_args(argv)
     logger = logging.getLogger("sbrdf_xr")

@@ -29,7 +29,27 @@ Plan = Any
 
 @dataclass(frozen=True)
 class BlockInputs:
-    """Body-frame directions of one block of geometries, flattened to (G, 3)."""
+    """Body-frame directions of one block of geometries, flattened to (G, 3).
+
+    Examples
+    --------
+    A block of a 1 attitude x 2 phase angle grid (what the plan's geometry hands to
+    every effect):
+
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.material_schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> plan = Scene(box, {"grey": grey}, attitudes=[[0, 0, 0, 1.0]], phase_angles=[0, 60]).plan()
+    >>> block = plan.geometry.block(slice(None))
+    >>> block.lead_shape, block.to_sun.shape
+    ((1, 2), (2, 3))
+    >>> block.to_sun.round(4).tolist()  # phase 0 and 60 deg about the bisector +x
+    [[1.0, 0.0, 0.0], [0.866, 0.5, 0.0]]
+    >>> block.sun_scale is None  # no Earth shadow: the whole solar disc
+    True
+    """
 
     to_sun: np.ndarray
     to_observer: np.ndarray
@@ -66,6 +86,15 @@ class Output:
         Its values have the dtype of the spectra (else float64).
     units, long_name : str
         CF attributes.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.effects import OUTPUTS
+    >>> out = OUTPUTS["signal"]
+    >>> out.tail, out.spectral
+    (('wavelength',), True)
+    >>> out.attrs["units"]
+    'm2 sr-1'
     """
 
     name: str
@@ -173,6 +202,28 @@ def reflected(
 
     Runs the kernel the plan chose (fused or numpy reference) or, with analytic
     evaluation, each material's BRDF model.
+
+    Examples
+    --------
+    A unit cube of Lambertian albedo 0.5 at identity attitude: at phase 0 only the +x
+    face (1 m2) is lit and seen, head on, so the signal is ``0.5 / pi``; at phase 60 deg
+    it is seen and lit at 30 deg, ``0.5 / pi * cos(30 deg)**2``.
+
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.material_schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> plan = Scene(box, {"grey": grey}, attitudes=[[0, 0, 0, 1.0]], phase_angles=[0, 60]).plan()
+    >>> from sbrdf_xr.effects import reflected
+    >>> block = plan.geometry.block(slice(None))
+    >>> sums = reflected(plan, block, block.to_sun, None, False)
+    >>> sums.signal.shape  # (geometries, wavelengths)
+    (2, 3)
+    >>> sums.signal[:, 0].round(6).tolist()
+    [0.159155, 0.119366]
+    >>> sums.area.round(6).tolist()  # projected area, cos(phase / 2) [m2]
+    [1.0, 0.866025]
     """
     t = plan.terms
     if plan.knobs["evaluation"] == "analytic":
@@ -350,6 +401,17 @@ class Effect:
         ``contribute(plan, block) -> {name: array}`` on every block.
     description : str
         The plan line when it runs (details are added by the planner).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.effects import EFFECTS
+    >>> e = EFFECTS["earthshine"]
+    >>> e.needs, e.source
+    (('to_earth',), 'earth')
+    >>> e.outputs
+    ('signal_earthshine', 'band_signal')
+    >>> EFFECTS["shadowing"].contribute is None  # it modifies the others' sums
+    True
     """
 
     name: str
@@ -432,6 +494,28 @@ def finish(
     ``spacecraft_sbrdf`` is paper 000 Eq. 4 (0 where no area contributes, the 0/0 of
     Eq. 4), ``brdf`` its trapezoid integral over wavelength (Eq. 2), ``band_signal``
     the band-weighted total signal (Sun plus Earth), or the pre-integrated sums.
+
+    Examples
+    --------
+    For a Lambertian body ``spacecraft_sbrdf`` is ``albedo / pi`` at every geometry, and
+    ``brdf`` its integral over 500-700 nm, ``200 * 0.5 / pi``:
+
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.material_schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> plan = Scene(box, {"grey": grey}, attitudes=[[0, 0, 0, 1.0]], phase_angles=[0, 60]).plan()
+    >>> from sbrdf_xr.effects import finish, reflected
+    >>> block = plan.geometry.block(slice(None))
+    >>> r = reflected(plan, block, block.to_sun, None, False)
+    >>> out = finish(plan, {"signal": r.signal, "paper": r.paper, "area": r.area}, (1, 2))
+    >>> sorted((k, v.shape) for k, v in out.items())
+    [('area', (1, 2)), ('brdf', (1, 2)), ('signal', (1, 2, 3)), ('spacecraft_sbrdf', (1, 2, 3))]
+    >>> out["spacecraft_sbrdf"][0, :, 0].round(6).tolist()
+    [0.159155, 0.159155]
+    >>> out["brdf"].round(4).tolist()
+    [[31.831, 31.831]]
     """
     names = plan.output_names
     dt = np.dtype(plan.knobs["dtype"])

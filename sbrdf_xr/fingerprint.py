@@ -188,6 +188,29 @@ def scene_fingerprint(scene: Any) -> dict[str, str]:
         table value, coordinate or attribute, of the mesh, the materials map, the
         filters, a knob, the geometry or the package version changes ``fingerprint``
         and the part concerned.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.material_schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> scene = Scene(box, {"grey": grey}, attitudes=[[0, 0, 0, 1.0]], phase_angles=[0.0, 60.0])
+    >>> from sbrdf_xr.fingerprint import scene_fingerprint
+    >>> fp = scene_fingerprint(scene)
+    >>> list(fp)  # doctest: +NORMALIZE_WHITESPACE
+    ['fingerprint', 'fingerprint_filters', 'fingerprint_geometry', 'fingerprint_knobs',
+     'fingerprint_knobs_json', 'fingerprint_material_grey', 'fingerprint_material_names',
+     'fingerprint_materials', 'fingerprint_mesh', 'fingerprint_package']
+    >>> len(fp["fingerprint"]), fp["fingerprint_material_names"]  # SHA-256 hex digest
+    (64, '{"grey": "grey"}')
+
+    Values, not identities, are hashed: the same scene built again has the same print.
+
+    >>> same = Scene(box, {"grey": grey}, attitudes=[[0, 0, 0, 1.0]], phase_angles=[0.0, 60.0])
+    >>> scene_fingerprint(same) == fp
+    True
     """
     materials = dict(scene.materials or {})
     names = sorted(materials)
@@ -243,6 +266,24 @@ def changes(old: Mapping[str, Any], new: Mapping[str, Any]) -> list[str]:
     list of str
         For example ``["material 'white-paint-a276': table changed"]``; empty when the
         fingerprints agree (or neither has one).
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.material_schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> scene = Scene(box, {"grey": grey}, attitudes=[[0, 0, 0, 1.0]], phase_angles=[0.0, 60.0])
+    >>> from sbrdf_xr.fingerprint import changes, scene_fingerprint
+    >>> fp = scene_fingerprint(scene)
+    >>> changes(fp, scene_fingerprint(scene.with_options(method="cubic")))
+    ["setting 'method': 'linear' -> 'cubic'"]
+    >>> brighter = lambertian(0.6, [500.0, 600.0, 700.0], material="grey")
+    >>> changes(fp, scene_fingerprint(scene.with_options(materials={"grey": brighter})))
+    ["material 'grey': table changed"]
+    >>> changes(fp, fp)
+    []
     """
     old = {k: str(v) for k, v in old.items() if str(k).startswith(PREFIX)}
     new = {k: str(v) for k, v in new.items() if str(k).startswith(PREFIX)}

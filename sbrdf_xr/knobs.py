@@ -45,6 +45,15 @@ class Knob:
         ``check(value)`` returns an error text, or None when the value is fine.
     trades : str
         What the knob trades, for people (``sbrdf-xr bench`` measures it).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.knobs import KNOBS
+    >>> k = KNOBS["method"]
+    >>> k.default, k.allowed
+    ('linear', ('nearest', 'linear', 'cubic'))
+    >>> KNOBS["shadow_density"].check(0)  # a knob checked by a function
+    'expected an integer from 1 to 64'
     """
 
     name: str
@@ -185,6 +194,16 @@ def check_knob(name: str, value: Any) -> Any:
     ------
     SceneError
         Unknown knob, or a value outside what it allows.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.knobs import check_knob
+    >>> check_knob("dtype", "float32")
+    'float32'
+    >>> check_knob("dtype", "float16")
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.SceneError: dtype: got 'float16'; allowed: float32, float64
     """
     try:
         knob = KNOBS[name]
@@ -206,6 +225,12 @@ def apply_preset(preset: str, changes: Mapping[str, Any] | None = None) -> dict[
     ------
     SceneError
         Unknown preset.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.knobs import apply_preset
+    >>> apply_preset("fast", {"method": "cubic"})
+    {'method': 'cubic', 'dtype': 'float32', 'shadow_method': 'exact'}
     """
     if preset not in PRESETS:
         raise SceneError(f"preset: unknown {preset!r}; allowed: {', '.join(PRESETS)}")
@@ -213,7 +238,17 @@ def apply_preset(preset: str, changes: Mapping[str, Any] | None = None) -> dict[
 
 
 def knob_table() -> str:
-    """The knobs and presets as a text table (``sbrdf-xr knobs``)."""
+    """The knobs and presets as a text table (``sbrdf-xr knobs``).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.knobs import knob_table
+    >>> print(knob_table())  # doctest: +ELLIPSIS
+    knob               default     fast / balanced / reference   trades
+    method             linear      linear / linear / cubic       look-up interpolation order: ...
+    dtype              float64     float32 / float64 / float64   precision of the spectra ...
+    ...
+    """
     w = max(len(k) for k in KNOBS)
     lines = [f"{'knob':<{w}}  {'default':<10}  {' / '.join(PRESETS):<28}  trades"]
     for k in KNOBS.values():

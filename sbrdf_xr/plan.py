@@ -82,6 +82,24 @@ class Terms:
         the first facet of the term.
     n_facets : ndarray of int, shape (T,)
         Facets merged into each term.
+
+    Examples
+    --------
+    A unit cube turned by 0 and 45 deg about z, Sun and observer in the xy plane: its
+    12 triangles merge into 6 faces, of which only +x and -y are ever lit and seen.
+
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, geometry, load_spacecraft
+    >>> from sbrdf_xr.material_schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> turns = geometry.axis_rotation([0, 0, 1], [0.0, 45.0])  # two attitudes about z
+    >>> scene = Scene(box, {"grey": grey}, attitudes=turns, phase_angles=[0.0, 60.0])
+    >>> terms = scene.plan().terms
+    >>> terms.size
+    2
+    >>> terms.normal.tolist(), terms.area.tolist(), terms.n_facets.tolist()
+    ([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0]], [1.0, 1.0], [2, 2])
     """
 
     normal: np.ndarray
@@ -98,7 +116,23 @@ class Terms:
 
 @dataclass(frozen=True)
 class PlannedOutput:
-    """An output variable: its name, dimensions, shape, dtype and CF attributes."""
+    """An output variable: its name, dimensions, shape, dtype and CF attributes.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, geometry, load_spacecraft
+    >>> from sbrdf_xr.material_schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> turns = geometry.axis_rotation([0, 0, 1], [0.0, 45.0])  # two attitudes about z
+    >>> scene = Scene(box, {"grey": grey}, attitudes=turns, phase_angles=[0.0, 60.0])
+    >>> out = scene.plan().outputs[1]
+    >>> out.name, out.dims, out.shape
+    ('signal', ('attitude', 'phase_angle', 'wavelength'), (2, 2, 3))
+    >>> out.dtype, out.nbytes, out.attrs["units"]
+    (dtype('float64'), 96, 'm2 sr-1')
+    """
 
     name: str
     dims: tuple[str, ...]
@@ -126,6 +160,19 @@ class Estimate:
         Size of one block's outputs [byte] (about the peak memory per block in flight).
     multiply_adds : float
         Upper bound of the spectral multiply-adds (every term lit and seen).
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, geometry, load_spacecraft
+    >>> from sbrdf_xr.material_schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> turns = geometry.axis_rotation([0, 0, 1], [0.0, 45.0])  # two attitudes about z
+    >>> scene = Scene(box, {"grey": grey}, attitudes=turns, phase_angles=[0.0, 60.0])
+    >>> est = scene.plan().estimate
+    >>> est.n_geometries, est.n_terms, est.output_bytes
+    (4, 2, 256)
     """
 
     n_geometries: int
@@ -141,6 +188,36 @@ class Plan:
 
     Build with :meth:`from_scene` (or :meth:`sbrdf_xr.scene.Scene.plan`).  Fields are
     read-only; arrays are not writeable.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, geometry, load_spacecraft
+    >>> from sbrdf_xr.material_schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> turns = geometry.axis_rotation([0, 0, 1], [0.0, 45.0])  # two attitudes about z
+    >>> scene = Scene(box, {"grey": grey}, attitudes=turns, phase_angles=[0.0, 60.0])
+    >>> plan = scene.plan()
+    >>> plan.n_blocks, plan.output_names
+    (1, ('spacecraft_sbrdf', 'signal', 'brdf', 'area'))
+    >>> plan.knobs["method"], plan.materials, plan.wavelength.tolist()
+    ('linear', ('grey',), [500.0, 600.0, 700.0])
+    >>> plan.merged, plan.shadowing, plan.effects
+    (True, False, ('sunlight',))
+    >>> print(plan)  # doctest: +ELLIPSIS
+    plan for scene 'scene':
+      geometry       2 attitudes x 2 phase angles = 4 geometries
+      shadowing      skipped: not requested
+    ...
+      outputs        spacecraft_sbrdf, signal, brdf, area
+    ...
+
+    A chunk of one attitude gives two blocks:
+
+    >>> chunked = scene.with_options(chunk=1).plan()
+    >>> chunked.n_blocks, chunked.block_slice(1)
+    (2, slice(1, 2, None))
     """
 
     name: str
@@ -256,6 +333,22 @@ def compile_plan(scene: Scene) -> Plan:
         on, bands the wavelengths do not cover), or its estimated size or work is
         beyond the limits (:data:`SIZE_LIMIT_BYTES`, :data:`WORK_LIMIT`; raise them
         with the scene field ``size_limit``).  Nothing is allocated before this check.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, geometry, load_spacecraft
+    >>> from sbrdf_xr.material_schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> turns = geometry.axis_rotation([0, 0, 1], [0.0, 45.0])  # two attitudes about z
+    >>> scene = Scene(box, {"grey": grey}, attitudes=turns, phase_angles=[0.0, 60.0])
+    >>> from sbrdf_xr.plan import compile_plan
+    >>> plan = compile_plan(scene)
+    >>> plan.estimate.n_geometries, plan.terms.size, plan.chunk
+    (4, 2, 2)
+    >>> compile_plan(scene.with_options(merge=False)).terms.size  # every lit and seen facet
+    4
     """
     knobs = {k: getattr(scene, k) for k in scene.knob_names()}
     geo = scene.geometry

@@ -263,6 +263,27 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
         something is needed (``phase_angles``, ``outputs``), or larger than
         :data:`MAX_SCENE_COUNT`; :class:`~sbrdf_xr.errors.CatalogError` for catalog names
         that do not exist.
+
+    Examples
+    --------
+    The CanX-1 mesh with every material replaced by the catalog's Lambertian grey
+    table, three attitudes of a sweep about z and two phase angles:
+
+    >>> from sbrdf_xr.scene import scene_from_dict
+    >>> grey = "lambertian-grey-50"
+    >>> scene = scene_from_dict({
+    ...     "name": "grey-canx1",
+    ...     "spacecraft": "canx1",
+    ...     "phase_angles": [10.0, 30.0],
+    ...     "attitude": {"kind": "sweep", "axis": [0, 0, 1], "stop": 90, "step": 30},
+    ...     "materials": {"aluminium-6061-t6": grey, "tjpv-cell": grey, "white-paint-a276": grey},
+    ... })
+    >>> scene.name, scene.n_geometries, scene.attitude_angle.tolist()
+    ('grey-canx1', 6, [0.0, 30.0, 60.0])
+    >>> scene_from_dict({"spacecraft": "canx1", "colour": "red"})
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.SceneError: scene: unknown key 'colour'; allowed: ...
     """
     _check_keys(d, _SCENE_KEYS, "scene")
     from . import catalog
@@ -400,6 +421,34 @@ def load_scene(path: str | Path) -> Scene:
         "white-paint-a276" = "white-paint-a276"
 
     Unknown keys and wrong types raise :class:`~sbrdf_xr.errors.SceneError`.
+
+    Examples
+    --------
+    The CanX-1 mesh with the catalog's Lambertian grey table for all its materials:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> text = '''
+    ... name = "grey-canx1"
+    ... spacecraft = "canx1"
+    ... phase_angles = [10.0]
+    ... [attitude]
+    ... kind = "sweep"
+    ... axis = [0, 0, 1]
+    ... stop = 90.0
+    ... step = 45.0
+    ... [materials]
+    ... "aluminium-6061-t6" = "lambertian-grey-50"
+    ... "tjpv-cell" = "lambertian-grey-50"
+    ... "white-paint-a276" = "lambertian-grey-50"
+    ... '''
+    >>> from sbrdf_xr.scene import load_scene
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = Path(tmp) / "grey.toml"
+    ...     _ = path.write_text(text)
+    ...     scene = load_scene(path)
+    >>> scene.name, scene.n_geometries, scene.spacecraft.n_facets
+    ('grey-canx1', 2, 684)
     """
     path = Path(path)
     try:
@@ -477,12 +526,34 @@ _BUILTIN = {
 
 
 def builtin_scenes() -> list[str]:
-    """Names of the built-in scenes."""
+    """Names of the built-in scenes.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.scene import builtin_scenes
+    >>> builtin_scenes()
+    ['canx1-plusx-specular', 'canx1-rotation', 'canx1-pass']
+    """
     return list(_BUILTIN)
 
 
 def builtin_scene(name: str) -> Scene:
-    """A built-in scene by name (see :func:`builtin_scenes`)."""
+    """A built-in scene by name (see :func:`builtin_scenes`).
+
+    Examples
+    --------
+    The built-in scenes simulate CanX-1 with its measured material tables, which are
+    built (or read from the cache) on first use; that takes seconds to a minute:
+
+    >>> from sbrdf_xr.scene import builtin_scene
+    >>> scene = builtin_scene("canx1-rotation")  # doctest: +SKIP
+    >>> scene.n_geometries  # doctest: +SKIP
+    360
+    >>> builtin_scene("canx1-spin")
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.SceneError: unknown scene 'canx1-spin'; built-in scenes: ...
+    """
     try:
         return _BUILTIN[name]()
     except KeyError:
@@ -492,7 +563,38 @@ def builtin_scene(name: str) -> Scene:
 
 
 def resolve_scene(spec: str | Path | Scene) -> Scene:
-    """A scene from a Scene, a built-in name or a TOML file path."""
+    """A scene from a Scene, a built-in name or a TOML file path.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> text = '''
+    ... name = "grey-canx1"
+    ... spacecraft = "canx1"
+    ... phase_angles = [10.0]
+    ... [attitude]
+    ... kind = "sweep"
+    ... axis = [0, 0, 1]
+    ... stop = 90.0
+    ... step = 45.0
+    ... [materials]
+    ... "aluminium-6061-t6" = "lambertian-grey-50"
+    ... "tjpv-cell" = "lambertian-grey-50"
+    ... "white-paint-a276" = "lambertian-grey-50"
+    ... '''
+    >>> from sbrdf_xr.scene import resolve_scene
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = Path(tmp) / "grey.toml"
+    ...     _ = path.write_text(text)
+    ...     scene = resolve_scene(str(path))
+    >>> scene.name, resolve_scene(scene) is scene
+    ('grey-canx1', True)
+    >>> resolve_scene("no-such-scene")
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.SceneError: unknown scene 'no-such-scene'; built-in scenes: ...
+    """
     if isinstance(spec, Scene):
         return spec
     if not isinstance(spec, str | Path):

@@ -134,6 +134,38 @@ class Scene:
         (:data:`sbrdf_xr.plan.SIZE_LIMIT_BYTES`, :data:`sbrdf_xr.plan.WORK_LIMIT`).
     name, description : str
         Labels stored in the output.
+
+    Examples
+    --------
+    A unit cube of one Lambertian material at one attitude and two phase angles:
+
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.material_schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> scene = Scene(box, {"grey": grey}, attitudes=[[0, 0, 0, 1.0]], phase_angles=[0.0, 60.0])
+    >>> scene.is_grid, scene.n_geometries
+    (True, 2)
+    >>> to_sun, to_observer = scene.body_vectors()
+    >>> to_sun.shape, to_observer.round(4).tolist()
+    ((1, 2, 3), [[[1.0, 0.0, 0.0], [0.866, -0.5, 0.0]]])
+    >>> scene.plan().n_blocks
+    1
+
+    Knobs and presets give changed copies; explicit body-frame pairs replace the grid:
+
+    >>> fast = scene.with_options(preset="fast")
+    >>> fast.dtype, fast.method
+    ('float32', 'linear')
+    >>> pairs = Scene(box, {"grey": grey}, to_sun=[[1.0, 0, 0]], to_observer=[[0, 1.0, 0]])
+    >>> pairs.is_grid, pairs.n_geometries
+    (False, 1)
+    >>> Scene(box, {"grey": grey}, to_sun=[[1.0, 0, 0]], to_observer=[[0, 1.0, 0]],
+    ...       outputs=("colour",))
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.SceneError: outputs: unknown ['colour']; allowed: spacecraft_sbrdf, signal, ...
     """
 
     spacecraft: Any

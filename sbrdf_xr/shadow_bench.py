@@ -68,6 +68,13 @@ class ShadowRow:
         Time over the exact method's, same run [1].
     worst_rel_error, median_rel_error : float
         Worst and median ``|S - S_exact| / S_exact`` over bodies and geometries [1].
+
+    Examples
+    --------
+    >>> from sbrdf_xr.shadow_bench import accuracy_rows
+    >>> row = accuracy_rows(densities=(2,), n_geometries=4, bodies=("l-shape",), repeat=1)[-1]
+    >>> row.label, row.method, row.density, row.bodies
+    ('sampled density 2', 'sampled', 2, 'l-shape')
     """
 
     label: str
@@ -102,6 +109,13 @@ class CostRow:
         exponent ``b`` of ``time ~ n_facets**b`` on the scaling rows.
     ratio_to : str
         What ``ratio`` is relative to.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.shadow_bench import CostRow
+    >>> row = CostRow("exact", "canx1", 684, 360, 0.25, 1.0, "exact")
+    >>> row.n_facets * row.n_geometries  # facet-geometry pairs timed
+    246240
     """
 
     label: str
@@ -118,6 +132,16 @@ def geometries(n: int = 18, seed: int = 7) -> tuple[np.ndarray, np.ndarray]:
 
     Suns uniform on the sphere; each observer at a phase angle uniform in 5-120 degree from
     its Sun (the range of ground-based photometry), at a random azimuth about it.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.shadow_bench import geometries
+    >>> s, o = geometries(3)
+    >>> s.shape, np.linalg.norm(o, axis=1).round(12).tolist()
+    ((3, 3), [1.0, 1.0, 1.0])
+    >>> np.degrees(np.arccos((s * o).sum(axis=1))).round(3).tolist()  # phase angles
+    [58.813, 39.849, 37.019]
     """
     rng = np.random.default_rng(seed)
     s = rng.normal(size=(n, 3))
@@ -138,7 +162,21 @@ def lambertian_signal(
     craft: Spacecraft, s: np.ndarray, o: np.ndarray, fraction: np.ndarray | None
 ) -> np.ndarray:
     """``sum_j A_j (N_j.s)+ (N_j.o)+ f_j`` per geometry [m2] (paper 000 Eq. 3 with a constant
-    sBRDF of 1 sr-1); ``fraction`` None means 1 (no shadowing)."""
+    sBRDF of 1 sr-1); ``fraction`` None means 1 (no shadowing).
+
+    Examples
+    --------
+    A unit cube with the Sun on +x: seen along +x, the +x face gives 1 m2; seen 60 deg
+    away in the xy plane, ``cos(0) cos(60 deg) = 0.5`` (the +y face is not lit).
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.shadow_bench import lambertian_signal
+    >>> from sbrdf_xr.testing import cube_spacecraft
+    >>> sun = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    >>> obs = np.array([[1.0, 0.0, 0.0], [0.5, np.sqrt(0.75), 0.0]])
+    >>> lambertian_signal(cube_spacecraft(), sun, obs, None).round(6).tolist()
+    [1.0, 0.5]
+    """
     n = np.asarray(craft.mesh.face_normals)
     w = craft.mesh.area_faces * np.clip(s @ n.T, 0, None) * np.clip(o @ n.T, 0, None)
     return (w if fraction is None else w * fraction).sum(axis=-1)
@@ -182,6 +220,18 @@ def accuracy_rows(
     -------
     list of ShadowRow
         ``exact``, ``off`` and one row per density.
+
+    Examples
+    --------
+    Four geometries on the L-shaped prism (the first call compiles the shadowing
+    kernels; later ones take milliseconds):
+
+    >>> from sbrdf_xr.shadow_bench import accuracy_rows
+    >>> rows = accuracy_rows(densities=(2,), n_geometries=4, bodies=("l-shape",), repeat=1)
+    >>> [(r.label, r.n_geometries) for r in rows]
+    [('exact', 4), ('off (no shadowing)', 4), ('sampled density 2', 4)]
+    >>> round(rows[1].worst_rel_error, 3)  # ignoring the shadow errs by this much
+    0.475
     """
     names = list(ACCURACY_BODIES) if bodies is None else list(bodies)
     s, o = geometries(n_geometries, seed)
@@ -247,6 +297,13 @@ def canx1_sweep_rows(n_attitudes: int = 360, density: int = 4, repeat: int = 2) 
     row's; the ``off`` row gives the largest relative change of the signal that shadowing
     makes (in its ``ratio``), the sampled row's ``ratio_to`` also carries its worst
     relative signal error against exact.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.shadow_bench import canx1_sweep_rows
+    >>> rows = canx1_sweep_rows(n_attitudes=4, density=2, repeat=1)
+    >>> [(r.label, r.n_facets, r.n_geometries) for r in rows]
+    [('exact', 684, 4), ('sampled density 2', 684, 4), ('off (no shadowing)', 684, 4)]
     """
     craft = canx1()
     ang = np.linspace(0.0, 2 * np.pi, n_attitudes, endpoint=False)
@@ -305,6 +362,15 @@ def scaling_rows(
     exact row's the exponent ``b`` of the least-squares fit ``time ~ n_facets**b`` over all
     counts.  With ``compare_density``, a sampled row follows each exact row, its ``ratio``
     its time over the exact time at that count (same run).
+
+    Examples
+    --------
+    One facet count (no exponent to fit) and two geometries:
+
+    >>> from sbrdf_xr.shadow_bench import scaling_rows
+    >>> rows = scaling_rows(subdivisions=(1,), n_geometries=2, compare_density=None)
+    >>> [(r.label, r.body, r.n_facets, r.ratio_to) for r in rows]
+    [('exact', 'canx1-antennas', 732, 'local exponent')]
     """
     s, o = geometries(n_geometries, seed)
     rows: list[CostRow] = []
@@ -365,7 +431,16 @@ def scaling_rows(
 
 
 def markdown(rows: Sequence[ShadowRow | CostRow]) -> str:
-    """The rows as a markdown table (floats to 3 significant digits)."""
+    """The rows as a markdown table (floats to 3 significant digits).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.shadow_bench import CostRow, markdown
+    >>> print(markdown([CostRow("exact", "canx1", 684, 360, 0.2512, 1.0, "exact")]))
+    | label | body | n_facets | n_geometries | ms_per_geometry | ratio | ratio_to |
+    |---|---|---|---|---|---|---|
+    | exact | canx1 | 684 | 360 | 0.251 | 1 | exact |
+    """
     if not rows:
         return ""
     names = [f.name for f in fields(rows[0])]

@@ -123,6 +123,12 @@ def kirchhoff_emissivity(reflectance: ArrayLike) -> NDArray[np.float64]:
     -------
     ndarray
         Emissivity [1].
+
+    Examples
+    --------
+    >>> from sbrdf_xr.sources import kirchhoff_emissivity
+    >>> kirchhoff_emissivity([0.2, 0.9, 1.05]).round(6).tolist()  # 1.05: clipped to 0
+    [0.8, 0.1, 0.0]
     """
     return np.clip(1.0 - np.asarray(reflectance, dtype=np.float64), 0.0, 1.0)
 
@@ -144,6 +150,17 @@ def emissivity_at(
     Returns
     -------
     ndarray, shape (..., n_wavelength)
+
+    Examples
+    --------
+    Two wavelengths tabulated at 0 and 90 degree; 45 degree lies halfway, 120 degree is
+    clamped to the last node:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.sources import emissivity_at
+    >>> eps = np.array([[0.8, 0.5], [0.6, 0.3]])  # (n_theta, n_wavelength)
+    >>> emissivity_at(eps, np.array([0.0, 90.0]), [45.0, 120.0]).round(6).tolist()
+    [[0.7, 0.4], [0.6, 0.3]]
     """
     grid = np.asarray(theta_grid, dtype=np.float64)
     t = np.clip(np.asarray(theta, dtype=np.float64), grid[0], grid[-1])

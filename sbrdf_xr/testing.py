@@ -39,6 +39,19 @@ def lobe_function(
     -------
     callable
         ``func(theta_i, delta_theta, phi) -> (n, n_wavelength)`` [sr-1].
+
+    Examples
+    --------
+    On the lobe's axis the sBRDF is ``(diffuse + peak) * s(lambda)``, 1.616 at 400 nm
+    (``s = 0.8``):
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.testing import lobe_function
+    >>> f = lobe_function(np.array([400.0, 750.0, 1100.0]))
+    >>> f([10.0], [0.0], [0.0]).round(6).tolist()
+    [[1.616, 2.02, 2.424]]
+    >>> f([10.0], [30.0], [0.0]).round(6).tolist()  # 30 deg off the lobe: the floor
+    [[0.016064, 0.02008, 0.024096]]
     """
     wl = np.asarray(wavelength, dtype=np.float64)
     s = 0.8 + 0.4 * (wl - 400.0) / 700.0
@@ -73,6 +86,15 @@ def make_measurements(
     Returns
     -------
     xarray.Dataset
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import make_measurements
+    >>> ds = make_measurements(n_wavelength=5)
+    >>> dict(ds.sizes), ds.attrs["material"]
+    ({'sample': 150, 'wavelength': 5}, 'test-lobe')
+    >>> sorted(set(ds.theta_i.values.tolist()))
+    [10.0, 25.0, 40.0, 55.0, 70.0]
     """
     from .goniometer import measure
 
@@ -114,6 +136,15 @@ def make_material(
     Returns
     -------
     xarray.DataArray
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import make_material
+    >>> lobe = make_material(5)
+    >>> lobe.dims, lobe.shape
+    (('theta_i', 'delta_theta', 'phi', 'wavelength'), (10, 11, 7, 5))
+    >>> float(make_material(3, value=0.2).max())
+    0.2
     """
     from .material import new_material
 
@@ -190,6 +221,15 @@ def prism_mesh(polygon_xy, z0: float, z1: float):
     -------
     trimesh.Trimesh
         ``4 n - 4`` facets: two per side wall, ``n - 2`` per cap.
+
+    Examples
+    --------
+    A unit square extruded over 2 m: 12 facets enclosing 2 m3.
+
+    >>> from sbrdf_xr.testing import prism_mesh
+    >>> mesh = prism_mesh([(0, 0), (1, 0), (1, 1), (0, 1)], 0.0, 2.0)
+    >>> len(mesh.faces), bool(mesh.is_watertight), round(float(mesh.volume), 6)
+    (12, True, 2.0)
     """
     import trimesh
 
@@ -228,6 +268,14 @@ def cube_spacecraft(size: float = 1.0, subdivisions: int = 1):
     Returns
     -------
     sbrdf_xr.spacecraft.Spacecraft
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import cube_spacecraft
+    >>> cube_spacecraft()
+    <Spacecraft 'cube-1m': 12 facets, materials ['white-paint-a276'], extent [1.0, 1.0, 1.0] m>
+    >>> cube_spacecraft(subdivisions=2).n_facets, cube_spacecraft().is_convex
+    (48, True)
     """
     import trimesh
 
@@ -247,6 +295,13 @@ def l_shaped_spacecraft(depth: float = 2.0):
 
     The floor ``y = 1, 1 <= x <= 2`` (normal +y) is shadowed by the wall ``x = 1,
     1 <= y <= 2`` (normal +x) when the Sun has ``s_x < 0``.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> body = l_shaped_spacecraft()
+    >>> body.n_facets, body.is_convex, round(float(body.mesh.volume), 6)  # 3 m2 x 2 m
+    (20, False, 6.0)
     """
     return _as_spacecraft(prism_mesh(L_SECTION, 0.0, depth), "l-shape")
 
@@ -257,14 +312,31 @@ def plate_with_fin_section(
     fin_height: float = 1.0,
     fin_thickness: float = 0.1,
 ) -> np.ndarray:
-    """Cross-section in xy of :func:`plate_with_fin_spacecraft` (counter-clockwise) [m]."""
+    """Cross-section in xy of :func:`plate_with_fin_spacecraft` (counter-clockwise) [m].
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import plate_with_fin_section
+    >>> plate_with_fin_section().tolist()[:4]
+    [[-1.0, -0.1], [1.0, -0.1], [1.0, 0.0], [0.05, 0.0]]
+    """
     w, t, h, f = half_width, thickness, fin_height, fin_thickness / 2
     return np.array([(-w, -t), (w, -t), (w, 0.0), (f, 0.0), (f, h), (-f, h), (-f, 0.0), (-w, 0.0)])
 
 
 def plate_with_fin_spacecraft(depth: float = 2.0, **section):
     """A plate ``[-1, 1] x [-0.1, 0]`` with a perpendicular fin ``[-0.05, 0.05] x [0, 1]`` (xy, [m]),
-    extruded over z in [0, depth]; ``section`` overrides :func:`plate_with_fin_section`."""
+    extruded over z in [0, depth]; ``section`` overrides :func:`plate_with_fin_section`.
+
+    Examples
+    --------
+    The section is 2 x 0.1 of plate and 0.1 x 1 of fin, 0.3 m2, extruded over 2 m:
+
+    >>> from sbrdf_xr.testing import plate_with_fin_spacecraft
+    >>> body = plate_with_fin_spacecraft()
+    >>> body.n_facets, body.is_convex, round(float(body.mesh.volume), 6)
+    (28, False, 0.6)
+    """
     return _as_spacecraft(
         prism_mesh(plate_with_fin_section(**section), 0.0, depth), "plate-with-fin"
     )
@@ -304,6 +376,15 @@ def bus_with_panel_spacecraft(depth: float = 1.0, subdivisions: int = 1):
         Extent along y of bus, boom and panel [m].
     subdivisions : int
         1 + rounds of :meth:`trimesh.Trimesh.subdivide` (4x the facets each).
+
+    Examples
+    --------
+    Bus 1 x 1, boom 0.8 x 0.06 and panel 0.04 x 1.8 m2 of section, 1 m deep:
+
+    >>> from sbrdf_xr.testing import bus_with_panel_spacecraft
+    >>> body = bus_with_panel_spacecraft()
+    >>> body.n_facets, body.is_convex, round(float(body.mesh.volume), 6)
+    (44, False, 1.12)
     """
     import trimesh
 
@@ -348,6 +429,15 @@ def canx1_with_antennas(subdivisions: int = 1, tilt: float = 30.0):
     Returns
     -------
     sbrdf_xr.spacecraft.Spacecraft
+
+    Examples
+    --------
+    CanX-1's 684 facets and 12 per rod:
+
+    >>> from sbrdf_xr.testing import canx1_with_antennas
+    >>> body = canx1_with_antennas()
+    >>> body.name, body.n_facets, body.is_convex
+    ('canx1-antennas', 732, False)
     """
     import trimesh
 

@@ -19,7 +19,34 @@ __all__ = ["band_terms", "magnitudes_to_signal", "read_spectrum"]
 
 def band_terms(per_material: xr.DataArray, bands: Sequence[str]) -> xr.DataArray:
     """Per-material band signals [m2 sr-1]: the solar-weighted band means of ``signal_material``
-    (:func:`sbrdf_xr.photometry.band_weights` normalised), ``wavelength`` replaced by ``band``."""
+    (:func:`sbrdf_xr.photometry.band_weights` normalised), ``wavelength`` replaced by ``band``.
+
+    Examples
+    --------
+    The grey sides (albedo 0.5 at every wavelength) of a unit cube have the same band
+    signal in every band; the red caps (albedo rising with wavelength) are brighter in R:
+
+    >>> import numpy as np, trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft, simulate
+    >>> from sbrdf_xr.material_schema import lambertian
+    >>> mesh = trimesh.creation.box()
+    >>> caps = np.abs(mesh.face_normals[:, 2]) > 0.5  # the +z and -z faces are red
+    >>> mesh.visual.face_colors = np.where(caps[:, None], [255, 0, 0, 255], [128, 128, 128, 255])
+    >>> box = load_spacecraft(mesh, {(255, 0, 0): "red", (128, 128, 128): "grey"})
+    >>> wl = np.linspace(400.0, 1000.0, 13)
+    >>> tables = {"grey": lambertian(0.5, wl, material="grey"),
+    ...           "red": lambertian(np.linspace(0.1, 0.8, 13), wl, material="red")}
+    >>> sun = [[0.6, 0.0, 0.8], [0.8, 0.0, 0.6]]
+    >>> obs = [[0.8, 0.0, 0.6], [0.0, 0.6, 0.8]]
+    >>> cube = simulate(Scene(box, tables, to_sun=sun, to_observer=obs,
+    ...                       outputs=("signal", "per_material")))
+    >>> from sbrdf_xr.invert import band_terms
+    >>> bands = band_terms(cube.signal_material, ["V", "R"])
+    >>> bands.dims, bands.attrs["units"]
+    (('geometry', 'material', 'band'), 'm2 sr-1')
+    >>> bands.isel(geometry=0).round(6).values.tolist()
+    [[0.076394, 0.076394], [0.042168, 0.061925]]
+    """
     from ..photometry import band_weights
 
     w = band_weights(list(bands), per_material["wavelength"].values, normalize=True)
@@ -41,6 +68,20 @@ def magnitudes_to_signal(
 
     Inverts :func:`sbrdf_xr.photometry.magnitudes` at 1 AU:
     ``S = d**2 10**(-0.4 (m - m_sun))``, ``sigma_S = S ln(10)/2.5 sigma_m``.
+
+    Examples
+    --------
+    V = 8 at 1000 km with the Sun's V = -26.768: ``S = 1e12 * 10**(-0.4 * 34.768)``:
+
+    >>> import xarray as xr
+    >>> from sbrdf_xr.invert import magnitudes_to_signal
+    >>> mags = xr.Dataset({"magnitude": ("band", [8.0, 7.6]),
+    ...                    "uncertainty": ("band", [0.02, 0.02])}, coords={"band": ["V", "R"]})
+    >>> signal, sigma = magnitudes_to_signal(mags, range_km=1000.0)
+    >>> signal.round(6).values.tolist(), signal.attrs["units"]
+    ([0.012381, 0.014961], 'm2 sr-1')
+    >>> round(float(sigma[0] / signal[0]), 6)  # ln(10) / 2.5 * 0.02
+    0.018421
     """
     from ..photometry import sun_magnitudes
 
@@ -71,7 +112,23 @@ def magnitudes_to_signal(
 
 def read_spectrum(path: str | os.PathLike[str]) -> tuple[xr.DataArray, xr.DataArray]:
     """A measured spectrum from CSV or netCDF: columns ``wavelength`` [nm], ``signal``
-    [m2 sr-1] and ``uncertainty`` (same units, > 0)."""
+    [m2 sr-1] and ``uncertainty`` (same units, > 0).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.invert import read_spectrum
+    >>> rows = "wavelength,signal,uncertainty\\n500,0.10,0.01\\n600,0.12,0.01\\n700,0.11,0.01\\n"
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = Path(tmp) / "spectrum.csv"
+    ...     _ = path.write_text(rows)
+    ...     signal, sigma = read_spectrum(path)
+    >>> signal.dims, signal.wavelength.values.tolist(), signal.values.tolist()
+    (('wavelength',), [500.0, 600.0, 700.0], [0.1, 0.12, 0.11])
+    >>> sigma.values.tolist()
+    [0.01, 0.01, 0.01]
+    """
     from pathlib import Path
 
     import pandas as pd
