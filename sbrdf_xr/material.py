@@ -29,6 +29,7 @@ from . import _lut, models
 from ._names import (
     ANGLE_DIMS,
     DELTA_THETA,
+    LUT_DIMS,
     MEASURED,
     PHI,
     SAMPLE,
@@ -127,6 +128,11 @@ def lookup(
     """
     _lut.check_method(method)
     material = validate_material(material, check_values=False)
+    if len(material.dims) != len(LUT_DIMS):
+        raise ValidationError(
+            f"material: {material.attrs.get('material', '')!r} is anisotropic (dims "
+            f"{material.dims}); look it up with lookup_anisotropic(..., psi=...)"
+        )
     angles = []
     for name, a in ((THETA_I, theta_i), (DELTA_THETA, delta_theta), (PHI, phi)):
         if not isinstance(a, xr.DataArray):
@@ -173,8 +179,10 @@ def lookup_anisotropic(
     The reference look-up of the layout of :func:`sbrdf_xr.models.render_anisotropic`:
     every ``psi`` slice is looked up as an isotropic table (:func:`lookup`, with the
     table's edges; ``method`` in the three table angles) and the slices are
-    interpolated linearly in ``psi``, which is periodic with period 180 deg (a grid
-    that ends at 180 wraps onto its start; otherwise ``psi`` is clamped to the grid).
+    interpolated linearly and periodically in ``psi`` (period 180 deg,
+    :func:`sbrdf_xr.anisotropy.psi_weights`: a grid ``[0, ..., 180]`` is closed, any
+    other wraps from its last node to its first).  No normal-incidence blend: an
+    anisotropic material depends on the observer's azimuth at ``theta_i = 0``.
 
     Parameters
     ----------
@@ -203,14 +211,13 @@ def lookup_anisotropic(
     ti, dt, ph, ps = np.broadcast_arrays(
         *(np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi, psi))
     )
+    from .anisotropy import psi_weights
+
     grid = np.asarray(material[PSI].values, dtype=np.float64)
-    x = np.mod(ps, 180.0)
-    if grid[-1] < 180.0:
-        x = np.clip(x, grid[0], grid[-1])
-    idx, w = _lut.axis_weights(grid, x.ravel(), "linear")
+    idx, w = psi_weights(grid, ps.ravel())
     grids = [np.asarray(material[d].values) for d in ANGLE_DIMS]
     values = np.asarray(material.values)
-    out = np.zeros((x.size, material.sizes[WAVELENGTH]))
+    out = np.zeros((ps.size, material.sizes[WAVELENGTH]))
     edges = _lut.table_edges(material.attrs)
     for k in range(grid.size):
         wk = np.where(idx == k, w, 0.0).sum(axis=1)
@@ -609,23 +616,48 @@ def hemispherical_reflectance(
     Returns
     -------
     xarray.DataArray
-        Dims ``(theta_i, wavelength)``, ``units = 1``.
+        Dims ``(theta_i, wavelength)``, ``units = 1``; for an anisotropic table
+        ``(theta_i, psi, wavelength)`` at the table's ``psi`` nodes: an observer on
+        the far side of the illumination plane sees the mirror geometry, whose tangent
+        is at ``-psi`` (:mod:`sbrdf_xr.anisotropy`), so the reflectance at ``psi`` is
+        the mean of the slice integrals at ``psi`` and ``-psi`` (each integrates one
+        side of the plane twice), the latter interpolated periodically.
     """
+    from ._names import PSI
+
     material = validate_material(material, check_values=False)
     grids = [np.asarray(material[d].values) for d in ANGLE_DIMS]
     ti = grids[0] if theta_i is None else np.atleast_1d(np.asarray(theta_i, dtype=np.float64))
-    rho = _lut.hemispherical_reflectance_kernel(
-        np.asarray(material.values),
-        *grids,
-        ti,
-        method,
-        zero_edges=_lut.table_edges(material.attrs),
-        normal_blend=_lut.table_normal_blend(material.attrs),
-    )
+
+    def kernel(values: np.ndarray) -> np.ndarray:
+        return _lut.hemispherical_reflectance_kernel(
+            values,
+            *grids,
+            ti,
+            method,
+            zero_edges=_lut.table_edges(material.attrs),
+            normal_blend=_lut.table_normal_blend(material.attrs),
+        )
+
+    coords = {THETA_I: (THETA_I, ti, attrs(THETA_I)), WAVELENGTH: material[WAVELENGTH]}
+    if PSI in material.dims:
+        from .anisotropy import psi_weights
+
+        values = np.asarray(material.values)
+        psi = np.asarray(material[PSI].values, dtype=np.float64)
+        half = np.stack([kernel(values[:, :, :, k, :]) for k in range(psi.size)], axis=1)
+        idx, w = psi_weights(psi, -psi)
+        mirror = np.einsum("tkpl,kp->tkl", half[:, idx, :], w)
+        rho = 0.5 * (half + mirror)
+        dims: tuple[str, ...] = (THETA_I, PSI, WAVELENGTH)
+        coords[PSI] = material[PSI]
+    else:
+        rho = kernel(np.asarray(material.values))
+        dims = (THETA_I, WAVELENGTH)
     out = xr.DataArray(
         rho,
-        dims=(THETA_I, WAVELENGTH),
-        coords={THETA_I: (THETA_I, ti, attrs(THETA_I)), WAVELENGTH: material[WAVELENGTH]},
+        dims=dims,
+        coords=coords,
         name="reflectance",
         attrs=attrs("reflectance", material=material.attrs.get("material", "")),
     )
@@ -634,7 +666,7 @@ def hemispherical_reflectance(
         warnings.warn(
             f"material {material.attrs.get('material', '')!r}: directional-hemispherical reflectance "
             f"reaches {rho[worst]:.3f} > 1 at theta_i = {ti[worst[0]]} deg, wavelength = "
-            f"{material[WAVELENGTH].values[worst[1]]} nm; the table does not conserve energy",
+            f"{material[WAVELENGTH].values[worst[-1]]} nm; the table does not conserve energy",
             NonPhysicalWarning,
             stacklevel=2,
         )
