@@ -60,6 +60,7 @@ __all__ = [
     "TANGENT_TOLERANCE",
     "illumination_azimuth",
     "project_tangents",
+    "psi_average",
     "psi_weights",
 ]
 
@@ -278,3 +279,47 @@ def psi_weights(grid: ArrayLike, psi: ArrayLike) -> tuple[NDArray[np.intp], NDAr
     idx = np.stack([i, j], axis=-1).reshape(*shape, 2)
     w = np.stack([1.0 - frac, frac], axis=-1).reshape(*shape, 2)
     return idx.astype(np.intp), w
+
+
+def psi_average(values: ArrayLike, grid: ArrayLike, axis: int = -1) -> NDArray[np.float64]:
+    """Mean over a period of ``psi`` of values on ``psi`` nodes, linear between them.
+
+    The exact mean of the periodic piecewise-linear interpolant of
+    :func:`psi_weights`: trapezoidal weights over the closed or wrapped grid.
+
+    Parameters
+    ----------
+    values : array_like
+        Values on the nodes along ``axis``.
+    grid : array_like, shape (n,)
+        ``psi`` nodes [degree] (as :func:`psi_weights`).
+    axis : int
+        The ``psi`` axis of ``values``.
+
+    Returns
+    -------
+    ndarray
+        ``values`` without ``axis``.
+
+    Examples
+    --------
+    >>> float(psi_average([1.0, 3.0], [0.0, 90.0]))
+    2.0
+    >>> float(psi_average([1.0, 3.0, 1.0], [0.0, 90.0, 180.0]))
+    2.0
+    """
+    g = np.asarray(grid, dtype=np.float64)
+    psi_weights(g, g[:1])  # validates the grid
+    v = np.moveaxis(np.asarray(values, dtype=np.float64), axis, -1)
+    if g.size == 1:
+        return v[..., 0]
+    closed = np.isclose(g[-1] - g[0], PSI_PERIOD, rtol=0.0, atol=1e-9)
+    nodes = g if closed else np.append(g, g[0] + PSI_PERIOD)
+    h = np.diff(nodes)
+    w = np.zeros(nodes.size)
+    w[:-1] += h / 2
+    w[1:] += h / 2
+    if not closed:
+        w[0] += w[-1]
+        w = w[:-1]
+    return v @ (w / PSI_PERIOD)

@@ -29,11 +29,13 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from . import sources
+from . import _aniso_kernels, sources
+from ._aniso_kernels import pack_anisotropic
 from ._kernels import PackedTables, pack_tables
 from ._lut import table_edges, table_normal_blend
-from ._names import BAND, MATERIAL, WAVELENGTH
+from ._names import ANGLE_DIMS, BAND, MATERIAL, PSI, WAVELENGTH
 from ._version import __version__
+from .anisotropy import psi_average
 from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS, BlockInputs
 from .errors import SceneError, ValidationError
 from .fingerprint import scene_fingerprint
@@ -77,6 +79,8 @@ class Terms:
         the first facet of the term.
     n_facets : ndarray of int, shape (T,)
         Facets merged into each term.
+    tangent : ndarray, shape (T, 3), optional
+        Unit tangents [1] (anisotropic materials; :mod:`sbrdf_xr.anisotropy`).
     """
 
     normal: np.ndarray
@@ -84,6 +88,7 @@ class Terms:
     material: np.ndarray
     facet: np.ndarray
     n_facets: np.ndarray
+    tangent: np.ndarray | None = None
 
     @property
     def size(self) -> int:
@@ -162,6 +167,8 @@ class Plan:
     estimate: Estimate
     steps: tuple[tuple[str, str], ...]
     attrs: Mapping[str, Any] = field(default_factory=dict)
+    #: Anisotropic tables by material index (:func:`sbrdf_xr._aniso_kernels.pack_anisotropic`).
+    anisotropic: Mapping[int, Any] = field(default_factory=dict)
     #: Products of the plan made on first use (the cube's coordinate template).
     cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -240,7 +247,7 @@ def _readonly(a: np.ndarray) -> np.ndarray:
 
 
 def _terms(
-    scene: Scene, shadowing: bool, steps: list[tuple[str, str]]
+    scene: Scene, shadowing: bool, steps: list[tuple[str, str]], aniso: frozenset[str] = frozenset()
 ) -> tuple[dict[str, np.ndarray], bool]:
     sc = scene.spacecraft
     may_merge = not shadowing
@@ -252,7 +259,7 @@ def _terms(
     f = sc.facets()
     n_fac = f.sizes["facet"]
     if merge:
-        m = sc.merged()
+        m = sc.merged(tangent_materials=aniso)
         term_of = np.asarray(m["facet_term"].values)
         first = np.full(m.sizes["term"], n_fac, dtype=np.int64)
         np.minimum.at(first, term_of, np.arange(n_fac))
@@ -262,6 +269,7 @@ def _terms(
             "material": np.asarray(m[MATERIAL].values),
             "facet": first,
             "n_facets": np.asarray(m["n_facets"].values),
+            "tangent": np.asarray(m["tangent"].values),
         }
         steps.append(
             (
@@ -278,6 +286,7 @@ def _terms(
             "material": np.asarray(f[MATERIAL].values),
             "facet": np.arange(n_fac),
             "n_facets": np.ones(n_fac, dtype=np.int64),
+            "tangent": np.asarray(f["tangent"].values),
         }
         steps.append(("facets", f"{n_fac} facets evaluated one by one ({why})"))
     return t, merge
@@ -478,7 +487,8 @@ def compile_plan(scene: Scene) -> Plan:
                 )
             )
 
-    raw, merged = _terms(scene, shadowing, steps)
+    aniso_names = frozenset(m for m, da in scene.materials.items() if PSI in da.dims)
+    raw, merged = _terms(scene, shadowing, steps, aniso_names)
     raw = _tilt(scene, raw, knobs["tilt_nodes"], steps)
     keep = _contributing(scene, raw["normal"])
     if not keep.all():
@@ -500,7 +510,14 @@ def compile_plan(scene: Scene) -> Plan:
     terms = Terms(
         *(
             _readonly(a[order])
-            for a in (raw["normal"], raw["area"], code, raw["facet"], raw["n_facets"])
+            for a in (
+                raw["normal"],
+                raw["area"],
+                code,
+                raw["facet"],
+                raw["n_facets"],
+                raw["tangent"],
+            )
         )
     )
 
@@ -516,6 +533,7 @@ def compile_plan(scene: Scene) -> Plan:
     spectral_asked = any(o in SPECTRAL_OUTPUTS for o in scene.outputs)
     pre = bool(scene.bands) and not spectral_asked and knobs["band_integration"] == "auto"
     dtype = np.dtype(knobs["dtype"])
+    aniso_tables: dict[int, Any] = {}
     if knobs["evaluation"] == "analytic":
         models = _models(scene, used)
         tables = pack_tables([], len(scene.bands) if pre else wl.size, dtype)
@@ -534,6 +552,14 @@ def compile_plan(scene: Scene) -> Plan:
             values = np.asarray(da.values)
             if pre:
                 values = np.asarray(values, dtype=np.float64) @ bw.T
+            if PSI in da.dims:  # its psi slices; the packed slot (psi[0]) is never read
+                aniso_tables[len(packed)] = pack_anisotropic(
+                    values,
+                    *(da[d].values for d in (*ANGLE_DIMS, PSI)),
+                    table_edges(scene.materials[m].attrs),
+                    dtype,
+                )
+                values = values[:, :, :, 0, :]
             packed.append(
                 (
                     values,
@@ -547,6 +573,8 @@ def compile_plan(scene: Scene) -> Plan:
             )
         tables = pack_tables(packed, len(scene.bands) if pre else wl.size, dtype)
         del packed
+        if aniso_tables:
+            steps.append(_aniso_kernels.plan_step(used, aniso_tables))
         res = (
             ""
             if knobs["table_theta_step"] is None
@@ -655,7 +683,8 @@ def compile_plan(scene: Scene) -> Plan:
             for m in used:
                 da = _table_on(scene.materials[m], wl, None)
                 th = np.asarray(da["theta_i"].values, dtype=np.float64)
-                rho = hemispherical_reflectance(da, th, warn=False).values
+                rho = hemispherical_reflectance(da, th, warn=False)
+                rho = psi_average(rho.values, da[PSI].values, 1) if PSI in rho.dims else rho.values
                 eps.append(_readonly(sources.kirchhoff_emissivity(rho)))
                 thetas.append(_readonly(th))
                 rad.append(_readonly(sources.planck(wl, _temperature(scene, m))))
@@ -779,6 +808,7 @@ def compile_plan(scene: Scene) -> Plan:
         estimate=est,
         steps=tuple(steps),
         attrs=MappingProxyType(attrs),
+        anisotropic=MappingProxyType(aniso_tables),
     )
     attrs["plan"] = str(plan)
     return plan
