@@ -20,6 +20,9 @@ For the unit facet normal ``N``, tangent ``t`` (made orthogonal to ``N``), bitan
   tangent's azimuth ``psi -> -psi``: ``psi`` is negated when ``o . p < 0``.
 * ``t`` and ``-t`` are the same tangent (the anisotropic GGX depends on ``(v.t)^2``
   and ``(v.b)^2`` only): ``psi`` is taken modulo 180 degree.
+* An observer within :func:`~sbrdf_xr.geometry.normal_incidence_tolerance` of the
+  plane (``phi = 0`` up to rounding) is not mirrored, so rounding does not pick
+  between ``psi`` and ``-psi`` (which describe the same reflectance there).
 
 So ``psi`` lies in ``[0, 180)`` degree and ``(theta_i, delta_theta, phi, psi)`` covers
 every geometry.  ``psi`` is periodic (180 is 0); it jumps from ``psi`` to ``-psi`` as
@@ -225,7 +228,8 @@ def illumination_azimuth(
     e_f = np.where(normal_inc[..., None], e_obs, e_sun)
     psi = np.degrees(np.arctan2(_dot(e_f, b), _dot(e_f, t)))
     op = _dot(o, np.cross(n, e_f))
-    psi = np.where(op < 0, -psi, psi)
+    # the mirror only off the plane: an observer in it (phi = 0 up to rounding) keeps psi
+    psi = np.where(op < -tol, -psi, psi)
     out = np.mod(psi, PSI_PERIOD)
     # mod of a tiny negative number rounds to the period itself
     return np.where(out >= PSI_PERIOD, 0.0, out).astype(dtype, copy=False)
