@@ -548,7 +548,13 @@ SAMPLE_ROTATION = "sample_rotation"
 
 
 def sample_rotation(measurements: xr.Dataset) -> float:
-    """The ``sample_rotation`` [degree] of a measurement set (attribute or coordinate)."""
+    """The ``sample_rotation`` [degree] of a measurement set (attribute or coordinate).
+
+    Examples
+    --------
+    >>> sample_rotation(xr.Dataset(attrs={"sample_rotation": 30}))
+    30.0
+    """
     if SAMPLE_ROTATION in measurements.coords:
         value = measurements[SAMPLE_ROTATION].values
     elif SAMPLE_ROTATION in measurements.attrs:

@@ -284,6 +284,15 @@ def face_tangents(mesh: trimesh.Trimesh, prop: str = TANGENT_ATTRIBUTE) -> np.nd
     Read from the trimesh face attribute ``prop``, or the PLY face property ``prop``
     (a list of 3 numbers per face), or the PLY face properties ``prop_x``, ``prop_y``,
     ``prop_z``.
+
+    Examples
+    --------
+    >>> box = trimesh.creation.box()
+    >>> face_tangents(box) is None
+    True
+    >>> box.face_attributes["tangent"] = np.tile([1.0, 0.0, 0.0], (12, 1))
+    >>> face_tangents(box).shape
+    (12, 3)
     """
     n = len(mesh.faces)
     vals: Any = None
