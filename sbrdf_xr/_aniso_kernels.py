@@ -33,11 +33,26 @@ from __future__ import annotations
 
 from typing import Any, NamedTuple
 
+import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from ._kernels import FusedSums, MaterialSums, PackedTables, fused_sums, material_sums, pack_tables
-from .anisotropy import illumination_azimuth, psi_weights
+from . import _lut
+from ._kernels import (
+    METHOD_CODES,
+    FusedSums,
+    MaterialSums,
+    PackedTables,
+    _axis,
+    _gather,
+    fused_sums,
+    material_sums,
+    pack_tables,
+)
+from .anisotropy import PSI_PERIOD, illumination_azimuth, psi_weights
+from .geometry import normal_incidence_tolerance
+
+_RAD2DEG = 180.0 / np.pi
 
 __all__ = ["AnisotropicTable", "anisotropic_sums", "pack_anisotropic", "plan_step", "reflected"]
 
@@ -148,8 +163,12 @@ def anisotropic_sums(
     fraction : ndarray, shape (G, F), optional
         Lit-and-visible area fraction of each facet [1]; default 1.
     kernel : {"numpy", "fused"}
-        :func:`sbrdf_xr._kernels.material_sums` per slice (the reference) or one
-        :func:`sbrdf_xr._kernels.fused_sums` call over the slices.
+        :func:`sbrdf_xr._kernels.material_sums` per slice (the reference), or
+        compiled: for ``nearest`` and ``linear`` a dedicated ``nogil`` numba kernel
+        (angles, ``psi``, the lit-and-visible test and the out-of-range policy per
+        geometry and facet, then the two ``psi`` slices gathered; it is tested against
+        the reference), for ``cubic`` one :func:`sbrdf_xr._kernels.fused_sums` call
+        over the slices (each clipped at zero as the reference).
 
     Returns
     -------
@@ -165,6 +184,8 @@ def anisotropic_sums(
     sig, pap = np.zeros((g, n_wl), dt), np.zeros((g, n_wl), dt)
     if f == 0 or g == 0:
         return MaterialSums(sig, pap, np.zeros(g), np.zeros(g))
+    if kernel == "fused" and method != "cubic":
+        return _compiled_sums(s, o, n, tangents, areas, table, method, fraction)
     cos_i, cos_r = s @ n.T, o @ n.T
     contributing = (cos_i > 0) & (cos_r > 0)
     base = np.where(contributing, 1.0, 0.0)
@@ -219,6 +240,196 @@ def anisotropic_sums(
             sig += r.signal
             pap += r.paper
     return MaterialSums(sig, pap, area, lit)
+
+
+@numba.njit(nogil=True, cache=True)
+def _aniso_fused(
+    s,
+    o,
+    normals,
+    tangents,
+    areas,
+    frac,
+    tables,
+    tgrid,
+    dgrid,
+    pgrid,
+    psi_nodes,
+    closed,
+    edges,
+    method,
+    tol,
+    edge_tol,
+    out_sig,
+    out_pap,
+    out_area,
+    out_lit,
+):  # pragma: no cover - compiled
+    """One anisotropic material, nearest or linear in the angles, linear in psi."""
+    n_geom = s.shape[0]
+    n_term = normals.shape[0]
+    n_wl = out_sig.shape[1]
+    has_frac = frac.shape[0] > 0
+    nt, nd, npp = tgrid.size, dgrid.size, pgrid.size
+    n_psi = psi_nodes.size
+    f = np.empty(n_wl, dtype=out_sig.dtype)
+    rows = np.empty(8, dtype=np.int64)
+    wn = np.empty(8, dtype=out_sig.dtype)
+    it = np.empty(4, dtype=np.int64)
+    idt = np.empty(4, dtype=np.int64)
+    iph = np.empty(4, dtype=np.int64)
+    wt = np.empty(4)
+    wdt = np.empty(4)
+    wph = np.empty(4)
+    for g in range(n_geom):
+        sx, sy, sz = s[g, 0], s[g, 1], s[g, 2]
+        ox, oy, oz = o[g, 0], o[g, 1], o[g, 2]
+        area_g = 0.0
+        lit_g = 0.0
+        for tt in range(n_term):
+            nx, ny, nz = normals[tt, 0], normals[tt, 1], normals[tt, 2]
+            ns = nx * sx + ny * sy + nz * sz
+            no = nx * ox + ny * oy + nz * oz
+            if not (ns > 0.0 and no > 0.0):
+                continue
+            a_eff = areas[tt]
+            if has_frac:
+                a_eff = a_eff * frac[g, tt]
+            a2d = a_eff * no
+            area_g += a2d
+            lit_g += a_eff
+            # angles of paper 000 Fig. 4, as geometry.facet_angles (and _kernels._fused_sums)
+            stx, sty, stz = sx - ns * nx, sy - ns * ny, sz - ns * nz
+            st_len = np.sqrt(stx * stx + sty * sty + stz * stz)
+            theta_i = np.arctan2(st_len, ns)
+            if st_len <= tol:
+                otx, oty, otz = ox - no * nx, oy - no * ny, oz - no * nz
+                ot_len = np.sqrt(otx * otx + oty * oty + otz * otz)
+                if ot_len > tol:
+                    ex, ey, ez = otx / ot_len, oty / ot_len, otz / ot_len
+                else:
+                    ax, ay, az = abs(nx), abs(ny), abs(nz)
+                    if ax <= ay and ax <= az:
+                        ex, ey, ez = 0.0, nz, -ny
+                    elif ay <= az:
+                        ex, ey, ez = -nz, 0.0, nx
+                    else:
+                        ex, ey, ez = ny, -nx, 0.0
+                    el = np.sqrt(ex * ex + ey * ey + ez * ez)
+                    ex, ey, ez = ex / el, ey / el, ez / el
+            else:
+                ex, ey, ez = -stx / st_len, -sty / st_len, -stz / st_len
+            px = ny * ez - nz * ey
+            py = nz * ex - nx * ez
+            pz = nx * ey - ny * ex
+            of = ox * ex + oy * ey + oz * ez
+            op = ox * px + oy * py + oz * pz
+            ti = theta_i * _RAD2DEG
+            dt = np.arctan2(of, no) * _RAD2DEG - ti
+            phi = np.arctan2(abs(op), np.hypot(of, no)) * _RAD2DEG
+            if (
+                (edges[0] and dt < dgrid[0] - edge_tol)
+                or (edges[1] and dt > dgrid[nd - 1] + edge_tol)
+                or (edges[2] and phi > pgrid[npp - 1] + edge_tol)
+            ):
+                continue
+            # psi (anisotropy.illumination_azimuth): tangent made orthogonal to the normal
+            tx, ty, tz = tangents[tt, 0], tangents[tt, 1], tangents[tt, 2]
+            tn = tx * nx + ty * ny + tz * nz
+            tx, ty, tz = tx - tn * nx, ty - tn * ny, tz - tn * nz
+            tl = np.sqrt(tx * tx + ty * ty + tz * tz)
+            tx, ty, tz = tx / tl, ty / tl, tz / tl
+            bx = ny * tz - nz * ty
+            by = nz * tx - nx * tz
+            bz = nx * ty - ny * tx
+            psi = np.arctan2(ex * bx + ey * by + ez * bz, ex * tx + ey * ty + ez * tz) * _RAD2DEG
+            if op < -tol:
+                psi = -psi
+            # periodic linear weights (anisotropy.psi_weights)
+            x = psi_nodes[0] + (psi - psi_nodes[0]) % PSI_PERIOD
+            if x >= psi_nodes[0] + PSI_PERIOD:
+                x = psi_nodes[0]
+            if n_psi == 1:
+                k0, k1, w1 = 0, 0, 0.0
+            else:
+                last = n_psi - 1 if closed else n_psi
+                k0 = 0
+                while k0 + 1 < last and psi_nodes[k0 + 1] <= x:
+                    k0 += 1
+                lo = psi_nodes[k0]
+                hi = psi_nodes[k0 + 1] if k0 + 1 < n_psi else psi_nodes[0] + PSI_PERIOD
+                k1 = k0 + 1 if k0 + 1 < n_psi else 0
+                w1 = (x - lo) / (hi - lo)
+                if w1 < 0.0:
+                    w1 = 0.0
+                elif w1 > 1.0:
+                    w1 = 1.0
+            kt = _axis(tgrid, 0, nt, ti, method, it, wt)
+            kd = _axis(dgrid, 0, nd, dt, method, idt, wdt)
+            kp = _axis(pgrid, 0, npp, phi, method, iph, wph)
+            nk = 0
+            for a in range(kt):
+                for b in range(kd):
+                    row0 = (it[a] * nd + idt[b]) * npp
+                    wab = wt[a] * wdt[b]
+                    for c in range(kp):
+                        rows[nk] = row0 + iph[c]
+                        wn[nk] = wab * wph[c]
+                        nk += 1
+            if w1 < 1.0:
+                _gather(
+                    tables[k0],
+                    rows,
+                    wn,
+                    nk,
+                    f,
+                    out_sig[g],
+                    out_pap[g],
+                    a2d * ns * (1.0 - w1),
+                    a2d * (1.0 - w1),
+                )
+            if w1 > 0.0:
+                _gather(
+                    tables[k1], rows, wn, nk, f, out_sig[g], out_pap[g], a2d * ns * w1, a2d * w1
+                )
+        out_area[g] = area_g
+        out_lit[g] = lit_g
+
+
+def _compiled_sums(s, o, n, tangents, areas, table, method, fraction):
+    """:func:`anisotropic_sums` with ``kernel="fused"`` and nearest or linear look-up."""
+    p = table.slices
+    g = s.shape[0]
+    dt = p.dtype
+    out_sig = np.zeros((g, p.n_spectral), dt)
+    out_pap = np.zeros((g, p.n_spectral), dt)
+    out_area, out_lit = np.zeros(g), np.zeros(g)
+    frac = np.zeros((0, 0)) if fraction is None else np.ascontiguousarray(fraction, np.float64)
+    psi = np.ascontiguousarray(table.psi, dtype=np.float64)
+    closed = bool(psi.size > 1 and np.isclose(psi[-1] - psi[0], PSI_PERIOD, rtol=0.0, atol=1e-9))
+    _aniso_fused(
+        np.ascontiguousarray(s),
+        np.ascontiguousarray(o),
+        np.ascontiguousarray(n),
+        np.ascontiguousarray(tangents, dtype=np.float64),
+        np.ascontiguousarray(areas, dtype=np.float64),
+        frac,
+        numba.typed.List(p.values),
+        p.tgrid[p.t_off[0] : p.t_off[1]],
+        p.dgrid[p.d_off[0] : p.d_off[1]],
+        p.pgrid[p.p_off[0] : p.p_off[1]],
+        psi,
+        closed,
+        np.array(table.zero_edges, dtype=np.bool_),
+        METHOD_CODES[method],
+        normal_incidence_tolerance(np.float64),
+        _lut.EDGE_TOL_DEG,
+        out_sig,
+        out_pap,
+        out_area,
+        out_lit,
+    )
+    return MaterialSums(out_sig, out_pap, out_area, out_lit)
 
 
 def reflected(
