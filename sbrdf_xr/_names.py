@@ -90,6 +90,10 @@ ATTRS: dict[str, dict[str, str]] = {
     MATERIAL: {"units": "1", "long_name": "material name"},
     "term": {"units": "1", "long_name": "index of a group of facets sharing normal and material"},
     "n_facets": {"units": "1", "long_name": "number of facets merged into the term"},
+    "tangent": {
+        "units": "1",
+        "long_name": "unit facet tangent in the body frame (anisotropic materials' alpha_x direction)",
+    },
     "facet_term": {"units": "1", "long_name": "term that each facet is merged into"},
     "lit_fraction": {
         "units": "1",

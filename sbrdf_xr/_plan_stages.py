@@ -15,7 +15,8 @@ import numpy as np
 import xarray as xr
 
 from . import sources
-from ._names import MATERIAL, WAVELENGTH
+from ._names import MATERIAL, PSI, WAVELENGTH
+from .anisotropy import psi_average
 from .errors import SceneError, ValidationError
 
 #: The scene being compiled (:class:`sbrdf_xr.scene.Scene`).
@@ -35,7 +36,10 @@ def readonly(a: np.ndarray) -> np.ndarray:
 
 
 def facet_terms(
-    scene: Scene, shadowing: bool, steps: list[tuple[str, str]]
+    scene: Scene,
+    shadowing: bool,
+    steps: list[tuple[str, str]],
+    aniso: frozenset[str] = frozenset(),
 ) -> tuple[dict[str, np.ndarray], bool]:
     sc = scene.spacecraft
     may_merge = not shadowing
@@ -47,7 +51,7 @@ def facet_terms(
     f = sc.facets()
     n_fac = f.sizes["facet"]
     if merge:
-        m = sc.merged()
+        m = sc.merged(tangent_materials=aniso)
         term_of = np.asarray(m["facet_term"].values)
         first = np.full(m.sizes["term"], n_fac, dtype=np.int64)
         np.minimum.at(first, term_of, np.arange(n_fac))
@@ -57,6 +61,7 @@ def facet_terms(
             "material": np.asarray(m[MATERIAL].values),
             "facet": first,
             "n_facets": np.asarray(m["n_facets"].values),
+            "tangent": np.asarray(m["tangent"].values),
         }
         steps.append(
             (
@@ -73,6 +78,7 @@ def facet_terms(
             "material": np.asarray(f[MATERIAL].values),
             "facet": np.arange(n_fac),
             "n_facets": np.ones(n_fac, dtype=np.int64),
+            "tangent": np.asarray(f["tangent"].values),
         }
         steps.append(("facets", f"{n_fac} facets evaluated one by one ({why})"))
     return t, merge
@@ -306,7 +312,12 @@ def effect_stage(
             for m in used:
                 da = table_on(scene.materials[m], wl, None)
                 th = np.asarray(da["theta_i"].values, dtype=np.float64)
-                rho = hemispherical_reflectance(da, th, warn=False).values
+                rho_da = hemispherical_reflectance(da, th, warn=False)
+                rho = (
+                    psi_average(rho_da.values, da[PSI].values, 1)
+                    if PSI in rho_da.dims
+                    else rho_da.values
+                )
                 eps.append(readonly(sources.kirchhoff_emissivity(rho)))
                 thetas.append(readonly(th))
                 rad.append(readonly(sources.planck(wl, temperature(scene, m))))

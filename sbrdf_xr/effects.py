@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from . import _kernels, sources
+from . import _aniso_kernels, _kernels, sources
 from ._names import BAND, MATERIAL, WAVELENGTH
 
 #: The compiled plan effects run on (:class:`sbrdf_xr.plan.Plan`, which imports this module).
@@ -228,6 +228,8 @@ def reflected(
     t = plan.terms
     if plan.knobs["evaluation"] == "analytic":
         return _analytic_sums(plan, to_source, block.to_observer, fraction, per_material)
+    if plan.anisotropic:  # tables with a psi axis (the isotropic ones keep their kernel)
+        return _aniso_kernels.reflected(plan, to_source, block.to_observer, fraction, per_material)
     if plan.knobs["kernel"] == "fused":
         return _kernels.fused_sums(
             to_source,
@@ -288,7 +290,8 @@ def _analytic_sums(
             continue
         eff = t.area[j] * (1.0 if fraction is None else fraction[on, j])
         model, kw = plan.models[t.material[j]]
-        f = model.brdf(n, s[on], o[on], wl, **kw)
+        tangent = {"tangent": t.tangent[j]} if getattr(model, "ANISOTROPIC", False) else {}
+        f = model.brdf(n, s[on], o[on], wl, **kw, **tangent)
         a2d = eff * cr[on]
         area[on] += a2d
         lit[on] += eff

@@ -164,11 +164,15 @@ def _mesh_sha(spacecraft: Any) -> str:
     mesh = getattr(spacecraft, "mesh", None)
     if mesh is None:
         return _sha(f"{type(spacecraft).__name__}:{spacecraft!r}")
-    return _sha(
+    parts = [
         _array_sha(np.asarray(mesh.vertices, dtype=np.float64)),
         _array_sha(np.asarray(mesh.faces, dtype=np.int64)),
         _array_sha(np.asarray(spacecraft.facet_material, dtype=str)),
-    )
+    ]
+    if getattr(spacecraft, "tangent_source", "default") != "default":
+        # tangents other than the default (a function of the mesh) change anisotropic terms
+        parts.append(_array_sha(np.asarray(spacecraft.facet_tangent, dtype=np.float64)))
+    return _sha(*parts)
 
 
 def scene_fingerprint(scene: Any) -> dict[str, str]:

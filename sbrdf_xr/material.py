@@ -19,6 +19,7 @@ This module wraps the pure-numpy kernels of :mod:`sbrdf_xr._lut`:
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -29,6 +30,7 @@ from . import _lut, models
 from ._names import (
     ANGLE_DIMS,
     DELTA_THETA,
+    LUT_DIMS,
     MEASURED,
     PHI,
     SAMPLE,
@@ -64,6 +66,7 @@ from .material_schema import (
 __all__ = [
     "LOOKUP_METHODS",
     "build_lut",
+    "build_lut_anisotropic",
     "constant_material",
     "hemispherical_reflectance",
     "lambertian",
@@ -74,6 +77,7 @@ __all__ = [
     "open_measurements",
     "paper_delta_theta_grid",
     "paper_phi_grid",
+    "sample_rotation",
     "to_netcdf",
     "validate_material",
     "validate_measurements",
@@ -127,6 +131,11 @@ def lookup(
     """
     _lut.check_method(method)
     material = validate_material(material, check_values=False)
+    if len(material.dims) != len(LUT_DIMS):
+        raise ValidationError(
+            f"material: {material.attrs.get('material', '')!r} is anisotropic (dims "
+            f"{material.dims}); look it up with lookup_anisotropic(..., psi=...)"
+        )
     angles = []
     for name, a in ((THETA_I, theta_i), (DELTA_THETA, delta_theta), (PHI, phi)):
         if not isinstance(a, xr.DataArray):
@@ -173,8 +182,10 @@ def lookup_anisotropic(
     The reference look-up of the layout of :func:`sbrdf_xr.models.render_anisotropic`:
     every ``psi`` slice is looked up as an isotropic table (:func:`lookup`, with the
     table's edges; ``method`` in the three table angles) and the slices are
-    interpolated linearly in ``psi``, which is periodic with period 180 deg (a grid
-    that ends at 180 wraps onto its start; otherwise ``psi`` is clamped to the grid).
+    interpolated linearly and periodically in ``psi`` (period 180 deg,
+    :func:`sbrdf_xr.anisotropy.psi_weights`: a grid ``[0, ..., 180]`` is closed, any
+    other wraps from its last node to its first).  No normal-incidence blend: an
+    anisotropic material depends on the observer's azimuth at ``theta_i = 0``.
 
     Parameters
     ----------
@@ -203,14 +214,13 @@ def lookup_anisotropic(
     ti, dt, ph, ps = np.broadcast_arrays(
         *(np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi, psi))
     )
+    from .anisotropy import psi_weights
+
     grid = np.asarray(material[PSI].values, dtype=np.float64)
-    x = np.mod(ps, 180.0)
-    if grid[-1] < 180.0:
-        x = np.clip(x, grid[0], grid[-1])
-    idx, w = _lut.axis_weights(grid, x.ravel(), "linear")
+    idx, w = psi_weights(grid, ps.ravel())
     grids = [np.asarray(material[d].values) for d in ANGLE_DIMS]
     values = np.asarray(material.values)
-    out = np.zeros((x.size, material.sizes[WAVELENGTH]))
+    out = np.zeros((ps.size, material.sizes[WAVELENGTH]))
     edges = _lut.table_edges(material.attrs)
     for k in range(grid.size):
         wk = np.where(idx == k, w, 0.0).sum(axis=1)
@@ -532,6 +542,153 @@ BELOW_NOISE = ("zero", "model")
 ENERGY_TOL = 1e-6
 
 
+#: Name of the attribute (or scalar coordinate) of a measurement set that says how
+#: the sample was turned about its normal: the ``psi`` of its illumination plane.
+SAMPLE_ROTATION = "sample_rotation"
+
+
+def sample_rotation(measurements: xr.Dataset) -> float:
+    """The ``sample_rotation`` [degree] of a measurement set (attribute or coordinate).
+
+    Examples
+    --------
+    >>> sample_rotation(xr.Dataset(attrs={"sample_rotation": 30}))
+    30.0
+    """
+    if SAMPLE_ROTATION in measurements.coords:
+        value = measurements[SAMPLE_ROTATION].values
+    elif SAMPLE_ROTATION in measurements.attrs:
+        value = measurements.attrs[SAMPLE_ROTATION]
+    else:
+        raise ValidationError(
+            f"measurements: a set of an anisotropic sample needs the attribute or scalar "
+            f"coordinate {SAMPLE_ROTATION!r} [degree]; got attributes {sorted(measurements.attrs)}"
+        )
+    arr = np.asarray(value, dtype=np.float64)
+    if arr.size != 1 or not np.isfinite(arr).all():
+        raise ValidationError(
+            f"{SAMPLE_ROTATION}: expected one finite angle [degree], got {value!r}"
+        )
+    return float(arr.reshape(-1)[0])
+
+
+def build_lut_anisotropic(
+    measurements: Sequence[xr.Dataset],
+    *,
+    n_phi: int = 41,
+    n_delta_theta: int = 41,
+    material: str | None = None,
+    dtype: type | np.dtype = np.float64,
+    normal_incidence: str = "paper",
+    **options: Any,
+) -> xr.DataArray:
+    """Anisotropic table from measurement sets taken at several sample rotations.
+
+    A goniospectrometer measures in a fixed illumination plane; turning an
+    anisotropic sample (brushed metal) about its normal turns its tangent relative to
+    that plane.  Each set is a measurement set as :func:`build_lut` takes (one
+    :func:`sbrdf_xr.goniometer.measure` run) with the attribute or scalar coordinate
+    ``sample_rotation`` [degree]: the azimuth ``psi`` of the illumination plane from
+    the sample's tangent (:mod:`sbrdf_xr.anisotropy`), the observer on the ``+p``
+    side of the plane (the side of :func:`sbrdf_xr.geometry.facet_vectors`).
+
+    Construction: every set becomes an isotropic table by :func:`build_lut`
+    (``options`` are passed on); the tables are resampled by :func:`lookup` (linear,
+    zero beyond each set's extents) onto common grids (``theta_i`` of the tables;
+    ``delta_theta`` by :func:`sbrdf_xr.construction.paper_delta_theta_grid` and
+    ``phi`` uniform, over the extremes of all sets, finer than one set's grid by
+    default since the lobe's extents change with the rotation); the slices are
+    stacked along ``psi`` at the rotations modulo 180 deg.  The look-up
+    (:func:`lookup_anisotropic`, the engine) interpolates linearly and periodically
+    in ``psi`` between the rotations.
+
+    Parameters
+    ----------
+    measurements : sequence of xarray.Dataset
+        At least two sets, at distinct rotations modulo 180 deg.
+    n_phi, n_delta_theta : int
+        Points of the common ``phi`` and ``delta_theta`` grids (odd for
+        ``delta_theta``).
+    material : str, optional
+        Name (default: the first set's).
+    dtype : numpy dtype
+    normal_incidence : {"paper", "symmetric"}
+        Passed to :func:`build_lut`; the anisotropic look-up itself has no
+        normal-incidence blend.
+    **options
+        Other :func:`build_lut` parameters (``theta_i``, ``below_noise``, ...).
+
+    Returns
+    -------
+    xarray.DataArray
+        Dims ``(theta_i, delta_theta, phi, psi, wavelength)``, validated.
+    """
+    from ._names import ANISO_LUT_DIMS, PSI
+    from .anisotropy import PSI_PERIOD
+
+    sets = list(measurements)
+    if len(sets) < 2:
+        raise ValidationError(
+            f"measurements: need sets at two or more sample rotations, got {len(sets)}"
+        )
+    rot = np.array([sample_rotation(m) for m in sets])
+    psi = np.mod(rot, PSI_PERIOD)
+    if np.unique(np.round(psi, 9)).size < psi.size:
+        raise ValidationError(
+            f"{SAMPLE_ROTATION}: rotations must differ modulo 180 deg, got {rot.tolist()}"
+        )
+    order = np.argsort(psi)
+    tables = [
+        build_lut(sets[k], n_phi=21, n_delta_theta=21, normal_incidence=normal_incidence, **options)
+        for k in order
+    ]
+    ti = np.asarray(tables[0][THETA_I].values)
+    wl = np.asarray(tables[0][WAVELENGTH].values)
+    for t in tables[1:]:
+        if not (np.array_equal(t[THETA_I].values, ti) and np.array_equal(t[WAVELENGTH].values, wl)):
+            raise ValidationError(
+                "measurements: every set must give the same theta_i grid and wavelengths"
+            )
+    lo = min(float(t[DELTA_THETA].values[0]) for t in tables)
+    hi = max(float(t[DELTA_THETA].values[-1]) for t in tables)
+    dt = paper_delta_theta_grid(lo, hi, n_delta_theta)
+    ph = np.linspace(0.0, max(float(t[PHI].values[-1]) for t in tables), n_phi)
+    grid = [xr.DataArray(g, dims=d) for g, d in ((ti, THETA_I), (dt, DELTA_THETA), (ph, PHI))]
+    slices = [
+        np.asarray(
+            lookup(t, *xr.broadcast(*grid), method="linear").transpose(*ANGLE_DIMS, WAVELENGTH)
+        )
+        for t in tables
+    ]
+    values = np.stack(slices, axis=3).astype(dtype)
+    edge_keys = ("edge_delta_theta_min", "edge_delta_theta_max", "edge_phi_max")
+    edges = {
+        k: "hold" if any(t.attrs.get(k, "zero") == "hold" for t in tables) else "zero"
+        for k in edge_keys
+    }
+    first = sets[order[0]]
+    coords = {
+        THETA_I: (THETA_I, ti, attrs(THETA_I)),
+        DELTA_THETA: (DELTA_THETA, dt, attrs(DELTA_THETA)),
+        PHI: (PHI, ph, attrs(PHI)),
+        PSI: (PSI, psi[order], attrs(PSI)),
+        WAVELENGTH: (WAVELENGTH, wl, attrs(WAVELENGTH)),
+    }
+    a = attrs(
+        SBRDF,
+        material=material or first.attrs.get("material", "unnamed"),
+        source=first.attrs.get("source", "measured"),
+        provenance=(
+            f"{first.attrs.get('provenance', '')}; built by sbrdf_xr.material.build_lut_anisotropic "
+            f"from {len(sets)} sample rotations {np.round(rot[order], 6).tolist()} deg"
+        ),
+        normal_incidence=normal_incidence,
+        **edges,
+    )
+    out = xr.DataArray(values, dims=ANISO_LUT_DIMS, coords=coords, name=SBRDF, attrs=a)
+    return validate_material(out)
+
+
 def _bound_grazing_rows(
     lut: np.ndarray,
     ti: np.ndarray,
@@ -609,23 +766,48 @@ def hemispherical_reflectance(
     Returns
     -------
     xarray.DataArray
-        Dims ``(theta_i, wavelength)``, ``units = 1``.
+        Dims ``(theta_i, wavelength)``, ``units = 1``; for an anisotropic table
+        ``(theta_i, psi, wavelength)`` at the table's ``psi`` nodes: an observer on
+        the far side of the illumination plane sees the mirror geometry, whose tangent
+        is at ``-psi`` (:mod:`sbrdf_xr.anisotropy`), so the reflectance at ``psi`` is
+        the mean of the slice integrals at ``psi`` and ``-psi`` (each integrates one
+        side of the plane twice), the latter interpolated periodically.
     """
+    from ._names import PSI
+
     material = validate_material(material, check_values=False)
     grids = [np.asarray(material[d].values) for d in ANGLE_DIMS]
     ti = grids[0] if theta_i is None else np.atleast_1d(np.asarray(theta_i, dtype=np.float64))
-    rho = _lut.hemispherical_reflectance_kernel(
-        np.asarray(material.values),
-        *grids,
-        ti,
-        method,
-        zero_edges=_lut.table_edges(material.attrs),
-        normal_blend=_lut.table_normal_blend(material.attrs),
-    )
+
+    def kernel(values: np.ndarray) -> np.ndarray:
+        return _lut.hemispherical_reflectance_kernel(
+            values,
+            *grids,
+            ti,
+            method,
+            zero_edges=_lut.table_edges(material.attrs),
+            normal_blend=_lut.table_normal_blend(material.attrs),
+        )
+
+    coords = {THETA_I: (THETA_I, ti, attrs(THETA_I)), WAVELENGTH: material[WAVELENGTH]}
+    if PSI in material.dims:
+        from .anisotropy import psi_weights
+
+        values = np.asarray(material.values)
+        psi = np.asarray(material[PSI].values, dtype=np.float64)
+        half = np.stack([kernel(values[:, :, :, k, :]) for k in range(psi.size)], axis=1)
+        idx, w = psi_weights(psi, -psi)
+        mirror = np.einsum("tkpl,kp->tkl", half[:, idx, :], w)
+        rho = 0.5 * (half + mirror)
+        dims: tuple[str, ...] = (THETA_I, PSI, WAVELENGTH)
+        coords[PSI] = material[PSI]
+    else:
+        rho = kernel(np.asarray(material.values))
+        dims = (THETA_I, WAVELENGTH)
     out = xr.DataArray(
         rho,
-        dims=(THETA_I, WAVELENGTH),
-        coords={THETA_I: (THETA_I, ti, attrs(THETA_I)), WAVELENGTH: material[WAVELENGTH]},
+        dims=dims,
+        coords=coords,
         name="reflectance",
         attrs=attrs("reflectance", material=material.attrs.get("material", "")),
     )
@@ -634,7 +816,7 @@ def hemispherical_reflectance(
         warnings.warn(
             f"material {material.attrs.get('material', '')!r}: directional-hemispherical reflectance "
             f"reaches {rho[worst]:.3f} > 1 at theta_i = {ti[worst[0]]} deg, wavelength = "
-            f"{material[WAVELENGTH].values[worst[1]]} nm; the table does not conserve energy",
+            f"{material[WAVELENGTH].values[worst[-1]]} nm; the table does not conserve energy",
             NonPhysicalWarning,
             stacklevel=2,
         )

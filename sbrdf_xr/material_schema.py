@@ -16,6 +16,7 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from ._names import (
+    ANISO_LUT_DIMS,
     DEGREE,
     DELTA_THETA,
     LUT_DIMS,
@@ -23,6 +24,7 @@ from ._names import (
     NM,
     PER_SR,
     PHI,
+    PSI,
     SAMPLE,
     SBRDF,
     THETA_I,
@@ -42,7 +44,7 @@ __all__ = [
 ]
 
 SOURCES = ("measured", "synthetic")
-_UNITS = {THETA_I: DEGREE, DELTA_THETA: DEGREE, PHI: DEGREE, WAVELENGTH: NM}
+_UNITS = {THETA_I: DEGREE, DELTA_THETA: DEGREE, PHI: DEGREE, PSI: DEGREE, WAVELENGTH: NM}
 
 
 # ------------------------------------------------------------------ schema
@@ -85,7 +87,9 @@ def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.Data
     -------
     xarray.DataArray
         ``da`` with its dims in the canonical order ``(theta_i, delta_theta, phi,
-        wavelength)`` (a transpose, never a change of values).
+        wavelength)`` (a transpose, never a change of values); an anisotropic table
+        (:mod:`sbrdf_xr.anisotropy`) has the dims ``(theta_i, delta_theta, phi, psi,
+        wavelength)``, ``psi`` strictly increasing in ``[0, 180]`` degree.
 
     Raises
     ------
@@ -96,10 +100,14 @@ def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.Data
     """
     if not isinstance(da, xr.DataArray):
         raise ValidationError(f"material: expected an xarray.DataArray, got {type(da).__name__}")
-    if set(da.dims) != set(LUT_DIMS) or len(da.dims) != len(LUT_DIMS):
-        raise ValidationError(f"material: dims must be {LUT_DIMS}, got {da.dims}")
-    da = da.transpose(*LUT_DIMS)
-    for dim in LUT_DIMS:
+    dims = ANISO_LUT_DIMS if PSI in da.dims else LUT_DIMS
+    if set(da.dims) != set(dims) or len(da.dims) != len(dims):
+        raise ValidationError(
+            f"material: dims must be {LUT_DIMS} (or {ANISO_LUT_DIMS} for an anisotropic "
+            f"table), got {da.dims}"
+        )
+    da = da.transpose(*dims)
+    for dim in dims:
         if dim not in da.coords:
             raise ValidationError(f"{dim}: coordinate is missing")
         _check_coord(dim, np.asarray(da[dim].values))
@@ -114,6 +122,10 @@ def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.Data
     ph = da[PHI].values
     if ph[0] < 0 or ph[-1] > 90:
         raise ValidationError(f"phi: must lie in [0, 90] degree, got [{ph[0]}, {ph[-1]}]")
+    if PSI in da.dims:
+        ps = da[PSI].values
+        if ps[0] < 0 or ps[-1] > 180:
+            raise ValidationError(f"psi: must lie in [0, 180] degree, got [{ps[0]}, {ps[-1]}]")
     if da[WAVELENGTH].values[0] <= 0:
         raise ValidationError("wavelength: must be positive")
     if "source" in da.attrs:

@@ -203,13 +203,23 @@ class _Labelled:
         self.faces: list[np.ndarray] = []
         self.rgb: list[np.ndarray] = []  # (n, 3) int, -1 where unknown
         self.names: list[list[np.ndarray]] = []  # per part: candidate name arrays (object)
+        self.tangents: list[np.ndarray] = []  # (n, 3) float, NaN where the file has none
+        self.tangent = np.zeros((0, 3))
         self.rgb_bits = 8
         self.offset = 0
 
     def add(
-        self, vertices: np.ndarray, faces: np.ndarray, rgb: np.ndarray | None, names: list[Any]
+        self,
+        vertices: np.ndarray,
+        faces: np.ndarray,
+        rgb: np.ndarray | None,
+        names: list[Any],
+        tangents: np.ndarray | None = None,
     ) -> None:
         n = len(faces)
+        self.tangents.append(
+            np.full((n, 3), np.nan) if tangents is None else np.asarray(tangents, np.float64)
+        )
         self.vertices.append(np.asarray(vertices, dtype=np.float64).reshape(-1, 3))
         self.faces.append(np.asarray(faces, dtype=np.int64).reshape(-1, 3) + self.offset)
         self.offset += len(self.vertices[-1])
@@ -235,6 +245,7 @@ class _Labelled:
                 for c, f in zip(self.names, self.faces, strict=True)
             ]
             cands.append(np.concatenate(parts))
+        self.tangent = np.concatenate(self.tangents)
         return (
             np.concatenate(self.vertices),
             np.concatenate(self.faces),
@@ -259,6 +270,58 @@ def _face_property(mesh: trimesh.Trimesh, prop: str) -> np.ndarray:
                 f"face_property: the mesh has no face property {prop!r}; available: {available}"
             )
     return vals.reshape(len(mesh.faces), -1)[:, 0]
+
+
+#: Name of the per-face tangent attribute read from meshes (a trimesh face attribute
+#: or a PLY face property of 3 values, or the three properties ``tangent_x``,
+#: ``tangent_y``, ``tangent_z``).
+TANGENT_ATTRIBUTE = "tangent"
+
+
+def face_tangents(mesh: trimesh.Trimesh, prop: str = TANGENT_ATTRIBUTE) -> np.ndarray | None:
+    """Per-face tangent directions a mesh carries, shape (n_faces, 3), or None.
+
+    Read from the trimesh face attribute ``prop``, or the PLY face property ``prop``
+    (a list of 3 numbers per face), or the PLY face properties ``prop_x``, ``prop_y``,
+    ``prop_z``.
+
+    Examples
+    --------
+    >>> box = trimesh.creation.box()
+    >>> face_tangents(box) is None
+    True
+    >>> box.face_attributes["tangent"] = np.tile([1.0, 0.0, 0.0], (12, 1))
+    >>> face_tangents(box).shape
+    (12, 3)
+    """
+    n = len(mesh.faces)
+    vals: Any = None
+    fa = getattr(mesh, "face_attributes", {}) or {}
+    raw = mesh.metadata.get("_ply_raw", {}).get("face", {}).get("data")
+    names = _ply_face_props(raw)
+    if prop in fa:
+        vals = fa[prop]
+    elif prop in names:
+        vals = raw[prop]
+        if isinstance(raw, np.ndarray) and vals.dtype.names and "f1" in vals.dtype.names:
+            vals = vals["f1"]  # binary PLY list property: (count, values)
+    elif all(f"{prop}_{c}" in names or f"{prop}_{c}" in fa for c in "xyz"):
+        cols = [fa.get(f"{prop}_{c}", None) for c in "xyz"]
+        vals = np.column_stack(
+            [
+                np.asarray(raw[f"{prop}_{c}"]) if v is None else v
+                for v, c in zip(cols, "xyz", strict=True)
+            ]
+        )
+    if vals is None:
+        return None
+    arr = np.asarray(vals, dtype=np.float64)
+    if arr.shape != (n, 3):
+        raise MeshError(
+            f"{prop}: the per-face tangent attribute must hold 3 numbers per facet "
+            f"(shape ({n}, 3)), got shape {arr.shape}"
+        )
+    return arr
 
 
 def _ply_face_props(raw: Any) -> set[str]:
@@ -331,7 +394,10 @@ def read_mesh(
             rgb, mat_name = _visual_labels(geom)
             prop = _face_property(geom, face_property) if face_property else None
             verts = trimesh.transform_points(np.asarray(geom.vertices, dtype=np.float64), transform)
-            out.add(verts, geom.faces, rgb, [prop, mat_name, geom_name, node])
+            tang = face_tangents(geom)
+            if tang is not None:  # directions turn with the node, lengths do not matter
+                tang = tang @ np.asarray(transform, dtype=np.float64)[:3, :3].T
+            out.add(verts, geom.faces, rgb, [prop, mat_name, geom_name, node], tang)
         if not out.faces:
             raise MeshError(
                 "the mesh source holds no triangle mesh (only "
@@ -349,7 +415,7 @@ def read_mesh(
         rgb = stl
         out.rgb_bits = 5
     prop = _face_property(obj, face_property) if face_property else None
-    out.add(obj.vertices, obj.faces, rgb, [prop, mat_name])
+    out.add(obj.vertices, obj.faces, rgb, [prop, mat_name], face_tangents(obj))
     return out, default_name or obj.metadata.get("name")
 
 

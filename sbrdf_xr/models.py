@@ -187,11 +187,17 @@ def spectra(
     return mod.brdf_angles(theta_i, delta_theta, phi, wl, **kw)
 
 
-def spectrum_function(spec: xr.Dataset) -> Any:
-    """``func(theta_i, delta_theta, phi) -> spectra`` of a model material (for the goniometer)."""
+def spectrum_function(spec: xr.Dataset, psi: float | None = None) -> Any:
+    """``func(theta_i, delta_theta, phi) -> spectra`` of a model material (for the goniometer).
+
+    ``psi`` [degree]: for an anisotropic model, the azimuth of the illumination plane
+    from the sample's tangent (a sample rotation, :func:`sbrdf_xr.material.build_lut_anisotropic`).
+    """
 
     def func(ti: np.ndarray, dt: np.ndarray, ph: np.ndarray) -> np.ndarray:
-        return spectra(spec, ti, dt, ph)
+        if psi is None:
+            return spectra(spec, ti, dt, ph)
+        return spectra(spec, ti, dt, ph, psi=np.full(np.shape(ti), float(psi)))
 
     return func
 

@@ -28,9 +28,11 @@ from typing import Any
 
 import numpy as np
 
+from . import _aniso_kernels
+from ._aniso_kernels import pack_anisotropic
 from ._kernels import PackedTables, pack_tables
 from ._lut import table_edges, table_normal_blend
-from ._names import BAND, MATERIAL, WAVELENGTH
+from ._names import ANGLE_DIMS, BAND, MATERIAL, PSI, WAVELENGTH
 from ._plan_stages import (
     band_weights_of,
     common_wavelength,
@@ -82,6 +84,8 @@ class Terms:
         the first facet of the term.
     n_facets : ndarray of int, shape (T,)
         Facets merged into each term.
+    tangent : ndarray, shape (T, 3), optional
+        Unit tangents [1] (anisotropic materials; :mod:`sbrdf_xr.anisotropy`).
 
     Examples
     --------
@@ -107,6 +111,7 @@ class Terms:
     material: np.ndarray
     facet: np.ndarray
     n_facets: np.ndarray
+    tangent: np.ndarray | None = None
 
     @property
     def size(self) -> int:
@@ -244,6 +249,8 @@ class Plan:
     estimate: Estimate
     steps: tuple[tuple[str, str], ...]
     attrs: Mapping[str, Any] = field(default_factory=dict)
+    #: Anisotropic tables by material index (:func:`sbrdf_xr._aniso_kernels.pack_anisotropic`).
+    anisotropic: Mapping[int, Any] = field(default_factory=dict)
     #: Products of the plan made on first use (the cube's coordinate template).
     cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -382,7 +389,8 @@ def compile_plan(scene: Scene) -> Plan:
                 )
             )
 
-    raw, merged = facet_terms(scene, shadowing, steps)
+    aniso_names = frozenset(m for m, da in scene.materials.items() if PSI in da.dims)
+    raw, merged = facet_terms(scene, shadowing, steps, aniso_names)
     raw = tilted_terms(scene, raw, knobs["tilt_nodes"], steps)
     keep = contributing_terms(scene, raw["normal"])
     if not keep.all():
@@ -404,7 +412,14 @@ def compile_plan(scene: Scene) -> Plan:
     terms = Terms(
         *(
             readonly(a[order])
-            for a in (raw["normal"], raw["area"], code, raw["facet"], raw["n_facets"])
+            for a in (
+                raw["normal"],
+                raw["area"],
+                code,
+                raw["facet"],
+                raw["n_facets"],
+                raw["tangent"],
+            )
         )
     )
 
@@ -420,6 +435,7 @@ def compile_plan(scene: Scene) -> Plan:
     spectral_asked = any(o in SPECTRAL_OUTPUTS for o in scene.outputs)
     pre = bool(scene.bands) and not spectral_asked and knobs["band_integration"] == "auto"
     dtype = np.dtype(knobs["dtype"])
+    aniso_tables: dict[int, Any] = {}
     if knobs["evaluation"] == "analytic":
         models = material_models(scene, used)
         tables = pack_tables([], len(scene.bands) if pre else wl.size, dtype)
@@ -438,6 +454,14 @@ def compile_plan(scene: Scene) -> Plan:
             values = np.asarray(da.values)
             if pre:
                 values = np.asarray(values, dtype=np.float64) @ bw.T
+            if PSI in da.dims:  # its psi slices; the packed slot (psi[0]) is never read
+                aniso_tables[len(packed)] = pack_anisotropic(
+                    values,
+                    *(da[d].values for d in (*ANGLE_DIMS, PSI)),
+                    table_edges(scene.materials[m].attrs),
+                    dtype,
+                )
+                values = values[:, :, :, 0, :]
             packed.append(
                 (
                     values,
@@ -451,6 +475,8 @@ def compile_plan(scene: Scene) -> Plan:
             )
         tables = pack_tables(packed, len(scene.bands) if pre else wl.size, dtype)
         del packed
+        if aniso_tables:
+            steps.append(_aniso_kernels.plan_step(used, aniso_tables))
         res = (
             ""
             if knobs["table_theta_step"] is None
@@ -597,6 +623,7 @@ def compile_plan(scene: Scene) -> Plan:
         estimate=est,
         steps=tuple(steps),
         attrs=MappingProxyType(attrs),
+        anisotropic=MappingProxyType(aniso_tables),
     )
     attrs["plan"] = str(plan)
     return plan

@@ -59,6 +59,7 @@ from numpy.typing import NDArray
 
 from . import _catalog_index
 from ._names import FACET, MATERIAL, VECTOR, attrs
+from .anisotropy import DEFAULT_TANGENT_DIRECTION, project_tangents
 from .errors import CatalogError, MeshError, MeshRepairWarning, ValidationError
 from .mesh_io import (
     LENGTH_UNITS,
@@ -119,6 +120,7 @@ def load_spacecraft(
     known_materials: Iterable[str] | None = None,
     face_property: str | None = None,
     file_type: str | None = None,
+    tangent: Any = None,
 ) -> Spacecraft:
     """Load a triangulated spacecraft model and label every facet with a material.
 
@@ -150,6 +152,16 @@ def load_spacecraft(
         Name of a per-face property (PLY) or face attribute holding the facet labels.
     file_type : str, optional
         Format of a file without a telling extension (``"stl"``, ``"ply"``, ...).
+    tangent : array_like, shape (3,) or (n_facets, 3), optional
+        Facet tangents for anisotropic materials (:mod:`sbrdf_xr.anisotropy`): a
+        body-frame direction [1] projected onto every facet, or one direction per
+        facet of the mesh as read.  Without it, the mesh's per-face ``tangent``
+        attribute if it has one (:func:`sbrdf_xr.mesh_io.face_tangents`; faces
+        without a valid one take the default), else the default direction
+        (:data:`sbrdf_xr.anisotropy.DEFAULT_TANGENT_DIRECTION`).  Directions parallel
+        to a facet's normal take the documented fallback of
+        :func:`sbrdf_xr.anisotropy.project_tangents`.  Isotropic materials ignore
+        tangents.
 
     Returns
     -------
@@ -193,9 +205,34 @@ def load_spacecraft(
         material = label_faces(labelled, rgb, names, colours, name_map)
     with np.errstate(invalid="ignore", over="ignore"):
         vertices = vertices * factor
-    mesh, material = clean_mesh(vertices, faces, material, repair)
+    source = "default"
+    if tangent is not None:
+        direction = np.asarray(tangent, dtype=np.float64)
+        if direction.ndim == 2 and direction.shape != (len(faces), 3):
+            raise ValidationError(
+                f"tangent: expected one direction (3,) or one per facet ({len(faces)}, 3), "
+                f"got shape {direction.shape}"
+            )
+        source = "per facet" if direction.ndim == 2 else "direction"
+        direction = np.broadcast_to(direction, (len(faces), 3))
+    else:
+        direction = labelled.tangent
+        have = np.isfinite(direction).all(axis=1) & (np.linalg.norm(direction, axis=1) > 0)
+        direction = np.where(have[:, None], direction, np.asarray(DEFAULT_TANGENT_DIRECTION))
+        if have.any():
+            source = "mesh attribute"
+    # clean_mesh drops and adds facets: follow every facet's origin through it
+    mesh, origin = clean_mesh(vertices, faces, np.arange(len(faces)), repair)
+    origin = np.asarray(origin, dtype=np.int64)
     palette = {m: c for c, m in colours.items()}
-    return Spacecraft(mesh, material, name=name or default_name or "spacecraft", colors=palette)
+    return Spacecraft(
+        mesh,
+        material[origin],
+        name=name or default_name or "spacecraft",
+        colors=palette,
+        tangent=direction[origin],
+        tangent_source=source,
+    )
 
 
 class Spacecraft:
@@ -215,6 +252,15 @@ class Spacecraft:
         Name of the spacecraft.
     colors : mapping of str to (r, g, b), optional
         Display colour of each material (0-255), used by :meth:`plot`.
+    tangent : array_like, shape (3,) or (n_facets, 3), optional
+        Tangent direction(s) [1] for anisotropic materials, projected onto every facet
+        (:func:`sbrdf_xr.anisotropy.project_tangents`, with its fallback for
+        directions along the normal); default
+        :data:`sbrdf_xr.anisotropy.DEFAULT_TANGENT_DIRECTION`.  Kept as
+        :attr:`facet_tangent`, unit vectors orthogonal to the facet normals.
+    tangent_source : str, optional
+        Where the tangents come from (``"default"``, ``"direction"``, ``"per facet"``,
+        ``"mesh attribute"``), for display; inferred when omitted.
     """
 
     def __init__(
@@ -224,6 +270,8 @@ class Spacecraft:
         *,
         name: str = "spacecraft",
         colors: Mapping[str, Color] | None = None,
+        tangent: Any = None,
+        tangent_source: str | None = None,
     ) -> None:
         if not isinstance(mesh, trimesh.Trimesh):
             raise ValidationError(f"mesh: expected a trimesh.Trimesh, got {type(mesh).__name__}")
@@ -238,6 +286,47 @@ class Spacecraft:
         self.name = str(name)
         self.colors: dict[str, Color] = dict(colors or {})
         self._cache: dict[str, Any] = {}
+        d = None if tangent is None else np.asarray(tangent, dtype=np.float64)
+        if d is not None and d.shape not in ((3,), (len(mesh.faces), 3)):
+            raise ValidationError(
+                f"tangent: expected one direction (3,) or one per facet ({len(mesh.faces)}, 3), "
+                f"got shape {d.shape}"
+            )
+        t = project_tangents(np.asarray(mesh.face_normals, dtype=np.float64), d)
+        t.setflags(write=False)
+        #: Unit tangent of every facet, orthogonal to its normal [1], shape (n_facets, 3).
+        self.facet_tangent: NDArray[np.float64] = t
+        self.tangent_source = tangent_source or (
+            "default" if d is None else "direction" if d.ndim == 1 else "per facet"
+        )
+
+    def with_tangent(self, tangent: Any) -> Spacecraft:
+        """The same spacecraft with other facet tangents (see the class parameters).
+
+        Parameters
+        ----------
+        tangent : array_like, shape (3,) or (n_facets, 3)
+            Body-frame direction [1], or one per facet.
+
+        Returns
+        -------
+        Spacecraft
+            Sharing the mesh and materials of this one.
+
+        Examples
+        --------
+        >>> import trimesh
+        >>> box = Spacecraft(trimesh.creation.box(), ["paint"] * 12)
+        >>> box.mesh.face_normals[:2].tolist()
+        [[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]]
+        >>> box.facet_tangent[:2].tolist()  # the default x, or y on the x faces
+        [[0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]
+        >>> box.with_tangent((0, 0, 1)).facet_tangent[:2].tolist()
+        [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0]]
+        """
+        return Spacecraft(
+            self.mesh, self.facet_material, name=self.name, colors=self.colors, tangent=tangent
+        )
 
     def __repr__(self) -> str:
         return (
@@ -295,7 +384,8 @@ class Spacecraft:
         -------
         xarray.Dataset
             Over dims ``facet`` and ``xyz``: ``normal (facet, xyz)`` [1], ``area (facet)``
-            [m2], ``centroid (facet, xyz)`` [m] and ``material (facet)`` (names).
+            [m2], ``centroid (facet, xyz)`` [m], ``material (facet)`` (names) and
+            ``tangent (facet, xyz)`` [1] (:attr:`facet_tangent`).
         """
         mesh = self.mesh
         ds = xr.Dataset(
@@ -312,6 +402,7 @@ class Spacecraft:
                     attrs("centroid"),
                 ),
                 MATERIAL: ((FACET,), self.facet_material.copy(), attrs(MATERIAL)),
+                "tangent": ((FACET, VECTOR), self.facet_tangent.copy(), attrs("tangent")),
             },
             coords={
                 FACET: (FACET, np.arange(self.n_facets), attrs(FACET)),
@@ -321,7 +412,9 @@ class Spacecraft:
         )
         return ds
 
-    def merged(self, tolerance: float = NORMAL_TOLERANCE) -> xr.Dataset:
+    def merged(
+        self, tolerance: float = NORMAL_TOLERANCE, tangent_materials: Iterable[str] = ()
+    ) -> xr.Dataset:
         """Collapse facets that share (normal, material) into terms with summed area.
 
         Any facet sum whose summand depends on a facet only through its normal, material and
@@ -336,12 +429,17 @@ class Spacecraft:
             round to the same grid point of spacing ``tolerance`` per component [1]; member
             normals then differ from the term normal by less than ``tolerance * sqrt(3)``.
             Exactly equal normals always share a term.
+        tangent_materials : iterable of str
+            Anisotropic materials: their facets share a term only if their tangents
+            (``t`` and ``-t`` alike) also round to the same grid point.
 
         Returns
         -------
         xarray.Dataset
             Over dim ``term``: ``normal (term, xyz)`` (area-weighted mean of the members,
-            renormalised), ``area (term)`` [m2], ``material (term)``, ``n_facets (term)``; and
+            renormalised), ``area (term)`` [m2], ``material (term)``, ``n_facets (term)``,
+            ``tangent (term, xyz)`` (the first member's, made orthogonal to the term
+            normal); and
             the mapping back ``facet_term (facet)``, the term of every facet.  Terms are in
             order of their first facet.
         """
@@ -352,8 +450,17 @@ class Spacecraft:
         normals = np.asarray(self.mesh.face_normals, dtype=np.float64)
         area = np.asarray(self.mesh.area_faces, dtype=np.float64)
         mat_names, mat_code = np.unique(self.facet_material, return_inverse=True)
+        aniso = np.isin(self.facet_material, list(tangent_materials))
+        tang = self.facet_tangent
+        # t and -t are the same tangent: the sign that makes the largest component positive
+        sign = np.sign(tang[np.arange(len(tang)), np.argmax(np.abs(tang), axis=1)])
+        t_key = np.where(aniso[:, None], np.round(sign[:, None] * tang / tolerance), 0)
         keys = np.column_stack(
-            [mat_code.reshape(-1), np.round(normals / tolerance).astype(np.int64)]
+            [
+                mat_code.reshape(-1),
+                np.round(normals / tolerance).astype(np.int64),
+                t_key.astype(np.int64),
+            ]
         )
         _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
         order = np.argsort(first, kind="stable")  # terms in order of first facet
@@ -372,6 +479,12 @@ class Spacecraft:
         t_normal = np.divide(t_normal, norm, out=np.zeros_like(t_normal), where=norm > 0)
         n_facets = np.bincount(term, minlength=n_terms)
         t_material = mat_names[mat_code.reshape(-1)[np.asarray(first)[order]]]
+        first_t = tang[np.asarray(first)[order]]
+        t_tangent = (
+            project_tangents(np.where(norm > 0, t_normal, [0.0, 0.0, 1.0]), first_t)
+            if n_terms
+            else np.zeros((0, 3))
+        )
         return xr.Dataset(
             {
                 "normal": (("term", VECTOR), t_normal, attrs("normal")),
@@ -382,6 +495,7 @@ class Spacecraft:
                 ),
                 MATERIAL: (("term",), t_material, attrs(MATERIAL)),
                 "n_facets": (("term",), n_facets, attrs("n_facets")),
+                "tangent": (("term", VECTOR), t_tangent, attrs("tangent")),
                 "facet_term": ((FACET,), term, attrs("facet_term")),
             },
             coords={

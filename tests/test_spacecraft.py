@@ -565,3 +565,102 @@ def test_read_material_map_errors(tmp_path):
         "alu": "a",
         3: "a",
     }
+
+
+# --------------------------------------------------------------------------- tangents
+
+
+def _tangent_box() -> trimesh.Trimesh:
+    box = trimesh.creation.box()
+    rng = np.random.default_rng(7)
+    box.face_attributes["tangent"] = rng.normal(size=(len(box.faces), 3))
+    return box
+
+
+def _projected(normals, d):
+    t = d - np.einsum("fk,fk->f", d, normals)[:, None] * normals
+    return t / np.linalg.norm(t, axis=1, keepdims=True)
+
+
+def test_tangents_default_direction_and_per_facet():
+    box = trimesh.creation.box()
+    n = box.face_normals
+    craft = sc.load_spacecraft(box, material="paint")
+    assert craft.tangent_source == "default"
+    # body x projected; on the +-x faces the fallback: y (the axis least aligned with x)
+    want = np.where(np.abs(n[:, :1]) > 0.5, [0.0, 1.0, 0.0], [1.0, 0.0, 0.0])
+    np.testing.assert_array_equal(craft.facet_tangent, want)
+    craft = sc.load_spacecraft(box, material="paint", tangent=(1.0, 2.0, 3.0))
+    assert craft.tangent_source == "direction"
+    np.testing.assert_allclose(
+        craft.facet_tangent, _projected(n, np.array([[1.0, 2, 3]])), rtol=1e-14
+    )
+    ds = craft.facets()
+    assert ds.tangent.dims == ("facet", "xyz") and ds.tangent.attrs["units"] == "1"
+    assert np.abs(np.einsum("fk,fk->f", ds.tangent.values, ds.normal.values)).max() < 1e-15
+    with pytest.raises(ValidationError, match="tangent"):
+        sc.load_spacecraft(box, material="paint", tangent=np.ones((5, 3)))
+
+
+def test_tangents_from_a_mesh_attribute_and_a_ply_file(tmp_path):
+    box = _tangent_box()
+    want = _projected(box.face_normals, np.asarray(box.face_attributes["tangent"]))
+    craft = sc.load_spacecraft(box, material="paint")
+    assert craft.tangent_source == "mesh attribute"
+    np.testing.assert_allclose(craft.facet_tangent, want, rtol=1e-14)
+    for encoding in ("binary", "ascii"):
+        path = tmp_path / f"box-{encoding}.ply"
+        path.write_bytes(box.export(file_type="ply", encoding=encoding))
+        craft = sc.load_spacecraft(path, material="paint")
+        # ASCII PLY keeps about 8 significant digits
+        rtol = 1e-12 if encoding == "binary" else 1e-6
+        np.testing.assert_allclose(craft.facet_tangent, want, rtol=rtol, atol=rtol)
+    # an explicit direction wins over the file's attribute
+    craft = sc.load_spacecraft(box, material="paint", tangent=(0.0, 0.0, 1.0))
+    assert craft.tangent_source == "direction"
+
+
+def test_tangents_follow_their_facets_through_repairs():
+    box = _tangent_box()
+    faces = np.vstack([box.faces, box.faces[:1]])  # a duplicate of facet 0
+    tang = np.vstack([box.face_attributes["tangent"], [[5.0, 5.0, 5.0]]])
+    dup = trimesh.Trimesh(box.vertices, faces, process=False)
+    dup.face_attributes["tangent"] = tang
+    with pytest.warns(sc.MeshRepairWarning, match="duplicate"):
+        craft = sc.load_spacecraft(dup, material="paint", repair=True)
+    assert craft.n_facets == 12
+    np.testing.assert_allclose(
+        craft.facet_tangent,
+        _projected(craft.mesh.face_normals, np.asarray(box.face_attributes["tangent"])),
+        rtol=1e-12,
+    )
+
+
+def test_merging_keeps_facets_of_different_tangents_apart_for_anisotropic_materials():
+    craft = cube_spacecraft(1.0, subdivisions=2)  # 8 facets per face
+    tang = np.tile([1.0, 0.0, 0.0], (craft.n_facets, 1))
+    tang[::2] = [0.0, 1.0, 1.0]
+    craft = craft.with_tangent(tang)
+    assert craft.tangent_source == "per facet"
+    mat = craft.materials[0]
+    assert craft.merged().sizes["term"] == 6
+    m = craft.merged(tangent_materials=[mat])
+    assert m.sizes["term"] == 12
+    # every term's tangent is its members' (t and -t alike) and orthogonal to its normal
+    tt, ft = m.tangent.values[m.facet_term.values], craft.facet_tangent
+    np.testing.assert_allclose(np.abs(np.einsum("fk,fk->f", tt, ft)), 1.0, rtol=1e-12)
+    # t and -t merge
+    flipped = craft.with_tangent(
+        tang * np.where(np.arange(craft.n_facets) % 4 == 0, -1, 1)[:, None]
+    )
+    assert flipped.merged(tangent_materials=[mat]).sizes["term"] == 12
+
+
+def test_fingerprint_sees_tangents_only_when_they_are_given():
+    from sbrdf_xr.fingerprint import _mesh_sha
+
+    craft = cube_spacecraft(1.0)
+    assert _mesh_sha(craft.with_tangent((0.0, 0.0, 1.0))) != _mesh_sha(craft)
+    assert _mesh_sha(craft.with_tangent((0.0, 0.0, 1.0))) != _mesh_sha(
+        craft.with_tangent((0.0, 1.0, 0.0))
+    )

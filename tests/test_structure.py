@@ -9,7 +9,8 @@ not run).
 * L0, kernels and names: ``_version``, ``_names``, ``errors``, ``geometry``, ``_lut``,
   ``_kernels``, ``sources``, ``brdf`` (and its models), ``imperfections``, ``knobs``,
   ``_catalog_index`` (where the shipped files are; it loads nothing), ``_shadow_kernels``,
-  ``_cache`` (tables built on load, cached on disk).
+  ``_cache`` (tables built on load, cached on disk), ``anisotropy`` (facet tangents,
+  ``psi``) and ``_aniso_kernels`` (the anisotropic look-up).
 * L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``models``,
   ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``visibility``,
   ``attitude_frames``, ``attitude``, ``orbits``, ``observe``, ``photometry`` (and its
@@ -51,6 +52,8 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "_catalog_index",
         "_shadow_kernels",
         "_cache",
+        "anisotropy",
+        "_aniso_kernels",
     ),
     (
         "material_schema",

@@ -221,11 +221,7 @@ def illumination_azimuth(
 ) -> NDArray[np.float64]:
     """``psi`` [degree] of a geometry: azimuth of the illumination plane from the tangent.
 
-    ``psi = atan2(e_f . b, e_f . t)`` with ``e_f`` the forward direction of
-    :func:`sbrdf_xr.geometry.facet_angles` (from the observer at normal incidence)
-    and ``b = N x t``; an observer on the ``-p`` side of the plane (``phi`` is
-    unsigned) mirrors the geometry, ``psi -> -psi``; ``psi`` is then taken modulo
-    180 deg (``t`` and ``-t`` are the same tangent).
+    :func:`sbrdf_xr.anisotropy.illumination_azimuth` (its convention), in float64.
 
     Parameters
     ----------
@@ -237,27 +233,10 @@ def illumination_azimuth(
     ndarray
         ``psi`` in ``[0, 180)`` degree.
     """
-    n = geometry.normalize(normal, "normal").astype(np.float64)
-    s = geometry.normalize(to_sun, "to_sun").astype(np.float64)
-    o = geometry.normalize(to_observer, "to_observer").astype(np.float64)
-    n, s, o = np.broadcast_arrays(n, s, o)
-    t, b = _frame(n, tangent)
-    tol = geometry.normal_incidence_tolerance(np.float64)
-    s_t = s - np.einsum("...k,...k->...", s, n)[..., None] * n
-    o_t = o - np.einsum("...k,...k->...", o, n)[..., None] * n
-    ls = np.linalg.norm(s_t, axis=-1, keepdims=True)
-    lo = np.linalg.norm(o_t, axis=-1, keepdims=True)
-    e_f = np.where(
-        ls > tol,
-        -s_t / np.where(ls > tol, ls, 1.0),
-        np.where(lo > tol, o_t / np.where(lo > tol, lo, 1.0), t),
-    )
-    psi = np.degrees(
-        np.arctan2(np.einsum("...k,...k->...", e_f, b), np.einsum("...k,...k->...", e_f, t))
-    )
-    p = np.cross(n, e_f)
-    psi = np.where(np.einsum("...k,...k->...", o, p) < 0, -psi, psi)
-    return np.mod(psi, 180.0)  # t and -t are the same tangent
+    from .. import anisotropy
+
+    f64 = [np.asarray(a, dtype=np.float64) for a in (normal, to_sun, to_observer)]
+    return anisotropy.illumination_azimuth(f64[0], tangent, f64[1], f64[2]).astype(np.float64)
 
 
 def brdf_angles(
