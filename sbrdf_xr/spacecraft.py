@@ -492,7 +492,7 @@ def load_catalog_entry(entry: _catalog_index.CatalogEntry) -> Spacecraft:
         ) from None
     return load_spacecraft(
         entry.file,
-        read_material_map(_catalog_index.data_path(map_file)),
+        read_material_map(entry.data_path(map_file)),
         length_unit=entry.extra.get("length_unit", "m"),
         name=entry.name,
         face_property=entry.extra.get("face_property"),
