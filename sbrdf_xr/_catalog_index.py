@@ -191,17 +191,18 @@ def _index() -> tuple[CatalogEntry, ...]:
     return tuple(out)
 
 
-def _stamp(directory: Path) -> tuple[Path, int]:
-    """The index file and its modification time (a changed file is read again)."""
+def _stamp(directory: Path) -> tuple[Path, tuple[int, int]]:
+    """The index file and its modification time and size (a changed file is read again)."""
     path = directory / "index.toml"
     try:
-        return path, path.stat().st_mtime_ns
+        st = path.stat()
+        return path, (st.st_mtime_ns, st.st_size)
     except OSError as exc:
         raise CatalogError(f"{path}: cannot be read ({exc.strerror or exc})") from None
 
 
 @cache
-def _read_index(path: Path, mtime_ns: int, root: Path | None) -> tuple[CatalogEntry, ...]:
+def _read_index(path: Path, stamp: tuple[int, int], root: Path | None) -> tuple[CatalogEntry, ...]:
     try:
         raw = tomllib.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError) as exc:
