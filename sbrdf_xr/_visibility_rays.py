@@ -59,7 +59,13 @@ SEED = 20240601
 
 
 def available_engines() -> list[str]:
-    """Ray engines usable in this environment (``"triangle"`` always; ``"embree"`` if installed)."""
+    """Ray engines usable in this environment (``"triangle"`` always; ``"embree"`` if installed).
+
+    Examples
+    --------
+    >>> "triangle" in available_engines()
+    True
+    """
     out = ["triangle"]
     try:
         import trimesh.ray.ray_pyembree  # noqa: F401
@@ -100,7 +106,13 @@ def check_density(density: int | str) -> int:
 
 
 def samples_per_facet(density: int | str) -> int:
-    """Number of rays per facet and direction at a sampling density (``density**2``)."""
+    """Number of rays per facet and direction at a sampling density (``density**2``).
+
+    Examples
+    --------
+    >>> samples_per_facet(4), samples_per_facet("reference")
+    (16, 256)
+    """
     return check_density(density) ** 2
 
 
@@ -126,6 +138,12 @@ def sample_triangle(n_samples: int, n_facets: int = 1, seed: int = SEED) -> NDAr
     -------
     ndarray, shape (n_facets, n_samples, 3)
         Weights of the three vertices; each row sums to 1 and is positive or zero.
+
+    Examples
+    --------
+    >>> w = sample_triangle(16, n_facets=2, seed=1)
+    >>> w.shape, bool(np.allclose(w.sum(axis=-1), 1.0)), bool((w >= 0).all())
+    ((2, 16, 3), True, True)
     """
     if isinstance(n_samples, bool) or int(n_samples) != n_samples or n_samples < 1 or n_facets < 0:
         raise ValidationError(

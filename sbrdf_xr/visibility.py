@@ -307,6 +307,24 @@ def lit_fraction(
     ValidationError
         On zero or non-finite directions, an unknown method, a density below 1, an unknown or
         unavailable engine.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1, x in [1, 2]
+    >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
+    ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
+    >>> area = body.mesh.area_faces[floor]
+    >>> def on_floor(f):  # area-weighted mean over the floor's two facets
+    ...     return round(float((f[..., floor] * area).sum(-1) / area.sum()), 6)
+    >>> body.is_convex
+    False
+    >>> sun = [-1.0, 2.0, 0.0]  # from -x, shadow 0.5 m long on the 1 m wide floor
+    >>> f = lit_fraction(body, sun)
+    >>> f.shape, on_floor(f)
+    ((20,), 0.5)
+    >>> abs(on_floor(lit_fraction(body, sun, method="sampled", density=8)) - 0.5) < 0.02
+    True
     """
     d, shape = _directions(directions, "directions")
     f, _ = _fractions(
@@ -330,6 +348,18 @@ def visible_fraction(
 
     Identical to :func:`lit_fraction` with observer directions in place of Sun directions
     (occlusion toward a distant observer is shadowing by a light at the observer).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1, x in [1, 2]
+    >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
+    ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
+    >>> area = body.mesh.area_faces[floor]
+    >>> def on_floor(f):  # area-weighted mean over the floor's two facets
+    ...     return round(float((f[..., floor] * area).sum(-1) / area.sum()), 6)
+    >>> on_floor(visible_fraction(body, [-1.0, 3.0, 0.0]))  # the wall hides 1/3 m of the floor
+    0.666667
     """
     return lit_fraction(
         spacecraft,
@@ -382,6 +412,19 @@ def lit_visible_fraction(
     ndarray, shape (..., n_facets)
         Fractions in ``[0, 1]`` [1]; 0 where ``N.s <= 0`` or ``N.o <= 0``.  With
         ``return_error``, a pair (fraction, standard error) of that shape.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1, x in [1, 2]
+    >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
+    ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
+    >>> area = body.mesh.area_faces[floor]
+    >>> def on_floor(f):  # area-weighted mean over the floor's two facets
+    ...     return round(float((f[..., floor] * area).sum(-1) / area.sum()), 6)
+    >>> sun, observer = [-1.0, 2.0, 0.0], [-1.0, 3.0, 0.0]
+    >>> on_floor(lit_visible_fraction(body, sun, observer))  # not 0.5 * 2/3: hidden is shadowed
+    0.5
     """
     s, o = np.broadcast_arrays(
         np.asarray(to_sun, dtype=np.float64), np.asarray(to_observer, dtype=np.float64)
@@ -425,6 +468,21 @@ def facet_visibility(
         ``lit_visible_fraction`` [1]; coordinates ``to_sun`` and ``to_observer``
         ``(geometry, xyz)``; attrs ``method`` and, for the sampled method, ``density``,
         ``samples_per_facet``, ``engine``.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1, x in [1, 2]
+    >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
+    ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
+    >>> area = body.mesh.area_faces[floor]
+    >>> def on_floor(f):  # area-weighted mean over the floor's two facets
+    ...     return round(float((f[..., floor] * area).sum(-1) / area.sum()), 6)
+    >>> ds = facet_visibility(body, [[-1.0, 2.0, 0.0]], [[-1.0, 3.0, 0.0]])
+    >>> dict(ds.sizes), ds.attrs["method"]
+    ({'geometry': 1, 'facet': 20, 'xyz': 3}, 'exact')
+    >>> on_floor(ds.lit_fraction.values[0]), on_floor(ds.visible_fraction.values[0])
+    (0.5, 0.666667)
     """
     s, o = np.broadcast_arrays(
         np.asarray(to_sun, dtype=np.float64), np.asarray(to_observer, dtype=np.float64)
