@@ -346,8 +346,8 @@ class Observation:
         Examples
         --------
         >>> from sbrdf_xr.attitude import Spin
-        >>> obs = Observation(Orbit.from_catalog("canx1-example"), Site.from_catalog("mont-megantic"),
-        ...                   times("2024-03-17T01:22:00", "2024-03-17T01:22:10", 5.0),
+        >>> orbit, site = Orbit.from_catalog("canx1-example"), Site.from_catalog("mont-megantic")
+        >>> obs = Observation(orbit, site, times("2024-03-17T01:22:00", "2024-03-17T01:22:10", 5.0),
         ...                   Spin(rate_deg_s=10.0))
         >>> ctx = obs.context()
         >>> ctx.position_km.shape, round(float(np.linalg.norm(ctx.position_km[0])), 0)  # [km]
@@ -364,8 +364,8 @@ class Observation:
         Examples
         --------
         >>> from sbrdf_xr.attitude import Spin
-        >>> obs = Observation(Orbit.from_catalog("canx1-example"), Site.from_catalog("mont-megantic"),
-        ...                   times("2024-03-17T01:22:00", "2024-03-17T01:22:10", 5.0),
+        >>> orbit, site = Orbit.from_catalog("canx1-example"), Site.from_catalog("mont-megantic")
+        >>> obs = Observation(orbit, site, times("2024-03-17T01:22:00", "2024-03-17T01:22:10", 5.0),
         ...                   Spin(rate_deg_s=10.0))
         >>> np.round(obs.quaternions(), 6)  # 10 degree s-1 about +z
         array([[0.      , 0.      , 0.      , 1.      ],
@@ -410,8 +410,8 @@ class Observation:
         Examples
         --------
         >>> from sbrdf_xr.attitude import Spin
-        >>> obs = Observation(Orbit.from_catalog("canx1-example"), Site.from_catalog("mont-megantic"),
-        ...                   times("2024-03-17T01:22:00", "2024-03-17T01:22:10", 5.0),
+        >>> orbit, site = Orbit.from_catalog("canx1-example"), Site.from_catalog("mont-megantic")
+        >>> obs = Observation(orbit, site, times("2024-03-17T01:22:00", "2024-03-17T01:22:10", 5.0),
         ...                   Spin(rate_deg_s=10.0))
         >>> g = obs.geometry()
         >>> dict(g.sizes)
@@ -552,7 +552,8 @@ def observation_from_dict(
     --------
     >>> obs = observation_from_dict({"orbit": "canx1-example", "site": "mont-megantic",
     ...                              "start": "2024-03-17T01:20:00", "stop": "2024-03-17T01:21:00",
-    ...                              "step_s": 30.0, "attitude": {"law": "spin", "rate_deg_s": 2.0}})
+    ...                              "step_s": 30.0,
+    ...                              "attitude": {"law": "spin", "rate_deg_s": 2.0}})
     >>> obs.times.size, type(obs.attitude).__name__
     (3, 'Spin')
     >>> observation_from_dict({"orbit": "canx1-example", "site": "mont-megantic", "when": "now"})
