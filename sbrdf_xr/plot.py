@@ -321,7 +321,8 @@ def magnitudes(mags: xr.DataArray, ax: Any = None, x: str | None = None, **sel: 
     ...             "wavelength": ("wavelength", [450.0, 550.0, 650.0], {"units": "nm"})})
     >>> wave = np.cos(np.radians(ang))
     >>> mags = xr.DataArray(np.stack([12 - wave, 11.5 - wave], 1),
-    ...                     dims=("attitude", "band"), attrs={"units": "1", "magnitude_system": "AB"},
+    ...                     dims=("attitude", "band"),
+    ...                     attrs={"units": "1", "magnitude_system": "AB"},
     ...                     coords={"attitude_angle": ("attitude", ang, {"units": "degree"}),
     ...                             "band": ["B", "V"]})
     >>> fig = magnitudes(mags)
