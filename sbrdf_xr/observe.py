@@ -663,7 +663,14 @@ CANX1_PASS = {
 
 
 def canx1_attitude() -> _att.AttitudeLaw:
-    """Attitude of the built-in pass: a slow spin about a tilted body axis from a fixed start."""
+    """Attitude of the built-in pass: a slow spin about a tilted body axis from a fixed start.
+
+    Examples
+    --------
+    >>> law = canx1_attitude()
+    >>> type(law).__name__, law.quaternions([0.0, 1.0]).shape
+    ('Spin', (2, 4))
+    """
     return _att.Spin(
         axis_body=(0.3, 0.4, 0.866),
         rate_deg_s=4.0,

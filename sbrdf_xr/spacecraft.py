@@ -555,6 +555,12 @@ def load_catalog_entry(entry: _catalog_index.CatalogEntry) -> Spacecraft:
     The entry's ``path`` is the mesh; extra fields: ``material_map`` (path of the TOML map,
     relative to the catalog directory; required), ``length_unit`` (default ``"m"``),
     ``face_property`` (optional).
+
+    Examples
+    --------
+    >>> sc = load_catalog_entry(_catalog_index.entry("canx1"))
+    >>> sc.name, sc.n_facets, round(float(sc.mesh.extents.max()), 4)  # largest extent [m]
+    ('canx1', 684, 0.1032)
     """
     try:
         map_file = entry.extra["material_map"]
