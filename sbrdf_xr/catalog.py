@@ -70,6 +70,7 @@ __all__ = [
     "load",
     "load_material_spec",
     "load_spacecraft_spec",
+    "material_tables",
     "names",
     "user_catalog_dirs",
 ]
@@ -359,3 +360,60 @@ def load_material_spec(
         "sbrdf_xr.material_io.to_netcdf) nor a BRDF model (a 'model' attribute, written by "
         "sbrdf_xr.models.to_netcdf)"
     )
+
+
+def material_tables(
+    specs: Mapping[str, str | os.PathLike[str]], base_dir: str | os.PathLike[str] | None = None
+) -> tuple[dict[str, xr.DataArray], dict[str, xr.Dataset]]:
+    """Material tables, and BRDF models, from catalog names or netCDF files.
+
+    Parameters
+    ----------
+    specs : mapping of str to str or Path
+        Material name (as the spacecraft labels its facets) -> a ``material`` or ``model``
+        catalog entry or a netCDF file of a table or a model
+        (:func:`sbrdf_xr.catalog.load_material_spec`).
+    base_dir : str or Path, optional
+        Directory that relative file paths are taken from.
+
+    Returns
+    -------
+    tables : dict of str to DataArray
+        A table for every material; a model is rendered by :func:`sbrdf_xr.models.render`
+        on its default grid.
+    models : dict of str to Dataset
+        The models given (for ``evaluation = "analytic"``, which evaluates them exactly).
+
+    Raises
+    ------
+    ValidationError
+        Naming the material, for an entry of another kind, a file with an unknown
+        suffix, or a file that is neither a table nor a model.
+    CatalogError
+        For an unknown name or a file that does not exist.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from sbrdf_xr import material_io, material_schema
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> table = material_schema.lambertian(0.3, wavelength=[500.0, 600.0], material="grey")
+    >>> _ = material_io.to_netcdf(table, folder / "grey.nc")
+    >>> tables, models = material_tables({"paint": "grey.nc"}, base_dir=folder)
+    >>> sorted(tables), tables["paint"].attrs["material"], models
+    (['paint'], 'grey', {})
+    """
+    tables: dict[str, xr.DataArray] = {}
+    given: dict[str, xr.Dataset] = {}
+    for mat, spec in specs.items():
+        try:
+            obj = load_material_spec(spec, base_dir=base_dir)
+            if isinstance(obj, xr.Dataset):
+                given[mat] = obj
+                obj = models.render(obj)
+        except CatalogError as exc:
+            raise CatalogError(f"[materials] {mat!r}: {exc}") from None
+        except ValidationError as exc:
+            raise ValidationError(f"[materials] {mat!r}: {exc}") from None
+        tables[mat] = obj
+    return tables, given
