@@ -12,13 +12,22 @@ The catalog directory holds ``index.toml``, one ``[[entry]]`` table per item::
     provenance = "..."                   # where its numbers come from
 
 In a source checkout the directory is the top-level ``catalogs/``; an installed
-package carries a copy at ``sbrdf_xr/catalogs`` (see ``pyproject.toml``).  This module
-reads the index only; the domain modules read an entry's file given the entry, and
-:mod:`sbrdf_xr.catalog` maps every kind to its loader.
+package carries a copy at ``sbrdf_xr/catalogs`` (see ``pyproject.toml``).
+
+User catalogs extend the shipped one: the environment variable ``SBRDF_XR_CATALOG_PATH``
+(:data:`CATALOG_PATH_ENV`) lists directories, separated by :data:`os.pathsep`, each with an
+``index.toml`` of the same format whose paths are relative to that directory.  Their
+entries may add names; a name already in the shipped catalog or in an earlier user
+catalog is refused with a :class:`~sbrdf_xr.errors.CatalogError` (a user entry never
+silently replaces another).  :attr:`CatalogEntry.origin` says where an entry comes from.
+
+This module reads the index only; the domain modules read an entry's file given the
+entry, and :mod:`sbrdf_xr.catalog` maps every kind to its loader.
 """
 
 from __future__ import annotations
 
+import os
 import tomllib
 from dataclasses import dataclass
 from functools import cache
@@ -28,6 +37,7 @@ from typing import Any
 from .errors import CatalogError
 
 __all__ = [
+    "CATALOG_PATH_ENV",
     "KINDS",
     "SOURCES",
     "CatalogEntry",
@@ -36,7 +46,11 @@ __all__ = [
     "entries",
     "entry",
     "names",
+    "user_catalog_dirs",
 ]
+
+#: Environment variable listing user catalog directories (separated by :data:`os.pathsep`).
+CATALOG_PATH_ENV = "SBRDF_XR_CATALOG_PATH"
 
 KINDS = ("material", "measurements", "model", "paint_parameters", "spacecraft", "orbit", "site")
 SOURCES = ("measured", "synthetic")
@@ -52,6 +66,8 @@ class CatalogEntry:
         Fields of the ``[[entry]]`` table (see the module docstring).
     extra : dict
         Any further fields of the table (for example the material of a model).
+    root : Path or None
+        Directory of the user catalog holding the entry; None for the shipped catalog.
 
     Examples
     --------
@@ -68,11 +84,21 @@ class CatalogEntry:
     description: str
     provenance: str
     extra: dict[str, Any]
+    root: Path | None = None
 
     @property
     def file(self) -> Path:
         """Absolute path of the entry's file."""
-        return data_path(self.path)
+        return self.data_path(self.path)
+
+    @property
+    def origin(self) -> str:
+        """Where the entry comes from: ``"shipped"`` or the user catalog's directory."""
+        return "shipped" if self.root is None else str(self.root)
+
+    def data_path(self, relative: str | Path) -> Path:
+        """Absolute path of a file of this entry's catalog (see :func:`data_path`)."""
+        return data_path(relative, self.root)
 
 
 @cache
@@ -105,13 +131,15 @@ def catalog_dir() -> Path:
     )
 
 
-def data_path(relative: str | Path) -> Path:
+def data_path(relative: str | Path, root: Path | None = None) -> Path:
     """Absolute path of a file inside the catalog directory.
 
     Parameters
     ----------
     relative : str or Path
         Path relative to the catalog directory.
+    root : Path, optional
+        A user catalog directory instead of the shipped one.
 
     Returns
     -------
@@ -133,18 +161,76 @@ def data_path(relative: str | Path) -> Path:
     ...
     sbrdf_xr.errors.CatalogError: catalog file spacecraft/nothing.ply does not exist in ...
     """
-    path = catalog_dir() / relative
+    base = catalog_dir() if root is None else root
+    path = base / relative
     if not path.is_file():
-        raise CatalogError(f"catalog file {relative!s} does not exist in {catalog_dir()}")
+        raise CatalogError(f"catalog file {relative!s} does not exist in {base}")
     return path
 
 
-@cache
+def user_catalog_dirs() -> list[Path]:
+    """The user catalog directories named by ``SBRDF_XR_CATALOG_PATH``, in order.
+
+    Returns
+    -------
+    list of pathlib.Path
+        Absolute directories (empty items of the variable are skipped).
+
+    Raises
+    ------
+    CatalogError
+        If a directory does not exist or holds no ``index.toml``.
+    """
+    out = []
+    for item in os.environ.get(CATALOG_PATH_ENV, "").split(os.pathsep):
+        if not item.strip():
+            continue
+        d = Path(item).expanduser().resolve()
+        if not (d / "index.toml").is_file():
+            what = "has no index.toml" if d.is_dir() else "is not a directory"
+            raise CatalogError(
+                f"{CATALOG_PATH_ENV}: user catalog {d} {what}; each directory of the "
+                "variable needs an index.toml of [[entry]] tables like the shipped catalog's"
+            )
+        out.append(d)
+    return out
+
+
 def _index() -> tuple[CatalogEntry, ...]:
-    path = catalog_dir() / "index.toml"
+    """The shipped entries, then those of every user catalog (names unique throughout)."""
+    found = {e.name: e for e in _read_index(*_stamp(catalog_dir()), None)}
+    out = list(found.values())
+    for d in user_catalog_dirs():
+        for e in _read_index(*_stamp(d), d):
+            if e.name in found:
+                first = found[e.name]
+                where = "shipped catalog" if first.root is None else f"user catalog {first.root}"
+                raise CatalogError(
+                    f"user catalog {d}: entry {e.name!r} is already in the {where}; user "
+                    "entries may add names, not replace them: give it another name"
+                )
+            found[e.name] = e
+            out.append(e)
+    return tuple(out)
+
+
+def _stamp(directory: Path) -> tuple[Path, tuple[int, int]]:
+    """The index file and its modification time and size (a changed file is read again)."""
+    path = directory / "index.toml"
+    try:
+        st = path.stat()
+        return path, (st.st_mtime_ns, st.st_size)
+    except OSError as exc:
+        raise CatalogError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+
+
+@cache
+def _read_index(path: Path, stamp: tuple[int, int], root: Path | None) -> tuple[CatalogEntry, ...]:
     try:
         raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:  # pragma: no cover - shipped file is tested
+    except (OSError, UnicodeDecodeError) as exc:
+        raise CatalogError(f"{path}: cannot be read ({exc})") from None
+    except tomllib.TOMLDecodeError as exc:
         raise CatalogError(f"{path}: invalid TOML: {exc}") from exc
     out = []
     required = ("name", "kind", "path", "source", "description", "provenance")
@@ -162,7 +248,7 @@ def _index() -> tuple[CatalogEntry, ...]:
                 f"{path}: entry {item['name']!r} has source {src!r}; allowed: measured, synthetic, model:<name>"
             )
         extra = {k: v for k, v in item.items() if k not in required}
-        out.append(CatalogEntry(*(item[k] for k in required), extra=extra))
+        out.append(CatalogEntry(*(item[k] for k in required), extra=extra, root=root))
     seen: set[str] = set()
     for e in out:
         if e.name in seen:

@@ -85,10 +85,23 @@ class AttitudeLaw:
     """Base of the attitude laws: ``law.quaternions(times, context) -> (n, 4)``.
 
     ``outer * inner`` composes two laws (:class:`Composed`).
+
+    Examples
+    --------
+    >>> law = Spin(axis_body="+z", rate_deg_s=90.0)
+    >>> isinstance(law, AttitudeLaw), law.quaternions([0.0, 1.0]).shape
+    (True, (2, 4))
     """
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
-        """Attitudes (body -> inertial, scalar-last) at ``times``; shape ``(n, 4)``."""
+        """Attitudes (body -> inertial, scalar-last) at ``times``; shape ``(n, 4)``.
+
+        Examples
+        --------
+        >>> np.round(Spin(rate_deg_s=180.0).quaternions([0.0, 1.0]), 6)  # half a turn in 1 s
+        array([[0., 0., 0., 1.],
+               [0., 0., 1., 0.]])
+        """
         raise NotImplementedError
 
     def __mul__(self, other: AttitudeLaw) -> Composed:
@@ -113,6 +126,13 @@ class Inertial(AttitudeLaw):
     ----------
     q : array_like, shape (4,)
         Unit quaternion, scalar-last, body -> inertial [1].
+
+    Examples
+    --------
+    >>> s = float(np.sqrt(0.5))
+    >>> Inertial((0.0, 0.0, s, s)).quaternions(np.zeros(2)).round(6)  # 90 degree about z, always
+    array([[0.      , 0.      , 0.707107, 0.707107],
+           [0.      , 0.      , 0.707107, 0.707107]])
     """
 
     q: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
@@ -141,6 +161,16 @@ class Nadir(AttitudeLaw):
         Yaw about the nadir axis [degree].
     nadir_axis, velocity_axis : str or array_like
         Perpendicular body axes (``"+z"``, ``"-x"``, ... or 3 components).
+
+    Examples
+    --------
+    >>> from scipy.spatial.transform import Rotation
+    >>> from sbrdf_xr.attitude_frames import Context
+    >>> ctx = Context(position_km=np.array([[7000.0, 0.0, 0.0]]),
+    ...               velocity_km_s=np.array([[0.0, 7.5, 0.0]]))
+    >>> q = Nadir(nadir_axis="+z", velocity_axis="+x").quaternions([0.0], ctx)
+    >>> np.round(Rotation.from_quat(q).apply([0.0, 0.0, 1.0]), 6) + 0.0  # +z on the geocentre
+    array([[-1.,  0.,  0.]])
     """
 
     yaw_deg: float = 0.0
@@ -185,6 +215,18 @@ class SunPointing(AttitudeLaw):
         ``orbit_normal`` (``r x v``), ``nadir``, ``velocity``, ``north`` (inertial +z) or
         three components in the inertial frame.  Where the target is parallel to the Sun
         direction the attitude is undefined and an :class:`AttitudeError` is raised.
+
+    Examples
+    --------
+    >>> from scipy.spatial.transform import Rotation
+    >>> from sbrdf_xr.attitude_frames import Context
+    >>> ctx = Context(position_km=np.array([[7000.0, 0.0, 0.0]]),
+    ...               velocity_km_s=np.array([[0.0, 7.5, 0.0]]),
+    ...               sun_km=np.array([[0.0, 1.5e8, 0.0]]))
+    >>> q = SunPointing(axis="+z", secondary_axis="+x").quaternions([0.0], ctx)
+    >>> R = Rotation.from_quat(q)
+    >>> np.round(R.apply([0.0, 0.0, 1.0]), 6) + 0.0, np.round(R.apply([1.0, 0.0, 0.0]), 6) + 0.0
+    (array([[0., 1., 0.]]), array([[0., 0., 1.]]))
     """
 
     axis: Any = "+z"
@@ -243,6 +285,14 @@ class Spin(AttitudeLaw):
         Attitude at angle 0 (default: identity).
     epoch : datetime64 or str, optional
         Time of ``phase_deg`` (default: the start of the observation).
+
+    Examples
+    --------
+    >>> spin = Spin(axis_body="+z", rate_deg_s=10.0, phase_deg=5.0)
+    >>> spin.angles([0.0, 1.0, 2.0])  # [degree]
+    array([ 5., 15., 25.])
+    >>> np.round(spin.quaternions([0.0]), 6)
+    array([[0.      , 0.      , 0.043619, 0.999048]])
     """
 
     axis_body: Any = "+z"
@@ -261,7 +311,13 @@ class Spin(AttitudeLaw):
         object.__setattr__(self, "epoch", check_epoch(self.epoch))
 
     def angles(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
-        """Spin angle ``phase + rate t`` at ``times`` [degree]."""
+        """Spin angle ``phase + rate t`` at ``times`` [degree].
+
+        Examples
+        --------
+        >>> Spin(rate_deg_s=2.0).angles([0.0, 0.5, 10.0])
+        array([ 0.,  1., 20.])
+        """
         return self.phase_deg + self.rate_deg_s * seconds_since(times, self.epoch, context)
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
@@ -322,6 +378,16 @@ class Tumble(AttitudeLaw):
         Attitude at the epoch.
     epoch : datetime64 or str, optional
         Time of the initial state (default: the start of the observation).
+
+    Examples
+    --------
+    >>> law = Tumble(inertia=(1.0, 2.0, 3.0), omega_deg_s=(0.0, 0.0, 10.0))  # a principal axis
+    >>> omega, q = law.states([0.0, 9.0])
+    >>> np.round(np.degrees(omega), 9) + 0.0  # steady spin about z [degree s-1]
+    array([[ 0.,  0., 10.],
+           [ 0.,  0., 10.]])
+    >>> np.round(q[-1], 9)  # 90 degree about z after 9 s
+    array([0.        , 0.        , 0.70710678, 0.70710678])
     """
 
     inertia: Any = (1.0, 1.0, 1.0)
@@ -359,6 +425,15 @@ class Tumble(AttitudeLaw):
             Uniform density [kg m-3].
         omega_deg_s, initial, epoch
             As for :class:`Tumble`.
+
+        Examples
+        --------
+        >>> import trimesh
+        >>> from sbrdf_xr.spacecraft import Spacecraft
+        >>> cube = Spacecraft(trimesh.creation.box(extents=(0.1, 0.1, 0.1)), ["paint"] * 12)
+        >>> law = Tumble.from_spacecraft(cube, 1000.0, (5.0, 0.0, 0.0))
+        >>> np.round(np.diag(law.inertia), 9)  # a 1 kg cube of side 0.1 m [kg m2]
+        array([0.00166667, 0.00166667, 0.00166667])
         """
         return cls(spacecraft.inertia(density_kg_m3), omega_deg_s, initial, epoch)
 
@@ -398,6 +473,12 @@ class Tumble(AttitudeLaw):
         -------
         omega : ndarray, shape (n, 3)
         quaternion : ndarray, shape (n, 4)
+
+        Examples
+        --------
+        >>> omega, q = Tumble((1.0, 2.0, 3.0), (10.0, 0.0, 0.0)).states([0.0, 1.0, 2.0])
+        >>> omega.shape, q.shape, np.round(np.linalg.norm(q, axis=1), 12)
+        ((3, 3), (3, 4), array([1., 1., 1.]))
         """
         from scipy.integrate import solve_ivp
 
@@ -450,6 +531,16 @@ class QuaternionSeries(AttitudeLaw):
         Time origin of float sample times (default: the start of the observation).
 
     Requests outside the sampled interval raise :class:`AttitudeError`.
+
+    Examples
+    --------
+    >>> series = QuaternionSeries([0.0, 10.0], [[0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 1.0, 0.0]])
+    >>> np.round(series.quaternions([5.0]), 6)  # halfway: 90 degree about z
+    array([[0.      , 0.      , 0.707107, 0.707107]])
+    >>> series.quaternions([11.0])
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.AttitudeError: quaternion_series: requested times span [11, 11] s, outside ...
     """
 
     times: Any
@@ -485,7 +576,22 @@ class QuaternionSeries(AttitudeLaw):
         columns: Sequence[str] = ("qx", "qy", "qz", "qw"),
         epoch: Any = None,
     ) -> QuaternionSeries:
-        """Read a CSV with a time column (ISO 8601 UTC, or seconds) and scalar-last quaternion columns."""
+        """Read a CSV: a time column (ISO 8601 UTC, or seconds), scalar-last quaternion columns.
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> from pathlib import Path
+        >>> path = Path(tempfile.mkdtemp()) / "att.csv"
+        >>> rows = ["time,qx,qy,qz,qw", "2024-03-17T01:20:00Z,0,0,0,1",
+        ...         "2024-03-17T01:20:10Z,0,0,1,0"]
+        >>> _ = path.write_text("\\n".join(rows))
+        >>> series = QuaternionSeries.from_csv(path)
+        >>> series.epoch
+        np.datetime64('2024-03-17T01:20:00.000000000')
+        >>> np.round(series.quaternions([5.0]), 6)
+        array([[0.      , 0.      , 0.707107, 0.707107]])
+        """
         import pandas as pd
 
         try:
@@ -509,6 +615,19 @@ class QuaternionSeries(AttitudeLaw):
         """Read ``variable(time, component)`` (components x, y, z, w) from a netCDF file.
 
         The ``quaternion`` of :meth:`sbrdf_xr.observe.Observation.geometry` reads back.
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> import xarray as xr
+        >>> from pathlib import Path
+        >>> path = Path(tempfile.mkdtemp()) / "att.nc"
+        >>> q = xr.DataArray([[0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 1.0, 0.0]],
+        ...                  dims=("time", "component"),
+        ...                  coords={"time": [0.0, 10.0], "component": ["x", "y", "z", "w"]})
+        >>> q.to_dataset(name="quaternion").to_netcdf(path)
+        >>> np.round(QuaternionSeries.from_netcdf(path).quaternions([5.0]), 6)
+        array([[0.      , 0.      , 0.707107, 0.707107]])
         """
         import xarray as xr
 
@@ -536,7 +655,15 @@ class QuaternionSeries(AttitudeLaw):
 
 @dataclass(frozen=True)
 class Composed(AttitudeLaw):
-    """``R(t) = R_outer(t) R_inner(t)``: the inner law expressed in the outer law's frame."""
+    """``R(t) = R_outer(t) R_inner(t)``: the inner law expressed in the outer law's frame.
+
+    Examples
+    --------
+    >>> s = float(np.sqrt(0.5))
+    >>> law = Composed(Inertial((0.0, 0.0, s, s)), Spin(rate_deg_s=90.0))
+    >>> np.round(law.quaternions([1.0]), 6)  # 90 degree then 90 degree about z
+    array([[0., 0., 1., 0.]])
+    """
 
     outer: AttitudeLaw
     inner: AttitudeLaw
@@ -555,7 +682,15 @@ class Composed(AttitudeLaw):
 
 
 def compose(outer: AttitudeLaw | ArrayLike, inner: AttitudeLaw | ArrayLike) -> Composed:
-    """Compose two laws (or a law and a fixed quaternion): ``R_outer(t) R_inner(t)``."""
+    """Compose two laws (or a law and a fixed quaternion): ``R_outer(t) R_inner(t)``.
+
+    Examples
+    --------
+    >>> s = float(np.sqrt(0.5))
+    >>> law = compose([0.0, 0.0, s, s], Spin(rate_deg_s=90.0))
+    >>> type(law).__name__, np.round(law.quaternions([1.0]), 6)
+    ('Composed', array([[0., 0., 1., 0.]]))
+    """
     return Composed(_law_or_quaternion(outer, "outer"), _law_or_quaternion(inner, "inner"))
 
 
@@ -593,6 +728,17 @@ def law_from_dict(table: Mapping[str, Any]) -> AttitudeLaw:
     ------
     AttitudeError
         For an unknown law or parameter, or bad parameter values.
+
+    Examples
+    --------
+    >>> law = law_from_dict({"law": "spin", "axis_body": "+x", "rate_deg_s": 6.0})
+    >>> law
+    Spin(axis_body='+x', rate_deg_s=6.0, phase_deg=0.0,
+         initial=Inertial(q=(0.0, 0.0, 0.0, 1.0)), epoch=None)
+    >>> law_from_dict({"law": "wobble"})
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.AttitudeError: attitude: unknown law 'wobble'; allowed: inertial, nadir, ...
     """
     if not isinstance(table, Mapping) or "law" not in table:
         raise AttitudeError(

@@ -29,7 +29,17 @@ NS_PER_S = 1e9
 
 
 def axis_vector(spec: str | ArrayLike, name: str) -> NDArray[np.float64]:
-    """A unit vector from ``"+x"``, ``"-z"``, ``"y"`` or three components."""
+    """A unit vector from ``"+x"``, ``"-z"``, ``"y"`` or three components.
+
+    Examples
+    --------
+    >>> axis_vector("-z", "axis") + 0.0, axis_vector([3.0, 0.0, 4.0], "axis")
+    (array([ 0.,  0., -1.]), array([0.6, 0. , 0.8]))
+    >>> axis_vector("+w", "axis")
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.AttitudeError: axis: got '+w'; allowed: +x, -x, +y, -y, +z, -z or 3 components
+    """
     if isinstance(spec, str):
         s = spec.strip().lower()
         sign = -1.0 if s.startswith("-") else 1.0
@@ -50,6 +60,21 @@ def axis_vector(spec: str | ArrayLike, name: str) -> NDArray[np.float64]:
 
 
 def check_quaternion(q: ArrayLike, name: str) -> NDArray[np.float64]:
+    """One unit quaternion (scalar-last), normalised; :class:`AttitudeError` naming ``name``.
+
+    Examples
+    --------
+    >>> check_quaternion([0, 0, 0, 1], "initial")
+    array([0., 0., 0., 1.])
+    >>> check_quaternion([0.0, 0.0, 0.0, 2.0], "initial")
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.AttitudeError: initial: quaternion: [0.0, 0.0, 0.0, 2.0] at index [] has ...
+    >>> check_quaternion([[0.0, 0.0, 0.0, 1.0]] * 2, "initial")
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.AttitudeError: initial: expected one quaternion of 4 components, got shape ...
+    """
     try:
         arr = check_quaternions(q)
     except ValidationError as exc:
@@ -88,6 +113,14 @@ def triad(
     -------
     ndarray, shape (n, 4)
         Scalar-last unit quaternions, body -> reference.
+
+    Examples
+    --------
+    >>> from scipy.spatial.transform import Rotation
+    >>> q = triad([0, 0, 1], [1, 0, 0], [[0.0, -1.0, 0.0]], [[1.0, 0.0, 0.0]])
+    >>> R = Rotation.from_quat(q)
+    >>> np.round(R.apply([0.0, 0.0, 1.0]), 6) + 0.0, np.round(R.apply([1.0, 0.0, 0.0]), 6) + 0.0
+    (array([[ 0., -1.,  0.]]), array([[1., 0., 0.]]))
     """
     b1 = np.asarray(body_primary, float)
     b2 = np.asarray(body_secondary, float)
@@ -110,6 +143,17 @@ def triad(
 def perpendicular_pair(
     primary: ArrayLike, secondary: ArrayLike, names: str
 ) -> tuple[np.ndarray, np.ndarray]:
+    """Two body axes, checked to be perpendicular (``names`` labels the error).
+
+    Examples
+    --------
+    >>> perpendicular_pair(np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]), "nadir")
+    (array([0., 0., 1.]), array([1., 0., 0.]))
+    >>> perpendicular_pair(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.6, 0.8]), "nadir")
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.AttitudeError: nadir: the two body axes must be perpendicular, got [0.0, ...
+    """
     a, b = primary, secondary
     if abs(float(np.dot(a, b))) > 1e-9:
         raise AttitudeError(
@@ -132,6 +176,14 @@ class Context:
         Its velocity [km s-1].
     sun_km : array_like, shape (n, 3)
         Position of the Sun relative to the spacecraft [km].
+
+    Examples
+    --------
+    >>> ctx = Context(epoch=np.datetime64("2024-03-17T01:20:00", "ns"),
+    ...               position_km=np.array([[7000.0, 0.0, 0.0]]),
+    ...               velocity_km_s=np.array([[0.0, 7.5, 0.0]]))
+    >>> ctx.sun_km is None, ctx.position_km.shape
+    (True, (1, 3))
     """
 
     epoch: np.datetime64 | None = None
@@ -143,7 +195,16 @@ class Context:
 def seconds_since(
     times: ArrayLike, epoch: np.datetime64 | None, context: Context | None
 ) -> NDArray[np.float64]:
-    """Float seconds of ``times`` from the law's epoch (see the module docstring)."""
+    """Float seconds of ``times`` from the law's epoch (see the module docstring).
+
+    Examples
+    --------
+    >>> t = np.array(["2024-03-17T01:20:00", "2024-03-17T01:20:30"], dtype="datetime64[ns]")
+    >>> seconds_since(t, np.datetime64("2024-03-17T01:19:00", "ns"), None)
+    array([60., 90.])
+    >>> seconds_since(t, None, None)  # no epoch: from the first time
+    array([ 0., 30.])
+    """
     t = np.atleast_1d(np.asarray(times))
     if t.ndim != 1:
         raise AttitudeError(f"times: expected a 1-D array, got shape {t.shape}")
@@ -168,6 +229,20 @@ def seconds_since(
 
 
 def context_fields(context: Context | None, n: int, law: str, *fields: str) -> list[np.ndarray]:
+    """The context arrays ``fields``, each checked to be of shape (n, 3); ``law`` labels the error.
+
+    Examples
+    --------
+    >>> ctx = Context(position_km=np.array([[7000.0, 0.0, 0.0]]),
+    ...               velocity_km_s=np.array([[0.0, 7.5, 0.0]]))
+    >>> r, v = context_fields(ctx, 1, "nadir", "position_km", "velocity_km_s")
+    >>> r.tolist(), v.tolist()
+    ([[7000.0, 0.0, 0.0]], [[0.0, 7.5, 0.0]])
+    >>> context_fields(ctx, 1, "sun_pointing", "sun_km")
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.AttitudeError: sun_pointing: the context lacks sun_km
+    """
     if context is None:
         raise AttitudeError(
             f"{law}: needs an orbit context ({', '.join(fields)}); use it inside an Observation"
@@ -185,6 +260,13 @@ def context_fields(context: Context | None, n: int, law: str, *fields: str) -> l
 
 
 def check_epoch(epoch: Any) -> np.datetime64 | None:
+    """The epoch of a law as datetime64[ns] UTC, or None.
+
+    Examples
+    --------
+    >>> check_epoch("2024-03-17T01:20:00"), check_epoch(None)
+    (np.datetime64('2024-03-17T01:20:00.000000000'), None)
+    """
     if epoch is None:
         return None
     try:

@@ -18,42 +18,61 @@ The catalog sits above the domain modules: it imports them and maps every kind t
 the function that builds its object from an entry (:data:`LOADERS`); none of them
 imports it (they read an entry's file given the entry, from
 :mod:`sbrdf_xr._catalog_index`).
+
+User catalogs (directories named by ``SBRDF_XR_CATALOG_PATH``, see
+:mod:`sbrdf_xr._catalog_index`) add entries; :func:`load_spacecraft_spec` and
+:func:`load_material_spec` also accept a file where a name is expected (a mesh file, a
+material table or model netCDF file).
 """
 
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable
+import os
+from collections.abc import Callable, Mapping
+from pathlib import Path
 from typing import Any
 
+import trimesh
 import xarray as xr
 
 from . import material, models, observe, spacecraft
 from ._cache import cached_table
 from ._catalog_index import (
+    CATALOG_PATH_ENV,
     KINDS,
     SOURCES,
     CatalogEntry,
-    _index,  # noqa: F401  (re-exported: tools clear its cache after writing the index)
+    _read_index,  # noqa: F401  (re-exported: tools clear its cache after writing an index)
     catalog_dir,
     data_path,
     entries,
     entry,
     names,
+    user_catalog_dirs,
 )
-from .errors import CatalogError
+from ._names import SBRDF
+from .errors import CatalogError, ValidationError
 
 __all__ = [
+    "CATALOG_PATH_ENV",
     "KINDS",
     "LOADERS",
+    "MATERIAL_SUFFIXES",
+    "MESH_SUFFIXES",
     "SOURCES",
     "CatalogEntry",
     "catalog_dir",
     "data_path",
     "entries",
     "entry",
+    "is_file_spec",
     "load",
+    "load_material_spec",
+    "load_spacecraft_spec",
+    "material_tables",
     "names",
+    "user_catalog_dirs",
 ]
 
 
@@ -167,3 +186,259 @@ def load(name: str) -> Any:
     except KeyError:  # pragma: no cover - every kind has a loader (asserted above)
         raise CatalogError(f"no loader for catalog kind {e.kind!r}") from None
     return loader(e)
+
+
+# --------------------------------------------------------------------------- names or files
+
+#: Suffixes of a material file: a material table or a model, in netCDF.
+MATERIAL_SUFFIXES: tuple[str, ...] = (".nc", ".nc4", ".netcdf")
+
+#: Suffixes of a mesh file: the mesh formats :mod:`trimesh` reads here.
+MESH_SUFFIXES: tuple[str, ...] = tuple(
+    sorted(
+        "." + f
+        for f in trimesh.available_formats()
+        if f.isalnum() and f not in ("zip", "bz2", "xyz")  # archives, point clouds
+    )
+)
+
+
+def is_file_spec(spec: str | os.PathLike[str]) -> bool:
+    """Whether ``spec`` names a file rather than a catalog entry.
+
+    A path object always names a file; a string names a catalog entry if there is one
+    of that name, and otherwise a file if it holds a path separator or ends in a
+    suffix (``.stl``, ``.nc``, ...).  Catalog names have neither.
+
+    Parameters
+    ----------
+    spec : str or os.PathLike
+        A catalog name or a file path.
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> is_file_spec("lambertian-grey-50"), is_file_spec("box.stl"), is_file_spec("meshes/box")
+    (False, True, True)
+    """
+    if not isinstance(spec, str):
+        return True
+    if spec in names():
+        return False
+    return "/" in spec or os.sep in spec or Path(spec).suffix != ""
+
+
+def _file_of(
+    spec: str | os.PathLike[str],
+    base_dir: str | os.PathLike[str] | None,
+    what: str,
+    suffixes: tuple[str, ...],
+) -> Path:
+    """The file a spec names (relative to ``base_dir``), with a known suffix, existing."""
+    path = Path(spec).expanduser()
+    if not path.is_absolute() and base_dir is not None:
+        path = Path(base_dir) / path
+    suffix = path.suffix.lower()
+    if suffix not in suffixes:
+        raise ValidationError(
+            f"{what}: {os.fspath(spec)!r} is neither a catalog name nor a file with a known "
+            f"suffix (got {suffix or 'no suffix'!r}); allowed suffixes: {', '.join(suffixes)}"
+        )
+    if not path.is_file():
+        where = f" (relative paths are taken from {base_dir})" if base_dir is not None else ""
+        raise CatalogError(f"{what}: file {path} does not exist{where}")
+    return path
+
+
+def load_spacecraft_spec(
+    spec: str | os.PathLike[str],
+    *,
+    base_dir: str | os.PathLike[str] | None = None,
+    material: str | None = None,
+    material_map: Mapping[Any, str] | str | os.PathLike[str] | None = None,
+    **options: Any,
+) -> Any:
+    """A spacecraft from a catalog name or a mesh file.
+
+    Parameters
+    ----------
+    spec : str or os.PathLike
+        A ``spacecraft`` catalog entry (shipped or user) or a mesh file (a suffix of
+        :data:`MESH_SUFFIXES`); see :func:`is_file_spec`.
+    base_dir : str or os.PathLike, optional
+        Directory that relative file paths (the mesh, a material map file) are taken from.
+    material, material_map
+        For a mesh file, exactly one: the one material of every facet, or the facet label
+        -> material map (a mapping, or a TOML map file,
+        :func:`sbrdf_xr.spacecraft.read_material_map`).
+    **options
+        For a mesh file: ``length_unit``, ``face_property``, ``repair``, ``name``, ``file_type``
+        of :func:`sbrdf_xr.spacecraft.load_spacecraft`.
+
+    Returns
+    -------
+    Spacecraft
+
+    Raises
+    ------
+    CatalogError
+        For an unknown name or a file that does not exist.
+    ValidationError
+        For a catalog entry that is not a spacecraft, an unknown suffix, a mesh file without
+        ``material`` or ``material_map``, options given with a catalog name.
+
+    Examples
+    --------
+    >>> import tempfile, trimesh
+    >>> path = Path(tempfile.mkdtemp()) / "box.stl"
+    >>> _ = trimesh.creation.box(extents=(1.0, 1.0, 1.0)).export(path)
+    >>> sc = load_spacecraft_spec(path, material="lambertian-grey-50")
+    >>> sc.name, sc.n_facets, sc.materials
+    ('box', 12, ['lambertian-grey-50'])
+    """
+    if not is_file_spec(spec):
+        name = str(spec)
+        if material is not None or material_map is not None or options:
+            given = [k for k, v in (("material", material), ("material_map", material_map)) if v]
+            raise ValidationError(
+                f"spacecraft: {name!r} is a catalog entry; the mesh options "
+                f"{given + sorted(options)} apply to a mesh file only"
+            )
+        e = entry(name)
+        if e.kind != "spacecraft":
+            raise ValidationError(
+                f"spacecraft: catalog entry {name!r} is a {e.kind} entry, not a spacecraft"
+            )
+        return load(name)
+    path = _file_of(spec, base_dir, "spacecraft", MESH_SUFFIXES)
+    if (material is None) == (material_map is None):
+        raise ValidationError(
+            f"spacecraft: the mesh file {path} needs exactly one of material (the material of "
+            "every facet) and material_map (facet colour or label -> material)"
+        )
+    if isinstance(material_map, str | os.PathLike):
+        material_map = _file_of(material_map, base_dir, "material_map", (".toml",))
+    return spacecraft.load_spacecraft(path, material_map=material_map, material=material, **options)
+
+
+def load_material_spec(
+    spec: str | os.PathLike[str], *, base_dir: str | os.PathLike[str] | None = None
+) -> xr.DataArray | xr.Dataset:
+    """A material table or a BRDF model from a catalog name or a netCDF file.
+
+    Parameters
+    ----------
+    spec : str or os.PathLike
+        A ``material`` or ``model`` catalog entry (shipped or user), or a netCDF file
+        (a suffix of :data:`MATERIAL_SUFFIXES`) holding a material table (written by
+        :func:`sbrdf_xr.material_io.to_netcdf`) or a model (written by
+        :func:`sbrdf_xr.models.to_netcdf`).
+    base_dir : str or os.PathLike, optional
+        Directory that a relative file path is taken from.
+
+    Returns
+    -------
+    xarray.DataArray or xarray.Dataset
+        The table (a DataArray), or the model parameters (a Dataset).
+
+    Raises
+    ------
+    CatalogError
+        For an unknown name or a file that does not exist.
+    ValidationError
+        For an entry of another kind, an unknown suffix, or a file that is neither.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from sbrdf_xr import material_io, material_schema
+    >>> path = Path(tempfile.mkdtemp()) / "grey.nc"
+    >>> table = material_schema.lambertian(0.3, wavelength=[500.0, 600.0], material="grey")
+    >>> _ = material_io.to_netcdf(table, path)
+    >>> da = load_material_spec(path)
+    >>> da.attrs["material"], da.sizes["wavelength"]
+    ('grey', 2)
+    """
+    if not is_file_spec(spec):
+        e = entry(str(spec))
+        if e.kind not in ("material", "model"):
+            raise ValidationError(
+                f"material: catalog entry {e.name!r} is a {e.kind} entry, not a material "
+                "table or model"
+            )
+        return load(e.name)
+    path = _file_of(spec, base_dir, "material", MATERIAL_SUFFIXES)
+    try:
+        with xr.open_dataset(path, engine="netcdf4") as ds:
+            is_table, is_model = SBRDF in ds.data_vars, "model" in ds.attrs
+    except (OSError, ValueError) as exc:
+        raise ValidationError(f"material: {path} cannot be read as netCDF ({exc})") from None
+    if is_table:
+        return material.open_material(path)
+    if is_model:
+        return models.open_model(path)
+    raise ValidationError(
+        f"material: {path} is neither a material table (an 'sbrdf' variable, written by "
+        "sbrdf_xr.material_io.to_netcdf) nor a BRDF model (a 'model' attribute, written by "
+        "sbrdf_xr.models.to_netcdf)"
+    )
+
+
+def material_tables(
+    specs: Mapping[str, str | os.PathLike[str]], base_dir: str | os.PathLike[str] | None = None
+) -> tuple[dict[str, xr.DataArray], dict[str, xr.Dataset]]:
+    """Material tables, and BRDF models, from catalog names or netCDF files.
+
+    Parameters
+    ----------
+    specs : mapping of str to str or Path
+        Material name (as the spacecraft labels its facets) -> a ``material`` or ``model``
+        catalog entry or a netCDF file of a table or a model
+        (:func:`sbrdf_xr.catalog.load_material_spec`).
+    base_dir : str or Path, optional
+        Directory that relative file paths are taken from.
+
+    Returns
+    -------
+    tables : dict of str to DataArray
+        A table for every material; a model is rendered by :func:`sbrdf_xr.models.render`
+        on its default grid.
+    models : dict of str to Dataset
+        The models given (for ``evaluation = "analytic"``, which evaluates them exactly).
+
+    Raises
+    ------
+    ValidationError
+        Naming the material, for an entry of another kind, a file with an unknown
+        suffix, or a file that is neither a table nor a model.
+    CatalogError
+        For an unknown name or a file that does not exist.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from sbrdf_xr import material_io, material_schema
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> table = material_schema.lambertian(0.3, wavelength=[500.0, 600.0], material="grey")
+    >>> _ = material_io.to_netcdf(table, folder / "grey.nc")
+    >>> tables, models = material_tables({"paint": "grey.nc"}, base_dir=folder)
+    >>> sorted(tables), tables["paint"].attrs["material"], models
+    (['paint'], 'grey', {})
+    """
+    tables: dict[str, xr.DataArray] = {}
+    given: dict[str, xr.Dataset] = {}
+    for mat, spec in specs.items():
+        try:
+            obj = load_material_spec(spec, base_dir=base_dir)
+            if isinstance(obj, xr.Dataset):
+                given[mat] = obj
+                obj = models.render(obj)
+        except CatalogError as exc:
+            raise CatalogError(f"[materials] {mat!r}: {exc}") from None
+        except ValidationError as exc:
+            raise ValidationError(f"[materials] {mat!r}: {exc}") from None
+        tables[mat] = obj
+    return tables, given

@@ -2,18 +2,25 @@
 
 Sub-commands::
 
-    sbrdf-xr catalog list [--kind KIND]     what ships in the catalogs, with provenance
+    sbrdf-xr catalog list [--kind KIND]     the catalog entries (shipped and user), with origin
     sbrdf-xr catalog show NAME              one entry and a summary of its contents
     sbrdf-xr info [FILE.nc]                 package and dependency versions, or a file's summary
     sbrdf-xr bench [--quick]                accuracy/cost benchmarks, timings as ratios in one run
     sbrdf-xr simulate SCENE -o CUBE.nc      run a scene (built-in name or TOML file) into a cube
              [--scheduler ADDR] [--preset NAME] [--plot FIG.png] [--overwrite | --resume] [--plan]
+             [--spacecraft NAME|MESH [--mesh-material M | --material-map MAP.toml]]
+             [--material M=NAME|FILE.nc ...]
     sbrdf-xr plot CUBE.nc -o FIG.png        the cube's natural figure (light curve or spectra)
     sbrdf-xr photometry CUBE.nc [--bands V R I] [--range-km KM] [--colours V-R,R-I]
              [--system ab|vega] [-o PHOT.nc] [--csv PHOT.csv]
     sbrdf-xr invert unmix MEASURED --cube CUBE.nc [--range-km R] [-o OUT.nc]   material areas
     sbrdf-xr invert spin CURVE --spacecraft canx1 --to-sun X Y Z --to-observer X Y Z
              --periods MIN MAX N [-o OUT.nc]                                      spin state
+
+Wherever a spacecraft or a material is named, a file may stand instead: a mesh file
+(``--mesh-material`` or ``--material-map`` label its facets) or a netCDF material table
+or model; relative paths are taken from the current directory.  Catalog names include
+the user catalogs of ``SBRDF_XR_CATALOG_PATH`` (see :mod:`sbrdf_xr.catalog`).
 """
 
 from __future__ import annotations
@@ -117,20 +124,33 @@ def _open_cube(path: str) -> Any:
             raise ValidationError(f"{path}: cannot be read ({exc})") from None
 
 
+def _catalog_label(e: catalog.CatalogEntry, users: list[Path]) -> str:
+    """``shipped`` or ``user<i>`` (the i-th directory of SBRDF_XR_CATALOG_PATH)."""
+    return "shipped" if e.root is None else f"user{users.index(e.root) + 1}"
+
+
 def _cmd_catalog_list(args: argparse.Namespace) -> int:
     rows = catalog.entries(args.kind)
+    users = catalog.user_catalog_dirs()
     width = max((len(e.name) for e in rows), default=4)
-    print(f"{'name':<{width}}  {'kind':<16}  {'source':<12}  description")
+    print(f"{'name':<{width}}  {'kind':<16}  {'source':<12}  {'catalog':<8}  description")
     for e in rows:
-        desc = textwrap.shorten(e.description, 80)
-        print(f"{e.name:<{width}}  {e.kind:<16}  {e.source:<12}  {desc}")
-    print(f"\n{len(rows)} entries in {catalog.catalog_dir()}")
+        desc = textwrap.shorten(e.description, 72)
+        label = _catalog_label(e, users)
+        print(escape(f"{e.name:<{width}}  {e.kind:<16}  {e.source:<12}  {label:<8}  {desc}"))
+    print(f"\n{len(rows)} entries; catalogs:")
+    print(f"  shipped  {catalog.catalog_dir()}")
+    for i, d in enumerate(users, 1):
+        print(escape(f"  user{i:<4} {d}"))
+    if not users:
+        print(f"  (no user catalogs: set {catalog.CATALOG_PATH_ENV} to add some)")
     return 0
 
 
 def _cmd_catalog_show(args: argparse.Namespace) -> int:
     e = catalog.entry(args.name)
     print(escape(f"name:        {e.name}\nkind:        {e.kind}\nsource:      {e.source}"))
+    print(escape(f"catalog:     {e.origin}"))
     print(escape(f"file:        {e.file}"))
     print(
         "description: " + textwrap.fill(escape(e.description, True), 88, subsequent_indent=" " * 13)
@@ -160,6 +180,8 @@ def _cmd_info(args: argparse.Namespace) -> int:
     for mod in (numpy, scipy, xarray, dask, trimesh):
         print(f"  {mod.__name__:<8} {mod.__version__}")
     print(f"  catalogs {catalog.catalog_dir()} ({len(catalog.names())} entries)")
+    for d in catalog.user_catalog_dirs():
+        print(escape(f"  user catalog {d}"))
     return 0
 
 
@@ -196,6 +218,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     from .simulate import simulate, write
 
     scene = resolve_scene(args.scene)
+    scene = _with_body(scene, args)
     changes = _knob_values(args.set or [])
     if args.preset:
         scene = scene.with_options(preset=args.preset, **changes)
@@ -243,6 +266,88 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     if args.plot:
         _save_figure(path, args.plot)
     return 0
+
+
+def _spacecraft_of(args: argparse.Namespace) -> Any:
+    """The spacecraft of ``--spacecraft`` (a catalog name or a mesh file) and its options."""
+    options: dict[str, Any] = {}
+    if args.mesh_material is not None:
+        options["material"] = args.mesh_material
+    if args.material_map is not None:
+        options["material_map"] = Path(args.material_map)
+    if args.length_unit is not None:
+        options["length_unit"] = args.length_unit
+    if options and args.spacecraft is None:
+        raise ValidationError(
+            "--mesh-material, --material-map and --length-unit describe the mesh file of "
+            "--spacecraft; give --spacecraft too"
+        )
+    if options and not catalog.is_file_spec(args.spacecraft):
+        raise ValidationError(
+            f"--spacecraft {args.spacecraft!r} is a catalog entry; --mesh-material, "
+            "--material-map and --length-unit apply to a mesh file only"
+        )
+    if (
+        args.spacecraft is not None
+        and catalog.is_file_spec(args.spacecraft)
+        and not ("material" in options or "material_map" in options)
+    ):
+        raise ValidationError(
+            f"--spacecraft {args.spacecraft}: a mesh file needs --mesh-material NAME (one "
+            "material for every facet) or --material-map MAP.toml (facet colour or label -> "
+            "material)"
+        )
+    return catalog.load_spacecraft_spec(args.spacecraft, **options)
+
+
+def _with_body(scene: Any, args: argparse.Namespace) -> Any:
+    """The scene with the spacecraft of ``--spacecraft`` and the tables of ``--material``."""
+    from .scene_io import material_tables
+
+    specs: dict[str, str] = {}
+    for item in args.material or []:
+        mat, sep, spec = item.partition("=")
+        if not sep or not mat.strip() or not spec.strip():
+            raise ValidationError(
+                f"--material: got {item!r}; expected MATERIAL=NAME or MATERIAL=FILE.nc"
+            )
+        specs[mat.strip()] = spec.strip()
+    mesh = args.mesh_material or args.material_map or args.length_unit
+    if args.spacecraft is None and not (mesh or specs):
+        return scene
+    body = scene.spacecraft if args.spacecraft is None and not mesh else _spacecraft_of(args)
+    unknown = sorted(set(specs) - set(body.materials))
+    if unknown:
+        raise ValidationError(
+            f"--material: {unknown} are not materials of the spacecraft {body.name!r}; "
+            f"its materials: {body.materials}"
+        )
+    kept = {m: t for m, t in (scene.materials or {}).items() if m in body.materials}
+    wanted = {m: specs.get(m, m) for m in body.materials if m in specs or m not in kept}
+    tables, models = material_tables(wanted)
+    old_models = {m: v for m, v in (scene.models or {}).items() if m not in wanted}
+    return scene.with_options(
+        spacecraft=body,
+        materials={**kept, **tables},
+        models={**old_models, **models} or None,
+    )
+
+
+def _mesh_options(q: argparse.ArgumentParser) -> None:
+    """The options that describe a mesh file given to ``--spacecraft``."""
+    q.add_argument(
+        "--mesh-material",
+        metavar="NAME",
+        help="with a mesh file: the one material of every facet (a catalog name)",
+    )
+    q.add_argument(
+        "--material-map",
+        metavar="MAP.toml",
+        help="with a mesh file: facet colour or label -> material (TOML [[material]] tables)",
+    )
+    q.add_argument(
+        "--length-unit", metavar="UNIT", help="with a mesh file: its length unit (default m)"
+    )
 
 
 def _knob_values(items: list[str]) -> dict[str, object]:
@@ -453,9 +558,7 @@ def _cmd_invert(args: argparse.Namespace) -> int:
             )
         print(f"  degenerate: {ds.attrs['degenerate']}")
     else:
-        from .spacecraft import canx1, load_spacecraft
-
-        sc = canx1() if args.spacecraft == "canx1" else load_spacecraft(args.spacecraft)
+        sc = _spacecraft_of(args)
         lo, hi, n = args.periods
         ds = invert.fit_spin(
             read_light_curve(args.measured),
@@ -504,9 +607,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="version", version=f"sbrdf_xr {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
 
-    pc = sub.add_parser("catalog", help="list or show what ships in the catalogs")
+    pc = sub.add_parser(
+        "catalog", help="list or show the catalog entries (shipped, and SBRDF_XR_CATALOG_PATH)"
+    )
     csub = pc.add_subparsers(dest="catalog_command", required=True)
-    pl = csub.add_parser("list", help="list the catalog entries")
+    pl = csub.add_parser("list", help="list the catalog entries and the catalog of each")
     pl.add_argument("--kind", choices=catalog.KINDS, help="only entries of this kind")
     pl.set_defaults(func=_cmd_catalog_list)
     ps = csub.add_parser("show", help="show one entry")
@@ -567,6 +672,18 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="resume an interrupted run from its .part file (with --overwrite: and "
         "replace the existing output); a finished output of the same scene is left as is",
+    )
+    psim.add_argument(
+        "--spacecraft",
+        metavar="NAME|MESH",
+        help="replace the scene's spacecraft: a catalog name or a mesh file",
+    )
+    _mesh_options(psim)
+    psim.add_argument(
+        "--material",
+        action="append",
+        metavar="MATERIAL=NAME|FILE.nc",
+        help="the table of a material: a catalog name or a netCDF table or model file (repeatable)",
     )
     psim.add_argument("--plan", action="store_true", help="print the plan and stop")
     psim.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
@@ -635,7 +752,10 @@ def build_parser() -> argparse.ArgumentParser:
     pspin.add_argument(
         "measured", help="light curve CSV/netCDF (read_light_curve format, times in s)"
     )
-    pspin.add_argument("--spacecraft", default="canx1", help="canx1 or a mesh file")
+    pspin.add_argument(
+        "--spacecraft", default="canx1", help="a catalog name (default canx1) or a mesh file"
+    )
+    _mesh_options(pspin)
     pspin.add_argument(
         "--to-sun", type=float, nargs=3, required=True, help="inertial direction to the Sun"
     )

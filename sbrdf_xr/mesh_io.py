@@ -74,6 +74,11 @@ def length_factor(length_unit: str) -> float:
     ------
     ValidationError
         If the unit is not a known length unit.
+
+    Examples
+    --------
+    >>> length_factor("mm"), length_factor("in")
+    (0.001, 0.0254)
     """
     key = length_unit.strip().lower() if isinstance(length_unit, str) else None
     if key not in LENGTH_UNITS:
@@ -110,6 +115,15 @@ def read_material_map(path: str | Path) -> dict[Any, str]:
     ------
     ValidationError
         If the file is not valid TOML or a table lacks ``name`` or has no key.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> path = Path(tempfile.mkdtemp()) / "colours.toml"
+    >>> _ = path.write_text('[[material]]\\nname = "paint"\\nrgb = [255, 255, 255]\\nlabels = ["panel"]\\n')
+    >>> read_material_map(path)
+    {(255, 255, 255): 'paint', 'panel': 'paint'}
     """
     path = Path(path)
     try:
@@ -166,6 +180,31 @@ def _as_color(key: Any) -> Color | None:
 def normalise_map(
     material_map: Mapping[Any, str] | str | Path, known_materials: Iterable[str] | None
 ) -> tuple[dict[Color, str], dict[str, str]]:
+    """Split a material map (or the TOML file of one) into colour keys and name keys.
+
+    Parameters
+    ----------
+    material_map : mapping or str or Path
+        Facet label -> material name (see :func:`sbrdf_xr.spacecraft.load_spacecraft`).
+    known_materials : iterable of str, optional
+        Materials that exist; a map naming any other is an error.
+
+    Returns
+    -------
+    colours : dict of (r, g, b) to str
+    names : dict of str to str
+
+    Raises
+    ------
+    ValidationError
+        For an empty map, a key that is neither a colour nor a name, an empty material
+        name, or a material not in ``known_materials``.
+
+    Examples
+    --------
+    >>> normalise_map({"#ff0000": "aluminium", (0, 0, 255): "cell", "panel": "paint"}, None)
+    ({(255, 0, 0): 'aluminium', (0, 0, 255): 'cell'}, {'panel': 'paint'})
+    """
     if isinstance(material_map, str | Path):
         material_map = read_material_map(material_map)
     if not isinstance(material_map, Mapping) or not material_map:
@@ -367,7 +406,15 @@ def _stl_colors(mesh: trimesh.Trimesh) -> np.ndarray | None:
 def read_mesh(
     path_or_mesh: Any, face_property: str | None, file_type: str | None
 ) -> tuple[_Labelled, str | None]:
-    """Read a mesh source into labelled arrays; return them and a default name."""
+    """Read a mesh source into labelled arrays; return them and a default name.
+
+    Examples
+    --------
+    >>> labelled, name = read_mesh(trimesh.creation.box(), None, None)
+    >>> vertices, faces, rgb, names = labelled.arrays()
+    >>> vertices.shape, faces.shape, rgb.shape
+    ((8, 3), (12, 3), (12, 3))
+    """
     out = _Labelled()
     default_name = None
     obj = path_or_mesh
@@ -426,7 +473,18 @@ def label_faces(
     colours: dict[Color, str],
     name_map: dict[str, str],
 ) -> np.ndarray:
-    """Material name of every face; MeshError listing the labels that are not in the map."""
+    """Material name of every face; MeshError listing the labels that are not in the map.
+
+    Examples
+    --------
+    >>> box = trimesh.creation.box()
+    >>> box.visual.face_colors = [255, 0, 0, 255]
+    >>> labelled, _ = read_mesh(box, None, None)
+    >>> vertices, faces, rgb, names = labelled.arrays()
+    >>> colours, name_map = normalise_map({"#ff0000": "aluminium"}, None)
+    >>> label_faces(labelled, rgb, names, colours, name_map)[:3]
+    array(['aluminium', 'aluminium', 'aluminium'], dtype='<U9')
+    """
     n = len(rgb)
     material = np.full(n, None, dtype=object)
     for cand in names:
@@ -480,7 +538,17 @@ def _problem(repair: bool, message: str, fix: str) -> None:
 def clean_mesh(
     vertices: np.ndarray, faces: np.ndarray, material: np.ndarray, repair: bool
 ) -> tuple[trimesh.Trimesh, np.ndarray]:
-    """Run checks/repairs 1-7 of the module docstring."""
+    """Run checks/repairs 1-7 of the module docstring.
+
+    Examples
+    --------
+    >>> box = trimesh.creation.box()
+    >>> mesh, material = clean_mesh(
+    ...     np.asarray(box.vertices), np.asarray(box.faces), np.full(12, "paint"), repair=False
+    ... )
+    >>> len(mesh.faces), bool(mesh.is_watertight), round(float(mesh.volume), 6)
+    (12, True, 1.0)
+    """
     if len(faces) == 0:
         raise MeshError("the mesh is empty: it has no facets")
     if faces.min() < 0 or faces.max() >= len(vertices):

@@ -253,6 +253,20 @@ class Observation:
     -----
     EpochGapWarning
         When a time is more than :data:`EPOCH_GAP_DAYS` from the element epoch.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.attitude import Spin
+    >>> obs = Observation(Orbit.from_catalog("canx1-example"), Site.from_catalog("mont-megantic"),
+    ...                   times("2024-03-17T01:22:00", "2024-03-17T01:22:10", 5.0),
+    ...                   Spin(rate_deg_s=10.0))
+    >>> obs.times.size, obs.attitude.rate_deg_s
+    (3, 10.0)
+    >>> g = obs.geometry()
+    >>> sorted(g.data_vars)
+    ['quaternion', 'to_earth', 'to_observer', 'to_sun']
+    >>> np.round(g.elevation.values, 2)  # [degree]
+    array([75.85, 75.93, 75.55])
     """
 
     orbit: Orbit
@@ -327,14 +341,37 @@ class Observation:
         return state
 
     def context(self) -> _att.Context:
-        """The :class:`~sbrdf_xr.attitude.Context` the attitude law sees."""
+        """The :class:`~sbrdf_xr.attitude.Context` the attitude law sees.
+
+        Examples
+        --------
+        >>> from sbrdf_xr.attitude import Spin
+        >>> orbit, site = Orbit.from_catalog("canx1-example"), Site.from_catalog("mont-megantic")
+        >>> obs = Observation(orbit, site, times("2024-03-17T01:22:00", "2024-03-17T01:22:10", 5.0),
+        ...                   Spin(rate_deg_s=10.0))
+        >>> ctx = obs.context()
+        >>> ctx.position_km.shape, round(float(np.linalg.norm(ctx.position_km[0])), 0)  # [km]
+        ((3, 3), 7187.0)
+        """
         st = self._state()
         return _att.Context(
             epoch=self.times[0], position_km=st["r"], velocity_km_s=st["v"], sun_km=st["sun"]
         )
 
     def quaternions(self) -> NDArray[np.float64]:
-        """Attitudes (body -> GCRS) at the observation times, sign-continuous; (n, 4)."""
+        """Attitudes (body -> GCRS) at the observation times, sign-continuous; (n, 4).
+
+        Examples
+        --------
+        >>> from sbrdf_xr.attitude import Spin
+        >>> orbit, site = Orbit.from_catalog("canx1-example"), Site.from_catalog("mont-megantic")
+        >>> obs = Observation(orbit, site, times("2024-03-17T01:22:00", "2024-03-17T01:22:10", 5.0),
+        ...                   Spin(rate_deg_s=10.0))
+        >>> np.round(obs.quaternions(), 6)  # 10 degree s-1 about +z
+        array([[0.      , 0.      , 0.      , 1.      ],
+               [0.      , 0.      , 0.422618, 0.906308],
+               [0.      , 0.      , 0.766044, 0.642788]])
+        """
         q = np.asarray(self.attitude.quaternions(self.times, self.context()), dtype=np.float64)
         if q.shape != (self.times.size, 4):
             raise AttitudeError(
@@ -369,6 +406,18 @@ class Observation:
             ``site_sun_elevation`` [degree].  Attrs: ``tle_line1``, ``tle_line2``,
             ``site_latitude``, ``site_longitude`` [degree], ``site_height`` [m],
             ``site_name`` and the frames and models used.
+
+        Examples
+        --------
+        >>> from sbrdf_xr.attitude import Spin
+        >>> orbit, site = Orbit.from_catalog("canx1-example"), Site.from_catalog("mont-megantic")
+        >>> obs = Observation(orbit, site, times("2024-03-17T01:22:00", "2024-03-17T01:22:10", 5.0),
+        ...                   Spin(rate_deg_s=10.0))
+        >>> g = obs.geometry()
+        >>> dict(g.sizes)
+        {'time': 3, 'xyz': 3, 'component': 4}
+        >>> np.round(g.phase_angle.values, 2), np.round(g.range.values, 1)
+        (array([73.74, 75.3 , 76.87]), array([840.9, 840.7, 841.9]))
         """
         if on_unobservable not in UNOBSERVABLE:
             raise ObservationError(
@@ -498,6 +547,19 @@ def observation_from_dict(
         [observation.attitude]
         law = "nadir"
         yaw_deg = 0.0
+
+    Examples
+    --------
+    >>> obs = observation_from_dict({"orbit": "canx1-example", "site": "mont-megantic",
+    ...                              "start": "2024-03-17T01:20:00", "stop": "2024-03-17T01:21:00",
+    ...                              "step_s": 30.0,
+    ...                              "attitude": {"law": "spin", "rate_deg_s": 2.0}})
+    >>> obs.times.size, type(obs.attitude).__name__
+    (3, 'Spin')
+    >>> observation_from_dict({"orbit": "canx1-example", "site": "mont-megantic", "when": "now"})
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.ObservationError: [observation]: unknown key(s) ['when']; allowed: ...
     """
     allowed = {
         "orbit",
@@ -601,7 +663,14 @@ CANX1_PASS = {
 
 
 def canx1_attitude() -> _att.AttitudeLaw:
-    """Attitude of the built-in pass: a slow spin about a tilted body axis from a fixed start."""
+    """Attitude of the built-in pass: a slow spin about a tilted body axis from a fixed start.
+
+    Examples
+    --------
+    >>> law = canx1_attitude()
+    >>> type(law).__name__, law.quaternions([0.0, 1.0]).shape
+    ('Spin', (2, 4))
+    """
     return _att.Spin(
         axis_body=(0.3, 0.4, 0.866),
         rate_deg_s=4.0,
@@ -621,6 +690,12 @@ def canx1_pass(attitude: _att.AttitudeLaw | None = None) -> Observation:
     Returns
     -------
     Observation
+
+    Examples
+    --------
+    >>> obs = canx1_pass()
+    >>> obs.name, obs.times.size, str(obs.times[0])
+    ('canx1-pass', 301, '2024-03-17T01:20:00.000000000')
     """
     p = CANX1_PASS
     return Observation(
@@ -644,6 +719,12 @@ def bench_geometry(n_times: int = 3600, step_s: float = 1.0, repeats: int = 3) -
     dict
         ``n_times``, ``first_call_seconds``, ``seconds`` (best warm call) and
         ``seconds_per_time``.
+
+    Examples
+    --------
+    >>> row = bench_geometry(n_times=60, repeats=1)
+    >>> sorted(row), row["n_times"]
+    (['first_call_seconds', 'n_times', 'seconds', 'seconds_per_time'], 60.0)
     """
     p = CANX1_PASS
     t0 = to_datetime64(p["start"], "start") - np.timedelta64(int(n_times * step_s / 2), "s")

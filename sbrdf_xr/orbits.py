@@ -89,7 +89,14 @@ KNOT_S = 600.0
 
 
 def spline_knots(t64: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Seconds of ``t64`` from its start, and spline knots covering them (>= 4)."""
+    """Seconds of ``t64`` from its start, and spline knots covering them (>= 4).
+
+    Examples
+    --------
+    >>> secs, knots = spline_knots(times("2024-03-17T00:00:00", "2024-03-17T01:00:00", 600.0))
+    >>> secs.tolist(), knots.size
+    ([0.0, 600.0, 1200.0, 1800.0, 2400.0, 3000.0, 3600.0], 9)
+    """
     secs = (t64 - t64[0]).astype(np.int64) / 1e9
     span = float(secs[-1])
     n = max(4, int(np.ceil(span / KNOT_S)) + 3)
@@ -97,6 +104,14 @@ def spline_knots(t64: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def skyfield_utc(t64: np.ndarray) -> Any:
+    """skyfield Time of a datetime64[ns] UTC array (no nutation splines: :func:`skyfield_time`).
+
+    Examples
+    --------
+    >>> t = skyfield_utc(np.array(["2024-03-17T01:20:00.5"], dtype="datetime64[ns]"))
+    >>> [float(x[0]) for x in t.utc]  # year, month, day, hour, minute, second
+    [2024.0, 3.0, 17.0, 1.0, 20.0, 0.5]
+    """
     ts, _ = skyfield_data()
     day = t64.astype("datetime64[D]")
     month = day.astype("datetime64[M]")
@@ -119,6 +134,12 @@ def skyfield_time(t64: np.ndarray) -> Any:
     equinoxes, which vary over days, are evaluated on knots every :data:`KNOT_S` and
     splined; skyfield's own formula then gives the apparent sidereal time at every
     time (the pattern skyfield documents for supplying nutation angles).
+
+    Examples
+    --------
+    >>> t = skyfield_time(times("2024-03-17T01:20:00", "2024-03-17T01:30:00", 60.0))
+    >>> len(t), round(float(t.gast[0]), 6)  # apparent sidereal time [h]
+    (11, 13.007692)
     """
     from scipy.interpolate import CubicSpline
     from skyfield.nutationlib import equation_of_the_equinoxes_complimentary_terms
@@ -139,6 +160,21 @@ def skyfield_time(t64: np.ndarray) -> Any:
 
 
 def to_datetime64(value: Any, name: str) -> np.datetime64:
+    """One UTC time (ISO 8601, ``Z`` allowed; datetime, naive is UTC; datetime64) as datetime64[ns].
+
+    Examples
+    --------
+    >>> import datetime
+    >>> to_datetime64("2024-03-17T01:20:00Z", "start")
+    np.datetime64('2024-03-17T01:20:00.000000000')
+    >>> cest = datetime.timezone(datetime.timedelta(hours=2))
+    >>> to_datetime64(datetime.datetime(2024, 3, 17, 3, 20, tzinfo=cest), "start")
+    np.datetime64('2024-03-17T01:20:00.000000000')
+    >>> to_datetime64("yesterday", "start")
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.ObservationError: start: got 'yesterday'; expected a UTC time (ISO 8601, ...
+    """
     if isinstance(value, _dt.datetime) and value.tzinfo is not None:
         value = value.astimezone(_dt.UTC).replace(tzinfo=None)
     if isinstance(value, str) and value.endswith("Z"):
@@ -167,6 +203,12 @@ def times(start: Any, stop: Any, step_s: float = 1.0) -> NDArray[np.datetime64]:
     Returns
     -------
     ndarray of datetime64[ns]
+
+    Examples
+    --------
+    >>> t = times("2024-03-17T01:20:00", "2024-03-17T01:20:02", step_s=0.5)
+    >>> t.size, str(t[0]), str(t[-1])
+    (5, '2024-03-17T01:20:00.000000000', '2024-03-17T01:20:02.000000000')
     """
     t0, t1 = to_datetime64(start, "start"), to_datetime64(stop, "stop")
     if not (np.isfinite(step_s) and step_s > 0):
@@ -179,6 +221,18 @@ def times(start: Any, stop: Any, step_s: float = 1.0) -> NDArray[np.datetime64]:
 
 
 def check_times(value: Any) -> NDArray[np.datetime64]:
+    """The UTC times of ``value`` as a strictly increasing 1-D datetime64[ns] array.
+
+    Examples
+    --------
+    >>> check_times(["2024-03-17T01:20:00Z", "2024-03-17T01:20:01"])
+    array(['2024-03-17T01:20:00.000000000', '2024-03-17T01:20:01.000000000'],
+          dtype='datetime64[ns]')
+    >>> check_times(["2024-03-17T01:20:01", "2024-03-17T01:20:00"])
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.ObservationError: times: must be strictly increasing
+    """
     t = np.atleast_1d(np.asarray(value))
     if t.dtype.kind in "US" or t.dtype == object:
         try:
@@ -198,7 +252,13 @@ def check_times(value: Any) -> NDArray[np.datetime64]:
 
 
 def tle_checksum(line: str) -> int:
-    """Checksum of a TLE line: digits summed, ``-`` counting 1, modulo 10."""
+    """Checksum of a TLE line: digits summed, ``-`` counting 1, modulo 10.
+
+    Examples
+    --------
+    >>> tle_checksum("1 27847U 03031H   24075.50000000  .00000015  00000-0  21000-4 0  9991")
+    1
+    """
     return (sum(int(c) for c in line[:68] if c.isdigit()) + line[:68].count("-")) % 10
 
 
@@ -272,6 +332,14 @@ class Orbit:
         The two-line elements (exported by :mod:`sgp4.exporter` for an OMM).
     name : str
     provenance : str
+
+    Examples
+    --------
+    >>> l1 = "1 27847U 03031H   24075.50000000  .00000015  00000-0  21000-4 0  9991"
+    >>> l2 = "2 27847  98.7200 129.5000 0012000  95.0000 265.0000 14.21950000109836"
+    >>> orbit = Orbit.from_tle(l1, l2, "CANX-1")
+    >>> orbit.name, orbit.epoch
+    ('CANX-1', np.datetime64('2024-03-15T12:00:00.000000000'))
     """
 
     satellite: Any
@@ -291,6 +359,17 @@ class Orbit:
         ObservationError
             For a line of the wrong length, start, checksum or catalog number, or a field
             SGP4 cannot read.
+
+        Examples
+        --------
+        >>> l1 = "1 27847U 03031H   24075.50000000  .00000015  00000-0  21000-4 0  9991"
+        >>> l2 = "2 27847  98.7200 129.5000 0012000  95.0000 265.0000 14.21950000109836"
+        >>> Orbit.from_tle(l1, l2).name
+        '27847'
+        >>> Orbit.from_tle(l1, l2[:-1] + "0")
+        Traceback (most recent call last):
+            ...
+        sbrdf_xr.errors.ObservationError: TLE line 2: checksum '0' does not match the computed ...
         """
         from skyfield.api import EarthSatellite
 
@@ -312,6 +391,19 @@ class Orbit:
         omm : mapping or path
             The OMM fields (``OBJECT_NAME``, ``EPOCH``, ``MEAN_MOTION``, ... as in CelesTrak's
             JSON/CSV) or a ``.xml``, ``.csv`` or ``.json`` file holding one.
+
+        Examples
+        --------
+        >>> omm = {"OBJECT_NAME": "CANX-1", "OBJECT_ID": "2003-031H",
+        ...        "EPOCH": "2024-03-15T12:00:00.000000", "MEAN_MOTION": 14.2195,
+        ...        "ECCENTRICITY": 0.0012, "INCLINATION": 98.72, "RA_OF_ASC_NODE": 129.5,
+        ...        "ARG_OF_PERICENTER": 95.0, "MEAN_ANOMALY": 265.0, "EPHEMERIS_TYPE": 0,
+        ...        "CLASSIFICATION_TYPE": "U", "NORAD_CAT_ID": 27847, "ELEMENT_SET_NO": 999,
+        ...        "REV_AT_EPOCH": 10983, "BSTAR": 2.1e-05, "MEAN_MOTION_DOT": 1.5e-07,
+        ...        "MEAN_MOTION_DDOT": 0.0}
+        >>> orbit = Orbit.from_omm(omm)
+        >>> orbit.name, orbit.epoch
+        ('CANX-1', np.datetime64('2024-03-15T12:00:00.000000000'))
         """
         from sgp4 import exporter
         from sgp4 import omm as sgp4_omm
@@ -345,7 +437,13 @@ class Orbit:
 
     @classmethod
     def from_catalog(cls, name: str) -> Orbit:
-        """A shipped orbit (catalog kind ``orbit``)."""
+        """A shipped orbit (catalog kind ``orbit``).
+
+        Examples
+        --------
+        >>> Orbit.from_catalog("canx1-example").name
+        'CANX-1 (example elements)'
+        """
         e = _catalog_index.entry(name)
         if e.kind != "orbit":
             raise ObservationError(f"catalog entry {name!r} is a {e.kind}, not an orbit")
@@ -353,7 +451,13 @@ class Orbit:
 
     @property
     def epoch(self) -> np.datetime64:
-        """Epoch of the elements (UTC)."""
+        """Epoch of the elements (UTC).
+
+        Examples
+        --------
+        >>> Orbit.from_catalog("canx1-example").epoch
+        np.datetime64('2024-03-15T12:00:00.000000000')
+        """
         return np.datetime64(self.satellite.epoch.utc_datetime().replace(tzinfo=None), "ns")
 
 
@@ -381,6 +485,16 @@ class Site:
     height_m : float
         Height above the ellipsoid [m], in [-500, 9000].
     name : str
+
+    Examples
+    --------
+    >>> site = Site(45.455, -71.1525, 1111.0, name="Mont Megantic")
+    >>> site.longitude_deg, Site(0.0, 270.0).longitude_deg  # east longitude, stored in [-180, 180)
+    (-71.1525, -90.0)
+    >>> Site(95.0, 0.0)
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.ObservationError: site latitude_deg: got 95.0; allowed: [-90, 90]
     """
 
     latitude_deg: float
@@ -408,7 +522,14 @@ class Site:
 
     @classmethod
     def from_catalog(cls, name: str) -> Site:
-        """A shipped observatory (catalog kind ``site``)."""
+        """A shipped observatory (catalog kind ``site``).
+
+        Examples
+        --------
+        >>> site = Site.from_catalog("mont-megantic")
+        >>> site.name, round(site.latitude_deg, 3)
+        ('mont-megantic', 45.456)
+        """
         e = _catalog_index.entry(name)
         if e.kind != "site":
             raise ObservationError(f"catalog entry {name!r} is a {e.kind}, not a site")
@@ -416,7 +537,13 @@ class Site:
 
     @property
     def position(self) -> Any:
-        """The skyfield WGS84 geographic position."""
+        """The skyfield WGS84 geographic position.
+
+        Examples
+        --------
+        >>> Site(45.0, -71.0, 1000.0).position
+        <GeographicPosition WGS84 latitude +45.0000 N longitude -71.0000 E elevation 1000.0 m>
+        """
         from skyfield.api import wgs84
 
         return wgs84.latlon(self.latitude_deg, self.longitude_deg, elevation_m=self.height_m)
@@ -440,6 +567,11 @@ def disc_overlap_fraction(a: ArrayLike, b: ArrayLike, c: ArrayLike) -> NDArray[n
     -------
     ndarray
         In ``[0, 1]``.
+
+    Examples
+    --------
+    >>> disc_overlap_fraction([1.0, 1.0, 1.0], [2.0, 0.5, 0.5], [5.0, 0.0, 1.0])
+    array([1.        , 0.75      , 0.88834752])
     """
     a, b, c = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (a, b, c)))
     # The lens of the two discs, written with atan2 (never arccos near +-1, which loses
@@ -488,6 +620,13 @@ def sunlit_fraction(
     Returns
     -------
     ndarray, shape (...)
+
+    Examples
+    --------
+    >>> sun = [[1.5e8, 0.0, 0.0]] * 3  # the Sun along +x from each spacecraft [km]
+    >>> pos = [[7000.0, 0.0, 0.0], [-7000.0, 0.0, 0.0], [-7000.0, 6378.137, 0.0]]
+    >>> np.round(sunlit_fraction(pos, sun), 3)  # day side, umbra, near the shadow's edge
+    array([1.   , 0.   , 0.501])
     """
     r = np.asarray(position_km, dtype=np.float64)
     s = np.asarray(sun_km, dtype=np.float64)
@@ -514,6 +653,11 @@ def airmass(elevation_deg: ArrayLike, model: str = "kastenyoung1989") -> NDArray
     -------
     ndarray
         Relative airmass [1].
+
+    Examples
+    --------
+    >>> np.round(airmass([90.0, 30.0, 10.0, -5.0]), 4)  # NaN below the horizon
+    array([0.9997, 1.9943, 5.586 ,    nan])
     """
     if model not in AIRMASS_MODELS:
         raise ObservationError(
@@ -528,7 +672,14 @@ def airmass(elevation_deg: ArrayLike, model: str = "kastenyoung1989") -> NDArray
 
 
 def load_orbit_entry(entry: _catalog_index.CatalogEntry) -> Orbit:
-    """A ``kind = "orbit"`` entry: a 2- or 3-line TLE file."""
+    """A ``kind = "orbit"`` entry: a 2- or 3-line TLE file.
+
+    Examples
+    --------
+    >>> from sbrdf_xr import _catalog_index
+    >>> load_orbit_entry(_catalog_index.entry("canx1-example")).name
+    'CANX-1 (example elements)'
+    """
     lines = [
         ln.rstrip() for ln in entry.file.read_text(encoding="utf-8").splitlines() if ln.strip()
     ]
@@ -544,7 +695,15 @@ def load_orbit_entry(entry: _catalog_index.CatalogEntry) -> Orbit:
 
 
 def load_site_entry(entry: _catalog_index.CatalogEntry) -> Site:
-    """A ``kind = "site"`` entry: the table of that name in a TOML file of sites."""
+    """A ``kind = "site"`` entry: the table of that name in a TOML file of sites.
+
+    Examples
+    --------
+    >>> from sbrdf_xr import _catalog_index
+    >>> site = load_site_entry(_catalog_index.entry("haleakala"))
+    >>> site.name, round(site.height_m)
+    ('haleakala', 3058)
+    """
     sites = tomllib.loads(entry.file.read_text(encoding="utf-8"))
     key = entry.extra.get("key", entry.name)
     if key not in sites:

@@ -86,6 +86,26 @@ def light_curve(
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import matplotlib.pyplot as plt
+    >>> ang = np.arange(0.0, 360.0, 30.0)
+    >>> s = 0.1 + 0.05 * np.cos(np.radians(ang))  # a broadband BRDF over a rotation [sr-1]
+    >>> cube = xr.Dataset(
+    ...     {"brdf": (("attitude", "phase_angle"), np.stack([s, s / 2], 1), {"units": "sr-1"}),
+    ...      "spacecraft_sbrdf": (("attitude", "phase_angle", "wavelength"),
+    ...                           np.stack([s, s / 2], 1)[..., None] * [0.8, 1.0, 1.1],
+    ...                           {"units": "sr-1"})},
+    ...     coords={"attitude_angle": ("attitude", ang, {"units": "degree"}),
+    ...             "phase_angle": ("phase_angle", [10.0, 60.0], {"units": "degree"}),
+    ...             "wavelength": ("wavelength", [450.0, 550.0, 650.0], {"units": "nm"})})
+    >>> fig = light_curve(cube)
+    >>> type(fig).__name__, [len(ax.lines) for ax in fig.axes]  # one line per phase angle
+    ('Figure', [2])
+    >>> plt.close(fig)
     """
     fig, ax = _axes(ax)
     da = cube[variable]
@@ -130,6 +150,26 @@ def spectra(
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import matplotlib.pyplot as plt
+    >>> ang = np.arange(0.0, 360.0, 30.0)
+    >>> s = 0.1 + 0.05 * np.cos(np.radians(ang))  # a broadband BRDF over a rotation [sr-1]
+    >>> cube = xr.Dataset(
+    ...     {"brdf": (("attitude", "phase_angle"), np.stack([s, s / 2], 1), {"units": "sr-1"}),
+    ...      "spacecraft_sbrdf": (("attitude", "phase_angle", "wavelength"),
+    ...                           np.stack([s, s / 2], 1)[..., None] * [0.8, 1.0, 1.1],
+    ...                           {"units": "sr-1"})},
+    ...     coords={"attitude_angle": ("attitude", ang, {"units": "degree"}),
+    ...             "phase_angle": ("phase_angle", [10.0, 60.0], {"units": "degree"}),
+    ...             "wavelength": ("wavelength", [450.0, 550.0, 650.0], {"units": "nm"})})
+    >>> fig = spectra(cube, attitude=0)
+    >>> type(fig).__name__, len(fig.axes[0].lines)  # one line per phase angle
+    ('Figure', 2)
+    >>> plt.close(fig)
     """
     fig, ax = _axes(ax)
     da = cube[variable].sel(**sel) if sel else cube[variable]
@@ -171,6 +211,17 @@ def lut_slice(
 
     Without ``wavelength`` the table is integrated over wavelength (the broadband
     BRDF of paper 000 Eq. 2).
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import matplotlib.pyplot as plt
+    >>> from sbrdf_xr.material_schema import lambertian
+    >>> fig = lut_slice(lambertian(0.5, wavelength=[500.0, 600.0]), theta_i=30.0)
+    >>> type(fig).__name__, fig.axes[0].get_xlabel()
+    ('Figure', 'delta_theta [deg]')
+    >>> plt.close(fig)
     """
     fig, ax = _axes(ax, figsize=(6, 4))
     da = material.sel(theta_i=theta_i, method="nearest")
@@ -198,6 +249,26 @@ def plot_cube(cube: xr.Dataset) -> Any:
 
     Axes are logarithmic where the data span more than :data:`LOG_RATIO` (a glinting
     light curve spans 100x).
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import matplotlib.pyplot as plt
+    >>> ang = np.arange(0.0, 360.0, 30.0)
+    >>> s = 0.1 + 0.05 * np.cos(np.radians(ang))  # a broadband BRDF over a rotation [sr-1]
+    >>> cube = xr.Dataset(
+    ...     {"brdf": (("attitude", "phase_angle"), np.stack([s, s / 2], 1), {"units": "sr-1"}),
+    ...      "spacecraft_sbrdf": (("attitude", "phase_angle", "wavelength"),
+    ...                           np.stack([s, s / 2], 1)[..., None] * [0.8, 1.0, 1.1],
+    ...                           {"units": "sr-1"})},
+    ...     coords={"attitude_angle": ("attitude", ang, {"units": "degree"}),
+    ...             "phase_angle": ("phase_angle", [10.0, 60.0], {"units": "degree"}),
+    ...             "wavelength": ("wavelength", [450.0, 550.0, 650.0], {"units": "nm"})})
+    >>> fig = plot_cube(cube)  # an attitude sweep: its light curve
+    >>> type(fig).__name__, fig.axes[0].get_xlabel()
+    ('Figure', 'attitude angle [deg]')
+    >>> plt.close(fig)
     """
     if "attitude" in cube.dims and cube.sizes["attitude"] > 1 and "brdf" in cube:
         return light_curve(cube)
@@ -232,6 +303,32 @@ def magnitudes(mags: xr.DataArray, ax: Any = None, x: str | None = None, **sel: 
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import matplotlib.pyplot as plt
+    >>> ang = np.arange(0.0, 360.0, 30.0)
+    >>> s = 0.1 + 0.05 * np.cos(np.radians(ang))  # a broadband BRDF over a rotation [sr-1]
+    >>> cube = xr.Dataset(
+    ...     {"brdf": (("attitude", "phase_angle"), np.stack([s, s / 2], 1), {"units": "sr-1"}),
+    ...      "spacecraft_sbrdf": (("attitude", "phase_angle", "wavelength"),
+    ...                           np.stack([s, s / 2], 1)[..., None] * [0.8, 1.0, 1.1],
+    ...                           {"units": "sr-1"})},
+    ...     coords={"attitude_angle": ("attitude", ang, {"units": "degree"}),
+    ...             "phase_angle": ("phase_angle", [10.0, 60.0], {"units": "degree"}),
+    ...             "wavelength": ("wavelength", [450.0, 550.0, 650.0], {"units": "nm"})})
+    >>> wave = np.cos(np.radians(ang))
+    >>> mags = xr.DataArray(np.stack([12 - wave, 11.5 - wave], 1),
+    ...                     dims=("attitude", "band"),
+    ...                     attrs={"units": "1", "magnitude_system": "AB"},
+    ...                     coords={"attitude_angle": ("attitude", ang, {"units": "degree"}),
+    ...                             "band": ["B", "V"]})
+    >>> fig = magnitudes(mags)
+    >>> type(fig).__name__, len(fig.axes[0].lines), bool(fig.axes[0].yaxis_inverted())  # bright up
+    ('Figure', 2, True)
+    >>> plt.close(fig)
     """
     fig, ax = _axes(ax)
     da = mags.sel(**sel) if sel else mags
@@ -280,6 +377,32 @@ def colour_colour(
     Returns
     -------
     matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import matplotlib.pyplot as plt
+    >>> ang = np.arange(0.0, 360.0, 30.0)
+    >>> s = 0.1 + 0.05 * np.cos(np.radians(ang))  # a broadband BRDF over a rotation [sr-1]
+    >>> cube = xr.Dataset(
+    ...     {"brdf": (("attitude", "phase_angle"), np.stack([s, s / 2], 1), {"units": "sr-1"}),
+    ...      "spacecraft_sbrdf": (("attitude", "phase_angle", "wavelength"),
+    ...                           np.stack([s, s / 2], 1)[..., None] * [0.8, 1.0, 1.1],
+    ...                           {"units": "sr-1"})},
+    ...     coords={"attitude_angle": ("attitude", ang, {"units": "degree"}),
+    ...             "phase_angle": ("phase_angle", [10.0, 60.0], {"units": "degree"}),
+    ...             "wavelength": ("wavelength", [450.0, 550.0, 650.0], {"units": "nm"})})
+    >>> ph = xr.Dataset({"colour_index": (("attitude", "colour"),
+    ...                                    np.stack([0.6 + 0.01 * np.cos(np.radians(ang)),
+    ...                                              0.4 + 0.02 * np.sin(np.radians(ang))], 1),
+    ...                                    {"units": "1"})},
+    ...                 coords={"colour": ["B-V", "V-R"], "first": ("colour", ["B", "V"]),
+    ...                         "second": ("colour", ["V", "R"])}, attrs={"magnitude_system": "AB"})
+    >>> fig = colour_colour(ph, "B-V", "V-R")
+    >>> type(fig).__name__, fig.axes[0].get_xlabel()
+    ('Figure', 'B-V')
+    >>> plt.close(fig)
     """
     fig, ax = _axes(ax, figsize=(5, 4.5))
     ci = ds["colour_index"]

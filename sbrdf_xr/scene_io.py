@@ -23,7 +23,7 @@ from .scene_model import Scene
 _SCENE_KEYS = {
     "name": str,
     "description": str,
-    "spacecraft": str,
+    "spacecraft": (str, dict),
     "materials": dict,
     "attitude": dict,
     "phase_angles": list,
@@ -55,6 +55,18 @@ _SCENE_KEYS = {
     "earth_range_km": (int, float),
     "earth_phase_angle": (int, float),
     "temperature": (int, float, dict),
+}
+
+
+#: Keys of a ``[spacecraft]`` table (a mesh file; see :func:`load_scene`).
+_SPACECRAFT_KEYS = {
+    "path": str,
+    "material": str,
+    "material_map": (str, dict),
+    "length_unit": str,
+    "face_property": str,
+    "repair": bool,
+    "name": str,
 }
 
 
@@ -252,9 +264,60 @@ def _attitudes_from_table(t: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray 
     )
 
 
+def _spacecraft(spec: Any, base_dir: str | Path | None) -> Any:
+    """The spacecraft of a scene file: a catalog name, a mesh path, or a [spacecraft] table."""
+    from . import catalog
+
+    options: dict[str, Any] = {}
+    if isinstance(spec, Mapping):
+        _check_keys(spec, _SPACECRAFT_KEYS, "[spacecraft]")
+        if "path" not in spec:
+            raise SceneError(
+                "[spacecraft]: key 'path' is required (a mesh file, relative to the scene file)"
+            )
+        options = {k: v for k, v in spec.items() if k != "path"}
+        spec = spec["path"]
+        if not catalog.is_file_spec(spec):
+            spec = Path(spec)  # a table always names a file
+    try:
+        return catalog.load_spacecraft_spec(spec, base_dir=base_dir, **options)
+    except (CatalogError, SceneError):
+        raise
+    except (ValidationError, FileNotFoundError) as exc:
+        hint = ""
+        if isinstance(spec, str) and catalog.is_file_spec(spec) and "needs exactly one" in str(exc):
+            hint = (
+                f'; write a [spacecraft] table: path = "{spec}" and material = "..." or '
+                'material_map = "map.toml"'
+            )
+        raise SceneError(f"{exc}{hint}") from None
+
+
+def material_tables(
+    specs: Mapping[str, str | Path], base_dir: str | Path | None = None
+) -> tuple[dict[str, xr.DataArray], dict[str, xr.Dataset]]:
+    """:func:`sbrdf_xr.catalog.material_tables`, with its bad input as a :class:`SceneError`.
+
+    Examples
+    --------
+    >>> tables, models = material_tables({"paint": "lambertian-grey-50"})
+    >>> sorted(tables), models
+    (['paint'], {})
+    """
+    from . import catalog
+
+    try:
+        return catalog.material_tables(specs, base_dir)
+    except SceneError:
+        raise
+    except ValidationError as exc:
+        raise SceneError(str(exc)) from None
+
+
 def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) -> Scene:
     """Build a scene from the contents of a scene file (see :func:`load_scene`); relative
-    file names in it (an ``[observation]``'s quaternion series) are taken from ``base_dir``.
+    file names in it (mesh, material map and material files, an ``[observation]``'s
+    quaternion series) are taken from ``base_dir``.
 
     Raises
     ------
@@ -262,7 +325,7 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
         For every key that is unknown, of the wrong type, out of its domain, empty where
         something is needed (``phase_angles``, ``outputs``), or larger than
         :data:`MAX_SCENE_COUNT`; :class:`~sbrdf_xr.errors.CatalogError` for catalog names
-        that do not exist.
+        and files that do not exist.
 
     Examples
     --------
@@ -286,8 +349,6 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
     sbrdf_xr.errors.SceneError: scene: unknown key 'colour'; allowed: ...
     """
     _check_keys(d, _SCENE_KEYS, "scene")
-    from . import catalog
-    from .spacecraft import Spacecraft
 
     kw: dict[str, Any] = {
         k: d[k]
@@ -368,26 +429,22 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
         kw["phase_angles"] = _numbers(d["phase_angles"], "phase_angles")
     elif "phase_angles" in d:
         raise SceneError("scene: 'phase_angles' needs an [attitude] table")
-    # Catalog entries are loaded last, once every cheap check has passed.
-    sc_name = d.get("spacecraft")
-    if sc_name is None:
-        raise SceneError("scene: key 'spacecraft' is required (a catalog name)")
-    sc = catalog.load(sc_name)
-    if not isinstance(sc, Spacecraft):
-        raise SceneError(f"spacecraft: catalog entry {sc_name!r} is not a spacecraft")
-    materials = None
-    if "materials" in d:
-        materials = {}
-        for mat, entry in d["materials"].items():
-            if not isinstance(entry, str):
-                raise SceneError(f"[materials]: {mat!r} must name a catalog entry (a string)")
-            table = catalog.load(entry)
-            if not isinstance(table, xr.DataArray):
-                raise SceneError(
-                    f"[materials]: {mat!r} = {entry!r} is a {type(table).__name__} "
-                    "entry, not a material table"
-                )
-            materials[mat] = table
+    # Catalog entries and files are loaded last, once every cheap check has passed.
+    if "spacecraft" not in d:
+        raise SceneError("scene: key 'spacecraft' is required (a catalog name or a mesh file)")
+    sc = _spacecraft(d["spacecraft"], base_dir)
+    # every material of the spacecraft by its own name, unless [materials] names another
+    specs: dict[str, str] = {m: m for m in sc.materials}
+    for mat, spec in d.get("materials", {}).items():
+        if not isinstance(spec, str):
+            raise SceneError(
+                f"[materials]: {mat!r} must name a catalog entry or a netCDF file (a "
+                f"string), got {_show(spec)}"
+            )
+        specs[mat] = spec
+    materials, given_models = material_tables(specs, base_dir)
+    if given_models:
+        kw["models"] = given_models
     try:
         return Scene(sc, materials=materials, **kw)
     except SceneError:
@@ -418,9 +475,33 @@ def load_scene(path: str | Path) -> Scene:
         initial_angle = 25
 
         [materials]                       # optional: material name -> catalog entry
-        "white-paint-a276" = "white-paint-a276"
+        "white-paint-a276" = "white-paint-a276"   # (default: the entry of that name)
 
-    Unknown keys and wrong types raise :class:`~sbrdf_xr.errors.SceneError`.
+    Wherever a catalog name is expected a file may stand instead, and relative paths are
+    taken from the scene file's directory.  The spacecraft may be a mesh file of one
+    material or labelled facets (any suffix of
+    :data:`sbrdf_xr.catalog.MESH_SUFFIXES`), given as a table::
+
+        [spacecraft]
+        path = "meshes/bus.stl"           # required
+        material = "lambertian-grey-50"   # one material for every facet, or:
+        # material_map = "bus-colours.toml" (sbrdf_xr.spacecraft.read_material_map format)
+        # material_map = { "#ff0000" = "aluminium-6061-t6", "panel" = "tjpv-cell" }
+        length_unit = "mm"                # optional, also face_property, repair, name
+
+    and a material may be a netCDF file of a material table
+    (:func:`sbrdf_xr.material_io.to_netcdf`) or of a BRDF model
+    (:func:`sbrdf_xr.models.to_netcdf`; rendered to a table by
+    :func:`sbrdf_xr.models.render`, and evaluated exactly with
+    ``evaluation = "analytic"``)::
+
+        [materials]
+        "lambertian-grey-50" = "tables/my-grey.nc"
+
+    Names are looked up in the shipped catalog and in the user catalogs of
+    ``SBRDF_XR_CATALOG_PATH`` (:mod:`sbrdf_xr.catalog`).  Unknown keys and wrong types
+    raise :class:`~sbrdf_xr.errors.SceneError`; unknown names and missing files
+    :class:`~sbrdf_xr.errors.CatalogError`.
 
     Examples
     --------

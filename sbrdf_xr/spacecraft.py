@@ -177,6 +177,15 @@ def load_spacecraft(
         If the length unit or the map is invalid, or the map names an unknown material.
     FileNotFoundError
         If ``path_or_mesh`` is a path that does not exist.
+
+    Examples
+    --------
+    >>> sc = load_spacecraft(trimesh.creation.box(extents=(100, 100, 100)), material="paint",
+    ...                      length_unit="mm", name="cube")
+    >>> sc
+    <Spacecraft 'cube': 12 facets, materials ['paint'], extent [0.1, 0.1, 0.1] m>
+    >>> round(float(sc.mesh.area), 6)
+    0.06
     """
     factor = length_factor(length_unit)
     if (material_map is None) == (material is None):
@@ -261,6 +270,19 @@ class Spacecraft:
     tangent_source : str, optional
         Where the tangents come from (``"default"``, ``"direction"``, ``"per facet"``,
         ``"mesh attribute"``), for display; inferred when omitted.
+
+    Examples
+    --------
+    >>> sc = Spacecraft(trimesh.creation.box(), ["paint"] * 6 + ["cell"] * 6, name="cube")
+    >>> sc.n_facets, sc.materials, sc.is_convex
+    (12, ['cell', 'paint'], True)
+    >>> facets = sc.facets()
+    >>> dict(facets.sizes), round(float(facets.area.sum()), 6)
+    ({'facet': 12, 'xyz': 3}, 6.0)
+    >>> sc.merged().sizes["term"]  # facets sharing a normal and a material
+    8
+    >>> np.round(np.diag(sc.inertia(density=1000.0)), 3)  # a 1000 kg cube of side 1 m [kg m2]
+    array([166.667, 166.667, 166.667])
     """
 
     def __init__(
@@ -336,12 +358,24 @@ class Spacecraft:
 
     @property
     def n_facets(self) -> int:
-        """Number of facets."""
+        """Number of facets.
+
+        Examples
+        --------
+        >>> Spacecraft(trimesh.creation.box(), ["paint"] * 12).n_facets
+        12
+        """
         return len(self.mesh.faces)
 
     @property
     def materials(self) -> list[str]:
-        """Sorted unique material names."""
+        """Sorted unique material names.
+
+        Examples
+        --------
+        >>> Spacecraft(trimesh.creation.box(), ["paint"] * 6 + ["cell"] * 6).materials
+        ['cell', 'paint']
+        """
         return sorted(set(self.facet_material.tolist()))
 
     @property
@@ -351,6 +385,11 @@ class Spacecraft:
         Uses :attr:`trimesh.Trimesh.is_convex`: a watertight single body whose every pair of
         adjacent facets is locally convex within ``1e-5`` times the bounding-box diagonal, so
         coplanar facets (a subdivided cube) count as convex.
+
+        Examples
+        --------
+        >>> Spacecraft(trimesh.creation.box(), ["paint"] * 12).is_convex
+        True
         """
         if "is_convex" not in self._cache:
             self._cache["is_convex"] = bool(self.mesh.is_convex)
@@ -371,6 +410,14 @@ class Spacecraft:
         -------
         ndarray, shape (3, 3)
             Inertia tensor in the body frame [kg m2].
+
+        Examples
+        --------
+        >>> sc = Spacecraft(trimesh.creation.box(extents=(1.0, 1.0, 1.0)), ["paint"] * 12)
+        >>> np.round(sc.inertia(density=6.0), 6)  # a 6 kg cube of side 1 m: m a**2 / 6 = 1 kg m2
+        array([[ 1., -0., -0.],
+               [-0.,  1., -0.],
+               [-0., -0.,  1.]])
         """
         if not (np.isfinite(density) and density > 0):
             raise ValidationError(f"density: must be a positive number [kg m-3], got {density!r}")
@@ -386,6 +433,14 @@ class Spacecraft:
             Over dims ``facet`` and ``xyz``: ``normal (facet, xyz)`` [1], ``area (facet)``
             [m2], ``centroid (facet, xyz)`` [m], ``material (facet)`` (names) and
             ``tangent (facet, xyz)`` [1] (:attr:`facet_tangent`).
+
+        Examples
+        --------
+        >>> ds = Spacecraft(trimesh.creation.box(), ["paint"] * 12).facets()
+        >>> sorted(ds.data_vars), ds.area.attrs["units"]
+        (['area', 'centroid', 'material', 'normal', 'tangent'], 'm2')
+        >>> ds.normal.isel(facet=0).values.tolist()
+        [-1.0, 0.0, 0.0]
         """
         mesh = self.mesh
         ds = xr.Dataset(
@@ -442,6 +497,13 @@ class Spacecraft:
             normal); and
             the mapping back ``facet_term (facet)``, the term of every facet.  Terms are in
             order of their first facet.
+
+        Examples
+        --------
+        >>> sc = Spacecraft(trimesh.creation.box(), ["paint"] * 12)
+        >>> terms = sc.merged()
+        >>> terms.sizes["term"], terms.area.values.tolist()  # 6 faces of 2 facets each
+        (6, [1.0, 1.0, 1.0, 1.0, 1.0, 1.0])
         """
         if not (np.isfinite(tolerance) and tolerance > 0):
             raise ValidationError(
@@ -540,6 +602,16 @@ class Spacecraft:
         Returns
         -------
         matplotlib.figure.Figure
+
+        Examples
+        --------
+        >>> import matplotlib
+        >>> matplotlib.use("Agg")
+        >>> import matplotlib.pyplot as plt
+        >>> fig = Spacecraft(trimesh.creation.box(), ["paint"] * 6 + ["cell"] * 6).plot()
+        >>> type(fig).__name__, len(fig.axes)
+        ('Figure', 1)
+        >>> plt.close(fig)
         """
         import matplotlib.pyplot as plt
         from matplotlib.colors import to_rgba
@@ -597,6 +669,12 @@ def load_catalog_entry(entry: _catalog_index.CatalogEntry) -> Spacecraft:
     The entry's ``path`` is the mesh; extra fields: ``material_map`` (path of the TOML map,
     relative to the catalog directory; required), ``length_unit`` (default ``"m"``),
     ``face_property`` (optional).
+
+    Examples
+    --------
+    >>> sc = load_catalog_entry(_catalog_index.entry("canx1"))
+    >>> sc.name, sc.n_facets, round(float(sc.mesh.extents.max()), 4)  # largest extent [m]
+    ('canx1', 684, 0.1032)
     """
     try:
         map_file = entry.extra["material_map"]
@@ -606,7 +684,7 @@ def load_catalog_entry(entry: _catalog_index.CatalogEntry) -> Spacecraft:
         ) from None
     return load_spacecraft(
         entry.file,
-        read_material_map(_catalog_index.data_path(map_file)),
+        read_material_map(entry.data_path(map_file)),
         length_unit=entry.extra.get("length_unit", "m"),
         name=entry.name,
         face_property=entry.extra.get("face_property"),
@@ -627,5 +705,11 @@ def canx1() -> Spacecraft:
     -------
     Spacecraft
         Materials ``aluminium-6061-t6``, ``tjpv-cell``, ``white-paint-a276``.
+
+    Examples
+    --------
+    >>> sc = canx1()
+    >>> sc.n_facets, sc.materials
+    (684, ['aluminium-6061-t6', 'tjpv-cell', 'white-paint-a276'])
     """
     return load_catalog_entry(_catalog_index.entry("canx1"))

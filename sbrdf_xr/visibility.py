@@ -65,7 +65,6 @@ Comm. ACM 17(1), 32-42.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -75,6 +74,21 @@ from numpy.typing import ArrayLike, NDArray
 
 from ._names import FACET, GEOMETRY, VECTOR, attrs
 from ._shadow_kernels import MAX_SHADOWS, exact_kernel, facet_shadows
+from ._visibility_rays import (
+    DENSITY_PRESETS,
+    ENGINES,
+    OFFSET_FACTOR,
+    SEED,
+    available_engines,
+    check_density,
+    engine_name,
+    escape_masks,
+    is_convex,
+    mesh_of,
+    sample_triangle,
+    samples_per_facet,
+    supporting,
+)
 from .errors import ValidationError
 from .geometry import normalize
 from .spacecraft import Spacecraft
@@ -100,38 +114,9 @@ METHODS: dict[str, str] = {
     "sampled": "density**2 scrambled Sobol' rays per facet (ray engine: see ENGINES)",
 }
 
-#: Ray engines of the sampled method: name -> description.
-ENGINES: dict[str, str] = {
-    "auto": "embree if the embreex package is installed, triangle otherwise",
-    "embree": "Intel Embree via trimesh.ray.ray_pyembree (embreex package; float32)",
-    "triangle": "trimesh.ray.ray_triangle, pure numpy (float64; slow)",
-}
-
-#: Named sampling densities of the sampled method (samples per facet = density**2).
-DENSITY_PRESETS: dict[str, int] = {"fast": 1, "balanced": 4, "reference": 16}
-
-#: Default ray-origin offset along the facet normal, as a fraction of the bounding-box diagonal.
-OFFSET_FACTOR = 1.0e-6
-
 #: Height above a facet's plane, as a fraction of the bounding-box diagonal, below which a
 #: vertex counts as on the plane (exact method; float64 rounding of coplanar facets is ~1e-16).
 PLANE_TOLERANCE = 1.0e-9
-
-#: Upper bound on the rays cast in one engine call (memory ~ 100 bytes per ray).
-MAX_RAYS_PER_CALL = 1 << 20
-
-#: Seed of the sampled method's point sets.
-SEED = 20240601
-
-
-def available_engines() -> list[str]:
-    """Ray engines usable in this environment (``"triangle"`` always; ``"embree"`` if installed)."""
-    out = ["triangle"]
-    try:
-        import trimesh.ray.ray_pyembree  # noqa: F401
-    except ImportError:
-        return out
-    return ["embree", *out]
 
 
 def _method(method: str) -> str:
@@ -140,220 +125,9 @@ def _method(method: str) -> str:
     return method
 
 
-def _engine_name(engine: str | None) -> str:
-    if engine is None:
-        engine = "auto"
-    if engine not in ENGINES:
-        raise ValidationError(f"engine: got {engine!r}; allowed: {', '.join(ENGINES)}")
-    avail = available_engines()
-    if engine == "auto":
-        return avail[0]
-    if engine not in avail:
-        raise ValidationError(
-            f"engine: {engine!r} is not available here (install the 'embreex' package, "
-            f"extra [shadows]); available: {', '.join(avail)}"
-        )
-    return engine
-
-
-def _density(density: int | str) -> int:
-    if isinstance(density, str):
-        if density not in DENSITY_PRESETS:
-            raise ValidationError(f"density: got {density!r}; presets: {DENSITY_PRESETS}")
-        return DENSITY_PRESETS[density]
-    if isinstance(density, bool) or not isinstance(density, int | np.integer) or density < 1:
-        raise ValidationError(
-            f"density: got {density!r}; expected an integer sampling density >= 1 "
-            f"or a preset name {list(DENSITY_PRESETS)}"
-        )
-    return int(density)
-
-
-def samples_per_facet(density: int | str) -> int:
-    """Number of rays per facet and direction at a sampling density (``density**2``)."""
-    return _density(density) ** 2
-
-
-def sample_triangle(n_samples: int, n_facets: int = 1, seed: int = SEED) -> NDArray[np.float64]:
-    """Low-discrepancy barycentric sample points, an independent set for every facet.
-
-    A scrambled Sobol' sequence (:class:`scipy.stats.qmc.Sobol`, its first ``n_samples``
-    points) is shifted modulo 1 by a random vector per facet (Cranley-Patterson rotation)
-    and mapped to the triangle by ``(u, v) -> (1 - sqrt(u), sqrt(u) (1 - v), sqrt(u) v)``,
-    which preserves area (Shirley and Chiu 1997), so each point stands for an equal share of
-    the facet.  Deterministic for a given ``seed``.
-
-    Parameters
-    ----------
-    n_samples : int
-        Points per facet (>= 1).
-    n_facets : int
-        Number of independent point sets.
-    seed : int
-        Seed of the scrambling and of the shifts.
-
-    Returns
-    -------
-    ndarray, shape (n_facets, n_samples, 3)
-        Weights of the three vertices; each row sums to 1 and is positive or zero.
-    """
-    if isinstance(n_samples, bool) or int(n_samples) != n_samples or n_samples < 1 or n_facets < 0:
-        raise ValidationError(
-            f"n_samples, n_facets: got {n_samples!r}, {n_facets!r}; expected integers >= 1 and >= 0"
-        )
-    base, shift = _sample_uv(int(n_samples), int(n_facets), seed)
-    return _to_triangle(base[None, :, :] + shift[:, None, :])
-
-
-def _sample_uv(n_samples: int, n_facets: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
-    """The scrambled Sobol' points (n_samples, 2) and the per-facet shifts (n_facets, 2)."""
-    from scipy.stats import qmc
-
-    rng = np.random.default_rng(seed)
-    m = max(0, int(np.ceil(np.log2(n_samples))))
-    base = qmc.Sobol(d=2, scramble=True, seed=rng).random_base2(m)[:n_samples]
-    return base, rng.random((n_facets, 2))
-
-
-def _to_triangle(uv: np.ndarray) -> np.ndarray:
-    """Barycentric weights of unit-square points (shifted modulo 1), area-preserving map."""
-    uv = uv % 1.0
-    r = np.sqrt(uv[..., 0])
-    return np.stack([1.0 - r, r * (1.0 - uv[..., 1]), r * uv[..., 1]], axis=-1)
-
-
-def _mesh_of(spacecraft: Spacecraft | trimesh.Trimesh) -> tuple[trimesh.Trimesh, dict[str, Any]]:
-    if isinstance(spacecraft, Spacecraft):
-        return spacecraft.mesh, spacecraft._cache
-    if isinstance(spacecraft, trimesh.Trimesh):
-        return spacecraft, {}
-    raise ValidationError(
-        f"spacecraft: expected a Spacecraft or trimesh.Trimesh, got {type(spacecraft).__name__}"
-    )
-
-
-def _is_convex(spacecraft: Spacecraft | trimesh.Trimesh) -> bool:
-    if isinstance(spacecraft, Spacecraft):
-        return spacecraft.is_convex
-    return bool(spacecraft.is_convex)
-
-
-def _intersector(
-    mesh: trimesh.Trimesh, cache: dict[str, Any], engine: str
-) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
-    """A function (origins, unit directions) -> bool hit, cached per spacecraft and engine."""
-    key = f"ray:{engine}"
-    if key in cache:
-        return cache[key]
-    if engine == "embree":
-        from trimesh.ray import ray_pyembree
-
-        rmi = ray_pyembree.RayMeshIntersector(mesh)
-
-        def hits(origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
-            return rmi.intersects_first(origins, directions) >= 0
-
-    else:
-        from trimesh.ray import ray_triangle
-
-        rmi = ray_triangle.RayMeshIntersector(mesh)
-
-        def hits(origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
-            # trimesh counts hits up to 1e-6 model units *behind* the origin; keep only
-            # hits strictly in front of it (own-plane hits are at -offset / N.d < 0).
-            out = np.zeros(len(origins), dtype=bool)
-            _, index_ray, loc = rmi.intersects_id(
-                origins, directions, multiple_hits=True, return_locations=True
-            )
-            index_ray = np.asarray(index_ray, dtype=np.int64)
-            if len(index_ray) == 0:  # no ray hit anything (locations come back as shape (0,))
-                return out
-            loc = np.asarray(loc, dtype=np.float64).reshape(-1, 3)
-            ahead = np.einsum("ij,ij->i", loc - origins[index_ray], directions[index_ray]) > 0
-            out[index_ray[ahead]] = True
-            return out
-
-    cache[key] = hits
-    return hits
-
-
-def _supporting(mesh: trimesh.Trimesh, cache: dict[str, Any], tol: float) -> np.ndarray:
-    """Facets whose plane has the whole mesh on or behind it (cannot be shadowed)."""
-    key = f"supporting:{tol!r}"
-    if key not in cache:
-        try:
-            pts = np.asarray(mesh.convex_hull.vertices)
-        except Exception:  # pragma: no cover - degenerate (flat) meshes
-            pts = np.asarray(mesh.vertices)
-        normals = np.asarray(mesh.face_normals)
-        origin = np.asarray(mesh.triangles[:, 0])
-        height = np.full(len(normals), -np.inf)
-        step = max(1, (1 << 22) // max(len(pts), 1))
-        for s in range(0, len(normals), step):  # chunks of facets, bounded memory
-            n, o = normals[s : s + step], origin[s : s + step]
-            height[s : s + step] = (pts @ n.T - np.einsum("ij,ij->i", n, o)).max(axis=0)
-        cache[key] = height <= tol
-    return cache[key]
-
-
 def _directions(directions: ArrayLike, name: str) -> tuple[np.ndarray, tuple[int, ...]]:
     d = normalize(np.asarray(directions, dtype=np.float64), name)
     return d.reshape(-1, 3), d.shape[:-1]
-
-
-# ----------------------------------------------------------------------------- sampled method
-
-
-def _escape_masks(
-    spacecraft: Spacecraft | trimesh.Trimesh,
-    directions: list[np.ndarray],
-    density: int | str,
-    engine: str | None,
-    offset: float | None,
-    convex_shortcut: bool,
-    seed: int,
-) -> np.ndarray:
-    """Per-sample escape flags, shape (len(directions), n_geometries, n_facets, n_samples)."""
-    mesh, cache = _mesh_of(spacecraft)
-    n = _density(density)
-    engine = _engine_name(engine)
-    scale = float(mesh.scale)
-    if offset is None:
-        offset = OFFSET_FACTOR * scale
-    if not (np.isfinite(offset) and offset > 0):
-        raise ValidationError(f"offset: got {offset!r}; expected a positive length [m]")
-    normals = np.asarray(mesh.face_normals, dtype=np.float64)
-    n_geom = len(directions[0])
-    n_fac = len(normals)
-    n_s = n * n
-    front = [d @ normals.T > 0 for d in directions]  # (n_geom, n_facets) each
-    out = np.stack([np.broadcast_to(f[:, :, None], (n_geom, n_fac, n_s)) for f in front]).copy()
-    if convex_shortcut and _is_convex(spacecraft):
-        return out
-    candidates = np.flatnonzero(~_supporting(mesh, cache, 0.1 * offset))
-    if len(candidates) == 0:
-        return out
-    hits = _intersector(mesh, cache, engine)
-    key = f"samples:{n_s}:{seed}"
-    if key not in cache:
-        cache[key] = _sample_uv(n_s, n_fac, seed)
-    base, shift = cache[key]
-    bary = _to_triangle(base[None, :, :] + shift[candidates, None, :])
-    tri = np.asarray(mesh.triangles, dtype=np.float64)[candidates]
-    points = np.einsum("fsk,fkx->fsx", bary, tri) + offset * normals[candidates, None, :]
-    per_geom = max(1, len(candidates) * n_s)
-    chunk = max(1, MAX_RAYS_PER_CALL // per_geom)
-    for k, d in enumerate(directions):
-        for g0 in range(0, n_geom, chunk):  # chunks of directions, not facets
-            sub = front[k][g0 : g0 + chunk][:, candidates]
-            gi, fi = np.nonzero(sub)
-            if len(gi) == 0:
-                continue
-            origins = points[fi].reshape(-1, 3)
-            dirs = np.repeat(d[g0 + gi], n_s, axis=0)
-            escaped = ~hits(origins, dirs).reshape(len(gi), n_s)
-            out[k, g0 + gi, candidates[fi], :] = escaped
-    return out
 
 
 # ----------------------------------------------------------------------------- exact method
@@ -381,7 +155,7 @@ def _plane_frames(mesh: trimesh.Trimesh, cache: dict[str, Any]) -> dict[str, Any
     rel = tri - tri[:, :1]
     T2 = np.stack([np.einsum("fvx,fx->fv", rel, E1), np.einsum("fvx,fx->fv", rel, E2)], axis=-1)
     tol = PLANE_TOLERANCE * float(mesh.scale)
-    receiver = ok & ~_supporting(mesh, cache, tol)
+    receiver = ok & ~supporting(mesh, cache, tol)
     frames = {
         "V": V,
         "F": F,
@@ -425,10 +199,10 @@ def _exact(
     spacecraft: Spacecraft | trimesh.Trimesh, directions: list[np.ndarray], convex_shortcut: bool
 ) -> np.ndarray:
     """Exact fraction unobstructed along every direction of the list, shape (n_geom, n_facets)."""
-    mesh, cache = _mesh_of(spacecraft)
+    mesh, cache = mesh_of(spacecraft)
     normals = np.asarray(mesh.face_normals, dtype=np.float64)
     front = np.logical_and.reduce([d @ normals.T > 0 for d in directions])
-    if convex_shortcut and _is_convex(spacecraft):
+    if convex_shortcut and is_convex(spacecraft):
         return front.astype(np.float64)
     frames = _plane_frames(mesh, cache)
     dirs = np.ascontiguousarray(np.stack(directions, axis=1), dtype=np.float64)  # (G, K, 3)
@@ -470,15 +244,15 @@ def _fractions(
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """Fractions unobstructed along all ``directions`` at once, (n_geom, n_facets), and the
     standard error of the sampled estimate (zeros for the exact method) if asked."""
-    _mesh_of(spacecraft)
+    mesh_of(spacecraft)
     if _method(method) == "exact":
-        _density(density)
-        _engine_name(engine)
+        check_density(density)
+        engine_name(engine)
         if offset is not None and not (np.isfinite(offset) and offset > 0):
             raise ValidationError(f"offset: got {offset!r}; expected a positive length [m]")
         f = _exact(spacecraft, directions, convex_shortcut)
         return f, (np.zeros_like(f) if return_error else None)
-    masks = _escape_masks(spacecraft, directions, density, engine, offset, convex_shortcut, seed)
+    masks = escape_masks(spacecraft, directions, density, engine, offset, convex_shortcut, seed)
     f = np.logical_and.reduce(masks, axis=0).mean(axis=-1)
     err = np.sqrt(f * (1.0 - f) / masks.shape[-1]) if return_error else None
     return f, err
@@ -533,6 +307,24 @@ def lit_fraction(
     ValidationError
         On zero or non-finite directions, an unknown method, a density below 1, an unknown or
         unavailable engine.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1, x in [1, 2]
+    >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
+    ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
+    >>> area = body.mesh.area_faces[floor]
+    >>> def on_floor(f):  # area-weighted mean over the floor's two facets
+    ...     return round(float((f[..., floor] * area).sum(-1) / area.sum()), 6)
+    >>> body.is_convex
+    False
+    >>> sun = [-1.0, 2.0, 0.0]  # from -x, shadow 0.5 m long on the 1 m wide floor
+    >>> f = lit_fraction(body, sun)
+    >>> f.shape, on_floor(f)
+    ((20,), 0.5)
+    >>> abs(on_floor(lit_fraction(body, sun, method="sampled", density=8)) - 0.5) < 0.02
+    True
     """
     d, shape = _directions(directions, "directions")
     f, _ = _fractions(
@@ -556,6 +348,18 @@ def visible_fraction(
 
     Identical to :func:`lit_fraction` with observer directions in place of Sun directions
     (occlusion toward a distant observer is shadowing by a light at the observer).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1, x in [1, 2]
+    >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
+    ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
+    >>> area = body.mesh.area_faces[floor]
+    >>> def on_floor(f):  # area-weighted mean over the floor's two facets
+    ...     return round(float((f[..., floor] * area).sum(-1) / area.sum()), 6)
+    >>> on_floor(visible_fraction(body, [-1.0, 3.0, 0.0]))  # the wall hides 1/3 m of the floor
+    0.666667
     """
     return lit_fraction(
         spacecraft,
@@ -608,6 +412,19 @@ def lit_visible_fraction(
     ndarray, shape (..., n_facets)
         Fractions in ``[0, 1]`` [1]; 0 where ``N.s <= 0`` or ``N.o <= 0``.  With
         ``return_error``, a pair (fraction, standard error) of that shape.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1, x in [1, 2]
+    >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
+    ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
+    >>> area = body.mesh.area_faces[floor]
+    >>> def on_floor(f):  # area-weighted mean over the floor's two facets
+    ...     return round(float((f[..., floor] * area).sum(-1) / area.sum()), 6)
+    >>> sun, observer = [-1.0, 2.0, 0.0], [-1.0, 3.0, 0.0]
+    >>> on_floor(lit_visible_fraction(body, sun, observer))  # not 0.5 * 2/3: hidden is shadowed
+    0.5
     """
     s, o = np.broadcast_arrays(
         np.asarray(to_sun, dtype=np.float64), np.asarray(to_observer, dtype=np.float64)
@@ -651,6 +468,21 @@ def facet_visibility(
         ``lit_visible_fraction`` [1]; coordinates ``to_sun`` and ``to_observer``
         ``(geometry, xyz)``; attrs ``method`` and, for the sampled method, ``density``,
         ``samples_per_facet``, ``engine``.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1, x in [1, 2]
+    >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
+    ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
+    >>> area = body.mesh.area_faces[floor]
+    >>> def on_floor(f):  # area-weighted mean over the floor's two facets
+    ...     return round(float((f[..., floor] * area).sum(-1) / area.sum()), 6)
+    >>> ds = facet_visibility(body, [[-1.0, 2.0, 0.0]], [[-1.0, 3.0, 0.0]])
+    >>> dict(ds.sizes), ds.attrs["method"]
+    ({'geometry': 1, 'facet': 20, 'xyz': 3}, 'exact')
+    >>> on_floor(ds.lit_fraction.values[0]), on_floor(ds.visible_fraction.values[0])
+    (0.5, 0.666667)
     """
     s, o = np.broadcast_arrays(
         np.asarray(to_sun, dtype=np.float64), np.asarray(to_observer, dtype=np.float64)
@@ -664,12 +496,12 @@ def facet_visibility(
         joint = _fractions(spacecraft, [ds, do], *args)[0]
         extra: dict[str, Any] = {}
     else:
-        masks = _escape_masks(spacecraft, [ds, do], density, engine, offset, True, seed)
+        masks = escape_masks(spacecraft, [ds, do], density, engine, offset, True, seed)
         lit, vis, joint = masks[0].mean(-1), masks[1].mean(-1), (masks[0] & masks[1]).mean(-1)
         extra = {
-            "density": _density(density),
+            "density": check_density(density),
             "samples_per_facet": samples_per_facet(density),
-            "engine": _engine_name(engine),
+            "engine": engine_name(engine),
             "seed": seed,
         }
     dims = (GEOMETRY, FACET)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 
 import matplotlib
+import pytest
 from hypothesis import settings
 
 matplotlib.use("Agg")
@@ -17,3 +18,63 @@ matplotlib.use("Agg")
 settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
 settings.register_profile("dev", deadline=None, print_blob=True)
 settings.load_profile("ci" if os.environ.get("CI") else "dev")
+
+
+@pytest.fixture(autouse=True)
+def _no_user_catalogs(monkeypatch):
+    """Tests see the shipped catalog only, whatever the environment says."""
+    monkeypatch.delenv("SBRDF_XR_CATALOG_PATH", raising=False)
+
+
+@pytest.fixture
+def user_files(tmp_path):
+    """A user catalog directory and loose files: a 1 m box mesh (``box.stl``), a Lambertian
+    table of albedo 0.3 (``grey30.nc``) and a Lambertian model of albedo 0.4 (``model40.nc``)
+    in ``tmp_path/files``, and ``tmp_path/usercat`` whose ``index.toml`` names the table
+    ``user-grey-30`` and the box (all facets ``user-grey-30``) ``user-box``."""
+    import numpy as np
+    import trimesh
+
+    from sbrdf_xr import material_io, material_schema, models
+
+    wl = [450.0, 550.0, 650.0]
+    files = tmp_path / "files"
+    cat = tmp_path / "usercat"
+    for d in (files, cat / "meshes", cat / "tables"):
+        d.mkdir(parents=True)
+    box = trimesh.creation.box(extents=(1.0, 1.0, 1.0))
+    box.export(files / "box.stl")
+    box.visual.face_colors = [128, 128, 128, 255]
+    box.export(cat / "meshes" / "box.ply")
+    grey = material_schema.lambertian(0.3, wavelength=wl, material="user-grey-30")
+    material_io.to_netcdf(grey, files / "grey30.nc")
+    material_io.to_netcdf(grey, cat / "tables" / "grey30.nc")
+    spec = models.model_material(
+        "lambert", np.array(wl), material="model-40", provenance="test: rho = 0.4", rho=0.4
+    )
+    models.to_netcdf(spec, files / "model40.nc")
+    (cat / "meshes" / "box.toml").write_text(
+        '[[material]]\nname = "user-grey-30"\nrgb = [128, 128, 128]\n', encoding="utf-8"
+    )
+    (cat / "index.toml").write_text(
+        """
+[[entry]]
+name = "user-grey-30"
+kind = "material"
+path = "tables/grey30.nc"
+source = "synthetic"
+description = "Lambertian, albedo 0.3"
+provenance = "test"
+
+[[entry]]
+name = "user-box"
+kind = "spacecraft"
+path = "meshes/box.ply"
+source = "synthetic"
+description = "1 m cube"
+provenance = "test"
+material_map = "meshes/box.toml"
+""",
+        encoding="utf-8",
+    )
+    return tmp_path

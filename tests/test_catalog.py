@@ -12,7 +12,7 @@ import pytest
 import xarray as xr
 
 from sbrdf_xr import catalog, material
-from sbrdf_xr.errors import CatalogError
+from sbrdf_xr.errors import CatalogError, ValidationError
 
 
 def test_every_entry_has_provenance_and_loads():
@@ -81,3 +81,144 @@ def test_installed_package_finds_its_catalogs_from_any_directory(tmp_path):
         pytest.skip("sbrdf_xr is installed in editable mode")
     assert Path(cat_dir).resolve().is_relative_to(Path(module_file).resolve().parent)
     assert int(n) == len(catalog.names())
+
+
+# ----------------------------------------------------------------- user catalogs and files
+
+
+def test_user_catalog_adds_entries_and_says_where_they_come_from(user_files, monkeypatch):
+    cat = user_files / "usercat"
+    shipped = catalog.names()
+    monkeypatch.setenv(catalog.CATALOG_PATH_ENV, os.pathsep.join(["", str(cat)]))
+    assert catalog.user_catalog_dirs() == [cat.resolve()]
+    assert catalog.names() == [*shipped, "user-grey-30", "user-box"]
+    e = catalog.entry("user-box")
+    assert e.origin == str(cat.resolve()) and e.file == cat.resolve() / "meshes" / "box.ply"
+    assert catalog.entry("canx1").origin == "shipped"
+    grey = catalog.load("user-grey-30")
+    np.testing.assert_allclose(grey.values, 0.3 / np.pi, rtol=1e-6)  # float32 table
+    box = catalog.load("user-box")  # its material map is read from the user catalog
+    assert box.name == "user-box" and box.materials == ["user-grey-30"]
+    assert catalog.load_spacecraft_spec("user-box").n_facets == 12
+
+
+def test_user_catalog_refuses_a_shipped_name_and_a_repeated_name(user_files, monkeypatch):
+    cat = user_files / "usercat"
+    text = (cat / "index.toml").read_text(encoding="utf-8")
+    (cat / "index.toml").write_text(
+        text.replace('name = "user-grey-30"', 'name = "lambertian-grey-50"'), encoding="utf-8"
+    )
+    monkeypatch.setenv(catalog.CATALOG_PATH_ENV, str(cat))
+    with pytest.raises(
+        CatalogError,
+        match=r"entry 'lambertian-grey-50' is already in the shipped catalog; user entries "
+        r"may add names, not replace them",
+    ):
+        catalog.names()
+    other = user_files / "other"
+    other.mkdir()
+    (other / "index.toml").write_text(text, encoding="utf-8")
+    (cat / "index.toml").write_text(text, encoding="utf-8")  # the file changed: read again
+    monkeypatch.setenv(catalog.CATALOG_PATH_ENV, os.pathsep.join([str(cat), str(other)]))
+    with pytest.raises(
+        CatalogError, match=r"'user-grey-30' is already in the user catalog .*usercat"
+    ):
+        catalog.entry("user-grey-30")
+
+
+def test_user_catalog_directory_must_hold_an_index(tmp_path, monkeypatch):
+    monkeypatch.setenv(catalog.CATALOG_PATH_ENV, str(tmp_path))
+    with pytest.raises(CatalogError, match=r"SBRDF_XR_CATALOG_PATH: user catalog .* has no index"):
+        catalog.names()
+    monkeypatch.setenv(catalog.CATALOG_PATH_ENV, str(tmp_path / "missing"))
+    with pytest.raises(CatalogError, match="is not a directory"):
+        catalog.names()
+    (tmp_path / "index.toml").write_text("[[entry]]\nname = 'x'\n", encoding="utf-8")
+    monkeypatch.setenv(catalog.CATALOG_PATH_ENV, str(tmp_path))
+    with pytest.raises(CatalogError, match=r"entry 0 lacks the field\(s\) \['kind'"):
+        catalog.names()
+
+
+def test_material_and_model_files(user_files):
+    files = user_files / "files"
+    table = catalog.load_material_spec("grey30.nc", base_dir=files)
+    assert isinstance(table, xr.DataArray) and table.attrs["material"] == "user-grey-30"
+    model = catalog.load_material_spec(files / "model40.nc")
+    assert isinstance(model, xr.Dataset) and model.attrs["model"] == "lambert"
+    assert isinstance(catalog.load_material_spec("lambertian-grey-50"), xr.DataArray)
+    assert (
+        catalog.load_material_spec("aluminium-6061-t6-model").attrs["source"].startswith("model:")
+    )
+
+
+@pytest.mark.parametrize(
+    ("spec", "error", "match"),
+    [
+        ("nope.nc", CatalogError, r"material: file .*files/nope.nc does not exist \(relative"),
+        (
+            "grey30.txt",
+            ValidationError,
+            r"'grey30.txt' is neither a catalog name nor a file with "
+            r"a known suffix \(got '.txt'\); allowed suffixes: .nc, .nc4, .netcdf",
+        ),
+        ("box.nc", ValidationError, "cannot be read as netCDF"),
+        ("plain.nc", ValidationError, "is neither a material table .* nor a BRDF model"),
+        ("canx1", ValidationError, "'canx1' is a spacecraft entry, not a material table or model"),
+        ("no-such-entry", CatalogError, "no catalog entry named 'no-such-entry'"),
+    ],
+)
+def test_bad_material_specs(user_files, spec, error, match):
+    files = user_files / "files"
+    (files / "box.nc").write_bytes((files / "box.stl").read_bytes())
+    xr.Dataset({"x": ("n", [1.0])}).to_netcdf(files / "plain.nc")
+    with pytest.raises(error, match=match):
+        catalog.load_material_spec(spec, base_dir=files)
+
+
+def test_mesh_files(user_files):
+    files = user_files / "files"
+    sc = catalog.load_spacecraft_spec("box.stl", base_dir=files, material="lambertian-grey-50")
+    assert sc.name == "box" and sc.n_facets == 12 and sc.materials == ["lambertian-grey-50"]
+    mm = catalog.load_spacecraft_spec(
+        files / "box.stl", material="m", length_unit="mm", name="small"
+    )
+    np.testing.assert_allclose(mm.mesh.extents, 1e-3)  # 1 mm after the unit conversion
+    assert mm.name == "small"
+
+
+@pytest.mark.parametrize(
+    ("spec", "kw", "error", "match"),
+    [
+        (
+            "nope.stl",
+            {"material": "m"},
+            CatalogError,
+            r"spacecraft: file .*nope.stl does not exist",
+        ),
+        (
+            "box.step",
+            {"material": "m"},
+            ValidationError,
+            r"got '.step'\); allowed suffixes: .*\.stl",
+        ),
+        ("box.stl", {}, ValidationError, "needs exactly one of material .* and material_map"),
+        (
+            "canx1",
+            {"material": "m"},
+            ValidationError,
+            r"'canx1' is a catalog entry; the mesh "
+            r"options \['material'\] apply to a mesh file only",
+        ),
+        ("lambertian-grey-50", {}, ValidationError, "is a material entry, not a spacecraft"),
+        ("box.stl", {"material_map": "colours.toml"}, CatalogError, "colours.toml does not exist"),
+    ],
+)
+def test_bad_spacecraft_specs(user_files, spec, kw, error, match):
+    with pytest.raises(error, match=match):
+        catalog.load_spacecraft_spec(spec, base_dir=user_files / "files", **kw)
+
+
+def test_names_come_before_files():
+    assert not catalog.is_file_spec("canx1")
+    assert catalog.is_file_spec("canx1.ply") and catalog.is_file_spec(Path("canx1"))
+    assert catalog.is_file_spec("meshes/bus") and not catalog.is_file_spec("bus")

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -71,3 +73,68 @@ def test_bench_quick_runs_and_reports_ratios(capsys, tmp_path):
     )
     ds.close()
     assert csv.stat().st_size > 0 and png.stat().st_size > 0
+
+
+def test_catalog_list_and_show_say_where_entries_come_from(user_files, monkeypatch, capsys):
+    cat = user_files / "usercat"
+    monkeypatch.setenv("SBRDF_XR_CATALOG_PATH", str(cat))
+    assert main(["catalog", "list"]) == 0
+    out = capsys.readouterr().out
+    line = next(ln for ln in out.splitlines() if ln.startswith("user-box "))
+    assert line.split()[1:4] == ["spacecraft", "synthetic", "user1"]
+    assert next(ln for ln in out.splitlines() if ln.startswith("canx1 ")).split()[3] == "shipped"
+    assert f"user1    {cat.resolve()}" in out and f"{len(catalog.names())} entries" in out
+    assert main(["catalog", "show", "user-grey-30"]) == 0
+    assert f"catalog:     {cat.resolve()}" in capsys.readouterr().out
+    assert main(["catalog", "show", "canx1"]) == 0
+    assert "catalog:     shipped" in capsys.readouterr().out
+
+
+def test_catalog_name_clash_is_one_error_line(user_files, monkeypatch, capsys):
+    cat = user_files / "usercat"
+    text = (cat / "index.toml").read_text(encoding="utf-8")
+    (cat / "index.toml").write_text(text.replace('"user-box"', '"canx1"'), encoding="utf-8")
+    monkeypatch.setenv("SBRDF_XR_CATALOG_PATH", str(cat))
+    assert main(["catalog", "list"]) == 2
+    err = capsys.readouterr().err
+    assert (
+        err.startswith("sbrdf-xr: error: user catalog ")
+        and "'canx1' is already in the shipped" in err
+    )
+
+
+def test_simulate_with_a_mesh_file_and_material_files(user_files, capsys):
+    files = user_files / "files"
+    out = user_files / "box.nc"
+    args = ["simulate", "canx1-plusx-specular", "-o", str(out), "-q"]
+    body = ["--spacecraft", str(files / "box.stl"), "--mesh-material", "paint"]
+    assert main([*args, *body, "--material", f"paint={files / 'grey30.nc'}"]) == 0
+    import xarray as xr
+
+    with xr.open_dataset(out) as cube:
+        assert cube.attrs["spacecraft"] == "box" and list(cube.material.values) == ["paint"]
+    capsys.readouterr()
+    # a model file, on the shipped spacecraft: only that material changes
+    assert main([*args, "--material", f"tjpv-cell={files / 'model40.nc'}", "--plan"]) == 0
+    assert "plan for scene" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("extra", "match"),
+    [
+        (["--spacecraft", "{files}/box.stl"], "a mesh file needs --mesh-material NAME"),
+        (["--spacecraft", "{files}/nope.stl", "--mesh-material", "m"], "nope.stl does not exist"),
+        (["--spacecraft", "{files}/box.step", "--mesh-material", "m"], "allowed suffixes"),
+        (["--spacecraft", "canx1", "--mesh-material", "m"], "'canx1' is a catalog entry"),
+        (["--mesh-material", "m"], "give --spacecraft too"),
+        (["--material", "paint"], "expected MATERIAL=NAME or MATERIAL=FILE.nc"),
+        (["--material", "paint=x.nc"], r"\['paint'\] are not materials of the spacecraft 'canx1'"),
+        (["--material", "tjpv-cell={files}/none.nc"], "none.nc does not exist"),
+    ],
+)
+def test_simulate_bad_body_options(user_files, capsys, extra, match):
+    files = user_files / "files"
+    argv = ["simulate", "canx1-plusx-specular", "-o", str(user_files / "x.nc"), "--plan"]
+    assert main(argv + [a.format(files=files) for a in extra]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("sbrdf-xr: error: ") and re.search(match, err), err

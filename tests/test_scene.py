@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sbrdf_xr.errors import SceneError
+from sbrdf_xr.errors import CatalogError, SceneError
 from sbrdf_xr.scene import builtin_scenes, load_scene, resolve_scene
 
 GREY = """
@@ -96,3 +96,148 @@ def test_resolve_scene_names_and_files(tmp_path):
         resolve_scene("nope")
     with pytest.raises(SceneError, match="does not exist"):
         resolve_scene(tmp_path / "missing.toml")
+
+
+# ----------------------------------------------------------------- files in scene files
+
+# Sun and observer both along +x: only the +x face of the 1 m cube (area 1 m2) counts, at
+# normal incidence, so the signal is albedo / pi [m2 sr-1] exactly (float32 tables: 1e-6).
+HEAD_ON = """
+[geometry]
+to_sun = [[1.0, 0.0, 0.0]]
+to_observer = [[1.0, 0.0, 0.0]]
+"""
+
+
+def _signal(scene):
+    from sbrdf_xr.simulate import simulate
+
+    return simulate(scene)["signal"].values.ravel()
+
+
+def test_mesh_and_material_files_relative_to_the_scene_file(user_files):
+    (user_files / "scenes").mkdir()
+    text = (
+        '[spacecraft]\npath = "../files/box.stl"\nmaterial = "paint"\n'
+        + HEAD_ON
+        + '[materials]\npaint = "../files/grey30.nc"\n'
+    )
+    scene = load_scene(write(user_files / "scenes", text))
+    assert scene.spacecraft.name == "box" and scene.models is None
+    np.testing.assert_allclose(_signal(scene), 0.3 / np.pi, rtol=1e-6)
+
+
+def test_a_model_file_is_rendered_and_kept_for_analytic_evaluation(user_files):
+    text = (
+        'spacecraft = { path = "files/box.stl", material = "paint" }\n'
+        + 'evaluation = "analytic"\n'
+        + HEAD_ON
+        + '[materials]\npaint = "files/model40.nc"\n'
+    )
+    scene = load_scene(write(user_files, text))
+    assert list(scene.models) == ["paint"] and scene.models["paint"].attrs["model"] == "lambert"
+    np.testing.assert_allclose(_signal(scene), 0.4 / np.pi, rtol=1e-12)  # analytic: exact
+    table = scene.with_options(evaluation="table")
+    np.testing.assert_allclose(_signal(table), 0.4 / np.pi, rtol=1e-12)  # rendered float64
+
+
+def test_user_catalog_names_in_a_scene_file(user_files, monkeypatch):
+    monkeypatch.setenv("SBRDF_XR_CATALOG_PATH", str(user_files / "usercat"))
+    # the material is not listed: it is the user catalog's entry of the same name
+    scene = load_scene(write(user_files, 'spacecraft = "user-box"\n' + HEAD_ON))
+    assert sorted(scene.materials) == ["user-grey-30"]
+    np.testing.assert_allclose(_signal(scene), 0.3 / np.pi, rtol=1e-6)
+
+
+def test_an_inline_material_map(user_files):
+    text = (
+        '[spacecraft]\npath = "usercat/meshes/box.ply"\n'
+        'material_map = { "#808080" = "lambertian-grey-50" }\n' + HEAD_ON
+    )
+    scene = load_scene(write(user_files, text))
+    assert scene.spacecraft.materials == ["lambertian-grey-50"]
+
+
+@pytest.mark.parametrize(
+    ("spacecraft", "materials", "error", "match"),
+    [
+        (
+            'spacecraft = "files/nope.stl"',
+            "",
+            CatalogError,
+            r"spacecraft: file .*files/nope.stl does not exist \(relative paths are taken from",
+        ),
+        (
+            'spacecraft = "files/box.step"',
+            "",
+            SceneError,
+            r"'files/box.step' is neither a catalog name nor a file with a known suffix",
+        ),
+        (
+            'spacecraft = "files/box.stl"',
+            "",
+            SceneError,
+            r"needs exactly one of material .*; write a \[spacecraft\] table: "
+            r'path = "files/box.stl" and material = "..."',
+        ),
+        (
+            'spacecraft = { material = "m" }',
+            "",
+            SceneError,
+            r"\[spacecraft\]: key 'path' is required",
+        ),
+        (
+            'spacecraft = { path = "files/box.stl", colour = "red" }',
+            "",
+            SceneError,
+            r"\[spacecraft\]: unknown key 'colour'",
+        ),
+        (
+            'spacecraft = { path = "files/box.stl", material = "paint" }',
+            'paint = "files/missing.nc"',
+            CatalogError,
+            r"\[materials\] 'paint': material: file .*missing.nc does not exist",
+        ),
+        (
+            'spacecraft = { path = "files/box.stl", material = "paint" }',
+            'paint = "files/grey30.csv"',
+            SceneError,
+            r"\[materials\] 'paint': .* allowed suffixes: .nc, .nc4, .netcdf",
+        ),
+        (
+            'spacecraft = { path = "files/box.stl", material = "paint" }',
+            'paint = "canx1"',
+            SceneError,
+            r"\[materials\] 'paint': material: catalog entry 'canx1' is a spacecraft entry",
+        ),
+        (
+            'spacecraft = { path = "files/box.stl", material = "paint" }',
+            "paint = 3",
+            SceneError,
+            r"\[materials\]: 'paint' must name a catalog entry or a netCDF file",
+        ),
+    ],
+)
+def test_bad_files_in_scene_files(user_files, spacecraft, materials, error, match):
+    text = spacecraft + "\n" + HEAD_ON + "[materials]\n" + materials + "\n"
+    with pytest.raises(error, match=match):
+        load_scene(write(user_files, text))
+
+
+def test_scene_construction_reads_no_files(user_files, monkeypatch):
+    """Scene(...) with every table given opens no file: the I/O is in load_scene."""
+    import builtins
+
+    from sbrdf_xr import catalog
+    from sbrdf_xr.scene import Scene
+
+    sc = catalog.load_spacecraft_spec(user_files / "files" / "box.stl", material="paint")
+    table = catalog.load_material_spec(user_files / "files" / "grey30.nc")
+
+    def no_open(*args, **kwargs):
+        raise AssertionError(f"Scene(...) opened {args[:1]}")
+
+    monkeypatch.setattr(builtins, "open", no_open)
+    monkeypatch.setattr(catalog, "load", no_open)
+    scene = Scene(sc, materials={"paint": table}, to_sun=[[1, 0, 0]], to_observer=[[1, 0, 0]])
+    assert scene.n_geometries == 1

@@ -12,9 +12,9 @@ not run).
   ``_cache`` (tables built on load, cached on disk), ``anisotropy`` (facet tangents,
   ``psi``) and ``_aniso_kernels`` (the anisotropic look-up).
 * L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``models``,
-  ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``visibility``,
-  ``attitude_frames``, ``attitude``, ``orbits``, ``observe``, ``photometry`` (and its
-  modules), ``fingerprint``.
+  ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``_visibility_rays`` (the
+  sampled method), ``visibility``, ``attitude_frames``, ``attitude``, ``orbits``,
+  ``observe``, ``photometry`` (and its modules), ``fingerprint``.
 * L2: ``catalog`` (knows every kind's loader in L1).
 * L3, the scene and its plan: ``effects``, ``plan``, ``sweep``, ``scene_model`` (the
   :class:`Scene`), ``scene_io`` (scene files, built-in scenes), ``scene`` (re-exports both).
@@ -64,6 +64,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "goniometer",
         "mesh_io",
         "spacecraft",
+        "_visibility_rays",
         "visibility",
         "attitude_frames",
         "attitude",

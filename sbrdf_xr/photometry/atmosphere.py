@@ -71,6 +71,11 @@ def airmass(elevation: ArrayLike | xr.DataArray, model: str = "kastenyoung1989")
     ------
     ValidationError
         Unknown model; an elevation that is not finite or not in (0, 90] degree.
+
+    Examples
+    --------
+    >>> np.round(airmass([90.0, 30.0, 10.0]), 4)  # Kasten and Young (1989)
+    array([0.9997, 1.9943, 5.586 ])
     """
     from pvlib.atmosphere import get_relative_airmass
 
@@ -118,6 +123,19 @@ def apply_extinction(mags: xr.DataArray, airmass: Any, coefficients: Any) -> xr.
     xarray.DataArray
         ``mags`` plus ``k X``, with attrs ``airmass`` (when scalar) and
         ``extinction_coefficients``.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> wl = np.arange(300.0, 1101.0, 10.0)
+    >>> grey = np.full((2, wl.size), 0.1)  # 0.1 m2 sr-1 at every wavelength, two geometries
+    >>> cube = xr.Dataset({"signal": (("geometry", "wavelength"), grey, {"units": "m2 sr-1"})},
+    ...                   coords={"wavelength": ("wavelength", wl, {"units": "nm"})})
+    >>> from sbrdf_xr.photometry import magnitudes
+    >>> m = magnitudes(cube, ["B", "V"], range_km=1000.0)
+    >>> seen = apply_extinction(m, 2.0, {"B": 0.25, "V": 0.15})
+    >>> np.round((seen - m).isel(geometry=0).values, 6)
+    array([0.5, 0.3])
     """
     if not isinstance(mags, xr.DataArray) or BAND not in mags.dims:
         raise ValidationError("mags: expected a DataArray with a 'band' dimension")
@@ -186,6 +204,11 @@ def rayleigh_optical_depth(
     -------
     ndarray
         [1]
+
+    Examples
+    --------
+    >>> np.round(rayleigh_optical_depth([400.0, 550.0, 700.0]), 4)
+    array([0.3601, 0.0973, 0.0365])
     """
     lam = np.asarray(wavelength, dtype=np.float64) / 1000.0
     return (
@@ -231,6 +254,12 @@ def transmission(
     xarray.DataArray
         ``transmission`` over ``wavelength`` [1], attrs ``airmass`` and
         ``model_description``; pass it as ``transmission=`` to the band functions.
+
+    Examples
+    --------
+    >>> t = transmission([400.0, 550.0, 700.0], airmass=1.5)
+    >>> t.attrs["units"], np.round(t.values, 4)
+    ('1', array([0.5202, 0.8018, 0.8962]))
     """
     wl = _check_grid(wavelength, "wavelength")
     for name, v, lo in (
@@ -280,6 +309,12 @@ def extinction_coefficients(
     -------
     xarray.DataArray
         ``extinction_coefficient`` over ``band`` [magnitudes per air mass].
+
+    Examples
+    --------
+    >>> k = extinction_coefficients(["B", "V"])
+    >>> k.attrs["units"], np.round(k.values, 3)  # [mag per air mass]
+    ('1', array([0.328, 0.162]))
     """
     from .magnitude import sun_magnitudes
     from .spectra import _solar_native

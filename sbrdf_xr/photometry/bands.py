@@ -91,7 +91,14 @@ def _speclite_dir() -> Path:
 
 
 def speclite_names() -> list[str]:
-    """Names of the filter curves shipped with speclite (``group-band``)."""
+    """Names of the filter curves shipped with speclite (``group-band``).
+
+    Examples
+    --------
+    >>> names = speclite_names()
+    >>> "bessell-V" in names, "sdss2010-r" in names
+    (True, True)
+    """
     return sorted(p.stem for p in _speclite_dir().glob("*.ecsv"))
 
 
@@ -250,6 +257,14 @@ def filters(bands: Any, wavelength: ArrayLike | None = None) -> xr.DataArray:
         (speclite name or ``user:<label>``) and ``filter_source`` (file and reference).
         Responses are as shipped: speclite curves are photon-detection probabilities
         (use them with ``weighting="photon"``, the default of the band functions).
+
+    Examples
+    --------
+    >>> f = filters(["V", "sdss2010-r"], wavelength=np.arange(400.0, 801.0, 100.0))
+    >>> f.band.values.tolist(), f.dims
+    (['V', 'sdss2010-r'], ('band', 'wavelength'))
+    >>> np.round(f.sel(band="V").values, 3)
+    array([0.   , 0.458, 0.359, 0.   , 0.   ])
     """
     bl = _resolve_bands(bands)
     if wavelength is None:
@@ -408,6 +423,15 @@ def band_weights(
     ValidationError
         Unknown band, weighting, quadrature or extrapolation; a band not covered by
         the grid (without ``extrapolate``) or by the solar spectrum.
+
+    Examples
+    --------
+    >>> wl = np.arange(300.0, 1101.0, 5.0)
+    >>> W = band_weights(["B", "V"], wl, normalize=True)
+    >>> W.dims, np.round(W.sum("wavelength").values, 12)  # normalised: a flat spectrum is kept
+    (('band', 'wavelength'), array([1., 1.]))
+    >>> np.round(W.values @ np.full(wl.size, 0.3), 12)  # the band means of a flat 0.3
+    array([0.3, 0.3])
     """
     _choose(weighting, WEIGHTINGS, "weighting")
     _choose(quadrature, QUADRATURES, "quadrature")
@@ -494,6 +518,14 @@ def pre_integrate(
     xarray.DataArray
         Same dims with ``band`` in place of ``wavelength``, same name and attrs
         (``units`` multiplied by the weight units when not normalised).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.material_schema import lambertian
+    >>> table = lambertian(0.3, wavelength=np.arange(300.0, 1101.0, 10.0))
+    >>> banded = pre_integrate(table, ["B", "V"])
+    >>> banded.dims, np.round(float(banded.max()), 6)  # 0.3 / pi in every band
+    (('theta_i', 'delta_theta', 'phi', 'band'), np.float64(0.095493))
     """
     if (
         not isinstance(table, xr.DataArray)

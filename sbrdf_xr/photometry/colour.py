@@ -72,8 +72,20 @@ def srgb(
     xarray.DataArray
         ``srgb`` [1] over the spectra's other dims plus ``rgb`` (R, G, B), encoded
         with the sRGB transfer function, in [0, 1].  Computed eagerly (loads the data).
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> wl = np.arange(300.0, 1101.0, 10.0)
+    >>> grey = np.full((2, wl.size), 0.1)  # 0.1 m2 sr-1 at every wavelength, two geometries
+    >>> cube = xr.Dataset({"signal": (("geometry", "wavelength"), grey, {"units": "m2 sr-1"})},
+    ...                   coords={"wavelength": ("wavelength", wl, {"units": "nm"})})
+    >>> rgb = srgb(cube)
+    >>> rgb.dims, np.round(rgb.isel(geometry=0).values, 3)  # a grey body under the Sun: white
+    (('geometry', 'rgb'), array([1., 1., 1.]))
     """
-    import colour
+    with np.printoptions():  # colour-science switches numpy to legacy printing on import
+        import colour
 
     _choose(white, {"sun": "", "D65": ""}, "white")
     _choose(normalise, {"each": "", "global": ""}, "normalise")

@@ -20,7 +20,22 @@ _SUFFIX = "_label"
 
 
 def cf_encode(ds: xr.Dataset) -> xr.Dataset:
-    """``ds`` with every string dimension coordinate ``d`` stored as ``d_label`` (no index)."""
+    """``ds`` with every string dimension coordinate ``d`` stored as ``d_label`` (no index).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.photometry import photometry
+    >>> wl = np.arange(300.0, 1101.0, 10.0)
+    >>> cube = xr.Dataset({"signal": (("geometry", "wavelength"), np.full((2, wl.size), 0.1),
+    ...                               {"units": "m2 sr-1"})},
+    ...                   coords={"wavelength": ("wavelength", wl, {"units": "nm"})})
+    >>> ph = photometry(cube, ["B", "V"], 1000.0)
+    >>> enc = cf_encode(ph)
+    >>> "band" in enc.indexes, enc.band_label.values.tolist()
+    (False, ['B', 'V'])
+    """
     out = ds.copy()
     for dim in list(out.dims):
         if dim in out.coords and out[dim].dtype.kind in "OSU":
@@ -31,7 +46,22 @@ def cf_encode(ds: xr.Dataset) -> xr.Dataset:
 
 
 def cf_decode(ds: xr.Dataset) -> xr.Dataset:
-    """Inverse of :func:`cf_encode`: ``d_label`` over ``d`` becomes the index of ``d``."""
+    """Inverse of :func:`cf_encode`: ``d_label`` over ``d`` becomes the index of ``d``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.photometry import photometry
+    >>> wl = np.arange(300.0, 1101.0, 10.0)
+    >>> cube = xr.Dataset({"signal": (("geometry", "wavelength"), np.full((2, wl.size), 0.1),
+    ...                               {"units": "m2 sr-1"})},
+    ...                   coords={"wavelength": ("wavelength", wl, {"units": "nm"})})
+    >>> ph = photometry(cube, ["B", "V"], 1000.0)
+    >>> back = cf_decode(cf_encode(ph))
+    >>> back.indexes["band"].tolist(), back.identical(ph)
+    (['B', 'V'], True)
+    """
     out = ds
     for name in list(out.coords):
         name = str(name)
@@ -51,6 +81,20 @@ def to_netcdf(ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool =
     Returns
     -------
     pathlib.Path
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.photometry import photometry
+    >>> wl = np.arange(300.0, 1101.0, 10.0)
+    >>> cube = xr.Dataset({"signal": (("geometry", "wavelength"), np.full((2, wl.size), 0.1),
+    ...                               {"units": "m2 sr-1"})},
+    ...                   coords={"wavelength": ("wavelength", wl, {"units": "nm"})})
+    >>> ph = photometry(cube, ["B", "V"], 1000.0)
+    >>> path = to_netcdf(ph, Path(tempfile.mkdtemp()) / "phot.nc")
+    >>> path.name, open_photometry(path).attrs["Conventions"]
+    ('phot.nc', 'CF-1.10')
     """
     from ..material import write_netcdf_atomic
 
@@ -66,7 +110,22 @@ def to_netcdf(ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool =
 
 
 def open_photometry(path: str | os.PathLike[str]) -> xr.Dataset:
-    """Read a file written by :func:`to_netcdf` (loaded), band and colour labels as indexes."""
+    """Read a file written by :func:`to_netcdf` (loaded), band and colour labels as indexes.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.photometry import photometry
+    >>> wl = np.arange(300.0, 1101.0, 10.0)
+    >>> cube = xr.Dataset({"signal": (("geometry", "wavelength"), np.full((2, wl.size), 0.1),
+    ...                               {"units": "m2 sr-1"})},
+    ...                   coords={"wavelength": ("wavelength", wl, {"units": "nm"})})
+    >>> ph = photometry(cube, ["B", "V"], 1000.0)
+    >>> back = open_photometry(to_netcdf(ph, Path(tempfile.mkdtemp()) / "phot.nc"))
+    >>> back.band.values.tolist(), bool(np.allclose(back.magnitude, ph.magnitude, rtol=0, atol=0))
+    (['B', 'V'], True)
+    """
     with xr.open_dataset(path, engine="netcdf4") as ds:
         ds = ds.load()
     return cf_decode(ds)

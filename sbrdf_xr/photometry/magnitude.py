@@ -66,6 +66,13 @@ def sun_magnitudes(
     -------
     xarray.DataArray
         ``sun_magnitude`` over ``band`` [1, magnitudes], attrs ``magnitude_system``.
+
+    Examples
+    --------
+    >>> np.round(sun_magnitudes(["B", "V"]).values, 3)  # AB, ASTM G173 Sun at 1 AU
+    array([-26.243, -26.768])
+    >>> np.round(sun_magnitudes(["V"], system="vega").values, 3)
+    array([-26.774])
     """
     _choose(weighting, WEIGHTINGS, "weighting")
     system = check_system(system)
@@ -165,6 +172,18 @@ def band_signal(
     xarray.DataArray
         ``band_signal`` with ``band`` in place of ``wavelength`` [m2 sr-1], lazy if the
         cube is, with the Sun's band magnitudes as coordinate ``sun_magnitude``.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> wl = np.arange(300.0, 1101.0, 10.0)
+    >>> grey = np.full((2, wl.size), 0.1)  # 0.1 m2 sr-1 at every wavelength, two geometries
+    >>> cube = xr.Dataset({"signal": (("geometry", "wavelength"), grey, {"units": "m2 sr-1"})},
+    ...                   coords={"wavelength": ("wavelength", wl, {"units": "nm"})})
+    >>> s = band_signal(cube, ["B", "V"])
+    >>> s.dims, np.round(s.values, 12)  # a grey body keeps its signal in every band
+    (('geometry', 'band'), array([[0.1, 0.1],
+           [0.1, 0.1]]))
     """
     s = _signal_of(cube, variable)
     out = pre_integrate(
@@ -243,6 +262,19 @@ def magnitudes(
     -------
     xarray.DataArray
         ``magnitude`` [1] over the cube's dims with ``band`` in place of ``wavelength``.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> wl = np.arange(300.0, 1101.0, 10.0)
+    >>> grey = np.full((2, wl.size), 0.1)  # 0.1 m2 sr-1 at every wavelength, two geometries
+    >>> cube = xr.Dataset({"signal": (("geometry", "wavelength"), grey, {"units": "m2 sr-1"})},
+    ...                   coords={"wavelength": ("wavelength", wl, {"units": "nm"})})
+    >>> m = magnitudes(cube, ["B", "V"], range_km=1000.0)
+    >>> m.dims, np.round(m.isel(geometry=0).values, 4)
+    (('geometry', 'band'), array([6.257 , 5.7318]))
+    >>> round(float(magnitudes(cube, ["V"], range_km=2000.0)[0, 0] - m[0, 1]), 6)  # 5 log10 2
+    1.50515
     """
     system = check_system(system)
     if range_km is None:
@@ -327,6 +359,17 @@ def colour_indices(
     xarray.DataArray
         ``colour_index`` [mag] with dim ``colour`` (labels ``"a-b"``) and coords
         ``first``, ``second``; NaN where either magnitude is infinite or NaN.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> wl = np.arange(300.0, 1101.0, 10.0)
+    >>> grey = np.full((2, wl.size), 0.1)  # 0.1 m2 sr-1 at every wavelength, two geometries
+    >>> cube = xr.Dataset({"signal": (("geometry", "wavelength"), grey, {"units": "m2 sr-1"})},
+    ...                   coords={"wavelength": ("wavelength", wl, {"units": "nm"})})
+    >>> ci = colour_indices(magnitudes(cube, ["B", "V", "R"], range_km=1000.0))
+    >>> ci.colour.values.tolist(), np.round(ci.isel(geometry=0).values, 4)  # the Sun's AB colours
+    (['B-V', 'V-R'], array([0.5252, 0.1944]))
     """
     if not isinstance(mags, xr.DataArray) or BAND not in mags.dims:
         raise ValidationError("mags: expected a DataArray with a 'band' dimension")
@@ -406,6 +449,17 @@ def photometry(
     xarray.Dataset
         ``band_signal`` [m2 sr-1], ``magnitude`` [mag], ``colour_index`` [mag] (when
         there are two bands or more), with the cube's coordinates.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> wl = np.arange(300.0, 1101.0, 10.0)
+    >>> grey = np.full((2, wl.size), 0.1)  # 0.1 m2 sr-1 at every wavelength, two geometries
+    >>> cube = xr.Dataset({"signal": (("geometry", "wavelength"), grey, {"units": "m2 sr-1"})},
+    ...                   coords={"wavelength": ("wavelength", wl, {"units": "nm"})})
+    >>> ph = photometry(cube, ["B", "V"], 1000.0)
+    >>> sorted(ph.data_vars), ph.attrs["magnitude_system"]
+    (['band_signal', 'colour_index', 'magnitude'], 'AB')
     """
     d = _range_m(range_km)
     system = check_system(system)

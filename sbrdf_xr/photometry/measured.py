@@ -189,6 +189,22 @@ def read_light_curve(
         and rotation_angle, non-numeric values or wrong units, an uncertainty below
         1e-6, unknown bands, several systems, times without a time zone, decreasing
         times or angles.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> rows = ["rotation_angle,band,magnitude,uncertainty,system"]
+    >>> for a in (0, 30, 60, 90):  # a double-peaked curve, 0.2 mag fainter, 20 degree later
+    ...     for b, m0 in (("B", 10.2), ("V", 9.8)):
+    ...         rows.append(f"{a},{b},{m0 + 0.5 * np.cos(np.radians(2 * (a + 20))):.4f},0.01,AB")
+    >>> path = Path(tempfile.mkdtemp()) / "curve.csv"
+    >>> _ = path.write_text("\\n".join(rows))
+    >>> lc = read_light_curve(path)
+    >>> dict(lc.sizes), lc.attrs["abscissa"], lc.attrs["magnitude_system"]
+    ({'obs': 8}, 'rotation_angle', 'AB')
+    >>> lc.band.values[:4].tolist(), lc.magnitude.values[:2].tolist()
+    (['B', 'V', 'B', 'V'], [10.583, 10.183])
     """
     import pandas as pd
 

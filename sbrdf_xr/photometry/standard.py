@@ -38,6 +38,11 @@ def lambert_sphere_phase(alpha_deg: ArrayLike) -> np.ndarray:
     -------
     ndarray
         [1]
+
+    Examples
+    --------
+    >>> np.round(lambert_sphere_phase([0.0, 90.0, 180.0]), 6)  # 1, 1/pi, 0
+    array([1.     , 0.31831, 0.     ])
     """
     a = np.radians(np.asarray(alpha_deg, dtype=np.float64))
     return ((np.pi - a) * np.cos(a) + np.sin(a)) / np.pi
@@ -49,6 +54,11 @@ def specular_sphere_phase(alpha_deg: ArrayLike) -> np.ndarray:
     A mirror sphere's glint has the same intensity in every direction (the
     reflected-ray density of a sphere is isotropic; e.g. van de Hulst 1957, *Light
     Scattering by Small Particles*, sect. 12.21).
+
+    Examples
+    --------
+    >>> specular_sphere_phase([0.0, 90.0])
+    array([1., 1.])
     """
     return np.ones_like(np.asarray(alpha_deg, dtype=np.float64))
 
@@ -101,6 +111,19 @@ def standard_magnitude(
     -------
     xarray.DataArray
         ``standard_magnitude`` [1], attrs state the normalisation.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> wl = np.arange(300.0, 1101.0, 10.0)
+    >>> grey = np.full((2, wl.size), 0.1)  # 0.1 m2 sr-1 at every wavelength, two geometries
+    >>> cube = xr.Dataset({"signal": (("geometry", "wavelength"), grey, {"units": "m2 sr-1"})},
+    ...                   coords={"wavelength": ("wavelength", wl, {"units": "nm"})})
+    >>> from sbrdf_xr.photometry import magnitudes
+    >>> m = magnitudes(cube, ["V"], range_km=2000.0)
+    >>> std = standard_magnitude(m, 2000.0)  # to 1000 km: 5 log10(2) brighter
+    >>> round(float((m - std)[0, 0]), 6)
+    1.50515
     """
     if not isinstance(mags, xr.DataArray):
         raise ValidationError(f"mags: expected a DataArray, got {type(mags).__name__}")
@@ -187,6 +210,11 @@ def sun_distance_au(time: Any) -> Any:
     -------
     float, ndarray or DataArray
         [AU]
+
+    Examples
+    --------
+    >>> np.round(sun_distance_au(np.array(["2024-01-03", "2024-07-05"], dtype="datetime64[ns]")), 4)
+    array([0.9833, 1.0167])
     """
     t = time.values if isinstance(time, xr.DataArray) else np.asarray(time)
     try:
@@ -244,6 +272,18 @@ def at_resolution(
     -------
     xarray.DataArray
         Same name, units and dims; attrs ``spectral_resolution``.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> wl = np.arange(500.0, 600.01, 0.5)
+    >>> line = xr.DataArray(np.exp(-0.5 * ((wl - 550.0) / 1.0) ** 2), dims="wavelength",
+    ...                     coords={"wavelength": wl}, attrs={"units": "W m-2 nm-1"})
+    >>> seen = at_resolution(line, fwhm_nm=10.0)  # sigma 1 nm -> sqrt(1 + (10 / 2.3548)**2) nm
+    >>> round(float(seen.max()), 4)
+    0.2291
+    >>> round(float(seen.integrate("wavelength")), 6), round(float(line.integrate("wavelength")), 6)
+    (2.506628, 2.506628)
     """
     from scipy.special import ndtr
 
