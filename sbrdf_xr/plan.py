@@ -415,7 +415,7 @@ def _models(scene: Scene, used: list[str]) -> dict[int, tuple[Any, Mapping[str, 
                     f"evaluation='analytic': material {name!r} has no model; give "
                     f"Scene(models={{{name!r}: ...}}) or a catalog entry '{name}-model' ({exc})"
                 ) from None
-        mod, _, kw = models_mod._params(spec)
+        mod, _, kw = models_mod.model_parameters(spec)
         out[m] = (mod, MappingProxyType(dict(kw)))
     return out
 

@@ -28,10 +28,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ValidationError
+from ._model import Parameter
 
 __all__ = [
     "FILM_INDEX",
     "HC_EV_NM",
+    "THIN_FILM_STACK",
     "aluminium_index",
     "fresnel_conductor",
     "fresnel_thin_film_stack",
@@ -307,6 +309,21 @@ def normal_incidence_reflectance(n_complex: ArrayLike) -> NDArray[np.float64]:
     """``((n-1)^2 + k^2) / ((n+1)^2 + k^2)`` [1] for ``N = n + ik`` [1] (Born & Wolf §14.2)."""
     n_c = _check_index(n_complex, "n_complex")
     return np.abs((n_c - 1) / (n_c + 1)) ** 2
+
+
+#: The variables of a thin-film stack in a model material (:func:`fresnel_thin_film_stack`'s
+#: ``layers``): the complex index of each layer ``(layer, wavelength)`` and its thickness.
+THIN_FILM_STACK = (
+    Parameter(
+        "layer_n",
+        "1",
+        "thin-film layer refractive index (ambient side first)",
+        lower=0.0,
+        lower_open=True,
+    ),
+    Parameter("layer_k", "1", "thin-film layer extinction coefficient", lower=0.0),
+    Parameter("layer_thickness", "nm", "thin-film layer thickness", lower=0.0, spectral=False),
+)
 
 
 def fresnel_thin_film_stack(
