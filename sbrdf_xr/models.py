@@ -1,14 +1,13 @@
 """Analytic materials as labelled parameter sets: evaluate, render to a table, measure.
 
 A *model material* is an :class:`xarray.Dataset` holding the parameters of one of
-the analytic models of :mod:`sbrdf_xr.brdf` over ``wavelength``: spectral
-parameters as variables over ``wavelength`` (scalars broadcast), an optional
-thin-film stack as ``layer_n``, ``layer_k`` ``(layer, wavelength)`` and
-``layer_thickness`` ``(layer,)`` [nm], and the attributes ``model``, ``material``,
-``source = model:<name>`` and ``provenance``.  It is the xarray layer over the
-pure-numpy models:
+the analytic models of :mod:`sbrdf_xr.brdf` over ``wavelength``
+(:mod:`sbrdf_xr.model_schema`).  This module is the xarray layer over the pure-numpy
+models:
 
-* :func:`model_material` - build and validate one;
+* :func:`model_material` - build and validate one (the metadata of each parameter is
+  its model's declaration, :class:`sbrdf_xr.brdf.Parameter`);
+* :func:`model_parameters` - the model and the keyword arguments of its functions;
 * :func:`spectra` - evaluate at paper-000 angles (numpy);
 * :func:`render` - a look-up table on any grid (paper 000's by default);
 * :func:`measure` - sample it with the virtual goniospectrometer
@@ -18,21 +17,18 @@ pure-numpy models:
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
-from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from . import brdf as _brdf
 from ._names import ANISO_LUT_DIMS, DELTA_THETA, PHI, PSI, SBRDF, THETA_I, WAVELENGTH, attrs
 from .brdf import Model
 from .errors import ValidationError
-from .material_io import write_netcdf_atomic
 from .material_schema import new_material
+from .model_schema import ModelParameters, model_material, model_parameters, open_model, to_netcdf
 
 __all__ = [
     "ModelParameters",
@@ -48,154 +44,6 @@ __all__ = [
     "spectrum_function",
     "to_netcdf",
 ]
-
-
-def model_material(
-    model: str,
-    wavelength: ArrayLike,
-    *,
-    material: str,
-    provenance: str,
-    layers: Sequence[tuple[ArrayLike, float]] | None = None,
-    **params: ArrayLike,
-) -> xr.Dataset:
-    """A validated model material.
-
-    Each parameter becomes a variable over ``wavelength`` with the ``units`` and
-    ``long_name`` its model declares (:class:`sbrdf_xr.brdf.Parameter`).
-
-    Parameters
-    ----------
-    model : str
-        A name of :data:`sbrdf_xr.brdf.BRDF_MODELS` (case-insensitive).
-    wavelength : array_like
-        Wavelengths [nm].
-    material : str
-        Material name.
-    provenance : str
-        Where the parameters come from.
-    layers : sequence of (complex index, thickness [nm]), optional
-        Thin-film stack, ambient side first (models with a ``stack``, such as
-        ``microfacet``).
-    **params
-        The model's parameters (:attr:`sbrdf_xr.brdf.Model.parameters`).
-
-    Returns
-    -------
-    xarray.Dataset
-
-    Raises
-    ------
-    ValidationError
-        Unknown model, parameters missing, unexpected or outside their domains, or
-        ``layers`` for a model without a thin-film stack.
-
-    Examples
-    --------
-    >>> spec = model_material("lambert", [450.0, 650.0], material="grey", provenance="doc",
-    ...                       rho=[0.2, 0.4])
-    >>> spec.rho.dims, spec.rho.attrs["units"], spec.attrs["source"]
-    (('wavelength',), '1', 'model:lambert')
-    """
-    m = _brdf.get_model(model)
-    wl = np.asarray(wavelength, dtype=np.float64)
-    checked = m.check_params(wl, **params)
-    data: dict[str, Any] = {k: (WAVELENGTH, v, m.parameter(k).attrs) for k, v in checked.items()}
-    if layers:
-        data.update(_stack_variables(m, layers, wl))
-    ds = xr.Dataset(data, coords={WAVELENGTH: (WAVELENGTH, wl, attrs(WAVELENGTH))})
-    ds.attrs = {
-        "model": m.name,
-        "material": material,
-        "source": f"model:{m.name}",
-        "provenance": provenance,
-        "Conventions": "CF-1.10",
-    }
-    return ds
-
-
-def _stack_variables(
-    m: Model, layers: Sequence[tuple[ArrayLike, float]], wl: np.ndarray
-) -> dict[str, Any]:
-    """The ``layer_n``, ``layer_k``, ``layer_thickness`` variables of a thin-film stack."""
-    if not m.thin_film:
-        with_stack = [k for k, x in _brdf.BRDF_MODELS.items() if x.thin_film]
-        raise ValidationError(
-            f"layers: only the {' and '.join(with_stack)} model"
-            f"{' has' if len(with_stack) == 1 else 's have'} a thin-film stack, not {m.name!r}"
-        )
-    idx = np.stack(
-        [np.broadcast_to(np.asarray(n, dtype=np.complex128), wl.shape) for n, _ in layers]
-    )
-    thick = np.array([float(t) for _, t in layers])
-    values = {"layer_n": idx.real, "layer_k": idx.imag, "layer_thickness": thick}
-    dims = {"layer_n": ("layer", WAVELENGTH), "layer_k": ("layer", WAVELENGTH)}
-    out = {}
-    for name, v in values.items():
-        p = m.parameter(name)
-        rows = np.atleast_2d(v)
-        checked = np.stack([p.validate(r, r.size) for r in rows]).reshape(v.shape)
-        out[name] = (dims.get(name, "layer"), checked, p.attrs)
-    return out
-
-
-class ModelParameters(NamedTuple):
-    """A model material unpacked for the numpy functions of its model."""
-
-    #: The model (:class:`sbrdf_xr.brdf.Model`).
-    model: Model
-    #: Wavelengths [nm].
-    wavelength: np.ndarray
-    #: Keyword arguments of the model's functions: its parameters (and ``layers``).
-    params: dict[str, Any]
-
-
-def model_parameters(spec: xr.Dataset) -> ModelParameters:
-    """The model, wavelengths and keyword arguments of a model material.
-
-    Parameters
-    ----------
-    spec : xarray.Dataset
-        A model material (:func:`model_material`).
-
-    Returns
-    -------
-    ModelParameters
-        ``(model, wavelength, params)``: ``model.brdf(normal, to_sun, to_observer,
-        wavelength, **params)`` evaluates the material.
-
-    Raises
-    ------
-    ValidationError
-        Not a model material, or a model that is not registered.
-
-    Examples
-    --------
-    >>> spec = model_material("lambert", [550.0], material="grey", provenance="doc", rho=0.5)
-    >>> m, wl, kw = model_parameters(spec)
-    >>> m.name, wl.tolist(), {k: v.tolist() for k, v in kw.items()}
-    ('lambert', [550.0], {'rho': [0.5]})
-    """
-    if not isinstance(spec, xr.Dataset) or "model" not in spec.attrs:
-        raise ValidationError("model material: expected a Dataset with a 'model' attribute")
-    m = _brdf.get_model(spec.attrs["model"])
-    wl = np.asarray(spec[WAVELENGTH].values)
-    missing = [k for k in m.param_names if k not in spec]
-    if missing:
-        raise ValidationError(
-            f"model material: model {m.name!r} needs the variables {list(m.param_names)}; "
-            f"missing {missing}"
-        )
-    kw: dict[str, Any] = {k: np.asarray(spec[k].values) for k in m.param_names}
-    if "layer_thickness" in spec:
-        if not m.thin_film:
-            raise ValidationError(
-                f"model material: model {m.name!r} has no thin-film stack, but the "
-                "material has layer variables"
-            )
-        idx = np.asarray(spec["layer_n"].values) + 1j * np.asarray(spec["layer_k"].values)
-        kw["layers"] = [(idx[j], float(t)) for j, t in enumerate(spec["layer_thickness"].values)]
-    return ModelParameters(m, wl, kw)
 
 
 def _require_isotropic(m: Model) -> None:
@@ -420,7 +268,7 @@ def render_values(
 
     A node whose geometry is not lit and visible carries the model's limit from
     inside the hemisphere (``model.render_grid(..., horizon="limit")``,
-    :func:`sbrdf_xr.brdf._common.evaluate_grid`): interpolating between such a node
+    :meth:`sbrdf_xr.brdf.Model.render_grid`): interpolating between such a node
     and a visible one then never blends in a zero that the physics does not have.
 
     Parameters
@@ -444,9 +292,9 @@ def render_values(
     >>> import numpy as np
     >>> from sbrdf_xr.brdf import get_model
     >>> v = render_values(get_model("lambert"), np.array([0.0, 90.0]), np.array([0.0]),
-    ...                   np.array([0.0, 90.0]), np.array([550.0]), {"rho": np.pi})
-    >>> v.shape, np.round(v.ravel(), 6).tolist()
-    ((2, 1, 2, 1), [1.0, 1.0, 1.0, 1.0])
+    ...                   np.array([0.0, 90.0]), np.array([550.0]), {"rho": 0.5})
+    >>> v.shape, np.round(v.ravel() * np.pi, 6).tolist()
+    ((2, 1, 2, 1), [0.5, 0.5, 0.5, 0.5])
     """
     return model.render_grid(ti, dt, ph, wl, horizon="limit", **kw)
 
@@ -468,6 +316,14 @@ def measure(spec: xr.Dataset, theta_i: Sequence[float], **kwargs: Any) -> xr.Dat
     -------
     xarray.Dataset
         The measurement set, labelled ``synthetic`` with the model as provenance.
+
+    Examples
+    --------
+    >>> spec = model_material("robertson_sandford", [500.0, 700.0], material="paint",
+    ...                       provenance="doc", rho_D=0.6, epsilon=0.2, b=0.1, e=0.3)
+    >>> meas = measure(spec, [20.0, 40.0, 60.0])
+    >>> dict(meas.sizes), meas.attrs["source"]
+    ({'sample': 90, 'wavelength': 2}, 'synthetic')
     """
     from .goniometer import measure as _measure
 
@@ -509,6 +365,14 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
     -------
     xarray.Dataset
         The fitted model material.
+
+    Examples
+    --------
+    >>> spec = model_material("robertson_sandford", [500.0, 700.0], material="paint",
+    ...                       provenance="doc", rho_D=0.6, epsilon=0.2, b=0.1, e=0.3)
+    >>> fit = fit_robertson_sandford(measure(spec, [20.0, 40.0, 60.0]))
+    >>> round(float(fit.b[0]), 6), round(float(fit.e[0]), 6), fit.rho_D.values.round(6).tolist()
+    (0.1, 0.3, [0.6, 0.6])
     """
     from ._names import MEASURED, SAMPLE
     from .brdf import robertson_sandford as rs
@@ -527,8 +391,8 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
         reference=_reference(ds),
         **kwargs,
     )
-    names = rs.MODEL.param_names
-    p = {k: np.asarray(fit[k], dtype=np.float64) for k in names}
+    m = rs.MODEL
+    p = {k: np.asarray(fit[k], dtype=np.float64) for k in m.param_names}
     g_b = float(rs.normalisation_G(p["b"]))
     p["epsilon"] = np.minimum(
         np.broadcast_to(p["epsilon"], wl.shape), np.maximum(g_b - p["rho_D"], 0.0)
@@ -542,38 +406,10 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
         f"(reduced chi-square {fit['chi2_reduced']:.3g}, {fit['n_used']} residuals)",
         **p,
     )
-    for k in names:
+    for k in m.param_names:
         u = np.broadcast_to(np.asarray(fit[f"u_{k}"], dtype=np.float64), wl.shape)
-        out[f"u_{k}"] = (
-            WAVELENGTH,
-            np.array(u),
-            {"units": "1", "long_name": f"standard uncertainty of {k}"},
-        )
+        u_attrs = {"units": m.parameter(k).units, "long_name": f"standard uncertainty of {k}"}
+        out[f"u_{k}"] = (WAVELENGTH, np.array(u), u_attrs)
     out.attrs["chi2_reduced"] = float(fit["chi2_reduced"])
     out.attrs["source"] = "model:robertson_sandford"
     return out
-
-
-def to_netcdf(spec: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
-    """Write a model material to netCDF (atomic, lossless).
-
-    Examples
-    --------
-    >>> import tempfile, pathlib
-    >>> spec = model_material("lambert", [550.0], material="grey", provenance="doc", rho=0.5)
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     path = to_netcdf(spec, pathlib.Path(tmp) / "grey.nc")
-    ...     back = open_model(path)
-    >>> path.name, float(back.rho[0]), back.attrs["model"]
-    ('grey.nc', 0.5, 'lambert')
-    """
-    model_parameters(spec)
-    return write_netcdf_atomic(spec, path, overwrite=overwrite)
-
-
-def open_model(path: str | os.PathLike[str]) -> xr.Dataset:
-    """Read a model material written by :func:`to_netcdf` (example there)."""
-    with xr.open_dataset(path, engine="netcdf4") as ds:
-        ds = ds.load()
-    model_parameters(ds)
-    return ds

@@ -10,8 +10,8 @@ not run).
   ``_kernels``, ``sources``, ``brdf`` (and its models), ``imperfections``, ``knobs``,
   ``_catalog_index`` (where the shipped files are; it loads nothing), ``_shadow_kernels``,
   ``_cache`` (tables built on load, cached on disk).
-* L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``models``,
-  ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``visibility``,
+* L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``model_schema``,
+  ``models``, ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``visibility``,
   ``attitude_frames``, ``attitude``, ``orbits``, ``observe``, ``photometry`` (and its
   modules), ``fingerprint``.
 * L2: ``catalog`` (knows every kind's loader in L1).
@@ -54,6 +54,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "material_schema",
         "material_io",
         "construction",
+        "model_schema",
         "models",
         "material",
         "goniometer",

@@ -8,7 +8,7 @@ float64 otherwise), clipped to the finite range of that dtype.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -146,17 +146,6 @@ def _angles_to_vectors(
     return geometry.facet_vectors(*arrays)
 
 
-#: Nodes are evaluated at least this far inside the lit and visible hemisphere [degree]
-#: by ``horizon="limit"`` rendering.
-HORIZON_MARGIN_DEG = 1e-6
-#: With ``horizon="limit"`` a ``theta_i = 90`` row is evaluated this far from grazing
-#: incidence [degree]: the specular peak of a microfacet model diverges as both
-#: directions graze, and a table node carries a value for the whole cell around it.
-GRAZING_MARGIN_DEG = 0.5
-#: The ways :func:`evaluate_grid` treats nodes that are not lit and visible.
-HORIZONS = ("zero", "limit")
-
-
 def tangent_from_azimuth(psi: ArrayLike) -> np.ndarray:
     """Facet tangent in the frame of :func:`sbrdf_xr.geometry.facet_vectors` for ``psi``.
 
@@ -182,135 +171,6 @@ def tangent_from_azimuth(psi: ArrayLike) -> np.ndarray:
     """
     a = np.radians(np.asarray(psi, dtype=np.float64))
     return np.stack([-np.cos(a), np.sin(a), np.zeros_like(a)], axis=-1)
-
-
-def evaluate_angles(
-    brdf: Callable[..., np.ndarray],
-    theta_i: ArrayLike,
-    delta_theta: ArrayLike,
-    phi: ArrayLike,
-    wavelength: ArrayLike,
-    *,
-    psi: ArrayLike | None = None,
-    **kwargs: Any,
-) -> np.ndarray:
-    """A model's ``brdf`` function evaluated at paper-000 angles (one for every model).
-
-    The facet-frame vectors of :func:`sbrdf_xr.geometry.facet_vectors` are built from
-    the angles; with ``psi`` the tangent of :func:`tangent_from_azimuth` is passed
-    as ``tangent`` (anisotropic models).
-
-    Parameters
-    ----------
-    brdf : callable
-        ``brdf(normal, to_sun, to_observer, wavelength, **kwargs)``.
-    theta_i, delta_theta, phi : array_like
-        Paper-000 Fig. 4 angles [degree], broadcast together.
-    wavelength : array_like, shape (n_wl,)
-        Vacuum wavelength [nm].
-    psi : array_like, optional
-        Azimuth of the illumination plane from the facet tangent [degree].
-    **kwargs
-        Passed to ``brdf``.
-
-    Returns
-    -------
-    ndarray, shape broadcast(...) + (n_wl,)
-        BRDF [sr-1].
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from sbrdf_xr.brdf import lambert
-    >>> f = evaluate_angles(lambert.brdf, [0.0, 95.0], 0.0, 0.0, [550.0], rho=np.pi / 10)
-    >>> np.round(f, 6)
-    array([[0.1],
-           [0. ]])
-    """
-    n, s, o = _angles_to_vectors(theta_i, delta_theta, phi)
-    if psi is None:
-        return brdf(n, s, o, wavelength, **kwargs)
-    t = tangent_from_azimuth(_check_angles(("psi", psi))[0])
-    n, s, o, t = np.broadcast_arrays(n, s, o, t)
-    return brdf(n, s, o, wavelength, tangent=t, **kwargs)
-
-
-def evaluate_grid(
-    brdf: Callable[..., np.ndarray],
-    theta_i: ArrayLike,
-    delta_theta: ArrayLike,
-    phi: ArrayLike,
-    wavelength: ArrayLike,
-    *,
-    psi: ArrayLike | None = None,
-    horizon: str = "zero",
-    **kwargs: Any,
-) -> np.ndarray:
-    """A model's ``brdf`` on the outer product of 1-D angle grids (one for every model).
-
-    With ``horizon="limit"`` a node whose geometry is not lit and visible
-    (``theta_i`` = 90 deg, the observer at or below the horizon: ``|theta_i +
-    delta_theta| >= 90`` or ``phi >= 90``) carries the model's limit from inside the
-    hemisphere: it is evaluated at the nearest lit and visible geometry,
-    :data:`HORIZON_MARGIN_DEG` inside the horizon and :data:`GRAZING_MARGIN_DEG` from
-    grazing incidence.  Interpolating between such a node and a visible one then
-    never blends in a zero that the physics does not have (a Lambertian surface
-    renders to ``rho / pi`` at every node).  ``horizon="zero"`` evaluates every node
-    as it is.
-
-    Parameters
-    ----------
-    brdf : callable
-        ``brdf(normal, to_sun, to_observer, wavelength, **kwargs)``.
-    theta_i, delta_theta, phi : array_like, 1-D
-        Grids [degree].
-    wavelength : array_like, shape (n_wl,)
-        Vacuum wavelength [nm].
-    psi : array_like, 1-D, optional
-        Grid of the azimuth of the illumination plane from the tangent [degree]
-        (anisotropic models): an axis before ``wavelength``.
-    horizon : {"zero", "limit"}, default "zero"
-        Treatment of nodes that are not lit and visible.
-    **kwargs
-        Passed to ``brdf``.
-
-    Returns
-    -------
-    ndarray, shape (n_ti, n_dt, n_phi[, n_psi], n_wl)
-        BRDF [sr-1].
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from sbrdf_xr.brdf import lambert
-    >>> g = evaluate_grid(lambert.brdf, [0.0, 90.0], [0.0], [0.0, 90.0], [550.0], rho=np.pi)
-    >>> g.shape, g[..., 0].ravel().tolist()
-    ((2, 1, 2, 1), [1.0, 0.0, 0.0, 0.0])
-    >>> evaluate_grid(
-    ...     lambert.brdf, [0.0, 90.0], [0.0], [0.0, 90.0], [550.0], horizon="limit", rho=np.pi
-    ... )[..., 0].ravel().tolist()
-    [1.0, 1.0, 1.0, 1.0]
-    """
-    if horizon not in HORIZONS:
-        raise ValidationError(f"horizon: got {horizon!r}; allowed: {list(HORIZONS)}")
-    named = [("theta_i", theta_i), ("delta_theta", delta_theta), ("phi", phi)]
-    if psi is not None:
-        named.append(("psi", psi))
-    grids = []
-    for name, a in named:
-        arr = np.asarray(a)
-        if arr.ndim != 1:
-            raise ValidationError(f"{name}: expected a 1-D grid [degree], got shape {arr.shape}")
-        grids.append(arr.astype(np.float64) if horizon == "limit" else arr)
-    mesh = np.meshgrid(*grids, indexing="ij")
-    t, d, p = mesh[:3]
-    if horizon == "limit":
-        m = HORIZON_MARGIN_DEG
-        t_c = np.minimum(t, 90.0 - GRAZING_MARGIN_DEG)
-        r_c = np.clip(t + d, -(90.0 - m), 90.0 - m)
-        t, d, p = t_c, r_c - t_c, np.minimum(p, 90.0 - m)
-    ps = mesh[3] if psi is not None else None
-    return evaluate_angles(brdf, t, d, p, wavelength, psi=ps, **kwargs)
 
 
 def _check_theta_i(theta_i: ArrayLike) -> np.ndarray:

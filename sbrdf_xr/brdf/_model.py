@@ -20,7 +20,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ValidationError
-from ._common import _band_param, _check_names, _check_wavelength, evaluate_angles, evaluate_grid
+from ._common import (
+    _angles_to_vectors,
+    _band_param,
+    _check_angles,
+    _check_names,
+    _check_wavelength,
+    tangent_from_azimuth,
+)
 
 __all__ = ["Model", "ModelRegistry", "Parameter"]
 
@@ -29,6 +36,15 @@ RESERVED_NAMES = frozenset(
     {"wavelength", "material", "provenance", "model", "layers", "psi", "tangent", "horizon"}
 )
 _NAME = re.compile(r"[a-z][a-z0-9_]*\Z")
+#: Nodes are evaluated at least this far inside the lit and visible hemisphere [degree]
+#: by ``horizon="limit"`` rendering (:meth:`Model.render_grid`).
+HORIZON_MARGIN_DEG = 1e-6
+#: With ``horizon="limit"`` a ``theta_i = 90`` row is evaluated this far from grazing
+#: incidence [degree]: the specular peak of a microfacet model diverges as both
+#: directions graze, and a table node carries a value for the whole cell around it.
+GRAZING_MARGIN_DEG = 0.5
+#: The ways :meth:`Model.render_grid` treats nodes that are not lit and visible.
+HORIZONS = ("zero", "limit")
 
 
 @dataclass(frozen=True)
@@ -117,8 +133,10 @@ def _check_declaration(model: Model) -> None:
     refl = model.reflectance
     if refl is not None and not callable(refl):
         raise ValidationError(f"{what}: reflectance must be a function or None")
-    if not isinstance(model.citation, str) or not model.citation.strip():
-        raise ValidationError(f"{what}: declare its citation (paper and equations)")
+    for key, what_it_is in (("citation", "paper and equations"), ("long_name", "one line")):
+        v = getattr(model, key)
+        if not isinstance(v, str) or not v.strip():
+            raise ValidationError(f"{what}: declare its {key} ({what_it_is}), got {v!r}")
     if not model.parameters:
         raise ValidationError(f"{what}: declares no parameters")
     seen: set[str] = set()
@@ -277,6 +295,10 @@ class Model:
     ) -> np.ndarray:
         """The BRDF from paper-000 angles [degree] (and ``psi``, anisotropic models).
 
+        :attr:`brdf` evaluated on the facet-frame vectors of
+        :func:`sbrdf_xr.geometry.facet_vectors`; with ``psi`` the tangent of
+        :func:`sbrdf_xr.brdf.anisotropic.tangent_from_azimuth` goes in as ``tangent``.
+
         Parameters
         ----------
         theta_i, delta_theta, phi : array_like
@@ -293,9 +315,22 @@ class Model:
         -------
         ndarray, shape broadcast(...) + (n_wl,)
             BRDF [sr-1].
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from sbrdf_xr.brdf import get_model
+        >>> f = get_model("lambert").brdf_angles([0.0, 95.0], 0.0, 0.0, [550.0], rho=np.pi / 10)
+        >>> np.round(f, 6).tolist()
+        [[0.1], [0.0]]
         """
         self._check_psi(psi)
-        return evaluate_angles(self.brdf, theta_i, delta_theta, phi, wavelength, psi=psi, **kwargs)
+        n, s, o = _angles_to_vectors(theta_i, delta_theta, phi)
+        if psi is None:
+            return self.brdf(n, s, o, wavelength, **kwargs)
+        t = tangent_from_azimuth(_check_angles(("psi", psi))[0])
+        n, s, o, t = np.broadcast_arrays(n, s, o, t)
+        return self.brdf(n, s, o, wavelength, tangent=t, **kwargs)
 
     def render_grid(
         self,
@@ -308,34 +343,65 @@ class Model:
         horizon: str = "zero",
         **kwargs: Any,
     ) -> np.ndarray:
-        """The BRDF on the outer product of 1-D angle grids [degree].
+        """:meth:`brdf_angles` on the outer product of 1-D grids [degree].
+
+        With ``horizon="limit"`` a node whose geometry is not lit and visible
+        (``theta_i`` = 90 deg, the observer at or below the horizon: ``|theta_i +
+        delta_theta| >= 90`` or ``phi >= 90``) carries the model's limit from inside
+        the hemisphere: it is evaluated at the nearest lit and visible geometry,
+        :data:`HORIZON_MARGIN_DEG` inside the horizon and :data:`GRAZING_MARGIN_DEG`
+        from grazing incidence.  Interpolating between such a node and a visible one
+        then never blends in a zero that the physics does not have (a Lambertian
+        surface renders to ``rho / pi`` at every node).  ``"zero"`` evaluates every
+        node as it is.
 
         Parameters
         ----------
-        theta_i, delta_theta, phi : array_like, 1-D
-            Grids of paper-000 angles [degree].
-        wavelength : array_like, shape (n_wl,)
-            Vacuum wavelength [nm].
-        psi : array_like, 1-D, optional
-            Grid of ``psi`` [degree] (anisotropic models): a ``psi`` axis before
-            ``wavelength``.
+        theta_i, delta_theta, phi, wavelength, psi, **kwargs
+            As :meth:`brdf_angles`, the angles (and ``psi``) as 1-D grids; a ``psi``
+            grid adds an axis before ``wavelength``.
         horizon : {"zero", "limit"}, default "zero"
-            ``"zero"``: every node evaluated as it is (zero below the horizon);
-            ``"limit"``: a node that is not lit and visible carries the limit from
-            inside the hemisphere (the table convention, see
-            :func:`sbrdf_xr.brdf._common.evaluate_grid`).
-        **kwargs
-            The parameters and any option of :attr:`brdf`.
+            Treatment of the nodes that are not lit and visible.
 
         Returns
         -------
         ndarray, shape (n_ti, n_dt, n_phi[, n_psi], n_wl)
             BRDF [sr-1].
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from sbrdf_xr.brdf import get_model
+        >>> m = get_model("lambert")
+        >>> g = m.render_grid([30.0], [0.0, 70.0], [0.0, 45.0], [550.0], rho=0.5)
+        >>> g.shape, np.round(g.ravel() * np.pi, 6).tolist()  # theta_r = 100 deg: unseen
+        ((1, 2, 2, 1), [0.5, 0.5, 0.0, 0.0])
+        >>> g = m.render_grid([30.0], [0.0, 70.0], [0.0, 45.0], [550.0], horizon="limit", rho=0.5)
+        >>> np.round(g.ravel() * np.pi, 6).tolist()
+        [0.5, 0.5, 0.5, 0.5]
         """
-        self._check_psi(psi)
-        return evaluate_grid(
-            self.brdf, theta_i, delta_theta, phi, wavelength, psi=psi, horizon=horizon, **kwargs
-        )
+        if horizon not in HORIZONS:
+            raise ValidationError(f"horizon: got {horizon!r}; allowed: {list(HORIZONS)}")
+        named = {"theta_i": theta_i, "delta_theta": delta_theta, "phi": phi}
+        if psi is not None:
+            named["psi"] = psi
+        grids = []
+        for name, a in named.items():
+            arr = np.asarray(a)
+            if arr.ndim != 1:
+                raise ValidationError(
+                    f"{name}: expected a 1-D grid [degree], got shape {arr.shape}"
+                )
+            grids.append(arr.astype(np.float64) if horizon == "limit" else arr)
+        mesh = np.meshgrid(*grids, indexing="ij")
+        t, d, p = mesh[:3]
+        if horizon == "limit":
+            m = HORIZON_MARGIN_DEG
+            t_c = np.minimum(t, 90.0 - GRAZING_MARGIN_DEG)
+            r_c = np.clip(t + d, -(90.0 - m), 90.0 - m)
+            t, d, p = t_c, r_c - t_c, np.minimum(p, 90.0 - m)
+        ps = mesh[3] if psi is not None else None
+        return self.brdf_angles(t, d, p, wavelength, psi=ps, **kwargs)
 
     def directional_hemispherical_reflectance(
         self, theta_i: ArrayLike, wavelength: ArrayLike, **kwargs: Any

@@ -70,6 +70,13 @@ def brdf(
     References
     ----------
     Paper 001 §2 (perfectly diffuse surface: ``1/pi`` sr-1 for unit reflectance).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> n, s, o = [0.0, 0.0, 1.0], [0.5, 0.0, 1.0], [-0.5, 0.0, 1.0]
+    >>> np.round(brdf(n, s, o, [450.0, 650.0], rho=[0.2, 0.4]) * np.pi, 6)
+    array([0.2, 0.4])
     """
     p = MODEL.check_params(wavelength, **params)
     _, _, _, _, _, mask, dtype = _facet_frame(normal, to_sun, to_observer)
@@ -95,6 +102,11 @@ def directional_hemispherical_reflectance(
     -------
     ndarray, shape theta_i.shape + (n_wl,)
         ``rho(lambda)`` for every ``theta_i`` [1] (paper 001 Eq. 1 integrated exactly).
+
+    Examples
+    --------
+    >>> directional_hemispherical_reflectance([0.0, 60.0], [450.0, 650.0], rho=[0.2, 0.4]).tolist()
+    [[0.2, 0.4], [0.2, 0.4]]
     """
     p = MODEL.check_params(wavelength, **params)
     ti = _check_theta_i(theta_i)
@@ -111,6 +123,4 @@ MODEL = Model(
     reflectance=directional_hemispherical_reflectance,
 )
 PARAMS = MODEL.param_names
-check_params = MODEL.check_params
-brdf_angles = MODEL.brdf_angles
-render_grid = MODEL.render_grid
+check_params, brdf_angles, render_grid = MODEL.check_params, MODEL.brdf_angles, MODEL.render_grid

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import pickle
 
 import cf_units
 import numpy as np
@@ -208,3 +209,10 @@ def test_isotropic_models_refuse_psi_and_anisotropic_ones_need_it():
     assert grid.shape == (1, 2, 1, 3, 3)
     with pytest.raises(ValidationError, match="horizon"):
         get_model("lambert").render_grid([0.0], [0.0], [0.0], WL, horizon="clip", rho=0.5)
+
+
+@pytest.mark.parametrize("name", sorted(BRDF_MODELS))
+def test_models_pickle_by_reference(name):
+    """Dask workers receive the models in the plan: a model pickles to an equal model."""
+    m = get_model(name)
+    assert pickle.loads(pickle.dumps(m)) == m
