@@ -221,7 +221,8 @@ def illumination_azimuth(
     --------
     >>> import numpy as np
     >>> n, s, o = [0.0, 0.0, 1.0], [0.5, 0.0, 1.0], [-0.5, 0.0, 1.0]
-    >>> float(np.round(illumination_azimuth(n, [0.0, 1.0, 0.0], s, o), 6))  # tangent across the plane
+    >>> across = [0.0, 1.0, 0.0]  # a tangent across the illumination plane
+    >>> float(np.round(illumination_azimuth(n, across, s, o), 6))
     90.0
     """
     n = geometry.normalize(normal, "normal").astype(np.float64)

@@ -99,7 +99,8 @@ def distribution_ggx(cos2_h: ArrayLike, sin2_h: ArrayLike, roughness: ArrayLike)
     Examples
     --------
     >>> import numpy as np
-    >>> round(float(distribution_ggx(1.0, 0.0, 0.5) * np.pi * 0.5**2), 6)  # 1 / (pi alpha^2) at the peak
+    >>> peak = distribution_ggx(1.0, 0.0, 0.5)  # 1 / (pi alpha^2) at the peak
+    >>> round(float(peak * np.pi * 0.5**2), 6)
     1.0
     """
     a2 = np.asarray(roughness, dtype=np.float64) ** 2

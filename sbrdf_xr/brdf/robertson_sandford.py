@@ -65,6 +65,8 @@ Sandford, B. P., "Infrared reflectance properties of aircraft paints" (paper 001
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -92,6 +94,7 @@ __all__ = [
     "CUTOFF_ANGLE",
     "MODEL",
     "PARAMS",
+    "TABLE4",
     "angular_g",
     "brdf",
     "brdf_angles",
@@ -115,6 +118,14 @@ __all__ = [
 E_MIN = 1.0e-12
 E_MAX = 1.0e6
 B_MAX = 1.0e6
+
+#: Paper 001 Table 4: the parameters of two aircraft paints at 4 um.
+TABLE4: Mapping[str, Mapping[str, float]] = MappingProxyType(
+    {
+        "AFGL-01": MappingProxyType({"rho_D": 0.07, "epsilon": 0.85, "b": 0.12, "e": 0.12}),
+        "AFGL-10": MappingProxyType({"rho_D": 0.05, "epsilon": 0.88, "b": 0.08, "e": 0.012}),
+    }
+)
 
 #: The parameters: diffuse reflectance rho_D and emissivity epsilon (spectral),
 #: grazing parameter b and lobe width e (scalar or per band); paper 001 Table 4.
@@ -186,9 +197,8 @@ def directional_emissivity(
 
     Examples
     --------
-    >>> import numpy as np
-    >>> afgl01 = {"rho_D": 0.07, "epsilon": 0.85, "b": 0.12, "e": 0.12}  # paper 001 Table 4
-    >>> np.round(directional_emissivity([0.0, 60.0, 89.0], [4000.0], **afgl01), 4).tolist()
+    >>> p = TABLE4["AFGL-01"]
+    >>> np.round(directional_emissivity([0.0, 60.0, 89.0], [4000.0], **p), 4).tolist()
     [[0.8931], [0.8561], [0.0185]]
     """
     p = MODEL.check_params(wavelength, **params)
@@ -218,9 +228,7 @@ def diffuse_reflectance(
 
     Examples
     --------
-    >>> import numpy as np
-    >>> afgl01 = {"rho_D": 0.07, "epsilon": 0.85, "b": 0.12, "e": 0.12}  # paper 001 Table 4
-    >>> np.round(diffuse_reflectance([0.0, 60.0], [4000.0], **afgl01), 4).tolist()
+    >>> np.round(diffuse_reflectance([0.0, 60.0], [4000.0], **TABLE4["AFGL-01"]), 4).tolist()
     [[0.0735], [0.0705]]
     """
     p = MODEL.check_params(wavelength, **params)
@@ -249,9 +257,7 @@ def specular_reflectance(
 
     Examples
     --------
-    >>> import numpy as np
-    >>> afgl01 = {"rho_D": 0.07, "epsilon": 0.85, "b": 0.12, "e": 0.12}  # paper 001 Table 4
-    >>> np.round(specular_reflectance([0.0, 60.0], [4000.0], **afgl01), 4).tolist()
+    >>> np.round(specular_reflectance([0.0, 60.0], [4000.0], **TABLE4["AFGL-01"]), 4).tolist()
     [[0.0334], [0.0734]]
     """
     p = MODEL.check_params(wavelength, **params)
@@ -281,9 +287,7 @@ def total_reflectance(
 
     Examples
     --------
-    >>> import numpy as np
-    >>> afgl01 = {"rho_D": 0.07, "epsilon": 0.85, "b": 0.12, "e": 0.12}  # paper 001 Table 4
-    >>> np.round(total_reflectance([0.0, 60.0], [4000.0], **afgl01), 4).tolist()
+    >>> np.round(total_reflectance([0.0, 60.0], [4000.0], **TABLE4["AFGL-01"]), 4).tolist()
     [[0.1069], [0.1439]]
     """
     return 1.0 - directional_emissivity(theta_i, wavelength, **params)
@@ -371,10 +375,8 @@ def diffuse_brdf(
 
     Examples
     --------
-    >>> import numpy as np
-    >>> afgl01 = {"rho_D": 0.07, "epsilon": 0.85, "b": 0.12, "e": 0.12}  # paper 001 Table 4
     >>> n, s, o = [0.0, 0.0, 1.0], [0.5, 0.0, 1.0], [-0.5, 0.0, 1.0]
-    >>> np.round(diffuse_brdf(n, s, o, [4000.0], **afgl01), 5).tolist()
+    >>> np.round(diffuse_brdf(n, s, o, [4000.0], **TABLE4["AFGL-01"]), 5).tolist()
     [0.02442]
     """
     return _evaluate(normal, to_sun, to_observer, wavelength, params, True, "diffuse")
@@ -413,10 +415,8 @@ def specular_brdf(
 
     Examples
     --------
-    >>> import numpy as np
-    >>> afgl01 = {"rho_D": 0.07, "epsilon": 0.85, "b": 0.12, "e": 0.12}  # paper 001 Table 4
     >>> n, s, o = [0.0, 0.0, 1.0], [0.5, 0.0, 1.0], [-0.5, 0.0, 1.0]
-    >>> np.round(specular_brdf(n, s, o, [4000.0], **afgl01), 3).tolist()
+    >>> np.round(specular_brdf(n, s, o, [4000.0], **TABLE4["AFGL-01"]), 3).tolist()
     [0.258]
     """
     return _evaluate(normal, to_sun, to_observer, wavelength, params, cutoff, "specular")
@@ -457,10 +457,9 @@ def brdf(
 
     Examples
     --------
-    >>> import numpy as np
-    >>> afgl01 = {"rho_D": 0.07, "epsilon": 0.85, "b": 0.12, "e": 0.12}  # paper 001 Table 4
     >>> n, s, o = [0.0, 0.0, 1.0], [0.5, 0.0, 1.0], [-0.5, 0.0, 1.0]
-    >>> np.round(brdf(n, s, o, [4000.0], **afgl01), 3).tolist()  # the glint: diffuse + specular
+    >>> p = TABLE4["AFGL-01"]
+    >>> np.round(brdf(n, s, o, [4000.0], **p), 3).tolist()  # the glint: diffuse + specular
     [0.282]
     """
     return _evaluate(normal, to_sun, to_observer, wavelength, params, cutoff, "total")
@@ -497,11 +496,11 @@ def directional_hemispherical_reflectance(
 
     Examples
     --------
-    >>> import numpy as np
-    >>> afgl01 = {"rho_D": 0.07, "epsilon": 0.85, "b": 0.12, "e": 0.12}  # paper 001 Table 4
-    >>> np.round(directional_hemispherical_reflectance([0.0, 60.0], [4000.0], **afgl01), 4).tolist()
+    >>> p = TABLE4["AFGL-01"]
+    >>> np.round(directional_hemispherical_reflectance([0.0, 60.0], [4000.0], **p), 4).tolist()
     [[0.1068], [0.1428]]
-    >>> r = directional_hemispherical_reflectance([0.0, 60.0], [4000.0], cutoff=False, **afgl01)
+    >>> p = TABLE4["AFGL-01"]
+    >>> r = directional_hemispherical_reflectance([0.0, 60.0], [4000.0], cutoff=False, **p)
     >>> np.round(r, 4).tolist()  # Eq. 11: 1 - epsilon(theta_i)
     [[0.1069], [0.1439]]
     """
