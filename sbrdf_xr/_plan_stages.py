@@ -216,7 +216,7 @@ def material_models(scene: Scene, used: list[str]) -> dict[int, tuple[Any, Mappi
                     f"evaluation='analytic': material {name!r} has no model; give "
                     f"Scene(models={{{name!r}: ...}}) or a catalog entry '{name}-model' ({exc})"
                 ) from None
-        mod, _, kw = models_mod._params(spec)
+        mod, _, kw = models_mod.model_parameters(spec)
         out[m] = (mod, MappingProxyType(dict(kw)))
     return out
 

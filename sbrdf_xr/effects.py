@@ -290,7 +290,7 @@ def _analytic_sums(
             continue
         eff = t.area[j] * (1.0 if fraction is None else fraction[on, j])
         model, kw = plan.models[t.material[j]]
-        tangent = {"tangent": t.tangent[j]} if getattr(model, "ANISOTROPIC", False) else {}
+        tangent = {"tangent": t.tangent[j]} if getattr(model, "anisotropic", False) else {}
         f = model.brdf(n, s[on], o[on], wl, **kw, **tangent)
         a2d = eff * cr[on]
         area[on] += a2d

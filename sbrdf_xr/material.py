@@ -704,7 +704,7 @@ def _bound_grazing_rows(
     rows = np.flatnonzero(ti > above)
     if rows.size == 0:
         return
-    mod, _, kw = models._params(_model_for(model, wl))
+    mod, _, kw = models.model_parameters(_model_for(model, wl))
     rho_m = mod.directional_hemispherical_reflectance(np.minimum(ti[rows], 90.0), wl, **kw)
     rho_t = _lut.hemispherical_reflectance_kernel(
         lut, ti, dt, ph, ti[rows], "linear", zero_edges=(True, True, True)
@@ -724,7 +724,7 @@ def _model_rows(
 ) -> np.ndarray:
     """A model material rendered on the table grid (rows ``ti``) at wavelengths ``wl``
     (below-horizon nodes carry the limit from the hemisphere, :func:`sbrdf_xr.models.render`)."""
-    mod, _, kw = models._params(_model_for(model, wl))
+    mod, _, kw = models.model_parameters(_model_for(model, wl))
     return models.render_values(mod, ti, dt, ph, wl, kw)
 
 

@@ -1,14 +1,13 @@
 """Analytic materials as labelled parameter sets: evaluate, render to a table, measure.
 
 A *model material* is an :class:`xarray.Dataset` holding the parameters of one of
-the analytic models of :mod:`sbrdf_xr.brdf` over ``wavelength``: spectral
-parameters as variables over ``wavelength`` (scalars broadcast), an optional
-thin-film stack as ``layer_n``, ``layer_k`` ``(layer, wavelength)`` and
-``layer_thickness`` ``(layer,)`` [nm], and the attributes ``model``, ``material``,
-``source = model:<name>`` and ``provenance``.  It is the xarray layer over the
-pure-numpy models:
+the analytic models of :mod:`sbrdf_xr.brdf` over ``wavelength``
+(:mod:`sbrdf_xr.model_schema`).  This module is the xarray layer over the pure-numpy
+models:
 
-* :func:`model_material` - build and validate one;
+* :func:`model_material` - build and validate one (the metadata of each parameter is
+  its model's declaration, :class:`sbrdf_xr.brdf.Parameter`);
+* :func:`model_parameters` - the model and the keyword arguments of its functions;
 * :func:`spectra` - evaluate at paper-000 angles (numpy);
 * :func:`render` - a look-up table on any grid (paper 000's by default);
 * :func:`measure` - sample it with the virtual goniospectrometer
@@ -18,26 +17,25 @@ pure-numpy models:
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from . import brdf as _brdf
 from ._names import ANISO_LUT_DIMS, DELTA_THETA, PHI, PSI, SBRDF, THETA_I, WAVELENGTH, attrs
+from .brdf import Model
 from .errors import ValidationError
-from .material_io import write_netcdf_atomic
 from .material_schema import new_material
+from .model_schema import ModelParameters, model_material, model_parameters, open_model, to_netcdf
 
 __all__ = [
-    "PARAM_ATTRS",
+    "ModelParameters",
     "fit_robertson_sandford",
     "measure",
     "model_material",
+    "model_parameters",
     "open_model",
     "render",
     "render_anisotropic",
@@ -47,111 +45,11 @@ __all__ = [
     "to_netcdf",
 ]
 
-PARAM_ATTRS: dict[str, dict[str, str]] = {
-    "rho": {"units": "1", "long_name": "Lambertian albedo"},
-    "rho_D": {"units": "1", "long_name": "diffuse spectral reflectance (Robertson-Sandford rho_D)"},
-    "epsilon": {
-        "units": "1",
-        "long_name": "spectral hemispherical emissivity (Robertson-Sandford)",
-    },
-    "b": {"units": "1", "long_name": "grazing-angle parameter (Robertson-Sandford b)"},
-    "e": {"units": "1", "long_name": "specular lobe width (Robertson-Sandford e)"},
-    "roughness": {"units": "1", "long_name": "GGX roughness alpha"},
-    "n": {"units": "1", "long_name": "substrate refractive index"},
-    "k": {"units": "1", "long_name": "substrate extinction coefficient"},
-    "rho_d": {"units": "1", "long_name": "Lambertian albedo added to the microfacet term"},
-    "layer_n": {"units": "1", "long_name": "thin-film layer refractive index (ambient side first)"},
-    "layer_k": {"units": "1", "long_name": "thin-film layer extinction coefficient"},
-    "layer_thickness": {"units": "nm", "long_name": "thin-film layer thickness"},
-    "alpha_x": {"units": "1", "long_name": "GGX roughness along the facet tangent"},
-    "alpha_y": {"units": "1", "long_name": "GGX roughness across the facet tangent"},
-}
 
-
-def model_material(
-    model: str,
-    wavelength: ArrayLike,
-    *,
-    material: str,
-    provenance: str,
-    layers: Sequence[tuple[ArrayLike, float]] | None = None,
-    **params: ArrayLike,
-) -> xr.Dataset:
-    """A validated model material.
-
-    Parameters
-    ----------
-    model : str
-        A name of :data:`sbrdf_xr.brdf.MODELS`.
-    wavelength : array_like
-        Wavelengths [nm].
-    material : str
-        Material name.
-    provenance : str
-        Where the parameters come from.
-    layers : sequence of (complex index, thickness [nm]), optional
-        Thin-film stack (``microfacet`` only), ambient side first.
-    **params
-        The model's parameters (see the model's ``check_params``).
-
-    Returns
-    -------
-    xarray.Dataset
-    """
-    mod = _brdf.get_model(model)
-    wl = np.asarray(wavelength, dtype=np.float64)
-    checked = mod.check_params(wl, **params)
-    data = {
-        k: (
-            WAVELENGTH,
-            np.asarray(v, dtype=np.float64),
-            PARAM_ATTRS.get(k, {"units": "1", "long_name": k}),
-        )
-        for k, v in checked.items()
-    }
-    if layers:
-        if model != "microfacet":
-            raise ValidationError(
-                f"layers: only the microfacet model has a thin-film stack, not {model!r}"
-            )
-        idx = np.stack(
-            [np.broadcast_to(np.asarray(n, dtype=np.complex128), wl.shape) for n, _ in layers]
-        )
-        data["layer_n"] = (("layer", WAVELENGTH), idx.real, PARAM_ATTRS["layer_n"])
-        data["layer_k"] = (("layer", WAVELENGTH), idx.imag, PARAM_ATTRS["layer_k"])
-        thick = np.array([float(t) for _, t in layers])
-        if np.any(thick < 0) or not np.all(np.isfinite(thick)):
-            raise ValidationError(
-                f"layers: thicknesses must be finite and >= 0 nm, got {thick.tolist()}"
-            )
-        data["layer_thickness"] = ("layer", thick, PARAM_ATTRS["layer_thickness"])
-    ds = xr.Dataset(data, coords={WAVELENGTH: (WAVELENGTH, wl, attrs(WAVELENGTH))})
-    ds.attrs = {
-        "model": model,
-        "material": material,
-        "source": f"model:{model}",
-        "provenance": provenance,
-        "Conventions": "CF-1.10",
-    }
-    return ds
-
-
-def _params(spec: xr.Dataset) -> tuple[Any, np.ndarray, dict[str, Any]]:
-    if not isinstance(spec, xr.Dataset) or "model" not in spec.attrs:
-        raise ValidationError("model material: expected a Dataset with a 'model' attribute")
-    mod = _brdf.get_model(spec.attrs["model"])
-    wl = np.asarray(spec[WAVELENGTH].values)
-    kw: dict[str, Any] = {k: np.asarray(spec[k].values) for k in mod.PARAMS}
-    if "layer_thickness" in spec:
-        idx = np.asarray(spec["layer_n"].values) + 1j * np.asarray(spec["layer_k"].values)
-        kw["layers"] = [(idx[j], float(t)) for j, t in enumerate(spec["layer_thickness"].values)]
-    return mod, wl, kw
-
-
-def _isotropic(mod: Any, spec: xr.Dataset) -> None:
-    if getattr(mod, "ANISOTROPIC", False):
+def _require_isotropic(m: Model) -> None:
+    if m.anisotropic:
         raise ValidationError(
-            f"model {spec.attrs['model']!r} is anisotropic: it needs the azimuth psi of the "
+            f"model {m.name!r} is anisotropic: it needs the azimuth psi of the "
             "illumination plane from the facet tangent (render_anisotropic, spectra(..., psi=...))"
         )
 
@@ -173,18 +71,27 @@ def spectra(
         Angles [degree], broadcast together.
     psi : array_like, optional
         Azimuth of the illumination plane from the facet tangent [degree]: required by
-        the anisotropic models (:data:`sbrdf_xr.brdf.ANISOTROPIC_MODELS`).
+        the anisotropic models (:data:`sbrdf_xr.brdf.ANISOTROPIC_MODELS`), ignored by
+        the isotropic ones.
 
     Returns
     -------
     ndarray, shape broadcast + (n_wavelength,)
         sBRDF [sr-1].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> spec = model_material("lambert", [550.0], material="grey", provenance="doc", rho=0.5)
+    >>> np.round(spectra(spec, [0.0, 60.0], 0.0, 0.0) * np.pi, 6)
+    array([[0.5],
+           [0.5]])
     """
-    mod, wl, kw = _params(spec)
-    if psi is not None and getattr(mod, "ANISOTROPIC", False):
-        return mod.brdf_angles(theta_i, delta_theta, phi, wl, psi=psi, **kw)
-    _isotropic(mod, spec)
-    return mod.brdf_angles(theta_i, delta_theta, phi, wl, **kw)
+    m, wl, kw = model_parameters(spec)
+    if m.anisotropic and psi is not None:
+        return m.brdf_angles(theta_i, delta_theta, phi, wl, psi=psi, **kw)
+    _require_isotropic(m)
+    return m.brdf_angles(theta_i, delta_theta, phi, wl, **kw)
 
 
 def spectrum_function(spec: xr.Dataset, psi: float | None = None) -> Any:
@@ -192,6 +99,13 @@ def spectrum_function(spec: xr.Dataset, psi: float | None = None) -> Any:
 
     ``psi`` [degree]: for an anisotropic model, the azimuth of the illumination plane
     from the sample's tangent (a sample rotation, :func:`sbrdf_xr.material.build_lut_anisotropic`).
+    Examples
+    --------
+    >>> import numpy as np
+    >>> spec = model_material("lambert", [550.0], material="grey", provenance="doc", rho=0.5)
+    >>> f = spectrum_function(spec)
+    >>> np.round(f(np.array([30.0]), np.array([0.0]), np.array([0.0])) * np.pi, 6)
+    array([[0.5]])
     """
 
     def func(ti: np.ndarray, dt: np.ndarray, ph: np.ndarray) -> np.ndarray:
@@ -225,8 +139,18 @@ def render(
     -------
     xarray.DataArray
         Material table with ``source = model:<name>``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> spec = model_material("lambert", [550.0], material="grey", provenance="doc", rho=0.5)
+    >>> lut = render(spec, [0.0, 45.0, 90.0], [-180.0, 0.0, 90.0], [0.0, 90.0])
+    >>> lut.dims, lut.shape
+    (('theta_i', 'delta_theta', 'phi', 'wavelength'), (3, 3, 2, 1))
+    >>> bool(np.allclose(lut * np.pi, 0.5, rtol=1e-12))
+    True
     """
-    mod, wl, kw = _params(spec)
+    m, wl, kw = model_parameters(spec)
     ti = np.arange(0.0, 91.0) if theta_i is None else np.asarray(theta_i, dtype=np.float64)
     dt = (
         np.arange(-180.0, 91.0, 3.0)
@@ -239,15 +163,10 @@ def render(
             raise ValidationError(
                 f"{name}: expected a non-empty 1-D grid [degree], got shape {g.shape}"
             )
-    _isotropic(mod, spec)
-    vals = render_values(mod, ti, dt, ph, wl, kw)
+    _require_isotropic(m)
+    vals = m.render_grid(ti, dt, ph, wl, horizon="limit", **kw)
     # Where the grid stops inside the hemisphere the model goes on: hold the edge
     # (exact for a Lambertian surface) rather than drop to zero.
-    edges = {
-        "edge_delta_theta_min": "zero" if dt[0] <= -180.0 else "hold",
-        "edge_delta_theta_max": "zero" if dt[-1] >= 90.0 else "hold",
-        "edge_phi_max": "zero" if ph[-1] >= 90.0 else "hold",
-    }
     blend = min(float(ti[1] - ti[0]), 1.0) if ti.size > 1 and ti[0] == 0.0 else 0.0
     return new_material(
         vals.astype(dtype),
@@ -261,8 +180,17 @@ def render(
         model=spec.attrs["model"],
         normal_incidence="symmetric",
         normal_incidence_blend=blend,
-        **edges,
+        **_edges(dt, ph),
     )
+
+
+def _edges(dt: np.ndarray, ph: np.ndarray) -> dict[str, str]:
+    """Edge policies of a rendered table: zero at the hemisphere's edge, else hold."""
+    return {
+        "edge_delta_theta_min": "zero" if dt[0] <= -180.0 else "hold",
+        "edge_delta_theta_max": "zero" if dt[-1] >= 90.0 else "hold",
+        "edge_phi_max": "zero" if ph[-1] >= 90.0 else "hold",
+    }
 
 
 def render_anisotropic(
@@ -294,10 +222,19 @@ def render_anisotropic(
     Returns
     -------
     xarray.DataArray
+
+    Examples
+    --------
+    >>> spec = model_material("anisotropic_microfacet", [550.0], material="brushed",
+    ...                       provenance="doc", alpha_x=0.1, alpha_y=0.3, n=1.0, k=6.0,
+    ...                       rho_d=0.0)
+    >>> tab = render_anisotropic(spec, [30.0], [0.0], [0.0, 10.0], [0.0, 90.0])
+    >>> tab.dims, tab.shape
+    (('theta_i', 'delta_theta', 'phi', 'psi', 'wavelength'), (1, 1, 2, 2, 1))
     """
-    mod, wl, kw = _params(spec)
-    if not getattr(mod, "ANISOTROPIC", False):
-        raise ValidationError(f"model {spec.attrs['model']!r} is isotropic: use render")
+    m, wl, kw = model_parameters(spec)
+    if not m.anisotropic:
+        raise ValidationError(f"model {m.name!r} is isotropic: use render")
     grids = [np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi, psi)]
     for name, g in zip((THETA_I, DELTA_THETA, PHI, PSI), grids, strict=True):
         if g.ndim != 1 or g.size == 0 or np.any(np.diff(g) <= 0):
@@ -307,55 +244,41 @@ def render_anisotropic(
     ps = grids[3]
     if ps[0] < 0 or ps[-1] > 180:
         raise ValidationError(f"psi: must lie in [0, 180] degree, got [{ps[0]}, {ps[-1]}]")
-    m = HORIZON_MARGIN_DEG
-    t4, d4, p4, s4 = np.meshgrid(*grids, indexing="ij")
-    t_c = np.minimum(t4, 90.0 - GRAZING_MARGIN_DEG)
-    r_c = np.clip(t4 + d4, -(90.0 - m), 90.0 - m)
-    vals = mod.brdf_angles(t_c, r_c - t_c, np.minimum(p4, 90.0 - m), wl, psi=s4, **kw)
-    dt, ph = grids[1], grids[2]
+    vals = m.render_grid(*grids[:3], wl, psi=ps, horizon="limit", **kw)
     a = attrs(
         SBRDF,
         material=spec.attrs["material"],
         source=spec.attrs["source"],
         provenance=f"{spec.attrs.get('provenance', '')}; rendered by sbrdf_xr.models.render_anisotropic",
         model=spec.attrs["model"],
-        edge_delta_theta_min="zero" if dt[0] <= -180.0 else "hold",
-        edge_delta_theta_max="zero" if dt[-1] >= 90.0 else "hold",
-        edge_phi_max="zero" if ph[-1] >= 90.0 else "hold",
+        **_edges(grids[1], grids[2]),
     )
     coords = {
         n: (n, g, attrs(n)) for n, g in zip((THETA_I, DELTA_THETA, PHI, PSI), grids, strict=True)
     }
     coords[WAVELENGTH] = (WAVELENGTH, wl, attrs(WAVELENGTH))
-    out = xr.DataArray(vals.astype(dtype), dims=ANISO_LUT_DIMS, coords=coords, name=SBRDF, attrs=a)
-    return out
-
-
-#: Nodes are evaluated at least this far inside the lit and visible hemisphere [degree].
-HORIZON_MARGIN_DEG = 1e-6
-#: A ``theta_i = 90`` row is evaluated this far from grazing incidence [degree]: the
-#: specular peak of a microfacet model diverges as both directions graze, and a
-#: table node carries a value for the whole cell around it.
-GRAZING_MARGIN_DEG = 0.5
+    return xr.DataArray(vals.astype(dtype), dims=ANISO_LUT_DIMS, coords=coords, name=SBRDF, attrs=a)
 
 
 def render_values(
-    mod: Any, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, wl: np.ndarray, kw: dict[str, Any]
+    model: Model,
+    ti: np.ndarray,
+    dt: np.ndarray,
+    ph: np.ndarray,
+    wl: np.ndarray,
+    kw: dict[str, Any],
 ) -> np.ndarray:
     """A model's sBRDF on the outer product of 1-D grids, every node inside the hemisphere.
 
-    A node whose geometry is not lit and visible (``theta_i`` = 90 deg, the observer
-    at or below the horizon: ``|theta_i + delta_theta| >= 90`` or ``phi >= 90``)
-    carries the model's limit from inside the hemisphere: it is evaluated at the
-    nearest lit and visible geometry, :data:`HORIZON_MARGIN_DEG` inside the horizon
-    and :data:`GRAZING_MARGIN_DEG` from grazing incidence.  Interpolating
-    between such a node and a visible one then never blends in a zero that the
-    physics does not have (a Lambertian surface renders to ``rho / pi`` at every node).
+    A node whose geometry is not lit and visible carries the model's limit from
+    inside the hemisphere (``model.render_grid(..., horizon="limit")``,
+    :meth:`sbrdf_xr.brdf.Model.render_grid`): interpolating between such a node
+    and a visible one then never blends in a zero that the physics does not have.
 
     Parameters
     ----------
-    mod : module
-        A model of :data:`sbrdf_xr.brdf.MODELS`.
+    model : Model
+        A model of :data:`sbrdf_xr.brdf.BRDF_MODELS` (isotropic).
     ti, dt, ph : ndarray, 1-D
         Grids [degree].
     wl : ndarray
@@ -367,15 +290,17 @@ def render_values(
     -------
     ndarray, shape (n_ti, n_dt, n_phi, n_wl)
         sBRDF [sr-1].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.brdf import get_model
+    >>> v = render_values(get_model("lambert"), np.array([0.0, 90.0]), np.array([0.0]),
+    ...                   np.array([0.0, 90.0]), np.array([550.0]), {"rho": 0.5})
+    >>> v.shape, np.round(v.ravel() * np.pi, 6).tolist()
+    ((2, 1, 2, 1), [0.5, 0.5, 0.5, 0.5])
     """
-    m = HORIZON_MARGIN_DEG
-    t3, d3, p3 = np.meshgrid(
-        np.asarray(ti, float), np.asarray(dt, float), np.asarray(ph, float), indexing="ij"
-    )
-    t_c = np.minimum(t3, 90.0 - GRAZING_MARGIN_DEG)
-    r_c = np.clip(t3 + d3, -(90.0 - m), 90.0 - m)
-    p_c = np.minimum(p3, 90.0 - m)
-    return mod.brdf_angles(t_c, r_c - t_c, p_c, wl, **kw)
+    return model.render_grid(ti, dt, ph, wl, horizon="limit", **kw)
 
 
 def measure(spec: xr.Dataset, theta_i: Sequence[float], **kwargs: Any) -> xr.Dataset:
@@ -395,6 +320,14 @@ def measure(spec: xr.Dataset, theta_i: Sequence[float], **kwargs: Any) -> xr.Dat
     -------
     xarray.Dataset
         The measurement set, labelled ``synthetic`` with the model as provenance.
+
+    Examples
+    --------
+    >>> spec = model_material("robertson_sandford", [500.0, 700.0], material="paint",
+    ...                       provenance="doc", rho_D=0.6, epsilon=0.2, b=0.1, e=0.3)
+    >>> meas = measure(spec, [20.0, 40.0, 60.0])
+    >>> dict(meas.sizes), meas.attrs["source"]
+    ({'sample': 90, 'wavelength': 2}, 'synthetic')
     """
     from .goniometer import measure as _measure
 
@@ -436,6 +369,14 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
     -------
     xarray.Dataset
         The fitted model material.
+
+    Examples
+    --------
+    >>> spec = model_material("robertson_sandford", [500.0, 700.0], material="paint",
+    ...                       provenance="doc", rho_D=0.6, epsilon=0.2, b=0.1, e=0.3)
+    >>> fit = fit_robertson_sandford(measure(spec, [20.0, 40.0, 60.0]))
+    >>> round(float(fit.b[0]), 6), round(float(fit.e[0]), 6), fit.rho_D.values.round(6).tolist()
+    (0.1, 0.3, [0.6, 0.6])
     """
     from ._names import MEASURED, SAMPLE
     from .brdf import robertson_sandford as rs
@@ -454,7 +395,8 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
         reference=_reference(ds),
         **kwargs,
     )
-    p = {k: np.asarray(fit[k], dtype=np.float64) for k in rs.PARAMS}
+    m = rs.MODEL
+    p = {k: np.asarray(fit[k], dtype=np.float64) for k in m.param_names}
     g_b = float(rs.normalisation_G(p["b"]))
     p["epsilon"] = np.minimum(
         np.broadcast_to(p["epsilon"], wl.shape), np.maximum(g_b - p["rho_D"], 0.0)
@@ -468,27 +410,10 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
         f"(reduced chi-square {fit['chi2_reduced']:.3g}, {fit['n_used']} residuals)",
         **p,
     )
-    for k in rs.PARAMS:
+    for k in m.param_names:
         u = np.broadcast_to(np.asarray(fit[f"u_{k}"], dtype=np.float64), wl.shape)
-        out[f"u_{k}"] = (
-            WAVELENGTH,
-            np.array(u),
-            {"units": "1", "long_name": f"standard uncertainty of {k}"},
-        )
+        u_attrs = {"units": m.parameter(k).units, "long_name": f"standard uncertainty of {k}"}
+        out[f"u_{k}"] = (WAVELENGTH, np.array(u), u_attrs)
     out.attrs["chi2_reduced"] = float(fit["chi2_reduced"])
     out.attrs["source"] = "model:robertson_sandford"
     return out
-
-
-def to_netcdf(spec: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
-    """Write a model material to netCDF (atomic, lossless)."""
-    _params(spec)
-    return write_netcdf_atomic(spec, path, overwrite=overwrite)
-
-
-def open_model(path: str | os.PathLike[str]) -> xr.Dataset:
-    """Read a model material written by :func:`to_netcdf`."""
-    with xr.open_dataset(path, engine="netcdf4") as ds:
-        ds = ds.load()
-    _params(ds)
-    return ds

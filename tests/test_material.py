@@ -367,9 +367,8 @@ def test_below_noise_model_fill_keeps_the_floor_and_the_measurements():
     )
     np.testing.assert_allclose(got, meas.measured_sbrdf.values[sel], rtol=0.2)
     # Energy: the filled table keeps the model's reflectance (interpolation: 2 %).
-    rho_m = models._params(spec)[0].directional_hemispherical_reflectance(
-        [20.0, 40.0, 60.0], wl, **models._params(spec)[2]
-    )
+    model, _, kw = models.model_parameters(spec)
+    rho_m = model.directional_hemispherical_reflectance([20.0, 40.0, 60.0], wl, **kw)
     np.testing.assert_allclose(
         M.hemispherical_reflectance(filled, [20.0, 40.0, 60.0]), rho_m, rtol=0.02
     )

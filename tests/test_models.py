@@ -4,11 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import xarray as xr
 
 from sbrdf_xr import catalog, material, models
-from sbrdf_xr.brdf import optics
-from sbrdf_xr.errors import ValidationError
 
 WL = np.linspace(400.0, 1100.0, 15)
 
@@ -44,52 +41,6 @@ def test_render_equals_direct_evaluation_and_conserves_energy():
     p = {k: spec[k].values for k in ("rho_D", "epsilon", "b", "e")}
     expected = rs.directional_hemispherical_reflectance(np.array([0.0, 30.0, 60.0]), WL, **p)
     np.testing.assert_allclose(rho, expected, rtol=5e-3)
-
-
-@pytest.mark.parametrize(
-    ("kw", "match"),
-    [
-        ({"b": -0.1}, "b"),
-        ({"e": 0.0}, "e"),
-        ({"rho_D": 0.95}, "rho_D \\+ epsilon"),
-        ({"rho_D": -np.ones(15)}, "rho_D"),
-    ],
-)
-def test_parameters_out_of_domain(kw, match):
-    with pytest.raises(ValidationError, match=match):
-        paint(**kw)
-
-
-def test_layers_only_for_microfacet_and_round_trip(tmp_path):
-    with pytest.raises(ValidationError, match="only the microfacet"):
-        models.model_material(
-            "lambert", WL, material="x", provenance="t", layers=[(1.5, 100.0)], rho=0.5
-        )
-    al = optics.aluminium_index(WL)
-    spec = models.model_material(
-        "microfacet",
-        WL,
-        material="c",
-        provenance="t",
-        layers=[(optics.silica_index(WL), 120.0)],
-        roughness=0.1,
-        n=al.real,
-        k=al.imag,
-        rho_d=0.01,
-    )
-    path = models.to_netcdf(spec, tmp_path / "m.nc")
-    back = models.open_model(path)
-    # the writer adds the file-level ACDD attributes title and history (CF/ACDD basics)
-    assert back.attrs.pop("title") and back.attrs.pop("history")
-    xr.testing.assert_identical(back, spec)
-    np.testing.assert_allclose(
-        models.spectra(back, 30.0, 0.0, 0.0), models.spectra(spec, 30.0, 0.0, 0.0)
-    )
-
-
-def test_unknown_model_name():
-    with pytest.raises(ValidationError, match="valid model names"):
-        models.model_material("phong", WL, material="x", provenance="t")
 
 
 def test_measure_then_build_reproduces_measured_geometries():

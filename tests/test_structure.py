@@ -11,7 +11,8 @@ not run).
   ``_catalog_index`` (where the shipped files are; it loads nothing), ``_shadow_kernels``,
   ``_cache`` (tables built on load, cached on disk), ``anisotropy`` (facet tangents,
   ``psi``) and ``_aniso_kernels`` (the anisotropic look-up).
-* L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``models``,
+* L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``model_schema``,
+  ``models``,
   ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``_visibility_rays`` (the
   sampled method), ``visibility``, ``attitude_frames``, ``attitude``, ``orbits``,
   ``observe``, ``photometry`` (and its modules), ``fingerprint``.
@@ -59,6 +60,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "material_schema",
         "material_io",
         "construction",
+        "model_schema",
         "models",
         "material",
         "goniometer",

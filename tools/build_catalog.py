@@ -12,7 +12,7 @@ import numpy as np
 import xarray as xr
 
 from sbrdf_xr import goniometer, material, models, testing
-from sbrdf_xr.brdf import optics
+from sbrdf_xr.brdf import get_model, optics
 
 ROOT = Path(__file__).resolve().parent.parent / "catalogs"
 
@@ -22,6 +22,8 @@ WAVELENGTH_PAPER = np.arange(450.0, 1100.1, 5.0)
 WAVELENGTH_CANX1 = np.arange(400.0, 1100.1, 5.0)
 #: Relative noise of the virtual measurements of the CanX-1 materials.
 CANX1_NOISE = 0.01
+#: The Robertson-Sandford model (its parameters' metadata label Table 4).
+RS = get_model("robertson_sandford")
 
 
 def canx1_models() -> dict[str, xr.Dataset]:
@@ -106,10 +108,10 @@ def table4_paints() -> None:
     """Paper 001 Table 4: Robertson-Sandford parameters at 4 um."""
     ds = xr.Dataset(
         {
-            "rho_D": ("sample", [0.07, 0.05], models.PARAM_ATTRS["rho_D"]),
-            "epsilon": ("sample", [0.85, 0.88], models.PARAM_ATTRS["epsilon"]),
-            "b": ("sample", [0.12, 0.08], models.PARAM_ATTRS["b"]),
-            "e": ("sample", [0.12, 0.012], models.PARAM_ATTRS["e"]),
+            "rho_D": ("sample", [0.07, 0.05], RS.parameter("rho_D").attrs),
+            "epsilon": ("sample", [0.85, 0.88], RS.parameter("epsilon").attrs),
+            "b": ("sample", [0.12, 0.08], RS.parameter("b").attrs),
+            "e": ("sample", [0.12, 0.012], RS.parameter("e").attrs),
         },
         coords={
             "sample": ("sample", ["AFGL-01", "AFGL-10"], {"long_name": "paint sample"}),

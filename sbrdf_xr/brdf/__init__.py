@@ -1,9 +1,17 @@
 """Analytic spectral BRDF models as pure, vectorised numpy functions.
 
-Every model module implements the same interface (see :mod:`sbrdf_xr.brdf.lambert`):
-``PARAMS``, ``check_params``, ``brdf``, ``brdf_angles``, ``render_grid`` and
-``directional_hemispherical_reflectance``.  Models are listed once in :data:`MODELS`
-and selected by name with :func:`get_model` (colour-science dispatcher style).
+Every model is one :class:`Model` object (:mod:`sbrdf_xr.brdf._model`): its name, its
+``brdf`` function, its parameters declared with units, long_name and domain
+(:class:`Parameter`), whether it is anisotropic, its citation and its
+directional-hemispherical reflectance.  The evaluation from paper-000 angles
+(``brdf_angles``), the rendering on angle grids (``render_grid``) and the parameter
+validation (``check_params``) are methods of :class:`Model`, written once for every
+model.  Models are registered in :data:`BRDF_MODELS` and selected by name with
+:func:`get_model` (case-insensitive; colour-science's ``CanonicalMapping`` and
+``validate_method`` style).
+
+Adding a model is one module defining a :class:`Model` and its line in
+:data:`_REGISTERED` below (or, from outside the package, :func:`register_model`).
 
 Models
 ------
@@ -17,8 +25,8 @@ Models
     (:mod:`~sbrdf_xr.brdf.microfacet`, :mod:`~sbrdf_xr.brdf.optics`).
 
 Anisotropic models (:data:`ANISOTROPIC_MODELS`) take the facet tangent as well: their
-``brdf`` has a ``tangent`` keyword, ``brdf_angles`` a ``psi`` keyword and
-``render_grid`` a ``psi`` grid (a table with an extra ``psi`` axis).
+``brdf`` has a ``tangent`` keyword, ``brdf_angles`` and ``render_grid`` a ``psi``
+keyword (a table with an extra ``psi`` axis).
 
 ``"anisotropic_microfacet"``
     Anisotropic GGX with Smith masking (:mod:`~sbrdf_xr.brdf.anisotropic`), for brushed
@@ -27,58 +35,127 @@ Anisotropic models (:data:`ANISOTROPIC_MODELS`) take the facet tangent as well: 
 
 from __future__ import annotations
 
-from types import ModuleType
-
-from ..errors import ValidationError
 from . import anisotropic, lambert, microfacet, optics, robertson_sandford
+from ._model import Model, ModelRegistry, Parameter
 
 __all__ = [
     "ANISOTROPIC_MODELS",
+    "BRDF_MODELS",
     "MODELS",
+    "Model",
+    "ModelRegistry",
+    "Parameter",
     "anisotropic",
     "get_model",
     "lambert",
     "microfacet",
     "optics",
+    "register_model",
     "robertson_sandford",
+    "unregister_model",
 ]
 
-#: Registry of the analytic models: name -> module implementing the common interface.
-MODELS: dict[str, ModuleType] = {
-    "lambert": lambert,
-    "robertson_sandford": robertson_sandford,
-    "microfacet": microfacet,
-}
-#: Registry of the anisotropic models (their tables have a ``psi`` axis).
-ANISOTROPIC_MODELS: dict[str, ModuleType] = {
-    "anisotropic_microfacet": anisotropic,
-}
+#: Every registered model, by name.
+BRDF_MODELS = ModelRegistry()
+#: The isotropic models (a live view of :data:`BRDF_MODELS`).
+MODELS = BRDF_MODELS.view(anisotropic=False)
+#: The anisotropic models (their tables have a ``psi`` axis; a live view).
+ANISOTROPIC_MODELS = BRDF_MODELS.view(anisotropic=True)
+
+#: The package's models, one line each.
+_REGISTERED = (lambert, robertson_sandford, microfacet, anisotropic)
 
 
-def get_model(name: str) -> ModuleType:
-    """Return the model module registered under ``name``.
+def get_model(name: str) -> Model:
+    """Return the model registered under ``name`` (case-insensitive).
 
     Parameters
     ----------
     name : str
-        One of the keys of :data:`MODELS` or :data:`ANISOTROPIC_MODELS`.
+        A name of :data:`BRDF_MODELS`; case, ``-``, ``_`` and spaces are ignored.
 
     Returns
     -------
-    module
-        The model module (``PARAMS``, ``check_params``, ``brdf``, ``brdf_angles``,
-        ``render_grid``, ``directional_hemispherical_reflectance``).
+    Model
 
     Raises
     ------
     ValidationError
         If ``name`` is not a registered model; the message lists the valid names.
+
+    Examples
+    --------
+    >>> get_model("Robertson-Sandford").param_names
+    ('rho_D', 'epsilon', 'b', 'e')
+    >>> get_model("phong")
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.ValidationError: model: got 'phong'; valid model names are
+    ['anisotropic_microfacet', 'lambert', 'microfacet', 'robertson_sandford'] (case-insensitive)
     """
-    if isinstance(name, str) and name in ANISOTROPIC_MODELS:
-        return ANISOTROPIC_MODELS[name]
-    if not isinstance(name, str) or name not in MODELS:
-        raise ValidationError(
-            f"model: got {name!r}; valid model names are {sorted(MODELS)} and the anisotropic "
-            f"{sorted(ANISOTROPIC_MODELS)}"
-        )
-    return MODELS[name]
+    return BRDF_MODELS[name]
+
+
+def register_model(model: Model, *, replace: bool = False) -> Model:
+    """Register ``model`` under ``model.name`` (:meth:`ModelRegistry.register`).
+
+    Parameters
+    ----------
+    model : Model
+        A complete declaration (every parameter with units, long_name and domain).
+    replace : bool, default False
+        Replace a model registered under the same name.
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    ValidationError
+        Not a :class:`Model`, or the name is taken and ``replace`` is false.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> def grey(normal, to_sun, to_observer, wavelength, **params):
+    ...     return lambert.brdf(normal, to_sun, to_observer, wavelength, rho=params["a"])
+    >>> m = register_model(
+    ...     Model(
+    ...         name="grey",
+    ...         long_name="a grey Lambertian surface",
+    ...         brdf=grey,
+    ...         parameters=(Parameter("a", "1", "albedo", lower=0.0, upper=1.0),),
+    ...         citation="Lambert (1760)",
+    ...     )
+    ... )
+    >>> f = get_model("grey").brdf_angles(0.0, 0.0, 0.0, [550.0], a=0.5)
+    >>> round(float(f[0] * np.pi), 6)
+    0.5
+    >>> unregister_model("grey").name
+    'grey'
+    """
+    return BRDF_MODELS.register(model, replace=replace)
+
+
+def unregister_model(name: str) -> Model:
+    """Remove the model registered under ``name`` and return it.
+
+    Raises
+    ------
+    ValidationError
+        If ``name`` is not a registered model.
+
+    Examples
+    --------
+    >>> import dataclasses
+    >>> m = register_model(dataclasses.replace(get_model("lambert"), name="lambert_copy"))
+    >>> unregister_model("Lambert-Copy").name
+    'lambert_copy'
+    """
+    return BRDF_MODELS.unregister(name)
+
+
+for _module in _REGISTERED:
+    register_model(_module.MODEL)
+del _module

@@ -8,7 +8,7 @@ float64 otherwise), clipped to the finite range of that dtype.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -125,38 +125,52 @@ def _sin2(n: np.ndarray, v: np.ndarray) -> np.ndarray:
     return np.einsum("...k,...k->...", c, c)
 
 
-def _angles_to_vectors(
-    theta_i: ArrayLike, delta_theta: ArrayLike, phi: ArrayLike
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Facet-frame unit vectors for paper-000 angles [degree] (``geometry.facet_vectors``)."""
+def _check_angles(*named: tuple[str, ArrayLike]) -> list[np.ndarray]:
+    """Angles [degree] checked to be finite real numbers."""
     arrays = []
-    for name, a in (("theta_i", theta_i), ("delta_theta", delta_theta), ("phi", phi)):
+    for name, a in named:
         arr = np.asarray(a)
         if not np.issubdtype(arr.dtype, np.number) or np.iscomplexobj(arr):
             raise ValidationError(f"{name}: expected real angles [degree], got dtype {arr.dtype}")
         if not np.all(np.isfinite(arr)):
             raise ValidationError(f"{name}: contains NaN or infinite angles [degree]")
         arrays.append(arr)
+    return arrays
+
+
+def _angles_to_vectors(
+    theta_i: ArrayLike, delta_theta: ArrayLike, phi: ArrayLike
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Facet-frame unit vectors for paper-000 angles [degree] (``geometry.facet_vectors``)."""
+    arrays = _check_angles(("theta_i", theta_i), ("delta_theta", delta_theta), ("phi", phi))
     return geometry.facet_vectors(*arrays)
 
 
-def _render_grid(
-    brdf_angles_func: Callable[..., np.ndarray],
-    theta_i: ArrayLike,
-    delta_theta: ArrayLike,
-    phi: ArrayLike,
-    wavelength: ArrayLike,
-    **kwargs: Any,
-) -> np.ndarray:
-    """Evaluate ``brdf_angles_func`` on the outer product of 1-D angle grids."""
-    grids = []
-    for name, a in (("theta_i", theta_i), ("delta_theta", delta_theta), ("phi", phi)):
-        arr = np.asarray(a)
-        if arr.ndim != 1:
-            raise ValidationError(f"{name}: expected a 1-D grid [degree], got shape {arr.shape}")
-        grids.append(arr)
-    ti, dt, ph = np.meshgrid(*grids, indexing="ij")
-    return brdf_angles_func(ti, dt, ph, wavelength, **kwargs)
+def tangent_from_azimuth(psi: ArrayLike) -> np.ndarray:
+    """Facet tangent in the frame of :func:`sbrdf_xr.geometry.facet_vectors` for ``psi``.
+
+    That frame has ``N = +z`` and the forward direction ``e_f = -x``; the tangent at
+    azimuth ``psi`` [degree] from which ``e_f`` is reached counter-clockwise about
+    ``N`` is ``(-cos psi, sin psi, 0)``.
+
+    Parameters
+    ----------
+    psi : array_like
+        Azimuth of the illumination plane from the tangent [degree].
+
+    Returns
+    -------
+    ndarray, shape psi.shape + (3,)
+        Unit tangents [1].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> (np.round(tangent_from_azimuth([0.0, 90.0]), 6) + 0.0).tolist()
+    [[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+    """
+    a = np.radians(np.asarray(psi, dtype=np.float64))
+    return np.stack([-np.cos(a), np.sin(a), np.zeros_like(a)], axis=-1)
 
 
 def _check_theta_i(theta_i: ArrayLike) -> np.ndarray:

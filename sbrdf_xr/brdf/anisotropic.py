@@ -43,18 +43,21 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import geometry
+from ..errors import ValidationError
 from . import optics
 from ._common import (
-    _band_param,
     _cast_out,
-    _check_names,
     _check_theta_i,
     _check_wavelength,
     _facet_frame,
+    tangent_from_azimuth,
 )
+from ._model import Model, Parameter
+from .microfacet import PARAMETERS as _ISOTROPIC
 from .microfacet import ROUGHNESS_MAX, ROUGHNESS_MIN
 
 __all__ = [
+    "MODEL",
     "PARAMS",
     "brdf",
     "brdf_angles",
@@ -66,50 +69,26 @@ __all__ = [
     "tangent_from_azimuth",
 ]
 
-#: Parameter names: roughness along the tangent ``alpha_x`` and across it ``alpha_y``
-#: [1], substrate index ``n`` and extinction ``k`` [1], Lambertian albedo ``rho_d`` [1].
-PARAMS: tuple[str, ...] = ("alpha_x", "alpha_y", "n", "k", "rho_d")
-#: This model needs the facet tangent (``psi``): tables of it have a ``psi`` axis.
-ANISOTROPIC = True
+#: The parameters: roughness along the tangent ``alpha_x`` and across it ``alpha_y``,
+#: and the microfacet model's substrate index ``n``, extinction ``k`` and albedo ``rho_d``.
+PARAMETERS = (
+    *(
+        Parameter(
+            f"alpha_{axis}",
+            "1",
+            f"GGX roughness {where} the facet tangent",
+            lower=ROUGHNESS_MIN,
+            upper=ROUGHNESS_MAX,
+            spectral=False,
+        )
+        for axis, where in (("x", "along"), ("y", "across"))
+    ),
+    *_ISOTROPIC[1:],
+)
 
 _VIS_FLOOR = 1.0e-150
 _N_PHI = 128
 _N_U = 128
-
-
-def check_params(wavelength: ArrayLike, **params: Any) -> dict[str, NDArray[np.float64]]:
-    """Validate the parameters and broadcast them to the wavelength grid.
-
-    Parameters
-    ----------
-    wavelength : array_like, shape (n_wl,)
-        Vacuum wavelength [nm].
-    alpha_x, alpha_y : array_like, scalar or shape (n_wl,)
-        GGX roughness along and across the tangent [1], in ``[1e-6, 1e3]``.
-    n, k : array_like, scalar or shape (n_wl,)
-        Substrate refractive index ``n > 0`` and extinction coefficient ``k >= 0`` [1].
-    rho_d : array_like, scalar or shape (n_wl,)
-        Lambertian albedo [1], ``0 <= rho_d <= 1``.
-
-    Returns
-    -------
-    dict
-        The parameters as float64 arrays of shape ``(n_wl,)``.
-    """
-    wl = _check_wavelength(wavelength)
-    _check_names(params, PARAMS, "anisotropic_microfacet")
-    m = wl.size
-    return {
-        "alpha_x": _band_param(
-            "alpha_x", params["alpha_x"], m, lower=ROUGHNESS_MIN, upper=ROUGHNESS_MAX
-        ),
-        "alpha_y": _band_param(
-            "alpha_y", params["alpha_y"], m, lower=ROUGHNESS_MIN, upper=ROUGHNESS_MAX
-        ),
-        "n": _band_param("n", params["n"], m, lower=0.0, lower_open=True),
-        "k": _band_param("k", params["k"], m, lower=0.0),
-        "rho_d": _band_param("rho_d", params["rho_d"], m, lower=0.0, upper=1.0),
-    }
 
 
 def distribution(h_local: ArrayLike, alpha_x: ArrayLike, alpha_y: ArrayLike) -> np.ndarray:
@@ -126,6 +105,12 @@ def distribution(h_local: ArrayLike, alpha_x: ArrayLike, alpha_y: ArrayLike) -> 
     -------
     ndarray
         ``D`` [sr-1]; ``int D cos(theta_h) d omega = 1``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> round(float(distribution([0.0, 0.0, 1.0], 0.1, 0.3) * np.pi * 0.1 * 0.3), 6)
+    1.0
     """
     h = np.asarray(h_local, dtype=np.float64)
     ax = np.asarray(alpha_x, dtype=np.float64)
@@ -151,8 +136,6 @@ def _frame(normal: np.ndarray, tangent: ArrayLike) -> tuple[np.ndarray, np.ndarr
     t = t - np.einsum("...k,...k->...", t, normal)[..., None] * normal
     length = np.linalg.norm(t, axis=-1, keepdims=True)
     if np.any(length <= 1e-12):
-        from ..errors import ValidationError
-
         raise ValidationError("tangent: must not be parallel to the facet normal (or zero)")
     t = t / length
     return t, np.cross(normal, t)
@@ -185,9 +168,17 @@ def brdf(
     -------
     ndarray, shape broadcast(...) + (n_wl,)
         BRDF [sr-1]; zero where ``N.s <= 0`` or ``N.o <= 0``.  Reciprocal.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> n, s, o = [0.0, 0.0, 1.0], [0.5, 0.0, 1.0], [-0.5, 0.0, 1.0]
+    >>> kw = {"n": 1.5, "k": 0.0, "rho_d": 0.0}
+    >>> np.round(brdf(n, s, o, [550.0], tangent=[1.0, 0.0, 0.0], alpha_x=0.2, alpha_y=0.2, **kw), 4)
+    array([0.1012])
     """
     wl = _check_wavelength(wavelength)
-    p = check_params(wl, **params)
+    p = MODEL.check_params(wl, **params)
     n, s, o, cos_i, cos_r, mask, dtype = _facet_frame(normal, to_sun, to_observer)
     t, b = _frame(n, tangent)
     h = geometry.half_vector(s, o).astype(np.float64)
@@ -203,17 +194,6 @@ def brdf(
     fres = optics.fresnel_conductor(cos_hs[..., None], p["n"] + 1j * p["k"])
     f = fres * d * vis + p["rho_d"] / np.pi
     return _cast_out(np.where(mask[..., None], f, 0.0), dtype)
-
-
-def tangent_from_azimuth(psi: ArrayLike) -> np.ndarray:
-    """Facet tangent in the frame of :func:`sbrdf_xr.geometry.facet_vectors` for ``psi``.
-
-    That frame has ``N = +z`` and the forward direction ``e_f = -x``; the tangent at
-    azimuth ``psi`` [degree] from which ``e_f`` is reached counter-clockwise about
-    ``N`` is ``(-cos psi, sin psi, 0)``.
-    """
-    a = np.radians(np.asarray(psi, dtype=np.float64))
-    return np.stack([-np.cos(a), np.sin(a), np.zeros_like(a)], axis=-1)
 
 
 def illumination_azimuth(
@@ -232,48 +212,19 @@ def illumination_azimuth(
     -------
     ndarray
         ``psi`` in ``[0, 180)`` degree.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> n, s, o = [0.0, 0.0, 1.0], [0.5, 0.0, 1.0], [-0.5, 0.0, 1.0]
+    >>> across = [0.0, 1.0, 0.0]  # a tangent across the illumination plane
+    >>> float(np.round(illumination_azimuth(n, across, s, o), 6))
+    90.0
     """
     from .. import anisotropy
 
     f64 = [np.asarray(a, dtype=np.float64) for a in (normal, to_sun, to_observer)]
     return anisotropy.illumination_azimuth(f64[0], tangent, f64[1], f64[2]).astype(np.float64)
-
-
-def brdf_angles(
-    theta_i: ArrayLike,
-    delta_theta: ArrayLike,
-    phi: ArrayLike,
-    wavelength: ArrayLike,
-    *,
-    psi: ArrayLike,
-    **params: Any,
-) -> np.ndarray:
-    """The BRDF from the paper-000 angles and ``psi`` [degree] (see :func:`brdf`)."""
-    n, s, o = geometry.facet_vectors(theta_i, delta_theta, phi)
-    t = tangent_from_azimuth(psi)
-    n, s, o, t = np.broadcast_arrays(n, s, o, t)
-    return brdf(n, s, o, wavelength, tangent=t, **params)
-
-
-def render_grid(
-    theta_i: ArrayLike,
-    delta_theta: ArrayLike,
-    phi: ArrayLike,
-    psi: ArrayLike,
-    wavelength: ArrayLike,
-    **params: Any,
-) -> np.ndarray:
-    """The BRDF on the outer product of 1-D grids ``(theta_i, delta_theta, phi, psi)``.
-
-    Returns
-    -------
-    ndarray, shape (n_ti, n_dt, n_phi, n_psi, n_wl)
-        BRDF [sr-1].
-    """
-    g = np.meshgrid(
-        *(np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi, psi)), indexing="ij"
-    )
-    return brdf_angles(g[0], g[1], g[2], wavelength, psi=g[3], **params)
 
 
 def directional_hemispherical_reflectance(
@@ -305,9 +256,17 @@ def directional_hemispherical_reflectance(
     -------
     ndarray, shape broadcast(theta_i, psi) + (n_wl,)
         Reflectance [1].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> r = directional_hemispherical_reflectance([0.0], [550.0], psi=0.0, alpha_x=0.2, alpha_y=0.2,
+    ...                                           n=1.5, k=0.0, rho_d=0.0)
+    >>> np.round(r, 3).tolist()  # the isotropic microfacet value, to the quadrature's 1e-3
+    [[0.038]]
     """
     wl = _check_wavelength(wavelength)
-    p = check_params(wl, **params)
+    p = MODEL.check_params(wl, **params)
     ti = _check_theta_i(theta_i)
     ti, ps = np.broadcast_arrays(ti, np.asarray(psi, dtype=np.float64))
     tx, wx = np.polynomial.legendre.leggauss(_N_U)
@@ -344,3 +303,17 @@ def directional_hemispherical_reflectance(
         integrand = np.where(ok, fres * g2_ci * np.clip(hs, 0, 1) / hz, 0.0)
         out[idx] = np.einsum("ufw,u,f->w", integrand, du, wf) / (2 * np.pi) + p["rho_d"]
     return out
+
+
+#: The anisotropic microfacet model.
+MODEL = Model(
+    name="anisotropic_microfacet",
+    long_name="anisotropic GGX microfacet model with Smith masking, plus a Lambertian term",
+    brdf=brdf,
+    parameters=PARAMETERS,
+    citation="Heitz, JCGT 3(2) 2014, Eqs. 85, 86 and 99; Walter et al., EGSR 2007",
+    reflectance=directional_hemispherical_reflectance,
+    anisotropic=True,
+)
+PARAMS = MODEL.param_names
+check_params, brdf_angles, render_grid = MODEL.check_params, MODEL.brdf_angles, MODEL.render_grid

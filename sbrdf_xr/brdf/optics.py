@@ -28,10 +28,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ValidationError
+from ._model import Parameter
 
 __all__ = [
     "FILM_INDEX",
     "HC_EV_NM",
+    "THIN_FILM_STACK",
     "aluminium_index",
     "fresnel_conductor",
     "fresnel_thin_film_stack",
@@ -110,6 +112,12 @@ def aluminium_index(wavelength_nm: ArrayLike) -> NDArray[np.complex128]:
     ndarray of complex128
         ``n + i k`` [1] with ``k >= 0``.  Normal-incidence reflectance is ~0.92 in the
         visible with the interband absorption dip near 800 nm (1.5 eV).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> np.round(aluminium_index([500.0, 800.0]), 3)  # the interband absorption near 800 nm
+    array([0.761+5.9j  , 2.674+8.335j])
     """
     w = HC_EV_NM / _check_wl(wavelength_nm)
     wp2 = _AL_OMEGA_P**2
@@ -162,6 +170,12 @@ def gaas_index(wavelength_nm: ArrayLike) -> NDArray[np.complex128]:
     -------
     ndarray of complex128
         ``n + i k`` [1].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> np.round(gaas_index([800.0]), 3)
+    array([3.558+0.126j])
     """
     wl = _check_wl(wavelength_nm)
     energy = np.minimum(HC_EV_NM / wl, _GAAS_E_CLIP)
@@ -188,6 +202,12 @@ def silica_index(wavelength_nm: ArrayLike) -> NDArray[np.float64]:
     -------
     ndarray
         ``n`` [1] (1.4585 at 587.6 nm).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> np.round(silica_index([589.3]), 4)  # the sodium D line
+    array([1.4584])
     """
     wl = _check_wl(wavelength_nm) * 1e-3
     return _sellmeier(wl, (0.6961663, 0.4079426, 0.8974794), (0.0684043, 0.1162414, 9.896161))
@@ -206,6 +226,12 @@ def sapphire_index(wavelength_nm: ArrayLike) -> NDArray[np.float64]:
     ndarray
         ``n_o`` [1] (about 1.77 at 589 nm; deposited alumina films: ~1.65,
         :data:`FILM_INDEX`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> np.round(sapphire_index([589.3]), 4)
+    array([1.7681])
     """
     wl = _check_wl(wavelength_nm) * 1e-3
     return _sellmeier(wl, (1.4313493, 0.65054713, 5.3414021), (0.0726631, 0.1193242, 18.028251))
@@ -225,6 +251,12 @@ def titania_index(wavelength_nm: ArrayLike) -> NDArray[np.float64]:
     -------
     ndarray
         ``n_o`` [1] (~2.65 at 550 nm; deposited films: 2.3–2.5, :data:`FILM_INDEX`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> np.round(titania_index([589.3]), 4)
+    array([2.6129])
     """
     wl = _check_wl(wavelength_nm) * 1e-3
     return np.sqrt(5.913 + 0.2441 / (wl**2 - 0.0803))
@@ -292,6 +324,12 @@ def fresnel_conductor(cos_theta: ArrayLike, n_complex: ArrayLike) -> NDArray[np.
     References
     ----------
     Born & Wolf, *Principles of Optics*, 7th ed., §1.5.2 and §14.2.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> np.round(fresnel_conductor([1.0, 0.0], 1.5), 6)  # glass: 4 % at normal incidence, 1 grazing
+    array([0.04, 1.  ])
     """
     c = _check_cos(cos_theta)
     n_c = _check_index(n_complex, "n_complex")
@@ -304,9 +342,30 @@ def fresnel_conductor(cos_theta: ArrayLike, n_complex: ArrayLike) -> NDArray[np.
 
 
 def normal_incidence_reflectance(n_complex: ArrayLike) -> NDArray[np.float64]:
-    """``((n-1)^2 + k^2) / ((n+1)^2 + k^2)`` [1] for ``N = n + ik`` [1] (Born & Wolf §14.2)."""
+    """``((n-1)^2 + k^2) / ((n+1)^2 + k^2)`` [1] for ``N = n + ik`` [1] (Born & Wolf §14.2).
+
+    Examples
+    --------
+    >>> round(float(normal_incidence_reflectance(1.5)), 6)
+    0.04
+    """
     n_c = _check_index(n_complex, "n_complex")
     return np.abs((n_c - 1) / (n_c + 1)) ** 2
+
+
+#: The variables of a thin-film stack in a model material (:func:`fresnel_thin_film_stack`'s
+#: ``layers``): the complex index of each layer ``(layer, wavelength)`` and its thickness.
+THIN_FILM_STACK = (
+    Parameter(
+        "layer_n",
+        "1",
+        "thin-film layer refractive index (ambient side first)",
+        lower=0.0,
+        lower_open=True,
+    ),
+    Parameter("layer_k", "1", "thin-film layer extinction coefficient", lower=0.0),
+    Parameter("layer_thickness", "nm", "thin-film layer thickness", lower=0.0, spectral=False),
+)
 
 
 def fresnel_thin_film_stack(
@@ -353,6 +412,13 @@ def fresnel_thin_film_stack(
         zero-thickness ones) this is :func:`fresnel_conductor`.  Interference
         extrema move to shorter wavelengths as the angle grows (``delta`` scales
         with ``cos theta_j``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> quarter_wave = [(1.38, 550.0 / (4 * 1.38))]  # MgF2 on glass, quarter-wave at 550 nm
+    >>> np.round(fresnel_thin_film_stack([1.0], [550.0], quarter_wave, 1.5), 6)
+    array([[0.01411]])
     """
     c = _check_cos(cos_theta)[..., None]
     return _stack_reflectance(c, wavelength, layers, substrate, ambient)

@@ -107,6 +107,18 @@ def fit_robertson_sandford(
     ValidationError
         Inconsistent shapes, or fewer than 4 usable geometries (four parameters)
         or fewer than 2 usable samples at some wavelength.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.brdf import robertson_sandford as rs
+    >>> ti, dt, ph = (a.ravel() for a in np.meshgrid(
+    ...     [20.0, 40.0, 60.0], [-40.0, -20.0, 0.0, 10.0], [0.0, 20.0], indexing="ij"))
+    >>> truth = {"rho_D": 0.6, "epsilon": 0.2, "b": 0.1, "e": 0.3}
+    >>> samples = rs.brdf_angles(ti, dt, ph, [550.0], **truth)
+    >>> fit = fit_robertson_sandford(ti, dt, ph, [550.0], samples)
+    >>> {k: np.round(fit[k], 6).tolist() for k in truth}  # noiseless samples: the truth
+    {'rho_D': [0.6], 'epsilon': [0.2], 'b': 0.1, 'e': 0.3}
     """
     wl = _check_wavelength(wavelength)
     n_wl = wl.size

@@ -177,7 +177,7 @@ def test_equal_roughness_psi_table_is_the_isotropic_table():
 
 
 def test_registry_lists_the_anisotropic_model():
-    assert get_model("anisotropic_microfacet") is A
+    assert get_model("anisotropic_microfacet") is A.MODEL
     with pytest.raises(ValidationError, match="anisotropic_microfacet"):
         get_model("nope")
 

@@ -38,7 +38,7 @@ def test_get_model_rejects_unknown_name_and_lists_valid_ones():
 def test_interface_members(name):
     model = get_model(name)
     for attr in (
-        "PARAMS",
+        "param_names",
         "check_params",
         "brdf",
         "brdf_angles",
@@ -47,7 +47,7 @@ def test_interface_members(name):
     ):
         assert hasattr(model, attr)
     checked = model.check_params(WL, **PARAMS[name])
-    assert tuple(checked) == model.PARAMS
+    assert tuple(checked) == model.param_names
     for v in checked.values():
         assert v.shape == WL.shape and v.dtype == np.float64
 
