@@ -270,10 +270,11 @@ def build_lut(
        (zero beyond that ``theta_i``'s measured extent when it is a reference
        point).
 
-    Where an extent is a measured point rather than a reference point (the
-    apparatus stopped before the signal reached the noise, as for diffuse
-    materials), the edge value is held beyond it instead of dropping to zero; the
-    paper's sets end in reference points, for which this is the paper's rule.
+
+       Where an extent is a measured point rather than a reference point (the
+       apparatus stopped before the signal reached the noise, as for diffuse
+       materials), the edge value is held beyond it instead of dropping to zero; the
+       paper's sets end in reference points, for which this is the paper's rule.
     3. ``theta_i``: a cubic smoothing spline over the measured incidence angles for
        every ``(delta_theta, phi, wavelength)``, evaluated at every integer degree
        0-90 (interpolating between and extrapolating beyond the measured angles).
