@@ -102,6 +102,17 @@ class FacetAngles(NamedTuple):
         ``N.s > 0``.
     visible : ndarray of bool
         ``N.o > 0``.
+
+    Examples
+    --------
+    The tuple :func:`facet_angles` returns; its fields are arrays (0-d for single vectors):
+
+    >>> from sbrdf_xr.geometry import FacetAngles, facet_angles
+    >>> a = facet_angles([0, 0, 1], [1, 0, 1], [0, 0, 1])
+    >>> isinstance(a, FacetAngles), a._fields
+    (True, ('theta_i', 'delta_theta', 'phi', 'lit', 'visible'))
+    >>> round(float(a.theta_i), 6), bool(a.lit), bool(a.visible)
+    (45.0, True, True)
     """
 
     theta_i: NDArray[np.floating]
@@ -137,6 +148,15 @@ def normal_incidence_tolerance(dtype: np.dtype | type = np.float64) -> float:
     -------
     float
         ``1e4 * eps(dtype)`` [1].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.geometry import normal_incidence_tolerance
+    >>> normal_incidence_tolerance()
+    2.22...e-12
+    >>> normal_incidence_tolerance(np.float32)
+    0.00119...
     """
     return float(NORMAL_INCIDENCE_EPS_FACTOR * np.finfo(dtype).eps)
 
@@ -177,6 +197,18 @@ def normalize(v: ArrayLike, name: str = "vector") -> NDArray[np.floating]:
     ------
     ValidationError
         If a vector is zero, not finite, or the last axis is not of length 3.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.geometry import normalize
+    >>> normalize([3.0, 0.0, 4.0])
+    array([0.6, 0. , 0.8])
+    >>> normalize([[0, 0, 2], [0, 5, 0]]).tolist()
+    [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]
+    >>> normalize([0, 0, 0], "to_sun")
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.ValidationError: to_sun: contains zero-length vectors; directions must be non-zero
     """
     arr = _check_vectors(v, name)
     arr = arr.astype(_float_dtype(arr), copy=False)
@@ -231,6 +263,29 @@ def facet_angles(
     -----
     Angles are defined for every input, lit or not; callers mask with ``lit`` and
     ``visible``.  See the module docstring for the treatment of normal incidence.
+
+    Examples
+    --------
+    Sun 30 deg from the normal, observer 40 deg on the far side of it in the same plane:
+    10 deg beyond the specular direction, in the illumination plane.
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.geometry import facet_angles
+    >>> ti, tr = np.radians(30.0), np.radians(40.0)
+    >>> a = facet_angles([0, 0, 1], [np.sin(ti), 0, np.cos(ti)], [-np.sin(tr), 0, np.cos(tr)])
+    >>> round(float(a.theta_i), 6), round(float(a.delta_theta), 6), round(float(a.phi), 6)
+    (30.0, 10.0, 0.0)
+    >>> bool(a.lit), bool(a.visible)
+    (True, True)
+
+    Inputs broadcast over leading axes, here three facets seen under one geometry:
+
+    >>> normals = [[0, 0, 1], [1, 0, 0], [0, 0, -1]]
+    >>> a = facet_angles(normals, [0, 0, 1], [0, 1, 1])
+    >>> np.round(a.theta_i, 6) + 0.0
+    array([  0.,  90., 180.])
+    >>> a.lit
+    array([ True, False, False])
     """
     if check:
         n = normalize(normal, "normal")
@@ -300,6 +355,16 @@ def facet_vectors(
     -------
     normal, to_sun, to_observer : ndarray, shape (..., 3)
         Unit vectors, broadcast over the inputs.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.geometry import facet_angles, facet_vectors
+    >>> n, s, o = facet_vectors(30.0, 10.0, 0.0)
+    >>> n, np.round(s, 4) + 0.0, np.round(o, 4) + 0.0
+    (array([0., 0., 1.]), array([0.5  , 0.   , 0.866]), array([-0.6428,  0.    ,  0.766 ]))
+    >>> [round(float(x), 6) for x in facet_angles(n, s, o)[:3]]
+    [30.0, 10.0, 0.0]
     """
     ti, dt, ph = np.broadcast_arrays(*(_as_float(a) for a in (theta_i, delta_theta, phi)))
     ti_r, ph_r = np.radians(ti), np.radians(ph)
@@ -324,6 +389,12 @@ def phase_angle(to_sun: ArrayLike, to_observer: ArrayLike) -> NDArray[np.floatin
     -------
     ndarray
         ``beta = atan2(|s x o|, s.o)`` [degree], in ``[0, 180]``; exact at 0 and 180.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.geometry import phase_angle
+    >>> phase_angle([1, 0, 0], [[1, 0, 0], [0, 1, 0], [-1, 0, 0]])
+    array([  0.,  90., 180.])
     """
     s = normalize(to_sun, "to_sun")
     o = normalize(to_observer, "to_observer")
@@ -348,6 +419,18 @@ def half_vector(to_sun: ArrayLike, to_observer: ArrayLike) -> NDArray[np.floatin
         the normalisation as ``sqrt(2 (1 + o.s))``, which equals ``|o + s|`` for
         unit vectors but cancels catastrophically near 180 deg; ``|o + s|`` is
         computed directly.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.geometry import half_vector
+    >>> half_vector([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]).round(6)
+    array([0.707107, 0.707107, 0.      ])
+
+    At exact forward scatter a unit vector perpendicular to the Sun direction comes back:
+
+    >>> h = half_vector([1.0, 0.0, 0.0], [-1.0, 0.0, 0.0])
+    >>> float(h @ h), float(h[0])
+    (1.0, 0.0)
     """
     s = np.asarray(to_sun)
     o = np.asarray(to_observer)
@@ -378,6 +461,14 @@ def to_conventional(
     -------
     theta_i, phi_i, theta_r, phi_r : ndarray
         Conventional angles [degree]; azimuths in ``[0, 360)``.
+
+    Examples
+    --------
+    The specular direction at 30 deg incidence has ``theta_r = 30`` and ``phi_r = 180``:
+
+    >>> from sbrdf_xr.geometry import to_conventional
+    >>> [round(float(x), 6) for x in to_conventional(30.0, 0.0, 0.0)]
+    [30.0, 0.0, 30.0, 180.0]
     """
     _, s, o = facet_vectors(theta_i, delta_theta, phi)
     ti = np.degrees(np.arctan2(np.hypot(s[..., 0], s[..., 1]), s[..., 2]))
@@ -403,6 +494,12 @@ def from_conventional(
     -------
     theta_i, delta_theta, phi : ndarray
         Paper-000 angles [degree] from :func:`facet_angles`.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.geometry import from_conventional
+    >>> [round(float(x), 6) for x in from_conventional(30.0, 0.0, 40.0, 180.0)]
+    [30.0, 10.0, 0.0]
     """
     ti, pi_, tr, pr = (np.radians(_as_float(a)) for a in (theta_i, phi_i, theta_r, phi_r))
     ti, pi_, tr, pr = np.broadcast_arrays(ti, pi_, tr, pr)
@@ -435,6 +532,16 @@ def observation_plane(
     Returns
     -------
     to_sun, to_observer : ndarray, shape beta.shape + (3,)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.geometry import observation_plane, phase_angle
+    >>> to_sun, to_observer = observation_plane([10.0, 90.0])
+    >>> to_sun.shape, np.round(phase_angle(to_sun, to_observer), 6)
+    ((2, 3), array([10., 90.]))
+    >>> np.round(to_sun[1], 6), np.round(to_observer[1], 6)
+    (array([0.707107, 0.707107, 0.      ]), array([ 0.707107, -0.707107,  0.      ]))
     """
     beta = np.asarray(phase_angle_deg, dtype=np.float64)
     if np.any((beta < 0) | (beta > 180)) or not np.all(np.isfinite(beta)):

@@ -53,6 +53,16 @@ def check_quaternions(q: ArrayLike) -> NDArray[np.float64]:
     ValidationError
         If the last axis is not 4 long, a value is not finite, or a norm differs
         from 1 by more than the tolerance (not a rotation).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.rotations import check_quaternions
+    >>> check_quaternions([0.0, 0.0, 0.0, 1.0])
+    array([0., 0., 0., 1.])
+    >>> check_quaternions([0.0, 0.0, 1.0, 1.0])
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.ValidationError: quaternion: [0.0, 0.0, 1.0, 1.0] at index [] has norm 1.41421356; ...
     """
     arr = np.asarray(q, dtype=np.float64)
     if arr.ndim == 0 or arr.shape[-1] != 4:
@@ -100,6 +110,20 @@ def rotation_matrices(q: ArrayLike) -> NDArray[np.float64]:
     Returns
     -------
     ndarray, shape (..., 3, 3)
+
+    Examples
+    --------
+    A quarter turn about +z takes the body +x axis to the reference +y axis:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.rotations import axis_rotation, rotation_matrices
+    >>> r = rotation_matrices(axis_rotation([0, 0, 1], 90.0))
+    >>> np.round(r, 6) + 0.0
+    array([[ 0., -1.,  0.],
+           [ 1.,  0.,  0.],
+           [ 0.,  0.,  1.]])
+    >>> rotation_matrices(axis_rotation([0, 0, 1], [0.0, 45.0, 90.0])).shape
+    (3, 3, 3)
     """
     arr = check_quaternions(q)
     return Rotation.from_quat(arr.reshape(-1, 4)).as_matrix().reshape(*arr.shape[:-1], 3, 3)
@@ -120,6 +144,17 @@ def to_body_frame(q: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
     -------
     ndarray, shape (n, ..., 3)
         ``R(q)^T v``.
+
+    Examples
+    --------
+    For a body turned by 90 deg about +z, the reference +x direction is body -y:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.rotations import axis_rotation, to_body_frame
+    >>> q = axis_rotation([0, 0, 1], [0.0, 90.0])
+    >>> np.round(to_body_frame(q, [1.0, 0.0, 0.0]), 6) + 0.0
+    array([[ 1.,  0.,  0.],
+           [ 0., -1.,  0.]])
     """
     r = rotation_matrices(q)
     vv = np.asarray(v, dtype=np.float64)
@@ -142,6 +177,15 @@ def axis_rotation(axis: ArrayLike, angle: ArrayLike) -> NDArray[np.float64]:
     -------
     ndarray, shape angle.shape + (4,)
         Scalar-last unit quaternions.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.rotations import axis_rotation
+    >>> axis_rotation([0, 0, 2], 90.0).round(6)
+    array([0.      , 0.      , 0.707107, 0.707107])
+    >>> axis_rotation([1, 0, 0], np.zeros((2, 5))).shape
+    (2, 5, 4)
     """
     a = _unit_axis(axis)
     half = np.radians(np.asarray(angle, dtype=np.float64)) / 2.0
@@ -149,7 +193,28 @@ def axis_rotation(axis: ArrayLike, angle: ArrayLike) -> NDArray[np.float64]:
 
 
 def compose(q_outer: ArrayLike, q_inner: ArrayLike) -> NDArray[np.float64]:
-    """Quaternion of the rotation ``q_inner`` followed by ``q_outer`` (``R_outer R_inner``)."""
+    """Quaternion of the rotation ``q_inner`` followed by ``q_outer`` (``R_outer R_inner``).
+
+    Parameters
+    ----------
+    q_outer, q_inner : array_like, shape (..., 4)
+        Unit quaternions, scalar-last [1], broadcast against each other.
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+        Scalar-last unit quaternions of the composed rotations.
+
+    Examples
+    --------
+    Turning by 30 deg and then by 60 deg about the same axis is a 90 deg turn:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.rotations import axis_rotation, compose
+    >>> q = compose(axis_rotation([0, 0, 1], 60.0), axis_rotation([0, 0, 1], 30.0))
+    >>> np.allclose(q, axis_rotation([0, 0, 1], 90.0))
+    True
+    """
     a, b = np.broadcast_arrays(check_quaternions(q_outer), check_quaternions(q_inner))
     shape = a.shape
     out = Rotation.from_quat(a.reshape(-1, 4)) * Rotation.from_quat(b.reshape(-1, 4))
@@ -179,7 +244,15 @@ def rotation_sweep(
     Examples
     --------
     Paper 000 §4, second scenario: an initial 25 deg about +z, then 360 steps of 1 deg
-    about -z: ``rotation_sweep([0, 0, -1], np.arange(360), axis_rotation([0, 0, 1], 25))``.
+    about -z; the body +x axis returns to the reference +x direction after 25 steps:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.rotations import axis_rotation, rotation_sweep, to_body_frame
+    >>> q = rotation_sweep([0, 0, -1], np.arange(360), axis_rotation([0, 0, 1], 25))
+    >>> q.shape
+    (360, 4)
+    >>> np.round(to_body_frame(q[25:26], [1.0, 0.0, 0.0]), 6) + 0.0
+    array([[1., 0., 0.]])
     """
     q = axis_rotation(axis, np.atleast_1d(angles))
     if initial is None:
@@ -200,6 +273,15 @@ def euler_attitudes(sequence: str, angles: ArrayLike) -> NDArray[np.float64]:
     Returns
     -------
     ndarray, shape (n, 4)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.rotations import euler_attitudes
+    >>> euler_attitudes("z", [[90.0]]).round(6)
+    array([[0.      , 0.      , 0.707107, 0.707107]])
+    >>> euler_attitudes("ZYX", [[10.0, 20.0, 30.0], [0.0, 0.0, 0.0]]).shape
+    (2, 4)
     """
     try:
         r = Rotation.from_euler(sequence, np.atleast_2d(np.asarray(angles, float)), degrees=True)
@@ -221,6 +303,14 @@ def uniform_attitudes(n: int, seed: int | None = 0) -> NDArray[np.float64]:
     Returns
     -------
     ndarray, shape (n, 4)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.rotations import uniform_attitudes
+    >>> q = uniform_attitudes(1000, seed=1)
+    >>> q.shape, bool(np.allclose(np.linalg.norm(q, axis=1), 1.0))
+    ((1000, 4), True)
     """
     if n < 1:
         raise ValidationError(f"n: need at least one attitude, got {n}")
