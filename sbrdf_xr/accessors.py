@@ -117,9 +117,10 @@ class SbrdfDatasetAccessor:
     >>> import sbrdf_xr
     >>> wl = np.linspace(400.0, 1000.0, 61)
     >>> cube = xr.Dataset(
-    ...     {"signal": (("geometry", "wavelength"), np.full((1, 61), 1 / np.pi), {"units": "m2 sr-1"})},
+    ...     {"signal": (("geometry", "wavelength"), np.full((1, 61), 1 / np.pi))},
     ...     coords={"wavelength": ("wavelength", wl, {"units": "nm"})},
     ... )
+    >>> cube.signal.attrs["units"] = "m2 sr-1"
     >>> band = cube.sbrdf.band_signal(["V"])
     >>> band.dims, round(float(band.squeeze()), 6)
     (('geometry', 'band'), 0.31831)

@@ -208,7 +208,7 @@ def normalize(v: ArrayLike, name: str = "vector") -> NDArray[np.floating]:
     >>> normalize([0, 0, 0], "to_sun")
     Traceback (most recent call last):
         ...
-    sbrdf_xr.errors.ValidationError: to_sun: contains zero-length vectors; directions must be non-zero
+    sbrdf_xr.errors.ValidationError: to_sun: contains zero-length vectors; ...
     """
     arr = _check_vectors(v, name)
     arr = arr.astype(_float_dtype(arr), copy=False)

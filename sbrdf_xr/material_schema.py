@@ -105,7 +105,7 @@ def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.Data
     >>> validate_material(table.rename(phi="azimuth"))
     Traceback (most recent call last):
         ...
-    sbrdf_xr.errors.ValidationError: material: dims must be (...), got ('theta_i', ..., 'azimuth', ...)
+    sbrdf_xr.errors.ValidationError: material: dims must be (...), got (..., 'azimuth', ...)
     """
     if not isinstance(da, xr.DataArray):
         raise ValidationError(f"material: expected an xarray.DataArray, got {type(da).__name__}")
