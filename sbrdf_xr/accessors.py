@@ -18,7 +18,24 @@ __all__ = ["SbrdfDataArrayAccessor", "SbrdfDatasetAccessor"]
 
 @xr.register_dataarray_accessor("sbrdf")
 class SbrdfDataArrayAccessor:
-    """Methods of a material table, as ``da.sbrdf.lookup(...)`` and friends."""
+    """Methods of a material table, as ``da.sbrdf.lookup(...)`` and friends.
+
+    Each method forwards to the function of the same name in :mod:`sbrdf_xr.material`.
+
+    Examples
+    --------
+    Importing :mod:`sbrdf_xr` registers the accessor on every DataArray:
+
+    >>> import numpy as np
+    >>> import sbrdf_xr
+    >>> grey = sbrdf_xr.lambertian(0.5, [500.0, 600.0])
+    >>> spectrum = grey.sbrdf.lookup(30.0, -5.0, 2.0)
+    >>> spectrum.dims, np.round(spectrum.values, 6)
+    (('wavelength',), array([0.159155, 0.159155]))
+    >>> np.round(grey.sbrdf.hemispherical_reflectance([0.0, 60.0]).values, 4)
+    array([[0.5, 0.5],
+           [0.5, 0.5]])
+    """
 
     def __init__(self, da: xr.DataArray) -> None:
         self._da = da
@@ -89,6 +106,26 @@ class SbrdfDatasetAccessor:
     """Methods of a simulation cube, as ``ds.sbrdf.photometry(...)`` and friends.
 
     Each method forwards to the function of the same name in :mod:`sbrdf_xr.photometry`.
+
+    Examples
+    --------
+    On a simulation cube (here a hand-made one: a grey signal of ``1/pi`` m2 sr-1 at
+    every wavelength), band means and magnitudes:
+
+    >>> import numpy as np
+    >>> import xarray as xr
+    >>> import sbrdf_xr
+    >>> wl = np.linspace(400.0, 1000.0, 61)
+    >>> cube = xr.Dataset(
+    ...     {"signal": (("geometry", "wavelength"), np.full((1, 61), 1 / np.pi))},
+    ...     coords={"wavelength": ("wavelength", wl, {"units": "nm"})},
+    ... )
+    >>> cube.signal.attrs["units"] = "m2 sr-1"
+    >>> band = cube.sbrdf.band_signal(["V"])
+    >>> band.dims, round(float(band.squeeze()), 6)
+    (('geometry', 'band'), 0.31831)
+    >>> cube.sbrdf.magnitudes(["V", "R"], range_km=1000).round(3).values
+    array([[4.475, 4.28 ]])
     """
 
     def __init__(self, ds: xr.Dataset) -> None:

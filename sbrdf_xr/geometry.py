@@ -2,6 +2,8 @@
 
 Pure, vectorised numpy: every function takes arrays whose last axis holds the
 three Cartesian components of a vector and broadcasts over all leading axes.
+The attitude (quaternion) helpers live in :mod:`sbrdf_xr.rotations` and are
+importable from here too.
 
 Angle convention (paper 000 §3.1, Fig. 4; DESIGN.md "Angle convention")
 -----------------------------------------------------------------------
@@ -46,8 +48,20 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .errors import ValidationError
+from .rotations import (
+    QUATERNION_NORM_TOL,
+    axis_rotation,
+    check_quaternions,
+    compose,
+    euler_attitudes,
+    rotation_matrices,
+    rotation_sweep,
+    to_body_frame,
+    uniform_attitudes,
+)
 
 __all__ = [
+    "QUATERNION_NORM_TOL",
     "FacetAngles",
     "axis_rotation",
     "check_quaternions",
@@ -88,6 +102,17 @@ class FacetAngles(NamedTuple):
         ``N.s > 0``.
     visible : ndarray of bool
         ``N.o > 0``.
+
+    Examples
+    --------
+    The tuple :func:`facet_angles` returns; its fields are arrays (0-d for single vectors):
+
+    >>> from sbrdf_xr.geometry import FacetAngles, facet_angles
+    >>> a = facet_angles([0, 0, 1], [1, 0, 1], [0, 0, 1])
+    >>> isinstance(a, FacetAngles), a._fields
+    (True, ('theta_i', 'delta_theta', 'phi', 'lit', 'visible'))
+    >>> round(float(a.theta_i), 6), bool(a.lit), bool(a.visible)
+    (45.0, True, True)
     """
 
     theta_i: NDArray[np.floating]
@@ -123,6 +148,15 @@ def normal_incidence_tolerance(dtype: np.dtype | type = np.float64) -> float:
     -------
     float
         ``1e4 * eps(dtype)`` [1].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.geometry import normal_incidence_tolerance
+    >>> normal_incidence_tolerance()
+    2.22...e-12
+    >>> normal_incidence_tolerance(np.float32)
+    0.00119...
     """
     return float(NORMAL_INCIDENCE_EPS_FACTOR * np.finfo(dtype).eps)
 
@@ -163,6 +197,18 @@ def normalize(v: ArrayLike, name: str = "vector") -> NDArray[np.floating]:
     ------
     ValidationError
         If a vector is zero, not finite, or the last axis is not of length 3.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.geometry import normalize
+    >>> normalize([3.0, 0.0, 4.0])
+    array([0.6, 0. , 0.8])
+    >>> normalize([[0, 0, 2], [0, 5, 0]]).tolist()
+    [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]
+    >>> normalize([0, 0, 0], "to_sun")
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.ValidationError: to_sun: contains zero-length vectors; ...
     """
     arr = _check_vectors(v, name)
     arr = arr.astype(_float_dtype(arr), copy=False)
@@ -217,6 +263,29 @@ def facet_angles(
     -----
     Angles are defined for every input, lit or not; callers mask with ``lit`` and
     ``visible``.  See the module docstring for the treatment of normal incidence.
+
+    Examples
+    --------
+    Sun 30 deg from the normal, observer 40 deg on the far side of it in the same plane:
+    10 deg beyond the specular direction, in the illumination plane.
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.geometry import facet_angles
+    >>> ti, tr = np.radians(30.0), np.radians(40.0)
+    >>> a = facet_angles([0, 0, 1], [np.sin(ti), 0, np.cos(ti)], [-np.sin(tr), 0, np.cos(tr)])
+    >>> round(float(a.theta_i), 6), round(float(a.delta_theta), 6), round(float(a.phi), 6)
+    (30.0, 10.0, 0.0)
+    >>> bool(a.lit), bool(a.visible)
+    (True, True)
+
+    Inputs broadcast over leading axes, here three facets seen under one geometry:
+
+    >>> normals = [[0, 0, 1], [1, 0, 0], [0, 0, -1]]
+    >>> a = facet_angles(normals, [0, 0, 1], [0, 1, 1])
+    >>> np.round(a.theta_i, 6) + 0.0
+    array([  0.,  90., 180.])
+    >>> a.lit
+    array([ True, False, False])
     """
     if check:
         n = normalize(normal, "normal")
@@ -286,6 +355,16 @@ def facet_vectors(
     -------
     normal, to_sun, to_observer : ndarray, shape (..., 3)
         Unit vectors, broadcast over the inputs.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.geometry import facet_angles, facet_vectors
+    >>> n, s, o = facet_vectors(30.0, 10.0, 0.0)
+    >>> n, np.round(s, 4) + 0.0, np.round(o, 4) + 0.0
+    (array([0., 0., 1.]), array([0.5  , 0.   , 0.866]), array([-0.6428,  0.    ,  0.766 ]))
+    >>> [round(float(x), 6) for x in facet_angles(n, s, o)[:3]]
+    [30.0, 10.0, 0.0]
     """
     ti, dt, ph = np.broadcast_arrays(*(_as_float(a) for a in (theta_i, delta_theta, phi)))
     ti_r, ph_r = np.radians(ti), np.radians(ph)
@@ -310,6 +389,12 @@ def phase_angle(to_sun: ArrayLike, to_observer: ArrayLike) -> NDArray[np.floatin
     -------
     ndarray
         ``beta = atan2(|s x o|, s.o)`` [degree], in ``[0, 180]``; exact at 0 and 180.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.geometry import phase_angle
+    >>> phase_angle([1, 0, 0], [[1, 0, 0], [0, 1, 0], [-1, 0, 0]])
+    array([  0.,  90., 180.])
     """
     s = normalize(to_sun, "to_sun")
     o = normalize(to_observer, "to_observer")
@@ -334,6 +419,18 @@ def half_vector(to_sun: ArrayLike, to_observer: ArrayLike) -> NDArray[np.floatin
         the normalisation as ``sqrt(2 (1 + o.s))``, which equals ``|o + s|`` for
         unit vectors but cancels catastrophically near 180 deg; ``|o + s|`` is
         computed directly.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.geometry import half_vector
+    >>> half_vector([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]).round(6)
+    array([0.707107, 0.707107, 0.      ])
+
+    At exact forward scatter a unit vector perpendicular to the Sun direction comes back:
+
+    >>> h = half_vector([1.0, 0.0, 0.0], [-1.0, 0.0, 0.0])
+    >>> float(h @ h), float(h[0])
+    (1.0, 0.0)
     """
     s = np.asarray(to_sun)
     o = np.asarray(to_observer)
@@ -364,6 +461,14 @@ def to_conventional(
     -------
     theta_i, phi_i, theta_r, phi_r : ndarray
         Conventional angles [degree]; azimuths in ``[0, 360)``.
+
+    Examples
+    --------
+    The specular direction at 30 deg incidence has ``theta_r = 30`` and ``phi_r = 180``:
+
+    >>> from sbrdf_xr.geometry import to_conventional
+    >>> [round(float(x), 6) for x in to_conventional(30.0, 0.0, 0.0)]
+    [30.0, 0.0, 30.0, 180.0]
     """
     _, s, o = facet_vectors(theta_i, delta_theta, phi)
     ti = np.degrees(np.arctan2(np.hypot(s[..., 0], s[..., 1]), s[..., 2]))
@@ -389,6 +494,12 @@ def from_conventional(
     -------
     theta_i, delta_theta, phi : ndarray
         Paper-000 angles [degree] from :func:`facet_angles`.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.geometry import from_conventional
+    >>> [round(float(x), 6) for x in from_conventional(30.0, 0.0, 40.0, 180.0)]
+    [30.0, 10.0, 0.0]
     """
     ti, pi_, tr, pr = (np.radians(_as_float(a)) for a in (theta_i, phi_i, theta_r, phi_r))
     ti, pi_, tr, pr = np.broadcast_arrays(ti, pi_, tr, pr)
@@ -398,200 +509,6 @@ def from_conventional(
     n[..., 2] = 1.0
     ang = facet_angles(n, s, o, check=False)
     return ang.theta_i, ang.delta_theta, ang.phi
-
-
-# ---------------------------------------------------------------- attitudes
-#
-# An attitude is the rotation R that takes body-frame vectors to the reference
-# (inertial / laboratory) frame, stored as a unit quaternion in scalar-last order
-# (x, y, z, w), the convention of scipy.spatial.transform.Rotation.  Sun and
-# observer directions given in the reference frame reach the body frame as R^T v.
-
-#: Largest accepted deviation of a quaternion's norm from 1.
-QUATERNION_NORM_TOL = 1e-6
-
-
-def check_quaternions(q: ArrayLike) -> NDArray[np.float64]:
-    """Validate unit quaternions (scalar-last ``x, y, z, w``).
-
-    Parameters
-    ----------
-    q : array_like, shape (..., 4)
-        Quaternions [1].
-
-    Returns
-    -------
-    ndarray, shape (..., 4)
-        The quaternions, renormalised (their norms are within
-        :data:`QUATERNION_NORM_TOL` of 1).
-
-    Raises
-    ------
-    ValidationError
-        If the last axis is not 4 long, a value is not finite, or a norm differs
-        from 1 by more than the tolerance (not a rotation).
-    """
-    arr = np.asarray(q, dtype=np.float64)
-    if arr.ndim == 0 or arr.shape[-1] != 4:
-        raise ValidationError(f"quaternion: expected shape (..., 4), got {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValidationError("quaternion: contains NaN or infinite components")
-    norm = np.linalg.norm(arr, axis=-1, keepdims=True)
-    bad = np.abs(norm[..., 0] - 1.0) > QUATERNION_NORM_TOL
-    if np.any(bad):
-        idx = np.argwhere(bad)[0]
-        raise ValidationError(
-            f"quaternion: {arr[tuple(idx)].tolist()} at index {idx.tolist()} has norm "
-            f"{float(norm[tuple(idx)][0]):.9g}; a rotation needs a unit quaternion "
-            f"(|norm - 1| <= {QUATERNION_NORM_TOL})"
-        )
-    return arr / norm
-
-
-def rotation_matrices(q: ArrayLike) -> NDArray[np.float64]:
-    """Rotation matrices (body -> reference) of unit quaternions.
-
-    Parameters
-    ----------
-    q : array_like, shape (..., 4)
-        Unit quaternions, scalar-last [1].
-
-    Returns
-    -------
-    ndarray, shape (..., 3, 3)
-    """
-    from scipy.spatial.transform import Rotation
-
-    arr = check_quaternions(q)
-    return Rotation.from_quat(arr.reshape(-1, 4)).as_matrix().reshape(*arr.shape[:-1], 3, 3)
-
-
-def to_body_frame(q: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
-    """Express reference-frame directions in the body frame of attitudes ``q``.
-
-    Parameters
-    ----------
-    q : array_like, shape (n, 4)
-        Attitudes (body -> reference), scalar-last unit quaternions [1].
-    v : array_like, shape (..., 3)
-        Directions in the reference frame [1], broadcast against the attitudes as
-        ``(n, ..., 3)`` when ``v`` has leading dimensions.
-
-    Returns
-    -------
-    ndarray, shape (n, ..., 3)
-        ``R(q)^T v``.
-    """
-    r = rotation_matrices(q)
-    vv = np.asarray(v, dtype=np.float64)
-    extra = vv.ndim - 1
-    rt = np.swapaxes(r, -1, -2).reshape(r.shape[0], *([1] * extra), 3, 3)
-    return np.einsum("...ij,...j->...i", rt, vv)
-
-
-def axis_rotation(axis: ArrayLike, angle: ArrayLike) -> NDArray[np.float64]:
-    """Quaternions of rotations by ``angle`` about ``axis`` (right-handed).
-
-    Parameters
-    ----------
-    axis : array_like, shape (3,)
-        Rotation axis [1], any non-zero length.
-    angle : array_like
-        Rotation angles [degree].
-
-    Returns
-    -------
-    ndarray, shape angle.shape + (4,)
-        Scalar-last unit quaternions.
-    """
-    a = normalize(axis, "axis")
-    half = np.radians(np.asarray(angle, dtype=np.float64)) / 2.0
-    return np.concatenate([np.sin(half)[..., None] * a, np.cos(half)[..., None]], axis=-1)
-
-
-def compose(q_outer: ArrayLike, q_inner: ArrayLike) -> NDArray[np.float64]:
-    """Quaternion of the rotation ``q_inner`` followed by ``q_outer`` (``R_outer R_inner``)."""
-    from scipy.spatial.transform import Rotation
-
-    a, b = np.broadcast_arrays(check_quaternions(q_outer), check_quaternions(q_inner))
-    shape = a.shape
-    out = Rotation.from_quat(a.reshape(-1, 4)) * Rotation.from_quat(b.reshape(-1, 4))
-    return out.as_quat().reshape(shape)
-
-
-def rotation_sweep(
-    axis: ArrayLike,
-    angles: ArrayLike,
-    initial: ArrayLike | None = None,
-) -> NDArray[np.float64]:
-    """Attitudes of a body rotated about a fixed reference-frame axis.
-
-    Parameters
-    ----------
-    axis : array_like, shape (3,)
-        Rotation axis in the reference frame [1].
-    angles : array_like, shape (n,)
-        Rotation angles about ``axis`` [degree].
-    initial : array_like, shape (4,), optional
-        Initial attitude applied first (scalar-last quaternion).
-
-    Returns
-    -------
-    ndarray, shape (n, 4)
-
-    Examples
-    --------
-    Paper 000 §4, second scenario: an initial 25 deg about +z, then 360 steps of 1 deg
-    about -z: ``rotation_sweep([0, 0, -1], np.arange(360), axis_rotation([0, 0, 1], 25))``.
-    """
-    q = axis_rotation(axis, np.atleast_1d(angles))
-    if initial is None:
-        return q
-    return compose(q, np.asarray(initial, dtype=np.float64))
-
-
-def euler_attitudes(sequence: str, angles: ArrayLike) -> NDArray[np.float64]:
-    """Attitudes from Euler angles (``scipy.spatial.transform.Rotation.from_euler``).
-
-    Parameters
-    ----------
-    sequence : str
-        Axis sequence: up to three of ``xyz`` (extrinsic) or ``XYZ`` (intrinsic).
-    angles : array_like, shape (n, len(sequence))
-        Angles [degree].
-
-    Returns
-    -------
-    ndarray, shape (n, 4)
-    """
-    from scipy.spatial.transform import Rotation
-
-    try:
-        r = Rotation.from_euler(sequence, np.atleast_2d(np.asarray(angles, float)), degrees=True)
-    except ValueError as exc:
-        raise ValidationError(f"euler: {exc}") from exc
-    return r.as_quat().reshape(-1, 4)
-
-
-def uniform_attitudes(n: int, seed: int | None = 0) -> NDArray[np.float64]:
-    """``n`` attitudes drawn uniformly from all orientations (Haar measure on SO(3)).
-
-    Parameters
-    ----------
-    n : int
-        Number of attitudes.
-    seed : int, optional
-        Seed of the generator (``scipy.spatial.transform.Rotation.random``).
-
-    Returns
-    -------
-    ndarray, shape (n, 4)
-    """
-    from scipy.spatial.transform import Rotation
-
-    if n < 1:
-        raise ValidationError(f"n: need at least one attitude, got {n}")
-    return Rotation.random(n, random_state=seed).as_quat().reshape(-1, 4)
 
 
 def observation_plane(
@@ -615,6 +532,16 @@ def observation_plane(
     Returns
     -------
     to_sun, to_observer : ndarray, shape beta.shape + (3,)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.geometry import observation_plane, phase_angle
+    >>> to_sun, to_observer = observation_plane([10.0, 90.0])
+    >>> to_sun.shape, np.round(phase_angle(to_sun, to_observer), 6)
+    ((2, 3), array([10., 90.]))
+    >>> np.round(to_sun[1], 6), np.round(to_observer[1], 6)
+    (array([0.707107, 0.707107, 0.      ]), array([ 0.707107, -0.707107,  0.      ]))
     """
     beta = np.asarray(phase_angle_deg, dtype=np.float64)
     if np.any((beta < 0) | (beta > 180)) or not np.all(np.isfinite(beta)):

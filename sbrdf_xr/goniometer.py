@@ -79,6 +79,18 @@ def paper_scheme(
         Geometries [degree]: 7 rows x 4 columns, then the two in-plane extents.
     reference : ndarray of bool, shape (30,)
         True for the reference points (9 when every extent is in the noise).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.goniometer import paper_scheme
+    >>> dt, ph, ref = paper_scheme(30.0, -20.0, 30.0, [10, 12, 14, 16, 14, 12, 10])
+    >>> dt.shape, int(ref.sum())
+    ((30,), 9)
+    >>> dt[:4], np.round(ph[:4], 4)
+    (array([22.5, 22.5, 22.5, 22.5]), array([ 0.    ,  3.3333,  6.6667, 10.    ]))
+    >>> ref[:4]
+    array([False, False, False,  True])
     """
     phi_max = np.asarray(phi_max, dtype=np.float64)
     if phi_max.shape != (7,):
@@ -159,6 +171,20 @@ def scheme_extents(
         Whether each extent (the 7 ``phi`` extents, then ``dt_max`` and ``dt_min``)
         is where the signal fell into the noise (a reference point, zero) rather
         than an apparatus limit (a measured point).
+
+    Examples
+    --------
+    A Gaussian lobe falls below a noise floor of 0.05 sr-1 at about 23 deg either side of
+    specular, long before the apparatus limits: every extent is a reference point.
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.goniometer import scheme_extents
+    >>> from sbrdf_xr.testing import lobe_function
+    >>> dt_min, dt_max, phi_max, in_noise = scheme_extents(
+    ...     lobe_function(np.array([500.0, 700.0])), 30.0, noise_floor=0.05
+    ... )
+    >>> round(dt_min, 6), round(dt_max, 6), phi_max.shape, bool(in_noise.all())
+    (-22.8, 22.8, (7,), True)
     """
 
     def band(ti: float, dt: np.ndarray, ph: np.ndarray) -> np.ndarray:
@@ -231,6 +257,18 @@ def measure(
     -------
     xarray.Dataset
         The measurement set consumed by :func:`sbrdf_xr.material.build_lut`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.goniometer import measure
+    >>> from sbrdf_xr.testing import lobe_function
+    >>> wl = np.array([500.0, 700.0])
+    >>> meas = measure(lobe_function(wl), wl, (20.0, 50.0), noise_floor=0.05, material="lobe")
+    >>> dict(meas.sizes), int(meas.reference.sum()), meas.attrs["material"]
+    ({'sample': 60, 'wavelength': 2}, 18, 'lobe')
+    >>> sorted(meas.coords)
+    ['delta_theta', 'phi', 'reference', 'theta_i', 'wavelength']
     """
     wl = np.asarray(wavelength, dtype=np.float64)
     tis = np.asarray(theta_i, dtype=np.float64)

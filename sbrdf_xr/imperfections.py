@@ -81,6 +81,21 @@ def tilted_normals(normals: ArrayLike, tilts: ArrayLike) -> NDArray[np.float64]:
     -------
     ndarray, shape (F, K, 3)
         ``cos|t| N + sin|t| (t_1 e_1 + t_2 e_2) / |t|``.
+
+    Examples
+    --------
+    Tilting the normal +z by 10 deg along the first tangent direction, and not at all:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.imperfections import tilted_normals
+    >>> n = tilted_normals([[0.0, 0.0, 1.0]], [[0.0, 0.0], [np.radians(10.0), 0.0]])
+    >>> n.shape
+    (1, 2, 3)
+    >>> np.round(n, 6) + 0.0
+    array([[[0.      , 0.      , 1.      ],
+            [0.      , 0.173648, 0.984808]]])
+    >>> round(float(np.degrees(np.arccos(n[0, 1, 2]))), 6)
+    10.0
     """
     n = np.asarray(normals, dtype=np.float64)
     t = np.asarray(tilts, dtype=np.float64)

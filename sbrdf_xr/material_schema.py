@@ -97,6 +97,19 @@ def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.Data
         Naming the first problem found: wrong type or dims, missing or
         non-monotonic coordinates, wrong units, angles out of their domain, NaN or
         negative values.
+
+    Examples
+    --------
+    A table with its dims in another order comes back in the canonical order:
+
+    >>> from sbrdf_xr.material_schema import lambertian, validate_material
+    >>> table = lambertian(0.5, [500.0, 600.0])
+    >>> validate_material(table.transpose("wavelength", "phi", "delta_theta", "theta_i")).dims
+    ('theta_i', 'delta_theta', 'phi', 'wavelength')
+    >>> validate_material(table.rename(phi="azimuth"))
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.ValidationError: material: dims must be (...), got (..., 'azimuth', ...)
     """
     if not isinstance(da, xr.DataArray):
         raise ValidationError(f"material: expected an xarray.DataArray, got {type(da).__name__}")
@@ -178,6 +191,20 @@ def new_material(
     Returns
     -------
     xarray.DataArray
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.material_schema import new_material
+    >>> table = new_material(
+    ...     np.full((2, 3, 2, 1), 0.1),
+    ...     theta_i=[0.0, 90.0], delta_theta=[-90.0, 0.0, 90.0], phi=[0.0, 90.0],
+    ...     wavelength=[550.0], material="grey", source="synthetic", provenance="an example",
+    ... )
+    >>> dict(table.sizes)
+    {'theta_i': 2, 'delta_theta': 3, 'phi': 2, 'wavelength': 1}
+    >>> table.attrs["units"], table.attrs["material"]
+    ('sr-1', 'grey')
     """
     _check_source(source)
     coords = {
@@ -228,6 +255,15 @@ def constant_material(
     Returns
     -------
     xarray.DataArray
+
+    Examples
+    --------
+    >>> from sbrdf_xr.material_schema import constant_material
+    >>> table = constant_material([0.1, 0.2], [500.0, 600.0], material="flat")
+    >>> table.shape, table.attrs["source"]
+    ((2, 2, 2, 2), 'synthetic')
+    >>> table.sel(wavelength=600.0).values.ravel().tolist()
+    [0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2]
     """
     wl = np.atleast_1d(np.asarray(wavelength, dtype=np.float64))
     v = np.asarray(value, dtype=np.float64)
@@ -274,6 +310,13 @@ def lambertian(
     Returns
     -------
     xarray.DataArray
+
+    Examples
+    --------
+    >>> from sbrdf_xr.material_schema import lambertian
+    >>> grey = lambertian(0.5, [500.0, 600.0])
+    >>> grey.attrs["material"], round(float(grey.max()), 6)
+    ('lambertian-0.5', 0.159155)
     """
     from .brdf import lambert
 
@@ -381,6 +424,20 @@ def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Da
     ------
     ValidationError
         Naming the first problem found.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.material_schema import validate_measurements
+    >>> from sbrdf_xr.testing import make_measurements
+    >>> meas = make_measurements(n_wavelength=3, theta_i=(20.0, 50.0))
+    >>> validate_measurements(meas) is meas
+    True
+    >>> dict(meas.sizes), int(meas.reference.sum())
+    ({'sample': 60, 'wavelength': 3}, 18)
+    >>> validate_measurements(meas.drop_vars("measured_sbrdf"))
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.ValidationError: measurements: ...
     """
     if not isinstance(ds, xr.Dataset):
         raise ValidationError(f"measurements: expected an xarray.Dataset, got {type(ds).__name__}")

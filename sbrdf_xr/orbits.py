@@ -83,7 +83,7 @@ def skyfield_data() -> tuple[Any, Any]:
 #: Spacing of the knots at which the slowly varying parts of the Earth orientation and
 #: the geocentric Sun are evaluated by skyfield, then cubic-spline interpolated [s].
 #: Nutation's fastest sizeable term (13.66 d, 0.2 arcsec) and the Earth-Sun vector
-#: (fourth derivative |r| (2 pi / yr)^4 ~ 2e-19 km s-4) are then exact to far below a
+#: (fourth derivative ``|r|`` (2 pi / yr)^4 ~ 2e-19 km s-4) are then exact to far below a
 #: microarcsecond and a millimetre.
 KNOT_S = 600.0
 

@@ -31,6 +31,7 @@ The cube (DESIGN.md data model)
     The contributing projected area, ``sum_j a_2D,j`` [m2].
 ``signal_material``
     ``signal`` per material (with the ``per_material`` output).
+
 Coordinates carry the geometry: ``to_sun`` and ``to_observer`` (body frame),
 the attitude quaternions and the phase angle.  :data:`sbrdf_xr.effects.OUTPUTS`
 declares every variable and its attributes.

@@ -38,6 +38,24 @@ class GridGeometry:
     Sun and observer directions lie in the reference-frame plane of ``bisector`` and
     ``plane_normal``, ``phase_angle / 2`` either side of the bisector; each attitude
     (body -> reference quaternion) turns them into the body frame.
+
+    Examples
+    --------
+    Three attitudes (quarter turns about +z) at two phase angles in the xy-plane:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.geometry import axis_rotation, observation_plane
+    >>> from sbrdf_xr.sweep import GridGeometry
+    >>> to_sun, to_observer = observation_plane([10.0, 90.0])
+    >>> grid = GridGeometry(axis_rotation([0, 0, 1], [0.0, 90.0, 180.0]), np.array([10.0, 90.0]),
+    ...                     to_sun, to_observer, None)
+    >>> grid.dims, grid.shape, grid.describe()
+    (('attitude', 'phase_angle'), (3, 2), '3 attitudes x 2 phase angles = 6 geometries')
+    >>> block = grid.block(slice(1, 2))  # the second attitude, in the body frame
+    >>> block.lead_shape, np.round(block.to_sun[1], 6) + 0.0
+    ((1, 2), array([ 0.707107, -0.707107,  0.      ]))
+    >>> sorted(grid.coords())
+    ['attitude', 'component', 'phase_angle', 'quaternion', 'to_observer', 'to_sun']
     """
 
     attitudes: np.ndarray  #: (n, 4) scalar-last quaternions
@@ -117,6 +135,18 @@ class PairGeometry:
     ``dim`` names the dimension (``geometry``, or ``time`` for an observation);
     ``sun_scale`` is the sunlit fraction of the solar disc per geometry (the Earth's
     shadow), or None; ``extra_coords`` are further coordinates along ``dim``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.sweep import PairGeometry
+    >>> pairs = PairGeometry(np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]),
+    ...                      np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]))
+    >>> pairs.dims, pairs.shape, pairs.describe()
+    (('geometry',), (2,), '2 explicit (to_sun, to_observer) pairs')
+    >>> dims, phase, attrs = pairs.coords()["phase_angle"]
+    >>> dims, np.round(phase, 6), attrs["units"]
+    ('geometry', array([ 0., 90.]), 'degree')
     """
 
     to_sun: np.ndarray

@@ -6,8 +6,8 @@ layer either).  Imports are read from the source with :mod:`ast`, at module leve
 inside functions alike; only those under ``if TYPE_CHECKING:`` are left out (they do
 not run).
 
-* L0, kernels and names: ``_version``, ``_names``, ``errors``, ``geometry``, ``_lut``,
-  ``_kernels``, ``sources``, ``brdf`` (and its models), ``imperfections``, ``knobs``,
+* L0, kernels and names: ``_version``, ``_names``, ``errors``, ``rotations``, ``geometry``,
+  ``_lut``, ``_kernels``, ``sources``, ``brdf`` (and its models), ``imperfections``, ``knobs``,
   ``_catalog_index`` (where the shipped files are; it loads nothing), ``_shadow_kernels``,
   ``_cache`` (tables built on load, cached on disk), ``anisotropy`` (facet tangents,
   ``psi``) and ``_aniso_kernels`` (the anisotropic look-up).
@@ -41,6 +41,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "_version",
         "_names",
         "errors",
+        "rotations",
         "geometry",
         "_lut",
         "_kernels",

@@ -16,7 +16,7 @@ from ..errors import InversionError
 __all__ = ["DEGENERACY_THRESHOLD", "MATERIAL", "material_areas", "unmix"]
 
 MATERIAL = "material"
-#: Default |correlation| between two materials' estimates above which they are degenerate.
+#: Default ``|correlation|`` between two materials' estimates above which they are degenerate.
 DEGENERACY_THRESHOLD = 0.95
 
 
@@ -222,7 +222,7 @@ def unmix(
     criterion : {"bic", "aic"}
         Information criterion minimised by the selection.
     degeneracy_threshold : float
-        |correlation| of two estimates above which the pair is reported as degenerate.
+        ``|correlation|`` of two estimates above which the pair is reported as degenerate.
 
     Returns
     -------
