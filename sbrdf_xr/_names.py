@@ -116,7 +116,10 @@ ATTRS: dict[str, dict[str, str]] = {
     },
     "band_weight": {
         "units": "1",
-        "long_name": "band-integration weight (solar spectrum x filter x spectral weighting x quadrature weight)",
+        "long_name": (
+            "band-integration weight "
+            "(solar spectrum x filter x spectral weighting x quadrature weight)"
+        ),
     },
     "band_signal": {
         "units": "m2 sr-1",

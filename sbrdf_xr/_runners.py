@@ -1,4 +1,8 @@
-"""How the cube writer computes its blocks: in the calling thread, in a thread pool, or on a Dask distributed cluster (and connecting to one)."""
+"""How the cube writer computes its blocks.
+
+In the calling thread, in a thread pool, or on a Dask distributed cluster (and
+connecting to one).
+"""
 
 from __future__ import annotations
 
@@ -188,7 +192,8 @@ def connect(address: str, timeout: float | str | None = None) -> Any:
         from distributed import Client
     except ImportError as exc:  # pragma: no cover - distributed is a test dependency
         raise SchedulerError(
-            f"scheduler {address!r} needs the 'distributed' package (pip install sbrdf-xr[distributed])"
+            f"scheduler {address!r} needs the 'distributed' package "
+            "(pip install sbrdf-xr[distributed])"
         ) from exc
     if timeout is None:
         timeout = dask.config.get("distributed.comm.timeouts.connect", "30s")

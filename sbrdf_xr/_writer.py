@@ -399,7 +399,8 @@ def _difference(old: Mapping[str, Any], new: Mapping[str, Any]) -> str:
     oa, na = old.get("attrs", {}), new.get("attrs", {})
     keys = sorted(k for k in set(oa) | set(na) if oa.get(k) != na.get(k))
     if keys:
-        return f"global attribute{'s' if len(keys) > 1 else ''} {', '.join(map(repr, keys[:5]))} differ"
+        plural = "s" if len(keys) > 1 else ""
+        return f"global attribute{plural} {', '.join(map(repr, keys[:5]))} differ"
     return "the file format version differs"
 
 
@@ -778,7 +779,8 @@ def _check_destination(path: Path, part: Path, log: Path, overwrite: bool, resum
         if has_path and not overwrite:
             raise FileExistsError(
                 f"{path} exists and {part} holds an unfinished write of it: pass {_opt('resume')} "
-                f"with {_opt('overwrite')} to finish it and replace {path.name}, or remove one of them"
+                f"with {_opt('overwrite')} to finish it and replace {path.name}, "
+                "or remove one of them"
             )
         return "resume"
     if has_path and resume and not overwrite:
@@ -820,7 +822,8 @@ def _check_finished(path: Path, ds: xr.Dataset) -> None:
                 break
     if problems:
         raise CubeWriteError(
-            f"{path} is a finished cube of other inputs ({'; '.join(problems)}); nothing was resumed. "
+            f"{path} is a finished cube of other inputs ({'; '.join(problems)}); "
+            "nothing was resumed. "
             f"Pass {_opt('overwrite')} to replace it"
         )
     _log.info("%s is already complete; there is nothing to resume", path)
@@ -1128,7 +1131,8 @@ def _write_locked(
         if writing and good >= 0:
             raise CubeWriteError(
                 f"{head}HDF5 failed in the middle of a block; {part} was cut back to its last "
-                f"synced state, with the blocks written so far. {_fix(why)[0].upper()}{_fix(why)[1:]} "
+                f"synced state, with the blocks written so far. "
+                f"{_fix(why)[0].upper()}{_fix(why)[1:]} "
                 f"and {_again()}; should HDF5 fail again at the same block, the file cannot be "
                 f"continued: {_discard()}"
             ) from exc

@@ -201,7 +201,8 @@ class SunPointing(AttitudeLaw):
         if isinstance(tgt, str):
             if tgt not in _SECONDARY_TARGETS:
                 raise AttitudeError(
-                    f"sun_pointing secondary_target: got {tgt!r}; allowed: {', '.join(_SECONDARY_TARGETS)} "
+                    f"sun_pointing secondary_target: got {tgt!r}; "
+                    f"allowed: {', '.join(_SECONDARY_TARGETS)} "
                     "or 3 components"
                 )
         else:
@@ -282,7 +283,8 @@ def _inertia(value: ArrayLike) -> NDArray[np.float64]:
         arr = np.diag(arr)
     if arr.shape != (3, 3) or not np.all(np.isfinite(arr)):
         raise AttitudeError(
-            f"tumble inertia: expected 3 principal moments or a finite 3x3 tensor [kg m2], got shape {arr.shape}"
+            "tumble inertia: expected 3 principal moments or a finite 3x3 tensor [kg m2], "
+            f"got shape {arr.shape}"
         )
     if not np.allclose(arr, arr.T, rtol=1e-9, atol=1e-12 * np.abs(arr).max()):
         raise AttitudeError("tumble inertia: the tensor must be symmetric")
@@ -334,7 +336,8 @@ class Tumble(AttitudeLaw):
         w = np.asarray(self.omega_deg_s, dtype=np.float64)
         if w.shape != (3,) or not np.all(np.isfinite(w)):
             raise AttitudeError(
-                f"tumble omega_deg_s: expected 3 finite body rates [degree s-1], got {self.omega_deg_s!r}"
+                "tumble omega_deg_s: expected 3 finite body rates [degree s-1], "
+                f"got {self.omega_deg_s!r}"
             )
         object.__setattr__(self, "omega_deg_s", w)
         object.__setattr__(self, "initial", check_quaternion(self.initial, "tumble initial"))
@@ -485,7 +488,10 @@ class QuaternionSeries(AttitudeLaw):
         columns: Sequence[str] = ("qx", "qy", "qz", "qw"),
         epoch: Any = None,
     ) -> QuaternionSeries:
-        """Read a CSV with a time column (ISO 8601 UTC, or seconds) and scalar-last quaternion columns."""
+        """Read a CSV with a time column and scalar-last quaternion columns.
+
+        The time column holds ISO 8601 UTC times, or seconds.
+        """
         import pandas as pd
 
         try:
@@ -528,7 +534,8 @@ class QuaternionSeries(AttitudeLaw):
         lo, hi = self._secs[0], self._secs[-1]  # type: ignore[attr-defined]
         if t.min() < lo or t.max() > hi:
             raise AttitudeError(
-                f"quaternion_series: requested times span [{t.min():.6g}, {t.max():.6g}] s, outside the "
+                f"quaternion_series: requested times span [{t.min():.6g}, {t.max():.6g}] s, "
+                "outside the "
                 f"series [{lo:.6g}, {hi:.6g}] s from its epoch {self.epoch}"
             )
         return self._slerp(t).as_quat().reshape(-1, 4)  # type: ignore[attr-defined]
@@ -545,7 +552,8 @@ class Composed(AttitudeLaw):
         for name in ("outer", "inner"):
             if not isinstance(getattr(self, name), AttitudeLaw):
                 raise AttitudeError(
-                    f"compose {name}: expected an attitude law, got {type(getattr(self, name)).__name__}"
+                    f"compose {name}: expected an attitude law, "
+                    f"got {type(getattr(self, name)).__name__}"
                 )
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:

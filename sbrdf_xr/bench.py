@@ -85,7 +85,10 @@ class BenchRow:
 
 
 def best_time(func: Callable[[], object], repeat: int = 3, number: int = 1) -> float:
-    """Best of ``repeat`` wall times of ``number`` calls of ``func`` after a warm-up [s per call]."""
+    """Best of ``repeat`` wall times of ``number`` calls of ``func``, after a warm-up.
+
+    In seconds per call.
+    """
     func()
     best = np.inf
     for _ in range(repeat):
@@ -488,7 +491,8 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
             t_merged,
             "per-facet loop",
             t_merged / t_base,
-            f"{work / t_merged:,.0f} facet-equivalent g-f-spectra/s; speed-up {t_base / t_merged:.1f}x; "
+            f"{work / t_merged:,.0f} facet-equivalent g-f-spectra/s; "
+            f"speed-up {t_base / t_merged:.1f}x; "
             f"agrees to {agree:.1e}",
             sweep="canx1-rotation",
         ),
@@ -498,7 +502,8 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
             "per-facet loop",
             (work / limit) / t_base,
             f"{limit:,.0f} g-f-spectra/s at {bandwidth / 1e9:.1f} GB/s (measured copy), 8 x {n_wl} "
-            f"float64 gathered per pair; the unmerged kernel reaches {(work / t_unmerged) / limit:.0%} "
+            "float64 gathered per pair; the unmerged kernel reaches "
+            f"{(work / t_unmerged) / limit:.0%} "
             "of it (neighbouring geometries reuse table rows from cache)",
             sweep="canx1-rotation",
         ),
@@ -507,7 +512,8 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
             work / compute_limit,
             "per-facet loop",
             (work / compute_limit) / t_base,
-            f"{compute_limit:,.0f} g-f-spectra/s at {flops / 1e9:.1f} GFLOP/s, 16 x {n_wl} flops per "
+            f"{compute_limit:,.0f} g-f-spectra/s at {flops / 1e9:.1f} GFLOP/s, "
+            f"16 x {n_wl} flops per "
             f"pair; the unmerged kernel reaches {(work / t_unmerged) / compute_limit:.0%} of it",
             sweep="canx1-rotation",
         ),
@@ -529,7 +535,8 @@ def format_rows(rows: list[BenchRow]) -> str:
             out += [
                 "",
                 f"[{sweep}]",
-                f"{'case':<{w}}  {'time/baseline':>13}  {'mmag max':>9}  {'mmag med':>9}  {'rel p99':>8}  notes",
+                f"{'case':<{w}}  {'time/baseline':>13}  "
+                f"{'mmag max':>9}  {'mmag med':>9}  {'rel p99':>8}  notes",
             ]
         err = (
             f"{r.mmag_max:>9.3g}  {r.mmag_median:>9.3g}  {r.rel_p99:>8.2g}"

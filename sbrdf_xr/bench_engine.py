@@ -253,7 +253,8 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
             ""
             if prev is None
             else (
-                f"; exponent {np.log(r['seconds'] / results[prev]['seconds']) / np.log(n / prev):.3f} "
+                "; exponent "
+                f"{np.log(r['seconds'] / results[prev]['seconds']) / np.log(n / prev):.3f} "
                 f"from {prev:.0e}"
             )
         )

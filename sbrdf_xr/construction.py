@@ -27,7 +27,8 @@ def paper_delta_theta_grid(dt_min: float, dt_max: float, n: int = 21) -> np.ndar
     ``dt_max/10`` steps on either side (for ``n = 21``) [degree]."""
     if not (dt_min < 0 < dt_max):
         raise ValidationError(
-            f"delta_theta: measured extent must straddle specular (min < 0 < max), got [{dt_min}, {dt_max}]"
+            "delta_theta: measured extent must straddle specular (min < 0 < max), "
+            f"got [{dt_min}, {dt_max}]"
         )
     if n < 3 or n % 2 == 0:
         raise ValidationError(f"n_delta_theta: must be odd and >= 3, got {n}")

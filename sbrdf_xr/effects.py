@@ -132,7 +132,8 @@ OUTPUTS: dict[str, Output] = {
             (WAVELENGTH,),
             True,
             "W sr-1 nm-1",
-            "thermal emission intensity sum_j A_j cos(theta_r) epsilon(lambda, theta_r) B(lambda, T)",
+            "thermal emission intensity "
+            "sum_j A_j cos(theta_r) epsilon(lambda, theta_r) B(lambda, T)",
         ),
         Output(
             "band_signal",

@@ -85,7 +85,8 @@ KNOBS: dict[str, Knob] = {
             "linear",
             ("nearest", "linear", "cubic"),
             None,
-            "look-up interpolation order: nearest (the paper's) < linear < cubic in accuracy and cost",
+            "look-up interpolation order: "
+            "nearest (the paper's) < linear < cubic in accuracy and cost",
         ),
         Knob(
             "dtype",
@@ -135,8 +136,8 @@ KNOBS: dict[str, Knob] = {
             "table",
             ("table", "analytic"),
             None,
-            "table: look-up tables; analytic: each material's generating BRDF model (no table error, "
-            "much slower)",
+            "table: look-up tables; analytic: each material's generating BRDF model "
+            "(no table error, much slower)",
         ),
         Knob(
             "tilt_nodes",

@@ -404,7 +404,8 @@ def build_lut(
     measured_ti = np.unique(ti_s)
     if measured_ti.size < 2:
         raise ValidationError(
-            f"theta_i: need measurements at >= 2 incidence angles to build a table, got {measured_ti.tolist()}"
+            "theta_i: need measurements at >= 2 incidence angles to build a table, "
+            f"got {measured_ti.tolist()}"
         )
     phi_grid = paper_phi_grid(ph_s.max(), n_phi)
     dt_grid = paper_delta_theta_grid(dt_s.min(), dt_s.max(), n_delta_theta)
@@ -632,7 +633,8 @@ def hemispherical_reflectance(
     if warn and np.any(rho > 1.0):
         worst = np.unravel_index(np.argmax(rho), rho.shape)
         warnings.warn(
-            f"material {material.attrs.get('material', '')!r}: directional-hemispherical reflectance "
+            f"material {material.attrs.get('material', '')!r}: "
+            "directional-hemispherical reflectance "
             f"reaches {rho[worst]:.3f} > 1 at theta_i = {ti[worst[0]]} deg, wavelength = "
             f"{material[WAVELENGTH].values[worst[1]]} nm; the table does not conserve energy",
             NonPhysicalWarning,

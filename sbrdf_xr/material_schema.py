@@ -126,7 +126,8 @@ def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.Data
             )
         if np.any(v < 0):
             raise ValidationError(
-                f"sbrdf: contains {int(np.sum(v < 0))} negative values (min {v.min():.3g}); a BRDF is >= 0"
+                f"sbrdf: contains {int(np.sum(v < 0))} negative values (min {v.min():.3g}); "
+                "a BRDF is >= 0"
             )
     return da
 
@@ -274,7 +275,10 @@ def lambertian(
         wl,
         material=name,
         source="model:lambert",
-        provenance=f"ideal Lambertian reflector, f_r = albedo / pi ({'albedo ' + format(float(albedo), 'g') if scalar else 'spectral albedo'})",
+        provenance=(
+            "ideal Lambertian reflector, f_r = albedo / pi "
+            f"({'albedo ' + format(float(albedo), 'g') if scalar else 'spectral albedo'})"
+        ),
         model="lambert",
         albedo=float(albedo) if scalar else rho,
     )
@@ -415,7 +419,8 @@ def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Da
             f"measurements: {int(np.sum(counts[dup]))} of {ds.sizes[SAMPLE]} samples repeat "
             f"{dup.size} geometr{'y' if dup.size == 1 else 'ies'} (first: theta_i = "
             f"{float(ds[THETA_I].values[k])}, delta_theta = {float(ds[DELTA_THETA].values[k])}, "
-            f"phi = {float(ds[PHI].values[k])} deg in samples {where[:10].tolist()}); a geometry must be "
+            f"phi = {float(ds[PHI].values[k])} deg in samples {where[:10].tolist()}); "
+            "a geometry must be "
             "measured once, or pass duplicates='mean' to average the repeats"
         )
     ref = _reference(ds)

@@ -170,7 +170,8 @@ def normalise_map(
         material_map = read_material_map(material_map)
     if not isinstance(material_map, Mapping) or not material_map:
         raise ValidationError(
-            f"material_map: expected a non-empty mapping of colour or name -> material, got {material_map!r}"
+            "material_map: expected a non-empty mapping of colour or name -> material, "
+            f"got {material_map!r}"
         )
     colours: dict[Color, str] = {}
     names: dict[str, str] = {}
@@ -425,7 +426,8 @@ def clean_mesh(
         bad_f = bad_v[faces].any(axis=1)
         _problem(
             repair,
-            f"{int(bad_v.sum())} vertices are not finite (NaN or inf), used by {int(bad_f.sum())} facets",
+            f"{int(bad_v.sum())} vertices are not finite (NaN or inf), "
+            f"used by {int(bad_f.sum())} facets",
             "remove them and their facets",
         )
         vertices = np.where(bad_v[:, None], 0.0, vertices)
@@ -450,7 +452,8 @@ def clean_mesh(
     if zero.any():
         _problem(
             repair,
-            f"{int(zero.sum())} of {len(faces)} facets have zero area (first: {np.flatnonzero(zero)[:5].tolist()})",
+            f"{int(zero.sum())} of {len(faces)} facets have zero area "
+            f"(first: {np.flatnonzero(zero)[:5].tolist()})",
             "remove them",
         )
         faces, material = faces[~zero], material[~zero]
@@ -463,7 +466,8 @@ def clean_mesh(
         keep[first] = True
         _problem(
             repair,
-            f"{len(faces) - len(first)} facets duplicate another facet (first: {np.flatnonzero(~keep)[:5].tolist()})",
+            f"{len(faces) - len(first)} facets duplicate another facet "
+            f"(first: {np.flatnonzero(~keep)[:5].tolist()})",
             "keep the first of each set of duplicates",
         )
         faces, material = faces[keep], material[keep]
@@ -473,7 +477,8 @@ def clean_mesh(
         n_open = len(trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1))
         _problem(
             repair,
-            f"the surface is not closed ({n_open} edges belong to a single facet, or edges are shared by more than two)",
+            f"the surface is not closed ({n_open} edges belong to a single facet, "
+            "or edges are shared by more than two)",
             "fill the holes with trimesh.repair.fill_holes",
         )
         n_before = len(mesh.faces)
@@ -503,7 +508,8 @@ def clean_mesh(
     if flipped.any():
         _problem(
             repair,
-            f"{int(flipped.sum())} facets belong to inside-out bodies (negative volume, normals pointing inwards)",
+            f"{int(flipped.sum())} facets belong to inside-out bodies "
+            "(negative volume, normals pointing inwards)",
             "flip them",
         )
         mesh = probe

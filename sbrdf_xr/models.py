@@ -311,7 +311,9 @@ def render_anisotropic(
         SBRDF,
         material=spec.attrs["material"],
         source=spec.attrs["source"],
-        provenance=f"{spec.attrs.get('provenance', '')}; rendered by sbrdf_xr.models.render_anisotropic",
+        provenance=(
+            f"{spec.attrs.get('provenance', '')}; rendered by sbrdf_xr.models.render_anisotropic"
+        ),
         model=spec.attrs["model"],
         edge_delta_theta_min="zero" if dt[0] <= -180.0 else "hold",
         edge_delta_theta_max="zero" if dt[-1] >= 90.0 else "hold",

@@ -316,7 +316,8 @@ def _tilt(
         (
             "imperfections",
             f"facet normals tilted by a Gaussian ({what}; paper 000 section 5), "
-            f"{nodes}x{nodes} Gauss-Hermite copies per term: {raw['area'].size} -> {out['area'].size} terms",
+            f"{nodes}x{nodes} Gauss-Hermite copies per term: "
+            f"{raw['area'].size} -> {out['area'].size} terms",
         )
     )
     return out
@@ -716,9 +717,11 @@ def compile_plan(scene: Scene) -> Plan:
     limit = scene.size_limit
     if out_bytes > limit * SIZE_LIMIT_BYTES or work > limit * WORK_LIMIT:
         raise SceneError(
-            f"scene {scene.name!r} is beyond reason: {geo.n_geometries:.3g} geometries x {terms.size} terms "
-            f"would write {_describe_bytes(out_bytes)} (limit {_describe_bytes(limit * SIZE_LIMIT_BYTES)}) "
-            f"and take up to {work:.3g} multiply-adds (limit {limit * WORK_LIMIT:.3g}); reduce the sweep, "
+            f"scene {scene.name!r} is beyond reason: {geo.n_geometries:.3g} geometries "
+            f"x {terms.size} terms would write {_describe_bytes(out_bytes)} "
+            f"(limit {_describe_bytes(limit * SIZE_LIMIT_BYTES)}) "
+            f"and take up to {work:.3g} multiply-adds (limit {limit * WORK_LIMIT:.3g}); "
+            "reduce the sweep, "
             "or raise the limits with size_limit (a factor, default 1) if you mean it"
         )
     n_blocks = max(1, -(-geo.n_lead // chunk)) if geo.n_lead else 0
@@ -735,9 +738,13 @@ def compile_plan(scene: Scene) -> Plan:
         "Conventions": "CF-1.10",
         "title": f"sbrdf_xr simulation of scene {scene.name}",
         "source": f"sbrdf_xr {__version__}",
-        "history": f"sbrdf_xr.simulate(scene={scene.name!r}, method={knobs['method']}, dtype={dtype.name})",
-        "references": "Bedard et al., A novel approach to modeling spacecraft spectral reflectance; "
-        "Sandford, Infrared reflectance properties of aircraft paints",
+        "history": (
+            f"sbrdf_xr.simulate(scene={scene.name!r}, method={knobs['method']}, dtype={dtype.name})"
+        ),
+        "references": (
+            "Bedard et al., A novel approach to modeling spacecraft spectral reflectance; "
+            "Sandford, Infrared reflectance properties of aircraft paints"
+        ),
         "scene": scene.name,
         "scene_description": scene.description,
         "spacecraft": getattr(scene.spacecraft, "name", ""),
@@ -750,7 +757,9 @@ def compile_plan(scene: Scene) -> Plan:
         "effects": ", ".join(active),
         "plan": "",
         **{f"material_provenance_{m.replace('-', '_')}": p for m, p in provenance.items()},
-        "note_sbrdf_zero_area": "spacecraft_sbrdf is 0 where area is 0 (no lit and visible facet; 0/0 of Eq. 4)",
+        "note_sbrdf_zero_area": (
+            "spacecraft_sbrdf is 0 where area is 0 (no lit and visible facet; 0/0 of Eq. 4)"
+        ),
         **geo.attrs,
         **scene_fingerprint(scene),  # checked when an interrupted write is resumed
     }

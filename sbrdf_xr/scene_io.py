@@ -204,7 +204,8 @@ def _attitudes_from_table(t: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray 
                 )
             if n > MAX_SCENE_COUNT:
                 raise SceneError(
-                    f"[attitude]: the sweep has {n} attitudes; at most {MAX_SCENE_COUNT} are allowed"
+                    f"[attitude]: the sweep has {n} attitudes; "
+                    f"at most {MAX_SCENE_COUNT} are allowed"
                 )
             angles = np.arange(start, stop, step)
             initial = None

@@ -1,4 +1,7 @@
-"""The :class:`Scene`: what to simulate (re-exported, with the scene files, from :mod:`sbrdf_xr.scene`)."""
+"""The :class:`Scene`: what to simulate.
+
+Re-exported, with the scene files, from :mod:`sbrdf_xr.scene`.
+"""
 
 from __future__ import annotations
 
@@ -220,7 +223,8 @@ class Scene:
             raise SceneError(f"earth_albedo: must lie in [0, 1], got {self.earth_albedo}")
         if not self.earth_range_km > 6371.0:
             raise SceneError(
-                f"earth_range_km: must exceed the Earth's radius (6371 km), got {self.earth_range_km}"
+                "earth_range_km: must exceed the Earth's radius (6371 km), "
+                f"got {self.earth_range_km}"
             )
         if not 0.0 <= self.earth_phase_angle <= 180.0:
             raise SceneError(

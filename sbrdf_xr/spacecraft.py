@@ -178,7 +178,8 @@ def load_spacecraft(
             raise ValidationError(f"material: expected a non-empty material name, got {material!r}")
         if known_materials is not None and material not in set(known_materials):
             raise ValidationError(
-                f"material: {material!r} does not exist; known materials: {sorted(set(known_materials))}"
+                f"material: {material!r} does not exist; "
+                f"known materials: {sorted(set(known_materials))}"
             )
         colours, name_map = {}, {}
     else:
@@ -230,7 +231,8 @@ class Spacecraft:
         labels = np.asarray(list(facet_material), dtype=str)
         if labels.shape != (len(mesh.faces),):
             raise ValidationError(
-                f"facet_material: expected {len(mesh.faces)} names (one per facet), got shape {labels.shape}"
+                f"facet_material: expected {len(mesh.faces)} names (one per facet), "
+                f"got shape {labels.shape}"
             )
         labels.setflags(write=False)
         self.mesh = mesh

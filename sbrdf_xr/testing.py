@@ -215,7 +215,9 @@ def _as_spacecraft(mesh, name: str):
 
 
 def cube_spacecraft(size: float = 1.0, subdivisions: int = 1):
-    """A convex cube [m] centred at the origin, each face cut into ``2 * 4**(subdivisions - 1)`` facets.
+    """A convex cube [m] centred at the origin.
+
+    Each face is cut into ``2 * 4**(subdivisions - 1)`` facets.
 
     Parameters
     ----------
@@ -263,8 +265,11 @@ def plate_with_fin_section(
 
 
 def plate_with_fin_spacecraft(depth: float = 2.0, **section):
-    """A plate ``[-1, 1] x [-0.1, 0]`` with a perpendicular fin ``[-0.05, 0.05] x [0, 1]`` (xy, [m]),
-    extruded over z in [0, depth]; ``section`` overrides :func:`plate_with_fin_section`."""
+    """A plate with a perpendicular fin, extruded over z in [0, depth].
+
+    The plate is ``[-1, 1] x [-0.1, 0]``, the fin ``[-0.05, 0.05] x [0, 1]`` (xy, [m]);
+    ``section`` overrides :func:`plate_with_fin_section`.
+    """
     return _as_spacecraft(
         prism_mesh(plate_with_fin_section(**section), 0.0, depth), "plate-with-fin"
     )

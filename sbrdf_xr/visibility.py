@@ -22,8 +22,9 @@ Methods (:data:`METHODS`)
     again a convex clip; an empty intersection prunes all its supersets); past 64 shadows or
     a work budget it is summed over vertical slabs bounded by every vertex and edge
     crossing (in each slab the covered length is linear in x); a facet with more than
-    :data:`MAX_SHADOWS` shadows is united by GEOS (:func:`shapely.union_all`).  Candidate occluders come from a uniform grid over the
-    bounding boxes in the plane perpendicular to ``d`` (a facet whose box does not overlap,
+    :data:`MAX_SHADOWS` shadows is united by GEOS (:func:`shapely.union_all`).  Candidate
+    occluders come from a uniform grid over the bounding boxes in the plane perpendicular
+    to ``d`` (a facet whose box does not overlap,
     or that lies wholly behind the receiver along ``d``, cannot shadow it), so the cost grows
     nearly linearly with the number of facets.  Compiled with numba.
 ``"sampled"``

@@ -199,7 +199,8 @@ def against_flow(graph: dict[str, set[str]]) -> list[str]:
         for dep in sorted(deps):
             if layer_of(dep) > layer_of(mod):
                 bad.append(
-                    f"{mod or 'sbrdf_xr'} (L{layer_of(mod)}) -> {dep or 'sbrdf_xr'} (L{layer_of(dep)})"
+                    f"{mod or 'sbrdf_xr'} (L{layer_of(mod)}) -> "
+                    f"{dep or 'sbrdf_xr'} (L{layer_of(dep)})"
                 )
     return bad
 

@@ -1,4 +1,7 @@
-"""Spin-state fit: global search over candidate spin states and local refinement (see the package docstring)."""
+"""Spin-state fit: global search over candidate spin states and local refinement.
+
+See the package docstring.
+"""
 
 from __future__ import annotations
 
@@ -234,7 +237,10 @@ class _Problem:
         self.n_bands = len(lc["labels"])
 
     def model(self, axes: np.ndarray, periods: np.ndarray, phases: np.ndarray) -> np.ndarray:
-        """Band signal at every observation (C, N) for candidates (C,) of axis (C, 3), period, phase."""
+        """Band signal at every observation (C, N).
+
+        For candidates (C,) of axis (C, 3), period, phase.
+        """
         align = _align_matrices(self.k, axes)
         ang = np.radians(phases[:, None] + 360.0 * self.times[None, :] / periods[:, None])
         sb = _body_vectors(self.s, align, self.k, ang)

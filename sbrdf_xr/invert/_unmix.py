@@ -1,4 +1,7 @@
-"""Material unmixing: non-negative least squares on the per-material terms (see the package docstring)."""
+"""Material unmixing: non-negative least squares on the per-material terms.
+
+See the package docstring.
+"""
 
 from __future__ import annotations
 
@@ -51,7 +54,8 @@ def _library(simulated: Any) -> xr.DataArray:
                     b = da[dim].values if dim in da.coords else None
                     if a is None or b is None or a.shape != b.shape or not np.array_equal(a, b):
                         raise InversionError(
-                            f"candidate library: {name!r} has {dim} {_describe(b)}, {ref_name!r} has "
+                            f"candidate library: {name!r} has {dim} {_describe(b)}, "
+                            f"{ref_name!r} has "
                             f"{_describe(a)}; every candidate must be on the same {dim} grid"
                         )
         simulated = xr.concat(

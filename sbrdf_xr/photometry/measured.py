@@ -320,8 +320,9 @@ def _validate(
             if naive and scale is None:
                 k = naive[0]
                 raise ValidationError(
-                    f"{path}: {row_name(k)}, column 'time': {raw.iloc[k]!r} has no time zone and cannot be "
-                    "read as UTC; write it as ISO 8601 with 'Z' or an offset (2024-01-01T00:00:00Z), or "
+                    f"{path}: {row_name(k)}, column 'time': {raw.iloc[k]!r} has no time zone "
+                    "and cannot be read as UTC; write it as ISO 8601 with 'Z' or an offset "
+                    "(2024-01-01T00:00:00Z), or "
                     "pass time_scale='utc' (table metadata time_scale: utc)"
                 )
             x = tt.dt.tz_convert("UTC").dt.tz_localize(None).to_numpy(dtype="datetime64[ns]")

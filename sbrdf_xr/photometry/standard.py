@@ -53,7 +53,8 @@ def specular_sphere_phase(alpha_deg: ArrayLike) -> np.ndarray:
     return np.ones_like(np.asarray(alpha_deg, dtype=np.float64))
 
 
-#: Phase functions for standard magnitudes: name -> (function of the phase angle [degree], description).
+#: Phase functions for standard magnitudes:
+#: name -> (function of the phase angle [degree], description).
 PHASE_FUNCTIONS: dict[str, Any] = {
     "lambert_sphere": (lambert_sphere_phase, "diffuse (Lambert) sphere, Russell 1916, ApJ 43, 173"),
     "specular_sphere": (specular_sphere_phase, "specular sphere (phase-independent)"),
