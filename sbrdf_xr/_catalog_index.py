@@ -142,7 +142,17 @@ def _index() -> tuple[CatalogEntry, ...]:
                 "allowed: measured, synthetic, model:<name>"
             )
         extra = {k: v for k, v in item.items() if k not in required}
-        out.append(CatalogEntry(*(item[k] for k in required), extra=extra))
+        out.append(
+            CatalogEntry(
+                name=item["name"],
+                kind=item["kind"],
+                path=item["path"],
+                source=item["source"],
+                description=item["description"],
+                provenance=item["provenance"],
+                extra=extra,
+            )
+        )
     seen: set[str] = set()
     for e in out:
         if e.name in seen:

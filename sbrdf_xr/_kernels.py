@@ -32,7 +32,7 @@ import numba
 import numba.typed
 import numpy as np
 import scipy.sparse as sp
-from numpy.typing import NDArray
+from numpy.typing import DTypeLike, NDArray
 
 from . import _lut
 from .geometry import facet_angles, normal_incidence_tolerance
@@ -496,7 +496,7 @@ class PackedTables(NamedTuple):
 def pack_tables(
     tables: list[tuple[Any, ...]],
     n_spectral: int = 1,
-    dtype: np.dtype | str = np.float64,
+    dtype: DTypeLike = np.float64,
 ) -> PackedTables:
     """Pack ``(values, theta_grid, delta_theta_grid, phi_grid, zero_edges[, normal_blend])``
     per material.
@@ -534,7 +534,7 @@ def pack_tables(
     pgrid, p_off = cat([np.asarray(t[3]) for t in tables])
     edges = np.array([t[4] for t in tables], dtype=bool).reshape(-1, 3)
     blend = np.array([float(t[5]) if len(t) > 5 else 0.0 for t in tables], dtype=np.float64)
-    shapes = tuple(tuple(int(x) for x in v.shape[:3]) for v, *_ in tables)
+    shapes = tuple((int(v.shape[0]), int(v.shape[1]), int(v.shape[2])) for v, *_ in tables)
     return PackedTables(
         values, tgrid, t_off, dgrid, d_off, pgrid, p_off, edges, blend, shapes, n_wl, dt
     )

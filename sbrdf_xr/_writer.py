@@ -208,7 +208,8 @@ class _Plan:
         return math.prod(self.grid) if self.block_dims else 0
 
     def index(self, k: int) -> dict[str, int]:
-        return dict(zip(self.block_dims, np.unravel_index(k, self.grid), strict=True))
+        idx = (int(i) for i in np.unravel_index(k, self.grid))
+        return dict(zip(self.block_dims, idx, strict=True))
 
     def slices(self, k: int) -> dict[str, slice]:
         idx = self.index(k)
@@ -1125,19 +1126,19 @@ def _write_locked(
                     nc.close()
                 nc = None
             lost = _cut_back(part, good, head)
-        head = f"writing {path} failed {where}after {len(done)} of {plan.n_blocks} blocks: {why}. "
+        intro = f"writing {path} failed {where}after {len(done)} of {plan.n_blocks} blocks: {why}. "
         if lost is not None:
-            raise CubeWriteError(f"{head}{part} could not be kept ({lost}); {_discard()}") from exc
+            raise CubeWriteError(f"{intro}{part} could not be kept ({lost}); {_discard()}") from exc
         if writing and good >= 0:
             raise CubeWriteError(
-                f"{head}HDF5 failed in the middle of a block; {part} was cut back to its last "
+                f"{intro}HDF5 failed in the middle of a block; {part} was cut back to its last "
                 f"synced state, with the blocks written so far. "
                 f"{_fix(why)[0].upper()}{_fix(why)[1:]} "
                 f"and {_again()}; should HDF5 fail again at the same block, the file cannot be "
                 f"continued: {_discard()}"
             ) from exc
         raise CubeWriteError(
-            f"{head}The blocks written so far are kept in {part}; {_fix(why)} and {_again()} "
+            f"{intro}The blocks written so far are kept in {part}; {_fix(why)} and {_again()} "
             "to compute only the missing blocks"
         ) from exc
     except BaseException as exc:

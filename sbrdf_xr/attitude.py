@@ -33,7 +33,7 @@ Composed            ``outer * inner``: ``R(t) = R_outer(t) R_inner(t)``
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -146,6 +146,7 @@ class Nadir(AttitudeLaw):
     yaw_deg: float = 0.0
     nadir_axis: Any = "+z"
     velocity_axis: Any = "+x"
+    _axes: tuple[np.ndarray, np.ndarray] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not np.isfinite(self.yaw_deg):
@@ -160,7 +161,7 @@ class Nadir(AttitudeLaw):
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         n = np.atleast_1d(np.asarray(times)).shape[0]
         r, v = context_fields(context, n, "nadir", "position_km", "velocity_km_s")
-        a, b = self._axes  # type: ignore[attr-defined]
+        a, b = self._axes
         q = triad(a, b, -r, v)
         if self.yaw_deg:
             yaw = Rotation.from_rotvec(np.radians(self.yaw_deg) * a)
@@ -190,6 +191,9 @@ class SunPointing(AttitudeLaw):
     axis: Any = "+z"
     secondary_axis: Any = "+x"
     secondary_target: Any = "orbit_normal"
+    _axes: tuple[np.ndarray, np.ndarray, str | np.ndarray] = field(
+        init=False, repr=False, compare=False
+    )
 
     def __post_init__(self) -> None:
         a, b = perpendicular_pair(
@@ -211,7 +215,7 @@ class SunPointing(AttitudeLaw):
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         n = np.atleast_1d(np.asarray(times)).shape[0]
-        a, b, tgt = self._axes  # type: ignore[attr-defined]
+        a, b, tgt = self._axes
         (sun,) = context_fields(context, n, "sun_pointing", "sun_km")
         if isinstance(tgt, str) and tgt != "north":
             r, v = context_fields(context, n, "sun_pointing", "position_km", "velocity_km_s")
@@ -251,6 +255,7 @@ class Spin(AttitudeLaw):
     phase_deg: float = 0.0
     initial: Any = (0.0, 0.0, 0.0, 1.0)
     epoch: Any = None
+    _axis_vec: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         for name in ("rate_deg_s", "phase_deg"):
@@ -267,7 +272,7 @@ class Spin(AttitudeLaw):
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         ang = np.radians(self.angles(times, context))
-        spin = Rotation.from_rotvec(ang[:, None] * self._axis_vec[None, :])  # type: ignore[attr-defined]
+        spin = Rotation.from_rotvec(ang[:, None] * self._axis_vec[None, :])
         q0 = self.initial.quaternions(times, context)
         return (Rotation.from_quat(q0) * spin).as_quat().reshape(-1, 4)
 
@@ -458,6 +463,8 @@ class QuaternionSeries(AttitudeLaw):
     times: Any
     samples: Any = None
     epoch: Any = None
+    _secs: np.ndarray = field(init=False, repr=False, compare=False)
+    _slerp: Slerp = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         t = np.atleast_1d(np.asarray(self.times))
@@ -531,14 +538,14 @@ class QuaternionSeries(AttitudeLaw):
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         t = seconds_since(times, self.epoch, context)
-        lo, hi = self._secs[0], self._secs[-1]  # type: ignore[attr-defined]
+        lo, hi = self._secs[0], self._secs[-1]
         if t.min() < lo or t.max() > hi:
             raise AttitudeError(
                 f"quaternion_series: requested times span [{t.min():.6g}, {t.max():.6g}] s, "
                 "outside the "
                 f"series [{lo:.6g}, {hi:.6g}] s from its epoch {self.epoch}"
             )
-        return self._slerp(t).as_quat().reshape(-1, 4)  # type: ignore[attr-defined]
+        return self._slerp(t).as_quat().reshape(-1, 4)
 
 
 @dataclass(frozen=True)
@@ -626,7 +633,7 @@ def law_from_dict(table: Mapping[str, Any]) -> AttitudeLaw:
             raise AttitudeError("attitude law 'quaternion_series': needs a path (.csv or .nc)")
         path = Path(params.pop("path"))
         if path.suffix.lower() == ".csv":
-            kw = {k: params[k] for k in ("time_column", "epoch") if k in params}
+            kw: dict[str, Any] = {k: params[k] for k in ("time_column", "epoch") if k in params}
             if "columns" in params:
                 kw["columns"] = tuple(params["columns"])
             return QuaternionSeries.from_csv(path, **kw)

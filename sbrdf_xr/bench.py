@@ -24,6 +24,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -143,11 +144,11 @@ def bench_lookup(
     dt = rng.uniform(float(lut.delta_theta[0]), float(lut.delta_theta[-1]), n_geometries)
     ph = rng.uniform(0, float(lut.phi[-1]), n_geometries)
     dims = [xr.DataArray(a, dims="geom") for a in (ti, dt, ph)]
-    grids = [np.asarray(lut[d].values) for d in ("theta_i", "delta_theta", "phi")]
+    tg, dg, pg = (np.asarray(lut[d].values) for d in ("theta_i", "delta_theta", "phi"))
     values = np.asarray(lut.values)
 
     def ours() -> np.ndarray:
-        return material._lut.lookup_kernel(values, *grids, ti, dt, ph)
+        return material._lut.lookup_kernel(values, tg, dg, pg, ti, dt, ph)
 
     def xr_interp() -> xr.DataArray:
         return lut.interp(theta_i=dims[0], delta_theta=dims[1], phi=dims[2], method="linear").load()
@@ -272,7 +273,7 @@ def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
     for sweep_name, sweep in sweeps.items():
         ref_cube = run_cube(sweep, **reference)
         ref = ref_cube.signal
-        t_ref = best_time(lambda sweep=sweep: run_cube(sweep, **reference), repeat)
+        t_ref = best_time(partial(run_cube, sweep, **reference), repeat)
         knobs: list[tuple[str, str, dict[str, Any]]] = [
             ("reference", "cubic look-up, 1-deg theta_i, 21x21, 5 nm, merged, float64", {}),
             ("lookup method", "nearest (the paper's)", {"method": "nearest"}),
@@ -316,7 +317,7 @@ def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
                 cube, t = ref_cube, t_ref
             else:
                 cube = run_cube(sweep, **cfg)
-                t = best_time(lambda sweep=sweep, cfg=cfg: run_cube(sweep, **cfg), repeat)
+                t = best_time(partial(run_cube, sweep, **cfg), repeat)
             test = cube.band_signal if "band_signal" in cube else cube.signal
             mx, med, p99 = _errors(test, ref)
             rows.append(
@@ -336,7 +337,7 @@ def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
         # (the simulation option evaluation="analytic", each material's catalog model).
         an_cfg = {**reference, "evaluation": "analytic"}
         an = run_cube(sweep, **an_cfg).signal
-        t_an = best_time(lambda sweep=sweep, an_cfg=an_cfg: run_cube(sweep, **an_cfg), 1)
+        t_an = best_time(partial(run_cube, sweep, **an_cfg), 1)
         mx, med, p99 = _errors(ref, an)
         rows.append(
             BenchRow(
@@ -426,7 +427,8 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
     facets = scene.spacecraft.facets()
     s, o = scene.body_vectors()
     s2, o2 = s.reshape(-1, 3), o.reshape(-1, 3)
-    tables = {m: scene.materials[m] for m in scene.spacecraft.materials}
+    materials = scene.materials or {}
+    tables = {m: materials[m] for m in scene.spacecraft.materials}
     n_geom, n_fac = s2.shape[0], facets.sizes["facet"]
     n_wl = tables[CANX1_MATERIALS[0]].sizes["wavelength"]
 

@@ -217,7 +217,7 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
     rot = builtin_scene("canx1-rotation")
     simulate(rot).compute()
     t_rot = best_time(lambda: simulate(rot).compute(), repeat)
-    one = rot.with_options(attitudes=rot.attitudes[:1], attitude_angle=None)
+    one = rot.with_options(attitudes=np.asarray(rot.attitudes)[:1], attitude_angle=None)
     simulate(one).compute()
     t_one = best_time(lambda: simulate(one).compute(), repeat, number=20)
     sweep = "end to end, warm"

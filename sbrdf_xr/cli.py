@@ -62,15 +62,15 @@ def _escaped_attrs(obj: Any) -> Any:
             out[name].attrs = clean(obj[name].attrs)
         return out.rename({n: escape(n, True) for n in out.variables if escape(n, True) != n})
     if isinstance(obj, xr.DataArray):
-        out = obj.copy()
-        out.attrs = clean(obj.attrs)
-        for c in out.coords:
-            out[c].attrs = clean(obj[c].attrs)
-        return out
+        arr = obj.copy()
+        arr.attrs = clean(obj.attrs)
+        for c in arr.coords:
+            arr[c].attrs = clean(obj[c].attrs)
+        return arr
     return obj
 
 
-def _open_dataset(path: str) -> Any:
+def _open_dataset(path: str | Path) -> Any:
     """Open a netCDF file, turning "not netCDF" into a :class:`ValidationError`."""
     import xarray as xr
 
@@ -90,7 +90,7 @@ def _open_dataset(path: str) -> Any:
         raise ValidationError(f"{path}: not a readable netCDF file ({why})") from None
 
 
-def _open_cube(path: str) -> Any:
+def _open_cube(path: str | Path) -> Any:
     """A loaded simulation cube, or :class:`ValidationError` naming what is missing."""
     with _open_dataset(path) as ds:
         spectral = [
@@ -268,7 +268,7 @@ def _cmd_knobs(args: argparse.Namespace) -> int:
     return 0
 
 
-def _save_figure(cube_path: str, figure_path: str) -> None:
+def _save_figure(cube_path: str | Path, figure_path: str) -> None:
     import matplotlib
 
     matplotlib.use("Agg")

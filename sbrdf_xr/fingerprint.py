@@ -72,7 +72,11 @@ _PARTS = {
 def _canonical(value: Any) -> Any:
     """A JSON-able, order-independent image of ``value`` (arrays by dtype, shape and hash)."""
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return {f.name: _canonical(getattr(value, f.name)) for f in dataclasses.fields(value)}
+        return {
+            f.name: _canonical(getattr(value, f.name))
+            for f in dataclasses.fields(value)
+            if f.compare  # not caches and derived state
+        }
     if isinstance(value, Mapping):
         return {str(k): _canonical(v) for k, v in sorted(value.items(), key=lambda kv: str(kv[0]))}
     if isinstance(value, np.ndarray):
@@ -102,7 +106,7 @@ def _array_sha(a: Any) -> str:
     if arr.dtype.kind in "OUS":
         h.update(json.dumps([str(x) for x in arr.ravel().tolist()]).encode())
     else:
-        h.update(memoryview(arr).cast("B"))
+        h.update(arr.data.cast("B"))
     return h.hexdigest()
 
 

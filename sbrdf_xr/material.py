@@ -208,7 +208,7 @@ def lookup_anisotropic(
     if grid[-1] < 180.0:
         x = np.clip(x, grid[0], grid[-1])
     idx, w = _lut.axis_weights(grid, x.ravel(), "linear")
-    grids = [np.asarray(material[d].values) for d in ANGLE_DIMS]
+    tg, dg, pg = (np.asarray(material[d].values) for d in ANGLE_DIMS)
     values = np.asarray(material.values)
     out = np.zeros((x.size, material.sizes[WAVELENGTH]))
     edges = _lut.table_edges(material.attrs)
@@ -218,7 +218,9 @@ def lookup_anisotropic(
         if sel.size:
             spec = _lut.lookup_kernel(
                 values[:, :, :, k, :],
-                *grids,
+                tg,
+                dg,
+                pg,
                 ti.ravel()[sel],
                 dt.ravel()[sel],
                 ph.ravel()[sel],
@@ -430,6 +432,7 @@ def build_lut(
         lut = np.tensordot(e, per_theta, axes=(1, 0))
         np.maximum(lut, 0.0, out=lut)
         if extrapolation == "model":
+            assert fit_model is not None  # fitted above whenever a model is used
             w = blend_weights(ti_out, measured_ti[0], measured_ti[-1], blend)
             rows = np.flatnonzero(w > 0)
             if rows.size:
@@ -437,6 +440,7 @@ def build_lut(
                 wr = w[rows][:, None, None, None]
                 lut[rows] = (1.0 - wr) * lut[rows] + wr * filled
     else:
+        assert fit_model is not None  # fitted above whenever a model is used
         dt_grid = extend_grid(dt_grid, -180.0, 90.0)
         phi_grid = extend_grid(phi_grid, phi_grid[0], 90.0)
         # Beyond -180/90 and phi = 90 lies the far side of the horizon: nothing to hold.
@@ -471,7 +475,7 @@ def build_lut(
         lut = _model_rows(fit_model, ti_out, dt_grid, phi_grid, wl) * r_lut
         if extrapolation == "model":
             _bound_grazing_rows(lut, ti_out, dt_grid, phi_grid, wl, fit_model, measured_ti[-1])
-    if extrapolation == "model" or below_noise == "model":
+    if fit_model is not None and (extrapolation == "model" or below_noise == "model"):
         extra = {
             "extrapolation_model": fit_model.attrs.get("model", ""),
             "extrapolation_model_provenance": fit_model.attrs.get("provenance", ""),
@@ -613,11 +617,13 @@ def hemispherical_reflectance(
         Dims ``(theta_i, wavelength)``, ``units = 1``.
     """
     material = validate_material(material, check_values=False)
-    grids = [np.asarray(material[d].values) for d in ANGLE_DIMS]
-    ti = grids[0] if theta_i is None else np.atleast_1d(np.asarray(theta_i, dtype=np.float64))
+    tg, dg, pg = (np.asarray(material[d].values) for d in ANGLE_DIMS)
+    ti = tg if theta_i is None else np.atleast_1d(np.asarray(theta_i, dtype=np.float64))
     rho = _lut.hemispherical_reflectance_kernel(
         np.asarray(material.values),
-        *grids,
+        tg,
+        dg,
+        pg,
         ti,
         method,
         zero_edges=_lut.table_edges(material.attrs),

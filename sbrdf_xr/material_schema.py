@@ -268,8 +268,9 @@ def lambertian(
 
     wl = np.atleast_1d(np.asarray(wavelength, dtype=np.float64))
     rho = lambert.check_params(wl, rho=albedo)["rho"]
-    scalar = np.ndim(albedo) == 0
-    name = material or (f"lambertian-{float(albedo):g}" if scalar else "lambertian")
+    alb = np.asarray(albedo, dtype=np.float64)
+    scalar = alb.ndim == 0
+    name = material or (f"lambertian-{float(alb):g}" if scalar else "lambertian")
     return constant_material(
         rho / np.pi,
         wl,
@@ -277,10 +278,10 @@ def lambertian(
         source="model:lambert",
         provenance=(
             "ideal Lambertian reflector, f_r = albedo / pi "
-            f"({'albedo ' + format(float(albedo), 'g') if scalar else 'spectral albedo'})"
+            f"({'albedo ' + format(float(alb), 'g') if scalar else 'spectral albedo'})"
         ),
         model="lambert",
-        albedo=float(albedo) if scalar else rho,
+        albedo=float(alb) if scalar else rho,
     )
 
 

@@ -270,11 +270,16 @@ def _ply_face_props(raw: Any) -> set[str]:
     return set()
 
 
+def _is_none(a: np.ndarray) -> np.ndarray:
+    """Elementwise ``a is None`` (for object arrays of labels)."""
+    return np.equal(a, np.array(None, dtype=object))
+
+
 def _visual_labels(mesh: trimesh.Trimesh) -> tuple[np.ndarray | None, str | None]:
     """Per-face colours and the material name carried by a mesh's visual."""
     visual = getattr(mesh, "visual", None)
     kind = getattr(visual, "kind", None)
-    if kind in ("face", "vertex"):
+    if visual is not None and kind in ("face", "vertex"):
         return np.asarray(visual.face_colors)[:, :3], None
     material = getattr(visual, "material", None)
     if material is not None:
@@ -365,13 +370,13 @@ def label_faces(
     n = len(rgb)
     material = np.full(n, None, dtype=object)
     for cand in names:
-        todo = np.flatnonzero(np.equal(material, None) & ~np.equal(cand, None))
+        todo = np.flatnonzero(_is_none(material) & ~_is_none(cand))
         if len(todo) == 0:
             continue
         uniq, inv = np.unique(cand[todo].astype(str), return_inverse=True)
         lookup = np.array([name_map.get(u) for u in uniq], dtype=object)
         material[todo] = lookup[inv]
-    todo = np.flatnonzero(np.equal(material, None))
+    todo = np.flatnonzero(_is_none(material))
     unmapped_colours: list[Color] = []
     if len(todo) and colours:
         have = todo[(rgb[todo] >= 0).all(axis=1)]
@@ -390,7 +395,7 @@ def label_faces(
                     c = u if labelled.rgb_bits == 8 else np.round(u * 255 / 31)
                     unmapped_colours.append((int(c[0]), int(c[1]), int(c[2])))
             material[have] = lookup[inv.reshape(-1)]
-    missing = np.flatnonzero(np.equal(material, None))
+    missing = np.flatnonzero(_is_none(material))
     if len(missing):
         labels: list[Any] = list(dict.fromkeys(unmapped_colours))
         for cand in names:

@@ -101,7 +101,7 @@ def model_material(
     mod = _brdf.get_model(model)
     wl = np.asarray(wavelength, dtype=np.float64)
     checked = mod.check_params(wl, **params)
-    data = {
+    data: dict[str, tuple[str | tuple[str, ...], np.ndarray, dict[str, str]]] = {
         k: (
             WAVELENGTH,
             np.asarray(v, dtype=np.float64),
@@ -450,7 +450,7 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
         reference=_reference(ds),
         **kwargs,
     )
-    p = {k: np.asarray(fit[k], dtype=np.float64) for k in rs.PARAMS}
+    p: dict[str, Any] = {k: np.asarray(fit[k], dtype=np.float64) for k in rs.PARAMS}
     g_b = float(rs.normalisation_G(p["b"]))
     p["epsilon"] = np.minimum(
         np.broadcast_to(p["epsilon"], wl.shape), np.maximum(g_b - p["rho_D"], 0.0)

@@ -41,7 +41,7 @@ import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 import numpy as np
 import xarray as xr
@@ -601,11 +601,20 @@ def observation_from_dict(
 
 # --------------------------------------------------------------------------- examples
 
+
+class _PassWindow(TypedDict):
+    orbit: str
+    site: str
+    start: str
+    stop: str
+    step_s: float
+
+
 #: The built-in example: orbit and site catalog entries and the pass window (UTC), found
 #: with ``tools/build_observe.py``: the site in astronomical darkness (Sun below
 #: -25 deg), the spacecraft between 27 and 76 deg elevation, leaving the Earth's shadow
 #: in the first minute (penumbra 01:20:46-01:21:00) and sunlit for the remaining four.
-CANX1_PASS = {
+CANX1_PASS: _PassWindow = {
     "orbit": "canx1-example",
     "site": "mont-megantic",
     "start": "2024-03-17T01:20:00",

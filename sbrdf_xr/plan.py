@@ -199,7 +199,8 @@ class Plan:
             t.dgrid[t.d_off[m] : t.d_off[m + 1]],
             t.pgrid[t.p_off[m] : t.p_off[m + 1]],
         )
-        return values, grids, tuple(bool(x) for x in t.edges[m]), float(t.blend[m])  # type: ignore[return-value]
+        lo, hi, phi = (bool(x) for x in t.edges[m])
+        return values, grids, (lo, hi, phi), float(t.blend[m])
 
     @property
     def spectral_axis(self) -> np.ndarray:
@@ -403,7 +404,7 @@ def _models(scene: Scene, used: list[str]) -> dict[int, tuple[Any, Mapping[str, 
     from . import models as models_mod
 
     given = dict(scene.models or {})
-    out = {}
+    out: dict[int, tuple[Any, Mapping[str, Any]]] = {}
     for m, name in enumerate(used):
         spec = given.get(name)
         if spec is None:
@@ -513,7 +514,7 @@ def compile_plan(scene: Scene) -> Plan:
     if scene.bands:
         w = _band_weights(scene, wl)
         bw = np.asarray(w.values)
-        band_coords = {c: w[c] for c in w.coords if BAND in w[c].dims}
+        band_coords = {str(c): w[c] for c in w.coords if BAND in w[c].dims}
     spectral_asked = any(o in SPECTRAL_OUTPUTS for o in scene.outputs)
     pre = bool(scene.bands) and not spectral_asked and knobs["band_integration"] == "auto"
     dtype = np.dtype(knobs["dtype"])
@@ -533,7 +534,7 @@ def compile_plan(scene: Scene) -> Plan:
         for m in used:
             da = _table_on(scene.materials[m], wl, knobs["table_theta_step"])
             values = np.asarray(da.values)
-            if pre:
+            if pre and bw is not None:
                 values = np.asarray(values, dtype=np.float64) @ bw.T
             packed.append(
                 (
@@ -585,7 +586,7 @@ def compile_plan(scene: Scene) -> Plan:
 
     # ---- effects
     active = ["sunlight"]
-    params: dict[str, dict[str, Any]] = {}
+    params: dict[str, Mapping[str, Any]] = {}
     if shadowing:
         active.append("shadowing")
     if geo.sun_scale is not None:

@@ -49,6 +49,7 @@ import dask.array as dsa
 import numpy as np
 import xarray as xr
 from dask.highlevelgraph import HighLevelGraph
+from dask.typing import Key
 
 from ._names import WAVELENGTH, attrs
 from ._writer import write_cube
@@ -147,7 +148,9 @@ def _lazy(plan: Plan, client: Any = None) -> dict[str, dsa.Array]:
     for o in plan.outputs:
         name = f"sbrdf-{o.name}-{token}"
         rest = (0,) * (len(o.shape) - 1)
-        layer = {(name, k, *rest): (_pick, (block_name, k), o.name) for k in range(nb)}
+        layer: dict[Key, Any] = {
+            (name, k, *rest): (_pick, (block_name, k), o.name) for k in range(nb)
+        }
         graph = HighLevelGraph(
             layers={block_name: block_layer, name: layer},
             dependencies={block_name: set(), name: {block_name}},

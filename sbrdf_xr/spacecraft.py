@@ -173,6 +173,8 @@ def load_spacecraft(
             f"material (one material for every facet); got material_map={material_map!r}, "
             f"material={material!r}"
         )
+    colours: dict[Color, str] = {}
+    name_map: dict[str, str] = {}
     if material is not None:
         if not isinstance(material, str) or not material.strip():
             raise ValidationError(f"material: expected a non-empty material name, got {material!r}")
@@ -181,22 +183,24 @@ def load_spacecraft(
                 f"material: {material!r} does not exist; "
                 f"known materials: {sorted(set(known_materials))}"
             )
-        colours, name_map = {}, {}
-    else:
+    elif material_map is not None:
         colours, name_map = normalise_map(material_map, known_materials)
     labelled, default_name = read_mesh(path_or_mesh, face_property, file_type)
     vertices, faces, rgb, names = labelled.arrays()
     if len(faces) == 0:
         raise MeshError("the mesh is empty: it has no facets")
-    if material is not None:
-        material = np.full(len(faces), material, dtype=object)
-    else:
-        material = label_faces(labelled, rgb, names, colours, name_map)
+    facet_material = (
+        np.full(len(faces), material, dtype=object)
+        if material is not None
+        else label_faces(labelled, rgb, names, colours, name_map)
+    )
     with np.errstate(invalid="ignore", over="ignore"):
         vertices = vertices * factor
-    mesh, material = clean_mesh(vertices, faces, material, repair)
+    mesh, facet_material = clean_mesh(vertices, faces, facet_material, repair)
     palette = {m: c for c, m in colours.items()}
-    return Spacecraft(mesh, material, name=name or default_name or "spacecraft", colors=palette)
+    return Spacecraft(
+        mesh, facet_material, name=name or default_name or "spacecraft", colors=palette
+    )
 
 
 class Spacecraft:
@@ -445,7 +449,8 @@ class Spacecraft:
             if colors and m in colors:
                 palette[m] = to_rgba(colors[m])
             elif m in self.colors:
-                palette[m] = to_rgba(np.asarray(self.colors[m]) / 255.0)
+                r, g, b = self.colors[m]
+                palette[m] = to_rgba((r / 255.0, g / 255.0, b / 255.0))
             else:
                 palette[m] = to_rgba(cycle[i % len(cycle)])
         names, code = np.unique(self.facet_material, return_inverse=True)

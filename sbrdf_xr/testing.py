@@ -148,7 +148,7 @@ TEST_SPACECRAFT_MATERIAL = "white-paint-a276"
 def _ear_clip(polygon: np.ndarray) -> np.ndarray:
     """Triangles (index triples, counter-clockwise) of a simple counter-clockwise polygon."""
     idx = list(range(len(polygon)))
-    tris = []
+    tris: list[tuple[int, ...]] = []
 
     def cross(o, a, b):
         return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])

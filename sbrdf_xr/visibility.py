@@ -67,7 +67,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable
-from typing import Any
+from typing import Any, Literal, overload
 
 import numpy as np
 import trimesh
@@ -257,13 +257,13 @@ def _intersector(
     else:
         from trimesh.ray import ray_triangle
 
-        rmi = ray_triangle.RayMeshIntersector(mesh)
+        tri_rmi = ray_triangle.RayMeshIntersector(mesh)
 
         def hits(origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
             # trimesh counts hits up to 1e-6 model units *behind* the origin; keep only
             # hits strictly in front of it (own-plane hits are at -offset / N.d < 0).
             out = np.zeros(len(origins), dtype=bool)
-            _, index_ray, loc = rmi.intersects_id(
+            _, index_ray, loc = tri_rmi.intersects_id(
                 origins, directions, multiple_hits=True, return_locations=True
             )
             index_ray = np.asarray(index_ray, dtype=np.int64)
@@ -570,6 +570,38 @@ def visible_fraction(
     )
 
 
+@overload
+def lit_visible_fraction(
+    spacecraft: Spacecraft | trimesh.Trimesh,
+    to_sun: ArrayLike,
+    to_observer: ArrayLike,
+    *,
+    method: str = ...,
+    density: int | str = ...,
+    engine: str | None = ...,
+    offset: float | None = ...,
+    convex_shortcut: bool = ...,
+    seed: int = ...,
+    return_error: Literal[False] = ...,
+) -> NDArray[np.float64]: ...
+
+
+@overload
+def lit_visible_fraction(
+    spacecraft: Spacecraft | trimesh.Trimesh,
+    to_sun: ArrayLike,
+    to_observer: ArrayLike,
+    *,
+    method: str = ...,
+    density: int | str = ...,
+    engine: str | None = ...,
+    offset: float | None = ...,
+    convex_shortcut: bool = ...,
+    seed: int = ...,
+    return_error: Literal[True],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+
+
 def lit_visible_fraction(
     spacecraft: Spacecraft | trimesh.Trimesh,
     to_sun: ArrayLike,
@@ -618,7 +650,7 @@ def lit_visible_fraction(
     f, err = _fractions(
         spacecraft, [ds, do], method, density, engine, offset, convex_shortcut, seed, return_error
     )
-    if return_error:
+    if return_error and err is not None:
         return f.reshape(*shape, -1), err.reshape(*shape, -1)
     return f.reshape(*shape, -1)
 

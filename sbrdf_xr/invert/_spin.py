@@ -294,10 +294,12 @@ def _search(
     chunk: int = 256,
 ) -> np.ndarray:
     """Chi-square over the grid (axes, periods, phases), threads over chunks of candidates."""
-    ia, ip, iq = np.meshgrid(
-        np.arange(len(axes)), np.arange(len(periods)), np.arange(len(phases)), indexing="ij"
+    ia, ip, iq = (
+        g.ravel()
+        for g in np.meshgrid(
+            np.arange(len(axes)), np.arange(len(periods)), np.arange(len(phases)), indexing="ij"
+        )
     )
-    ia, ip, iq = ia.ravel(), ip.ravel(), iq.ravel()
     out = np.empty(ia.size)
     edges = [*list(range(0, ia.size, chunk)), ia.size]
 

@@ -262,13 +262,15 @@ def unmix(
         results = {c: score(c) for c in subsets}
         best = min(results, key=lambda c: results[c][crit])
     elif select == "greedy":
-        results, chosen, best = {}, (), None
+        results = {}
+        chosen: tuple[int, ...] = ()
+        best = chosen  # () until the first subset is scored
         while len(chosen) < kmax:
             trial = {tuple(sorted((*chosen, j))): None for j in range(k) if j not in chosen}
             for c in trial:
                 results[c] = score(c)
             cand = min(trial, key=lambda c: results[c][crit])
-            if best is not None and results[cand][crit] >= results[best][crit]:
+            if best and results[cand][crit] >= results[best][crit]:
                 break
             best = chosen = cand
     else:

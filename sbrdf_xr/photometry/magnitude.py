@@ -187,7 +187,8 @@ def band_signal(
     return out
 
 
-def _range_m(range_km: Any) -> Any:
+def _range_m(range_km: Any) -> xr.DataArray | np.ndarray:
+    r: xr.DataArray | np.ndarray
     if isinstance(range_km, xr.DataArray):
         vals = np.asarray(range_km.values, dtype=np.float64)
         r = range_km.astype(np.float64) * 1e3

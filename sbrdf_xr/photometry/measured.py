@@ -95,7 +95,7 @@ def _from_astropy(path: Path, fmt: str) -> tuple[Any, dict[str, Any], dict[str, 
                 f"{path}: column {key!r} is not one value per row (shape {col.shape})"
             )
         unit = getattr(col, "unit", None)
-        data = (
+        data: np.ndarray | list[str] = (
             np.ma.filled(np.ma.asarray(col), np.nan) if col.dtype.kind in "fiu" else np.asarray(col)
         )
         if key in want and unit is not None and col.dtype.kind in "fiu":

@@ -263,8 +263,7 @@ def at_resolution(
         fwhm = x / float(resolving_power)
         how = f"Gaussian line-spread function, resolving power R = {resolving_power:g}"
     else:
-        _positive(fwhm_nm, "fwhm_nm")
-        fwhm = np.full(x.size, float(fwhm_nm))
+        fwhm = np.full(x.size, float(_positive(fwhm_nm, "fwhm_nm")))
         how = f"Gaussian line-spread function, FWHM {fwhm_nm:g} nm"
     sigma = fwhm / (2.0 * np.sqrt(2.0 * np.log(2.0)))
     edges = np.concatenate([[t[0]], 0.5 * (t[1:] + t[:-1]), [t[-1]]])
