@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from . import catalog, material
+from . import _lut, catalog, material
 from .goniometer import measure
 from .testing import lobe_function
 
@@ -148,7 +148,7 @@ def bench_lookup(
     values = np.asarray(lut.values)
 
     def ours() -> np.ndarray:
-        return material._lut.lookup_kernel(values, tg, dg, pg, ti, dt, ph)
+        return _lut.lookup_kernel(values, tg, dg, pg, ti, dt, ph)
 
     def xr_interp() -> xr.DataArray:
         return lut.interp(theta_i=dims[0], delta_theta=dims[1], phi=dims[2], method="linear").load()

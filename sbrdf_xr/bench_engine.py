@@ -69,7 +69,7 @@ def sweep_job(
     """
     import resource
 
-    from .simulate import _n_threads, run_block, simulate, write
+    from .simulate import default_n_threads, run_block, simulate, write
 
     scene = _sweep_scene(n, bands)
     plan = scene.plan()
@@ -95,7 +95,7 @@ def sweep_job(
             )
 
         t0 = time.perf_counter()
-        with ThreadPoolExecutor(_n_threads()) as pool:
+        with ThreadPoolExecutor(default_n_threads()) as pool:
             list(pool.map(one, blocks))
         seconds = time.perf_counter() - t0
     elif mode == "zarr":

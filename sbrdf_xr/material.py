@@ -51,12 +51,12 @@ from .material_io import open_material, open_measurements, to_netcdf, write_netc
 from .material_schema import (
     DUPLICATES,  # noqa: F401  (re-exported)
     SOURCES,  # noqa: F401  (re-exported)
-    _average_duplicates,
-    _check_coord,
-    _reference,
+    average_duplicates,
+    check_coord,
     constant_material,
     lambertian,
     new_material,
+    reference_mask,
     validate_material,
     validate_measurements,
 )
@@ -383,7 +383,7 @@ def build_lut(
     """
     ds = validate_measurements(measurements, duplicates=duplicates)
     if duplicates == "mean":
-        ds = _average_duplicates(ds)
+        ds = average_duplicates(ds)
     if extrapolation not in EXTRAPOLATIONS:
         raise ValidationError(
             f"extrapolation: got {extrapolation!r}; allowed: {', '.join(EXTRAPOLATIONS)}"
@@ -396,7 +396,7 @@ def build_lut(
         raise ValidationError(
             f"below_noise: got {below_noise!r}; allowed: {', '.join(BELOW_NOISE)}"
         )
-    ref = _reference(ds)
+    ref = reference_mask(ds)
     ti_s = np.asarray(ds[THETA_I].values, dtype=np.float64)
     dt_s = np.asarray(ds[DELTA_THETA].values, dtype=np.float64)
     ph_s = np.asarray(ds[PHI].values, dtype=np.float64)
@@ -412,7 +412,7 @@ def build_lut(
     phi_grid = paper_phi_grid(ph_s.max(), n_phi)
     dt_grid = paper_delta_theta_grid(dt_s.min(), dt_s.max(), n_delta_theta)
     ti_out = np.arange(0.0, 91.0) if theta_i is None else np.asarray(theta_i, dtype=np.float64)
-    _check_coord("theta_i", ti_out)
+    check_coord("theta_i", ti_out)
     lam = _lut.csaps_default_lambda(measured_ti) if smoothing == "csaps" else float(smoothing)
     extra: dict[str, Any] = {}
     fit_model = model

@@ -436,7 +436,7 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
     from ._names import MEASURED, SAMPLE
     from .brdf import robertson_sandford as rs
     from .brdf import robertson_sandford_fit
-    from .material_schema import _reference, validate_measurements
+    from .material_schema import reference_mask, validate_measurements
 
     ds = validate_measurements(measurements, duplicates="mean")
     wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
@@ -447,7 +447,7 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
         ds[PHI].values,
         wl,
         spectra,
-        reference=_reference(ds),
+        reference=reference_mask(ds),
         **kwargs,
     )
     p: dict[str, Any] = {k: np.asarray(fit[k], dtype=np.float64) for k in rs.PARAMS}
