@@ -31,11 +31,14 @@ import hashlib
 import json
 import re
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ._version import __version__
+
+if TYPE_CHECKING:
+    from .scene_model import Scene
 
 __all__ = ["PREFIX", "changes", "scene_fingerprint"]
 
@@ -175,7 +178,7 @@ def _mesh_sha(spacecraft: Any) -> str:
     )
 
 
-def scene_fingerprint(scene: Any) -> dict[str, str]:
+def scene_fingerprint(scene: Scene) -> dict[str, str]:
     """Content fingerprint of a scene, as flat netCDF global attributes.
 
     Parameters
