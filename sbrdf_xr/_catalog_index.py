@@ -4,8 +4,10 @@ The catalog directory holds ``index.toml``, one ``[[entry]]`` table per item::
 
     [[entry]]
     name = "lambertian-grey-50"          # unique, lower-case, used by load()
-    kind = "material"                    # material | measurements | model | paint_parameters | spacecraft
-                                         # | orbit (a TLE file) | site (a table of a TOML file of sites)
+    kind = "material"                    # material | measurements | model
+                                         # | paint_parameters | spacecraft
+                                         # | orbit (a TLE file)
+                                         # | site (a table of a TOML file of sites)
     path = "materials/lambertian-grey-50.nc"   # relative to the catalog directory
     source = "synthetic"                 # measured | synthetic | model:<name>
     description = "..."                  # what it is
@@ -245,7 +247,8 @@ def _read_index(path: Path, stamp: tuple[int, int], root: Path | None) -> tuple[
         src = item["source"]
         if src not in SOURCES and not src.startswith("model:"):
             raise CatalogError(
-                f"{path}: entry {item['name']!r} has source {src!r}; allowed: measured, synthetic, model:<name>"
+                f"{path}: entry {item['name']!r} has source {src!r}; "
+                "allowed: measured, synthetic, model:<name>"
             )
         extra = {k: v for k, v in item.items() if k not in required}
         out.append(CatalogEntry(*(item[k] for k in required), extra=extra, root=root))

@@ -1,4 +1,7 @@
-"""The exclusive writer lock of a cube (``<path>.lock``): flock where the file system has it, a PID file otherwise, stale locks taken over."""
+"""The exclusive writer lock of a cube (``<path>.lock``).
+
+flock where the file system has it, a PID file otherwise, stale locks taken over.
+"""
 
 from __future__ import annotations
 
@@ -36,7 +39,10 @@ def _pid_alive(pid: Any) -> bool:
 
 
 def _try_flock(fd: int) -> bool | None:
-    """True if this process now holds ``flock`` on ``fd``, False if another holds it, None if unsupported."""
+    """True if this process now holds ``flock`` on ``fd``.
+
+    False if another holds it, None if unsupported.
+    """
     try:
         import fcntl
     except ImportError:  # pragma: no cover - not on POSIX
@@ -153,7 +159,8 @@ class _Lock:
                     raise CubeLockedError(
                         f"{self.target} is locked by pid {pid} on host {host} (started "
                         f"{info.get('started')}); whether that writer still runs cannot be checked "
-                        f"from {socket.gethostname()}. If it does not, remove {self.path} and try again"
+                        f"from {socket.gethostname()}. If it does not, remove {self.path} "
+                        "and try again"
                     )
                 if held is None and _pid_alive(pid):
                     raise self._locked(info)

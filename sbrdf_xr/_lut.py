@@ -44,10 +44,11 @@ def table_edges(attrs: dict) -> tuple[bool, bool, bool]:
     ``edge_delta_theta_max`` and ``edge_phi_max`` as ``"zero"`` (a reference point)
     or ``"hold"`` (a measured point where the apparatus stopped).
     """
-    return tuple(
+    lo, hi, phi = (
         attrs.get(k, "zero") != "hold"
         for k in ("edge_delta_theta_min", "edge_delta_theta_max", "edge_phi_max")
-    )  # type: ignore[return-value]
+    )
+    return lo, hi, phi
 
 
 def table_normal_blend(attrs: dict) -> float:
@@ -421,11 +422,11 @@ def smoothing_spline_matrix(
     else:
         f, c = eye, np.zeros((n, n))
     # Evaluate the piecewise cubic with values f and second derivatives c.
-    j = np.clip(np.searchsorted(x, xo, side="right") - 1, 0, n - 2)
-    hj = h[j][:, None]
-    a = (x[j + 1][:, None] - xo[:, None]) / hj
-    b = (xo[:, None] - x[j][:, None]) / hj
-    e = a * f[j] + b * f[j + 1] + ((a**3 - a) * c[j] + (b**3 - b) * c[j + 1]) * hj**2 / 6.0
+    k = np.clip(np.searchsorted(x, xo, side="right") - 1, 0, n - 2)
+    hk = h[k][:, None]
+    a = (x[k + 1][:, None] - xo[:, None]) / hk
+    b = (xo[:, None] - x[k][:, None]) / hk
+    e = a * f[k] + b * f[k + 1] + ((a**3 - a) * c[k] + (b**3 - b) * c[k + 1]) * hk**2 / 6.0
     if extrapolation != "cubic":
         lo, hi = xo < x[0], xo > x[-1]
         slope0 = (f[1] - f[0]) / h[0] - h[0] * (2 * c[0] + c[1]) / 6.0

@@ -92,7 +92,9 @@ ATTRS: dict[str, dict[str, str]] = {
     "n_facets": {"units": "1", "long_name": "number of facets merged into the term"},
     "tangent": {
         "units": "1",
-        "long_name": "unit facet tangent in the body frame (anisotropic materials' alpha_x direction)",
+        "long_name": (
+            "unit facet tangent in the body frame (anisotropic materials' alpha_x direction)"
+        ),
     },
     "facet_term": {"units": "1", "long_name": "term that each facet is merged into"},
     "lit_fraction": {
@@ -120,7 +122,10 @@ ATTRS: dict[str, dict[str, str]] = {
     },
     "band_weight": {
         "units": "1",
-        "long_name": "band-integration weight (solar spectrum x filter x spectral weighting x quadrature weight)",
+        "long_name": (
+            "band-integration weight "
+            "(solar spectrum x filter x spectral weighting x quadrature weight)"
+        ),
     },
     "band_signal": {
         "units": "m2 sr-1",

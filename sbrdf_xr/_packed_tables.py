@@ -9,7 +9,7 @@ from __future__ import annotations
 from typing import Any, NamedTuple
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import DTypeLike, NDArray
 
 __all__ = ["MAX_BUCKETS", "PackedTables", "bucket_map", "pack_tables"]
 
@@ -70,7 +70,7 @@ class PackedTables(NamedTuple):
 def pack_tables(
     tables: list[tuple[Any, ...]],
     n_spectral: int = 1,
-    dtype: np.dtype | str = np.float64,
+    dtype: DTypeLike = np.float64,
 ) -> PackedTables:
     """Pack ``(values, theta_grid, delta_theta_grid, phi_grid, zero_edges[, normal_blend])``
     per material.

@@ -117,7 +117,8 @@ def tilted_terms(
         (
             "imperfections",
             f"facet normals tilted by a Gaussian ({what}; paper 000 section 5), "
-            f"{nodes}x{nodes} Gauss-Hermite copies per term: {raw['area'].size} -> {out['area'].size} terms",
+            f"{nodes}x{nodes} Gauss-Hermite copies per term: "
+            f"{raw['area'].size} -> {out['area'].size} terms",
         )
     )
     return out

@@ -1,11 +1,15 @@
-"""How the cube writer computes its blocks: in the calling thread, in a thread pool, or on a Dask distributed cluster (and connecting to one)."""
+"""How the cube writer computes its blocks.
+
+In the calling thread, in a thread pool, or on a Dask distributed cluster (and
+connecting to one).
+"""
 
 from __future__ import annotations
 
 import contextlib
 from collections import deque
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
-from typing import Any
+from typing import Any, Protocol
 
 import dask
 import numpy as np
@@ -18,6 +22,23 @@ from ._write_common import (
     SchedulerError,
 )
 from .errors import ValidationError
+
+
+class _Runner(Protocol):
+    """What the writer asks of a runner: submit blocks, take them back as they finish."""
+
+    n_workers: int
+
+    @property
+    def pending(self) -> int: ...
+
+    def submit(self, k: int, task: tuple[dict[Any, Any], Any]) -> None: ...
+
+    def next_done(self) -> tuple[int, Any]: ...
+
+    def result(self, handle: Any) -> tuple[np.ndarray, ...]: ...
+
+    def close(self) -> None: ...
 
 
 class _SyncRunner:
@@ -114,7 +135,7 @@ class _DistributedRunner:
             self.client.close()
 
 
-def _runner(client: Any, scheduler: str | None) -> _SyncRunner | _ThreadRunner | _DistributedRunner:
+def _runner(client: Any, scheduler: str | None) -> _Runner:
     if client is not None and scheduler is not None:
         raise ValidationError("pass either client or scheduler, not both")
     if client is not None:
@@ -188,7 +209,8 @@ def connect(address: str, timeout: float | str | None = None) -> Any:
         from distributed import Client
     except ImportError as exc:  # pragma: no cover - distributed is a test dependency
         raise SchedulerError(
-            f"scheduler {address!r} needs the 'distributed' package (pip install sbrdf-xr[distributed])"
+            f"scheduler {address!r} needs the 'distributed' package "
+            "(pip install sbrdf-xr[distributed])"
         ) from exc
     if timeout is None:
         timeout = dask.config.get("distributed.comm.timeouts.connect", "30s")

@@ -210,7 +210,8 @@ class _Plan:
         return math.prod(self.grid) if self.block_dims else 0
 
     def index(self, k: int) -> dict[str, int]:
-        return dict(zip(self.block_dims, np.unravel_index(k, self.grid), strict=True))
+        idx = (int(i) for i in np.unravel_index(k, self.grid))
+        return dict(zip(self.block_dims, idx, strict=True))
 
     def slices(self, k: int) -> dict[str, slice]:
         idx = self.index(k)
@@ -401,7 +402,8 @@ def _difference(old: Mapping[str, Any], new: Mapping[str, Any]) -> str:
     oa, na = old.get("attrs", {}), new.get("attrs", {})
     keys = sorted(k for k in set(oa) | set(na) if oa.get(k) != na.get(k))
     if keys:
-        return f"global attribute{'s' if len(keys) > 1 else ''} {', '.join(map(repr, keys[:5]))} differ"
+        plural = "s" if len(keys) > 1 else ""
+        return f"global attribute{plural} {', '.join(map(repr, keys[:5]))} differ"
     return "the file format version differs"
 
 
@@ -780,7 +782,8 @@ def _check_destination(path: Path, part: Path, log: Path, overwrite: bool, resum
         if has_path and not overwrite:
             raise FileExistsError(
                 f"{path} exists and {part} holds an unfinished write of it: pass {_opt('resume')} "
-                f"with {_opt('overwrite')} to finish it and replace {path.name}, or remove one of them"
+                f"with {_opt('overwrite')} to finish it and replace {path.name}, "
+                "or remove one of them"
             )
         return "resume"
     if has_path and resume and not overwrite:
@@ -822,7 +825,8 @@ def _check_finished(path: Path, ds: xr.Dataset) -> None:
                 break
     if problems:
         raise CubeWriteError(
-            f"{path} is a finished cube of other inputs ({'; '.join(problems)}); nothing was resumed. "
+            f"{path} is a finished cube of other inputs ({'; '.join(problems)}); "
+            "nothing was resumed. "
             f"Pass {_opt('overwrite')} to replace it"
         )
     _log.info("%s is already complete; there is nothing to resume", path)
@@ -1124,18 +1128,19 @@ def _write_locked(
                     nc.close()
                 nc = None
             lost = _cut_back(part, good, head)
-        head = f"writing {path} failed {where}after {len(done)} of {plan.n_blocks} blocks: {why}. "
+        intro = f"writing {path} failed {where}after {len(done)} of {plan.n_blocks} blocks: {why}. "
         if lost is not None:
-            raise CubeWriteError(f"{head}{part} could not be kept ({lost}); {_discard()}") from exc
+            raise CubeWriteError(f"{intro}{part} could not be kept ({lost}); {_discard()}") from exc
         if writing and good >= 0:
             raise CubeWriteError(
-                f"{head}HDF5 failed in the middle of a block; {part} was cut back to its last "
-                f"synced state, with the blocks written so far. {_fix(why)[0].upper()}{_fix(why)[1:]} "
+                f"{intro}HDF5 failed in the middle of a block; {part} was cut back to its last "
+                f"synced state, with the blocks written so far. "
+                f"{_fix(why)[0].upper()}{_fix(why)[1:]} "
                 f"and {_again()}; should HDF5 fail again at the same block, the file cannot be "
                 f"continued: {_discard()}"
             ) from exc
         raise CubeWriteError(
-            f"{head}The blocks written so far are kept in {part}; {_fix(why)} and {_again()} "
+            f"{intro}The blocks written so far are kept in {part}; {_fix(why)} and {_again()} "
             "to compute only the missing blocks"
         ) from exc
     except BaseException as exc:

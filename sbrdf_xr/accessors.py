@@ -66,7 +66,10 @@ class SbrdfDataArrayAccessor:
 
     @property
     def plot(self) -> _Plotter:
-        """Figures of this array: ``da.sbrdf.plot.magnitudes()``, ``da.sbrdf.plot.lut_slice(30)``."""
+        """Figures of this array.
+
+        ``da.sbrdf.plot.magnitudes()``, ``da.sbrdf.plot.lut_slice(30)``.
+        """
         return _Plotter(self._da, {"magnitudes": "magnitudes", "lut_slice": "lut_slice"})
 
 

@@ -33,7 +33,7 @@ Composed            ``outer * inner``: ``R(t) = R_outer(t) R_inner(t)``
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -176,6 +176,7 @@ class Nadir(AttitudeLaw):
     yaw_deg: float = 0.0
     nadir_axis: Any = "+z"
     velocity_axis: Any = "+x"
+    _axes: tuple[np.ndarray, np.ndarray] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not np.isfinite(self.yaw_deg):
@@ -190,7 +191,7 @@ class Nadir(AttitudeLaw):
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         n = np.atleast_1d(np.asarray(times)).shape[0]
         r, v = context_fields(context, n, "nadir", "position_km", "velocity_km_s")
-        a, b = self._axes  # type: ignore[attr-defined]
+        a, b = self._axes
         q = triad(a, b, -r, v)
         if self.yaw_deg:
             yaw = Rotation.from_rotvec(np.radians(self.yaw_deg) * a)
@@ -232,6 +233,9 @@ class SunPointing(AttitudeLaw):
     axis: Any = "+z"
     secondary_axis: Any = "+x"
     secondary_target: Any = "orbit_normal"
+    _axes: tuple[np.ndarray, np.ndarray, str | np.ndarray] = field(
+        init=False, repr=False, compare=False
+    )
 
     def __post_init__(self) -> None:
         a, b = perpendicular_pair(
@@ -243,7 +247,8 @@ class SunPointing(AttitudeLaw):
         if isinstance(tgt, str):
             if tgt not in _SECONDARY_TARGETS:
                 raise AttitudeError(
-                    f"sun_pointing secondary_target: got {tgt!r}; allowed: {', '.join(_SECONDARY_TARGETS)} "
+                    f"sun_pointing secondary_target: got {tgt!r}; "
+                    f"allowed: {', '.join(_SECONDARY_TARGETS)} "
                     "or 3 components"
                 )
         else:
@@ -252,7 +257,7 @@ class SunPointing(AttitudeLaw):
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         n = np.atleast_1d(np.asarray(times)).shape[0]
-        a, b, tgt = self._axes  # type: ignore[attr-defined]
+        a, b, tgt = self._axes
         (sun,) = context_fields(context, n, "sun_pointing", "sun_km")
         if isinstance(tgt, str) and tgt != "north":
             r, v = context_fields(context, n, "sun_pointing", "position_km", "velocity_km_s")
@@ -300,6 +305,7 @@ class Spin(AttitudeLaw):
     phase_deg: float = 0.0
     initial: Any = (0.0, 0.0, 0.0, 1.0)
     epoch: Any = None
+    _axis_vec: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         for name in ("rate_deg_s", "phase_deg"):
@@ -322,7 +328,7 @@ class Spin(AttitudeLaw):
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         ang = np.radians(self.angles(times, context))
-        spin = Rotation.from_rotvec(ang[:, None] * self._axis_vec[None, :])  # type: ignore[attr-defined]
+        spin = Rotation.from_rotvec(ang[:, None] * self._axis_vec[None, :])
         q0 = self.initial.quaternions(times, context)
         return (Rotation.from_quat(q0) * spin).as_quat().reshape(-1, 4)
 
@@ -338,7 +344,8 @@ def _inertia(value: ArrayLike) -> NDArray[np.float64]:
         arr = np.diag(arr)
     if arr.shape != (3, 3) or not np.all(np.isfinite(arr)):
         raise AttitudeError(
-            f"tumble inertia: expected 3 principal moments or a finite 3x3 tensor [kg m2], got shape {arr.shape}"
+            "tumble inertia: expected 3 principal moments or a finite 3x3 tensor [kg m2], "
+            f"got shape {arr.shape}"
         )
     if not np.allclose(arr, arr.T, rtol=1e-9, atol=1e-12 * np.abs(arr).max()):
         raise AttitudeError("tumble inertia: the tensor must be symmetric")
@@ -400,7 +407,8 @@ class Tumble(AttitudeLaw):
         w = np.asarray(self.omega_deg_s, dtype=np.float64)
         if w.shape != (3,) or not np.all(np.isfinite(w)):
             raise AttitudeError(
-                f"tumble omega_deg_s: expected 3 finite body rates [degree s-1], got {self.omega_deg_s!r}"
+                "tumble omega_deg_s: expected 3 finite body rates [degree s-1], "
+                f"got {self.omega_deg_s!r}"
             )
         object.__setattr__(self, "omega_deg_s", w)
         object.__setattr__(self, "initial", check_quaternion(self.initial, "tumble initial"))
@@ -546,6 +554,8 @@ class QuaternionSeries(AttitudeLaw):
     times: Any
     samples: Any = None
     epoch: Any = None
+    _secs: np.ndarray = field(init=False, repr=False, compare=False)
+    _slerp: Slerp = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         t = np.atleast_1d(np.asarray(self.times))
@@ -644,13 +654,14 @@ class QuaternionSeries(AttitudeLaw):
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         t = seconds_since(times, self.epoch, context)
-        lo, hi = self._secs[0], self._secs[-1]  # type: ignore[attr-defined]
+        lo, hi = self._secs[0], self._secs[-1]
         if t.min() < lo or t.max() > hi:
             raise AttitudeError(
-                f"quaternion_series: requested times span [{t.min():.6g}, {t.max():.6g}] s, outside the "
+                f"quaternion_series: requested times span [{t.min():.6g}, {t.max():.6g}] s, "
+                "outside the "
                 f"series [{lo:.6g}, {hi:.6g}] s from its epoch {self.epoch}"
             )
-        return self._slerp(t).as_quat().reshape(-1, 4)  # type: ignore[attr-defined]
+        return self._slerp(t).as_quat().reshape(-1, 4)
 
 
 @dataclass(frozen=True)
@@ -672,7 +683,8 @@ class Composed(AttitudeLaw):
         for name in ("outer", "inner"):
             if not isinstance(getattr(self, name), AttitudeLaw):
                 raise AttitudeError(
-                    f"compose {name}: expected an attitude law, got {type(getattr(self, name)).__name__}"
+                    f"compose {name}: expected an attitude law, "
+                    f"got {type(getattr(self, name)).__name__}"
                 )
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
@@ -764,7 +776,7 @@ def law_from_dict(table: Mapping[str, Any]) -> AttitudeLaw:
             raise AttitudeError("attitude law 'quaternion_series': needs a path (.csv or .nc)")
         path = Path(params.pop("path"))
         if path.suffix.lower() == ".csv":
-            kw = {k: params[k] for k in ("time_column", "epoch") if k in params}
+            kw: dict[str, Any] = {k: params[k] for k in ("time_column", "epoch") if k in params}
             if "columns" in params:
                 kw["columns"] = tuple(params["columns"])
             return QuaternionSeries.from_csv(path, **kw)

@@ -141,7 +141,7 @@ def triad(
 
 
 def perpendicular_pair(
-    primary: ArrayLike, secondary: ArrayLike, names: str
+    primary: np.ndarray, secondary: np.ndarray, names: str
 ) -> tuple[np.ndarray, np.ndarray]:
     """Two body axes, checked to be perpendicular (``names`` labels the error).
 
@@ -215,14 +215,17 @@ def seconds_since(
             if epoch is not None
             else (context.epoch if context is not None and context.epoch is not None else t[0])
         )
-        return (t - np.datetime64(origin, "ns")).astype(np.int64) / NS_PER_S
+        return (t - np.asarray(origin, dtype="datetime64[ns]")).astype(np.int64) / NS_PER_S
     if not np.issubdtype(t.dtype, np.number):
         raise AttitudeError(f"times: expected datetime64 or seconds, got dtype {t.dtype}")
     t = t.astype(np.float64)
     if epoch is not None and context is not None and context.epoch is not None:
         t = (
             t
-            + (np.datetime64(context.epoch, "ns") - np.datetime64(epoch, "ns")).astype(np.int64)
+            + (
+                np.asarray(context.epoch, dtype="datetime64[ns]")
+                - np.asarray(epoch, dtype="datetime64[ns]")
+            ).astype(np.int64)
             / NS_PER_S
         )
     return t

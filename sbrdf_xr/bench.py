@@ -24,12 +24,13 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from . import catalog, material
+from . import _lut, catalog, material
 from .goniometer import measure
 from .testing import lobe_function
 
@@ -181,11 +182,11 @@ def bench_lookup(
     dt = rng.uniform(float(lut.delta_theta[0]), float(lut.delta_theta[-1]), n_geometries)
     ph = rng.uniform(0, float(lut.phi[-1]), n_geometries)
     dims = [xr.DataArray(a, dims="geom") for a in (ti, dt, ph)]
-    grids = [np.asarray(lut[d].values) for d in ("theta_i", "delta_theta", "phi")]
+    tg, dg, pg = (np.asarray(lut[d].values) for d in ("theta_i", "delta_theta", "phi"))
     values = np.asarray(lut.values)
 
     def ours() -> np.ndarray:
-        return material._lut.lookup_kernel(values, *grids, ti, dt, ph)
+        return _lut.lookup_kernel(values, tg, dg, pg, ti, dt, ph)
 
     def xr_interp() -> xr.DataArray:
         return lut.interp(theta_i=dims[0], delta_theta=dims[1], phi=dims[2], method="linear").load()
@@ -324,7 +325,7 @@ def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
     for sweep_name, sweep in sweeps.items():
         ref_cube = run_cube(sweep, **reference)
         ref = ref_cube.signal
-        t_ref = best_time(lambda sweep=sweep: run_cube(sweep, **reference), repeat)
+        t_ref = best_time(partial(run_cube, sweep, **reference), repeat)
         knobs: list[tuple[str, str, dict[str, Any]]] = [
             ("reference", "cubic look-up, 1-deg theta_i, 21x21, 5 nm, merged, float64", {}),
             ("lookup method", "nearest (the paper's)", {"method": "nearest"}),
@@ -368,7 +369,7 @@ def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
                 cube, t = ref_cube, t_ref
             else:
                 cube = run_cube(sweep, **cfg)
-                t = best_time(lambda sweep=sweep, cfg=cfg: run_cube(sweep, **cfg), repeat)
+                t = best_time(partial(run_cube, sweep, **cfg), repeat)
             test = cube.band_signal if "band_signal" in cube else cube.signal
             mx, med, p99 = _errors(test, ref)
             rows.append(
@@ -388,7 +389,7 @@ def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
         # (the simulation option evaluation="analytic", each material's catalog model).
         an_cfg = {**reference, "evaluation": "analytic"}
         an = run_cube(sweep, **an_cfg).signal
-        t_an = best_time(lambda sweep=sweep, an_cfg=an_cfg: run_cube(sweep, **an_cfg), 1)
+        t_an = best_time(partial(run_cube, sweep, **an_cfg), 1)
         mx, med, p99 = _errors(ref, an)
         rows.append(
             BenchRow(
@@ -502,7 +503,8 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
     facets = scene.spacecraft.facets()
     s, o = scene.body_vectors()
     s2, o2 = s.reshape(-1, 3), o.reshape(-1, 3)
-    tables = {m: scene.materials[m] for m in scene.spacecraft.materials}
+    materials = scene.materials or {}
+    tables = {m: materials[m] for m in scene.spacecraft.materials}
     n_geom, n_fac = s2.shape[0], facets.sizes["facet"]
     n_wl = tables[CANX1_MATERIALS[0]].sizes["wavelength"]
 
@@ -567,7 +569,8 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
             t_merged,
             "per-facet loop",
             t_merged / t_base,
-            f"{work / t_merged:,.0f} facet-equivalent g-f-spectra/s; speed-up {t_base / t_merged:.1f}x; "
+            f"{work / t_merged:,.0f} facet-equivalent g-f-spectra/s; "
+            f"speed-up {t_base / t_merged:.1f}x; "
             f"agrees to {agree:.1e}",
             sweep="canx1-rotation",
         ),
@@ -577,7 +580,8 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
             "per-facet loop",
             (work / limit) / t_base,
             f"{limit:,.0f} g-f-spectra/s at {bandwidth / 1e9:.1f} GB/s (measured copy), 8 x {n_wl} "
-            f"float64 gathered per pair; the unmerged kernel reaches {(work / t_unmerged) / limit:.0%} "
+            "float64 gathered per pair; the unmerged kernel reaches "
+            f"{(work / t_unmerged) / limit:.0%} "
             "of it (neighbouring geometries reuse table rows from cache)",
             sweep="canx1-rotation",
         ),
@@ -586,7 +590,8 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
             work / compute_limit,
             "per-facet loop",
             (work / compute_limit) / t_base,
-            f"{compute_limit:,.0f} g-f-spectra/s at {flops / 1e9:.1f} GFLOP/s, 16 x {n_wl} flops per "
+            f"{compute_limit:,.0f} g-f-spectra/s at {flops / 1e9:.1f} GFLOP/s, "
+            f"16 x {n_wl} flops per "
             f"pair; the unmerged kernel reaches {(work / t_unmerged) / compute_limit:.0%} of it",
             sweep="canx1-rotation",
         ),
@@ -625,7 +630,8 @@ def format_rows(rows: list[BenchRow]) -> str:
             out += [
                 "",
                 f"[{sweep}]",
-                f"{'case':<{w}}  {'time/baseline':>13}  {'mmag max':>9}  {'mmag med':>9}  {'rel p99':>8}  notes",
+                f"{'case':<{w}}  {'time/baseline':>13}  "
+                f"{'mmag max':>9}  {'mmag med':>9}  {'rel p99':>8}  notes",
             ]
         err = (
             f"{r.mmag_max:>9.3g}  {r.mmag_median:>9.3g}  {r.rel_p99:>8.2g}"

@@ -84,7 +84,7 @@ def sweep_job(
     """
     import resource
 
-    from .simulate import _n_threads, run_block, simulate, write
+    from .simulate import default_n_threads, run_block, simulate, write
 
     scene = _sweep_scene(n, bands)
     plan = scene.plan()
@@ -113,7 +113,7 @@ def sweep_job(
             )
 
         t0 = time.perf_counter()
-        with ThreadPoolExecutor(_n_threads()) as pool:
+        with ThreadPoolExecutor(default_n_threads()) as pool:
             list(pool.map(one, blocks))
         seconds = time.perf_counter() - t0
     elif mode == "zarr":
@@ -262,7 +262,7 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
     simulate(rot).compute()
     # many repeats: the best of a few short calls is at the mercy of the machine's load
     t_rot = best_time(lambda: simulate(rot).compute(), max(repeat, 20))
-    one = rot.with_options(attitudes=rot.attitudes[:1], attitude_angle=None)
+    one = rot.with_options(attitudes=np.asarray(rot.attitudes)[:1], attitude_angle=None)
     simulate(one).compute()
     t_one = best_time(lambda: simulate(one).compute(), max(repeat, 5), number=20)
     sweep = "end to end, warm"
@@ -298,7 +298,8 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
             ""
             if prev is None
             else (
-                f"; exponent {np.log(r['seconds'] / results[prev]['seconds']) / np.log(n / prev):.3f} "
+                "; exponent "
+                f"{np.log(r['seconds'] / results[prev]['seconds']) / np.log(n / prev):.3f} "
                 f"from {prev:.0e}"
             )
         )

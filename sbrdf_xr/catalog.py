@@ -4,8 +4,10 @@ The catalog directory holds ``index.toml``, one ``[[entry]]`` table per item::
 
     [[entry]]
     name = "lambertian-grey-50"          # unique, lower-case, used by load()
-    kind = "material"                    # material | measurements | model | paint_parameters | spacecraft
-                                         # | orbit (a TLE file) | site (a table of a TOML file of sites)
+    kind = "material"                    # material | measurements | model
+                                         # | paint_parameters | spacecraft
+                                         # | orbit (a TLE file)
+                                         # | site (a table of a TOML file of sites)
     path = "materials/lambertian-grey-50.nc"   # relative to the catalog directory
     source = "synthetic"                 # measured | synthetic | model:<name>
     description = "..."                  # what it is

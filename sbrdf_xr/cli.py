@@ -77,15 +77,15 @@ def _escaped_attrs(obj: Any) -> Any:
             out[name].attrs = clean(obj[name].attrs)
         return out.rename({n: escape(n, True) for n in out.variables if escape(n, True) != n})
     if isinstance(obj, xr.DataArray):
-        out = obj.copy()
-        out.attrs = clean(obj.attrs)
-        for c in out.coords:
-            out[c].attrs = clean(obj[c].attrs)
-        return out
+        arr = obj.copy()
+        arr.attrs = clean(obj.attrs)
+        for c in arr.coords:
+            arr[c].attrs = clean(obj[c].attrs)
+        return arr
     return obj
 
 
-def _open_dataset(path: str) -> Any:
+def _open_dataset(path: str | Path) -> Any:
     """Open a netCDF file, turning "not netCDF" into a :class:`ValidationError`."""
     import xarray as xr
 
@@ -105,7 +105,7 @@ def _open_dataset(path: str) -> Any:
         raise ValidationError(f"{path}: not a readable netCDF file ({why})") from None
 
 
-def _open_cube(path: str) -> Any:
+def _open_cube(path: str | Path) -> Any:
     """A loaded simulation cube, or :class:`ValidationError` naming what is missing."""
     with _open_dataset(path) as ds:
         spectral = [
@@ -115,8 +115,9 @@ def _open_cube(path: str) -> Any:
         if not spectral and not curve:
             names = ", ".join(map(str, list(ds.data_vars)[:8])) or "none"
             raise ValidationError(
-                f"{path}: not a simulation cube of 'sbrdf-xr simulate' (it needs 'spacecraft_sbrdf' "
-                f"or 'signal' over wavelength, or 'brdf' over attitude; its variables: {escape(names, True)})"
+                f"{path}: not a simulation cube of 'sbrdf-xr simulate' "
+                "(it needs 'spacecraft_sbrdf' or 'signal' over wavelength, or 'brdf' over "
+                f"attitude; its variables: {escape(names, True)})"
             )
         try:
             return ds.load()
@@ -380,7 +381,7 @@ def _cmd_knobs(args: argparse.Namespace) -> int:
     return 0
 
 
-def _save_figure(cube_path: str, figure_path: str) -> None:
+def _save_figure(cube_path: str | Path, figure_path: str) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -483,7 +484,8 @@ def _cmd_photometry(args: argparse.Namespace) -> int:
             else f"{'inf':>8} {'inf':>8} {'inf':>8}"
         )
         print(
-            f"{b!s:<8} {ds.filter.sel(band=b).item()!s:<14} {float(ds.sun_magnitude.sel(band=b)):8.3f} {stats}"
+            f"{b!s:<8} {ds.filter.sel(band=b).item()!s:<14} "
+            f"{float(ds.sun_magnitude.sel(band=b)):8.3f} {stats}"
         )
     if "colour_index" in ds:
         for c in ds.colour.values:
@@ -548,7 +550,8 @@ def _cmd_invert(args: argparse.Namespace) -> int:
             criterion=args.criterion,
         )
         print(
-            f"unmix {args.measured}: chi2 {float(ds.chi2):.4g}, reduced {float(ds.reduced_chi2):.4g}, "
+            f"unmix {args.measured}: chi2 {float(ds.chi2):.4g}, "
+            f"reduced {float(ds.reduced_chi2):.4g}, "
             f"{args.criterion} selection: {ds.attrs['selected_materials']}"
         )
         for m in ds.material.values:
@@ -573,15 +576,18 @@ def _cmd_invert(args: argparse.Namespace) -> int:
         )
         print(
             f"spin fit of {args.measured}: {ds.attrs['n_candidates']} candidates in "
-            f"{ds.attrs['search_seconds']:.1f} s; chi2 {float(ds.chi2):.4g}, reduced {float(ds.reduced_chi2):.4g}"
+            f"{ds.attrs['search_seconds']:.1f} s; chi2 {float(ds.chi2):.4g}, "
+            f"reduced {float(ds.reduced_chi2):.4g}"
         )
         for k in ("axis_longitude", "axis_latitude", "period", "phase"):
             print(
-                f"  {k:<15} {float(ds[k]):10.4f} +- {float(ds[k + '_uncertainty']):.4f} {ds[k].attrs['units']}"
+                f"  {k:<15} {float(ds[k]):10.4f} +- {float(ds[k + '_uncertainty']):.4f} "
+                f"{ds[k].attrs['units']}"
             )
         for sname in ds.solution.values:
             print(
-                f"  alternative {sname!s:<14} chi2 gap {float(ds.chi2_gap.sel(solution=sname)):10.2f}"
+                f"  alternative {sname!s:<14} "
+                f"chi2 gap {float(ds.chi2_gap.sel(solution=sname)):10.2f}"
             )
     if args.output:
         write_netcdf_atomic(ds, args.output, overwrite=args.overwrite)
@@ -846,7 +852,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         out = getattr(args, "output", None)
         hint = ""
         if out and Path(str(out) + LOG_SUFFIX).exists():
-            hint = f"; the blocks written so far are kept in {out}{PART_SUFFIX}: run again with --resume"
+            hint = (
+                f"; the blocks written so far are kept in {out}{PART_SUFFIX}: "
+                "run again with --resume"
+            )
         print(f"sbrdf-xr: interrupted{hint}", file=sys.stderr)
         return 130
     finally:

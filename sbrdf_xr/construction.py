@@ -70,7 +70,8 @@ def paper_delta_theta_grid(dt_min: float, dt_max: float, n: int = 21) -> np.ndar
     """
     if not (dt_min < 0 < dt_max):
         raise ValidationError(
-            f"delta_theta: measured extent must straddle specular (min < 0 < max), got [{dt_min}, {dt_max}]"
+            "delta_theta: measured extent must straddle specular (min < 0 < max), "
+            f"got [{dt_min}, {dt_max}]"
         )
     if n < 3 or n % 2 == 0:
         raise ValidationError(f"n_delta_theta: must be odd and >= 3, got {n}")
@@ -289,13 +290,13 @@ def per_theta_tables(
             # A measured (apparatus-limited) in-plane extent borrows the phi profile of the
             # nearest fully measured row, scaled to its own in-plane value.
             full = np.flatnonzero(row_n > 1)
-            for r in np.flatnonzero((row_n == 1) & ~row_ref):
+            for lone in np.flatnonzero((row_n == 1) & ~row_ref):
                 if full.size == 0:
                     break
-                adj = full[np.argmin(np.abs(full - r))]
+                adj = full[np.argmin(np.abs(full - lone))]
                 base = row_vals[adj, 0]
-                scale = np.divide(row_vals[r, 0], base, out=np.zeros_like(base), where=base > 0)
-                row_vals[r, 1:] = row_vals[adj, 1:] * scale
+                scale = np.divide(row_vals[lone, 0], base, out=np.zeros_like(base), where=base > 0)
+                row_vals[lone, 1:] = row_vals[adj, 1:] * scale
         # Step 2: delta_theta interpolation for every grid phi.
         w = interp_weights(
             rows, dt_grid, hold_lo=hold_all or not row_ref[0], hold_hi=hold_all or not row_ref[-1]

@@ -161,7 +161,8 @@ OUTPUTS: dict[str, Output] = {
             (WAVELENGTH,),
             True,
             "W sr-1 nm-1",
-            "thermal emission intensity sum_j A_j cos(theta_r) epsilon(lambda, theta_r) B(lambda, T)",
+            "thermal emission intensity "
+            "sum_j A_j cos(theta_r) epsilon(lambda, theta_r) B(lambda, T)",
         ),
         Output(
             "band_signal",
@@ -249,14 +250,16 @@ def reflected(
     pm = np.zeros((g, len(plan.materials), n_wl), dt) if per_material else None
     for m in range(len(plan.materials)):
         sel = t.material == m
-        values, grids, edges, blend = plan.table(m)
+        values, (tgrid, dgrid, pgrid), edges, blend = plan.table(m)
         r = _kernels.material_sums(
             to_source,
             block.to_observer,
             t.normal[sel],
             t.area[sel],
             values,
-            *grids,
+            tgrid,
+            dgrid,
+            pgrid,
             plan.knobs["method"],
             None if fraction is None else fraction[:, sel],
             edges,
@@ -355,8 +358,10 @@ def _sunlight(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
 
 
 def _earthshine(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
-    frac = _shadow_fraction(plan, block.to_earth, block.to_observer)
-    r = reflected(plan, block, block.to_earth, frac, False)
+    to_earth = block.to_earth
+    assert to_earth is not None  # blocks carry Earth vectors whenever earthshine is on
+    frac = _shadow_fraction(plan, to_earth, block.to_observer)
+    r = reflected(plan, block, to_earth, frac, False)
     if block.earth_scale is not None:  # per geometry (an observation's Earth distance and phase)
         return {"signal_earthshine": (block.earth_scale[:, None] * r.signal).astype(r.signal.dtype)}
     ratio = plan.effect_params["earthshine"]["ratio"]

@@ -31,11 +31,14 @@ import hashlib
 import json
 import re
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ._version import __version__
+
+if TYPE_CHECKING:
+    from .scene_model import Scene
 
 __all__ = ["PREFIX", "changes", "scene_fingerprint"]
 
@@ -72,7 +75,11 @@ _PARTS = {
 def _canonical(value: Any) -> Any:
     """A JSON-able, order-independent image of ``value`` (arrays by dtype, shape and hash)."""
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return {f.name: _canonical(getattr(value, f.name)) for f in dataclasses.fields(value)}
+        return {
+            f.name: _canonical(getattr(value, f.name))
+            for f in dataclasses.fields(value)
+            if f.compare  # not caches and derived state
+        }
     if isinstance(value, Mapping):
         return {str(k): _canonical(v) for k, v in sorted(value.items(), key=lambda kv: str(kv[0]))}
     if isinstance(value, np.ndarray):
@@ -102,7 +109,7 @@ def _array_sha(a: Any) -> str:
     if arr.dtype.kind in "OUS":
         h.update(json.dumps([str(x) for x in arr.ravel().tolist()]).encode())
     else:
-        h.update(memoryview(arr).cast("B"))
+        h.update(arr.data.cast("B"))
     return h.hexdigest()
 
 
@@ -175,7 +182,7 @@ def _mesh_sha(spacecraft: Any) -> str:
     return _sha(*parts)
 
 
-def scene_fingerprint(scene: Any) -> dict[str, str]:
+def scene_fingerprint(scene: Scene) -> dict[str, str]:
     """Content fingerprint of a scene, as flat netCDF global attributes.
 
     Parameters

@@ -140,7 +140,7 @@ def scheme_extents(
     min_phase_angle: float = 5.0,
     max_phi: float = 89.0,
     step: float = 0.1,
-) -> tuple[float, float, np.ndarray]:
+) -> tuple[float, float, np.ndarray, np.ndarray]:
     """Extents of the sampling scheme where the signal falls below the noise.
 
     Parameters
@@ -190,6 +190,9 @@ def scheme_extents(
     def band(ti: float, dt: np.ndarray, ph: np.ndarray) -> np.ndarray:
         return np.mean(func(np.full(dt.shape, ti), dt, ph), axis=-1)
 
+    def row(d: float) -> Callable[[np.ndarray], np.ndarray]:
+        return lambda x: band(theta_i, np.full(x.shape, d), x)
+
     far_limit = max_theta_r - theta_i
     near_limit = max(-max_theta_r - theta_i, -2.0 * theta_i + min_phase_angle)
     if not (near_limit < 0 < far_limit):
@@ -201,10 +204,7 @@ def scheme_extents(
     rows = np.array(
         [f * dt_max for f in ROW_FRACTIONS_FAR] + [0.0] + [f * dt_min for f in ROW_FRACTIONS_NEAR]
     )
-    walks = [
-        _walk_out(lambda x, d=d: band(theta_i, np.full(x.shape, d), x), max_phi, noise_floor, step)
-        for d in rows
-    ]
+    walks = [_walk_out(row(d), max_phi, noise_floor, step) for d in rows]
     phi_max = np.array([w[0] for w in walks])
     in_noise = np.array([w[1] for w in walks] + [ref_max, ref_min])
     return dt_min, dt_max, phi_max, in_noise

@@ -94,7 +94,8 @@ KNOBS: dict[str, Knob] = {
             "linear",
             ("nearest", "linear", "cubic"),
             None,
-            "look-up interpolation order: nearest (the paper's) < linear < cubic in accuracy and cost",
+            "look-up interpolation order: "
+            "nearest (the paper's) < linear < cubic in accuracy and cost",
         ),
         Knob(
             "dtype",
@@ -144,8 +145,8 @@ KNOBS: dict[str, Knob] = {
             "table",
             ("table", "analytic"),
             None,
-            "table: look-up tables; analytic: each material's generating BRDF model (no table error, "
-            "much slower)",
+            "table: look-up tables; analytic: each material's generating BRDF model "
+            "(no table error, much slower)",
         ),
         Knob(
             "tilt_nodes",

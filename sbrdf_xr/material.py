@@ -53,12 +53,12 @@ from .material_io import open_material, open_measurements, to_netcdf, write_netc
 from .material_schema import (
     DUPLICATES,  # noqa: F401  (re-exported)
     SOURCES,  # noqa: F401  (re-exported)
-    _average_duplicates,
-    _check_coord,
-    _reference,
+    average_duplicates,
+    check_coord,
     constant_material,
     lambertian,
     new_material,
+    reference_mask,
     validate_material,
     validate_measurements,
 )
@@ -455,7 +455,7 @@ def build_lut(
     """
     ds = validate_measurements(measurements, duplicates=duplicates)
     if duplicates == "mean":
-        ds = _average_duplicates(ds)
+        ds = average_duplicates(ds)
     if extrapolation not in EXTRAPOLATIONS:
         raise ValidationError(
             f"extrapolation: got {extrapolation!r}; allowed: {', '.join(EXTRAPOLATIONS)}"
@@ -468,7 +468,7 @@ def build_lut(
         raise ValidationError(
             f"below_noise: got {below_noise!r}; allowed: {', '.join(BELOW_NOISE)}"
         )
-    ref = _reference(ds)
+    ref = reference_mask(ds)
     ti_s = np.asarray(ds[THETA_I].values, dtype=np.float64)
     dt_s = np.asarray(ds[DELTA_THETA].values, dtype=np.float64)
     ph_s = np.asarray(ds[PHI].values, dtype=np.float64)
@@ -478,12 +478,13 @@ def build_lut(
     measured_ti = np.unique(ti_s)
     if measured_ti.size < 2:
         raise ValidationError(
-            f"theta_i: need measurements at >= 2 incidence angles to build a table, got {measured_ti.tolist()}"
+            "theta_i: need measurements at >= 2 incidence angles to build a table, "
+            f"got {measured_ti.tolist()}"
         )
     phi_grid = paper_phi_grid(ph_s.max(), n_phi)
     dt_grid = paper_delta_theta_grid(dt_s.min(), dt_s.max(), n_delta_theta)
     ti_out = np.arange(0.0, 91.0) if theta_i is None else np.asarray(theta_i, dtype=np.float64)
-    _check_coord("theta_i", ti_out)
+    check_coord("theta_i", ti_out)
     lam = _lut.csaps_default_lambda(measured_ti) if smoothing == "csaps" else float(smoothing)
     extra: dict[str, Any] = {}
     fit_model = model
@@ -503,6 +504,7 @@ def build_lut(
         lut = np.tensordot(e, per_theta, axes=(1, 0))
         np.maximum(lut, 0.0, out=lut)
         if extrapolation == "model":
+            assert fit_model is not None  # fitted above whenever a model is used
             w = blend_weights(ti_out, measured_ti[0], measured_ti[-1], blend)
             rows = np.flatnonzero(w > 0)
             if rows.size:
@@ -510,6 +512,7 @@ def build_lut(
                 wr = w[rows][:, None, None, None]
                 lut[rows] = (1.0 - wr) * lut[rows] + wr * filled
     else:
+        assert fit_model is not None  # fitted above whenever a model is used
         dt_grid = extend_grid(dt_grid, -180.0, 90.0)
         phi_grid = extend_grid(phi_grid, phi_grid[0], 90.0)
         # Beyond -180/90 and phi = 90 lies the far side of the horizon: nothing to hold.
@@ -544,7 +547,7 @@ def build_lut(
         lut = _model_rows(fit_model, ti_out, dt_grid, phi_grid, wl) * r_lut
         if extrapolation == "model":
             _bound_grazing_rows(lut, ti_out, dt_grid, phi_grid, wl, fit_model, measured_ti[-1])
-    if extrapolation == "model" or below_noise == "model":
+    if fit_model is not None and (extrapolation == "model" or below_noise == "model"):
         extra = {
             "extrapolation_model": fit_model.attrs.get("model", ""),
             "extrapolation_model_provenance": fit_model.attrs.get("provenance", ""),
@@ -743,8 +746,9 @@ def build_lut_anisotropic(
         material=material or first.attrs.get("material", "unnamed"),
         source=first.attrs.get("source", "measured"),
         provenance=(
-            f"{first.attrs.get('provenance', '')}; built by sbrdf_xr.material.build_lut_anisotropic "
-            f"from {len(sets)} sample rotations {np.round(rot[order], 6).tolist()} deg"
+            f"{first.attrs.get('provenance', '')}; built by "
+            f"sbrdf_xr.material.build_lut_anisotropic from {len(sets)} sample rotations "
+            f"{np.round(rot[order], 6).tolist()} deg"
         ),
         normal_incidence=normal_incidence,
         **edges,
@@ -890,7 +894,8 @@ def hemispherical_reflectance(
     if warn and np.any(rho > 1.0):
         worst = np.unravel_index(np.argmax(rho), rho.shape)
         warnings.warn(
-            f"material {material.attrs.get('material', '')!r}: directional-hemispherical reflectance "
+            f"material {material.attrs.get('material', '')!r}: "
+            "directional-hemispherical reflectance "
             f"reaches {rho[worst]:.3f} > 1 at theta_i = {ti[worst[0]]} deg, wavelength = "
             f"{material[WAVELENGTH].values[worst[-1]]} nm; the table does not conserve energy",
             NonPhysicalWarning,

@@ -22,10 +22,12 @@ __all__ = ["open_material", "open_measurements", "to_netcdf", "write_netcdf_atom
 
 def _encoding(obj: xr.Dataset) -> dict[str, dict[str, Any]]:
     """No fill values anywhere; lossless zlib compression of the data variables."""
-    enc: dict[str, dict[str, Any]] = {name: {"_FillValue": None} for name in list(obj.variables)}
+    enc: dict[str, dict[str, Any]] = {
+        str(name): {"_FillValue": None} for name in list(obj.variables)
+    }
     for name, var in obj.data_vars.items():
         if var.ndim and np.issubdtype(var.dtype, np.floating):
-            enc[name].update(zlib=True, complevel=4, shuffle=True)
+            enc[str(name)].update(zlib=True, complevel=4, shuffle=True)
     return enc
 
 

@@ -36,9 +36,12 @@ from .errors import ValidationError
 __all__ = [
     "DUPLICATES",
     "SOURCES",
+    "average_duplicates",
+    "check_coord",
     "constant_material",
     "lambertian",
     "new_material",
+    "reference_mask",
     "validate_material",
     "validate_measurements",
 ]
@@ -57,7 +60,33 @@ def _check_source(source: str) -> None:
         )
 
 
-def _check_coord(name: str, values: np.ndarray, *, strict: bool = True) -> None:
+def check_coord(name: str, values: np.ndarray, *, strict: bool = True) -> None:
+    """Check a 1-D coordinate of a table or measurement set.
+
+    Parameters
+    ----------
+    name : str
+        Name of the coordinate, for messages.
+    values : ndarray
+        Its values.
+    strict : bool, default True
+        Also require strictly increasing values.
+
+    Raises
+    ------
+    ValidationError
+        If the coordinate is not 1-D, is empty, has a non-finite or non-numeric value,
+        or (``strict``) does not increase strictly.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> check_coord("theta_i", np.array([0.0, 10.0, 20.0]))
+    >>> check_coord("theta_i", np.array([0.0, 20.0, 10.0]))
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.ValidationError: theta_i: coordinate must be strictly increasing; ...
+    """
     if values.ndim != 1:
         raise ValidationError(f"{name}: coordinate must be 1-D, got shape {values.shape}")
     if values.size == 0:
@@ -123,7 +152,7 @@ def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.Data
     for dim in dims:
         if dim not in da.coords:
             raise ValidationError(f"{dim}: coordinate is missing")
-        _check_coord(dim, np.asarray(da[dim].values))
+        check_coord(dim, np.asarray(da[dim].values))
         units = da[dim].attrs.get("units")
         if units != _UNITS[dim]:
             raise ValidationError(f"{dim}: units must be {_UNITS[dim]!r}, got {units!r}")
@@ -151,7 +180,8 @@ def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.Data
             )
         if np.any(v < 0):
             raise ValidationError(
-                f"sbrdf: contains {int(np.sum(v < 0))} negative values (min {v.min():.3g}); a BRDF is >= 0"
+                f"sbrdf: contains {int(np.sum(v < 0))} negative values (min {v.min():.3g}); "
+                "a BRDF is >= 0"
             )
     return da
 
@@ -322,16 +352,20 @@ def lambertian(
 
     wl = np.atleast_1d(np.asarray(wavelength, dtype=np.float64))
     rho = lambert.check_params(wl, rho=albedo)["rho"]
-    scalar = np.ndim(albedo) == 0
-    name = material or (f"lambertian-{float(albedo):g}" if scalar else "lambertian")
+    alb = np.asarray(albedo, dtype=np.float64)
+    scalar = alb.ndim == 0
+    name = material or (f"lambertian-{float(alb):g}" if scalar else "lambertian")
     return constant_material(
         rho / np.pi,
         wl,
         material=name,
         source="model:lambert",
-        provenance=f"ideal Lambertian reflector, f_r = albedo / pi ({'albedo ' + format(float(albedo), 'g') if scalar else 'spectral albedo'})",
+        provenance=(
+            "ideal Lambertian reflector, f_r = albedo / pi "
+            f"({'albedo ' + format(float(alb), 'g') if scalar else 'spectral albedo'})"
+        ),
         model="lambert",
-        albedo=float(albedo) if scalar else rho,
+        albedo=float(alb) if scalar else rho,
     )
 
 
@@ -370,13 +404,35 @@ def _geometry_groups(ds: xr.Dataset) -> tuple[np.ndarray, np.ndarray, np.ndarray
     return groups.ravel(), first, counts
 
 
-def _average_duplicates(ds: xr.Dataset) -> xr.Dataset:
+def average_duplicates(ds: xr.Dataset) -> xr.Dataset:
     """One sample per geometry: the mean spectrum of its measured (non-reference) repeats;
-    a reference point only if every repeat is one."""
+    a reference point only if every repeat is one.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A measurement set (see :func:`validate_measurements`).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``ds`` itself if no geometry repeats, else the set with one sample per geometry,
+        in the order of each geometry's first sample.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> from sbrdf_xr.testing import make_measurements
+    >>> ds = make_measurements(n_wavelength=3, theta_i=(10.0, 40.0))
+    >>> twice = xr.concat([ds, ds.isel(sample=[0])], "sample")
+    >>> once = average_duplicates(twice)
+    >>> twice.sizes["sample"] - ds.sizes["sample"], once.sizes["sample"] == ds.sizes["sample"]
+    (1, True)
+    """
     groups, first, counts = _geometry_groups(ds)
     if np.all(counts == 1):
         return ds
-    ref = _reference(ds)
+    ref = reference_mask(ds)
     spectra = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64)
     n_meas = np.bincount(groups, weights=(~ref).astype(float), minlength=first.size)
     total = np.zeros((first.size, spectra.shape[1]))
@@ -458,12 +514,12 @@ def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Da
         c = ds[name]
         if c.dims != (SAMPLE,):
             raise ValidationError(f"{name}: must be over ('sample',), got {c.dims}")
-        _check_coord(name, np.asarray(c.values), strict=False)
+        check_coord(name, np.asarray(c.values), strict=False)
         if c.attrs.get("units") != DEGREE:
             raise ValidationError(f"{name}: units must be 'degree', got {c.attrs.get('units')!r}")
     if WAVELENGTH not in ds.coords:
         raise ValidationError("wavelength: coordinate is missing")
-    _check_coord(WAVELENGTH, np.asarray(ds[WAVELENGTH].values))
+    check_coord(WAVELENGTH, np.asarray(ds[WAVELENGTH].values))
     if ds[WAVELENGTH].attrs.get("units") != NM:
         raise ValidationError(
             f"wavelength: units must be 'nm', got {ds[WAVELENGTH].attrs.get('units')!r}"
@@ -484,10 +540,11 @@ def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Da
             f"measurements: {int(np.sum(counts[dup]))} of {ds.sizes[SAMPLE]} samples repeat "
             f"{dup.size} geometr{'y' if dup.size == 1 else 'ies'} (first: theta_i = "
             f"{float(ds[THETA_I].values[k])}, delta_theta = {float(ds[DELTA_THETA].values[k])}, "
-            f"phi = {float(ds[PHI].values[k])} deg in samples {where[:10].tolist()}); a geometry must be "
+            f"phi = {float(ds[PHI].values[k])} deg in samples {where[:10].tolist()}); "
+            "a geometry must be "
             "measured once, or pass duplicates='mean' to average the repeats"
         )
-    ref = _reference(ds)
+    ref = reference_mask(ds)
     v = np.asarray(da.transpose(SAMPLE, WAVELENGTH).values)[~ref]
     if not np.all(np.isfinite(v)):
         bad = np.flatnonzero(
@@ -501,7 +558,27 @@ def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Da
     return ds
 
 
-def _reference(ds: xr.Dataset) -> np.ndarray:
+def reference_mask(ds: xr.Dataset) -> np.ndarray:
+    """Which samples of a measurement set are reference points (signal in the noise).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A measurement set.
+
+    Returns
+    -------
+    ndarray of bool, shape (n_sample,)
+        Its ``reference`` variable, or all False if it has none.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import make_measurements
+    >>> ds = make_measurements(n_wavelength=3, theta_i=(10.0, 40.0))
+    >>> mask = reference_mask(ds)
+    >>> mask.dtype, mask.shape == (ds.sizes["sample"],)
+    (dtype('bool'), True)
+    """
     if "reference" in ds:
         ref = np.asarray(ds["reference"].values)
         if ref.dtype != bool:

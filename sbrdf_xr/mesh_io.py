@@ -121,7 +121,8 @@ def read_material_map(path: str | Path) -> dict[Any, str]:
     >>> import tempfile
     >>> from pathlib import Path
     >>> path = Path(tempfile.mkdtemp()) / "colours.toml"
-    >>> _ = path.write_text('[[material]]\\nname = "paint"\\nrgb = [255, 255, 255]\\nlabels = ["panel"]\\n')
+    >>> text = '[[material]]\\nname = "paint"\\nrgb = [255, 255, 255]\\nlabels = ["panel"]\\n'
+    >>> _ = path.write_text(text)
     >>> read_material_map(path)
     {(255, 255, 255): 'paint', 'panel': 'paint'}
     """
@@ -209,7 +210,8 @@ def normalise_map(
         material_map = read_material_map(material_map)
     if not isinstance(material_map, Mapping) or not material_map:
         raise ValidationError(
-            f"material_map: expected a non-empty mapping of colour or name -> material, got {material_map!r}"
+            "material_map: expected a non-empty mapping of colour or name -> material, "
+            f"got {material_map!r}"
         )
     colours: dict[Color, str] = {}
     names: dict[str, str] = {}
@@ -371,11 +373,16 @@ def _ply_face_props(raw: Any) -> set[str]:
     return set()
 
 
+def _is_none(a: np.ndarray) -> np.ndarray:
+    """Elementwise ``a is None`` (for object arrays of labels)."""
+    return np.equal(a, np.array(None, dtype=object))
+
+
 def _visual_labels(mesh: trimesh.Trimesh) -> tuple[np.ndarray | None, str | None]:
     """Per-face colours and the material name carried by a mesh's visual."""
     visual = getattr(mesh, "visual", None)
     kind = getattr(visual, "kind", None)
-    if kind in ("face", "vertex"):
+    if visual is not None and kind in ("face", "vertex"):
         return np.asarray(visual.face_colors)[:, :3], None
     material = getattr(visual, "material", None)
     if material is not None:
@@ -488,13 +495,13 @@ def label_faces(
     n = len(rgb)
     material = np.full(n, None, dtype=object)
     for cand in names:
-        todo = np.flatnonzero(np.equal(material, None) & ~np.equal(cand, None))
+        todo = np.flatnonzero(_is_none(material) & ~_is_none(cand))
         if len(todo) == 0:
             continue
         uniq, inv = np.unique(cand[todo].astype(str), return_inverse=True)
         lookup = np.array([name_map.get(u) for u in uniq], dtype=object)
         material[todo] = lookup[inv]
-    todo = np.flatnonzero(np.equal(material, None))
+    todo = np.flatnonzero(_is_none(material))
     unmapped_colours: list[Color] = []
     if len(todo) and colours:
         have = todo[(rgb[todo] >= 0).all(axis=1)]
@@ -513,7 +520,7 @@ def label_faces(
                     c = u if labelled.rgb_bits == 8 else np.round(u * 255 / 31)
                     unmapped_colours.append((int(c[0]), int(c[1]), int(c[2])))
             material[have] = lookup[inv.reshape(-1)]
-    missing = np.flatnonzero(np.equal(material, None))
+    missing = np.flatnonzero(_is_none(material))
     if len(missing):
         labels: list[Any] = list(dict.fromkeys(unmapped_colours))
         for cand in names:
@@ -559,7 +566,8 @@ def clean_mesh(
         bad_f = bad_v[faces].any(axis=1)
         _problem(
             repair,
-            f"{int(bad_v.sum())} vertices are not finite (NaN or inf), used by {int(bad_f.sum())} facets",
+            f"{int(bad_v.sum())} vertices are not finite (NaN or inf), "
+            f"used by {int(bad_f.sum())} facets",
             "remove them and their facets",
         )
         vertices = np.where(bad_v[:, None], 0.0, vertices)
@@ -584,7 +592,8 @@ def clean_mesh(
     if zero.any():
         _problem(
             repair,
-            f"{int(zero.sum())} of {len(faces)} facets have zero area (first: {np.flatnonzero(zero)[:5].tolist()})",
+            f"{int(zero.sum())} of {len(faces)} facets have zero area "
+            f"(first: {np.flatnonzero(zero)[:5].tolist()})",
             "remove them",
         )
         faces, material = faces[~zero], material[~zero]
@@ -597,7 +606,8 @@ def clean_mesh(
         keep[first] = True
         _problem(
             repair,
-            f"{len(faces) - len(first)} facets duplicate another facet (first: {np.flatnonzero(~keep)[:5].tolist()})",
+            f"{len(faces) - len(first)} facets duplicate another facet "
+            f"(first: {np.flatnonzero(~keep)[:5].tolist()})",
             "keep the first of each set of duplicates",
         )
         faces, material = faces[keep], material[keep]
@@ -607,7 +617,8 @@ def clean_mesh(
         n_open = len(trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1))
         _problem(
             repair,
-            f"the surface is not closed ({n_open} edges belong to a single facet, or edges are shared by more than two)",
+            f"the surface is not closed ({n_open} edges belong to a single facet, "
+            "or edges are shared by more than two)",
             "fill the holes with trimesh.repair.fill_holes",
         )
         n_before = len(mesh.faces)
@@ -637,7 +648,8 @@ def clean_mesh(
     if flipped.any():
         _problem(
             repair,
-            f"{int(flipped.sum())} facets belong to inside-out bodies (negative volume, normals pointing inwards)",
+            f"{int(flipped.sum())} facets belong to inside-out bodies "
+            "(negative volume, normals pointing inwards)",
             "flip them",
         )
         mesh = probe

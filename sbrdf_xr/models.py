@@ -249,7 +249,9 @@ def render_anisotropic(
         SBRDF,
         material=spec.attrs["material"],
         source=spec.attrs["source"],
-        provenance=f"{spec.attrs.get('provenance', '')}; rendered by sbrdf_xr.models.render_anisotropic",
+        provenance=(
+            f"{spec.attrs.get('provenance', '')}; rendered by sbrdf_xr.models.render_anisotropic"
+        ),
         model=spec.attrs["model"],
         **_edges(grids[1], grids[2]),
     )
@@ -381,7 +383,7 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
     from ._names import MEASURED, SAMPLE
     from .brdf import robertson_sandford as rs
     from .brdf import robertson_sandford_fit
-    from .material_schema import _reference, validate_measurements
+    from .material_schema import reference_mask, validate_measurements
 
     ds = validate_measurements(measurements, duplicates="mean")
     wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
@@ -392,11 +394,11 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
         ds[PHI].values,
         wl,
         spectra,
-        reference=_reference(ds),
+        reference=reference_mask(ds),
         **kwargs,
     )
     m = rs.MODEL
-    p = {k: np.asarray(fit[k], dtype=np.float64) for k in m.param_names}
+    p: dict[str, Any] = {k: np.asarray(fit[k], dtype=np.float64) for k in m.param_names}
     g_b = float(rs.normalisation_G(p["b"]))
     p["epsilon"] = np.minimum(
         np.broadcast_to(p["epsilon"], wl.shape), np.maximum(g_b - p["rho_D"], 0.0)

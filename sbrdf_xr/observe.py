@@ -41,7 +41,7 @@ import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 import numpy as np
 import xarray as xr
@@ -299,8 +299,9 @@ class Observation:
         gap = np.abs(t[[0, -1]] - epoch).max().astype(np.int64) / 86400e9
         if gap > EPOCH_GAP_DAYS:
             warnings.warn(
-                f"observation times {t[0]} .. {t[-1]} reach {gap:.1f} days from the epoch {epoch} of the "
-                f"elements of {self.orbit.name!r} (more than {EPOCH_GAP_DAYS:g} days): SGP4 errors grow "
+                f"observation times {t[0]} .. {t[-1]} reach {gap:.1f} days from the epoch "
+                f"{epoch} of the elements of {self.orbit.name!r} "
+                f"(more than {EPOCH_GAP_DAYS:g} days): SGP4 errors grow "
                 "by about 1-3 km per day in LEO; use elements nearer the observation",
                 EpochGapWarning,
                 stacklevel=2,
@@ -311,7 +312,8 @@ class Observation:
         step = f", step {(t[1] - t[0]) / np.timedelta64(1, 's'):g} s" if t.size > 1 else ""
         return (
             f"<Observation {self.name!r}: {self.orbit.name!r} from {self.site.name or 'site'} "
-            f"({self.site.latitude_deg:.4f}, {self.site.longitude_deg:.4f}, {self.site.height_m:g} m), "
+            f"({self.site.latitude_deg:.4f}, {self.site.longitude_deg:.4f}, "
+            f"{self.site.height_m:g} m), "
             f"{t.size} times {t[0]} .. {t[-1]}{step}, attitude {self.attitude!r}>"
         )
 
@@ -514,13 +516,23 @@ class Observation:
             "site_latitude": self.site.latitude_deg,
             "site_longitude": self.site.longitude_deg,
             "site_height": self.site.height_m,
-            "site_coordinates": "WGS84 geodetic latitude and east longitude [degree], height above the ellipsoid [m]",
+            "site_coordinates": (
+                "WGS84 geodetic latitude and east longitude [degree], "
+                "height above the ellipsoid [m]"
+            ),
             "attitude_law": repr(self.attitude),
-            "reference_frame": "GCRS (ICRF axes, geocentric); quaternions rotate body vectors into it",
+            "reference_frame": (
+                "GCRS (ICRF axes, geocentric); quaternions rotate body vectors into it"
+            ),
             "propagator": f"SGP4 (sgp4 via skyfield {skyfield.__version__})",
-            "ephemeris": f"de421.bsp and finals2000A.all from skyfield-data {getattr(skyfield_data, '__version__', '')}".strip(),
-            "shadow_model": f"spherical Earth R = {EARTH_RADIUS_KM} km, solar disc R = {SUN_RADIUS_KM} km, "
-            "exact disc-overlap area (Montenbruck & Gill 2000, 3.4.2)",
+            "ephemeris": (
+                "de421.bsp and finals2000A.all from skyfield-data "
+                f"{getattr(skyfield_data, '__version__', '')}"
+            ).strip(),
+            "shadow_model": (
+                f"spherical Earth R = {EARTH_RADIUS_KM} km, solar disc R = {SUN_RADIUS_KM} km, "
+                "exact disc-overlap area (Montenbruck & Gill 2000, 3.4.2)"
+            ),
             "airmass_model": self.airmass_model,
         }
 
@@ -593,7 +605,8 @@ def observation_from_dict(
     orbit_keys = [k for k in ("orbit", "tle", "tle_line1", "omm") if k in table]
     if len(orbit_keys) != 1:
         raise ObservationError(
-            f"[observation]: give exactly one of orbit, tle, tle_line1/tle_line2, omm; got {orbit_keys}"
+            "[observation]: give exactly one of orbit, tle, tle_line1/tle_line2, omm; "
+            f"got {orbit_keys}"
         )
     if "orbit" in table:
         orbit = Orbit.from_catalog(table["orbit"])
@@ -617,7 +630,8 @@ def observation_from_dict(
         extra = sorted(set(site_v) - {"latitude_deg", "longitude_deg", "height_m", "name"})
         if extra or not {"latitude_deg", "longitude_deg"} <= set(site_v):
             raise ObservationError(
-                f"[observation] site: needs latitude_deg, longitude_deg (and optional height_m, name); got {sorted(site_v)}"
+                "[observation] site: needs latitude_deg, longitude_deg "
+                f"(and optional height_m, name); got {sorted(site_v)}"
             )
         site = Site(**site_v)
     else:
@@ -649,11 +663,20 @@ def observation_from_dict(
 
 # --------------------------------------------------------------------------- examples
 
+
+class _PassWindow(TypedDict):
+    orbit: str
+    site: str
+    start: str
+    stop: str
+    step_s: float
+
+
 #: The built-in example: orbit and site catalog entries and the pass window (UTC), found
 #: with ``tools/build_observe.py``: the site in astronomical darkness (Sun below
 #: -25 deg), the spacecraft between 27 and 76 deg elevation, leaving the Earth's shadow
 #: in the first minute (penumbra 01:20:46-01:21:00) and sunlit for the remaining four.
-CANX1_PASS = {
+CANX1_PASS: _PassWindow = {
     "orbit": "canx1-example",
     "site": "mont-megantic",
     "start": "2024-03-17T01:20:00",

@@ -299,7 +299,8 @@ def _check_tle(line1: Any, line2: Any) -> tuple[str, str]:
             raise ObservationError(f"TLE line {i}: must start with '{i} ', got {line[:2]!r}")
         if not line[68].isdigit() or int(line[68]) != tle_checksum(line):
             raise ObservationError(
-                f"TLE line {i}: checksum {line[68]!r} does not match the computed {tle_checksum(line)} "
+                f"TLE line {i}: checksum {line[68]!r} does not match the computed "
+                f"{tle_checksum(line)} "
                 f"(digits summed, '-' counting 1, modulo 10): {line!r}"
             )
         lines.append(line)
@@ -310,7 +311,8 @@ def _check_tle(line1: Any, line2: Any) -> tuple[str, str]:
             ok = text.strip().isdigit() if fname == "eccentricity" else _is_number(text)
             if not ok:
                 raise ObservationError(
-                    f"TLE line {i}: field {fname!r} (columns {lo + 1}-{hi}) is {text!r}, not a number"
+                    f"TLE line {i}: field {fname!r} (columns {lo + 1}-{hi}) is {text!r}, "
+                    "not a number"
                 )
     if lines[0][2:7] != lines[1][2:7]:
         raise ObservationError(

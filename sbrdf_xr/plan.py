@@ -288,7 +288,8 @@ class Plan:
             t.dgrid[t.d_off[m] : t.d_off[m + 1]],
             t.pgrid[t.p_off[m] : t.p_off[m + 1]],
         )
-        return values, grids, tuple(bool(x) for x in t.edges[m]), float(t.blend[m])  # type: ignore[return-value]
+        lo, hi, phi = (bool(x) for x in t.edges[m])
+        return values, grids, (lo, hi, phi), float(t.blend[m])
 
     @property
     def spectral_axis(self) -> np.ndarray:
@@ -431,7 +432,7 @@ def compile_plan(scene: Scene) -> Plan:
     if scene.bands:
         w = band_weights_of(scene, wl)
         bw = np.asarray(w.values)
-        band_coords = {c: w[c] for c in w.coords if BAND in w[c].dims}
+        band_coords = {str(c): w[c] for c in w.coords if BAND in w[c].dims}
     spectral_asked = any(o in SPECTRAL_OUTPUTS for o in scene.outputs)
     pre = bool(scene.bands) and not spectral_asked and knobs["band_integration"] == "auto"
     dtype = np.dtype(knobs["dtype"])
@@ -452,7 +453,7 @@ def compile_plan(scene: Scene) -> Plan:
         for m in used:
             da = table_on(scene.materials[m], wl, knobs["table_theta_step"])
             values = np.asarray(da.values)
-            if pre:
+            if pre and bw is not None:
                 values = np.asarray(values, dtype=np.float64) @ bw.T
             if PSI in da.dims:  # its psi slices; the packed slot (psi[0]) is never read
                 aniso_tables[len(packed)] = pack_anisotropic(
@@ -560,9 +561,11 @@ def compile_plan(scene: Scene) -> Plan:
     limit = scene.size_limit
     if out_bytes > limit * SIZE_LIMIT_BYTES or work > limit * WORK_LIMIT:
         raise SceneError(
-            f"scene {scene.name!r} is beyond reason: {geo.n_geometries:.3g} geometries x {terms.size} terms "
-            f"would write {describe_bytes(out_bytes)} (limit {describe_bytes(limit * SIZE_LIMIT_BYTES)}) "
-            f"and take up to {work:.3g} multiply-adds (limit {limit * WORK_LIMIT:.3g}); reduce the sweep, "
+            f"scene {scene.name!r} is beyond reason: {geo.n_geometries:.3g} geometries "
+            f"x {terms.size} terms would write {describe_bytes(out_bytes)} "
+            f"(limit {describe_bytes(limit * SIZE_LIMIT_BYTES)}) "
+            f"and take up to {work:.3g} multiply-adds (limit {limit * WORK_LIMIT:.3g}); "
+            "reduce the sweep, "
             "or raise the limits with size_limit (a factor, default 1) if you mean it"
         )
     n_blocks = max(1, -(-geo.n_lead // chunk)) if geo.n_lead else 0
@@ -579,9 +582,13 @@ def compile_plan(scene: Scene) -> Plan:
         "Conventions": "CF-1.10",
         "title": f"sbrdf_xr simulation of scene {scene.name}",
         "source": f"sbrdf_xr {__version__}",
-        "history": f"sbrdf_xr.simulate(scene={scene.name!r}, method={knobs['method']}, dtype={dtype.name})",
-        "references": "Bedard et al., A novel approach to modeling spacecraft spectral reflectance; "
-        "Sandford, Infrared reflectance properties of aircraft paints",
+        "history": (
+            f"sbrdf_xr.simulate(scene={scene.name!r}, method={knobs['method']}, dtype={dtype.name})"
+        ),
+        "references": (
+            "Bedard et al., A novel approach to modeling spacecraft spectral reflectance; "
+            "Sandford, Infrared reflectance properties of aircraft paints"
+        ),
         "scene": scene.name,
         "scene_description": scene.description,
         "spacecraft": getattr(scene.spacecraft, "name", ""),
@@ -594,7 +601,9 @@ def compile_plan(scene: Scene) -> Plan:
         "effects": ", ".join(active),
         "plan": "",
         **{f"material_provenance_{m.replace('-', '_')}": p for m, p in provenance.items()},
-        "note_sbrdf_zero_area": "spacecraft_sbrdf is 0 where area is 0 (no lit and visible facet; 0/0 of Eq. 4)",
+        "note_sbrdf_zero_area": (
+            "spacecraft_sbrdf is 0 where area is 0 (no lit and visible facet; 0/0 of Eq. 4)"
+        ),
         **geo.attrs,
         **scene_fingerprint(scene),  # checked when an interrupted write is resumed
     }

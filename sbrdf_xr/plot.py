@@ -334,7 +334,7 @@ def magnitudes(mags: xr.DataArray, ax: Any = None, x: str | None = None, **sel: 
     da = mags.sel(**sel) if sel else mags
     if "phase_angle" in da.dims and da.sizes["phase_angle"] == 1:
         da = da.isel(phase_angle=0)
-    other = [d for d in da.dims if d != "band"]
+    other = [str(d) for d in da.dims if d != "band"]
     if len(other) != 1:
         raise ValueError(
             f"magnitudes: expected dims (band, one more) after selection, got {da.dims}; "

@@ -7,6 +7,7 @@ three.  All are re-exported from :mod:`sbrdf_xr.scene`.
 
 from __future__ import annotations
 
+import os
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
@@ -167,14 +168,14 @@ def _rows(v: Any, width: int, where: str) -> np.ndarray:
 def _vector(v: Any, where: str) -> tuple[float, float, float]:
     if not isinstance(v, list) or len(v) != 3:
         raise SceneError(f"{where}: expected a vector of 3 numbers, got {_show(v)}")
-    x = tuple(_number(c, f"{where}[{i}]") for i, c in enumerate(v))
+    x = (_number(v[0], f"{where}[0]"), _number(v[1], f"{where}[1]"), _number(v[2], f"{where}[2]"))
     if not any(x):
         raise SceneError(f"{where}: the zero vector has no direction")
     if max(map(abs, x)) > _MAX_COMPONENT:
         raise SceneError(
             f"{where}: components must not exceed {_MAX_COMPONENT:g} in magnitude, got {list(x)}"
         )
-    return x  # type: ignore[return-value]
+    return x
 
 
 def _strings(v: Any, where: str, *, allow_empty: bool = True) -> tuple[str, ...]:
@@ -216,7 +217,8 @@ def _attitudes_from_table(t: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray 
                 )
             if n > MAX_SCENE_COUNT:
                 raise SceneError(
-                    f"[attitude]: the sweep has {n} attitudes; at most {MAX_SCENE_COUNT} are allowed"
+                    f"[attitude]: the sweep has {n} attitudes; "
+                    f"at most {MAX_SCENE_COUNT} are allowed"
                 )
             angles = np.arange(start, stop, step)
             initial = None
@@ -643,7 +645,7 @@ def builtin_scene(name: str) -> Scene:
         ) from None
 
 
-def resolve_scene(spec: str | Path | Scene) -> Scene:
+def resolve_scene(spec: str | os.PathLike[str] | Scene) -> Scene:
     """A scene from a Scene, a built-in name or a TOML file path.
 
     Examples
@@ -678,18 +680,17 @@ def resolve_scene(spec: str | Path | Scene) -> Scene:
     """
     if isinstance(spec, Scene):
         return spec
-    if not isinstance(spec, str | Path):
+    if not isinstance(spec, str | os.PathLike):
         raise SceneError(
             f"scene: expected a Scene, a built-in scene name or a TOML file path, "
             f"got {type(spec).__name__}"
         )
-    if str(spec) in _BUILTIN:
-        return builtin_scene(str(spec))
-    if "\0" in str(spec):
-        raise SceneError(
-            f"unknown scene {str(spec)!r}: a name or path cannot contain a NUL character"
-        )
-    path = Path(spec)
+    text = os.fspath(spec)
+    if text in _BUILTIN:
+        return builtin_scene(text)
+    if "\0" in text:
+        raise SceneError(f"unknown scene {text!r}: a name or path cannot contain a NUL character")
+    path = Path(text)
     if path.suffix == ".toml" or path.exists():
         if path.is_dir():
             raise SceneError(f"scene file {path} is a directory")
@@ -697,5 +698,5 @@ def resolve_scene(spec: str | Path | Scene) -> Scene:
             raise SceneError(f"scene file {path} does not exist")
         return load_scene(path)
     raise SceneError(
-        f"unknown scene {str(spec)!r}; built-in scenes: {', '.join(_BUILTIN)}, or a .toml file"
+        f"unknown scene {text!r}; built-in scenes: {', '.join(_BUILTIN)}, or a .toml file"
     )

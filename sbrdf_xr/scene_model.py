@@ -1,4 +1,7 @@
-"""The :class:`Scene`: what to simulate (re-exported, with the scene files, from :mod:`sbrdf_xr.scene`)."""
+"""The :class:`Scene`: what to simulate.
+
+Re-exported, with the scene files, from :mod:`sbrdf_xr.scene`.
+"""
 
 from __future__ import annotations
 
@@ -51,6 +54,10 @@ def _unit_vectors(v: ArrayLike, name: str) -> np.ndarray:
             f"directions must be unit vectors (|length - 1| <= {_UNIT_TOL})"
         )
     return arr / norm[:, None]
+
+
+def _optional_array(v: ArrayLike | None) -> np.ndarray | None:
+    return None if v is None else np.asarray(v)
 
 
 @dataclass(frozen=True)
@@ -252,7 +259,8 @@ class Scene:
             raise SceneError(f"earth_albedo: must lie in [0, 1], got {self.earth_albedo}")
         if not self.earth_range_km > 6371.0:
             raise SceneError(
-                f"earth_range_km: must exceed the Earth's radius (6371 km), got {self.earth_range_km}"
+                "earth_range_km: must exceed the Earth's radius (6371 km), "
+                f"got {self.earth_range_km}"
             )
         if not 0.0 <= self.earth_phase_angle <= 180.0:
             raise SceneError(
@@ -312,16 +320,16 @@ class Scene:
                 raise SceneError(
                     "to_earth: explicit geometry with earthshine needs body-frame to_earth vectors"
                 )
-        if self.materials is None:
+        materials = self.materials
+        if materials is None:
             from . import catalog
 
-            object.__setattr__(
-                self, "materials", {m: catalog.load(m) for m in self.spacecraft.materials}
-            )
-        missing = [m for m in self.spacecraft.materials if m not in self.materials]
+            materials = {m: catalog.load(m) for m in self.spacecraft.materials}
+            object.__setattr__(self, "materials", materials)
+        missing = [m for m in self.spacecraft.materials if m not in materials]
         if missing:
-            raise SceneError(f"materials: no table for {missing}; given: {sorted(self.materials)}")
-        for name, da in self.materials.items():
+            raise SceneError(f"materials: no table for {missing}; given: {sorted(materials)}")
+        for name, da in materials.items():
             try:
                 validate_material(da, check_values=True)
             except ValidationError as exc:
@@ -350,13 +358,20 @@ class Scene:
                 raise SceneError(f"observation: {exc}") from exc
             return PairGeometry.from_observation(g, "earthshine" in self.effects, self.earth_albedo)
         if self.is_grid:
-            s, o = geometry.observation_plane(self.phase_angles, self.bisector, self.plane_normal)
+            phase = np.asarray(self.phase_angles)
+            s, o = geometry.observation_plane(phase, self.bisector, self.plane_normal)
             e = None
             if "earthshine" in self.effects:
                 e = geometry.normalize(self.earth_direction, "earth_direction")
-                e = np.broadcast_to(e, (len(self.phase_angles), 3)).copy()
-            return GridGeometry(self.attitudes, self.phase_angles, s, o, e, self.attitude_angle)
-        return PairGeometry(self.to_sun, self.to_observer, self.to_earth)
+                e = np.broadcast_to(e, (len(phase), 3)).copy()
+            return GridGeometry(
+                np.asarray(self.attitudes), phase, s, o, e, _optional_array(self.attitude_angle)
+            )
+        return PairGeometry(
+            np.asarray(self.to_sun),
+            np.asarray(self.to_observer),
+            _optional_array(self.to_earth),
+        )
 
     def body_vectors(self, attitude_slice: slice | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Sun and observer unit vectors in the body frame.
@@ -370,13 +385,14 @@ class Scene:
         b = self.geometry.block(attitude_slice or slice(None))
         return b.to_sun.reshape(*b.lead_shape, 3), b.to_observer.reshape(*b.lead_shape, 3)
 
-    def earth_vectors(self, attitude_slice: slice | None = None) -> np.ndarray:
+    def earth_vectors(self, attitude_slice: slice | None = None) -> np.ndarray | None:
         """Unit vectors to the Earth in the body frame (shaped like :meth:`body_vectors`)."""
         if not self.is_grid:
             return self.geometry.block(attitude_slice or slice(None)).to_earth
-        q = self.attitudes if attitude_slice is None else self.attitudes[attitude_slice]
+        att = np.asarray(self.attitudes)
+        q = att if attitude_slice is None else att[attitude_slice]
         e = geometry.normalize(self.earth_direction, "earth_direction")
-        e = np.broadcast_to(e, (len(self.phase_angles), 3))
+        e = np.broadcast_to(e, (len(np.asarray(self.phase_angles)), 3))
         return geometry.to_body_frame(q, e)
 
     @classmethod

@@ -18,6 +18,8 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, fields
+from functools import partial
+from typing import TypeVar
 
 import numpy as np
 
@@ -182,10 +184,14 @@ def lambertian_signal(
     return (w if fraction is None else w * fraction).sum(axis=-1)
 
 
-def _timed(func: Callable[[], np.ndarray], repeat: int) -> tuple[np.ndarray, float]:
-    best = np.inf
-    out = None
-    for _ in range(max(1, repeat)):
+_T = TypeVar("_T")
+
+
+def _timed(func: Callable[[], _T], repeat: int) -> tuple[_T, float]:
+    t0 = time.perf_counter()
+    out = func()
+    best = time.perf_counter() - t0
+    for _ in range(max(1, repeat) - 1):
         t0 = time.perf_counter()
         out = func()
         best = min(best, time.perf_counter() - t0)
@@ -243,7 +249,7 @@ def accuracy_rows(
     ref: dict[str, np.ndarray] = {}
     keep: dict[str, np.ndarray] = {}
     for name, craft in crafts.items():
-        f, t = _timed(lambda craft=craft: lit_visible_fraction(craft, s, o), repeat)
+        f, t = _timed(partial(lit_visible_fraction, craft, s, o), repeat)
         exact_t += t
         sig = lambertian_signal(craft, s, o, f)
         keep[name] = sig > 1e-12 * craft.mesh.area.sum()
@@ -276,10 +282,7 @@ def accuracy_rows(
         errs = []
         for name, craft in crafts.items():
             f, t = _timed(
-                lambda craft=craft, d=d: lit_visible_fraction(
-                    craft, s, o, method="sampled", density=d
-                ),
-                repeat,
+                partial(lit_visible_fraction, craft, s, o, method="sampled", density=d), repeat
             )
             total += t
             sig = lambertian_signal(craft, s, o, f)
@@ -374,11 +377,11 @@ def scaling_rows(
     """
     s, o = geometries(n_geometries, seed)
     rows: list[CostRow] = []
-    pts = []
+    pts: list[tuple[int, float]] = []
     for k in subdivisions:
         craft = testing.canx1_with_antennas(subdivisions=k)
         lit_visible_fraction(craft, s[:1], o[:1])  # caches (supporting planes, frames)
-        _, t = _timed(lambda craft=craft: lit_visible_fraction(craft, s, o), repeat)
+        _, t = _timed(partial(lit_visible_fraction, craft, s, o), repeat)
         ms = 1e3 * t / n_geometries
         local = (np.log(ms / pts[-1][1]) / np.log(craft.n_facets / pts[-1][0])) if pts else np.nan
         pts.append((craft.n_facets, ms))
@@ -397,10 +400,7 @@ def scaling_rows(
             d = compare_density
             lit_visible_fraction(craft, s[:1], o[:1], method="sampled", density=d)
             _, ts = _timed(
-                lambda craft=craft, d=d: lit_visible_fraction(
-                    craft, s, o, method="sampled", density=d
-                ),
-                repeat,
+                partial(lit_visible_fraction, craft, s, o, method="sampled", density=d), repeat
             )
             rows.append(
                 CostRow(

@@ -50,6 +50,7 @@ import dask.array as dsa
 import numpy as np
 import xarray as xr
 from dask.highlevelgraph import HighLevelGraph
+from dask.typing import Key
 
 from ._names import WAVELENGTH, attrs
 from ._writer import write_cube
@@ -112,7 +113,15 @@ def _block_task(plan: Plan, k: int) -> dict[str, np.ndarray]:
     return run_block(plan, plan.block_slice(k))
 
 
-def _n_threads() -> int:
+def default_n_threads() -> int:
+    """Threads of an in-process simulation: ``SBRDF_XR_NUM_THREADS``, ``NUMBA_NUM_THREADS``
+    or the number of CPUs.
+
+    Examples
+    --------
+    >>> default_n_threads() >= 1
+    True
+    """
     n = os.environ.get("SBRDF_XR_NUM_THREADS") or os.environ.get("NUMBA_NUM_THREADS")
     return max(1, int(n)) if n else max(1, os.cpu_count() or 1)
 
@@ -120,7 +129,7 @@ def _n_threads() -> int:
 def _in_process(plan: Plan, n_threads: int | None = None) -> dict[str, np.ndarray]:
     """All outputs at once in this process, split over threads (the kernel releases the GIL)."""
     n = plan.n_lead
-    workers = max(1, min(n_threads or _n_threads(), n // _MIN_PER_THREAD))
+    workers = max(1, min(n_threads or default_n_threads(), n // _MIN_PER_THREAD))
     if workers == 1:
         return run_block(plan, slice(0, n))
     edges = np.linspace(0, n, workers + 1).astype(int)
@@ -172,7 +181,9 @@ def _lazy(plan: Plan, client: Any = None) -> dict[str, dsa.Array]:
     for o in plan.outputs:
         name = f"sbrdf-{o.name}-{token}"
         rest = (0,) * (len(o.shape) - 1)
-        layer = {(name, k, *rest): (_pick, (block_name, k), o.name) for k in range(nb)}
+        layer: dict[Key, Any] = {
+            (name, k, *rest): (_pick, (block_name, k), o.name) for k in range(nb)
+        }
         graph = HighLevelGraph(
             layers={block_name: block_layer, name: layer},
             dependencies={block_name: set(), name: {block_name}},

@@ -194,24 +194,27 @@ def load_spacecraft(
             f"material (one material for every facet); got material_map={material_map!r}, "
             f"material={material!r}"
         )
+    colours: dict[Color, str] = {}
+    name_map: dict[str, str] = {}
     if material is not None:
         if not isinstance(material, str) or not material.strip():
             raise ValidationError(f"material: expected a non-empty material name, got {material!r}")
         if known_materials is not None and material not in set(known_materials):
             raise ValidationError(
-                f"material: {material!r} does not exist; known materials: {sorted(set(known_materials))}"
+                f"material: {material!r} does not exist; "
+                f"known materials: {sorted(set(known_materials))}"
             )
-        colours, name_map = {}, {}
-    else:
+    elif material_map is not None:
         colours, name_map = normalise_map(material_map, known_materials)
     labelled, default_name = read_mesh(path_or_mesh, face_property, file_type)
     vertices, faces, rgb, names = labelled.arrays()
     if len(faces) == 0:
         raise MeshError("the mesh is empty: it has no facets")
-    if material is not None:
-        material = np.full(len(faces), material, dtype=object)
-    else:
-        material = label_faces(labelled, rgb, names, colours, name_map)
+    facet_material = (
+        np.full(len(faces), material, dtype=object)
+        if material is not None
+        else label_faces(labelled, rgb, names, colours, name_map)
+    )
     with np.errstate(invalid="ignore", over="ignore"):
         vertices = vertices * factor
     source = "default"
@@ -236,7 +239,7 @@ def load_spacecraft(
     palette = {m: c for c, m in colours.items()}
     return Spacecraft(
         mesh,
-        material[origin],
+        facet_material[origin],
         name=name or default_name or "spacecraft",
         colors=palette,
         tangent=direction[origin],
@@ -300,7 +303,8 @@ class Spacecraft:
         labels = np.asarray(list(facet_material), dtype=str)
         if labels.shape != (len(mesh.faces),):
             raise ValidationError(
-                f"facet_material: expected {len(mesh.faces)} names (one per facet), got shape {labels.shape}"
+                f"facet_material: expected {len(mesh.faces)} names (one per facet), "
+                f"got shape {labels.shape}"
             )
         labels.setflags(write=False)
         self.mesh = mesh
@@ -629,7 +633,8 @@ class Spacecraft:
             if colors and m in colors:
                 palette[m] = to_rgba(colors[m])
             elif m in self.colors:
-                palette[m] = to_rgba(np.asarray(self.colors[m]) / 255.0)
+                r, g, b = self.colors[m]
+                palette[m] = to_rgba((r / 255.0, g / 255.0, b / 255.0))
             else:
                 palette[m] = to_rgba(cycle[i % len(cycle)])
         names, code = np.unique(self.facet_material, return_inverse=True)

@@ -179,7 +179,7 @@ TEST_SPACECRAFT_MATERIAL = "white-paint-a276"
 def _ear_clip(polygon: np.ndarray) -> np.ndarray:
     """Triangles (index triples, counter-clockwise) of a simple counter-clockwise polygon."""
     idx = list(range(len(polygon)))
-    tris = []
+    tris: list[tuple[int, ...]] = []
 
     def cross(o, a, b):
         return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
@@ -255,7 +255,9 @@ def _as_spacecraft(mesh, name: str):
 
 
 def cube_spacecraft(size: float = 1.0, subdivisions: int = 1):
-    """A convex cube [m] centred at the origin, each face cut into ``2 * 4**(subdivisions - 1)`` facets.
+    """A convex cube [m] centred at the origin.
+
+    Each face is cut into ``2 * 4**(subdivisions - 1)`` facets.
 
     Parameters
     ----------
@@ -325,7 +327,8 @@ def plate_with_fin_section(
 
 
 def plate_with_fin_spacecraft(depth: float = 2.0, **section):
-    """A plate ``[-1, 1] x [-0.1, 0]`` with a perpendicular fin ``[-0.05, 0.05] x [0, 1]`` (xy, [m]),
+    """A plate ``[-1, 1] x [-0.1, 0]`` with a perpendicular fin ``[-0.05, 0.05] x [0, 1]``
+    (xy, [m]),
     extruded over z in [0, depth]; ``section`` overrides :func:`plate_with_fin_section`.
 
     Examples

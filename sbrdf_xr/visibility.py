@@ -22,8 +22,9 @@ Methods (:data:`METHODS`)
     again a convex clip; an empty intersection prunes all its supersets); past 64 shadows or
     a work budget it is summed over vertical slabs bounded by every vertex and edge
     crossing (in each slab the covered length is linear in x); a facet with more than
-    :data:`MAX_SHADOWS` shadows is united by GEOS (:func:`shapely.union_all`).  Candidate occluders come from a uniform grid over the
-    bounding boxes in the plane perpendicular to ``d`` (a facet whose box does not overlap,
+    :data:`MAX_SHADOWS` shadows is united by GEOS (:func:`shapely.union_all`).  Candidate
+    occluders come from a uniform grid over the bounding boxes in the plane perpendicular
+    to ``d`` (a facet whose box does not overlap,
     or that lies wholly behind the receiver along ``d``, cannot shadow it), so the cost grows
     nearly linearly with the number of facets.  Compiled with numba.
 ``"sampled"``
@@ -65,7 +66,7 @@ Comm. ACM 17(1), 32-42.
 from __future__ import annotations
 
 import itertools
-from typing import Any
+from typing import Any, Literal, overload
 
 import numpy as np
 import trimesh
@@ -311,7 +312,7 @@ def lit_fraction(
     Examples
     --------
     >>> from sbrdf_xr.testing import l_shaped_spacecraft
-    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1, x in [1, 2]
+    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1
     >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
     ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
     >>> area = body.mesh.area_faces[floor]
@@ -352,7 +353,7 @@ def visible_fraction(
     Examples
     --------
     >>> from sbrdf_xr.testing import l_shaped_spacecraft
-    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1, x in [1, 2]
+    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1
     >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
     ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
     >>> area = body.mesh.area_faces[floor]
@@ -371,6 +372,38 @@ def visible_fraction(
         convex_shortcut=convex_shortcut,
         seed=seed,
     )
+
+
+@overload
+def lit_visible_fraction(
+    spacecraft: Spacecraft | trimesh.Trimesh,
+    to_sun: ArrayLike,
+    to_observer: ArrayLike,
+    *,
+    method: str = ...,
+    density: int | str = ...,
+    engine: str | None = ...,
+    offset: float | None = ...,
+    convex_shortcut: bool = ...,
+    seed: int = ...,
+    return_error: Literal[False] = ...,
+) -> NDArray[np.float64]: ...
+
+
+@overload
+def lit_visible_fraction(
+    spacecraft: Spacecraft | trimesh.Trimesh,
+    to_sun: ArrayLike,
+    to_observer: ArrayLike,
+    *,
+    method: str = ...,
+    density: int | str = ...,
+    engine: str | None = ...,
+    offset: float | None = ...,
+    convex_shortcut: bool = ...,
+    seed: int = ...,
+    return_error: Literal[True],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
 
 
 def lit_visible_fraction(
@@ -416,7 +449,7 @@ def lit_visible_fraction(
     Examples
     --------
     >>> from sbrdf_xr.testing import l_shaped_spacecraft
-    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1, x in [1, 2]
+    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1
     >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
     ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
     >>> area = body.mesh.area_faces[floor]
@@ -434,7 +467,7 @@ def lit_visible_fraction(
     f, err = _fractions(
         spacecraft, [ds, do], method, density, engine, offset, convex_shortcut, seed, return_error
     )
-    if return_error:
+    if return_error and err is not None:
         return f.reshape(*shape, -1), err.reshape(*shape, -1)
     return f.reshape(*shape, -1)
 
@@ -472,7 +505,7 @@ def facet_visibility(
     Examples
     --------
     >>> from sbrdf_xr.testing import l_shaped_spacecraft
-    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1, x in [1, 2]
+    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1
     >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
     ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
     >>> area = body.mesh.area_faces[floor]

@@ -81,7 +81,10 @@ def fault_table(request):
 
 
 def cube_24(**kw) -> xr.Dataset:
-    """24 blocks of about 100 kB: (24 attitudes in chunks of 1) x 4 phase angles x 2000 wavelengths."""
+    """24 blocks of about 100 kB.
+
+    (24 attitudes in chunks of 1) x 4 phase angles x 2000 wavelengths.
+    """
     return make_cube(n_attitude=24, n_phase=4, n_wavelength=2000, chunks=(1, 4), **kw)
 
 

@@ -196,7 +196,8 @@ def test_shadow_entry_conical_closed_form(radius, beta_deg):
     # Both within a millisecond (the root finder works to 1e-10 s; the fraction leaves 1
     # as the 3/2 power of the overlap depth, so eps = 1e-12 moves the root < 1e-6 s).
     print(
-        f"r={radius} beta={beta_deg}: penumbra {t_pen - out['pen']:.2e} s, umbra {t_umb - out['umb']:.2e} s"
+        f"r={radius} beta={beta_deg}: penumbra {t_pen - out['pen']:.2e} s, "
+        f"umbra {t_umb - out['umb']:.2e} s"
     )
     assert abs(t_pen - out["pen"]) < 1e-3, t_pen - out["pen"]
     assert abs(t_umb - out["umb"]) < 1e-3, t_umb - out["umb"]

@@ -622,7 +622,10 @@ def test_light_curve_iso_times_and_band_whitelist(tmp_path):
 
 
 def test_light_curve_fit_reports_the_half_turn_ambiguity_of_a_symmetric_body(tmp_path):
-    """A curve with period 180 deg fits equally well half a turn away; an asymmetric one does not."""
+    """A curve with period 180 deg fits equally well half a turn away.
+
+    An asymmetric one does not.
+    """
     import pandas as pd
 
     ang = np.arange(0.0, 360.0, 1.0)

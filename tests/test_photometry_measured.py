@@ -1,4 +1,7 @@
-"""Measured light curves through astropy tables (ECSV, FITS, VOTable, CSV) and the fit's bad inputs."""
+"""Measured light curves through astropy tables, and the fit's bad inputs.
+
+The tables are ECSV, FITS, VOTable or CSV.
+"""
 
 from __future__ import annotations
 

@@ -1,4 +1,7 @@
-"""Figures: short labels with units, log axes for large ranges, magnitudes, colour-colour, accessor."""
+"""Figures.
+
+Short labels with units, log axes for large ranges, magnitudes, colour-colour, accessor.
+"""
 
 from __future__ import annotations
 

@@ -53,8 +53,8 @@ def test_toml_scene_round_trip(tmp_path):
 
 def test_toml_explicit_geometry(tmp_path):
     text = (
-        'spacecraft = "canx1"\n[geometry]\nto_sun = [[1.0, 0.0, 0.0]]\nto_observer = [[0.0, 1.0, 0.0]]\n'
-        + GREY
+        'spacecraft = "canx1"\n[geometry]\nto_sun = [[1.0, 0.0, 0.0]]\n'
+        "to_observer = [[0.0, 1.0, 0.0]]\n" + GREY
     )
     scene = load_scene(write(tmp_path, text))
     assert not scene.is_grid and scene.n_geometries == 1
@@ -79,8 +79,8 @@ def test_toml_explicit_geometry(tmp_path):
         ),
         ("this is = not toml", "invalid TOML"),
         (
-            'spacecraft = "canx1"\n[geometry]\nto_sun = [[2.0, 0.0, 0.0]]\nto_observer = [[0.0, 1.0, 0.0]]\n'
-            + GREY,
+            'spacecraft = "canx1"\n[geometry]\nto_sun = [[2.0, 0.0, 0.0]]\n'
+            "to_observer = [[0.0, 1.0, 0.0]]\n" + GREY,
             "unit vectors",
         ),
     ],

@@ -38,7 +38,10 @@ def cube_scene(**kw):
 
 
 def test_lambertian_cube_matches_closed_form():
-    """Convex unit cube, Lambertian 0.5: S = (0.5/pi) sum_faces cos_i cos_r over lit+visible faces."""
+    """Convex unit cube, Lambertian 0.5.
+
+    S = (0.5/pi) sum_faces cos_i cos_r over lit+visible faces.
+    """
     rng = np.random.default_rng(0)
     s = rng.normal(size=(40, 3))
     o = rng.normal(size=(40, 3))

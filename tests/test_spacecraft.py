@@ -225,7 +225,8 @@ def test_merged_canx1_reduction(canx1):
         np.bincount(term, weights=canx1.mesh.area_faces), m["area"].values, rtol=AREA_RTOL
     )
     np.testing.assert_array_equal(m["material"].values[term], canx1.facet_material)
-    # term normals are the facet normals up to rounding (trimesh normals are within 1 ulp of the axes)
+    # term normals are the facet normals up to rounding (trimesh normals are within 1 ulp
+    # of the axes)
     np.testing.assert_allclose(
         m["normal"].values[term], canx1.mesh.face_normals, rtol=0, atol=1e-15
     )
@@ -373,8 +374,10 @@ def test_load_ply_face_colours_and_property(tmp_path):
     np.testing.assert_array_equal(craft.facet_material, [ALU] * 6 + [CELL] * 6)
     np.testing.assert_allclose(craft.mesh.extents, 0.0254, rtol=1e-7)
     header = (
-        "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
-        "element face 12\nproperty list uchar int vertex_indices\nproperty int material_id\nend_header\n"
+        "ply\nformat ascii 1.0\nelement vertex 8\n"
+        "property float x\nproperty float y\nproperty float z\n"
+        "element face 12\nproperty list uchar int vertex_indices\n"
+        "property int material_id\nend_header\n"
     )
     body = "".join(f"{x} {y} {z}\n" for x, y, z in box.vertices)
     body += "".join(f"3 {a} {b} {c} {i // 6}\n" for i, (a, b, c) in enumerate(box.faces))

@@ -208,7 +208,8 @@ def against_flow(graph: dict[str, set[str]]) -> list[str]:
         for dep in sorted(deps):
             if layer_of(dep) > layer_of(mod):
                 bad.append(
-                    f"{mod or 'sbrdf_xr'} (L{layer_of(mod)}) -> {dep or 'sbrdf_xr'} (L{layer_of(dep)})"
+                    f"{mod or 'sbrdf_xr'} (L{layer_of(mod)}) -> "
+                    f"{dep or 'sbrdf_xr'} (L{layer_of(dep)})"
                 )
     return bad
 
@@ -267,3 +268,145 @@ def test_type_checking_imports_are_left_out(tmp_path):
 @pytest.mark.parametrize("mod", ["material", "models", "spacecraft", "observe"])
 def test_domain_modules_do_not_import_the_catalog(mod):
     assert "catalog" not in import_graph()[mod]
+
+
+# ----------------------------------------------------------------- private names
+#
+# A name with a leading underscore is private to where it is defined.  Outside it, a module
+# uses (``from x import _n``, or ``x._n`` on an imported module ``x``) only:
+#
+# * the names of a private module (``_lut``, ``_write_common``, ``brdf._common``, ...),
+#   public or not, from its own package: an implementation module has no public face;
+# * the private names of a module of a subpackage (``photometry``, ``brdf``, ``invert``)
+#   from another module of that subpackage: a subpackage is one unit split into files.
+#
+# Any other use is listed here, with the reason it stands, or fails the test.
+
+#: (importer, "module._name" or "module") -> why the use stands.
+PRIVATE_USES: dict[tuple[str, str], str] = {
+    ("material", "models._params"): (
+        "the BRDF model and parameters of a model material, read by the table construction "
+        "(the model interface's own reader; no public equivalent yet)"
+    ),
+    ("plan", "models._params"): (
+        "the BRDF model and parameters of a model material, read by the analytic evaluation "
+        "(the model interface's own reader; no public equivalent yet)"
+    ),
+}
+
+
+def _is_private(name: str) -> bool:
+    return name.startswith("_") and not (name.startswith("__") and name.endswith("__"))
+
+
+def _package_of(mod: str) -> str:
+    return mod.rpartition(".")[0]
+
+
+def _allowed_private(importer: str, owner: str) -> bool:
+    """True if ``importer`` may use the private names of module ``owner`` (see above)."""
+    if importer == owner:
+        return True
+    if _is_private(owner.rpartition(".")[2]):
+        pkg = _package_of(owner)
+        return not pkg or importer == pkg or importer.startswith(pkg + ".")
+    pkg = _package_of(owner)
+    return bool(pkg) and importer.startswith(pkg + ".")
+
+
+def private_uses(root: Path = PACKAGE) -> list[tuple[str, str]]:
+    """``(importer, "module._name")`` for every use of a private name outside its module.
+
+    Read with :mod:`ast` from every import (``from x import _n``, ``from . import _mod``,
+    anywhere, ``TYPE_CHECKING`` included) and every attribute ``x._n`` on a name bound to
+    a package module by an import.  Names relative to the package.
+    """
+    files = {_module_name(p, root): p for p in root.rglob("*.py")}
+    found: set[tuple[str, str]] = set()
+    for mod, path in files.items():
+        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+        pkg = mod.split(".") if path.name == "__init__.py" else mod.split(".")[:-1]
+        if mod == "":
+            pkg = []
+        bound: dict[str, str] = {}  # local name -> package module
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom):
+                if node.level:
+                    base = ".".join(
+                        pkg[: len(pkg) - node.level + 1] + ([node.module] if node.module else [])
+                    )
+                elif node.module and (
+                    node.module == "sbrdf_xr" or node.module.startswith("sbrdf_xr.")
+                ):
+                    base = node.module.removeprefix("sbrdf_xr").lstrip(".")
+                else:
+                    continue
+                for a in node.names:
+                    sub = f"{base}.{a.name}" if base else a.name
+                    if sub in files:  # a module
+                        bound[a.asname or a.name] = sub
+                        if _is_private(a.name) and not _allowed_private(mod, sub):
+                            found.add((mod, sub))
+                    elif _is_private(a.name) and not _allowed_private(mod, base):
+                        found.add((mod, f"{base}.{a.name}" if base else a.name))
+            elif isinstance(node, ast.Import):
+                for a in node.names:
+                    if a.name.startswith("sbrdf_xr.") and a.asname:
+                        bound[a.asname] = a.name.removeprefix("sbrdf_xr.")
+        for node in ast.walk(tree):
+            if (
+                isinstance(node, ast.Attribute)
+                and _is_private(node.attr)
+                and isinstance(node.value, ast.Name)
+                and node.value.id in bound
+            ):
+                owner = bound[node.value.id]
+                if not _allowed_private(mod, owner):
+                    found.add((mod, f"{owner}.{node.attr}"))
+    return sorted(found)
+
+
+def _listed(use: tuple[str, str]) -> bool:
+    importer, name = use
+    return (importer, name) in PRIVATE_USES or (importer, name.rpartition(".")[0]) in PRIVATE_USES
+
+
+def test_no_module_uses_another_modules_private_names():
+    bad = [f"{m or 'sbrdf_xr'} uses {n}" for m, n in private_uses() if not _listed((m, n))]
+    assert not bad, (
+        "private names used outside their module (make the name public where it is "
+        "defined, move it to a private module, or list the use with its reason in "
+        "PRIVATE_USES):\n" + "\n".join(bad)
+    )
+
+
+def test_every_listed_private_use_is_still_made():
+    made = set(private_uses())
+    stale = [
+        k
+        for k in PRIVATE_USES
+        if k not in made and not any(m == k[0] and n.startswith(k[1] + ".") for m, n in made)
+    ]
+    assert not stale, f"PRIVATE_USES entries no longer needed: {stale}"
+
+
+def test_the_private_check_catches_imports_and_attributes(tmp_path):
+    pkg = tmp_path / "sbrdf_xr"
+    (pkg / "photometry").mkdir(parents=True)
+    (pkg / "__init__.py").write_text("")
+    (pkg / "_impl.py").write_text("def _helper():\n    pass\n")
+    (pkg / "material.py").write_text("from . import _impl\n\ndef _reference():\n    pass\n")
+    (pkg / "photometry" / "__init__.py").write_text("")
+    (pkg / "photometry" / "spectra.py").write_text("def _choose():\n    pass\n")
+    (pkg / "photometry" / "bands.py").write_text("from .spectra import _choose\n")
+    (pkg / "models.py").write_text(
+        "from . import material\nfrom .material import _reference\n"
+        "from ._impl import _helper\n\n"
+        "def f():\n    from .photometry.spectra import _choose\n"
+        "    return material._impl, _choose\n"
+    )
+    assert private_uses(pkg) == [
+        ("models", "material._impl"),
+        ("models", "material._reference"),
+        ("models", "photometry.spectra._choose"),
+    ]

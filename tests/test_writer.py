@@ -493,8 +493,11 @@ def _peak_rss_script(path: Path, shape: tuple[int, int, int], chunks: tuple[int,
         from test_writer import lazy
         from sbrdf_xr._writer import write_cube
         shape, chunks = {shape!r}, {chunks!r}
-        ch = tuple(da.core.normalize_chunks(c, (n,))[0] for c, n in zip(chunks + (shape[2],), shape))
-        ds = xr.Dataset({{"sbrdf": (("attitude", "phase_angle", "wavelength"), lazy(ch, "f8", seed=9))}})
+        ch = tuple(
+            da.core.normalize_chunks(c, (n,))[0] for c, n in zip(chunks + (shape[2],), shape)
+        )
+        dims = ("attitude", "phase_angle", "wavelength")
+        ds = xr.Dataset({{"sbrdf": (dims, lazy(ch, "f8", seed=9))}})
         warm = ds.isel(attitude=slice(0, chunks[0]), phase_angle=slice(0, chunks[1]))
         write_cube(warm, {str(path)!r} + ".warm")  # one block: loads the libraries
         before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss

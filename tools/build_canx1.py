@@ -236,7 +236,10 @@ rgb = [255, 255, 255]
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Write ``canx1.ply`` and ``canx1.toml`` into ``catalogs/spacecraft`` (or the given directory)."""
+    """Write ``canx1.ply`` and ``canx1.toml`` into ``catalogs/spacecraft``.
+
+    Or into the given directory.
+    """
     argv = sys.argv[1:] if argv is None else argv
     out = (
         Path(argv[0])

@@ -181,8 +181,8 @@ def brushed_aluminium_model() -> xr.Dataset:
         wl,
         material="brushed-aluminium",
         provenance="synthetic: anisotropic GGX, alpha_x 0.05 along the brushing (facet tangent), "
-        "alpha_y 0.30 across it, Fresnel of aluminium from the Lorentz-Drude model of Rakic et al., "
-        "Appl. Opt. 37, 5271 (1998), diffuse 0.01 R(lambda)",
+        "alpha_y 0.30 across it, Fresnel of aluminium from the Lorentz-Drude model of "
+        "Rakic et al., Appl. Opt. 37, 5271 (1998), diffuse 0.01 R(lambda)",
         alpha_x=0.05,
         alpha_y=0.30,
         n=al.real,

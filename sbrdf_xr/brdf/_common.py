@@ -182,6 +182,7 @@ def _check_theta_i(theta_i: ArrayLike) -> np.ndarray:
     if not np.all(np.isfinite(ti)) or np.any((ti < 0) | (ti > 90)):
         bad = ti[~(np.isfinite(ti) & (ti >= 0) & (ti <= 90))]
         raise ValidationError(
-            f"theta_i: got {bad.ravel()[:5].tolist()}; allowed domain is 0 <= theta_i <= 90 [degree]"
+            f"theta_i: got {bad.ravel()[:5].tolist()}; "
+            "allowed domain is 0 <= theta_i <= 90 [degree]"
         )
     return ti

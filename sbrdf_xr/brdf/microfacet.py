@@ -280,8 +280,9 @@ def directional_hemispherical_reflectance(
     For each azimuth the range of ``theta_h`` is cut exactly at the horizon (``N.o = R
     cos(2 theta_h - beta) = 0``) and split in two smooth pieces (core in ``x`` with
     ``u = sin^2 x``, ``tan(theta_h) = alpha tan(x)``; tail in ``theta_h``), each
-    integrated with Gauss–Legendre rules (96 x 64 nodes).  Accuracy ~1e-6 relative or better for ``alpha <= 1``, except
-    within a few ``alpha`` of grazing incidence (~1e-4).  The Lambertian term adds ``rho_d`` exactly.
+    integrated with Gauss–Legendre rules (96 x 64 nodes).  Accuracy ~1e-6 relative or
+    better for ``alpha <= 1``, except within a few ``alpha`` of grazing incidence
+    (~1e-4).  The Lambertian term adds ``rho_d`` exactly.
 
     Parameters
     ----------

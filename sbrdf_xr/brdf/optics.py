@@ -286,9 +286,10 @@ def _check_index(index: ArrayLike, name: str) -> NDArray[np.complex128]:
         raise ValidationError(f"{name}: expected a (complex) refractive index, got {arr.dtype}")
     arr = arr.astype(np.complex128)
     if (not np.all(np.isfinite(arr))) or np.any(arr.real <= 0) or np.any(arr.imag < 0):
+        flat = arr.ravel()
         raise ValidationError(
             f"{name}: got values with n <= 0, k < 0 or NaN (first: "
-            f"{arr.ravel()[~(np.isfinite(arr.ravel()) & (arr.ravel().real > 0) & (arr.ravel().imag >= 0))][:3].tolist()}); "
+            f"{flat[~(np.isfinite(flat) & (flat.real > 0) & (flat.imag >= 0))][:3].tolist()}); "
             f"allowed domain is n > 0, k >= 0 for {name} = n + ik [1]"
         )
     return arr

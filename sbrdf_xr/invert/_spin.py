@@ -1,4 +1,7 @@
-"""Spin-state fit: global search over candidate spin states and local refinement (see the package docstring)."""
+"""Spin-state fit: global search over candidate spin states and local refinement.
+
+See the package docstring.
+"""
 
 from __future__ import annotations
 
@@ -278,7 +281,10 @@ class _Problem:
         self.n_bands = len(lc["labels"])
 
     def model(self, axes: np.ndarray, periods: np.ndarray, phases: np.ndarray) -> np.ndarray:
-        """Band signal at every observation (C, N) for candidates (C,) of axis (C, 3), period, phase."""
+        """Band signal at every observation (C, N).
+
+        For candidates (C,) of axis (C, 3), period, phase.
+        """
         align = _align_matrices(self.k, axes)
         ang = np.radians(phases[:, None] + 360.0 * self.times[None, :] / periods[:, None])
         sb = _body_vectors(self.s, align, self.k, ang)
@@ -332,10 +338,12 @@ def _search(
     chunk: int = 256,
 ) -> np.ndarray:
     """Chi-square over the grid (axes, periods, phases), threads over chunks of candidates."""
-    ia, ip, iq = np.meshgrid(
-        np.arange(len(axes)), np.arange(len(periods)), np.arange(len(phases)), indexing="ij"
+    ia, ip, iq = (
+        g.ravel()
+        for g in np.meshgrid(
+            np.arange(len(axes)), np.arange(len(periods)), np.arange(len(phases)), indexing="ij"
+        )
     )
-    ia, ip, iq = ia.ravel(), ip.ravel(), iq.ravel()
     out = np.empty(ia.size)
     edges = [*list(range(0, ia.size, chunk)), ia.size]
 

@@ -1,4 +1,7 @@
-"""Material unmixing: non-negative least squares on the per-material terms (see the package docstring)."""
+"""Material unmixing: non-negative least squares on the per-material terms.
+
+See the package docstring.
+"""
 
 from __future__ import annotations
 
@@ -61,7 +64,8 @@ def _library(simulated: Any) -> xr.DataArray:
                     b = da[dim].values if dim in da.coords else None
                     if a is None or b is None or a.shape != b.shape or not np.array_equal(a, b):
                         raise InversionError(
-                            f"candidate library: {name!r} has {dim} {_describe(b)}, {ref_name!r} has "
+                            f"candidate library: {name!r} has {dim} {_describe(b)}, "
+                            f"{ref_name!r} has "
                             f"{_describe(a)}; every candidate must be on the same {dim} grid"
                         )
         simulated = xr.concat(
@@ -305,13 +309,15 @@ def unmix(
         results = {c: score(c) for c in subsets}
         best = min(results, key=lambda c: results[c][crit])
     elif select == "greedy":
-        results, chosen, best = {}, (), None
+        results = {}
+        chosen: tuple[int, ...] = ()
+        best = chosen  # () until the first subset is scored
         while len(chosen) < kmax:
             trial = {tuple(sorted((*chosen, j))): None for j in range(k) if j not in chosen}
             for c in trial:
                 results[c] = score(c)
             cand = min(trial, key=lambda c: results[c][crit])
-            if best is not None and results[cand][crit] >= results[best][crit]:
+            if best and results[cand][crit] >= results[best][crit]:
                 break
             best = chosen = cand
     else:

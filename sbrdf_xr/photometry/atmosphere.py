@@ -277,7 +277,8 @@ def transmission(
     )
     desc = (
         f"Rayleigh (Hansen & Travis 1974, P = {pressure_hpa:g} hPa) + Angstrom aerosols "
-        f"(tau_550 = {aerosol_optical_depth:g}, alpha = {angstrom_exponent:g}) at air mass {airmass:g}"
+        f"(tau_550 = {aerosol_optical_depth:g}, alpha = {angstrom_exponent:g}) "
+        f"at air mass {airmass:g}"
     )
     return xr.DataArray(
         np.exp(-tau * airmass),

@@ -46,14 +46,17 @@ BAND_ALIASES: dict[str, str] = {
 
 #: Spectral weightings of the band integral: name -> description.
 WEIGHTINGS: dict[str, str] = {
-    "photon": "photon counting: F = int f T lambda/(h c) dlambda (T a photon-detection probability)",
+    "photon": (
+        "photon counting: F = int f T lambda/(h c) dlambda (T a photon-detection probability)"
+    ),
     "energy": "energy weighting: F = int f T dlambda (T an energy response)",
 }
 
 #: Quadratures of :func:`band_weights`: name -> description.
 QUADRATURES: dict[str, str] = {
     "trapezoid": "trapezoid rule on the given wavelength grid; the solar spectrum enters as its "
-    "conservative (hat-weighted) average at each grid node, the filter and the weighting at the nodes",
+    "conservative (hat-weighted) average at each grid node, "
+    "the filter and the weighting at the nodes",
     "linear": "the spectrum is taken as piecewise linear between the grid nodes and multiplied by "
     "solar spectrum x filter x weighting at their native resolution; exact for that interpolant "
     "up to the native sampling",
@@ -292,7 +295,8 @@ def _coverage_error(
 ) -> ValidationError:
     blo, bhi = band.support
     return ValidationError(
-        f"band {band.label!r} ({band.filter}) has non-zero response over {blo:g}-{bhi:g} nm but the "
+        f"band {band.label!r} ({band.filter}) has non-zero response over "
+        f"{blo:g}-{bhi:g} nm but the "
         f"{what} covers only {lo:g}-{hi:g} nm{extra}"
     )
 

@@ -186,8 +186,8 @@ def compare_light_curves(
 
         labels = sorted({str(b) for b in measured[BAND].values})
         zero = xr.DataArray(np.zeros(len(labels)), dims=(BAND,), coords={BAND: labels})
-        k = apply_extinction(zero, 1.0, extinction)
-        kb = dict(zip(labels, k.values.tolist(), strict=True))
+        k_band = apply_extinction(zero, 1.0, extinction)
+        kb = dict(zip(labels, k_band.values.tolist(), strict=True))
         extra += np.array([kb[str(b)] for b in measured[BAND].values]) * np.asarray(
             measured["airmass"].values, dtype=np.float64
         )

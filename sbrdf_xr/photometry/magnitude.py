@@ -206,7 +206,8 @@ def band_signal(
     return out
 
 
-def _range_m(range_km: Any) -> Any:
+def _range_m(range_km: Any) -> xr.DataArray | np.ndarray:
+    r: xr.DataArray | np.ndarray
     if isinstance(range_km, xr.DataArray):
         vals = np.asarray(range_km.values, dtype=np.float64)
         r = range_km.astype(np.float64) * 1e3
@@ -480,17 +481,20 @@ def photometry(
         out["colour_index"] = colour_indices(m, pairs)
     ds = xr.Dataset(out)
     src = cube.attrs if isinstance(cube, xr.Dataset) else {}
+    range_text = (
+        "DataArray" if isinstance(range_km, xr.DataArray) else np.asarray(range_km).tolist()
+    )
     ds.attrs = {
         "Conventions": "CF-1.10",
         "title": f"sbrdf_xr photometry of {src.get('title', 'a spectrum')}",
         "source": src.get("source", "sbrdf_xr"),
         "history": f"sbrdf_xr.photometry(bands={[str(b) for b in sb[BAND].values]}, "
-        f"range_km={np.asarray(range_km).tolist() if not isinstance(range_km, xr.DataArray) else 'DataArray'}, "
-        f"system={system}, weighting={weighting}, quadrature={quadrature}, extrapolate={extrapolate}, "
-        f"solar={solar})",
-        "references": "AB: Oke & Gunn 1983, ApJ 266, 713; Vega: CALSPEC alpha_lyr_stis_011, Bohlin et al. "
-        "2020, AJ 160, 21; filters: speclite (Bessell 1990, PASP 102, 1181; Doi et al. 2010, AJ 139, 1628); "
-        f"Sun: {SOLAR_SPECTRA[solar]}",
+        f"range_km={range_text}, "
+        f"system={system}, weighting={weighting}, quadrature={quadrature}, "
+        f"extrapolate={extrapolate}, solar={solar})",
+        "references": "AB: Oke & Gunn 1983, ApJ 266, 713; Vega: CALSPEC alpha_lyr_stis_011, "
+        "Bohlin et al. 2020, AJ 160, 21; filters: speclite (Bessell 1990, PASP 102, 1181; "
+        f"Doi et al. 2010, AJ 139, 1628); Sun: {SOLAR_SPECTRA[solar]}",
         **_system_attrs(system),
         **_method_attrs(weighting, quadrature, extrapolate, solar, transmission),
     }

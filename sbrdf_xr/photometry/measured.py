@@ -95,7 +95,7 @@ def _from_astropy(path: Path, fmt: str) -> tuple[Any, dict[str, Any], dict[str, 
                 f"{path}: column {key!r} is not one value per row (shape {col.shape})"
             )
         unit = getattr(col, "unit", None)
-        data = (
+        data: np.ndarray | list[str] = (
             np.ma.filled(np.ma.asarray(col), np.nan) if col.dtype.kind in "fiu" else np.asarray(col)
         )
         if key in want and unit is not None and col.dtype.kind in "fiu":
@@ -336,8 +336,9 @@ def _validate(
             if naive and scale is None:
                 k = naive[0]
                 raise ValidationError(
-                    f"{path}: {row_name(k)}, column 'time': {raw.iloc[k]!r} has no time zone and cannot be "
-                    "read as UTC; write it as ISO 8601 with 'Z' or an offset (2024-01-01T00:00:00Z), or "
+                    f"{path}: {row_name(k)}, column 'time': {raw.iloc[k]!r} has no time zone "
+                    "and cannot be read as UTC; write it as ISO 8601 with 'Z' or an offset "
+                    "(2024-01-01T00:00:00Z), or "
                     "pass time_scale='utc' (table metadata time_scale: utc)"
                 )
             x = tt.dt.tz_convert("UTC").dt.tz_localize(None).to_numpy(dtype="datetime64[ns]")

@@ -41,7 +41,9 @@ SOLAR_SPECTRA: dict[str, str] = {
 
 #: Photometric systems (``system=`` of the magnitude functions): name -> definition.
 MAGNITUDE_SYSTEMS: dict[str, str] = {
-    "AB": "AB (Oke & Gunn 1983, ApJ 266, 713): a flat f_nu of 3631 Jy has magnitude 0 in every band",
+    "AB": (
+        "AB (Oke & Gunn 1983, ApJ 266, 713): a flat f_nu of 3631 Jy has magnitude 0 in every band"
+    ),
     "Vega": "Vega: alpha Lyr (CALSPEC alpha_lyr_stis_011; Bohlin et al. 2020, AJ 160, 21) has "
     "magnitude 0 in every band",
 }
@@ -418,7 +420,10 @@ def solar_spectrum(
             how = "linear interpolation of the native table"
         else:
             e = hat_integrals(wl0, e0, wl) / trapezoid_weights(wl)
-            how = "conservative hat-weighted average of the native table (trapezoid-integral preserving)"
+            how = (
+                "conservative hat-weighted average of the native table "
+                "(trapezoid-integral preserving)"
+            )
     return xr.DataArray(
         e,
         dims=(WAVELENGTH,),

@@ -63,7 +63,8 @@ def specular_sphere_phase(alpha_deg: ArrayLike) -> np.ndarray:
     return np.ones_like(np.asarray(alpha_deg, dtype=np.float64))
 
 
-#: Phase functions for standard magnitudes: name -> (function of the phase angle [degree], description).
+#: Phase functions for standard magnitudes:
+#: name -> (function of the phase angle [degree], description).
 PHASE_FUNCTIONS: dict[str, Any] = {
     "lambert_sphere": (lambert_sphere_phase, "diffuse (Lambert) sphere, Russell 1916, ApJ 43, 173"),
     "specular_sphere": (specular_sphere_phase, "specular sphere (phase-independent)"),
@@ -302,8 +303,7 @@ def at_resolution(
         fwhm = x / float(resolving_power)
         how = f"Gaussian line-spread function, resolving power R = {resolving_power:g}"
     else:
-        _positive(fwhm_nm, "fwhm_nm")
-        fwhm = np.full(x.size, float(fwhm_nm))
+        fwhm = np.full(x.size, float(_positive(fwhm_nm, "fwhm_nm")))
         how = f"Gaussian line-spread function, FWHM {fwhm_nm:g} nm"
     sigma = fwhm / (2.0 * np.sqrt(2.0 * np.log(2.0)))
     edges = np.concatenate([[t[0]], 0.5 * (t[1:] + t[:-1]), [t[-1]]])
