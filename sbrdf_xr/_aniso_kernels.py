@@ -35,7 +35,7 @@ from typing import Any, NamedTuple
 
 import numba
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import DTypeLike, NDArray
 
 from . import _lut
 from ._kernels import (
@@ -72,7 +72,7 @@ def pack_anisotropic(
     phi_grid: NDArray[np.floating],
     psi_grid: NDArray[np.floating],
     zero_edges: tuple[bool, bool, bool] = (True, True, True),
-    dtype: np.dtype | str = np.float64,
+    dtype: DTypeLike = np.float64,
 ) -> AnisotropicTable:
     """Pack a ``(n_theta, n_delta_theta, n_phi, n_psi, L)`` table (once per plan).
 
@@ -208,6 +208,7 @@ def anisotropic_sums(
         wk = np.where(idx == k, w, 0.0).sum(axis=-1)
         cols = np.flatnonzero(wk.any(axis=0))
         parts.append((k, cols, wk[:, cols]))
+    r: FusedSums | MaterialSums
     if kernel == "fused":
         if parts:
             r = fused_sums(
@@ -224,14 +225,16 @@ def anisotropic_sums(
             pap += r.paper
     else:
         for k, cols, wk in parts:
-            values, grids = _slice(table, k)
+            values, (tg, dg, pg) = _slice(table, k)
             r = material_sums(
                 s,
                 o,
                 n[cols],
                 np.asarray(areas)[cols],
                 values,
-                *grids,
+                tg,
+                dg,
+                pg,
                 method,
                 wk,
                 table.zero_edges,
@@ -476,7 +479,7 @@ def reflected(
     pm = np.zeros((g, len(plan.materials), n_wl), dt) if per_material else None
     iso = ~np.isin(t.material, np.array(list(aniso), dtype=np.int64))
     if iso.any() and kernel == "fused":
-        r = fused_sums(
+        fr = fused_sums(
             to_source,
             to_observer,
             t.normal[iso],
@@ -487,12 +490,12 @@ def reflected(
             None if fraction is None else fraction[:, iso],
             per_material,
         )
-        sig += r.signal
-        pap += r.paper
-        area += r.area
-        lit += r.lit_visible_area
-        if pm is not None:
-            pm += r.per_material
+        sig += fr.signal
+        pap += fr.paper
+        area += fr.area
+        lit += fr.lit_visible_area
+        if pm is not None and fr.per_material is not None:
+            pm += fr.per_material
     for m in range(len(plan.materials)):
         sel = t.material == m
         if not sel.any() or (m not in aniso and kernel == "fused"):
@@ -511,14 +514,16 @@ def reflected(
                 kernel,
             )
         else:
-            values, grids, edges, blend = plan.table(m)
+            values, (tg, dg, pg), edges, blend = plan.table(m)
             r = material_sums(
                 to_source,
                 to_observer,
                 t.normal[sel],
                 t.area[sel],
                 values,
-                *grids,
+                tg,
+                dg,
+                pg,
                 method,
                 frac,
                 edges,

@@ -251,7 +251,19 @@ def _read_index(path: Path, stamp: tuple[int, int], root: Path | None) -> tuple[
                 "allowed: measured, synthetic, model:<name>"
             )
         extra = {k: v for k, v in item.items() if k not in required}
-        out.append(CatalogEntry(*(item[k] for k in required), extra=extra, root=root))
+        name, kind, path, source, description, provenance = (item[k] for k in required)
+        out.append(
+            CatalogEntry(
+                str(name),
+                str(kind),
+                str(path),
+                str(source),
+                str(description),
+                str(provenance),
+                extra=extra,
+                root=root,
+            )
+        )
     seen: set[str] = set()
     for e in out:
         if e.name in seen:

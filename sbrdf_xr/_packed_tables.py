@@ -108,7 +108,7 @@ def pack_tables(
     pgrid, p_off = cat([np.asarray(t[3]) for t in tables])
     edges = np.array([t[4] for t in tables], dtype=bool).reshape(-1, 3)
     blend = np.array([float(t[5]) if len(t) > 5 else 0.0 for t in tables], dtype=np.float64)
-    shapes = tuple(tuple(int(x) for x in v.shape[:3]) for v, *_ in tables)
+    shapes = tuple((int(v.shape[0]), int(v.shape[1]), int(v.shape[2])) for v, *_ in tables)
     maps = [[bucket_map(np.asarray(t[1 + a])) for t in tables] for a in range(3)]
     lengths = [[m.size for m, _ in axis] for axis in maps]
     width = max(sum(n) for n in lengths)

@@ -204,7 +204,7 @@ def material_models(scene: Scene, used: list[str]) -> dict[int, tuple[Any, Mappi
     from . import models as models_mod
 
     given = dict(scene.models or {})
-    out = {}
+    out: dict[int, tuple[Any, Mapping[str, Any]]] = {}
     for m, name in enumerate(used):
         spec = given.get(name)
         if spec is None:
@@ -242,7 +242,7 @@ def effect_stage(
     emission only where asked for and not negligible.  Appends the plan's lines."""
     geo = scene.geometry
     active = ["sunlight"]
-    params: dict[str, dict[str, Any]] = {}
+    params: dict[str, Mapping[str, Any]] = {}
     if shadowing:
         active.append("shadowing")
     if geo.sun_scale is not None:

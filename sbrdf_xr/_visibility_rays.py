@@ -198,7 +198,7 @@ def intersector(
     if engine == "embree":
         from trimesh.ray import ray_pyembree
 
-        rmi = ray_pyembree.RayMeshIntersector(mesh)
+        rmi: Any = ray_pyembree.RayMeshIntersector(mesh)
 
         def hits(origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
             return rmi.intersects_first(origins, directions) >= 0

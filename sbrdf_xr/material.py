@@ -271,7 +271,9 @@ def lookup_anisotropic(
         if sel.size:
             spec = _lut.lookup_kernel(
                 values[:, :, :, k, :],
-                *grids,
+                grids[0],
+                grids[1],
+                grids[2],
                 ti.ravel()[sel],
                 dt.ravel()[sel],
                 ph.ravel()[sel],
@@ -639,6 +641,14 @@ def sample_rotation(measurements: xr.Dataset) -> float:
     return float(arr.reshape(-1)[0])
 
 
+def _broadcast3(
+    grid: list[xr.DataArray],
+) -> tuple[xr.DataArray, xr.DataArray, xr.DataArray]:
+    """The three angle grids broadcast against each other (for :func:`lookup`)."""
+    a, b, c = xr.broadcast(*grid)
+    return a, b, c
+
+
 def build_lut_anisotropic(
     measurements: Sequence[xr.Dataset],
     *,
@@ -723,7 +733,7 @@ def build_lut_anisotropic(
     grid = [xr.DataArray(g, dims=d) for g, d in ((ti, THETA_I), (dt, DELTA_THETA), (ph, PHI))]
     slices = [
         np.asarray(
-            lookup(t, *xr.broadcast(*grid), method="linear").transpose(*ANGLE_DIMS, WAVELENGTH)
+            lookup(t, *_broadcast3(grid), method="linear").transpose(*ANGLE_DIMS, WAVELENGTH)
         )
         for t in tables
     ]
@@ -862,7 +872,9 @@ def hemispherical_reflectance(
     def kernel(values: np.ndarray) -> np.ndarray:
         return _lut.hemispherical_reflectance_kernel(
             values,
-            *grids,
+            grids[0],
+            grids[1],
+            grids[2],
             ti,
             method,
             zero_edges=_lut.table_edges(material.attrs),

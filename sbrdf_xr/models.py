@@ -244,7 +244,7 @@ def render_anisotropic(
     ps = grids[3]
     if ps[0] < 0 or ps[-1] > 180:
         raise ValidationError(f"psi: must lie in [0, 180] degree, got [{ps[0]}, {ps[-1]}]")
-    vals = m.render_grid(*grids[:3], wl, psi=ps, horizon="limit", **kw)
+    vals = m.render_grid(grids[0], grids[1], grids[2], wl, psi=ps, horizon="limit", **kw)
     a = attrs(
         SBRDF,
         material=spec.attrs["material"],

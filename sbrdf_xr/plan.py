@@ -449,16 +449,20 @@ def compile_plan(scene: Scene) -> Plan:
         )
     else:
         models = {}
-        packed = []
+        packed: list[tuple[Any, ...]] = []
         for m in used:
             da = table_on(scene.materials[m], wl, knobs["table_theta_step"])
             values = np.asarray(da.values)
             if pre and bw is not None:
                 values = np.asarray(values, dtype=np.float64) @ bw.T
             if PSI in da.dims:  # its psi slices; the packed slot (psi[0]) is never read
+                tg, dg, pg, psg = (np.asarray(da[d].values) for d in (*ANGLE_DIMS, PSI))
                 aniso_tables[len(packed)] = pack_anisotropic(
                     values,
-                    *(da[d].values for d in (*ANGLE_DIMS, PSI)),
+                    tg,
+                    dg,
+                    pg,
+                    psg,
                     table_edges(scene.materials[m].attrs),
                     dtype,
                 )

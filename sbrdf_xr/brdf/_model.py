@@ -475,7 +475,7 @@ class ModelRegistry(Mapping[str, Model]):
     def __repr__(self) -> str:
         return f"ModelRegistry({sorted(self)})"
 
-    def get(self, name: str, default: Any = None) -> Any:  # type: ignore[override]
+    def get(self, name: str, default: Any = None) -> Any:
         """The model matching ``name``, or ``default``."""
         return self[name] if name in self else default
 

@@ -47,7 +47,7 @@ _N_X = 48
 # --------------------------------------------------------------------------
 
 
-def _g_cs(cos2: np.ndarray, sin2: np.ndarray, b: np.ndarray) -> np.ndarray:
+def _g_cs(cos2: np.ndarray, sin2: np.ndarray, b: np.ndarray | float) -> np.ndarray:
     """Eq. 9 as ``cos^2 / (cos^2 + b^2 sin^2)``, = 1 for b = 0, 0 at 90 deg for b > 0."""
     den = cos2 + (b * b) * sin2
     ok = den > 0
@@ -149,7 +149,7 @@ def structure_h(alpha: ArrayLike, e: ArrayLike) -> NDArray[np.float64]:
     return _h_cs(np.cos(a) ** 2, np.sin(a) ** 2, np.asarray(e, dtype=np.float64))
 
 
-def _e2_h_norm(cos_i: np.ndarray, e: np.ndarray) -> np.ndarray:
+def _e2_h_norm(cos_i: np.ndarray, e: np.ndarray | float) -> np.ndarray:
     """``e^2 H(theta_i)`` (Eq. 18) in its cancellation-free form."""
     a = (1.0 - e) * (1.0 + e) * cos_i
     s = np.hypot(a, 2.0 * e)
@@ -207,7 +207,7 @@ def _cutoff_cs(cos_r: np.ndarray, sin2_r: np.ndarray, b: np.ndarray) -> np.ndarr
     return np.where(cos_r >= _COS_CUT, 1.0, np.minimum(d * d80_inv, 1.0))
 
 
-def _cutoff_over_cos(cos_r: np.ndarray, sin2_r: np.ndarray, b: np.ndarray) -> np.ndarray:
+def _cutoff_over_cos(cos_r: np.ndarray, sin2_r: np.ndarray, b: np.ndarray | float) -> np.ndarray:
     """``c(theta_r) / cos(theta_r)`` without dividing by a vanishing cosine."""
     cr = np.maximum(cos_r, _COS_FLOOR)
     d80_inv = 1.0 + (b * b) * _TAN2_CUT
