@@ -17,7 +17,8 @@ not run).
 * L2: ``catalog`` (knows every kind's loader in L1).
 * L3, the scene and its plan: ``effects``, ``plan``, ``sweep``, ``scene_model`` (the
   :class:`Scene`), ``scene_io`` (scene files, built-in scenes), ``scene`` (re-exports both).
-* L4, the cube: ``simulate``, ``_writer`` and its parts ``_write_common``, ``_runners``, ``_lock``.
+* L4, the cube: ``simulate``, ``_writer`` and its parts ``_write_common``, ``_write_layout``,
+  ``_write_files``, ``_write_disk``, ``_write_progress``, ``_runners``, ``_lock``.
 * L5, users of everything: ``invert`` (and its modules), ``bench``, ``bench_engine``,
   ``shadow_bench``, ``plot``,
   ``accessors``, ``cli``, ``testing`` and the package's ``__init__``.
@@ -69,7 +70,17 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ),
     ("catalog",),
     ("effects", "plan", "sweep", "scene_model", "scene_io", "scene"),
-    ("simulate", "_writer", "_write_common", "_runners", "_lock"),
+    (
+        "simulate",
+        "_writer",
+        "_write_common",
+        "_write_layout",
+        "_write_files",
+        "_write_disk",
+        "_write_progress",
+        "_runners",
+        "_lock",
+    ),
     ("invert", "bench", "bench_engine", "shadow_bench", "plot", "accessors", "cli", "testing", ""),
 )
 
