@@ -9,7 +9,7 @@ not run).
 * L0, kernels and names: ``_version``, ``_names``, ``errors``, ``geometry``, ``_lut``,
   ``_kernels``, ``sources``, ``brdf`` (and its models), ``imperfections``, ``knobs``,
   ``_catalog_index`` (where the shipped files are; it loads nothing), ``_shadow_kernels``,
-  ``_cache`` (tables built on load, cached on disk).
+  ``_polygon_kernels``, ``_cache`` (tables built on load, cached on disk).
 * L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``models``,
   ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``visibility``,
   ``attitude_frames``, ``attitude``, ``orbits``, ``observe``, ``photometry`` (and its
@@ -49,6 +49,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "knobs",
         "_catalog_index",
         "_shadow_kernels",
+        "_polygon_kernels",
         "_cache",
     ),
     (
