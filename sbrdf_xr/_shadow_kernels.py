@@ -1,8 +1,9 @@
 """Compiled kernels of the exact shadow method of :mod:`sbrdf_xr.visibility`.
 
-Polygon clipping, convex hulls and the area of a union of polygons in the plane of a
-receiving facet (numba, nogil), the view grid that finds candidate occluders, and
-the per-facet kernel that projects every occluder along a direction.  Plain arrays in
+The view grid that finds candidate occluders, the shadow one facet casts on another,
+and the per-facet kernel that projects every occluder along a direction (numba,
+nogil); the polygon clipping, convex hulls and the area of a union of polygons in the
+plane of a receiving facet are in :mod:`sbrdf_xr._polygon_kernels`.  Plain arrays in
 and out; polygons are (x, y) float arrays plus a count.
 """
 
@@ -11,288 +12,10 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-_MAXV = 96  #: vertex capacity of one clipped polygon
-#: Shadow polygons per facet united by inclusion-exclusion (more, or past the work budget:
-#: vertical slabs).
-_MAXM = 64
+from ._polygon_kernels import MAXM, MAXV, clip, hull, signed_area, union_area, union_area_slabs
+
 #: Shadow polygons per facet held by the compiled kernel; a facet with more goes to GEOS.
 MAX_SHADOWS = 1024
-_BUDGET = 20000  #: polygon intersections per facet before falling back to the GEOS union
-
-
-@nb.njit(cache=True, nogil=True)
-def _signed_area(px, py, n):
-    s = 0.0
-    for k in range(n):
-        k1 = k + 1 if k + 1 < n else 0
-        s += px[k] * py[k1] - px[k1] * py[k]
-    return 0.5 * s
-
-
-@nb.njit(cache=True, nogil=True)
-def _clip(sx, sy, ns, cx, cy, nc, ox, oy, tx, ty):
-    """Sutherland-Hodgman: subject polygon (sx, sy, ns) clipped by the convex counter-clockwise
-    polygon (cx, cy, nc), written to (ox, oy); (tx, ty) is scratch.  Returns the vertex count
-    (-1 if the capacity would be exceeded).  Exact for convex subjects (the intersection of two
-    convex sets is the clipped polygon)."""
-    n = ns
-    for k in range(n):
-        ox[k] = sx[k]
-        oy[k] = sy[k]
-    for e in range(nc):
-        if n == 0:
-            return 0
-        ax = cx[e]
-        ay = cy[e]
-        e1 = e + 1 if e + 1 < nc else 0
-        bx = cx[e1] - ax
-        by = cy[e1] - ay
-        for k in range(n):
-            tx[k] = ox[k]
-            ty[k] = oy[k]
-        m = 0
-        px = tx[n - 1]
-        py = ty[n - 1]
-        dp = bx * (py - ay) - by * (px - ax)
-        for k in range(n):
-            qx = tx[k]
-            qy = ty[k]
-            dq = bx * (qy - ay) - by * (qx - ax)
-            if m + 2 >= ox.shape[0]:
-                return -1
-            if dq >= 0.0:
-                if dp < 0.0:
-                    t = dp / (dp - dq)
-                    ox[m] = px + t * (qx - px)
-                    oy[m] = py + t * (qy - py)
-                    m += 1
-                ox[m] = qx
-                oy[m] = qy
-                m += 1
-            elif dp > 0.0:
-                t = dp / (dp - dq)
-                ox[m] = px + t * (qx - px)
-                oy[m] = py + t * (qy - py)
-                m += 1
-            px = qx
-            py = qy
-            dp = dq
-        n = m
-    return n
-
-
-@nb.njit(cache=True, nogil=True)
-def _hull(px, py, n, ox, oy, idx):
-    """Convex hull (Andrew's monotone chain, counter-clockwise, collinear points dropped) of n
-    points, written to (ox, oy); idx is integer scratch.  Returns the vertex count.  Clipped
-    polygons are convex only up to rounding; their hull is exactly convex, so every edge line
-    of it supports it, and near-duplicate vertices cannot leave a stray edge direction."""
-    for k in range(n):
-        idx[k] = k
-    for k in range(1, n):  # insertion sort by (x, y)
-        v = idx[k]
-        q = k - 1
-        while q >= 0 and (px[idx[q]] > px[v] or (px[idx[q]] == px[v] and py[idx[q]] > py[v])):
-            idx[q + 1] = idx[q]
-            q -= 1
-        idx[q + 1] = v
-    m = 0
-    for k in range(n):  # lower chain
-        v = idx[k]
-        while (
-            m >= 2
-            and (
-                (ox[m - 1] - ox[m - 2]) * (py[v] - oy[m - 2])
-                - (oy[m - 1] - oy[m - 2]) * (px[v] - ox[m - 2])
-            )
-            <= 0.0
-        ):
-            m -= 1
-        ox[m] = px[v]
-        oy[m] = py[v]
-        m += 1
-    low = m + 1
-    for k in range(n - 2, -1, -1):  # upper chain
-        v = idx[k]
-        while (
-            m >= low
-            and (
-                (ox[m - 1] - ox[m - 2]) * (py[v] - oy[m - 2])
-                - (oy[m - 1] - oy[m - 2]) * (px[v] - ox[m - 2])
-            )
-            <= 0.0
-        ):
-            m -= 1
-        ox[m] = px[v]
-        oy[m] = py[v]
-        m += 1
-    return m - 1 if m > 1 else m
-
-
-@nb.njit(cache=True, nogil=True)
-def _bounds(px, py, n, out):
-    out[0] = out[2] = np.inf
-    out[1] = out[3] = -np.inf
-    for k in range(n):
-        out[0] = min(out[0], px[k])
-        out[1] = max(out[1], px[k])
-        out[2] = min(out[2], py[k])
-        out[3] = max(out[3], py[k])
-
-
-@nb.njit(cache=True, nogil=True)
-def _union_area(gx, gy, gn, m, tiny, stack_x, stack_y, stack_n, nxt, tx, ty):
-    """Area of the union of m convex counter-clockwise polygons (gx[k], gy[k], gn[k]) by
-    inclusion-exclusion over the non-empty intersections, depth first (an empty intersection
-    prunes every superset; bounding boxes that do not overlap skip the clip).  Returns
-    (area, ok); ok is False past the work budget."""
-    box = np.empty((m, 4))
-    sbox = np.empty((m + 1, 4))
-    for k in range(m):
-        _bounds(gx[k], gy[k], gn[k], box[k])
-    total = 0.0
-    ops = 0
-    for a in range(m):
-        n0 = gn[a]
-        for k in range(n0):
-            stack_x[0, k] = gx[a, k]
-            stack_y[0, k] = gy[a, k]
-        stack_n[0] = n0
-        sbox[0] = box[a]
-        total += _signed_area(gx[a], gy[a], n0)
-        nxt[0] = a + 1
-        d = 0
-        while d >= 0:
-            if nxt[d] >= m:
-                d -= 1
-                continue
-            b = nxt[d]
-            nxt[d] += 1
-            if (
-                box[b, 0] >= sbox[d, 1]
-                or box[b, 1] <= sbox[d, 0]
-                or box[b, 2] >= sbox[d, 3]
-                or box[b, 3] <= sbox[d, 2]
-            ):
-                continue
-            ops += 1
-            if ops > _BUDGET:
-                return 0.0, False
-            nq = _clip(
-                stack_x[d],
-                stack_y[d],
-                stack_n[d],
-                gx[b],
-                gy[b],
-                gn[b],
-                stack_x[d + 1],
-                stack_y[d + 1],
-                tx,
-                ty,
-            )
-            if nq < 0:
-                return 0.0, False
-            if nq < 3:
-                continue
-            area = _signed_area(stack_x[d + 1], stack_y[d + 1], nq)
-            if area <= tiny:
-                continue
-            total += area if (d % 2 == 1) else -area  # subset size d + 2
-            stack_n[d + 1] = nq
-            _bounds(stack_x[d + 1], stack_y[d + 1], nq, sbox[d + 1])
-            nxt[d + 1] = b + 1
-            d += 1
-    return total, True
-
-
-@nb.njit(cache=True, nogil=True)
-def _union_area_slabs(gx, gy, gn, m):
-    """Area of the union of m convex polygons by vertical slabs.
-
-    The slab boundaries are every vertex abscissa and every abscissa where edges of two
-    polygons cross; inside a slab each polygon covers a y-interval whose ends move linearly
-    with x and never cross another end, so the length of the union of the intervals is
-    linear in x and its value at the slab's middle times the slab's width is the slab's
-    area, exactly.  O(E**2) for E edges in all: used past the inclusion-exclusion budget.
-    """
-    nv = 0
-    for k in range(m):
-        nv += gn[k]
-    ne = 0
-    xs = np.empty(0)
-    n_cross = 0
-    for sweep in range(2):  # count the crossings, then store them
-        if sweep == 1:
-            xs = np.empty(nv + n_cross)
-            for k in range(m):
-                for v in range(gn[k]):
-                    xs[ne] = gx[k, v]
-                    ne += 1
-        ne = 0 if sweep == 0 else ne
-        for k in range(m):
-            for v in range(gn[k]):
-                v1 = v + 1 if v + 1 < gn[k] else 0
-                ax, ay = gx[k, v], gy[k, v]
-                rx, ry = gx[k, v1] - ax, gy[k, v1] - ay
-                for q in range(k + 1, m):
-                    for w in range(gn[q]):
-                        w1 = w + 1 if w + 1 < gn[q] else 0
-                        bx, by = gx[q, w], gy[q, w]
-                        sx, sy = gx[q, w1] - bx, gy[q, w1] - by
-                        den = rx * sy - ry * sx
-                        if den == 0.0:
-                            continue  # parallel: their ends never swap inside a slab
-                        t = ((bx - ax) * sy - (by - ay) * sx) / den
-                        u = ((bx - ax) * ry - (by - ay) * rx) / den
-                        if 0.0 < t < 1.0 and 0.0 < u < 1.0:
-                            if sweep == 0:
-                                n_cross += 1
-                            else:
-                                xs[ne] = ax + t * rx
-                                ne += 1
-    xs = np.sort(xs[:ne])
-    lo = np.empty(m)
-    hi = np.empty(m)
-    total = 0.0
-    for e in range(ne - 1):
-        x0 = xs[e]
-        x1 = xs[e + 1]
-        if x1 <= x0:
-            continue
-        xm = 0.5 * (x0 + x1)
-        n_int = 0
-        for k in range(m):
-            ylo = np.inf
-            yhi = -np.inf
-            for v in range(gn[k]):
-                v1 = v + 1 if v + 1 < gn[k] else 0
-                xa, xb = gx[k, v], gx[k, v1]
-                if (xa < xm) != (xb < xm):
-                    y = gy[k, v] + (xm - xa) * (gy[k, v1] - gy[k, v]) / (xb - xa)
-                    ylo = min(ylo, y)
-                    yhi = max(yhi, y)
-            if yhi > ylo:
-                lo[n_int] = ylo
-                hi[n_int] = yhi
-                n_int += 1
-        if n_int == 0:
-            continue
-        order = np.argsort(lo[:n_int])
-        length = 0.0
-        cur_lo = lo[order[0]]
-        cur_hi = hi[order[0]]
-        for q in range(1, n_int):
-            a = lo[order[q]]
-            b = hi[order[q]]
-            if a > cur_hi:
-                length += cur_hi - cur_lo
-                cur_lo = a
-                cur_hi = b
-            elif b > cur_hi:
-                cur_hi = b
-        length += cur_hi - cur_lo
-        total += (x1 - x0) * length
-    return total
 
 
 @nb.njit(cache=True, nogil=True)
@@ -423,15 +146,15 @@ def _shadow_polygon(
                 break
         if outside:
             return 0
-    if _signed_area(px, py, n_p) < 0.0:  # make it counter-clockwise
+    if signed_area(px, py, n_p) < 0.0:  # make it counter-clockwise
         for v in range(n_p // 2):
             px[v], px[n_p - 1 - v] = px[n_p - 1 - v], px[v]
             py[v], py[n_p - 1 - v] = py[n_p - 1 - v], py[v]
-    nc = _clip(px, py, n_p, cx, cy, 3, tx, ty, qx, qy)
+    nc = clip(px, py, n_p, cx, cy, 3, tx, ty, qx, qy)
     if nc < 3:
         return 0
-    nq = _hull(tx, ty, nc, qx, qy, idx)
-    if nq < 3 or _signed_area(qx, qy, nq) <= 1e-15 * _signed_area(cx, cy, 3):
+    nq = hull(tx, ty, nc, qx, qy, idx)
+    if nq < 3 or signed_area(qx, qy, nq) <= 1e-15 * signed_area(cx, cy, 3):
         return 0
     return nq
 
@@ -457,18 +180,18 @@ def exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
     gx = np.empty((MAX_SHADOWS, 8))  # a shadow clipped to a triangle has at most 7 vertices
     gy = np.empty((MAX_SHADOWS, 8))
     gn = np.empty(MAX_SHADOWS, dtype=np.int64)
-    stack_x = np.empty((_MAXM + 1, _MAXV))
-    stack_y = np.empty((_MAXM + 1, _MAXV))
-    stack_n = np.empty(_MAXM + 1, dtype=np.int64)
-    nxt = np.empty(_MAXM + 1, dtype=np.int64)
-    tx = np.empty(_MAXV)
-    ty = np.empty(_MAXV)
+    stack_x = np.empty((MAXM + 1, MAXV))
+    stack_y = np.empty((MAXM + 1, MAXV))
+    stack_n = np.empty(MAXM + 1, dtype=np.int64)
+    nxt = np.empty(MAXM + 1, dtype=np.int64)
+    tx = np.empty(MAXV)
+    ty = np.empty(MAXV)
     px = np.empty(8)
     py = np.empty(8)
     hh = np.empty(3)
-    qx = np.empty(_MAXV)
-    qy = np.empty(_MAXV)
-    idx = np.empty(_MAXV, dtype=np.int64)
+    qx = np.empty(MAXV)
+    qy = np.empty(MAXV)
+    idx = np.empty(MAXV, dtype=np.int64)
     cx = np.empty(3)
     cy = np.empty(3)
     nd = np.empty((K, nf))
@@ -504,7 +227,7 @@ def exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
             for c in range(3):
                 cx[c] = T2[i, c, 0]
                 cy[c] = T2[i, c, 1]
-            area_t = _signed_area(cx, cy, 3)
+            area_t = signed_area(cx, cy, 3)
             m = 0
             too_many = False
             for k in range(K):
@@ -581,12 +304,12 @@ def exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
                 continue
             ok = False
             shadow = 0.0
-            if m <= _MAXM:
-                shadow, ok = _union_area(
+            if m <= MAXM:
+                shadow, ok = union_area(
                     gx, gy, gn, m, 1e-15 * area_t, stack_x, stack_y, stack_n, nxt, tx, ty
                 )
             if not ok:
-                shadow = _union_area_slabs(gx, gy, gn, m)
+                shadow = union_area_slabs(gx, gy, gn, m)
             frac[g, i] = min(1.0, max(0.0, 1.0 - shadow / area_t))
     return frac
 
@@ -599,14 +322,14 @@ def facet_shadows(i, dirs, V, F, N, P0, E1, E2, T2, watertight, eps_h):
     K = dirs.shape[0]
     cx = T2[i, :, 0].copy()
     cy = T2[i, :, 1].copy()
-    tx = np.empty(_MAXV)
-    ty = np.empty(_MAXV)
+    tx = np.empty(MAXV)
+    ty = np.empty(MAXV)
     px = np.empty(8)
     py = np.empty(8)
     hh = np.empty(3)
-    qx = np.empty(_MAXV)
-    qy = np.empty(_MAXV)
-    idx = np.empty(_MAXV, dtype=np.int64)
+    qx = np.empty(MAXV)
+    qy = np.empty(MAXV)
+    idx = np.empty(MAXV, dtype=np.int64)
     xy = np.empty((8 * 64, 2))
     start = [0]
     n = 0

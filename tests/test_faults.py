@@ -118,13 +118,13 @@ WRITER = textwrap.dedent(
     import json, os, resource, signal, sys
     sys.path[:0] = [{repo!r}, {tests!r}]
     from test_faults import cube_24
-    from sbrdf_xr import _writer
+    from sbrdf_xr import _write_disk, _writer
     from sbrdf_xr.errors import SbrdfError
     args = json.loads(sys.argv[1])
     if args.get("limit"):
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # writes past the limit fail with EFBIG
         resource.setrlimit(resource.RLIMIT_FSIZE, (args["limit"], resource.RLIM_INFINITY))
-    _writer._CHECK_SPACE = args.get("check_space", True)
+    _write_disk.CHECK_SPACE = args.get("check_space", True)
     kill_after = args.get("kill_after")
     def on_block(event):
         if kill_after is not None and event.n_written >= kill_after:

@@ -14,7 +14,7 @@ import xarray as xr
 
 from sbrdf_xr import geometry, invert
 from sbrdf_xr.errors import InversionError
-from sbrdf_xr.invert import _spin
+from sbrdf_xr.invert import _spin_search
 from sbrdf_xr.scene import Scene
 from sbrdf_xr.simulate import simulate
 from sbrdf_xr.spacecraft import canx1
@@ -225,16 +225,16 @@ def test_search_paths_agree(sc):
     lc = _spin_curve(
         sc, axis_body, invert.axis_vector(10.0, 60.0), 30.0, 0.0, times, s_in, o_in, 0.02, 1
     )
-    prob = _spin._Problem(
-        invert.light_curve_fluxes(lc), _spin._Kernel(sc, BANDS), s_in, o_in, axis_body, "band"
+    prob = _spin_search.Problem(
+        invert.light_curve_fluxes(lc), _spin_search.Kernel(sc, BANDS), s_in, o_in, axis_body, "band"
     )
     axes, periods, phases = (
         invert.fibonacci_sphere(5),
         np.array([29.0, 30.0]),
         np.array([0.0, 90.0]),
     )
-    a = _spin._search(prob, axes, periods, phases, 1)
-    b = _spin._search_shift(prob, axes, periods, phases, 1, n_angles=7200)
+    a = _spin_search.search(prob, axes, periods, phases, 1)
+    b = _spin_search.search_shift(prob, axes, periods, phases, 1, n_angles=7200)
     # 0.05 degree angle grid with linear interpolation: chi-square within 2 %
     np.testing.assert_allclose(b, a, rtol=0.02)
 
@@ -357,7 +357,7 @@ def test_cli_spin(sc, tmp_path, capsys):
             "time": lc.time.values,
             "band": lc.band.values,
             "magnitude": -2.5 * np.log10(f),
-            "uncertainty": 0.02 / _spin._LN10_2P5,
+            "uncertainty": 0.02 / _spin_search.LN10_2P5,
         }
     ).to_csv(tmp_path / "lc.csv", index=False)
     out = tmp_path / "spin.nc"

@@ -9,7 +9,8 @@ not run).
 * L0, kernels and names: ``_version``, ``_names``, ``errors``, ``rotations``, ``geometry``,
   ``_lut``, ``_kernels``, ``sources``, ``brdf`` (and its models), ``imperfections``, ``knobs``,
   ``_catalog_index`` (where the shipped files are; it loads nothing), ``_shadow_kernels``,
-  ``_cache`` (tables built on load, cached on disk), ``anisotropy`` (facet tangents,
+  ``_polygon_kernels``, ``_cache`` (tables built on load, cached on disk), ``anisotropy``
+  (facet tangents,
   ``psi``) and ``_aniso_kernels`` (the anisotropic look-up).
 * L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``model_schema``,
   ``models``,
@@ -19,7 +20,8 @@ not run).
 * L2: ``catalog`` (knows every kind's loader in L1).
 * L3, the scene and its plan: ``effects``, ``plan``, ``sweep``, ``scene_model`` (the
   :class:`Scene`), ``scene_io`` (scene files, built-in scenes), ``scene`` (re-exports both).
-* L4, the cube: ``simulate``, ``_writer`` and its parts ``_write_common``, ``_runners``, ``_lock``.
+* L4, the cube: ``simulate``, ``_writer`` and its parts ``_write_common``, ``_write_layout``,
+  ``_write_files``, ``_write_disk``, ``_write_progress``, ``_runners``, ``_lock``.
 * L5, users of everything: ``invert`` (and its modules), ``bench``, ``bench_engine``,
   ``shadow_bench``, ``plot``,
   ``accessors``, ``cli``, ``testing`` and the package's ``__init__``.
@@ -53,6 +55,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "knobs",
         "_catalog_index",
         "_shadow_kernels",
+        "_polygon_kernels",
         "_cache",
         "anisotropy",
         "_aniso_kernels",
@@ -78,7 +81,17 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ),
     ("catalog",),
     ("effects", "plan", "_plan_stages", "sweep", "scene_model", "scene_io", "scene"),
-    ("simulate", "_writer", "_write_common", "_runners", "_lock"),
+    (
+        "simulate",
+        "_writer",
+        "_write_common",
+        "_write_layout",
+        "_write_files",
+        "_write_disk",
+        "_write_progress",
+        "_runners",
+        "_lock",
+    ),
     ("invert", "bench", "bench_engine", "shadow_bench", "plot", "accessors", "cli", "testing", ""),
 )
 

@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from shapely.geometry import MultiPoint, Polygon
 
-from sbrdf_xr import _shadow_kernels as sk
+from sbrdf_xr import _polygon_kernels as pk
 from sbrdf_xr import spacecraft as sc
 from sbrdf_xr import visibility as vis
 from sbrdf_xr.errors import ValidationError
@@ -539,21 +539,21 @@ def test_union_kernels_against_geos(m):
     for _ in range(20):
         gx, gy, gn, polys = _random_convex_polygons(rng, m)
         ref = shapely.union_all(polys).area
-        assert sk._union_area_slabs(gx, gy, gn, m) == pytest.approx(ref, rel=1e-12)
+        assert pk.union_area_slabs(gx, gy, gn, m) == pytest.approx(ref, rel=1e-12)
         if m <= 12:  # inclusion-exclusion of heavily overlapping sets is exponential
-            buf = sk._MAXM + 1
-            area, ok = sk._union_area(
+            buf = pk.MAXM + 1
+            area, ok = pk.union_area(
                 gx,
                 gy,
                 gn,
                 m,
                 0.0,
-                np.zeros((buf, sk._MAXV)),
-                np.zeros((buf, sk._MAXV)),
+                np.zeros((buf, pk.MAXV)),
+                np.zeros((buf, pk.MAXV)),
                 np.zeros(buf, np.int64),
                 np.zeros(buf, np.int64),
-                np.zeros(sk._MAXV),
-                np.zeros(sk._MAXV),
+                np.zeros(pk.MAXV),
+                np.zeros(pk.MAXV),
             )
             assert ok and area == pytest.approx(ref, rel=1e-12)
 

@@ -34,14 +34,8 @@ from __future__ import annotations
 from ..errors import InversionError
 from ._bench import benchmark_spin_search
 from ._data import band_terms, magnitudes_to_signal, read_spectrum
-from ._spin import (
-    axis_separation,
-    axis_vector,
-    fibonacci_sphere,
-    fit_spin,
-    light_curve_fluxes,
-    spin_model,
-)
+from ._spin import axis_separation, axis_vector, fit_spin
+from ._spin_search import fibonacci_sphere, light_curve_fluxes, spin_model
 from ._unmix import DEGENERACY_THRESHOLD, material_areas, unmix
 
 __all__ = [

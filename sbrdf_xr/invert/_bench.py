@@ -9,7 +9,14 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ._spin import _Kernel, _Problem, _search, _search_shift, fibonacci_sphere, light_curve_fluxes
+from ._spin_search import (
+    Kernel,
+    Problem,
+    fibonacci_sphere,
+    light_curve_fluxes,
+    search,
+    search_shift,
+)
 
 __all__ = ["benchmark_spin_search"]
 
@@ -67,16 +74,16 @@ def benchmark_spin_search(
         },
     )
     data = light_curve_fluxes(lc)
-    kern = _Kernel(sc, list(bands))
-    prob = _Problem(
+    kern = Kernel(sc, list(bands))
+    prob = Problem(
         data, kern, [1.0, 0, 0], [np.cos(0.5), np.sin(0.5), 0.0], np.array([0.0, 0, 1]), "band"
     )
     periods = np.linspace(20.0, 40.0, 10)
     phases = np.arange(10) * 36.0
-    _search(prob, fibonacci_sphere(2), periods[:1], phases[:1], n_threads)  # compile, warm caches
+    search(prob, fibonacci_sphere(2), periods[:1], phases[:1], n_threads)  # compile, warm caches
     rows = []
     for method in methods:
-        run = {"direct": _search, "shift": _search_shift}[method]
+        run = {"direct": search, "shift": search_shift}[method]
         for n in n_candidates:
             axes = fibonacci_sphere(max(1, int(n) // 100))
             t0 = time.perf_counter()

@@ -9,7 +9,7 @@ import numpy as np
 import xarray as xr
 
 from ..errors import InversionError
-from ._spin import _LN10_2P5
+from ._spin_search import LN10_2P5
 
 __all__ = ["band_terms", "magnitudes_to_signal", "read_spectrum"]
 
@@ -95,7 +95,7 @@ def magnitudes_to_signal(
     msun = sun_magnitudes(bands).values
     m = np.asarray(light_curve["magnitude"].values, dtype=np.float64)
     s = (range_km * 1e3) ** 2 * 10 ** (-0.4 * (m - msun))
-    sig = s * _LN10_2P5 * np.asarray(light_curve["uncertainty"].values, dtype=np.float64)
+    sig = s * LN10_2P5 * np.asarray(light_curve["uncertainty"].values, dtype=np.float64)
     coords = {"band": bands}
     return (
         xr.DataArray(
