@@ -182,6 +182,20 @@ def user_catalog_dirs() -> list[Path]:
     ------
     CatalogError
         If a directory does not exist or holds no ``index.toml``.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.catalog import user_catalog_dirs
+    >>> d = Path(tempfile.mkdtemp())
+    >>> _ = (d / "index.toml").write_text("")
+    >>> os.environ["SBRDF_XR_CATALOG_PATH"] = str(d)
+    >>> user_catalog_dirs() == [d.resolve()]
+    True
+    >>> del os.environ["SBRDF_XR_CATALOG_PATH"]
+    >>> user_catalog_dirs()
+    []
     """
     out = []
     for item in os.environ.get(CATALOG_PATH_ENV, "").split(os.pathsep):

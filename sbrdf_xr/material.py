@@ -699,6 +699,23 @@ def build_lut_anisotropic(
     -------
     xarray.DataArray
         Dims ``(theta_i, delta_theta, phi, psi, wavelength)``, validated.
+
+    Examples
+    --------
+    A brushed metal measured (virtually) at two sample rotations, 0 and 90 deg:
+
+    >>> from sbrdf_xr import goniometer, models
+    >>> spec = models.model_material(
+    ...     "anisotropic_microfacet", [550.0], material="brushed", provenance="doc",
+    ...     alpha_x=0.15, alpha_y=0.4, n=1.5, k=7.5, rho_d=0.01)
+    >>> sets = []
+    >>> for rot in (0.0, 90.0):
+    ...     m = goniometer.measure(models.spectrum_function(spec, psi=rot), [550.0], [20.0, 40.0])
+    ...     m.attrs["sample_rotation"] = rot
+    ...     sets.append(m)
+    >>> table = build_lut_anisotropic(sets, n_phi=11, n_delta_theta=11, check_energy=False)
+    >>> table.dims, table.psi.values.tolist()
+    (('theta_i', 'delta_theta', 'phi', 'psi', 'wavelength'), [0.0, 90.0])
     """
     from ._names import ANISO_LUT_DIMS, PSI
     from .anisotropy import PSI_PERIOD

@@ -62,7 +62,18 @@ _NS = np.dtype("datetime64[ns]")
 
 @cache
 def skyfield_data() -> tuple[Any, Any]:
-    """Timescale (with polar motion) and ephemeris from the ``skyfield-data`` directory."""
+    """Timescale (with polar motion) and ephemeris from the ``skyfield-data`` directory.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.orbits import skyfield_data
+    >>> ts, eph = skyfield_data()
+    >>> t = ts.utc(2024, 3, 17)
+    >>> round(float((t.tt - t.ut1) * 86400), 3)  # TT - UT1 [s] from the shipped IERS table
+    69.193
+    >>> type(eph).__name__, 399 in eph  # the JPL DE421 kernel, with the Earth
+    ('SpiceKernel', True)
+    """
     import skyfield_data
     from skyfield.api import Loader
     from skyfield.data import iers

@@ -296,16 +296,7 @@ def test_domain_modules_do_not_import_the_catalog(mod):
 # Any other use is listed here, with the reason it stands, or fails the test.
 
 #: (importer, "module._name" or "module") -> why the use stands.
-PRIVATE_USES: dict[tuple[str, str], str] = {
-    ("material", "models._params"): (
-        "the BRDF model and parameters of a model material, read by the table construction "
-        "(the model interface's own reader; no public equivalent yet)"
-    ),
-    ("plan", "models._params"): (
-        "the BRDF model and parameters of a model material, read by the analytic evaluation "
-        "(the model interface's own reader; no public equivalent yet)"
-    ),
-}
+PRIVATE_USES: dict[tuple[str, str], str] = {}
 
 
 def _is_private(name: str) -> bool:
