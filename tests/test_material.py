@@ -350,7 +350,26 @@ def test_below_noise_model_fill_keeps_the_floor_and_the_measurements():
     # The theta_i = 90 row of a glossy table is not resolved by its grid (the lobe meets
     # the horizon between 5-degree nodes): build_lut says so, naming the row.
     with pytest.warns(NonPhysicalWarning, match=r"theta_i = \[90.0\] deg"):
-        filled = M.build_lut(meas, below_noise="model", model=spec, extrapolation="constant")
+        M.build_lut(
+            meas, below_noise="model", model=spec, extrapolation="constant", renormalise="none"
+        )
+    # The flux-conserving renormalisation (the default with below_noise="model") scales
+    # every row by the energy the model loses or gains on the grid: with every
+    # measured/model ratio 1 the table keeps the model's reflectance at every row, to
+    # the accuracy of the model's own quadrature (~1e-6; 1e-4 next to grazing).
+    filled = M.build_lut(meas, below_noise="model", model=spec, extrapolation="constant")
+    assert filled.attrs["renormalise"] == "model"
+    mod, _, kw = models._params(spec)
+    ti_all = filled.theta_i.values
+    np.testing.assert_allclose(
+        M.hemispherical_reflectance(filled),
+        mod.directional_hemispherical_reflectance(np.minimum(ti_all, 90.0), wl, **kw),
+        rtol=1e-9,
+    )
+    with pytest.raises(ValidationError, match="renormalise: got 'flux'"):
+        M.build_lut(meas, below_noise="model", model=spec, renormalise="flux")
+    with pytest.raises(ValidationError, match="needs below_noise='model'"):
+        M.build_lut(meas, renormalise="model")
     assert filled.attrs["below_noise"] == "model"
     assert filled.delta_theta.values[0] == -180.0 and filled.delta_theta.values[-1] == 90.0
     assert filled.phi.values[-1] == 90.0
