@@ -6,6 +6,8 @@ same tiny materials, measurement sets and spacecraft the test-suite uses.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import xarray as xr
 
@@ -150,7 +152,7 @@ def _reference_breaks(lo: float, hi: float, centre: float, fine: float) -> np.nd
     pts = np.concatenate([[lo, hi], centre + steps, centre - steps, [centre]])
     pts = np.unique(pts[(pts >= lo) & (pts <= hi)])
     out = [pts[:1]]
-    for a, b in zip(pts[:-1], pts[1:], strict=True):  # no piece wider than 10 degree
+    for a, b in itertools.pairwise(pts):  # no piece wider than 10 degree
         out.append(np.linspace(a, b, int(np.ceil((b - a) / 10.0)) + 1)[1:])
     return np.concatenate(out)
 
