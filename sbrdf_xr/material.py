@@ -311,6 +311,7 @@ def build_lut(
     below_noise: str = "zero",
     duplicates: str = "error",
     check_energy: bool = True,
+    renormalise: str = "auto",
 ) -> xr.DataArray:
     """Look-up table from sparse measurements, by the construction of paper 000 §3.2.
 
@@ -412,6 +413,25 @@ def build_lut(
         A geometry measured more than once is an error (:func:`validate_measurements`)
         or its repeats are averaged (``mean``: the mean of the measured repeats; a
         reference point only if all repeats are).
+    renormalise : {"auto", "none", "model"}, default "auto"
+        ``model`` (``auto`` with ``below_noise="model"``) is a flux-conserving
+        correction of the interpolant.  A lobe sampled on nodes a few degrees apart,
+        above all one meeting the horizon at grazing incidence, integrates under the
+        look-up's multilinear interpolation to more or less energy than the lobe
+        itself: a GGX lobe of roughness 0.15 rendered on such a grid gains 18 % at
+        ``theta_i = 85`` deg.  Every row ``(theta_i, wavelength)`` is scaled by
+        ``rho_model / rho_grid``, the factor that restores to the model rendered on
+        the grid the model's own directional-hemispherical reflectance
+        (``rho_grid`` by the quadrature of :func:`hemispherical_reflectance`), and
+        keeps the ratio to the measurements: a table of the model itself has the
+        model's energy exactly, and the rows beyond the measured angles, where the
+        table is the model, are bounded by its reflectance.  It is the
+        normalisation step of conservative remapping (P. W. Jones, Mon. Wea. Rev.
+        127, 2204, 1999: rescale the interpolant so that it keeps the integral of
+        the field it samples), applied per row.  ``none`` keeps the interpolant (and,
+        with ``extrapolation="model"``, only scales rows above the measured angles
+        down to the model's reflectance); ``auto`` is ``none`` with
+        ``below_noise="zero"`` (the paper's construction).
     check_energy : bool, default True
         Compute the table's directional-hemispherical reflectance every 5 deg of
         ``theta_i`` (and at the last row) and issue a
@@ -469,6 +489,17 @@ def build_lut(
     if below_noise not in BELOW_NOISE:
         raise ValidationError(
             f"below_noise: got {below_noise!r}; allowed: {', '.join(BELOW_NOISE)}"
+        )
+    if renormalise not in RENORMALISE:
+        raise ValidationError(
+            f"renormalise: got {renormalise!r}; allowed: {', '.join(RENORMALISE)}"
+        )
+    if renormalise == "auto":
+        renormalise = "model" if below_noise == "model" else "none"
+    elif renormalise == "model" and below_noise != "model":
+        raise ValidationError(
+            "renormalise: 'model' corrects a table made of a model times a ratio and needs "
+            f"below_noise='model', got below_noise={below_noise!r}"
         )
     ref = reference_mask(ds)
     ti_s = np.asarray(ds[THETA_I].values, dtype=np.float64)
@@ -546,8 +577,9 @@ def build_lut(
             # lobe meets the horizon): the model alone, reached over ``blend`` degrees.
             w = blend_weights(ti_out, -np.inf, measured_ti[-1], blend)[:, None, None, None]
             r_lut = (1.0 - w) * r_lut + w
-        lut = _model_rows(fit_model, ti_out, dt_grid, phi_grid, wl) * r_lut
-        if extrapolation == "model":
+        base = _model_rows(fit_model, ti_out, dt_grid, phi_grid, wl)
+        lut = base * r_lut
+        if extrapolation == "model" and renormalise == "none":
             _bound_grazing_rows(lut, ti_out, dt_grid, phi_grid, wl, fit_model, measured_ti[-1])
     if fit_model is not None and (extrapolation == "model" or below_noise == "model"):
         extra = {
@@ -558,7 +590,22 @@ def build_lut(
             extra["blend_width"] = blend
     if normal_incidence == "symmetric" and ti_out[0] == 0.0:
         lut[0] = azimuthal_average(lut[0], dt_grid, phi_grid, lut_edges(edges))
+        if renormalise == "model":
+            base[0] = azimuthal_average(base[0], dt_grid, phi_grid, lut_edges(edges))
         extra["normal_incidence_blend"] = float(blend_normal)
+    if renormalise == "model":
+        if fit_model is None:  # pragma: no cover - below_noise="model" needs the model
+            raise ValidationError("renormalise='model' needs the table's model")
+        _renormalise_rows(
+            lut,
+            base,
+            (ti_out, dt_grid, phi_grid),
+            wl,
+            fit_model,
+            lut_edges(edges),
+            extra.get("normal_incidence_blend", 0.0),
+        )
+        extra["renormalise"] = "model"
 
     name = material or ds.attrs.get("material", "unnamed")
     prov = ds.attrs.get("provenance", "")
@@ -606,6 +653,8 @@ def build_lut(
 EXTRAPOLATIONS = ("cubic", "linear", "constant", "model")
 #: Below-noise policies of :func:`build_lut`.
 BELOW_NOISE = ("zero", "model")
+#: Row renormalisations of :func:`build_lut`.
+RENORMALISE = ("auto", "none", "model")
 #: Reflectance above ``1 + ENERGY_TOL`` is reported by :func:`build_lut` (the
 #: quadrature of a float32 table is good to ~1e-7).
 ENERGY_TOL = 1e-6
@@ -806,6 +855,47 @@ def _bound_grazing_rows(
     )
     scale = np.where(rho_t > rho_m, rho_m / np.maximum(rho_t, 1e-300), 1.0)
     lut[rows] *= scale[:, None, None, :]
+
+
+def _renormalise_rows(
+    lut: np.ndarray,
+    base: np.ndarray,
+    grids: tuple[np.ndarray, np.ndarray, np.ndarray],
+    wl: np.ndarray,
+    model: xr.Dataset,
+    zero_edges: tuple[bool, bool, bool],
+    normal_blend: float,
+) -> None:
+    """Scale every row ``(theta_i, wavelength)`` of ``lut`` (in place) by the energy its
+    model loses or gains on the grid: ``rho_model / rho_grid``, with ``rho_model`` the
+    model's own directional-hemispherical reflectance and ``rho_grid`` that of ``base``
+    (the model rendered on the table grid) by the quadrature of the look-up's
+    interpolant (:func:`sbrdf_xr._lut.hemispherical_reflectance_kernel`)."""
+    ti = grids[0]
+    mod, _, kw = models.model_parameters(_model_for(model, wl))
+    rho_m = mod.directional_hemispherical_reflectance(np.minimum(ti, 90.0), wl, **kw)
+    tg, dg, pg = grids
+    rho_g = _lut.hemispherical_reflectance_kernel(
+        base, tg, dg, pg, ti, "linear", zero_edges=zero_edges, normal_blend=normal_blend
+    )
+    scale = np.divide(rho_m, rho_g, out=np.ones_like(rho_m), where=rho_g > 0)
+    # Below ``normal_blend`` a look-up mixes the row with the theta_i = 0 profile: with
+    # that profile already scaled, the row's own part takes the rest.
+    blended = np.flatnonzero((ti > 0) & (ti < normal_blend)) if ti[0] == 0.0 else np.zeros(0, int)
+    if len(blended):
+        idx = np.concatenate([[0], blended])
+        sub = base[idx].copy()
+        sub[0] *= scale[0]
+        both = _lut.hemispherical_reflectance_kernel(
+            sub, ti[idx], dg, pg, None, zero_edges=zero_edges, normal_blend=normal_blend
+        )[1:]
+        sub[1:] = 0.0
+        part0 = _lut.hemispherical_reflectance_kernel(
+            sub, ti[idx], dg, pg, None, zero_edges=zero_edges, normal_blend=normal_blend
+        )[1:]
+        own = both - part0
+        scale[blended] = np.divide(rho_m[blended] - part0, own, out=scale[blended], where=own > 0)
+    lut *= scale[:, None, None, :]
 
 
 def _model_for(model: xr.Dataset, wl: np.ndarray) -> xr.Dataset:

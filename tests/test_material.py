@@ -350,7 +350,26 @@ def test_below_noise_model_fill_keeps_the_floor_and_the_measurements():
     # The theta_i = 90 row of a glossy table is not resolved by its grid (the lobe meets
     # the horizon between 5-degree nodes): build_lut says so, naming the row.
     with pytest.warns(NonPhysicalWarning, match=r"theta_i = \[90.0\] deg"):
-        filled = M.build_lut(meas, below_noise="model", model=spec, extrapolation="constant")
+        M.build_lut(
+            meas, below_noise="model", model=spec, extrapolation="constant", renormalise="none"
+        )
+    # The flux-conserving renormalisation (the default with below_noise="model") scales
+    # every row by the energy the model loses or gains on the grid: with every
+    # measured/model ratio 1 the table keeps the model's reflectance at every row, to
+    # the accuracy of the model's own quadrature (~1e-6; 1e-4 next to grazing).
+    filled = M.build_lut(meas, below_noise="model", model=spec, extrapolation="constant")
+    assert filled.attrs["renormalise"] == "model"
+    mod, _, kw = models._params(spec)
+    ti_all = filled.theta_i.values
+    np.testing.assert_allclose(
+        M.hemispherical_reflectance(filled),
+        mod.directional_hemispherical_reflectance(np.minimum(ti_all, 90.0), wl, **kw),
+        rtol=1e-9,
+    )
+    with pytest.raises(ValidationError, match="renormalise: got 'flux'"):
+        M.build_lut(meas, below_noise="model", model=spec, renormalise="flux")
+    with pytest.raises(ValidationError, match="needs below_noise='model'"):
+        M.build_lut(meas, renormalise="model")
     assert filled.attrs["below_noise"] == "model"
     assert filled.delta_theta.values[0] == -180.0 and filled.delta_theta.values[-1] == 90.0
     assert filled.phi.values[-1] == 90.0
@@ -606,3 +625,64 @@ def test_anisotropic_construction_rejects_bad_rotations():
     del sets[1].attrs["sample_rotation"]
     with pytest.raises(ValidationError, match="sample_rotation"):
         M.build_lut_anisotropic(sets)
+
+
+# ------------------------------------------------- energy of the shipped tables
+
+#: Incidence angles of the energy check [degree].
+ENERGY_THETA_I = np.array([0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 85.0])
+#: The catalog's tables that must keep their generating model's energy, with that model.
+#: The "-paper" tables are the paper's construction alone (zero below the noise, cubic
+#: extrapolation), kept for comparison with the paper, and example-lobe is a
+#: non-physical test lobe built with build_lut's (paper) defaults: neither claims to.
+ENERGY_TABLES = {
+    "aluminium-6061-t6": "aluminium-6061-t6-model",
+    "white-paint-a276": "white-paint-a276-model",
+    "lambertian-grey-50": None,
+    "tjpv-cell": "tjpv-cell-model",
+}
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        *sorted(k for k in ENERGY_TABLES if k != "tjpv-cell"),
+        # Zero below the noise (the paper's rule): the GGX tails beyond the measured
+        # extents carry most of the cell's energy (the table is -20 to -67 % off).
+        pytest.param(
+            "tjpv-cell",
+            marks=pytest.mark.xfail(strict=True, reason="tjpv-cell loses its tails' energy"),
+        ),
+    ],
+)
+def test_shipped_tables_keep_their_generating_models_energy(name):
+    """Directional-hemispherical reflectance of every shipped table within 3 % of its
+    generating model's at every theta_i 0-85 deg and wavelength, and at most 1 on every
+    row.  The table's reflectance is the package's quadrature of its interpolant (exact
+    to ~1e-12 for the multilinear look-up); the model's is the model's own half-vector
+    quadrature, checked here against a direct quadrature of the model function
+    (testing.reference_reflectance) on a subset of wavelengths to 1e-4 (they agree to
+    ~1e-5: so the 3 % is the table's error alone, the bound the construction is held to)."""
+    from sbrdf_xr import catalog, models
+
+    table = catalog.load(name)
+    wl = table.wavelength.values
+    rho_t = M.hemispherical_reflectance(table, ENERGY_THETA_I).values
+    if ENERGY_TABLES[name] is None:  # a Lambertian table: rho is its albedo, 0.5
+        rho_m = np.full_like(rho_t, 0.5)
+    else:
+        spec = catalog.load(ENERGY_TABLES[name])
+        mod, _, kw = models._params(spec)
+        rho_m = mod.directional_hemispherical_reflectance(ENERGY_THETA_I, wl, **kw)
+        sub = slice(0, None, 35)
+        direct = testing.reference_reflectance(
+            models.spectrum_function(spec.isel(wavelength=sub)), ENERGY_THETA_I, fine=0.2, order=6
+        )
+        np.testing.assert_allclose(direct, rho_m[:, sub], rtol=1e-4)
+    rel = np.abs(rho_t / rho_m - 1.0)
+    worst = np.unravel_index(np.argmax(rel), rel.shape)
+    assert rel.max() <= 0.03, (
+        f"{name}: reflectance off its model's by {rel[worst]:.3f} at theta_i = "
+        f"{ENERGY_THETA_I[worst[0]]} deg, {wl[worst[1]]} nm"
+    )
+    assert float(M.hemispherical_reflectance(table).max()) <= 1.0  # every row, 0-90 deg
