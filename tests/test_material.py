@@ -518,7 +518,14 @@ def test_shipped_tables_do_not_jump_at_normal_incidence(name, theta_r, obs_az, d
     from sbrdf_xr import catalog
 
     table = catalog.load(name)
-    spread = _sun_azimuth_spread(table, theta_r, obs_az, dtype)
+    # A jump is a discontinuity. A continuous look-up still varies with the Sun's azimuth
+    # because the specular direction moves by 2 theta_i: with the observer within 0.002 deg
+    # of a peaked normal-incidence profile (the "-paper" aluminium, slope ~500/deg relative)
+    # that is 0.1 % at theta_i = 1e-6 deg. In float64, theta_i = 1e-8 deg shrinks that
+    # physical part 100-fold and leaves any jump as it is; float32 cannot resolve
+    # 1e-8 deg (it rounds to normal incidence), so it keeps 1e-6 deg and its 0.5 % bound.
+    ti_deg = 1e-8 if dtype == np.float64 else 1e-6
+    spread = _sun_azimuth_spread(table, theta_r, obs_az, dtype, ti_deg=ti_deg)
     assert spread <= (1e-3 if dtype == np.float64 else 5e-3)
 
 
