@@ -224,9 +224,11 @@ def _paper_tables(**build: Any) -> dict[str, xr.DataArray]:
     out = {}
     for m in CANX1_MATERIALS:
         meas = catalog.load(f"{m}-measurements")
-        shipped = {k: v for k, v in catalog.entry(m).extra.get("build", {}).items() if k != "fit"}
+        build_opts = catalog.entry(m).extra.get("build", {})
+        fit = build_opts.get("fit", f"{m}-fit")  # the model the shipped table is built with
+        shipped = {k: v for k, v in build_opts.items() if k != "fit"}
         out[m] = material.build_lut(
-            meas, model=catalog.load(f"{m}-fit"), material=m, **{**shipped, **build}
+            meas, model=catalog.load(fit), material=m, **{**shipped, **build}
         )
     return out
 
