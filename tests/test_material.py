@@ -359,7 +359,7 @@ def test_below_noise_model_fill_keeps_the_floor_and_the_measurements():
     # the accuracy of the model's own quadrature (~1e-6; 1e-4 next to grazing).
     filled = M.build_lut(meas, below_noise="model", model=spec, extrapolation="constant")
     assert filled.attrs["renormalise"] == "model"
-    mod, _, kw = models._params(spec)
+    mod, _, kw = models.model_parameters(spec)
     ti_all = filled.theta_i.values
     np.testing.assert_allclose(
         M.hemispherical_reflectance(filled),
@@ -679,7 +679,7 @@ def test_shipped_tables_keep_their_generating_models_energy(name):
         rho_m = np.full_like(rho_t, 0.5)
     else:
         spec = catalog.load(ENERGY_TABLES[name])
-        mod, _, kw = models._params(spec)
+        mod, _, kw = models.model_parameters(spec)
         rho_m = mod.directional_hemispherical_reflectance(ENERGY_THETA_I, wl, **kw)
         sub = slice(0, None, 35)
         direct = testing.reference_reflectance(

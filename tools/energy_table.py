@@ -47,7 +47,7 @@ def generating_function(name: str, wl: np.ndarray):
     spec = catalog.load(name.removesuffix("-paper") + "-model")
     if not np.array_equal(spec.wavelength.values, wl):
         spec = spec.interp(wavelength=wl)
-    mod, _, kw = models._params(spec)
+    mod, _, kw = models.model_parameters(spec)
     return models.spectrum_function(spec), (
         lambda ti: mod.directional_hemispherical_reflectance(np.asarray(ti), wl, **kw)
     )
