@@ -82,7 +82,6 @@ def sweep_job(
     >>> sorted(sweep_job(1000, "cube.nc"))  # doctest: +SKIP
     ['blocks', 'rss', 'seconds']
     """
-    import resource
 
     from .simulate import default_n_threads, run_block, simulate, write
 
@@ -137,8 +136,25 @@ def sweep_job(
         t0 = time.perf_counter()
         write(simulate(plan), path, overwrite=True)
         seconds = time.perf_counter() - t0
-    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-    return {"seconds": seconds, "rss": float(rss), "blocks": float(plan.n_blocks)}
+    return {"seconds": seconds, "rss": float(_peak_rss()), "blocks": float(plan.n_blocks)}
+
+
+def _peak_rss() -> int:
+    """Peak resident memory of this process [byte].
+
+    Linux's ``ru_maxrss`` keeps the parent's peak across ``fork`` + ``exec``, so a
+    benchmark subprocess would report its parent's; ``VmHWM`` is this process's own.
+    """
+    import resource
+
+    try:
+        with open("/proc/self/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 
 
 def _subprocess(
