@@ -829,10 +829,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     block_bytes        33554432    - / - / -                     memory budget of one block's ...
     0
     >>> main(["catalog", "list", "--kind", "spacecraft"])  # doctest: +ELLIPSIS
-    name   kind              source        description
-    canx1  spacecraft        synthetic     CanX-1 Engineering Model-like 10 cm cube ...
+    name   kind              source        catalog   description
+    canx1  spacecraft        synthetic     shipped   CanX-1 Engineering Model-like 10 cm cube ...
     <BLANKLINE>
-    1 entries in ...catalogs
+    1 entries; catalogs:
+      shipped  ...catalogs
+      (no user catalogs: set SBRDF_XR_CATALOG_PATH to add some)
     0
     """
     args = build_parser().parse_args(argv)
