@@ -31,14 +31,15 @@ import hashlib
 import json
 import re
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from ._version import __version__
 
-if TYPE_CHECKING:
-    from .scene_model import Scene
+#: The scene being fingerprinted (:class:`sbrdf_xr.scene.Scene`, two layers up, which
+#: imports this module; not imported here, even for type checking, to keep the flow).
+Scene = Any
 
 __all__ = ["PREFIX", "changes", "scene_fingerprint"]
 
