@@ -45,6 +45,7 @@ from ._kernels import (
     PackedTables,
     _axis,
     _gather,
+    facet_frame,
     fused_sums,
     material_sums,
     pack_tables,
@@ -305,35 +306,10 @@ def _aniso_fused(
             a2d = a_eff * no
             area_g += a2d
             lit_g += a_eff
-            # angles of paper 000 Fig. 4, as geometry.facet_angles (and _kernels._fused_sums)
-            stx, sty, stz = sx - ns * nx, sy - ns * ny, sz - ns * nz
-            st_len = np.sqrt(stx * stx + sty * sty + stz * stz)
-            theta_i = np.arctan2(st_len, ns)
-            if st_len <= tol:
-                otx, oty, otz = ox - no * nx, oy - no * ny, oz - no * nz
-                ot_len = np.sqrt(otx * otx + oty * oty + otz * otz)
-                if ot_len > tol:
-                    ex, ey, ez = otx / ot_len, oty / ot_len, otz / ot_len
-                else:
-                    ax, ay, az = abs(nx), abs(ny), abs(nz)
-                    if ax <= ay and ax <= az:
-                        ex, ey, ez = 0.0, nz, -ny
-                    elif ay <= az:
-                        ex, ey, ez = -nz, 0.0, nx
-                    else:
-                        ex, ey, ez = ny, -nx, 0.0
-                    el = np.sqrt(ex * ex + ey * ey + ez * ez)
-                    ex, ey, ez = ex / el, ey / el, ez / el
-            else:
-                ex, ey, ez = -stx / st_len, -sty / st_len, -stz / st_len
-            px = ny * ez - nz * ey
-            py = nz * ex - nx * ez
-            pz = nx * ey - ny * ex
-            of = ox * ex + oy * ey + oz * ez
-            op = ox * px + oy * py + oz * pz
-            ti = theta_i * _RAD2DEG
-            dt = np.arctan2(of, no) * _RAD2DEG - ti
-            phi = np.arctan2(abs(op), np.hypot(of, no)) * _RAD2DEG
+            # angles of paper 000 Fig. 4, as geometry.facet_angles
+            ti, dt, phi, ex, ey, ez, op = facet_frame(
+                nx, ny, nz, sx, sy, sz, ox, oy, oz, ns, no, tol
+            )
             if (
                 (edges[0] and dt < dgrid[0] - edge_tol)
                 or (edges[1] and dt > dgrid[nd - 1] + edge_tol)

@@ -136,6 +136,61 @@ def _axis(
     return k
 
 
+@numba.njit(nogil=True, cache=True, inline="always")
+def facet_frame(
+    nx: float,
+    ny: float,
+    nz: float,
+    sx: float,
+    sy: float,
+    sz: float,
+    ox: float,
+    oy: float,
+    oz: float,
+    ns: float,
+    no: float,
+    tol: float,
+) -> tuple[float, float, float, float, float, float, float]:  # pragma: no cover - compiled
+    """The angles of paper 000 Fig. 4 of one lit and seen pair, as
+    :func:`sbrdf_xr.geometry.facet_angles`: ``(theta_i, delta_theta, phi)`` [degree], the
+    forward in-plane unit vector ``e`` and the observer's out-of-plane component ``o.p``.
+
+    ``ns``, ``no`` are ``N.s`` and ``N.o``; at normal incidence (in-plane Sun component
+    under ``tol``) the plane is taken through the observer, or through the axis least
+    aligned with ``N`` when the observer is on the normal too.
+    """
+    stx, sty, stz = sx - ns * nx, sy - ns * ny, sz - ns * nz
+    st_len = np.sqrt(stx * stx + sty * sty + stz * stz)
+    theta_i = np.arctan2(st_len, ns)
+    if st_len <= tol:
+        otx, oty, otz = ox - no * nx, oy - no * ny, oz - no * nz
+        ot_len = np.sqrt(otx * otx + oty * oty + otz * otz)
+        if ot_len > tol:
+            ex, ey, ez = otx / ot_len, oty / ot_len, otz / ot_len
+        else:
+            # a perpendicular: cross with the axis least aligned with n
+            ax, ay, az = abs(nx), abs(ny), abs(nz)
+            if ax <= ay and ax <= az:
+                ex, ey, ez = 0.0, nz, -ny
+            elif ay <= az:
+                ex, ey, ez = -nz, 0.0, nx
+            else:
+                ex, ey, ez = ny, -nx, 0.0
+            el = np.sqrt(ex * ex + ey * ey + ez * ez)
+            ex, ey, ez = ex / el, ey / el, ez / el
+    else:
+        ex, ey, ez = -stx / st_len, -sty / st_len, -stz / st_len
+    px = ny * ez - nz * ey
+    py = nz * ex - nx * ez
+    pz = nx * ey - ny * ex
+    of = ox * ex + oy * ey + oz * ez
+    op = ox * px + oy * py + oz * pz
+    trp = np.arctan2(of, no)
+    phi = np.arctan2(abs(op), np.hypot(of, no)) * _RAD2DEG
+    dt = trp * _RAD2DEG - theta_i * _RAD2DEG
+    return theta_i * _RAD2DEG, dt, phi, ex, ey, ez, op
+
+
 @numba.njit(nogil=True, cache=True)
 def _gather(values, rows, wn, nk, f, acc_s, acc_p, ws, wp):  # pragma: no cover - compiled
     """``acc_s += ws * sum_n wn[n] values[rows[n]]`` and likewise ``acc_p`` with ``wp``.
@@ -273,36 +328,9 @@ def _fused_sums(
                 area_g += a2d
                 lit_g += a_eff
                 # angles of paper 000 Fig. 4, as geometry.facet_angles
-                stx, sty, stz = sx - ns * nx, sy - ns * ny, sz - ns * nz
-                st_len = np.sqrt(stx * stx + sty * sty + stz * stz)
-                theta_i = np.arctan2(st_len, ns)
-                if st_len <= tol:
-                    otx, oty, otz = ox - no * nx, oy - no * ny, oz - no * nz
-                    ot_len = np.sqrt(otx * otx + oty * oty + otz * otz)
-                    if ot_len > tol:
-                        ex, ey, ez = otx / ot_len, oty / ot_len, otz / ot_len
-                    else:
-                        # a perpendicular: cross with the axis least aligned with n
-                        ax, ay, az = abs(nx), abs(ny), abs(nz)
-                        if ax <= ay and ax <= az:
-                            ex, ey, ez = 0.0, nz, -ny
-                        elif ay <= az:
-                            ex, ey, ez = -nz, 0.0, nx
-                        else:
-                            ex, ey, ez = ny, -nx, 0.0
-                        el = np.sqrt(ex * ex + ey * ey + ez * ez)
-                        ex, ey, ez = ex / el, ey / el, ez / el
-                else:
-                    ex, ey, ez = -stx / st_len, -sty / st_len, -stz / st_len
-                px = ny * ez - nz * ey
-                py = nz * ex - nx * ez
-                pz = nx * ey - ny * ex
-                of = ox * ex + oy * ey + oz * ez
-                op = ox * px + oy * py + oz * pz
-                trp = np.arctan2(of, no)
-                phi = np.arctan2(abs(op), np.hypot(of, no)) * _RAD2DEG
-                dt = trp * _RAD2DEG - theta_i * _RAD2DEG
-                ti = theta_i * _RAD2DEG
+                ti, dt, phi, _, _, _, _ = facet_frame(
+                    nx, ny, nz, sx, sy, sz, ox, oy, oz, ns, no, tol
+                )
                 d0 = d_off[m]
                 nd = d_off[m + 1] - d0
                 p0 = p_off[m]
