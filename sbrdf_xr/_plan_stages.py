@@ -150,9 +150,9 @@ def contributing_terms(scene: Scene, normals: np.ndarray) -> np.ndarray:
 
 
 def common_wavelength(scene: Scene, used: list[str]) -> np.ndarray:
-    wl = np.asarray(scene.materials[used[0]][WAVELENGTH].values) if used else np.array([550.0])
+    wl = np.asarray(scene.tables[used[0]][WAVELENGTH].values) if used else np.array([550.0])
     for m in used[1:]:
-        other = np.asarray(scene.materials[m][WAVELENGTH].values)
+        other = np.asarray(scene.tables[m][WAVELENGTH].values)
         if other.shape != wl.shape or not np.allclose(other, wl, rtol=0, atol=1e-9):
             lo, hi = max(wl[0], other[0]), min(wl[-1], other[-1])
             if lo >= hi:
@@ -195,7 +195,7 @@ def thermal_to_reflected(scene: Scene, wl: np.ndarray) -> float:
     from .photometry import solar_spectrum
 
     e_sun = solar_spectrum(wl).values
-    b = np.max([sources.planck(wl, temperature(scene, m)) for m in scene.materials], axis=0)
+    b = np.max([sources.planck(wl, temperature(scene, m)) for m in scene.tables], axis=0)
     return float(np.max(b / np.maximum(e_sun / np.pi, 1e-300)))
 
 
@@ -311,7 +311,7 @@ def effect_stage(
             active.append("thermal")
             eps, thetas, rad = [], [], []
             for m in used:
-                da = table_on(scene.materials[m], wl, None)
+                da = table_on(scene.tables[m], wl, None)
                 th = np.asarray(da["theta_i"].values, dtype=np.float64)
                 rho_da = hemispherical_reflectance(da, th, warn=False)
                 rho = (

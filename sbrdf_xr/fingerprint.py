@@ -224,7 +224,7 @@ def scene_fingerprint(scene: Scene) -> dict[str, str]:
     >>> scene_fingerprint(same) == fp
     True
     """
-    materials = dict(scene.materials or {})
+    materials = dict(scene.tables)
     names = sorted(materials)
     suffix = _attr_suffixes(names)
     out: dict[str, str] = {}

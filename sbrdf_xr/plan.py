@@ -390,7 +390,7 @@ def compile_plan(scene: Scene) -> Plan:
                 )
             )
 
-    aniso_names = frozenset(m for m, da in scene.materials.items() if PSI in da.dims)
+    aniso_names = frozenset(m for m, da in scene.tables.items() if PSI in da.dims)
     raw, merged = facet_terms(scene, shadowing, steps, aniso_names)
     raw = tilted_terms(scene, raw, knobs["tilt_nodes"], steps)
     keep = contributing_terms(scene, raw["normal"])
@@ -425,7 +425,7 @@ def compile_plan(scene: Scene) -> Plan:
     )
 
     # ---- spectral axis
-    wl_full = common_wavelength(scene, used or list(scene.materials))
+    wl_full = common_wavelength(scene, used or list(scene.tables))
     wl = wl_full[:: knobs["wavelength_stride"]]
     bw = None
     band_coords: dict[str, Any] = {}
@@ -451,7 +451,7 @@ def compile_plan(scene: Scene) -> Plan:
         models = {}
         packed: list[tuple[Any, ...]] = []
         for m in used:
-            da = table_on(scene.materials[m], wl, knobs["table_theta_step"])
+            da = table_on(scene.tables[m], wl, knobs["table_theta_step"])
             values = np.asarray(da.values)
             if pre and bw is not None:
                 values = np.asarray(values, dtype=np.float64) @ bw.T
@@ -463,7 +463,7 @@ def compile_plan(scene: Scene) -> Plan:
                     dg,
                     pg,
                     psg,
-                    table_edges(scene.materials[m].attrs),
+                    table_edges(scene.tables[m].attrs),
                     dtype,
                 )
                 values = values[:, :, :, 0, :]
@@ -474,8 +474,8 @@ def compile_plan(scene: Scene) -> Plan:
                         np.asarray(da[d].values, dtype=np.float64)
                         for d in ("theta_i", "delta_theta", "phi")
                     ),
-                    table_edges(scene.materials[m].attrs),
-                    table_normal_blend(scene.materials[m].attrs),
+                    table_edges(scene.tables[m].attrs),
+                    table_normal_blend(scene.tables[m].attrs),
                 )
             )
         tables = pack_tables(packed, len(scene.bands) if pre else wl.size, dtype)
@@ -581,7 +581,7 @@ def compile_plan(scene: Scene) -> Plan:
         )
     )
 
-    provenance = {m: scene.materials[m].attrs.get("provenance", "") for m in used}
+    provenance = {m: scene.tables[m].attrs.get("provenance", "") for m in used}
     attrs = {
         "Conventions": "CF-1.10",
         "title": f"sbrdf_xr simulation of scene {scene.name}",

@@ -14,9 +14,9 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from . import geometry
+from . import catalog, geometry
 from .effects import SCENE_OUTPUTS, SPECTRAL_OUTPUTS
-from .errors import SceneError, ValidationError
+from .errors import CatalogError, SceneError, ValidationError
 from .knobs import KNOBS, PRESETS, apply_preset, check_knob
 from .material import validate_material
 from .plan import Plan, compile_plan
@@ -69,8 +69,8 @@ class Scene:
     spacecraft : sbrdf_xr.spacecraft.Spacecraft
         The body.
     materials : mapping of str to DataArray, optional
-        Material tables by name; default: every material of the spacecraft loaded
-        from the catalog.
+        Material tables by name; default: every material of the spacecraft, loaded
+        from the catalog when first needed (:attr:`tables`), not by the constructor.
     attitudes : array_like, shape (n, 4), optional
         Attitudes (body -> reference frame, scalar-last unit quaternions).
     phase_angles : array_like, shape (m,), optional
@@ -320,12 +320,10 @@ class Scene:
                 raise SceneError(
                     "to_earth: explicit geometry with earthshine needs body-frame to_earth vectors"
                 )
-        materials = self.materials
-        if materials is None:
-            from . import catalog
+        if self.materials is not None:
+            self._check_tables(self.materials)
 
-            materials = {m: catalog.load(m) for m in self.spacecraft.materials}
-            object.__setattr__(self, "materials", materials)
+    def _check_tables(self, materials: Mapping[str, xr.DataArray]) -> None:
         missing = [m for m in self.spacecraft.materials if m not in materials]
         if missing:
             raise SceneError(f"materials: no table for {missing}; given: {sorted(materials)}")
@@ -334,6 +332,28 @@ class Scene:
                 validate_material(da, check_values=True)
             except ValidationError as exc:
                 raise SceneError(f"material {name!r}: {exc}") from None
+
+    @cached_property
+    def tables(self) -> Mapping[str, xr.DataArray]:
+        """The material tables by name: ``materials`` as given, or else every material of
+        the spacecraft loaded from the catalog on first use (the constructor reads no file).
+
+        Raises
+        ------
+        SceneError
+            When a material of the spacecraft is neither given nor in the catalog.
+        """
+        if self.materials is not None:
+            return self.materials
+        try:
+            tables = {m: catalog.load(m) for m in self.spacecraft.materials}
+        except CatalogError as exc:
+            raise SceneError(
+                f"materials: not given, and the catalog has no table for a material of "
+                f"{self.spacecraft.name!r}: {exc}"
+            ) from None
+        self._check_tables(tables)
+        return tables
 
     # ----------------------------------------------------------- geometry
     @property
@@ -405,9 +425,12 @@ class Scene:
         if "preset" in changes:
             changes = apply_preset(changes.pop("preset"), changes)
         try:
-            return replace(self, **changes)
+            new = replace(self, **changes)
         except TypeError as exc:
             raise SceneError(f"with_options: {exc}") from None
+        if "tables" in self.__dict__ and not {"materials", "spacecraft"} & set(changes):
+            new.__dict__["tables"] = self.__dict__["tables"]  # loaded once per scene family
+        return new
 
     def plan(self) -> Plan:
         """The compiled :class:`~sbrdf_xr.plan.Plan` of this scene (computed once, then cached)."""

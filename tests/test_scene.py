@@ -241,3 +241,40 @@ def test_scene_construction_reads_no_files(user_files, monkeypatch):
     monkeypatch.setattr(catalog, "load", no_open)
     scene = Scene(sc, materials={"paint": table}, to_sun=[[1, 0, 0]], to_observer=[[1, 0, 0]])
     assert scene.n_geometries == 1
+
+
+def test_scene_without_tables_loads_them_on_first_use(monkeypatch):
+    """Scene(spacecraft) with no materials reads nothing until its tables are needed; the
+    tables then come from the catalog once, and copies made by with_options share them."""
+    import trimesh
+
+    from sbrdf_xr import catalog, spacecraft
+    from sbrdf_xr.scene import Scene
+
+    body = spacecraft.load_spacecraft(trimesh.creation.box(), material="lambertian-grey-50")
+    loaded: list[str] = []
+    real_load = catalog.load
+
+    def counting_load(name):
+        loaded.append(name)
+        return real_load(name)
+
+    monkeypatch.setattr(catalog, "load", counting_load)
+    scene = Scene(body, to_sun=[[1, 0, 0]], to_observer=[[1, 0, 0]])
+    assert loaded == [] and scene.materials is None
+    assert sorted(scene.tables) == ["lambertian-grey-50"] and loaded == ["lambertian-grey-50"]
+    again = scene.with_options(method="nearest")
+    assert again.tables is scene.tables and loaded == ["lambertian-grey-50"]
+    np.testing.assert_allclose(_signal(again), 0.5 / np.pi, rtol=1e-6)  # +x face, head-on
+
+
+def test_scene_without_tables_names_a_material_the_catalog_lacks():
+    import trimesh
+
+    from sbrdf_xr import spacecraft
+    from sbrdf_xr.scene import Scene
+
+    body = spacecraft.load_spacecraft(trimesh.creation.box(), material="no-such-table")
+    scene = Scene(body, to_sun=[[1, 0, 0]], to_observer=[[1, 0, 0]])  # reads nothing yet
+    with pytest.raises(SceneError, match="no-such-table"):
+        scene.plan()
