@@ -12,12 +12,15 @@ from types import MappingProxyType
 from typing import Any
 
 import numpy as np
-import xarray as xr
 
 from . import sources
-from ._names import MATERIAL, PSI, WAVELENGTH
+from ._names import MATERIAL, PSI
+from ._plan_tables import table_on
 from .anisotropy import psi_average
-from .errors import SceneError, ValidationError
+from .errors import SceneError
+from .imperfections import tilt_quadrature, tilted_normals
+from .material import hemispherical_reflectance
+from .photometry import solar_spectrum
 
 #: The scene being compiled (:class:`sbrdf_xr.scene.Scene`).
 Scene = Any
@@ -33,6 +36,39 @@ def readonly(a: np.ndarray) -> np.ndarray:
     a = np.ascontiguousarray(a)
     a.flags.writeable = False
     return a
+
+
+def shadow_stage(
+    scene: Scene, knobs: Mapping[str, Any], steps: list[tuple[str, str]]
+) -> tuple[bool, dict[str, Any]]:
+    """Whether the plan shadows (asked for, and the body is not convex), and how."""
+    want_shadow = "shadowing" in scene.effects
+    convex = bool(scene.spacecraft.is_convex) if want_shadow else None
+    shadowing = want_shadow and not convex
+    shadow_options: dict[str, Any] = {}
+    if not want_shadow:
+        steps.append(("shadowing", "skipped: not requested"))
+    elif convex:
+        steps.append(("shadowing", "skipped: the body is convex, no facet can shadow another"))
+    else:
+        shadow_options = {"method": knobs["shadow_method"]}
+        if knobs["shadow_method"] == "sampled":
+            shadow_options["density"] = knobs["shadow_density"]
+            steps.append(
+                (
+                    "shadowing",
+                    f"sampled self-shadowing and self-occlusion, "
+                    f"{knobs['shadow_density']}**2 samples per facet (non-convex body)",
+                )
+            )
+        else:
+            steps.append(
+                (
+                    "shadowing",
+                    "exact self-shadowing and self-occlusion by polygon clipping (non-convex body)",
+                )
+            )
+    return shadowing, shadow_options
 
 
 def facet_terms(
@@ -88,8 +124,6 @@ def tilted_terms(
     scene: Scene, raw: dict[str, np.ndarray], nodes: int, steps: list[tuple[str, str]]
 ) -> dict[str, np.ndarray]:
     """Terms replaced by their tilted copies where the scene asks for surface imperfections."""
-    from .imperfections import tilt_quadrature, tilted_normals
-
     st = scene.surface_tilt
     sigma = np.array(
         [
@@ -149,41 +183,6 @@ def contributing_terms(scene: Scene, normals: np.ndarray) -> np.ndarray:
     return keep
 
 
-def common_wavelength(scene: Scene, used: list[str]) -> np.ndarray:
-    wl = np.asarray(scene.tables[used[0]][WAVELENGTH].values) if used else np.array([550.0])
-    for m in used[1:]:
-        other = np.asarray(scene.tables[m][WAVELENGTH].values)
-        if other.shape != wl.shape or not np.allclose(other, wl, rtol=0, atol=1e-9):
-            lo, hi = max(wl[0], other[0]), min(wl[-1], other[-1])
-            if lo >= hi:
-                raise SceneError(f"materials {used[0]!r} and {m!r} have no wavelengths in common")
-            wl = wl[(wl >= lo) & (wl <= hi)]
-    return wl
-
-
-def band_weights_of(scene: Scene, wl: np.ndarray) -> xr.DataArray:
-    from .photometry import band_weights
-
-    try:
-        return band_weights(
-            list(scene.bands), wl, normalize=True, extrapolate=scene.band_extrapolate
-        )
-    except ValidationError as exc:
-        raise SceneError(f"bands: {exc} (scene field band_extrapolate)") from None
-
-
-def table_on(da: xr.DataArray, wl: np.ndarray, theta_step: float | None) -> xr.DataArray:
-    if not np.array_equal(da[WAVELENGTH].values, wl):
-        da = da.interp({WAVELENGTH: wl})
-    if theta_step is not None:
-        ti = da["theta_i"].values
-        new = np.arange(ti[0], ti[-1] + 1e-9, float(theta_step))
-        if new[-1] < ti[-1]:
-            new = np.append(new, ti[-1])
-        da = da.interp(theta_i=new)
-    return da
-
-
 def temperature(scene: Scene, material: str) -> float:
     t = scene.temperature
     return float(t.get(material, 300.0)) if isinstance(t, Mapping) else float(t)
@@ -192,34 +191,9 @@ def temperature(scene: Scene, material: str) -> float:
 def thermal_to_reflected(scene: Scene, wl: np.ndarray) -> float:
     """Largest ratio of blackbody radiance (emissivity 1) to the radiance of a white
     Lambertian surface in sunlight, E_sun / pi, over the scene's wavelengths."""
-    from .photometry import solar_spectrum
-
     e_sun = solar_spectrum(wl).values
     b = np.max([sources.planck(wl, temperature(scene, m)) for m in scene.tables], axis=0)
     return float(np.max(b / np.maximum(e_sun / np.pi, 1e-300)))
-
-
-def material_models(scene: Scene, used: list[str]) -> dict[int, tuple[Any, Mapping[str, Any]]]:
-    """BRDF model and parameters of every material, for analytic evaluation."""
-    from . import models as models_mod
-
-    given = dict(scene.models or {})
-    out: dict[int, tuple[Any, Mapping[str, Any]]] = {}
-    for m, name in enumerate(used):
-        spec = given.get(name)
-        if spec is None:
-            from . import catalog
-
-            try:
-                spec = catalog.load(f"{name}-model")
-            except Exception as exc:
-                raise SceneError(
-                    f"evaluation='analytic': material {name!r} has no model; give "
-                    f"Scene(models={{{name!r}: ...}}) or a catalog entry '{name}-model' ({exc})"
-                ) from None
-        mod, _, kw = models_mod.model_parameters(spec)
-        out[m] = (mod, MappingProxyType(dict(kw)))
-    return out
 
 
 def describe_bytes(n: float) -> str:
@@ -306,8 +280,6 @@ def effect_stage(
                 )
             )
         else:
-            from .material import hemispherical_reflectance
-
             active.append("thermal")
             eps, thetas, rad = [], [], []
             for m in used:

@@ -28,25 +28,20 @@ from typing import Any
 
 import numpy as np
 
-from . import _aniso_kernels
-from ._aniso_kernels import pack_anisotropic
-from ._kernels import PackedTables, pack_tables
-from ._lut import table_edges, table_normal_blend
-from ._names import ANGLE_DIMS, BAND, MATERIAL, PSI, WAVELENGTH
+from ._kernels import PackedTables
+from ._names import BAND, MATERIAL, PSI, WAVELENGTH
 from ._plan_stages import (
-    band_weights_of,
-    common_wavelength,
     contributing_terms,
     describe_bytes,
     effect_stage,
     facet_terms,
-    material_models,
     readonly,
-    table_on,
+    shadow_stage,
     tilted_terms,
 )
+from ._plan_tables import spectral_stage
 from ._version import __version__
-from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS, BlockInputs
+from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, BlockInputs
 from .errors import SceneError
 from .fingerprint import scene_fingerprint
 
@@ -363,32 +358,7 @@ def compile_plan(scene: Scene) -> Plan:
     steps: list[tuple[str, str]] = [("geometry", geo.describe())]
 
     # ---- effects that change what terms are needed
-    want_shadow = "shadowing" in scene.effects
-    convex = bool(scene.spacecraft.is_convex) if want_shadow else None
-    shadowing = want_shadow and not convex
-    shadow_options: dict[str, Any] = {}
-    if not want_shadow:
-        steps.append(("shadowing", "skipped: not requested"))
-    elif convex:
-        steps.append(("shadowing", "skipped: the body is convex, no facet can shadow another"))
-    else:
-        shadow_options = {"method": knobs["shadow_method"]}
-        if knobs["shadow_method"] == "sampled":
-            shadow_options["density"] = knobs["shadow_density"]
-            steps.append(
-                (
-                    "shadowing",
-                    f"sampled self-shadowing and self-occlusion, "
-                    f"{knobs['shadow_density']}**2 samples per facet (non-convex body)",
-                )
-            )
-        else:
-            steps.append(
-                (
-                    "shadowing",
-                    "exact self-shadowing and self-occlusion by polygon clipping (non-convex body)",
-                )
-            )
+    shadowing, shadow_options = shadow_stage(scene, knobs, steps)
 
     aniso_names = frozenset(m for m, da in scene.tables.items() if PSI in da.dims)
     raw, merged = facet_terms(scene, shadowing, steps, aniso_names)
@@ -424,98 +394,9 @@ def compile_plan(scene: Scene) -> Plan:
         )
     )
 
-    # ---- spectral axis
-    wl_full = common_wavelength(scene, used or list(scene.tables))
-    wl = wl_full[:: knobs["wavelength_stride"]]
-    bw = None
-    band_coords: dict[str, Any] = {}
-    if scene.bands:
-        w = band_weights_of(scene, wl)
-        bw = np.asarray(w.values)
-        band_coords = {str(c): w[c] for c in w.coords if BAND in w[c].dims}
-    spectral_asked = any(o in SPECTRAL_OUTPUTS for o in scene.outputs)
-    pre = bool(scene.bands) and not spectral_asked and knobs["band_integration"] == "auto"
-    dtype = np.dtype(knobs["dtype"])
-    aniso_tables: dict[int, Any] = {}
-    if knobs["evaluation"] == "analytic":
-        models = material_models(scene, used)
-        tables = pack_tables([], len(scene.bands) if pre else wl.size, dtype)
-        steps.append(
-            (
-                "materials",
-                f"{len(used)} materials ({', '.join(used)}) evaluated by their "
-                f"BRDF models (analytic, no table), {dtype.name}",
-            )
-        )
-    else:
-        models = {}
-        packed: list[tuple[Any, ...]] = []
-        for m in used:
-            da = table_on(scene.tables[m], wl, knobs["table_theta_step"])
-            values = np.asarray(da.values)
-            if pre and bw is not None:
-                values = np.asarray(values, dtype=np.float64) @ bw.T
-            if PSI in da.dims:  # its psi slices; the packed slot (psi[0]) is never read
-                tg, dg, pg, psg = (np.asarray(da[d].values) for d in (*ANGLE_DIMS, PSI))
-                aniso_tables[len(packed)] = pack_anisotropic(
-                    values,
-                    tg,
-                    dg,
-                    pg,
-                    psg,
-                    table_edges(scene.tables[m].attrs),
-                    dtype,
-                )
-                values = values[:, :, :, 0, :]
-            packed.append(
-                (
-                    values,
-                    *(
-                        np.asarray(da[d].values, dtype=np.float64)
-                        for d in ("theta_i", "delta_theta", "phi")
-                    ),
-                    table_edges(scene.tables[m].attrs),
-                    table_normal_blend(scene.tables[m].attrs),
-                )
-            )
-        tables = pack_tables(packed, len(scene.bands) if pre else wl.size, dtype)
-        del packed
-        if aniso_tables:
-            steps.append(_aniso_kernels.plan_step(used, aniso_tables))
-        res = (
-            ""
-            if knobs["table_theta_step"] is None
-            else f", theta_i resampled every {knobs['table_theta_step']:g} deg"
-        )
-        steps.append(
-            (
-                "materials",
-                f"{len(used)} tabulated materials ({', '.join(used)}), "
-                f"{knobs['method']} look-up, {dtype.name}, {knobs['kernel']} kernel{res}",
-            )
-        )
-    stride = "" if knobs["wavelength_stride"] == 1 else f" (every {knobs['wavelength_stride']}th)"
-    if not scene.bands:
-        steps.append(("bands", "skipped: no band output requested"))
-    elif pre:
-        steps.append(
-            (
-                "bands",
-                f"tables pre-integrated over {', '.join(scene.bands)} (filter x Sun, photon "
-                "counting) before the sweep: exact, the facet sum is linear in f_r; the sweep "
-                f"evaluates {len(scene.bands)} values per look-up instead of {wl.size}",
-            )
-        )
-    else:
-        why = (
-            "spectral outputs are requested too"
-            if spectral_asked
-            else "band_integration = 'spectral'"
-        )
-        steps.append(
-            ("bands", f"{', '.join(scene.bands)} integrated from the spectral signal ({why})")
-        )
-    steps.append(("wavelength", f"{wl.size} wavelengths {wl[0]:g}-{wl[-1]:g} nm{stride}"))
+    # ---- spectral axis, bands and tables
+    sx = spectral_stage(scene, used, knobs, steps)
+    wl, bw, pre, dtype = sx.wavelength, sx.band_weights, sx.pre_integrated, sx.dtype
 
     # ---- effects
     active, params = effect_stage(scene, wl, used, pre, shadowing, steps)
@@ -618,25 +499,25 @@ def compile_plan(scene: Scene) -> Plan:
         geometry=geo,
         terms=terms,
         materials=tuple(used),
-        tables=tables,
+        tables=sx.tables,
         wavelength=readonly(wl),
         bands=tuple(scene.bands),
         band_weights=None if bw is None else readonly(bw),
-        band_coords=MappingProxyType(band_coords),
+        band_coords=MappingProxyType(sx.band_coords),
         pre_integrated=pre,
         shadowing=shadowing,
         merged=merged,
         shadow_options=MappingProxyType(shadow_options),
         effects=tuple(active),
         effect_params=MappingProxyType(params),
-        models=MappingProxyType(models),
+        models=MappingProxyType(sx.models),
         knobs=MappingProxyType(knobs),
         outputs=tuple(outputs),
         chunk=int(chunk),
         estimate=est,
         steps=tuple(steps),
         attrs=MappingProxyType(attrs),
-        anisotropic=MappingProxyType(aniso_tables),
+        anisotropic=MappingProxyType(sx.anisotropic),
     )
     attrs["plan"] = str(plan)
     return plan

@@ -18,7 +18,8 @@ not run).
   sampled method), ``visibility``, ``attitude_frames``, ``attitude``, ``orbits``,
   ``observe``, ``photometry`` (and its modules), ``fingerprint``.
 * L2: ``catalog`` (knows every kind's loader in L1).
-* L3, the scene and its plan: ``effects``, ``plan``, ``sweep``, ``scene_model`` (the
+* L3, the scene and its plan: ``effects``, ``plan`` (and its stages ``_plan_stages``,
+  ``_plan_tables``), ``sweep``, ``scene_model`` (the
   :class:`Scene`), ``scene_io`` (scene files, built-in scenes), ``scene`` (re-exports both).
 * L4, the cube: ``simulate``, ``_writer`` and its parts ``_write_common``, ``_write_layout``,
   ``_write_files``, ``_write_disk``, ``_write_progress``, ``_runners``, ``_lock``.
@@ -80,7 +81,16 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "fingerprint",
     ),
     ("catalog",),
-    ("effects", "plan", "_plan_stages", "sweep", "scene_model", "scene_io", "scene"),
+    (
+        "effects",
+        "plan",
+        "_plan_stages",
+        "_plan_tables",
+        "sweep",
+        "scene_model",
+        "scene_io",
+        "scene",
+    ),
     (
         "simulate",
         "_writer",
