@@ -16,7 +16,8 @@ not run).
   ``models``,
   ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``_visibility_rays`` (the
   sampled method), ``visibility``, ``attitude_frames``, ``attitude``, ``timescales``,
-  ``earth_shadow``, ``orbits``, ``observe``, ``photometry`` (and its modules), ``fingerprint``.
+  ``earth_shadow``, ``orbits``, ``observation``, ``observe``, ``photometry`` (and its
+  modules), ``fingerprint``.
 * L2: ``catalog`` (knows every kind's loader in L1).
 * L3, the scene and its plan: ``effects``, ``plan``, ``sweep``, ``scene_model`` (the
   :class:`Scene`), ``scene_io`` (scene files, built-in scenes), ``scene`` (re-exports both).
@@ -77,6 +78,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "timescales",
         "earth_shadow",
         "orbits",
+        "observation",
         "observe",
         "photometry",
         "fingerprint",
