@@ -8,8 +8,9 @@ The inertial frame of :mod:`sbrdf_xr.observe` is the GCRS (geocentric, ICRF axes
 Times are either ``datetime64`` (UTC) or float seconds.  Float seconds count from the
 law's ``epoch``; a law without an ``epoch`` counts from ``context.epoch`` (the start of
 the observation), or from the first requested time.  Laws that follow the orbit
-(:class:`Nadir`, :class:`SunPointing`) need a :class:`Context` with the spacecraft's
-position and velocity and the direction of the Sun at the requested times.
+(:class:`~sbrdf_xr.attitude_pointing.Nadir`, :class:`~sbrdf_xr.attitude_pointing.SunPointing`)
+need a :class:`~sbrdf_xr.attitude_frames.Context` with the spacecraft's position and
+velocity and the direction of the Sun at the requested times.
 
 Laws
 ----
@@ -27,33 +28,45 @@ QuaternionSeries    a user time series (arrays, CSV or netCDF), slerp-interpolat
 Composed            ``outer * inner``: ``R(t) = R_outer(t) R_inner(t)``
 ==================  ========================================================================
 
-:func:`law_from_dict` builds a law from a TOML table (``[observation.attitude]``).
+:func:`law_from_dict` builds a law from a TOML table (``[observation.attitude]``);
+:func:`compose` and :class:`Spin` take a law, a quaternion or such a table, so they
+stand here with it.  The other laws are defined by job and importable from here too:
+the :class:`~sbrdf_xr.attitude_pointing.AttitudeLaw` interface, its composition and the
+pointing laws in :mod:`sbrdf_xr.attitude_pointing`, the tumble in
+:mod:`sbrdf_xr.attitude_tumble`, the time series in :mod:`sbrdf_xr.attitude_series`, and
+the frames, :class:`~sbrdf_xr.attitude_frames.Context` and :func:`triad` in
+:mod:`sbrdf_xr.attitude_frames`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial.transform import Rotation, Slerp
+from scipy.spatial.transform import Rotation
 
 from .attitude_frames import (
-    NS_PER_S,
+    NS_PER_S,  # noqa: F401  (re-exported)
     Context,
     axis_vector,
     check_epoch,
-    check_quaternion,
-    context_fields,
-    perpendicular_pair,
+    check_quaternion,  # noqa: F401  (re-exported)
+    context_fields,  # noqa: F401  (re-exported)
+    perpendicular_pair,  # noqa: F401  (re-exported)
     seconds_since,
     triad,
 )
+from .attitude_pointing import AttitudeLaw, Composed, Inertial, Nadir, SunPointing
+from .attitude_series import QuaternionSeries
+from .attitude_tumble import (
+    TUMBLE_RTOL,  # noqa: F401  (re-exported)
+    Tumble,
+)
 from .errors import AttitudeError
-from .geometry import check_quaternions
 
 __all__ = [
     "LAWS",
@@ -71,44 +84,6 @@ __all__ = [
     "triad",
 ]
 
-#: Relative tolerance of the tumble integration (scipy ``solve_ivp``, DOP853).
-TUMBLE_RTOL = 1e-12
-
-
-# --------------------------------------------------------------------------- helpers
-
-
-# --------------------------------------------------------------------------- laws
-
-
-class AttitudeLaw:
-    """Base of the attitude laws: ``law.quaternions(times, context) -> (n, 4)``.
-
-    ``outer * inner`` composes two laws (:class:`Composed`).
-
-    Examples
-    --------
-    >>> law = Spin(axis_body="+z", rate_deg_s=90.0)
-    >>> isinstance(law, AttitudeLaw), law.quaternions([0.0, 1.0]).shape
-    (True, (2, 4))
-    """
-
-    def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
-        """Attitudes (body -> inertial, scalar-last) at ``times``; shape ``(n, 4)``.
-
-        Examples
-        --------
-        >>> np.round(Spin(rate_deg_s=180.0).quaternions([0.0, 1.0]), 6)  # half a turn in 1 s
-        array([[0., 0., 0., 1.],
-               [0., 0., 1., 0.]])
-        """
-        raise NotImplementedError
-
-    def __mul__(self, other: AttitudeLaw) -> Composed:
-        if not isinstance(other, AttitudeLaw):
-            return NotImplemented
-        return Composed(self, other)
-
 
 def _law_or_quaternion(value: Any, name: str) -> AttitudeLaw:
     if isinstance(value, AttitudeLaw):
@@ -116,155 +91,6 @@ def _law_or_quaternion(value: Any, name: str) -> AttitudeLaw:
     if isinstance(value, Mapping):
         return law_from_dict(value)
     return Inertial(value)
-
-
-@dataclass(frozen=True)
-class Inertial(AttitudeLaw):
-    """A fixed orientation in the inertial frame.
-
-    Parameters
-    ----------
-    q : array_like, shape (4,)
-        Unit quaternion, scalar-last, body -> inertial [1].
-
-    Examples
-    --------
-    >>> s = float(np.sqrt(0.5))
-    >>> Inertial((0.0, 0.0, s, s)).quaternions(np.zeros(2)).round(6)  # 90 degree about z, always
-    array([[0.      , 0.      , 0.707107, 0.707107],
-           [0.      , 0.      , 0.707107, 0.707107]])
-    """
-
-    q: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "q", tuple(check_quaternion(self.q, "inertial q").tolist()))
-
-    def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
-        n = np.atleast_1d(np.asarray(times)).shape[0]
-        return np.tile(np.asarray(self.q), (n, 1))
-
-
-@dataclass(frozen=True)
-class Nadir(AttitudeLaw):
-    """Nadir pointing in the local-vertical local-horizontal (LVLH) frame, with a yaw.
-
-    At yaw 0 the body ``nadir_axis`` points from the spacecraft to the Earth's centre
-    (``-r/|r|``) and ``velocity_axis`` along the along-track direction (the part of
-    the velocity perpendicular to ``r``).  The yaw then turns the body about the nadir
-    axis by ``yaw_deg`` (right-handed about ``nadir_axis``), so the nadir axis stays on
-    the geocentre.
-
-    Parameters
-    ----------
-    yaw_deg : float
-        Yaw about the nadir axis [degree].
-    nadir_axis, velocity_axis : str or array_like
-        Perpendicular body axes (``"+z"``, ``"-x"``, ... or 3 components).
-
-    Examples
-    --------
-    >>> from scipy.spatial.transform import Rotation
-    >>> from sbrdf_xr.attitude_frames import Context
-    >>> ctx = Context(position_km=np.array([[7000.0, 0.0, 0.0]]),
-    ...               velocity_km_s=np.array([[0.0, 7.5, 0.0]]))
-    >>> q = Nadir(nadir_axis="+z", velocity_axis="+x").quaternions([0.0], ctx)
-    >>> np.round(Rotation.from_quat(q).apply([0.0, 0.0, 1.0]), 6) + 0.0  # +z on the geocentre
-    array([[-1.,  0.,  0.]])
-    """
-
-    yaw_deg: float = 0.0
-    nadir_axis: Any = "+z"
-    velocity_axis: Any = "+x"
-    _axes: tuple[np.ndarray, np.ndarray] = field(init=False, repr=False, compare=False)
-
-    def __post_init__(self) -> None:
-        if not np.isfinite(self.yaw_deg):
-            raise AttitudeError(f"nadir yaw_deg: must be finite, got {self.yaw_deg}")
-        a, b = perpendicular_pair(
-            axis_vector(self.nadir_axis, "nadir_axis"),
-            axis_vector(self.velocity_axis, "velocity_axis"),
-            "nadir",
-        )
-        object.__setattr__(self, "_axes", (a, b))
-
-    def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
-        n = np.atleast_1d(np.asarray(times)).shape[0]
-        r, v = context_fields(context, n, "nadir", "position_km", "velocity_km_s")
-        a, b = self._axes
-        q = triad(a, b, -r, v)
-        if self.yaw_deg:
-            yaw = Rotation.from_rotvec(np.radians(self.yaw_deg) * a)
-            q = (Rotation.from_quat(q) * yaw).as_quat().reshape(-1, 4)
-        return q
-
-
-_SECONDARY_TARGETS = ("orbit_normal", "nadir", "velocity", "north")
-
-
-@dataclass(frozen=True)
-class SunPointing(AttitudeLaw):
-    """A body axis on the Sun, a second body axis as near a target direction as allowed.
-
-    Parameters
-    ----------
-    axis : str or array_like
-        Body axis pointed at the Sun.
-    secondary_axis : str or array_like
-        Body axis perpendicular to ``axis``, turned toward ``secondary_target``.
-    secondary_target : str or array_like
-        ``orbit_normal`` (``r x v``), ``nadir``, ``velocity``, ``north`` (inertial +z) or
-        three components in the inertial frame.  Where the target is parallel to the Sun
-        direction the attitude is undefined and an :class:`AttitudeError` is raised.
-
-    Examples
-    --------
-    >>> from scipy.spatial.transform import Rotation
-    >>> from sbrdf_xr.attitude_frames import Context
-    >>> ctx = Context(position_km=np.array([[7000.0, 0.0, 0.0]]),
-    ...               velocity_km_s=np.array([[0.0, 7.5, 0.0]]),
-    ...               sun_km=np.array([[0.0, 1.5e8, 0.0]]))
-    >>> q = SunPointing(axis="+z", secondary_axis="+x").quaternions([0.0], ctx)
-    >>> R = Rotation.from_quat(q)
-    >>> np.round(R.apply([0.0, 0.0, 1.0]), 6) + 0.0, np.round(R.apply([1.0, 0.0, 0.0]), 6) + 0.0
-    (array([[0., 1., 0.]]), array([[0., 0., 1.]]))
-    """
-
-    axis: Any = "+z"
-    secondary_axis: Any = "+x"
-    secondary_target: Any = "orbit_normal"
-    _axes: tuple[np.ndarray, np.ndarray, str | np.ndarray] = field(
-        init=False, repr=False, compare=False
-    )
-
-    def __post_init__(self) -> None:
-        a, b = perpendicular_pair(
-            axis_vector(self.axis, "axis"),
-            axis_vector(self.secondary_axis, "secondary_axis"),
-            "sun_pointing",
-        )
-        tgt = self.secondary_target
-        if isinstance(tgt, str):
-            if tgt not in _SECONDARY_TARGETS:
-                raise AttitudeError(
-                    f"sun_pointing secondary_target: got {tgt!r}; "
-                    f"allowed: {', '.join(_SECONDARY_TARGETS)} "
-                    "or 3 components"
-                )
-        else:
-            tgt = axis_vector(tgt, "secondary_target")
-        object.__setattr__(self, "_axes", (a, b, tgt))
-
-    def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
-        n = np.atleast_1d(np.asarray(times)).shape[0]
-        a, b, tgt = self._axes
-        (sun,) = context_fields(context, n, "sun_pointing", "sun_km")
-        if isinstance(tgt, str) and tgt != "north":
-            r, v = context_fields(context, n, "sun_pointing", "position_km", "velocity_km_s")
-            target = {"orbit_normal": np.cross(r, v), "nadir": -r, "velocity": v}[tgt]
-        else:
-            target = np.tile([0.0, 0.0, 1.0] if isinstance(tgt, str) else tgt, (n, 1))
-        return triad(a, b, sun, target)
 
 
 @dataclass(frozen=True)
@@ -331,366 +157,6 @@ class Spin(AttitudeLaw):
         spin = Rotation.from_rotvec(ang[:, None] * self._axis_vec[None, :])
         q0 = self.initial.quaternions(times, context)
         return (Rotation.from_quat(q0) * spin).as_quat().reshape(-1, 4)
-
-
-def _inertia(value: ArrayLike) -> NDArray[np.float64]:
-    try:
-        arr = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise AttitudeError(
-            f"tumble inertia: got {value!r}; expected 3 principal moments or a 3x3 tensor"
-        ) from None
-    if arr.shape == (3,):
-        arr = np.diag(arr)
-    if arr.shape != (3, 3) or not np.all(np.isfinite(arr)):
-        raise AttitudeError(
-            "tumble inertia: expected 3 principal moments or a finite 3x3 tensor [kg m2], "
-            f"got shape {arr.shape}"
-        )
-    if not np.allclose(arr, arr.T, rtol=1e-9, atol=1e-12 * np.abs(arr).max()):
-        raise AttitudeError("tumble inertia: the tensor must be symmetric")
-    moments = np.linalg.eigvalsh(arr)
-    if moments[0] <= 0:
-        raise AttitudeError(
-            f"tumble inertia: principal moments must be positive, got {moments.tolist()}"
-        )
-    if moments[0] + moments[1] < moments[2] * (1 - 1e-9):
-        raise AttitudeError(
-            f"tumble inertia: principal moments {moments.tolist()} break the triangle inequality "
-            "I1 + I2 >= I3 of a physical body"
-        )
-    return 0.5 * (arr + arr.T)
-
-
-@dataclass(frozen=True)
-class Tumble(AttitudeLaw):
-    """Torque-free rigid-body motion (Euler's equations).
-
-    ``I dω/dt = -ω x (I ω)`` for the body angular velocity ``ω``, with the attitude
-    kinematics ``dq/dt = ½ q ⊗ (ω, 0)`` (body -> inertial, scalar-last; Markley & Crassidis,
-    *Fundamentals of Spacecraft Attitude Determination and Control*, 2014, eqs. 3.20 and
-    3.81), integrated from the epoch forward and backward with
-    :func:`scipy.integrate.solve_ivp` (DOP853, ``rtol`` = :data:`TUMBLE_RTOL`).  Kinetic
-    energy ``½ ω·Iω`` and the inertial angular momentum ``R I ω`` are invariants of the
-    exact motion; :meth:`states` lets one check them.
-
-    Parameters
-    ----------
-    inertia : array_like, shape (3,) or (3, 3)
-        Inertia tensor about the centre of mass in the body frame [kg m2] (or its
-        principal moments), e.g. :meth:`sbrdf_xr.spacecraft.Spacecraft.inertia`.
-    omega_deg_s : array_like, shape (3,)
-        Body angular velocity at the epoch [degree s-1].
-    initial : array_like, shape (4,)
-        Attitude at the epoch.
-    epoch : datetime64 or str, optional
-        Time of the initial state (default: the start of the observation).
-
-    Examples
-    --------
-    >>> law = Tumble(inertia=(1.0, 2.0, 3.0), omega_deg_s=(0.0, 0.0, 10.0))  # a principal axis
-    >>> omega, q = law.states([0.0, 9.0])
-    >>> np.round(np.degrees(omega), 9) + 0.0  # steady spin about z [degree s-1]
-    array([[ 0.,  0., 10.],
-           [ 0.,  0., 10.]])
-    >>> np.round(q[-1], 9)  # 90 degree about z after 9 s
-    array([0.        , 0.        , 0.70710678, 0.70710678])
-    """
-
-    inertia: Any = (1.0, 1.0, 1.0)
-    omega_deg_s: Any = (0.0, 0.0, 1.0)
-    initial: Any = (0.0, 0.0, 0.0, 1.0)
-    epoch: Any = None
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "inertia", _inertia(self.inertia))
-        w = np.asarray(self.omega_deg_s, dtype=np.float64)
-        if w.shape != (3,) or not np.all(np.isfinite(w)):
-            raise AttitudeError(
-                "tumble omega_deg_s: expected 3 finite body rates [degree s-1], "
-                f"got {self.omega_deg_s!r}"
-            )
-        object.__setattr__(self, "omega_deg_s", w)
-        object.__setattr__(self, "initial", check_quaternion(self.initial, "tumble initial"))
-        object.__setattr__(self, "epoch", check_epoch(self.epoch))
-
-    @classmethod
-    def from_spacecraft(
-        cls,
-        spacecraft: Any,
-        density_kg_m3: float,
-        omega_deg_s: ArrayLike,
-        initial: ArrayLike = (0.0, 0.0, 0.0, 1.0),
-        epoch: Any = None,
-    ) -> Tumble:
-        """A tumble of a spacecraft filled at uniform density (``spacecraft.inertia``).
-
-        Parameters
-        ----------
-        spacecraft : sbrdf_xr.spacecraft.Spacecraft
-            The body (a closed mesh).
-        density_kg_m3 : float
-            Uniform density [kg m-3].
-        omega_deg_s, initial, epoch
-            As for :class:`Tumble`.
-
-        Examples
-        --------
-        >>> import trimesh
-        >>> from sbrdf_xr.spacecraft import Spacecraft
-        >>> cube = Spacecraft(trimesh.creation.box(extents=(0.1, 0.1, 0.1)), ["paint"] * 12)
-        >>> law = Tumble.from_spacecraft(cube, 1000.0, (5.0, 0.0, 0.0))
-        >>> np.round(np.diag(law.inertia), 9)  # a 1 kg cube of side 0.1 m [kg m2]
-        array([0.00166667, 0.00166667, 0.00166667])
-        """
-        return cls(spacecraft.inertia(density_kg_m3), omega_deg_s, initial, epoch)
-
-    def _rhs_function(self):
-        """Right-hand side of Euler's equations and the kinematics, on plain floats (fast)."""
-        (a, b, c), (d, e, f), (g, h, k) = self.inertia.tolist()
-        (ia, ib, ic), (id_, ie, if_), (ig, ih, ik) = np.linalg.inv(self.inertia).tolist()
-
-        def rhs(t: float, y: np.ndarray) -> list[float]:
-            wx, wy, wz, x, yq, z, s = y.tolist()
-            lx, ly, lz = (
-                a * wx + b * wy + c * wz,
-                d * wx + e * wy + f * wz,
-                g * wx + h * wy + k * wz,
-            )
-            # I dw/dt = -w x (I w) = (I w) x w
-            tx, ty, tz = ly * wz - lz * wy, lz * wx - lx * wz, lx * wy - ly * wx
-            return [
-                ia * tx + ib * ty + ic * tz,
-                id_ * tx + ie * ty + if_ * tz,
-                ig * tx + ih * ty + ik * tz,
-                # dq/dt = 1/2 q (x) (w, 0), scalar-last Hamilton product.
-                0.5 * (s * wx + yq * wz - z * wy),
-                0.5 * (s * wy + z * wx - x * wz),
-                0.5 * (s * wz + x * wy - yq * wx),
-                -0.5 * (x * wx + yq * wy + z * wz),
-            ]
-
-        return rhs
-
-    def states(
-        self, times: ArrayLike, context: Context | None = None
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Body angular velocity [rad s-1] and attitude at ``times``.
-
-        Returns
-        -------
-        omega : ndarray, shape (n, 3)
-        quaternion : ndarray, shape (n, 4)
-
-        Examples
-        --------
-        >>> omega, q = Tumble((1.0, 2.0, 3.0), (10.0, 0.0, 0.0)).states([0.0, 1.0, 2.0])
-        >>> omega.shape, q.shape, np.round(np.linalg.norm(q, axis=1), 12)
-        ((3, 3), (3, 4), array([1., 1., 1.]))
-        """
-        from scipy.integrate import solve_ivp
-
-        t = seconds_since(times, self.epoch, context)
-        rhs = self._rhs_function()
-        y0 = np.concatenate([np.radians(self.omega_deg_s), self.initial])
-        out = np.empty((t.size, 7))
-        scale = max(float(np.linalg.norm(y0[:3])), 1e-12)
-        atol = np.concatenate([np.full(3, 1e-14 * scale), np.full(4, 1e-14)])
-        for sel in (t >= 0, t < 0):
-            if not sel.any():
-                continue
-            ts = t[sel]
-            order = np.argsort(ts) if ts[0] >= 0 else np.argsort(-ts)
-            tq = ts[order]
-            if np.all(tq == 0):
-                out[np.flatnonzero(sel)] = y0
-                continue
-            sol = solve_ivp(
-                rhs,
-                (0.0, float(tq[-1])),
-                y0,
-                method="DOP853",
-                t_eval=tq,
-                rtol=TUMBLE_RTOL,
-                atol=atol,
-            )
-            if not sol.success:  # pragma: no cover - smooth right-hand side
-                raise AttitudeError(f"tumble: integration failed: {sol.message}")
-            idx = np.flatnonzero(sel)[order]
-            out[idx] = sol.y.T
-        q = out[:, 3:] / np.linalg.norm(out[:, 3:], axis=1, keepdims=True)
-        return out[:, :3], q
-
-    def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
-        return self.states(times, context)[1]
-
-
-@dataclass(frozen=True)
-class QuaternionSeries(AttitudeLaw):
-    """A user attitude time series, interpolated by slerp (:class:`scipy.spatial.transform.Slerp`).
-
-    Parameters
-    ----------
-    times : array_like
-        Strictly increasing sample times: ``datetime64`` (UTC) or seconds from ``epoch``.
-    samples : array_like, shape (n, 4)
-        Unit quaternions, scalar-last, body -> inertial.
-    epoch : datetime64 or str, optional
-        Time origin of float sample times (default: the start of the observation).
-
-    Requests outside the sampled interval raise :class:`AttitudeError`.
-
-    Examples
-    --------
-    >>> series = QuaternionSeries([0.0, 10.0], [[0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 1.0, 0.0]])
-    >>> np.round(series.quaternions([5.0]), 6)  # halfway: 90 degree about z
-    array([[0.      , 0.      , 0.707107, 0.707107]])
-    >>> series.quaternions([11.0])
-    Traceback (most recent call last):
-        ...
-    sbrdf_xr.errors.AttitudeError: quaternion_series: requested times span [11, 11] s, outside ...
-    """
-
-    times: Any
-    samples: Any = None
-    epoch: Any = None
-    _secs: np.ndarray = field(init=False, repr=False, compare=False)
-    _slerp: Slerp = field(init=False, repr=False, compare=False)
-
-    def __post_init__(self) -> None:
-        t = np.atleast_1d(np.asarray(self.times))
-        q = check_quaternions(self.samples) if self.samples is not None else None
-        if q is None or q.ndim != 2 or q.shape[0] != t.shape[0] or t.ndim != 1 or t.size < 2:
-            raise AttitudeError(
-                f"quaternion_series: need >= 2 times and as many quaternions (n, 4); got times "
-                f"{t.shape} and quaternions {None if q is None else q.shape}"
-            )
-        epoch = check_epoch(self.epoch)
-        if np.issubdtype(t.dtype, np.datetime64):
-            t = t.astype("datetime64[ns]")
-            epoch = t[0] if epoch is None else epoch
-            secs = (t - epoch).astype(np.int64) / NS_PER_S
-        else:
-            secs = t.astype(np.float64)
-        if not np.all(np.diff(secs) > 0):
-            raise AttitudeError("quaternion_series: times must be strictly increasing")
-        object.__setattr__(self, "epoch", epoch)
-        object.__setattr__(self, "_secs", secs)
-        object.__setattr__(self, "_slerp", Slerp(secs, Rotation.from_quat(q)))
-
-    @classmethod
-    def from_csv(
-        cls,
-        path: str | Path,
-        time_column: str = "time",
-        columns: Sequence[str] = ("qx", "qy", "qz", "qw"),
-        epoch: Any = None,
-    ) -> QuaternionSeries:
-        """Read a CSV: a time column (ISO 8601 UTC, or seconds), scalar-last quaternion columns.
-
-        Examples
-        --------
-        >>> import tempfile
-        >>> from pathlib import Path
-        >>> path = Path(tempfile.mkdtemp()) / "att.csv"
-        >>> rows = ["time,qx,qy,qz,qw", "2024-03-17T01:20:00Z,0,0,0,1",
-        ...         "2024-03-17T01:20:10Z,0,0,1,0"]
-        >>> _ = path.write_text("\\n".join(rows))
-        >>> series = QuaternionSeries.from_csv(path)
-        >>> series.epoch
-        np.datetime64('2024-03-17T01:20:00.000000000')
-        >>> np.round(series.quaternions([5.0]), 6)
-        array([[0.      , 0.      , 0.707107, 0.707107]])
-        """
-        import pandas as pd
-
-        try:
-            df = pd.read_csv(path)
-        except (OSError, ValueError) as exc:
-            raise AttitudeError(f"quaternion_series: cannot read {path}: {exc}") from None
-        missing = [c for c in (time_column, *columns) if c not in df.columns]
-        if missing:
-            raise AttitudeError(
-                f"quaternion_series: {path} lacks the columns {missing}; has {list(df.columns)}"
-            )
-        tcol = df[time_column]
-        if pd.api.types.is_numeric_dtype(tcol):
-            t = tcol.to_numpy(np.float64)
-        else:
-            t = pd.to_datetime(tcol, utc=True).dt.tz_localize(None).to_numpy("datetime64[ns]")
-        return cls(t, df[list(columns)].to_numpy(np.float64), epoch)
-
-    @classmethod
-    def from_netcdf(cls, path: str | Path, variable: str = "quaternion") -> QuaternionSeries:
-        """Read ``variable(time, component)`` (components x, y, z, w) from a netCDF file.
-
-        The ``quaternion`` of :meth:`sbrdf_xr.observe.Observation.geometry` reads back.
-
-        Examples
-        --------
-        >>> import tempfile
-        >>> import xarray as xr
-        >>> from pathlib import Path
-        >>> path = Path(tempfile.mkdtemp()) / "att.nc"
-        >>> q = xr.DataArray([[0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 1.0, 0.0]],
-        ...                  dims=("time", "component"),
-        ...                  coords={"time": [0.0, 10.0], "component": ["x", "y", "z", "w"]})
-        >>> q.to_dataset(name="quaternion").to_netcdf(path)
-        >>> np.round(QuaternionSeries.from_netcdf(path).quaternions([5.0]), 6)
-        array([[0.      , 0.      , 0.707107, 0.707107]])
-        """
-        import xarray as xr
-
-        try:
-            with xr.open_dataset(path) as ds:
-                da = ds[variable].load()
-        except (OSError, KeyError, ValueError) as exc:
-            raise AttitudeError(
-                f"quaternion_series: cannot read {variable!r} from {path}: {exc}"
-            ) from None
-        if "component" in da.dims:
-            da = da.transpose(..., "component").sel(component=["x", "y", "z", "w"])
-        return cls(da[da.dims[0]].values, da.values)
-
-    def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
-        t = seconds_since(times, self.epoch, context)
-        lo, hi = self._secs[0], self._secs[-1]
-        if t.min() < lo or t.max() > hi:
-            raise AttitudeError(
-                f"quaternion_series: requested times span [{t.min():.6g}, {t.max():.6g}] s, "
-                "outside the "
-                f"series [{lo:.6g}, {hi:.6g}] s from its epoch {self.epoch}"
-            )
-        return self._slerp(t).as_quat().reshape(-1, 4)
-
-
-@dataclass(frozen=True)
-class Composed(AttitudeLaw):
-    """``R(t) = R_outer(t) R_inner(t)``: the inner law expressed in the outer law's frame.
-
-    Examples
-    --------
-    >>> s = float(np.sqrt(0.5))
-    >>> law = Composed(Inertial((0.0, 0.0, s, s)), Spin(rate_deg_s=90.0))
-    >>> np.round(law.quaternions([1.0]), 6)  # 90 degree then 90 degree about z
-    array([[0., 0., 1., 0.]])
-    """
-
-    outer: AttitudeLaw
-    inner: AttitudeLaw
-
-    def __post_init__(self) -> None:
-        for name in ("outer", "inner"):
-            if not isinstance(getattr(self, name), AttitudeLaw):
-                raise AttitudeError(
-                    f"compose {name}: expected an attitude law, "
-                    f"got {type(getattr(self, name)).__name__}"
-                )
-
-    def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
-        a = Rotation.from_quat(self.outer.quaternions(times, context))
-        b = Rotation.from_quat(self.inner.quaternions(times, context))
-        return (a * b).as_quat().reshape(-1, 4)
 
 
 def compose(outer: AttitudeLaw | ArrayLike, inner: AttitudeLaw | ArrayLike) -> Composed:

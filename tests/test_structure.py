@@ -15,8 +15,10 @@ not run).
 * L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``model_schema``,
   ``models``,
   ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``_visibility_rays`` (the
-  sampled method), ``visibility``, ``attitude_frames``, ``attitude``, ``orbits``,
-  ``observe``, ``photometry`` (and its modules), ``fingerprint``.
+  sampled method), ``visibility``, ``attitude_frames``, ``attitude_pointing``,
+  ``attitude_tumble``, ``attitude_series``, ``attitude``, ``timescales``, ``earth_shadow``,
+  ``orbits``, ``observation``, ``observe``, ``photometry`` (and its modules),
+  ``fingerprint``.
 * L2: ``catalog`` (knows every kind's loader in L1).
 * L3, the scene and its plan: ``effects``, ``plan`` (and its stages ``_plan_stages``,
   ``_plan_tables``), ``sweep``, ``scene_model`` (the
@@ -74,8 +76,14 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "_visibility_rays",
         "visibility",
         "attitude_frames",
+        "attitude_pointing",
+        "attitude_tumble",
+        "attitude_series",
         "attitude",
+        "timescales",
+        "earth_shadow",
         "orbits",
+        "observation",
         "observe",
         "photometry",
         "fingerprint",
