@@ -22,7 +22,8 @@ not run).
   :class:`Scene`), ``scene_io`` (scene files, built-in scenes), ``scene`` (re-exports both).
 * L4, the cube: ``simulate``, ``_writer`` and its parts ``_write_common``, ``_write_layout``,
   ``_write_files``, ``_write_disk``, ``_write_progress``, ``_runners``, ``_lock``.
-* L5, users of everything: ``invert`` (and its modules), ``bench``, ``bench_engine``,
+* L5, users of everything: ``invert`` (and its modules), ``bench_rows`` (the rows,
+  their timing and output), ``bench`` and its sweep ``_bench_accuracy``, ``bench_engine``,
   ``shadow_bench``, ``plot``,
   ``accessors``, ``cli``, ``testing`` and the package's ``__init__``.
 
@@ -92,7 +93,19 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "_runners",
         "_lock",
     ),
-    ("invert", "bench", "bench_engine", "shadow_bench", "plot", "accessors", "cli", "testing", ""),
+    (
+        "invert",
+        "bench_rows",
+        "_bench_accuracy",
+        "bench",
+        "bench_engine",
+        "shadow_bench",
+        "plot",
+        "accessors",
+        "cli",
+        "testing",
+        "",
+    ),
 )
 
 
