@@ -25,7 +25,8 @@ not run).
 * L5, users of everything: ``invert`` (and its modules), ``bench_rows`` (the rows,
   their timing and output), ``bench`` and its sweep ``_bench_accuracy``, ``bench_engine``,
   ``shadow_bench``, ``plot``,
-  ``accessors``, ``cli``, ``testing`` and the package's ``__init__``.
+  ``accessors``, ``cli`` (the parser and ``main``) and its parts ``_cli_output``,
+  ``_cli_commands``, ``_cli_analysis``, ``testing`` and the package's ``__init__``.
 
 A new module must be given a layer here.
 """
@@ -102,6 +103,9 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "shadow_bench",
         "plot",
         "accessors",
+        "_cli_output",
+        "_cli_commands",
+        "_cli_analysis",
         "cli",
         "testing",
         "",
