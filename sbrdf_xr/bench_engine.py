@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from .bench import BenchRow, best_time
+from .bench_rows import BenchRow, best_time
 
 __all__ = ["engine_rows", "sweep_job"]
 

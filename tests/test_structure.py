@@ -25,9 +25,11 @@ not run).
   :class:`Scene`), ``scene_io`` (scene files, built-in scenes), ``scene`` (re-exports both).
 * L4, the cube: ``simulate``, ``_writer`` and its parts ``_write_common``, ``_write_layout``,
   ``_write_files``, ``_write_disk``, ``_write_progress``, ``_runners``, ``_lock``.
-* L5, users of everything: ``invert`` (and its modules), ``bench``, ``bench_engine``,
+* L5, users of everything: ``invert`` (and its modules), ``bench_rows`` (the rows,
+  their timing and output), ``bench`` and its sweep ``_bench_accuracy``, ``bench_engine``,
   ``shadow_bench``, ``plot``,
-  ``accessors``, ``cli``, ``testing`` and the package's ``__init__``.
+  ``accessors``, ``cli`` (the parser and ``main``) and its parts ``_cli_output``,
+  ``_cli_commands``, ``_cli_analysis``, ``testing`` and the package's ``__init__``.
 
 A new module must be given a layer here.
 """
@@ -110,7 +112,22 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "_runners",
         "_lock",
     ),
-    ("invert", "bench", "bench_engine", "shadow_bench", "plot", "accessors", "cli", "testing", ""),
+    (
+        "invert",
+        "bench_rows",
+        "_bench_accuracy",
+        "bench",
+        "bench_engine",
+        "shadow_bench",
+        "plot",
+        "accessors",
+        "_cli_output",
+        "_cli_commands",
+        "_cli_analysis",
+        "cli",
+        "testing",
+        "",
+    ),
 )
 
 
