@@ -192,8 +192,7 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
     facets = scene.spacecraft.facets()
     s, o = scene.body_vectors()
     s2, o2 = s.reshape(-1, 3), o.reshape(-1, 3)
-    materials = scene.materials or {}
-    tables = {m: materials[m] for m in scene.spacecraft.materials}
+    tables = {m: scene.tables[m] for m in scene.spacecraft.materials}
     n_geom, n_fac = s2.shape[0], facets.sizes["facet"]
     n_wl = tables[CANX1_MATERIALS[0]].sizes["wavelength"]
 
