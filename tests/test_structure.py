@@ -13,8 +13,8 @@ not run).
   (facet tangents,
   ``psi``) and ``_aniso_kernels`` (the anisotropic look-up).
 * L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``model_schema``,
-  ``models``,
-  ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``_visibility_rays`` (the
+  ``models``, ``material_energy`` (a table's hemispherical reflectance), ``material_build``
+  (the construction's front end), ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``_visibility_rays`` (the
   sampled method), ``visibility``, ``attitude_frames``, ``attitude``, ``orbits``,
   ``observe``, ``photometry`` (and its modules), ``fingerprint``.
 * L2: ``catalog`` (knows every kind's loader in L1).
@@ -66,6 +66,8 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "construction",
         "model_schema",
         "models",
+        "material_energy",
+        "material_build",
         "material",
         "goniometer",
         "mesh_io",
