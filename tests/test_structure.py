@@ -13,12 +13,12 @@ not run).
   (facet tangents,
   ``psi``) and ``_aniso_kernels`` (the anisotropic look-up).
 * L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``model_schema``,
-  ``models``,
-  ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``_visibility_rays`` (the
-  sampled method), ``visibility``, ``attitude_frames``, ``attitude_pointing``,
-  ``attitude_tumble``, ``attitude_series``, ``attitude``, ``timescales``, ``earth_shadow``,
-  ``orbits``, ``observation``, ``observe``, ``photometry`` (and its modules),
-  ``fingerprint``.
+  ``models``, ``material_energy`` (a table's hemispherical reflectance), ``material_build``
+  (the construction's front end), ``material``, ``goniometer``, ``mesh_io``,
+  ``spacecraft``, ``_visibility_rays`` (the sampled method), ``visibility``,
+  ``attitude_frames``, ``attitude_pointing``, ``attitude_tumble``, ``attitude_series``,
+  ``attitude``, ``timescales``, ``earth_shadow``, ``orbits``, ``observation``, ``observe``,
+  ``photometry`` (and its modules), ``fingerprint``.
 * L2: ``catalog`` (knows every kind's loader in L1).
 * L3, the scene and its plan: ``effects``, ``plan`` (and its stages ``_plan_stages``,
   ``_plan_tables``), ``sweep``, ``scene_model`` (the
@@ -71,6 +71,8 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "construction",
         "model_schema",
         "models",
+        "material_energy",
+        "material_build",
         "material",
         "goniometer",
         "mesh_io",
