@@ -14,7 +14,8 @@ not run).
   ``psi``) and ``_aniso_kernels`` (the anisotropic look-up).
 * L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``model_schema``,
   ``models``,
-  ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``_visibility_rays`` (the
+  ``material``, ``goniometer``, ``mesh_io``, ``mesh_repair``, ``spacecraft_facets``,
+  ``spacecraft_plot``, ``spacecraft``, ``_visibility_rays`` (the
   sampled method), ``visibility``, ``attitude_frames``, ``attitude``, ``orbits``,
   ``observe``, ``photometry`` (and its modules), ``fingerprint``.
 * L2: ``catalog`` (knows every kind's loader in L1).
@@ -69,6 +70,9 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "material",
         "goniometer",
         "mesh_io",
+        "mesh_repair",
+        "spacecraft_facets",
+        "spacecraft_plot",
         "spacecraft",
         "_visibility_rays",
         "visibility",
