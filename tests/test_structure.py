@@ -20,7 +20,8 @@ not run).
   ``observe``, ``photometry`` (and its modules), ``fingerprint``.
 * L2: ``catalog`` (knows every kind's loader in L1).
 * L3, the scene and its plan: ``effects``, ``plan``, ``sweep``, ``scene_model`` (the
-  :class:`Scene`), ``scene_io`` (scene files, built-in scenes), ``scene`` (re-exports both).
+  :class:`Scene`), ``scene_file`` (scene files), ``scene_io`` (built-in scenes, and scene
+  files re-exported), ``scene`` (re-exports both).
 * L4, the cube: ``simulate``, ``_writer`` and its parts ``_write_common``, ``_write_layout``,
   ``_write_files``, ``_write_disk``, ``_write_progress``, ``_runners``, ``_lock``.
 * L5, users of everything: ``invert`` (and its modules), ``bench``, ``bench_engine``,
@@ -84,7 +85,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "fingerprint",
     ),
     ("catalog",),
-    ("effects", "plan", "_plan_stages", "sweep", "scene_model", "scene_io", "scene"),
+    ("effects", "plan", "_plan_stages", "sweep", "scene_model", "scene_file", "scene_io", "scene"),
     (
         "simulate",
         "_writer",
