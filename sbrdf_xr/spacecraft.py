@@ -4,10 +4,9 @@ Paper 000 §3.3 represents a spacecraft by a triangular-faceted CAD model (STL) 
 colour of a facet selects its material (Table 2: vertices ``V``, facets ``F``, normals ``N``,
 colours ``C``).  This module reads such models from any format :mod:`trimesh` reads, maps
 facet colours or material/group names to material names, checks that the surface can be used
-(finite, no zero-area or duplicate facets, closed and consistently wound with outward normals)
-and converts the length unit to metres.  It also builds the facet table used by the
-simulation, merges facets that share (normal, material), and ships the CanX-1-like model of
-paper 000 §4 (:func:`canx1`).
+(:mod:`sbrdf_xr.mesh_repair`) and converts the length unit to metres.  It also builds the
+facet table used by the simulation, merges facets that share (normal, material), and ships
+the CanX-1-like model of paper 000 §4 (:func:`canx1`).
 
 Facet labels, by format
 -----------------------
@@ -23,27 +22,16 @@ glTF/GLB  material names and base colours of the primitives; also node and mesh 
 
 Checks and repairs
 ------------------
-Every problem raises :class:`~sbrdf_xr.errors.MeshError` unless ``repair=True``; then the
-documented repair below is applied and reported with a :class:`MeshRepairWarning` (never
-silently).  In order:
+Every problem of the surface (non-finite vertices, zero-area or duplicate facets, an open
+surface, inconsistent winding, inside-out bodies) raises :class:`~sbrdf_xr.errors.MeshError`
+unless ``repair=True``; then the documented repair is applied and reported with a
+:class:`MeshRepairWarning` (never silently).  The checks, their order, repairs and
+tolerances are listed in :mod:`sbrdf_xr.mesh_repair`.  Self-intersections and internal
+faces are not detected; zero-thickness panels make a surface open (model them as thin
+boxes).
 
-1. non-finite (NaN/inf) vertices: the vertex and every facet using it are removed;
-2. (not a repair) vertices at the same position (coordinates equal after rounding to
-   :data:`MERGE_DISTANCE` = 1e-8 m) are merged, since STL stores
-   every facet with its own three vertices;
-3. zero-area facets (area <= :data:`ZERO_AREA_FACTOR` x the squared bounding-box diagonal,
-   or repeated vertices): removed;
-4. duplicate facets (same three vertices, any order or winding): the first is kept;
-5. open surface (edges used by one facet): holes are filled with :func:`trimesh.repair.fill_holes`;
-   each new facet takes the material of the nearest original facet; an error remains if the
-   surface is still open;
-6. inconsistent winding: :func:`trimesh.repair.fix_winding`;
-7. inside-out bodies (negative volume): their facets are flipped
-   (:func:`trimesh.repair.fix_inversion`).
-
-Self-intersections and internal faces are not detected.  Zero-thickness panels, common in
-CAD exports, make a surface open: model them as thin boxes (ray-cast shadowing needs a closed
-surface to tell the inside from the outside).
+The facet tables are built by :mod:`sbrdf_xr.spacecraft_facets` and the picture by
+:mod:`sbrdf_xr.spacecraft_plot`.
 """
 
 from __future__ import annotations
@@ -58,20 +46,25 @@ import xarray as xr
 from numpy.typing import NDArray
 
 from . import _catalog_index
-from ._names import FACET, MATERIAL, VECTOR, attrs
 from .anisotropy import DEFAULT_TANGENT_DIRECTION, project_tangents
 from .errors import CatalogError, MeshError, MeshRepairWarning, ValidationError
 from .mesh_io import (
     LENGTH_UNITS,
-    NORMAL_TOLERANCE,
     Color,
-    clean_mesh,
     label_faces,
     length_factor,
     normalise_map,
     read_material_map,
     read_mesh,
 )
+from .mesh_repair import clean_mesh
+from .spacecraft_facets import (
+    NORMAL_TOLERANCE,
+    check_facet_material,
+    facet_table,
+    merge_facets,
+)
+from .spacecraft_plot import plot_facets
 
 __all__ = [
     "CANX1_MATERIALS",
@@ -94,19 +87,18 @@ CANX1_MATERIALS: dict[str, tuple[int, int, int]] = {
 }
 
 
-# --------------------------------------------------------------------------- units
-
-
-# --------------------------------------------------------------------------- material maps
-
-
-# --------------------------------------------------------------------------- reading
-
-
-# --------------------------------------------------------------------------- checks and repairs
-
-
 # --------------------------------------------------------------------------- public API
+
+
+def _tangent_directions(tangent: Any, n_facets: int) -> NDArray[np.float64]:
+    """Tangent direction(s) [1], shape (3,) or (n_facets, 3); ValidationError otherwise."""
+    d = np.asarray(tangent, dtype=np.float64)
+    if d.shape not in ((3,), (n_facets, 3)):
+        raise ValidationError(
+            f"tangent: expected one direction (3,) or one per facet ({n_facets}, 3), "
+            f"got shape {d.shape}"
+        )
+    return d
 
 
 def load_spacecraft(
@@ -142,7 +134,7 @@ def load_spacecraft(
         Length unit of the file's coordinates (see :data:`LENGTH_UNITS`); converted to
         metres.  CAD exports are often in ``"mm"``.
     repair : bool
-        Repair the problems listed in the module docstring (with a
+        Repair the problems listed in :mod:`sbrdf_xr.mesh_repair` (with a
         :class:`MeshRepairWarning` for each) instead of raising :class:`MeshError`.
     name : str, optional
         Name of the spacecraft (default: the file stem, the mesh's name or ``"spacecraft"``).
@@ -172,7 +164,7 @@ def load_spacecraft(
     ------
     MeshError
         If the source is not a triangle mesh, is empty, has unmapped facets, or has one of
-        the problems of the module docstring while ``repair`` is False.
+        the problems of :mod:`sbrdf_xr.mesh_repair` while ``repair`` is False.
     ValidationError
         If the length unit or the map is invalid, or the map names an unknown material.
     FileNotFoundError
@@ -219,12 +211,7 @@ def load_spacecraft(
         vertices = vertices * factor
     source = "default"
     if tangent is not None:
-        direction = np.asarray(tangent, dtype=np.float64)
-        if direction.ndim == 2 and direction.shape != (len(faces), 3):
-            raise ValidationError(
-                f"tangent: expected one direction (3,) or one per facet ({len(faces)}, 3), "
-                f"got shape {direction.shape}"
-            )
+        direction = _tangent_directions(tangent, len(faces))
         source = "per facet" if direction.ndim == 2 else "direction"
         direction = np.broadcast_to(direction, (len(faces), 3))
     else:
@@ -300,24 +287,14 @@ class Spacecraft:
     ) -> None:
         if not isinstance(mesh, trimesh.Trimesh):
             raise ValidationError(f"mesh: expected a trimesh.Trimesh, got {type(mesh).__name__}")
-        labels = np.asarray(list(facet_material), dtype=str)
-        if labels.shape != (len(mesh.faces),):
-            raise ValidationError(
-                f"facet_material: expected {len(mesh.faces)} names (one per facet), "
-                f"got shape {labels.shape}"
-            )
+        labels = check_facet_material(facet_material, len(mesh.faces))
         labels.setflags(write=False)
         self.mesh = mesh
         self.facet_material: NDArray[np.str_] = labels
         self.name = str(name)
         self.colors: dict[str, Color] = dict(colors or {})
         self._cache: dict[str, Any] = {}
-        d = None if tangent is None else np.asarray(tangent, dtype=np.float64)
-        if d is not None and d.shape not in ((3,), (len(mesh.faces), 3)):
-            raise ValidationError(
-                f"tangent: expected one direction (3,) or one per facet ({len(mesh.faces)}, 3), "
-                f"got shape {d.shape}"
-            )
+        d = None if tangent is None else _tangent_directions(tangent, len(mesh.faces))
         t = project_tangents(np.asarray(mesh.face_normals, dtype=np.float64), d)
         t.setflags(write=False)
         #: Unit tangent of every facet, orthogonal to its normal [1], shape (n_facets, 3).
@@ -446,30 +423,7 @@ class Spacecraft:
         >>> ds.normal.isel(facet=0).values.tolist()
         [-1.0, 0.0, 0.0]
         """
-        mesh = self.mesh
-        ds = xr.Dataset(
-            {
-                "normal": (
-                    (FACET, VECTOR),
-                    np.asarray(mesh.face_normals, dtype=np.float64),
-                    attrs("normal"),
-                ),
-                "area": ((FACET,), np.asarray(mesh.area_faces, dtype=np.float64), attrs("area")),
-                "centroid": (
-                    (FACET, VECTOR),
-                    np.asarray(mesh.triangles_center, dtype=np.float64),
-                    attrs("centroid"),
-                ),
-                MATERIAL: ((FACET,), self.facet_material.copy(), attrs(MATERIAL)),
-                "tangent": ((FACET, VECTOR), self.facet_tangent.copy(), attrs("tangent")),
-            },
-            coords={
-                FACET: (FACET, np.arange(self.n_facets), attrs(FACET)),
-                VECTOR: (VECTOR, ["x", "y", "z"], attrs(VECTOR)),
-            },
-            attrs={"spacecraft": self.name, "title": f"facets of {self.name}"},
-        )
-        return ds
+        return facet_table(self.mesh, self.facet_material, self.facet_tangent, self.name)
 
     def merged(
         self, tolerance: float = NORMAL_TOLERANCE, tangent_materials: Iterable[str] = ()
@@ -509,71 +463,13 @@ class Spacecraft:
         >>> terms.sizes["term"], terms.area.values.tolist()  # 6 faces of 2 facets each
         (6, [1.0, 1.0, 1.0, 1.0, 1.0, 1.0])
         """
-        if not (np.isfinite(tolerance) and tolerance > 0):
-            raise ValidationError(
-                f"tolerance: got {tolerance!r}; expected a positive finite number"
-            )
-        normals = np.asarray(self.mesh.face_normals, dtype=np.float64)
-        area = np.asarray(self.mesh.area_faces, dtype=np.float64)
-        mat_names, mat_code = np.unique(self.facet_material, return_inverse=True)
-        aniso = np.isin(self.facet_material, list(tangent_materials))
-        tang = self.facet_tangent
-        # t and -t are the same tangent: the sign that makes the largest component positive
-        sign = np.sign(tang[np.arange(len(tang)), np.argmax(np.abs(tang), axis=1)])
-        t_key = np.where(aniso[:, None], np.round(sign[:, None] * tang / tolerance), 0)
-        keys = np.column_stack(
-            [
-                mat_code.reshape(-1),
-                np.round(normals / tolerance).astype(np.int64),
-                t_key.astype(np.int64),
-            ]
-        )
-        _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
-        order = np.argsort(first, kind="stable")  # terms in order of first facet
-        rank = np.empty_like(order)
-        rank[order] = np.arange(len(order))
-        term = rank[inverse.reshape(-1)]
-        n_terms = len(order)
-        t_area = np.bincount(term, weights=area, minlength=n_terms)
-        t_normal = np.stack(
-            [np.bincount(term, weights=area * normals[:, k], minlength=n_terms) for k in range(3)],
-            axis=1,
-        )
-        norm = np.linalg.norm(t_normal, axis=1, keepdims=True)
-        # A term of zero-area facets only (no normal) keeps a zero normal: it faces
-        # nothing and contributes nothing, without 0/0.
-        t_normal = np.divide(t_normal, norm, out=np.zeros_like(t_normal), where=norm > 0)
-        n_facets = np.bincount(term, minlength=n_terms)
-        t_material = mat_names[mat_code.reshape(-1)[np.asarray(first)[order]]]
-        first_t = tang[np.asarray(first)[order]]
-        t_tangent = (
-            project_tangents(np.where(norm > 0, t_normal, [0.0, 0.0, 1.0]), first_t)
-            if n_terms
-            else np.zeros((0, 3))
-        )
-        return xr.Dataset(
-            {
-                "normal": (("term", VECTOR), t_normal, attrs("normal")),
-                "area": (
-                    ("term",),
-                    t_area,
-                    attrs("area", long_name="summed facet area of the term"),
-                ),
-                MATERIAL: (("term",), t_material, attrs(MATERIAL)),
-                "n_facets": (("term",), n_facets, attrs("n_facets")),
-                "tangent": (("term", VECTOR), t_tangent, attrs("tangent")),
-                "facet_term": ((FACET,), term, attrs("facet_term")),
-            },
-            coords={
-                "term": ("term", np.arange(n_terms), attrs("term")),
-                FACET: (FACET, np.arange(self.n_facets), attrs(FACET)),
-                VECTOR: (VECTOR, ["x", "y", "z"], attrs(VECTOR)),
-            },
-            attrs={
-                "spacecraft": self.name,
-                "normal_tolerance": tolerance,
-                "title": f"merged facets of {self.name}",
-            },
+        return merge_facets(
+            self.mesh,
+            self.facet_material,
+            self.facet_tangent,
+            self.name,
+            tolerance=tolerance,
+            tangent_materials=tangent_materials,
         )
 
     def plot(
@@ -617,52 +513,19 @@ class Spacecraft:
         ('Figure', 1)
         >>> plt.close(fig)
         """
-        import matplotlib.pyplot as plt
-        from matplotlib.colors import to_rgba
-        from matplotlib.patches import Patch
-        from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
-        if ax is None:
-            fig = plt.figure(figsize=(6, 6))
-            ax = fig.add_subplot(projection="3d")
-        else:
-            fig = ax.figure
-        cycle = plt.rcParams["axes.prop_cycle"].by_key().get("color", ["C0"])
-        palette: dict[str, Any] = {}
-        for i, m in enumerate(self.materials):
-            if colors and m in colors:
-                palette[m] = to_rgba(colors[m])
-            elif m in self.colors:
-                r, g, b = self.colors[m]
-                palette[m] = to_rgba((r / 255.0, g / 255.0, b / 255.0))
-            else:
-                palette[m] = to_rgba(cycle[i % len(cycle)])
-        names, code = np.unique(self.facet_material, return_inverse=True)
-        face_rgba = np.array([palette[n] for n in names])[code.reshape(-1)]
-        tri = np.asarray(self.mesh.triangles)
-        coll = Poly3DCollection(
-            tri, facecolors=face_rgba, edgecolors=edgecolor, linewidths=linewidth
+        return plot_facets(
+            self.mesh,
+            self.facet_material,
+            ax,
+            name=self.name,
+            colors=colors,
+            rgb=self.colors,
+            edgecolor=edgecolor,
+            linewidth=linewidth,
+            legend=legend,
+            elev=elev,
+            azim=azim,
         )
-        ax.add_collection3d(coll)
-        lo, hi = self.mesh.bounds
-        centre, half = (lo + hi) / 2, float(np.max(hi - lo)) / 2
-        ax.set_xlim(centre[0] - half, centre[0] + half)
-        ax.set_ylim(centre[1] - half, centre[1] + half)
-        ax.set_zlim(centre[2] - half, centre[2] + half)
-        ax.set_box_aspect((1, 1, 1))
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("y [m]")
-        ax.set_zlabel("z [m]")
-        ax.view_init(elev=elev, azim=azim)
-        ax.set_title(f"{self.name}: {self.n_facets} facets")
-        if legend:
-            ax.legend(
-                handles=[
-                    Patch(facecolor=palette[m], edgecolor="0.3", label=m) for m in self.materials
-                ],
-                loc="upper left",
-            )
-        return fig
 
 
 # --------------------------------------------------------------------------- catalog

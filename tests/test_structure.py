@@ -15,14 +15,16 @@ not run).
 * L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``model_schema``,
   ``models``, ``material_energy`` (a table's hemispherical reflectance), ``material_build``
   (the construction's front end), ``material``, ``goniometer``, ``mesh_io``,
-  ``spacecraft``, ``_visibility_rays`` (the sampled method), ``visibility``,
+  ``mesh_repair``, ``spacecraft_facets``, ``spacecraft_plot``, ``spacecraft``,
+  ``_visibility_rays`` (the sampled method), ``visibility``,
   ``attitude_frames``, ``attitude_pointing``, ``attitude_tumble``, ``attitude_series``,
   ``attitude``, ``timescales``, ``earth_shadow``, ``orbits``, ``observation``, ``observe``,
   ``photometry`` (and its modules), ``fingerprint``.
 * L2: ``catalog`` (knows every kind's loader in L1).
 * L3, the scene and its plan: ``effects``, ``plan`` (and its stages ``_plan_stages``,
-  ``_plan_tables``), ``sweep``, ``scene_model`` (the
-  :class:`Scene`), ``scene_io`` (scene files, built-in scenes), ``scene`` (re-exports both).
+  ``_plan_tables``), ``sweep``, ``scene_model`` (the :class:`Scene`), ``scene_file``
+  (scene files), ``scene_io`` (built-in scenes, and scene files re-exported), ``scene``
+  (re-exports both).
 * L4, the cube: ``simulate``, ``_writer`` and its parts ``_write_common``, ``_write_layout``,
   ``_write_files``, ``_write_disk``, ``_write_progress``, ``_runners``, ``_lock``.
 * L5, users of everything: ``invert`` (and its modules), ``bench_rows`` (the rows,
@@ -76,6 +78,9 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "material",
         "goniometer",
         "mesh_io",
+        "mesh_repair",
+        "spacecraft_facets",
+        "spacecraft_plot",
         "spacecraft",
         "_visibility_rays",
         "visibility",
@@ -100,6 +105,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "_plan_tables",
         "sweep",
         "scene_model",
+        "scene_file",
         "scene_io",
         "scene",
     ),
