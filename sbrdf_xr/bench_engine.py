@@ -31,11 +31,12 @@ import time
 from pathlib import Path
 from typing import Any
 
+import numba
 import numpy as np
 
 from .bench_rows import BenchRow, best_time
 
-__all__ = ["engine_rows", "sweep_job"]
+__all__ = ["disk_rate", "engine_rows", "sweep_job", "thread_scaling"]
 
 #: The sweeps: canx1 at random attitudes, phase angle 10 deg, default outputs.
 _SIZES_QUICK = (10_000, 100_000)
@@ -136,7 +137,68 @@ def sweep_job(
         t0 = time.perf_counter()
         write(simulate(plan), path, overwrite=True)
         seconds = time.perf_counter() - t0
-    return {"seconds": seconds, "rss": float(_peak_rss()), "blocks": float(plan.n_blocks)}
+    out = {"seconds": seconds, "rss": float(_peak_rss()), "blocks": float(plan.n_blocks)}
+    if mode == "write":
+        out["bytes"] = float(os.path.getsize(path))
+    return out
+
+
+@numba.njit(nogil=True, cache=True)
+def _scalar_loop(n: int) -> float:  # pragma: no cover - compiled
+    """Square roots and additions only: arithmetic that touches no memory."""
+    s = 0.0
+    for i in range(n):
+        s += np.sqrt(i + 1.0) * 1e-9
+    return s
+
+
+def thread_scaling(n: int = 50_000_000, jobs: int = 4, repeat: int = 3) -> tuple[float, float]:
+    """Seconds for ``jobs`` equal compute-bound jobs (:func:`_scalar_loop`: no memory
+    traffic, the GIL released) on one thread and on two.  Their ratio is this machine's
+    own ceiling for any two-thread speed-up.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench_engine import thread_scaling
+    >>> one, two = thread_scaling(n=200_000, repeat=1)
+    >>> 0.5 < one / two < 2.5
+    True
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    _scalar_loop(10)
+
+    def run(threads: int) -> None:
+        with ThreadPoolExecutor(threads) as pool:
+            list(pool.map(_scalar_loop, [n] * jobs))
+
+    return best_time(lambda: run(1), repeat), best_time(lambda: run(2), repeat)
+
+
+def disk_rate(where: str | None = None, nbytes: int = 512 * 2**20) -> float:
+    """Rate [byte/s] at which this machine writes ``nbytes`` to a new file in ``where``
+    (the temporary directory by default) and flushes it to disk (``fsync``): the floor
+    under any cube write of that size there.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench_engine import disk_rate
+    >>> disk_rate(nbytes=2**20) > 1e6  # at least a megabyte per second
+    True
+    """
+    block = np.ones(min(nbytes, 16 * 2**20) // 8)
+    with tempfile.TemporaryDirectory(prefix="sbrdf-disk-", dir=where) as tmp:
+        path = Path(tmp) / "probe.bin"
+        t0 = time.perf_counter()
+        with open(path, "wb") as f:
+            done = 0
+            while done < nbytes:
+                block.tofile(f)
+                done += block.nbytes
+            f.flush()
+            os.fsync(f.fileno())
+        seconds = time.perf_counter() - t0
+    return done / seconds
 
 
 def _peak_rss() -> int:
@@ -307,6 +369,17 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
     results = {n: _subprocess(n) for n in sizes}
     kernels = {n: _subprocess(n, mode="kernel") for n in sizes}
     sw = "sweeps written to netCDF, default settings, 141 wavelengths"
+    rate = disk_rate()
+    rows.append(
+        BenchRow(
+            "this machine: write and fsync 512 MiB",
+            512 * 2**20 / rate,
+            "",
+            1.0,
+            f"{rate / 1e6:.0f} MB/s: the floor under a cube write",
+            sweep=sw,
+        )
+    )
     prev = None
     for n in sizes:
         r, k = results[n], kernels[n]
@@ -327,6 +400,18 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
                 r["seconds"] / k["seconds"],
                 f"{r['seconds']:.2f} s in {int(r['blocks'])} blocks, peak RSS "
                 f"{r['rss'] / 2**30:.2f} GiB{exp}",
+                sweep=sw,
+            )
+        )
+        floor = max(k["seconds"], r["bytes"] / rate)
+        rows.append(
+            BenchRow(
+                f"{n:.0e} attitudes, write, against its floor",
+                r["seconds"],
+                "the slower of the bare kernel and the disk",
+                r["seconds"] / floor,
+                f"{r['bytes'] / 1e6:.0f} MB file: {r['bytes'] / rate:.2f} s at the disk's rate, "
+                f"kernel {k['seconds']:.2f} s",
                 sweep=sw,
             )
         )
@@ -352,6 +437,18 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
             single["seconds"] / results[n5]["seconds"],
             f"two cores are {single['seconds'] / results[n5]['seconds']:.2f}x one core",
             sweep=sw,
+        )
+    )
+    one_t, two_t = thread_scaling()
+    ceiling = one_t / two_t
+    rows.append(
+        BenchRow(
+            "this machine: compute-bound numba loop, one thread",
+            one_t,
+            "two threads",
+            ceiling,
+            f"two threads are {ceiling:.2f}x one: the ceiling of any two-core speed-up here",
+            sweep="compute only, default settings, 141 wavelengths",
         )
     )
     c2 = _subprocess(n5, mode="compute")

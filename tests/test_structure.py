@@ -270,6 +270,19 @@ def against_flow(graph: dict[str, set[str]]) -> list[str]:
     return bad
 
 
+#: A module longer than this is doing more than one job: split it by job.
+MAX_MODULE_LINES = 600
+
+
+def test_no_module_is_over_the_line_limit():
+    long = {
+        str(p.relative_to(PACKAGE)): n
+        for p in sorted(PACKAGE.rglob("*.py"))
+        if (n := len(p.read_text(encoding="utf-8").splitlines())) > MAX_MODULE_LINES
+    }
+    assert not long, f"modules over {MAX_MODULE_LINES} lines (split them by job): {long}"
+
+
 def test_every_module_has_a_layer():
     with pytest.raises(KeyError):
         layer_of("a_new_module")
