@@ -26,6 +26,7 @@ from .errors import (
     CatalogError,
     ObservationError,
 )
+from .photometry import atmosphere
 from .timescales import (
     KNOT_S,
     check_times,
@@ -70,17 +71,9 @@ AU_KM = 149597870.700
 EPOCH_GAP_DAYS = 7.0
 
 
-#: Relative airmass models of :func:`pvlib.atmosphere.get_relative_airmass`.
-AIRMASS_MODELS = (
-    "simple",
-    "kasten1966",
-    "youngirvine1967",
-    "kastenyoung1989",
-    "gueymard1993",
-    "young1994",
-    "pickering2002",
-    "gueymard2003",
-)
+#: Relative air-mass models of :func:`pvlib.atmosphere.get_relative_airmass`, those of
+#: :data:`sbrdf_xr.photometry.atmosphere.AIRMASS_MODELS` (declared there, once).
+AIRMASS_MODELS = tuple(atmosphere.AIRMASS_MODELS)
 
 
 def tle_checksum(line: str) -> int:
