@@ -150,13 +150,43 @@ ATTRS: dict[str, dict[str, str]] = {
         "long_name": "atmospheric extinction coefficient (magnitudes per unit air mass)",
     },
     "range": {"units": "km", "long_name": "observer-object range"},
-    "time": {"long_name": "observation time (UTC)"},
+    "time": {"long_name": "time (UTC)", "standard_name": "time"},
     "srgb": {
         "units": "1",
         "long_name": "sRGB swatch of the reflected sunlight (display-normalised)",
     },
     "obs": {"units": "1", "long_name": "observation index"},
     "rotation_angle": {"units": DEGREE, "long_name": "body rotation angle"},
+    # --- observations (sbrdf_xr.observation) ---
+    "to_earth": {
+        "units": "1",
+        "long_name": "unit vector toward the Earth's centre in the body frame",
+    },
+    "azimuth": {
+        "units": "degree",
+        "long_name": "azimuth of the spacecraft from north through east",
+    },
+    "solar_elongation": {
+        "units": "degree",
+        "long_name": "angle between the Sun and the spacecraft seen by the observer",
+    },
+    "sun_distance": {"units": "au", "long_name": "distance from the spacecraft to the Sun"},
+    "sunlit_fraction": {
+        "units": "1",
+        "long_name": "fraction of the solar disc seen from the spacecraft not hidden by the Earth",
+    },
+    "earth_distance": {
+        "units": "km",
+        "long_name": "distance from the spacecraft to the Earth's centre",
+    },
+    "earth_phase_angle": {
+        "units": "degree",
+        "long_name": "Sun-Earth-spacecraft angle seen from the Earth's centre",
+    },
+    "site_sun_elevation": {
+        "units": "degree",
+        "long_name": "elevation of the Sun above the observer's horizon",
+    },
     # --- simulation cubes ---
     ATTITUDE: {"units": "1", "long_name": "attitude index"},
     "attitude_angle": {"units": DEGREE, "long_name": "rotation angle of the attitude sweep"},
@@ -164,7 +194,7 @@ ATTRS: dict[str, dict[str, str]] = {
         "units": "1",
         "long_name": "attitude quaternion, body to reference frame, scalar last (x, y, z, w)",
     },
-    "component": {"units": "1", "long_name": "quaternion component"},
+    "component": {"units": "1", "long_name": "quaternion component (scalar last)"},
     GEOMETRY: {"units": "1", "long_name": "geometry index"},
     "time_since_first": {"units": "s", "long_name": "time since the first observation"},
 }

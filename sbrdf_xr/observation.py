@@ -48,7 +48,7 @@ import xarray as xr
 from numpy.typing import NDArray
 
 from . import attitude as _att
-from ._names import VECTOR
+from ._names import VECTOR, attrs
 from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, sunlit_fraction
 from .errors import (
     AttitudeError,
@@ -67,53 +67,38 @@ TIME = "time"
 #: Name of the quaternion component dimension.
 COMPONENT = "component"
 
-#: CF attributes of every variable of :meth:`Observation.geometry`.
-ATTRS: dict[str, dict[str, str]] = {
-    TIME: {"long_name": "time (UTC)", "standard_name": "time"},
-    COMPONENT: {"units": "1", "long_name": "quaternion component (scalar last)"},
-    "to_sun": {"units": "1", "long_name": "unit vector toward the Sun in the body frame"},
-    "to_observer": {"units": "1", "long_name": "unit vector toward the observer in the body frame"},
-    "to_earth": {
-        "units": "1",
-        "long_name": "unit vector toward the Earth's centre in the body frame",
-    },
-    "quaternion": {"units": "1", "long_name": "attitude quaternion, body to GCRS, scalar last"},
-    "range": {"units": "km", "long_name": "distance from the observer to the spacecraft"},
-    "elevation": {
-        "units": "degree",
-        "long_name": "elevation of the spacecraft above the observer's geodetic horizon",
-    },
-    "azimuth": {
-        "units": "degree",
-        "long_name": "azimuth of the spacecraft from north through east",
-    },
-    "phase_angle": {
-        "units": "degree",
-        "long_name": "angle between the Sun and observer directions",
-    },
-    "solar_elongation": {
-        "units": "degree",
-        "long_name": "angle between the Sun and the spacecraft seen by the observer",
-    },
-    "sun_distance": {"units": "au", "long_name": "distance from the spacecraft to the Sun"},
-    "sunlit_fraction": {
-        "units": "1",
-        "long_name": "fraction of the solar disc seen from the spacecraft not hidden by the Earth",
-    },
-    "airmass": {"units": "1", "long_name": "relative airmass along the line of sight"},
-    "earth_distance": {
-        "units": "km",
-        "long_name": "distance from the spacecraft to the Earth's centre",
-    },
-    "earth_phase_angle": {
-        "units": "degree",
-        "long_name": "Sun-Earth-spacecraft angle seen from the Earth's centre",
-    },
-    "site_sun_elevation": {
-        "units": "degree",
-        "long_name": "elevation of the Sun above the observer's horizon",
-    },
-    VECTOR: {"units": "1", "long_name": "Cartesian component in the spacecraft body frame"},
+_PRECISE: dict[str, dict[str, str]] = {
+    "quaternion": {"long_name": "attitude quaternion, body to GCRS, scalar last"},
+    "range": {"long_name": "distance from the observer to the spacecraft"},
+    "elevation": {"long_name": "elevation of the spacecraft above the observer's geodetic horizon"},
+    "airmass": {"long_name": "relative airmass along the line of sight"},
+}
+
+#: CF attributes of every variable of :meth:`Observation.geometry`: the package's entries
+#: (:data:`sbrdf_xr._names.ATTRS`, where every name is declared once), with the long names
+#: an observation can state more precisely (its frame is the GCRS, its horizon geodetic).
+ATTRS: dict[str, dict[str, Any]] = {
+    k: attrs(k, **_PRECISE.get(k, {}))
+    for k in (
+        TIME,
+        COMPONENT,
+        "to_sun",
+        "to_observer",
+        "to_earth",
+        "quaternion",
+        "range",
+        "elevation",
+        "azimuth",
+        "phase_angle",
+        "solar_elongation",
+        "sun_distance",
+        "sunlit_fraction",
+        "airmass",
+        "earth_distance",
+        "earth_phase_angle",
+        "site_sun_elevation",
+        VECTOR,
+    )
 }
 
 
