@@ -14,8 +14,9 @@ not run).
   ``psi``) and ``_aniso_kernels`` (the anisotropic look-up).
 * L1, the domain: ``material_schema``, ``material_io``, ``construction``, ``model_schema``,
   ``models``, ``material_energy`` (a table's hemispherical reflectance), ``material_build``
-  (the construction's front end), ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``, ``_visibility_rays`` (the
-  sampled method), ``visibility``, ``attitude_frames``, ``attitude``, ``orbits``,
+  (the construction's front end), ``material``, ``goniometer``, ``mesh_io``, ``spacecraft``,
+  ``_visibility_rays`` (the sampled method), ``visibility``, ``attitude_frames``, ``attitude``,
+  ``orbits``,
   ``observe``, ``photometry`` (and its modules), ``fingerprint``.
 * L2: ``catalog`` (knows every kind's loader in L1).
 * L3, the scene and its plan: ``effects``, ``plan``, ``sweep``, ``scene_model`` (the
