@@ -650,18 +650,7 @@ ENERGY_TABLES = {
 }
 
 
-@pytest.mark.parametrize(
-    "name",
-    [
-        *sorted(k for k in ENERGY_TABLES if k != "tjpv-cell"),
-        # Zero below the noise (the paper's rule): the GGX tails beyond the measured
-        # extents carry most of the cell's energy (the table is -20 to -67 % off).
-        pytest.param(
-            "tjpv-cell",
-            marks=pytest.mark.xfail(strict=True, reason="tjpv-cell loses its tails' energy"),
-        ),
-    ],
-)
+@pytest.mark.parametrize("name", sorted(ENERGY_TABLES))
 def test_shipped_tables_keep_their_generating_models_energy(name):
     """Directional-hemispherical reflectance of every shipped table within 3 % of its
     generating model's at every theta_i 0-85 deg and wavelength, and at most 1 on every

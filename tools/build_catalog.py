@@ -7,6 +7,7 @@ here is synthetic; its index entry in ``catalogs/index.toml`` says how it was ma
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -105,7 +106,14 @@ def canx1_materials() -> None:
 
 
 def fit_microfacet(
-    meas: xr.Dataset, *, roughness: float, n: float, k: float, rho_d: float, spectral_diffuse: bool
+    meas: xr.Dataset,
+    *,
+    roughness: float,
+    n: float,
+    k: float,
+    rho_d: float,
+    spectral_diffuse: bool,
+    coating: tuple[tuple[str, float], ...] = (),
 ) -> xr.Dataset:
     """GGX microfacet model (:mod:`sbrdf_xr.brdf.microfacet`) fitted to a measurement set.
 
@@ -117,6 +125,11 @@ def fit_microfacet(
     (:func:`scipy.optimize.least_squares`, trust region with bounds; the Jacobian's
     sparsity, every wavelength on its own but for the shared parameters, makes it a
     few evaluations per step).  The start values are the keyword arguments.
+
+    ``coating`` names the thin-film layers over the substrate, ambient side first, as
+    ``(material, start thickness [nm])`` with ``material`` a dispersion of
+    :mod:`sbrdf_xr.brdf.optics` (``"sapphire"`` for ``optics.sapphire_index``); their
+    thicknesses are fitted too, shared by all wavelengths.
     """
     import scipy.optimize as so
     import scipy.sparse as sp
@@ -132,18 +145,24 @@ def fit_microfacet(
     m = wl.size
     good = y > 0
     ly = np.log(np.where(good, y, 1.0))
-    n_shared = 1 if spectral_diffuse else 2
+    n_layers = len(coating)
+    indices = [getattr(optics, f"{name}_index")(wl) for name, _ in coating]
+    n_shared = (1 if spectral_diffuse else 2) + n_layers
     n_spectral = 3 if spectral_diffuse else 2
 
-    def unpack(x: np.ndarray) -> dict[str, np.ndarray]:
+    def unpack(x: np.ndarray) -> dict[str, Any]:
         e = np.exp(x)
         spec = e[n_shared:].reshape(n_spectral, m)
-        return {
+        p: dict[str, Any] = {
             "roughness": np.full(m, e[0]),
             "n": spec[0],
             "k": spec[1],
             "rho_d": spec[2] if spectral_diffuse else np.full(m, e[1]),
         }
+        if n_layers:
+            thick = e[n_shared - n_layers : n_shared]
+            p["layers"] = [(idx, float(t)) for idx, t in zip(indices, thick, strict=True)]
+        return p
 
     def residuals(x: np.ndarray) -> np.ndarray:
         f = microfacet.brdf_angles(ti, dt, ph, wl, **unpack(x))
@@ -155,11 +174,11 @@ def fit_microfacet(
     pattern[:, :n_shared] = 1
     for j in range(n_spectral):
         pattern[rows, n_shared + j * m + col] = 1
-    start = [roughness] + ([] if spectral_diffuse else [rho_d])
+    start = [roughness] + ([] if spectral_diffuse else [rho_d]) + [t for _, t in coating]
     start_spec = [n, k] + ([rho_d] if spectral_diffuse else [])
     lo_s, hi_s = (
-        [1e-3] + ([] if spectral_diffuse else [1e-6]),
-        [1.0] + ([] if spectral_diffuse else [0.9]),
+        [1e-3] + ([] if spectral_diffuse else [1e-6]) + [1.0] * n_layers,
+        [1.0] + ([] if spectral_diffuse else [0.9]) + [1000.0] * n_layers,
     )
     lo_p, hi_p = (
         [0.05, 1e-4] + ([1e-6] if spectral_diffuse else []),
@@ -182,6 +201,10 @@ def fit_microfacet(
             f"{meas.attrs['material']} (log residuals, scipy.optimize.least_squares): roughness "
             f"{p['roughness'][0]:.4g}, substrate n, k per wavelength, diffuse "
             + ("per wavelength" if spectral_diffuse else f"{p['rho_d'][0]:.3g}")
+            + "".join(
+                f", {name} {t:.4g} nm"
+                for (name, _), (_, t) in zip(coating, p.get("layers", ()), strict=True)
+            )
         ),
         **p,
     )
@@ -210,6 +233,93 @@ def canx1_microfacet_fits() -> None:
         meas = material.open_measurements(ROOT / "materials" / f"{name}-measurements.nc")
         fit = fit_microfacet(meas, **start)
         models.to_netcdf(fit, ROOT / "materials" / f"{name}-microfacet-fit.nc", overwrite=True)
+
+
+#: Layer thicknesses [nm] of the grid of :func:`coating_start`.
+COATING_GRID = np.arange(10.0, 251.0, 10.0)
+
+
+def coating_start(
+    meas: xr.Dataset,
+    *,
+    substrate: str,
+    coating: tuple[str, ...],
+    roughness: float,
+    rho_d: float,
+    grid: np.ndarray = COATING_GRID,
+) -> tuple[float, ...]:
+    """Start thicknesses [nm] of a coating fit: the best point of a grid.
+
+    A thin-film stack's reflectance is periodic in each layer's optical thickness, so
+    the log-residual cost of :func:`fit_microfacet` has a minimum in every period;
+    a local fit finds the one next to its start.  The grid (every ``grid`` thickness
+    for every layer) evaluates that cost with the substrate's dispersion
+    (``optics.<substrate>_index``) and the given roughness and diffuse albedo; the
+    fit then starts from its best point.
+    """
+    from itertools import product
+
+    from sbrdf_xr.brdf import microfacet
+
+    ok = ~meas["reference"].values
+    ti, dt, ph = (
+        np.asarray(meas[c].values, dtype=np.float64)[ok] for c in ("theta_i", "delta_theta", "phi")
+    )
+    y = np.asarray(meas["measured_sbrdf"].transpose("sample", "wavelength").values)[ok]
+    wl = np.asarray(meas.wavelength.values, dtype=np.float64)
+    good = y > 0
+    ly = np.log(np.where(good, y, 1.0))
+    sub = getattr(optics, f"{substrate}_index")(wl)
+    indices = [getattr(optics, f"{name}_index")(wl) for name in coating]
+    common = {
+        "roughness": np.full(wl.size, roughness),
+        "n": sub.real,
+        "k": sub.imag,
+        "rho_d": np.full(wl.size, rho_d),
+    }
+
+    def cost(thick: tuple[float, ...]) -> float:
+        layers = [(idx, t) for idx, t in zip(indices, thick, strict=True)]
+        f = microfacet.brdf_angles(ti, dt, ph, wl, layers=layers, **common)
+        return float(np.mean(np.where(good, np.log(np.maximum(f, 1e-300)) - ly, 0.0) ** 2))
+
+    return min(product(*([[float(t) for t in grid]] * len(coating))), key=cost)
+
+
+#: The cell's coated fit: GGX over a GaAs substrate (its n, k fitted per wavelength)
+#: under the anti-reflection coating's two layers, sapphire over titania, whose
+#: thicknesses are fitted too (started from :func:`coating_start`, with the roughness
+#: and diffuse albedo of the bare fit).
+CANX1_COATED_FITS = {
+    "tjpv-cell": {"substrate": "gaas", "coating": ("sapphire", "titania")},
+}
+
+
+def canx1_coated_fits() -> None:
+    """Write the coated microfacet fit of the CanX-1 cell (its table's model)."""
+    for name, how in CANX1_COATED_FITS.items():
+        meas = material.open_measurements(ROOT / "materials" / f"{name}-measurements.nc")
+        bare = models.open_model(ROOT / "materials" / f"{name}-microfacet-fit.nc")
+        roughness, rho_d = (float(bare[v].values.reshape(-1)[0]) for v in ("roughness", "rho_d"))
+        start = coating_start(
+            meas,
+            substrate=how["substrate"],
+            coating=how["coating"],
+            roughness=roughness,
+            rho_d=rho_d,
+        )
+        sub = getattr(optics, f"{how['substrate']}_index")(np.array([700.0]))[0]
+        fit = fit_microfacet(
+            meas,
+            roughness=roughness,
+            n=float(sub.real),
+            k=float(sub.imag),
+            rho_d=rho_d,
+            spectral_diffuse=False,
+            coating=tuple(zip(how["coating"], start, strict=True)),
+        )
+        fit.attrs["coating_start"] = np.array(start)
+        models.to_netcdf(fit, ROOT / "materials" / f"{name}-coated-fit.nc", overwrite=True)
 
 
 def table4_paints() -> None:
@@ -313,6 +423,7 @@ def main() -> None:
     example_lobe_measurements()
     canx1_materials()
     canx1_microfacet_fits()
+    canx1_coated_fits()
     table4_paints()
 
 
