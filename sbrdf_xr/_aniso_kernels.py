@@ -50,6 +50,7 @@ from ._kernels import (
     material_sums,
     pack_tables,
 )
+from ._packed_tables import typed_values
 from .anisotropy import PSI_PERIOD, illumination_azimuth, psi_weights
 from .geometry import normal_incidence_tolerance
 
@@ -397,7 +398,7 @@ def _compiled_sums(s, o, n, tangents, areas, table, method, fraction):
         np.ascontiguousarray(tangents, dtype=np.float64),
         np.ascontiguousarray(areas, dtype=np.float64),
         frac,
-        numba.typed.List(p.values),
+        typed_values(p),
         p.tgrid[p.t_off[0] : p.t_off[1]],
         p.dgrid[p.d_off[0] : p.d_off[1]],
         p.pgrid[p.p_off[0] : p.p_off[1]],

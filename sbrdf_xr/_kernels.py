@@ -29,12 +29,11 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numba
-import numba.typed
 import numpy as np
 from numpy.typing import NDArray
 
 from . import _lut
-from ._packed_tables import PackedTables, pack_tables
+from ._packed_tables import PackedTables, pack_tables, typed_values
 from ._reference_kernel import MaterialSums, material_sums
 from .geometry import normal_incidence_tolerance
 
@@ -500,7 +499,7 @@ def fused_sums(
         np.zeros((0, 0)) if fraction is None else np.ascontiguousarray(fraction, dtype=np.float64)
     )
     if g and normals.shape[0]:
-        typed = numba.typed.List(tables.values)
+        typed = typed_values(tables)
         _fused_sums(
             s,
             o,

@@ -6,12 +6,14 @@ an axis cell without a binary search.
 
 from __future__ import annotations
 
+import threading
 from typing import Any, NamedTuple
 
+import numba.typed
 import numpy as np
 from numpy.typing import DTypeLike, NDArray
 
-__all__ = ["MAX_BUCKETS", "PackedTables", "bucket_map", "pack_tables"]
+__all__ = ["MAX_BUCKETS", "PackedTables", "bucket_map", "pack_tables", "typed_values"]
 
 
 #: Most buckets of an axis' bucket map (a grid with very uneven spacing gets fewer
@@ -136,3 +138,26 @@ def pack_tables(
         b_off,
         binv,
     )
+
+
+#: The numba lists of the last few packings' values, by the identity of their tuple
+#: (each entry keeps its tuple alive, so the identity cannot be reused meanwhile).
+_TYPED: dict[int, tuple[tuple[NDArray[np.floating], ...], Any]] = {}
+_TYPED_LOCK = threading.Lock()
+_TYPED_KEEP = 8
+
+
+def typed_values(tables: PackedTables) -> Any:
+    """``tables.values`` as the ``numba.typed.List`` the kernels take, built once per
+    packing (building it costs about 70 us, paid on every block otherwise)."""
+    key = id(tables.values)
+    with _TYPED_LOCK:
+        hit = _TYPED.get(key)
+        if hit is not None and hit[0] is tables.values:
+            return hit[1]
+    typed = numba.typed.List(tables.values)
+    with _TYPED_LOCK:
+        while len(_TYPED) >= _TYPED_KEEP:
+            del _TYPED[next(iter(_TYPED))]
+        _TYPED[key] = (tables.values, typed)
+    return typed
