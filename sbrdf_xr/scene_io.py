@@ -129,33 +129,15 @@ def builtin_scene(name: str) -> Scene:
 
 
 def resolve_scene(spec: str | os.PathLike[str] | Scene) -> Scene:
-    """A scene from a Scene, a built-in name or a TOML file path.
+    """A scene from a Scene, a built-in name or a TOML file path (read by
+    :func:`~sbrdf_xr.scene_file.load_scene`, whose example writes one).
 
     Examples
     --------
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> text = '''
-    ... name = "grey-canx1"
-    ... spacecraft = "canx1"
-    ... phase_angles = [10.0]
-    ... [attitude]
-    ... kind = "sweep"
-    ... axis = [0, 0, 1]
-    ... stop = 90.0
-    ... step = 45.0
-    ... [materials]
-    ... "aluminium-6061-t6" = "lambertian-grey-50"
-    ... "tjpv-cell" = "lambertian-grey-50"
-    ... "white-paint-a276" = "lambertian-grey-50"
-    ... '''
     >>> from sbrdf_xr.scene import resolve_scene
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     path = Path(tmp) / "grey.toml"
-    ...     _ = path.write_text(text)
-    ...     scene = resolve_scene(str(path))
-    >>> scene.name, resolve_scene(scene) is scene
-    ('grey-canx1', True)
+    >>> scene = resolve_scene("canx1-rotation")  # a built-in name; its tables load on first use
+    >>> scene.name, scene.n_geometries, resolve_scene(scene) is scene
+    ('canx1-rotation', 360, True)
     >>> resolve_scene("no-such-scene")
     Traceback (most recent call last):
     ...
