@@ -395,7 +395,8 @@ def _write_locked(
         limit = int(max_in_flight or 2 * runner.n_workers)
         todo = iter([b for b in range(plan.n_blocks) if b not in done])
         kinds = {str(n): storage_kind(n, v.dtype) for n, v in ds.variables.items()}
-        bar = progress_bar(progress, plan.n_blocks, len(done), path.name)
+        # a cube held in memory is written with its header: no blocks to count
+        bar = progress_bar(progress and plan.n_blocks > 0, plan.n_blocks, len(done), path.name)
         pieces: dict[int, list[tuple[str, tuple[slice, ...], Any]]] = {}
         exhausted = False
         while True:
