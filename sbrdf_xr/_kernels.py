@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import _lut
+from ._angle_kernels import chunk_angles
 from ._packed_tables import PackedTables, pack_tables, typed_values
 from ._reference_kernel import MaterialSums, material_sums
 from .geometry import normal_incidence_tolerance
@@ -61,6 +62,9 @@ __all__ = [
 METHOD_CODES: dict[str, int] = {"nearest": 0, "linear": 1, "cubic": 2}
 
 _RAD2DEG = 180.0 / np.pi
+
+#: Geometries per chunk of the fused kernel's vectorised angle stage.
+_CHUNK = 64
 
 
 @numba.njit(nogil=True, cache=True, inline="always")
@@ -302,9 +306,24 @@ def _fused_sums(
     wdt = np.empty(4)
     wph = np.empty(4)
     bt, bd, bp = bmap[0], bmap[1], bmap[2]
+    # stage 1 (chunk_angles): the angles of a chunk of geometries against every term in
+    # one vectorised pass; stage 2: per geometry, the look-ups of its lit and seen pairs
+    # (terms in order, so that terms of one face read the same table rows from cache)
+    s_t = np.ascontiguousarray(s.T)
+    o_t = np.ascontiguousarray(o.T)
+    n_chunk = min(_CHUNK, n_geom)
+    b_ns = np.empty((n_term, n_chunk))
+    b_no = np.empty((n_term, n_chunk))
+    b_st = np.empty((n_term, n_chunk))
+    b_ti = np.empty((n_term, n_chunk))
+    b_dt = np.empty((n_term, n_chunk))
+    b_ph = np.empty((n_term, n_chunk))
     for g in range(n_geom):
-        sx, sy, sz = s[g, 0], s[g, 1], s[g, 2]
-        ox, oy, oz = o[g, 0], o[g, 1], o[g, 2]
+        j = g % _CHUNK
+        if j == 0:
+            chunk_angles(
+                s_t, o_t, g, min(_CHUNK, n_geom - g), normals, b_ns, b_no, b_st, b_ti, b_dt, b_ph
+            )
         area_g = 0.0
         lit_g = 0.0
         t = 0
@@ -314,10 +333,10 @@ def _fused_sums(
             while stop < n_term and term_mat[stop] == m:
                 stop += 1
             any_lookup = False
+            values = tables[m]
             for tt in range(t, stop):
-                nx, ny, nz = normals[tt, 0], normals[tt, 1], normals[tt, 2]
-                ns = nx * sx + ny * sy + nz * sz
-                no = nx * ox + ny * oy + nz * oz
+                ns = b_ns[tt, j]
+                no = b_no[tt, j]
                 if not (ns > 0.0 and no > 0.0):
                     continue
                 a_eff = areas[tt]
@@ -327,9 +346,23 @@ def _fused_sums(
                 area_g += a2d
                 lit_g += a_eff
                 # angles of paper 000 Fig. 4, as geometry.facet_angles
-                ti, dt, phi, _, _, _, _ = facet_frame(
-                    nx, ny, nz, sx, sy, sz, ox, oy, oz, ns, no, tol
-                )
+                if b_st[tt, j] > tol:
+                    ti, dt, phi = b_ti[tt, j], b_dt[tt, j], b_ph[tt, j]
+                else:  # normal incidence: the plane through the observer or an axis
+                    ti, dt, phi, _, _, _, _ = facet_frame(
+                        normals[tt, 0],
+                        normals[tt, 1],
+                        normals[tt, 2],
+                        s[g, 0],
+                        s[g, 1],
+                        s[g, 2],
+                        o[g, 0],
+                        o[g, 1],
+                        o[g, 2],
+                        ns,
+                        no,
+                        tol,
+                    )
                 d0 = d_off[m]
                 nd = d_off[m + 1] - d0
                 p0 = p_off[m]
@@ -412,7 +445,7 @@ def _fused_sums(
                 wbuf[1] = a2d
                 ws = wbuf[0]
                 wp = wbuf[1]
-                _gather(tables[m], rows, wn, nk, f, acc_s, acc_p, ws, wp)
+                _gather(values, rows, wn, nk, f, acc_s, acc_p, ws, wp)
             if any_lookup:
                 if method == 2:
                     for k in range(n_wl):
