@@ -527,6 +527,9 @@ def finish(
     """
     names = plan.output_names
     dt = np.dtype(plan.knobs["dtype"])
+    # the spectral integrals are einsum, not BLAS: this runs on every engine thread at
+    # once, and a threaded BLAS call starts threads of its own that then spin on the
+    # cores the other blocks need
     area = sums["area"]
     out: dict[str, np.ndarray] = {}
     if "area" in names:
@@ -543,7 +546,7 @@ def finish(
         if "spacecraft_sbrdf" in names:
             out["spacecraft_sbrdf"] = sbrdf
         if "brdf" in names:
-            out["brdf"] = (sbrdf @ _trapezoid_weights(plan)).astype(dt)
+            out["brdf"] = np.einsum("gl,l->g", sbrdf, _trapezoid_weights(plan)).astype(dt)
     for k in ("signal", "signal_material", "signal_earthshine", "thermal_intensity"):
         if k in names:
             out[k] = sums[k]
@@ -551,7 +554,7 @@ def finish(
         total = sums["signal"]
         if "signal_earthshine" in sums:
             total = total + sums["signal_earthshine"]
-        out["band_signal"] = (total if plan.pre_integrated else total @ plan.band_weights.T).astype(
-            dt
-        )
+        if not plan.pre_integrated:
+            total = np.einsum("gl,bl->gb", total, plan.band_weights)
+        out["band_signal"] = total.astype(dt)
     return {k: v.reshape(*lead_shape, *v.shape[1:]) for k, v in out.items()}
