@@ -18,7 +18,7 @@ import math
 import numba
 import numpy as np
 
-__all__ = ["atan2_pos", "chunk_angles"]
+__all__ = ["atan2_pos", "chunk_angles", "facet_frame"]
 
 # Cephes atan.c, double precision
 _P0 = -8.750608600031904122785e-1
@@ -92,7 +92,7 @@ def chunk_angles(
     every term, into ``(T, nc)`` buffers.
 
     ``s_t``, ``o_t`` are the Sun and observer unit vectors as ``(3, G)`` rows.  The
-    angles are those of :func:`sbrdf_xr._kernels.facet_frame` away from normal incidence
+    angles are those of :func:`facet_frame` away from normal incidence
     (in-plane Sun component above the tolerance); callers recompute the other pairs,
     and skip pairs that are not lit and seen, whose values here are unspecified.
     """
@@ -124,3 +124,58 @@ def chunk_angles(
             ti_out[t, j] = ti * _RAD2DEG
             dt_out[t, j] = trp * _RAD2DEG - ti * _RAD2DEG
             phi_out[t, j] = phi * _RAD2DEG
+
+
+@numba.njit(nogil=True, cache=True, inline="always")
+def facet_frame(
+    nx: float,
+    ny: float,
+    nz: float,
+    sx: float,
+    sy: float,
+    sz: float,
+    ox: float,
+    oy: float,
+    oz: float,
+    ns: float,
+    no: float,
+    tol: float,
+) -> tuple[float, float, float, float, float, float, float]:  # pragma: no cover - compiled
+    """The angles of paper 000 Fig. 4 of one lit and seen pair, as
+    :func:`sbrdf_xr.geometry.facet_angles`: ``(theta_i, delta_theta, phi)`` [degree], the
+    forward in-plane unit vector ``e`` and the observer's out-of-plane component ``o.p``.
+
+    ``ns``, ``no`` are ``N.s`` and ``N.o``; at normal incidence (in-plane Sun component
+    under ``tol``) the plane is taken through the observer, or through the axis least
+    aligned with ``N`` when the observer is on the normal too.
+    """
+    stx, sty, stz = sx - ns * nx, sy - ns * ny, sz - ns * nz
+    st_len = np.sqrt(stx * stx + sty * sty + stz * stz)
+    theta_i = np.arctan2(st_len, ns)
+    if st_len <= tol:
+        otx, oty, otz = ox - no * nx, oy - no * ny, oz - no * nz
+        ot_len = np.sqrt(otx * otx + oty * oty + otz * otz)
+        if ot_len > tol:
+            ex, ey, ez = otx / ot_len, oty / ot_len, otz / ot_len
+        else:
+            # a perpendicular: cross with the axis least aligned with n
+            ax, ay, az = abs(nx), abs(ny), abs(nz)
+            if ax <= ay and ax <= az:
+                ex, ey, ez = 0.0, nz, -ny
+            elif ay <= az:
+                ex, ey, ez = -nz, 0.0, nx
+            else:
+                ex, ey, ez = ny, -nx, 0.0
+            el = np.sqrt(ex * ex + ey * ey + ez * ez)
+            ex, ey, ez = ex / el, ey / el, ez / el
+    else:
+        ex, ey, ez = -stx / st_len, -sty / st_len, -stz / st_len
+    px = ny * ez - nz * ey
+    py = nz * ex - nx * ez
+    pz = nx * ey - ny * ex
+    of = ox * ex + oy * ey + oz * ez
+    op = ox * px + oy * py + oz * pz
+    trp = np.arctan2(of, no)
+    phi = np.arctan2(abs(op), np.hypot(of, no)) * _RAD2DEG
+    dt = trp * _RAD2DEG - theta_i * _RAD2DEG
+    return theta_i * _RAD2DEG, dt, phi, ex, ey, ez, op

@@ -38,18 +38,17 @@ import numpy as np
 from numpy.typing import DTypeLike, NDArray
 
 from . import _lut
+from ._angle_kernels import facet_frame
 from ._kernels import (
     METHOD_CODES,
     FusedSums,
     MaterialSums,
     PackedTables,
-    _axis,
-    _gather,
-    facet_frame,
     fused_sums,
     material_sums,
     pack_tables,
 )
+from ._lookup_kernels import _axis, _gather
 from ._packed_tables import typed_values
 from .anisotropy import PSI_PERIOD, illumination_azimuth, psi_weights
 from .geometry import normal_incidence_tolerance

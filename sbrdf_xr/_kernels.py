@@ -33,7 +33,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import _lut
-from ._angle_kernels import chunk_angles
+from ._angle_kernels import chunk_angles, facet_frame
+from ._lookup_kernels import _axis, _cell, _gather, _gather8
 from ._packed_tables import PackedTables, pack_tables, typed_values
 from ._reference_kernel import MaterialSums, material_sums
 from .geometry import normal_incidence_tolerance
@@ -65,198 +66,6 @@ _RAD2DEG = 180.0 / np.pi
 
 #: Geometries per chunk of the fused kernel's vectorised angle stage.
 _CHUNK = 64
-
-
-@numba.njit(nogil=True, cache=True, inline="always")
-def _axis(
-    grid: np.ndarray,
-    lo: int,
-    n: int,
-    x: float,
-    method: int,
-    idx: np.ndarray,
-    w: np.ndarray,
-    bmap: np.ndarray,
-    blo: int,
-    nb: int,
-    binv: float,
-) -> int:  # pragma: no cover - compiled
-    """Node indices and weights along one axis (``_lut.axis_weights``); returns the count.
-
-    The cell is found from the axis' bucket map (:func:`bucket_map`) and corrected by
-    comparisons with the nodes, so it is exactly ``searchsorted(grid, x, "right") - 1``
-    without a binary search's unpredictable branches.
-    """
-    g0 = grid[lo]
-    g1 = grid[lo + n - 1]
-    if x < g0:
-        x = g0
-    elif x > g1:
-        x = g1
-    if n == 1:
-        idx[0] = 0
-        w[0] = 1.0
-        return 1
-    # searchsorted(grid, x, side="right") - 1, clipped to [0, n - 2]
-    kb = int((x - g0) * binv)
-    if kb < 0:
-        kb = 0
-    elif kb > nb - 1:
-        kb = nb - 1
-    i = bmap[blo + kb]
-    while i < n - 1 and grid[lo + i + 1] <= x:
-        i += 1
-    while i > 0 and grid[lo + i] > x:
-        i -= 1
-    if i > n - 2:
-        i = n - 2
-    t = (x - grid[lo + i]) / (grid[lo + i + 1] - grid[lo + i])
-    if method == 0:
-        idx[0] = i + 1 if t >= 0.5 else i
-        w[0] = 1.0
-        return 1
-    if method == 1:
-        idx[0] = i
-        idx[1] = i + 1
-        w[0] = 1.0 - t
-        w[1] = t
-        return 2
-    k = 4 if n >= 4 else n
-    j0 = i - 1
-    if j0 < 0:
-        j0 = 0
-    elif j0 > n - k:
-        j0 = n - k
-    for p in range(k):
-        idx[p] = j0 + p
-        w[p] = 1.0
-    for p in range(k):
-        xp = grid[lo + j0 + p]
-        for q in range(k):
-            if p != q:
-                xq = grid[lo + j0 + q]
-                w[p] *= (x - xq) / (xp - xq)
-    return k
-
-
-@numba.njit(nogil=True, cache=True, inline="always")
-def facet_frame(
-    nx: float,
-    ny: float,
-    nz: float,
-    sx: float,
-    sy: float,
-    sz: float,
-    ox: float,
-    oy: float,
-    oz: float,
-    ns: float,
-    no: float,
-    tol: float,
-) -> tuple[float, float, float, float, float, float, float]:  # pragma: no cover - compiled
-    """The angles of paper 000 Fig. 4 of one lit and seen pair, as
-    :func:`sbrdf_xr.geometry.facet_angles`: ``(theta_i, delta_theta, phi)`` [degree], the
-    forward in-plane unit vector ``e`` and the observer's out-of-plane component ``o.p``.
-
-    ``ns``, ``no`` are ``N.s`` and ``N.o``; at normal incidence (in-plane Sun component
-    under ``tol``) the plane is taken through the observer, or through the axis least
-    aligned with ``N`` when the observer is on the normal too.
-    """
-    stx, sty, stz = sx - ns * nx, sy - ns * ny, sz - ns * nz
-    st_len = np.sqrt(stx * stx + sty * sty + stz * stz)
-    theta_i = np.arctan2(st_len, ns)
-    if st_len <= tol:
-        otx, oty, otz = ox - no * nx, oy - no * ny, oz - no * nz
-        ot_len = np.sqrt(otx * otx + oty * oty + otz * otz)
-        if ot_len > tol:
-            ex, ey, ez = otx / ot_len, oty / ot_len, otz / ot_len
-        else:
-            # a perpendicular: cross with the axis least aligned with n
-            ax, ay, az = abs(nx), abs(ny), abs(nz)
-            if ax <= ay and ax <= az:
-                ex, ey, ez = 0.0, nz, -ny
-            elif ay <= az:
-                ex, ey, ez = -nz, 0.0, nx
-            else:
-                ex, ey, ez = ny, -nx, 0.0
-            el = np.sqrt(ex * ex + ey * ey + ez * ez)
-            ex, ey, ez = ex / el, ey / el, ez / el
-    else:
-        ex, ey, ez = -stx / st_len, -sty / st_len, -stz / st_len
-    px = ny * ez - nz * ey
-    py = nz * ex - nx * ez
-    pz = nx * ey - ny * ex
-    of = ox * ex + oy * ey + oz * ez
-    op = ox * px + oy * py + oz * pz
-    trp = np.arctan2(of, no)
-    phi = np.arctan2(abs(op), np.hypot(of, no)) * _RAD2DEG
-    dt = trp * _RAD2DEG - theta_i * _RAD2DEG
-    return theta_i * _RAD2DEG, dt, phi, ex, ey, ez, op
-
-
-@numba.njit(nogil=True, cache=True)
-def _gather(values, rows, wn, nk, f, acc_s, acc_p, ws, wp):  # pragma: no cover - compiled
-    """``acc_s += ws * sum_n wn[n] values[rows[n]]`` and likewise ``acc_p`` with ``wp``.
-
-    Four table rows per pass over the spectrum (fewer loads and stores of ``f``);
-    the last pass adds straight into the accumulators.
-    """
-    n_wl = values.shape[1]
-    n4 = nk - nk % 4
-    n = 0
-    started = False
-    while n < nk:
-        last = (n + 4 >= nk) if n < n4 else (n + 1 == nk)
-        if n < n4:
-            r0, r1, r2, r3 = rows[n], rows[n + 1], rows[n + 2], rows[n + 3]
-            w0, w1, w2, w3 = wn[n], wn[n + 1], wn[n + 2], wn[n + 3]
-            if last and not started:
-                for k in range(n_wl):
-                    v = (w0 * values[r0, k] + w1 * values[r1, k]) + (
-                        w2 * values[r2, k] + w3 * values[r3, k]
-                    )
-                    acc_s[k] += ws * v
-                    acc_p[k] += wp * v
-            elif last:
-                for k in range(n_wl):
-                    v = f[k] + (
-                        (w0 * values[r0, k] + w1 * values[r1, k])
-                        + (w2 * values[r2, k] + w3 * values[r3, k])
-                    )
-                    acc_s[k] += ws * v
-                    acc_p[k] += wp * v
-            elif not started:
-                for k in range(n_wl):
-                    f[k] = (w0 * values[r0, k] + w1 * values[r1, k]) + (
-                        w2 * values[r2, k] + w3 * values[r3, k]
-                    )
-            else:
-                for k in range(n_wl):
-                    f[k] += (w0 * values[r0, k] + w1 * values[r1, k]) + (
-                        w2 * values[r2, k] + w3 * values[r3, k]
-                    )
-            n += 4
-        else:
-            r0 = rows[n]
-            w0 = wn[n]
-            if last and not started:
-                for k in range(n_wl):
-                    v = w0 * values[r0, k]
-                    acc_s[k] += ws * v
-                    acc_p[k] += wp * v
-            elif last:
-                for k in range(n_wl):
-                    v = f[k] + w0 * values[r0, k]
-                    acc_s[k] += ws * v
-                    acc_p[k] += wp * v
-            elif not started:
-                for k in range(n_wl):
-                    f[k] = w0 * values[r0, k]
-            else:
-                for k in range(n_wl):
-                    f[k] += w0 * values[r0, k]
-            n += 1
-        started = True
 
 
 @numba.njit(nogil=True, cache=True)
@@ -372,6 +181,7 @@ def _fused_sums(
                 bt0, nbt, bit = b_off[0, m], b_off[0, m + 1] - b_off[0, m], binv[0, m]
                 bd0, nbd, bid = b_off[1, m], b_off[1, m + 1] - b_off[1, m], binv[1, m]
                 bp0, nbp, bip = b_off[2, m], b_off[2, m + 1] - b_off[2, m], binv[2, m]
+                linear8 = method == 1 and nt > 1 and nd > 1 and npp > 1
                 outside = (
                     (edges[m, 0] and dt < dgrid[d0] - edge_tol)
                     or (edges[m, 1] and dt > dgrid[d0 + nd - 1] + edge_tol)
@@ -385,6 +195,28 @@ def _fused_sums(
                     if x < 0.0:
                         x = 0.0
                     w_n = 1.0 - x * x * (3.0 - 2.0 * x)
+                if linear8 and w_n == 0.0 and not outside:
+                    # linear in all three axes, no blend: the 8 rows straight from the cells
+                    i0, u0 = _cell(tgrid, t0, nt, ti, bt, bt0, nbt, bit)
+                    i1, u1 = _cell(dgrid, d0, nd, dt, bd, bd0, nbd, bid)
+                    i2, u2 = _cell(pgrid, p0, npp, phi, bp, bp0, nbp, bip)
+                    r = (i0 * nd + i1) * npp + i2
+                    sd = npp
+                    st_ = nd * npp
+                    wa0, wa1 = 1.0 - u0, u0
+                    wb0, wb1 = 1.0 - u1, u1
+                    wc0, wc1 = 1.0 - u2, u2
+                    w00, w01, w10, w11 = wa0 * wb0, wa0 * wb1, wa1 * wb0, wa1 * wb1
+                    wn[0], wn[1], wn[2], wn[3] = w00 * wc0, w00 * wc1, w01 * wc0, w01 * wc1
+                    wn[4], wn[5], wn[6], wn[7] = w10 * wc0, w10 * wc1, w11 * wc0, w11 * wc1
+                    if not any_lookup:
+                        acc_s[:] = 0.0
+                        acc_p[:] = 0.0
+                        any_lookup = True
+                    wbuf[0] = a2d * ns
+                    wbuf[1] = a2d
+                    _gather8(values, r, sd, st_, wn, acc_s, acc_p, wbuf[0], wbuf[1])
+                    continue
                 nk = 0
                 if not outside and w_n < 1.0:
                     kt = _axis(tgrid, t0, nt, ti, method, it, wt, bt, bt0, nbt, bit)

@@ -215,7 +215,7 @@ def test_bucket_map_finds_the_same_cell_as_searchsorted(nodes, xs, method):
     """The kernel's axis look-up (bucket map + correcting steps) is exactly the clipped
     ``searchsorted(grid, x, "right") - 1`` of ``_lut.axis_weights``, also at nodes,
     between nodes closer than the bucket width and outside the grid."""
-    from sbrdf_xr._kernels import _axis
+    from sbrdf_xr._lookup_kernels import _axis
     from sbrdf_xr._packed_tables import bucket_map
 
     # nodes at least 1e-6 degree apart (table grids are; closer nodes make the cubic

@@ -7,7 +7,8 @@ inside functions alike; only those under ``if TYPE_CHECKING:`` are left out (the
 not run).
 
 * L0, kernels and names: ``_version``, ``_names``, ``errors``, ``rotations``, ``geometry``,
-  ``_lut``, ``_kernels`` (with ``_angle_kernels``, its vectorised angle stage),
+  ``_lut``, ``_kernels`` (with ``_angle_kernels``, its vectorised angle stage, and
+  ``_lookup_kernels``, cells, weights and row sums),
   ``sources``, ``brdf`` (and its models), ``imperfections``, ``knobs``,
   ``_catalog_index`` (where the shipped files are; it loads nothing), ``_shadow_kernels``,
   ``_polygon_kernels``, ``_cache`` (tables built on load, cached on disk), ``anisotropy``
@@ -56,6 +57,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "_lut",
         "_kernels",
         "_angle_kernels",
+        "_lookup_kernels",
         "_packed_tables",
         "_reference_kernel",
         "sources",
