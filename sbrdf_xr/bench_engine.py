@@ -13,8 +13,9 @@ absolute claim:
   the disk writing and syncing as many bytes, :func:`disk_rate`), and the peak
   resident memory;
 * band-only (V, R, I) against full spectrum on the 1e5 sweep;
-* two cores against one (one thread everywhere: ``SBRDF_XR_NUM_THREADS=1`` and one
-  writer thread), written and computed only (every output, nothing written), and
+* two cores against one (one thread everywhere: ``SBRDF_XR_NUM_THREADS=1``, and the
+  process, its writer thread too, pinned to one CPU), written and computed only (every
+  output, nothing written), and
   two process workers against one on a ``LocalCluster`` writing a Zarr store by
   blocks; beside them the machine's own two-thread ceiling (:func:`thread_scaling`);
 * kernel throughput (facet-spectra per second, linear, 141 wavelengths, unmerged)
@@ -239,8 +240,14 @@ def _subprocess(
                 NUMBA_NUM_THREADS=str(threads),
                 OMP_NUM_THREADS=str(threads),
             )
+        # one core means one: the process (its writer thread too) is pinned to one CPU
+        pin = (
+            "import os; os.sched_setaffinity(0, sorted(os.sched_getaffinity(0))[:1]); "
+            if threads == 1 and hasattr(os, "sched_setaffinity")
+            else ""
+        )
         code = (
-            "import json, sys; from sbrdf_xr.bench_engine import sweep_job; "
+            f"{pin}import json, sys; from sbrdf_xr.bench_engine import sweep_job; "
             f"print(json.dumps(sweep_job({n}, {path!r}, {bands}, {mode!r}, {workers})))"
         )
         out = subprocess.run(
@@ -426,7 +433,7 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
     single = _subprocess(n5, threads=1)
     rows.append(
         BenchRow(
-            "1e5 attitudes, one core (one thread everywhere)",
+            "1e5 attitudes, one core (one thread everywhere, pinned to one CPU)",
             single["seconds"],
             "two cores",
             single["seconds"] / results[n5]["seconds"],
