@@ -13,6 +13,16 @@ __all__: list[str] = []
 
 
 @numba.njit(nogil=True, cache=True, inline="always")
+def _clip(grid: np.ndarray, lo: int, n: int, x: float) -> float:  # pragma: no cover - compiled
+    """``x`` clipped to the axis' first and last node."""
+    if x < grid[lo]:
+        return grid[lo]
+    if x > grid[lo + n - 1]:
+        return grid[lo + n - 1]
+    return x
+
+
+@numba.njit(nogil=True, cache=True, inline="always")
 def _cell(
     grid: np.ndarray, lo: int, n: int, x: float, bmap: np.ndarray, blo: int, nb: int, binv: float
 ) -> tuple[int, float]:  # pragma: no cover - compiled
@@ -20,13 +30,8 @@ def _cell(
     fraction ``t`` within it: ``searchsorted(grid, x, "right") - 1`` clipped to
     ``[0, n - 2]``, from the bucket map (:func:`bucket_map`) and comparisons with the
     nodes (no binary search's unpredictable branches)."""
-    g0 = grid[lo]
-    g1 = grid[lo + n - 1]
-    if x < g0:
-        x = g0
-    elif x > g1:
-        x = g1
-    kb = int((x - g0) * binv)
+    x = _clip(grid, lo, n, x)
+    kb = int((x - grid[lo]) * binv)
     if kb < 0:
         kb = 0
     elif kb > nb - 1:
@@ -61,12 +66,7 @@ def _axis(
     comparisons with the nodes, so it is exactly ``searchsorted(grid, x, "right") - 1``
     without a binary search's unpredictable branches.
     """
-    g0 = grid[lo]
-    g1 = grid[lo + n - 1]
-    if x < g0:
-        x = g0
-    elif x > g1:
-        x = g1
+    x = _clip(grid, lo, n, x)
     if n == 1:
         idx[0] = 0
         w[0] = 1.0
