@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import _lut
-from ._angle_kernels import chunk_angles, facet_frame
+from ._angle_kernels import _RAD2DEG, chunk_angles, facet_frame
 from ._lookup_kernels import _axis, _cell, _gather, _gather8
 from ._packed_tables import PackedTables, pack_tables, typed_values
 from ._reference_kernel import MaterialSums, material_sums
@@ -61,8 +61,6 @@ __all__ = [
 
 #: Look-up method codes of the fused kernel.
 METHOD_CODES: dict[str, int] = {"nearest": 0, "linear": 1, "cubic": 2}
-
-_RAD2DEG = 180.0 / np.pi
 
 #: Geometries per chunk of the fused kernel's vectorised angle stage.
 _CHUNK = 64
@@ -201,8 +199,6 @@ def _fused_sums(
                     i1, u1 = _cell(dgrid, d0, nd, dt, bd, bd0, nbd, bid)
                     i2, u2 = _cell(pgrid, p0, npp, phi, bp, bp0, nbp, bip)
                     r = (i0 * nd + i1) * npp + i2
-                    sd = npp
-                    st_ = nd * npp
                     wa0, wa1 = 1.0 - u0, u0
                     wb0, wb1 = 1.0 - u1, u1
                     wc0, wc1 = 1.0 - u2, u2
@@ -215,7 +211,7 @@ def _fused_sums(
                         any_lookup = True
                     wbuf[0] = a2d * ns
                     wbuf[1] = a2d
-                    _gather8(values, r, sd, st_, wn, acc_s, acc_p, wbuf[0], wbuf[1])
+                    _gather8(values, r, npp, nd * npp, wn, acc_s, acc_p, wbuf[0], wbuf[1])
                     continue
                 nk = 0
                 if not outside and w_n < 1.0:
