@@ -25,6 +25,7 @@ __all__ = [
     "check_opens",
     "check_room",
     "cut_back",
+    "drop_behind",
     "fallocate_fn",
     "fence",
     "file_kind",
@@ -110,6 +111,24 @@ def reserve(fd: int, nbytes: int) -> None:
             raise _NoRoom(
                 code, f"reserving {_mib(int(nbytes) + _SPACE_MARGIN)} for the next block failed"
             )
+
+
+def drop_behind(fd: int) -> None:
+    """Let the kernel drop the page cache of the file open as ``fd`` (called after ``fsync``).
+
+    Each block is on disk once synced, so its cached pages are clean and nobody reads
+    them again during the write.  Dropping them after every block keeps the page
+    cache the write occupies at about one block, whatever the cube's size, and hands
+    the same pages to the next block.  Pages the kernel has to find anew cost far
+    more than reused ones on virtual machines whose memory the host reclaims (free
+    page reporting): on this project's 2-core machine a 225 MB cube written through
+    fresh pages ran at about 300 MB/s, and about 2.5x faster with its pages dropped
+    behind it.  A no-op where ``posix_fadvise`` is missing.
+    """
+    advise = getattr(os, "posix_fadvise", None)
+    if advise is not None:
+        with contextlib.suppress(OSError):
+            advise(fd, 0, 0, os.POSIX_FADV_DONTNEED)
 
 
 def file_kind(p: Path) -> str | None:

@@ -41,6 +41,16 @@ Durability
     file) and the file is cut back to its last synced size and superblock; if it
     then does not open, the message says that the ``.part`` was lost.
 
+Memory
+    At most ``max_in_flight`` blocks are computed or waiting to be written.  The
+    page cache of each block is dropped once the block is synced
+    (:func:`~sbrdf_xr._write_disk.drop_behind`): a streamed cube occupies about one
+    block of page cache whatever its size, and on virtual machines whose memory the
+    host reclaims the next block reuses the same pages instead of faulting in new
+    ones (on this project's 2-core machine a 2.4 GB cube was written 2.3x faster).
+    Memory freed while preparing the cube is handed back before the blocks stream
+    (:func:`~sbrdf_xr._write_common.release_freed_memory`).
+
 Bookkeeping (``<path>.part.jsonl``)
     A sidecar JSON-lines file next to the ``.part``.  Line 1 is a header object::
 
@@ -130,8 +140,18 @@ from ._write_common import (
     _NoRoom,
     _reason,
     command_line_messages,
+    release_freed_memory,
 )
-from ._write_disk import HEAD_BYTES, check_room, cut_back, fence, file_kind, fsync_dir, reserve
+from ._write_disk import (
+    HEAD_BYTES,
+    check_room,
+    cut_back,
+    drop_behind,
+    fence,
+    file_kind,
+    fsync_dir,
+    reserve,
+)
 from ._write_files import (
     check_destination,
     check_finished,
@@ -214,7 +234,8 @@ def write_cube(
     max_in_flight : int, optional
         Largest number of blocks being computed or waiting to be written at any
         time; bounds memory at about ``max_in_flight`` block sizes.  Default
-        twice the number of worker threads.
+        one more than the number of worker threads (each computes a block while
+        the last one finished is written).
     progress : bool, default False
         Show a progress bar of blocks on stderr (tqdm if installed).
     complevel : int, default 0
@@ -392,7 +413,8 @@ def _write_locked(
         good, head = os.fstat(fd).st_size, os.pread(fd, HEAD_BYTES, 0)
         log_fd = os.open(log, os.O_WRONLY | os.O_APPEND)
         writing = False
-        limit = int(max_in_flight or 2 * runner.n_workers)
+        release_freed_memory()  # what preparing the cube freed, before the blocks stream
+        limit = int(max_in_flight or runner.n_workers + 1)
         todo = iter([b for b in range(plan.n_blocks) if b not in done])
         kinds = {str(n): storage_kind(n, v.dtype) for n, v in ds.variables.items()}
         # a cube held in memory is written with its header: no blocks to count
@@ -430,6 +452,7 @@ def _write_locked(
             nc.sync()
             os.fsync(fd)
             good, head = os.fstat(fd).st_size, os.pread(fd, HEAD_BYTES, 0)
+            drop_behind(fd)
             writing = False
             os.write(log_fd, (json.dumps({"block": k}) + "\n").encode())
             os.fsync(log_fd)

@@ -20,6 +20,7 @@ import threading
 import time
 from pathlib import Path
 
+import dask
 import dask.array as da
 import netCDF4
 import numpy as np
@@ -28,6 +29,8 @@ import xarray as xr
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from sbrdf_xr._write_common import release_freed_memory
+from sbrdf_xr._write_disk import drop_behind
 from sbrdf_xr._writer import (
     LOG_SUFFIX,
     PART_SUFFIX,
@@ -482,6 +485,75 @@ def test_blocks_in_flight_are_bounded(tmp_path, max_in_flight):
     assert _COUNTS["worst"] <= max_in_flight
     if max_in_flight > 1:
         assert _COUNTS["worst"] > 1  # blocks did overlap
+
+
+def test_default_blocks_in_flight_are_one_more_than_the_workers(tmp_path):
+    _COUNTS.update(started=0, written=0, worst=0)
+    chunks = ((2,) * 10, (2,) * 5, (8,))
+    ds = xr.Dataset(
+        {
+            "v": (
+                ("attitude", "phase_angle", "wavelength"),
+                da.map_blocks(counting_block, chunks=chunks, dtype="f8", meta=np.array((), "f8")),
+            )
+        }
+    )
+
+    def written(event: BlockWritten) -> None:
+        with _LOCK:
+            _COUNTS["written"] += 1
+
+    with dask.config.set(num_workers=2):
+        write_cube(ds, tmp_path / "c.nc", on_block=written)
+    assert _COUNTS["started"] == _COUNTS["written"] == 50
+    assert 1 < _COUNTS["worst"] <= 3  # two workers computing, one block being written
+
+
+def _resident_bytes(path: Path) -> int:
+    """Bytes of ``path`` in the page cache (``mincore`` over a read-only mapping)."""
+    import ctypes
+    import ctypes.util
+    import mmap
+
+    libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+    size = path.stat().st_size
+    page = mmap.PAGESIZE
+    vec = (ctypes.c_ubyte * (-(-size // page)))()
+    with open(path, "rb") as f, mmap.mmap(f.fileno(), size, prot=mmap.PROT_READ) as mm:
+        view = np.frombuffer(mm, dtype=np.uint8)
+        rc = libc.mincore(ctypes.c_void_p(view.ctypes.data), ctypes.c_size_t(size), vec)
+        del view  # the mapping closes only without exported buffers
+    assert rc == 0, os.strerror(ctypes.get_errno())
+    return sum(b & 1 for b in vec) * page
+
+
+@pytest.mark.skipif(not hasattr(os, "posix_fadvise"), reason="no posix_fadvise here")
+def test_written_blocks_leave_the_page_cache(tmp_path):
+    """Each synced block is dropped from the page cache: a streamed cube occupies about
+    one block of it at the end, not the whole file."""
+    chunks = ((64,) * 16, (4,), (256,))  # 16 blocks of 512 KiB, 8 MiB in all
+    ds = xr.Dataset({"v": (("attitude", "phase_angle", "wavelength"), lazy(chunks, "f8", 3))})
+    out = write_cube(ds, tmp_path / "c.nc")
+    block = 64 * 4 * 256 * 8
+    resident = _resident_bytes(out)
+    assert out.stat().st_size > 16 * block
+    assert resident <= 2 * block, (resident, block)
+    xr.testing.assert_identical(read(out), ds.compute())  # and nothing was lost
+
+
+def test_drop_behind_keeps_the_file_and_ignores_bad_descriptors(tmp_path):
+    path = tmp_path / "f.bin"
+    data = np.random.default_rng(1).bytes(3 * 2**20)
+    path.write_bytes(data)
+    fd = os.open(path, os.O_RDWR)
+    try:
+        os.fsync(fd)
+        drop_behind(fd)
+    finally:
+        os.close(fd)
+    assert path.read_bytes() == data
+    drop_behind(fd)  # closed: nothing raised, nothing done
+    release_freed_memory()  # harmless at any time
 
 
 def _peak_rss_script(path: Path, shape: tuple[int, int, int], chunks: tuple[int, int]) -> str:
