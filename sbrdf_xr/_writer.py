@@ -31,7 +31,10 @@ Lock (``<path>.lock``)
 
 Durability
     A block is reported (``on_block``, the sidecar) only after its data were
-    written, the file flushed (``nc.sync``) and ``fsync``-ed.  Before each block
+    written, the file flushed (``nc.sync``) and ``fsync``-ed.  The ``fsync`` of a
+    block (then its line in the sidecar, synced too) runs in a thread of its own
+    while the next block is written, and is waited for before that block is
+    reported, before anything is cut back and before the file is closed.  Before each block
     the room it needs is checked (free space, ``RLIMIT_FSIZE``) and reserved
     (``fallocate`` past the end of the file, where supported), so that a full disk
     or a file-size limit stops the write *before* HDF5 writes anything: the
@@ -109,6 +112,7 @@ import contextlib
 import json
 import os
 from collections.abc import Callable, Mapping
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -402,6 +406,8 @@ def _write_locked(
         raise
 
     bar: Any = NoProgress()
+    syncer: ThreadPoolExecutor | None = None
+    behind: tuple[int, Future[None]] | None = None
     fd = log_fd = -1
     k = -1
     writing = False
@@ -414,6 +420,19 @@ def _write_locked(
         log_fd = os.open(log, os.O_WRONLY | os.O_APPEND)
         writing = False
         release_freed_memory()  # what preparing the cube freed, before the blocks stream
+        # each block goes to disk (fsync, then the log) in this thread while the next one is
+        # written: the block whose sync runs behind, and the function that settles it here
+        syncer = ThreadPoolExecutor(1, thread_name_prefix="write_cube_sync")
+
+        def commit(kk: int, fut: Future[None]) -> None:
+            fut.result()  # the fsync's or the log's OSError is raised here
+            done.add(kk)
+            bar.update(1)
+            if on_block is not None:
+                on_block(
+                    BlockWritten(kk, plan.slices(kk), len(done), plan.n_blocks, runner.pending)
+                )
+
         limit = int(max_in_flight or runner.n_workers + 1)
         todo = iter([b for b in range(plan.n_blocks) if b not in done])
         kinds = {str(n): storage_kind(n, v.dtype) for n, v in ds.variables.items()}
@@ -450,18 +469,17 @@ def _write_locked(
                 nc.variables[name][region] = to_storage(values, kinds[name])
             del arrays
             nc.sync()
-            os.fsync(fd)
             good, head = os.fstat(fd).st_size, os.pread(fd, HEAD_BYTES, 0)
-            drop_behind(fd)
+            if behind is not None:  # the previous block synced meanwhile
+                prev, behind = behind, None
+                commit(*prev)
+            behind = (k, syncer.submit(_to_disk, fd, log_fd, k))
             writing = False
-            os.write(log_fd, (json.dumps({"block": k}) + "\n").encode())
-            os.fsync(log_fd)
-            done.add(k)
-            bar.update(1)
-            if on_block is not None:
-                on_block(BlockWritten(k, plan.slices(k), len(done), plan.n_blocks, runner.pending))
             k = -1
         writing = True
+        if behind is not None:
+            prev, behind = behind, None
+            commit(*prev)
         nc.close()
         nc = None
         os.ftruncate(fd, os.fstat(fd).st_size)  # release room reserved past the end
@@ -473,6 +491,8 @@ def _write_locked(
                 raise CubeWriteError(f"{p} became {kind} during the write; it was not replaced")
         os.replace(part, path)
     except Exception as exc:
+        _settle(behind, done)
+        behind = None
         where = f"at block {k} ({_describe(plan.slices(k))}) " if k >= 0 else ""
         why = (
             _reason(exc, part)
@@ -503,12 +523,16 @@ def _write_locked(
             "to compute only the missing blocks"
         ) from exc
     except BaseException as exc:
+        _settle(behind, done)
+        behind = None
         exc.add_note(
             f"write_cube: {len(done)} of {plan.n_blocks} blocks of {path} are kept in {part}; "
             f"{_again()} to finish it"
         )
         raise
     finally:
+        if syncer is not None:
+            syncer.shutdown(wait=True)
         runner.close()
         bar.close()
         if nc is not None:
@@ -523,6 +547,25 @@ def _write_locked(
     log.unlink(missing_ok=True)
     fsync_dir(path.parent)
     return path
+
+
+def _to_disk(fd: int, log_fd: int, k: int) -> None:
+    """Block ``k`` to disk, then to the log (in the writer's sync thread): the file
+    ``fsync``-ed and its page cache dropped, the log line appended and ``fsync``-ed."""
+    os.fsync(fd)
+    drop_behind(fd)
+    os.write(log_fd, (json.dumps({"block": k}) + "\n").encode())
+    os.fsync(log_fd)
+
+
+def _settle(behind: tuple[int, Future[None]] | None, done: set[int]) -> None:
+    """Wait, on a failure, for the sync running behind (before the file is cut back or
+    closed); its block counts as kept when it reached the log."""
+    if behind is not None:
+        k, fut = behind
+        with contextlib.suppress(Exception):
+            fut.result()
+            done.add(k)
 
 
 def _describe(slices: Mapping[str, slice]) -> str:

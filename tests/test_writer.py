@@ -482,7 +482,10 @@ def test_blocks_in_flight_are_bounded(tmp_path, max_in_flight):
 
     write_cube(ds, tmp_path / "c.nc", max_in_flight=max_in_flight, on_block=written)
     assert _COUNTS["started"] == _COUNTS["written"] == 50
-    assert _COUNTS["worst"] <= max_in_flight
+    # a block is reported once its sync, which runs while the next block is computed and
+    # written, has returned: one block more than those in flight, and that one holds no
+    # arrays any more (they were released when it was written)
+    assert _COUNTS["worst"] <= max_in_flight + 1
     if max_in_flight > 1:
         assert _COUNTS["worst"] > 1  # blocks did overlap
 
@@ -506,7 +509,8 @@ def test_default_blocks_in_flight_are_one_more_than_the_workers(tmp_path):
     with dask.config.set(num_workers=2):
         write_cube(ds, tmp_path / "c.nc", on_block=written)
     assert _COUNTS["started"] == _COUNTS["written"] == 50
-    assert 1 < _COUNTS["worst"] <= 3  # two workers computing, one block being written
+    # two workers computing, one block being written, one block syncing (reported late)
+    assert 1 < _COUNTS["worst"] <= 4
 
 
 def _resident_bytes(path: Path) -> int:
