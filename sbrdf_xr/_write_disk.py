@@ -9,9 +9,12 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import json
 import os
 import stat
 import sys
+from collections import deque
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +25,7 @@ __all__ = [
     "FALLOCATE",
     "FALLOC_FL_KEEP_SIZE",
     "HEAD_BYTES",
+    "SyncBehind",
     "check_opens",
     "check_room",
     "cut_back",
@@ -129,6 +133,59 @@ def drop_behind(fd: int) -> None:
     if advise is not None:
         with contextlib.suppress(OSError):
             advise(fd, 0, 0, os.POSIX_FADV_DONTNEED)
+
+
+class SyncBehind:
+    """Blocks to disk in a thread of their own, in order, while the writer writes the next.
+
+    For each block submitted: the cube file ``fsync``-ed and its page cache dropped
+    (:func:`drop_behind`), then the block's line appended to the log and the log
+    ``fsync``-ed, so a block reaches the log only once its data are on disk.  After a
+    failed sync nothing more is logged (a later ``fsync`` may succeed although data
+    were lost).  The writing thread takes each block back with :meth:`wait_oldest`,
+    which raises that block's ``OSError``.
+    """
+
+    def __init__(self, fd: int, log_fd: int) -> None:
+        self.fd, self.log_fd = fd, log_fd
+        self.pool = ThreadPoolExecutor(1, thread_name_prefix="write_cube_sync")
+        self.pending: deque[tuple[int, Future[None]]] = deque()
+        self.failed = False
+
+    def submit(self, k: int) -> None:
+        """Queue block ``k``, whose data the HDF5 library has just flushed to the file."""
+        self.pending.append((k, self.pool.submit(self._to_disk, k)))
+
+    def _to_disk(self, k: int) -> None:
+        if self.failed:
+            raise OSError(errno.EIO, "an earlier block could not be synced")
+        try:
+            os.fsync(self.fd)
+            drop_behind(self.fd)
+            os.write(self.log_fd, (json.dumps({"block": k}) + "\n").encode())
+            os.fsync(self.log_fd)
+        except BaseException:
+            self.failed = True
+            raise
+
+    def wait_oldest(self) -> int:
+        """Wait for the oldest queued block to be on disk and logged; return its index."""
+        k, fut = self.pending.popleft()
+        fut.result()
+        return k
+
+    def settle(self) -> list[int]:
+        """Wait for every queued block (after a failure elsewhere); the ones logged."""
+        logged = []
+        while self.pending:
+            k, fut = self.pending.popleft()
+            with contextlib.suppress(Exception):
+                fut.result()
+                logged.append(k)
+        return logged
+
+    def close(self) -> None:
+        self.pool.shutdown(wait=True)
 
 
 def file_kind(p: Path) -> str | None:

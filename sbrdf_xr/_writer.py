@@ -109,10 +109,8 @@ Encoding
 from __future__ import annotations
 
 import contextlib
-import json
 import os
 from collections.abc import Callable, Mapping
-from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -148,9 +146,9 @@ from ._write_common import (
 )
 from ._write_disk import (
     HEAD_BYTES,
+    SyncBehind,
     check_room,
     cut_back,
-    drop_behind,
     fence,
     file_kind,
     fsync_dir,
@@ -406,8 +404,7 @@ def _write_locked(
         raise
 
     bar: Any = NoProgress()
-    syncer: ThreadPoolExecutor | None = None
-    behind: tuple[int, Future[None]] | None = None
+    sync: SyncBehind | None = None
     fd = log_fd = -1
     k = -1
     writing = False
@@ -420,12 +417,11 @@ def _write_locked(
         log_fd = os.open(log, os.O_WRONLY | os.O_APPEND)
         writing = False
         release_freed_memory()  # what preparing the cube freed, before the blocks stream
-        # each block goes to disk (fsync, then the log) in this thread while the next one is
-        # written: the block whose sync runs behind, and the function that settles it here
-        syncer = ThreadPoolExecutor(1, thread_name_prefix="write_cube_sync")
+        # each block goes to disk (fsync, then the log) in a thread of its own while the
+        # next one is computed and written; it is reported once it is there
+        sync = SyncBehind(fd, log_fd)
 
-        def commit(kk: int, fut: Future[None]) -> None:
-            fut.result()  # the fsync's or the log's OSError is raised here
+        def report(kk: int) -> None:
             done.add(kk)
             bar.update(1)
             if on_block is not None:
@@ -470,16 +466,19 @@ def _write_locked(
             del arrays
             nc.sync()
             good, head = os.fstat(fd).st_size, os.pread(fd, HEAD_BYTES, 0)
-            if behind is not None:  # the previous block synced meanwhile
-                prev, behind = behind, None
-                commit(*prev)
-            behind = (k, syncer.submit(_to_disk, fd, log_fd, k))
+            sync.submit(k)
+            # the previous block, synced while this one was computed and written
+            ready = sync.wait_oldest() if len(sync.pending) > 1 else None
             writing = False
+            if ready is not None:
+                report(ready)
             k = -1
         writing = True
-        if behind is not None:
-            prev, behind = behind, None
-            commit(*prev)
+        ready = sync.wait_oldest() if sync.pending else None
+        writing = False
+        if ready is not None:
+            report(ready)
+        writing = True
         nc.close()
         nc = None
         os.ftruncate(fd, os.fstat(fd).st_size)  # release room reserved past the end
@@ -491,8 +490,8 @@ def _write_locked(
                 raise CubeWriteError(f"{p} became {kind} during the write; it was not replaced")
         os.replace(part, path)
     except Exception as exc:
-        _settle(behind, done)
-        behind = None
+        if sync is not None:  # before anything is cut back: the blocks synced behind count
+            done.update(sync.settle())
         where = f"at block {k} ({_describe(plan.slices(k))}) " if k >= 0 else ""
         why = (
             _reason(exc, part)
@@ -523,16 +522,16 @@ def _write_locked(
             "to compute only the missing blocks"
         ) from exc
     except BaseException as exc:
-        _settle(behind, done)
-        behind = None
+        if sync is not None:
+            done.update(sync.settle())
         exc.add_note(
             f"write_cube: {len(done)} of {plan.n_blocks} blocks of {path} are kept in {part}; "
             f"{_again()} to finish it"
         )
         raise
     finally:
-        if syncer is not None:
-            syncer.shutdown(wait=True)
+        if sync is not None:
+            sync.close()
         runner.close()
         bar.close()
         if nc is not None:
@@ -547,25 +546,6 @@ def _write_locked(
     log.unlink(missing_ok=True)
     fsync_dir(path.parent)
     return path
-
-
-def _to_disk(fd: int, log_fd: int, k: int) -> None:
-    """Block ``k`` to disk, then to the log (in the writer's sync thread): the file
-    ``fsync``-ed and its page cache dropped, the log line appended and ``fsync``-ed."""
-    os.fsync(fd)
-    drop_behind(fd)
-    os.write(log_fd, (json.dumps({"block": k}) + "\n").encode())
-    os.fsync(log_fd)
-
-
-def _settle(behind: tuple[int, Future[None]] | None, done: set[int]) -> None:
-    """Wait, on a failure, for the sync running behind (before the file is cut back or
-    closed); its block counts as kept when it reached the log."""
-    if behind is not None:
-        k, fut = behind
-        with contextlib.suppress(Exception):
-            fut.result()
-            done.add(k)
 
 
 def _describe(slices: Mapping[str, slice]) -> str:

@@ -470,7 +470,8 @@ def test_resume_after_a_changed_table_is_refused(tmp_path, capsys):
         text=True,
     )
     assert proc.returncode == -signal.SIGKILL, proc.stderr[-2000:]
-    assert sorted(recorded(path)) == list(range(8)) and not path.exists()
+    # the 8 blocks reported, and perhaps the next one, whose sync ran behind them
+    assert sorted(recorded(path)) in (list(range(8)), list(range(9))) and not path.exists()
     part, log = (path.with_name(path.name + s) for s in (PART_SUFFIX, LOG_SUFFIX))
     saved = {p: (p.read_bytes(), p.stat().st_mtime_ns) for p in (part, log)}
 

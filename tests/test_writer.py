@@ -30,7 +30,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from sbrdf_xr._write_common import release_freed_memory
-from sbrdf_xr._write_disk import drop_behind
+from sbrdf_xr._write_disk import SyncBehind, drop_behind
 from sbrdf_xr._writer import (
     LOG_SUFFIX,
     PART_SUFFIX,
@@ -537,6 +537,50 @@ def test_drop_behind_keeps_the_file_and_ignores_bad_descriptors(tmp_path):
     assert path.read_bytes() == data
     drop_behind(fd)  # closed: nothing raised, nothing done
     release_freed_memory()  # harmless at any time
+
+
+def test_sync_behind_logs_blocks_in_order_once_on_disk(tmp_path):
+    data, log = tmp_path / "c.part", tmp_path / "c.part.jsonl"
+    data.write_bytes(b"x" * 2**20)
+    log.write_text('{"format": "test"}\n')
+    fd, log_fd = os.open(data, os.O_RDWR), os.open(log, os.O_WRONLY | os.O_APPEND)
+    sync = SyncBehind(fd, log_fd)
+    try:
+        for k in (4, 0, 7):
+            sync.submit(k)
+        assert [sync.wait_oldest() for _ in range(3)] == [4, 0, 7]
+    finally:
+        sync.close()
+        os.close(fd)
+        os.close(log_fd)
+    assert [json.loads(x) for x in log.read_text().splitlines()[1:]] == [
+        {"block": 4},
+        {"block": 0},
+        {"block": 7},
+    ]
+
+
+def test_sync_behind_logs_nothing_after_a_failed_sync(tmp_path):
+    """A descriptor that cannot be synced (a pipe: EINVAL) fails its block, and every later
+    block too: nothing reaches the log, and settling reports no block as kept."""
+    log = tmp_path / "c.part.jsonl"
+    log.write_text('{"format": "test"}\n')
+    read_end, write_end = os.pipe()
+    log_fd = os.open(log, os.O_WRONLY | os.O_APPEND)
+    sync = SyncBehind(write_end, log_fd)
+    try:
+        sync.submit(0)
+        with pytest.raises(OSError):
+            sync.wait_oldest()
+        sync.submit(1)
+        sync.submit(2)
+        assert sync.settle() == []
+        assert not sync.pending
+    finally:
+        sync.close()
+        for f in (read_end, write_end, log_fd):
+            os.close(f)
+    assert log.read_text().splitlines()[1:] == []
 
 
 def _peak_rss_script(path: Path, shape: tuple[int, int, int], chunks: tuple[int, int]) -> str:
