@@ -14,8 +14,8 @@ absolute claim:
   resident memory;
 * band-only (V, R, I) against full spectrum on the 1e5 sweep;
 * two cores against one (one thread everywhere: ``SBRDF_XR_NUM_THREADS=1``, and the
-  process, its writer thread too, pinned to one CPU), written and computed only (every
-  output, nothing written), and
+  process, its writer thread too, pinned to one CPU), written, computed only (every
+  output, nothing written) and the bare kernel alone, and
   two process workers against one on a ``LocalCluster`` writing a Zarr store by
   blocks; beside them the machine's own two-thread ceiling (:func:`thread_scaling`);
 * kernel throughput (facet-spectra per second, linear, 141 wavelengths, unmerged)
@@ -467,6 +467,18 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
             c1["seconds"] / c2["seconds"],
             f"two cores are {c1['seconds'] / c2['seconds']:.2f}x one core "
             f"({c2['seconds']:.2f} s against {c1['seconds']:.2f} s)",
+            sweep="compute only, default settings, 141 wavelengths",
+        )
+    )
+    k1 = _subprocess(n5, mode="kernel", threads=1)
+    rows.append(
+        BenchRow(
+            "1e5 attitudes, bare kernel, one core",
+            k1["seconds"],
+            "two cores",
+            k1["seconds"] / kernels[n5]["seconds"],
+            f"two cores are {k1['seconds'] / kernels[n5]['seconds']:.2f}x one core for the "
+            "kernel alone (its table rows come from memory both cores share)",
             sweep="compute only, default settings, 141 wavelengths",
         )
     )
