@@ -178,18 +178,26 @@ class _NoRoom(OSError):
     """Raised before a write that would not fit: nothing was written."""
 
 
-def _malloc_trim() -> Any:
-    """glibc's ``malloc_trim``, or None where the C library has none."""
+def libc_function(name: str, argtypes: list[Any], restype: Any) -> Any:
+    """The C library's function ``name`` through ctypes (``errno`` kept), or None where
+    the C library has no such function."""
     try:
         import ctypes
         import ctypes.util
 
-        fn = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").malloc_trim
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+        fn = getattr(libc, name)
     except (OSError, AttributeError):  # pragma: no cover - not glibc
         return None
-    fn.argtypes = [ctypes.c_size_t]
-    fn.restype = ctypes.c_int
+    fn.argtypes = argtypes
+    fn.restype = restype
     return fn
+
+
+def _malloc_trim() -> Any:
+    import ctypes
+
+    return libc_function("malloc_trim", [ctypes.c_size_t], ctypes.c_int)
 
 
 _MALLOC_TRIM = _malloc_trim()

@@ -18,7 +18,7 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
-from ._write_common import _SPACE_MARGIN, _file_size_limit, _mib, _NoRoom
+from ._write_common import _SPACE_MARGIN, _file_size_limit, _mib, _NoRoom, libc_function
 
 __all__ = [
     "CHECK_SPACE",
@@ -81,17 +81,11 @@ FALLOC_FL_KEEP_SIZE = 1
 
 
 def fallocate_fn() -> Any:
-    try:
-        import ctypes
-        import ctypes.util
+    import ctypes
 
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
-        fn = libc.fallocate
-    except (OSError, AttributeError):  # pragma: no cover - not glibc
-        return None
-    fn.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_int64, ctypes.c_int64]
-    fn.restype = ctypes.c_int
-    return fn
+    return libc_function(
+        "fallocate", [ctypes.c_int, ctypes.c_int, ctypes.c_int64, ctypes.c_int64], ctypes.c_int
+    )
 
 
 FALLOCATE = fallocate_fn() if sys.platform.startswith("linux") else None

@@ -34,8 +34,9 @@ Durability
     written, the file flushed (``nc.sync``) and ``fsync``-ed.  The ``fsync`` of a
     block (then its line in the sidecar, synced too) runs in a thread of its own
     while the next block is written, and is waited for before that block is
-    reported, before anything is cut back and before the file is closed.  Before each block
-    the room it needs is checked (free space, ``RLIMIT_FSIZE``) and reserved
+    reported, before anything is cut back and before the file is closed
+    (:class:`~sbrdf_xr._write_disk.SyncBehind`).  Before each block the room it
+    needs is checked (free space, ``RLIMIT_FSIZE``) and reserved
     (``fallocate`` past the end of the file, where supported), so that a full disk
     or a file-size limit stops the write *before* HDF5 writes anything: the
     ``.part`` stays exactly as last synced and the error names the cause ("no

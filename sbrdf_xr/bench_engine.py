@@ -37,6 +37,7 @@ from typing import Any
 import numba
 import numpy as np
 
+from ._write_disk import drop_behind
 from .bench_rows import BenchRow, best_time
 
 __all__ = ["disk_rate", "engine_rows", "sweep_job", "thread_scaling"]
@@ -190,8 +191,6 @@ def disk_rate(where: str | None = None, nbytes: int = 512 * 2**20) -> float:
     >>> disk_rate(nbytes=2**20) > 1e6  # at least a megabyte per second
     True
     """
-    from ._write_disk import drop_behind
-
     block = np.ones(min(nbytes, 32 * 2**20) // 8)
     with tempfile.TemporaryDirectory(prefix="sbrdf-disk-", dir=where) as tmp:
         path = Path(tmp) / "probe.bin"
