@@ -4,7 +4,8 @@ Some catalog materials are built from their measurement sets when loaded (the pa
 §3.2 construction, filled by a fitted model); that takes seconds per table.  The table
 is written once to the user's cache directory and read from there afterwards.  The key
 hashes the entry's inputs (its measurement file, its fit's file, its build options) and
-the package's own source, so a change of either builds anew.
+the sources of the modules that build tables (:func:`build_modules`), so a change of
+either builds anew.
 
 The directory is ``$SBRDF_XR_CACHE_DIR`` if set (``off`` disables the cache), else
 ``$XDG_CACHE_HOME/sbrdf_xr`` or ``~/.cache/sbrdf_xr``.
@@ -12,6 +13,7 @@ The directory is ``$SBRDF_XR_CACHE_DIR`` if set (``off`` disables the cache), el
 
 from __future__ import annotations
 
+import ast
 import hashlib
 import os
 from collections.abc import Callable, Iterable
@@ -20,7 +22,7 @@ from pathlib import Path
 
 import xarray as xr
 
-__all__ = ["cache_dir", "cached_table", "source_digest"]
+__all__ = ["build_modules", "cache_dir", "cached_table", "source_digest"]
 
 
 def cache_dir() -> Path | None:
@@ -32,12 +34,82 @@ def cache_dir() -> Path | None:
     return Path(base) / "sbrdf_xr"
 
 
+#: The modules whose code builds a catalog table: the import closure of these.
+_BUILD_ROOTS = ("sbrdf_xr.catalog",)
+
+
+def _module_file(root: Path, name: str) -> Path | None:
+    """The source file of module ``name`` (``sbrdf_xr.a.b``) under the package ``root``."""
+    p = root.joinpath(*name.split(".")[1:])
+    for f in (p / "__init__.py", p.with_suffix(".py")):
+        if f.is_file():
+            return f
+    return None
+
+
+def _package_imports(root: Path, name: str) -> set[str]:
+    """The package modules that module ``name`` imports, anywhere in its code (``ast``)."""
+    f = _module_file(root, name)
+    if f is None:
+        return set()
+    pkg = name if f.name == "__init__.py" else name.rpartition(".")[0]
+    out: set[str] = set()
+    for node in ast.walk(ast.parse(f.read_bytes())):
+        if isinstance(node, ast.Import):
+            out.update(
+                a.name
+                for a in node.names
+                if a.name.startswith("sbrdf_xr") and _module_file(root, a.name)
+            )
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                parts = pkg.split(".")[: len(pkg.split(".")) - node.level + 1]
+                base = ".".join(parts + ([node.module] if node.module else []))
+            elif node.module and node.module.startswith("sbrdf_xr"):
+                base = node.module
+            else:
+                continue
+            subs = [f"{base}.{a.name}" for a in node.names]
+            subs = [n for n in subs if _module_file(root, n)]
+            out.update(subs)
+            if len(subs) < len(node.names) and _module_file(root, base):
+                out.add(base)  # names taken from the module itself
+    return out
+
+
+def build_modules(roots: Iterable[str] = _BUILD_ROOTS) -> list[Path]:
+    """Source files of the modules that can take part in building a catalog table.
+
+    The import closure of ``roots`` (every ``import`` in a module's code, at its top or
+    inside a function), plus the ``__init__.py`` of every package on the way, whose code
+    runs on any import below it.  The engine, the writers, the benchmarks and the
+    command line are outside it, so changing them keeps the built tables.
+    """
+    root = Path(__file__).resolve().parent
+    seen: set[str] = set()
+    todo = list(roots)
+    while todo:
+        name = todo.pop()
+        if name not in seen:
+            seen.add(name)
+            todo.extend(_package_imports(root, name) - seen)
+    files = {f for n in seen if (f := _module_file(root, n)) is not None}
+    for n in seen:  # the packages' own __init__, without following their imports
+        parts = n.split(".")
+        for k in range(1, len(parts)):
+            init = _module_file(root, ".".join(parts[:k]))
+            if init is not None and init.name == "__init__.py":
+                files.add(init)
+    return sorted(files)
+
+
 @cache
 def source_digest() -> str:
-    """SHA-256 of the package's Python sources (a code change invalidates the cache)."""
+    """SHA-256 of the sources that build a table (:func:`build_modules`): a change to
+    one of them invalidates the cache."""
     root = Path(__file__).resolve().parent
     h = hashlib.sha256()
-    for p in sorted(root.rglob("*.py")):
+    for p in build_modules():
         h.update(str(p.relative_to(root)).encode())
         h.update(p.read_bytes())
     return h.hexdigest()

@@ -33,3 +33,41 @@ def test_cache_can_be_switched_off(tmp_path, monkeypatch):
     monkeypatch.setenv("SBRDF_XR_CACHE_DIR", str(tmp_path / "c"))
     assert _cache.cache_dir() == tmp_path / "c"
     assert len(_cache.source_digest()) == 64
+
+
+def test_the_cache_key_covers_every_module_a_build_runs(monkeypatch):
+    """The key hashes only the modules that can build a table (so an engine or writer
+    change keeps the cache); every package function a build calls must be among them."""
+    import sys
+    import threading
+    from pathlib import Path
+
+    import sbrdf_xr
+    from sbrdf_xr import material
+
+    monkeypatch.setenv("SBRDF_XR_CACHE_DIR", "off")
+    root = Path(sbrdf_xr.__file__).resolve().parent
+    meas = catalog.load("example-lobe-measurements").isel(wavelength=slice(0, 131, 40))
+    model = catalog.load("aluminium-6061-t6-microfacet-fit")
+    called: set[str] = set()
+
+    def profile(frame, event, arg):
+        if event == "call":
+            called.add(frame.f_code.co_filename)
+
+    sys.setprofile(profile)
+    threading.setprofile(profile)
+    try:
+        material.build_lut(meas, material="plain")
+        material.build_lut(
+            meas, material="filled", model=model, extrapolation="model", below_noise="model"
+        )
+    finally:
+        sys.setprofile(None)
+        threading.setprofile(None)
+    ran = {Path(f).resolve() for f in called if f.startswith(str(root))}
+    assert len(ran) > 5  # the tracing saw the build
+    assert ran <= set(_cache.build_modules())
+    # ... and the engine is outside the key
+    names = {p.name for p in _cache.build_modules()}
+    assert not names & {"_kernels.py", "_writer.py", "simulate.py", "plan.py", "bench.py"}
