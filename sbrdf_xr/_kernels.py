@@ -114,8 +114,10 @@ def _fused_sums(
     wph = np.empty(4)
     bt, bd, bp = bmap[0], bmap[1], bmap[2]
     # stage 1 (chunk_angles): the angles of a chunk of geometries against every term in
-    # one vectorised pass; stage 2: per geometry, the look-ups of its lit and seen pairs
-    # (terms in order, so that terms of one face read the same table rows from cache)
+    # one vectorised pass; stage 2: per material of the chunk, per geometry, the look-ups
+    # of its lit and seen pairs (terms in order, so that terms of one face read the same
+    # table rows from cache).  Each output element receives its terms in term order, as
+    # in material_sums, whatever the chunking.
     s_t = np.ascontiguousarray(s.T)
     o_t = np.ascontiguousarray(o.T)
     n_chunk = min(_CHUNK, n_geom)
@@ -125,171 +127,166 @@ def _fused_sums(
     b_ti = np.empty((n_term, n_chunk))
     b_dt = np.empty((n_term, n_chunk))
     b_ph = np.empty((n_term, n_chunk))
-    for g in range(n_geom):
-        j = g % _CHUNK
-        if j == 0:
-            chunk_angles(
-                s_t, o_t, g, min(_CHUNK, n_geom - g), normals, b_ns, b_no, b_st, b_ti, b_dt, b_ph
-            )
-        area_g = 0.0
-        lit_g = 0.0
+    for c0 in range(0, n_geom, _CHUNK):
+        nc = min(_CHUNK, n_geom - c0)
+        chunk_angles(s_t, o_t, c0, nc, normals, b_ns, b_no, b_st, b_ti, b_dt, b_ph)
         t = 0
         while t < n_term:
             m = term_mat[t]
             stop = t
             while stop < n_term and term_mat[stop] == m:
                 stop += 1
-            any_lookup = False
-            values = tables[m]
-            for tt in range(t, stop):
-                ns = b_ns[tt, j]
-                no = b_no[tt, j]
-                if not (ns > 0.0 and no > 0.0):
-                    continue
-                a_eff = areas[tt]
-                if has_frac:
-                    a_eff = a_eff * frac[g, tt]
-                a2d = a_eff * no
-                area_g += a2d
-                lit_g += a_eff
-                # angles of paper 000 Fig. 4, as geometry.facet_angles
-                if b_st[tt, j] > tol:
-                    ti, dt, phi = b_ti[tt, j], b_dt[tt, j], b_ph[tt, j]
-                else:  # normal incidence: the plane through the observer or an axis
-                    ti, dt, phi, _, _, _, _ = facet_frame(
-                        normals[tt, 0],
-                        normals[tt, 1],
-                        normals[tt, 2],
-                        s[g, 0],
-                        s[g, 1],
-                        s[g, 2],
-                        o[g, 0],
-                        o[g, 1],
-                        o[g, 2],
-                        ns,
-                        no,
-                        tol,
+            values = tables[m]  # once per chunk and material (an item of a typed list costs)
+            for j in range(nc):
+                g = c0 + j
+                any_lookup = False
+                for tt in range(t, stop):
+                    ns = b_ns[tt, j]
+                    no = b_no[tt, j]
+                    if not (ns > 0.0 and no > 0.0):
+                        continue
+                    a_eff = areas[tt]
+                    if has_frac:
+                        a_eff = a_eff * frac[g, tt]
+                    a2d = a_eff * no
+                    out_area[g] += a2d
+                    out_lit[g] += a_eff
+                    # angles of paper 000 Fig. 4, as geometry.facet_angles
+                    if b_st[tt, j] > tol:
+                        ti, dt, phi = b_ti[tt, j], b_dt[tt, j], b_ph[tt, j]
+                    else:  # normal incidence: the plane through the observer or an axis
+                        ti, dt, phi, _, _, _, _ = facet_frame(
+                            normals[tt, 0],
+                            normals[tt, 1],
+                            normals[tt, 2],
+                            s[g, 0],
+                            s[g, 1],
+                            s[g, 2],
+                            o[g, 0],
+                            o[g, 1],
+                            o[g, 2],
+                            ns,
+                            no,
+                            tol,
+                        )
+                    d0 = d_off[m]
+                    nd = d_off[m + 1] - d0
+                    p0 = p_off[m]
+                    npp = p_off[m + 1] - p0
+                    t0 = t_off[m]
+                    nt = t_off[m + 1] - t0
+                    bt0, nbt, bit = b_off[0, m], b_off[0, m + 1] - b_off[0, m], binv[0, m]
+                    bd0, nbd, bid = b_off[1, m], b_off[1, m + 1] - b_off[1, m], binv[1, m]
+                    bp0, nbp, bip = b_off[2, m], b_off[2, m + 1] - b_off[2, m], binv[2, m]
+                    linear8 = method == 1 and nt > 1 and nd > 1 and npp > 1
+                    outside = (
+                        (edges[m, 0] and dt < dgrid[d0] - edge_tol)
+                        or (edges[m, 1] and dt > dgrid[d0 + nd - 1] + edge_tol)
+                        or (edges[m, 2] and phi > pgrid[p0 + npp - 1] + edge_tol)
                     )
-                d0 = d_off[m]
-                nd = d_off[m + 1] - d0
-                p0 = p_off[m]
-                npp = p_off[m + 1] - p0
-                t0 = t_off[m]
-                nt = t_off[m + 1] - t0
-                bt0, nbt, bit = b_off[0, m], b_off[0, m + 1] - b_off[0, m], binv[0, m]
-                bd0, nbd, bid = b_off[1, m], b_off[1, m + 1] - b_off[1, m], binv[1, m]
-                bp0, nbp, bip = b_off[2, m], b_off[2, m + 1] - b_off[2, m], binv[2, m]
-                linear8 = method == 1 and nt > 1 and nd > 1 and npp > 1
-                outside = (
-                    (edges[m, 0] and dt < dgrid[d0] - edge_tol)
-                    or (edges[m, 1] and dt > dgrid[d0 + nd - 1] + edge_tol)
-                    or (edges[m, 2] and phi > pgrid[p0 + npp - 1] + edge_tol)
-                )
-                # normal-incidence blend (_lut.lookup_matrix): weight of the theta_i = 0 profile
-                w_n = 0.0
-                b_m = blend[m]
-                if b_m > 0.0 and tgrid[t0] == 0.0 and ti < b_m:
-                    x = ti / b_m
-                    if x < 0.0:
-                        x = 0.0
-                    w_n = 1.0 - x * x * (3.0 - 2.0 * x)
-                if linear8 and w_n == 0.0 and not outside:
-                    # linear in all three axes, no blend: the 8 rows straight from the cells
-                    i0, u0 = _cell(tgrid, t0, nt, ti, bt, bt0, nbt, bit)
-                    i1, u1 = _cell(dgrid, d0, nd, dt, bd, bd0, nbd, bid)
-                    i2, u2 = _cell(pgrid, p0, npp, phi, bp, bp0, nbp, bip)
-                    r = (i0 * nd + i1) * npp + i2
-                    wa0, wa1 = 1.0 - u0, u0
-                    wb0, wb1 = 1.0 - u1, u1
-                    wc0, wc1 = 1.0 - u2, u2
-                    w00, w01, w10, w11 = wa0 * wb0, wa0 * wb1, wa1 * wb0, wa1 * wb1
-                    wn[0], wn[1], wn[2], wn[3] = w00 * wc0, w00 * wc1, w01 * wc0, w01 * wc1
-                    wn[4], wn[5], wn[6], wn[7] = w10 * wc0, w10 * wc1, w11 * wc0, w11 * wc1
+                    # normal-incidence blend (_lut.lookup_matrix): weight of the theta_i = 0 profile
+                    w_n = 0.0
+                    b_m = blend[m]
+                    if b_m > 0.0 and tgrid[t0] == 0.0 and ti < b_m:
+                        x = ti / b_m
+                        if x < 0.0:
+                            x = 0.0
+                        w_n = 1.0 - x * x * (3.0 - 2.0 * x)
+                    if linear8 and w_n == 0.0 and not outside:
+                        # linear in all three axes, no blend: the 8 rows straight from the cells
+                        i0, u0 = _cell(tgrid, t0, nt, ti, bt, bt0, nbt, bit)
+                        i1, u1 = _cell(dgrid, d0, nd, dt, bd, bd0, nbd, bid)
+                        i2, u2 = _cell(pgrid, p0, npp, phi, bp, bp0, nbp, bip)
+                        r = (i0 * nd + i1) * npp + i2
+                        wa0, wa1 = 1.0 - u0, u0
+                        wb0, wb1 = 1.0 - u1, u1
+                        wc0, wc1 = 1.0 - u2, u2
+                        w00, w01, w10, w11 = wa0 * wb0, wa0 * wb1, wa1 * wb0, wa1 * wb1
+                        wn[0], wn[1], wn[2], wn[3] = w00 * wc0, w00 * wc1, w01 * wc0, w01 * wc1
+                        wn[4], wn[5], wn[6], wn[7] = w10 * wc0, w10 * wc1, w11 * wc0, w11 * wc1
+                        if not any_lookup:
+                            acc_s[:] = 0.0
+                            acc_p[:] = 0.0
+                            any_lookup = True
+                        wbuf[0] = a2d * ns
+                        wbuf[1] = a2d
+                        _gather8(values, r, npp, nd * npp, wn, acc_s, acc_p, wbuf[0], wbuf[1])
+                        continue
+                    nk = 0
+                    if not outside and w_n < 1.0:
+                        kt = _axis(tgrid, t0, nt, ti, method, it, wt, bt, bt0, nbt, bit)
+                        kd = _axis(dgrid, d0, nd, dt, method, idt, wdt, bd, bd0, nbd, bid)
+                        kp = _axis(pgrid, p0, npp, phi, method, iph, wph, bp, bp0, nbp, bip)
+                        for a in range(kt):
+                            for b in range(kd):
+                                row0 = (it[a] * nd + idt[b]) * npp
+                                wab = wt[a] * wdt[b] * (1.0 - w_n)
+                                for c in range(kp):
+                                    rows[nk] = row0 + iph[c]
+                                    wn[nk] = wab * wph[c]
+                                    nk += 1
+                    if w_n > 0.0:
+                        # the theta_i = 0 row along its in-plane profile at +-gamma, the angle from
+                        # the specular direction (_lut.observer_polar_angle(0, dt, phi))
+                        pr = phi / _RAD2DEG
+                        tr = dt / _RAD2DEG
+                        cp = np.cos(pr)
+                        gam = (
+                            np.arctan2(np.hypot(np.sin(pr), cp * np.sin(tr)), abs(cp * np.cos(tr)))
+                            * _RAD2DEG
+                        )
+                        ok_hi = (gam <= dgrid[d0 + nd - 1] + edge_tol) or not edges[m, 1]
+                        ok_lo = (-gam >= dgrid[d0] - edge_tol) or not edges[m, 0]
+                        n_ok = (1 if ok_hi else 0) + (1 if ok_lo else 0)
+                        if n_ok > 0:
+                            base_w = w_n / n_ok
+                            kp = _axis(pgrid, p0, npp, 0.0, method, iph, wph, bp, bp0, nbp, bip)
+                            for side in range(2):
+                                if (side == 0 and not ok_hi) or (side == 1 and not ok_lo):
+                                    continue
+                                kd = _axis(
+                                    dgrid,
+                                    d0,
+                                    nd,
+                                    gam if side == 0 else -gam,
+                                    method,
+                                    idt,
+                                    wdt,
+                                    bd,
+                                    bd0,
+                                    nbd,
+                                    bid,
+                                )
+                                for b in range(kd):
+                                    for c in range(kp):
+                                        rows[nk] = idt[b] * npp + iph[c]
+                                        wn[nk] = base_w * wdt[b] * wph[c]
+                                        nk += 1
+                    if nk == 0:
+                        continue
                     if not any_lookup:
                         acc_s[:] = 0.0
                         acc_p[:] = 0.0
                         any_lookup = True
                     wbuf[0] = a2d * ns
                     wbuf[1] = a2d
-                    _gather8(values, r, npp, nd * npp, wn, acc_s, acc_p, wbuf[0], wbuf[1])
-                    continue
-                nk = 0
-                if not outside and w_n < 1.0:
-                    kt = _axis(tgrid, t0, nt, ti, method, it, wt, bt, bt0, nbt, bit)
-                    kd = _axis(dgrid, d0, nd, dt, method, idt, wdt, bd, bd0, nbd, bid)
-                    kp = _axis(pgrid, p0, npp, phi, method, iph, wph, bp, bp0, nbp, bip)
-                    for a in range(kt):
-                        for b in range(kd):
-                            row0 = (it[a] * nd + idt[b]) * npp
-                            wab = wt[a] * wdt[b] * (1.0 - w_n)
-                            for c in range(kp):
-                                rows[nk] = row0 + iph[c]
-                                wn[nk] = wab * wph[c]
-                                nk += 1
-                if w_n > 0.0:
-                    # the theta_i = 0 row along its in-plane profile at +-gamma, the angle from
-                    # the specular direction (_lut.observer_polar_angle(0, dt, phi))
-                    pr = phi / _RAD2DEG
-                    tr = dt / _RAD2DEG
-                    cp = np.cos(pr)
-                    gam = (
-                        np.arctan2(np.hypot(np.sin(pr), cp * np.sin(tr)), abs(cp * np.cos(tr)))
-                        * _RAD2DEG
-                    )
-                    ok_hi = (gam <= dgrid[d0 + nd - 1] + edge_tol) or not edges[m, 1]
-                    ok_lo = (-gam >= dgrid[d0] - edge_tol) or not edges[m, 0]
-                    n_ok = (1 if ok_hi else 0) + (1 if ok_lo else 0)
-                    if n_ok > 0:
-                        base_w = w_n / n_ok
-                        kp = _axis(pgrid, p0, npp, 0.0, method, iph, wph, bp, bp0, nbp, bip)
-                        for side in range(2):
-                            if (side == 0 and not ok_hi) or (side == 1 and not ok_lo):
-                                continue
-                            kd = _axis(
-                                dgrid,
-                                d0,
-                                nd,
-                                gam if side == 0 else -gam,
-                                method,
-                                idt,
-                                wdt,
-                                bd,
-                                bd0,
-                                nbd,
-                                bid,
-                            )
-                            for b in range(kd):
-                                for c in range(kp):
-                                    rows[nk] = idt[b] * npp + iph[c]
-                                    wn[nk] = base_w * wdt[b] * wph[c]
-                                    nk += 1
-                if nk == 0:
-                    continue
-                if not any_lookup:
-                    acc_s[:] = 0.0
-                    acc_p[:] = 0.0
-                    any_lookup = True
-                wbuf[0] = a2d * ns
-                wbuf[1] = a2d
-                ws = wbuf[0]
-                wp = wbuf[1]
-                _gather(values, rows, wn, nk, f, acc_s, acc_p, ws, wp)
-            if any_lookup:
-                if method == 2:
+                    ws = wbuf[0]
+                    wp = wbuf[1]
+                    _gather(values, rows, wn, nk, f, acc_s, acc_p, ws, wp)
+                if any_lookup:
+                    if method == 2:
+                        for k in range(n_wl):
+                            if acc_s[k] < 0.0:
+                                acc_s[k] = 0.0
+                            if acc_p[k] < 0.0:
+                                acc_p[k] = 0.0
                     for k in range(n_wl):
-                        if acc_s[k] < 0.0:
-                            acc_s[k] = 0.0
-                        if acc_p[k] < 0.0:
-                            acc_p[k] = 0.0
-                for k in range(n_wl):
-                    out_sig[g, k] += acc_s[k]
-                    out_pap[g, k] += acc_p[k]
-                if want_pm:
-                    for k in range(n_wl):
-                        out_pm[g, m, k] += acc_s[k]
+                        out_sig[g, k] += acc_s[k]
+                        out_pap[g, k] += acc_p[k]
+                    if want_pm:
+                        for k in range(n_wl):
+                            out_pm[g, m, k] += acc_s[k]
             t = stop
-        out_area[g] = area_g
-        out_lit[g] = lit_g
 
 
 class FusedSums(NamedTuple):
