@@ -137,6 +137,20 @@ def _fused_sums(
             while stop < n_term and term_mat[stop] == m:
                 stop += 1
             values = tables[m]  # once per chunk and material (an item of a typed list costs)
+            d0 = d_off[m]
+            nd = d_off[m + 1] - d0
+            p0 = p_off[m]
+            npp = p_off[m + 1] - p0
+            t0 = t_off[m]
+            nt = t_off[m + 1] - t0
+            bt0, nbt, bit = b_off[0, m], b_off[0, m + 1] - b_off[0, m], binv[0, m]
+            bd0, nbd, bid = b_off[1, m], b_off[1, m + 1] - b_off[1, m], binv[1, m]
+            bp0, nbp, bip = b_off[2, m], b_off[2, m + 1] - b_off[2, m], binv[2, m]
+            linear8 = method == 1 and nt > 1 and nd > 1 and npp > 1
+            # the material's edges: delta_theta below, above; phi above; the blend width
+            e_dlo, e_dhi, e_phi = edges[m, 0], edges[m, 1], edges[m, 2]
+            d_lo, d_hi, p_hi = dgrid[d0], dgrid[d0 + nd - 1], pgrid[p0 + npp - 1]
+            b_m = blend[m] if tgrid[t0] == 0.0 else 0.0
             for j in range(nc):
                 g = c0 + j
                 any_lookup = False
@@ -169,25 +183,14 @@ def _fused_sums(
                             no,
                             tol,
                         )
-                    d0 = d_off[m]
-                    nd = d_off[m + 1] - d0
-                    p0 = p_off[m]
-                    npp = p_off[m + 1] - p0
-                    t0 = t_off[m]
-                    nt = t_off[m + 1] - t0
-                    bt0, nbt, bit = b_off[0, m], b_off[0, m + 1] - b_off[0, m], binv[0, m]
-                    bd0, nbd, bid = b_off[1, m], b_off[1, m + 1] - b_off[1, m], binv[1, m]
-                    bp0, nbp, bip = b_off[2, m], b_off[2, m + 1] - b_off[2, m], binv[2, m]
-                    linear8 = method == 1 and nt > 1 and nd > 1 and npp > 1
                     outside = (
-                        (edges[m, 0] and dt < dgrid[d0] - edge_tol)
-                        or (edges[m, 1] and dt > dgrid[d0 + nd - 1] + edge_tol)
-                        or (edges[m, 2] and phi > pgrid[p0 + npp - 1] + edge_tol)
+                        (e_dlo and dt < d_lo - edge_tol)
+                        or (e_dhi and dt > d_hi + edge_tol)
+                        or (e_phi and phi > p_hi + edge_tol)
                     )
                     # normal-incidence blend (_lut.lookup_matrix): weight of the theta_i = 0 profile
                     w_n = 0.0
-                    b_m = blend[m]
-                    if b_m > 0.0 and tgrid[t0] == 0.0 and ti < b_m:
+                    if b_m > 0.0 and ti < b_m:
                         x = ti / b_m
                         if x < 0.0:
                             x = 0.0
@@ -235,8 +238,8 @@ def _fused_sums(
                             np.arctan2(np.hypot(np.sin(pr), cp * np.sin(tr)), abs(cp * np.cos(tr)))
                             * _RAD2DEG
                         )
-                        ok_hi = (gam <= dgrid[d0 + nd - 1] + edge_tol) or not edges[m, 1]
-                        ok_lo = (-gam >= dgrid[d0] - edge_tol) or not edges[m, 0]
+                        ok_hi = (gam <= d_hi + edge_tol) or not e_dhi
+                        ok_lo = (-gam >= d_lo - edge_tol) or not e_dlo
                         n_ok = (1 if ok_hi else 0) + (1 if ok_lo else 0)
                         if n_ok > 0:
                             base_w = w_n / n_ok
