@@ -166,7 +166,7 @@ def values_sha(values: np.ndarray, kind: str) -> str:
         h.update(json.dumps([str(x) for x in values.ravel().tolist()]).encode())
     else:
         h.update(str(values.dtype).encode())
-        h.update(np.ascontiguousarray(values).tobytes())
+        h.update(np.ascontiguousarray(values).data)  # the buffer itself, not a copy
     return h.hexdigest()
 
 

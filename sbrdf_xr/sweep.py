@@ -96,15 +96,17 @@ class GridGeometry:
         """Body-frame directions of the attitudes in ``sl`` (flattened to (n * P, 3))."""
         q = self.attitudes[sl]  # unit quaternions, checked by the Scene
         p = len(self.phase_angles)
-        refs = [self.sun_ref, self.obs_ref] + ([] if self.earth_ref is None else [self.earth_ref])
-        # v_body = R^T v for every attitude, as row vectors: v^T R
-        body = (
-            np.matmul(np.concatenate(refs)[None], Rotation.from_quat(q).as_matrix())
-            if len(q)
-            else np.zeros((0, len(refs) * p, 3))
-        )
-        s, o = body[:, :p].reshape(-1, 3), body[:, p : 2 * p].reshape(-1, 3)
-        e = None if self.earth_ref is None else body[:, 2 * p :].reshape(-1, 3)
+        # v_body = R^T v for every attitude, as row vectors: v^T R, written out per
+        # reference direction (a stacked matmul of 3 x 3 matrices costs twice as much)
+        rot = Rotation.from_quat(q).as_matrix() if len(q) else np.zeros((0, 3, 3))
+        r0, r1, r2 = rot[:, 0, None, :], rot[:, 1, None, :], rot[:, 2, None, :]
+
+        def body(ref: np.ndarray) -> np.ndarray:
+            v = ref[None, :, :, None]  # (1, P, 3, 1)
+            return (v[:, :, 0] * r0 + v[:, :, 1] * r1 + v[:, :, 2] * r2).reshape(-1, 3)
+
+        s, o = body(self.sun_ref), body(self.obs_ref)
+        e = None if self.earth_ref is None else body(self.earth_ref)
         return BlockInputs(s, o, e, None, (len(q), p))
 
     def coords(self) -> dict[str, Any]:
