@@ -71,6 +71,7 @@ def _fused_sums(
     s,
     o,
     normals,
+    uniq,
     areas,
     term_mat,
     frac,
@@ -121,15 +122,20 @@ def _fused_sums(
     s_t = np.ascontiguousarray(s.T)
     o_t = np.ascontiguousarray(o.T)
     n_chunk = min(_CHUNK, n_geom)
-    b_ns = np.empty((n_term, n_chunk))
-    b_no = np.empty((n_term, n_chunk))
-    b_st = np.empty((n_term, n_chunk))
-    b_ti = np.empty((n_term, n_chunk))
-    b_dt = np.empty((n_term, n_chunk))
-    b_ph = np.empty((n_term, n_chunk))
+    # the angles depend on the normal only: terms of one face (its materials) share a row
+    u_norm = np.empty((uniq.max() + 1, 3))
+    for tt in range(n_term):
+        u_norm[uniq[tt]] = normals[tt]
+    n_u = u_norm.shape[0]
+    b_ns = np.empty((n_u, n_chunk))
+    b_no = np.empty((n_u, n_chunk))
+    b_st = np.empty((n_u, n_chunk))
+    b_ti = np.empty((n_u, n_chunk))
+    b_dt = np.empty((n_u, n_chunk))
+    b_ph = np.empty((n_u, n_chunk))
     for c0 in range(0, n_geom, _CHUNK):
         nc = min(_CHUNK, n_geom - c0)
-        chunk_angles(s_t, o_t, c0, nc, normals, b_ns, b_no, b_st, b_ti, b_dt, b_ph)
+        chunk_angles(s_t, o_t, c0, nc, u_norm, b_ns, b_no, b_st, b_ti, b_dt, b_ph)
         t = 0
         while t < n_term:
             m = term_mat[t]
@@ -155,8 +161,9 @@ def _fused_sums(
                 g = c0 + j
                 any_lookup = False
                 for tt in range(t, stop):
-                    ns = b_ns[tt, j]
-                    no = b_no[tt, j]
+                    u = uniq[tt]
+                    ns = b_ns[u, j]
+                    no = b_no[u, j]
                     if not (ns > 0.0 and no > 0.0):
                         continue
                     a_eff = areas[tt]
@@ -166,8 +173,8 @@ def _fused_sums(
                     out_area[g] += a2d
                     out_lit[g] += a_eff
                     # angles of paper 000 Fig. 4, as geometry.facet_angles
-                    if b_st[tt, j] > tol:
-                        ti, dt, phi = b_ti[tt, j], b_dt[tt, j], b_ph[tt, j]
+                    if b_st[u, j] > tol:
+                        ti, dt, phi = b_ti[u, j], b_dt[u, j], b_ph[u, j]
                     else:  # normal incidence: the plane through the observer or an axis
                         ti, dt, phi, _, _, _, _ = facet_frame(
                             normals[tt, 0],
@@ -361,10 +368,14 @@ def fused_sums(
     )
     if g and normals.shape[0]:
         typed = typed_values(tables)
+        nrm = np.ascontiguousarray(normals, dtype=np.float64)
+        # terms with bit-identical normals share their angles
+        _, uniq = np.unique(nrm.view(np.dtype((np.void, 24))).ravel(), return_inverse=True)
         _fused_sums(
             s,
             o,
-            np.ascontiguousarray(normals, dtype=np.float64),
+            nrm,
+            uniq.astype(np.int64).ravel(),
             np.ascontiguousarray(areas, dtype=np.float64),
             tm,
             frac,
