@@ -463,6 +463,7 @@ def test_resume_after_a_changed_table_is_refused(tmp_path, capsys):
     path = tmp_path / "cube.nc"
     script = tmp_path / "killer.py"
     script.write_text(KILLER.format(repo=str(REPO)))
+    load_scene(scene).plan()  # the tables built here and cached: the child only reads them
     proc = subprocess.run(
         [sys.executable, str(script), str(scene), str(path)],
         timeout=TIMEOUT,
