@@ -272,7 +272,8 @@ def _matmul_rate(threads: int = 1) -> float:
 
 
 def kernel_rows(repeat: int = 3) -> list[BenchRow]:
-    """Kernel throughput (linear, 141 wavelengths, unmerged CanX-1 rotation, one thread).
+    """Kernel throughput (linear, 141 wavelengths, unmerged CanX-1 rotation, one thread),
+    and the band-only kernel against the full-spectrum one on random CanX-1 attitudes.
 
     Examples
     --------
@@ -282,7 +283,7 @@ def kernel_rows(repeat: int = 3) -> list[BenchRow]:
     >>> from sbrdf_xr.bench_engine import kernel_rows
     >>> list(inspect.signature(kernel_rows).parameters)
     ['repeat']
-    >>> [r.name for r in kernel_rows(repeat=1)]  # doctest: +SKIP
+    >>> [r.name for r in kernel_rows(repeat=1)][:2]  # doctest: +SKIP
     ['kernel: numpy reference (sparse matrix)', 'kernel: fused (numba)']
     """
     from ._kernels import fused_sums
@@ -307,6 +308,29 @@ def kernel_rows(repeat: int = 3) -> list[BenchRow]:
     ceiling = rate / (
         2 * 8 * n_wl
     )  # 8 weighted table rows of n_wl multiply-adds per facet-spectrum
+    # band-only against full spectrum, kernel alone: random CanX-1 attitudes (merged terms)
+    per_lit = {}
+    for bands in (False, True):
+        sp = _sweep_scene(20_000, bands).plan()
+        sb, st = sp.geometry.block(slice(None)), sp.terms
+        sec = best_time(
+            lambda sp=sp, sb=sb, st=st: fused_sums(
+                sb.to_sun, sb.to_observer, st.normal, st.area, st.material, sp.tables, "linear"
+            ),
+            repeat,
+        )
+        n_lit = int(np.sum((sb.to_sun @ st.normal.T > 0) & (sb.to_observer @ st.normal.T > 0)))
+        per_lit[bands] = (sec, sec / n_lit, n_lit / len(sb.to_sun))
+    band_row = BenchRow(
+        "kernel: band-only (V, R, I), 2e4 random attitudes",
+        per_lit[True][0],
+        "full spectrum, same geometries",
+        per_lit[True][0] / per_lit[False][0],
+        f"{per_lit[True][1] * 1e9:.0f} ns against {per_lit[False][1] * 1e9:.0f} ns per lit "
+        f"and seen facet, every cost included ({per_lit[True][2]:.1f} per attitude): "
+        f"{per_lit[False][0] / per_lit[True][0]:.1f}x faster",
+        sweep="kernel, canx1 sweep, merged, linear, 1 thread",
+    )
     return [
         BenchRow(
             "kernel: numpy reference (sparse matrix)",
@@ -325,6 +349,7 @@ def kernel_rows(repeat: int = 3) -> list[BenchRow]:
             f"dense-matmul ceiling ({ceiling:,.0f}/s at {rate / 1e9:.1f} GFLOP/s, 1 thread)",
             sweep="kernel, canx1-rotation unmerged, linear, 141 nm, 1 thread",
         ),
+        band_row,
     ]
 
 
