@@ -46,6 +46,7 @@ __all__ = [
     "PackedTables",
     "fused_sums",
     "material_sums",
+    "normal_rows",
     "pack_tables",
 ]
 
@@ -299,6 +300,23 @@ def _fused_sums(
             t = stop
 
 
+def normal_rows(normals: NDArray[np.floating]) -> NDArray[np.int64]:
+    """The row of each term's normal among the distinct ones: terms whose normals are
+    bit-identical (one face, several materials) share the fused kernel's angles.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr._kernels import normal_rows
+    >>> rows = normal_rows(np.array([[0.0, 0, 1], [1, 0, 0], [0, 0, 1]]))
+    >>> bool(rows[0] == rows[2] != rows[1]), sorted(set(rows.tolist()))
+    (True, [0, 1])
+    """
+    nrm = np.ascontiguousarray(normals, dtype=np.float64)
+    _, inverse = np.unique(nrm.view(np.dtype((np.void, 24))).ravel(), return_inverse=True)
+    return inverse.astype(np.int64).ravel()
+
+
 class FusedSums(NamedTuple):
     """Outputs of :func:`fused_sums` for a block of geometries."""
 
@@ -319,6 +337,7 @@ def fused_sums(
     method: str = "linear",
     fraction: NDArray[np.floating] | None = None,
     per_material: bool = False,
+    rows: NDArray[np.int64] | None = None,
 ) -> FusedSums:
     """The facet sums of :func:`material_sums`, over all materials at once, compiled.
 
@@ -341,6 +360,9 @@ def fused_sums(
         Lit-and-visible area fraction of each term [1].
     per_material : bool
         Also return the signal of each material.
+    rows : ndarray of int, shape (T,), optional
+        :func:`normal_rows` of ``normals``, when the caller keeps it (a plan's terms do);
+        computed here otherwise.
 
     Returns
     -------
@@ -369,13 +391,11 @@ def fused_sums(
     if g and normals.shape[0]:
         typed = typed_values(tables)
         nrm = np.ascontiguousarray(normals, dtype=np.float64)
-        # terms with bit-identical normals share their angles
-        _, uniq = np.unique(nrm.view(np.dtype((np.void, 24))).ravel(), return_inverse=True)
         _fused_sums(
             s,
             o,
             nrm,
-            uniq.astype(np.int64).ravel(),
+            normal_rows(nrm) if rows is None else rows,
             np.ascontiguousarray(areas, dtype=np.float64),
             tm,
             frac,

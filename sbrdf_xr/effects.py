@@ -242,6 +242,7 @@ def reflected(
             plan.knobs["method"],
             fraction,
             per_material,
+            t.normal_rows,
         )
     g, n_wl = to_source.shape[0], plan.tables.n_spectral
     dt = plan.tables.dtype

@@ -23,12 +23,13 @@ import math
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 
-from ._kernels import PackedTables
+from ._kernels import PackedTables, normal_rows
 from ._names import BAND, MATERIAL, PSI, WAVELENGTH
 from ._plan_stages import (
     contributing_terms,
@@ -112,6 +113,12 @@ class Terms:
     def size(self) -> int:
         """Number of terms."""
         return int(self.area.size)
+
+    @cached_property
+    def normal_rows(self) -> np.ndarray:
+        """Each term's row among the distinct normals (:func:`~sbrdf_xr._kernels.normal_rows`),
+        found once per plan rather than once per block."""
+        return normal_rows(self.normal)
 
 
 @dataclass(frozen=True)
