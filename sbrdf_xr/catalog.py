@@ -35,8 +35,10 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import trimesh
 import xarray as xr
+from numpy.typing import DTypeLike
 
 from . import material, models, observe, spacecraft
 from ._cache import cached_table
@@ -63,6 +65,7 @@ __all__ = [
     "MATERIAL_SUFFIXES",
     "MESH_SUFFIXES",
     "SOURCES",
+    "TABLE_DTYPES",
     "CatalogEntry",
     "catalog_dir",
     "data_path",
@@ -78,23 +81,55 @@ __all__ = [
 ]
 
 
-def _load_material(e: CatalogEntry) -> xr.DataArray:
-    """A table file, or (``build_from`` set) a table built from a measurement entry."""
+#: The value types a material can be loaded in (:func:`load`'s ``dtype``).
+TABLE_DTYPES: tuple[str, ...] = ("float32", "float64")
+
+
+def _table_dtype(dtype: DTypeLike | None) -> str | None:
+    """``dtype`` checked against :data:`TABLE_DTYPES`, by name (None stays None)."""
+    if dtype is None:
+        return None
+    try:
+        name = np.dtype(dtype).name
+    except TypeError:
+        name = repr(dtype)
+    if name not in TABLE_DTYPES:
+        raise CatalogError(
+            f"dtype: got {dtype!r}; a material table loads as one of {', '.join(TABLE_DTYPES)}"
+        )
+    return name
+
+
+def _load_material(e: CatalogEntry, dtype: str | None = None) -> xr.DataArray:
+    """A table file, or (``build_from`` set) a table built from a measurement entry;
+    its values in ``dtype`` (None: as stored)."""
     source = e.extra.get("build_from")
     if source is None:
-        return material.open_material(e.file)
+        da = material.open_material(e.file)
+        return da if dtype is None else da.astype(dtype, copy=False)
     options = tuple(sorted(e.extra.get("build", {}).items()))
     # a new DataArray (its own attrs) over the one built table, whose values are read-only:
     # every load in a process shares them (a copy each would double the resident tables);
     # ``.copy()`` gives a writable table
-    return _built_material(e.name, source, options).copy(deep=False)
+    # built tables are float64: asking for it is asking for the one cached table
+    da = _built_material(e.name, source, options, None if dtype == "float64" else dtype)
+    da = da.copy(deep=False)
+    return da if dtype is None or da.dtype == np.dtype(dtype) else da.astype(dtype)
 
 
 @functools.lru_cache(maxsize=16)
 def _built_material(
-    name: str, measurements: str, options: tuple[tuple[str, Any], ...]
+    name: str,
+    measurements: str,
+    options: tuple[tuple[str, Any], ...],
+    dtype: str | None = None,
 ) -> xr.DataArray:
-    """A table built from a measurement entry, through the disk cache (:mod:`sbrdf_xr._cache`)."""
+    """A table built from a measurement entry, through the disk cache (:mod:`sbrdf_xr._cache`),
+    its values in ``dtype`` (None: as built, float64).
+
+    A table in another dtype is cast from the file's values, not from the float64 table
+    cached here, so a process that asks only for float32 holds no float64 copy.
+    """
     kw = dict(options)
     inputs = [entry(measurements).file] + ([entry(kw["fit"]).file] if "fit" in kw else [])
 
@@ -118,6 +153,8 @@ def _built_material(
         lambda da, path: material.to_netcdf(da, path, overwrite=True),
         read,
     )
+    if dtype is not None and da.dtype != np.dtype(dtype):
+        da = da.astype(dtype)
     da.values.flags.writeable = False
     return da
 
@@ -144,13 +181,17 @@ LOADERS: dict[str, Callable[[CatalogEntry], Any]] = {
 assert set(LOADERS) == set(KINDS)
 
 
-def load(name: str) -> Any:
+def load(name: str, dtype: DTypeLike | None = None) -> Any:
     """Load a catalog entry by name.
 
     Parameters
     ----------
     name : str
         Entry name (see :func:`names` or ``sbrdf-xr catalog list``).
+    dtype : {None, "float32", "float64"}, optional
+        For a ``material`` only: its values in this dtype.  ``float32`` holds half the
+        memory of the stored float64 table (a scene in float32 loads its tables so, and
+        its plan then reads them without a copy); None keeps the stored dtype.
 
     Returns
     -------
@@ -181,8 +222,24 @@ def load(name: str) -> Any:
     <Spacecraft 'canx1': 684 facets, materials ['aluminium-6061-t6', 'tjpv-cell', ...] m>
     >>> catalog.load("mont-megantic").latitude_deg
     45.4555
+
+    The grey table in float32, as a scene with ``dtype="float32"`` loads it:
+
+    >>> catalog.load("lambertian-grey-50", dtype="float32").dtype
+    dtype('float32')
+    >>> catalog.load("canx1", dtype="float32")
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.CatalogError: dtype: 'canx1' is a spacecraft entry; only a material ...
     """
     e = entry(name)
+    dt = _table_dtype(dtype)
+    if dt is not None:
+        if e.kind != "material":
+            raise CatalogError(
+                f"dtype: {name!r} is a {e.kind} entry; only a material loads in a chosen dtype"
+            )
+        return _load_material(e, dt)
     try:
         loader = LOADERS[e.kind]
     except KeyError:  # pragma: no cover - every kind has a loader (asserted above)

@@ -94,7 +94,8 @@ class Scene:
     method : str
         Look-up method (``nearest``, ``linear``, ``cubic``).
     dtype : str
-        ``float64`` or ``float32`` for the spectra.
+        ``float64`` or ``float32`` for the spectra.  Catalog tables (``materials`` not
+        given) are loaded in this dtype too, so ``float32`` halves the memory they hold.
     merge : bool or None
         Merge facets sharing (normal, material); default: whenever allowed.
     shadow_method : {"exact", "sampled"}
@@ -346,7 +347,8 @@ class Scene:
         if self.materials is not None:
             return self.materials
         try:
-            tables = {m: catalog.load(m) for m in self.spacecraft.materials}
+            # in the scene's precision: a float32 scene holds no float64 copy of its tables
+            tables = {m: catalog.load(m, dtype=self.dtype) for m in self.spacecraft.materials}
         except CatalogError as exc:
             raise SceneError(
                 f"materials: not given, and the catalog has no table for a material of "
@@ -428,7 +430,10 @@ class Scene:
             new = replace(self, **changes)
         except TypeError as exc:
             raise SceneError(f"with_options: {exc}") from None
-        if "tables" in self.__dict__ and not {"materials", "spacecraft"} & set(changes):
+        same = not {"materials", "spacecraft"} & set(changes) and (
+            self.materials is not None or new.dtype == self.dtype
+        )
+        if "tables" in self.__dict__ and same:
             new.__dict__["tables"] = self.__dict__["tables"]  # loaded once per scene family
         return new
 

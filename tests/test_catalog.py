@@ -57,6 +57,40 @@ def test_built_entry_equals_build_lut_of_its_measurements_and_is_read_only():
     assert np.shares_memory(again.values, built.values)
 
 
+def test_a_material_loads_in_a_chosen_dtype_without_a_second_float64_table():
+    """``dtype="float32"`` gives the built table's values rounded once to float32 (cast
+    from the file, so no float64 copy is kept for it); ``float64`` is the one shared
+    table, not a second copy; a file table is cast likewise."""
+    built = catalog.load("example-lobe")
+    assert built.dtype == np.float64
+    single = catalog.load("example-lobe", dtype="float32")
+    assert single.dtype == np.float32 and single.dims == built.dims
+    xr.testing.assert_identical(single, built.astype(np.float32))  # values, coords, attrs
+    with pytest.raises(ValueError, match=r"read-only|copy"):
+        single[...] = 0.0  # shared by every float32 load, like the float64 table
+    assert np.shares_memory(catalog.load("example-lobe", dtype=np.float32).values, single.values)
+    assert np.shares_memory(catalog.load("example-lobe", dtype="float64").values, built.values)
+    grey = catalog.load("lambertian-grey-50")  # stored in float32
+    wide = catalog.load("lambertian-grey-50", dtype="float64")
+    assert wide.dtype == np.float64
+    np.testing.assert_array_equal(wide.values, grey.values.astype(np.float64))
+
+
+@pytest.mark.parametrize(
+    ("name", "dtype", "match"),
+    [
+        ("example-lobe", "float16", "dtype: got 'float16'; a material table loads as one of"),
+        ("example-lobe", "int", "dtype: got 'int'"),
+        ("example-lobe", "not a dtype", "dtype: got 'not a dtype'"),
+        ("canx1", "float32", "'canx1' is a spacecraft entry; only a material"),
+        ("example-lobe-measurements", "float32", "is a measurements entry"),
+    ],
+)
+def test_a_dtype_is_refused_where_it_means_nothing(name, dtype, match):
+    with pytest.raises(CatalogError, match=match):
+        catalog.load(name, dtype=dtype)
+
+
 def test_installed_package_finds_its_catalogs_from_any_directory(tmp_path):
     """After `pip install .` the catalogs ship inside the package (not editable)."""
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}

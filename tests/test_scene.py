@@ -255,9 +255,9 @@ def test_scene_without_tables_loads_them_on_first_use(monkeypatch):
     loaded: list[str] = []
     real_load = catalog.load
 
-    def counting_load(name):
+    def counting_load(name, **kwargs):
         loaded.append(name)
-        return real_load(name)
+        return real_load(name, **kwargs)
 
     monkeypatch.setattr(catalog, "load", counting_load)
     scene = Scene(body, to_sun=[[1, 0, 0]], to_observer=[[1, 0, 0]])
@@ -266,6 +266,33 @@ def test_scene_without_tables_loads_them_on_first_use(monkeypatch):
     again = scene.with_options(method="nearest")
     assert again.tables is scene.tables and loaded == ["lambertian-grey-50"]
     np.testing.assert_allclose(_signal(again), 0.5 / np.pi, rtol=1e-6)  # +x face, head-on
+
+
+def test_a_float32_scene_loads_its_tables_in_float32_and_its_plan_reads_them_in_place():
+    """A float32 scene holds its catalog tables once, in float32 (half the memory of
+    the float64 tables), and its plan packs views of them, not copies; changing the
+    dtype loads the tables again, changing another knob shares them."""
+    import trimesh
+
+    from sbrdf_xr import spacecraft
+    from sbrdf_xr.scene import Scene
+
+    body = spacecraft.load_spacecraft(trimesh.creation.icosphere(2), material="example-lobe")
+    rng = np.random.default_rng(3)
+    sun = rng.normal(size=(50, 3))
+    obs = sun + 0.3 * rng.normal(size=(50, 3))
+    sun, obs = (v / np.linalg.norm(v, axis=1, keepdims=True) for v in (sun, obs))
+    single = Scene(body, to_sun=sun, to_observer=obs, dtype="float32")
+    assert all(da.dtype == np.float32 for da in single.tables.values())
+    packed = single.plan().tables.values
+    assert all(v.dtype == np.float32 for v in packed)
+    for v, da in zip(packed, single.tables.values(), strict=True):
+        assert np.shares_memory(v, da.values)
+    wide = single.with_options(dtype="float64")
+    assert all(da.dtype == np.float64 for da in wide.tables.values())
+    assert single.with_options(method="nearest").tables is single.tables
+    # float32 tables and sums against float64: a few float32 roundings, far below 1e-5
+    np.testing.assert_allclose(_signal(single), _signal(wide), rtol=1e-5, atol=0)
 
 
 def test_scene_without_tables_names_a_material_the_catalog_lacks():
