@@ -112,12 +112,13 @@ class BlockWritten:
     in_flight: int
 
 
-def _reason(exc: BaseException, part: Path | None = None) -> str:
-    """The cause of an I/O failure in words ("no space left on device", ...)."""
+def _reason(exc: BaseException, part: Path | None = None, need: int = 0) -> str:
+    """The cause of an I/O failure in words ("no space left on device", ...); ``need``:
+    bytes the file was still to grow by (its final size, when it was being created)."""
     code = getattr(exc, "errno", None)
     words = _ERRNO_WORDS.get(code) if isinstance(code, int) else None
     if words is None and part is not None:
-        words = _diagnose(part)
+        words = _diagnose(part, need)
     if words is None:
         return f"{type(exc).__name__}: {exc}"
     detail = getattr(exc, "strerror", None) if isinstance(exc, _NoRoom) else None
@@ -149,19 +150,22 @@ def _fix(reason: str) -> str:
     return next((v for k, v in _FIXES.items() if reason.startswith(k)), "fix the cause")
 
 
-def _diagnose(part: Path) -> str | None:
+def _diagnose(part: Path, need: int = 0) -> str | None:
     """Why a write into ``part`` may have failed when HDF5 does not say (it reports "HDF error")."""
     try:
         st = os.statvfs(part.parent)
         free = (st.f_bfree if os.geteuid() == 0 else st.f_bavail) * st.f_frsize
-        if free < _SPACE_MARGIN:
+        if free < need + _SPACE_MARGIN:
             return "no space left on device"
     except (OSError, AttributeError):
         pass
     limit = _file_size_limit()
-    with contextlib.suppress(OSError):
-        if limit is not None and part.stat().st_size + _SPACE_MARGIN > limit:
-            return "file size limit exceeded"
+    try:
+        size = part.stat().st_size
+    except OSError:
+        size = 0
+    if limit is not None and size + need + _SPACE_MARGIN > limit:
+        return "file size limit exceeded"
     return None
 
 

@@ -91,6 +91,25 @@ def fallocate_fn() -> Any:
 FALLOCATE = fallocate_fn() if sys.platform.startswith("linux") else None
 
 
+def reserve_file(fd: int) -> None:
+    """Allocate the disk blocks of the whole file open as ``fd`` (its size unchanged).
+
+    An uncompressed cube's variables are laid out whole when the ``.part`` is created
+    (a sparse file of the cube's final size): reserving its holes finds a full disk
+    before any block is computed.  Parts already allocated cost nothing; file systems
+    without ``fallocate`` skip the reservation.
+    """
+    if FALLOCATE is None or not CHECK_SPACE:
+        return
+    import ctypes
+
+    size = os.fstat(fd).st_size
+    if size and FALLOCATE(fd, FALLOC_FL_KEEP_SIZE, 0, size) != 0:
+        code = ctypes.get_errno()
+        if code in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
+            raise _NoRoom(code, f"reserving the cube's {_mib(size)} on disk failed")
+
+
 def reserve(fd: int, nbytes: int) -> None:
     """Reserve ``nbytes`` of disk beyond the end of the file open as ``fd`` (size unchanged).
 

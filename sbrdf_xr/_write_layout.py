@@ -269,6 +269,11 @@ def difference(old: Mapping[str, Any], new: Mapping[str, Any]) -> str:
     return "the file format version differs"
 
 
+def lazy_bytes(plan: BlockLayout) -> int:
+    """Raw size of all the lazy variables [byte] (the blocks' share of the file)."""
+    return sum(math.prod(v.data.shape) * v.data.dtype.itemsize for v in plan.lazy)
+
+
 def block_bytes(plan: BlockLayout) -> int:
     """Largest raw size of one block [byte] (what a block may add to the file, uncompressed)."""
     total = 0

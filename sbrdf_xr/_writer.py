@@ -35,15 +35,23 @@ Durability
     block (then its line in the sidecar, synced too) runs in a thread of its own
     while the next block is written, and is waited for before that block is
     reported, before anything is cut back and before the file is closed
-    (:class:`~sbrdf_xr._write_disk.SyncBehind`).  Before each block the room it
-    needs is checked (free space, ``RLIMIT_FSIZE``) and reserved
-    (``fallocate`` past the end of the file, where supported), so that a full disk
-    or a file-size limit stops the write *before* HDF5 writes anything: the
-    ``.part`` stays exactly as last synced and the error names the cause ("no
-    space left on device", "file size limit exceeded").  Should HDF5's own write
-    fail anyway, HDF5's descriptor is made read-only (nothing more reaches the
-    file) and the file is cut back to its last synced size and superblock; if it
-    then does not open, the message says that the ``.part`` was lost.
+    (:class:`~sbrdf_xr._write_disk.SyncBehind`).  An uncompressed cube's streamed
+    variables are stored contiguous and laid out whole when the ``.part`` is created
+    (:func:`~sbrdf_xr._write_files.is_contiguous`): the room of the whole cube is
+    checked (free space, ``RLIMIT_FSIZE``) before creation and reserved
+    (``fallocate``, where supported) before the first block, so a full disk or a
+    file-size limit stops the write before any block is computed, and the blocks
+    write raw values at fixed offsets without touching HDF5's metadata: a writer
+    killed at any instant leaves the metadata synced at creation, and a resume
+    rewrites the blocks not logged.  A compressed cube's chunks are appended and
+    indexed as blocks arrive: before each block the room it needs is checked and
+    reserved (``fallocate`` past the end of the file), so that a full disk or a
+    file-size limit stops the write *before* HDF5 writes anything: the ``.part``
+    stays exactly as last synced and the error names the cause ("no space left on
+    device", "file size limit exceeded").  Should HDF5's own write fail anyway,
+    HDF5's descriptor is made read-only (nothing more reaches the file) and the
+    file is cut back to its last synced size and superblock; if it then does not
+    open, the message says that the ``.part`` was lost.
 
 Memory
     At most ``max_in_flight`` blocks are computed or waiting to be written.  The
@@ -150,16 +158,19 @@ from ._write_disk import (
     SyncBehind,
     check_room,
     cut_back,
+    drop_behind,
     fence,
     file_kind,
     fsync_dir,
     reserve,
+    reserve_file,
 )
 from ._write_files import (
     check_destination,
     check_finished,
     create_part,
     open_part,
+    read_back_error,
     read_log,
     to_storage,
     write_header,
@@ -170,6 +181,7 @@ from ._write_layout import (
     block_bytes,
     difference,
     layout_of,
+    lazy_bytes,
     storage_kind,
 )
 from ._write_progress import NoProgress, progress_bar
@@ -385,19 +397,23 @@ def _write_locked(
         else:
             log.unlink(missing_ok=True)
             part.unlink(missing_ok=True)
+            # an uncompressed cube is laid out whole at creation: its room is needed now
+            need = 0 if complevel else lazy_bytes(plan)
             try:
-                check_room(part, 0)
+                check_room(part, need)
                 nc = create_part(part, ds, plan, complevel)
                 write_header(log, plan)
             except BaseException as exc:
                 if nc is not None:
                     with contextlib.suppress(Exception):
                         nc.close()
+                why = _reason(exc, part, need) if isinstance(exc, Exception) else ""
                 part.unlink(missing_ok=True)  # nothing recorded yet: nothing lost
                 log.unlink(missing_ok=True)
                 if isinstance(exc, Exception) and not isinstance(exc, SbrdfError):
                     raise CubeWriteError(
-                        f"cannot write {path}: creating {part} failed: {_reason(exc, part)}"
+                        f"cannot write {path}: creating {part} failed: {why}. Nothing was "
+                        f"written; {_fix(why)} and write again"
                     ) from exc
                 raise
     except BaseException:
@@ -410,12 +426,17 @@ def _write_locked(
     k = -1
     writing = False
     good, head = -1, b""
+    damaged: str | None = None
     try:
         writing = True
         fd = os.open(part, os.O_RDWR)
         os.fsync(fd)
         good, head = os.fstat(fd).st_size, os.pread(fd, HEAD_BYTES, 0)
         log_fd = os.open(log, os.O_WRONLY | os.O_APPEND)
+        # blocks grow the file only where a variable is chunked (compressed)
+        grows = any(nc.variables[v.name].chunking() != "contiguous" for v in plan.lazy)
+        if not grows:
+            reserve_file(fd)
         writing = False
         release_freed_memory()  # what preparing the cube freed, before the blocks stream
         # each block goes to disk (fsync, then the log) in a thread of its own while the
@@ -453,8 +474,9 @@ def _write_locked(
                 continue
             block = pieces.pop(k)
             nbytes = sum(np.asarray(a).nbytes for a in arrays)
-            check_room(part, nbytes)
-            reserve(fd, nbytes)
+            if grows:
+                check_room(part, nbytes)
+                reserve(fd, nbytes)
             writing = True
             for (name, region, _), values in zip(block, arrays, strict=True):
                 expected = tuple(s.stop - s.start for s in region)
@@ -489,7 +511,10 @@ def _write_locked(
             kind = file_kind(p)
             if kind not in (None, "file"):
                 raise CubeWriteError(f"{p} became {kind} during the write; it was not replaced")
-        os.replace(part, path)
+        damaged = read_back_error(part)
+        drop_behind(fd)  # what reading it back brought into the page cache
+        if damaged is None:  # never a cube that does not read under the final name
+            os.replace(part, path)
     except Exception as exc:
         if sync is not None:  # before anything is cut back: the blocks synced behind count
             done.update(sync.settle())
@@ -544,6 +569,12 @@ def _write_locked(
         for f in (fd, log_fd):
             if f >= 0:
                 os.close(f)
+    if damaged is not None:
+        raise CubeWriteError(
+            f"{part} holds every block but does not read back ({damaged}): an earlier "
+            f"failure damaged its HDF5 metadata, so it was not renamed to {path.name}; "
+            f"{_discard()}"
+        )
     log.unlink(missing_ok=True)
     fsync_dir(path.parent)
     return path

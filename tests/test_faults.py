@@ -132,7 +132,7 @@ WRITER = textwrap.dedent(
     try:
         _writer.write_cube(cube_24(delay=args.get("delay", 0.0)), args["path"],
                            overwrite=args.get("overwrite", False), resume=args.get("resume", False),
-                           max_in_flight=2, on_block=on_block)
+                           max_in_flight=2, on_block=on_block, complevel=args.get("complevel", 0))
         print(json.dumps({{"ok": True}}))
     except Exception as exc:
         print(json.dumps({{"ok": False, "named": isinstance(exc, SbrdfError),
@@ -207,10 +207,43 @@ def test_sigkill_at_random_points(tmp_path, reference, caplog):
 
 
 @pytest.mark.parametrize("check_space", [True, False], ids=["checked", "unforeseen"])
-def test_file_size_limit(tmp_path, reference, check_space):
-    """A file-size limit (EFBIG, as a full disk gives ENOSPC) stops the write with the cause
-    named; the ``.part`` keeps its blocks, a resume under the limit is refused by name, and a
-    resume without the limit finishes the cube.
+def test_file_size_limit_is_found_before_any_block(tmp_path, reference, check_space):
+    """An uncompressed cube is laid out whole when its ``.part`` is created, so a
+    file-size limit below its size (EFBIG, as a full disk gives ENOSPC) stops the write
+    at creation, named, before any block is computed, and leaves nothing behind; under
+    the limit a resume is refused the same way; without it the cube is written.
+
+    ``checked``: the room is checked first (the default).  ``unforeseen``: the check is
+    off, so HDF5's own flush fails, and the cause is still named.
+    """
+    rng = random.Random(SEED + check_space)
+    for trial in range(2):
+        path = tmp_path / f"limit{trial}" / "cube.nc"
+        path.parent.mkdir()
+        limit = rng.randint(600_000, 2_000_000)  # the whole cube is about 2.5 MB
+        kind = f"file size limit, whole ({'checked' if check_space else 'unforeseen'})"
+        for resume in (False, True):
+            r = result(
+                writer(
+                    path.parent, path=str(path), limit=limit, check_space=check_space, resume=resume
+                )
+            )
+            assert not r["ok"] and r["named"], r
+            assert "file size limit exceeded" in r["message"], r
+            assert "Nothing was written; raise the file size limit" in r["message"], r
+            assert sorted(p.name for p in path.parent.iterdir()) == ["writer.py"]
+        write_cube(cube_24(), path, resume=True)
+        outcome = "named error, resumed" if same_values(path, reference) else "wrong cube"
+        TRIALS.append((kind, outcome))
+        assert outcome == "named error, resumed"
+
+
+@pytest.mark.parametrize("check_space", [True, False], ids=["checked", "unforeseen"])
+def test_file_size_limit_of_a_compressed_cube(tmp_path, reference, check_space):
+    """A compressed cube grows block by block (its chunks are indexed as they arrive):
+    a file-size limit (EFBIG, as a full disk gives ENOSPC) stops the write with the
+    cause named; the ``.part`` keeps its blocks, a resume under the limit is refused by
+    name, and a resume without the limit finishes the cube.
 
     ``checked``: the room is checked before each block (the default).  ``unforeseen``: the
     check is off, so HDF5's own write fails mid-block and the file is cut back to its last
@@ -220,9 +253,10 @@ def test_file_size_limit(tmp_path, reference, check_space):
     for trial in range(3):
         path = tmp_path / f"limit{trial}" / "cube.nc"
         path.parent.mkdir()
-        limit = rng.randint(600_000, 2_000_000)  # the whole cube is about 2.5 MB
-        r = result(writer(path.parent, path=str(path), limit=limit, check_space=check_space))
-        kind = f"file size limit ({'checked' if check_space else 'unforeseen'})"
+        limit = rng.randint(600_000, 1_800_000)  # the compressed cube is about 2.3 MB
+        args = {"path": str(path), "limit": limit, "check_space": check_space, "complevel": 1}
+        r = result(writer(path.parent, **args))
+        kind = f"file size limit, zlib ({'checked' if check_space else 'unforeseen'})"
         assert not r["ok"] and r["named"], r
         assert "file size limit exceeded" in r["message"], r
         assert not path.exists()
@@ -232,14 +266,12 @@ def test_file_size_limit(tmp_path, reference, check_space):
             assert not check_space, r
             continue
         # Still "full": resuming is refused with the cause, not a traceback.
-        again = result(
-            writer(path.parent, path=str(path), limit=limit, resume=True, check_space=check_space)
-        )
+        again = result(writer(path.parent, **args, resume=True))
         assert not again["ok"] and again["named"], again
         assert "file size limit exceeded" in again["message"], again
         # Space freed: resume finishes the cube from the blocks kept.
         try:
-            write_cube(cube_24(), path, resume=True)
+            write_cube(cube_24(), path, resume=True, complevel=1)
         except SbrdfError:
             TRIALS.append((kind, "data lost"))
             assert not check_space

@@ -341,6 +341,63 @@ def test_resume_after_killed_process(tmp_path):
     xr.testing.assert_identical(read(path), make_cube().compute())
 
 
+def test_blocks_of_an_uncompressed_cube_change_no_hdf5_metadata(tmp_path):
+    """What makes a kill at any instant resumable: the streamed variables are laid out
+    whole at creation, so from the first block to the last every byte of the ``.part``
+    that changes lies inside a variable's data; the metadata a resume reads are the
+    ones synced at creation.  A compressed cube's chunk index does change (the contrast
+    shows the check can fail)."""
+    h5py = pytest.importorskip("h5py")
+
+    def snapshots(path, **kw) -> list[bytes]:
+        part = path.with_name(path.name + ".part")
+        seen: list[bytes] = []
+        write_cube(make_cube(), path, on_block=lambda e: seen.append(part.read_bytes()), **kw)
+        return seen
+
+    def outside_data(path, seen) -> set[int]:
+        """Offsets outside the streamed variables' data that differ between snapshots."""
+        with h5py.File(path, "r", locking=False) as f:
+            spans = [
+                (f[n].id.get_offset(), f[n].id.get_storage_size())
+                for n in ("irradiance", "sbrdf", "lit")
+                if f[n].id.get_offset() is not None
+            ]
+        first = np.frombuffer(seen[0], dtype=np.uint8)
+        changed: set[int] = set()
+        for snap in seen[1:]:
+            b = np.frombuffer(snap, dtype=np.uint8)
+            n = min(b.size, first.size)
+            diff = np.flatnonzero(b[:n] != first[:n]).tolist() + list(range(n, b.size))
+            changed.update(i for i in diff if not any(o <= i < o + z for o, z in spans))
+        return changed
+
+    whole = tmp_path / "whole.nc"
+    seen = snapshots(whole)
+    assert len(seen) == 9 and len({len(b) for b in seen}) == 1  # the file never grows
+    with h5py.File(whole, "r", locking=False) as f:
+        assert f["sbrdf"].id.get_create_plist().get_layout() == h5py.h5d.CONTIGUOUS
+    assert outside_data(whole, seen) == set()
+    xr.testing.assert_identical(read(whole), make_cube().compute())
+
+    zipped = tmp_path / "zipped.nc"
+    seen = snapshots(zipped, complevel=1)
+    assert outside_data(zipped, seen)  # chunks were appended and indexed
+    xr.testing.assert_identical(read(zipped), make_cube().compute())
+
+
+def test_read_back_error_names_a_damaged_file_and_passes_a_sound_one(tmp_path):
+    from sbrdf_xr._write_files import read_back_error
+
+    path = tmp_path / "cube.nc"
+    write_cube(make_cube(), path, complevel=1)
+    assert read_back_error(path) is None
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2])  # the second half (chunks, index) gone
+    err = read_back_error(path)
+    assert err is not None and err.split(":")[0] in ("OSError", "RuntimeError", "IndexError")
+
+
 def test_existing_file_is_not_touched(tmp_path):
     path = tmp_path / "cube.nc"
     path.write_bytes(b"an older cube")
