@@ -511,8 +511,12 @@ def _write_locked(
             kind = file_kind(p)
             if kind not in (None, "file"):
                 raise CubeWriteError(f"{p} became {kind} during the write; it was not replaced")
-        damaged = read_back_error(part)
-        drop_behind(fd)  # what reading it back brought into the page cache
+        # a .part resumed, or one whose chunk index grew with its blocks, may carry HDF5
+        # metadata torn by an earlier failure; a fresh uncompressed cube's were written
+        # once, at creation, and closed without error
+        if resuming or grows:
+            damaged = read_back_error(part)
+            drop_behind(fd)  # what reading it back brought into the page cache
         if damaged is None:  # never a cube that does not read under the final name
             os.replace(part, path)
     except Exception as exc:
