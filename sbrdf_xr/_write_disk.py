@@ -91,6 +91,19 @@ def fallocate_fn() -> Any:
 FALLOCATE = fallocate_fn() if sys.platform.startswith("linux") else None
 
 
+def _allocate(fd: int, offset: int, length: int, what: str) -> None:
+    """``fallocate`` ``length`` bytes from ``offset`` of the file open as ``fd`` (its size
+    unchanged); a full disk, quota or size limit raises :class:`_NoRoom` naming ``what``."""
+    if FALLOCATE is None or not CHECK_SPACE or length <= 0:
+        return
+    import ctypes
+
+    if FALLOCATE(fd, FALLOC_FL_KEEP_SIZE, offset, length) != 0:
+        code = ctypes.get_errno()
+        if code in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
+            raise _NoRoom(code, f"reserving {_mib(length)} {what} failed")
+
+
 def reserve_file(fd: int) -> None:
     """Allocate the disk blocks of the whole file open as ``fd`` (its size unchanged).
 
@@ -99,15 +112,7 @@ def reserve_file(fd: int) -> None:
     before any block is computed.  Parts already allocated cost nothing; file systems
     without ``fallocate`` skip the reservation.
     """
-    if FALLOCATE is None or not CHECK_SPACE:
-        return
-    import ctypes
-
-    size = os.fstat(fd).st_size
-    if size and FALLOCATE(fd, FALLOC_FL_KEEP_SIZE, 0, size) != 0:
-        code = ctypes.get_errno()
-        if code in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
-            raise _NoRoom(code, f"reserving the cube's {_mib(size)} on disk failed")
+    _allocate(fd, 0, os.fstat(fd).st_size, "for the cube on disk")
 
 
 def reserve(fd: int, nbytes: int) -> None:
@@ -117,17 +122,7 @@ def reserve(fd: int, nbytes: int) -> None:
     a full disk is found here, before HDF5 writes anything, instead of in the middle
     of HDF5's flush.  File systems without ``fallocate`` skip the reservation.
     """
-    if FALLOCATE is None or not CHECK_SPACE:
-        return
-    import ctypes
-
-    size = os.fstat(fd).st_size
-    if FALLOCATE(fd, FALLOC_FL_KEEP_SIZE, size, int(nbytes) + _SPACE_MARGIN) != 0:
-        code = ctypes.get_errno()
-        if code in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
-            raise _NoRoom(
-                code, f"reserving {_mib(int(nbytes) + _SPACE_MARGIN)} for the next block failed"
-            )
+    _allocate(fd, os.fstat(fd).st_size, int(nbytes) + _SPACE_MARGIN, "for the next block")
 
 
 def drop_behind(fd: int) -> None:
