@@ -54,7 +54,9 @@ Durability
     open, the message says that the ``.part`` was lost.
 
 Memory
-    At most ``max_in_flight`` blocks are computed or waiting to be written.  The
+    At most ``max_in_flight`` blocks are computed or waiting to be written.  The first
+    ones are submitted as soon as the room is checked, so they compute while the
+    ``.part`` is created, its numpy-backed variables written and its space reserved.  The
     page cache of each block is dropped once the block is synced
     (:func:`~sbrdf_xr._write_disk.drop_behind`): a streamed cube occupies about one
     block of page cache whatever its size, and on virtual machines whose memory the
@@ -376,6 +378,12 @@ def _write_locked(
         done = {k for k in done if 0 <= k < plan.n_blocks}
 
     runner = _runner(client, scheduler)
+    feed = _Feed(
+        plan,
+        runner,
+        [b for b in range(plan.n_blocks) if b not in done],
+        int(max_in_flight or runner.n_workers + 1),
+    )
     nc: netCDF4.Dataset | None = None
     try:
         if resuming:
@@ -383,6 +391,7 @@ def _write_locked(
             try:
                 check_room(part, block_bytes(plan))
                 nc = open_part(part, ds, plan)
+                feed.fill()  # the first missing blocks compute while the file is prepared
             except CubeWriteError:
                 raise
             except Exception as exc:
@@ -400,7 +409,9 @@ def _write_locked(
             # an uncompressed cube is laid out whole at creation: its room is needed now
             need = 0 if complevel else lazy_bytes(plan)
             try:
-                check_room(part, need)
+                check_room(part, need)  # before any block is computed
+                # the first blocks compute while the file is created and laid out
+                feed.fill()
                 nc = create_part(part, ds, plan, complevel)
                 write_header(log, plan)
             except BaseException as exc:
@@ -451,28 +462,18 @@ def _write_locked(
                     BlockWritten(kk, plan.slices(kk), len(done), plan.n_blocks, runner.pending)
                 )
 
-        limit = int(max_in_flight or runner.n_workers + 1)
-        todo = iter([b for b in range(plan.n_blocks) if b not in done])
         kinds = {str(n): storage_kind(n, v.dtype) for n, v in ds.variables.items()}
         # a cube held in memory is written with its header: no blocks to count
         bar = progress_bar(progress and plan.n_blocks > 0, plan.n_blocks, len(done), path.name)
-        pieces: dict[int, list[tuple[str, tuple[slice, ...], Any]]] = {}
-        exhausted = False
         while True:
-            while not exhausted and runner.pending < limit:
-                nxt = next(todo, None)
-                if nxt is None:
-                    exhausted = True
-                else:
-                    pieces[nxt] = plan.pieces(nxt)
-                    runner.submit(nxt, plan.task(nxt, [p for _, _, p in pieces[nxt]]))
+            feed.fill()
             if not runner.pending:
                 break
             k, handle = runner.next_done()
             arrays = runner.result(handle)
             if k in done:  # a block is written exactly once
                 continue
-            block = pieces.pop(k)
+            block = feed.pieces.pop(k)
             nbytes = sum(np.asarray(a).nbytes for a in arrays)
             if grows:
                 check_room(part, nbytes)
@@ -582,6 +583,30 @@ def _write_locked(
     log.unlink(missing_ok=True)
     fsync_dir(path.parent)
     return path
+
+
+class _Feed:
+    """The blocks still to compute, handed to the runner so that at most ``limit`` are
+    computed or waiting to be written at any time."""
+
+    def __init__(self, plan: BlockLayout, runner: Any, todo: list[int], limit: int) -> None:
+        self.plan = plan
+        self.runner = runner
+        self.todo = iter(todo)
+        self.limit = limit
+        self.exhausted = not todo
+        #: ``(variable, region, Dask key)`` of every block submitted and not yet written
+        self.pieces: dict[int, list[tuple[str, tuple[slice, ...], Any]]] = {}
+
+    def fill(self) -> None:
+        """Submit blocks until ``limit`` are pending or none is left."""
+        while not self.exhausted and self.runner.pending < self.limit:
+            k = next(self.todo, None)
+            if k is None:
+                self.exhausted = True
+                return
+            self.pieces[k] = self.plan.pieces(k)
+            self.runner.submit(k, self.plan.task(k, [p for _, _, p in self.pieces[k]]))
 
 
 def _describe(slices: Mapping[str, slice]) -> str:

@@ -549,6 +549,58 @@ def test_blocks_in_flight_are_bounded(tmp_path, max_in_flight):
         assert _COUNTS["worst"] > 1  # blocks did overlap
 
 
+_STARTED = threading.Event()
+
+
+def flagged_block(block_info=None) -> np.ndarray:
+    """A block that says it has started computing."""
+    _STARTED.set()
+    return np.ones(block_info[None]["chunk-shape"])
+
+
+def flagged_cube() -> xr.Dataset:
+    chunks = ((4,) * 6, (16,))
+    data = da.map_blocks(flagged_block, chunks=chunks, dtype="f8", meta=np.array((), "f8"))
+    return xr.Dataset({"v": (("attitude", "wavelength"), data, {"units": "1"})})
+
+
+def test_first_blocks_compute_while_the_file_is_created(tmp_path, monkeypatch):
+    """Blocks are submitted once the room is checked, before the ``.part`` is created
+    and laid out, so the kernel does not wait for the file's preparation."""
+    import sbrdf_xr._writer as writer
+
+    create = writer.create_part
+    seen: list[bool] = []
+
+    def create_after_a_block_started(*args, **kwargs):
+        seen.append(_STARTED.wait(timeout=60.0))  # a hang guard, not a timing
+        return create(*args, **kwargs)
+
+    _STARTED.clear()
+    monkeypatch.setattr(writer, "create_part", create_after_a_block_started)
+    with dask.config.set(num_workers=2):
+        write_cube(flagged_cube(), tmp_path / "c.nc")
+    assert seen == [True]
+    np.testing.assert_array_equal(read(tmp_path / "c.nc").v.values, 1.0)
+
+
+def test_no_block_is_computed_when_the_room_is_refused(tmp_path, monkeypatch):
+    import errno
+
+    import sbrdf_xr._writer as writer
+    from sbrdf_xr._write_common import _NoRoom
+
+    def full(part, need):
+        raise _NoRoom(errno.ENOSPC, f"about {need} B needed, 0 B free")
+
+    _STARTED.clear()
+    monkeypatch.setattr(writer, "check_room", full)
+    with pytest.raises(CubeWriteError, match=r"no space left on device.*Nothing was written"):
+        write_cube(flagged_cube(), tmp_path / "c.nc")
+    assert not _STARTED.is_set()
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
 def _resident_bytes(path: Path) -> int:
     """Bytes of ``path`` in the page cache (``mincore`` over a read-only mapping)."""
     import ctypes
