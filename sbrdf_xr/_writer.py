@@ -391,7 +391,6 @@ def _write_locked(
             try:
                 check_room(part, block_bytes(plan))
                 nc = open_part(part, ds, plan)
-                feed.fill()  # the first missing blocks compute while the file is prepared
             except CubeWriteError:
                 raise
             except Exception as exc:
@@ -403,30 +402,43 @@ def _write_locked(
                     f"cannot resume {path}: {why}. The {len(done)} of {plan.n_blocks} blocks "
                     f"written so far are kept in {part}; {_fix(why)} and {_again()}"
                 ) from exc
+            feed.fill()
         else:
             log.unlink(missing_ok=True)
             part.unlink(missing_ok=True)
             # an uncompressed cube is laid out whole at creation: its room is needed now
             need = 0 if complevel else lazy_bytes(plan)
-            try:
-                check_room(part, need)  # before any block is computed
-                # the first blocks compute while the file is created and laid out
-                feed.fill()
-                nc = create_part(part, ds, plan, complevel)
-                write_header(log, plan)
-            except BaseException as exc:
+
+            def creation_failed(exc: BaseException) -> BaseException:
                 if nc is not None:
                     with contextlib.suppress(Exception):
                         nc.close()
                 why = _reason(exc, part, need) if isinstance(exc, Exception) else ""
                 part.unlink(missing_ok=True)  # nothing recorded yet: nothing lost
                 log.unlink(missing_ok=True)
-                if isinstance(exc, Exception) and not isinstance(exc, SbrdfError):
-                    raise CubeWriteError(
-                        f"cannot write {path}: creating {part} failed: {why}. Nothing was "
-                        f"written; {_fix(why)} and write again"
-                    ) from exc
-                raise
+                if not isinstance(exc, Exception) or isinstance(exc, SbrdfError):
+                    return exc
+                return CubeWriteError(
+                    f"cannot write {path}: creating {part} failed: {why}. Nothing was "
+                    f"written; {_fix(why)} and write again"
+                )
+
+            try:
+                check_room(part, need)  # before any block is computed
+            except BaseException as exc:
+                failure = creation_failed(exc)
+                if failure is exc:
+                    raise
+                raise failure from exc
+            feed.fill()  # the first blocks compute while the file is created and laid out
+            try:
+                nc = create_part(part, ds, plan, complevel)
+                write_header(log, plan)
+            except BaseException as exc:
+                failure = creation_failed(exc)
+                if failure is exc:
+                    raise
+                raise failure from exc
     except BaseException:
         runner.close()
         raise
