@@ -374,9 +374,8 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
     from .simulate import simulate
 
     rows: list[BenchRow] = []
-    # the kernel rows first, in a process and on a machine that nothing else has loaded
-    # yet: run after the sweeps (gigabytes written, a cluster started and stopped) the
-    # same kernel measured 22-23 % of the matmul rate, alone 25-28 %
+    # the kernel rows first, in a process and on a machine that the sweeps (gigabytes
+    # written, a cluster started and stopped) have not loaded yet
     kernel = kernel_rows(repeat)
     rot = builtin_scene("canx1-rotation")
     simulate(rot).compute()
