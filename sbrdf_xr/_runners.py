@@ -9,7 +9,7 @@ from __future__ import annotations
 import contextlib
 from collections import deque
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import dask
 import numpy as np
@@ -22,6 +22,9 @@ from ._write_common import (
     SchedulerError,
 )
 from .errors import ValidationError
+
+if TYPE_CHECKING:
+    from ._write_layout import BlockLayout
 
 
 class _Runner(Protocol):
@@ -222,3 +225,27 @@ def connect(address: str, timeout: float | str | None = None) -> Any:
             f"cannot connect to the Dask scheduler at {address} ({what}: {exc}); start one with "
             "'dask scheduler --host 127.0.0.1' or check the address"
         ) from exc
+
+
+class Feed:
+    """The blocks still to compute, handed to the runner so that at most ``limit`` are
+    computed or waiting to be written at any time."""
+
+    def __init__(self, plan: BlockLayout, runner: _Runner, todo: list[int], limit: int) -> None:
+        self.plan = plan
+        self.runner = runner
+        self.todo = iter(todo)
+        self.limit = limit
+        self.exhausted = not todo
+        #: ``(variable, region, Dask key)`` of every block submitted and not yet written
+        self.pieces: dict[int, list[tuple[str, tuple[slice, ...], Any]]] = {}
+
+    def fill(self) -> None:
+        """Submit blocks until ``limit`` are pending or none is left."""
+        while not self.exhausted and self.runner.pending < self.limit:
+            k = next(self.todo, None)
+            if k is None:
+                self.exhausted = True
+                return
+            self.pieces[k] = self.plan.pieces(k)
+            self.runner.submit(k, self.plan.task(k, [p for _, _, p in self.pieces[k]]))

@@ -123,7 +123,7 @@ import contextlib
 import os
 from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import netCDF4
 import numpy as np
@@ -133,6 +133,7 @@ from ._lock import (
     _Lock,
 )
 from ._runners import (
+    Feed,
     _check_address,
     _runner,
     connect,
@@ -378,7 +379,7 @@ def _write_locked(
         done = {k for k in done if 0 <= k < plan.n_blocks}
 
     runner = _runner(client, scheduler)
-    feed = _Feed(
+    feed = Feed(
         plan,
         runner,
         [b for b in range(plan.n_blocks) if b not in done],
@@ -409,7 +410,7 @@ def _write_locked(
             # an uncompressed cube is laid out whole at creation: its room is needed now
             need = 0 if complevel else lazy_bytes(plan)
 
-            def creation_failed(exc: BaseException) -> BaseException:
+            def creation_failed(exc: BaseException) -> NoReturn:
                 if nc is not None:
                     with contextlib.suppress(Exception):
                         nc.close()
@@ -417,28 +418,22 @@ def _write_locked(
                 part.unlink(missing_ok=True)  # nothing recorded yet: nothing lost
                 log.unlink(missing_ok=True)
                 if not isinstance(exc, Exception) or isinstance(exc, SbrdfError):
-                    return exc
-                return CubeWriteError(
+                    raise exc
+                raise CubeWriteError(
                     f"cannot write {path}: creating {part} failed: {why}. Nothing was "
                     f"written; {_fix(why)} and write again"
-                )
+                ) from exc
 
             try:
                 check_room(part, need)  # before any block is computed
             except BaseException as exc:
-                failure = creation_failed(exc)
-                if failure is exc:
-                    raise
-                raise failure from exc
+                creation_failed(exc)
             feed.fill()  # the first blocks compute while the file is created and laid out
             try:
                 nc = create_part(part, ds, plan, complevel)
                 write_header(log, plan)
             except BaseException as exc:
-                failure = creation_failed(exc)
-                if failure is exc:
-                    raise
-                raise failure from exc
+                creation_failed(exc)
     except BaseException:
         runner.close()
         raise
@@ -595,30 +590,6 @@ def _write_locked(
     log.unlink(missing_ok=True)
     fsync_dir(path.parent)
     return path
-
-
-class _Feed:
-    """The blocks still to compute, handed to the runner so that at most ``limit`` are
-    computed or waiting to be written at any time."""
-
-    def __init__(self, plan: BlockLayout, runner: Any, todo: list[int], limit: int) -> None:
-        self.plan = plan
-        self.runner = runner
-        self.todo = iter(todo)
-        self.limit = limit
-        self.exhausted = not todo
-        #: ``(variable, region, Dask key)`` of every block submitted and not yet written
-        self.pieces: dict[int, list[tuple[str, tuple[slice, ...], Any]]] = {}
-
-    def fill(self) -> None:
-        """Submit blocks until ``limit`` are pending or none is left."""
-        while not self.exhausted and self.runner.pending < self.limit:
-            k = next(self.todo, None)
-            if k is None:
-                self.exhausted = True
-                return
-            self.pieces[k] = self.plan.pieces(k)
-            self.runner.submit(k, self.plan.task(k, [p for _, _, p in self.pieces[k]]))
 
 
 def _describe(slices: Mapping[str, slice]) -> str:
