@@ -234,18 +234,14 @@ class Feed:
     def __init__(self, plan: BlockLayout, runner: _Runner, todo: list[int], limit: int) -> None:
         self.plan = plan
         self.runner = runner
-        self.todo = iter(todo)
+        self.todo = deque(todo)
         self.limit = limit
-        self.exhausted = not todo
         #: ``(variable, region, Dask key)`` of every block submitted and not yet written
         self.pieces: dict[int, list[tuple[str, tuple[slice, ...], Any]]] = {}
 
     def fill(self) -> None:
         """Submit blocks until ``limit`` are pending or none is left."""
-        while not self.exhausted and self.runner.pending < self.limit:
-            k = next(self.todo, None)
-            if k is None:
-                self.exhausted = True
-                return
+        while self.todo and self.runner.pending < self.limit:
+            k = self.todo.popleft()
             self.pieces[k] = self.plan.pieces(k)
             self.runner.submit(k, self.plan.task(k, [p for _, _, p in self.pieces[k]]))
