@@ -1,23 +1,17 @@
 """Shared pytest configuration.
 
-Hypothesis runs derandomized when ``CI`` is set, so a CI run is reproducible (the
-examples are still many and varied; locally every run explores new ones), and without
-deadlines, because shared machines are noisy.
+Hypothesis runs under the profiles of ``hypothesis_profiles`` (reproducible unless
+``SBRDF_XR_HYPOTHESIS_PROFILE`` asks for ``dev`` or ``deep``), without deadlines,
+because shared machines are noisy.
 """
 
 from __future__ import annotations
 
-import os
-
+import hypothesis_profiles  # noqa: F401  (registers and loads the profile)
 import matplotlib
 import pytest
-from hypothesis import settings
 
 matplotlib.use("Agg")
-
-settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
-settings.register_profile("dev", deadline=None, print_blob=True)
-settings.load_profile("ci" if os.environ.get("CI") else "dev")
 
 
 @pytest.fixture(autouse=True)

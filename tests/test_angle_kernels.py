@@ -8,6 +8,7 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
+from hypothesis_profiles import examples
 
 from sbrdf_xr._angle_kernels import atan2_pos, chunk_angles
 from sbrdf_xr.geometry import facet_angles, normal_incidence_tolerance
@@ -27,7 +28,7 @@ finite = st.floats(min_value=-1e300, max_value=1e300, width=64)
 positive = st.floats(min_value=2.3e-308, max_value=1e300, width=64)
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 @given(
     arrays(np.float64, 64, elements=finite),
     arrays(np.float64, 64, elements=positive),
@@ -59,7 +60,7 @@ unit = arrays(np.float64, 3, elements=st.floats(-1, 1, width=64)).filter(
 )
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.lists(unit, min_size=1, max_size=6), st.lists(st.tuples(unit, unit), min_size=1))
 @example(  # found by hypothesis: delta_theta 1.34e-12 degree apart at -15.8 degree
     [np.array([-0.3125, 0.0, 0.42578125])],

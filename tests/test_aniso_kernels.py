@@ -7,6 +7,7 @@ import pytest
 import trimesh
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_profiles import examples
 
 from sbrdf_xr import _aniso_kernels as AK
 from sbrdf_xr import anisotropy, catalog, geometry, material, models
@@ -345,7 +346,7 @@ def test_band_pre_integration_is_exact_for_anisotropic_tables(rough_table):
 _vec = st.tuples(*[st.floats(-1, 1, allow_nan=False)] * 3).filter(lambda v: np.linalg.norm(v) > 0.1)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(
     s=st.lists(_vec, min_size=1, max_size=6),
     o=st.lists(_vec, min_size=1, max_size=6),

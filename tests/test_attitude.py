@@ -7,6 +7,7 @@ import pytest
 import trimesh
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_profiles import examples
 from scipy.spatial.transform import Rotation
 
 from sbrdf_xr import attitude as att
@@ -267,7 +268,7 @@ def test_law_from_dict_builds_every_law_and_rejects_bad_tables():
 unit3 = st.tuples(*[st.floats(-1, 1) for _ in range(3)]).filter(lambda v: np.linalg.norm(v) > 0.1)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(unit3, unit3)
 def test_triad_maps_the_primary_exactly(r1, r2):
     r1, r2 = np.asarray(r1), np.asarray(r2)

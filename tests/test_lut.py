@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_profiles import examples
 from scipy.interpolate import RegularGridInterpolator, make_smoothing_spline
 
 from sbrdf_xr import _lut
@@ -101,7 +102,7 @@ def test_weighted_lookup_matrix_sums_weighted_spectra():
     np.testing.assert_allclose(total.ravel(), direct, rtol=1e-12)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(
     ti=st.floats(-10, 100),
     dt=st.floats(-60, 50),

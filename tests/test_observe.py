@@ -14,6 +14,7 @@ import pytest
 import xarray as xr
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_profiles import examples
 from scipy.optimize import brentq
 
 from sbrdf_xr import attitude as att
@@ -207,7 +208,7 @@ def test_shadow_entry_conical_closed_form(radius, beta_deg):
 radii = st.floats(1e-4, 0.05)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(radii, radii, st.floats(0.0, 1.0), st.floats(0.0, 1.0))
 def test_sunlit_fraction_bounded_and_monotone_through_penumbra(a, b, u1, u2):
     lo, hi = abs(a - b), a + b
@@ -222,7 +223,7 @@ def test_sunlit_fraction_bounded_and_monotone_through_penumbra(a, b, u1, u2):
     assert abs(edge[0] - nested) < 1e-6 and abs(edge[3] - nested) < 1e-6
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(st.floats(0.5, 2.0), st.floats(0.2, 5.0), st.floats(0.0, 1.0))
 def test_disc_overlap_against_shapely_polygons(a, ratio, u):
     shapely = pytest.importorskip("shapely")

@@ -7,6 +7,7 @@ import pytest
 import xarray as xr
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_profiles import examples
 
 from sbrdf_xr import photometry as P
 from sbrdf_xr.errors import ValidationError
@@ -46,7 +47,7 @@ def test_airmass_wraps_pvlib_models_and_refuses_the_horizon():
         P.airmass(10.0, model="bogus")
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=examples(50), deadline=None)
 @given(st.floats(1.0, 10.0), st.floats(0.0, 1.0), st.floats(0.0, 1.0), st.floats(0.0, 1.0))
 def test_extinction_law_is_exact(x, kb, kv, kr):
     k = {"B": kb, "V": kv, "R": kr}

@@ -9,6 +9,7 @@ import pytest
 import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_profiles import examples
 from shapely.geometry import MultiPoint, Polygon
 
 from sbrdf_xr import _polygon_kernels as pk
@@ -231,7 +232,7 @@ unit = (
 )
 
 
-@settings(max_examples=40)
+@settings(max_examples=examples(40))
 @given(name=st.sampled_from(sorted(NONCONVEX)), s=unit, o=unit)
 def test_exact_properties(name, s, o):
     """0 <= fraction <= 1; 0 where N.s <= 0 or N.o <= 0; symmetric in Sun and observer; at
@@ -248,7 +249,7 @@ def test_exact_properties(name, s, o):
     assert np.all(f >= lit + seen - 1 - 1e-12)
 
 
-@settings(max_examples=25)
+@settings(max_examples=examples(25))
 @given(s=unit, o=unit, subdivisions=st.integers(1, 2))
 def test_exactly_one_on_convex_body(s, o, subdivisions):
     """On a convex body (coplanar facets included) nothing is shadowed: exactly 1 where the
@@ -262,7 +263,7 @@ def test_exactly_one_on_convex_body(s, o, subdivisions):
         )
 
 
-@settings(max_examples=25)
+@settings(max_examples=examples(25))
 @given(
     name=st.sampled_from(sorted(NONCONVEX)), s=unit, o=unit, step=st.tuples(*[st.floats(-1, 1)] * 3)
 )

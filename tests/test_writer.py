@@ -28,6 +28,7 @@ import pytest
 import xarray as xr
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_profiles import examples
 
 from sbrdf_xr._write_common import release_freed_memory
 from sbrdf_xr._write_disk import SyncBehind, drop_behind
@@ -217,7 +218,7 @@ def test_round_trip_threaded(tmp_path, factory):
             assert "_FillValue" not in nc.variables[name].ncattrs()
 
 
-@settings(max_examples=15, deadline=None, database=None)
+@settings(max_examples=examples(15), deadline=None, database=None)
 @given(
     shape=st.tuples(st.integers(1, 9), st.integers(1, 7), st.integers(1, 5)),
     data=st.data(),

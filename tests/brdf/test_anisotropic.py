@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_profiles import examples
 
 from sbrdf_xr import geometry, material, models
 from sbrdf_xr.brdf import anisotropic as A
@@ -28,7 +29,7 @@ vectors = st.tuples(*[st.floats(-1, 1)] * 3).filter(lambda v: v[0] ** 2 + v[1] *
 rough = st.floats(-2.5, 0.3).map(lambda x: 10**x)
 
 
-@settings(max_examples=80, deadline=None)
+@settings(max_examples=examples(80), deadline=None)
 @given(s=vectors, o=vectors, t=vectors, a=rough)
 def test_equal_roughnesses_reproduce_the_isotropic_model(s, o, t, a):
     # Same arithmetic up to the order of operations: 1e-12 relative.
@@ -39,7 +40,7 @@ def test_equal_roughnesses_reproduce_the_isotropic_model(s, o, t, a):
     np.testing.assert_allclose(got, want, rtol=1e-12, atol=0)
 
 
-@settings(max_examples=80, deadline=None)
+@settings(max_examples=examples(80), deadline=None)
 @given(s=vectors, o=vectors, t=vectors, ax=rough, ay=rough)
 def test_reciprocity(s, o, t, ax, ay):
     s, o, t = upper(s), upper(o), np.array(t)
@@ -60,7 +61,7 @@ def test_reflectance_quadrature_matches_the_isotropic_one():
         np.testing.assert_allclose(got, want, rtol=1e-3)
 
 
-@settings(max_examples=15, deadline=None)
+@settings(max_examples=examples(15), deadline=None)
 @given(
     ax=st.floats(0.02, 1.0),
     ay=st.floats(0.02, 1.0),

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_profiles import examples
 
 from sbrdf_xr.brdf import lambert
 from sbrdf_xr.errors import ValidationError
@@ -56,7 +57,7 @@ def test_shapes_dtype_and_grid():
     assert np.all(g[:2] == pytest.approx(0.3 / np.pi)) and np.all(g[2] == 0)
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(
     st.lists(st.floats(-1, 1), min_size=6, max_size=6).filter(
         lambda v: sum(x * x for x in v[:3]) > 1e-6 and sum(x * x for x in v[3:]) > 1e-6

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_profiles import examples
 from scipy import integrate
 
 from sbrdf_xr.brdf import robertson_sandford as rs
@@ -278,7 +279,7 @@ def rs_params(draw):
     return {"rho_D": t * u * g, "epsilon": t * (1 - u) * g, "b": b, "e": e}
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 @given(
     s=directions(),
     o=directions(),
