@@ -107,6 +107,9 @@ def chunk_angles(
             ns = nx * a + ny * b + nz * c
             no = nx * u + ny * v + nz * w
             stx, sty, stz = a - ns * nx, b - ns * ny, c - ns * nz
+            # projected twice, as geometry._tangential: in the plane to eps |s_t|
+            d = stx * nx + sty * ny + stz * nz
+            stx, sty, stz = stx - d * nx, sty - d * ny, stz - d * nz
             st = np.sqrt(stx * stx + sty * sty + stz * stz)
             ti = atan2_pos(st, ns)
             inv = 1.0 / st
@@ -150,10 +153,14 @@ def facet_frame(
     aligned with ``N`` when the observer is on the normal too.
     """
     stx, sty, stz = sx - ns * nx, sy - ns * ny, sz - ns * nz
+    d = stx * nx + sty * ny + stz * nz  # projected twice, as geometry._tangential
+    stx, sty, stz = stx - d * nx, sty - d * ny, stz - d * nz
     st_len = np.sqrt(stx * stx + sty * sty + stz * stz)
     theta_i = np.arctan2(st_len, ns)
     if st_len <= tol:
         otx, oty, otz = ox - no * nx, oy - no * ny, oz - no * nz
+        d = otx * nx + oty * ny + otz * nz
+        otx, oty, otz = otx - d * nx, oty - d * ny, otz - d * nz
         ot_len = np.sqrt(otx * otx + oty * oty + otz * otz)
         if ot_len > tol:
             ex, ey, ez = otx / ot_len, oty / ot_len, otz / ot_len

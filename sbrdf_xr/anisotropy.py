@@ -55,7 +55,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .errors import ValidationError
-from .geometry import normal_incidence_tolerance, normalize
+from .geometry import _forward_direction, normal_incidence_tolerance, normalize
 
 __all__ = [
     "DEFAULT_TANGENT_DIRECTION",
@@ -86,12 +86,6 @@ def _least_aligned_axis(n: np.ndarray) -> np.ndarray:
     idx = np.argmin(np.abs(n), axis=-1)
     np.put_along_axis(axis, idx[..., None], 1.0, axis=-1)
     return axis
-
-
-def _perpendicular(n: np.ndarray) -> np.ndarray:
-    """The fixed perpendicular of :func:`sbrdf_xr.geometry.facet_angles` (``n x axis``)."""
-    p = np.cross(n, _least_aligned_axis(n))
-    return p / np.linalg.norm(p, axis=-1, keepdims=True)
 
 
 def project_tangents(normal: ArrayLike, direction: ArrayLike | None = None) -> NDArray[np.float64]:
@@ -216,16 +210,7 @@ def illumination_azimuth(
         )
     t = t / lt[..., None]
     b = np.cross(n, t)
-    ns, no = _dot(n, s), _dot(n, o)
-    s_t = s - ns[..., None] * n
-    o_t = o - no[..., None] * n
-    ls = np.linalg.norm(s_t, axis=-1)
-    lo = np.linalg.norm(o_t, axis=-1)
-    normal_inc = ls <= tol
-    e_sun = -s_t / np.where(normal_inc, 1.0, ls)[..., None]
-    e_obs = o_t / np.where(lo > tol, lo, 1.0)[..., None]
-    e_obs = np.where((lo > tol)[..., None], e_obs, _perpendicular(n))
-    e_f = np.where(normal_inc[..., None], e_obs, e_sun)
+    e_f, _ = _forward_direction(n, s, o, _dot(n, s), _dot(n, o), tol)
     psi = np.degrees(np.arctan2(_dot(e_f, b), _dot(e_f, t)))
     op = _dot(o, np.cross(n, e_f))
     # the mirror only off the plane: an observer in it (phi = 0 up to rounding) keeps psi

@@ -228,6 +228,40 @@ def _perpendicular(n: np.ndarray) -> np.ndarray:
     return p / np.linalg.norm(p, axis=-1, keepdims=True)
 
 
+def _tangential(v: np.ndarray, n: np.ndarray, vn: np.ndarray) -> np.ndarray:
+    """The part of ``v`` in the plane of the unit normal ``n`` (``vn = n.v``), projected twice.
+
+    One projection ``v - (n.v) n`` leaves a normal component of the rounding of ``n.v``
+    (about ``eps``), which near normal incidence is a large fraction of a short
+    tangential part and tilts the frame built on it out of the plane (``e_f.N`` of
+    ``eps / |v_t|``); a second projection brings it to ``eps |v_t|`` ("twice is enough",
+    Giraud et al., Numer. Math. 101, 87, 2005).
+    """
+    v_t = v - vn[..., None] * n
+    return v_t - _dot(v_t, n)[..., None] * n
+
+
+def _forward_direction(
+    n: np.ndarray, s: np.ndarray, o: np.ndarray, ns: np.ndarray, no: np.ndarray, tol: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The in-plane forward unit vector ``e_f`` of paper 000 Fig. 4 and ``|s_t|``.
+
+    ``e_f = -s_t / |s_t|`` from the Sun's tangential part ``s_t``; at normal incidence
+    (``|s_t| <= tol``) from the observer's, ``o_t / |o_t|`` (so ``phi = 0``); with the
+    observer along the normal too, the fixed perpendicular of :func:`_perpendicular`.
+    """
+    s_t = _tangential(s, n, ns)
+    s_t_len = np.linalg.norm(s_t, axis=-1)
+    normal_inc = s_t_len <= tol
+    o_t = _tangential(o, n, no)
+    o_t_len = np.linalg.norm(o_t, axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        e_sun = -s_t / np.where(normal_inc, 1.0, s_t_len)[..., None]
+        e_obs = o_t / np.where(o_t_len > tol, o_t_len, 1.0)[..., None]
+    e_obs = np.where((o_t_len > tol)[..., None], e_obs, _perpendicular(n))
+    return np.where(normal_inc[..., None], e_obs, e_sun), s_t_len
+
+
 def facet_angles(
     normal: ArrayLike,
     to_sun: ArrayLike,
@@ -300,21 +334,8 @@ def facet_angles(
 
     ns = _dot(n, s)
     no = _dot(n, o)
-    s_t = s - ns[..., None] * n
-    s_t_len = np.linalg.norm(s_t, axis=-1)
+    e_f, s_t_len = _forward_direction(n, s, o, ns, no, normal_incidence_tolerance(dtype))
     theta_i = np.arctan2(s_t_len, ns)
-
-    tol = normal_incidence_tolerance(dtype)
-    normal_inc = s_t_len <= tol
-    # Forward direction from the Sun; at normal incidence from the observer; if the
-    # observer is along the normal too, any perpendicular will do.
-    o_t = o - no[..., None] * n
-    o_t_len = np.linalg.norm(o_t, axis=-1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        e_sun = -s_t / np.where(normal_inc, 1.0, s_t_len)[..., None]
-        e_obs = o_t / np.where(o_t_len > tol, o_t_len, 1.0)[..., None]
-    e_obs = np.where((o_t_len > tol)[..., None], e_obs, _perpendicular(n))
-    e_f = np.where(normal_inc[..., None], e_obs, e_sun)
     p = np.cross(n, e_f)
 
     of = _dot(o, e_f)
@@ -413,9 +434,13 @@ def half_vector(to_sun: ArrayLike, to_observer: ArrayLike) -> NDArray[np.floatin
     Returns
     -------
     ndarray, shape (..., 3)
-        The bisector of ``s`` and ``o``.  At exact forward scatter (``o = -s``,
-        phase angle 180 deg) the bisector is any unit vector perpendicular to
-        ``s``; a deterministic one is returned instead of 0/0.  Paper 001 writes
+        The bisector of ``s`` and ``o``.  At forward scatter (``|o + s|`` under
+        :func:`normal_incidence_tolerance`, phase angle within about 1e-12 rad of
+        180 deg, where ``(o + s) / |o + s|`` is rounding noise) the bisector is any
+        unit vector perpendicular to ``s - o``; a deterministic one is returned
+        instead of 0/0, and swapping ``s`` and ``o`` returns exactly its negative,
+        so that every function of the bisector that is even in it (``(h.N)^2``,
+        ``|h x N|^2``) stays reciprocal there.  Paper 001 writes
         the normalisation as ``sqrt(2 (1 + o.s))``, which equals ``|o + s|`` for
         unit vectors but cancels catastrophically near 180 deg; ``|o + s|`` is
         computed directly.
@@ -440,7 +465,9 @@ def half_vector(to_sun: ArrayLike, to_observer: ArrayLike) -> NDArray[np.floatin
     g_len = np.linalg.norm(g, axis=-1, keepdims=True)
     tiny = g_len <= normal_incidence_tolerance(dtype)
     out = g / np.where(tiny, 1.0, g_len)
-    return np.where(tiny, _perpendicular(s), out)
+    # s - o is 2 s there, and o - s is exactly -(s - o): the fallback is odd in the swap
+    # (elsewhere s - o may be 0, at backscatter: s stands in for it, and is discarded)
+    return np.where(tiny, _perpendicular(np.where(tiny, s - o, s)), out)
 
 
 def to_conventional(
