@@ -125,6 +125,17 @@ def _sin2(n: np.ndarray, v: np.ndarray) -> np.ndarray:
     return np.einsum("...k,...k->...", c, c)
 
 
+def _cos_half(s: np.ndarray, o: np.ndarray) -> np.ndarray:
+    """``h.s = h.o = |s + o| / 2`` for unit ``s``, ``o`` (the microfacet cosine).
+
+    ``h.s`` and ``h.o`` are equal in exact arithmetic, but computed as dot products
+    they differ by the rounding of ``|s|^2 - |o|^2`` over ``|s + o|``, which is large
+    near forward scatter; ``|s + o| / 2`` is symmetric in ``s`` and ``o`` to the bit
+    and accurate everywhere.
+    """
+    return 0.5 * np.linalg.norm(s + o, axis=-1)
+
+
 def _check_angles(*named: tuple[str, ArrayLike]) -> list[np.ndarray]:
     """Angles [degree] checked to be finite real numbers."""
     arrays = []

@@ -194,6 +194,10 @@ class Model:
     constraint : callable, optional
         ``constraint(checked) -> None``, a joint condition on the validated parameters
         (raises :class:`~sbrdf_xr.errors.ValidationError`).
+    reciprocal : bool, default False
+        The model claims Helmholtz reciprocity, ``f(s, o) = f(o, s)``, over its whole
+        domain (grazing and forward-scatter geometries included); the suite checks
+        every model that claims it.
 
     Raises
     ------
@@ -225,6 +229,7 @@ class Model:
     constraint: Callable[[dict[str, NDArray[np.float64]]], None] | None = field(
         default=None, repr=False
     )
+    reciprocal: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "parameters", tuple(self.parameters))

@@ -49,6 +49,7 @@ from ._common import (
     _cast_out,
     _check_theta_i,
     _check_wavelength,
+    _cos_half,
     _facet_frame,
     tangent_from_azimuth,
 )
@@ -167,7 +168,9 @@ def brdf(
     Returns
     -------
     ndarray, shape broadcast(...) + (n_wl,)
-        BRDF [sr-1]; zero where ``N.s <= 0`` or ``N.o <= 0``.  Reciprocal.
+        BRDF [sr-1]; zero where ``N.s <= 0`` or ``N.o <= 0`` (at and below the
+        horizon).  Reciprocal to the bit over the whole domain, as
+        :func:`sbrdf_xr.brdf.microfacet.brdf` (finite near the horizon likewise).
 
     Examples
     --------
@@ -190,7 +193,7 @@ def brdf(
     ci = np.clip(cos_i, 0.0, 1.0)[..., None]
     cr = np.clip(cos_r, 0.0, 1.0)[..., None]
     vis = 1.0 / np.maximum(2.0 * (cr * _s_term(sl, ax, ay) + ci * _s_term(ol, ax, ay)), _VIS_FLOOR)
-    cos_hs = np.clip(np.einsum("...k,...k->...", h, s), 0.0, 1.0)
+    cos_hs = np.clip(_cos_half(s, o), 0.0, 1.0)
     fres = optics.fresnel_conductor(cos_hs[..., None], p["n"] + 1j * p["k"])
     f = fres * d * vis + p["rho_d"] / np.pi
     return _cast_out(np.where(mask[..., None], f, 0.0), dtype)
@@ -314,6 +317,7 @@ MODEL = Model(
     citation="Heitz, JCGT 3(2) 2014, Eqs. 85, 86 and 99; Walter et al., EGSR 2007",
     reflectance=directional_hemispherical_reflectance,
     anisotropic=True,
+    reciprocal=True,
 )
 PARAMS = MODEL.param_names
 check_params, brdf_angles, render_grid = MODEL.check_params, MODEL.brdf_angles, MODEL.render_grid

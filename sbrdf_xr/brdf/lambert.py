@@ -121,6 +121,7 @@ MODEL = Model(
     parameters=PARAMETERS,
     citation="Sandford, paper 001 section 2 (a perfectly diffuse sample: 1/pi sr-1)",
     reflectance=directional_hemispherical_reflectance,
+    reciprocal=True,
 )
 PARAMS = MODEL.param_names
 check_params, brdf_angles, render_grid = MODEL.check_params, MODEL.brdf_angles, MODEL.render_grid

@@ -39,7 +39,15 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import geometry
 from . import optics
-from ._common import _band_param, _cast_out, _check_theta_i, _check_wavelength, _facet_frame, _sin2
+from ._common import (
+    _band_param,
+    _cast_out,
+    _check_theta_i,
+    _check_wavelength,
+    _cos_half,
+    _facet_frame,
+    _sin2,
+)
 from ._model import Model, Parameter
 
 __all__ = [
@@ -147,7 +155,7 @@ def _specular_parts(
     ci = np.clip(cos_i, 0.0, 1.0)[..., None]
     cr = np.clip(cos_r, 0.0, 1.0)[..., None]
     geo = distribution_ggx(cos_h**2, sin2_h, roughness) * _vis(ci, cr, a2)
-    return geo, np.einsum("...k,...k->...", h, s)
+    return geo, _cos_half(s, o)
 
 
 def specular_factor(
@@ -221,7 +229,13 @@ def brdf(
     Returns
     -------
     ndarray, shape broadcast(...) + (n_wl,)
-        BRDF [sr-1]; exactly zero where ``N.s <= 0`` or ``N.o <= 0``.  Reciprocal.
+        BRDF [sr-1]; exactly zero where ``N.s <= 0`` or ``N.o <= 0`` (at and below
+        the horizon).  Reciprocal to the bit, ``f(s, o) = f(o, s)``, over the whole
+        domain (forward scatter and cosines down to the smallest normal float
+        included).  Above the horizon the value is the formula's: as both ``N.s`` and
+        ``N.o`` go to 0 the visibility term grows like ``1 / (2 alpha (N.s + N.o))``
+        (its denominator floored at ``1e-150``), so the BRDF stays finite,
+        while the radiometric product ``N.s N.o f_r`` goes to 0 continuously.
 
     Examples
     --------
@@ -360,6 +374,7 @@ MODEL = Model(
     ),
     reflectance=directional_hemispherical_reflectance,
     stack=optics.THIN_FILM_STACK,
+    reciprocal=True,
 )
 PARAMS = MODEL.param_names
 check_params, brdf_angles, render_grid = MODEL.check_params, MODEL.brdf_angles, MODEL.render_grid

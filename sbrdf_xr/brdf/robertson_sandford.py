@@ -453,7 +453,10 @@ def brdf(
         BRDF [sr-1]; exactly zero where ``N.s <= 0`` or ``N.o <= 0``.  Integrated
         over the hemisphere (``f_r cos(theta_r) dOmega_r``) it gives
         ``1 - epsilon(lambda, theta_i)`` (Eq. 11) without the cut-off, and
-        :func:`directional_hemispherical_reflectance` with it.
+        :func:`directional_hemispherical_reflectance` with it.  Not reciprocal,
+        as the paper's model is not: the specular term of Eq. 15 carries
+        ``1 / cos(theta_r)`` and the incidence normalisation ``H(theta_i)`` of Eq. 18
+        (the diffuse term, Eq. 13, is reciprocal, Eq. 12).
 
     Examples
     --------
