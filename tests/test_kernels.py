@@ -18,8 +18,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
+from hypothesis_profiles import examples
 
 from sbrdf_xr import geometry
 from sbrdf_xr import testing as T
@@ -86,7 +87,7 @@ def _compare(s, o, normals, areas, mat, tables, method, dtype, fraction=None):
     assert np.all(np.isfinite(got.signal)) and np.all(got.signal >= 0)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(
     seed=st.integers(0, 2**31 - 1),
     method=st.sampled_from(["nearest", "linear", "cubic"]),
@@ -205,12 +206,15 @@ def test_cube_spacecraft_through_both_kernels():
     )
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(
     st.lists(st.floats(-200, 200, allow_nan=False, allow_infinity=False), min_size=1, max_size=40),
     st.lists(st.floats(-250, 250, allow_nan=False, allow_infinity=False), max_size=30),
     st.integers(0, 2),
 )
+# found by the deep profile: two nodes 6.1e-5 apart among nodes 190 wide give cubic
+# weights of 1e7 whose sum carries 4e-9 of rounding
+@example(nodes=[0.0, 1.0, 6.103515625e-05, -190.0], xs=[-27.0], method=2)
 def test_bucket_map_finds_the_same_cell_as_searchsorted(nodes, xs, method):
     """The kernel's axis look-up (bucket map + correcting steps) is exactly the clipped
     ``searchsorted(grid, x, "right") - 1`` of ``_lut.axis_weights``, also at nodes,
@@ -237,4 +241,8 @@ def test_bucket_map_finds_the_same_cell_as_searchsorted(nodes, xs, method):
         elif method == 0:
             t = (xc - grid[i]) / (grid[i + 1] - grid[i])
             assert idx[0] == (i + 1 if t >= 0.5 else i)
-        assert np.isclose(w[:k].sum(), 1.0, rtol=1e-9, atol=1e-9)
+        # Each Lagrange weight is a product of three ratios (<= 6 roundings: |dw| <= 3 eps |w|)
+        # and the sum of four adds <= 3 eps sum|w|: the partition of unity holds to
+        # 8 eps sum|w| (1e-9 where the weights are O(1)).
+        tol = max(1e-9, 8 * np.finfo(float).eps * np.abs(w[:k]).sum())
+        assert abs(w[:k].sum() - 1.0) <= tol

@@ -7,8 +7,9 @@ import dask.array as dsa
 import numpy as np
 import pytest
 import xarray as xr
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
+from hypothesis_profiles import examples
 
 import sbrdf_xr  # noqa: F401  (registers the accessors)
 from sbrdf_xr import material as M
@@ -453,12 +454,17 @@ def _sun_azimuth_spread(table, theta_r, obs_az, dtype, ti_deg=1e-6, n_az=48):
     s = np.stack([np.sin(ti) * np.cos(az), np.sin(ti) * np.sin(az), np.full(n_az, np.cos(ti))], -1)
     a = geometry.facet_angles(np.array([0, 0, 1], dtype=dtype), s.astype(dtype), o[None, :])
     v = M.lookup(table, a.theta_i, a.delta_theta, a.phi).values.astype(np.float64)
-    ref = v.max(axis=0)
+    # Relative to the local value, but not below 1e-4 of the normal-incidence row's peak:
+    # near a zero of the profile (the "-paper" aluminium is 0 at the exact specular point
+    # of theta_i = 0) a continuous look-up varies by ~2 theta_i / theta_r of a value that
+    # is itself ~0, which is no jump; a jump of 1e-3 of anything above that floor is caught.
+    floor = 1e-4 * np.asarray(table.isel(theta_i=0).max(("delta_theta", "phi")), dtype=float)
+    ref = np.maximum(v.max(axis=0), floor)
     ok = ref > 1e-9
     return float(np.max((v.max(axis=0) - v.min(axis=0))[ok] / ref[ok])) if ok.any() else 0.0
 
 
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=examples(25), deadline=None)
 @given(
     theta_r=st.floats(0.0, 85.0),
     obs_az=st.floats(0.0, 2 * np.pi),
@@ -508,12 +514,15 @@ SHIPPED = [
 
 
 @pytest.mark.parametrize("name", SHIPPED)
-@settings(max_examples=10, deadline=None)
+@settings(max_examples=examples(10), deadline=None)
 @given(
     theta_r=st.floats(0.0, 85.0),
     obs_az=st.floats(0.0, 2 * np.pi),
     dtype=st.sampled_from([np.float64, np.float32]),
 )
+# found by the deep profile: the observer 1e-6 deg from the normal, beside the zero of
+# the "-paper" aluminium at the specular point (old relative spread 2 %, of a 6e-8 value)
+@example(theta_r=1e-06, obs_az=0.0, dtype=np.float64)
 def test_shipped_tables_do_not_jump_at_normal_incidence(name, theta_r, obs_az, dtype):
     from sbrdf_xr import catalog
 
