@@ -21,10 +21,11 @@ import matplotlib.pyplot as plt
 import numpy as np
 import trimesh
 
-from sbrdf_xr import catalog, geometry, models
-from sbrdf_xr.scene import Scene
-from sbrdf_xr.simulate import simulate
-from sbrdf_xr.spacecraft import Spacecraft
+from sbrdf_xr import catalog, geometry
+from sbrdf_xr.body.spacecraft import Spacecraft
+from sbrdf_xr.engine import Scene
+from sbrdf_xr.engine.run import simulate
+from sbrdf_xr.materials import models
 
 OUT = Path(__file__).parent / "img" / "brushed_panel.png"
 WAVELENGTH = 560.0  # [nm]

@@ -11,9 +11,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
 from sbrdf_xr import geometry, plot
-from sbrdf_xr.scene import builtin_scene
-from sbrdf_xr.simulate import simulate
-from sbrdf_xr.spacecraft import canx1
+from sbrdf_xr.body.spacecraft import canx1
+from sbrdf_xr.engine import builtin_scene
+from sbrdf_xr.engine.run import simulate
 
 OUT = Path(__file__).resolve().parent / "img"
 DPI = 80

@@ -15,8 +15,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-from sbrdf_xr.scene import builtin_scene
-from sbrdf_xr.simulate import simulate
+from sbrdf_xr.engine import builtin_scene
+from sbrdf_xr.engine.run import simulate
 
 OUT = Path(__file__).parent / "img" / "canx1_imperfections.png"
 

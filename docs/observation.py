@@ -14,9 +14,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from sbrdf_xr.engine import builtin_scene
+from sbrdf_xr.engine.run import simulate
 from sbrdf_xr.photometry import magnitudes
-from sbrdf_xr.scene import builtin_scene
-from sbrdf_xr.simulate import simulate
 
 OUT = Path(__file__).parent / "img" / "canx1_pass.png"
 

@@ -5,13 +5,35 @@ points: :func:`build_lut` and :func:`lookup` (materials), :func:`load_spacecraft
 :func:`canx1` (spacecraft), :class:`Scene`, :func:`simulate` and :func:`write`
 (simulations), :mod:`sbrdf_xr.photometry` (colour photometry) and
 :mod:`sbrdf_xr.catalog` (shipped data).
+
+The packages are the layers, lowest first; a package imports only from lower ones:
+
+* shared by every layer: :mod:`~sbrdf_xr.errors`, :mod:`~sbrdf_xr.rotations`,
+  :mod:`~sbrdf_xr.geometry`, :mod:`~sbrdf_xr.anisotropy`, :mod:`~sbrdf_xr.sources`;
+* :mod:`~sbrdf_xr.kernels` (compiled and numpy kernels), :mod:`~sbrdf_xr.brdf`
+  (analytic BRDF models);
+* :mod:`~sbrdf_xr.materials` (tables, models, measurements), :mod:`~sbrdf_xr.body`
+  (spacecraft meshes, facets, shadowing), :mod:`~sbrdf_xr.photometry` (bands,
+  magnitudes, light curves), :mod:`~sbrdf_xr.observing` (orbits, sites, times,
+  attitude laws, the Earth's shadow);
+* :mod:`~sbrdf_xr.catalog` (the shipped data, loaded by kind);
+* :mod:`~sbrdf_xr.store` (the cube writer) and :mod:`~sbrdf_xr.engine` (scenes,
+  plans, simulation);
+* users of everything: :mod:`~sbrdf_xr.invert`, :mod:`~sbrdf_xr.bench`,
+  :mod:`~sbrdf_xr.plot`, :mod:`~sbrdf_xr.accessors`, :mod:`~sbrdf_xr.testing` and
+  :mod:`~sbrdf_xr.cli`.
+
+``dir(sbrdf_xr)`` lists :data:`__all__`: the functions and classes above and every
+public package and module, each imported on first use.
 """
 
-from __future__ import annotations
+import importlib as _importlib
 
-from . import accessors, catalog, errors, geometry, material  # noqa: F401
+from . import accessors, catalog, errors, geometry
 from ._version import __version__
-from .material import (
+from .body import Spacecraft, canx1, load_spacecraft
+from .engine import Scene, builtin_scene, load_scene, simulate, write
+from .materials import (
     build_lut,
     constant_material,
     hemispherical_reflectance,
@@ -19,28 +41,78 @@ from .material import (
     lookup,
     open_material,
 )
-from .scene import Scene, builtin_scene, load_scene
-from .simulate import simulate, write
-from .spacecraft import Spacecraft, canx1, load_spacecraft
+
+#: The public modules and packages, reachable as attributes (imported on first use).
+_SUBMODULES = (
+    "accessors",
+    "anisotropy",
+    "bench",
+    "body",
+    "brdf",
+    "catalog",
+    "cli",
+    "engine",
+    "errors",
+    "geometry",
+    "invert",
+    "kernels",
+    "materials",
+    "observing",
+    "photometry",
+    "plot",
+    "rotations",
+    "sources",
+    "store",
+    "testing",
+)
 
 __all__ = [
     "Scene",
     "Spacecraft",
     "__version__",
+    "accessors",
+    "anisotropy",
+    "bench",
+    "body",
+    "brdf",
     "build_lut",
     "builtin_scene",
     "canx1",
     "catalog",
+    "cli",
     "constant_material",
+    "engine",
     "errors",
     "geometry",
     "hemispherical_reflectance",
+    "invert",
+    "kernels",
     "lambertian",
     "load_scene",
     "load_spacecraft",
     "lookup",
-    "material",
+    "materials",
+    "observing",
     "open_material",
+    "photometry",
+    "plot",
+    "rotations",
     "simulate",
+    "sources",
+    "store",
+    "testing",
     "write",
 ]
+
+
+assert set(_SUBMODULES) <= set(__all__)
+
+
+def __getattr__(name: str) -> object:
+    if name in _SUBMODULES:
+        return _importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return list(__all__)

@@ -157,7 +157,7 @@ ATTRS: dict[str, dict[str, str]] = {
     },
     "obs": {"units": "1", "long_name": "observation index"},
     "rotation_angle": {"units": DEGREE, "long_name": "body rotation angle"},
-    # --- observations (sbrdf_xr.observation) ---
+    # --- observations (sbrdf_xr.observing.observation) ---
     "to_earth": {
         "units": "1",
         "long_name": "unit vector toward the Earth's centre in the body frame",

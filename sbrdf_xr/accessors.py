@@ -1,7 +1,7 @@
 """xarray accessors: ``da.sbrdf.<method>`` forwards to the module functions.
 
 Compose, never subclass: every accessor method is a one-line call of the function
-documented in :mod:`sbrdf_xr.material`.
+documented in :mod:`sbrdf_xr.materials.tables`.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from typing import Any
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from . import material as _material
+from .materials import tables as _material
 
 __all__ = ["SbrdfDataArrayAccessor", "SbrdfDatasetAccessor"]
 
@@ -20,7 +20,7 @@ __all__ = ["SbrdfDataArrayAccessor", "SbrdfDatasetAccessor"]
 class SbrdfDataArrayAccessor:
     """Methods of a material table, as ``da.sbrdf.lookup(...)`` and friends.
 
-    Each method forwards to the function of the same name in :mod:`sbrdf_xr.material`.
+    Each method forwards to the function of the same name in :mod:`sbrdf_xr.materials.tables`.
 
     Examples
     --------
@@ -41,7 +41,7 @@ class SbrdfDataArrayAccessor:
         self._da = da
 
     def validate(self, **kwargs: Any) -> xr.DataArray:
-        """:func:`sbrdf_xr.material.validate_material`."""
+        """:func:`sbrdf_xr.materials.tables.validate_material`."""
         return _material.validate_material(self._da, **kwargs)
 
     def lookup(
@@ -51,17 +51,17 @@ class SbrdfDataArrayAccessor:
         phi: ArrayLike | xr.DataArray,
         method: str = "linear",
     ) -> xr.DataArray:
-        """:func:`sbrdf_xr.material.lookup` on this table."""
+        """:func:`sbrdf_xr.materials.tables.lookup` on this table."""
         return _material.lookup(self._da, theta_i, delta_theta, phi, method=method)
 
     def hemispherical_reflectance(
         self, theta_i: ArrayLike | None = None, **kwargs: Any
     ) -> xr.DataArray:
-        """:func:`sbrdf_xr.material.hemispherical_reflectance` of this table."""
+        """:func:`sbrdf_xr.materials.tables.hemispherical_reflectance` of this table."""
         return _material.hemispherical_reflectance(self._da, theta_i, **kwargs)
 
     def to_netcdf(self, path: Any, **kwargs: Any) -> Any:
-        """:func:`sbrdf_xr.material.to_netcdf` of this table."""
+        """:func:`sbrdf_xr.materials.tables.to_netcdf` of this table."""
         return _material.to_netcdf(self._da, path, **kwargs)
 
     @property

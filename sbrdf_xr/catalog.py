@@ -1,17 +1,7 @@
 """The catalogs that ship with sbrdf_xr: materials, measurement sets, paint parameters, spacecraft.
 
-The catalog directory holds ``index.toml``, one ``[[entry]]`` table per item::
-
-    [[entry]]
-    name = "lambertian-grey-50"          # unique, lower-case, used by load()
-    kind = "material"                    # material | measurements | model
-                                         # | paint_parameters | spacecraft
-                                         # | orbit (a TLE file)
-                                         # | site (a table of a TOML file of sites)
-    path = "materials/lambertian-grey-50.nc"   # relative to the catalog directory
-    source = "synthetic"                 # measured | synthetic | model:<name>
-    description = "..."                  # what it is
-    provenance = "..."                   # where its numbers come from
+The catalog directory holds ``index.toml``, one ``[[entry]]`` table per item (its fields
+are described in :mod:`sbrdf_xr._catalog_index`).
 
 In a source checkout the directory is the top-level ``catalogs/``; an installed
 package carries a copy at ``sbrdf_xr/catalogs`` (see ``pyproject.toml``).
@@ -40,7 +30,6 @@ import trimesh
 import xarray as xr
 from numpy.typing import DTypeLike
 
-from . import material, models, observe, spacecraft
 from ._cache import cached_table
 from ._catalog_index import (
     CATALOG_PATH_ENV,
@@ -56,7 +45,11 @@ from ._catalog_index import (
     user_catalog_dirs,
 )
 from ._names import SBRDF
+from .body import spacecraft
 from .errors import CatalogError, ValidationError
+from .materials import models
+from .materials import tables as material
+from .observing import observe
 
 __all__ = [
     "CATALOG_PATH_ENV",
@@ -198,9 +191,10 @@ def load(name: str, dtype: DTypeLike | None = None) -> Any:
     object
         A material ``DataArray`` for ``material``; a measurement ``Dataset`` for
         ``measurements``; a parameter ``Dataset`` for ``model`` (see
-        :mod:`sbrdf_xr.models`) and ``paint_parameters``; a
-        :class:`~sbrdf_xr.spacecraft.Spacecraft` for ``spacecraft``; an
-        :class:`~sbrdf_xr.observe.Orbit` for ``orbit``; a :class:`~sbrdf_xr.observe.Site`
+        :mod:`sbrdf_xr.materials.models`) and ``paint_parameters``; a
+        :class:`~sbrdf_xr.body.spacecraft.Spacecraft` for ``spacecraft``; an
+        :class:`~sbrdf_xr.observing.observe.Orbit` for ``orbit``; a
+        :class:`~sbrdf_xr.observing.observe.Site`
         for ``site``.  A material built from measurements on load shares its values
         with every other load of it in the process: they are read-only (``.copy()``
         gives a writable table); its attributes are each load's own.
@@ -332,10 +326,10 @@ def load_spacecraft_spec(
     material, material_map
         For a mesh file, exactly one: the one material of every facet, or the facet label
         -> material map (a mapping, or a TOML map file,
-        :func:`sbrdf_xr.spacecraft.read_material_map`).
+        :func:`sbrdf_xr.body.spacecraft.read_material_map`).
     **options
         For a mesh file: ``length_unit``, ``face_property``, ``repair``, ``name``, ``file_type``
-        of :func:`sbrdf_xr.spacecraft.load_spacecraft`.
+        of :func:`sbrdf_xr.body.spacecraft.load_spacecraft`.
 
     Returns
     -------
@@ -393,8 +387,8 @@ def load_material_spec(
     spec : str or os.PathLike
         A ``material`` or ``model`` catalog entry (shipped or user), or a netCDF file
         (a suffix of :data:`MATERIAL_SUFFIXES`) holding a material table (written by
-        :func:`sbrdf_xr.material_io.to_netcdf`) or a model (written by
-        :func:`sbrdf_xr.models.to_netcdf`).
+        :func:`sbrdf_xr.materials.files.to_netcdf`) or a model (written by
+        :func:`sbrdf_xr.materials.models.to_netcdf`).
     base_dir : str or os.PathLike, optional
         Directory that a relative file path is taken from.
 
@@ -441,8 +435,8 @@ def load_material_spec(
         return models.open_model(path)
     raise ValidationError(
         f"material: {path} is neither a material table (an 'sbrdf' variable, written by "
-        "sbrdf_xr.material_io.to_netcdf) nor a BRDF model (a 'model' attribute, written by "
-        "sbrdf_xr.models.to_netcdf)"
+        "sbrdf_xr.materials.files.to_netcdf) nor a BRDF model (a 'model' attribute, written by "
+        "sbrdf_xr.materials.models.to_netcdf)"
     )
 
 
@@ -463,7 +457,7 @@ def material_tables(
     Returns
     -------
     tables : dict of str to DataArray
-        A table for every material; a model is rendered by :func:`sbrdf_xr.models.render`
+        A table for every material; a model is rendered by :func:`sbrdf_xr.materials.models.render`
         on its default grid.
     models : dict of str to Dataset
         The models given (for ``evaluation = "analytic"``, which evaluates them exactly).

@@ -70,7 +70,7 @@ class NonPhysicalWarning(SbrdfWarning):
 
 
 class MeshRepairWarning(SbrdfWarning):
-    """A spacecraft mesh was repaired as documented in :mod:`sbrdf_xr.spacecraft`."""
+    """A spacecraft mesh was repaired as documented in :mod:`sbrdf_xr.body.spacecraft`."""
 
 
 class EpochGapWarning(SbrdfWarning):

@@ -217,7 +217,7 @@ def lut_slice(
     >>> import matplotlib
     >>> matplotlib.use("Agg")
     >>> import matplotlib.pyplot as plt
-    >>> from sbrdf_xr.material_schema import lambertian
+    >>> from sbrdf_xr.materials.schema import lambertian
     >>> fig = lut_slice(lambertian(0.5, wavelength=[500.0, 600.0]), theta_i=30.0)
     >>> type(fig).__name__, fig.axes[0].get_xlabel()
     ('Figure', 'delta_theta [deg]')

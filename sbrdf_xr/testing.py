@@ -98,7 +98,7 @@ def make_measurements(
     >>> sorted(set(ds.theta_i.values.tolist()))
     [10.0, 25.0, 40.0, 55.0, 70.0]
     """
-    from .goniometer import measure
+    from .materials.goniometer import measure
 
     wl = np.linspace(400.0, 1100.0, n_wavelength)
     return measure(
@@ -148,7 +148,7 @@ def make_material(
     >>> float(make_material(3, value=0.2).max())
     0.2
     """
-    from .material import new_material
+    from .materials.tables import new_material
 
     wl = np.linspace(400.0, 1100.0, n_wavelength)
     ti = np.arange(0.0, 91.0, 10.0) if theta_i is None else np.asarray(theta_i, float)
@@ -207,7 +207,7 @@ def reference_reflectance(
     ----------
     func : callable
         ``func(theta_i, delta_theta, phi) -> (n, n_wavelength)`` sBRDF [sr-1] for 1-D
-        angle arrays [degree] (:func:`sbrdf_xr.models.spectrum_function`,
+        angle arrays [degree] (:func:`sbrdf_xr.materials.models.spectrum_function`,
         :func:`lobe_function`).
     theta_i : array_like
         Incidence angles [degree], ``0 <= theta_i < 90``.
@@ -329,7 +329,7 @@ def prism_mesh(polygon_xy, z0: float, z1: float):
 
 
 def _as_spacecraft(mesh, name: str):
-    from .spacecraft import load_spacecraft
+    from .body.spacecraft import load_spacecraft
 
     mesh.visual.face_colors = np.tile([200, 200, 200, 255], (len(mesh.faces), 1))
     return load_spacecraft(mesh, {(200, 200, 200): TEST_SPACECRAFT_MATERIAL}, name=name)
@@ -350,7 +350,7 @@ def cube_spacecraft(size: float = 1.0, subdivisions: int = 1):
 
     Returns
     -------
-    sbrdf_xr.spacecraft.Spacecraft
+    sbrdf_xr.body.spacecraft.Spacecraft
 
     Examples
     --------
@@ -494,7 +494,7 @@ CANX1_ANTENNAS = (
 
 
 def canx1_with_antennas(subdivisions: int = 1, tilt: float = 30.0):
-    """CanX-1 (:func:`sbrdf_xr.spacecraft.canx1`) with four aluminium whip antennas.
+    """CanX-1 (:func:`sbrdf_xr.body.spacecraft.canx1`) with four aluminium whip antennas.
 
     Each antenna is a closed square rod (4 mm wide, 80 mm long) that rises from a point of
     the +Z face, tilted by ``tilt`` degrees outward (away from the z axis), standing 1 mm off
@@ -512,7 +512,7 @@ def canx1_with_antennas(subdivisions: int = 1, tilt: float = 30.0):
 
     Returns
     -------
-    sbrdf_xr.spacecraft.Spacecraft
+    sbrdf_xr.body.spacecraft.Spacecraft
 
     Examples
     --------
@@ -525,7 +525,7 @@ def canx1_with_antennas(subdivisions: int = 1, tilt: float = 30.0):
     """
     import trimesh
 
-    from .spacecraft import Spacecraft, canx1
+    from .body.spacecraft import Spacecraft, canx1
 
     base = canx1()
     roots, half, length, gap = CANX1_ANTENNAS

@@ -29,7 +29,9 @@ def user_files(tmp_path):
     import numpy as np
     import trimesh
 
-    from sbrdf_xr import material_io, material_schema, models
+    from sbrdf_xr.materials import files as material_io
+    from sbrdf_xr.materials import models
+    from sbrdf_xr.materials import schema as material_schema
 
     wl = [450.0, 550.0, 650.0]
     files = tmp_path / "files"

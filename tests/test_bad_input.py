@@ -28,8 +28,8 @@ from hypothesis import strategies as st
 from hypothesis_profiles import examples
 
 from sbrdf_xr.cli import main
+from sbrdf_xr.engine import MAX_SCENE_COUNT, Scene, load_scene
 from sbrdf_xr.errors import SbrdfError, SceneError
-from sbrdf_xr.scene import MAX_SCENE_COUNT, Scene, load_scene
 
 COUNTS: Counter[str] = Counter()
 
@@ -295,7 +295,7 @@ def test_non_utf8_and_unreadable_scene_files(tmp_path):
     (tmp_path / "dir.toml").mkdir()
     with pytest.raises(SceneError, match=r"(?i)cannot be read.*is a directory"):
         load_scene(tmp_path / "dir.toml")
-    from sbrdf_xr.scene import resolve_scene
+    from sbrdf_xr.engine import resolve_scene
 
     with pytest.raises(SceneError, match="is a directory"):
         resolve_scene(tmp_path / "dir.toml")
@@ -303,7 +303,8 @@ def test_non_utf8_and_unreadable_scene_files(tmp_path):
 
 def test_empty_results_are_refused_through_the_python_api(tmp_path):
     """A Scene asking for no output or no phase angle cannot write an empty cube."""
-    from sbrdf_xr import simulate, write
+    from sbrdf_xr import write
+    from sbrdf_xr.engine import run as simulate
     from sbrdf_xr.errors import ValidationError
 
     path = tmp_path / "scene.toml"
@@ -317,7 +318,8 @@ def test_empty_results_are_refused_through_the_python_api(tmp_path):
 
 
 def test_nan_and_negative_tables_are_refused():
-    from sbrdf_xr import catalog, spacecraft
+    from sbrdf_xr import catalog
+    from sbrdf_xr.body import spacecraft
 
     sc = spacecraft.canx1()
     grey = catalog.load("lambertian-grey-50")
@@ -334,7 +336,7 @@ def test_nan_and_negative_tables_are_refused():
 def test_zero_area_facet_does_not_warn():
     import trimesh
 
-    from sbrdf_xr.spacecraft import Spacecraft
+    from sbrdf_xr.body.spacecraft import Spacecraft
 
     v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
     sc = Spacecraft(trimesh.Trimesh(v, np.array([[0, 1, 2], [0, 1, 1]]), process=False), ["a", "a"])
@@ -349,7 +351,8 @@ def test_zero_area_facet_does_not_warn():
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
     """Files that are not cubes, and places that cannot be written."""
-    from sbrdf_xr import material, testing
+    from sbrdf_xr import testing
+    from sbrdf_xr.materials import tables as material
 
     d = tmp_path_factory.mktemp("cli")
     (d / "text.nc").write_text("hello, I am not netCDF\n")

@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from sbrdf_xr import catalog, material
+from sbrdf_xr import catalog
 from sbrdf_xr.errors import CatalogError, ValidationError
+from sbrdf_xr.materials import tables as material
 
 
 def test_every_entry_has_provenance_and_loads():

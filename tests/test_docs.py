@@ -76,7 +76,7 @@ def html(tmp_path_factory) -> Path:
         "getting_started.html",
         "api/index.html",
         "api/sbrdf_xr.geometry.html",
-        "api/sbrdf_xr.material.html",
+        "api/sbrdf_xr.materials.tables.html",
         "api/sbrdf_xr.brdf.robertson_sandford.html",
         "api/sbrdf_xr.photometry.magnitude.html",
         "api/sbrdf_xr.invert.html",

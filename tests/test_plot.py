@@ -13,13 +13,14 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from sbrdf_xr import models, plot
 from sbrdf_xr import photometry as P
+from sbrdf_xr import plot
 from sbrdf_xr import testing as T
 from sbrdf_xr.cli import main
-from sbrdf_xr.material import write_netcdf_atomic
-from sbrdf_xr.scene import Scene
-from sbrdf_xr.simulate import simulate
+from sbrdf_xr.engine import Scene
+from sbrdf_xr.engine.run import simulate
+from sbrdf_xr.materials import models
+from sbrdf_xr.materials.tables import write_netcdf_atomic
 
 MAX_LABEL = 40  # characters: an axis label that fits a 4-inch axis at the default font size
 

@@ -219,7 +219,7 @@ def ply_text() -> str:
 
 MAP_TEXT = """\
 # Facet colour -> material of canx1.ply (the colours of paper 000, Fig. 11).
-# Read by sbrdf_xr.spacecraft.read_material_map; written by python tools/build_canx1.py.
+# Read by sbrdf_xr.body.spacecraft.read_material_map; written by python tools/build_canx1.py.
 
 [[material]]
 name = "aluminium-6061-t6"

@@ -12,8 +12,10 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from sbrdf_xr import goniometer, material, models, testing
+from sbrdf_xr import testing
 from sbrdf_xr.brdf import get_model, optics
+from sbrdf_xr.materials import goniometer, models
+from sbrdf_xr.materials import tables as material
 
 ROOT = Path(__file__).resolve().parent.parent / "catalogs"
 

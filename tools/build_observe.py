@@ -74,7 +74,7 @@ def find_passes(
     max_sun_elevation_deg: float = -18.0,
 ) -> list[dict]:
     """Passes above ``min_elevation_deg`` with the site dark and the shadow boundary crossed."""
-    from sbrdf_xr import observe
+    from sbrdf_xr.observing import observe
 
     t = observe.times(start, stop, step_s)
     obs = observe.Observation(orbit, site, t, None)
@@ -101,7 +101,8 @@ def find_passes(
 
 
 def main() -> None:
-    from sbrdf_xr import catalog, observe
+    from sbrdf_xr import catalog
+    from sbrdf_xr.observing import observe
 
     l1, l2 = example_tle()
     path = Path(__file__).resolve().parent.parent / "catalogs" / "observe" / "canx1-example.tle"

@@ -1,7 +1,7 @@
 """Least-squares fit of the Robertson-Sandford model (paper 001) to measured sBRDF samples.
 
 The model itself (:mod:`sbrdf_xr.brdf.robertson_sandford`) stays apart from its fit;
-:func:`sbrdf_xr.models.fit_robertson_sandford` wraps this numpy fit for measurement sets.
+:func:`sbrdf_xr.materials.models.fit_robertson_sandford` wraps this numpy fit for measurement sets.
 """
 
 from __future__ import annotations

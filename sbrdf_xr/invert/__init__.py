@@ -17,7 +17,7 @@ Two inverse problems built on the forward model:
     as degenerate.
 :func:`fit_spin`
     Spin axis (two angles of the inertial axis of a known body axis), period and phase
-    of a uniform spin (:class:`sbrdf_xr.attitude.Spin`) fitted to a colour light curve:
+    of a uniform spin (:class:`sbrdf_xr.observing.attitude.Spin`) fitted to a colour light curve:
     a global search over a Fibonacci sphere of axes x periods x phases, evaluating every
     candidate with the compiled kernel on band pre-integrated tables (threads: the
     kernel releases the GIL), with the unknown flux scale of each band (or one common

@@ -58,7 +58,7 @@ def benchmark_spin_search(
     >>> sorted(rows[0])
     ['bands', 'candidates', 'method', 'per_candidate_ms', 'samples', 'seconds']
     """
-    from ..spacecraft import canx1
+    from ..body.spacecraft import canx1
 
     sc = spacecraft if spacecraft is not None else canx1()
     t = np.linspace(0.0, 300.0, n_samples)

@@ -28,7 +28,7 @@ def band_terms(per_material: xr.DataArray, bands: Sequence[str]) -> xr.DataArray
 
     >>> import numpy as np, trimesh
     >>> from sbrdf_xr import Scene, load_spacecraft, simulate
-    >>> from sbrdf_xr.material_schema import lambertian
+    >>> from sbrdf_xr.materials.schema import lambertian
     >>> mesh = trimesh.creation.box()
     >>> caps = np.abs(mesh.face_normals[:, 2]) > 0.5  # the +z and -z faces are red
     >>> mesh.visual.face_colors = np.where(caps[:, None], [255, 0, 0, 255], [128, 128, 128, 255])

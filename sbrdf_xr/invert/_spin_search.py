@@ -18,8 +18,8 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from .. import _kernels
 from ..errors import InversionError
+from ..kernels import sums as _kernels
 
 __all__ = [
     "LN10_2P5",
@@ -92,7 +92,7 @@ def align_matrices(axis_body: np.ndarray, axes: np.ndarray) -> np.ndarray:
 
 
 def spin_model(axis_body: ArrayLike, axis: ArrayLike, period_s: float, phase_deg: float) -> Any:
-    """The :class:`sbrdf_xr.attitude.Spin` law of a spin state: the body turns about
+    """The :class:`sbrdf_xr.observing.attitude.Spin` law of a spin state: the body turns about
     ``axis_body`` at ``360/period_s`` degree s-1 from the attitude that takes
     ``axis_body`` to the inertial ``axis`` by the shortest arc, angle ``phase_deg`` at t = 0.
 
@@ -111,7 +111,7 @@ def spin_model(axis_body: ArrayLike, axis: ArrayLike, period_s: float, phase_deg
     """
     from scipy.spatial.transform import Rotation
 
-    from ..attitude import Spin
+    from ..observing.attitude import Spin
 
     m = align_matrices(np.asarray(axis_body, float), np.asarray(axis, float)[None, :])[0]
     q = Rotation.from_matrix(m).as_quat()
@@ -143,7 +143,7 @@ class Kernel:
         materials: Mapping[str, Any] | None = None,
         method: str = "linear",
     ) -> None:
-        from ..scene import Scene
+        from ..engine import Scene
 
         f = fibonacci_sphere(256)
         scene = Scene(

@@ -525,7 +525,7 @@ def pre_integrate(
 
     Examples
     --------
-    >>> from sbrdf_xr.material_schema import lambertian
+    >>> from sbrdf_xr.materials.schema import lambertian
     >>> table = lambertian(0.3, wavelength=np.arange(300.0, 1101.0, 10.0))
     >>> banded = pre_integrate(table, ["B", "V"])
     >>> banded.dims, np.round(float(banded.max()), 6)  # 0.3 / pi in every band

@@ -96,7 +96,7 @@ def to_netcdf(ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool =
     >>> path.name, open_photometry(path).attrs["Conventions"]
     ('phot.nc', 'CF-1.10')
     """
-    from ..material import write_netcdf_atomic
+    from ..materials.tables import write_netcdf_atomic
 
     if not isinstance(ds, xr.Dataset):
         raise ValidationError(f"ds: expected an xarray Dataset, got {type(ds).__name__}")

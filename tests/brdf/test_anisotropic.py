@@ -8,11 +8,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis_profiles import examples
 
-from sbrdf_xr import geometry, material, models
+from sbrdf_xr import geometry
 from sbrdf_xr.brdf import anisotropic as A
 from sbrdf_xr.brdf import get_model
 from sbrdf_xr.brdf import microfacet as M
 from sbrdf_xr.errors import ValidationError
+from sbrdf_xr.materials import models
+from sbrdf_xr.materials import tables as material
 
 WL = np.array([450.0, 650.0, 900.0])
 METAL = {"n": [1.2, 1.4, 2.0], "k": [6.0, 7.5, 8.5], "rho_d": 0.01}

@@ -9,7 +9,7 @@ import cf_units
 import numpy as np
 import pytest
 
-from sbrdf_xr import catalog, geometry, material, models
+from sbrdf_xr import catalog, geometry
 from sbrdf_xr import testing as T
 from sbrdf_xr.brdf import (
     ANISOTROPIC_MODELS,
@@ -22,6 +22,8 @@ from sbrdf_xr.brdf import (
     unregister_model,
 )
 from sbrdf_xr.errors import ValidationError
+from sbrdf_xr.materials import models
+from sbrdf_xr.materials import tables as material
 
 WL = np.array([450.0, 650.0, 900.0])
 RHO = np.array([0.2, 0.5, 0.9])
@@ -86,8 +88,8 @@ def test_a_registered_model_renders_to_a_table_of_rho_over_pi(toy):
 def test_the_engine_evaluates_a_registered_model(toy):
     """evaluation="analytic" runs the toy model through Model.brdf with no engine change:
     a constant 0.5 / pi is the lambertian-grey-50 table, which is exact (as in test_plan)."""
-    from sbrdf_xr.scene import Scene
-    from sbrdf_xr.simulate import simulate
+    from sbrdf_xr.engine import Scene
+    from sbrdf_xr.engine.run import simulate
 
     lam = catalog.load("lambertian-grey-50")
     spec = models.model_material(

@@ -1,0 +1,69 @@
+"""Benchmarks: what accuracy costs in time (``sbrdf-xr bench``).
+
+Every benchmark returns rows (:class:`BenchRow`) timed against a baseline measured in
+the same run, so their ratios are comparable on a shared machine.
+
+Modules
+-------
+``rows``
+    The record of one measurement, how it is timed and how rows are shown.
+``suite``
+    The benchmarks users run: table construction, look-up, kernel throughput.
+``accuracy``
+    The accuracy/cost sweep of the knobs and presets.
+``engine``
+    What a sweep costs end to end.
+``shadowing``
+    Accuracy and cost of the shadowing methods against the exact method.
+"""
+
+from . import accuracy, engine, rows, shadowing, suite
+from .accuracy import BANDS, CANX1_MATERIALS, accuracy_cost, shadow_rows
+from .engine import disk_rate, engine_rows, sweep_job, thread_scaling
+from .rows import BenchRow, best_time, format_rows, plot_front, rows_to_dataset
+from .shadowing import (
+    ACCURACY_BODIES,
+    CostRow,
+    ShadowRow,
+    accuracy_rows,
+    canx1_sweep_rows,
+    geometries,
+    lambertian_signal,
+    markdown,
+    scaling_rows,
+)
+from .suite import bench_build_lut, bench_lookup, kernel_throughput, run
+
+__all__ = [
+    "ACCURACY_BODIES",
+    "BANDS",
+    "CANX1_MATERIALS",
+    "BenchRow",
+    "CostRow",
+    "ShadowRow",
+    "accuracy",
+    "accuracy_cost",
+    "accuracy_rows",
+    "bench_build_lut",
+    "bench_lookup",
+    "best_time",
+    "canx1_sweep_rows",
+    "disk_rate",
+    "engine",
+    "engine_rows",
+    "format_rows",
+    "geometries",
+    "kernel_throughput",
+    "lambertian_signal",
+    "markdown",
+    "plot_front",
+    "rows",
+    "rows_to_dataset",
+    "run",
+    "scaling_rows",
+    "shadow_rows",
+    "shadowing",
+    "suite",
+    "sweep_job",
+    "thread_scaling",
+]

@@ -1,0 +1,277 @@
+"""The accuracy/cost sweep of :func:`sbrdf_xr.bench.suite.accuracy_cost` and its shadowing rows.
+
+One knob at a time away from the ``reference`` configuration, on the CanX-1 rotation and
+a sweep of random attitudes: the band magnitude and spectral errors against the reference
+and the wall time as a ratio to the reference's; the CanX-1 tables are rebuilt from
+their shipped measurements with other construction knobs.  :func:`shadow_rows` adds the
+self-shadowing comparison of :mod:`sbrdf_xr.bench.shadowing`.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from .. import catalog
+from ..materials import tables as material
+from .rows import BenchRow, best_time
+
+__all__ = ["BANDS", "CANX1_MATERIALS", "accuracy_cost", "shadow_rows"]
+
+BANDS = ("V", "R", "I")
+CANX1_MATERIALS = ("aluminium-6061-t6", "tjpv-cell", "white-paint-a276")
+
+# ---------------------------------------------------- accuracy and cost
+
+
+def _paper_tables(**build: Any) -> dict[str, xr.DataArray]:
+    """The CanX-1 tables rebuilt from their measurements as shipped (the catalog's build
+    options), with other construction knobs."""
+    out = {}
+    for m in CANX1_MATERIALS:
+        meas = catalog.load(f"{m}-measurements")
+        build_opts = catalog.entry(m).extra.get("build", {})
+        fit = build_opts.get("fit", f"{m}-fit")  # the model the shipped table is built with
+        shipped = {k: v for k, v in build_opts.items() if k != "fit"}
+        out[m] = material.build_lut(
+            meas, model=catalog.load(fit), material=m, **{**shipped, **build}
+        )
+    return out
+
+
+def _subsample_wavelengths(tables: dict[str, xr.DataArray], step: int) -> dict[str, xr.DataArray]:
+    return {k: v.isel(wavelength=slice(None, None, step)) for k, v in tables.items()}
+
+
+def _band_mags(signal: xr.DataArray) -> np.ndarray:
+    from ..photometry import pre_integrate
+
+    b = pre_integrate(signal, list(BANDS), normalize=True).values
+    with np.errstate(divide="ignore"):
+        return -2.5 * np.log10(np.maximum(b, 1e-300))
+
+
+def _errors(test: xr.DataArray, ref: xr.DataArray) -> tuple[float, float, float]:
+    """(max mmag, median mmag, p99 relative spectral error) of ``test`` against ``ref``."""
+    if "wavelength" in test.dims:
+        mt, mr = _band_mags(test), _band_mags(ref)
+        t_sp = (
+            test.interp(wavelength=ref.wavelength)
+            if test.sizes["wavelength"] != ref.sizes["wavelength"]
+            else test
+        )
+        rel = np.abs(t_sp.values - ref.values) / np.maximum(np.abs(ref.values), 1e-300)
+        keep_sp = np.abs(ref.values) > 1e-3 * np.abs(ref.values).max()
+        p99 = float(np.percentile(rel[keep_sp], 99))
+    else:  # band_signal over band
+        mt = -2.5 * np.log10(np.maximum(test.values, 1e-300))
+        mr = _band_mags(ref)
+        p99 = float("nan")
+    bref = 10 ** (-0.4 * mr)
+    keep = bref > 1e-3 * bref.max()
+    d = np.abs(mt - mr)[keep] * 1e3
+    return float(d.max()), float(np.median(d)), p99
+
+
+def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
+    """The accuracy/cost table: one knob at a time away from the reference.
+
+    Parameters
+    ----------
+    quick : bool
+        Smaller sweeps and fewer knob settings (a smoke run, for CI).
+    repeat : int
+        Timing repeats (the best is kept).
+
+    Returns
+    -------
+    list of BenchRow
+
+    Examples
+    --------
+    The table rebuilds the CanX-1 tables and runs minutes even with ``quick``; it is
+    not run here:
+
+    >>> import inspect
+    >>> from sbrdf_xr.bench import accuracy_cost, format_rows
+    >>> list(inspect.signature(accuracy_cost).parameters)
+    ['quick', 'repeat']
+    >>> rows = accuracy_cost(quick=True, repeat=1)  # doctest: +SKIP
+    >>> rows[0].name  # doctest: +SKIP
+    'reference: cubic look-up, 1-deg theta_i, 21x21, 5 nm, merged, float64'
+    >>> print(format_rows(rows))  # doctest: +SKIP
+    """
+    from .. import geometry
+    from ..engine import builtin_scene
+    from ..engine.run import simulate
+
+    rot = builtin_scene("canx1-rotation")
+    n_big = 400 if quick else 5000
+    big = rot.with_options(
+        attitudes=geometry.uniform_attitudes(n_big, seed=7),
+        attitude_angle=None,
+        phase_angles=[10.0, 45.0, 90.0],
+        chunk=500,
+        name=f"random-{n_big}x3",
+    )
+    sweeps = {"canx1-rotation": rot} if quick else {"canx1-rotation": rot, big.name: big}
+    if quick:
+        sweeps[big.name] = big
+    rows: list[BenchRow] = []
+    base_tables = _paper_tables()
+    reference = {
+        "method": "cubic",
+        "dtype": "float64",
+        "merge": True,
+        "materials": base_tables,
+        "outputs": ("signal", "area"),
+    }
+
+    def run_cube(scene: Any, **opts: Any) -> xr.Dataset:
+        return simulate(scene.with_options(**opts)).compute(scheduler="sync")
+
+    for sweep_name, sweep in sweeps.items():
+        ref_cube = run_cube(sweep, **reference)
+        ref = ref_cube.signal
+        t_ref = best_time(partial(run_cube, sweep, **reference), repeat)
+        knobs: list[tuple[str, str, dict[str, Any]]] = [
+            ("reference", "cubic look-up, 1-deg theta_i, 21x21, 5 nm, merged, float64", {}),
+            ("lookup method", "nearest (the paper's)", {"method": "nearest"}),
+            ("lookup method", "linear", {"method": "linear"}),
+            ("precision", "float32", {"dtype": "float32"}),
+            ("wavelength", "10 nm sampling", {"materials": _subsample_wavelengths(base_tables, 2)}),
+            ("wavelength", "20 nm sampling", {"materials": _subsample_wavelengths(base_tables, 4)}),
+            (
+                "wavelength",
+                "band pre-integration (V, R, I)",
+                {"outputs": ("band_signal", "area"), "bands": BANDS},
+            ),
+            ("facets", "not merged (684 facets)", {"merge": False}),
+        ]
+        if not quick:
+            knobs += [
+                (
+                    "table",
+                    "theta_i every 2 deg",
+                    {"materials": _paper_tables(theta_i=np.arange(0.0, 91.0, 2.0))},
+                ),
+                (
+                    "table",
+                    "theta_i every 5 deg",
+                    {"materials": _paper_tables(theta_i=np.arange(0.0, 91.0, 5.0))},
+                ),
+                (
+                    "table",
+                    "11 x 11 delta_theta x phi",
+                    {"materials": _paper_tables(n_phi=11, n_delta_theta=11)},
+                ),
+                (
+                    "table",
+                    "41 x 41 delta_theta x phi",
+                    {"materials": _paper_tables(n_phi=41, n_delta_theta=41)},
+                ),
+            ]
+        for knob, setting, opts in knobs:
+            cfg = {**reference, **opts}
+            if knob == "reference":
+                cube, t = ref_cube, t_ref
+            else:
+                cube = run_cube(sweep, **cfg)
+                t = best_time(partial(run_cube, sweep, **cfg), repeat)
+            test = cube.band_signal if "band_signal" in cube else cube.signal
+            mx, med, p99 = _errors(test, ref)
+            rows.append(
+                BenchRow(
+                    f"{knob}: {setting}",
+                    t,
+                    "reference",
+                    t / t_ref,
+                    sweep=sweep_name,
+                    mmag_max=mx,
+                    mmag_median=med,
+                    rel_p99=p99,
+                    knob=knob,
+                )
+            )
+        # Tabulated vs analytic: the table method's own error, against the generating models
+        # (the simulation option evaluation="analytic", each material's catalog model).
+        an_cfg = {**reference, "evaluation": "analytic"}
+        an = run_cube(sweep, **an_cfg).signal
+        t_an = best_time(partial(run_cube, sweep, **an_cfg), 1)
+        mx, med, p99 = _errors(ref, an)
+        rows.append(
+            BenchRow(
+                "materials: analytic generating models (ground truth)",
+                t_an,
+                "reference",
+                t_an / t_ref,
+                "error column: the tabulated reference against them",
+                sweep=sweep_name,
+                mmag_max=mx,
+                mmag_median=med,
+                rel_p99=p99,
+                knob="materials",
+            )
+        )
+    rows += shadow_rows(quick=quick, repeat=repeat)
+    return rows
+
+
+def shadow_rows(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
+    """Self-shadowing: the sampled method at several densities against the exact method
+    (polygon clipping) on the package's non-convex test bodies (an L prism, a plate with a
+    fin, a bus with a panel, CanX-1 with antennas), and the cost of both on a CanX-1 sweep
+    (:mod:`sbrdf_xr.bench.shadowing`).  Errors are of the Lambertian signal against exact.
+
+    Examples
+    --------
+    Even ``quick`` takes over a second (four bodies, three densities, a CanX-1 sweep);
+    :func:`sbrdf_xr.bench.shadowing.accuracy_rows` runs the same comparison on one body
+    in milliseconds.  Not run here:
+
+    >>> from sbrdf_xr.bench import shadow_rows
+    >>> rows = shadow_rows(quick=True, repeat=1)  # doctest: +SKIP
+    >>> [r.name for r in rows][:2]  # doctest: +SKIP
+    ['shadowing: exact', 'shadowing: off (no shadowing)']
+    """
+    from . import shadowing as shadow_bench
+
+    rows = []
+    acc = shadow_bench.accuracy_rows(
+        densities=(2, 4, 8) if quick else (2, 4, 8, 16, 32),
+        n_geometries=8 if quick else 18,
+        repeat=repeat,
+    )
+    for r in acc:
+        mmag = 2500.0 * np.log10(1.0 + r.worst_rel_error)
+        med = 2500.0 * np.log10(1.0 + r.median_rel_error)
+        rows.append(
+            BenchRow(
+                f"shadowing: {r.label}",
+                r.ms_per_geometry * 1e-3,
+                "exact shadowing",
+                r.time_ratio,
+                f"worst {r.worst_rel_error:.2g}, median {r.median_rel_error:.2g} "
+                f"relative ({r.bodies}; {r.n_geometries} geometries each)",
+                sweep="shadowing, non-convex bodies",
+                mmag_max=mmag,
+                mmag_median=med,
+                knob="shadowing",
+            )
+        )
+    for c in shadow_bench.canx1_sweep_rows(n_attitudes=90 if quick else 360, repeat=repeat):
+        rows.append(
+            BenchRow(
+                f"shadowing cost: {c.label}",
+                c.ms_per_geometry * 1e-3,
+                c.ratio_to,
+                c.ratio,
+                f"{c.ms_per_geometry:.2f} ms per geometry, {c.n_facets} facets",
+                sweep="shadowing, CanX-1 sweep",
+                knob="shadowing",
+            )
+        )
+    return rows

@@ -1,0 +1,218 @@
+"""Benchmark rows: the record of one measurement, how it is timed, and how rows are shown.
+
+A :class:`BenchRow` holds what was measured, its best wall time (:func:`best_time`) and
+the ratio to a baseline measured in the same run; :func:`format_rows` prints rows as a
+plain-text table, :func:`rows_to_dataset` labels them for netCDF or CSV, and
+:func:`plot_front` draws the accuracy/time front.  The benchmarks of :mod:`sbrdf_xr.bench`
+and :mod:`sbrdf_xr.bench.engine` report in these rows.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+__all__ = ["BenchRow", "best_time", "format_rows", "plot_front", "rows_to_dataset"]
+
+
+@dataclass
+class BenchRow:
+    """One benchmark result.
+
+    Attributes
+    ----------
+    name : str
+        What was measured (the knob and its setting).
+    seconds : float
+        Best wall time over the repeats [s].
+    baseline : str
+        Name of the baseline of the ratio.
+    ratio : float
+        ``seconds / baseline seconds``: the cost relative to the baseline
+        (< 1 is faster).
+    extra : str
+        Throughput or notes, in words.
+    sweep : str
+        Which sweep.
+    mmag_max, mmag_median, rel_p99 : float
+        Error against the reference (NaN when not applicable).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench.rows import BenchRow
+    >>> row = BenchRow("lookup method: linear", 0.6, "reference", 0.3, mmag_max=12.0)
+    >>> row.ratio, row.mmag_max, row.rel_p99
+    (0.3, 12.0, nan)
+    """
+
+    name: str
+    seconds: float
+    baseline: str
+    ratio: float
+    extra: str = ""
+    sweep: str = ""
+    mmag_max: float = float("nan")
+    mmag_median: float = float("nan")
+    rel_p99: float = float("nan")
+    knob: str = field(default="", repr=False)
+
+
+def best_time(func: Callable[[], object], repeat: int = 3, number: int = 1) -> float:
+    """Best of ``repeat`` wall times of ``number`` calls of ``func`` after a warm-up [s per call].
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench.rows import best_time
+    >>> calls = []
+    >>> t = best_time(lambda: calls.append(1), repeat=3, number=2)
+    >>> len(calls), 0.0 <= t < 1.0  # one warm-up call, then 3 x 2 timed calls
+    (7, True)
+    """
+    func()
+    best = np.inf
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        for _ in range(number):
+            func()
+        best = min(best, (time.perf_counter() - t0) / number)
+    return float(best)
+
+
+def format_rows(rows: list[BenchRow]) -> str:
+    """A plain-text table of benchmark rows (time as a ratio to the row's baseline).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench.rows import BenchRow
+    >>> rows = [
+    ...     BenchRow("reference", 2.0, "reference", 1.0, sweep="demo",
+    ...              mmag_max=0.0, mmag_median=0.0, rel_p99=0.0),
+    ...     BenchRow("lookup method: linear", 0.6, "reference", 0.3, sweep="demo",
+    ...              mmag_max=12.0, mmag_median=0.4, rel_p99=0.01),
+    ... ]
+    >>> from sbrdf_xr.bench.rows import format_rows
+    >>> print(format_rows(rows))
+    [demo]
+    case                   time/baseline   mmag max   mmag med   rel p99  notes
+    reference                         1x          0          0         0  vs reference
+    lookup method: linear           0.3x         12        0.4      0.01  vs reference
+    """
+    w = max(len(r.name) for r in rows)
+    out = []
+    sweep = None
+    for r in rows:
+        if r.sweep != sweep:
+            sweep = r.sweep
+            out += [
+                "",
+                f"[{sweep}]",
+                f"{'case':<{w}}  {'time/baseline':>13}  "
+                f"{'mmag max':>9}  {'mmag med':>9}  {'rel p99':>8}  notes",
+            ]
+        err = (
+            f"{r.mmag_max:>9.3g}  {r.mmag_median:>9.3g}  {r.rel_p99:>8.2g}"
+            if np.isfinite(r.mmag_max)
+            else f"{'':>9}  {'':>9}  {'':>8}"
+        )
+        note = r.extra or f"vs {r.baseline}"
+        out.append(f"{r.name:<{w}}  {r.ratio:>12.3g}x  {err}  {note}")
+    return "\n".join(out).lstrip("\n")
+
+
+def rows_to_dataset(rows: list[BenchRow]) -> xr.Dataset:
+    """The rows as a labelled Dataset over ``case`` (for netCDF or CSV).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench.rows import BenchRow
+    >>> rows = [
+    ...     BenchRow("reference", 2.0, "reference", 1.0, sweep="demo",
+    ...              mmag_max=0.0, mmag_median=0.0, rel_p99=0.0),
+    ...     BenchRow("lookup method: linear", 0.6, "reference", 0.3, sweep="demo",
+    ...              mmag_max=12.0, mmag_median=0.4, rel_p99=0.01),
+    ... ]
+    >>> from sbrdf_xr.bench.rows import rows_to_dataset
+    >>> ds = rows_to_dataset(rows)
+    >>> ds.case.values.tolist(), ds.time_ratio.values.tolist()
+    (['reference', 'lookup method: linear'], [1.0, 0.3])
+    >>> ds.mmag_max.attrs["units"]
+    'mmag'
+    """
+
+    def col(name: str) -> list[Any]:
+        return [getattr(r, name) for r in rows]
+
+    return xr.Dataset(
+        {
+            "seconds": ("case", col("seconds"), {"units": "s", "long_name": "best wall time"}),
+            "time_ratio": (
+                "case",
+                col("ratio"),
+                {"units": "1", "long_name": "wall time / baseline wall time"},
+            ),
+            "mmag_max": (
+                "case",
+                col("mmag_max"),
+                {"units": "mmag", "long_name": "largest band magnitude error"},
+            ),
+            "mmag_median": (
+                "case",
+                col("mmag_median"),
+                {"units": "mmag", "long_name": "median band magnitude error"},
+            ),
+            "rel_p99": (
+                "case",
+                col("rel_p99"),
+                {"units": "1", "long_name": "99th percentile relative spectral error"},
+            ),
+            "baseline": ("case", col("baseline"), {"long_name": "baseline of the time ratio"}),
+            "sweep": ("case", col("sweep"), {"long_name": "sweep"}),
+            "notes": ("case", col("extra"), {"long_name": "notes"}),
+        },
+        coords={"case": ("case", col("name"), {"long_name": "knob and setting"})},
+        attrs={"title": "sbrdf_xr accuracy/cost benchmark"},
+    )
+
+
+def plot_front(rows: list[BenchRow], ax: Any = None) -> Any:
+    """The accuracy/time front: worst band error against relative time, per sweep.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench.rows import BenchRow
+    >>> rows = [
+    ...     BenchRow("reference", 2.0, "reference", 1.0, sweep="demo",
+    ...              mmag_max=0.0, mmag_median=0.0, rel_p99=0.0),
+    ...     BenchRow("lookup method: linear", 0.6, "reference", 0.3, sweep="demo",
+    ...              mmag_max=12.0, mmag_median=0.4, rel_p99=0.01),
+    ... ]
+    >>> import matplotlib.pyplot as plt
+    >>> from sbrdf_xr.bench.rows import plot_front
+    >>> fig = plot_front(rows)
+    >>> ax = fig.axes[0]
+    >>> ax.get_xscale(), ax.get_yscale(), ax.get_xlabel()
+    ('log', 'log', 'wall time / reference wall time')
+    >>> plt.close(fig)
+    """
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(7, 4.5), layout="constrained")
+    else:
+        fig = ax.figure
+    for sweep in dict.fromkeys(r.sweep for r in rows if np.isfinite(r.mmag_max)):
+        pts = [r for r in rows if r.sweep == sweep and np.isfinite(r.mmag_max)]
+        ax.scatter([r.ratio for r in pts], [max(r.mmag_max, 1e-6) for r in pts], label=sweep)
+        for r in pts:
+            ax.annotate(r.name.split(": ", 1)[-1], (r.ratio, max(r.mmag_max, 1e-6)), fontsize=6)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall time / reference wall time")
+    ax.set_ylabel("largest band error [mmag]")
+    ax.legend(fontsize=7)
+    return fig

@@ -1,0 +1,121 @@
+"""The spacecraft body: its mesh, facets, materials on the facets, and what it hides.
+
+Modules
+-------
+``spacecraft``
+    :class:`Spacecraft`: a triangulated surface in metres whose every facet carries a
+    material name (:func:`load_spacecraft`, :func:`canx1`).
+``meshes`` and ``repair``
+    Reading meshes in five formats with length units and material maps; checks and repairs.
+``facets``
+    Facet tables: one row per facet, or facets merged by (normal, material).
+``imperfections``
+    Surface imperfections of CAD facets, a distribution of normal tilts (paper 000 §5).
+``visibility`` and ``rays``
+    Self-shadowing and self-occlusion: exact polygon clipping, or sampled rays.
+``picture``
+    A 3-D picture of a spacecraft, each facet coloured by its material.
+"""
+
+from ..errors import MeshError, MeshRepairWarning
+from . import facets, imperfections, meshes, picture, rays, repair, spacecraft, visibility
+from .facets import NORMAL_TOLERANCE, check_facet_material, facet_table, merge_facets
+from .imperfections import tilt_quadrature, tilted_normals
+from .meshes import (
+    LENGTH_UNITS,
+    TANGENT_ATTRIBUTE,
+    Color,
+    face_tangents,
+    label_faces,
+    length_factor,
+    normalise_map,
+    read_material_map,
+    read_mesh,
+)
+from .picture import plot_facets
+from .rays import (
+    DENSITY_PRESETS,
+    ENGINES,
+    MAX_RAYS_PER_CALL,
+    OFFSET_FACTOR,
+    SEED,
+    available_engines,
+    check_density,
+    engine_name,
+    escape_masks,
+    intersector,
+    is_convex,
+    mesh_of,
+    sample_triangle,
+    sample_uv,
+    samples_per_facet,
+    supporting,
+    to_triangle,
+)
+from .repair import MERGE_DISTANCE, ZERO_AREA_FACTOR, clean_mesh
+from .spacecraft import CANX1_MATERIALS, Spacecraft, canx1, load_spacecraft
+from .visibility import (
+    METHODS,
+    facet_visibility,
+    lit_fraction,
+    lit_visible_fraction,
+    visible_fraction,
+)
+
+__all__ = [
+    "CANX1_MATERIALS",
+    "DENSITY_PRESETS",
+    "ENGINES",
+    "LENGTH_UNITS",
+    "MAX_RAYS_PER_CALL",
+    "MERGE_DISTANCE",
+    "METHODS",
+    "NORMAL_TOLERANCE",
+    "OFFSET_FACTOR",
+    "SEED",
+    "TANGENT_ATTRIBUTE",
+    "ZERO_AREA_FACTOR",
+    "Color",
+    "MeshError",
+    "MeshRepairWarning",
+    "Spacecraft",
+    "available_engines",
+    "canx1",
+    "check_density",
+    "check_facet_material",
+    "clean_mesh",
+    "engine_name",
+    "escape_masks",
+    "face_tangents",
+    "facet_table",
+    "facet_visibility",
+    "facets",
+    "imperfections",
+    "intersector",
+    "is_convex",
+    "label_faces",
+    "length_factor",
+    "lit_fraction",
+    "lit_visible_fraction",
+    "load_spacecraft",
+    "merge_facets",
+    "mesh_of",
+    "meshes",
+    "normalise_map",
+    "picture",
+    "plot_facets",
+    "rays",
+    "read_material_map",
+    "read_mesh",
+    "repair",
+    "sample_triangle",
+    "sample_uv",
+    "samples_per_facet",
+    "spacecraft",
+    "supporting",
+    "tilt_quadrature",
+    "tilted_normals",
+    "to_triangle",
+    "visibility",
+    "visible_fraction",
+]

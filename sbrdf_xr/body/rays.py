@@ -1,0 +1,301 @@
+"""The sampled method of :mod:`sbrdf_xr.body.visibility`: point sets on facets and ray engines.
+
+Also the mesh access both methods share (the mesh and per-spacecraft cache of a
+:class:`~sbrdf_xr.body.spacecraft.Spacecraft` or a bare :class:`trimesh.Trimesh`, the facets whose
+plane supports the whole mesh).  The public names are re-exported by
+:mod:`sbrdf_xr.body.visibility`, which documents the methods.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import trimesh
+from numpy.typing import NDArray
+
+from ..errors import ValidationError
+from .spacecraft import Spacecraft
+
+__all__ = [
+    "DENSITY_PRESETS",
+    "ENGINES",
+    "MAX_RAYS_PER_CALL",
+    "OFFSET_FACTOR",
+    "SEED",
+    "available_engines",
+    "check_density",
+    "engine_name",
+    "escape_masks",
+    "intersector",
+    "is_convex",
+    "mesh_of",
+    "sample_triangle",
+    "sample_uv",
+    "samples_per_facet",
+    "supporting",
+    "to_triangle",
+]
+
+#: Ray engines of the sampled method: name -> description.
+ENGINES: dict[str, str] = {
+    "auto": "embree if the embreex package is installed, triangle otherwise",
+    "embree": "Intel Embree via trimesh.ray.ray_pyembree (embreex package; float32)",
+    "triangle": "trimesh.ray.ray_triangle, pure numpy (float64; slow)",
+}
+
+#: Named sampling densities of the sampled method (samples per facet = density**2).
+DENSITY_PRESETS: dict[str, int] = {"fast": 1, "balanced": 4, "reference": 16}
+
+#: Default ray-origin offset along the facet normal, as a fraction of the bounding-box diagonal.
+OFFSET_FACTOR = 1.0e-6
+
+#: Upper bound on the rays cast in one engine call (memory ~ 100 bytes per ray).
+MAX_RAYS_PER_CALL = 1 << 20
+
+#: Seed of the sampled method's point sets.
+SEED = 20240601
+
+
+def available_engines() -> list[str]:
+    """Ray engines usable in this environment (``"triangle"`` always; ``"embree"`` if installed).
+
+    Examples
+    --------
+    >>> "triangle" in available_engines()
+    True
+    """
+    out = ["triangle"]
+    try:
+        import trimesh.ray.ray_pyembree  # noqa: F401
+    except ImportError:
+        return out
+    return ["embree", *out]
+
+
+def engine_name(engine: str | None) -> str:
+    """The ray engine to use for ``engine`` (None or ``"auto"``: the best available)."""
+    if engine is None:
+        engine = "auto"
+    if engine not in ENGINES:
+        raise ValidationError(f"engine: got {engine!r}; allowed: {', '.join(ENGINES)}")
+    avail = available_engines()
+    if engine == "auto":
+        return avail[0]
+    if engine not in avail:
+        raise ValidationError(
+            f"engine: {engine!r} is not available here (install the 'embreex' package, "
+            f"extra [shadows]); available: {', '.join(avail)}"
+        )
+    return engine
+
+
+def check_density(density: int | str) -> int:
+    """The sampling density of an integer >= 1 or a preset name of :data:`DENSITY_PRESETS`."""
+    if isinstance(density, str):
+        if density not in DENSITY_PRESETS:
+            raise ValidationError(f"density: got {density!r}; presets: {DENSITY_PRESETS}")
+        return DENSITY_PRESETS[density]
+    if isinstance(density, bool) or not isinstance(density, int | np.integer) or density < 1:
+        raise ValidationError(
+            f"density: got {density!r}; expected an integer sampling density >= 1 "
+            f"or a preset name {list(DENSITY_PRESETS)}"
+        )
+    return int(density)
+
+
+def samples_per_facet(density: int | str) -> int:
+    """Number of rays per facet and direction at a sampling density (``density**2``).
+
+    Examples
+    --------
+    >>> samples_per_facet(4), samples_per_facet("reference")
+    (16, 256)
+    """
+    return check_density(density) ** 2
+
+
+def sample_triangle(n_samples: int, n_facets: int = 1, seed: int = SEED) -> NDArray[np.float64]:
+    """Low-discrepancy barycentric sample points, an independent set for every facet.
+
+    A scrambled Sobol' sequence (:class:`scipy.stats.qmc.Sobol`, its first ``n_samples``
+    points) is shifted modulo 1 by a random vector per facet (Cranley-Patterson rotation)
+    and mapped to the triangle by ``(u, v) -> (1 - sqrt(u), sqrt(u) (1 - v), sqrt(u) v)``,
+    which preserves area (Shirley and Chiu 1997), so each point stands for an equal share of
+    the facet.  Deterministic for a given ``seed``.
+
+    Parameters
+    ----------
+    n_samples : int
+        Points per facet (>= 1).
+    n_facets : int
+        Number of independent point sets.
+    seed : int
+        Seed of the scrambling and of the shifts.
+
+    Returns
+    -------
+    ndarray, shape (n_facets, n_samples, 3)
+        Weights of the three vertices; each row sums to 1 and is positive or zero.
+
+    Examples
+    --------
+    >>> w = sample_triangle(16, n_facets=2, seed=1)
+    >>> w.shape, bool(np.allclose(w.sum(axis=-1), 1.0)), bool((w >= 0).all())
+    ((2, 16, 3), True, True)
+    """
+    if isinstance(n_samples, bool) or int(n_samples) != n_samples or n_samples < 1 or n_facets < 0:
+        raise ValidationError(
+            f"n_samples, n_facets: got {n_samples!r}, {n_facets!r}; expected integers >= 1 and >= 0"
+        )
+    base, shift = sample_uv(int(n_samples), int(n_facets), seed)
+    return to_triangle(base[None, :, :] + shift[:, None, :])
+
+
+def sample_uv(n_samples: int, n_facets: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """The scrambled Sobol' points (n_samples, 2) and the per-facet shifts (n_facets, 2)."""
+    from scipy.stats import qmc
+
+    rng = np.random.default_rng(seed)
+    m = max(0, int(np.ceil(np.log2(n_samples))))
+    base = qmc.Sobol(d=2, scramble=True, seed=rng).random_base2(m)[:n_samples]
+    return base, rng.random((n_facets, 2))
+
+
+def to_triangle(uv: np.ndarray) -> np.ndarray:
+    """Barycentric weights of unit-square points (shifted modulo 1), area-preserving map."""
+    uv = uv % 1.0
+    r = np.sqrt(uv[..., 0])
+    return np.stack([1.0 - r, r * (1.0 - uv[..., 1]), r * uv[..., 1]], axis=-1)
+
+
+def mesh_of(spacecraft: Spacecraft | trimesh.Trimesh) -> tuple[trimesh.Trimesh, dict[str, Any]]:
+    """The mesh of a spacecraft (or bare mesh) and its per-spacecraft cache."""
+    if isinstance(spacecraft, Spacecraft):
+        return spacecraft.mesh, spacecraft._cache
+    if isinstance(spacecraft, trimesh.Trimesh):
+        return spacecraft, {}
+    raise ValidationError(
+        f"spacecraft: expected a Spacecraft or trimesh.Trimesh, got {type(spacecraft).__name__}"
+    )
+
+
+def is_convex(spacecraft: Spacecraft | trimesh.Trimesh) -> bool:
+    """Whether the surface is convex (cached on a Spacecraft)."""
+    if isinstance(spacecraft, Spacecraft):
+        return spacecraft.is_convex
+    return bool(spacecraft.is_convex)
+
+
+def intersector(
+    mesh: trimesh.Trimesh, cache: dict[str, Any], engine: str
+) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+    """A function (origins, unit directions) -> bool hit, cached per spacecraft and engine."""
+    key = f"ray:{engine}"
+    if key in cache:
+        return cache[key]
+    if engine == "embree":
+        from trimesh.ray import ray_pyembree
+
+        rmi: Any = ray_pyembree.RayMeshIntersector(mesh)
+
+        def hits(origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
+            return rmi.intersects_first(origins, directions) >= 0
+
+    else:
+        from trimesh.ray import ray_triangle
+
+        rmi = ray_triangle.RayMeshIntersector(mesh)
+
+        def hits(origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
+            # trimesh counts hits up to 1e-6 model units *behind* the origin; keep only
+            # hits strictly in front of it (own-plane hits are at -offset / N.d < 0).
+            out = np.zeros(len(origins), dtype=bool)
+            _, index_ray, loc = rmi.intersects_id(
+                origins, directions, multiple_hits=True, return_locations=True
+            )
+            index_ray = np.asarray(index_ray, dtype=np.int64)
+            if len(index_ray) == 0:  # no ray hit anything (locations come back as shape (0,))
+                return out
+            loc = np.asarray(loc, dtype=np.float64).reshape(-1, 3)
+            ahead = np.einsum("ij,ij->i", loc - origins[index_ray], directions[index_ray]) > 0
+            out[index_ray[ahead]] = True
+            return out
+
+    cache[key] = hits
+    return hits
+
+
+def supporting(mesh: trimesh.Trimesh, cache: dict[str, Any], tol: float) -> np.ndarray:
+    """Facets whose plane has the whole mesh on or behind it (cannot be shadowed)."""
+    key = f"supporting:{tol!r}"
+    if key not in cache:
+        try:
+            pts = np.asarray(mesh.convex_hull.vertices)
+        except Exception:  # pragma: no cover - degenerate (flat) meshes
+            pts = np.asarray(mesh.vertices)
+        normals = np.asarray(mesh.face_normals)
+        origin = np.asarray(mesh.triangles[:, 0])
+        height = np.full(len(normals), -np.inf)
+        step = max(1, (1 << 22) // max(len(pts), 1))
+        for s in range(0, len(normals), step):  # chunks of facets, bounded memory
+            n, o = normals[s : s + step], origin[s : s + step]
+            height[s : s + step] = (pts @ n.T - np.einsum("ij,ij->i", n, o)).max(axis=0)
+        cache[key] = height <= tol
+    return cache[key]
+
+
+# ----------------------------------------------------------------------------- sampled method
+
+
+def escape_masks(
+    spacecraft: Spacecraft | trimesh.Trimesh,
+    directions: list[np.ndarray],
+    density: int | str,
+    engine: str | None,
+    offset: float | None,
+    convex_shortcut: bool,
+    seed: int,
+) -> np.ndarray:
+    """Per-sample escape flags, shape (len(directions), n_geometries, n_facets, n_samples)."""
+    mesh, cache = mesh_of(spacecraft)
+    n = check_density(density)
+    engine = engine_name(engine)
+    scale = float(mesh.scale)
+    if offset is None:
+        offset = OFFSET_FACTOR * scale
+    if not (np.isfinite(offset) and offset > 0):
+        raise ValidationError(f"offset: got {offset!r}; expected a positive length [m]")
+    normals = np.asarray(mesh.face_normals, dtype=np.float64)
+    n_geom = len(directions[0])
+    n_fac = len(normals)
+    n_s = n * n
+    front = [d @ normals.T > 0 for d in directions]  # (n_geom, n_facets) each
+    out = np.stack([np.broadcast_to(f[:, :, None], (n_geom, n_fac, n_s)) for f in front]).copy()
+    if convex_shortcut and is_convex(spacecraft):
+        return out
+    candidates = np.flatnonzero(~supporting(mesh, cache, 0.1 * offset))
+    if len(candidates) == 0:
+        return out
+    hits = intersector(mesh, cache, engine)
+    key = f"samples:{n_s}:{seed}"
+    if key not in cache:
+        cache[key] = sample_uv(n_s, n_fac, seed)
+    base, shift = cache[key]
+    bary = to_triangle(base[None, :, :] + shift[candidates, None, :])
+    tri = np.asarray(mesh.triangles, dtype=np.float64)[candidates]
+    points = np.einsum("fsk,fkx->fsx", bary, tri) + offset * normals[candidates, None, :]
+    per_geom = max(1, len(candidates) * n_s)
+    chunk = max(1, MAX_RAYS_PER_CALL // per_geom)
+    for k, d in enumerate(directions):
+        for g0 in range(0, n_geom, chunk):  # chunks of directions, not facets
+            sub = front[k][g0 : g0 + chunk][:, candidates]
+            gi, fi = np.nonzero(sub)
+            if len(gi) == 0:
+                continue
+            origins = points[fi].reshape(-1, 3)
+            dirs = np.repeat(d[g0 + gi], n_s, axis=0)
+            escaped = ~hits(origins, dirs).reshape(len(gi), n_s)
+            out[k, g0 + gi, candidates[fi], :] = escaped
+    return out

@@ -1,0 +1,554 @@
+"""Self-shadowing and self-occlusion of a spacecraft: exact polygon clipping, or sampled rays.
+
+A facet of a non-convex spacecraft can be hidden from the Sun (self-shadowing) or from the
+observer (self-occlusion) by other parts of the spacecraft.  Paper 000 Eq. 3-4 sum over all
+facets that face the Sun and the observer; with these effects the area ``A_j`` of facet ``j``
+becomes ``A_j * f_j`` with the fractions computed here.  Facets are one-sided: only the
+front (outward) side of a facet receives light or is seen.
+
+Methods (:data:`METHODS`)
+-------------------------
+``"exact"`` (default)
+    Area-exact, to float rounding.  A point ``p`` of facet ``i`` (``N_i.d > 0``) is shadowed
+    along the direction ``d`` iff the ray ``p + t d``, ``t > 0``, meets the surface.  On a
+    closed surface the first hit enters the solid, so the occluders are the facets with
+    ``N_j.d < 0`` (on an open surface: every facet not edge-on); each is cut to its part in
+    front of the plane of ``i`` (``N_i.(x - p_i) >= 0``) and projected along ``d`` onto that
+    plane, ``x - d N_i.(x - p_i) / N_i.d`` (a parallel projection: the shadow volume of a
+    triangle).  The shadows of every occluder along the Sun *and* the observer directions,
+    clipped to the facet (Sutherland-Hodgman; convex against convex is exact), are united
+    and the fraction is ``1 - area(union) / area(facet)``.  The union area is the
+    inclusion-exclusion sum over the non-empty intersections of the convex shadows (each one
+    again a convex clip; an empty intersection prunes all its supersets); past 64 shadows or
+    a work budget it is summed over vertical slabs bounded by every vertex and edge
+    crossing (in each slab the covered length is linear in x); a facet with more than
+    :data:`MAX_SHADOWS` shadows is united by GEOS (:func:`shapely.union_all`).  Candidate
+    occluders come from a uniform grid over the bounding boxes in the plane perpendicular
+    to ``d`` (a facet whose box does not overlap,
+    or that lies wholly behind the receiver along ``d``, cannot shadow it), so the cost grows
+    nearly linearly with the number of facets.  Compiled with numba.
+``"sampled"``
+    ``density**2`` points per facet from a scrambled Sobol' sequence (seeded, so the result
+    is deterministic), given an independent random shift modulo 1 on every facet and mapped
+    to the triangle by the area-preserving map ``(1 - sqrt(u), sqrt(u) (1 - v), sqrt(u) v)``
+    (Shirley and Chiu 1997); a ray is cast from each toward the direction asked and the
+    fraction is the share of rays that hit nothing.  The points are irregular, so they
+    cannot line up with the straight (often axis-aligned) edges of CAD shadows: the error of
+    a facet crossed by a shadow edge falls as ``N**-0.75`` for ``N`` samples (randomised QMC
+    for a discontinuous integrand in two dimensions, Owen 1997; i.e. ``density**-1.5``),
+    with no stalls at special densities.  ``return_error=True`` also gives the binomial
+    standard error ``sqrt(f (1 - f) / N)`` of every fraction (a bound for independent
+    samples; the QMC error is usually smaller).  Ray origins are lifted off the facet along
+    its normal by ``offset`` (default :data:`OFFSET_FACTOR` = 1e-6 times the bounding-box
+    diagonal) so that a ray never hits its own facet or a coplanar neighbour.
+
+In both methods a facet facing away from a direction (``N.d <= 0``) gets 0; a facet whose
+plane supports the whole mesh (every vertex on or behind it, like every facet of a convex
+body) cannot be shadowed and gets 1 without further work, and a convex spacecraft
+(:attr:`~sbrdf_xr.body.spacecraft.Spacecraft.is_convex`) skips the computation entirely.
+
+Ray engines of the sampled method (:data:`ENGINES`): ``"embree"`` is
+:mod:`trimesh.ray.ray_pyembree` (Intel Embree through the ``embreex`` package, float32,
+fast); ``"triangle"`` is trimesh's pure-numpy :mod:`trimesh.ray.ray_triangle` (float64, slow;
+only hits in front of the origin count); ``"auto"`` (or None) picks embree when installed.
+
+All functions take directions in the body frame of the spacecraft.
+
+References
+----------
+Shirley, P. and Chiu, K. (1997), A low distortion map between disk and square, J. Graphics
+Tools 2(3), 45-52 (the triangle map, their Eq. 1 and §3).
+Owen, A. B. (1997), Scrambled net variance for integrals of smooth functions, Ann. Statist.
+25(4), 1541-1562; Sutherland, I. E. and Hodgman, G. W. (1974), Reentrant polygon clipping,
+Comm. ACM 17(1), 32-42.
+"""
+
+from __future__ import annotations
+
+import itertools
+from typing import Any, Literal, overload
+
+import numpy as np
+import trimesh
+import xarray as xr
+from numpy.typing import ArrayLike, NDArray
+
+from .._names import FACET, GEOMETRY, VECTOR, attrs
+from ..errors import ValidationError
+from ..geometry import normalize
+from ..kernels.shadow import MAX_SHADOWS, exact_kernel, facet_shadows
+from .rays import (
+    DENSITY_PRESETS,
+    ENGINES,
+    OFFSET_FACTOR,
+    SEED,
+    available_engines,
+    check_density,
+    engine_name,
+    escape_masks,
+    is_convex,
+    mesh_of,
+    sample_triangle,
+    samples_per_facet,
+    supporting,
+)
+from .spacecraft import Spacecraft
+
+__all__ = [
+    "DENSITY_PRESETS",
+    "ENGINES",
+    "MAX_SHADOWS",
+    "METHODS",
+    "OFFSET_FACTOR",
+    "available_engines",
+    "facet_visibility",
+    "lit_fraction",
+    "lit_visible_fraction",
+    "sample_triangle",
+    "samples_per_facet",
+    "visible_fraction",
+]
+
+#: Shadowing methods: name -> description.
+METHODS: dict[str, str] = {
+    "exact": "area-exact polygon clipping of the projected occluders (numba, GEOS fallback)",
+    "sampled": "density**2 scrambled Sobol' rays per facet (ray engine: see ENGINES)",
+}
+
+#: Height above a facet's plane, as a fraction of the bounding-box diagonal, below which a
+#: vertex counts as on the plane (exact method; float64 rounding of coplanar facets is ~1e-16).
+PLANE_TOLERANCE = 1.0e-9
+
+
+def _method(method: str) -> str:
+    if method not in METHODS:
+        raise ValidationError(f"method: got {method!r}; allowed: {', '.join(METHODS)}")
+    return method
+
+
+def _directions(directions: ArrayLike, name: str) -> tuple[np.ndarray, tuple[int, ...]]:
+    d = normalize(np.asarray(directions, dtype=np.float64), name)
+    return d.reshape(-1, 3), d.shape[:-1]
+
+
+# ----------------------------------------------------------------------------- exact method
+
+
+def _plane_frames(mesh: trimesh.Trimesh, cache: dict[str, Any]) -> dict[str, Any]:
+    """Per-facet arrays of the exact method: vertices, faces, normals from the winding, an
+    in-plane orthonormal frame (E1 along the first edge, E2 = N x E1), the triangle in that
+    frame (counter-clockwise), the receivers that can be shadowed and the surface type."""
+    if "exact:frames" in cache:
+        return cache["exact:frames"]
+    V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
+    F = np.ascontiguousarray(mesh.faces, dtype=np.int64)
+    tri = V[F]
+    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    norm = np.linalg.norm(cross, axis=1)
+    ok = norm > 0
+    N = np.zeros_like(cross)
+    N[ok] = cross[ok] / norm[ok, None]
+    e1 = tri[:, 1] - tri[:, 0]
+    len1 = np.linalg.norm(e1, axis=1)
+    E1 = np.zeros_like(e1)
+    E1[ok] = e1[ok] / len1[ok, None]
+    E2 = np.cross(N, E1)
+    rel = tri - tri[:, :1]
+    T2 = np.stack([np.einsum("fvx,fx->fv", rel, E1), np.einsum("fvx,fx->fv", rel, E2)], axis=-1)
+    tol = PLANE_TOLERANCE * float(mesh.scale)
+    receiver = ok & ~supporting(mesh, cache, tol)
+    frames = {
+        "V": V,
+        "F": F,
+        "N": N,
+        "P0": np.ascontiguousarray(tri[:, 0]),
+        "E1": E1,
+        "E2": E2,
+        "T2": np.ascontiguousarray(T2),
+        "receiver": receiver,
+        "eps": tol,
+        "watertight": bool(mesh.is_watertight) and bool(mesh.is_winding_consistent),
+    }
+    cache["exact:frames"] = frames
+    return frames
+
+
+def _geos_fraction(frames: dict[str, Any], i: int, dirs: np.ndarray) -> float:
+    """Fraction of facet i left by the GEOS union of its shadows (the kernel's fallback)."""
+    import shapely
+
+    xy, start = facet_shadows(
+        i,
+        dirs,
+        frames["V"],
+        frames["F"],
+        frames["N"],
+        frames["P0"],
+        frames["E1"],
+        frames["E2"],
+        frames["T2"],
+        frames["watertight"],
+        frames["eps"],
+    )
+    tri = shapely.Polygon(frames["T2"][i])
+    rings = [xy[a:b] for a, b in itertools.pairwise(start)]
+    shadow = shapely.union_all([shapely.Polygon(r) for r in rings])
+    return float(min(1.0, max(0.0, 1.0 - shadow.area / tri.area)))
+
+
+def _exact(
+    spacecraft: Spacecraft | trimesh.Trimesh, directions: list[np.ndarray], convex_shortcut: bool
+) -> np.ndarray:
+    """Exact fraction unobstructed along every direction of the list, shape (n_geom, n_facets)."""
+    mesh, cache = mesh_of(spacecraft)
+    normals = np.asarray(mesh.face_normals, dtype=np.float64)
+    front = np.logical_and.reduce([d @ normals.T > 0 for d in directions])
+    if convex_shortcut and is_convex(spacecraft):
+        return front.astype(np.float64)
+    frames = _plane_frames(mesh, cache)
+    dirs = np.ascontiguousarray(np.stack(directions, axis=1), dtype=np.float64)  # (G, K, 3)
+    if not frames["receiver"].any():
+        return front.astype(np.float64)
+    frac = exact_kernel(
+        frames["V"],
+        frames["F"],
+        frames["N"],
+        frames["P0"],
+        frames["E1"],
+        frames["E2"],
+        frames["T2"],
+        frames["receiver"],
+        dirs,
+        frames["watertight"],
+        frames["eps"],
+    )
+    for g, i in np.argwhere(np.isnan(frac)):
+        frac[g, i] = _geos_fraction(frames, int(i), dirs[g])
+    # a facet facing a direction per the stored normals but not per its winding (or
+    # vice versa) keeps the stored normals' verdict, as the sampled method does
+    return np.where(front, frac, 0.0)
+
+
+# ----------------------------------------------------------------------------- public API
+
+
+def _fractions(
+    spacecraft: Spacecraft | trimesh.Trimesh,
+    directions: list[np.ndarray],
+    method: str,
+    density: int | str,
+    engine: str | None,
+    offset: float | None,
+    convex_shortcut: bool,
+    seed: int,
+    return_error: bool,
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """Fractions unobstructed along all ``directions`` at once, (n_geom, n_facets), and the
+    standard error of the sampled estimate (zeros for the exact method) if asked."""
+    mesh_of(spacecraft)
+    if _method(method) == "exact":
+        check_density(density)
+        engine_name(engine)
+        if offset is not None and not (np.isfinite(offset) and offset > 0):
+            raise ValidationError(f"offset: got {offset!r}; expected a positive length [m]")
+        f = _exact(spacecraft, directions, convex_shortcut)
+        return f, (np.zeros_like(f) if return_error else None)
+    masks = escape_masks(spacecraft, directions, density, engine, offset, convex_shortcut, seed)
+    f = np.logical_and.reduce(masks, axis=0).mean(axis=-1)
+    err = np.sqrt(f * (1.0 - f) / masks.shape[-1]) if return_error else None
+    return f, err
+
+
+def lit_fraction(
+    spacecraft: Spacecraft | trimesh.Trimesh,
+    directions: ArrayLike,
+    *,
+    method: str = "exact",
+    density: int | str = 4,
+    engine: str | None = None,
+    offset: float | None = None,
+    convex_shortcut: bool = True,
+    seed: int = SEED,
+) -> NDArray[np.float64]:
+    """Fraction of each facet's area from which the direction is unobstructed.
+
+    For the Sun direction this is the fraction not self-shadowed; for the observer
+    direction the fraction not self-occluded (:func:`visible_fraction` is this function).
+
+    Parameters
+    ----------
+    spacecraft : Spacecraft or trimesh.Trimesh
+        A closed, outward-oriented surface [m].
+    directions : array_like, shape (..., 3)
+        Directions toward the Sun (or observer) in the body frame; normalised here, must be
+        finite and non-zero.
+    method : {"exact", "sampled"}
+        Area-exact polygon clipping or sampled rays (see :data:`METHODS`).
+    density : int or str
+        Sampled method: ``density**2`` rays per facet (``density >= 1``) or a preset of
+        :data:`DENSITY_PRESETS`; checked but unused by the exact method.
+    engine : {"auto", "embree", "triangle"} or None
+        Ray engine of the sampled method (see :data:`ENGINES`); None is ``"auto"``.
+    offset : float, optional
+        Sampled method: lift of the ray origins along the facet normal [m]; default
+        :data:`OFFSET_FACTOR` times the bounding-box diagonal.
+    convex_shortcut : bool
+        Skip the computation for convex spacecraft (the result is the same; False forces it,
+        for testing).
+    seed : int
+        Seed of the sampled method's points.
+
+    Returns
+    -------
+    ndarray, shape (..., n_facets)
+        Fractions in ``[0, 1]`` [1]; 0 for facets with ``N.d <= 0``.
+
+    Raises
+    ------
+    ValidationError
+        On zero or non-finite directions, an unknown method, a density below 1, an unknown or
+        unavailable engine.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1
+    >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
+    ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
+    >>> area = body.mesh.area_faces[floor]
+    >>> def on_floor(f):  # area-weighted mean over the floor's two facets
+    ...     return round(float((f[..., floor] * area).sum(-1) / area.sum()), 6)
+    >>> body.is_convex
+    False
+    >>> sun = [-1.0, 2.0, 0.0]  # from -x, shadow 0.5 m long on the 1 m wide floor
+    >>> f = lit_fraction(body, sun)
+    >>> f.shape, on_floor(f)
+    ((20,), 0.5)
+    >>> abs(on_floor(lit_fraction(body, sun, method="sampled", density=8)) - 0.5) < 0.02
+    True
+    """
+    d, shape = _directions(directions, "directions")
+    f, _ = _fractions(
+        spacecraft, [d], method, density, engine, offset, convex_shortcut, seed, False
+    )
+    return f.reshape(*shape, -1)
+
+
+def visible_fraction(
+    spacecraft: Spacecraft | trimesh.Trimesh,
+    directions: ArrayLike,
+    *,
+    method: str = "exact",
+    density: int | str = 4,
+    engine: str | None = None,
+    offset: float | None = None,
+    convex_shortcut: bool = True,
+    seed: int = SEED,
+) -> NDArray[np.float64]:
+    """Fraction of each facet's area seen from each observer direction (not self-occluded).
+
+    Identical to :func:`lit_fraction` with observer directions in place of Sun directions
+    (occlusion toward a distant observer is shadowing by a light at the observer).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1
+    >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
+    ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
+    >>> area = body.mesh.area_faces[floor]
+    >>> def on_floor(f):  # area-weighted mean over the floor's two facets
+    ...     return round(float((f[..., floor] * area).sum(-1) / area.sum()), 6)
+    >>> on_floor(visible_fraction(body, [-1.0, 3.0, 0.0]))  # the wall hides 1/3 m of the floor
+    0.666667
+    """
+    return lit_fraction(
+        spacecraft,
+        directions,
+        method=method,
+        density=density,
+        engine=engine,
+        offset=offset,
+        convex_shortcut=convex_shortcut,
+        seed=seed,
+    )
+
+
+@overload
+def lit_visible_fraction(
+    spacecraft: Spacecraft | trimesh.Trimesh,
+    to_sun: ArrayLike,
+    to_observer: ArrayLike,
+    *,
+    method: str = ...,
+    density: int | str = ...,
+    engine: str | None = ...,
+    offset: float | None = ...,
+    convex_shortcut: bool = ...,
+    seed: int = ...,
+    return_error: Literal[False] = ...,
+) -> NDArray[np.float64]: ...
+
+
+@overload
+def lit_visible_fraction(
+    spacecraft: Spacecraft | trimesh.Trimesh,
+    to_sun: ArrayLike,
+    to_observer: ArrayLike,
+    *,
+    method: str = ...,
+    density: int | str = ...,
+    engine: str | None = ...,
+    offset: float | None = ...,
+    convex_shortcut: bool = ...,
+    seed: int = ...,
+    return_error: Literal[True],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+
+
+def lit_visible_fraction(
+    spacecraft: Spacecraft | trimesh.Trimesh,
+    to_sun: ArrayLike,
+    to_observer: ArrayLike,
+    *,
+    method: str = "exact",
+    density: int | str = 4,
+    engine: str | None = None,
+    offset: float | None = None,
+    convex_shortcut: bool = True,
+    seed: int = SEED,
+    return_error: bool = False,
+) -> NDArray[np.float64] | tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Fraction of each facet's area both lit by the Sun and seen by the observer.
+
+    Exact method: one minus the area of the union of the Sun shadow and the occluded region
+    over the facet area.  Sampled method: the share of sample points that see both.  Either
+    way it is not the product of :func:`lit_fraction` and :func:`visible_fraction` when the
+    shadow and the occluded region only partly overlap.
+
+    Parameters
+    ----------
+    spacecraft : Spacecraft or trimesh.Trimesh
+        A closed, outward-oriented surface [m].
+    to_sun, to_observer : array_like, shape (..., 3)
+        Directions toward the Sun and observer in the body frame, broadcast together.
+    method, density, engine, offset, convex_shortcut, seed
+        As in :func:`lit_fraction`.
+    return_error : bool
+        Also return the standard error of every fraction: the binomial
+        ``sqrt(f (1 - f) / density**2)`` of the sampled method, zeros for the exact method.
+        The standard error of a signal ``sum_j w_j f_j`` is then about
+        ``sqrt(sum_j (w_j err_j)**2)`` (facets have independent point sets).
+
+    Returns
+    -------
+    ndarray, shape (..., n_facets)
+        Fractions in ``[0, 1]`` [1]; 0 where ``N.s <= 0`` or ``N.o <= 0``.  With
+        ``return_error``, a pair (fraction, standard error) of that shape.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1
+    >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
+    ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
+    >>> area = body.mesh.area_faces[floor]
+    >>> def on_floor(f):  # area-weighted mean over the floor's two facets
+    ...     return round(float((f[..., floor] * area).sum(-1) / area.sum()), 6)
+    >>> sun, observer = [-1.0, 2.0, 0.0], [-1.0, 3.0, 0.0]
+    >>> on_floor(lit_visible_fraction(body, sun, observer))  # not 0.5 * 2/3: hidden is shadowed
+    0.5
+    """
+    s, o = np.broadcast_arrays(
+        np.asarray(to_sun, dtype=np.float64), np.asarray(to_observer, dtype=np.float64)
+    )
+    ds, shape = _directions(s, "to_sun")
+    do, _ = _directions(o, "to_observer")
+    f, err = _fractions(
+        spacecraft, [ds, do], method, density, engine, offset, convex_shortcut, seed, return_error
+    )
+    if return_error and err is not None:
+        return f.reshape(*shape, -1), err.reshape(*shape, -1)
+    return f.reshape(*shape, -1)
+
+
+def facet_visibility(
+    spacecraft: Spacecraft,
+    to_sun: ArrayLike,
+    to_observer: ArrayLike,
+    *,
+    method: str = "exact",
+    density: int | str = 4,
+    engine: str | None = None,
+    offset: float | None = None,
+    seed: int = SEED,
+) -> xr.Dataset:
+    """Shadowing and occlusion fractions of every facet for a list of geometries.
+
+    Parameters
+    ----------
+    spacecraft : Spacecraft
+        The model.
+    to_sun, to_observer : array_like, shape (n_geometry, 3) or (3,)
+        Directions toward the Sun and observer in the body frame.
+    method, density, engine, offset, seed
+        As in :func:`lit_fraction`.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``(geometry, facet)``: ``lit_fraction``, ``visible_fraction`` and
+        ``lit_visible_fraction`` [1]; coordinates ``to_sun`` and ``to_observer``
+        ``(geometry, xyz)``; attrs ``method`` and, for the sampled method, ``density``,
+        ``samples_per_facet``, ``engine``.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> body = l_shaped_spacecraft()  # the wall x = 1 (1 m tall) shades the floor y = 1
+    >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
+    ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
+    >>> area = body.mesh.area_faces[floor]
+    >>> def on_floor(f):  # area-weighted mean over the floor's two facets
+    ...     return round(float((f[..., floor] * area).sum(-1) / area.sum()), 6)
+    >>> ds = facet_visibility(body, [[-1.0, 2.0, 0.0]], [[-1.0, 3.0, 0.0]])
+    >>> dict(ds.sizes), ds.attrs["method"]
+    ({'geometry': 1, 'facet': 20, 'xyz': 3}, 'exact')
+    >>> on_floor(ds.lit_fraction.values[0]), on_floor(ds.visible_fraction.values[0])
+    (0.5, 0.666667)
+    """
+    s, o = np.broadcast_arrays(
+        np.asarray(to_sun, dtype=np.float64), np.asarray(to_observer, dtype=np.float64)
+    )
+    ds, _ = _directions(s, "to_sun")
+    do, _ = _directions(o, "to_observer")
+    args = (method, density, engine, offset, True, seed, False)
+    if _method(method) == "exact":
+        lit = _fractions(spacecraft, [ds], *args)[0]
+        vis = _fractions(spacecraft, [do], *args)[0]
+        joint = _fractions(spacecraft, [ds, do], *args)[0]
+        extra: dict[str, Any] = {}
+    else:
+        masks = escape_masks(spacecraft, [ds, do], density, engine, offset, True, seed)
+        lit, vis, joint = masks[0].mean(-1), masks[1].mean(-1), (masks[0] & masks[1]).mean(-1)
+        extra = {
+            "density": check_density(density),
+            "samples_per_facet": samples_per_facet(density),
+            "engine": engine_name(engine),
+            "seed": seed,
+        }
+    dims = (GEOMETRY, FACET)
+    return xr.Dataset(
+        {
+            "lit_fraction": (dims, lit, attrs("lit_fraction")),
+            "visible_fraction": (dims, vis, attrs("visible_fraction")),
+            "lit_visible_fraction": (dims, joint, attrs("lit_visible_fraction")),
+        },
+        coords={
+            "to_sun": ((GEOMETRY, VECTOR), ds, attrs("to_sun")),
+            "to_observer": ((GEOMETRY, VECTOR), do, attrs("to_observer")),
+            FACET: (FACET, np.arange(spacecraft.n_facets), attrs(FACET)),
+            VECTOR: (VECTOR, ["x", "y", "z"], attrs(VECTOR)),
+        },
+        attrs={"spacecraft": spacecraft.name, "method": method, **extra},
+    )

@@ -1,0 +1,203 @@
+"""The sub-commands of ``sbrdf-xr`` that analyse a cube or measured data: ``photometry``
+(band magnitudes and colours) and ``invert`` (material areas, spin state).  Each
+``cmd_*`` takes the parsed arguments and returns the exit status.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..errors import SbrdfError, ValidationError
+from .commands import spacecraft_of
+from .output import open_dataset
+
+__all__ = ["cmd_invert", "cmd_photometry"]
+
+
+def _cube_range_km(cube) -> float | None:
+    """The observer range a cube records [km] (attribute or scalar variable), if any."""
+    for name in ("range_km", "observer_range_km"):
+        if name in cube.attrs:
+            return float(cube.attrs[name])
+        if name in cube.variables and cube[name].ndim == 0:
+            return float(cube[name].values)
+    return None
+
+
+def _parse_colours(text: str | None) -> list[tuple[str, str]] | None:
+    if not text:
+        return None
+    pairs = []
+    for item in text.split(","):
+        a, sep, b = item.strip().partition("-")
+        if not sep or not a or not b:
+            raise SbrdfError(
+                f"--colours: {item.strip()!r} is not a band pair like V-R (give e.g. V-R,R-I)"
+            )
+        pairs.append((a, b))
+    return pairs
+
+
+def cmd_photometry(args: argparse.Namespace) -> int:
+    import numpy as np
+    import xarray as xr
+    from tqdm.dask import TqdmCallback
+
+    from .. import photometry as phot
+
+    for out in (args.output, args.csv):
+        if out and Path(out).exists() and not args.overwrite:
+            raise FileExistsError(f"{out} exists; pass --overwrite to replace it")
+    with open_dataset(args.cube) as probe:
+        if not any(
+            v in probe and "wavelength" in probe[v].dims for v in ("signal", "spacecraft_sbrdf")
+        ):
+            raise ValidationError(
+                f"{args.cube}: not a spectral simulation cube of 'sbrdf-xr simulate' "
+                "(it needs 'signal' or 'spacecraft_sbrdf' over wavelength)"
+            )
+    colours = _parse_colours(args.colours)
+    with xr.open_dataset(args.cube, chunks={}) as cube:
+        range_km = args.range_km if args.range_km is not None else _cube_range_km(cube)
+        if range_km is None:
+            raise SbrdfError(
+                f"{args.cube} records no observer range; give it with --range-km KM "
+                "(e.g. --range-km 36000 for a geostationary object)"
+            )
+        lazy = phot.photometry(
+            cube,
+            args.bands,
+            range_km,
+            pairs=colours,
+            system=args.system,
+            weighting=args.weighting,
+            quadrature=args.quadrature,
+            extrapolate=args.extrapolate,
+            solar=args.solar,
+        )
+        with TqdmCallback(desc="photometry", disable=args.quiet):
+            ds = lazy.compute()
+    print(
+        f"photometry of {args.cube}: range {range_km:g} km, {ds.attrs['magnitude_system']} "
+        f"magnitudes, {args.weighting} weighting, solar spectrum {args.solar}"
+    )
+    print(f"{'band':<8} {'filter':<14} {'m_sun':>8} {'min':>8} {'median':>8} {'max':>8}")
+    for b in ds.band.values:
+        m = np.asarray(ds.magnitude.sel(band=b).values).ravel()
+        fin = m[np.isfinite(m)]
+        stats = (
+            f"{fin.min():8.3f} {np.median(fin):8.3f} {fin.max():8.3f}"
+            if fin.size
+            else f"{'inf':>8} {'inf':>8} {'inf':>8}"
+        )
+        print(
+            f"{b!s:<8} {ds.filter.sel(band=b).item()!s:<14} "
+            f"{float(ds.sun_magnitude.sel(band=b)):8.3f} {stats}"
+        )
+    if "colour_index" in ds:
+        for c in ds.colour.values:
+            v = np.asarray(ds.colour_index.sel(colour=c).values).ravel()
+            v = v[np.isfinite(v)]
+            med = f"{np.median(v):.3f}" if v.size else "nan"
+            print(f"colour {c!s:<10} median {med} mag")
+    if args.output:
+        phot.to_netcdf(ds, args.output, overwrite=args.overwrite)
+        print(f"wrote {args.output}")
+    if args.csv:
+        lead = set(ds.magnitude.dims) - {"band"}
+        parts = [
+            ds.magnitude.to_dataset(dim="band").rename({str(b): f"mag_{b}" for b in ds.band.values})
+        ]
+        if "colour_index" in ds:
+            parts.append(ds.colour_index.to_dataset(dim="colour"))
+        wide = xr.merge(parts, compat="override")
+        wide = wide.drop_vars(
+            [c for c in wide.coords if not set(wide[c].dims) <= lead or c in ("band", "colour")],
+            errors="ignore",
+        )
+        wide.to_dataframe().to_csv(args.csv)
+        print(f"wrote {args.csv}")
+    return 0
+
+
+def cmd_invert(args: argparse.Namespace) -> int:
+    import numpy as np
+    import xarray as xr
+
+    from .. import invert
+    from ..errors import InversionError
+    from ..materials.tables import write_netcdf_atomic
+    from ..photometry import read_light_curve
+
+    if args.invert_command == "unmix":
+        with xr.open_dataset(args.cube) as cube:
+            terms = cube.load()["signal_material"] if "signal_material" in cube else None
+        if terms is None:
+            raise InversionError(
+                f"{args.cube}: no signal_material; simulate with the per_material output"
+            )
+        for item in args.isel or []:
+            dim, _, idx = item.partition("=")
+            terms = terms.isel({dim: int(idx)})
+        try:
+            y, sigma = invert.read_spectrum(args.measured)
+        except InversionError:
+            lc = read_light_curve(args.measured)
+            if args.range_km is None:
+                raise InversionError(
+                    "--range-km: needed to turn measured magnitudes into signal"
+                ) from None
+            y, sigma = invert.magnitudes_to_signal(lc, args.range_km)
+            terms = invert.band_terms(terms, [str(b) for b in y.band.values])
+        ds = invert.unmix(
+            y,
+            terms,
+            sigma,
+            select=None if args.select == "none" else args.select,
+            criterion=args.criterion,
+        )
+        print(
+            f"unmix {args.measured}: chi2 {float(ds.chi2):.4g}, "
+            f"reduced {float(ds.reduced_chi2):.4g}, "
+            f"{args.criterion} selection: {ds.attrs['selected_materials']}"
+        )
+        for m in ds.material.values:
+            print(
+                f"  {m!s:<24} scale {float(ds.scale.sel(material=m)):.4f} "
+                f"+- {float(ds.scale_uncertainty.sel(material=m)):.4f}"
+            )
+        print(f"  degenerate: {ds.attrs['degenerate']}")
+    else:
+        sc = spacecraft_of(args)
+        lo, hi, n = args.periods
+        ds = invert.fit_spin(
+            read_light_curve(args.measured),
+            sc,
+            to_sun=args.to_sun,
+            to_observer=args.to_observer,
+            periods=np.linspace(lo, hi, int(n)),
+            axis_body=args.axis_body,
+            n_axes=args.n_axes,
+            n_phases=args.n_phases,
+            offset=args.offset,
+        )
+        print(
+            f"spin fit of {args.measured}: {ds.attrs['n_candidates']} candidates in "
+            f"{ds.attrs['search_seconds']:.1f} s; chi2 {float(ds.chi2):.4g}, "
+            f"reduced {float(ds.reduced_chi2):.4g}"
+        )
+        for k in ("axis_longitude", "axis_latitude", "period", "phase"):
+            print(
+                f"  {k:<15} {float(ds[k]):10.4f} +- {float(ds[k + '_uncertainty']):.4f} "
+                f"{ds[k].attrs['units']}"
+            )
+        for sname in ds.solution.values:
+            print(
+                f"  alternative {sname!s:<14} "
+                f"chi2 gap {float(ds.chi2_gap.sel(solution=sname)):10.2f}"
+            )
+    if args.output:
+        write_netcdf_atomic(ds, args.output, overwrite=args.overwrite)
+        print(f"wrote {args.output}")
+    return 0

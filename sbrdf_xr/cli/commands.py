@@ -1,0 +1,294 @@
+"""The sub-commands of ``sbrdf-xr`` that list, run and draw: ``catalog``, ``info``,
+``knobs``, ``bench``, ``simulate`` (with its spacecraft and material options) and
+``plot``.  Each ``cmd_*`` takes the parsed arguments and returns the exit status.
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import textwrap
+from pathlib import Path
+from typing import Any
+
+from .. import catalog
+from .._version import __version__
+from ..errors import ValidationError
+from ..store.writer import PART_SUFFIX
+from .output import escape, escaped_attrs, open_cube, open_dataset
+
+__all__ = [
+    "cmd_bench",
+    "cmd_catalog_list",
+    "cmd_catalog_show",
+    "cmd_info",
+    "cmd_knobs",
+    "cmd_plot",
+    "cmd_simulate",
+    "spacecraft_of",
+]
+
+
+def _catalog_label(e: catalog.CatalogEntry, users: list[Path]) -> str:
+    """``shipped`` or ``user<i>`` (the i-th directory of SBRDF_XR_CATALOG_PATH)."""
+    return "shipped" if e.root is None else f"user{users.index(e.root) + 1}"
+
+
+def cmd_catalog_list(args: argparse.Namespace) -> int:
+    rows = catalog.entries(args.kind)
+    users = catalog.user_catalog_dirs()
+    width = max((len(e.name) for e in rows), default=4)
+    print(f"{'name':<{width}}  {'kind':<16}  {'source':<12}  {'catalog':<8}  description")
+    for e in rows:
+        desc = textwrap.shorten(e.description, 72)
+        label = _catalog_label(e, users)
+        print(escape(f"{e.name:<{width}}  {e.kind:<16}  {e.source:<12}  {label:<8}  {desc}"))
+    print(f"\n{len(rows)} entries; catalogs:")
+    print(f"  shipped  {catalog.catalog_dir()}")
+    for i, d in enumerate(users, 1):
+        print(escape(f"  user{i:<4} {d}"))
+    if not users:
+        print(f"  (no user catalogs: set {catalog.CATALOG_PATH_ENV} to add some)")
+    return 0
+
+
+def cmd_catalog_show(args: argparse.Namespace) -> int:
+    e = catalog.entry(args.name)
+    print(escape(f"name:        {e.name}\nkind:        {e.kind}\nsource:      {e.source}"))
+    print(escape(f"catalog:     {e.origin}"))
+    print(escape(f"file:        {e.file}"))
+    print(
+        "description: " + textwrap.fill(escape(e.description, True), 88, subsequent_indent=" " * 13)
+    )
+    print(
+        "provenance:  " + textwrap.fill(escape(e.provenance, True), 88, subsequent_indent=" " * 13)
+    )
+    for k, v in e.extra.items():
+        print(escape(f"{escape(k, True) + ':':<13}{escape(v, True)}"))
+    print()
+    print(escape(escaped_attrs(catalog.load(e.name))))
+    return 0
+
+
+def cmd_info(args: argparse.Namespace) -> int:
+    if args.file:
+        with open_dataset(args.file) as ds:
+            print(escape(escaped_attrs(ds)))
+        return 0
+    import dask
+    import numpy
+    import scipy
+    import trimesh
+    import xarray
+
+    print(f"sbrdf_xr {__version__}")
+    for mod in (numpy, scipy, xarray, dask, trimesh):
+        print(f"  {mod.__name__:<8} {mod.__version__}")
+    print(f"  catalogs {catalog.catalog_dir()} ({len(catalog.names())} entries)")
+    for d in catalog.user_catalog_dirs():
+        print(escape(f"  user catalog {d}"))
+    return 0
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    from .. import bench
+
+    if args.engine:
+        from ..bench.engine import engine_rows
+
+        rows = engine_rows(quick=args.quick)
+    else:
+        rows = bench.run(quick=args.quick)
+    print(bench.format_rows(rows))
+    ds = bench.rows_to_dataset(rows)
+    if args.output:
+        from ..materials.tables import write_netcdf_atomic
+
+        write_netcdf_atomic(ds, args.output, overwrite=True)
+        print(f"wrote {args.output}")
+    if args.csv:
+        ds.to_dataframe().to_csv(args.csv)
+        print(f"wrote {args.csv}")
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        bench.plot_front(rows).savefig(args.plot, dpi=120)
+        print(f"wrote {args.plot}")
+    return 0
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    from ..engine import resolve_scene
+    from ..engine.run import simulate, write
+
+    scene = resolve_scene(args.scene)
+    scene = _with_body(scene, args)
+    changes = _knob_values(args.set or [])
+    if args.preset:
+        scene = scene.with_options(preset=args.preset, **changes)
+    elif changes:
+        scene = scene.with_options(**changes)
+    plan = scene.plan()
+    print(plan)
+    if args.plan:
+        return 0
+    out = Path(args.output)
+    finished = (
+        args.resume
+        and not args.overwrite
+        and out.is_file()
+        and not out.with_name(out.name + PART_SUFFIX).exists()
+    )
+    client = None
+    if args.scheduler is not None:
+        from ..store.writer import connect
+
+        client = connect(args.scheduler)
+    if hasattr(
+        signal, "SIGXFSZ"
+    ):  # past a file size limit, fail the write (named) instead of dying
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    try:
+        cube = simulate(plan, client=client)
+        extra = {} if str(out).endswith(".zarr") else {"complevel": args.complevel}
+        path = write(
+            cube,
+            out,
+            overwrite=args.overwrite,
+            resume=args.resume,
+            client=client,
+            progress=not args.quiet,
+            **extra,
+        )
+    finally:
+        if client is not None:
+            client.close()
+    if finished:
+        print(f"{path} is already complete; nothing to resume")
+    else:
+        print(f"wrote {path}")
+    if args.plot:
+        _save_figure(path, args.plot)
+    return 0
+
+
+def spacecraft_of(args: argparse.Namespace) -> Any:
+    """The spacecraft of ``--spacecraft`` (a catalog name or a mesh file) and its options."""
+    options: dict[str, Any] = {}
+    if args.mesh_material is not None:
+        options["material"] = args.mesh_material
+    if args.material_map is not None:
+        options["material_map"] = Path(args.material_map)
+    if args.length_unit is not None:
+        options["length_unit"] = args.length_unit
+    if options and args.spacecraft is None:
+        raise ValidationError(
+            "--mesh-material, --material-map and --length-unit describe the mesh file of "
+            "--spacecraft; give --spacecraft too"
+        )
+    if options and not catalog.is_file_spec(args.spacecraft):
+        raise ValidationError(
+            f"--spacecraft {args.spacecraft!r} is a catalog entry; --mesh-material, "
+            "--material-map and --length-unit apply to a mesh file only"
+        )
+    if (
+        args.spacecraft is not None
+        and catalog.is_file_spec(args.spacecraft)
+        and not ("material" in options or "material_map" in options)
+    ):
+        raise ValidationError(
+            f"--spacecraft {args.spacecraft}: a mesh file needs --mesh-material NAME (one "
+            "material for every facet) or --material-map MAP.toml (facet colour or label -> "
+            "material)"
+        )
+    return catalog.load_spacecraft_spec(args.spacecraft, **options)
+
+
+def _with_body(scene: Any, args: argparse.Namespace) -> Any:
+    """The scene with the spacecraft of ``--spacecraft`` and the tables of ``--material``."""
+    from ..engine.builtin import material_tables
+
+    specs: dict[str, str] = {}
+    for item in args.material or []:
+        mat, sep, spec = item.partition("=")
+        if not sep or not mat.strip() or not spec.strip():
+            raise ValidationError(
+                f"--material: got {item!r}; expected MATERIAL=NAME or MATERIAL=FILE.nc"
+            )
+        specs[mat.strip()] = spec.strip()
+    mesh = args.mesh_material or args.material_map or args.length_unit
+    if args.spacecraft is None and not (mesh or specs):
+        return scene
+    body = scene.spacecraft if args.spacecraft is None and not mesh else spacecraft_of(args)
+    unknown = sorted(set(specs) - set(body.materials))
+    if unknown:
+        raise ValidationError(
+            f"--material: {unknown} are not materials of the spacecraft {body.name!r}; "
+            f"its materials: {body.materials}"
+        )
+    kept = {m: t for m, t in (scene.materials or {}).items() if m in body.materials}
+    wanted = {m: specs.get(m, m) for m in body.materials if m in specs or m not in kept}
+    tables, models = material_tables(wanted)
+    old_models = {m: v for m, v in (scene.models or {}).items() if m not in wanted}
+    return scene.with_options(
+        spacecraft=body,
+        materials={**kept, **tables},
+        models={**old_models, **models} or None,
+    )
+
+
+def _knob_values(items: list[str]) -> dict[str, object]:
+    """``NAME=VALUE`` strings as knob values (TOML syntax for the value, else a string)."""
+    import tomllib
+
+    from ..engine.knobs import KNOBS
+    from ..errors import SceneError
+
+    out: dict[str, object] = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        name = name.strip()
+        if not sep or name not in KNOBS:
+            raise SceneError(
+                f"--set {item!r}: expected NAME=VALUE with NAME one of {', '.join(KNOBS)}"
+            )
+        try:
+            value = tomllib.loads(f"v = {text.strip()}")["v"]
+        except tomllib.TOMLDecodeError:
+            value = text.strip()
+        out[name] = None if value == "none" else value
+    return out
+
+
+def cmd_knobs(args: argparse.Namespace) -> int:
+    from ..engine.knobs import knob_table
+
+    print(knob_table())
+    return 0
+
+
+def _save_figure(cube_path: str | Path, figure_path: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+
+    from ..plot import plot_cube
+
+    cube = open_cube(cube_path)
+    try:
+        fig = plot_cube(cube)
+    except (KeyError, ValueError, IndexError) as exc:
+        raise ValidationError(
+            f"{cube_path}: cannot be drawn ({type(exc).__name__}: {exc})"
+        ) from None
+    try:
+        fig.savefig(figure_path, dpi=120)
+    except ValueError as exc:  # an unknown image format
+        raise ValidationError(f"{figure_path}: {exc}") from None
+    print(f"wrote {figure_path}")
+
+
+def cmd_plot(args: argparse.Namespace) -> int:
+    _save_figure(args.cube, args.output)
+    return 0

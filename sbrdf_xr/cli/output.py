@@ -1,0 +1,99 @@
+"""What the command line reads and prints: netCDF files opened with clear errors, and
+text made safe for a terminal.
+
+Attributes of files and catalog entries are printed through :func:`escape` (and
+:func:`escaped_attrs` for a Dataset or DataArray), so that a terminal escape sequence
+stored in a file prints as text instead of acting on the terminal.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from ..errors import ValidationError
+
+__all__ = ["escape", "escaped_attrs", "open_cube", "open_dataset"]
+
+
+def escape(text: Any, newlines: bool = False) -> str:
+    """``text`` with control and other non-printable characters written as escapes.
+
+    Attributes of files and catalog entries are printed through this, so that a
+    terminal escape sequence in a file prints as ``\\x1b[...`` instead of acting on the
+    terminal.  Newlines and tabs are kept unless ``newlines`` is true.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.cli import escape
+    >>> print(escape("red " + chr(27) + "[31mtext"))  # the terminal's escape character
+    red \\x1b[31mtext
+    >>> print(escape("two" + chr(10) + "lines", newlines=True))
+    two\\nlines
+    """
+    keep = "" if newlines else "\n\t"
+    return "".join(c if c.isprintable() or c in keep else repr(c)[1:-1] for c in str(text))
+
+
+def escaped_attrs(obj: Any) -> Any:
+    """A shallow copy of a Dataset/DataArray whose attributes (and names) print safely."""
+    import xarray as xr
+
+    def clean(attrs: dict[Any, Any]) -> dict[str, Any]:
+        return {
+            escape(k, True): escape(v, True) if isinstance(v, str) else v for k, v in attrs.items()
+        }
+
+    if isinstance(obj, xr.Dataset):
+        out = obj.copy()
+        out.attrs = clean(obj.attrs)
+        for name in out.variables:
+            out[name].attrs = clean(obj[name].attrs)
+        return out.rename({n: escape(n, True) for n in out.variables if escape(n, True) != n})
+    if isinstance(obj, xr.DataArray):
+        arr = obj.copy()
+        arr.attrs = clean(obj.attrs)
+        for c in arr.coords:
+            arr[c].attrs = clean(obj[c].attrs)
+        return arr
+    return obj
+
+
+def open_dataset(path: str | Path) -> Any:
+    """Open a netCDF file, turning "not netCDF" into a :class:`ValidationError`."""
+    import xarray as xr
+
+    p = Path(path)
+    if not p.exists():
+        raise FileNotFoundError(f"{path}: no such file")
+    if not p.is_file():
+        raise ValidationError(f"{path}: not a file")
+    try:
+        return xr.open_dataset(p)
+    except (OSError, ValueError, TypeError, KeyError, RuntimeError) as exc:
+        why = (
+            "unrecognised format"
+            if "did not find a match" in str(exc)
+            else f"{type(exc).__name__}: {exc}"
+        )
+        raise ValidationError(f"{path}: not a readable netCDF file ({why})") from None
+
+
+def open_cube(path: str | Path) -> Any:
+    """A loaded simulation cube, or :class:`ValidationError` naming what is missing."""
+    with open_dataset(path) as ds:
+        spectral = [
+            v for v in ("spacecraft_sbrdf", "signal") if v in ds and "wavelength" in ds[v].dims
+        ]
+        curve = "brdf" in ds and "attitude" in ds.dims and "phase_angle" in ds.coords
+        if not spectral and not curve:
+            names = ", ".join(map(str, list(ds.data_vars)[:8])) or "none"
+            raise ValidationError(
+                f"{path}: not a simulation cube of 'sbrdf-xr simulate' "
+                "(it needs 'spacecraft_sbrdf' or 'signal' over wavelength, or 'brdf' over "
+                f"attitude; its variables: {escape(names, True)})"
+            )
+        try:
+            return ds.load()
+        except (OSError, ValueError, RuntimeError) as exc:
+            raise ValidationError(f"{path}: cannot be read ({exc})") from None

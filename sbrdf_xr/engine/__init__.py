@@ -1,0 +1,88 @@
+"""The engine: what to simulate (a :class:`Scene`), its plan, and running it into a cube.
+
+DESIGN.md principle 3: a scene is compiled into a :class:`~sbrdf_xr.engine.plan.Plan`
+that states every step that will run and every step skipped, and why; only the
+effects a scene calls for are simulated.
+
+Modules
+-------
+``knobs``
+    Every numerical knob of a simulation, and the presets, in one table.
+``effects``
+    The effects a simulation can include and the outputs of a cube.
+``sweep``
+    The geometry of a sweep: where the Sun and the observer are, in the body frame.
+``scene``, ``scene_file`` and ``builtin``
+    :class:`Scene`, scene files (TOML) and the built-in scenes.
+``plan``, ``stages`` and ``spectral``
+    The plan and its stages.
+``run``
+    Executing a plan: blocks of geometries through the kernel into an xarray cube
+    (:func:`simulate`, :func:`write`).
+"""
+
+from ..errors import SceneError
+from . import builtin, effects, knobs, plan, run, scene, scene_file, spectral, stages, sweep
+from .builtin import builtin_scene, builtin_scenes, resolve_scene
+from .effects import SPECTRAL_OUTPUTS, BlockInputs, Effect, Output, finish, reflected
+from .knobs import KNOBS, PRESETS, Knob, apply_preset, check_knob, knob_table
+from .plan import Estimate, Plan, PlannedOutput, Terms, compile_plan
+from .run import IN_PROCESS_BYTES, run_block, simulate, write
+from .scene import EFFECTS, OUTPUTS, Scene
+from .scene_file import (
+    MAX_SCENE_COUNT,
+    MAX_SHADOW_DENSITY,
+    load_scene,
+    material_tables,
+    scene_from_dict,
+)
+from .sweep import QUATERNION_COMPONENTS, GridGeometry, PairGeometry
+
+__all__ = [
+    "EFFECTS",
+    "IN_PROCESS_BYTES",
+    "KNOBS",
+    "MAX_SCENE_COUNT",
+    "MAX_SHADOW_DENSITY",
+    "OUTPUTS",
+    "PRESETS",
+    "QUATERNION_COMPONENTS",
+    "SPECTRAL_OUTPUTS",
+    "BlockInputs",
+    "Effect",
+    "Estimate",
+    "GridGeometry",
+    "Knob",
+    "Output",
+    "PairGeometry",
+    "Plan",
+    "PlannedOutput",
+    "Scene",
+    "SceneError",
+    "Terms",
+    "apply_preset",
+    "builtin",
+    "builtin_scene",
+    "builtin_scenes",
+    "check_knob",
+    "compile_plan",
+    "effects",
+    "finish",
+    "knob_table",
+    "knobs",
+    "load_scene",
+    "material_tables",
+    "plan",
+    "reflected",
+    "resolve_scene",
+    "run",
+    "run_block",
+    "scene",
+    "scene_file",
+    "scene_from_dict",
+    "simulate",
+    "spectral",
+    "stages",
+    "sweep",
+    "write",
+]

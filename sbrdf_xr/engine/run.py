@@ -1,0 +1,440 @@
+"""Execute a plan: blocks of geometries through the kernel into an xarray cube.
+
+:func:`simulate` takes a scene (or its :class:`~sbrdf_xr.engine.plan.Plan`) and returns the
+cube.  It derives nothing: everything it runs was resolved by the plan.  Small
+scenes (outputs under :data:`IN_PROCESS_BYTES`) run at once, in this process, on a
+few threads (the compiled kernel releases the GIL), without building a Dask graph:
+the cube comes back numpy-backed.  Larger ones, or any call with ``chunk``,
+``lazy=True`` or a ``client``, return a *lazy* cube: one Dask task per block, built
+directly (the plan enters the graph once), chunked over the first geometry
+dimension with the spectral dimension whole.  :func:`write` streams a cube to
+netCDF block by block (atomic, resumable; see :mod:`sbrdf_xr.store.writer`), or to a
+Zarr store whose blocks the Dask workers write themselves.  This module and the
+writer are the only ones that know about Dask scheduling.
+
+The cube (DESIGN.md data model)
+-------------------------------
+``spacecraft_sbrdf``
+    The paper's overall spacecraft sBRDF, paper 000 Eq. 4:
+    ``sum_j a_2D,j f_r,j / sum_j a_2D,j`` with ``a_2D,j = A_j cos(theta_r,j)`` over
+    the lit and visible facets [sr-1].  When nothing contributes (0/0) it is 0 and
+    ``area`` is 0: the cube says "no contributing area" instead of NaN.
+``signal``
+    The radiometric signal ``S = sum_j A_j cos(theta_i,j) cos(theta_r,j) f_r,j``
+    [m2 sr-1]: reflected intensity per unit solar irradiance.  Paper 000 Eq. 3
+    leaves out ``cos(theta_i)``; ``signal`` keeps it, ``spacecraft_sbrdf`` follows
+    the paper.  (Not named ``sbrdf``: ``cube.sbrdf`` is the Dataset accessor.)
+``brdf``
+    The paper's broadband BRDF, Eq. 2: ``spacecraft_sbrdf`` integrated over wavelength
+    (trapezoid) [sr-1 nm].
+``area``
+    The contributing projected area, ``sum_j a_2D,j`` [m2].
+``signal_material``
+    ``signal`` per material (with the ``per_material`` output).
+
+Coordinates carry the geometry: ``to_sun`` and ``to_observer`` (body frame),
+the attitude quaternions and the phase angle.  :data:`sbrdf_xr.engine.effects.OUTPUTS`
+declares every variable and its attributes.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+import uuid
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import dask.array as dsa
+import numpy as np
+import xarray as xr
+from dask.highlevelgraph import HighLevelGraph
+from dask.typing import Key
+
+from .._names import WAVELENGTH, attrs
+from ..errors import SceneError
+from ..store.writer import write_cube
+from .builtin import resolve_scene
+from .effects import EFFECTS, finish
+from .plan import Plan
+from .scene import Scene
+
+__all__ = ["IN_PROCESS_BYTES", "run_block", "simulate", "write"]
+
+#: Scenes whose outputs are smaller than this [byte] run in-process, without Dask
+#: (unless ``chunk``, ``lazy=True`` or a client is given).
+IN_PROCESS_BYTES = 64 * 2**20
+#: Fewest geometries per thread when an in-process run is split across threads.
+_MIN_PER_THREAD = 16
+
+
+def run_block(plan: Plan, sl: slice) -> dict[str, np.ndarray]:
+    """Every output of the plan for the geometries ``sl`` of its first dimension.
+
+    Runs each effect of the plan (:data:`sbrdf_xr.engine.effects.EFFECTS`) on the block and
+    combines their sums into the outputs (:func:`sbrdf_xr.engine.effects.finish`).
+
+    Returns
+    -------
+    dict of str to ndarray
+        Arrays shaped ``(block length, *other dims)`` per output variable.
+
+    Examples
+    --------
+    The second attitude (45 deg about z) of a Lambertian unit cube: at phase 0 the
+    +x and -y faces are each lit and seen at 45 deg, ``2 * cos(45 deg)**2 * 0.5 / pi``.
+
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, geometry, load_spacecraft, simulate
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> turns = geometry.axis_rotation([0, 0, 1], [0.0, 45.0])  # two attitudes about z
+    >>> scene = Scene(box, {"grey": grey}, attitudes=turns, phase_angles=[0.0, 60.0])
+    >>> from sbrdf_xr.simulate import run_block
+    >>> out = run_block(scene.plan(), slice(1, 2))
+    >>> sorted((k, v.shape) for k, v in out.items())
+    [('area', (1, 2)), ('brdf', (1, 2)), ('signal', (1, 2, 3)), ('spacecraft_sbrdf', (1, 2, 3))]
+    >>> round(float(out["signal"][0, 0, 0]), 6)
+    0.159155
+    """
+    block = plan.geometry.block(sl)
+    sums: dict[str, np.ndarray] = {}
+    for name in plan.effects:
+        contribute = EFFECTS[name].contribute
+        if contribute is None:
+            continue
+        for k, v in contribute(plan, block).items():
+            sums[k] = sums[k] + v if k in sums else v
+    return finish(plan, sums, block.lead_shape)
+
+
+def _block_task(plan: Plan, k: int) -> dict[str, np.ndarray]:
+    return run_block(plan, plan.block_slice(k))
+
+
+def default_n_threads() -> int:
+    """Threads of an in-process simulation: ``SBRDF_XR_NUM_THREADS``, ``NUMBA_NUM_THREADS``
+    or the number of CPUs.
+
+    Examples
+    --------
+    >>> default_n_threads() >= 1
+    True
+    """
+    n = os.environ.get("SBRDF_XR_NUM_THREADS") or os.environ.get("NUMBA_NUM_THREADS")
+    return max(1, int(n)) if n else max(1, os.cpu_count() or 1)
+
+
+def _in_process(plan: Plan, n_threads: int | None = None) -> dict[str, np.ndarray]:
+    """All outputs at once in this process, split over threads (the kernel releases the GIL)."""
+    n = plan.n_lead
+    workers = max(1, min(n_threads or default_n_threads(), n // _MIN_PER_THREAD))
+    if workers == 1:
+        return run_block(plan, slice(0, n))
+    edges = np.linspace(0, n, workers + 1).astype(int)
+    pool = _pool(workers - 1)  # the calling thread computes the first part itself
+    futures = [
+        pool.submit(run_block, plan, slice(edges[i], edges[i + 1])) for i in range(1, workers)
+    ]
+    try:
+        parts = [run_block(plan, slice(edges[0], edges[1]))]
+    finally:
+        parts += [f.result() for f in futures]
+    return {k: np.concatenate([p[k] for p in parts], axis=0) for k in parts[0]}
+
+
+_POOLS: dict[int, ThreadPoolExecutor] = {}
+_POOL_LOCK = threading.Lock()
+
+
+def _pool(workers: int) -> ThreadPoolExecutor:
+    """A thread pool kept for the life of the process (starting threads per call would cost
+    more than a small scene's whole kernel)."""
+    with _POOL_LOCK:
+        if workers not in _POOLS:
+            _POOLS[workers] = ThreadPoolExecutor(workers, thread_name_prefix="sbrdf_xr")
+        return _POOLS[workers]
+
+
+def _lazy(plan: Plan, client: Any = None) -> dict[str, dsa.Array]:
+    """One Dask task per block, and per output one array whose chunks select from it.
+
+    The graph is written directly: the plan enters it once (scattered to the workers
+    with ``client``), each block task refers to it by key, and nothing is tokenized
+    per block.
+    """
+    token = uuid.uuid4().hex
+    plan_key = f"sbrdf-plan-{token}"
+    block_name = f"sbrdf-block-{token}"
+    if client is not None:  # the graph holds the future: the plan lives as long as the cube
+        plan_ref: Any = client.scatter(plan, broadcast=True, hash=False)
+        layer0: dict[Any, Any] = {}
+    else:
+        plan_ref = plan_key
+        layer0 = {plan_key: plan}
+    nb = plan.n_blocks
+    blocks = {(block_name, k): (_block_task, plan_ref, k) for k in range(nb)}
+    block_layer = {**layer0, **blocks}
+    lead = tuple(plan.block_slice(k).stop - plan.block_slice(k).start for k in range(nb))
+    out = {}
+    for o in plan.outputs:
+        name = f"sbrdf-{o.name}-{token}"
+        rest = (0,) * (len(o.shape) - 1)
+        layer: dict[Key, Any] = {
+            (name, k, *rest): (_pick, (block_name, k), o.name) for k in range(nb)
+        }
+        graph = HighLevelGraph(
+            layers={block_name: block_layer, name: layer},
+            dependencies={block_name: set(), name: {block_name}},
+        )
+        chunks = (lead, *((s,) for s in o.shape[1:]))
+        out[o.name] = dsa.Array(graph, name, chunks, dtype=o.dtype)
+    return out
+
+
+def _pick(d: dict[str, np.ndarray], name: str) -> np.ndarray:
+    return d[name]
+
+
+def _template(plan: Plan) -> xr.Dataset:
+    """The cube's coordinates and attributes (made once per plan)."""
+    if "template" in plan.cache:
+        return plan.cache["template"]
+    coords = plan.geometry.coords()
+    coords["xyz"] = ("xyz", ["x", "y", "z"], attrs("xyz"))
+    dims = {d for o in plan.outputs for d in o.dims}
+    if WAVELENGTH in dims:
+        coords[WAVELENGTH] = (WAVELENGTH, plan.wavelength, attrs(WAVELENGTH))
+    if "band" in dims:
+        coords.update(plan.band_coords)
+    if "material" in dims:
+        coords["material"] = ("material", list(plan.materials), attrs("material"))
+    plan.cache["template"] = xr.Dataset(coords=coords, attrs=dict(plan.attrs))
+    return plan.cache["template"]
+
+
+def _dataset(plan: Plan, arrays: dict[str, Any]) -> xr.Dataset:
+    """The cube: every output with its dims and attributes, the geometry as coordinates.
+
+    Assembled from the plan's template without re-deriving coordinates or indexes
+    (xarray's direct constructor): a single-geometry call costs microseconds here.
+    """
+    t = _template(plan)
+    variables = dict(t.variables)
+    for o in plan.outputs:
+        variables[o.name] = xr.Variable(o.dims, arrays[o.name], attrs=dict(o.attrs))
+    return xr.Dataset._construct_direct(
+        variables, set(t.coords), None, dict(t.attrs), dict(t.xindexes)
+    )
+
+
+def simulate(
+    scene: Scene | Plan | str | os.PathLike[str],
+    plan: Plan | None = None,
+    *,
+    client: Any = None,
+    lazy: bool | None = None,
+    **options: Any,
+) -> xr.Dataset:
+    """Simulate a scene (or execute its plan) into a cube.
+
+    Parameters
+    ----------
+    scene : Scene, Plan, str or path
+        A scene, its compiled plan, a built-in scene name or a TOML scene file.
+    plan : Plan, optional
+        The scene's own plan (``scene.plan()``); kept for compatibility, pass the plan
+        as the first argument instead.
+    client : dask.distributed.Client, optional
+        The cube will be computed on this cluster: the plan (with its tables) is
+        scattered to every worker once.  Implies a lazy cube.
+    lazy : bool, optional
+        True: always a Dask-backed cube; False: always computed in-process now;
+        default: in-process when the outputs are under :data:`IN_PROCESS_BYTES` and
+        no ``chunk`` was set, lazy otherwise.
+    **options
+        Scene fields to change first (``preset="fast"``, ``method="cubic"``, ``chunk=...``).
+
+    Returns
+    -------
+    xarray.Dataset
+        The cube over ``(attitude, phase_angle, ...)`` for a grid, ``(geometry, ...)``
+        for explicit pairs; see the module docstring for its variables.
+
+    Raises
+    ------
+    SceneError
+        A plan together with options or with another scene; or a bad scene.
+
+    Examples
+    --------
+    A Lambertian unit cube (albedo 0.5) turned by 0 and 45 deg about z, at phase
+    angles 0 and 60 deg.  At identity attitude the signal is
+    ``0.5 / pi * cos(phase / 2)**2``; at 45 deg and phase 60 deg the +x and -y faces
+    each give ``cos(15 deg) cos(75 deg) = 1/4`` of ``0.5 / pi``.
+
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, geometry, load_spacecraft, simulate
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> turns = geometry.axis_rotation([0, 0, 1], [0.0, 45.0])  # two attitudes about z
+    >>> scene = Scene(box, {"grey": grey}, attitudes=turns, phase_angles=[0.0, 60.0])
+    >>> cube = simulate(scene)
+    >>> cube.signal.dims, cube.signal.shape
+    (('attitude', 'phase_angle', 'wavelength'), (2, 2, 3))
+    >>> cube.signal.attrs["units"]
+    'm2 sr-1'
+    >>> cube.signal.isel(wavelength=0).round(6).values.tolist()
+    [[0.159155, 0.119366], [0.159155, 0.079577]]
+    >>> cube.area.round(6).values.tolist()  # projected area [m2]
+    [[1.0, 0.866025], [1.414214, 1.224745]]
+
+    With a ``chunk`` the cube is Dask-backed, one task per block:
+
+    >>> lazy = simulate(scene, chunk=1)
+    >>> lazy.signal.chunks
+    ((1, 1), (2,), (3,))
+    >>> round(float(lazy.signal[1, 0, 0]), 6)
+    0.159155
+    """
+    if isinstance(scene, Plan):
+        if plan is not None or options:
+            raise SceneError(
+                "simulate(plan): a plan is already compiled; change the scene and "
+                "plan it again instead of passing options"
+            )
+        the_plan = scene
+    else:
+        sc = resolve_scene(scene)
+        if options:
+            if plan is not None:
+                raise SceneError("simulate: pass either a plan or scene options, not both")
+            sc = sc.with_options(**options)
+        the_plan = sc.plan()
+        if plan is not None and plan is not the_plan:
+            raise SceneError(
+                "simulate(scene, plan): the plan is not this scene's own plan "
+                "(scene.plan()); pass the plan alone: simulate(plan)"
+            )
+    if lazy is None:
+        lazy = (
+            client is not None
+            or the_plan.knobs["chunk"] is not None
+            or the_plan.estimate.output_bytes > IN_PROCESS_BYTES
+        )
+    if lazy:
+        arrays: dict[str, Any] = _lazy(the_plan, client)
+    else:
+        if client is not None:
+            raise SceneError(
+                "simulate: lazy=False computes in this process; it cannot use a client"
+            )
+        arrays = _in_process(the_plan)
+    return _dataset(the_plan, arrays)
+
+
+def write(cube: xr.Dataset, path: str | os.PathLike[str], **kwargs: Any) -> Path:
+    """Write a cube: netCDF block by block, or a Zarr store for a path ending in ``.zarr``.
+
+    netCDF (the default): :func:`sbrdf_xr.store.writer.write_cube` (atomic, resumable, the
+    calling process writes; see it for the keyword arguments).  Zarr: every block is
+    computed *and written* by the Dask worker (or thread) that computes it, so adding
+    workers to a cluster speeds the whole sweep up; the store is written as
+    ``<path>.part`` and renamed when complete (keywords ``overwrite``, ``client``,
+    ``progress``).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, geometry, load_spacecraft, simulate
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> turns = geometry.axis_rotation([0, 0, 1], [0.0, 45.0])  # two attitudes about z
+    >>> scene = Scene(box, {"grey": grey}, attitudes=turns, phase_angles=[0.0, 60.0])
+    >>> import tempfile, xarray as xr
+    >>> from pathlib import Path
+    >>> from sbrdf_xr import write
+    >>> cube = simulate(scene)
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = write(cube, Path(tmp) / "cube.nc")
+    ...     with xr.open_dataset(path) as back:
+    ...         print(path.name, back.signal.shape, round(float(back.signal[1, 0, 0]), 6))
+    cube.nc (2, 2, 3) 0.159155
+    """
+    if str(path).rstrip("/").endswith(".zarr"):
+        return _write_zarr(cube, Path(path), **kwargs)
+    return write_cube(_encode_times(cube), path, **kwargs)
+
+
+def _encode_times(cube: xr.Dataset) -> xr.Dataset:
+    """datetime64 coordinates as CF numbers with ``units`` and ``calendar`` (xarray's own
+    encoder, the one ``open_dataset`` decodes), for the netCDF writer."""
+    times = [k for k, v in cube.coords.items() if v.dtype.kind in "mM"]
+    if not times:
+        return cube
+    encoded = {}
+    for k in times:
+        v = xr.conventions.encode_cf_variable(cube[k].variable, name=str(k))
+        v.attrs.pop("_FillValue", None)  # CF 2.5.1: no fill value on a coordinate variable
+        encoded[k] = v
+    return cube.assign_coords(encoded)
+
+
+def _write_zarr(
+    cube: xr.Dataset,
+    path: Path,
+    *,
+    overwrite: bool = False,
+    client: Any = None,
+    progress: bool = False,
+    resume: bool = False,
+    scheduler: str | None = None,
+) -> Path:
+    import shutil
+
+    from ..errors import ValidationError
+
+    if resume:
+        raise ValidationError("resume: supported for netCDF cubes; a Zarr store is rewritten whole")
+    if scheduler is not None and client is None:
+        raise ValidationError(
+            "scheduler: for a Zarr store pass client= (a dask.distributed.Client)"
+        )
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{path} exists; pass --overwrite (overwrite=True) to replace it")
+    if path.exists() and not path.is_dir():
+        raise ValidationError(f"{path} exists and is not a Zarr store (a directory); not replaced")
+    part = path.with_name(path.name + ".part")
+    if part.exists():
+        shutil.rmtree(part)
+    ds = cube.copy()
+    for v in ds.variables.values():
+        v.encoding = {}
+    job = ds.to_zarr(part, mode="w", compute=False, consolidated=True, zarr_format=2)
+    if client is not None:
+        fut = client.compute(job)
+        if progress:
+            from distributed import progress as dist_progress
+
+            dist_progress(fut)
+        fut.result()
+    elif progress:
+        from dask.diagnostics import ProgressBar
+
+        with ProgressBar():
+            job.compute()
+    else:
+        job.compute()
+    if path.exists():
+        shutil.rmtree(path)
+    os.replace(part, path)
+    return path

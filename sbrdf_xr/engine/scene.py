@@ -1,0 +1,451 @@
+"""The :class:`Scene`: what to simulate.
+
+Re-exported, with the scene files, from :mod:`sbrdf_xr.engine`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from numpy.typing import ArrayLike
+
+from .. import catalog, geometry
+from ..errors import CatalogError, SceneError, ValidationError
+from ..materials.tables import validate_material
+from .effects import SCENE_OUTPUTS, SPECTRAL_OUTPUTS
+from .knobs import KNOBS, PRESETS, apply_preset, check_knob
+from .plan import Plan, compile_plan
+from .sweep import GridGeometry, PairGeometry
+
+__all__ = ["EFFECTS", "OUTPUTS", "PRESETS", "GridGeometry", "PairGeometry", "Scene"]
+
+#: Outputs a scene may ask for.
+OUTPUTS = tuple(SCENE_OUTPUTS)
+#: Effects a scene may ask for (the Earth's shadow comes with an observation).
+EFFECTS = ("sunlight", "shadowing", "earthshine", "thermal")
+_ = SPECTRAL_OUTPUTS  # re-exported
+
+
+_UNIT_TOL = 1e-6
+
+
+def _unit_vectors(v: ArrayLike, name: str) -> np.ndarray:
+    try:
+        arr = np.asarray(v, dtype=np.float64)
+    except (ValueError, TypeError) as exc:
+        raise SceneError(f"{name}: expected n vectors of 3 numbers (shape (n, 3)); {exc}") from None
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise SceneError(f"{name}: expected shape (n, 3), got {arr.shape}")
+    if arr.shape[0] == 0:
+        raise SceneError(f"{name}: needs at least one vector, got none")
+    if not np.all(np.isfinite(arr)):
+        raise SceneError(f"{name}: contains NaN or infinite components")
+    with np.errstate(over="ignore"):  # a huge component: length inf, refused below
+        norm = np.linalg.norm(arr, axis=1)
+    bad = np.flatnonzero(~(np.abs(norm - 1.0) <= _UNIT_TOL))
+    if bad.size:
+        raise SceneError(
+            f"{name}: vector {bad[0]} {arr[bad[0]].tolist()} has length {norm[bad[0]]:.6g}; "
+            f"directions must be unit vectors (|length - 1| <= {_UNIT_TOL})"
+        )
+    return arr / norm[:, None]
+
+
+def _optional_array(v: ArrayLike | None) -> np.ndarray | None:
+    return None if v is None else np.asarray(v)
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A spacecraft, its materials, a geometry sweep, and what to compute.
+
+    Parameters
+    ----------
+    spacecraft : sbrdf_xr.body.spacecraft.Spacecraft
+        The body.
+    materials : mapping of str to DataArray, optional
+        Material tables by name; default: every material of the spacecraft, loaded
+        from the catalog when first needed (:attr:`tables`), not by the constructor.
+    attitudes : array_like, shape (n, 4), optional
+        Attitudes (body -> reference frame, scalar-last unit quaternions).
+    phase_angles : array_like, shape (m,), optional
+        Phase angles [degree] of the observation plane (with ``attitudes``).
+    bisector, plane_normal : array_like, shape (3,)
+        Observation plane in the reference frame (default: bisector +x, plane xy).
+    to_sun, to_observer : array_like, shape (n, 3), optional
+        Explicit body-frame geometry pairs instead of a grid.
+    observation : sbrdf_xr.observing.observe.Observation, optional
+        A real pass (orbit, site, times, attitude law) instead of a grid or pairs: the
+        cube gets a ``time`` dimension with the observation's geometry as coordinates,
+        the Earth's shadow scales the sunlight, and earthshine (when asked) follows the
+        Earth's distance and phase at every time.  Its geometry is computed when the
+        scene is planned.
+    attitude_angle : array_like, shape (n,), optional
+        A label per attitude (for example the sweep angle [degree]).
+    outputs : sequence of str
+        Among :data:`OUTPUTS`.
+    effects : sequence of str
+        Among :data:`EFFECTS`; ``sunlight`` is always on.
+    method : str
+        Look-up method (``nearest``, ``linear``, ``cubic``).
+    dtype : str
+        ``float64`` or ``float32`` for the spectra.  Catalog tables (``materials`` not
+        given) are loaded in this dtype too, so ``float32`` halves the memory they hold.
+    merge : bool or None
+        Merge facets sharing (normal, material); default: whenever allowed.
+    shadow_method : {"exact", "sampled"}
+        Self-shadowing by polygon clipping (area-exact) or by sub-facet ray sampling.
+    shadow_density : int
+        Sampled shadowing: samples per facet side.
+    wavelength_stride, band_integration, table_theta_step, evaluation, kernel, block_bytes
+        The other numerical knobs (:data:`sbrdf_xr.engine.knobs.KNOBS` says what each trades).
+    surface_tilt : float or mapping of str to float
+        Surface imperfections (paper 000 §5): standard deviation [degree] of each
+        tangent component of a Gaussian tilt of the facet normals, for all facets or
+        per material (:mod:`sbrdf_xr.body.imperfections`); 0, the default, is the perfect
+        CAD facet.  ``tilt_nodes`` sets the quadrature.
+    chunk : int, optional
+        Geometries per block along the attitude (or geometry) dimension; default from
+        ``block_bytes``.  Given explicitly, :func:`~sbrdf_xr.engine.run.simulate` always
+        returns a Dask-backed cube with that chunking.
+    bands : sequence of str
+        Photometric bands of the ``band_signal`` output (see
+        :func:`sbrdf_xr.photometry.filters`).
+    band_extrapolate : {None, "zero", "constant"}
+        How spectra continue past the materials' wavelengths inside a band
+        (:func:`sbrdf_xr.photometry.band_weights`); by default a band the
+        wavelengths do not cover is an error.
+    earth_direction : array_like, shape (3,)
+        Direction from the spacecraft to the Earth in the reference frame (grids),
+        for the ``earthshine`` effect.
+    to_earth : array_like, shape (n, 3), optional
+        The same in the body frame, one per explicit geometry pair.
+    earth_albedo : float
+        Bond albedo of the Lambertian Earth [1].
+    earth_range_km : float
+        Distance from the spacecraft to the Earth's centre [km].
+    earth_phase_angle : float
+        Sun-Earth-spacecraft angle seen from the Earth's centre [degree] (0: the
+        spacecraft sees a full Earth).
+    temperature : float or mapping of str to float
+        Facet temperature [K] of the ``thermal`` effect, one for all or per material.
+    models : mapping of str to Dataset, optional
+        BRDF model parameters per material for ``evaluation="analytic"`` (default:
+        the catalog entry ``<material>-model``).
+    size_limit : float
+        Factor on the limits of output size and work beyond which a plan is refused
+        (:data:`sbrdf_xr.engine.plan.SIZE_LIMIT_BYTES`, :data:`sbrdf_xr.engine.plan.WORK_LIMIT`).
+    name, description : str
+        Labels stored in the output.
+
+    Examples
+    --------
+    A unit cube of one Lambertian material at one attitude and two phase angles:
+
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> scene = Scene(box, {"grey": grey}, attitudes=[[0, 0, 0, 1.0]], phase_angles=[0.0, 60.0])
+    >>> scene.is_grid, scene.n_geometries
+    (True, 2)
+    >>> to_sun, to_observer = scene.body_vectors()
+    >>> to_sun.shape, to_observer.round(4).tolist()
+    ((1, 2, 3), [[[1.0, 0.0, 0.0], [0.866, -0.5, 0.0]]])
+    >>> scene.plan().n_blocks
+    1
+
+    Knobs and presets give changed copies; explicit body-frame pairs replace the grid:
+
+    >>> fast = scene.with_options(preset="fast")
+    >>> fast.dtype, fast.method
+    ('float32', 'linear')
+    >>> pairs = Scene(box, {"grey": grey}, to_sun=[[1.0, 0, 0]], to_observer=[[0, 1.0, 0]])
+    >>> pairs.is_grid, pairs.n_geometries
+    (False, 1)
+    >>> Scene(box, {"grey": grey}, to_sun=[[1.0, 0, 0]], to_observer=[[0, 1.0, 0]],
+    ...       outputs=("colour",))
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.SceneError: outputs: unknown ['colour']; allowed: spacecraft_sbrdf, signal, ...
+    """
+
+    spacecraft: Any
+    materials: Mapping[str, xr.DataArray] | None = None
+    attitudes: ArrayLike | None = None
+    phase_angles: ArrayLike | None = None
+    bisector: tuple[float, float, float] = (1.0, 0.0, 0.0)
+    plane_normal: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    to_sun: ArrayLike | None = None
+    to_observer: ArrayLike | None = None
+    observation: Any = None
+    attitude_angle: ArrayLike | None = None
+    outputs: Sequence[str] = ("spacecraft_sbrdf", "signal", "brdf", "area")
+    effects: Sequence[str] = ("sunlight",)
+    method: str = "linear"
+    dtype: str = "float64"
+    merge: bool | None = None
+    shadow_method: str = "exact"
+    shadow_density: int = 4
+    wavelength_stride: int = 1
+    band_integration: str = "auto"
+    table_theta_step: float | None = None
+    evaluation: str = "table"
+    kernel: str = "fused"
+    tilt_nodes: int = 5
+    surface_tilt: float | Mapping[str, float] = 0.0
+    chunk: int | None = None
+    block_bytes: int = 32 * 2**20
+    bands: Sequence[str] = ()
+    band_extrapolate: str | None = None
+    earth_direction: tuple[float, float, float] = (0.0, -1.0, 0.0)
+    to_earth: ArrayLike | None = None
+    earth_albedo: float = 0.3
+    earth_range_km: float = 42164.0
+    earth_phase_angle: float = 90.0
+    temperature: float | Mapping[str, float] = 300.0
+    models: Mapping[str, xr.Dataset] | None = None
+    size_limit: float = 1.0
+    name: str = "scene"
+    description: str = ""
+    _cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        bad = [o for o in self.outputs if o not in OUTPUTS]
+        if bad:
+            raise SceneError(f"outputs: unknown {bad}; allowed: {', '.join(OUTPUTS)}")
+        bad = [e for e in self.effects if e not in EFFECTS]
+        if bad:
+            raise SceneError(f"effects: unknown {bad}; allowed: {', '.join(EFFECTS)}")
+        for k in KNOBS:
+            check_knob(k, getattr(self, k))
+        tilts = (
+            self.surface_tilt.values()
+            if isinstance(self.surface_tilt, Mapping)
+            else [self.surface_tilt]
+        )
+        if any(
+            isinstance(x, bool)
+            or not isinstance(x, int | float)
+            or not (np.isfinite(x) and 0 <= x <= 45)
+            for x in tilts
+        ):
+            raise SceneError(
+                f"surface_tilt: expected tilts in [0, 45] degree, got {self.surface_tilt!r}"
+            )
+        if not (
+            isinstance(self.size_limit, int | float)
+            and np.isfinite(self.size_limit)
+            and self.size_limit > 0
+        ):
+            raise SceneError(f"size_limit: must be a positive factor, got {self.size_limit!r}")
+        if "band_signal" in self.outputs and not self.bands:
+            raise SceneError(
+                "bands: the band_signal output needs at least one band (e.g. bands=('B', 'V'))"
+            )
+        if self.bands:
+            from ..photometry import filters
+
+            try:
+                filters(list(self.bands))
+            except ValidationError as exc:
+                raise SceneError(f"bands: {exc}") from None
+        if not 0.0 <= self.earth_albedo <= 1.0:
+            raise SceneError(f"earth_albedo: must lie in [0, 1], got {self.earth_albedo}")
+        if not self.earth_range_km > 6371.0:
+            raise SceneError(
+                "earth_range_km: must exceed the Earth's radius (6371 km), "
+                f"got {self.earth_range_km}"
+            )
+        if not 0.0 <= self.earth_phase_angle <= 180.0:
+            raise SceneError(
+                f"earth_phase_angle: must lie in [0, 180] degree, got {self.earth_phase_angle}"
+            )
+        temps = (
+            self.temperature.values()
+            if isinstance(self.temperature, Mapping)
+            else [self.temperature]
+        )
+        if any(not (np.isfinite(x) and x > 0) for x in temps):
+            raise SceneError(f"temperature: must be positive kelvin, got {self.temperature}")
+        grid = self.attitudes is not None or self.phase_angles is not None
+        explicit = self.to_sun is not None or self.to_observer is not None
+        observed = self.observation is not None
+        if grid + explicit + observed != 1:
+            raise SceneError(
+                "geometry: give either attitudes and phase_angles (a grid), to_sun and "
+                "to_observer (explicit pairs) or an observation, not several and not neither"
+            )
+        if observed:
+            from ..observing.observe import Observation
+
+            if not isinstance(self.observation, Observation):
+                raise SceneError(
+                    f"observation: expected a sbrdf_xr.observing.Observation, got "
+                    f"{type(self.observation).__name__}"
+                )
+        elif grid:
+            if self.attitudes is None or self.phase_angles is None:
+                raise SceneError("geometry: a grid needs both attitudes and phase_angles")
+            try:
+                q = geometry.check_quaternions(self.attitudes)
+                beta = np.atleast_1d(np.asarray(self.phase_angles, dtype=np.float64))
+                geometry.observation_plane(beta, self.bisector, self.plane_normal)
+            except ValidationError as exc:
+                raise SceneError(str(exc)) from None
+            if q.ndim != 2:
+                raise SceneError(f"attitudes: expected shape (n, 4), got {q.shape}")
+            object.__setattr__(self, "attitudes", q)
+            object.__setattr__(self, "phase_angles", beta)
+        else:
+            if self.to_sun is None or self.to_observer is None:
+                raise SceneError("geometry: explicit pairs need both to_sun and to_observer")
+            s = _unit_vectors(self.to_sun, "to_sun")
+            o = _unit_vectors(self.to_observer, "to_observer")
+            if s.shape != o.shape:
+                raise SceneError(f"to_sun {s.shape} and to_observer {o.shape} differ in shape")
+            object.__setattr__(self, "to_sun", s)
+            object.__setattr__(self, "to_observer", o)
+            if self.to_earth is not None:
+                e = _unit_vectors(self.to_earth, "to_earth")
+                if e.shape != s.shape:
+                    raise SceneError(f"to_earth {e.shape} and to_sun {s.shape} differ in shape")
+                object.__setattr__(self, "to_earth", e)
+            elif "earthshine" in self.effects:
+                raise SceneError(
+                    "to_earth: explicit geometry with earthshine needs body-frame to_earth vectors"
+                )
+        if self.materials is not None:
+            self._check_tables(self.materials)
+
+    def _check_tables(self, materials: Mapping[str, xr.DataArray]) -> None:
+        missing = [m for m in self.spacecraft.materials if m not in materials]
+        if missing:
+            raise SceneError(f"materials: no table for {missing}; given: {sorted(materials)}")
+        for name, da in materials.items():
+            try:
+                validate_material(da, check_values=True)
+            except ValidationError as exc:
+                raise SceneError(f"material {name!r}: {exc}") from None
+
+    @cached_property
+    def tables(self) -> Mapping[str, xr.DataArray]:
+        """The material tables by name: ``materials`` as given, or else every material of
+        the spacecraft loaded from the catalog on first use (the constructor reads no file).
+
+        Raises
+        ------
+        SceneError
+            When a material of the spacecraft is neither given nor in the catalog.
+        """
+        if self.materials is not None:
+            return self.materials
+        try:
+            # in the scene's precision: a float32 scene holds no float64 copy of its tables
+            tables = {m: catalog.load(m, dtype=self.dtype) for m in self.spacecraft.materials}
+        except CatalogError as exc:
+            raise SceneError(
+                f"materials: not given, and the catalog has no table for a material of "
+                f"{self.spacecraft.name!r}: {exc}"
+            ) from None
+        self._check_tables(tables)
+        return tables
+
+    # ----------------------------------------------------------- geometry
+    @property
+    def is_grid(self) -> bool:
+        """True for an attitude x phase-angle grid, False for explicit pairs."""
+        return self.attitudes is not None
+
+    @property
+    def n_geometries(self) -> int:
+        """Number of (Sun, observer) geometries of the sweep."""
+        return self.geometry.n_geometries
+
+    @cached_property
+    def geometry(self) -> GridGeometry | PairGeometry:
+        """The sweep's geometry (:class:`GridGeometry` or :class:`PairGeometry`)."""
+        if self.observation is not None:
+            from ..errors import ObservationError
+
+            try:
+                g = self.observation.geometry()
+            except ObservationError as exc:
+                raise SceneError(f"observation: {exc}") from exc
+            return PairGeometry.from_observation(g, "earthshine" in self.effects, self.earth_albedo)
+        if self.is_grid:
+            phase = np.asarray(self.phase_angles)
+            s, o = geometry.observation_plane(phase, self.bisector, self.plane_normal)
+            e = None
+            if "earthshine" in self.effects:
+                e = geometry.normalize(self.earth_direction, "earth_direction")
+                e = np.broadcast_to(e, (len(phase), 3)).copy()
+            return GridGeometry(
+                np.asarray(self.attitudes), phase, s, o, e, _optional_array(self.attitude_angle)
+            )
+        return PairGeometry(
+            np.asarray(self.to_sun),
+            np.asarray(self.to_observer),
+            _optional_array(self.to_earth),
+        )
+
+    def body_vectors(self, attitude_slice: slice | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Sun and observer unit vectors in the body frame.
+
+        Returns
+        -------
+        to_sun, to_observer : ndarray
+            Shape ``(n_attitude, n_phase, 3)`` for a grid (optionally for a slice of
+            attitudes) or ``(n_geometry, 3)`` for explicit pairs.
+        """
+        b = self.geometry.block(attitude_slice or slice(None))
+        return b.to_sun.reshape(*b.lead_shape, 3), b.to_observer.reshape(*b.lead_shape, 3)
+
+    def earth_vectors(self, attitude_slice: slice | None = None) -> np.ndarray | None:
+        """Unit vectors to the Earth in the body frame (shaped like :meth:`body_vectors`)."""
+        if not self.is_grid:
+            return self.geometry.block(attitude_slice or slice(None)).to_earth
+        att = np.asarray(self.attitudes)
+        q = att if attitude_slice is None else att[attitude_slice]
+        e = geometry.normalize(self.earth_direction, "earth_direction")
+        e = np.broadcast_to(e, (len(np.asarray(self.phase_angles)), 3))
+        return geometry.to_body_frame(q, e)
+
+    @classmethod
+    def knob_names(cls) -> tuple[str, ...]:
+        """The numerical knobs, each a field of the scene (:data:`sbrdf_xr.engine.knobs.KNOBS`)."""
+        return tuple(KNOBS)
+
+    def with_options(self, **changes: Any) -> Scene:
+        """A copy with some fields changed; ``preset=`` sets the knobs of a preset first."""
+        if "preset" in changes:
+            changes = apply_preset(changes.pop("preset"), changes)
+        try:
+            new = replace(self, **changes)
+        except TypeError as exc:
+            raise SceneError(f"with_options: {exc}") from None
+        same = not {"materials", "spacecraft"} & set(changes) and (
+            self.materials is not None or new.dtype == self.dtype
+        )
+        if "tables" in self.__dict__ and same:
+            new.__dict__["tables"] = self.__dict__["tables"]  # loaded once per scene family
+        return new
+
+    def plan(self) -> Plan:
+        """The compiled :class:`~sbrdf_xr.engine.plan.Plan` of this scene (computed once, then
+        cached)."""
+        if "plan" not in self._cache:
+            self._cache["plan"] = compile_plan(self)
+        return self._cache["plan"]
+
+
+# ----------------------------------------------------------- scene files
+
+
+# --------------------------------------------------------- built-in scenes

@@ -1,0 +1,105 @@
+"""The compiled and numpy kernels: the arithmetic every layer above runs on.
+
+Nothing here knows about xarray, files or scenes; every function takes and returns
+plain arrays.
+
+Modules
+-------
+``lut``
+    Table look-up, smoothing splines and quadrature behind :mod:`sbrdf_xr.materials`
+    (paper 000 §3.2-3.3).
+``angles``
+    The facet angles of paper 000 Fig. 4 for a chunk of geometries x terms (vectorised).
+``lookup``
+    Cells, weights and row sums of the compiled look-up.
+``packing``
+    Material tables packed for the fused kernel (:class:`PackedTables`).
+``reference``
+    The numpy reference kernel of the spacecraft sum of paper 000 §3.4 (Eqs. 3-4).
+``sums``
+    The fused numba kernel of the same sum, and the dispatch between the two.
+``anisotropic``
+    The facet sums of anisotropic tables (a ``psi`` axis).
+``polygon`` and ``shadow``
+    Plane-polygon clipping and the exact shadow kernel of :mod:`sbrdf_xr.body.visibility`.
+"""
+
+from ..errors import ValidationError
+from . import angles, anisotropic, lookup, lut, packing, polygon, reference, shadow, sums
+from .angles import atan2_pos, chunk_angles, facet_frame
+from .anisotropic import AnisotropicTable, anisotropic_sums, pack_anisotropic, plan_step, reflected
+from .lut import (
+    LOOKUP_METHODS,
+    axis_weights,
+    hemispherical_reflectance_kernel,
+    lookup_kernel,
+    lookup_matrix,
+    normal_incidence_weight,
+    smoothing_spline_matrix,
+    table_edges,
+    table_normal_blend,
+)
+from .packing import MAX_BUCKETS, PackedTables, bucket_map, pack_tables, typed_values
+from .polygon import (
+    BUDGET,
+    MAXM,
+    MAXV,
+    bounds,
+    clip,
+    hull,
+    signed_area,
+    union_area,
+    union_area_slabs,
+)
+from .reference import MaterialSums, material_sums
+from .sums import METHOD_CODES, FusedSums, fused_sums, normal_rows
+
+__all__ = [
+    "BUDGET",
+    "LOOKUP_METHODS",
+    "MAXM",
+    "MAXV",
+    "MAX_BUCKETS",
+    "METHOD_CODES",
+    "AnisotropicTable",
+    "FusedSums",
+    "MaterialSums",
+    "PackedTables",
+    "ValidationError",
+    "angles",
+    "anisotropic",
+    "anisotropic_sums",
+    "atan2_pos",
+    "axis_weights",
+    "bounds",
+    "bucket_map",
+    "chunk_angles",
+    "clip",
+    "facet_frame",
+    "fused_sums",
+    "hemispherical_reflectance_kernel",
+    "hull",
+    "lookup",
+    "lookup_kernel",
+    "lookup_matrix",
+    "lut",
+    "material_sums",
+    "normal_incidence_weight",
+    "normal_rows",
+    "pack_anisotropic",
+    "pack_tables",
+    "packing",
+    "plan_step",
+    "polygon",
+    "reference",
+    "reflected",
+    "shadow",
+    "signed_area",
+    "smoothing_spline_matrix",
+    "sums",
+    "table_edges",
+    "table_normal_blend",
+    "typed_values",
+    "union_area",
+    "union_area_slabs",
+]

@@ -1,0 +1,514 @@
+"""Facet sums for anisotropic materials: tables with a ``psi`` axis.
+
+An anisotropic table (dims ``(theta_i, delta_theta, phi, psi, wavelength)``) is a
+stack of isotropic tables, one per ``psi`` node (:mod:`sbrdf_xr.anisotropy`).  The
+look-up interpolates each slice in ``(theta_i, delta_theta, phi)`` with the isotropic
+method and the slices linearly and periodically in ``psi``.  The facet sums of
+paper 000 Eqs. 3-4 are linear in ``f_r``, so
+
+``sum_j a_j f_r(g, j) = sum_k sum_j (a_j w_k(g, j)) f_k(g, j)``
+
+with ``w_k(g, j)`` the ``psi`` weight of node ``k`` (two non-zero per geometry and
+facet, summing to one) and ``f_k`` the look-up in slice ``k``: each slice is an
+isotropic material whose facets carry the extra area fraction ``w_k``.  That is
+how the isotropic kernels are reused here, without a change: :func:`anisotropic_sums`
+calls :func:`sbrdf_xr.kernels.sums.material_sums` (the numpy reference) once per slice
+that any facet needs, or :func:`sbrdf_xr.kernels.sums.fused_sums` (compiled, ``nogil``)
+once over the slices packed as materials.  Consequences, stated once:
+
+* no normal-incidence blend (an anisotropic material depends on the observer's
+  azimuth from the tangent at ``theta_i = 0``);
+* with ``cubic`` look-up each slice's sums are clipped at zero (as each isotropic
+  material's are);
+* the cost is that of an isotropic look-up per slice the block needs (at most the
+  number of ``psi`` nodes), so a table with ``n_psi`` nodes costs up to ``n_psi``
+  times an isotropic one.
+
+:func:`reflected` is the hook the engine calls for a plan with anisotropic tables:
+isotropic materials go through the plan's kernel as before, anisotropic ones through
+:func:`anisotropic_sums`.
+"""
+
+from __future__ import annotations
+
+from typing import Any, NamedTuple
+
+import numba
+import numpy as np
+from numpy.typing import DTypeLike, NDArray
+
+from ..anisotropy import PSI_PERIOD, illumination_azimuth, psi_weights
+from ..geometry import normal_incidence_tolerance
+from . import lut as _lut
+from .angles import facet_frame
+from .lookup import _axis, _gather
+from .packing import typed_values
+from .sums import (
+    METHOD_CODES,
+    FusedSums,
+    MaterialSums,
+    PackedTables,
+    fused_sums,
+    material_sums,
+    pack_tables,
+)
+
+_RAD2DEG = 180.0 / np.pi
+
+__all__ = ["AnisotropicTable", "anisotropic_sums", "pack_anisotropic", "plan_step", "reflected"]
+
+
+class AnisotropicTable(NamedTuple):
+    """An anisotropic table as the kernels read it: one packed isotropic table per ``psi``."""
+
+    slices: PackedTables  #: material k of the packing is the slice at psi[k]
+    psi: NDArray[np.float64]  #: (n_psi,) [degree]
+    zero_edges: tuple[bool, bool, bool]
+
+
+def pack_anisotropic(
+    values: NDArray[np.floating],
+    theta_grid: NDArray[np.floating],
+    delta_theta_grid: NDArray[np.floating],
+    phi_grid: NDArray[np.floating],
+    psi_grid: NDArray[np.floating],
+    zero_edges: tuple[bool, bool, bool] = (True, True, True),
+    dtype: DTypeLike = np.float64,
+) -> AnisotropicTable:
+    """Pack a ``(n_theta, n_delta_theta, n_phi, n_psi, L)`` table (once per plan).
+
+    Parameters
+    ----------
+    values : ndarray, shape (n_theta, n_delta_theta, n_phi, n_psi, L)
+        sBRDF [sr-1] (or its band integrals).
+    theta_grid, delta_theta_grid, phi_grid, psi_grid : ndarray
+        Table coordinates [degree].
+    zero_edges : tuple of 3 bool
+        Out-of-range policy (:func:`sbrdf_xr.kernels.lut.lookup_matrix`).
+    dtype : numpy dtype
+        dtype of the spectral outputs.
+
+    Returns
+    -------
+    AnisotropicTable
+
+    Examples
+    --------
+    >>> g = np.array([0.0, 90.0])
+    >>> t = pack_anisotropic(np.ones((2, 2, 2, 3, 1)), g, g - 90, g, np.array([0.0, 60, 120]))
+    >>> len(t.slices.values), t.psi.tolist()
+    (3, [0.0, 60.0, 120.0])
+    """
+    v = np.asarray(values)
+    psi = np.asarray(psi_grid, dtype=np.float64)
+    if v.ndim != 5 or v.shape[3] != psi.size:
+        raise ValueError(f"values: expected (n_theta, n_dt, n_phi, {psi.size}, L), got {v.shape}")
+    grids = tuple(np.asarray(a, dtype=np.float64) for a in (theta_grid, delta_theta_grid, phi_grid))
+    slices = pack_tables(
+        [(v[:, :, :, k, :], *grids, zero_edges, 0.0) for k in range(psi.size)],
+        v.shape[-1],
+        dtype,
+    )
+    edges = tuple(bool(x) for x in zero_edges)
+    return AnisotropicTable(slices, psi, edges)  # type: ignore[arg-type]
+
+
+def plan_step(materials: Any, tables: dict[int, AnisotropicTable]) -> tuple[str, str]:
+    """The plan's line for its anisotropic tables."""
+    what = ", ".join(f"{materials[m]} ({t.psi.size} psi nodes)" for m, t in sorted(tables.items()))
+    return (
+        "anisotropy",
+        f"{what}: psi of every term from its tangent, linear and periodic in psi over "
+        "isotropic look-ups of the psi slices (terms merged only with equal tangents)",
+    )
+
+
+def _slice(table: AnisotropicTable, k: int) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
+    p = table.slices
+    values = p.values[k].reshape(*p.shapes[k], -1)
+    grids = (
+        p.tgrid[p.t_off[k] : p.t_off[k + 1]],
+        p.dgrid[p.d_off[k] : p.d_off[k + 1]],
+        p.pgrid[p.p_off[k] : p.p_off[k + 1]],
+    )
+    return values, grids
+
+
+def anisotropic_sums(
+    to_sun: NDArray[np.floating],
+    to_observer: NDArray[np.floating],
+    normals: NDArray[np.floating],
+    tangents: NDArray[np.floating],
+    areas: NDArray[np.floating],
+    table: AnisotropicTable,
+    method: str = "linear",
+    fraction: NDArray[np.floating] | None = None,
+    kernel: str = "numpy",
+) -> MaterialSums:
+    """Facet sums of paper 000 Eqs. 3-4 for one anisotropic material.
+
+    Parameters
+    ----------
+    to_sun, to_observer : ndarray, shape (G, 3)
+        Unit vectors to the Sun and the observer in the body frame [1].
+    normals, tangents : ndarray, shape (F, 3)
+        Unit facet normals and tangents [1] (tangents are made orthogonal to the
+        normals).
+    areas : ndarray, shape (F,)
+        Facet areas [m2].
+    table : AnisotropicTable
+        From :func:`pack_anisotropic`.
+    method : {"nearest", "linear", "cubic"}
+        Look-up method in ``(theta_i, delta_theta, phi)``; ``psi`` is always linear
+        (periodic).
+    fraction : ndarray, shape (G, F), optional
+        Lit-and-visible area fraction of each facet [1]; default 1.
+    kernel : {"numpy", "fused"}
+        :func:`sbrdf_xr.kernels.sums.material_sums` per slice (the reference), or
+        compiled: for ``nearest`` and ``linear`` a dedicated ``nogil`` numba kernel
+        (angles, ``psi``, the lit-and-visible test and the out-of-range policy per
+        geometry and facet, then the two ``psi`` slices gathered; it is tested against
+        the reference), for ``cubic`` one :func:`sbrdf_xr.kernels.sums.fused_sums` call
+        over the slices (each clipped at zero as the reference).
+
+    Returns
+    -------
+    MaterialSums
+        In the dtype of the table; ``area`` and ``lit_visible_area`` in float64.
+    """
+    s = np.asarray(to_sun, dtype=np.float64)
+    o = np.asarray(to_observer, dtype=np.float64)
+    n = np.asarray(normals, dtype=np.float64)
+    g, f = s.shape[0], n.shape[0]
+    dt = table.slices.dtype
+    n_wl = table.slices.n_spectral
+    sig, pap = np.zeros((g, n_wl), dt), np.zeros((g, n_wl), dt)
+    if f == 0 or g == 0:
+        return MaterialSums(sig, pap, np.zeros(g), np.zeros(g))
+    if kernel == "fused" and method != "cubic":
+        return _compiled_sums(s, o, n, tangents, areas, table, method, fraction)
+    cos_i, cos_r = s @ n.T, o @ n.T
+    contributing = (cos_i > 0) & (cos_r > 0)
+    base = np.where(contributing, 1.0, 0.0)
+    if fraction is not None:
+        base = base * np.asarray(fraction, dtype=np.float64)
+    eff = base * np.asarray(areas, dtype=np.float64)[None, :]
+    area, lit = (eff * cos_r).sum(axis=1), eff.sum(axis=1)
+    psi = illumination_azimuth(
+        n[None, :, :],
+        np.asarray(tangents, dtype=np.float64)[None, :, :],
+        s[:, None],
+        o[:, None],
+        check=False,
+    )
+    idx, w = psi_weights(table.psi, psi)  # (G, F, 2)
+    w = w * base[..., None]
+    used = np.unique(idx[w > 0])
+    parts: list[tuple[int, np.ndarray, np.ndarray]] = []
+    for k in used.tolist():
+        wk = np.where(idx == k, w, 0.0).sum(axis=-1)
+        cols = np.flatnonzero(wk.any(axis=0))
+        parts.append((k, cols, wk[:, cols]))
+    r: FusedSums | MaterialSums
+    if kernel == "fused":
+        if parts:
+            r = fused_sums(
+                s,
+                o,
+                np.concatenate([n[c] for _, c, _ in parts]),
+                np.concatenate([np.asarray(areas)[c] for _, c, _ in parts]),
+                np.concatenate([np.full(c.size, k, np.int64) for k, c, _ in parts]),
+                table.slices,
+                method,
+                np.concatenate([wk for _, _, wk in parts], axis=1),
+            )
+            sig += r.signal
+            pap += r.paper
+    else:
+        for k, cols, wk in parts:
+            values, (tg, dg, pg) = _slice(table, k)
+            r = material_sums(
+                s,
+                o,
+                n[cols],
+                np.asarray(areas)[cols],
+                values,
+                tg,
+                dg,
+                pg,
+                method,
+                wk,
+                table.zero_edges,
+                0.0,
+            )
+            sig += r.signal
+            pap += r.paper
+    return MaterialSums(sig, pap, area, lit)
+
+
+@numba.njit(nogil=True, cache=True)
+def _aniso_fused(
+    s,
+    o,
+    normals,
+    tangents,
+    areas,
+    frac,
+    tables,
+    tgrid,
+    dgrid,
+    pgrid,
+    bt,
+    bd,
+    bp,
+    binv,
+    psi_nodes,
+    closed,
+    edges,
+    method,
+    tol,
+    edge_tol,
+    out_sig,
+    out_pap,
+    out_area,
+    out_lit,
+):  # pragma: no cover - compiled
+    """One anisotropic material, nearest or linear in the angles, linear in psi."""
+    n_geom = s.shape[0]
+    n_term = normals.shape[0]
+    n_wl = out_sig.shape[1]
+    has_frac = frac.shape[0] > 0
+    nt, nd, npp = tgrid.size, dgrid.size, pgrid.size
+    n_psi = psi_nodes.size
+    f = np.empty(n_wl, dtype=out_sig.dtype)
+    rows = np.empty(8, dtype=np.int64)
+    wn = np.empty(8, dtype=out_sig.dtype)
+    it = np.empty(4, dtype=np.int64)
+    idt = np.empty(4, dtype=np.int64)
+    iph = np.empty(4, dtype=np.int64)
+    wt = np.empty(4)
+    wdt = np.empty(4)
+    wph = np.empty(4)
+    for g in range(n_geom):
+        sx, sy, sz = s[g, 0], s[g, 1], s[g, 2]
+        ox, oy, oz = o[g, 0], o[g, 1], o[g, 2]
+        area_g = 0.0
+        lit_g = 0.0
+        for tt in range(n_term):
+            nx, ny, nz = normals[tt, 0], normals[tt, 1], normals[tt, 2]
+            ns = nx * sx + ny * sy + nz * sz
+            no = nx * ox + ny * oy + nz * oz
+            if not (ns > 0.0 and no > 0.0):
+                continue
+            a_eff = areas[tt]
+            if has_frac:
+                a_eff = a_eff * frac[g, tt]
+            a2d = a_eff * no
+            area_g += a2d
+            lit_g += a_eff
+            # angles of paper 000 Fig. 4, as geometry.facet_angles
+            ti, dt, phi, ex, ey, ez, op = facet_frame(
+                nx, ny, nz, sx, sy, sz, ox, oy, oz, ns, no, tol
+            )
+            if (
+                (edges[0] and dt < dgrid[0] - edge_tol)
+                or (edges[1] and dt > dgrid[nd - 1] + edge_tol)
+                or (edges[2] and phi > pgrid[npp - 1] + edge_tol)
+            ):
+                continue
+            # psi (anisotropy.illumination_azimuth): tangent made orthogonal to the normal
+            tx, ty, tz = tangents[tt, 0], tangents[tt, 1], tangents[tt, 2]
+            tn = tx * nx + ty * ny + tz * nz
+            tx, ty, tz = tx - tn * nx, ty - tn * ny, tz - tn * nz
+            tl = np.sqrt(tx * tx + ty * ty + tz * tz)
+            tx, ty, tz = tx / tl, ty / tl, tz / tl
+            bx = ny * tz - nz * ty
+            by = nz * tx - nx * tz
+            bz = nx * ty - ny * tx
+            psi = np.arctan2(ex * bx + ey * by + ez * bz, ex * tx + ey * ty + ez * tz) * _RAD2DEG
+            if op < -tol:
+                psi = -psi
+            # periodic linear weights (anisotropy.psi_weights)
+            x = psi_nodes[0] + (psi - psi_nodes[0]) % PSI_PERIOD
+            if x >= psi_nodes[0] + PSI_PERIOD:
+                x = psi_nodes[0]
+            if n_psi == 1:
+                k0, k1, w1 = 0, 0, 0.0
+            else:
+                last = n_psi - 1 if closed else n_psi
+                k0 = 0
+                while k0 + 1 < last and psi_nodes[k0 + 1] <= x:
+                    k0 += 1
+                lo = psi_nodes[k0]
+                hi = psi_nodes[k0 + 1] if k0 + 1 < n_psi else psi_nodes[0] + PSI_PERIOD
+                k1 = k0 + 1 if k0 + 1 < n_psi else 0
+                w1 = (x - lo) / (hi - lo)
+                if w1 < 0.0:
+                    w1 = 0.0
+                elif w1 > 1.0:
+                    w1 = 1.0
+            kt = _axis(tgrid, 0, nt, ti, method, it, wt, bt, 0, bt.size, binv[0])
+            kd = _axis(dgrid, 0, nd, dt, method, idt, wdt, bd, 0, bd.size, binv[1])
+            kp = _axis(pgrid, 0, npp, phi, method, iph, wph, bp, 0, bp.size, binv[2])
+            nk = 0
+            for a in range(kt):
+                for b in range(kd):
+                    row0 = (it[a] * nd + idt[b]) * npp
+                    wab = wt[a] * wdt[b]
+                    for c in range(kp):
+                        rows[nk] = row0 + iph[c]
+                        wn[nk] = wab * wph[c]
+                        nk += 1
+            if w1 < 1.0:
+                _gather(
+                    tables[k0],
+                    rows,
+                    wn,
+                    nk,
+                    f,
+                    out_sig[g],
+                    out_pap[g],
+                    a2d * ns * (1.0 - w1),
+                    a2d * (1.0 - w1),
+                )
+            if w1 > 0.0:
+                _gather(
+                    tables[k1], rows, wn, nk, f, out_sig[g], out_pap[g], a2d * ns * w1, a2d * w1
+                )
+        out_area[g] = area_g
+        out_lit[g] = lit_g
+
+
+def _compiled_sums(s, o, n, tangents, areas, table, method, fraction):
+    """:func:`anisotropic_sums` with ``kernel="fused"`` and nearest or linear look-up."""
+    p = table.slices
+    g = s.shape[0]
+    dt = p.dtype
+    out_sig = np.zeros((g, p.n_spectral), dt)
+    out_pap = np.zeros((g, p.n_spectral), dt)
+    out_area, out_lit = np.zeros(g), np.zeros(g)
+    frac = np.zeros((0, 0)) if fraction is None else np.ascontiguousarray(fraction, np.float64)
+    psi = np.ascontiguousarray(table.psi, dtype=np.float64)
+    closed = bool(psi.size > 1 and np.isclose(psi[-1] - psi[0], PSI_PERIOD, rtol=0.0, atol=1e-9))
+    _aniso_fused(
+        np.ascontiguousarray(s),
+        np.ascontiguousarray(o),
+        np.ascontiguousarray(n),
+        np.ascontiguousarray(tangents, dtype=np.float64),
+        np.ascontiguousarray(areas, dtype=np.float64),
+        frac,
+        typed_values(p),
+        p.tgrid[p.t_off[0] : p.t_off[1]],
+        p.dgrid[p.d_off[0] : p.d_off[1]],
+        p.pgrid[p.p_off[0] : p.p_off[1]],
+        *(p.bmap[a, p.b_off[a, 0] : p.b_off[a, 1]] for a in range(3)),
+        np.ascontiguousarray(p.binv[:, 0]),
+        psi,
+        closed,
+        np.array(table.zero_edges, dtype=np.bool_),
+        METHOD_CODES[method],
+        normal_incidence_tolerance(np.float64),
+        _lut.EDGE_TOL_DEG,
+        out_sig,
+        out_pap,
+        out_area,
+        out_lit,
+    )
+    return MaterialSums(out_sig, out_pap, out_area, out_lit)
+
+
+def reflected(
+    plan: Any,
+    to_source: NDArray[np.floating],
+    to_observer: NDArray[np.floating],
+    fraction: NDArray[np.floating] | None,
+    per_material: bool,
+) -> FusedSums:
+    """Facet sums of a plan that has anisotropic tables (``plan.anisotropic``).
+
+    The isotropic materials' terms run through the plan's kernel exactly as without
+    anisotropic ones (``fused`` over all of them at once, or the numpy reference per
+    material); each anisotropic material through :func:`anisotropic_sums` with the
+    terms' tangents (``plan.terms.tangent``).
+
+    Parameters
+    ----------
+    plan : sbrdf_xr.engine.plan.Plan
+        A compiled plan with table evaluation.
+    to_source, to_observer : ndarray, shape (G, 3)
+        Body-frame unit vectors to the source and the observer [1].
+    fraction : ndarray, shape (G, T), optional
+        Lit-and-visible fraction of each term [1].
+    per_material : bool
+        Also return each material's signal.
+
+    Returns
+    -------
+    FusedSums
+    """
+    t = plan.terms
+    aniso = plan.anisotropic
+    method, kernel = plan.knobs["method"], plan.knobs["kernel"]
+    g, n_wl, dt = to_source.shape[0], plan.tables.n_spectral, plan.tables.dtype
+    sig, pap = np.zeros((g, n_wl), dt), np.zeros((g, n_wl), dt)
+    area, lit = np.zeros(g), np.zeros(g)
+    pm = np.zeros((g, len(plan.materials), n_wl), dt) if per_material else None
+    iso = ~np.isin(t.material, np.array(list(aniso), dtype=np.int64))
+    if iso.any() and kernel == "fused":
+        fr = fused_sums(
+            to_source,
+            to_observer,
+            t.normal[iso],
+            t.area[iso],
+            t.material[iso],
+            plan.tables,
+            method,
+            None if fraction is None else fraction[:, iso],
+            per_material,
+        )
+        sig += fr.signal
+        pap += fr.paper
+        area += fr.area
+        lit += fr.lit_visible_area
+        if pm is not None and fr.per_material is not None:
+            pm += fr.per_material
+    for m in range(len(plan.materials)):
+        sel = t.material == m
+        if not sel.any() or (m not in aniso and kernel == "fused"):
+            continue
+        frac = None if fraction is None else fraction[:, sel]
+        if m in aniso:
+            r = anisotropic_sums(
+                to_source,
+                to_observer,
+                t.normal[sel],
+                t.tangent[sel],
+                t.area[sel],
+                aniso[m],
+                method,
+                frac,
+                kernel,
+            )
+        else:
+            values, (tg, dg, pg), edges, blend = plan.table(m)
+            r = material_sums(
+                to_source,
+                to_observer,
+                t.normal[sel],
+                t.area[sel],
+                values,
+                tg,
+                dg,
+                pg,
+                method,
+                frac,
+                edges,
+                blend,
+            )
+        sig += r.signal
+        pap += r.paper
+        area += r.area
+        lit += r.lit_visible_area
+        if pm is not None:
+            pm[:, m] += r.signal
+    return FusedSums(sig, pap, area, lit, pm)

@@ -1,0 +1,163 @@
+"""Material tables packed for the fused kernel (:func:`sbrdf_xr.kernels.sums.fused_sums`):
+one ``(nodes, L)`` view per material, the concatenated grids with offsets, the
+out-of-range policy and normal-incidence blend per material, and bucket maps that find
+an axis cell without a binary search.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Any, NamedTuple
+
+import numba.typed
+import numpy as np
+from numpy.typing import DTypeLike, NDArray
+
+__all__ = ["MAX_BUCKETS", "PackedTables", "bucket_map", "pack_tables", "typed_values"]
+
+
+#: Most buckets of an axis' bucket map (a grid with very uneven spacing gets fewer
+#: buckets than nodes' spacing asks for, and a short scan within a bucket).
+MAX_BUCKETS = 4096
+
+
+def bucket_map(grid: np.ndarray) -> tuple[np.ndarray, float]:
+    """Uniform buckets over ``grid`` and the cell at each bucket's start.
+
+    Bucket ``k`` starts at ``grid[0] + k / inv``; ``map[k]`` is
+    ``searchsorted(grid, start, "right") - 1``.  The bucket width is the smallest node
+    spacing (at most :data:`MAX_BUCKETS` buckets), so a bucket holds at most one node
+    and :func:`_axis` needs at most one correcting step.
+    """
+    g = np.asarray(grid, dtype=np.float64)
+    if g.size < 2 or g[-1] <= g[0]:
+        return np.zeros(1, dtype=np.int64), 0.0
+    span = g[-1] - g[0]
+    width = max(float(np.min(np.diff(g))), span / MAX_BUCKETS)
+    nb = int(np.ceil(span / width)) + 1
+    inv = 1.0 / width
+    starts = g[0] + np.arange(nb) / inv
+    bmap = np.clip(np.searchsorted(g, starts, side="right") - 1, 0, g.size - 1)
+    return bmap.astype(np.int64), inv
+
+
+class PackedTables(NamedTuple):
+    """Material tables as the fused kernel reads them.
+
+    ``values[m]`` is material ``m``'s table as a ``(n_nodes, L)`` view (its
+    ``(theta_i, delta_theta, phi)`` nodes in C order; no copy of a C-contiguous table in
+    the right dtype); its grids are the slices ``t_off[m]:t_off[m + 1]`` (likewise
+    ``d_off``, ``p_off``) of the concatenated grids.
+    """
+
+    values: tuple[NDArray[np.floating], ...]  #: per material (n_nodes, L) [sr-1]
+    tgrid: NDArray[np.float64]
+    t_off: NDArray[np.int64]
+    dgrid: NDArray[np.float64]
+    d_off: NDArray[np.int64]
+    pgrid: NDArray[np.float64]
+    p_off: NDArray[np.int64]
+    edges: NDArray[np.bool_]  #: (M, 3) zero beyond delta_theta min, max, phi max
+    blend: NDArray[np.float64]  #: (M,) normal-incidence blend [degree] (0: none)
+    shapes: tuple[tuple[int, int, int], ...]  #: (n_theta, n_delta_theta, n_phi) per material
+    n_spectral: int
+    dtype: np.dtype
+    #: bucket maps of the (theta_i, delta_theta, phi) axes (:func:`bucket_map`): the
+    #: concatenated maps (3, total), offsets (3, M + 1) and inverse widths (3, M)
+    bmap: NDArray[np.int64] = np.zeros((3, 1), dtype=np.int64)
+    b_off: NDArray[np.int64] = np.zeros((3, 1), dtype=np.int64)
+    binv: NDArray[np.float64] = np.zeros((3, 0))
+
+
+def pack_tables(
+    tables: list[tuple[Any, ...]],
+    n_spectral: int = 1,
+    dtype: DTypeLike = np.float64,
+) -> PackedTables:
+    """Pack ``(values, theta_grid, delta_theta_grid, phi_grid, zero_edges[, normal_blend])``
+    per material.
+
+    ``values`` has shape ``(n_theta, n_delta_theta, n_phi, L)``; every table has the
+    same ``L`` and dtype.  ``n_spectral`` and ``dtype`` shape an empty packing (no
+    tables).
+    """
+
+    def cat(arrays: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        off = np.concatenate([[0], np.cumsum([a.size for a in arrays])]).astype(np.int64)
+        return np.ascontiguousarray(np.concatenate(arrays), dtype=np.float64), off
+
+    dt = np.dtype(dtype)
+    if not tables:
+        z = np.zeros(1, dtype=np.int64)
+        return PackedTables(
+            (),
+            np.zeros(0),
+            z,
+            np.zeros(0),
+            z,
+            np.zeros(0),
+            z,
+            np.zeros((0, 3), dtype=bool),
+            np.zeros(0),
+            (),
+            n_spectral,
+            dt,
+        )
+    n_wl = tables[0][0].shape[-1]
+    values = tuple(np.ascontiguousarray(v, dtype=dt).reshape(-1, n_wl) for v, *_ in tables)
+    tgrid, t_off = cat([np.asarray(t[1]) for t in tables])
+    dgrid, d_off = cat([np.asarray(t[2]) for t in tables])
+    pgrid, p_off = cat([np.asarray(t[3]) for t in tables])
+    edges = np.array([t[4] for t in tables], dtype=bool).reshape(-1, 3)
+    blend = np.array([float(t[5]) if len(t) > 5 else 0.0 for t in tables], dtype=np.float64)
+    shapes = tuple((int(v.shape[0]), int(v.shape[1]), int(v.shape[2])) for v, *_ in tables)
+    maps = [[bucket_map(np.asarray(t[1 + a])) for t in tables] for a in range(3)]
+    lengths = [[m.size for m, _ in axis] for axis in maps]
+    width = max(sum(n) for n in lengths)
+    bmap = np.zeros((3, width), dtype=np.int64)
+    b_off = np.zeros((3, len(tables) + 1), dtype=np.int64)
+    binv = np.zeros((3, len(tables)))
+    for a, axis in enumerate(maps):
+        b_off[a, 1:] = np.cumsum(lengths[a])
+        bmap[a, : b_off[a, -1]] = np.concatenate([m for m, _ in axis])
+        binv[a] = [inv for _, inv in axis]
+    return PackedTables(
+        values,
+        tgrid,
+        t_off,
+        dgrid,
+        d_off,
+        pgrid,
+        p_off,
+        edges,
+        blend,
+        shapes,
+        n_wl,
+        dt,
+        bmap,
+        b_off,
+        binv,
+    )
+
+
+#: The numba lists of the last few packings' values, by the identity of their tuple
+#: (each entry keeps its tuple alive, so the identity cannot be reused meanwhile).
+_TYPED: dict[int, tuple[tuple[NDArray[np.floating], ...], Any]] = {}
+_TYPED_LOCK = threading.Lock()
+_TYPED_KEEP = 8
+
+
+def typed_values(tables: PackedTables) -> Any:
+    """``tables.values`` as the ``numba.typed.List`` the kernels take, built once per
+    packing (building it costs about 70 us, paid on every block otherwise)."""
+    key = id(tables.values)
+    with _TYPED_LOCK:
+        hit = _TYPED.get(key)
+        if hit is not None and hit[0] is tables.values:
+            return hit[1]
+    typed = numba.typed.List(tables.values)
+    with _TYPED_LOCK:
+        while len(_TYPED) >= _TYPED_KEEP:
+            del _TYPED[next(iter(_TYPED))]
+        _TYPED[key] = (tables.values, typed)
+    return typed

@@ -1,0 +1,111 @@
+"""Materials: spectral BRDF look-up tables and the models and measurements they come from.
+
+A material is a labelled :class:`xarray.DataArray` over ``(theta_i, delta_theta, phi,
+wavelength)`` (paper 000 §3.1) or a model parameter set (paper 001 §4).
+
+Modules
+-------
+``schema``
+    The table and measurement-set schema (:func:`new_material`, :func:`validate_material`).
+``construction`` and ``build``
+    The table construction from sparse measurements of paper 000 §3.2 (:func:`build_lut`).
+``tables``
+    Look-up (:func:`lookup`), anisotropic tables and the material front end.
+``energy``
+    The directional-hemispherical reflectance of a table.
+``files``
+    Lossless, atomic netCDF files of tables and measurement sets.
+``model_schema`` and ``models``
+    Analytic materials as labelled parameter sets: evaluate, render to a table, measure.
+``goniometer``
+    A virtual goniospectrometer sampling any material with the scheme of paper 000.
+"""
+
+from ..errors import NonPhysicalWarning, ValidationError
+from . import build, construction, energy, files, goniometer, model_schema, models, schema, tables
+from .build import BELOW_NOISE, EXTRAPOLATIONS, RENORMALISE, build_lut
+from .construction import paper_delta_theta_grid, paper_phi_grid
+from .energy import ENERGY_TOL, hemispherical_reflectance
+from .files import open_material, open_measurements, write_netcdf_atomic
+from .goniometer import PAPER_THETA_I, paper_scheme, scheme_extents
+from .model_schema import ModelParameters, model_material, model_parameters, open_model
+from .models import (
+    fit_robertson_sandford,
+    render,
+    render_anisotropic,
+    render_values,
+    spectra,
+    spectrum_function,
+)
+from .schema import (
+    DUPLICATES,
+    SOURCES,
+    average_duplicates,
+    check_coord,
+    constant_material,
+    lambertian,
+    new_material,
+    reference_mask,
+    validate_material,
+    validate_measurements,
+)
+from .tables import (
+    LOOKUP_METHODS,
+    build_lut_anisotropic,
+    lookup,
+    lookup_anisotropic,
+    sample_rotation,
+)
+
+__all__ = [
+    "BELOW_NOISE",
+    "DUPLICATES",
+    "ENERGY_TOL",
+    "EXTRAPOLATIONS",
+    "LOOKUP_METHODS",
+    "PAPER_THETA_I",
+    "RENORMALISE",
+    "SOURCES",
+    "ModelParameters",
+    "NonPhysicalWarning",
+    "ValidationError",
+    "average_duplicates",
+    "build",
+    "build_lut",
+    "build_lut_anisotropic",
+    "check_coord",
+    "constant_material",
+    "construction",
+    "energy",
+    "files",
+    "fit_robertson_sandford",
+    "goniometer",
+    "hemispherical_reflectance",
+    "lambertian",
+    "lookup",
+    "lookup_anisotropic",
+    "model_material",
+    "model_parameters",
+    "model_schema",
+    "models",
+    "new_material",
+    "open_material",
+    "open_measurements",
+    "open_model",
+    "paper_delta_theta_grid",
+    "paper_phi_grid",
+    "paper_scheme",
+    "reference_mask",
+    "render",
+    "render_anisotropic",
+    "render_values",
+    "sample_rotation",
+    "schema",
+    "scheme_extents",
+    "spectra",
+    "spectrum_function",
+    "tables",
+    "validate_material",
+    "validate_measurements",
+    "write_netcdf_atomic",
+]

@@ -1,0 +1,124 @@
+"""The energy of a material table: its directional-hemispherical reflectance.
+
+:func:`hemispherical_reflectance` integrates the look-up's interpolant over the visible
+hemisphere (:func:`sbrdf_xr.kernels.lut.hemispherical_reflectance_kernel`); a value above one
+means the table creates energy.  :func:`sbrdf_xr.materials.build.build_lut` checks the
+tables it builds with it (tolerance :data:`ENERGY_TOL`).
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import xarray as xr
+from numpy.typing import ArrayLike
+
+from .._names import ANGLE_DIMS, PSI, THETA_I, WAVELENGTH, attrs
+from ..anisotropy import psi_weights
+from ..errors import NonPhysicalWarning
+from ..kernels import lut as _lut
+from .schema import validate_material
+
+__all__ = ["ENERGY_TOL", "hemispherical_reflectance"]
+
+#: Reflectance above ``1 + ENERGY_TOL`` is reported by
+#: :func:`sbrdf_xr.materials.build.build_lut` (the quadrature of a float32 table is good
+#: to ~1e-7).
+ENERGY_TOL = 1e-6
+
+
+def hemispherical_reflectance(
+    material: xr.DataArray,
+    theta_i: ArrayLike | None = None,
+    *,
+    method: str = "linear",
+    warn: bool = True,
+) -> xr.DataArray:
+    """Directional-hemispherical reflectance ``rho(theta_i, wavelength)`` of a table.
+
+    Quadrature over the visible hemisphere of the interpolated table
+    (:func:`sbrdf_xr.kernels.lut.hemispherical_reflectance_kernel`).  Values above one
+    are non-physical (energy is not conserved) and issue a
+    :class:`~sbrdf_xr.errors.NonPhysicalWarning` when ``warn`` is true.
+
+    Parameters
+    ----------
+    material : xarray.DataArray
+        Material table.
+    theta_i : array_like, optional
+        Incidence angles [degree]; default the table's own.
+    method : str, default "linear"
+        Look-up method of the integrand.
+    warn : bool, default True
+        Warn when any reflectance exceeds 1.
+
+    Returns
+    -------
+    xarray.DataArray
+        Dims ``(theta_i, wavelength)``, ``units = 1``; for an anisotropic table
+        ``(theta_i, psi, wavelength)`` at the table's ``psi`` nodes: an observer on
+        the far side of the illumination plane sees the mirror geometry, whose tangent
+        is at ``-psi`` (:mod:`sbrdf_xr.anisotropy`), so the reflectance at ``psi`` is
+        the mean of the slice integrals at ``psi`` and ``-psi`` (each integrates one
+        side of the plane twice), the latter interpolated periodically.
+
+    Examples
+    --------
+    The directional-hemispherical reflectance of a Lambertian table is its albedo:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.materials.tables import hemispherical_reflectance, lambertian
+    >>> rho = hemispherical_reflectance(lambertian(0.5, [550.0]), [0.0, 30.0, 60.0])
+    >>> rho.dims, rho.attrs["units"]
+    (('theta_i', 'wavelength'), '1')
+    >>> np.round(rho.values[:, 0], 4)
+    array([0.5, 0.5, 0.5])
+    """
+    material = validate_material(material, check_values=False)
+    grids = [np.asarray(material[d].values) for d in ANGLE_DIMS]
+    ti = grids[0] if theta_i is None else np.atleast_1d(np.asarray(theta_i, dtype=np.float64))
+
+    def kernel(values: np.ndarray) -> np.ndarray:
+        return _lut.hemispherical_reflectance_kernel(
+            values,
+            grids[0],
+            grids[1],
+            grids[2],
+            ti,
+            method,
+            zero_edges=_lut.table_edges(material.attrs),
+            normal_blend=_lut.table_normal_blend(material.attrs),
+        )
+
+    coords = {THETA_I: (THETA_I, ti, attrs(THETA_I)), WAVELENGTH: material[WAVELENGTH]}
+    if PSI in material.dims:
+        values = np.asarray(material.values)
+        psi = np.asarray(material[PSI].values, dtype=np.float64)
+        half = np.stack([kernel(values[:, :, :, k, :]) for k in range(psi.size)], axis=1)
+        idx, w = psi_weights(psi, -psi)
+        mirror = np.einsum("tkpl,kp->tkl", half[:, idx, :], w)
+        rho = 0.5 * (half + mirror)
+        dims: tuple[str, ...] = (THETA_I, PSI, WAVELENGTH)
+        coords[PSI] = material[PSI]
+    else:
+        rho = kernel(np.asarray(material.values))
+        dims = (THETA_I, WAVELENGTH)
+    out = xr.DataArray(
+        rho,
+        dims=dims,
+        coords=coords,
+        name="reflectance",
+        attrs=attrs("reflectance", material=material.attrs.get("material", "")),
+    )
+    if warn and np.any(rho > 1.0):
+        worst = np.unravel_index(np.argmax(rho), rho.shape)
+        warnings.warn(
+            f"material {material.attrs.get('material', '')!r}: "
+            "directional-hemispherical reflectance "
+            f"reaches {rho[worst]:.3f} > 1 at theta_i = {ti[worst[0]]} deg, wavelength = "
+            f"{material[WAVELENGTH].values[worst[-1]]} nm; the table does not conserve energy",
+            NonPhysicalWarning,
+            stacklevel=2,
+        )
+    return out

@@ -1,0 +1,425 @@
+"""Analytic materials as labelled parameter sets: evaluate, render to a table, measure.
+
+A *model material* is an :class:`xarray.Dataset` holding the parameters of one of
+the analytic models of :mod:`sbrdf_xr.brdf` over ``wavelength``
+(:mod:`sbrdf_xr.materials.model_schema`).  This module is the xarray layer over the pure-numpy
+models:
+
+* :func:`model_material` - build and validate one (the metadata of each parameter is
+  its model's declaration, :class:`sbrdf_xr.brdf.Parameter`);
+* :func:`model_parameters` - the model and the keyword arguments of its functions;
+* :func:`spectra` - evaluate at paper-000 angles (numpy);
+* :func:`render` - a look-up table on any grid (paper 000's by default);
+* :func:`measure` - sample it with the virtual goniospectrometer
+  (:mod:`sbrdf_xr.materials.goniometer`), so that a table built from the measurements can
+  be compared with its ground truth.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from numpy.typing import ArrayLike
+
+from .._names import ANISO_LUT_DIMS, DELTA_THETA, PHI, PSI, SBRDF, THETA_I, WAVELENGTH, attrs
+from ..brdf import Model
+from ..errors import ValidationError
+from .model_schema import ModelParameters, model_material, model_parameters, open_model, to_netcdf
+from .schema import new_material
+
+__all__ = [
+    "ModelParameters",
+    "fit_robertson_sandford",
+    "measure",
+    "model_material",
+    "model_parameters",
+    "open_model",
+    "render",
+    "render_anisotropic",
+    "render_values",
+    "spectra",
+    "spectrum_function",
+    "to_netcdf",
+]
+
+
+def _require_isotropic(m: Model) -> None:
+    if m.anisotropic:
+        raise ValidationError(
+            f"model {m.name!r} is anisotropic: it needs the azimuth psi of the "
+            "illumination plane from the facet tangent (render_anisotropic, spectra(..., psi=...))"
+        )
+
+
+def spectra(
+    spec: xr.Dataset,
+    theta_i: ArrayLike,
+    delta_theta: ArrayLike,
+    phi: ArrayLike,
+    psi: ArrayLike | None = None,
+) -> np.ndarray:
+    """The model's spectra at paper-000 angles.
+
+    Parameters
+    ----------
+    spec : xarray.Dataset
+        A model material.
+    theta_i, delta_theta, phi : array_like
+        Angles [degree], broadcast together.
+    psi : array_like, optional
+        Azimuth of the illumination plane from the facet tangent [degree]: required by
+        the anisotropic models (:data:`sbrdf_xr.brdf.ANISOTROPIC_MODELS`), ignored by
+        the isotropic ones.
+
+    Returns
+    -------
+    ndarray, shape broadcast + (n_wavelength,)
+        sBRDF [sr-1].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> spec = model_material("lambert", [550.0], material="grey", provenance="doc", rho=0.5)
+    >>> np.round(spectra(spec, [0.0, 60.0], 0.0, 0.0) * np.pi, 6)
+    array([[0.5],
+           [0.5]])
+    """
+    m, wl, kw = model_parameters(spec)
+    if m.anisotropic and psi is not None:
+        return m.brdf_angles(theta_i, delta_theta, phi, wl, psi=psi, **kw)
+    _require_isotropic(m)
+    return m.brdf_angles(theta_i, delta_theta, phi, wl, **kw)
+
+
+def spectrum_function(spec: xr.Dataset, psi: float | None = None) -> Any:
+    """``func(theta_i, delta_theta, phi) -> spectra`` of a model material (for the goniometer).
+
+    ``psi`` [degree]: for an anisotropic model, the azimuth of the illumination plane
+    from the sample's tangent (a sample rotation,
+    :func:`sbrdf_xr.materials.tables.build_lut_anisotropic`).
+    Examples
+    --------
+    >>> import numpy as np
+    >>> spec = model_material("lambert", [550.0], material="grey", provenance="doc", rho=0.5)
+    >>> f = spectrum_function(spec)
+    >>> np.round(f(np.array([30.0]), np.array([0.0]), np.array([0.0])) * np.pi, 6)
+    array([[0.5]])
+    """
+
+    def func(ti: np.ndarray, dt: np.ndarray, ph: np.ndarray) -> np.ndarray:
+        if psi is None:
+            return spectra(spec, ti, dt, ph)
+        return spectra(spec, ti, dt, ph, psi=np.full(np.shape(ti), float(psi)))
+
+    return func
+
+
+def render(
+    spec: xr.Dataset,
+    theta_i: ArrayLike | None = None,
+    delta_theta: ArrayLike | None = None,
+    phi: ArrayLike | None = None,
+    dtype: type | np.dtype = np.float64,
+) -> xr.DataArray:
+    """Render a model material to a look-up table.
+
+    Parameters
+    ----------
+    spec : xarray.Dataset
+        A model material.
+    theta_i, delta_theta, phi : array_like, optional
+        Grids [degree]; defaults: every integer 0-90, and -180..90 and 0-90 in
+        3-degree steps (the whole visible hemisphere; with 141 wavelengths that is
+        already 290 MB in float64: pass narrower grids for narrow lobes).
+    dtype : numpy dtype
+
+    Returns
+    -------
+    xarray.DataArray
+        Material table with ``source = model:<name>``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> spec = model_material("lambert", [550.0], material="grey", provenance="doc", rho=0.5)
+    >>> lut = render(spec, [0.0, 45.0, 90.0], [-180.0, 0.0, 90.0], [0.0, 90.0])
+    >>> lut.dims, lut.shape
+    (('theta_i', 'delta_theta', 'phi', 'wavelength'), (3, 3, 2, 1))
+    >>> bool(np.allclose(lut * np.pi, 0.5, rtol=1e-12))
+    True
+    """
+    m, wl, kw = model_parameters(spec)
+    ti = np.arange(0.0, 91.0) if theta_i is None else np.asarray(theta_i, dtype=np.float64)
+    dt = (
+        np.arange(-180.0, 91.0, 3.0)
+        if delta_theta is None
+        else np.asarray(delta_theta, dtype=np.float64)
+    )
+    ph = np.arange(0.0, 91.0, 3.0) if phi is None else np.asarray(phi, dtype=np.float64)
+    for name, g in ((THETA_I, ti), (DELTA_THETA, dt), (PHI, ph)):
+        if g.ndim != 1 or g.size == 0:
+            raise ValidationError(
+                f"{name}: expected a non-empty 1-D grid [degree], got shape {g.shape}"
+            )
+    _require_isotropic(m)
+    vals = m.render_grid(ti, dt, ph, wl, horizon="limit", **kw)
+    # Where the grid stops inside the hemisphere the model goes on: hold the edge
+    # (exact for a Lambertian surface) rather than drop to zero.
+    blend = min(float(ti[1] - ti[0]), 1.0) if ti.size > 1 and ti[0] == 0.0 else 0.0
+    return new_material(
+        vals.astype(dtype),
+        ti,
+        dt,
+        ph,
+        wl,
+        material=spec.attrs["material"],
+        source=spec.attrs["source"],
+        provenance=(
+            f"{spec.attrs.get('provenance', '')}; rendered by sbrdf_xr.materials.models.render"
+        ),
+        model=spec.attrs["model"],
+        normal_incidence="symmetric",
+        normal_incidence_blend=blend,
+        **_edges(dt, ph),
+    )
+
+
+def _edges(dt: np.ndarray, ph: np.ndarray) -> dict[str, str]:
+    """Edge policies of a rendered table: zero at the hemisphere's edge, else hold."""
+    return {
+        "edge_delta_theta_min": "zero" if dt[0] <= -180.0 else "hold",
+        "edge_delta_theta_max": "zero" if dt[-1] >= 90.0 else "hold",
+        "edge_phi_max": "zero" if ph[-1] >= 90.0 else "hold",
+    }
+
+
+def render_anisotropic(
+    spec: xr.Dataset,
+    theta_i: ArrayLike,
+    delta_theta: ArrayLike,
+    phi: ArrayLike,
+    psi: ArrayLike,
+    dtype: type | np.dtype = np.float64,
+) -> xr.DataArray:
+    """Render an anisotropic model material to a table with a ``psi`` axis.
+
+    Layout: a ``DataArray`` named ``sbrdf`` with dims ``(theta_i, delta_theta, phi,
+    psi, wavelength)`` (:data:`sbrdf_xr._names.ANISO_LUT_DIMS`), every ``psi`` slice an
+    isotropic table on the same grids (same attributes, edges and below-horizon
+    treatment as :func:`render`).  ``psi`` [degree] is the azimuth of the
+    illumination plane from the facet tangent, in ``[0, 180]`` (periodic:
+    ``psi = 180`` is ``psi = 0``; :func:`sbrdf_xr.brdf.anisotropic.illumination_azimuth`
+    gives it for a geometry).  Look-up: :func:`sbrdf_xr.materials.tables.lookup_anisotropic`.
+
+    Parameters
+    ----------
+    spec : xarray.Dataset
+        A model material of an anisotropic model.
+    theta_i, delta_theta, phi, psi : array_like
+        1-D grids [degree].
+    dtype : numpy dtype
+
+    Returns
+    -------
+    xarray.DataArray
+
+    Examples
+    --------
+    >>> spec = model_material("anisotropic_microfacet", [550.0], material="brushed",
+    ...                       provenance="doc", alpha_x=0.1, alpha_y=0.3, n=1.0, k=6.0,
+    ...                       rho_d=0.0)
+    >>> tab = render_anisotropic(spec, [30.0], [0.0], [0.0, 10.0], [0.0, 90.0])
+    >>> tab.dims, tab.shape
+    (('theta_i', 'delta_theta', 'phi', 'psi', 'wavelength'), (1, 1, 2, 2, 1))
+    """
+    m, wl, kw = model_parameters(spec)
+    if not m.anisotropic:
+        raise ValidationError(f"model {m.name!r} is isotropic: use render")
+    grids = [np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi, psi)]
+    for name, g in zip((THETA_I, DELTA_THETA, PHI, PSI), grids, strict=True):
+        if g.ndim != 1 or g.size == 0 or np.any(np.diff(g) <= 0):
+            raise ValidationError(
+                f"{name}: expected a non-empty, strictly increasing 1-D grid [degree]"
+            )
+    ps = grids[3]
+    if ps[0] < 0 or ps[-1] > 180:
+        raise ValidationError(f"psi: must lie in [0, 180] degree, got [{ps[0]}, {ps[-1]}]")
+    vals = m.render_grid(grids[0], grids[1], grids[2], wl, psi=ps, horizon="limit", **kw)
+    a = attrs(
+        SBRDF,
+        material=spec.attrs["material"],
+        source=spec.attrs["source"],
+        provenance=(
+            f"{spec.attrs.get('provenance', '')}; "
+            "rendered by sbrdf_xr.materials.models.render_anisotropic"
+        ),
+        model=spec.attrs["model"],
+        **_edges(grids[1], grids[2]),
+    )
+    coords = {
+        n: (n, g, attrs(n)) for n, g in zip((THETA_I, DELTA_THETA, PHI, PSI), grids, strict=True)
+    }
+    coords[WAVELENGTH] = (WAVELENGTH, wl, attrs(WAVELENGTH))
+    return xr.DataArray(vals.astype(dtype), dims=ANISO_LUT_DIMS, coords=coords, name=SBRDF, attrs=a)
+
+
+def render_values(
+    model: Model,
+    ti: np.ndarray,
+    dt: np.ndarray,
+    ph: np.ndarray,
+    wl: np.ndarray,
+    kw: dict[str, Any],
+) -> np.ndarray:
+    """A model's sBRDF on the outer product of 1-D grids, every node inside the hemisphere.
+
+    A node whose geometry is not lit and visible carries the model's limit from
+    inside the hemisphere (``model.render_grid(..., horizon="limit")``,
+    :meth:`sbrdf_xr.brdf.Model.render_grid`): interpolating between such a node
+    and a visible one then never blends in a zero that the physics does not have.
+
+    Parameters
+    ----------
+    model : Model
+        A model of :data:`sbrdf_xr.brdf.BRDF_MODELS` (isotropic).
+    ti, dt, ph : ndarray, 1-D
+        Grids [degree].
+    wl : ndarray
+        Wavelengths [nm].
+    kw : dict
+        The model's parameters.
+
+    Returns
+    -------
+    ndarray, shape (n_ti, n_dt, n_phi, n_wl)
+        sBRDF [sr-1].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.brdf import get_model
+    >>> v = render_values(get_model("lambert"), np.array([0.0, 90.0]), np.array([0.0]),
+    ...                   np.array([0.0, 90.0]), np.array([550.0]), {"rho": 0.5})
+    >>> v.shape, np.round(v.ravel() * np.pi, 6).tolist()
+    ((2, 1, 2, 1), [0.5, 0.5, 0.5, 0.5])
+    """
+    return model.render_grid(ti, dt, ph, wl, horizon="limit", **kw)
+
+
+def measure(spec: xr.Dataset, theta_i: Sequence[float], **kwargs: Any) -> xr.Dataset:
+    """Measure a model material with the virtual goniospectrometer.
+
+    Parameters
+    ----------
+    spec : xarray.Dataset
+        A model material (the ground truth).
+    theta_i : sequence of float
+        Incidence angles [degree].
+    **kwargs
+        Passed to :func:`sbrdf_xr.materials.goniometer.measure` (``noise``, ``seed``,
+        ``noise_floor``, apparatus limits).
+
+    Returns
+    -------
+    xarray.Dataset
+        The measurement set, labelled ``synthetic`` with the model as provenance.
+
+    Examples
+    --------
+    >>> spec = model_material("robertson_sandford", [500.0, 700.0], material="paint",
+    ...                       provenance="doc", rho_D=0.6, epsilon=0.2, b=0.1, e=0.3)
+    >>> meas = measure(spec, [20.0, 40.0, 60.0])
+    >>> dict(meas.sizes), meas.attrs["source"]
+    ({'sample': 90, 'wavelength': 2}, 'synthetic')
+    """
+    from .goniometer import measure as _measure
+
+    wl = np.asarray(spec[WAVELENGTH].values)
+    prov = (
+        f"virtual goniospectrometer measurement of model {spec.attrs['model']!r} "
+        f"({spec.attrs.get('provenance', '')})"
+    )
+    return _measure(
+        spectrum_function(spec),
+        wl,
+        theta_i,
+        material=spec.attrs["material"],
+        source="synthetic",
+        provenance=prov,
+        **kwargs,
+    )
+
+
+def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Dataset:
+    """Fit the Robertson-Sandford model (paper 001) to a measurement set.
+
+    Wraps :func:`sbrdf_xr.brdf.robertson_sandford_fit.fit_robertson_sandford`
+    (log-residual least squares; ``rho_D`` and ``epsilon`` per wavelength, shared
+    ``b`` and ``e``) and returns a model material with the standard uncertainties
+    as variables ``u_rho_D``, ``u_epsilon``, ``u_b``, ``u_e`` and the reduced
+    chi-square as an attribute.  Where the fit lands marginally outside
+    ``rho_D + epsilon <= G(b)`` (Eq. 17's ``rho_s >= 0``; the fit bounds each
+    parameter, not their sum), ``epsilon`` gives way.
+
+    Parameters
+    ----------
+    measurements : xarray.Dataset
+        A measurement set (:func:`sbrdf_xr.materials.tables.validate_measurements`).
+    **kwargs
+        Passed to the numpy fit (``sigma``, ``cutoff``).
+
+    Returns
+    -------
+    xarray.Dataset
+        The fitted model material.
+
+    Examples
+    --------
+    >>> spec = model_material("robertson_sandford", [500.0, 700.0], material="paint",
+    ...                       provenance="doc", rho_D=0.6, epsilon=0.2, b=0.1, e=0.3)
+    >>> fit = fit_robertson_sandford(measure(spec, [20.0, 40.0, 60.0]))
+    >>> round(float(fit.b[0]), 6), round(float(fit.e[0]), 6), fit.rho_D.values.round(6).tolist()
+    (0.1, 0.3, [0.6, 0.6])
+    """
+    from .._names import MEASURED, SAMPLE
+    from ..brdf import robertson_sandford as rs
+    from ..brdf import robertson_sandford_fit
+    from .schema import reference_mask, validate_measurements
+
+    ds = validate_measurements(measurements, duplicates="mean")
+    wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
+    spectra = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64)
+    fit = robertson_sandford_fit.fit_robertson_sandford(
+        ds[THETA_I].values,
+        ds[DELTA_THETA].values,
+        ds[PHI].values,
+        wl,
+        spectra,
+        reference=reference_mask(ds),
+        **kwargs,
+    )
+    m = rs.MODEL
+    p: dict[str, Any] = {k: np.asarray(fit[k], dtype=np.float64) for k in m.param_names}
+    g_b = float(rs.normalisation_G(p["b"]))
+    p["epsilon"] = np.minimum(
+        np.broadcast_to(p["epsilon"], wl.shape), np.maximum(g_b - p["rho_D"], 0.0)
+    )
+    name = ds.attrs.get("material", "unnamed")
+    out = model_material(
+        "robertson_sandford",
+        wl,
+        material=name,
+        provenance=f"Robertson-Sandford fit to the measurements of {name} "
+        f"(reduced chi-square {fit['chi2_reduced']:.3g}, {fit['n_used']} residuals)",
+        **p,
+    )
+    for k in m.param_names:
+        u = np.broadcast_to(np.asarray(fit[f"u_{k}"], dtype=np.float64), wl.shape)
+        u_attrs = {"units": m.parameter(k).units, "long_name": f"standard uncertainty of {k}"}
+        out[f"u_{k}"] = (WAVELENGTH, np.array(u), u_attrs)
+    out.attrs["chi2_reduced"] = float(fit["chi2_reduced"])
+    out.attrs["source"] = "model:robertson_sandford"
+    return out

@@ -1,0 +1,295 @@
+"""Observations from TOML tables, and the built-in CanX-1 pass.
+
+:func:`observation_from_dict` builds an :class:`~sbrdf_xr.observing.observation.Observation` from
+an ``[observation]`` table (an orbit, a site, UTC times and an attitude law);
+:func:`canx1_pass` is the built-in example and :func:`bench_geometry` times its geometry.
+The frames and models of the geometry are described in :mod:`sbrdf_xr.observing.observation`.
+This module also gathers the observation API in one place: the :class:`Observation`,
+the :class:`~sbrdf_xr.observing.orbits.Orbit` and :class:`~sbrdf_xr.observing.orbits.Site`, the UTC
+times of
+:mod:`sbrdf_xr.observing.timescales` and the models of :mod:`sbrdf_xr.observing.earth_shadow` and
+:func:`~sbrdf_xr.observing.orbits.airmass` are importable from here.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any, TypedDict
+
+import numpy as np
+
+from ..errors import ObservationError
+from . import attitude as _att
+from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, disc_overlap_fraction, sunlit_fraction
+from .observation import ATTRS, TIME, Observation
+from .orbits import (
+    AIRMASS_MODELS,
+    AU_KM,
+    EPOCH_GAP_DAYS,
+    Orbit,
+    Site,
+    airmass,
+    load_orbit_entry,
+    load_site_entry,
+    tle_checksum,
+)
+from .timescales import (
+    check_times,
+    times,
+    to_datetime64,
+)
+
+__all__ = [
+    "AIRMASS_MODELS",
+    "ATTRS",
+    "AU_KM",
+    "EARTH_RADIUS_KM",
+    "EPOCH_GAP_DAYS",
+    "SUN_RADIUS_KM",
+    "TIME",
+    "Observation",
+    "Orbit",
+    "Site",
+    "airmass",
+    "bench_geometry",
+    "canx1_pass",
+    "disc_overlap_fraction",
+    "load_orbit_entry",
+    "load_site_entry",
+    "observation_from_dict",
+    "sunlit_fraction",
+    "times",
+    "tle_checksum",
+]
+
+
+def observation_from_dict(
+    table: Mapping[str, Any], base_dir: str | Path | None = None
+) -> Observation:
+    """An :class:`Observation` from a TOML ``[observation]`` table.
+
+    Keys: the orbit as ``orbit`` (a catalog name), ``tle = [line1, line2]`` (or
+    ``tle_line1``/``tle_line2``) or ``omm`` (a path or a table); ``site`` as a catalog name
+    or a table ``{latitude_deg, longitude_deg, height_m, name}``; times as ``start``,
+    ``stop``, ``step_s`` or a list ``times``; ``attitude`` a table for
+    :func:`sbrdf_xr.observing.attitude.law_from_dict`; optional ``airmass_model``,
+    ``min_elevation_deg``, ``name``.  Relative paths are taken from ``base_dir``.
+    Example::
+
+        [observation]
+        orbit = "canx1-example"
+        site = "mont-megantic"
+        start = "2024-03-17T01:20:00"
+        stop = "2024-03-17T01:25:00"
+        step_s = 1.0
+        [observation.attitude]
+        law = "nadir"
+        yaw_deg = 0.0
+
+    Examples
+    --------
+    >>> obs = observation_from_dict({"orbit": "canx1-example", "site": "mont-megantic",
+    ...                              "start": "2024-03-17T01:20:00", "stop": "2024-03-17T01:21:00",
+    ...                              "step_s": 30.0,
+    ...                              "attitude": {"law": "spin", "rate_deg_s": 2.0}})
+    >>> obs.times.size, type(obs.attitude).__name__
+    (3, 'Spin')
+    >>> observation_from_dict({"orbit": "canx1-example", "site": "mont-megantic", "when": "now"})
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.ObservationError: [observation]: unknown key(s) ['when']; allowed: ...
+    """
+    allowed = {
+        "orbit",
+        "tle",
+        "tle_line1",
+        "tle_line2",
+        "omm",
+        "name",
+        "site",
+        "start",
+        "stop",
+        "step_s",
+        "times",
+        "attitude",
+        "airmass_model",
+        "min_elevation_deg",
+    }
+    if not isinstance(table, Mapping):
+        raise ObservationError(f"[observation]: expected a table, got {type(table).__name__}")
+    bad = sorted(set(table) - allowed)
+    if bad:
+        raise ObservationError(
+            f"[observation]: unknown key(s) {bad}; allowed: {', '.join(sorted(allowed))}"
+        )
+    base = Path(base_dir) if base_dir is not None else Path.cwd()
+
+    def resolve(p: str) -> Path:
+        path = Path(p)
+        return path if path.is_absolute() else base / path
+
+    orbit_keys = [k for k in ("orbit", "tle", "tle_line1", "omm") if k in table]
+    if len(orbit_keys) != 1:
+        raise ObservationError(
+            "[observation]: give exactly one of orbit, tle, tle_line1/tle_line2, omm; "
+            f"got {orbit_keys}"
+        )
+    if "orbit" in table:
+        orbit = Orbit.from_catalog(table["orbit"])
+    elif "tle" in table:
+        tle = table["tle"]
+        if not isinstance(tle, Sequence) or isinstance(tle, str) or len(tle) != 2:
+            raise ObservationError(f"[observation] tle: expected [line1, line2], got {tle!r}")
+        orbit = Orbit.from_tle(tle[0], tle[1], table.get("name"))
+    elif "tle_line1" in table:
+        if "tle_line2" not in table:
+            raise ObservationError("[observation]: tle_line1 needs tle_line2")
+        orbit = Orbit.from_tle(table["tle_line1"], table["tle_line2"], table.get("name"))
+    else:
+        omm = table["omm"]
+        orbit = Orbit.from_omm(omm if isinstance(omm, Mapping) else resolve(omm))
+
+    site_v = table.get("site")
+    if isinstance(site_v, str):
+        site = Site.from_catalog(site_v)
+    elif isinstance(site_v, Mapping):
+        extra = sorted(set(site_v) - {"latitude_deg", "longitude_deg", "height_m", "name"})
+        if extra or not {"latitude_deg", "longitude_deg"} <= set(site_v):
+            raise ObservationError(
+                "[observation] site: needs latitude_deg, longitude_deg "
+                f"(and optional height_m, name); got {sorted(site_v)}"
+            )
+        site = Site(**site_v)
+    else:
+        raise ObservationError(
+            f"[observation] site: expected a catalog name or a table, got {site_v!r}"
+        )
+
+    if "times" in table:
+        if any(k in table for k in ("start", "stop", "step_s")):
+            raise ObservationError("[observation]: give times or start/stop/step_s, not both")
+        t = check_times(table["times"])
+    else:
+        missing = [k for k in ("start", "stop") if k not in table]
+        if missing:
+            raise ObservationError(
+                f"[observation]: needs times or start and stop (missing {missing})"
+            )
+        t = times(table["start"], table["stop"], float(table.get("step_s", 1.0)))
+
+    att = table.get("attitude")
+    if isinstance(att, Mapping) and att.get("law") == "quaternion_series" and "path" in att:
+        att = {**att, "path": str(resolve(att["path"]))}
+    kw = {k: table[k] for k in ("airmass_model", "min_elevation_deg", "name") if k in table}
+    return Observation(orbit, site, t, att, **kw)
+
+
+# --------------------------------------------------------------------------- examples
+
+
+class _PassWindow(TypedDict):
+    orbit: str
+    site: str
+    start: str
+    stop: str
+    step_s: float
+
+
+#: The built-in example: orbit and site catalog entries and the pass window (UTC), found
+#: with ``tools/build_observe.py``: the site in astronomical darkness (Sun below
+#: -25 deg), the spacecraft between 27 and 76 deg elevation, leaving the Earth's shadow
+#: in the first minute (penumbra 01:20:46-01:21:00) and sunlit for the remaining four.
+CANX1_PASS: _PassWindow = {
+    "orbit": "canx1-example",
+    "site": "mont-megantic",
+    "start": "2024-03-17T01:20:00",
+    "stop": "2024-03-17T01:25:00",
+    "step_s": 1.0,
+}
+
+
+def canx1_attitude() -> _att.AttitudeLaw:
+    """Attitude of the built-in pass: a slow spin about a tilted body axis from a fixed start.
+
+    Examples
+    --------
+    >>> law = canx1_attitude()
+    >>> type(law).__name__, law.quaternions([0.0, 1.0]).shape
+    ('Spin', (2, 4))
+    """
+    return _att.Spin(
+        axis_body=(0.3, 0.4, 0.866),
+        rate_deg_s=4.0,
+        phase_deg=0.0,
+        initial=_att.Inertial((0.2, -0.1, 0.3, 0.92736185)),
+    )
+
+
+def canx1_pass(attitude: _att.AttitudeLaw | None = None) -> Observation:
+    """The built-in observation: CanX-1 over the Mont Mégantic Observatory for a few minutes at 1 s.
+
+    Parameters
+    ----------
+    attitude : AttitudeLaw, optional
+        Replaces the default :func:`canx1_attitude`.
+
+    Returns
+    -------
+    Observation
+
+    Examples
+    --------
+    >>> obs = canx1_pass()
+    >>> obs.name, obs.times.size, str(obs.times[0])
+    ('canx1-pass', 301, '2024-03-17T01:20:00.000000000')
+    """
+    p = CANX1_PASS
+    return Observation(
+        Orbit.from_catalog(p["orbit"]),
+        Site.from_catalog(p["site"]),
+        times(p["start"], p["stop"], p["step_s"]),
+        attitude if attitude is not None else canx1_attitude(),
+        name="canx1-pass",
+    )
+
+
+def bench_geometry(n_times: int = 3600, step_s: float = 1.0, repeats: int = 3) -> dict[str, float]:
+    """Time :meth:`Observation.geometry` of the built-in orbit and site over ``n_times`` steps.
+
+    The first call in a process also pays the one-off imports and the loading of the
+    skyfield data; it is reported apart from the best of ``repeats`` further calls on
+    fresh observations (nothing cached between them).
+
+    Returns
+    -------
+    dict
+        ``n_times``, ``first_call_seconds``, ``seconds`` (best warm call) and
+        ``seconds_per_time``.
+
+    Examples
+    --------
+    >>> row = bench_geometry(n_times=60, repeats=1)
+    >>> sorted(row), row["n_times"]
+    (['first_call_seconds', 'n_times', 'seconds', 'seconds_per_time'], 60.0)
+    """
+    p = CANX1_PASS
+    t0 = to_datetime64(p["start"], "start") - np.timedelta64(int(n_times * step_s / 2), "s")
+    t = t0 + np.timedelta64(round(step_s * 1e9), "ns") * np.arange(n_times)
+    start = _time.perf_counter()
+    orbit, site = Orbit.from_catalog(p["orbit"]), Site.from_catalog(p["site"])
+    Observation(orbit, site, t, canx1_attitude()).geometry(on_unobservable="keep")
+    first = _time.perf_counter() - start
+    best = np.inf
+    for _ in range(max(1, repeats)):
+        obs = Observation(orbit, site, t, canx1_attitude())
+        start = _time.perf_counter()
+        obs.geometry(on_unobservable="keep")
+        best = min(best, _time.perf_counter() - start)
+    return {
+        "n_times": float(n_times),
+        "first_call_seconds": first,
+        "seconds": best,
+        "seconds_per_time": best / n_times,
+    }

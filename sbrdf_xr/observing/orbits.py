@@ -1,0 +1,446 @@
+"""Orbits and observatories: SGP4 elements, WGS84 sites and the airmass seen from them.
+
+:class:`Orbit` (SGP4 elements from a TLE, an OMM or a catalog entry), :class:`Site`
+(a WGS84 observatory), the relative :func:`airmass` of a line of sight, and the catalog
+loaders of both kinds.  The UTC times are those of :mod:`sbrdf_xr.observing.timescales`, the
+Earth's shadow that of :mod:`sbrdf_xr.observing.earth_shadow` (both importable from here too).
+:mod:`sbrdf_xr.observing.observe` combines them with an attitude law into an
+:class:`~sbrdf_xr.observing.observation.Observation`.
+"""
+
+from __future__ import annotations
+
+import json
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _catalog_index
+from ..errors import CatalogError, ObservationError
+from ..photometry import atmosphere
+from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, disc_overlap_fraction, sunlit_fraction
+from .timescales import (
+    KNOT_S,
+    check_times,
+    skyfield_data,
+    skyfield_time,
+    skyfield_utc,
+    spline_knots,
+    times,
+    to_datetime64,
+)
+
+__all__ = [
+    "AIRMASS_MODELS",
+    "AU_KM",
+    "EARTH_RADIUS_KM",
+    "EPOCH_GAP_DAYS",
+    "KNOT_S",
+    "SUN_RADIUS_KM",
+    "Orbit",
+    "Site",
+    "airmass",
+    "check_times",
+    "disc_overlap_fraction",
+    "load_orbit_entry",
+    "load_site_entry",
+    "skyfield_data",
+    "skyfield_time",
+    "skyfield_utc",
+    "spline_knots",
+    "sunlit_fraction",
+    "times",
+    "tle_checksum",
+    "to_datetime64",
+]
+
+#: Astronomical unit (IAU 2012 Resolution B2) [km].
+AU_KM = 149597870.700
+
+
+#: Times farther than this from the element epoch raise an :class:`EpochGapWarning` [day]:
+#: SGP4 errors of LEO elements grow by about 1-3 km per day from the epoch.
+EPOCH_GAP_DAYS = 7.0
+
+
+#: Relative air-mass models of :func:`pvlib.atmosphere.get_relative_airmass`, those of
+#: :data:`sbrdf_xr.photometry.atmosphere.AIRMASS_MODELS` (declared there, once).
+AIRMASS_MODELS = tuple(atmosphere.AIRMASS_MODELS)
+
+
+def tle_checksum(line: str) -> int:
+    """Checksum of a TLE line: digits summed, ``-`` counting 1, modulo 10.
+
+    Examples
+    --------
+    >>> tle_checksum("1 27847U 03031H   24075.50000000  .00000015  00000-0  21000-4 0  9991")
+    1
+    """
+    return (sum(int(c) for c in line[:68] if c.isdigit()) + line[:68].count("-")) % 10
+
+
+#: Numeric fields of the TLE lines: name, first and last column (0-based, end excluded).
+_TLE_FIELDS_1 = (("catalog number", 2, 7), ("epoch", 18, 32), ("mean motion derivative", 33, 43))
+
+
+_TLE_FIELDS_2 = (
+    ("catalog number", 2, 7),
+    ("inclination", 8, 16),
+    ("right ascension of the node", 17, 25),
+    ("eccentricity", 26, 33),
+    ("argument of perigee", 34, 42),
+    ("mean anomaly", 43, 51),
+    ("mean motion", 52, 63),
+)
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _check_tle(line1: Any, line2: Any) -> tuple[str, str]:
+    lines = []
+    for i, line in ((1, line1), (2, line2)):
+        if not isinstance(line, str):
+            raise ObservationError(f"TLE line {i}: expected a string, got {type(line).__name__}")
+        line = line.rstrip()
+        if len(line) != 69:
+            raise ObservationError(
+                f"TLE line {i}: has {len(line)} characters; a TLE line has 69: {line!r}"
+            )
+        if line[0] != str(i) or line[1] != " ":
+            raise ObservationError(f"TLE line {i}: must start with '{i} ', got {line[:2]!r}")
+        if not line[68].isdigit() or int(line[68]) != tle_checksum(line):
+            raise ObservationError(
+                f"TLE line {i}: checksum {line[68]!r} does not match the computed "
+                f"{tle_checksum(line)} "
+                f"(digits summed, '-' counting 1, modulo 10): {line!r}"
+            )
+        lines.append(line)
+    for i, fields in ((1, _TLE_FIELDS_1), (2, _TLE_FIELDS_2)):
+        line = lines[i - 1]
+        for fname, lo, hi in fields:
+            text = line[lo:hi]
+            ok = text.strip().isdigit() if fname == "eccentricity" else _is_number(text)
+            if not ok:
+                raise ObservationError(
+                    f"TLE line {i}: field {fname!r} (columns {lo + 1}-{hi}) is {text!r}, "
+                    "not a number"
+                )
+    if lines[0][2:7] != lines[1][2:7]:
+        raise ObservationError(
+            f"TLE: catalog numbers differ between the lines ({lines[0][2:7]!r}, {lines[1][2:7]!r})"
+        )
+    return lines[0], lines[1]
+
+
+@dataclass(frozen=True)
+class Orbit:
+    """Orbital elements propagated by SGP4 (skyfield :class:`~skyfield.sgp4lib.EarthSatellite`).
+
+    Build with :meth:`from_tle`, :meth:`from_omm` or :meth:`from_catalog`.
+
+    Attributes
+    ----------
+    satellite : skyfield.sgp4lib.EarthSatellite
+    line1, line2 : str
+        The two-line elements (exported by :mod:`sgp4.exporter` for an OMM).
+    name : str
+    provenance : str
+
+    Examples
+    --------
+    >>> l1 = "1 27847U 03031H   24075.50000000  .00000015  00000-0  21000-4 0  9991"
+    >>> l2 = "2 27847  98.7200 129.5000 0012000  95.0000 265.0000 14.21950000109836"
+    >>> orbit = Orbit.from_tle(l1, l2, "CANX-1")
+    >>> orbit.name, orbit.epoch
+    ('CANX-1', np.datetime64('2024-03-15T12:00:00.000000000'))
+    """
+
+    satellite: Any
+    line1: str
+    line2: str
+    name: str = ""
+    provenance: str = ""
+
+    @classmethod
+    def from_tle(
+        cls, line1: str, line2: str, name: str | None = None, provenance: str = ""
+    ) -> Orbit:
+        """Orbit from the two lines of a TLE.
+
+        Raises
+        ------
+        ObservationError
+            For a line of the wrong length, start, checksum or catalog number, or a field
+            SGP4 cannot read.
+
+        Examples
+        --------
+        >>> l1 = "1 27847U 03031H   24075.50000000  .00000015  00000-0  21000-4 0  9991"
+        >>> l2 = "2 27847  98.7200 129.5000 0012000  95.0000 265.0000 14.21950000109836"
+        >>> Orbit.from_tle(l1, l2).name
+        '27847'
+        >>> Orbit.from_tle(l1, l2[:-1] + "0")
+        Traceback (most recent call last):
+            ...
+        sbrdf_xr.errors.ObservationError: TLE line 2: checksum '0' does not match the computed ...
+        """
+        from skyfield.api import EarthSatellite
+
+        l1, l2 = _check_tle(line1, line2)
+        ts, _ = skyfield_data()
+        try:
+            sat = EarthSatellite(l1, l2, name, ts)
+        except (ValueError, IndexError) as exc:
+            raise ObservationError(f"TLE: a field cannot be read: {exc}") from None
+        _check_model(sat, name or l1[2:7])
+        return cls(sat, l1, l2, name or sat.name or l1[2:7].strip(), provenance)
+
+    @classmethod
+    def from_omm(cls, omm: Mapping[str, Any] | str | Path, provenance: str = "") -> Orbit:
+        """Orbit from an Orbit Mean-Elements Message (CCSDS 502.0-B).
+
+        Parameters
+        ----------
+        omm : mapping or path
+            The OMM fields (``OBJECT_NAME``, ``EPOCH``, ``MEAN_MOTION``, ... as in CelesTrak's
+            JSON/CSV) or a ``.xml``, ``.csv`` or ``.json`` file holding one.
+
+        Examples
+        --------
+        >>> omm = {"OBJECT_NAME": "CANX-1", "OBJECT_ID": "2003-031H",
+        ...        "EPOCH": "2024-03-15T12:00:00.000000", "MEAN_MOTION": 14.2195,
+        ...        "ECCENTRICITY": 0.0012, "INCLINATION": 98.72, "RA_OF_ASC_NODE": 129.5,
+        ...        "ARG_OF_PERICENTER": 95.0, "MEAN_ANOMALY": 265.0, "EPHEMERIS_TYPE": 0,
+        ...        "CLASSIFICATION_TYPE": "U", "NORAD_CAT_ID": 27847, "ELEMENT_SET_NO": 999,
+        ...        "REV_AT_EPOCH": 10983, "BSTAR": 2.1e-05, "MEAN_MOTION_DOT": 1.5e-07,
+        ...        "MEAN_MOTION_DDOT": 0.0}
+        >>> orbit = Orbit.from_omm(omm)
+        >>> orbit.name, orbit.epoch
+        ('CANX-1', np.datetime64('2024-03-15T12:00:00.000000000'))
+        """
+        from sgp4 import exporter
+        from sgp4 import omm as sgp4_omm
+        from skyfield.api import EarthSatellite
+
+        if not isinstance(omm, Mapping):
+            path = Path(omm)
+            try:
+                with open(path, encoding="utf-8") as f:
+                    if path.suffix.lower() == ".xml":
+                        fields = next(iter(sgp4_omm.parse_xml(f)))
+                    elif path.suffix.lower() == ".csv":
+                        fields = next(iter(sgp4_omm.parse_csv(f)))
+                    else:
+                        data = json.load(f)
+                        fields = data[0] if isinstance(data, list) else data
+            except (OSError, ValueError, StopIteration, KeyError) as exc:
+                raise ObservationError(f"OMM: cannot read {path}: {exc!r}") from None
+        else:
+            fields = dict(omm)
+        ts, _ = skyfield_data()
+        try:
+            sat = EarthSatellite.from_omm(ts, fields)
+        except (KeyError, ValueError, TypeError) as exc:
+            raise ObservationError(
+                f"OMM: missing or bad field: {exc!r}; fields given: {sorted(fields)}"
+            ) from None
+        _check_model(sat, fields.get("OBJECT_NAME", "OMM"))
+        l1, l2 = exporter.export_tle(sat.model)
+        return cls(sat, l1, l2, str(fields.get("OBJECT_NAME", "")), provenance)
+
+    @classmethod
+    def from_catalog(cls, name: str) -> Orbit:
+        """A shipped orbit (catalog kind ``orbit``).
+
+        Examples
+        --------
+        >>> Orbit.from_catalog("canx1-example").name
+        'CANX-1 (example elements)'
+        """
+        e = _catalog_index.entry(name)
+        if e.kind != "orbit":
+            raise ObservationError(f"catalog entry {name!r} is a {e.kind}, not an orbit")
+        return load_orbit_entry(e)
+
+    @property
+    def epoch(self) -> np.datetime64:
+        """Epoch of the elements (UTC).
+
+        Examples
+        --------
+        >>> Orbit.from_catalog("canx1-example").epoch
+        np.datetime64('2024-03-15T12:00:00.000000000')
+        """
+        return np.datetime64(self.satellite.epoch.utc_datetime().replace(tzinfo=None), "ns")
+
+
+def _check_model(sat: Any, label: str) -> None:
+    from sgp4.api import SGP4_ERRORS
+
+    err = getattr(sat.model, "error", 0)
+    if err:
+        raise ObservationError(
+            f"orbit {label}: SGP4 rejects the elements (error {err}: "
+            f"{SGP4_ERRORS.get(err, 'unknown')})"
+        )
+
+
+@dataclass(frozen=True)
+class Site:
+    """An observer on the WGS84 ellipsoid.
+
+    Parameters
+    ----------
+    latitude_deg : float
+        Geodetic latitude [degree], in [-90, 90].
+    longitude_deg : float
+        East longitude [degree], in [-180, 360] (stored in [-180, 180)).
+    height_m : float
+        Height above the ellipsoid [m], in [-500, 9000].
+    name : str
+
+    Examples
+    --------
+    >>> site = Site(45.455, -71.1525, 1111.0, name="Mont Megantic")
+    >>> site.longitude_deg, Site(0.0, 270.0).longitude_deg  # east longitude, stored in [-180, 180)
+    (-71.1525, -90.0)
+    >>> Site(95.0, 0.0)
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.ObservationError: site latitude_deg: got 95.0; allowed: [-90, 90]
+    """
+
+    latitude_deg: float
+    longitude_deg: float
+    height_m: float = 0.0
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        checks = (
+            ("latitude_deg", -90.0, 90.0),
+            ("longitude_deg", -180.0, 360.0),
+            ("height_m", -500.0, 9000.0),
+        )
+        for attr, lo, hi in checks:
+            v = getattr(self, attr)
+            try:
+                x = float(v)
+            except (TypeError, ValueError):
+                raise ObservationError(f"site {attr}: expected a number, got {v!r}") from None
+            if not (np.isfinite(x) and lo <= x <= hi):
+                raise ObservationError(f"site {attr}: got {v!r}; allowed: [{lo:g}, {hi:g}]")
+            object.__setattr__(self, attr, x)
+        lon = (self.longitude_deg + 180.0) % 360.0 - 180.0
+        object.__setattr__(self, "longitude_deg", lon)
+
+    @classmethod
+    def from_catalog(cls, name: str) -> Site:
+        """A shipped observatory (catalog kind ``site``).
+
+        Examples
+        --------
+        >>> site = Site.from_catalog("mont-megantic")
+        >>> site.name, round(site.latitude_deg, 3)
+        ('mont-megantic', 45.456)
+        """
+        e = _catalog_index.entry(name)
+        if e.kind != "site":
+            raise ObservationError(f"catalog entry {name!r} is a {e.kind}, not a site")
+        return load_site_entry(e)
+
+    @property
+    def position(self) -> Any:
+        """The skyfield WGS84 geographic position.
+
+        Examples
+        --------
+        >>> Site(45.0, -71.0, 1000.0).position
+        <GeographicPosition WGS84 latitude +45.0000 N longitude -71.0000 E elevation 1000.0 m>
+        """
+        from skyfield.api import wgs84
+
+        return wgs84.latlon(self.latitude_deg, self.longitude_deg, elevation_m=self.height_m)
+
+
+def airmass(elevation_deg: ArrayLike, model: str = "kastenyoung1989") -> NDArray[np.float64]:
+    """Relative airmass at an elevation (pvlib ``get_relative_airmass``); NaN below the horizon.
+
+    Parameters
+    ----------
+    elevation_deg : array_like
+        Elevation [degree].
+    model : str
+        One of :data:`AIRMASS_MODELS`; ``kastenyoung1989`` is Kasten & Young, Appl. Opt. 28,
+        4735 (1989), ``1 / (cos z + 0.50572 (96.07995 - z)^-1.6364)``.
+
+    Returns
+    -------
+    ndarray
+        Relative airmass [1].
+
+    Examples
+    --------
+    >>> np.round(airmass([90.0, 30.0, 10.0, -5.0]), 4)  # NaN below the horizon
+    array([0.9997, 1.9943, 5.586 ,    nan])
+    """
+    if model not in AIRMASS_MODELS:
+        raise ObservationError(
+            f"airmass_model: got {model!r}; allowed: {', '.join(AIRMASS_MODELS)}"
+        )
+    from pvlib.atmosphere import get_relative_airmass
+
+    el = np.asarray(elevation_deg, dtype=np.float64)
+    zen = np.where(el >= 0, 90.0 - el, 90.0)
+    am = np.asarray(get_relative_airmass(zen, model=model), dtype=np.float64)
+    return np.where(el >= 0, am, np.nan)
+
+
+def load_orbit_entry(entry: _catalog_index.CatalogEntry) -> Orbit:
+    """A ``kind = "orbit"`` entry: a 2- or 3-line TLE file.
+
+    Examples
+    --------
+    >>> from sbrdf_xr import _catalog_index
+    >>> load_orbit_entry(_catalog_index.entry("canx1-example")).name
+    'CANX-1 (example elements)'
+    """
+    lines = [
+        ln.rstrip() for ln in entry.file.read_text(encoding="utf-8").splitlines() if ln.strip()
+    ]
+    if len(lines) == 3:
+        name, l1, l2 = lines[0].removeprefix("0 ").strip(), lines[1], lines[2]
+    elif len(lines) == 2:
+        name, l1, l2 = entry.name, lines[0], lines[1]
+    else:
+        raise CatalogError(
+            f"orbit entry {entry.name!r}: {entry.path} must hold 2 or 3 lines, has {len(lines)}"
+        )
+    return Orbit.from_tle(l1, l2, name, provenance=entry.provenance)
+
+
+def load_site_entry(entry: _catalog_index.CatalogEntry) -> Site:
+    """A ``kind = "site"`` entry: the table of that name in a TOML file of sites.
+
+    Examples
+    --------
+    >>> from sbrdf_xr import _catalog_index
+    >>> site = load_site_entry(_catalog_index.entry("haleakala"))
+    >>> site.name, round(site.height_m)
+    ('haleakala', 3058)
+    """
+    sites = tomllib.loads(entry.file.read_text(encoding="utf-8"))
+    key = entry.extra.get("key", entry.name)
+    if key not in sites:
+        raise CatalogError(f"site entry {entry.name!r}: {entry.path} has no table [{key}]")
+    return Site(name=entry.name, **sites[key])

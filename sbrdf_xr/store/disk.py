@@ -1,0 +1,293 @@
+"""Disk-durability primitives of the cube writer (see ``Durability`` in
+:mod:`sbrdf_xr.store.writer`).
+
+Room checked and reserved before a block is written (free space, ``RLIMIT_FSIZE``,
+``fallocate``), a failed HDF5 write fenced off and cut back to the last synced state,
+directories synced, and what kind of file is at a path.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import json
+import os
+import stat
+import sys
+from collections import deque
+from concurrent.futures import Future, ThreadPoolExecutor
+from pathlib import Path
+from typing import Any
+
+from .common import _SPACE_MARGIN, _file_size_limit, _mib, _NoRoom, libc_function
+
+__all__ = [
+    "CHECK_SPACE",
+    "FALLOCATE",
+    "FALLOC_FL_KEEP_SIZE",
+    "HEAD_BYTES",
+    "SyncBehind",
+    "check_opens",
+    "check_room",
+    "cut_back",
+    "drop_behind",
+    "fallocate_fn",
+    "fence",
+    "file_kind",
+    "fsync_dir",
+    "reserve",
+]
+
+#: Whether each block's room on the file system is checked before it is written.
+CHECK_SPACE = True
+#: Bytes at the start of a ``.part`` (the HDF5 superblock) saved after each sync.
+HEAD_BYTES = 4096
+
+
+def fsync_dir(directory: Path) -> None:
+    with contextlib.suppress(OSError):
+        fd = os.open(directory, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
+def check_room(part: Path, need: int) -> None:
+    """Refuse, before writing, ``need`` bytes (plus metadata) that would not fit."""
+    if not CHECK_SPACE:
+        return
+    need = int(need) + _SPACE_MARGIN
+    try:
+        st = os.statvfs(part.parent)
+    except (OSError, AttributeError):  # pragma: no cover - not on POSIX
+        st = None
+    if st is not None:
+        free = (st.f_bfree if os.geteuid() == 0 else st.f_bavail) * st.f_frsize
+        if free < need:
+            raise _NoRoom(
+                errno.ENOSPC, f"about {_mib(need)} needed, {_mib(free)} free on {part.parent}"
+            )
+    limit = _file_size_limit()
+    if limit is not None:
+        size = part.stat().st_size if part.exists() else 0
+        if size + need > limit:
+            raise _NoRoom(
+                errno.EFBIG,
+                f"{part.name} would grow from {_mib(size)} past the limit of {_mib(limit)}",
+            )
+
+
+FALLOC_FL_KEEP_SIZE = 1
+
+
+def fallocate_fn() -> Any:
+    import ctypes
+
+    return libc_function(
+        "fallocate", [ctypes.c_int, ctypes.c_int, ctypes.c_int64, ctypes.c_int64], ctypes.c_int
+    )
+
+
+FALLOCATE = fallocate_fn() if sys.platform.startswith("linux") else None
+
+
+def _allocate(fd: int, offset: int, length: int, what: str) -> None:
+    """``fallocate`` ``length`` bytes from ``offset`` of the file open as ``fd`` (its size
+    unchanged); a full disk, quota or size limit raises :class:`_NoRoom` naming ``what``."""
+    if FALLOCATE is None or not CHECK_SPACE or length <= 0:
+        return
+    import ctypes
+
+    if FALLOCATE(fd, FALLOC_FL_KEEP_SIZE, offset, length) != 0:
+        code = ctypes.get_errno()
+        if code in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
+            raise _NoRoom(code, f"reserving {_mib(length)} {what} failed")
+
+
+def reserve_file(fd: int) -> None:
+    """Allocate the disk blocks of the whole file open as ``fd`` (its size unchanged).
+
+    An uncompressed cube's variables are laid out whole when the ``.part`` is created
+    (a sparse file of the cube's final size): reserving its holes finds a full disk
+    before any block is computed.  Parts already allocated cost nothing; file systems
+    without ``fallocate`` skip the reservation.
+    """
+    _allocate(fd, 0, os.fstat(fd).st_size, "for the cube on disk")
+
+
+def reserve(fd: int, nbytes: int) -> None:
+    """Reserve ``nbytes`` of disk beyond the end of the file open as ``fd`` (size unchanged).
+
+    HDF5 appends each block at the end of the file; with the room already allocated
+    a full disk is found here, before HDF5 writes anything, instead of in the middle
+    of HDF5's flush.  File systems without ``fallocate`` skip the reservation.
+    """
+    _allocate(fd, os.fstat(fd).st_size, int(nbytes) + _SPACE_MARGIN, "for the next block")
+
+
+def drop_behind(fd: int) -> None:
+    """Let the kernel drop the page cache of the file open as ``fd`` (called after ``fsync``).
+
+    Each block is on disk once synced, so its cached pages are clean and nobody reads
+    them again during the write.  Dropping them after every block keeps the page
+    cache the write occupies at about one block, whatever the cube's size, and hands
+    the same pages to the next block.  Pages the kernel has to find anew cost far
+    more than reused ones on virtual machines whose memory the host reclaims (free
+    page reporting): on this project's 2-core machine a 225 MB cube written through
+    fresh pages ran at about 300 MB/s, and about 2.5x faster with its pages dropped
+    behind it.  A no-op where ``posix_fadvise`` is missing.
+    """
+    advise = getattr(os, "posix_fadvise", None)
+    if advise is not None:
+        with contextlib.suppress(OSError):
+            advise(fd, 0, 0, os.POSIX_FADV_DONTNEED)
+
+
+class SyncBehind:
+    """Blocks to disk in a thread of their own, in order, while the writer writes the next.
+
+    For each block submitted: the cube file ``fsync``-ed and its page cache dropped
+    (:func:`drop_behind`), then the block's line appended to the log and the log
+    ``fsync``-ed, so a block reaches the log only once its data are on disk.  After a
+    failed sync nothing more is logged (a later ``fsync`` may succeed although data
+    were lost).  The writing thread takes each block back with :meth:`wait_oldest`,
+    which raises that block's ``OSError``.
+    """
+
+    def __init__(self, fd: int, log_fd: int) -> None:
+        self.fd, self.log_fd = fd, log_fd
+        self.pool = ThreadPoolExecutor(1, thread_name_prefix="write_cube_sync")
+        self.pending: deque[tuple[int, Future[None]]] = deque()
+        self.failed = False
+
+    def submit(self, k: int) -> None:
+        """Queue block ``k``, whose data the HDF5 library has just flushed to the file."""
+        self.pending.append((k, self.pool.submit(self._to_disk, k)))
+
+    def _to_disk(self, k: int) -> None:
+        if self.failed:
+            raise OSError(errno.EIO, "an earlier block could not be synced")
+        try:
+            os.fsync(self.fd)
+            drop_behind(self.fd)
+            os.write(self.log_fd, (json.dumps({"block": k}) + "\n").encode())
+            os.fsync(self.log_fd)
+        except BaseException:
+            self.failed = True
+            raise
+
+    def wait_oldest(self) -> int:
+        """Wait for the oldest queued block to be on disk and logged; return its index."""
+        k, fut = self.pending.popleft()
+        fut.result()
+        return k
+
+    def settle(self) -> list[int]:
+        """Wait for every queued block (after a failure elsewhere); the ones logged."""
+        logged = []
+        while self.pending:
+            k, fut = self.pending.popleft()
+            with contextlib.suppress(Exception):
+                fut.result()
+                logged.append(k)
+        return logged
+
+    def close(self) -> None:
+        self.pool.shutdown(wait=True)
+
+
+def file_kind(p: Path) -> str | None:
+    """None if nothing is at ``p``, ``"file"`` for a regular file, else what it is."""
+    try:
+        mode = os.lstat(p).st_mode
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+    if stat.S_ISREG(mode):
+        return "file"
+    kinds = (
+        (stat.S_ISDIR, "a directory"),
+        (stat.S_ISLNK, "a symbolic link"),
+        (stat.S_ISFIFO, "a FIFO (named pipe)"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISSOCK, "a socket"),
+    )
+    return next((name for test, name in kinds if test(mode)), "not a regular file")
+
+
+def fence(part: Path) -> None:
+    """Make every read-write descriptor of ``part`` in this process read-only.
+
+    After a failed write HDF5 still holds dirty metadata of the failed block; were it
+    flushed (on close, or at exit), it would overwrite the last synced state in place
+    and point it at data that never reached the disk.  Replacing HDF5's descriptor by
+    a read-only one on the same file makes those writes fail harmlessly, so the file
+    can be cut back to its last synced size.  (Linux: descriptors found in /proc.)
+    """
+    fds = Path("/proc/self/fd")
+    if not fds.is_dir():  # pragma: no cover - not Linux
+        return
+    try:
+        ino = part.stat().st_ino
+    except OSError:
+        return
+    ro = -1
+    try:
+        for entry in list(fds.iterdir()):
+            with contextlib.suppress(OSError, ValueError):
+                n = int(entry.name)
+                st = os.fstat(n)
+                if st.st_ino != ino or not stat.S_ISREG(st.st_mode):
+                    continue
+                flags = Path(f"/proc/self/fdinfo/{n}").read_text().split("flags:")[1].split()[0]
+                if int(flags, 8) & os.O_ACCMODE == os.O_RDONLY:
+                    continue
+                if ro < 0:
+                    ro = os.open(part, os.O_RDONLY)
+                os.dup2(ro, n)
+    finally:
+        if ro >= 0:
+            os.close(ro)
+
+
+def cut_back(part: Path, size: int, head: bytes) -> str | None:
+    """Restore ``part`` to its last synced state: its ``size`` and its first bytes ``head``.
+
+    HDF5 rewrites its superblock (at the start of the file, holding the end-of-file
+    address) in place when a write fails; the rest of the synced file is untouched
+    (blocks are appended).  Returns None if the file then opens, else why not.
+    """
+    try:
+        if part.stat().st_size > size:
+            os.truncate(part, size)
+        fd = os.open(part, os.O_WRONLY)
+        try:
+            os.pwrite(fd, head, 0)
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+    except OSError as exc:
+        return str(exc)
+    return check_opens(part)
+
+
+def check_opens(part: Path) -> str | None:
+    """None if ``part`` opens as netCDF in a fresh process (this one's HDF5 may still hold it)."""
+    import subprocess
+
+    code = "import sys, netCDF4; netCDF4.Dataset(sys.argv[1]).close()"
+    try:
+        r = subprocess.run(
+            [sys.executable, "-c", code, str(part)],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            env={**os.environ, "HDF5_USE_FILE_LOCKING": "FALSE"},
+        )
+    except (OSError, subprocess.SubprocessError) as exc:
+        return f"it could not be checked: {exc}"
+    if r.returncode:
+        lines = r.stderr.strip().splitlines()
+        return lines[-1] if lines else f"exit status {r.returncode}"
+    return None

@@ -1,0 +1,337 @@
+"""Content fingerprint of a scene: what a cube was computed from, as global attributes.
+
+A cube is a function of its material tables, its mesh, which table stands for which
+material, the filters of its bands, every numerical knob, its geometry and the package
+version.  :func:`scene_fingerprint` hashes each of these (SHA-256) and returns them as
+flat string attributes whose names are valid netCDF/CF attribute names (letters, digits
+and underscores, starting with a letter)::
+
+    fingerprint                               the whole scene (SHA-256 of the parts below)
+    fingerprint_material_<name>               one per material table: values, coords, attrs
+    fingerprint_material_names                JSON: attribute suffix -> material name
+    fingerprint_materials                     the materials map (name -> table identity)
+    fingerprint_mesh                          vertices, faces and facet material labels
+    fingerprint_filters                       responses of the filters of the scene's bands
+    fingerprint_knobs                         every other scene field (method, dtype, ...)
+    fingerprint_knobs_json                    those fields in canonical JSON (readable)
+    fingerprint_geometry                      attitudes, phase angles, Sun/observer vectors
+    fingerprint_package                       the sbrdf_xr version
+
+:func:`sbrdf_xr.engine.run.simulate` stores them in every cube, and
+:func:`sbrdf_xr.store.writer.write_cube` refuses to resume an unfinished cube whose
+fingerprint differs, naming what changed (:func:`changes`).  Hashes are computed from
+values, never from object identity, so the same scene built twice has the same
+fingerprint.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import re
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from .._version import __version__
+
+#: The scene being fingerprinted (:class:`sbrdf_xr.engine.Scene`, two layers up, which
+#: imports this module; not imported here, even for type checking, to keep the flow).
+Scene = Any
+
+__all__ = ["PREFIX", "changes", "scene_fingerprint"]
+
+#: Prefix of every fingerprint attribute.
+PREFIX = "fingerprint"
+_MATERIAL = f"{PREFIX}_material_"
+_NAMES = f"{PREFIX}_material_names"
+_KNOBS_JSON = f"{PREFIX}_knobs_json"
+#: Scene fields that are geometry (hashed together) rather than knobs.
+_GEOMETRY_FIELDS = (
+    "attitudes",
+    "phase_angles",
+    "bisector",
+    "plane_normal",
+    "to_sun",
+    "to_observer",
+    "to_earth",
+    "attitude_angle",
+    "observation",
+)
+#: Scene fields hashed on their own, or labels that do not change any value.
+_OTHER_FIELDS = ("spacecraft", "materials", "name", "description", "_checked", "_cache")
+#: What each single-hash part stands for, in messages.
+_PARTS = {
+    "materials": "the materials map (which table stands for each material)",
+    "mesh": "the spacecraft mesh (vertices, faces or facet materials)",
+    "filters": "the filters of the bands",
+    "knobs": "the scene's numerical settings",
+    "geometry": "the geometry (attitudes, phase angles or Sun/observer vectors)",
+    "package": "the sbrdf_xr version",
+}
+
+
+def _canonical(value: Any) -> Any:
+    """A JSON-able, order-independent image of ``value`` (arrays by dtype, shape and hash)."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {
+            f.name: _canonical(getattr(value, f.name))
+            for f in dataclasses.fields(value)
+            if f.compare  # not caches and derived state
+        }
+    if isinstance(value, Mapping):
+        return {str(k): _canonical(v) for k, v in sorted(value.items(), key=lambda kv: str(kv[0]))}
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind in "OUS":
+            return [_canonical(x) for x in value.tolist()]
+        return {"dtype": str(value.dtype), "shape": list(value.shape), "sha256": _array_sha(value)}
+    if isinstance(value, np.generic):
+        return _canonical(value.item())
+    if isinstance(value, list | tuple):
+        return [_canonical(x) for x in value]
+    if isinstance(value, float):
+        return repr(value)  # exact, and NaN/inf survive JSON
+    if value is None or isinstance(value, bool | int | str):
+        return value
+    return f"{type(value).__name__}:{value!r}"
+
+
+def _json(value: Any) -> str:
+    return json.dumps(_canonical(value), sort_keys=True, separators=(",", ":"))
+
+
+def _array_sha(a: Any) -> str:
+    arr = np.ascontiguousarray(np.asarray(a))
+    h = hashlib.sha256(f"{arr.dtype.str}{arr.shape}".encode())
+    if arr.dtype.kind in "mM":  # datetimes and durations: their integer counts
+        arr = arr.view(np.int64)
+    if arr.dtype.kind in "OUS":
+        h.update(json.dumps([str(x) for x in arr.ravel().tolist()]).encode())
+    else:
+        h.update(arr.data.cast("B"))
+    return h.hexdigest()
+
+
+def _sha(*parts: str) -> str:
+    h = hashlib.sha256()
+    for p in parts:
+        h.update(p.encode())
+        h.update(b"\0")
+    return h.hexdigest()
+
+
+def _table_sha(da: Any) -> str:
+    """Values, dims, every coordinate and the attributes of one material table."""
+    parts = [_array_sha(np.asarray(da.values)), _json(list(map(str, da.dims)))]
+    for name in sorted(map(str, da.coords)):
+        c = da.coords[name]
+        parts += [
+            name,
+            _json(list(map(str, c.dims))),
+            _array_sha(np.asarray(c.values)),
+            _json(dict(c.attrs)),
+        ]
+    # when and by what a file was written says nothing about its values
+    parts.append(_json({k: v for k, v in da.attrs.items() if k not in _VOLATILE_TABLE_ATTRS}))
+    return _sha(*parts)
+
+
+#: Table attributes that record when a file was written, not what it holds.
+_VOLATILE_TABLE_ATTRS = frozenset(
+    {"history", "date_created", "date_modified", "date_issued", "date_metadata_modified"}
+)
+
+
+def _attr_suffixes(names: list[str]) -> dict[str, str]:
+    """Material name -> attribute-name suffix (letters, digits, underscores), collision-free."""
+    clean = {n: re.sub(r"[^A-Za-z0-9_]", "_", n) or "_" for n in names}
+    counts: dict[str, int] = {}
+    for s in clean.values():
+        counts[s] = counts.get(s, 0) + 1
+    return {
+        n: s if counts[s] == 1 else f"{s}_{hashlib.sha256(n.encode()).hexdigest()[:8]}"
+        for n, s in clean.items()
+    }
+
+
+def _filters_sha(bands: Any) -> str:
+    if not bands:
+        return _sha("no bands")
+    from ..photometry import filters
+
+    f = filters(list(bands))
+    return _sha(
+        _array_sha(f.values),
+        *(_array_sha(np.asarray(f[c].values)) for c in sorted(map(str, f.coords))),
+    )
+
+
+def _mesh_sha(spacecraft: Any) -> str:
+    mesh = getattr(spacecraft, "mesh", None)
+    if mesh is None:
+        return _sha(f"{type(spacecraft).__name__}:{spacecraft!r}")
+    parts = [
+        _array_sha(np.asarray(mesh.vertices, dtype=np.float64)),
+        _array_sha(np.asarray(mesh.faces, dtype=np.int64)),
+        _array_sha(np.asarray(spacecraft.facet_material, dtype=str)),
+    ]
+    if getattr(spacecraft, "tangent_source", "default") != "default":
+        # tangents other than the default (a function of the mesh) change anisotropic terms
+        parts.append(_array_sha(np.asarray(spacecraft.facet_tangent, dtype=np.float64)))
+    return _sha(*parts)
+
+
+def scene_fingerprint(scene: Scene) -> dict[str, str]:
+    """Content fingerprint of a scene, as flat netCDF global attributes.
+
+    Parameters
+    ----------
+    scene : sbrdf_xr.engine.Scene
+        A validated scene.
+
+    Returns
+    -------
+    dict of str to str
+        Attribute name -> SHA-256 hex digest (and two JSON strings,
+        ``fingerprint_material_names`` and ``fingerprint_knobs_json``); see the module
+        documentation for the names.  Equal scenes give equal dicts; any change of a
+        table value, coordinate or attribute, of the mesh, the materials map, the
+        filters, a knob, the geometry or the package version changes ``fingerprint``
+        and the part concerned.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> scene = Scene(box, {"grey": grey}, attitudes=[[0, 0, 0, 1.0]], phase_angles=[0.0, 60.0])
+    >>> from sbrdf_xr.store.fingerprint import scene_fingerprint
+    >>> fp = scene_fingerprint(scene)
+    >>> list(fp)  # doctest: +NORMALIZE_WHITESPACE
+    ['fingerprint', 'fingerprint_filters', 'fingerprint_geometry', 'fingerprint_knobs',
+     'fingerprint_knobs_json', 'fingerprint_material_grey', 'fingerprint_material_names',
+     'fingerprint_materials', 'fingerprint_mesh', 'fingerprint_package']
+    >>> len(fp["fingerprint"]), fp["fingerprint_material_names"]  # SHA-256 hex digest
+    (64, '{"grey": "grey"}')
+
+    Values, not identities, are hashed: the same scene built again has the same print.
+
+    >>> same = Scene(box, {"grey": grey}, attitudes=[[0, 0, 0, 1.0]], phase_angles=[0.0, 60.0])
+    >>> scene_fingerprint(same) == fp
+    True
+    """
+    materials = dict(scene.tables)
+    names = sorted(materials)
+    suffix = _attr_suffixes(names)
+    out: dict[str, str] = {}
+    for n in names:
+        out[_MATERIAL + suffix[n]] = _table_sha(materials[n])
+    out[_NAMES] = json.dumps({suffix[n]: n for n in names}, sort_keys=True)
+    out[f"{PREFIX}_materials"] = _sha(
+        _json(
+            {
+                n: {
+                    "material": materials[n].attrs.get("material"),
+                    "source": materials[n].attrs.get("source"),
+                    "name": materials[n].name,
+                }
+                for n in names
+            }
+        )
+    )
+    out[f"{PREFIX}_mesh"] = _mesh_sha(scene.spacecraft)
+    out[f"{PREFIX}_filters"] = _filters_sha(getattr(scene, "bands", ()))
+    fields = [f.name for f in dataclasses.fields(scene)]
+    knobs = {f: getattr(scene, f) for f in fields if f not in _GEOMETRY_FIELDS + _OTHER_FIELDS}
+    out[_KNOBS_JSON] = _json(knobs)
+    out[f"{PREFIX}_knobs"] = _sha(out[_KNOBS_JSON])
+    out[f"{PREFIX}_geometry"] = _sha(
+        *(f"{f}={_json(getattr(scene, f, None))}" for f in _GEOMETRY_FIELDS)
+    )
+    out[f"{PREFIX}_package"] = _sha(f"sbrdf_xr {__version__}")
+    out[PREFIX] = _sha(*(f"{k}={v}" for k, v in sorted(out.items())))
+    return {PREFIX: out.pop(PREFIX), **dict(sorted(out.items()))}
+
+
+def _names(attrs: Mapping[str, Any]) -> dict[str, str]:
+    try:
+        names = json.loads(str(attrs.get(_NAMES, "{}")))
+        return {str(k): str(v) for k, v in names.items()} if isinstance(names, dict) else {}
+    except ValueError:
+        return {}
+
+
+def changes(old: Mapping[str, Any], new: Mapping[str, Any]) -> list[str]:
+    """What differs between two fingerprints (or two sets of global attributes), in words.
+
+    Parameters
+    ----------
+    old, new : mapping
+        Attributes holding :func:`scene_fingerprint` entries (other keys are ignored).
+
+    Returns
+    -------
+    list of str
+        For example ``["material 'white-paint-a276': table changed"]``; empty when the
+        fingerprints agree (or neither has one).
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> scene = Scene(box, {"grey": grey}, attitudes=[[0, 0, 0, 1.0]], phase_angles=[0.0, 60.0])
+    >>> from sbrdf_xr.store.fingerprint import changes, scene_fingerprint
+    >>> fp = scene_fingerprint(scene)
+    >>> changes(fp, scene_fingerprint(scene.with_options(method="cubic")))
+    ["setting 'method': 'linear' -> 'cubic'"]
+    >>> brighter = lambertian(0.6, [500.0, 600.0, 700.0], material="grey")
+    >>> changes(fp, scene_fingerprint(scene.with_options(materials={"grey": brighter})))
+    ["material 'grey': table changed"]
+    >>> changes(fp, fp)
+    []
+    """
+    old = {k: str(v) for k, v in old.items() if str(k).startswith(PREFIX)}
+    new = {k: str(v) for k, v in new.items() if str(k).startswith(PREFIX)}
+    if old.get(PREFIX) == new.get(PREFIX):
+        return []
+    if not old or not new:
+        which = "the unfinished cube has" if not old else "the new cube has"
+        return [f"only {which} a content fingerprint"]
+    out = []
+    names = {**_names(old), **_names(new)}
+    keys = sorted({k for k in (*old, *new) if k.startswith(_MATERIAL) and k != _NAMES})
+    for k in keys:
+        label = names.get(k[len(_MATERIAL) :], k[len(_MATERIAL) :])
+        if k not in old:
+            out.append(f"material {label!r}: added")
+        elif k not in new:
+            out.append(f"material {label!r}: removed")
+        elif old[k] != new[k]:
+            out.append(f"material {label!r}: table changed")
+    for part, what in _PARTS.items():
+        k = f"{PREFIX}_{part}"
+        if old.get(k) == new.get(k):
+            continue
+        if part == "knobs":
+            out.append(
+                _knob_changes(old.get(_KNOBS_JSON), new.get(_KNOBS_JSON)) or f"{what} changed"
+            )
+        else:
+            out.append(f"{what} changed")
+    return out or ["the content fingerprint changed"]
+
+
+def _knob_changes(old: str | None, new: str | None) -> str:
+    try:
+        a, b = json.loads(old or "{}"), json.loads(new or "{}")
+    except ValueError:
+        return ""
+    diff = [k for k in sorted(set(a) | set(b)) if a.get(k) != b.get(k)]
+    return "; ".join(f"setting {k!r}: {a.get(k)!r} -> {b.get(k)!r}" for k in diff)
