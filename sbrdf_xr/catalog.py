@@ -407,7 +407,7 @@ def load_material_spec(
     Examples
     --------
     >>> import tempfile
-    >>> from sbrdf_xr import material_io, material_schema
+    >>> from sbrdf_xr.materials import files as material_io, schema as material_schema
     >>> path = Path(tempfile.mkdtemp()) / "grey.nc"
     >>> table = material_schema.lambertian(0.3, wavelength=[500.0, 600.0], material="grey")
     >>> _ = material_io.to_netcdf(table, path)
@@ -473,7 +473,7 @@ def material_tables(
     Examples
     --------
     >>> import tempfile
-    >>> from sbrdf_xr import material_io, material_schema
+    >>> from sbrdf_xr.materials import files as material_io, schema as material_schema
     >>> folder = Path(tempfile.mkdtemp())
     >>> table = material_schema.lambertian(0.3, wavelength=[500.0, 600.0], material="grey")
     >>> _ = material_io.to_netcdf(table, folder / "grey.nc")

@@ -72,7 +72,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     Examples
     --------
-    >>> from sbrdf_xr.cli import build_parser
+    >>> from sbrdf_xr.cli.parser import build_parser
     >>> args = build_parser().parse_args(
     ...     ["simulate", "canx1-rotation", "-o", "cube.nc", "--preset", "fast"]
     ... )

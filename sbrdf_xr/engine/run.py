@@ -92,7 +92,7 @@ def run_block(plan: Plan, sl: slice) -> dict[str, np.ndarray]:
     >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
     >>> turns = geometry.axis_rotation([0, 0, 1], [0.0, 45.0])  # two attitudes about z
     >>> scene = Scene(box, {"grey": grey}, attitudes=turns, phase_angles=[0.0, 60.0])
-    >>> from sbrdf_xr.simulate import run_block
+    >>> from sbrdf_xr.engine import run_block
     >>> out = run_block(scene.plan(), slice(1, 2))
     >>> sorted((k, v.shape) for k, v in out.items())
     [('area', (1, 2)), ('brdf', (1, 2)), ('signal', (1, 2, 3)), ('spacecraft_sbrdf', (1, 2, 3))]

@@ -378,7 +378,7 @@ def build_lut_anisotropic(
     --------
     A brushed metal measured (virtually) at two sample rotations, 0 and 90 deg:
 
-    >>> from sbrdf_xr import goniometer, models
+    >>> from sbrdf_xr.materials import goniometer, models
     >>> spec = models.model_material(
     ...     "anisotropic_microfacet", [550.0], material="brushed", provenance="doc",
     ...     alpha_x=0.15, alpha_y=0.4, n=1.5, k=7.5, rho_d=0.01)
