@@ -303,8 +303,7 @@ def test_non_utf8_and_unreadable_scene_files(tmp_path):
 
 def test_empty_results_are_refused_through_the_python_api(tmp_path):
     """A Scene asking for no output or no phase angle cannot write an empty cube."""
-    from sbrdf_xr import write
-    from sbrdf_xr import simulate
+    from sbrdf_xr import simulate, write
     from sbrdf_xr.errors import ValidationError
 
     path = tmp_path / "scene.toml"

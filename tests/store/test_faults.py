@@ -488,8 +488,8 @@ def test_resume_after_a_changed_table_is_refused(tmp_path, capsys):
     """The issue's case: a run killed after 8 of 24 blocks and resumed with
     ``white-paint-a276`` remapped to the paper's table is refused, naming the material;
     the original scene then resumes to the uninterrupted cube."""
-    from sbrdf_xr.engine import load_scene
     from sbrdf_xr import simulate
+    from sbrdf_xr.engine import load_scene
     from sbrdf_xr.store.fingerprint import scene_fingerprint
 
     scene, remapped = tmp_path / "scene.toml", tmp_path / "remapped.toml"
