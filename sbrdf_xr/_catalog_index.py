@@ -36,7 +36,7 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
-from .errors import CatalogError
+from .errors import CatalogError, did_you_mean
 
 __all__ = [
     "CATALOG_PATH_ENV",
@@ -331,7 +331,7 @@ def entry(name: str) -> CatalogEntry:
     Raises
     ------
     CatalogError
-        If there is no such entry; the message lists the known names.
+        If there is no such entry; the message suggests the close names and lists all.
 
     Examples
     --------
@@ -342,9 +342,11 @@ def entry(name: str) -> CatalogEntry:
     >>> catalog.entry("lambertian-grey-51")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    sbrdf_xr.errors.CatalogError: no catalog entry named 'lambertian-grey-51'; known: ...
+    sbrdf_xr.errors.CatalogError: no catalog entry named 'lambertian-grey-51'; did you mean ...
     """
     for e in _index():
         if e.name == name:
             return e
-    raise CatalogError(f"no catalog entry named {name!r}; known: {', '.join(names())}")
+    raise CatalogError(
+        f"no catalog entry named {name!r}; {did_you_mean(name, names(), 'known entries')}"
+    )

@@ -46,7 +46,7 @@ from ._catalog_index import (
 )
 from ._names import SBRDF
 from .body import spacecraft
-from .errors import CatalogError, ValidationError
+from .errors import CatalogError, ValidationError, did_you_mean
 from .materials import models
 from .materials import tables as material
 from .observing import observe
@@ -284,6 +284,18 @@ def is_file_spec(spec: str | os.PathLike[str]) -> bool:
     return "/" in spec or os.sep in spec or Path(spec).suffix != ""
 
 
+def _entry_of(name: str, kinds: tuple[str, ...], what: str) -> CatalogEntry:
+    """The entry ``name``; if there is none, a :class:`CatalogError` that suggests only the
+    close names of ``kinds`` (a misspelt material is not offered a site)."""
+    if name not in names():
+        known = [n for kind in kinds for n in names(kind)]
+        label = f"catalog {' and '.join(k if k == 'spacecraft' else k + 's' for k in kinds)}"
+        raise CatalogError(
+            f"{what}: no catalog entry named {name!r}; {did_you_mean(name, known, label)}"
+        )
+    return entry(name)
+
+
 def _file_of(
     spec: str | os.PathLike[str],
     base_dir: str | os.PathLike[str] | None,
@@ -360,7 +372,7 @@ def load_spacecraft_spec(
                 f"spacecraft: {name!r} is a catalog entry; the mesh options "
                 f"{given + sorted(options)} apply to a mesh file only"
             )
-        e = entry(name)
+        e = _entry_of(name, ("spacecraft",), "spacecraft")
         if e.kind != "spacecraft":
             raise ValidationError(
                 f"spacecraft: catalog entry {name!r} is a {e.kind} entry, not a spacecraft"
@@ -416,7 +428,7 @@ def load_material_spec(
     ('grey', 2)
     """
     if not is_file_spec(spec):
-        e = entry(str(spec))
+        e = _entry_of(str(spec), ("material", "model"), "material")
         if e.kind not in ("material", "model"):
             raise ValidationError(
                 f"material: catalog entry {e.name!r} is a {e.kind} entry, not a material "
@@ -441,7 +453,9 @@ def load_material_spec(
 
 
 def material_tables(
-    specs: Mapping[str, str | os.PathLike[str]], base_dir: str | os.PathLike[str] | None = None
+    specs: Mapping[str, str | os.PathLike[str]],
+    base_dir: str | os.PathLike[str] | None = None,
+    where: Mapping[str, str] | None = None,
 ) -> tuple[dict[str, xr.DataArray], dict[str, xr.Dataset]]:
     """Material tables, and BRDF models, from catalog names or netCDF files.
 
@@ -453,6 +467,9 @@ def material_tables(
         (:func:`sbrdf_xr.catalog.load_material_spec`).
     base_dir : str or Path, optional
         Directory that relative file paths are taken from.
+    where : mapping of str to str, optional
+        Where each material was named (``"[spacecraft] material_map"``, ``"--material"``),
+        for the error messages; default ``"[materials]"``.
 
     Returns
     -------
@@ -490,8 +507,10 @@ def material_tables(
                 given[mat] = obj
                 obj = models.render(obj)
         except CatalogError as exc:
-            raise CatalogError(f"[materials] {mat!r}: {exc}") from None
+            raise CatalogError(f"{(where or {}).get(mat, '[materials]')} {mat!r}: {exc}") from None
         except ValidationError as exc:
-            raise ValidationError(f"[materials] {mat!r}: {exc}") from None
+            raise ValidationError(
+                f"{(where or {}).get(mat, '[materials]')} {mat!r}: {exc}"
+            ) from None
         tables[mat] = obj
     return tables, given

@@ -4,9 +4,13 @@ A small hierarchy: :class:`SbrdfError` is the base of everything the package
 raises on purpose; :class:`ValidationError` (also a :class:`ValueError`) is raised
 for bad input, with a message that names the field, what was received and what
 is allowed.  Warnings derive from :class:`SbrdfWarning` so users can filter them.
+:func:`did_you_mean` words the close matches of an unknown name, the same way everywhere.
 """
 
 from __future__ import annotations
+
+import difflib
+from collections.abc import Iterable
 
 __all__ = [
     "AttitudeError",
@@ -22,7 +26,51 @@ __all__ = [
     "SbrdfWarning",
     "SceneError",
     "ValidationError",
+    "did_you_mean",
 ]
+
+
+def did_you_mean(name: str, known: Iterable[str], kind: str = "known names") -> str:
+    """The tail of a message about an unknown name: its close matches, then the known names.
+
+    Close matches are those of :func:`difflib.get_close_matches` (at most three, ratio at
+    least 0.6), best first.  Pass only the names of the right kind (materials for a
+    material, keys of that table for a key), so that the suggestion fits where the name
+    was written.
+
+    Parameters
+    ----------
+    name : str
+        The unknown name, as given.
+    known : iterable of str
+        The names that would have been accepted there.
+    kind : str, default "known names"
+        What they are, in the plural, heading their list (``"allowed keys"``,
+        ``"known materials"``).
+
+    Returns
+    -------
+    str
+        ``"did you mean 'a'? known materials: a, b, c"``, or ``"known materials: a, b,
+        c"`` when nothing is close (``"no known materials"`` when there are none); the
+        known names sorted.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.errors import did_you_mean
+    >>> did_you_mean("phase_angle", ["bisector", "phase_angles"], "allowed keys")
+    "did you mean 'phase_angles'? allowed keys: bisector, phase_angles"
+    >>> did_you_mean("colour", ["bisector", "phase_angles"], "allowed keys")
+    'allowed keys: bisector, phase_angles'
+    """
+    names = sorted({str(k) for k in known})
+    if not names:
+        return f"no {kind}"
+    listed = f"{kind}: {', '.join(names)}"
+    close = difflib.get_close_matches(str(name), names, n=3, cutoff=0.6)
+    if not close:
+        return listed
+    return f"did you mean {' or '.join(repr(c) for c in close)}? {listed}"
 
 
 class SbrdfError(Exception):

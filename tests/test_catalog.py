@@ -30,8 +30,10 @@ def test_every_entry_has_provenance_and_loads():
 
 
 def test_unknown_names_and_kinds():
-    with pytest.raises(CatalogError, match="no catalog entry named 'nope'; known:"):
+    with pytest.raises(CatalogError, match="no catalog entry named 'nope'; known entries:"):
         catalog.load("nope")
+    with pytest.raises(CatalogError, match="'mont-megantc'; did you mean 'mont-megantic'\\?"):
+        catalog.load("mont-megantc")
     with pytest.raises(CatalogError, match="unknown catalog kind"):
         catalog.entries("colour")
 
@@ -200,6 +202,13 @@ def test_material_and_model_files(user_files):
         ("plain.nc", ValidationError, "is neither a material table .* nor a BRDF model"),
         ("canx1", ValidationError, "'canx1' is a spacecraft entry, not a material table or model"),
         ("no-such-entry", CatalogError, "no catalog entry named 'no-such-entry'"),
+        (  # a misspelt material is offered the close materials, no other kind of entry
+            "white-paint",
+            CatalogError,
+            r"^material: no catalog entry named 'white-paint'; did you mean 'white-paint-a276"
+            r"(-\w+)?'( or 'white-paint-a276(-\w+)?')*\? catalog materials and models: "
+            r"aluminium-6061-t6, [^:]*white-paint-a276-paper$",
+        ),
     ],
 )
 def test_bad_material_specs(user_files, spec, error, match):

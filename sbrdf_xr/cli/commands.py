@@ -13,7 +13,7 @@ from typing import Any
 
 from .. import catalog
 from .._version import __version__
-from ..errors import ValidationError
+from ..errors import ValidationError, did_you_mean
 from ..store.writer import PART_SUFFIX
 from .output import escape, escaped_attrs, open_cube, open_dataset
 
@@ -225,11 +225,19 @@ def _with_body(scene: Any, args: argparse.Namespace) -> Any:
     if unknown:
         raise ValidationError(
             f"--material: {unknown} are not materials of the spacecraft {body.name!r}; "
-            f"its materials: {body.materials}"
+            + did_you_mean(unknown[0], body.materials, "its materials")
         )
     kept = {m: t for m, t in (scene.materials or {}).items() if m in body.materials}
     wanted = {m: specs.get(m, m) for m in body.materials if m in specs or m not in kept}
-    tables, models = material_tables(wanted)
+    named_in = (
+        "--material-map"
+        if args.material_map
+        else "--mesh-material"
+        if args.mesh_material
+        else f"spacecraft {body.name!r}"
+    )
+    where = {m: "--material" if m in specs else named_in for m in wanted}
+    tables, models = material_tables(wanted, where=where)
     old_models = {m: v for m, v in (scene.models or {}).items() if m not in wanted}
     return scene.with_options(
         spacecraft=body,

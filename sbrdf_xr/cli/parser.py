@@ -33,8 +33,9 @@ from pathlib import Path
 
 from .. import catalog
 from .._version import __version__
+from ..engine.builtin import builtin_scenes
 from ..errors import SbrdfError
-from ..store.writer import LOG_SUFFIX, PART_SUFFIX, command_line_messages
+from ..store.writer import DEFAULT_COMPLEVEL, LOG_SUFFIX, PART_SUFFIX, command_line_messages
 from .analysis import cmd_invert, cmd_photometry
 from .commands import (
     cmd_bench,
@@ -77,7 +78,7 @@ def build_parser() -> argparse.ArgumentParser:
     ...     ["simulate", "canx1-rotation", "-o", "cube.nc", "--preset", "fast"]
     ... )
     >>> args.command, args.scene, args.output, args.preset, args.complevel
-    ('simulate', 'canx1-rotation', 'cube.nc', 'fast', 4)
+    ('simulate', 'canx1-rotation', 'cube.nc', 'fast', 0)
     """
     p = argparse.ArgumentParser(
         prog="sbrdf-xr", description="Spectral BRDF simulation of unresolved spacecraft."
@@ -117,7 +118,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     psim = sub.add_parser("simulate", help="run a scene into a netCDF cube")
     psim.add_argument(
-        "scene", help="built-in scene name (canx1-rotation, canx1-plusx-specular) or a TOML file"
+        "scene", help=f"built-in scene name ({', '.join(builtin_scenes())}) or a TOML file"
     )
     psim.add_argument("-o", "--output", required=True, help="netCDF file to write")
     psim.add_argument(
@@ -134,10 +135,11 @@ def build_parser() -> argparse.ArgumentParser:
     psim.add_argument(
         "--complevel",
         type=int,
-        default=4,
+        default=DEFAULT_COMPLEVEL,
         choices=range(10),
         metavar="0-9",
-        help="zlib compression level of the netCDF cube (default 4; 0: none, fastest)",
+        help=f"zlib compression level of the netCDF cube (default {DEFAULT_COMPLEVEL}; 0: "
+        "none, fastest, and resumable after a kill at any instant)",
     )
     psim.add_argument("--plot", help="also write the cube's figure to this PNG file")
     psim.add_argument(

@@ -18,7 +18,7 @@ import numpy as np
 import xarray as xr
 
 from .. import geometry
-from ..errors import CatalogError, SceneError, ValidationError
+from ..errors import CatalogError, SceneError, ValidationError, did_you_mean
 from .knobs import KNOBS
 from .scene import Scene
 
@@ -102,7 +102,9 @@ def _check_keys(table: Any, allowed: Mapping[str, Any], where: str) -> None:
         raise SceneError(f"{where}: expected a table of keys, got {type(table).__name__}")
     for k, v in table.items():
         if k not in allowed:
-            raise SceneError(f"{where}: unknown key {k!r}; allowed: {', '.join(sorted(allowed))}")
+            raise SceneError(
+                f"{where}: unknown key {k!r}; {did_you_mean(k, allowed, 'allowed keys')}"
+            )
         types = allowed[k]
         if not isinstance(v, types) or (isinstance(v, bool) and types in (int, (int, float))):
             names = " or ".join(
@@ -306,7 +308,9 @@ def _spacecraft(spec: Any, base_dir: str | Path | None) -> Any:
 
 
 def material_tables(
-    specs: Mapping[str, str | Path], base_dir: str | Path | None = None
+    specs: Mapping[str, str | Path],
+    base_dir: str | Path | None = None,
+    where: Mapping[str, str] | None = None,
 ) -> tuple[dict[str, xr.DataArray], dict[str, xr.Dataset]]:
     """:func:`sbrdf_xr.catalog.material_tables`, with its bad input as a :class:`SceneError`.
 
@@ -319,7 +323,7 @@ def material_tables(
     from .. import catalog
 
     try:
-        return catalog.material_tables(specs, base_dir)
+        return catalog.material_tables(specs, base_dir, where)
     except SceneError:
         raise
     except ValidationError as exc:
@@ -358,7 +362,7 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
     >>> scene_from_dict({"spacecraft": "canx1", "colour": "red"})
     Traceback (most recent call last):
     ...
-    sbrdf_xr.errors.SceneError: scene: unknown key 'colour'; allowed: ...
+    sbrdf_xr.errors.SceneError: scene: unknown key 'colour'; allowed keys: ...
     """
     _check_keys(d, _SCENE_KEYS, "scene")
 
@@ -445,16 +449,30 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
     if "spacecraft" not in d:
         raise SceneError("scene: key 'spacecraft' is required (a catalog name or a mesh file)")
     sc = _spacecraft(d["spacecraft"], base_dir)
-    # every material of the spacecraft by its own name, unless [materials] names another
+    # every material of the spacecraft by its own name, unless [materials] names another;
+    # an error names the section the name was written in
+    body = d["spacecraft"]
+    named_in = (
+        f"[spacecraft] {'material_map' if 'material_map' in body else 'material'}"
+        if isinstance(body, Mapping)
+        else f"spacecraft {body!r}"
+    )
     specs: dict[str, str] = {m: m for m in sc.materials}
+    where = dict.fromkeys(sc.materials, named_in)
     for mat, spec in d.get("materials", {}).items():
+        if mat not in specs:
+            raise SceneError(
+                f"[materials]: {mat!r} is not a material of the spacecraft {sc.name!r}; "
+                + did_you_mean(mat, sc.materials, "its materials")
+            )
+        where[mat] = "[materials]"
         if not isinstance(spec, str):
             raise SceneError(
                 f"[materials]: {mat!r} must name a catalog entry or a netCDF file (a "
                 f"string), got {_show(spec)}"
             )
         specs[mat] = spec
-    materials, given_models = material_tables(specs, base_dir)
+    materials, given_models = material_tables(specs, base_dir, where)
     if given_models:
         kw["models"] = given_models
     try:

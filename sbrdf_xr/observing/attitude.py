@@ -49,7 +49,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from ..errors import AttitudeError
+from ..errors import AttitudeError, did_you_mean
 from .frames import (
     Context,
     axis_vector,
@@ -209,7 +209,7 @@ def law_from_dict(table: Mapping[str, Any]) -> AttitudeLaw:
     >>> law_from_dict({"law": "wobble"})
     Traceback (most recent call last):
         ...
-    sbrdf_xr.errors.AttitudeError: attitude: unknown law 'wobble'; allowed: inertial, nadir, ...
+    sbrdf_xr.errors.AttitudeError: attitude: unknown law 'wobble'; allowed laws: compose, ...
     """
     if not isinstance(table, Mapping) or "law" not in table:
         raise AttitudeError(
@@ -217,13 +217,16 @@ def law_from_dict(table: Mapping[str, Any]) -> AttitudeLaw:
         )
     name = table["law"]
     if name not in LAWS:
-        raise AttitudeError(f"attitude: unknown law {name!r}; allowed: {', '.join(LAWS)}")
+        raise AttitudeError(
+            f"attitude: unknown law {name!r}; {did_you_mean(name, LAWS, 'allowed laws')}"
+        )
     cls, allowed = LAWS[name]
     params = {k: v for k, v in table.items() if k != "law"}
     bad = sorted(set(params) - set(allowed))
     if bad:
         raise AttitudeError(
-            f"attitude law {name!r}: unknown parameter(s) {bad}; allowed: {', '.join(allowed)}"
+            f"attitude law {name!r}: unknown parameter(s) {bad}; "
+            + did_you_mean(bad[0], allowed, "allowed parameters")
         )
     if name == "compose":
         missing = [k for k in ("outer", "inner") if k not in params]

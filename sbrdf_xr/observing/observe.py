@@ -20,7 +20,7 @@ from typing import Any, TypedDict
 
 import numpy as np
 
-from ..errors import ObservationError
+from ..errors import ObservationError, did_you_mean
 from . import attitude as _att
 from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, disc_overlap_fraction, sunlit_fraction
 from .observation import ATTRS, TIME, Observation
@@ -99,7 +99,7 @@ def observation_from_dict(
     >>> observation_from_dict({"orbit": "canx1-example", "site": "mont-megantic", "when": "now"})
     Traceback (most recent call last):
         ...
-    sbrdf_xr.errors.ObservationError: [observation]: unknown key(s) ['when']; allowed: ...
+    sbrdf_xr.errors.ObservationError: [observation]: unknown key(s) ['when']; allowed keys: ...
     """
     allowed = {
         "orbit",
@@ -122,7 +122,7 @@ def observation_from_dict(
     bad = sorted(set(table) - allowed)
     if bad:
         raise ObservationError(
-            f"[observation]: unknown key(s) {bad}; allowed: {', '.join(sorted(allowed))}"
+            f"[observation]: unknown key(s) {bad}; " + did_you_mean(bad[0], allowed, "allowed keys")
         )
     base = Path(base_dir) if base_dir is not None else Path.cwd()
 

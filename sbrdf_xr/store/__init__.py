@@ -76,10 +76,11 @@ from .layout import (
 )
 from .progress import NoProgress, TextProgress, progress_bar
 from .runners import connect
-from .writer import write_cube
+from .writer import DEFAULT_COMPLEVEL, write_cube
 
 __all__ = [
     "CHECK_SPACE",
+    "DEFAULT_COMPLEVEL",
     "FALLOCATE",
     "FALLOC_FL_KEEP_SIZE",
     "FORMAT",

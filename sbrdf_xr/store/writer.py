@@ -184,6 +184,7 @@ from .progress import NoProgress, progress_bar
 from .runners import Feed, _check_address, _runner, connect
 
 __all__ = [
+    "DEFAULT_COMPLEVEL",
     "LOCK_SUFFIX",
     "LOG_SUFFIX",
     "PART_SUFFIX",
@@ -198,6 +199,11 @@ __all__ = [
 ]
 
 
+#: Default zlib level of a cube: 0, uncompressed, the layout that a writer killed at any
+#: instant leaves resumable (see Durability above) and the fastest to write.
+DEFAULT_COMPLEVEL = 0
+
+
 def write_cube(
     ds: xr.Dataset,
     path: str | os.PathLike[str],
@@ -208,7 +214,7 @@ def write_cube(
     scheduler: str | None = None,
     max_in_flight: int | None = None,
     progress: bool = False,
-    complevel: int = 0,
+    complevel: int = DEFAULT_COMPLEVEL,
     on_block: Callable[[BlockWritten], None] | None = None,
 ) -> Path:
     """Compute a lazy cube block by block and stream it to a netCDF-4 file.
@@ -249,9 +255,9 @@ def write_cube(
         the last one finished is written).
     progress : bool, default False
         Show a progress bar of blocks on stderr (tqdm if installed).
-    complevel : int, default 0
+    complevel : int, default :data:`DEFAULT_COMPLEVEL` (0)
         zlib level (1-9, with byte shuffle) for the numeric variables; 0 stores
-        them uncompressed.
+        them uncompressed (contiguous, resumable after a kill at any instant).
     on_block : callable, optional
         Called with a :class:`BlockWritten` in the writing thread after each
         block is committed (written, flushed, synced and recorded).

@@ -139,3 +139,55 @@ def test_simulate_bad_body_options(user_files, capsys, extra, match):
     assert main(argv + [a.format(files=files) for a in extra]) == 2
     err = capsys.readouterr().err
     assert err.startswith("sbrdf-xr: error: ") and re.search(match, err), err
+
+
+def test_simulate_defaults_are_the_librarys():
+    """The command line writes what the library writes unless told otherwise: an
+    uncompressed cube (the one a kill at any instant leaves resumable)."""
+    import inspect
+
+    from sbrdf_xr.cli.parser import build_parser
+    from sbrdf_xr.store.writer import DEFAULT_COMPLEVEL, write_cube
+
+    args = build_parser().parse_args(["simulate", "canx1-rotation", "-o", "cube.nc"])
+    library = inspect.signature(write_cube).parameters["complevel"].default
+    assert args.complevel == library == DEFAULT_COMPLEVEL == 0
+
+
+def test_simulate_help_lists_every_builtin_scene(capsys, monkeypatch):
+    from sbrdf_xr.engine import builtin_scenes
+
+    monkeypatch.setenv("COLUMNS", "400")  # no line break inside a hyphenated name
+    with pytest.raises(SystemExit):
+        main(["simulate", "--help"])
+    out = capsys.readouterr().out
+    assert len(builtin_scenes()) == 3
+    for name in builtin_scenes():
+        assert name in out
+
+
+@pytest.mark.parametrize(
+    ("extra", "match"),
+    [
+        (
+            ["--spacecraft", "{files}/box.stl", "--mesh-material", "aluminium-6061"],
+            r"--mesh-material 'aluminium-6061': material: no catalog entry named "
+            r"'aluminium-6061'; did you mean 'aluminium-6061-t6'",
+        ),
+        (
+            ["--material", "tjpv-cell=aluminium-6061"],
+            r"--material 'tjpv-cell': .*; did you mean 'aluminium-6061-t6'",
+        ),
+        (
+            ["--material", "tjpv-cel=lambertian-grey-50"],
+            r"\['tjpv-cel'\] are not materials .*; did you mean 'tjpv-cell'\?",
+        ),
+    ],
+)
+def test_simulate_misspelt_materials_get_suggestions(user_files, capsys, extra, match):
+    files = user_files / "files"
+    argv = ["simulate", "canx1-plusx-specular", "-o", str(user_files / "x.nc"), "--plan"]
+    assert main(argv + [a.format(files=files) for a in extra]) == 2
+    err = capsys.readouterr().err
+    assert re.search(match, err), err
+    assert not [n for n in catalog.names("site") + catalog.names("orbit") if n in err]

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -306,3 +308,91 @@ def test_scene_without_tables_names_a_material_the_catalog_lacks():
     scene = Scene(body, to_sun=[[1, 0, 0]], to_observer=[[1, 0, 0]])  # reads nothing yet
     with pytest.raises(SceneError, match="no-such-table"):
         scene.plan()
+
+
+# ----------------------------------------------------------------- errors that suggest
+
+
+def _other_kinds() -> list[str]:
+    """Catalog names that are not materials: a material error must offer none of them."""
+    from sbrdf_xr import catalog
+
+    return [n for k in ("site", "orbit", "spacecraft") for n in catalog.names(k)]
+
+
+@pytest.mark.parametrize(
+    ("spacecraft", "materials", "section"),
+    [
+        (  # the misspelt name labels facets in the map: the map is blamed, not [materials]
+            '[spacecraft]\npath = "usercat/meshes/box.ply"\n'
+            'material_map = { "#808080" = "aluminium-6061" }\n',
+            "",
+            "[spacecraft] material_map 'aluminium-6061'",
+        ),
+        (
+            'spacecraft = { path = "files/box.stl", material = "aluminium-6061" }\n',
+            "",
+            "[spacecraft] material 'aluminium-6061'",
+        ),
+        (
+            'spacecraft = { path = "files/box.stl", material = "paint" }\n',
+            '[materials]\npaint = "aluminium-6061"\n',
+            "[materials] 'paint'",
+        ),
+    ],
+)
+def test_a_misspelt_material_suggests_materials_and_names_its_section(
+    user_files, spacecraft, materials, section
+):
+    with pytest.raises(CatalogError) as info:
+        load_scene(write(user_files, spacecraft + HEAD_ON + materials))
+    text = str(info.value)
+    assert text.startswith(section + ": ")
+    assert "did you mean 'aluminium-6061-t6'" in text
+    assert "[materials]" not in text or section.startswith("[materials]")
+    offered = text.partition("did you mean")[2]
+    assert not [n for n in _other_kinds() if re.search(rf"(?<![\w-]){n}(?![\w-])", offered)]
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "match"),
+    [
+        (
+            "phase_angles = [10.0, 20.0]",
+            "phase_angle = [10.0, 20.0]",
+            r"^scene: unknown key 'phase_angle'; did you mean 'phase_angles'",
+        ),
+        (
+            "stop = 360",
+            "stpo = 360",
+            r"^\[attitude\]: unknown key 'stpo'; did you mean 'stop' or 'step'\?",
+        ),
+        (  # nothing close: no suggestion, the keys of the table listed
+            "chunk = 50",
+            "colour = 50",
+            r"^scene: unknown key 'colour'; allowed keys: attitude, ",
+        ),
+    ],
+)
+def test_an_unknown_key_suggests_the_keys_of_its_table(tmp_path, old, new, match):
+    assert old in ROTATION
+    with pytest.raises(SceneError, match=match) as info:
+        load_scene(write(tmp_path, ROTATION.replace(old, new)))
+    if new.startswith("stpo"):  # the [attitude] keys only, not the scene's
+        assert "phase_angles" not in str(info.value)
+
+
+@pytest.mark.parametrize(
+    ("name", "match"),
+    [
+        (
+            "kryptonite",
+            r"'kryptonite' is not a material of the spacecraft 'canx1'; its materials: ",
+        ),
+        ("tjpv-cel", r"'tjpv-cel' is not a material .*; did you mean 'tjpv-cell'\?"),
+    ],
+)
+def test_materials_keys_must_be_materials_of_the_spacecraft(tmp_path, name, match):
+    text = ROTATION + f'"{name}" = "lambertian-grey-50"\n'
+    with pytest.raises(SceneError, match=r"^\[materials\]: " + match):
+        load_scene(write(tmp_path, text))

@@ -347,6 +347,8 @@ def test_observation_from_toml_table():
     assert g.sizes["time"] == 2
     with pytest.raises(ObservationError, match="unknown key"):
         observe.observation_from_dict({**table, "sight": 1})
+    with pytest.raises(ObservationError, match=r"\['stepp_s'\]; did you mean 'step_s'\?"):
+        observe.observation_from_dict({**table, "stepp_s": 1.0})
     with pytest.raises(ObservationError, match="exactly one of"):
         observe.observation_from_dict({k: v for k, v in table.items() if k != "tle"})
     with pytest.raises(AttitudeError, match="unknown law"):
