@@ -143,10 +143,10 @@ def _array_sha(a: Any) -> str:
     """
     if not isinstance(a, np.ndarray) or a.dtype.kind in "OUS" or not _read_only(a):
         return _array_sha_now(a)
-    key = id(a)
+    key, layout = id(a), _layout(a)
     with _DIGESTS_LOCK:
         hit = _DIGESTS.get(key)
-    if hit is not None and hit[0]() is a and hit[1] == _layout(a):
+    if hit is not None and hit[0]() is a and hit[1] == layout:
         return hit[2]
     sha = _array_sha_now(a)
 
@@ -156,7 +156,7 @@ def _array_sha(a: Any) -> str:
                 del _DIGESTS[key]
 
     with _DIGESTS_LOCK:
-        _DIGESTS[key] = (weakref.ref(a, forget), _layout(a), sha)
+        _DIGESTS[key] = (weakref.ref(a, forget), layout, sha)
     return sha
 
 
