@@ -148,7 +148,10 @@ def _built_material(
     )
     if dtype is not None and da.dtype != np.dtype(dtype):
         da = da.astype(dtype)
-    da.values.flags.writeable = False
+    base: Any = da.values  # read-only through and through (also the array it views), so that
+    while isinstance(base, np.ndarray):  # its fingerprint can be computed once and kept
+        base.flags.writeable = False
+        base = base.base
     return da
 
 

@@ -21,7 +21,11 @@ and underscores, starting with a letter)::
 :func:`sbrdf_xr.store.writer.write_cube` refuses to resume an unfinished cube whose
 fingerprint differs, naming what changed (:func:`changes`).  Hashes are computed from
 values, never from object identity, so the same scene built twice has the same
-fingerprint.
+fingerprint.  The digest of a read-only array (a catalog table, whose values no one can
+write) is computed once and kept while the array lives, so a scene that differs from the
+last one only in geometry or knobs does not hash its tables again; writeable arrays are
+hashed every time.  (Making a read-only array writeable again and changing it in place
+defeats this; the catalog's tables are read-only so that they can be shared.)
 """
 
 from __future__ import annotations
@@ -30,6 +34,8 @@ import dataclasses
 import hashlib
 import json
 import re
+import threading
+import weakref
 from collections.abc import Mapping
 from typing import Any
 
@@ -102,7 +108,59 @@ def _json(value: Any) -> str:
     return json.dumps(_canonical(value), sort_keys=True, separators=(",", ":"))
 
 
+def _read_only(a: np.ndarray) -> bool:
+    """Whether no one can write ``a``'s values: it and every array it views are read-only,
+    and the memory at the bottom of the chain is its own or an immutable buffer."""
+    base: Any = a
+    while isinstance(base, np.ndarray):
+        if base.flags.writeable:
+            return False
+        base = base.base
+    if base is None:
+        return True
+    try:
+        return memoryview(base).readonly
+    except TypeError:  # memory of an unknown kind (an mmap, a foreign buffer): may change
+        return False
+
+
+#: id(array) -> (weak reference, layout when hashed, digest) for read-only arrays.
+_DIGESTS: dict[int, tuple[weakref.ref, tuple, str]] = {}
+_DIGESTS_LOCK = threading.Lock()
+
+
+def _layout(a: np.ndarray) -> tuple:
+    return (a.__array_interface__["data"][0], a.shape, a.strides, a.dtype.str)
+
+
 def _array_sha(a: Any) -> str:
+    """SHA-256 of an array's dtype, shape and values.
+
+    The digest of a read-only array (:func:`_read_only`: it and every array under it)
+    is kept while the array lives and reused as long as it is still read-only and still
+    views the same memory; a writeable array is hashed every time, so changing its
+    values in place always changes its digest.
+    """
+    if not isinstance(a, np.ndarray) or a.dtype.kind in "OUS" or not _read_only(a):
+        return _array_sha_now(a)
+    key, layout = id(a), _layout(a)
+    with _DIGESTS_LOCK:
+        hit = _DIGESTS.get(key)
+    if hit is not None and hit[0]() is a and hit[1] == layout:
+        return hit[2]
+    sha = _array_sha_now(a)
+
+    def forget(ref: weakref.ref, key: int = key) -> None:
+        with _DIGESTS_LOCK:
+            if key in _DIGESTS and _DIGESTS[key][0] is ref:
+                del _DIGESTS[key]
+
+    with _DIGESTS_LOCK:
+        _DIGESTS[key] = (weakref.ref(a, forget), layout, sha)
+    return sha
+
+
+def _array_sha_now(a: Any) -> str:
     arr = np.ascontiguousarray(np.asarray(a))
     h = hashlib.sha256(f"{arr.dtype.str}{arr.shape}".encode())
     if arr.dtype.kind in "mM":  # datetimes and durations: their integer counts
