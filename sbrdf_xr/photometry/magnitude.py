@@ -278,8 +278,8 @@ def magnitudes(
     >>> round(float(magnitudes(cube, ["V"], range_km=2000.0)[0, 0] - m[0, 1]), 6)  # 5 log10 2
     1.50515
     >>> import astropy.units as u
-    >>> float(magnitudes(cube, ["V"], range_km=2e6 * u.m)[0, 0] - m[0, 1]) == 5 * np.log10(2)
-    True
+    >>> round(float(magnitudes(cube, ["V"], range_km=2e6 * u.m)[0, 0] - m[0, 1]), 6)  # 2000 km
+    1.50515
     """
     system = check_system(system)
     d, r, notes = _distances(cube, range_km, sun_distance_au)
