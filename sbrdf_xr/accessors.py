@@ -134,8 +134,9 @@ class SbrdfDatasetAccessor:
     def __init__(self, ds: xr.Dataset) -> None:
         self._ds = ds
 
-    def photometry(self, bands: Any, range_km: Any, **kwargs: Any) -> xr.Dataset:
-        """:func:`sbrdf_xr.photometry.photometry` of this cube."""
+    def photometry(self, bands: Any, range_km: Any = None, **kwargs: Any) -> xr.Dataset:
+        """:func:`sbrdf_xr.photometry.photometry` of this cube (its own ``range`` and
+        ``sun_distance`` unless given)."""
         from . import photometry as _phot
 
         return _phot.photometry(self._ds, bands, range_km, **kwargs)
@@ -146,8 +147,9 @@ class SbrdfDatasetAccessor:
 
         return _phot.band_signal(self._ds, bands, **kwargs)
 
-    def magnitudes(self, bands: Any, range_km: Any, **kwargs: Any) -> xr.DataArray:
-        """:func:`sbrdf_xr.photometry.magnitudes` of this cube."""
+    def magnitudes(self, bands: Any = None, range_km: Any = None, **kwargs: Any) -> xr.DataArray:
+        """:func:`sbrdf_xr.photometry.magnitudes` of this cube (its own ``range`` and
+        ``sun_distance`` unless given; ``extinction={band: k}`` with its ``airmass``)."""
         from . import photometry as _phot
 
         return _phot.magnitudes(self._ds, bands, range_km, **kwargs)

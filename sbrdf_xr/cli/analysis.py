@@ -25,6 +25,23 @@ def _cube_range_km(cube) -> float | None:
     return None
 
 
+def _parse_extinction(items: list[str] | None) -> dict[str, float] | None:
+    if not items:
+        return None
+    out: dict[str, float] = {}
+    for item in items:
+        band, sep, k = item.partition("=")
+        try:
+            if not sep or not band:
+                raise ValueError
+            out[band.strip()] = float(k)
+        except ValueError:
+            raise SbrdfError(
+                f"--extinction: {item!r} is not BAND=K (give e.g. --extinction V=0.2 R=0.1)"
+            ) from None
+    return out
+
+
 def _parse_colours(text: str | None) -> list[tuple[str, str]] | None:
     if not text:
         return None
@@ -58,12 +75,20 @@ def cmd_photometry(args: argparse.Namespace) -> int:
                 "(it needs 'signal' or 'spacecraft_sbrdf' over wavelength)"
             )
     colours = _parse_colours(args.colours)
+    extinction = _parse_extinction(args.extinction)
     with xr.open_dataset(args.cube, chunks={}) as cube:
-        range_km = args.range_km if args.range_km is not None else _cube_range_km(cube)
-        if range_km is None:
+        range_km = args.range_km
+        if range_km is None and "range" not in cube.variables:
+            range_km = _cube_range_km(cube)
+            if range_km is None:
+                raise SbrdfError(
+                    f"{args.cube} records no observer range; give it with --range-km KM "
+                    "(e.g. --range-km 36000 for a geostationary object)"
+                )
+        if extinction is not None and "airmass" not in cube.variables:
             raise SbrdfError(
-                f"{args.cube} records no observer range; give it with --range-km KM "
-                "(e.g. --range-km 36000 for a geostationary object)"
+                f"--extinction: {args.cube} records no airmass (only the cube of an "
+                "observation does)"
             )
         lazy = phot.photometry(
             cube,
@@ -71,6 +96,8 @@ def cmd_photometry(args: argparse.Namespace) -> int:
             range_km,
             pairs=colours,
             system=args.system,
+            sun_distance_au=args.sun_distance_au,
+            extinction=extinction,
             weighting=args.weighting,
             quadrature=args.quadrature,
             extrapolate=args.extrapolate,
@@ -79,9 +106,13 @@ def cmd_photometry(args: argparse.Namespace) -> int:
         with TqdmCallback(desc="photometry", disable=args.quiet):
             ds = lazy.compute()
     print(
-        f"photometry of {args.cube}: range {range_km:g} km, {ds.attrs['magnitude_system']} "
+        f"photometry of {args.cube}: range {ds.attrs['range_source']}, Sun distance "
+        f"{ds.attrs['sun_distance_source']}, {ds.attrs['magnitude_system']} "
         f"magnitudes, {args.weighting} weighting, solar spectrum {args.solar}"
     )
+    for k in ("range_override", "sun_distance_override", "extinction_coefficients"):
+        if k in ds.attrs:
+            print(f"{k.replace('_', ' ')}: {ds.attrs[k]}")
     print(f"{'band':<8} {'filter':<14} {'m_sun':>8} {'min':>8} {'median':>8} {'max':>8}")
     for b in ds.band.values:
         m = np.asarray(ds.magnitude.sel(band=b).values).ravel()

@@ -11,7 +11,8 @@ Sub-commands::
              [--spacecraft NAME|MESH [--mesh-material M | --material-map MAP.toml]]
              [--material M=NAME|FILE.nc ...]
     sbrdf-xr plot CUBE.nc -o FIG.png        the cube's natural figure (light curve or spectra)
-    sbrdf-xr photometry CUBE.nc [--bands V R I] [--range-km KM] [--colours V-R,R-I]
+    sbrdf-xr photometry CUBE.nc [--bands V R I] [--range-km KM] [--extinction V=0.2 ...]
+                        [--colours V-R,R-I]
              [--system ab|vega] [-o PHOT.nc] [--csv PHOT.csv]
     sbrdf-xr invert unmix MEASURED --cube CUBE.nc [--range-km R] [-o OUT.nc]   material areas
     sbrdf-xr invert spin CURVE --spacecraft canx1 --to-sun X Y Z --to-observer X Y Z
@@ -180,7 +181,19 @@ def build_parser() -> argparse.ArgumentParser:
     pph.add_argument(
         "--range-km",
         type=float,
-        help="observer range [km] (default: the range the cube records, if any)",
+        help="observer range [km] (default: the cube's 'range' per time, or the range it records)",
+    )
+    pph.add_argument(
+        "--sun-distance-au",
+        type=float,
+        help="Sun-object distance [au] (default: the cube's 'sun_distance', else 1)",
+    )
+    pph.add_argument(
+        "--extinction",
+        nargs="+",
+        metavar="BAND=K",
+        help="first-order extinction k [mag per airmass] per band, with the cube's airmass "
+        "(e.g. --extinction V=0.2 R=0.1 I=0.05; every band needs one)",
     )
     pph.add_argument(
         "--colours", help="colour indices as band pairs, e.g. V-R,R-I (default consecutive bands)"

@@ -11,6 +11,7 @@ import xarray as xr
 
 from .._names import BAND, WAVELENGTH, attrs
 from ..errors import ValidationError
+from ._observed import _distances, _with_extinction
 from .bands import (
     WEIGHTINGS,
     _band_coords,
@@ -206,28 +207,14 @@ def band_signal(
     return out
 
 
-def _range_m(range_km: Any) -> xr.DataArray | np.ndarray:
-    r: xr.DataArray | np.ndarray
-    if isinstance(range_km, xr.DataArray):
-        vals = np.asarray(range_km.values, dtype=np.float64)
-        r = range_km.astype(np.float64) * 1e3
-    else:
-        vals = np.asarray(range_km, dtype=np.float64)
-        r = vals * 1e3
-    if vals.size == 0 or not np.all(np.isfinite(vals)) or np.any(vals <= 0):
-        raise ValidationError(
-            f"range_km: must be finite and > 0 km, got {vals.ravel()[:5].tolist()}"
-        )
-    return r
-
-
 def magnitudes(
     cube: xr.Dataset | xr.DataArray,
     bands: Any = None,
     range_km: Any = None,
     *,
     system: str = "AB",
-    sun_distance_au: Any = 1.0,
+    sun_distance_au: Any = None,
+    extinction: dict[str, float] | None = None,
     weighting: str = "photon",
     quadrature: str = "trapezoid",
     extrapolate: str | None = None,
@@ -240,6 +227,13 @@ def magnitudes(
     observer range [m] (module docstring).  ``S_band = 0`` gives ``+inf`` (no
     warning), a negative ``S_band`` gives NaN.
 
+    A cube of an observation records ``range`` [km] and ``sun_distance`` [au] (per time
+    or scalar, coordinates or variables, converted from their ``units``): they are used
+    unless ``range_km`` or ``sun_distance_au`` is given.  The attributes
+    ``range_source`` and ``sun_distance_source`` say where each came from;
+    ``range_override`` / ``sun_distance_override`` note an argument that replaced the
+    cube's value, and which value that was.
+
     Parameters
     ----------
     cube : xarray.Dataset or DataArray
@@ -247,15 +241,22 @@ def magnitudes(
         (then ``bands`` is not needed).
     bands : str, sequence, mapping or DataArray
         See :func:`filters`.
-    range_km : float, array_like or DataArray
-        Observer range [km], > 0; broadcast against the cube (a DataArray aligns by dims).
+    range_km : float, array_like, DataArray or astropy Quantity, optional
+        Observer range [km], > 0; broadcast against the cube (a DataArray aligns by
+        dims).  A Quantity of length is converted (``1e6 * u.m`` is 1000 km), any other
+        Quantity refused.  Default the cube's ``range``; required if it has none.
     system : {"AB", "Vega"}
         Magnitude system, any case (:data:`~sbrdf_xr.photometry.MAGNITUDE_SYSTEMS`);
         recorded in the attribute ``magnitude_system``.  A :func:`band_signal` input
         must have been made in the same system.
-    sun_distance_au : float, array_like or DataArray
+    sun_distance_au : float, array_like, DataArray or astropy Quantity, optional
         Sun-object distance [AU], > 0 (e.g. :func:`sun_distance_au` of the
-        observation times); broadcast like ``range_km``.
+        observation times); broadcast like ``range_km``.  Default the cube's
+        ``sun_distance``, else 1 AU.
+    extinction : mapping, optional
+        ``{band: k}`` [mag per airmass], >= 0, for every band: adds ``k X`` with ``X``
+        the cube's ``airmass`` (first-order extinction; NaN where ``X`` is NaN, below
+        the horizon).  A cube without ``airmass`` is refused.
     weighting, quadrature, extrapolate, solar, transmission
         See :func:`band_weights`.
 
@@ -276,14 +277,12 @@ def magnitudes(
     (('geometry', 'band'), array([6.257 , 5.7318]))
     >>> round(float(magnitudes(cube, ["V"], range_km=2000.0)[0, 0] - m[0, 1]), 6)  # 5 log10 2
     1.50515
+    >>> import astropy.units as u
+    >>> round(float(magnitudes(cube, ["V"], range_km=2e6 * u.m)[0, 0] - m[0, 1]), 6)  # 2000 km
+    1.50515
     """
     system = check_system(system)
-    if range_km is None:
-        raise ValidationError(
-            "range_km: the observer range [km] is required (e.g. range_km=1000.0)"
-        )
-    d = _range_m(range_km)
-    r = _positive(sun_distance_au, "sun_distance_au")
+    d, r, notes = _distances(cube, range_km, sun_distance_au)
     if isinstance(cube, xr.DataArray) and BAND in cube.dims and "sun_magnitude" in cube.coords:
         sb = cube
         have = sb.attrs.get(
@@ -307,17 +306,13 @@ def magnitudes(
             solar=solar,
             transmission=transmission,
         )
-    return _magnitudes_from(sb, d, r, system)
+    m = _magnitudes_from(sb, d, r, system, notes)
+    return m if extinction is None else _with_extinction(m, cube, extinction)
 
 
-def _positive(value: Any, what: str) -> Any:
-    vals = np.asarray(value.values if isinstance(value, xr.DataArray) else value, dtype=np.float64)
-    if vals.size == 0 or not np.all(np.isfinite(vals)) or np.any(vals <= 0):
-        raise ValidationError(f"{what}: must be finite and > 0, got {vals.ravel()[:5].tolist()}")
-    return value.astype(np.float64) if isinstance(value, xr.DataArray) else vals
-
-
-def _magnitudes_from(sb: xr.DataArray, d_m: Any, sun_distance_au: Any, system: str) -> xr.DataArray:
+def _magnitudes_from(
+    sb: xr.DataArray, d_m: Any, sun_distance_au: Any, system: str, notes: dict[str, str]
+) -> xr.DataArray:
     ratio = sb / d_m**2
     pos = ratio > 0
     safe = xr.where(pos, ratio, 1.0)
@@ -332,6 +327,7 @@ def _magnitudes_from(sb: xr.DataArray, d_m: Any, sun_distance_au: Any, system: s
         note="+inf where the band signal is 0 (nothing reflects toward the observer); "
         "NaN where it is negative",
         formula="m = m_sun,band(1 AU) + 5 log10(r/AU) - 2.5 log10(S_band / d^2), d in m",
+        **notes,
     )
     if not isinstance(sun_distance_au, xr.DataArray) and np.ndim(sun_distance_au) == 0:
         m.attrs["sun_distance_au"] = float(sun_distance_au)
@@ -429,11 +425,12 @@ def _band_index(mags: xr.DataArray, label: str) -> int:
 def photometry(
     cube: xr.Dataset | xr.DataArray,
     bands: Any,
-    range_km: Any,
+    range_km: Any = None,
     *,
     pairs: Sequence[tuple[str, str]] | None = None,
     system: str = "AB",
-    sun_distance_au: Any = 1.0,
+    sun_distance_au: Any = None,
+    extinction: dict[str, float] | None = None,
     weighting: str = "photon",
     quadrature: str = "trapezoid",
     extrapolate: str | None = None,
@@ -462,9 +459,8 @@ def photometry(
     >>> sorted(ph.data_vars), ph.attrs["magnitude_system"]
     (['band_signal', 'colour_index', 'magnitude'], 'AB')
     """
-    d = _range_m(range_km)
     system = check_system(system)
-    r = _positive(sun_distance_au, "sun_distance_au")
+    d, r, notes = _distances(cube, range_km, sun_distance_au)
     sb = band_signal(
         cube,
         bands,
@@ -475,21 +471,21 @@ def photometry(
         solar=solar,
         transmission=transmission,
     )
-    m = _magnitudes_from(sb, d, r, system)
+    m = _magnitudes_from(sb, d, r, system, notes)
+    if extinction is not None:
+        m = _with_extinction(m, cube, extinction)
     out = {"band_signal": sb, "magnitude": m}
     if sb.sizes[BAND] > 1 or pairs:
         out["colour_index"] = colour_indices(m, pairs)
     ds = xr.Dataset(out)
     src = cube.attrs if isinstance(cube, xr.Dataset) else {}
-    range_text = (
-        "DataArray" if isinstance(range_km, xr.DataArray) else np.asarray(range_km).tolist()
-    )
+    range_text = notes["range_source"]
     ds.attrs = {
         "Conventions": "CF-1.10",
         "title": f"sbrdf_xr photometry of {src.get('title', 'a spectrum')}",
         "source": src.get("source", "sbrdf_xr"),
         "history": f"sbrdf_xr.photometry(bands={[str(b) for b in sb[BAND].values]}, "
-        f"range_km={range_text}, "
+        f"range: {range_text}, "
         f"system={system}, weighting={weighting}, quadrature={quadrature}, "
         f"extrapolate={extrapolate}, solar={solar})",
         "references": "AB: Oke & Gunn 1983, ApJ 266, 713; Vega: CALSPEC alpha_lyr_stis_011, "
@@ -502,4 +498,7 @@ def photometry(
         ds.attrs["sun_distance_au"] = m.attrs["sun_distance_au"]
     if "range_km" in m.attrs:
         ds.attrs["range_km"] = m.attrs["range_km"]
+    for k, v in m.attrs.items():
+        if k.endswith(("_source", "_override")) or k.startswith("extinction"):
+            ds.attrs[k] = v
     return ds
