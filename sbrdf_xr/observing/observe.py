@@ -204,7 +204,8 @@ class _PassWindow(TypedDict):
 #: The built-in example: orbit and site catalog entries and the pass window (UTC), found
 #: with ``tools/build_observe.py``: the site in astronomical darkness (Sun below
 #: -25 deg), the spacecraft between 27 and 76 deg elevation, leaving the Earth's shadow
-#: in the first minute (penumbra 01:20:46-01:21:00) and sunlit for the remaining four.
+#: in the first minute (penumbra 01:20:40-01:20:55 on the WGS84 ellipsoid, 01:20:45-01:21:01
+#: on a sphere) and sunlit for the remaining four.
 CANX1_PASS: _PassWindow = {
     "orbit": "canx1-example",
     "site": "mont-megantic",
