@@ -446,7 +446,8 @@ class Observation:
         data["quaternion"] = ((TIME, COMPONENT), q, ATTRS["quaternion"])
         ds = xr.Dataset(data, coords=coords, attrs=self._attrs())
         for k, when in shadow_events(self.times, r, sun, earth=self.earth, pole=pole).items():
-            ds.attrs[k] = " ".join(str(w) for w in when.astype("datetime64[ms]"))
+            ms = (when + np.timedelta64(500_000, "ns")).astype("datetime64[ms]")  # rounded
+            ds.attrs[k] = " ".join(str(w) for w in ms)
         ds[TIME].encoding.update(
             units="seconds since 1970-01-01 00:00:00", calendar="standard", dtype="float64"
         )
