@@ -30,7 +30,14 @@ from . import (
     tumble,
 )
 from .attitude import LAWS, Spin, compose, law_from_dict
-from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, disc_overlap_fraction, sunlit_fraction
+from .earth_shadow import (
+    EARTH_MODELS,
+    EARTH_RADIUS_KM,
+    SUN_RADIUS_KM,
+    disc_overlap_fraction,
+    shadow_events,
+    sunlit_fraction,
+)
 from .frames import Context, triad
 from .observation import ATTRS, COMPONENT, TIME, UNOBSERVABLE, Observation
 from .observe import bench_geometry, canx1_pass, observation_from_dict
@@ -64,6 +71,7 @@ __all__ = [
     "ATTRS",
     "AU_KM",
     "COMPONENT",
+    "EARTH_MODELS",
     "EARTH_RADIUS_KM",
     "EPOCH_GAP_DAYS",
     "KNOT_S",
@@ -106,6 +114,7 @@ __all__ = [
     "orbits",
     "pointing",
     "series",
+    "shadow_events",
     "skyfield_data",
     "skyfield_time",
     "skyfield_utc",

@@ -1,9 +1,20 @@
 """The Earth's shadow on a spacecraft: the sunlit fraction of the solar disc.
 
-A spherical Earth and the Sun's finite disc: the fraction of the apparent solar disc seen
-from the spacecraft that the apparent Earth disc does not cover (:func:`sunlit_fraction`),
-from the exact area of overlap of two circles (:func:`disc_overlap_fraction`; Montenbruck &
-Gill, *Satellite Orbits*, 2000, §3.4.2).  Pure vectorised numpy.
+The WGS84 ellipsoid (or a sphere) and the Sun's finite disc: the fraction of the apparent
+solar disc seen from the spacecraft that the apparent Earth disc does not cover
+(:func:`sunlit_fraction`), from the exact area of overlap of two circles
+(:func:`disc_overlap_fraction`; Montenbruck & Gill, *Satellite Orbits*, 2000, §3.4.2), and
+the times the spacecraft crosses the edges of the umbra and the penumbra
+(:func:`shadow_events`).  Pure vectorised numpy.
+
+The ellipsoid is made a sphere of radius ``a`` by stretching space along the polar axis by
+``k = a/b``.  The map sends lines to lines, so whether a ray from the spacecraft meets the
+Earth is unchanged: the Earth's disc and the direction of the Sun's centre are exact.  The
+stretched Sun is a spheroid; its apparent disc is taken as a circle of its angular extent
+towards the Earth's centre, ``asin(R_sun |M e| / |s'|)`` (``M`` the stretch, ``e`` that
+direction), which puts the edges of the umbra and the penumbra where the tangent rays are
+(to the order of the Sun's angular radius times ``k - 1``, ``1.6e-5`` of it) and leaves the
+sunlit fraction inside the penumbra within ``k - 1 = 0.34 %`` of the solar disc's area.
 """
 
 from __future__ import annotations
@@ -11,10 +22,29 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["EARTH_RADIUS_KM", "SUN_RADIUS_KM", "disc_overlap_fraction", "sunlit_fraction"]
+from ..errors import ObservationError
+
+__all__ = [
+    "EARTH_MODELS",
+    "EARTH_RADIUS_KM",
+    "SHADOW_EVENTS",
+    "SUN_RADIUS_KM",
+    "WGS84_FLATTENING",
+    "disc_overlap_fraction",
+    "shadow_angles",
+    "shadow_events",
+    "sunlit_fraction",
+]
 
 #: Equatorial radius of the Earth (WGS84) used by the shadow model [km].
 EARTH_RADIUS_KM = 6378.137
+
+#: Flattening of the WGS84 ellipsoid, ``f = 1/298.257223563`` (polar radius ``a (1 - f)``).
+WGS84_FLATTENING = 1.0 / 298.257223563
+
+#: Shapes of the Earth the shadow model knows: the WGS84 ellipsoid, or a sphere of the
+#: equatorial radius.
+EARTH_MODELS = ("wgs84", "sphere")
 
 
 #: Nominal solar radius (IAU 2015 Resolution B3) [km].
@@ -67,18 +97,71 @@ def disc_overlap_fraction(a: ArrayLike, b: ArrayLike, c: ArrayLike) -> NDArray[n
     return np.clip(out, 0.0, 1.0)
 
 
+def _stretch(x: NDArray[np.float64], pole: NDArray[np.float64], k: float) -> NDArray[np.float64]:
+    """``x + (k - 1) (x . p) p``: the stretch by ``k`` along the unit vector ``p``."""
+    return x + (k - 1.0) * np.einsum("...i,...i->...", x, pole)[..., None] * pole
+
+
+def shadow_angles(
+    position_km: ArrayLike,
+    sun_km: ArrayLike,
+    earth: str = "wgs84",
+    pole: ArrayLike = (0.0, 0.0, 1.0),
+    earth_radius_km: float = EARTH_RADIUS_KM,
+    sun_radius_km: float = SUN_RADIUS_KM,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Apparent radii of the Sun and the Earth and their separation [rad] (see the module).
+
+    The arguments are those of :func:`sunlit_fraction`; returns ``(a, b, c)`` for
+    :func:`disc_overlap_fraction`.  The umbra is ``c < b - a``, the penumbra
+    ``b - a < c < a + b``.
+    """
+    if earth not in EARTH_MODELS:
+        raise ObservationError(f"earth: got {earth!r}; allowed: {', '.join(EARTH_MODELS)}")
+    r = np.asarray(position_km, dtype=np.float64)
+    s = np.asarray(sun_km, dtype=np.float64)
+    factor: NDArray[np.float64] | float = 1.0
+    if earth == "wgs84":
+        p = np.asarray(pole, dtype=np.float64)
+        p = p / np.linalg.norm(p, axis=-1, keepdims=True)
+        k = 1.0 / (1.0 - WGS84_FLATTENING)
+        r, s = _stretch(r, p, k), _stretch(s, p, k)
+        # Unit vector across the line of sight towards the Earth's centre (any one on the
+        # axis of the shadow, where the factor does not matter: the discs are concentric).
+        e = (
+            -r
+            - np.einsum("...i,...i->...", -r, s)[..., None]
+            * s
+            / np.einsum("...i,...i->...", s, s)[..., None]
+        )
+        ne = np.linalg.norm(e, axis=-1)
+        e = e / np.where(ne > 0, ne, 1.0)[..., None]
+        factor = np.where(ne > 0, np.linalg.norm(_stretch(e, p, k), axis=-1), 1.0)
+    dr = np.linalg.norm(r, axis=-1)
+    ds = np.linalg.norm(s, axis=-1)
+    a = np.arcsin(np.minimum(sun_radius_km * factor / ds, 1.0))
+    b = np.arcsin(np.minimum(earth_radius_km / dr, 1.0))
+    c = np.arctan2(np.linalg.norm(np.cross(s, -r), axis=-1), np.einsum("...i,...i->...", s, -r))
+    return a, b, c
+
+
 def sunlit_fraction(
     position_km: ArrayLike,
     sun_km: ArrayLike,
     earth_radius_km: float = EARTH_RADIUS_KM,
     sun_radius_km: float = SUN_RADIUS_KM,
+    *,
+    earth: str = "wgs84",
+    pole: ArrayLike = (0.0, 0.0, 1.0),
 ) -> NDArray[np.float64]:
     """Fraction of the solar disc seen from a spacecraft that the Earth does not hide.
 
-    Apparent radii ``a = asin(R_sun/|s|)``, ``b = asin(R_earth/|r|)`` and separation ``c``
-    (angle between ``s`` and ``-r``, by ``atan2``) enter :func:`disc_overlap_fraction`
-    (Montenbruck & Gill 2000, §3.4.2): 0 in the umbra, the visible fraction of the disc
-    in the penumbra, 1 in sunlight.
+    Apparent radii ``a`` (Sun) and ``b`` (Earth) and separation ``c`` enter
+    :func:`disc_overlap_fraction` (Montenbruck & Gill 2000, §3.4.2): 0 in the umbra, the
+    visible fraction of the disc in the penumbra, 1 in sunlight.  For a sphere
+    ``a = asin(R_sun/|s|)``, ``b = asin(R_earth/|r|)`` and ``c`` the angle between ``s`` and
+    ``-r``; for the WGS84 ellipsoid the same after the stretch along the pole of the module
+    description.
 
     Parameters
     ----------
@@ -87,24 +170,118 @@ def sunlit_fraction(
     sun_km : array_like, shape (..., 3)
         Position of the Sun relative to the spacecraft [km].
     earth_radius_km, sun_radius_km : float
-        Radii of the spheres [km]; ``sun_radius_km = 0`` gives a point Sun.
+        Equatorial radius of the Earth and radius of the Sun [km]; ``sun_radius_km = 0``
+        gives a point Sun.
+    earth : {"wgs84", "sphere"}
+        The WGS84 ellipsoid (polar radius ``earth_radius_km (1 - f)``,
+        :data:`WGS84_FLATTENING`) or a sphere of radius ``earth_radius_km``.
+    pole : array_like, shape (..., 3)
+        The Earth's rotation axis in the frame of the vectors (the ITRS ``z`` axis; the
+        GCRS ``z`` axis is off it by precession and nutation, 0.13 degree in 2024).
 
     Returns
     -------
     ndarray, shape (...)
 
+    Raises
+    ------
+    ObservationError
+        For an unknown ``earth``.
+
     Examples
     --------
     >>> sun = [[1.5e8, 0.0, 0.0]] * 3  # the Sun along +x from each spacecraft [km]
     >>> pos = [[7000.0, 0.0, 0.0], [-7000.0, 0.0, 0.0], [-7000.0, 6378.137, 0.0]]
-    >>> np.round(sunlit_fraction(pos, sun), 3)  # day side, umbra, near the shadow's edge
+    >>> np.round(sunlit_fraction(pos, sun, earth="sphere"), 3)  # day, umbra, shadow's edge
     array([1.   , 0.   , 0.501])
+    >>> over_pole = [-7000.0, 0.0, 6380.0]  # a sphere hides more than the ellipsoid here
+    >>> np.round([sunlit_fraction(over_pole, sun[0], earth=e) for e in EARTH_MODELS], 3)
+    array([0.913, 0.537])
     """
+    return disc_overlap_fraction(
+        *shadow_angles(position_km, sun_km, earth, pole, earth_radius_km, sun_radius_km)
+    )
+
+
+#: Names of the shadow events of :func:`shadow_events`, in the order of an eclipse.
+SHADOW_EVENTS = ("penumbra_entry", "umbra_entry", "umbra_exit", "penumbra_exit")
+
+
+def shadow_events(
+    times: ArrayLike,
+    position_km: ArrayLike,
+    sun_km: ArrayLike,
+    *,
+    earth: str = "wgs84",
+    pole: ArrayLike = (0.0, 0.0, 1.0),
+    earth_radius_km: float = EARTH_RADIUS_KM,
+    sun_radius_km: float = SUN_RADIUS_KM,
+) -> dict[str, NDArray[np.datetime64]]:
+    """UTC times the spacecraft crosses the edges of the penumbra and the umbra.
+
+    The vectors sampled at ``times`` are interpolated by cubic splines in time; an edge is
+    a sign change of ``c - (a + b)`` (penumbra) or ``c - (b - a)`` (umbra) of
+    :func:`shadow_angles` between two samples, refined by Brent's method to 1 µs.  Two
+    crossings of one edge within one step are not seen.
+
+    Parameters
+    ----------
+    times : array_like of datetime64, shape (n,)
+        Strictly increasing UTC times.
+    position_km, sun_km : array_like, shape (n, 3)
+        As in :func:`sunlit_fraction`, at ``times``.
+    earth, pole, earth_radius_km, sun_radius_km
+        As in :func:`sunlit_fraction`; ``pole`` of shape (3,) or (n, 3).
+
+    Returns
+    -------
+    dict
+        For each name of :data:`SHADOW_EVENTS` the datetime64[ns] times of that event,
+        in order (empty when there is none).
+
+    Examples
+    --------
+    >>> t = np.datetime64("2024-01-01T00:00:00", "ns") + np.arange(0, 121, 10) * 10**9
+    >>> w = 2 * np.pi / 5900.0  # a circular orbit of 7000 km in the Sun's plane [rad s-1]
+    >>> phase = 1.95 + w * np.arange(0, 121, 10)
+    >>> pos = 7000.0 * np.stack([np.cos(phase), np.sin(phase), 0 * phase], axis=1)
+    >>> ev = shadow_events(t, pos, [1.5e8, 0.0, 0.0] - pos, earth="sphere")
+    >>> for k, v in ev.items():  # entering the shadow
+    ...     print(k, v.astype("datetime64[ms]"))
+    penumbra_entry ['2024-01-01T00:00:38.326']
+    umbra_entry ['2024-01-01T00:00:47.036']
+    umbra_exit []
+    penumbra_exit []
+    """
+    from scipy.interpolate import CubicSpline
+    from scipy.optimize import brentq
+
+    t = np.asarray(times).astype("datetime64[ns]")
+    out: dict[str, NDArray[np.datetime64]] = {k: t[:0] for k in SHADOW_EVENTS}
+    if t.size < 2:
+        return out
+    secs = (t - t[0]).astype(np.int64) / 1e9
     r = np.asarray(position_km, dtype=np.float64)
-    s = np.asarray(sun_km, dtype=np.float64)
-    dr = np.linalg.norm(r, axis=-1)
-    ds = np.linalg.norm(s, axis=-1)
-    a = np.arcsin(np.minimum(sun_radius_km / ds, 1.0))
-    b = np.arcsin(np.minimum(earth_radius_km / dr, 1.0))
-    c = np.arctan2(np.linalg.norm(np.cross(s, -r), axis=-1), np.einsum("...i,...i->...", s, -r))
-    return disc_overlap_fraction(a, b, c)
+    s = np.broadcast_to(np.asarray(sun_km, dtype=np.float64), r.shape)
+    p = np.broadcast_to(np.asarray(pole, dtype=np.float64), r.shape)
+    spline = CubicSpline(secs, np.concatenate([r, s, p], axis=1), axis=0)
+
+    def edges(x: ArrayLike) -> NDArray[np.float64]:
+        v = spline(x)
+        a, b, c = shadow_angles(
+            v[..., 0:3], v[..., 3:6], earth, v[..., 6:9], earth_radius_km, sun_radius_km
+        )
+        return np.stack([c - (a + b), c - (b - a)], axis=-1)
+
+    g = edges(secs)
+    for j, (entry, leave) in enumerate(
+        (("penumbra_entry", "penumbra_exit"), ("umbra_entry", "umbra_exit"))
+    ):
+        inside = g[:, j] < 0
+        found: dict[str, list[float]] = {entry: [], leave: []}
+        for i in np.flatnonzero(inside[1:] != inside[:-1]):
+            root = brentq(lambda x, j=j: float(edges(x)[j]), secs[i], secs[i + 1], xtol=1e-6)
+            found[entry if inside[i + 1] else leave].append(root)
+        for k, v in found.items():
+            out[k] = t[0] + np.round(np.asarray(v) * 1e9).astype("timedelta64[ns]")
+    return out

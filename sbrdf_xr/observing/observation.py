@@ -25,12 +25,15 @@ Frames and models
   splined (they vary over days), so that one skyfield pass serves thousands of times.
 * Elevation and azimuth (from north through east) are taken in the site's geodetic
   (WGS84) horizon.
-* Earth shadow (:mod:`sbrdf_xr.observing.earth_shadow`): a spherical Earth of radius
-  :data:`~sbrdf_xr.observing.earth_shadow.EARTH_RADIUS_KM` and the Sun's finite disc (radius
+* Earth shadow (:mod:`sbrdf_xr.observing.earth_shadow`): the WGS84 ellipsoid (pole the ITRS
+  ``z`` axis, polar motion included), or with ``earth="sphere"`` a sphere of radius
+  :data:`~sbrdf_xr.observing.earth_shadow.EARTH_RADIUS_KM`, and the Sun's finite disc (radius
   :data:`~sbrdf_xr.observing.earth_shadow.SUN_RADIUS_KM`); the sunlit fraction is the fraction of
   the apparent solar disc not covered by the apparent Earth disc, from the exact area of
   overlap of the two circles (Montenbruck & Gill, *Satellite Orbits*, 2000, §3.4.2,
-  eqs. 3.85-3.89).  No atmosphere (refraction, absorption) is modelled.
+  eqs. 3.85-3.89).  The UTC times of the edges of the penumbra and the umbra crossed in the
+  window are attributes (``penumbra_entry``, ``umbra_entry``, ``umbra_exit``,
+  ``penumbra_exit``).  No atmosphere (refraction, absorption) is modelled.
 * Airmass: relative airmass of the geometric elevation by a pvlib model
   (:func:`pvlib.atmosphere.get_relative_airmass`), Kasten & Young (1989) by default;
   NaN below the horizon.
@@ -51,7 +54,14 @@ from .._names import VECTOR, attrs
 from ..errors import AttitudeError, EpochGapWarning, NotObservableError, ObservationError
 from ..geometry import rotation_matrices
 from . import attitude as _att
-from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, sunlit_fraction
+from .earth_shadow import (
+    EARTH_MODELS,
+    EARTH_RADIUS_KM,
+    SUN_RADIUS_KM,
+    WGS84_FLATTENING,
+    shadow_events,
+    sunlit_fraction,
+)
 from .orbits import AIRMASS_MODELS, AU_KM, EPOCH_GAP_DAYS, Orbit, Site, airmass
 from .timescales import check_times, skyfield_data, skyfield_time, skyfield_utc, spline_knots
 
@@ -178,6 +188,8 @@ class Observation:
         Elevation [degree] below which the object counts as not observable (for the
         whole-window check of :meth:`geometry`).
     name : str
+    earth : {"wgs84", "sphere"}
+        Shape of the Earth for its shadow (:data:`~sbrdf_xr.observing.earth_shadow.EARTH_MODELS`).
 
     Warns
     -----
@@ -208,6 +220,7 @@ class Observation:
     airmass_model: str = "kastenyoung1989"
     min_elevation_deg: float = 0.0
     name: str = "observation"
+    earth: str = "wgs84"
     _cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -223,6 +236,8 @@ class Observation:
             raise ObservationError(
                 f"airmass_model: got {self.airmass_model!r}; allowed: {', '.join(AIRMASS_MODELS)}"
             )
+        if self.earth not in EARTH_MODELS:
+            raise ObservationError(f"earth: got {self.earth!r}; allowed: {', '.join(EARTH_MODELS)}")
         if not -90.0 <= float(self.min_elevation_deg) <= 90.0:
             raise ObservationError(
                 f"min_elevation_deg: must lie in [-90, 90], got {self.min_elevation_deg}"
@@ -378,7 +393,8 @@ class Observation:
         sun_el = np.degrees(
             np.arctan2(sun_site_itrs @ up, np.hypot(sun_site_itrs @ east, sun_site_itrs @ north))
         )
-        sunlit = sunlit_fraction(r, sun)
+        pole = np.moveaxis(rot[2], 0, -1)  # the ITRS z axis in the GCRS, (n, 3)
+        sunlit = sunlit_fraction(r, sun, earth=self.earth, pole=pole)
         phase = _angle(sun, los)
         elong = _angle(sun_site, -los)
         earth_phase = _angle(sun + r, r)
@@ -429,6 +445,9 @@ class Observation:
         data = {k: ((TIME, VECTOR), val, ATTRS[k]) for k, val in body.items()}
         data["quaternion"] = ((TIME, COMPONENT), q, ATTRS["quaternion"])
         ds = xr.Dataset(data, coords=coords, attrs=self._attrs())
+        for k, when in shadow_events(self.times, r, sun, earth=self.earth, pole=pole).items():
+            ms = (when + np.timedelta64(500_000, "ns")).astype("datetime64[ms]")  # rounded
+            ds.attrs[k] = " ".join(str(w) for w in ms)
         ds[TIME].encoding.update(
             units="seconds since 1970-01-01 00:00:00", calendar="standard", dtype="float64"
         )
@@ -465,8 +484,14 @@ class Observation:
                 f"{getattr(skyfield_data, '__version__', '')}"
             ).strip(),
             "shadow_model": (
-                f"spherical Earth R = {EARTH_RADIUS_KM} km, solar disc R = {SUN_RADIUS_KM} km, "
-                "exact disc-overlap area (Montenbruck & Gill 2000, 3.4.2)"
+                (
+                    f"WGS84 ellipsoid a = {EARTH_RADIUS_KM} km, 1/f = {1 / WGS84_FLATTENING:.9f}"
+                    if self.earth == "wgs84"
+                    else f"spherical Earth R = {EARTH_RADIUS_KM} km"
+                )
+                + f", solar disc R = {SUN_RADIUS_KM} km, "
+                "exact disc-overlap area (Montenbruck & Gill 2000, 3.4.2); "
+                "edge times UTC [ms], space-separated, empty when none"
             ),
             "airmass_model": self.airmass_model,
         }

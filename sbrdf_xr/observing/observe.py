@@ -75,7 +75,8 @@ def observation_from_dict(
     or a table ``{latitude_deg, longitude_deg, height_m, name}``; times as ``start``,
     ``stop``, ``step_s`` or a list ``times``; ``attitude`` a table for
     :func:`sbrdf_xr.observing.attitude.law_from_dict`; optional ``airmass_model``,
-    ``min_elevation_deg``, ``name``.  Relative paths are taken from ``base_dir``.
+    ``min_elevation_deg``, ``name`` and ``earth`` (``"wgs84"``, the default, or
+    ``"sphere"``: the Earth of the shadow).  Relative paths are taken from ``base_dir``.
     Example::
 
         [observation]
@@ -116,6 +117,7 @@ def observation_from_dict(
         "attitude",
         "airmass_model",
         "min_elevation_deg",
+        "earth",
     }
     if not isinstance(table, Mapping):
         raise ObservationError(f"[observation]: expected a table, got {type(table).__name__}")
@@ -182,7 +184,9 @@ def observation_from_dict(
     att = table.get("attitude")
     if isinstance(att, Mapping) and att.get("law") == "quaternion_series" and "path" in att:
         att = {**att, "path": str(resolve(att["path"]))}
-    kw = {k: table[k] for k in ("airmass_model", "min_elevation_deg", "name") if k in table}
+    kw = {
+        k: table[k] for k in ("airmass_model", "min_elevation_deg", "name", "earth") if k in table
+    }
     return Observation(orbit, site, t, att, **kw)
 
 
@@ -200,7 +204,8 @@ class _PassWindow(TypedDict):
 #: The built-in example: orbit and site catalog entries and the pass window (UTC), found
 #: with ``tools/build_observe.py``: the site in astronomical darkness (Sun below
 #: -25 deg), the spacecraft between 27 and 76 deg elevation, leaving the Earth's shadow
-#: in the first minute (penumbra 01:20:46-01:21:00) and sunlit for the remaining four.
+#: in the first minute (penumbra 01:20:40-01:20:55 on the WGS84 ellipsoid, 01:20:45-01:21:01
+#: on a sphere) and sunlit for the remaining four.
 CANX1_PASS: _PassWindow = {
     "orbit": "canx1-example",
     "site": "mont-megantic",

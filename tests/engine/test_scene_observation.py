@@ -44,6 +44,10 @@ def test_cube_has_a_time_axis_with_the_observation_as_coordinates(cube):
         assert cube[c].attrs["long_name"]
     for a in ("tle_line1", "tle_line2", "site_latitude", "site_longitude", "site_height"):
         assert cube.attrs[a] == g.attrs[a]
+    # The Earth's shadow edges crossed in the window (WGS84 ellipsoid), UTC to the ms.
+    assert cube.attrs["umbra_exit"] == g.attrs["umbra_exit"] == "2024-03-17T01:20:39.966"
+    assert cube.attrs["penumbra_exit"] == "2024-03-17T01:20:55.237"
+    assert cube.attrs["umbra_entry"] == cube.attrs["penumbra_entry"] == ""
     # The body-frame directions are the observation's own.
     np.testing.assert_array_equal(cube.to_sun.values, g.to_sun.values)
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import datetime as dt
 import json
 import subprocess
@@ -119,8 +120,9 @@ def test_sun_direction_and_phase_angle_against_skyfield(canx1):
 
 def test_shadow_boundary_brackets_skyfield_is_sunlit(canx1):
     # skyfield's is_sunlit is a point Sun with a spherical Earth: its switch must fall in
-    # our penumbra, where the disc is about half covered.
-    obs, g = canx1
+    # the penumbra of our spherical Earth, where the disc is about half covered.
+    obs = dataclasses.replace(canx1[0], earth="sphere")
+    g = obs.geometry()
     _, eph = orbits.skyfield_data()
     t, _ = skyfield_times(g.time.values)
     lit = obs.orbit.satellite.at(t).is_sunlit(eph)
@@ -139,14 +141,15 @@ MU = 398600.4418
 
 
 def circular_shadow_times(radius, beta_deg, sun_distance, sun_radius):
-    """Penumbra and umbra entry times of a circular orbit (model under test)."""
+    """Penumbra and umbra entry times of a circular orbit (model under test, a sphere)."""
     n = np.sqrt(MU / radius**3)
     beta = np.radians(beta_deg)
     s_hat = np.array([np.cos(beta), 0.0, np.sin(beta)])
 
     def frac(t):
         r = radius * np.array([np.cos(n * t), np.sin(n * t), 0.0])
-        return float(observe.sunlit_fraction(r, sun_distance * s_hat - r, sun_radius_km=sun_radius))
+        s = sun_distance * s_hat - r
+        return float(observe.sunlit_fraction(r, s, sun_radius_km=sun_radius, earth="sphere"))
 
     x_cyl = np.sqrt(radius**2 - R_E**2)
     t_cyl = np.arccos(-x_cyl / (radius * np.cos(beta))) / n
