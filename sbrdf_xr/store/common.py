@@ -62,7 +62,32 @@ _STYLE: contextvars.ContextVar[str] = contextvars.ContextVar(
 
 @contextlib.contextmanager
 def command_line_messages() -> Any:
-    """Within this context, messages name command-line options (``--resume``), not arguments."""
+    """Within this context, messages name command-line options (``--resume``), not arguments.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import dask.array as da
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.common import command_line_messages
+    >>> from sbrdf_xr.store.writer import write_cube
+    >>> ds = xr.Dataset({"radiance": ("attitude", da.ones(4, chunks=2))})
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = Path(tmp) / "cube.nc"
+    ...     _ = path.write_bytes(b"")  # a file already there: write_cube refuses to replace it
+    ...     try:
+    ...         write_cube(ds, path)
+    ...     except FileExistsError as exc:
+    ...         print(str(exc).split("; ")[1])
+    ...     with command_line_messages():
+    ...         try:
+    ...             write_cube(ds, path)
+    ...         except FileExistsError as exc:
+    ...             print(str(exc).split("; ")[1])
+    pass overwrite=True to replace it
+    pass --overwrite to replace it
+    """
     token = _STYLE.set("cli")
     try:
         yield
@@ -103,6 +128,23 @@ class BlockWritten:
         Blocks in the cube.
     in_flight : int
         Blocks submitted for computation but not yet written, after this one.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import dask.array as da
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.writer import write_cube
+    >>> ds = xr.Dataset({"radiance": (("attitude", "wavelength"), da.ones((4, 3), chunks=(2, 3)))})
+    >>> events = []
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = Path(tmp) / "cube.nc"
+    ...     _ = write_cube(ds, path, scheduler="synchronous", on_block=events.append)
+    >>> for e in events:
+    ...     print(e.index, e.slices["attitude"], f"{e.n_written}/{e.n_blocks}", e.in_flight)
+    0 slice(0, 2, None) 1/2 0
+    1 slice(2, 4, None) 2/2 0
     """
 
     index: int
@@ -184,7 +226,18 @@ class _NoRoom(OSError):
 
 def libc_function(name: str, argtypes: list[Any], restype: Any) -> Any:
     """The C library's function ``name`` through ctypes (``errno`` kept), or None where
-    the C library has no such function."""
+    the C library has no such function.
+
+    Examples
+    --------
+    >>> import ctypes
+    >>> from sbrdf_xr.store.common import libc_function
+    >>> strlen = libc_function("strlen", [ctypes.c_char_p], ctypes.c_size_t)
+    >>> strlen(b"spectral")
+    8
+    >>> libc_function("no_such_libc_function", [], ctypes.c_int) is None
+    True
+    """
     try:
         import ctypes
         import ctypes.util
@@ -217,6 +270,15 @@ def release_freed_memory() -> None:
     it streams the blocks; Dask's documentation recommends the same call for memory
     that was freed but not released.  On this project's 2-core machine it lowered a
     1e6-attitude write's peak resident memory by about 50 MiB.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.store.common import release_freed_memory
+    >>> temporaries = [np.ones(2**16) for _ in range(16)]
+    >>> del temporaries
+    >>> release_freed_memory() is None  # nothing to return, and safe on any platform
+    True
     """
     if _MALLOC_TRIM is not None:
         _MALLOC_TRIM(0)

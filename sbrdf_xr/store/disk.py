@@ -45,6 +45,23 @@ HEAD_BYTES = 4096
 
 
 def fsync_dir(directory: Path) -> None:
+    """``fsync`` ``directory``, so that a file created, renamed or removed in it stays so
+    after a crash; a directory that cannot be opened is skipped without error.
+
+    Examples
+    --------
+    >>> import os
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.store.disk import fsync_dir
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     _ = (Path(tmp) / "cube.nc.part").write_bytes(b"data")
+    ...     os.replace(Path(tmp) / "cube.nc.part", Path(tmp) / "cube.nc")
+    ...     fsync_dir(Path(tmp))  # the rename is now durable
+    ...     fsync_dir(Path(tmp) / "missing")  # nothing to sync: no error
+    ...     print(os.listdir(tmp))
+    ['cube.nc']
+    """
     with contextlib.suppress(OSError):
         fd = os.open(directory, os.O_RDONLY)
         try:
@@ -54,7 +71,27 @@ def fsync_dir(directory: Path) -> None:
 
 
 def check_room(part: Path, need: int) -> None:
-    """Refuse, before writing, ``need`` bytes (plus metadata) that would not fit."""
+    """Refuse, before writing, ``need`` bytes (plus metadata) that would not fit.
+
+    Raises an :class:`OSError` with ``errno`` ``ENOSPC`` (not enough free space on the
+    file system of ``part``) or ``EFBIG`` (``part`` would grow past ``RLIMIT_FSIZE``).
+
+    Examples
+    --------
+    >>> import errno
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.store.disk import check_room
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     part = Path(tmp) / "cube.nc.part"
+    ...     print(check_room(part, 4096))
+    ...     try:
+    ...         check_room(part, 2**62)  # 4 EiB: more than any disk holds
+    ...     except OSError as exc:
+    ...         print(errno.errorcode[exc.errno], str(exc).split(",")[0])
+    None
+    ENOSPC [Errno 28] about 4398046511104.2 MiB needed
+    """
     if not CHECK_SPACE:
         return
     need = int(need) + _SPACE_MARGIN
@@ -82,6 +119,27 @@ FALLOC_FL_KEEP_SIZE = 1
 
 
 def fallocate_fn() -> Any:
+    """The C library's ``fallocate(fd, mode, offset, length)`` through ctypes (0 on
+    success, -1 with ``ctypes.get_errno()`` set on failure), or None without it.
+
+    Examples
+    --------
+    >>> import os
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.store.disk import FALLOC_FL_KEEP_SIZE, fallocate_fn
+    >>> fallocate = fallocate_fn()
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     fd = os.open(Path(tmp) / "cube.nc.part", os.O_RDWR | os.O_CREAT)
+    ...     try:
+    ...         print(fallocate(fd, FALLOC_FL_KEEP_SIZE, 0, 2**20))
+    ...         st = os.fstat(fd)
+    ...     finally:
+    ...         os.close(fd)
+    0
+    >>> st.st_size, st.st_blocks * 512 >= 2**20  # size unchanged, 1 MiB of disk allocated
+    (0, True)
+    """
     import ctypes
 
     return libc_function(
@@ -122,6 +180,23 @@ def reserve(fd: int, nbytes: int) -> None:
     HDF5 appends each block at the end of the file; with the room already allocated
     a full disk is found here, before HDF5 writes anything, instead of in the middle
     of HDF5's flush.  File systems without ``fallocate`` skip the reservation.
+
+    Examples
+    --------
+    >>> import os
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.store.disk import reserve
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     fd = os.open(Path(tmp) / "cube.nc.part", os.O_RDWR | os.O_CREAT)
+    ...     try:
+    ...         _ = os.write(fd, b"superblock")
+    ...         reserve(fd, 2**20)  # room for a 1 MiB block, past the end of the file
+    ...         st = os.fstat(fd)
+    ...     finally:
+    ...         os.close(fd)
+    >>> st.st_size, st.st_blocks * 512 >= 2**20 + 10
+    (10, True)
     """
     _allocate(fd, os.fstat(fd).st_size, int(nbytes) + _SPACE_MARGIN, "for the next block")
 
@@ -137,6 +212,23 @@ def drop_behind(fd: int) -> None:
     page reporting): on this project's 2-core machine a 225 MB cube written through
     fresh pages ran at about 300 MB/s, and about 2.5x faster with its pages dropped
     behind it.  A no-op where ``posix_fadvise`` is missing.
+
+    Examples
+    --------
+    >>> import os
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.store.disk import drop_behind
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     fd = os.open(Path(tmp) / "cube.nc.part", os.O_RDWR | os.O_CREAT)
+    ...     try:
+    ...         _ = os.write(fd, b"block 0")
+    ...         os.fsync(fd)
+    ...         drop_behind(fd)  # only the cache goes: the synced data stay
+    ...         print(os.pread(fd, 7, 0))
+    ...     finally:
+    ...         os.close(fd)
+    b'block 0'
     """
     advise = getattr(os, "posix_fadvise", None)
     if advise is not None:
@@ -153,6 +245,31 @@ class SyncBehind:
     failed sync nothing more is logged (a later ``fsync`` may succeed although data
     were lost).  The writing thread takes each block back with :meth:`wait_oldest`,
     which raises that block's ``OSError``.
+
+    Examples
+    --------
+    >>> import os
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.store.disk import SyncBehind
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     fd = os.open(Path(tmp) / "cube.nc.part", os.O_RDWR | os.O_CREAT)
+    ...     log_fd = os.open(Path(tmp) / "cube.nc.part.jsonl", os.O_WRONLY | os.O_CREAT)
+    ...     sync = SyncBehind(fd, log_fd)
+    ...     try:
+    ...         for k in range(3):
+    ...             _ = os.write(fd, b"block")  # block k written to the cube file
+    ...             sync.submit(k)  # synced and logged while the next one is written
+    ...         print([sync.wait_oldest() for _ in range(3)])
+    ...     finally:
+    ...         sync.close()
+    ...         os.close(fd)
+    ...         os.close(log_fd)
+    ...     print((Path(tmp) / "cube.nc.part.jsonl").read_text(), end="")
+    [0, 1, 2]
+    {"block": 0}
+    {"block": 1}
+    {"block": 2}
     """
 
     def __init__(self, fd: int, log_fd: int) -> None:
@@ -198,7 +315,27 @@ class SyncBehind:
 
 
 def file_kind(p: Path) -> str | None:
-    """None if nothing is at ``p``, ``"file"`` for a regular file, else what it is."""
+    """None if nothing is at ``p``, ``"file"`` for a regular file, else what it is.
+
+    Examples
+    --------
+    >>> import os
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.store.disk import file_kind
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     d = Path(tmp)
+    ...     _ = (d / "cube.nc").write_bytes(b"")
+    ...     (d / "link.nc").symlink_to(d / "cube.nc")
+    ...     os.mkfifo(d / "pipe.nc")
+    ...     for name in ("missing.nc", "cube.nc", "link.nc", "pipe.nc", "."):
+    ...         print(name, file_kind(d / name))
+    missing.nc None
+    cube.nc file
+    link.nc a symbolic link
+    pipe.nc a FIFO (named pipe)
+    . a directory
+    """
     try:
         mode = os.lstat(p).st_mode
     except (FileNotFoundError, NotADirectoryError):
@@ -224,6 +361,31 @@ def fence(part: Path) -> None:
     and point it at data that never reached the disk.  Replacing HDF5's descriptor by
     a read-only one on the same file makes those writes fail harmlessly, so the file
     can be cut back to its last synced size.  (Linux: descriptors found in /proc.)
+
+    Examples
+    --------
+    >>> import errno
+    >>> import os
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.store.disk import fence
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     part = Path(tmp) / "cube.nc.part"
+    ...     _ = part.write_bytes(b"synced")
+    ...     fd = os.open(part, os.O_RDWR)  # as HDF5 holds it
+    ...     try:
+    ...         fence(part)
+    ...         try:
+    ...             os.write(fd, b"torn metadata")
+    ...         except OSError as exc:
+    ...             print(errno.errorcode[exc.errno])
+    ...         print(os.pread(fd, 6, 0))  # still readable
+    ...     finally:
+    ...         os.close(fd)
+    ...     print(part.read_bytes())
+    EBADF
+    b'synced'
+    b'synced'
     """
     fds = Path("/proc/self/fd")
     if not fds.is_dir():  # pragma: no cover - not Linux
@@ -257,6 +419,28 @@ def cut_back(part: Path, size: int, head: bytes) -> str | None:
     HDF5 rewrites its superblock (at the start of the file, holding the end-of-file
     address) in place when a write fails; the rest of the synced file is untouched
     (blocks are appended).  Returns None if the file then opens, else why not.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import netCDF4
+    >>> from sbrdf_xr.store.disk import HEAD_BYTES, cut_back
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     part = Path(tmp) / "cube.nc.part"
+    ...     with netCDF4.Dataset(part, "w") as nc:
+    ...         _ = nc.createDimension("attitude", 3)
+    ...         nc.createVariable("radiance", "f4", ("attitude",))[:] = [1.0, 2.0, 3.0]
+    ...     size, head = part.stat().st_size, part.read_bytes()[:HEAD_BYTES]  # last synced
+    ...     with open(part, "r+b") as f:  # a failed write: superblock torn, bytes appended
+    ...         _ = f.write(bytes(64))
+    ...         _ = f.seek(0, 2)
+    ...         _ = f.write(b"x" * 1000)
+    ...     print(cut_back(part, size, head), part.stat().st_size == size)
+    ...     with netCDF4.Dataset(part) as nc:
+    ...         print(nc["radiance"][:].tolist())
+    None True
+    [1.0, 2.0, 3.0]
     """
     try:
         if part.stat().st_size > size:
@@ -273,7 +457,25 @@ def cut_back(part: Path, size: int, head: bytes) -> str | None:
 
 
 def check_opens(part: Path) -> str | None:
-    """None if ``part`` opens as netCDF in a fresh process (this one's HDF5 may still hold it)."""
+    """None if ``part`` opens as netCDF in a fresh process (this one's HDF5 may still hold it).
+
+    Otherwise the last line of that process's error output says why not.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import netCDF4
+    >>> from sbrdf_xr.store.disk import check_opens
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     good, bad = Path(tmp) / "good.nc", Path(tmp) / "bad.nc"
+    ...     netCDF4.Dataset(good, "w").close()
+    ...     _ = bad.write_bytes(b"not a netCDF file")
+    ...     print(check_opens(good))
+    ...     print(check_opens(bad).rsplit(":", 1)[0])  # the file's name follows
+    None
+    OSError: [Errno -51] NetCDF: Unknown file format
+    """
     import subprocess
 
     code = "import sys, netCDF4; netCDF4.Dataset(sys.argv[1]).close()"

@@ -10,7 +10,25 @@ __all__ = ["NoProgress", "TextProgress", "progress_bar"]
 
 
 class TextProgress:
-    """A one-line stderr counter, used when tqdm is not installed."""
+    """A one-line stderr counter, used when tqdm is not installed.
+
+    It shows ``initial`` at once, then at most twice a second, and always the last block.
+
+    Examples
+    --------
+    >>> import contextlib
+    >>> import io
+    >>> from sbrdf_xr.store.progress import TextProgress
+    >>> err = io.StringIO()
+    >>> with contextlib.redirect_stderr(err):
+    ...     bar = TextProgress(total=4, initial=1, desc="cube.nc")  # 1 block from a resumed run
+    ...     bar.update(3)
+    ...     bar.close()
+    >>> err.getvalue().endswith("\\n")  # close ends the line
+    True
+    >>> err.getvalue().rstrip().split("\\r")[1:]  # each redraw starts with a carriage return
+    ['cube.nc: 1/4 blocks', 'cube.nc: 4/4 blocks', 'cube.nc: 4/4 blocks']
+    """
 
     def __init__(self, total: int, initial: int, desc: str) -> None:
         self.n, self.total, self.desc = initial, total, desc
@@ -35,6 +53,22 @@ class TextProgress:
 
 
 class NoProgress:
+    """The progress bar of a write that shows none: :meth:`update` and :meth:`close` do nothing.
+
+    Examples
+    --------
+    >>> import contextlib
+    >>> import io
+    >>> from sbrdf_xr.store.progress import NoProgress
+    >>> err = io.StringIO()
+    >>> with contextlib.redirect_stderr(err):
+    ...     bar = NoProgress()
+    ...     bar.update(3)
+    ...     bar.close()
+    >>> err.getvalue()
+    ''
+    """
+
     def update(self, n: int = 1) -> None:
         pass
 
@@ -43,6 +77,40 @@ class NoProgress:
 
 
 def progress_bar(enabled: bool, total: int, initial: int, desc: str) -> Any:
+    """A progress bar of ``total`` blocks on stderr, starting at ``initial``.
+
+    Parameters
+    ----------
+    enabled : bool
+        False gives a :class:`NoProgress`, which shows nothing.
+    total, initial : int
+        Blocks in the cube, and blocks already written (by a resumed run).
+    desc : str
+        Label in front of the count (the cube's file name).
+
+    Returns
+    -------
+    tqdm.tqdm or TextProgress or NoProgress
+        A tqdm bar counting in ``block`` units if tqdm is installed, else a
+        :class:`TextProgress`; each has ``update(n)`` and ``close()``.
+
+    Examples
+    --------
+    >>> import contextlib
+    >>> import io
+    >>> from sbrdf_xr.store.progress import progress_bar
+    >>> type(progress_bar(False, total=4, initial=0, desc="cube.nc")).__name__
+    'NoProgress'
+    >>> err = io.StringIO()
+    >>> with contextlib.redirect_stderr(err):
+    ...     bar = progress_bar(True, total=4, initial=1, desc="cube.nc")
+    ...     bar.update(3)
+    ...     print(bar.n, bar.total)
+    ...     bar.close()
+    4 4
+    >>> "cube.nc: " in err.getvalue()
+    True
+    """
     if not enabled:
         return NoProgress()
     try:

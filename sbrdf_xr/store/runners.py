@@ -201,6 +201,22 @@ def connect(address: str, timeout: float | str | None = None) -> Any:
         A malformed address.
     SchedulerError
         No scheduler answers at that address in time, or ``distributed`` is missing.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.errors import ValidationError
+    >>> from sbrdf_xr.store.common import SchedulerError
+    >>> from sbrdf_xr.store.runners import connect
+    >>> try:
+    ...     connect("localhost")  # no port
+    ... except ValidationError as exc:
+    ...     print(str(exc).split(";")[0])
+    scheduler: got 'localhost'
+    >>> try:
+    ...     connect("tcp://127.0.0.1:9", timeout=0.2)  # nothing listens on port 9
+    ... except SchedulerError as exc:
+    ...     print(str(exc).split(" (")[0])
+    cannot connect to the Dask scheduler at tcp://127.0.0.1:9
     """
     address = _check_address(address)
     try:
@@ -224,7 +240,39 @@ def connect(address: str, timeout: float | str | None = None) -> Any:
 
 class Feed:
     """The blocks still to compute, handed to the runner so that at most ``limit`` are
-    computed or waiting to be written at any time."""
+    computed or waiting to be written at any time.
+
+    Examples
+    --------
+    >>> import dask
+    >>> import dask.array as da
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.layout import layout_of
+    >>> from sbrdf_xr.store.runners import Feed
+    >>> ds = xr.Dataset({"radiance": ("attitude", da.arange(6.0, chunks=2))})
+    >>> class Runner:  # holds the submitted blocks, computes none
+    ...     def __init__(self):
+    ...         self.tasks = {}
+    ...
+    ...     @property
+    ...     def pending(self):
+    ...         return len(self.tasks)
+    ...
+    ...     def submit(self, k, task):
+    ...         self.tasks[k] = task
+    >>> runner = Runner()
+    >>> feed = Feed(layout_of(ds), runner, todo=[0, 1, 2], limit=2)
+    >>> feed.fill()
+    >>> sorted(runner.tasks), list(feed.todo)
+    ([0, 1], [2])
+    >>> [(name, region) for name, region, _ in feed.pieces[1]]
+    [('radiance', (slice(2, 4, None),))]
+    >>> dask.get(*runner.tasks.pop(1))[0].tolist()  # block 1, computed
+    [2.0, 3.0]
+    >>> feed.fill()  # room for one more
+    >>> sorted(runner.tasks), list(feed.todo)
+    ([0, 2], [])
+    """
 
     def __init__(self, plan: BlockLayout, runner: _Runner, todo: list[int], limit: int) -> None:
         self.plan = plan

@@ -298,6 +298,30 @@ def write_cube(
     Only the calling process writes; workers only compute.  Tasks shared by
     several blocks (for example a lazily built look-up table) are recomputed
     for every block: persist or compute them first.
+
+    Examples
+    --------
+    >>> import os
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import dask.array as da
+    >>> import numpy as np
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.writer import write_cube
+    >>> radiance = da.random.default_rng(0).random((4, 3), chunks=(2, 3)).astype("f4")
+    >>> ds = xr.Dataset(
+    ...     {"radiance": (("attitude", "wavelength"), radiance, {"units": "W m-2 sr-1 nm-1"})},
+    ...     coords={"attitude": np.arange(4), "wavelength": [500.0, 600.0, 700.0]},
+    ... )
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = write_cube(ds, Path(tmp) / "cube.nc")  # 2 blocks of 2 attitudes
+    ...     print(path.name, os.listdir(tmp))  # no .part, .part.jsonl or .lock left
+    ...     with xr.open_dataset(path) as back:
+    ...         print(back.identical(ds.compute()), back["radiance"].dtype)
+    ...     print(write_cube(ds, path, resume=True) == path)  # the same cube: nothing to do
+    cube.nc ['cube.nc']
+    True float32
+    True
     """
     path = Path(path)
     if path.name in ("", ".", ".."):
