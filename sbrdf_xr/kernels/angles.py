@@ -95,6 +95,30 @@ def chunk_angles(
     angles are those of :func:`facet_frame` away from normal incidence
     (in-plane Sun component above the tolerance); callers recompute the other pairs,
     and skip pairs that are not lit and seen, whose values here are unspecified.
+
+    Examples
+    --------
+    The Sun 30 deg from the normal ``+z``; the observer at the specular direction, at
+    the zenith, and 45 deg out of the plane of incidence:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.angles import chunk_angles
+    >>> c, s, h = np.cos(np.radians(30)), np.sin(np.radians(30)), np.sqrt(0.5)
+    >>> s_t = np.ascontiguousarray(np.array([[s, 0, c]] * 3).T)  # (3, G)
+    >>> o_t = np.ascontiguousarray(np.array([[-s, 0, c], [0, 0, 1.0], [0, h, h]]).T)
+    >>> normals = np.array([[0.0, 0.0, 1.0]])
+    >>> ns, no, st, ti, dt, phi = (np.empty((1, 3)) for _ in range(6))
+    >>> chunk_angles(s_t, o_t, 0, 3, normals, ns, no, st, ti, dt, phi)
+    >>> ti.round(6).tolist(), (dt.round(6) + 0.0).tolist(), (phi.round(6) + 0.0).tolist()
+    ([[30.0, 30.0, 30.0]], [[0.0, -30.0, -30.0]], [[0.0, 0.0, 45.0]])
+    >>> ns.round(6).tolist(), st.round(6).tolist()
+    ([[0.866025, 0.866025, 0.866025]], [[0.5, 0.5, 0.5]])
+
+    A chunk starting at geometry ``g0 = 1`` fills its first ``nc`` columns:
+
+    >>> chunk_angles(s_t, o_t, 1, 2, normals, ns, no, st, ti, dt, phi)
+    >>> (dt[:, :2].round(6) + 0.0).tolist(), (phi[:, :2].round(6) + 0.0).tolist()
+    ([[-30.0, -30.0]], [[0.0, 45.0]])
     """
     sx, sy, sz = s_t[0], s_t[1], s_t[2]
     ox, oy, oz = o_t[0], o_t[1], o_t[2]
@@ -151,6 +175,26 @@ def facet_frame(
     ``ns``, ``no`` are ``N.s`` and ``N.o``; at normal incidence (in-plane Sun component
     under ``tol``) the plane is taken through the observer, or through the axis least
     aligned with ``N`` when the observer is on the normal too.
+
+    Examples
+    --------
+    The Sun 30 deg from the normal ``+z`` and the observer at the specular direction:
+    ``delta_theta = phi = 0`` and the forward vector ``e`` points away from the Sun.
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.angles import facet_frame
+    >>> c, s = np.cos(np.radians(30)), np.sin(np.radians(30))
+    >>> r = facet_frame(0.0, 0.0, 1.0, s, 0.0, c, -s, 0.0, c, c, c, 1e-12)
+    >>> [round(v, 6) + 0.0 for v in r]  # theta_i, delta_theta, phi, e, o.p
+    [30.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0]
+
+    At normal incidence the plane goes through the observer (here 40 deg off the normal
+    towards ``+x``), so ``delta_theta`` is the observer's polar angle:
+
+    >>> c4, s4 = np.cos(np.radians(40)), np.sin(np.radians(40))
+    >>> r = facet_frame(0.0, 0.0, 1.0, 0.0, 0.0, 1.0, s4, 0.0, c4, 1.0, c4, 1e-12)
+    >>> [round(v, 6) + 0.0 for v in r]
+    [0.0, 40.0, 0.0, 1.0, 0.0, 0.0, 0.0]
     """
     stx, sty, stz = sx - ns * nx, sy - ns * ny, sz - ns * nz
     d = stx * nx + sty * ny + stz * nz  # projected twice, as geometry._tangential

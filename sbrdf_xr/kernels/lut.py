@@ -44,6 +44,14 @@ def table_edges(attrs: dict) -> tuple[bool, bool, bool]:
     :func:`sbrdf_xr.materials.tables.build_lut` records ``edge_delta_theta_min``,
     ``edge_delta_theta_max`` and ``edge_phi_max`` as ``"zero"`` (a reference point)
     or ``"hold"`` (a measured point where the apparatus stopped).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.kernels.lut import table_edges
+    >>> table_edges({})
+    (True, True, True)
+    >>> table_edges({"edge_delta_theta_min": "zero", "edge_phi_max": "hold"})
+    (True, True, False)
     """
     lo, hi, phi = (
         attrs.get(k, "zero") != "hold"
@@ -58,6 +66,14 @@ def table_normal_blend(attrs: dict) -> float:
     :func:`sbrdf_xr.materials.tables.build_lut` (``normal_incidence="symmetric"``, its
     default) and :func:`sbrdf_xr.materials.models.render` record it as
     ``normal_incidence_blend``; see :func:`lookup_matrix`.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.kernels.lut import table_normal_blend
+    >>> table_normal_blend({"normal_incidence": "symmetric", "normal_incidence_blend": 5.0})
+    5.0
+    >>> table_normal_blend({"normal_incidence": "paper", "normal_incidence_blend": 5.0})
+    0.0
     """
     if attrs.get("normal_incidence", "paper") != "symmetric":
         return 0.0
@@ -70,6 +86,14 @@ def normal_incidence_weight(theta_i: ArrayLike, blend: float) -> NDArray[np.floa
     One at ``theta_i = 0``, zero from ``theta_i = blend`` on, with zero slope at both
     ends (so the look-up stays smooth in ``theta_i``); ``1 - 3 x**2 + 2 x**3`` with
     ``x = theta_i / blend``.  Zero everywhere for ``blend <= 0``.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.kernels.lut import normal_incidence_weight
+    >>> normal_incidence_weight([0.0, 2.5, 5.0, 10.0], 5.0).tolist()
+    [1.0, 0.5, 0.0, 0.0]
+    >>> normal_incidence_weight([0.0, 2.5], 0.0).tolist()
+    [0.0, 0.0]
     """
     ti = np.asarray(theta_i, dtype=np.float64)
     if not blend > 0:
@@ -136,6 +160,25 @@ def axis_weights(
         Node indices.
     w : ndarray of float64, shape (q, k)
         Weights summing to one on every row.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.lut import axis_weights
+    >>> grid = np.array([0.0, 10.0, 20.0, 30.0])
+    >>> idx, w = axis_weights(grid, np.array([4.0, 15.0]), "linear")
+    >>> idx.tolist(), w.round(6).tolist()
+    ([[0, 1], [1, 2]], [[0.6, 0.4], [0.5, 0.5]])
+    >>> axis_weights(grid, np.array([4.0, 15.0, 99.0]), "nearest")[0].ravel().tolist()
+    [0, 2, 3]
+
+    ``cubic`` is exact for a cubic polynomial, here on a non-uniform grid:
+
+    >>> grid = np.array([0.0, 5.0, 15.0, 30.0, 50.0])
+    >>> x = np.array([2.0, 21.0, 44.0])
+    >>> idx, w = axis_weights(grid, x, "cubic")
+    >>> idx.shape, bool(np.allclose((w * grid[idx] ** 3).sum(axis=1), x**3))
+    ((3, 4), True)
     """
     n = grid.size
     x = np.clip(np.asarray(x, dtype=np.float64), grid[0], grid[-1])
@@ -230,6 +273,21 @@ def lookup_matrix(
     Returns
     -------
     scipy.sparse.csr_matrix, shape (n_queries, n_theta * n_delta_theta * n_phi)
+
+    Examples
+    --------
+    A 3 x 3 x 3 table; a linear look-up inside it has 8 weights summing to one, one
+    beyond its largest ``delta_theta`` (a zero edge) none, unless that edge is held:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.lut import lookup_matrix
+    >>> t, d, p = np.array([0.0, 45, 90]), np.array([-60.0, 0, 60]), np.array([0.0, 45, 90])
+    >>> m = lookup_matrix(t, d, p, [30.0, 30.0], [10.0, 70.0], [20.0, 20.0])
+    >>> m.shape, np.diff(m.indptr).tolist(), m.sum(axis=1).round(12).ravel().tolist()
+    ((2, 27), [8, 8], [1.0, 0.0])
+    >>> held = lookup_matrix(t, d, p, 30.0, 70.0, 20.0, zero_edges=(True, False, True))
+    >>> round(float(held.sum()), 12)
+    1.0
     """
     check_method(method)
     arrays = [np.asarray(v, dtype=np.float64) for v in (theta_i, delta_theta, phi)]
@@ -332,6 +390,21 @@ def lookup_kernel(
     ndarray, shape broadcast(theta_i, delta_theta, phi) + (n_wavelength,)
         Spectra [sr-1] in the dtype of ``values``; out-of-range policy as in
         :func:`lookup_matrix`.
+
+    Examples
+    --------
+    A linear look-up reproduces a table that is linear in the angles:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.lut import lookup_kernel
+    >>> t, d, p = np.array([0.0, 45, 90]), np.array([-60.0, 0, 60]), np.array([0.0, 45, 90])
+    >>> T, D, P = np.meshgrid(t, d, p, indexing="ij")
+    >>> values = (100 + T + 2 * D + 3 * P)[..., None] * [1.0, 2.0]  # two wavelengths
+    >>> out = lookup_kernel(values, t, d, p, [10.0, 20.0], 5.0, 30.0)
+    >>> out.shape, out.round(9).tolist()
+    ((2, 2), [[210.0, 420.0], [220.0, 440.0]])
+    >>> lookup_kernel(values.astype(np.float32), t, d, p, 10.0, 5.0, 30.0).dtype
+    dtype('float32')
     """
     shape = np.broadcast_shapes(np.shape(theta_i), np.shape(delta_theta), np.shape(phi))
     m = lookup_matrix(
@@ -391,6 +464,24 @@ def smoothing_spline_matrix(
     Returns
     -------
     ndarray, shape (m, n)
+
+    Examples
+    --------
+    ``lam = 0`` interpolates (the operator at the sites is the identity); any ``lam``
+    reproduces a straight line, which has no curvature to penalise:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.lut import smoothing_spline_matrix
+    >>> x = np.array([0.0, 10.0, 25.0, 40.0, 60.0])
+    >>> bool(np.allclose(smoothing_spline_matrix(x, x, 0.0), np.eye(5)))
+    True
+    >>> e = smoothing_spline_matrix(x, [5.0, 50.0, 70.0], 300.0, extrapolation="linear")
+    >>> e.shape, (e @ (2 * x + 1)).round(9).tolist()
+    ((3, 5), [11.0, 101.0, 141.0])
+    >>> smoothing_spline_matrix(x, x, -1.0)
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.ValidationError: lam: smoothing parameter must be finite and >= 0, got -1.0
     """
     x = np.asarray(x, dtype=np.float64)
     xo = np.asarray(x_out, dtype=np.float64)
@@ -537,6 +628,21 @@ def hemispherical_reflectance_kernel(
     -------
     ndarray, shape (n_theta_i, n_wavelength)
         Reflectance [1].
+
+    Examples
+    --------
+    A Lambertian table ``f_r = 0.5 / pi`` with held edges (it extends to the horizon)
+    reflects 0.5 at every incidence angle:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.lut import hemispherical_reflectance_kernel
+    >>> t, d, p = np.array([0.0, 45, 90]), np.array([-90.0, 0, 90]), np.array([0.0, 90])
+    >>> values = np.full((3, 3, 2, 1), 0.5 / np.pi)
+    >>> rho = hemispherical_reflectance_kernel(
+    ...     values, t, d, p, theta_i=[0.0, 30.0, 60.0], zero_edges=(False, False, False)
+    ... )
+    >>> rho.shape, rho.round(9).ravel().tolist()
+    ((3, 1), [0.5, 0.5, 0.5])
     """
     ti_all = theta_grid if theta_i is None else np.atleast_1d(np.asarray(theta_i, float))
     if phi_grid.size == 1:

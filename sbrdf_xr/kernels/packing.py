@@ -28,6 +28,23 @@ def bucket_map(grid: np.ndarray) -> tuple[np.ndarray, float]:
     ``searchsorted(grid, start, "right") - 1``.  The bucket width is the smallest node
     spacing (at most :data:`MAX_BUCKETS` buckets), so a bucket holds at most one node
     and :func:`_axis` needs at most one correcting step.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.packing import bucket_map
+    >>> grid = np.array([0.0, 1.0, 3.0])
+    >>> bmap, inv = bucket_map(grid)
+    >>> bmap.tolist(), inv
+    ([0, 1, 1, 2], 1.0)
+    >>> starts = grid[0] + np.arange(bmap.size) / inv
+    >>> bool(np.array_equal(bmap, np.searchsorted(grid, starts, side="right") - 1))
+    True
+
+    A grid of one node has a single bucket:
+
+    >>> bucket_map(np.array([5.0]))
+    (array([0]), 0.0)
     """
     g = np.asarray(grid, dtype=np.float64)
     if g.size < 2 or g[-1] <= g[0]:
@@ -48,6 +65,24 @@ class PackedTables(NamedTuple):
     ``(theta_i, delta_theta, phi)`` nodes in C order; no copy of a C-contiguous table in
     the right dtype); its grids are the slices ``t_off[m]:t_off[m + 1]`` (likewise
     ``d_off``, ``p_off``) of the concatenated grids.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.packing import pack_tables
+    >>> g, g3 = np.array([0.0, 90.0]), np.array([0.0, 45.0, 90.0])
+    >>> p = pack_tables(
+    ...     [
+    ...         (np.ones((2, 2, 2, 3)), g, g - 90, g, (True, True, True)),
+    ...         (np.ones((3, 2, 2, 3)), g3, g - 90, g, (True, True, False)),
+    ...     ]
+    ... )
+    >>> p.shapes, [v.shape for v in p.values]
+    (((2, 2, 2), (3, 2, 2)), [(8, 3), (12, 3)])
+    >>> p.t_off.tolist(), p.tgrid[p.t_off[1] : p.t_off[2]].tolist()
+    ([0, 2, 5], [0.0, 45.0, 90.0])
+    >>> p.edges.tolist()
+    [[True, True, True], [True, True, False]]
     """
 
     values: tuple[NDArray[np.floating], ...]  #: per material (n_nodes, L) [sr-1]
@@ -80,6 +115,24 @@ def pack_tables(
     ``values`` has shape ``(n_theta, n_delta_theta, n_phi, L)``; every table has the
     same ``L`` and dtype.  ``n_spectral`` and ``dtype`` shape an empty packing (no
     tables).
+
+    Examples
+    --------
+    A C-contiguous table in the packing's dtype is viewed, not copied; the sixth item
+    is the normal-incidence blend [degree]:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.packing import pack_tables
+    >>> g = np.array([0.0, 90.0])
+    >>> v = np.ones((2, 2, 2, 3))
+    >>> p = pack_tables([(v, g, g - 90, g, (True, True, True), 5.0)])
+    >>> p.n_spectral, p.dtype, p.blend.tolist(), bool(np.shares_memory(p.values[0], v))
+    (3, dtype('float64'), [5.0], True)
+    >>> pack_tables([(v, g, g - 90, g, (True, True, True))], dtype=np.float32).values[0].dtype
+    dtype('float32')
+    >>> e = pack_tables([], n_spectral=4, dtype=np.float32)
+    >>> e.values, e.n_spectral, e.dtype, e.edges.shape
+    ((), 4, dtype('float32'), (0, 3))
     """
 
     def cat(arrays: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
@@ -149,7 +202,18 @@ _TYPED_KEEP = 8
 
 def typed_values(tables: PackedTables) -> Any:
     """``tables.values`` as the ``numba.typed.List`` the kernels take, built once per
-    packing (building it costs about 70 us, paid on every block otherwise)."""
+    packing (building it costs about 70 us, paid on every block otherwise).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.packing import pack_tables, typed_values
+    >>> g = np.array([0.0, 90.0])
+    >>> p = pack_tables([(np.ones((2, 2, 2, 3)), g, g - 90, g, (True, True, True))])
+    >>> typed = typed_values(p)
+    >>> type(typed).__name__, len(typed), typed[0].shape, typed_values(p) is typed
+    ('List', 1, (8, 3), True)
+    """
     key = id(tables.values)
     with _TYPED_LOCK:
         hit = _TYPED.get(key)

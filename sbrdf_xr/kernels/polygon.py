@@ -33,6 +33,19 @@ BUDGET = 20000  #: polygon intersections per facet before falling back to the GE
 
 @nb.njit(cache=True, nogil=True)
 def signed_area(px, py, n):
+    """Signed area of the polygon (px, py, n) by the shoelace formula, positive when
+    counter-clockwise.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.polygon import signed_area
+    >>> px, py = np.array([0.0, 2.0, 2.0, 0.0]), np.array([0.0, 0.0, 1.0, 1.0])
+    >>> signed_area(px, py, 4), signed_area(px[::-1].copy(), py[::-1].copy(), 4)
+    (2.0, -2.0)
+    >>> signed_area(px, py, 3)  # the first three vertices: a triangle
+    1.0
+    """
     s = 0.0
     for k in range(n):
         k1 = k + 1 if k + 1 < n else 0
@@ -45,7 +58,22 @@ def clip(sx, sy, ns, cx, cy, nc, ox, oy, tx, ty):
     """Sutherland-Hodgman: subject polygon (sx, sy, ns) clipped by the convex counter-clockwise
     polygon (cx, cy, nc), written to (ox, oy); (tx, ty) is scratch.  Returns the vertex count
     (-1 if the capacity would be exceeded).  Exact for convex subjects (the intersection of two
-    convex sets is the clipped polygon)."""
+    convex sets is the clipped polygon).
+
+    Examples
+    --------
+    The unit square clipped by itself shifted by (0.5, 0.5) is a square of area 0.25:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.polygon import MAXV, clip, signed_area
+    >>> sx, sy = np.array([0.0, 1.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0, 1.0])
+    >>> ox, oy, tx, ty = (np.empty(MAXV) for _ in range(4))
+    >>> n = clip(sx, sy, 4, sx + 0.5, sy + 0.5, 4, ox, oy, tx, ty)
+    >>> n, signed_area(ox, oy, n), sorted(zip(ox[:n].tolist(), oy[:n].tolist()))
+    (4, 0.25, [(0.5, 0.5), (0.5, 1.0), (1.0, 0.5), (1.0, 1.0)])
+    >>> clip(sx, sy, 4, sx + 2.0, sy, 4, ox, oy, tx, ty)  # disjoint
+    0
+    """
     n = ns
     for k in range(n):
         ox[k] = sx[k]
@@ -97,7 +125,22 @@ def hull(px, py, n, ox, oy, idx):
     """Convex hull (Andrew's monotone chain, counter-clockwise, collinear points dropped) of n
     points, written to (ox, oy); idx is integer scratch.  Returns the vertex count.  Clipped
     polygons are convex only up to rounding; their hull is exactly convex, so every edge line
-    of it supports it, and near-duplicate vertices cannot leave a stray edge direction."""
+    of it supports it, and near-duplicate vertices cannot leave a stray edge direction.
+
+    Examples
+    --------
+    A square's corners, its centre and an edge midpoint (collinear) give the square,
+    counter-clockwise from its lowest-leftmost corner:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.polygon import MAXV, hull
+    >>> px = np.array([1.0, 0.0, 0.5, 1.0, 0.0, 0.5])
+    >>> py = np.array([1.0, 0.0, 0.5, 0.0, 1.0, 0.0])
+    >>> ox, oy, idx = np.empty(MAXV), np.empty(MAXV), np.empty(MAXV, dtype=np.int64)
+    >>> n = hull(px, py, 6, ox, oy, idx)
+    >>> n, ox[:n].tolist(), oy[:n].tolist()
+    (4, [0.0, 1.0, 1.0, 0.0], [0.0, 0.0, 1.0, 1.0])
+    """
     for k in range(n):
         idx[k] = k
     for k in range(1, n):  # insertion sort by (x, y)
@@ -142,6 +185,17 @@ def hull(px, py, n, ox, oy, idx):
 
 @nb.njit(cache=True, nogil=True)
 def bounds(px, py, n, out):
+    """Bounding box of the polygon (px, py, n), written to out as (xmin, xmax, ymin, ymax).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.polygon import bounds
+    >>> out = np.empty(4)
+    >>> bounds(np.array([0.0, 2.0, 1.0]), np.array([-1.0, 0.5, 3.0]), 3, out)
+    >>> out.tolist()
+    [0.0, 2.0, -1.0, 3.0]
+    """
     out[0] = out[2] = np.inf
     out[1] = out[3] = -np.inf
     for k in range(n):
@@ -156,7 +210,25 @@ def union_area(gx, gy, gn, m, tiny, stack_x, stack_y, stack_n, nxt, tx, ty):
     """Area of the union of m convex counter-clockwise polygons (gx[k], gy[k], gn[k]) by
     inclusion-exclusion over the non-empty intersections, depth first (an empty intersection
     prunes every superset; bounding boxes that do not overlap skip the clip).  Returns
-    (area, ok); ok is False past the work budget."""
+    (area, ok); ok is False past the work budget.
+
+    Examples
+    --------
+    Two unit squares overlapping by half and a third across both (the union is
+    ``[0, 1.5] x [0, 1]`` and the top half of the third, 2 in all):
+
+    >>> import numpy as np
+    >>> gx = np.array([[0.0, 1, 1, 0], [0.5, 1.5, 1.5, 0.5], [0.25, 1.25, 1.25, 0.25]])
+    >>> gy = np.array([[0.0, 0, 1, 1], [0.0, 0, 1, 1], [0.5, 0.5, 1.5, 1.5]])
+    >>> gn = np.array([4, 4, 4])
+    >>> from sbrdf_xr.kernels.polygon import MAXM, MAXV, union_area
+    >>> stack_x, stack_y = np.empty((MAXM + 1, MAXV)), np.empty((MAXM + 1, MAXV))
+    >>> stack_n, nxt = np.empty(MAXM + 1, dtype=np.int64), np.empty(MAXM + 1, dtype=np.int64)
+    >>> tx, ty = np.empty(MAXV), np.empty(MAXV)
+    >>> area, ok = union_area(gx, gy, gn, 3, 1e-15, stack_x, stack_y, stack_n, nxt, tx, ty)
+    >>> round(area, 12), ok
+    (2.0, True)
+    """
     box = np.empty((m, 4))
     sbox = np.empty((m + 1, 4))
     for k in range(m):
@@ -225,6 +297,19 @@ def union_area_slabs(gx, gy, gn, m):
     with x and never cross another end, so the length of the union of the intervals is
     linear in x and its value at the slab's middle times the slab's width is the slab's
     area, exactly.  O(E**2) for E edges in all: used past the inclusion-exclusion budget.
+
+    Examples
+    --------
+    Two unit squares overlapping by half and a third across both (the union is
+    ``[0, 1.5] x [0, 1]`` and the top half of the third, 2 in all):
+
+    >>> import numpy as np
+    >>> gx = np.array([[0.0, 1, 1, 0], [0.5, 1.5, 1.5, 0.5], [0.25, 1.25, 1.25, 0.25]])
+    >>> gy = np.array([[0.0, 0, 1, 1], [0.0, 0, 1, 1], [0.5, 0.5, 1.5, 1.5]])
+    >>> gn = np.array([4, 4, 4])
+    >>> from sbrdf_xr.kernels.polygon import union_area_slabs
+    >>> round(union_area_slabs(gx, gy, gn, 3), 12)
+    2.0
     """
     nv = 0
     for k in range(m):

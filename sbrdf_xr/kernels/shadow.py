@@ -172,6 +172,32 @@ def exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
     computed by inclusion-exclusion over convex intersections; facets past the work budget
     get NaN (the caller unions their polygons with GEOS).  Candidate occluders come from a
     uniform grid over the bounding boxes in the plane perpendicular to d, then a depth test.
+
+    Examples
+    --------
+    An open surface: a 2 x 2 plate at z = 0 and a 1 x 2 plate above its left half at z = 1,
+    lit from +z.  The upper plate shades a quarter of the lower plate's first triangle and
+    three quarters of its second; the upper plate is fully lit.
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.shadow import exact_kernel
+    >>> V = np.array([[0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0],
+    ...               [0, 0, 1], [1, 0, 1], [1, 2, 1], [0, 2, 1]], dtype=float)
+    >>> F = np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])
+    >>> tri = V[F]
+    >>> N = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    >>> N /= np.linalg.norm(N, axis=1, keepdims=True)
+    >>> E1 = tri[:, 1] - tri[:, 0]
+    >>> E1 /= np.linalg.norm(E1, axis=1, keepdims=True)
+    >>> E2 = np.cross(N, E1)
+    >>> rel = tri - tri[:, :1]
+    >>> T2 = np.ascontiguousarray(np.stack(
+    ...     [np.einsum("fvx,fx->fv", rel, E1), np.einsum("fvx,fx->fv", rel, E2)], axis=-1))
+    >>> P0 = np.ascontiguousarray(tri[:, 0])
+    >>> dirs = np.array([[[0.0, 0.0, 1.0]]])  # (G=1, K=1, 3)
+    >>> frac = exact_kernel(V, F, N, P0, E1, E2, T2, np.ones(4, bool), dirs, False, 1e-9)
+    >>> print(np.round(frac, 6))
+    [[0.75 0.25 1.   1.  ]]
     """
     G = dirs.shape[0]
     K = dirs.shape[1]
@@ -317,7 +343,38 @@ def exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
 @nb.njit(cache=True, nogil=True)
 def facet_shadows(i, dirs, V, F, N, P0, E1, E2, T2, watertight, eps_h):
     """Every shadow polygon on facet i for the K directions ``dirs`` (K, 3), by testing every
-    facet (no grid): vertices (n, 2) and CSR offsets.  For the GEOS fallback."""
+    facet (no grid): vertices (n, 2) and CSR offsets.  For the GEOS fallback.
+
+    Examples
+    --------
+    The two plates of :func:`exact_kernel`'s example: on the lower plate's first triangle
+    the upper plate casts one shadow, the triangle (0, 0), (1, 0), (1, 1) in the facet's
+    own frame (area 1/2 of the triangle's 2, so the lit fraction is 3/4).
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.shadow import facet_shadows
+    >>> V = np.array([[0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0],
+    ...               [0, 0, 1], [1, 0, 1], [1, 2, 1], [0, 2, 1]], dtype=float)
+    >>> F = np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])
+    >>> tri = V[F]
+    >>> N = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    >>> N /= np.linalg.norm(N, axis=1, keepdims=True)
+    >>> E1 = tri[:, 1] - tri[:, 0]
+    >>> E1 /= np.linalg.norm(E1, axis=1, keepdims=True)
+    >>> E2 = np.cross(N, E1)
+    >>> rel = tri - tri[:, :1]
+    >>> T2 = np.ascontiguousarray(np.stack(
+    ...     [np.einsum("fvx,fx->fv", rel, E1), np.einsum("fvx,fx->fv", rel, E2)], axis=-1))
+    >>> P0 = np.ascontiguousarray(tri[:, 0])
+    >>> dirs = np.array([[0.0, 0.0, 1.0]])  # (K=1, 3)
+    >>> xy, start = facet_shadows(0, dirs, V, F, N, P0, E1, E2, T2, False, 1e-9)
+    >>> start.tolist()
+    [0, 3]
+    >>> print(np.round(xy, 6))
+    [[0. 0.]
+     [1. 0.]
+     [1. 1.]]
+    """
     nf = F.shape[0]
     K = dirs.shape[0]
     cx = T2[i, :, 0].copy()

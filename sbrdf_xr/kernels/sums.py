@@ -303,7 +303,27 @@ def normal_rows(normals: NDArray[np.floating]) -> NDArray[np.int64]:
 
 
 class FusedSums(NamedTuple):
-    """Outputs of :func:`fused_sums` for a block of geometries."""
+    """Outputs of :func:`fused_sums` for a block of geometries.
+
+    Examples
+    --------
+    The fields of :class:`~sbrdf_xr.kernels.reference.MaterialSums` and the signal of each
+    material, ``None`` unless asked for (a block without terms, so nothing to compile):
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.sums import FusedSums, fused_sums, pack_tables
+    >>> g = np.array([0.0, 90.0])
+    >>> tables = pack_tables([(np.ones((2, 2, 2, 3)), g, g - 90, g, (True, True, True))])
+    >>> s = o = np.array([[0.0, 0, 1], [1, 0, 0]])
+    >>> no_terms = np.empty((0, 3)), np.empty(0), np.empty(0, dtype=np.int64)
+    >>> FusedSums._fields
+    ('signal', 'paper', 'area', 'lit_visible_area', 'per_material')
+    >>> fused_sums(s, o, *no_terms, tables).per_material is None
+    True
+    >>> r = fused_sums(s, o, *no_terms, tables, per_material=True)
+    >>> r.signal.shape, r.per_material.shape  # (G, L), (G, M, L)
+    ((2, 3), (2, 1, 3))
+    """
 
     signal: NDArray[np.floating]  #: (G, L) [m2 sr-1]
     paper: NDArray[np.floating]  #: (G, L) [m2 sr-1]
@@ -355,6 +375,26 @@ def fused_sums(
         The spectral sums in the dtype of the tables (no promotion of float32);
         ``area`` and ``lit_visible_area`` in float64.  For ``cubic`` each material's
         sums are clipped at 0 as in :func:`material_sums`.
+
+    Examples
+    --------
+    The terms must come sorted by material, and a float32 packing gives float32 sums (a
+    block without terms returns zeros without running the compiled kernel):
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.sums import fused_sums, pack_tables
+    >>> g = np.array([0.0, 90.0])
+    >>> one = (np.ones((2, 2, 2, 3)), g, g - 90, g, (True, True, True))
+    >>> tables = pack_tables([one, one], dtype=np.float32)
+    >>> s = o = np.array([[0.0, 0, 1]])
+    >>> normals = np.array([[0.0, 0, 1], [0, 0, 1]])
+    >>> fused_sums(s, o, normals, np.ones(2), np.array([1, 0]), tables)
+    Traceback (most recent call last):
+        ...
+    ValueError: term_material: terms of one material must be contiguous (sorted)
+    >>> r = fused_sums(s, o, np.empty((0, 3)), np.empty(0), np.empty(0, dtype=np.int64), tables)
+    >>> r.signal.dtype, r.area.dtype, r.signal.tolist()
+    (dtype('float32'), dtype('float64'), [[0.0, 0.0, 0.0]])
     """
     tm = np.ascontiguousarray(term_material, dtype=np.int64)
     if tm.size and np.any(np.diff(tm) < 0):
