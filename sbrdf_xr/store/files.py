@@ -53,7 +53,24 @@ HDF5_CHUNK_BYTES = 2 * 2**20
 
 
 def coordinates_attrs(ds: xr.Dataset) -> tuple[dict[str, str], str | None]:
-    """Per-variable and global ``coordinates`` attributes, as xarray writes them."""
+    """Per-variable and global ``coordinates`` attributes, as xarray writes them.
+
+    Examples
+    --------
+    ``lat`` lies along ``x`` and so belongs to ``v``; no variable has the dimension of
+    ``label``, which is named in the global attribute instead.
+
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.files import coordinates_attrs
+    >>> ds = xr.Dataset(
+    ...     {"v": (("x", "y"), [[1.0, 2.0], [3.0, 4.0]])},
+    ...     coords={"x": [0, 1], "lat": ("x", [10.0, 20.0]), "label": ("z", ["a", "b"])},
+    ... )
+    >>> coordinates_attrs(ds)
+    ({'v': 'lat'}, 'label')
+    >>> coordinates_attrs(ds.drop_vars(["lat", "label"]))
+    ({}, None)
+    """
     non_dim = {str(c) for c in ds.coords if c not in ds.dims}
     per_var: dict[str, set[str]] = {str(n): set() for n in ds.variables}
     for c in non_dim:
@@ -70,6 +87,18 @@ def coordinates_attrs(ds: xr.Dataset) -> tuple[dict[str, str], str | None]:
 
 
 def nc_attr(value: Any) -> Any:
+    """An attribute value as netCDF4 stores it: a list of str, an array of numbers, or as is.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.store.files import nc_attr
+    >>> nc_attr(("red", "green"))
+    ['red', 'green']
+    >>> nc_attr((0.0, 1.0)), nc_attr([1, 2]).dtype.kind
+    (array([0., 1.]), 'i')
+    >>> nc_attr("sr-1"), nc_attr(0.5)
+    ('sr-1', 0.5)
+    """
     if isinstance(value, list | tuple) and value and all(isinstance(x, str) for x in value):
         return list(value)
     if isinstance(value, list | tuple):
@@ -78,11 +107,42 @@ def nc_attr(value: Any) -> Any:
 
 
 def set_attrs(target: Any, attrs: Mapping[str, Any]) -> None:
+    """Set ``attrs`` on a netCDF4 dataset or variable, each value as :func:`nc_attr` makes it.
+
+    Examples
+    --------
+    >>> import netCDF4
+    >>> from sbrdf_xr.store.files import set_attrs
+    >>> nc = netCDF4.Dataset("attrs.nc", "w", diskless=True)  # in memory, no file
+    >>> v = nc.createVariable("v", "f8")
+    >>> set_attrs(v, {"units": "sr-1", "valid_range": (0.0, 1.0), "bands": ("r", "g")})
+    >>> {k: v.getncattr(k) for k in v.ncattrs()}
+    {'units': 'sr-1', 'valid_range': array([0., 1.]), 'bands': ['r', 'g']}
+    >>> nc.close()
+    """
     for key, value in attrs.items():
         target.setncattr(key, nc_attr(value))
 
 
 def to_storage(values: Any, kind: str) -> np.ndarray:
+    """Values as they are written for their :func:`~sbrdf_xr.store.layout.storage_kind`.
+
+    Booleans become ``int8`` (0/1), strings an object array of ``str``, and numbers
+    keep their dtype in native byte order.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.store.files import to_storage
+    >>> to_storage(np.array([True, False]), "bool")
+    array([1, 0], dtype=int8)
+    >>> to_storage(np.array(["r", "gb"]), "str")
+    array(['r', 'gb'], dtype=object)
+    >>> big_endian = np.arange(3, dtype=">f8")
+    >>> out = to_storage(big_endian, "numeric")
+    >>> out.dtype, out.dtype.isnative, bool(np.array_equal(out, big_endian))
+    (dtype('float64'), True, True)
+    """
     arr = np.asarray(values)
     if kind == "bool":
         return arr.astype(np.int8)
@@ -96,7 +156,22 @@ def to_storage(values: Any, kind: str) -> np.ndarray:
 
 
 def hdf5_chunks(shape: tuple[int, ...], itemsize: int) -> list[int] | None:
-    """HDF5 chunk shape for a streamed variable: its Dask chunk, halved until small."""
+    """HDF5 chunk shape for a streamed variable: its Dask chunk, halved until small.
+
+    Examples
+    --------
+    A 4096 x 1024 float64 chunk (32 MiB) is halved, longest side first, down to
+    :data:`HDF5_CHUNK_BYTES` (2 MiB); a small chunk is kept as it is.
+
+    >>> from sbrdf_xr.store.files import HDF5_CHUNK_BYTES, hdf5_chunks
+    >>> c = hdf5_chunks((4096, 1024), 8)
+    >>> c, c[0] * c[1] * 8 == HDF5_CHUNK_BYTES
+    ([512, 512], True)
+    >>> hdf5_chunks((10, 3), 8)
+    [10, 3]
+    >>> hdf5_chunks((), 8) is None, hdf5_chunks((0, 3), 8) is None
+    (True, True)
+    """
     if not shape or 0 in shape:
         return None
     c = list(shape)
@@ -126,6 +201,18 @@ def tune(v: netCDF4.Variable, streamed: bool) -> None:
     and make memory grow with the number of variables rather than the block size.
     Blocks cover whole HDF5 chunks except at irregular chunk edges, so one chunk
     of cache is enough.
+
+    Examples
+    --------
+    >>> import netCDF4
+    >>> from sbrdf_xr.store.files import tune
+    >>> nc = netCDF4.Dataset("tune.nc", "w", diskless=True)  # in memory, no file
+    >>> _ = nc.createDimension("x", 2**19)
+    >>> v = nc.createVariable("v", "f8", ("x",), chunksizes=(2**18,))
+    >>> tune(v, streamed=True)
+    >>> v.get_var_chunk_cache()[0] == 2**18 * 8, v.mask, v.scale  # one 2 MiB chunk
+    (True, False, False)
+    >>> nc.close()
     """
     v.set_auto_maskandscale(False)
     chunking = v.chunking()
@@ -135,7 +222,41 @@ def tune(v: netCDF4.Variable, streamed: bool) -> None:
 
 
 def create_part(part: Path, ds: xr.Dataset, plan: BlockLayout, complevel: int) -> netCDF4.Dataset:
-    """Create ``part`` with every dim, variable and attribute; write the numpy-backed values."""
+    """Create ``part`` with every dim, variable and attribute; write the numpy-backed values.
+
+    Examples
+    --------
+    The coordinate ``x`` is written at once; the Dask-backed ``v`` is laid out
+    contiguous (uncompressed) or in HDF5 chunks of its Dask chunks (compressed), for the
+    blocks to fill; a boolean is stored as ``int8`` tagged ``dtype = "bool"``.
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import dask.array as da
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.files import create_part
+    >>> from sbrdf_xr.store.layout import layout_of
+    >>> ds = xr.Dataset(
+    ...     {
+    ...         "v": (("x", "y"), da.zeros((4, 3), chunks=(2, 3))),
+    ...         "ok": ("x", da.ones(4, chunks=2, dtype=bool)),
+    ...     },
+    ...     coords={"x": [0.0, 1.0, 2.0, 3.0]},
+    ...     attrs={"title": "demo"},
+    ... )
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     part = Path(tmp) / "cube.nc.part"
+    ...     with create_part(part, ds, layout_of(ds), complevel=0) as nc:
+    ...         print({d: len(n) for d, n in nc.dimensions.items()}, list(nc.variables))
+    ...         print(nc["x"][:].tolist(), nc["v"].chunking(), nc.getncattr("title"))
+    ...         print(nc["ok"].dtype, nc["ok"].getncattr("dtype"))
+    ...     with create_part(part, ds, layout_of(ds), complevel=4) as nc:
+    ...         print(nc["v"].chunking(), nc["v"].filters()["complevel"])
+    {'x': 4, 'y': 3} ['v', 'ok', 'x']
+    [0.0, 1.0, 2.0, 3.0] contiguous demo
+    int8 bool
+    [2, 3] 4
+    """
     coords_attr, global_coords = coordinates_attrs(ds)
     nc = netCDF4.Dataset(part, mode="w", format="NETCDF4")
     try:
@@ -179,6 +300,20 @@ def create_part(part: Path, ds: xr.Dataset, plan: BlockLayout, complevel: int) -
 
 
 def set_global_attrs(nc: netCDF4.Dataset, ds: xr.Dataset, global_coords: str | None) -> None:
+    """Replace the global attributes of ``nc`` by those of ``ds`` (and ``coordinates``).
+
+    Examples
+    --------
+    >>> import netCDF4
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.files import set_global_attrs
+    >>> nc = netCDF4.Dataset("globals.nc", "w", diskless=True)  # in memory, no file
+    >>> nc.setncattr("history", "an earlier run")
+    >>> set_global_attrs(nc, xr.Dataset(attrs={"title": "demo"}), "label")
+    >>> {k: nc.getncattr(k) for k in nc.ncattrs()}
+    {'title': 'demo', 'coordinates': 'label'}
+    >>> nc.close()
+    """
     for key in nc.ncattrs():
         nc.delncattr(key)
     attrs = dict(ds.attrs)
@@ -188,7 +323,31 @@ def set_global_attrs(nc: netCDF4.Dataset, ds: xr.Dataset, global_coords: str | N
 
 
 def open_part(part: Path, ds: xr.Dataset, plan: BlockLayout) -> netCDF4.Dataset:
-    """Open an unfinished ``part`` for appending and check its layout against ``ds``."""
+    """Open an unfinished ``part`` for appending and check its layout against ``ds``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import dask.array as da
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.common import CubeWriteError
+    >>> from sbrdf_xr.store.files import create_part, open_part
+    >>> from sbrdf_xr.store.layout import layout_of
+    >>> ds = xr.Dataset({"v": (("x", "y"), da.zeros((4, 3), chunks=(2, 3)))})
+    >>> smaller = ds.isel(y=slice(0, 2))
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     part = Path(tmp) / "cube.nc.part"
+    ...     create_part(part, ds, layout_of(ds), complevel=0).close()
+    ...     with open_part(part, ds, layout_of(ds)) as nc:
+    ...         print(nc.isopen(), nc.filepath() == str(part))
+    ...     try:
+    ...         open_part(part, smaller, layout_of(smaller))
+    ...     except CubeWriteError as exc:
+    ...         print(str(exc).replace(tmp, "<tmp>"))
+    True True
+    <tmp>/cube.nc.part: dimension 'y' is missing or has another size
+    """
     try:
         nc = netCDF4.Dataset(part, mode="a")
     except OSError as exc:
@@ -241,7 +400,36 @@ def read_back_error(part: Path) -> str | None:
 
 
 def read_log(log: Path, part: Path) -> tuple[dict[str, Any], set[int]]:
-    """Header and completed blocks of an unfinished cube."""
+    """Header and completed blocks of an unfinished cube.
+
+    Examples
+    --------
+    A torn last line (a write interrupted mid-record) is ignored:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import dask.array as da
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.common import CubeWriteError
+    >>> from sbrdf_xr.store.files import read_log, write_header
+    >>> from sbrdf_xr.store.layout import layout_of
+    >>> plan = layout_of(xr.Dataset({"v": ("x", da.zeros(4, chunks=1))}))
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     part, log = Path(tmp) / "cube.nc.part", Path(tmp) / "cube.nc.part.jsonl"
+    ...     write_header(log, plan)
+    ...     with open(log, "a", encoding="utf-8") as f:
+    ...         _ = f.write('{"block": 2}\\n{"block": 0}\\n{"blo')
+    ...     header, done = read_log(log, part)
+    ...     print(header["n_blocks"], header["fingerprint"] == plan.fingerprint, sorted(done))
+    ...     log.unlink()
+    ...     try:
+    ...         read_log(log, part)
+    ...     except CubeWriteError as exc:
+    ...         print(str(exc).replace(tmp, "<tmp>"))
+    4 True [0, 2]
+    <tmp>/cube.nc.part has no bookkeeping file cube.nc.part.jsonl, so which blocks it holds
+    is unknown; pass overwrite=True, resume=False to discard it and start again
+    """
     if not log.exists():
         raise CubeWriteError(
             f"{part} has no bookkeeping file {log.name}, so which blocks it holds is unknown; "
@@ -270,6 +458,33 @@ def read_log(log: Path, part: Path) -> tuple[dict[str, Any], set[int]]:
 
 
 def write_header(log: Path, plan: BlockLayout) -> None:
+    """Write the bookkeeping sidecar ``log`` afresh: one JSON header line, synced to disk.
+
+    The header is written to ``<log>.tmp`` and renamed over ``log``, so a reader sees
+    the old file or the whole new header, never part of it.
+
+    Examples
+    --------
+    >>> import json
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import dask.array as da
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.files import write_header
+    >>> from sbrdf_xr.store.layout import layout_of
+    >>> plan = layout_of(xr.Dataset({"v": (("x", "y"), da.zeros((4, 3), chunks=(2, 3)))}))
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     log = Path(tmp) / "cube.nc.part.jsonl"
+    ...     write_header(log, plan)
+    ...     lines = log.read_text(encoding="utf-8").splitlines()
+    ...     print(len(lines), sorted(p.name for p in Path(tmp).iterdir()))
+    1 ['cube.nc.part.jsonl']
+    >>> header = json.loads(lines[0])
+    >>> sorted(header)
+    ['block_dims', 'fingerprint', 'format', 'n_blocks', 'structure', 'version']
+    >>> header["format"], header["version"], header["n_blocks"], header["block_dims"]
+    ('sbrdf_xr.write_cube', 1, 2, ['x', 'y'])
+    """
     header = {
         "format": FORMAT,
         "version": FORMAT_VERSION,
@@ -291,6 +506,39 @@ def check_destination(path: Path, part: Path, log: Path, overwrite: bool, resume
 
     Returns ``"new"`` (start afresh), ``"resume"`` (continue the ``.part``) or
     ``"finished"`` (``resume`` with a finished cube and no ``.part``).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.store.common import CubeWriteError
+    >>> from sbrdf_xr.store.files import check_destination
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = Path(tmp) / "cube.nc"
+    ...     part, log = Path(tmp) / "cube.nc.part", Path(tmp) / "cube.nc.part.jsonl"
+    ...     print(check_destination(path, part, log, overwrite=False, resume=False))
+    ...     path.touch()  # a finished cube
+    ...     print(check_destination(path, part, log, overwrite=False, resume=True))
+    ...     try:
+    ...         check_destination(path, part, log, overwrite=False, resume=False)
+    ...     except FileExistsError as exc:
+    ...         print(str(exc).replace(tmp, "<tmp>"))
+    ...     part.touch()  # and an unfinished write of it
+    ...     print(check_destination(path, part, log, overwrite=True, resume=True))
+    ...     print(check_destination(path, part, log, overwrite=True, resume=False))
+    ...     path.unlink()
+    ...     path.mkdir()
+    ...     try:
+    ...         check_destination(path, part, log, overwrite=True, resume=False)
+    ...     except CubeWriteError as exc:
+    ...         print(str(exc).replace(tmp, "<tmp>"))
+    new
+    finished
+    <tmp>/cube.nc exists; pass overwrite=True to replace it
+    resume
+    new
+    <tmp>/cube.nc is a directory, not a regular file; cubes replace only regular files, even
+    with overwrite=True. Remove it or choose another output
     """
     for p in (path, part, log):
         kind = file_kind(p)
@@ -321,7 +569,36 @@ def check_destination(path: Path, part: Path, log: Path, overwrite: bool, resume
 
 
 def check_finished(path: Path, ds: xr.Dataset) -> None:
-    """``resume`` of a finished cube: a no-op if it is this cube, else an error."""
+    """``resume`` of a finished cube: a no-op if it is this cube, else an error.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import dask.array as da
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.common import CubeWriteError
+    >>> from sbrdf_xr.store.files import check_finished
+    >>> from sbrdf_xr.store.writer import write_cube
+    >>> ds = xr.Dataset(
+    ...     {"v": (("x", "y"), da.zeros((4, 3), chunks=(2, 3)))},
+    ...     coords={"x": [0.0, 1.0, 2.0, 3.0]},
+    ...     attrs={"title": "demo"},
+    ... )
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = write_cube(ds, Path(tmp) / "cube.nc", scheduler="synchronous")
+    ...     print(check_finished(path, ds), check_finished(path, ds.assign_attrs(history="now")))
+    ...     for other in (ds.isel(x=slice(0, 2)), ds.assign_attrs(title="other")):
+    ...         try:
+    ...             check_finished(path, other)
+    ...         except CubeWriteError as exc:
+    ...             print(str(exc).replace(tmp, "<tmp>"))
+    None None
+    <tmp>/cube.nc is a finished cube of other inputs (dims and sizes differ: {'x': 4, 'y': 3}
+    in the file, {'x': 2, 'y': 3} now); nothing was resumed. Pass overwrite=True to replace it
+    <tmp>/cube.nc is a finished cube of other inputs (global attribute 'title' differs);
+    nothing was resumed. Pass overwrite=True to replace it
+    """
     try:
         with netCDF4.Dataset(path) as nc:
             dims = {str(d): len(v) for d, v in nc.dimensions.items()}

@@ -49,6 +49,20 @@ NUMERIC_KINDS = "iuf"
 
 @dataclasses.dataclass
 class LazyVariable:
+    """A Dask-backed variable of a cube: its name, its dims and the Dask array the blocks write.
+
+    Examples
+    --------
+    >>> import dask.array as da
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.layout import layout_of
+    >>> ds = xr.Dataset(
+    ...     {"v": (("x", "y"), da.zeros((4, 3), chunks=(2, 3))), "w": ("x", [1.0, 2.0, 3.0, 4.0])}
+    ... )
+    >>> [(lv.name, lv.dims, lv.data.chunks) for lv in layout_of(ds).lazy]  # w is numpy-backed
+    [('v', ('x', 'y'), ((2, 2), (3,)))]
+    """
+
     name: str
     dims: tuple[str, ...]
     data: da.Array
@@ -56,7 +70,35 @@ class LazyVariable:
 
 @dataclasses.dataclass
 class BlockLayout:
-    """Blocks of a cube and its fingerprint (built from metadata only)."""
+    """Blocks of a cube and its fingerprint (built from metadata only).
+
+    Examples
+    --------
+    A cube chunked in two along ``x`` has two blocks; block 1 is the second ``x`` chunk,
+    and every lazy variable with a piece in it is written with it.
+
+    >>> import dask.array as da
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.layout import layout_of
+    >>> ds = xr.Dataset(
+    ...     {
+    ...         "v": (("x", "y"), da.zeros((4, 3), chunks=(2, 3))),
+    ...         "w": ("x", da.ones(4, chunks=2)),
+    ...     },
+    ...     coords={"x": [0.0, 1.0, 2.0, 3.0]},
+    ... )
+    >>> plan = layout_of(ds)
+    >>> plan.block_dims, plan.grid, plan.n_blocks
+    (('x', 'y'), (2, 1), 2)
+    >>> plan.index(1)
+    {'x': 1, 'y': 0}
+    >>> plan.slices(1)
+    {'x': slice(2, 4, None), 'y': slice(0, 3, None)}
+    >>> for name, region, key in plan.pieces(1):
+    ...     print(name, region, key[1:])
+    v (slice(2, 4, None), slice(0, 3, None)) (1, 0)
+    w (slice(2, 4, None),) (1,)
+    """
 
     block_dims: tuple[str, ...]
     chunks: dict[str, tuple[int, ...]]
@@ -113,7 +155,25 @@ class BlockLayout:
 
 
 def storage_kind(name: Hashable, dtype: np.dtype) -> str:
-    """``numeric``, ``bool`` or ``str``; anything else is an error."""
+    """``numeric``, ``bool`` or ``str``; anything else is an error.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.store.layout import storage_kind
+    >>> [storage_kind("v", np.dtype(t)) for t in ("float32", "int16", "bool", "U8", "O")]
+    ['numeric', 'numeric', 'bool', 'str', 'str']
+    >>> storage_kind("v", np.dtype("float16"))
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.ValidationError: v: dtype float16 cannot be stored in netCDF; cast to float32
+    >>> try:
+    ...     storage_kind("t", np.dtype("datetime64[ns]"))
+    ... except ValueError as exc:
+    ...     print(exc)
+    t: dtype datetime64[ns] is not supported by write_cube (allowed: integers, float32, float64,
+    bool, str); encode times as numbers with CF units first
+    """
     if dtype.kind in NUMERIC_KINDS and dtype.itemsize in (1, 2, 4, 8):
         if dtype.kind == "f" and dtype.itemsize < 4:
             raise ValidationError(
@@ -132,6 +192,19 @@ def storage_kind(name: Hashable, dtype: np.dtype) -> str:
 
 
 def attr_json(value: Any) -> Any:
+    """An attribute value as JSON can hold it, numpy values tagged with their dtype.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.store.layout import attr_json
+    >>> attr_json(np.array([1.0, 2.0]))
+    {'array': [1.0, 2.0], 'dtype': 'float64'}
+    >>> attr_json(np.float32(0.5))
+    {'scalar': 0.5, 'dtype': 'float32'}
+    >>> attr_json(("nm", np.int64(3))), attr_json("sr-1")
+    (['nm', {'scalar': 3, 'dtype': 'int64'}], 'sr-1')
+    """
     if isinstance(value, np.ndarray):
         return {"array": value.tolist(), "dtype": str(value.dtype)}
     if isinstance(value, np.generic):
@@ -142,6 +215,24 @@ def attr_json(value: Any) -> Any:
 
 
 def check_attrs(owner: str, attrs: Mapping[Any, Any]) -> None:
+    """Raise :class:`~sbrdf_xr.errors.ValidationError` for an attribute netCDF cannot store.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.store.layout import check_attrs
+    >>> check_attrs("variable 'v'", {"units": "nm", "valid_range": (0.0, 1.0)}) is None
+    True
+    >>> check_attrs("variable 'v'", {"masked": True})
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.ValidationError: variable 'v': attribute 'masked' = True cannot be stored in
+    netCDF (allowed: str, numbers, sequences of them); convert it, e.g. to str
+    >>> check_attrs("global attributes", {"coordinates": "x"})
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.ValidationError: global attributes: attribute 'coordinates' is written by
+    write_cube itself; remove it
+    """
     for key, value in attrs.items():
         if not isinstance(key, str):
             raise ValidationError(f"{owner}: attribute names must be str, got {key!r}")
@@ -161,6 +252,21 @@ def check_attrs(owner: str, attrs: Mapping[Any, Any]) -> None:
 
 
 def values_sha(values: np.ndarray, kind: str) -> str:
+    """SHA-256 hex digest of an array's values (and dtype, unless ``kind`` is ``str``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.store.layout import values_sha
+    >>> a = np.arange(3.0)
+    >>> len(values_sha(a, "numeric")), values_sha(a, "numeric") == values_sha(a.copy(), "numeric")
+    (64, True)
+    >>> values_sha(a, "numeric") == values_sha(a.astype(np.float32), "numeric")  # dtype counts
+    False
+    >>> words = ["r", "g"]
+    >>> values_sha(np.array(words), "str") == values_sha(np.array(words, dtype=object), "str")
+    True
+    """
     h = hashlib.sha256()
     if kind == "str":
         h.update(json.dumps([str(x) for x in values.ravel().tolist()]).encode())
@@ -171,7 +277,37 @@ def values_sha(values: np.ndarray, kind: str) -> str:
 
 
 def layout_of(ds: xr.Dataset) -> BlockLayout:
-    """Validate ``ds`` (metadata only, nothing is computed) and lay out its blocks."""
+    """Validate ``ds`` (metadata only, nothing is computed) and lay out its blocks.
+
+    Examples
+    --------
+    >>> import dask.array as da
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.layout import layout_of
+    >>> ds = xr.Dataset(
+    ...     {"v": (("x", "y"), da.zeros((4, 3), chunks=(2, 3)))},
+    ...     coords={"x": [0.0, 1.0, 2.0, 3.0]},
+    ...     attrs={"title": "demo", "history": "written today"},
+    ... )
+    >>> plan = layout_of(ds)
+    >>> plan.block_dims, plan.chunks, plan.n_blocks
+    (('x', 'y'), {'x': (2, 2), 'y': (3,)}, 2)
+    >>> len(plan.fingerprint), sorted(plan.structure["attrs"])  # history is volatile
+    (64, ['title'])
+
+    The fingerprint follows the values of the numpy-backed variables, not the volatile
+    attributes:
+
+    >>> layout_of(ds.assign_attrs(history="resumed")).fingerprint == plan.fingerprint
+    True
+    >>> layout_of(ds.assign_coords(x=[0.0, 1.0, 2.0, 4.0])).fingerprint == plan.fingerprint
+    False
+    >>> layout_of(ds.isel(x=slice(0, 0)))
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.ValidationError: ds: the cube is empty along x (size 0); there is nothing to
+    write
+    """
     if not isinstance(ds, xr.Dataset):
         raise ValidationError(f"ds: expected an xarray.Dataset, got {type(ds).__name__}")
     try:
@@ -243,6 +379,28 @@ def difference(old: Mapping[str, Any], new: Mapping[str, Any]) -> str:
 
     Differences of the content fingerprint (:mod:`sbrdf_xr.store.fingerprint`) come first,
     naming every part that changed (a material table, the mesh, a setting, ...).
+
+    Examples
+    --------
+    >>> import dask.array as da
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.layout import difference, layout_of
+    >>> ds = xr.Dataset(
+    ...     {"v": (("x", "y"), da.zeros((4, 3), chunks=(2, 3)))},
+    ...     coords={"x": [0.0, 1.0, 2.0, 3.0]},
+    ... )
+    >>> old = layout_of(ds).structure
+    >>> difference(old, layout_of(ds.assign_coords(x=[0.0, 1.0, 2.0, 4.0])).structure)
+    "values of 'x' differ"
+    >>> difference(old, layout_of(ds.chunk(x=1)).structure)
+    "chunks differ: [['x', [2, 2]], ['y', [3]]] in the .part, [['x', [1, 1, 1, 1]], ['y', [3]]] now"
+    >>> difference(old, layout_of(ds.isel(x=slice(0, 2))).structure)
+    "dims and sizes differ: [['x', 4], ['y', 3]] in the .part, [['x', 2], ['y', 3]] now"
+
+    Equal records leave the version of the file format as the difference:
+
+    >>> difference(old, old)
+    'the file format version differs'
     """
     new = json.loads(json.dumps(new))  # compare like with like (tuples become lists)
     changed = _fingerprint.changes(old.get("attrs", {}), new.get("attrs", {}))
@@ -275,7 +433,25 @@ def lazy_bytes(plan: BlockLayout) -> int:
 
 
 def block_bytes(plan: BlockLayout) -> int:
-    """Largest raw size of one block [byte] (what a block may add to the file, uncompressed)."""
+    """Largest raw size of one block [byte] (what a block may add to the file, uncompressed).
+
+    Examples
+    --------
+    One block of this cube holds a 2 x 3 float64 piece of ``v`` and 2 float32 values of
+    ``w``: 2 * 3 * 8 + 2 * 4 = 56 bytes.
+
+    >>> import dask.array as da
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.layout import block_bytes, layout_of
+    >>> ds = xr.Dataset(
+    ...     {
+    ...         "v": (("x", "y"), da.zeros((4, 3), chunks=(2, 3))),
+    ...         "w": ("x", da.ones(4, chunks=2, dtype="float32")),
+    ...     }
+    ... )
+    >>> block_bytes(layout_of(ds))
+    56
+    """
     total = 0
     for v in plan.lazy:
         shape = [
