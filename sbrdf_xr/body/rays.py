@@ -75,7 +75,18 @@ def available_engines() -> list[str]:
 
 
 def engine_name(engine: str | None) -> str:
-    """The ray engine to use for ``engine`` (None or ``"auto"``: the best available)."""
+    """The ray engine to use for ``engine`` (None or ``"auto"``: the best available).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.body.rays import available_engines, engine_name
+    >>> engine_name("triangle"), engine_name(None) == available_engines()[0]
+    ('triangle', True)
+    >>> engine_name("optix")
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.ValidationError: engine: got 'optix'; allowed: auto, embree, triangle
+    """
     if engine is None:
         engine = "auto"
     if engine not in ENGINES:
@@ -92,7 +103,19 @@ def engine_name(engine: str | None) -> str:
 
 
 def check_density(density: int | str) -> int:
-    """The sampling density of an integer >= 1 or a preset name of :data:`DENSITY_PRESETS`."""
+    """The sampling density of an integer >= 1 or a preset name of :data:`DENSITY_PRESETS`.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.body.rays import check_density
+    >>> check_density(3), check_density("balanced")
+    (3, 4)
+    >>> check_density(0)
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.ValidationError: density: got 0; expected an integer sampling density >= 1 \
+or a preset name ['fast', 'balanced', 'reference']
+    """
     if isinstance(density, str):
         if density not in DENSITY_PRESETS:
             raise ValidationError(f"density: got {density!r}; presets: {DENSITY_PRESETS}")
@@ -154,7 +177,21 @@ def sample_triangle(n_samples: int, n_facets: int = 1, seed: int = SEED) -> NDAr
 
 
 def sample_uv(n_samples: int, n_facets: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
-    """The scrambled Sobol' points (n_samples, 2) and the per-facet shifts (n_facets, 2)."""
+    """The scrambled Sobol' points (n_samples, 2) and the per-facet shifts (n_facets, 2).
+
+    Examples
+    --------
+    Eight points of a base-2 Sobol' set fall one in each eighth of either axis:
+
+    >>> from sbrdf_xr.body.rays import sample_uv
+    >>> base, shift = sample_uv(8, 3, seed=1)
+    >>> base.shape, shift.shape
+    ((8, 2), (3, 2))
+    >>> sorted((base[:, 0] * 8).astype(int).tolist()) == list(range(8))
+    True
+    >>> sorted((base[:, 1] * 8).astype(int).tolist()) == list(range(8))
+    True
+    """
     from scipy.stats import qmc
 
     rng = np.random.default_rng(seed)
@@ -164,14 +201,41 @@ def sample_uv(n_samples: int, n_facets: int, seed: int) -> tuple[np.ndarray, np.
 
 
 def to_triangle(uv: np.ndarray) -> np.ndarray:
-    """Barycentric weights of unit-square points (shifted modulo 1), area-preserving map."""
+    """Barycentric weights of unit-square points (shifted modulo 1), area-preserving map.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.body.rays import to_triangle
+    >>> uv = np.array([[0.0, 0.0], [0.25, 0.5], [1.25, 1.5]])  # the last is the second, mod 1
+    >>> to_triangle(uv).round(6).tolist()
+    [[1.0, 0.0, 0.0], [0.5, 0.25, 0.25], [0.5, 0.25, 0.25]]
+    """
     uv = uv % 1.0
     r = np.sqrt(uv[..., 0])
     return np.stack([1.0 - r, r * (1.0 - uv[..., 1]), r * uv[..., 1]], axis=-1)
 
 
 def mesh_of(spacecraft: Spacecraft | trimesh.Trimesh) -> tuple[trimesh.Trimesh, dict[str, Any]]:
-    """The mesh of a spacecraft (or bare mesh) and its per-spacecraft cache."""
+    """The mesh of a spacecraft (or bare mesh) and its per-spacecraft cache.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr.body.rays import mesh_of
+    >>> from sbrdf_xr.testing import cube_spacecraft
+    >>> body = cube_spacecraft()
+    >>> mesh, cache = mesh_of(body)
+    >>> mesh is body.mesh, cache is body._cache
+    (True, True)
+    >>> box = trimesh.creation.box()
+    >>> mesh_of(box)[0] is box, mesh_of(box)[1]  # a bare mesh gets a fresh, empty cache
+    (True, {})
+    >>> mesh_of("cube.stl")
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.ValidationError: spacecraft: expected a Spacecraft or trimesh.Trimesh, got str
+    """
     if isinstance(spacecraft, Spacecraft):
         return spacecraft.mesh, spacecraft._cache
     if isinstance(spacecraft, trimesh.Trimesh):
@@ -182,7 +246,17 @@ def mesh_of(spacecraft: Spacecraft | trimesh.Trimesh) -> tuple[trimesh.Trimesh, 
 
 
 def is_convex(spacecraft: Spacecraft | trimesh.Trimesh) -> bool:
-    """Whether the surface is convex (cached on a Spacecraft)."""
+    """Whether the surface is convex (cached on a Spacecraft).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.body.rays import is_convex
+    >>> from sbrdf_xr.testing import cube_spacecraft, l_shaped_spacecraft
+    >>> is_convex(cube_spacecraft()), is_convex(l_shaped_spacecraft())
+    (True, False)
+    >>> is_convex(l_shaped_spacecraft().mesh)  # a bare mesh too
+    False
+    """
     if isinstance(spacecraft, Spacecraft):
         return spacecraft.is_convex
     return bool(spacecraft.is_convex)
@@ -191,7 +265,23 @@ def is_convex(spacecraft: Spacecraft | trimesh.Trimesh) -> bool:
 def intersector(
     mesh: trimesh.Trimesh, cache: dict[str, Any], engine: str
 ) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
-    """A function (origins, unit directions) -> bool hit, cached per spacecraft and engine."""
+    """A function (origins, unit directions) -> bool hit, cached per spacecraft and engine.
+
+    Examples
+    --------
+    A ray from above the unit box hits it going down and misses it going up:
+
+    >>> import numpy as np
+    >>> import trimesh
+    >>> from sbrdf_xr.body.rays import intersector
+    >>> cache = {}
+    >>> hits = intersector(trimesh.creation.box(), cache, "triangle")
+    >>> origins = np.array([[0.0, 0.0, 2.0], [0.0, 0.0, 2.0]])
+    >>> hits(origins, np.array([[0.0, 0.0, -1.0], [0.0, 0.0, 1.0]])).tolist()
+    [True, False]
+    >>> list(cache), intersector(trimesh.creation.box(), cache, "triangle") is hits
+    (['ray:triangle'], True)
+    """
     key = f"ray:{engine}"
     if key in cache:
         return cache[key]
@@ -228,7 +318,23 @@ def intersector(
 
 
 def supporting(mesh: trimesh.Trimesh, cache: dict[str, Any], tol: float) -> np.ndarray:
-    """Facets whose plane has the whole mesh on or behind it (cannot be shadowed)."""
+    """Facets whose plane has the whole mesh on or behind it (cannot be shadowed).
+
+    Examples
+    --------
+    Every facet of a box supports it; of the L-shaped body's 20 facets, the four on the
+    inner faces of the corner (the floor and the wall it shades) do not:
+
+    >>> import trimesh
+    >>> from sbrdf_xr.body.rays import supporting
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> bool(supporting(trimesh.creation.box(), {}, 1e-9).all())
+    True
+    >>> body = l_shaped_spacecraft()
+    >>> s = supporting(body.mesh, {}, 1e-9)
+    >>> s.shape, int((~s).sum())
+    ((20,), 4)
+    """
     key = f"supporting:{tol!r}"
     if key not in cache:
         try:
@@ -258,7 +364,29 @@ def escape_masks(
     convex_shortcut: bool,
     seed: int,
 ) -> np.ndarray:
-    """Per-sample escape flags, shape (len(directions), n_geometries, n_facets, n_samples)."""
+    """Per-sample escape flags, shape (len(directions), n_geometries, n_facets, n_samples).
+
+    Examples
+    --------
+    The wall of the L-shaped body shades half of its floor for a Sun at ``(-1, 2, 0)``;
+    at density 2 (four samples per facet) half the floor's samples escape towards it:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.body.rays import SEED, escape_masks
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> body = l_shaped_spacecraft()
+    >>> sun = np.array([[-1.0, 2.0, 0.0]]) / np.sqrt(5.0)
+    >>> m = escape_masks(body, [sun], 2, "triangle", None, True, SEED)
+    >>> m.shape, m.dtype
+    ((1, 1, 20, 4), dtype('bool'))
+    >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
+    ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
+    >>> float(m[0, 0, floor].mean())
+    0.5
+    >>> facing_away = body.mesh.face_normals @ sun[0] <= 0
+    >>> bool(m[0, 0, facing_away].any())  # facets facing away from the Sun never escape
+    False
+    """
     mesh, cache = mesh_of(spacecraft)
     n = check_density(density)
     engine = engine_name(engine)

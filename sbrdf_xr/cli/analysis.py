@@ -57,6 +57,43 @@ def _parse_colours(text: str | None) -> list[tuple[str, str]] | None:
 
 
 def cmd_photometry(args: argparse.Namespace) -> int:
+    """``sbrdf-xr photometry CUBE``: the band magnitudes (and colour indices) of a cube at
+    the observer range of ``--range-km`` or the one the cube records, their table printed
+    and written to the files of ``--output`` (netCDF) and ``--csv``; returns 0.
+
+    Examples
+    --------
+    A unit box of albedo 0.5 facing the Sun and the observer sends ``0.5 / pi m2 sr-1``;
+    at 1000 km its magnitudes are the Sun's plus ``30 - 2.5 log10(0.5 / pi) = 31.995``, and
+    a grey body has the Sun's colours:
+
+    >>> import contextlib
+    >>> import io
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import numpy as np
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft, simulate, write
+    >>> from sbrdf_xr.cli import cmd_photometry
+    >>> from sbrdf_xr.cli.parser import build_parser
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, np.arange(400.0, 1001.0, 20.0), material="grey")
+    >>> x = [[1.0, 0.0, 0.0]]
+    >>> scene = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, kernel="numpy")
+    >>> out = io.StringIO()
+    >>> with tempfile.TemporaryDirectory() as tmp, contextlib.redirect_stdout(out):
+    ...     cube = write(simulate(scene), Path(tmp) / "cube.nc")
+    ...     argv = ["photometry", str(cube), "--bands", "V", "R", "--range-km", "1000", "-q"]
+    ...     status = cmd_photometry(build_parser().parse_args(argv))
+    >>> status
+    0
+    >>> print(*out.getvalue().splitlines()[1:], sep="\\n")
+    band     filter            m_sun      min   median      max
+    V        bessell-V       -26.768    5.227    5.227    5.227
+    R        bessell-R       -26.963    5.033    5.033    5.033
+    colour V-R        median 0.194 mag
+    """
     import numpy as np
     import xarray as xr
     from tqdm.dask import TqdmCallback
@@ -153,6 +190,53 @@ def cmd_photometry(args: argparse.Namespace) -> int:
 
 
 def cmd_invert(args: argparse.Namespace) -> int:
+    """``sbrdf-xr invert unmix MEASURED --cube CUBE`` (the material areas of a measured
+    spectrum or band magnitudes, :func:`sbrdf_xr.invert.unmix`) or ``sbrdf-xr invert spin
+    CURVE`` (spin axis, period and phase of a light curve, :func:`sbrdf_xr.invert.fit_spin`):
+    the fit printed and written to the file of ``--output``; returns 0.
+
+    Examples
+    --------
+    A measured spectrum twice the simulated signal of a unit box unmixes to twice its
+    area of the material, ``+- 0.01 / (0.5 / pi) / sqrt(3)`` for three wavelengths:
+
+    >>> import contextlib
+    >>> import io
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft, simulate, write
+    >>> from sbrdf_xr.cli import cmd_invert
+    >>> from sbrdf_xr.cli.parser import build_parser
+    >>> from sbrdf_xr.errors import InversionError
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> x = [[1.0, 0.0, 0.0]]
+    >>> scene = Scene(box, {"grey": grey}, to_sun=x, to_observer=x,
+    ...               outputs=("signal", "per_material"), kernel="numpy")
+    >>> rows = "wavelength,signal,uncertainty\\n" + "".join(
+    ...     f"{wl},0.3183099,0.01\\n" for wl in (500, 600, 700))
+    >>> out = io.StringIO()
+    >>> with tempfile.TemporaryDirectory() as tmp, contextlib.redirect_stdout(out):
+    ...     cube = write(simulate(scene), Path(tmp) / "cube.nc")
+    ...     _ = (Path(tmp) / "spectrum.csv").write_text(rows)
+    ...     argv = ["invert", "unmix", str(Path(tmp) / "spectrum.csv"), "--cube", str(cube),
+    ...             "--isel", "geometry=0", "--select", "none"]
+    ...     status = cmd_invert(build_parser().parse_args(argv))
+    ...     _ = write(simulate(scene)[["signal"]], cube, overwrite=True)  # no per-material
+    ...     try:
+    ...         cmd_invert(build_parser().parse_args(argv))
+    ...     except InversionError as exc:
+    ...         error = str(exc).replace(tmp, "TMP")
+    >>> status
+    0
+    >>> print(*out.getvalue().splitlines()[1:], sep="\\n")
+      grey                     scale 2.0000 +- 0.0363
+      degenerate: none
+    >>> print(error)
+    TMP/cube.nc: no signal_material; simulate with the per_material output
+    """
     import numpy as np
     import xarray as xr
 

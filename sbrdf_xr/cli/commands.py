@@ -35,6 +35,25 @@ def _catalog_label(e: catalog.CatalogEntry, users: list[Path]) -> str:
 
 
 def cmd_catalog_list(args: argparse.Namespace) -> int:
+    """``sbrdf-xr catalog list``: one line per catalog entry (name, kind, source, catalog,
+    description), then the catalog directories; returns 0.
+
+    Examples
+    --------
+    >>> import contextlib
+    >>> import io
+    >>> from sbrdf_xr.cli import cmd_catalog_list
+    >>> from sbrdf_xr.cli.parser import build_parser
+    >>> args = build_parser().parse_args(["catalog", "list", "--kind", "spacecraft"])
+    >>> out = io.StringIO()
+    >>> with contextlib.redirect_stdout(out):
+    ...     status = cmd_catalog_list(args)
+    >>> lines = out.getvalue().splitlines()
+    >>> status, lines[0].split()
+    (0, ['name', 'kind', 'source', 'catalog', 'description'])
+    >>> lines[1].split()[:4], lines[3]
+    (['canx1', 'spacecraft', 'synthetic', 'shipped'], '1 entries; catalogs:')
+    """
     rows = catalog.entries(args.kind)
     users = catalog.user_catalog_dirs()
     width = max((len(e.name) for e in rows), default=4)
@@ -53,6 +72,29 @@ def cmd_catalog_list(args: argparse.Namespace) -> int:
 
 
 def cmd_catalog_show(args: argparse.Namespace) -> int:
+    """``sbrdf-xr catalog show NAME``: the entry's fields, then a summary of its loaded
+    contents; returns 0.
+
+    Examples
+    --------
+    >>> import contextlib
+    >>> import io
+    >>> from sbrdf_xr.cli import cmd_catalog_show
+    >>> from sbrdf_xr.cli.parser import build_parser
+    >>> out = io.StringIO()
+    >>> with contextlib.redirect_stdout(out):
+    ...     status = cmd_catalog_show(build_parser().parse_args(["catalog", "show", "canx1"]))
+    >>> lines = out.getvalue().splitlines()
+    >>> status
+    0
+    >>> print(*lines[:4], sep="\\n")
+    name:        canx1
+    kind:        spacecraft
+    source:      synthetic
+    catalog:     shipped
+    >>> print(lines[-1].split(":")[0])  # the loaded entry itself
+    <Spacecraft 'canx1'
+    """
     e = catalog.entry(args.name)
     print(escape(f"name:        {e.name}\nkind:        {e.kind}\nsource:      {e.source}"))
     print(escape(f"catalog:     {e.origin}"))
@@ -71,6 +113,36 @@ def cmd_catalog_show(args: argparse.Namespace) -> int:
 
 
 def cmd_info(args: argparse.Namespace) -> int:
+    """``sbrdf-xr info [FILE]``: the versions of the package and its main dependencies and
+    the catalogs, or the summary of a netCDF file (its attributes escaped); returns 0.
+
+    Examples
+    --------
+    >>> import contextlib
+    >>> import io
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import xarray as xr
+    >>> import sbrdf_xr
+    >>> from sbrdf_xr.cli import cmd_info
+    >>> from sbrdf_xr.cli.parser import build_parser
+    >>> out = io.StringIO()
+    >>> with contextlib.redirect_stdout(out):
+    ...     status = cmd_info(build_parser().parse_args(["info"]))
+    >>> status, out.getvalue().splitlines()[0] == f"sbrdf_xr {sbrdf_xr.__version__}"
+    (0, True)
+
+    A file's attribute holding a terminal escape sequence prints as text:
+
+    >>> ds = xr.Dataset({"v": ("x", [1.0])}, attrs={"title": chr(27) + "[2Jcube"})
+    >>> out = io.StringIO()
+    >>> with tempfile.TemporaryDirectory() as tmp, contextlib.redirect_stdout(out):
+    ...     ds.to_netcdf(Path(tmp) / "t.nc")
+    ...     status = cmd_info(build_parser().parse_args(["info", str(Path(tmp) / "t.nc")]))
+    >>> text = out.getvalue()
+    >>> status, "title:    \\\\x1b[2Jcube" in text, chr(27) in text
+    (0, True, False)
+    """
     if args.file:
         with open_dataset(args.file) as ds:
             print(escape(escaped_attrs(ds)))
@@ -91,6 +163,24 @@ def cmd_info(args: argparse.Namespace) -> int:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
+    """``sbrdf-xr bench``: the accuracy/cost benchmarks (:func:`sbrdf_xr.bench.run`; with
+    ``--engine`` the engine rows), their table printed and written to the files of
+    ``--output`` (netCDF), ``--csv`` and ``--plot`` (PNG); returns 0.
+
+    Even with ``--quick`` the benchmarks run for minutes.
+
+    Examples
+    --------
+    The options it reads, parsed from a command line:
+
+    >>> from sbrdf_xr.cli import cmd_bench
+    >>> from sbrdf_xr.cli.parser import build_parser
+    >>> args = build_parser().parse_args(["bench", "--quick", "--csv", "bench.csv"])
+    >>> args.func is cmd_bench
+    True
+    >>> args.quick, args.engine, args.output, args.csv, args.plot
+    (True, False, None, 'bench.csv', None)
+    """
     from .. import bench
 
     if args.engine:
@@ -119,6 +209,52 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
+    """``sbrdf-xr simulate SCENE -o CUBE``: the scene (with the spacecraft, materials, preset
+    and knobs of the options) is planned and its plan printed; unless ``--plan``, it is
+    run and the cube written (overwritten or resumed as asked), with its figure for
+    ``--plot``; returns 0.
+
+    Examples
+    --------
+    A unit box of the catalog's Lambertian grey (albedo 0.5) at two attitudes and two
+    phase angles; facing the Sun and the observer, it sends ``1 m2 x 0.5 / pi sr-1``:
+
+    >>> import contextlib
+    >>> import io
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import trimesh
+    >>> import xarray as xr
+    >>> from sbrdf_xr.cli import cmd_simulate
+    >>> from sbrdf_xr.cli.parser import build_parser
+    >>> text = '''
+    ... name = "grey-box"
+    ... spacecraft = { path = "box.stl", material = "lambertian-grey-50" }
+    ... phase_angles = [0.0, 60.0]
+    ... [attitude]
+    ... kind = "sweep"
+    ... axis = [0, 0, 1]
+    ... stop = 90.0
+    ... step = 45.0
+    ... '''
+    >>> out = io.StringIO()
+    >>> with tempfile.TemporaryDirectory() as tmp, contextlib.redirect_stdout(out):
+    ...     _ = trimesh.creation.box().export(Path(tmp) / "box.stl")
+    ...     _ = (Path(tmp) / "box.toml").write_text(text)
+    ...     cube = Path(tmp) / "cube.nc"
+    ...     argv = ["simulate", str(Path(tmp) / "box.toml"), "-o", str(cube), "-q"]
+    ...     planned = cmd_simulate(build_parser().parse_args([*argv, "--plan"]))
+    ...     after_plan = cube.exists()
+    ...     ran = cmd_simulate(build_parser().parse_args([*argv, "--set", "kernel=numpy"]))
+    ...     with xr.open_dataset(cube) as ds:
+    ...         signal = round(float(ds.signal.isel(attitude=0, phase_angle=0, wavelength=0)), 6)
+    >>> planned, after_plan, ran, signal
+    (0, False, 0, 0.159155)
+    >>> lines = out.getvalue().splitlines()
+    >>> lines[0], lines[1].split()
+    ("plan for scene 'grey-box':", ['geometry', '2', 'attitudes', 'x', '2', 'phase', 'angles', \
+'=', '4', 'geometries'])
+    """
     from ..engine import resolve_scene
     from ..engine.run import simulate, write
 
@@ -174,7 +310,22 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def spacecraft_of(args: argparse.Namespace) -> Any:
-    """The spacecraft of ``--spacecraft`` (a catalog name or a mesh file) and its options."""
+    """The spacecraft of ``--spacecraft`` (a catalog name or a mesh file) and its options.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.cli import spacecraft_of
+    >>> from sbrdf_xr.cli.parser import build_parser
+    >>> parse = build_parser().parse_args
+    >>> body = spacecraft_of(parse(["simulate", "s.toml", "-o", "c.nc", "--spacecraft", "canx1"]))
+    >>> body.name, body.n_facets, body.materials
+    ('canx1', 684, ['aluminium-6061-t6', 'tjpv-cell', 'white-paint-a276'])
+    >>> spacecraft_of(parse(["simulate", "s.toml", "-o", "c.nc", "--spacecraft", "bus.stl"]))
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.ValidationError: --spacecraft bus.stl: a mesh file needs --mesh-material \
+NAME (one material for every facet) or --material-map MAP.toml (facet colour or label -> material)
+    """
     options: dict[str, Any] = {}
     if args.mesh_material is not None:
         options["material"] = args.mesh_material
@@ -270,6 +421,24 @@ def _knob_values(items: list[str]) -> dict[str, object]:
 
 
 def cmd_knobs(args: argparse.Namespace) -> int:
+    """``sbrdf-xr knobs``: the table of :func:`sbrdf_xr.engine.knobs.knob_table`; returns 0.
+
+    Examples
+    --------
+    >>> import contextlib
+    >>> import io
+    >>> from sbrdf_xr.cli import cmd_knobs
+    >>> from sbrdf_xr.cli.parser import build_parser
+    >>> from sbrdf_xr.engine.knobs import KNOBS
+    >>> out = io.StringIO()
+    >>> with contextlib.redirect_stdout(out):
+    ...     status = cmd_knobs(build_parser().parse_args(["knobs"]))
+    >>> lines = out.getvalue().splitlines()
+    >>> status, lines[0].split()
+    (0, ['knob', 'default', 'fast', '/', 'balanced', '/', 'reference', 'trades'])
+    >>> [line.split()[0] for line in lines[1:]] == list(KNOBS)  # one line per knob
+    True
+    """
     from ..engine.knobs import knob_table
 
     print(knob_table())
@@ -298,5 +467,32 @@ def _save_figure(cube_path: str | Path, figure_path: str) -> None:
 
 
 def cmd_plot(args: argparse.Namespace) -> int:
+    """``sbrdf-xr plot CUBE -o FIG``: the cube's figure (:func:`sbrdf_xr.plot.plot_cube`) in
+    an image file; returns 0.
+
+    Examples
+    --------
+    >>> import contextlib
+    >>> import io
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, geometry, load_spacecraft, simulate, write
+    >>> from sbrdf_xr.cli import cmd_plot
+    >>> from sbrdf_xr.cli.parser import build_parser
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> turns = geometry.axis_rotation([0, 0, 1], [0.0, 45.0])
+    >>> scene = Scene(box, {"grey": grey}, attitudes=turns, phase_angles=[0.0], kernel="numpy")
+    >>> out = io.StringIO()
+    >>> with tempfile.TemporaryDirectory() as tmp, contextlib.redirect_stdout(out):
+    ...     cube, fig = Path(tmp) / "cube.nc", Path(tmp) / "cube.png"
+    ...     _ = write(simulate(scene), cube)
+    ...     status = cmd_plot(build_parser().parse_args(["plot", str(cube), "-o", str(fig)]))
+    ...     png = fig.read_bytes()[1:4]
+    >>> status, png, out.getvalue().startswith("wrote ")
+    (0, b'PNG', True)
+    """
     _save_figure(args.cube, args.output)
     return 0

@@ -36,7 +36,24 @@ def escape(text: Any, newlines: bool = False) -> str:
 
 
 def escaped_attrs(obj: Any) -> Any:
-    """A shallow copy of a Dataset/DataArray whose attributes (and names) print safely."""
+    """A shallow copy of a Dataset/DataArray whose attributes (and names) print safely.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> from sbrdf_xr.cli import escaped_attrs
+    >>> esc = chr(27)  # the terminal's escape character
+    >>> ds = xr.Dataset({"a" + esc: ("x", [1.0, 2.0])}, attrs={"title": esc + "[2Jcube"})
+    >>> safe = escaped_attrs(ds)
+    >>> print(safe.attrs["title"])
+    \\x1b[2Jcube
+    >>> print(*safe.data_vars)  # the variable's name too
+    a\\x1b
+    >>> ds.attrs["title"] == esc + "[2Jcube"  # the original is left as it was
+    True
+    >>> escaped_attrs([1, 2])  # anything else is returned unchanged
+    [1, 2]
+    """
     import xarray as xr
 
     def clean(attrs: dict[Any, Any]) -> dict[str, Any]:
@@ -60,7 +77,31 @@ def escaped_attrs(obj: Any) -> Any:
 
 
 def open_dataset(path: str | Path) -> Any:
-    """Open a netCDF file, turning "not netCDF" into a :class:`ValidationError`."""
+    """Open a netCDF file, turning "not netCDF" into a :class:`ValidationError`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import xarray as xr
+    >>> from sbrdf_xr.cli import open_dataset
+    >>> from sbrdf_xr.errors import ValidationError
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     xr.Dataset({"v": ("x", [1.0, 2.0])}).to_netcdf(Path(tmp) / "ok.nc")
+    ...     with open_dataset(Path(tmp) / "ok.nc") as ds:
+    ...         print(ds.v.values.tolist())
+    ...     _ = (Path(tmp) / "notes.nc").write_text("not netCDF")
+    ...     try:
+    ...         open_dataset(Path(tmp) / "notes.nc")
+    ...     except ValidationError as exc:
+    ...         print(str(exc).replace(tmp, "TMP"))
+    [1.0, 2.0]
+    TMP/notes.nc: not a readable netCDF file (unrecognised format)
+    >>> open_dataset("no-such-file.nc")
+    Traceback (most recent call last):
+    ...
+    FileNotFoundError: no-such-file.nc: no such file
+    """
     import xarray as xr
 
     p = Path(path)
@@ -80,7 +121,29 @@ def open_dataset(path: str | Path) -> Any:
 
 
 def open_cube(path: str | Path) -> Any:
-    """A loaded simulation cube, or :class:`ValidationError` naming what is missing."""
+    """A loaded simulation cube, or :class:`ValidationError` naming what is missing.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import xarray as xr
+    >>> from sbrdf_xr.cli import open_cube
+    >>> from sbrdf_xr.errors import ValidationError
+    >>> spectra = xr.Dataset({"signal": (("attitude", "wavelength"), [[0.1, 0.2]])},
+    ...                      coords={"wavelength": [500.0, 600.0]})
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     spectra.to_netcdf(Path(tmp) / "cube.nc")
+    ...     cube = open_cube(Path(tmp) / "cube.nc")  # loaded: usable after the file is gone
+    ...     xr.Dataset({"area": ("x", [1.0])}).to_netcdf(Path(tmp) / "area.nc")
+    ...     try:
+    ...         open_cube(Path(tmp) / "area.nc")
+    ...     except ValidationError as exc:
+    ...         print(str(exc).split("; ")[-1])
+    its variables: area)
+    >>> cube.signal.values.tolist()
+    [[0.1, 0.2]]
+    """
     with open_dataset(path) as ds:
         spectral = [
             v for v in ("spacecraft_sbrdf", "signal") if v in ds and "wavelength" in ds[v].dims

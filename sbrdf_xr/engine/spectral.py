@@ -31,7 +31,29 @@ Scene = Any
 
 
 def common_wavelength(scene: Scene, used: list[str]) -> np.ndarray:
-    """The wavelengths every used material's table covers (those of the first table)."""
+    """The wavelengths every used material's table covers (those of the first table).
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> from sbrdf_xr.engine.spectral import common_wavelength
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> dark = lambertian(0.2, [400.0, 500.0, 600.0], material="dark")
+    >>> far = lambertian(0.2, [800.0, 900.0], material="far")
+    >>> scene = Scene(box, {"grey": grey, "dark": dark, "far": far}, to_sun=x, to_observer=x)
+    >>> common_wavelength(scene, ["grey", "dark"]).tolist()  # the overlap, on grey's grid
+    [500.0, 600.0]
+    >>> common_wavelength(scene, []).tolist()  # no material: one visible wavelength
+    [550.0]
+    >>> common_wavelength(scene, ["grey", "far"])
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.SceneError: materials 'grey' and 'far' have no wavelengths in common
+    """
     wl = np.asarray(scene.tables[used[0]][WAVELENGTH].values) if used else np.array([550.0])
     for m in used[1:]:
         other = np.asarray(scene.tables[m][WAVELENGTH].values)
@@ -44,7 +66,34 @@ def common_wavelength(scene: Scene, used: list[str]) -> np.ndarray:
 
 
 def band_weights_of(scene: Scene, wl: np.ndarray) -> xr.DataArray:
-    """The scene's band weights (filter x Sun, normalised) on the wavelengths ``wl``."""
+    """The scene's band weights (filter x Sun, normalised) on the wavelengths ``wl``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> from sbrdf_xr.engine.spectral import band_weights_of
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> scene = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, bands=("V", "R"))
+    >>> w = band_weights_of(scene, np.arange(400.0, 901.0, 10.0))
+    >>> w.dims, w.shape, w.filter.values.tolist()
+    (('band', 'wavelength'), (2, 51), ['bessell-V', 'bessell-R'])
+    >>> bool(np.allclose(w.sum("wavelength"), 1.0))  # each band's weights sum to one
+    True
+
+    A grid short of a band's response is an error unless the scene extrapolates:
+
+    >>> band_weights_of(scene, np.array([500.0, 600.0, 700.0]))
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.SceneError: bands: band 'V' (bessell-V) has non-zero response over \
+470-700 nm but the spectrum covers only 500-700 nm; pass extrapolate='zero' or 'constant' to \
+continue the spectrum past its grid (scene field band_extrapolate)
+    """
     try:
         return band_weights(
             list(scene.bands), wl, normalize=True, extrapolate=scene.band_extrapolate
@@ -54,7 +103,26 @@ def band_weights_of(scene: Scene, wl: np.ndarray) -> xr.DataArray:
 
 
 def table_on(da: xr.DataArray, wl: np.ndarray, theta_step: float | None) -> xr.DataArray:
-    """A table on the wavelengths ``wl``, its theta_i resampled every ``theta_step`` degree."""
+    """A table on the wavelengths ``wl``, its theta_i resampled every ``theta_step`` degree.
+
+    Examples
+    --------
+    The last node of theta_i is kept when the step does not reach it:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.engine.spectral import table_on
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> grey.theta_i.values.tolist()
+    [0.0, 90.0]
+    >>> t = table_on(grey, np.array([550.0]), 40.0)
+    >>> t.theta_i.values.tolist(), t.wavelength.values.tolist()
+    ([0.0, 40.0, 80.0, 90.0], [550.0])
+    >>> bool(np.allclose(t, 0.5 / np.pi))  # a Lambertian table stays albedo / pi
+    True
+    >>> table_on(grey, np.array([500.0, 600.0, 700.0]), None) is grey  # already on the grid
+    True
+    """
     if not np.array_equal(da[WAVELENGTH].values, wl):
         da = da.interp({WAVELENGTH: wl})
     if theta_step is not None:
@@ -67,7 +135,36 @@ def table_on(da: xr.DataArray, wl: np.ndarray, theta_step: float | None) -> xr.D
 
 
 def material_models(scene: Scene, used: list[str]) -> dict[int, tuple[Any, Mapping[str, Any]]]:
-    """BRDF model and parameters of every material, for analytic evaluation."""
+    """BRDF model and parameters of every material, for analytic evaluation.
+
+    Examples
+    --------
+    The models come by material index, from ``Scene(models=...)`` or the catalog entry
+    ``NAME-model``:
+
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> from sbrdf_xr.engine.spectral import material_models
+    >>> from sbrdf_xr.errors import SceneError
+    >>> from sbrdf_xr.materials.models import model_material
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> spec = model_material("lambert", [500.0, 600.0, 700.0], material="grey",
+    ...                       provenance="albedo 0.5", rho=0.5)
+    >>> scene = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, models={"grey": spec})
+    >>> found = material_models(scene, ["grey"])
+    >>> model, params = found[0]
+    >>> list(found), model.name, params["rho"].tolist()
+    ([0], 'lambert', [0.5, 0.5, 0.5])
+    >>> try:
+    ...     material_models(Scene(box, {"grey": grey}, to_sun=x, to_observer=x), ["grey"])
+    ... except SceneError as exc:
+    ...     print(str(exc).split(" (")[0])
+    evaluation='analytic': material 'grey' has no model; give Scene(models={'grey': ...}) or a \
+catalog entry 'grey-model'
+    """
     given = dict(scene.models or {})
     out: dict[int, tuple[Any, Mapping[str, Any]]] = {}
     for m, name in enumerate(used):
@@ -87,7 +184,33 @@ def material_models(scene: Scene, used: list[str]) -> dict[int, tuple[Any, Mappi
 
 @dataclass(frozen=True)
 class Spectral:
-    """What the spectral stage resolved: the grid, the bands and the tables."""
+    """What the spectral stage resolved: the grid, the bands and the tables.
+
+    Examples
+    --------
+    A Lambertian grey in the V and R bands, only band outputs asked for: the tables are
+    pre-integrated over the bands, so the packed values are two (one per band), each
+    albedo / pi:
+
+    >>> import numpy as np
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> from sbrdf_xr.engine.spectral import spectral_stage
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
+    >>> grey = lambertian(0.5, np.arange(400.0, 1001.0, 50.0), material="grey")
+    >>> scene = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, bands=("V", "R"),
+    ...               outputs=("band_signal",))
+    >>> knobs = {k: getattr(scene, k) for k in scene.knob_names()}
+    >>> sx = spectral_stage(scene, ["grey"], knobs, [])
+    >>> type(sx).__name__, sx.wavelength.size, sx.band_weights.shape, sx.pre_integrated
+    ('Spectral', 13, (2, 13), True)
+    >>> sx.dtype, sx.tables.n_spectral, bool(np.allclose(sx.tables.values[0], 0.5 / np.pi))
+    (dtype('float64'), 2, True)
+    >>> sx.models, sx.anisotropic, sorted(sx.band_coords)
+    ({}, {}, ['band', 'filter', 'filter_source'])
+    """
 
     wavelength: np.ndarray
     band_weights: np.ndarray | None
@@ -102,7 +225,34 @@ class Spectral:
 def spectral_stage(
     scene: Scene, used: list[str], knobs: Mapping[str, Any], steps: list[tuple[str, str]]
 ) -> Spectral:
-    """The wavelength grid, the band weights, and the tables (or models) of ``used``."""
+    """The wavelength grid, the band weights, and the tables (or models) of ``used``.
+
+    Examples
+    --------
+    The knob ``wavelength_stride`` keeps every n-th wavelength; the plan's lines say so:
+
+    >>> import numpy as np
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> from sbrdf_xr.engine.spectral import spectral_stage
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
+    >>> grey = lambertian(0.5, [500.0, 550.0, 600.0, 650.0, 700.0], material="grey")
+    >>> scene = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, wavelength_stride=2)
+    >>> knobs = {k: getattr(scene, k) for k in scene.knob_names()}
+    >>> steps = []
+    >>> sx = spectral_stage(scene, ["grey"], knobs, steps)
+    >>> sx.wavelength.tolist(), sx.band_weights, sx.pre_integrated
+    ([500.0, 600.0, 700.0], None, False)
+    >>> sx.tables.n_spectral, bool(np.allclose(sx.tables.values[0], 0.5 / np.pi))
+    (3, True)
+    >>> for name, line in steps:
+    ...     print(f"{name}: {line}")
+    materials: 1 tabulated materials (grey), linear look-up, float64, fused kernel
+    bands: skipped: no band output requested
+    wavelength: 3 wavelengths 500-700 nm (every 2th)
+    """
     wl_full = common_wavelength(scene, used or list(scene.tables))
     wl = wl_full[:: knobs["wavelength_stride"]]
     bw = None

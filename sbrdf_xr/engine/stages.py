@@ -33,6 +33,21 @@ DROP_BLOCK = 2_000_000
 
 
 def readonly(a: np.ndarray) -> np.ndarray:
+    """A C-contiguous, read-only copy (or view) of ``a``, for the frozen plan.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.engine.stages import readonly
+    >>> every_other = np.arange(6).reshape(2, 3)[:, ::2]
+    >>> r = readonly(every_other)
+    >>> r.tolist(), r.flags.c_contiguous, r.flags.writeable
+    ([[0, 2], [3, 5]], True, False)
+    >>> r[0, 0] = 1
+    Traceback (most recent call last):
+    ...
+    ValueError: assignment destination is read-only
+    """
     a = np.ascontiguousarray(a)
     a.flags.writeable = False
     return a
@@ -41,7 +56,27 @@ def readonly(a: np.ndarray) -> np.ndarray:
 def shadow_stage(
     scene: Scene, knobs: Mapping[str, Any], steps: list[tuple[str, str]]
 ) -> tuple[bool, dict[str, Any]]:
-    """Whether the plan shadows (asked for, and the body is not convex), and how."""
+    """Whether the plan shadows (asked for, and the body is not convex), and how.
+
+    Examples
+    --------
+    >>> from sbrdf_xr import Scene
+    >>> from sbrdf_xr.engine.stages import shadow_stage
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> from sbrdf_xr.testing import cube_spacecraft, l_shaped_spacecraft
+    >>> paint = {"white-paint-a276": lambertian(0.8, [500.0, 600.0], material="white-paint-a276")}
+    >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
+    >>> def shadows(body):
+    ...     scene = Scene(body, paint, to_sun=x, to_observer=x, effects=("sunlight", "shadowing"))
+    ...     steps = []
+    ...     knobs = {k: getattr(scene, k) for k in scene.knob_names()}
+    ...     return shadow_stage(scene, knobs, steps), steps[0][1]
+    >>> shadows(cube_spacecraft())
+    ((False, {}), 'skipped: the body is convex, no facet can shadow another')
+    >>> shadows(l_shaped_spacecraft())
+    ((True, {'method': 'exact'}), 'exact self-shadowing and self-occlusion by polygon clipping \
+(non-convex body)')
+    """
     want_shadow = "shadowing" in scene.effects
     convex = bool(scene.spacecraft.is_convex) if want_shadow else None
     shadowing = want_shadow and not convex
@@ -77,6 +112,39 @@ def facet_terms(
     steps: list[tuple[str, str]],
     aniso: frozenset[str] = frozenset(),
 ) -> tuple[dict[str, np.ndarray], bool]:
+    """The facet terms (normal, area, material, first facet, facet count, tangent) and
+    whether the facets were merged by (normal, material); merging is the default unless
+    the plan shadows.
+
+    Examples
+    --------
+    The twelve triangles of a box merge into its six faces, two facets each:
+
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> from sbrdf_xr.engine.stages import facet_terms
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
+    >>> scene = Scene(box, {"grey": grey}, to_sun=x, to_observer=x)
+    >>> steps = []
+    >>> terms, merged = facet_terms(scene, False, steps)
+    >>> merged, sorted(terms), terms["area"].tolist(), terms["n_facets"].tolist()
+    (True, ['area', 'facet', 'material', 'n_facets', 'normal', 'tangent'], \
+[1.0, 1.0, 1.0, 1.0, 1.0, 1.0], [2, 2, 2, 2, 2, 2])
+    >>> steps[0][1]
+    '12 facets -> 6 terms, merged by (normal, material): exact for flat facets, no per-facet \
+effect is on'
+    >>> facet_terms(scene, True, [])[0]["area"].shape  # shadowing: one term per facet
+    (12,)
+    >>> merging = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, merge=True)
+    >>> facet_terms(merging, True, [])
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.SceneError: merge: facets cannot be merged while self-shadowing is on \
+(a per-facet effect)
+    """
     sc = scene.spacecraft
     may_merge = not shadowing
     merge = may_merge if scene.merge is None else bool(scene.merge)
@@ -123,7 +191,35 @@ def facet_terms(
 def tilted_terms(
     scene: Scene, raw: dict[str, np.ndarray], nodes: int, steps: list[tuple[str, str]]
 ) -> dict[str, np.ndarray]:
-    """Terms replaced by their tilted copies where the scene asks for surface imperfections."""
+    """Terms replaced by their tilted copies where the scene asks for surface imperfections.
+
+    Examples
+    --------
+    With 3 x 3 quadrature nodes each face of a box becomes nine tilted unit-normal copies
+    whose areas add up to the face's:
+
+    >>> import numpy as np
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> from sbrdf_xr.engine.stages import facet_terms, tilted_terms
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
+    >>> flat = Scene(box, {"grey": grey}, to_sun=x, to_observer=x)
+    >>> raw, _ = facet_terms(flat, False, [])
+    >>> tilted_terms(flat, raw, 3, []) is raw  # no tilt: the terms as they were
+    True
+    >>> rough = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, surface_tilt=5.0)
+    >>> steps = []
+    >>> out = tilted_terms(rough, raw, 3, steps)
+    >>> out["area"].shape, out["area"].reshape(6, 9).sum(axis=1).round(12).tolist()
+    ((54,), [1.0, 1.0, 1.0, 1.0, 1.0, 1.0])
+    >>> bool(np.allclose(np.linalg.norm(out["normal"], axis=1), 1.0))
+    True
+    >>> print(steps[0][1].split(": ")[-1])
+    6 -> 54 terms
+    """
     st = scene.surface_tilt
     sigma = np.array(
         [
@@ -160,7 +256,35 @@ def tilted_terms(
 
 def contributing_terms(scene: Scene, normals: np.ndarray) -> np.ndarray:
     """Boolean per term: lit (by the Sun, or the Earth with earthshine) and visible for
-    at least one geometry of the sweep; with thermal emission, visible is enough."""
+    at least one geometry of the sweep; with thermal emission, visible is enough.
+
+    Examples
+    --------
+    With the Sun along +x and the observer along +y no face of a box is both lit and
+    seen; with thermal emission the face seen (+y) contributes:
+
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> from sbrdf_xr.engine.stages import contributing_terms, facet_terms
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
+    >>> y = [[0.0, 1.0, 0.0]]
+    >>> scene = Scene(box, {"grey": grey}, to_sun=x, to_observer=y)
+    >>> raw, _ = facet_terms(scene, False, [])
+    >>> raw["normal"].tolist()
+    [[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0], \
+[1.0, 0.0, 0.0]]
+    >>> contributing_terms(scene, raw["normal"]).tolist()
+    [False, False, False, False, False, False]
+    >>> warm = Scene(box, {"grey": grey}, to_sun=x, to_observer=y, effects=("sunlight", "thermal"))
+    >>> contributing_terms(warm, raw["normal"]).tolist()
+    [False, False, False, False, True, False]
+    >>> facing = Scene(box, {"grey": grey}, to_sun=x, to_observer=x)
+    >>> contributing_terms(facing, raw["normal"]).tolist()  # only +x faces both
+    [False, False, False, False, False, True]
+    """
     geo = scene.geometry
     keep = np.zeros(len(normals), dtype=bool)
     per = max(1, geo.n_geometries // max(1, geo.n_lead))
@@ -184,19 +308,70 @@ def contributing_terms(scene: Scene, normals: np.ndarray) -> np.ndarray:
 
 
 def temperature(scene: Scene, material: str) -> float:
+    """The temperature [K] of a material: the scene's one value, or its entry in the
+    scene's mapping (300 K if it has none).
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> from sbrdf_xr.engine.stages import temperature
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
+    >>> temperature(Scene(box, {"grey": grey}, to_sun=x, to_observer=x), "grey")
+    300.0
+    >>> hot = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, temperature={"grey": 350.0})
+    >>> temperature(hot, "grey"), temperature(hot, "paint")
+    (350.0, 300.0)
+    """
     t = scene.temperature
     return float(t.get(material, 300.0)) if isinstance(t, Mapping) else float(t)
 
 
 def thermal_to_reflected(scene: Scene, wl: np.ndarray) -> float:
     """Largest ratio of blackbody radiance (emissivity 1) to the radiance of a white
-    Lambertian surface in sunlight, E_sun / pi, over the scene's wavelengths."""
+    Lambertian surface in sunlight, E_sun / pi, over the scene's wavelengths.
+
+    Examples
+    --------
+    At 300 K the emission is negligible in the visible but not at 2-4 um; at 600 K it
+    outshines the reflected sunlight there:
+
+    >>> import numpy as np
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> from sbrdf_xr.engine.stages import THERMAL_NEGLIGIBLE, thermal_to_reflected
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
+    >>> scene = Scene(box, {"grey": grey}, to_sun=x, to_observer=x)
+    >>> visible, infrared = np.array([500.0, 600.0, 700.0]), np.array([2000.0, 4000.0])
+    >>> ratio = thermal_to_reflected(scene, visible)
+    >>> f"{ratio:.1e}", ratio < THERMAL_NEGLIGIBLE
+    ('2.6e-24', True)
+    >>> round(thermal_to_reflected(scene, infrared), 3)
+    0.106
+    >>> hot = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, temperature=600.0)
+    >>> round(thermal_to_reflected(hot, infrared), 1)
+    42.7
+    """
     e_sun = solar_spectrum(wl).values
     b = np.max([sources.planck(wl, temperature(scene, m)) for m in scene.tables], axis=0)
     return float(np.max(b / np.maximum(e_sun / np.pi, 1e-300)))
 
 
 def describe_bytes(n: float) -> str:
+    """A byte count in decimal units (B, kB, MB, GB, TB), three significant digits.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.engine.stages import describe_bytes
+    >>> [describe_bytes(n) for n in (999, 1000, 1_234_567, 2.5e9, 3e13)]
+    ['999 B', '1 kB', '1.23 MB', '2.5 GB', '30 TB']
+    """
     for unit, scale in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
         if n >= scale:
             return f"{n / scale:.3g} {unit}"
@@ -213,7 +388,37 @@ def effect_stage(
 ) -> tuple[list[str], dict[str, Any]]:
     """The effects a scene calls for (:data:`sbrdf_xr.engine.effects.EFFECTS` names) and their
     parameters: sunlight always; shadowing, the Earth's shadow, earthshine and thermal
-    emission only where asked for and not negligible.  Appends the plan's lines."""
+    emission only where asked for and not negligible.  Appends the plan's lines.
+
+    Examples
+    --------
+    Thermal emission at 2-4 um: its emissivity is ``1 - rho`` (Kirchhoff), 0.5 for
+    a Lambertian of albedo 0.5; it is skipped when only bands of reflected light are
+    computed (``pre=True``):
+
+    >>> import numpy as np
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> from sbrdf_xr.engine.stages import effect_stage
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> wl = np.array([2000.0, 3000.0, 4000.0])
+    >>> grey = lambertian(0.5, wl, material="grey")
+    >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
+    >>> warm = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, effects=("sunlight", "thermal"))
+    >>> steps = []
+    >>> active, params = effect_stage(warm, wl, ["grey"], False, False, steps)
+    >>> active, sorted(params["thermal"])
+    (['sunlight', 'thermal'], ['emissivity', 'radiance', 'theta'])
+    >>> params["thermal"]["emissivity"][0].tolist(), params["thermal"]["theta"][0].tolist()
+    ([[0.5, 0.5, 0.5], [0.5, 0.5, 0.5]], [0.0, 90.0])
+    >>> effect_stage(warm, wl, ["grey"], True, False, [])
+    (['sunlight'], {})
+    >>> for name, line in steps:
+    ...     print(f"{name}: {line.split('; ')[-1]}")
+    earthshine: skipped: not requested
+    thermal: up to 1.8e-01 of reflected sunlight
+    """
     geo = scene.geometry
     active = ["sunlight"]
     params: dict[str, Mapping[str, Any]] = {}
