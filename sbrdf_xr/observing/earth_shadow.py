@@ -115,6 +115,26 @@ def shadow_angles(
     The arguments are those of :func:`sunlit_fraction`; returns ``(a, b, c)`` for
     :func:`disc_overlap_fraction`.  The umbra is ``c < b - a``, the penumbra
     ``b - a < c < a + b``.
+
+    Examples
+    --------
+    7000 km from the Earth's centre, straight behind it, 1 AU from the Sun: for a spherical
+    Earth ``b = asin(R_earth / 7000 km)`` = 65.6665 deg, the Sun's disc 0.2664 deg, and the
+    spacecraft is in the umbra; a quarter turn of the orbit later it is in full sunlight.
+    Over the pole the WGS84 angles are those of the stretched space (see the module), in
+    which the polar distance grows by ``a/b`` and the Earth's disc looks smaller.
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.observing.earth_shadow import shadow_angles
+    >>> a, b, c = shadow_angles([-7000.0, 0.0, 0.0], [1.496e8, 0.0, 0.0], earth="sphere")
+    >>> print(np.degrees([a, b, c]).round(4), bool(c < b - a))
+    [ 0.2664 65.6665  0.    ] True
+    >>> a, b, c = shadow_angles([0.0, 7000.0, 0.0], [1.496e8, 0.0, 0.0])
+    >>> print(np.degrees(c).round(4), bool(c > a + b))
+    90.0 True
+    >>> a, b, c = shadow_angles([0.0, 0.0, -7000.0], [0.0, 0.0, 1.496e8])
+    >>> print(np.degrees(b).round(4))
+    65.2451
     """
     if earth not in EARTH_MODELS:
         raise ObservationError(f"earth: got {earth!r}; allowed: {', '.join(EARTH_MODELS)}")
