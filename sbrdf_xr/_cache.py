@@ -16,11 +16,14 @@ from __future__ import annotations
 import ast
 import hashlib
 import os
+import warnings
 from collections.abc import Callable, Iterable
 from functools import cache
 from pathlib import Path
 
 import xarray as xr
+
+from .errors import CacheWarning
 
 __all__ = ["build_modules", "cache_dir", "cached_table", "source_digest"]
 
@@ -147,12 +150,25 @@ def cached_table(
     if path.is_file():
         try:
             return read(path)
-        except (OSError, ValueError):
-            path.unlink(missing_ok=True)  # a damaged cache file: build again
+        except (OSError, ValueError) as exc:  # a damaged cache file: build again
+            warnings.warn(
+                f"table cache file {path} could not be read ({type(exc).__name__}: {exc}); "
+                f"building table {name} again",
+                CacheWarning,
+                stacklevel=2,
+            )
+            path.unlink(missing_ok=True)
     table = build()
     try:
         d.mkdir(parents=True, exist_ok=True)
-        write(table, path)
+        write(table, path)  # atomic: a temporary file renamed, so two builders cannot clash
         return read(path)
-    except OSError:  # read-only or full: the built table, uncached
+    except OSError as exc:  # read-only or full: the built table, uncached
+        warnings.warn(
+            f"table cache {d} is not usable ({type(exc).__name__}: {exc}); table {name} "
+            "was built but not kept (set SBRDF_XR_CACHE_DIR to a writable directory, or "
+            "'off' to build every time without this warning)",
+            CacheWarning,
+            stacklevel=2,
+        )
         return table

@@ -14,6 +14,7 @@ from collections.abc import Iterable
 
 __all__ = [
     "AttitudeError",
+    "CacheWarning",
     "CatalogError",
     "EpochGapWarning",
     "InversionError",
@@ -119,6 +120,11 @@ class NonPhysicalWarning(SbrdfWarning):
 
 class MeshRepairWarning(SbrdfWarning):
     """A spacecraft mesh was repaired as documented in :mod:`sbrdf_xr.body.spacecraft`."""
+
+
+class CacheWarning(SbrdfWarning):
+    """The table cache could not be used: a damaged file was built again, or the directory
+    is not writable (or full), so the table was built without being kept."""
 
 
 class EpochGapWarning(SbrdfWarning):
