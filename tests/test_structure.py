@@ -8,13 +8,14 @@ alike; only those under ``if TYPE_CHECKING:`` are left out (they do not run).
 
 * L0, shared by every layer: ``_version``, ``_names``, ``errors``, ``rotations``,
   ``geometry``, ``anisotropy`` (facet tangents, ``psi``), ``sources``, ``_catalog_index``
-  (where the shipped files are; it loads nothing) and ``_cache`` (tables built on load,
-  cached on disk).
+  (where the shipped files are; it loads nothing), ``_cache`` (tables built on load,
+  cached on disk) and ``_output`` (the safe output every writer goes through).
 * L1, arithmetic: ``kernels`` (compiled and numpy kernels) and ``brdf`` (analytic models).
 * L2, the domain: ``materials``, ``body`` (the spacecraft), ``photometry`` and
   ``observing`` (orbits, sites, times, attitude laws, the Earth's shadow).
 * L3: ``catalog`` (knows every kind's loader in L2).
-* L4, the cube: ``store`` (the writer) and ``engine`` (scenes, plans, simulation).
+* L4, the cube: ``store`` (the output formats and cube writers) and ``engine`` (scenes,
+  plans, simulation).
 * L5, users of everything: ``invert``, ``bench``, ``plot``, ``accessors``, ``testing``,
   ``cli`` and the package's ``__init__``.
 
@@ -43,6 +44,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "sources",
         "_catalog_index",
         "_cache",
+        "_output",
     ),
     ("kernels", "brdf"),
     ("materials", "body", "photometry", "observing"),

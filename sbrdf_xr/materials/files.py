@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -11,6 +10,7 @@ import numpy as np
 import xarray as xr
 
 from .._names import SBRDF
+from .._output import atomic_file, check_output
 from ..errors import ValidationError
 from .schema import validate_material, validate_measurements
 
@@ -34,7 +34,10 @@ def _encoding(obj: xr.Dataset) -> dict[str, dict[str, Any]]:
 def write_netcdf_atomic(
     ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False
 ) -> Path:
-    """Write ``ds`` to ``path`` atomically (temporary file, then rename).
+    """Write ``ds`` to ``path`` atomically (a temporary file beside it, then a rename).
+
+    The package's safe output (:mod:`sbrdf_xr._output`): only a regular file is ever
+    replaced; a FIFO, socket, device, symbolic link or directory at ``path`` is refused.
 
     Parameters
     ----------
@@ -50,6 +53,14 @@ def write_netcdf_atomic(
     -------
     pathlib.Path
 
+    Raises
+    ------
+    FileExistsError
+        ``path`` exists and ``overwrite`` is false.
+    OutputError
+        Something other than a regular file at ``path``, or the write failed (nothing
+        was replaced).
+
     Examples
     --------
     >>> import tempfile
@@ -64,24 +75,12 @@ def write_netcdf_atomic(
     >>> names, again.x.values.tolist(), again.attrs["Conventions"]
     (['example.nc'], [1.0, 2.0], 'CF-1.10')
     """
-    path = Path(path)
-    if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True to replace it")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".part", dir=path.parent)
-    os.close(fd)
     from .._names import cf_finish
 
+    path = check_output(path, overwrite=overwrite)
     ds = cf_finish(ds)  # Conventions, title, source, history, flags, ancillary links
-    try:
+    with atomic_file(path, overwrite=overwrite) as tmp:
         ds.to_netcdf(tmp, engine="netcdf4", encoding=_encoding(ds))
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
     return path
 
 
