@@ -33,10 +33,11 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from .. import catalog
+from .._output import command_line_messages
 from .._version import __version__
 from ..engine.builtin import builtin_scenes
 from ..errors import SbrdfError
-from ..store.writer import DEFAULT_COMPLEVEL, LOG_SUFFIX, PART_SUFFIX, command_line_messages
+from ..store import DEFAULT_COMPLEVEL, PART_SUFFIX
 from .analysis import cmd_invert, cmd_photometry
 from .commands import (
     cmd_bench,
@@ -115,13 +116,20 @@ def build_parser() -> argparse.ArgumentParser:
     pb.add_argument("-o", "--output", help="write the table to this netCDF file")
     pb.add_argument("--csv", help="write the table to this CSV file")
     pb.add_argument("--plot", help="draw the accuracy/time front to this PNG file")
+    pb.add_argument("--overwrite", action="store_true", help="replace existing output files")
     pb.set_defaults(func=cmd_bench)
 
     psim = sub.add_parser("simulate", help="run a scene into a netCDF cube")
     psim.add_argument(
         "scene", help=f"built-in scene name ({', '.join(builtin_scenes())}) or a TOML file"
     )
-    psim.add_argument("-o", "--output", required=True, help="netCDF file to write")
+    psim.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        help="the cube to write: netCDF (CUBE.nc), or a Zarr store (CUBE.zarr) whose blocks "
+        "the Dask workers store themselves",
+    )
     psim.add_argument(
         "--scheduler", help="address of a dask.distributed scheduler (default: threads)"
     )
@@ -139,14 +147,15 @@ def build_parser() -> argparse.ArgumentParser:
         default=DEFAULT_COMPLEVEL,
         choices=range(10),
         metavar="0-9",
-        help=f"zlib compression level of the netCDF cube (default {DEFAULT_COMPLEVEL}; 0: "
-        "none, fastest, and resumable after a kill at any instant)",
+        help=f"zlib compression level of the cube, netCDF or Zarr (default {DEFAULT_COMPLEVEL};"
+        " 0: none, fastest, and resumable after a kill at any instant; a resume keeps the "
+        "level the cube was started with)",
     )
-    psim.add_argument("--plot", help="also write the cube's figure to this PNG file")
+    psim.add_argument("--plot", help="also write the cube's figure to this PNG (PDF, SVG) file")
     psim.add_argument(
         "--overwrite",
         action="store_true",
-        help="replace an existing output file (a regular file only)",
+        help="replace existing output files (regular files, and Zarr stores sbrdf-xr wrote, only)",
     )
     psim.add_argument(
         "--resume",
@@ -280,7 +289,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     pp = sub.add_parser("plot", help="draw a cube's figure")
     pp.add_argument("cube")
-    pp.add_argument("-o", "--output", required=True)
+    pp.add_argument("-o", "--output", required=True, help="the image file (PNG, PDF, SVG, ...)")
+    pp.add_argument("--overwrite", action="store_true", help="replace an existing image file")
     pp.set_defaults(func=cmd_plot)
     return p
 
@@ -340,7 +350,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         out = getattr(args, "output", None)
         hint = ""
-        if out and Path(str(out) + LOG_SUFFIX).exists():
+        if out and Path(str(out) + PART_SUFFIX).exists():
             hint = (
                 f"; the blocks written so far are kept in {out}{PART_SUFFIX}: "
                 "run again with --resume"

@@ -256,8 +256,8 @@ def test_cli_unmix_spectrum_and_bands(per_material, tmp_path, capsys):
     import pandas as pd
 
     from sbrdf_xr.cli import main
-    from sbrdf_xr.engine.run import write
     from sbrdf_xr.photometry import sun_magnitudes
+    from sbrdf_xr.store import write
 
     cube = xr.Dataset({"signal_material": per_material})
     write(cube, tmp_path / "cube.nc")

@@ -31,8 +31,8 @@ from hypothesis import strategies as st
 from hypothesis_profiles import examples
 
 from sbrdf_xr.errors import ValidationError
-from sbrdf_xr.store.common import release_freed_memory
 from sbrdf_xr.store.disk import SyncBehind, drop_behind
+from sbrdf_xr.store.runners import release_freed_memory
 from sbrdf_xr.store.writer import (
     LOG_SUFFIX,
     PART_SUFFIX,
@@ -590,7 +590,7 @@ def test_no_block_is_computed_when_the_room_is_refused(tmp_path, monkeypatch):
     import errno
 
     import sbrdf_xr.store.writer as writer
-    from sbrdf_xr.store.common import _NoRoom
+    from sbrdf_xr.store.disk import _NoRoom
 
     def full(part, need):
         raise _NoRoom(errno.ENOSPC, f"about {need} B needed, 0 B free")
