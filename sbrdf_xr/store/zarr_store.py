@@ -306,6 +306,8 @@ def _resumable(part: Path, plan: BlockLayout, complevel: int) -> set[int] | None
             f"Resume with {f'--complevel {kept}' if cli_style() else f'complevel={kept}'}, or "
             f"{discard_hint()}"
         )
+    if marker.get("state") == "complete":  # stopped while it was being renamed
+        return set(range(plan.n_blocks))
     return marked_blocks(part, plan.n_blocks)
 
 
@@ -356,15 +358,15 @@ def _create(ds: xr.Dataset, part: Path, plan: BlockLayout, complevel: int) -> No
             f"cannot write {part.name[: -len(PART_SUFFIX)]}: {why}. Nothing was written; "
             f"{fix(why)} and write again"
         ) from exc
-    make_marked_dir(part, _header(plan, complevel, "creating"))
-    os.mkdir(part / BLOCKS)
     meta = ds.copy()
     for v in meta.variables.values():
         v.encoding = {}
     codecs = _codecs(complevel)
-    with warnings.catch_warnings():
-        warnings.filterwarnings("ignore", message=".*not recognized as a component of a Zarr")
-        try:
+    try:
+        make_marked_dir(part, _header(plan, complevel, "creating"))
+        os.mkdir(part / BLOCKS)
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message=".*not recognized as a component of a")
             meta.to_zarr(
                 part,
                 mode="a",
@@ -373,11 +375,18 @@ def _create(ds: xr.Dataset, part: Path, plan: BlockLayout, complevel: int) -> No
                 zarr_format=2,
                 encoding={str(n): dict(codecs) for n in meta.variables},
             )
-        except (ValueError, NotImplementedError, TypeError) as exc:
-            remove_marked_dir(part, error=CubeWriteError)
+        fsync_tree(part)
+        write_marker(part, _header(plan, complevel, "writing"))
+    except Exception as exc:
+        with contextlib.suppress(Exception):  # nothing recorded yet: nothing lost
+            remove_marked_dir(part, empty_ok=True, error=CubeWriteError)
+        if isinstance(exc, ValueError | NotImplementedError | TypeError):
             raise ValidationError(f"ds: cannot be stored as Zarr ({exc})") from exc
-    fsync_tree(part)
-    write_marker(part, _header(plan, complevel, "writing"))
+        why = reason(exc, part)
+        raise CubeWriteError(
+            f"cannot write {part.name[: -len(PART_SUFFIX)]}: creating {part} failed: {why}. "
+            f"Nothing was written; {fix(why)} and write again"
+        ) from exc
 
 
 def store_block(
@@ -516,16 +525,19 @@ def _stream(
 
 
 def _finish(path: Path, part: Path, plan: BlockLayout, overwrite: bool) -> None:
-    """Check every block is marked, tidy the store and rename it to ``path``."""
-    missing = sorted(set(range(plan.n_blocks)) - marked_blocks(part, plan.n_blocks))
-    if missing:
-        raise CubeWriteError(
-            f"{part}: blocks {missing[:8]} were computed but are not marked as stored; "
-            f"{again_hint(_FUNCTION)} to store them"
-        )
+    """Check every block is marked, mark the store complete, tidy it and rename it to
+    ``path`` (a store already marked complete was stopped while this was done)."""
     marker = read_marker(part) or {}
-    write_marker(part, {**marker, "state": "complete"})
-    shutil.rmtree(part / BLOCKS)
+    if marker.get("state") != "complete":
+        missing = sorted(set(range(plan.n_blocks)) - marked_blocks(part, plan.n_blocks))
+        if missing:
+            raise CubeWriteError(
+                f"{part}: blocks {missing[:8]} were computed but are not marked as stored; "
+                f"{again_hint(_FUNCTION)} to store them"
+            )
+        write_marker(part, {**marker, "state": "complete"})
+    if (part / BLOCKS).is_dir():
+        shutil.rmtree(part / BLOCKS)
     for leftover in part.glob("*/*.partial"):  # Zarr's temporary chunks of a killed writer
         leftover.unlink(missing_ok=True)
     fsync_dir(part)

@@ -612,9 +612,15 @@ def zarr_kill_trials(tmp_path: Path, reference: xr.Dataset, n: int, seed: int) -
     for trial in range(n):
         path = tmp_path / f"kill{trial}" / "cube.zarr"
         path.parent.mkdir()
-        # 24 blocks of 0.1 s on the threads of this machine: about 1.5 s with the creation
+        # the instant: while the store is created (-1), or after a random number of blocks
+        # were stored and a random part of the next 0.1 s block (24: during the rename)
+        after = rng.randint(-1, 24)
         proc = zarr_writer(path.parent, path=str(path), delay=0.1)
-        time.sleep(rng.uniform(0.0, 1.6))
+        deadline = time.monotonic() + TIMEOUT
+        while after > 0 and zarr_marks(path) < after and proc.poll() is None:
+            assert time.monotonic() < deadline, "the writer made no progress"
+            time.sleep(0.002)
+        time.sleep(rng.uniform(0.0, 0.3 if after < 0 else 0.1))
         with contextlib.suppress(ProcessLookupError):
             os.kill(proc.pid, signal.SIGKILL)
         proc.wait(timeout=TIMEOUT)
@@ -623,8 +629,8 @@ def zarr_kill_trials(tmp_path: Path, reference: xr.Dataset, n: int, seed: int) -
         part = path.with_name(path.name + PART_SUFFIX)
         stored = 24 if path.exists() else zarr_marks(path) if part.exists() else -1
         KILL_POINTS.append(stored)
-        if not path.exists():
-            write_zarr(cube_24(), path, resume=True)
+        # what a user does next: resume (a no-op for a finished store, which clears the lock)
+        write_zarr(cube_24(), path, resume=True)
         try:
             xr.testing.assert_identical(read_zarr(path), reference)
             outcome = "value-identical"
@@ -638,8 +644,9 @@ def zarr_kill_trials(tmp_path: Path, reference: xr.Dataset, n: int, seed: int) -
 
 
 def test_zarr_sigkill_at_random_instants(tmp_path, reference):
-    """Writers of a Zarr cube killed at seeded random instants (creation, blocks in
-    flight, renaming) resume to value-identical stores, leaving no lock or ``.part``."""
+    """Writers of a Zarr cube killed at seeded random instants (while the store is
+    created, with blocks in flight, while it is renamed) resume to value-identical
+    stores, leaving no lock or ``.part``."""
     zarr_kill_trials(tmp_path, reference, n=3, seed=SEED)
 
 

@@ -282,3 +282,45 @@ def test_the_registry_picks_zarr_by_suffix_and_writes_times(tmp_path):
     assert formats.format_for(tmp_path / "c.zarr/", "cube").name == "zarr-cube"
     path = formats.write(cube, tmp_path / "c.zarr")
     xr.testing.assert_identical(read(path), cube.compute())
+
+
+def test_a_store_that_cannot_be_created_leaves_nothing(tmp_path, monkeypatch):
+    """A full disk while the store's metadata are written: named, and no ``.part`` left
+    (no block was recorded, so nothing is lost)."""
+    import errno
+
+    def full(self, *args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(xr.Dataset, "to_zarr", full)
+    with pytest.raises(CubeWriteError, match=r"no space left on device.*Nothing was written"):
+        write_zarr(make_cube(), tmp_path / "c.zarr")
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("stop_in", ["make_marked_dir", "to_zarr", "rename_no_replace"])
+def test_a_writer_stopped_while_creating_or_renaming_resumes(tmp_path, monkeypatch, stop_in):
+    """Stopped (as by a kill) while the store is created, or when it is complete and
+    being renamed (its block marks already removed): a resume finishes it."""
+    import sbrdf_xr.store.zarr_store as zs
+
+    path = tmp_path / "c.zarr"
+    original = xr.Dataset.to_zarr if stop_in == "to_zarr" else getattr(zs, stop_in)
+
+    def stopped(*args, **kwargs):
+        if stop_in == "make_marked_dir":
+            original(*args, **kwargs)  # the directory and its marker, then the stop
+        raise KeyboardInterrupt
+
+    if stop_in == "to_zarr":
+        monkeypatch.setattr(xr.Dataset, "to_zarr", stopped)
+    else:
+        monkeypatch.setattr(zs, stop_in, stopped)
+    with pytest.raises(KeyboardInterrupt):
+        write_zarr(make_cube(), path)
+    part = path.with_name(path.name + PART_SUFFIX)
+    assert part.is_dir() and not path.exists()
+    monkeypatch.undo()
+    write_zarr(make_cube(), path, resume=True)
+    xr.testing.assert_identical(read(path), make_cube().compute())
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c.zarr"]
