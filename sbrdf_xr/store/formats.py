@@ -430,6 +430,8 @@ def check(
     """
     fmt = format_for(path, kind, name)
     p = Path(path)
+    if p.name in ("", ".", ".."):
+        raise ValidationError(f"{str(path)!r} names no file; give a file name for the output")
     if fmt.destination is not None:
         fmt.destination(p, overwrite, resume)
     else:

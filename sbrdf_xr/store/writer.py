@@ -404,8 +404,12 @@ def _write_locked(
                 f"{part} belongs to a different cube ({why}); it was left untouched. "
                 f"Resume with the same inputs, or {discard_hint()}"
             )
-        if "complevel" in header and int(header["complevel"]) != int(complevel):
-            _refuse_complevel(part, int(header["complevel"]), complevel)
+        kept = header.get("complevel")
+        if kept is None:  # a sidecar written before it recorded the level: read the file
+            with contextlib.suppress(OSError), netCDF4.Dataset(part, mode="r") as nc_read:
+                kept = part_complevel(nc_read, plan)
+        if kept is not None and int(kept) != int(complevel):
+            _refuse_complevel(part, int(kept), complevel)
         done = {k for k in done if 0 <= k < plan.n_blocks}
 
     runner = _runner(client, scheduler)
@@ -422,8 +426,6 @@ def _write_locked(
             try:
                 check_room(part, block_bytes(plan))
                 nc = open_part(part, ds, plan)
-                if part_complevel(nc, plan) != int(complevel):  # a sidecar of version 1.0
-                    _refuse_complevel(part, part_complevel(nc, plan), complevel)
             except CubeWriteError:
                 raise
             except Exception as exc:

@@ -332,3 +332,10 @@ def test_check_refuses_before_anything_is_computed(tmp_path):
     os.mkfifo(lock)
     with pytest.raises(OutputError, match=r"c\.nc\.lock is a FIFO"):
         formats.check(out, "cube", overwrite=True)
+
+
+@pytest.mark.parametrize("bad", ["", ".", "..", "/"])
+def test_names_that_name_no_file_are_refused_by_name(bad):
+    for kind in ("cube", "photometry", "figure"):
+        with pytest.raises(ValidationError):
+            formats.check(bad, kind)
