@@ -282,8 +282,9 @@ class _DistributedRunner:
             return fut.result()
         except Exception as exc:
             if type(exc).__name__ in ("FutureCancelledError", "CancelledError"):
+                first = (str(exc).splitlines() or [""])[0]
                 raise ClusterLost(
-                    f"the Dask cluster cancelled the block ({type(exc).__name__}: {exc}); its "
+                    f"the Dask cluster cancelled the block ({type(exc).__name__}: {first}); its "
                     "scheduler or every worker went away"
                 ) from exc
             raise

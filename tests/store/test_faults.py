@@ -723,3 +723,36 @@ def test_every_worker_of_the_cluster_dies(tmp_path, dask_cluster, suffix):  # no
     with xr.open_zarr(path) if suffix == ".zarr" else xr.open_dataset(path) as back:
         xr.testing.assert_identical(back.load(), make_cube(chunks=(3, 2)).compute())
     TRIALS.append((f"every worker killed ({suffix})", "named error, resumed"))
+
+
+@pytest.mark.parametrize("suffix", [".nc", ".zarr"])
+def test_the_scheduler_dies(tmp_path, dask_cluster, suffix):  # noqa: F811
+    """The scheduler killed mid-sweep: a named WorkersLostError, the blocks written kept,
+    and a resume without the cluster finishes the cube."""
+    import distributed
+
+    from sbrdf_xr.errors import WorkersLostError
+    from sbrdf_xr.store import write
+
+    if suffix == ".zarr":
+        pytest.importorskip("zarr")
+    address, _ = dask_cluster
+    with distributed.Client(address, set_as_default=False) as c:
+        scheduler_pid = c.run_on_scheduler(os.getpid)
+    path = tmp_path / f"c{suffix}"
+    events: list[int] = []
+
+    def on_block(event) -> None:
+        events.append(event.index)
+        if len(events) == 3:
+            os.kill(scheduler_pid, signal.SIGKILL)
+
+    with pytest.raises(WorkersLostError) as info:
+        write(make_cube(chunks=(3, 2), delay=0.2), path, scheduler=address, on_block=on_block)
+    message = str(info.value)
+    assert "scheduler" in message and "resume=True" in message and "\n" not in message, message
+    assert f"{path}{PART_SUFFIX}" in message and not path.exists()
+    write(make_cube(chunks=(3, 2)), path, resume=True)
+    with xr.open_zarr(path) if suffix == ".zarr" else xr.open_dataset(path) as back:
+        xr.testing.assert_identical(back.load(), make_cube(chunks=(3, 2)).compute())
+    TRIALS.append((f"scheduler killed ({suffix})", "named error, resumed"))
