@@ -80,7 +80,7 @@ def build_parser() -> argparse.ArgumentParser:
     ...     ["simulate", "canx1-rotation", "-o", "cube.nc", "--preset", "fast"]
     ... )
     >>> args.command, args.scene, args.output, args.preset, args.complevel
-    ('simulate', 'canx1-rotation', 'cube.nc', 'fast', 0)
+    ('simulate', 'canx1-rotation', 'cube.nc', 'fast', None)
     """
     p = argparse.ArgumentParser(
         prog="sbrdf-xr", description="Spectral BRDF simulation of unresolved spacecraft."
@@ -144,12 +144,12 @@ def build_parser() -> argparse.ArgumentParser:
     psim.add_argument(
         "--complevel",
         type=int,
-        default=DEFAULT_COMPLEVEL,
+        default=None,
         choices=range(10),
         metavar="0-9",
-        help=f"zlib compression level of the cube, netCDF or Zarr (default {DEFAULT_COMPLEVEL};"
-        " 0: none, fastest, and resumable after a kill at any instant; a resume keeps the "
-        "level the cube was started with)",
+        help=f"compression of the cube: 0 none, 1-9 zlib with byte shuffle (default: netCDF "
+        f"{DEFAULT_COMPLEVEL}, uncompressed, the fastest and resumable after a kill at any "
+        "instant; Zarr its own LZ4); a resume keeps the level the cube was started with",
     )
     psim.add_argument("--plot", help="also write the cube's figure to this PNG (PDF, SVG) file")
     psim.add_argument(

@@ -105,7 +105,7 @@ def check_arguments(max_in_flight: Any, complevel: Any, client: Any, scheduler: 
         not isinstance(max_in_flight, int | np.integer) or max_in_flight < 1
     ):
         raise ValidationError(f"max_in_flight: must be an integer >= 1, got {max_in_flight!r}")
-    if (
+    if complevel is not None and (
         isinstance(complevel, bool)
         or not isinstance(complevel, int | np.integer)
         or not 0 <= int(complevel) <= 9

@@ -234,7 +234,7 @@ def write_cube(
     scheduler: str | None = None,
     max_in_flight: int | None = None,
     progress: bool = False,
-    complevel: int = DEFAULT_COMPLEVEL,
+    complevel: int | None = DEFAULT_COMPLEVEL,
     on_block: Callable[[BlockWritten], None] | None = None,
 ) -> Path:
     """Compute a lazy cube block by block and stream it to a netCDF-4 file.
@@ -275,9 +275,11 @@ def write_cube(
         the last one finished is written).
     progress : bool, default False
         Show a progress bar of blocks on stderr (tqdm if installed).
-    complevel : int, default :data:`DEFAULT_COMPLEVEL` (0)
+    complevel : int or None, default :data:`DEFAULT_COMPLEVEL` (0)
         zlib level (1-9, with byte shuffle) for the numeric variables; 0 stores
-        them uncompressed (contiguous, resumable after a kill at any instant).
+        them uncompressed (contiguous, resumable after a kill at any instant).  None:
+        the level of the ``.part`` when resuming, else the default.  A resume with
+        another level than the ``.part``'s is refused.
     on_block : callable, optional
         Called with a :class:`BlockWritten` in the writing thread after each
         block is committed (written, flushed, synced and recorded).
@@ -386,7 +388,7 @@ def _write_locked(
     scheduler: str | None,
     max_in_flight: int | None,
     progress: bool,
-    complevel: int,
+    complevel: int | None,
     on_block: Callable[[BlockWritten], None] | None,
 ) -> Path:
     """:func:`write_cube` once the lock is held."""
@@ -408,9 +410,12 @@ def _write_locked(
         if kept is None:  # a sidecar written before it recorded the level: read the file
             with contextlib.suppress(OSError), netCDF4.Dataset(part, mode="r") as nc_read:
                 kept = part_complevel(nc_read, plan)
-        if kept is not None and int(kept) != int(complevel):
+        if complevel is None:  # a resume keeps the level the cube was started with
+            complevel = DEFAULT_COMPLEVEL if kept is None else int(kept)
+        elif kept is not None and int(kept) != int(complevel):
             _refuse_complevel(part, int(kept), complevel)
         done = {k for k in done if 0 <= k < plan.n_blocks}
+    level = DEFAULT_COMPLEVEL if complevel is None else int(complevel)
 
     runner = _runner(client, scheduler)
     feed = Feed(
@@ -442,7 +447,7 @@ def _write_locked(
             log.unlink(missing_ok=True)
             part.unlink(missing_ok=True)
             # an uncompressed cube is laid out whole at creation: its room is needed now
-            need = 0 if complevel else lazy_bytes(plan)
+            need = 0 if level else lazy_bytes(plan)
 
             def creation_failed(exc: BaseException) -> NoReturn:
                 if nc is not None:
@@ -464,8 +469,8 @@ def _write_locked(
                 creation_failed(exc)
             feed.fill()  # the first blocks compute while the file is created and laid out
             try:
-                nc = create_part(part, ds, plan, complevel)
-                write_header(log, plan, complevel)
+                nc = create_part(part, ds, plan, level)
+                write_header(log, plan, level)
             except BaseException as exc:
                 creation_failed(exc)
     except BaseException:

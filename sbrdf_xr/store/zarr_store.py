@@ -30,8 +30,11 @@ Resume
     holds no block and is created again.
 
 Compression
-    ``complevel`` 0 (the default, as for netCDF) stores chunks uncompressed; 1-9 with
-    Blosc's zlib at that level and byte shuffle (netCDF's zlib and shuffle).
+    By default (``complevel=None``) Zarr's own default, Blosc's LZ4 with byte shuffle:
+    fast, and Zarr's chunks are independent, so compression costs a resume nothing.
+    ``complevel`` 0 stores chunks uncompressed, 1-9 compresses them with Blosc's zlib at
+    that level and byte shuffle (netCDF's zlib and shuffle).  A resume keeps the level of
+    the ``.part`` (``complevel=None``) or refuses another one.
 
 Chunks
     Zarr chunks are the Dask chunks, so no two blocks share a chunk; Zarr needs them of
@@ -70,7 +73,7 @@ from .._output import (
     write_marker,
 )
 from ..errors import CubeWriteError, ValidationError
-from .disk import check_room, fix, reason
+from .disk import check_room, drop_behind, fix, reason
 from .files import PART_SUFFIX, again_hint, discard_hint, make_parent
 from .layout import (
     BlockLayout,
@@ -83,7 +86,6 @@ from .layout import (
 from .lock import LOCK_SUFFIX, _Lock
 from .progress import NoProgress, progress_bar
 from .runners import BlockWritten, ClusterLost, Feed, _runner, check_arguments, lost_workers
-from .writer import DEFAULT_COMPLEVEL
 
 __all__ = [
     "BLOCKS",
@@ -116,14 +118,15 @@ def write_zarr(
     scheduler: str | None = None,
     max_in_flight: int | None = None,
     progress: bool = False,
-    complevel: int = DEFAULT_COMPLEVEL,
+    complevel: int | None = None,
     on_block: Callable[[BlockWritten], None] | None = None,
 ) -> Path:
     """Compute a lazy cube block by block into a Zarr store, each block stored by its worker.
 
     The arguments, returns and errors are those of
     :func:`sbrdf_xr.store.writer.write_cube` (see the module documentation for the
-    store's files); ``path`` is a directory (``cube.zarr``).
+    store's files); ``path`` is a directory (``cube.zarr``), and ``complevel`` defaults
+    to Zarr's own compression (see ``Compression`` above).
 
     Examples
     --------
@@ -165,6 +168,8 @@ def write_zarr(
             return path
         kept = _resumable(part, plan, complevel) if state == "resume" else None
         if kept is None:  # a new store, or a .part that holds no block yet
+            if state == "resume" and complevel is None:  # the level it was started with
+                complevel = (read_marker(part) or {}).get("complevel")
             remove_marked_dir(part, empty_ok=True, error=CubeWriteError)
             _create(ds, part, plan, complevel)
         done = kept or set()
@@ -196,7 +201,7 @@ def _layout(ds: xr.Dataset) -> BlockLayout:
     return plan
 
 
-def _header(plan: BlockLayout, complevel: int, state: str) -> dict[str, Any]:
+def _header(plan: BlockLayout, complevel: int | None, state: str) -> dict[str, Any]:
     return {
         "format": FORMAT,
         "version": FORMAT_VERSION,
@@ -204,7 +209,7 @@ def _header(plan: BlockLayout, complevel: int, state: str) -> dict[str, Any]:
         "fingerprint": plan.fingerprint,
         "n_blocks": plan.n_blocks,
         "block_dims": list(plan.block_dims),
-        "complevel": int(complevel),
+        "complevel": None if complevel is None else int(complevel),
         "structure": plan.structure,
     }
 
@@ -282,7 +287,7 @@ def _check_finished(path: Path, plan: BlockLayout) -> None:
     _log.info("%s is already complete; there is nothing to resume", path)
 
 
-def _resumable(part: Path, plan: BlockLayout, complevel: int) -> set[int] | None:
+def _resumable(part: Path, plan: BlockLayout, complevel: int | None) -> set[int] | None:
     """Blocks already stored in ``part`` (None: it holds none and is created again)."""
     marker = read_marker(part)
     if marker is None or marker.get("state") == "creating":
@@ -298,13 +303,16 @@ def _resumable(part: Path, plan: BlockLayout, complevel: int) -> set[int] | None
             f"{part} belongs to a different cube ({why}); it was left untouched. "
             f"Resume with the same inputs, or {discard_hint()}"
         )
-    kept = int(marker.get("complevel", 0))
-    if kept != int(complevel):
+    kept = marker.get("complevel")
+    if complevel is not None and kept != int(complevel):
+        how = "Zarr's default compression" if kept is None else f"complevel {kept}"
+        again = "without --complevel" if cli_style() else "with complevel=None"
+        if kept is not None:
+            again = f"--complevel {kept}" if cli_style() else f"complevel={kept}"
         raise CubeWriteError(
-            f"{part} was started with complevel {kept} and this write asks for {complevel}: "
-            f"its chunks keep their compression, so it is resumed only with the same level. "
-            f"Resume with {f'--complevel {kept}' if cli_style() else f'complevel={kept}'}, or "
-            f"{discard_hint()}"
+            f"{part} was started with {how} and this write asks for complevel {complevel}: "
+            f"its chunks keep their compression, so it is resumed only with the same. "
+            f"Resume with {again}, or {discard_hint()}"
         )
     if marker.get("state") == "complete":  # stopped while it was being renamed
         return set(range(plan.n_blocks))
@@ -333,10 +341,13 @@ def marked_blocks(part: Path, n_blocks: int) -> set[int]:
     return {int(n) for n in names if n.isdigit() and int(n) < n_blocks}
 
 
-def _codecs(complevel: int) -> dict[str, Any]:
-    """The encoding of every variable: Blosc's zlib with byte shuffle at ``complevel``, or none."""
+def _codecs(complevel: int | None) -> dict[str, Any]:
+    """The encoding of every variable: Zarr's default (None), none (0), or Blosc's zlib with
+    byte shuffle at ``complevel``."""
     import zarr
 
+    if complevel is None:
+        return {}
     if not complevel:
         codec = None
     else:
@@ -348,10 +359,10 @@ def _codecs(complevel: int) -> dict[str, Any]:
     return {"compressor": codec}  # pragma: no cover - zarr 2
 
 
-def _create(ds: xr.Dataset, part: Path, plan: BlockLayout, complevel: int) -> None:
+def _create(ds: xr.Dataset, part: Path, plan: BlockLayout, complevel: int | None) -> None:
     """Create the marked ``part``: metadata and numpy-backed variables, synced."""
     try:
-        check_room(part, 0 if complevel else lazy_bytes(plan))
+        check_room(part, lazy_bytes(plan) if complevel == 0 else 0)
     except OSError as exc:
         why = reason(exc, part)
         raise CubeWriteError(
@@ -449,6 +460,9 @@ def _sync_chunks(array: Path, chunks: tuple[int, ...], region: tuple[slice, ...]
             fd = open_regular(array / key, os.O_RDONLY, error=CubeWriteError)
             try:
                 os.fsync(fd)
+                # on disk: its pages are not needed again (disk.drop_behind); on this
+                # project's 2-core machine a 648 MB store then wrote 1.5x faster
+                drop_behind(fd)
             finally:
                 os.close(fd)
     fsync_dir(array)
@@ -573,7 +587,6 @@ def unfinished(path: str | os.PathLike[str]) -> str | None:
         return None
     n = int(marker.get("n_blocks", 0))
     chunks = describe_chunks(marker.get("structure", {}).get("chunks", []))
-    return (
-        f"{part}: {len(marked_blocks(part, n))} of {n} blocks stored, complevel "
-        f"{marker.get('complevel', 0)}, {chunks}"
-    )
+    level = marker.get("complevel")
+    how = "Zarr's default compression" if level is None else f"complevel {level}"
+    return f"{part}: {len(marked_blocks(part, n))} of {n} blocks stored, {how}, {chunks}"

@@ -71,12 +71,13 @@ def read(path: Path) -> xr.Dataset:
 
 
 @pytest.mark.parametrize("suffix", [".nc", ".zarr"])
-def test_resume_states_what_it_keeps(tmp_path, scene, capsys, suffix):
+@pytest.mark.parametrize("level", [[], ["--complevel", "2"]], ids=["kept", "same"])
+def test_resume_states_what_it_keeps(tmp_path, scene, capsys, suffix, level):
     if suffix == ".zarr":
         pytest.importorskip("zarr")
     out = tmp_path / f"cube{suffix}"
     interrupted(scene, out, complevel=2)
-    assert main(["simulate", str(scene), "-o", str(out), "--resume", "--complevel", "2", "-q"]) == 0
+    assert main(["simulate", str(scene), "-o", str(out), "--resume", "-q", *level]) == 0
     lines = capsys.readouterr().out.splitlines()
     said = next(line for line in lines if line.startswith("resumed "))
     # the two blocks reported, and perhaps the next one, synced behind them
@@ -92,7 +93,7 @@ def test_resume_states_what_it_keeps(tmp_path, scene, capsys, suffix):
     ("extra", "match"),
     [
         (["--complevel", "5"], "started with complevel 2 .*Resume with --complevel 2"),
-        (["--complevel", "2", "--set", "chunk=5"], r"different cube \(setting 'chunk': 2 -> 5\)"),
+        (["--set", "chunk=5"], r"different cube \(setting 'chunk': 2 -> 5\)"),
     ],
     ids=["complevel", "chunking"],
 )

@@ -74,16 +74,22 @@ def test_round_trip_equals_the_cube_and_the_netcdf_writer(tmp_path, factory):
         xr.testing.assert_identical(back, nc.load())
 
 
-def test_complevel_compresses_with_zlib_and_keeps_values(tmp_path):
+def test_complevel_chooses_the_compression_and_keeps_values(tmp_path):
     import zarr
 
     ds = make_cube()
-    plain = write_zarr(ds, tmp_path / "plain.zarr")
+    default = write_zarr(ds, tmp_path / "default.zarr")
+    plain = write_zarr(ds, tmp_path / "plain.zarr", complevel=0)
     packed = write_zarr(ds, tmp_path / "packed.zarr", complevel=5)
-    assert zarr.open_array(store=str(plain / "sbrdf"), mode="r").metadata.compressor is None
-    codec = zarr.open_array(store=str(packed / "sbrdf"), mode="r").metadata.compressor
-    assert codec.cname == "zlib" and codec.clevel == 5 and codec.shuffle == 1
+
+    def codec(store):
+        return zarr.open_array(store=str(store / "sbrdf"), mode="r").metadata.compressor
+
+    assert codec(default).cname == "lz4"  # Zarr's own default
+    assert codec(plain) is None
+    assert (codec(packed).cname, codec(packed).clevel, codec(packed).shuffle) == ("zlib", 5, 1)
     xr.testing.assert_identical(read(plain), read(packed))
+    xr.testing.assert_identical(read(plain), read(default))
     with pytest.raises(ValidationError, match="complevel"):
         write_zarr(ds, tmp_path / "bad.zarr", complevel=10)
 
@@ -118,7 +124,7 @@ def test_resume_computes_only_the_unmarked_blocks(tmp_path):
     part = path.with_name(path.name + PART_SUFFIX)
     kept = marked_blocks(part, 9)
     assert kept == set(range(7)) and not path.exists()
-    assert "7 of 9 blocks stored, complevel 0" in unfinished(path)
+    assert "7 of 9 blocks stored, Zarr's default compression" in unfinished(path)
     switch.unlink()
     calls.unlink()
     write_zarr(make_cube(calls=str(calls)), path, resume=True)
@@ -159,13 +165,16 @@ def test_resume_with_another_complevel_is_refused_naming_the_level(tmp_path):
     part = path.with_name(path.name + PART_SUFFIX)
     before = tree(part)
     with pytest.raises(CubeWriteError, match=r"started with complevel 3.*complevel=3"):
-        write_zarr(make_cube(), path, resume=True)
-    with command_line_messages(), pytest.raises(CubeWriteError, match="--complevel 3"):
         write_zarr(make_cube(), path, resume=True, complevel=0)
+    with command_line_messages(), pytest.raises(CubeWriteError, match="--complevel 3"):
+        write_zarr(make_cube(), path, resume=True, complevel=5)
     assert tree(part) == before
     switch.unlink()
-    write_zarr(make_cube(), path, resume=True, complevel=3)
+    write_zarr(make_cube(), path, resume=True)  # no level given: the .part's is kept
     xr.testing.assert_identical(read(path), make_cube().compute())
+    import zarr
+
+    assert zarr.open_array(store=str(path / "sbrdf"), mode="r").metadata.compressor.clevel == 3
 
 
 def test_a_leftover_part_is_kept_without_overwrite(tmp_path):
