@@ -9,7 +9,8 @@ Modules
 ``knobs``
     Every numerical knob of a simulation, and the presets, in one table.
 ``effects``
-    The effects a simulation can include and the outputs of a cube.
+    The effects a simulation can include, one module and one registry entry each, and
+    the outputs of a cube; the rest of the engine reads the entries.
 ``sweep``
     The geometry of a sweep: where the Sun and the observer are, in the body frame.
 ``scene``, ``scene_file`` and ``builtin``

@@ -124,14 +124,15 @@ KNOBS: dict[str, Knob] = {
             "exact",
             ("exact", "sampled"),
             None,
-            "self-shadowing and occlusion: exact polygon clipping, or sub-facet ray sampling",
+            "facets hiding each other from the Sun and the observer: exact polygon clipping, "
+            "or sub-facet ray sampling",
         ),
         Knob(
             "shadow_density",
             4,
             None,
             _positive_int(64),
-            "sampled shadowing: samples per facet side (density**2 per facet)",
+            "shadow_method sampled: samples per facet side (density**2 per facet)",
         ),
         Knob(
             "table_theta_step",

@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike
 from .. import catalog, geometry
 from ..errors import CatalogError, SceneError, ValidationError
 from ..materials.tables import validate_material
-from .effects import SCENE_OUTPUTS, SPECTRAL_OUTPUTS
+from .effects import DEFAULT_EFFECTS, SCENE_EFFECTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS, scene_effects
 from .knobs import KNOBS, PRESETS, apply_preset, check_knob
 from .plan import Plan, compile_plan
 from .sweep import GridGeometry, PairGeometry
@@ -26,9 +26,31 @@ __all__ = ["EFFECTS", "OUTPUTS", "PRESETS", "GridGeometry", "PairGeometry", "Sce
 
 #: Outputs a scene may ask for.
 OUTPUTS = tuple(SCENE_OUTPUTS)
-#: Effects a scene may ask for (the Earth's shadow comes with an observation).
-EFFECTS = ("sunlight", "shadowing", "earthshine", "thermal")
+#: Effects a scene may ask for (:data:`sbrdf_xr.engine.effects.EFFECTS` but those the
+#: geometry brings, such as the Earth's shadow of an observation).
+EFFECTS = SCENE_EFFECTS
 _ = SPECTRAL_OUTPUTS  # re-exported
+
+
+def _needs_to_earth(scene: Scene, effect: str) -> None:
+    if not scene.is_grid and scene.observation is None and scene.to_earth is None:
+        raise SceneError(
+            f"to_earth: explicit geometry with {effect} needs body-frame to_earth vectors"
+        )
+
+
+def _needs_observation(scene: Scene, effect: str) -> None:
+    if scene.observation is None:
+        raise SceneError(
+            f"effects: {effect} needs an observation (Scene(observation=...) or an "
+            "[observation] table): its source comes from the ephemeris at the observation's "
+            "times"
+        )
+
+
+#: What an effect may need from a scene (:attr:`sbrdf_xr.engine.effects.Effect.needs`),
+#: and the check that the scene has it.
+_NEEDS = {"to_earth": _needs_to_earth, "observation": _needs_observation}
 
 
 _UNIT_TOL = 1e-6
@@ -187,7 +209,7 @@ class Scene:
     observation: Any = None
     attitude_angle: ArrayLike | None = None
     outputs: Sequence[str] = ("spacecraft_sbrdf", "signal", "brdf", "area")
-    effects: Sequence[str] = ("sunlight",)
+    effects: Sequence[str] = DEFAULT_EFFECTS
     method: str = "linear"
     dtype: str = "float64"
     merge: bool | None = None
@@ -317,10 +339,10 @@ class Scene:
                 if e.shape != s.shape:
                     raise SceneError(f"to_earth {e.shape} and to_sun {s.shape} differ in shape")
                 object.__setattr__(self, "to_earth", e)
-            elif "earthshine" in self.effects:
-                raise SceneError(
-                    "to_earth: explicit geometry with earthshine needs body-frame to_earth vectors"
-                )
+        for effect in scene_effects(self.effects):
+            for need in effect.needs:
+                if need in _NEEDS:
+                    _NEEDS[need](self, effect.name)
         if self.materials is not None:
             self._check_tables(self.materials)
 
@@ -371,29 +393,33 @@ class Scene:
     @cached_property
     def geometry(self) -> GridGeometry | PairGeometry:
         """The sweep's geometry (:class:`GridGeometry` or :class:`PairGeometry`)."""
+        observed = None
         if self.observation is not None:
             from ..errors import ObservationError
 
             try:
-                g = self.observation.geometry()
+                observed = self.observation.geometry()
             except ObservationError as exc:
                 raise SceneError(f"observation: {exc}") from exc
-            return PairGeometry.from_observation(g, "earthshine" in self.effects, self.earth_albedo)
+        # the other sources of the effects asked for (their entries' geometry)
+        sources: dict[str, np.ndarray] = {}
+        for effect in scene_effects(self.effects):
+            if effect.geometry is not None:
+                sources.update(effect.geometry(self, observed))
+        if observed is not None:
+            return PairGeometry.from_observation(observed, sources)
         if self.is_grid:
             phase = np.asarray(self.phase_angles)
             s, o = geometry.observation_plane(phase, self.bisector, self.plane_normal)
-            e = None
-            if "earthshine" in self.effects:
-                e = geometry.normalize(self.earth_direction, "earth_direction")
-                e = np.broadcast_to(e, (len(phase), 3)).copy()
             return GridGeometry(
-                np.asarray(self.attitudes), phase, s, o, e, _optional_array(self.attitude_angle)
+                np.asarray(self.attitudes),
+                phase,
+                s,
+                o,
+                sources,
+                _optional_array(self.attitude_angle),
             )
-        return PairGeometry(
-            np.asarray(self.to_sun),
-            np.asarray(self.to_observer),
-            _optional_array(self.to_earth),
-        )
+        return PairGeometry(np.asarray(self.to_sun), np.asarray(self.to_observer), sources)
 
     def body_vectors(self, attitude_slice: slice | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Sun and observer unit vectors in the body frame.
@@ -410,7 +436,9 @@ class Scene:
     def earth_vectors(self, attitude_slice: slice | None = None) -> np.ndarray | None:
         """Unit vectors to the Earth in the body frame (shaped like :meth:`body_vectors`)."""
         if not self.is_grid:
-            return self.geometry.block(attitude_slice or slice(None)).to_earth
+            if self.to_earth is not None:
+                return np.asarray(self.to_earth)[attitude_slice or slice(None)]
+            return self.geometry.block(attitude_slice or slice(None)).sources.get("to_earth")
         att = np.asarray(self.attitudes)
         q = att if attitude_slice is None else att[attitude_slice]
         e = geometry.normalize(self.earth_direction, "earth_direction")

@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import xarray as xr
@@ -24,10 +24,10 @@ from ..kernels.lut import table_edges, table_normal_blend
 from ..kernels.sums import PackedTables, pack_tables
 from ..materials import models
 from ..photometry import band_weights
-from .effects import SPECTRAL_OUTPUTS
+from .effects.base import SPECTRAL_OUTPUTS
 
-#: The scene being compiled (:class:`sbrdf_xr.engine.Scene`).
-Scene = Any
+if TYPE_CHECKING:
+    from .scene import Scene
 
 
 def common_wavelength(scene: Scene, used: list[str]) -> np.ndarray:
