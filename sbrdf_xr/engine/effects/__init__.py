@@ -12,6 +12,8 @@ Every effect is one :class:`Effect` entry of :data:`EFFECTS`, written in its own
     Sunlight reflected by a Lambertian Earth, a second distant source.
 ``thermal``
     Thermal emission of the facets, Kirchhoff emissivity times Planck.
+``moonlight``
+    Sunlight reflected by the Moon during an observation, a second distant source.
 
 The engine reads nothing else about an effect: whether a scene may ask for it and what
 it needs (:class:`~sbrdf_xr.engine.Scene`), the directions and scales of its source in the
@@ -29,16 +31,16 @@ Examples
 --------
 >>> from sbrdf_xr.engine.effects import EFFECTS, SCENE_EFFECTS, scene_effects
 >>> list(EFFECTS)
-['sunlight', 'shadowing', 'eclipse', 'earthshine', 'thermal']
+['sunlight', 'shadowing', 'eclipse', 'earthshine', 'thermal', 'moonlight']
 >>> SCENE_EFFECTS  # what Scene(effects=...) accepts
-('sunlight', 'shadowing', 'earthshine', 'thermal')
+('sunlight', 'shadowing', 'earthshine', 'thermal', 'moonlight')
 >>> [e.name for e in scene_effects(["thermal"])]  # planned for a scene asking for thermal
 ['sunlight', 'eclipse', 'thermal']
 """
 
 from collections.abc import Iterable
 
-from . import base, earthshine, eclipse, shadowing, sunlight, thermal
+from . import base, earthshine, eclipse, moonlight, shadowing, sunlight, thermal
 from .base import (
     SCENE_OUTPUTS,
     SPECTRAL_OUTPUTS,
@@ -70,6 +72,7 @@ __all__ = [
     "eclipse",
     "facet_fraction",
     "finish",
+    "moonlight",
     "readonly",
     "reflected",
     "scene_effects",
@@ -87,6 +90,7 @@ EFFECTS: dict[str, Effect] = {
         eclipse.EFFECT,
         earthshine.EFFECT,
         thermal.EFFECT,
+        moonlight.EFFECT,
     )
 }
 
