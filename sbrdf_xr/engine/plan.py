@@ -28,18 +28,22 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import xarray as xr
 
 from .._names import BAND, MATERIAL, PSI, WAVELENGTH
 from .._version import __version__
 from ..errors import SceneError
 from ..kernels.sums import PackedTables, normal_rows
+from ..materials.models import model_parameters
 from ..store.fingerprint import scene_fingerprint
 from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, BlockInputs, Effect, PlanInputs, readonly
 from .spectral import spectral_stage
 from .stages import contributing_terms, describe_bytes, effect_stage, facet_terms, tilted_terms
 
 if TYPE_CHECKING:
+    from ..body.spacecraft import Spacecraft
     from .scene import Scene
+    from .sweep import GridGeometry, PairGeometry
 
 __all__ = ["BlockInputs", "Estimate", "Plan", "PlannedOutput", "Terms", "compile_plan"]
 
@@ -225,8 +229,8 @@ class Plan:
 
     name: str
     description: str
-    spacecraft: Any
-    geometry: Any
+    spacecraft: Spacecraft
+    geometry: GridGeometry | PairGeometry
     terms: Terms
     materials: tuple[str, ...]
     tables: PackedTables
@@ -330,6 +334,13 @@ class Plan:
 # ------------------------------------------------------------------ compiler
 
 
+def _anisotropic(material: xr.DataArray | xr.Dataset) -> bool:
+    """A table with a psi axis, or a model of an anisotropic BRDF."""
+    if isinstance(material, xr.Dataset):
+        return bool(getattr(model_parameters(material)[0], "anisotropic", False))
+    return PSI in material.dims
+
+
 def compile_plan(scene: Scene) -> Plan:
     """Compile a scene into its :class:`Plan` (see the module docstring).
 
@@ -373,7 +384,7 @@ def compile_plan(scene: Scene) -> Plan:
     early, params = effect_stage(PlanInputs(scene, knobs), True, steps)
     per_facet = tuple(EFFECTS[e].title for e in early)
 
-    aniso_names = frozenset(m for m, da in scene.tables.items() if PSI in da.dims)
+    aniso_names = frozenset(m for m, v in scene.material_data.items() if _anisotropic(v))
     raw, merged = facet_terms(scene, per_facet, steps, aniso_names)
     raw = tilted_terms(scene, raw, knobs["tilt_nodes"], steps)
     keep = contributing_terms(scene, raw["normal"])
@@ -475,7 +486,7 @@ def compile_plan(scene: Scene) -> Plan:
         )
     )
 
-    provenance = {m: scene.tables[m].attrs.get("provenance", "") for m in used}
+    provenance = {m: scene.material_data[m].attrs.get("provenance", "") for m in used}
     attrs = {
         "Conventions": "CF-1.10",
         "title": f"sbrdf_xr simulation of scene {scene.name}",

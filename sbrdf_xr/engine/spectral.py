@@ -54,9 +54,10 @@ def common_wavelength(scene: Scene, used: list[str]) -> np.ndarray:
     ...
     sbrdf_xr.errors.SceneError: materials 'grey' and 'far' have no wavelengths in common
     """
-    wl = np.asarray(scene.tables[used[0]][WAVELENGTH].values) if used else np.array([550.0])
+    data = scene.material_data  # tables, or models (the tables they render to share the grid)
+    wl = np.asarray(data[used[0]][WAVELENGTH].values) if used else np.array([550.0])
     for m in used[1:]:
-        other = np.asarray(scene.tables[m][WAVELENGTH].values)
+        other = np.asarray(data[m][WAVELENGTH].values)
         if other.shape != wl.shape or not np.allclose(other, wl, rtol=0, atol=1e-9):
             lo, hi = max(wl[0], other[0]), min(wl[-1], other[-1])
             if lo >= hi:
@@ -253,7 +254,7 @@ def spectral_stage(
     bands: skipped: no band output requested
     wavelength: 3 wavelengths 500-700 nm (every 2th)
     """
-    wl_full = common_wavelength(scene, used or list(scene.tables))
+    wl_full = common_wavelength(scene, used or list(scene.material_data))
     wl = wl_full[:: knobs["wavelength_stride"]]
     bw = None
     band_coords: dict[str, Any] = {}

@@ -313,6 +313,9 @@ class Effect:
         fraction of every term that it applies to every reflected source.  Such an
         effect is per facet: it is planned before the facet terms and facets are not
         merged while it runs.
+    reads : tuple of str
+        The scene fields (and scene-file keys) that are its parameters, for the
+        reference of the scene files (:func:`sbrdf_xr.engine.schema.reference`).
     geometry : callable or None
         ``geometry(scene, observed) -> {name: array}``: its source's directions and
         scales for the sweep (``observed`` is the observation's geometry, or None for a
@@ -340,6 +343,7 @@ class Effect:
     outputs: tuple[str, ...] = ()
     declares: tuple[Output, ...] = ()
     band: tuple[str, ...] = ()
+    reads: tuple[str, ...] = ()
     plan: Callable[[PlanInputs], Decision] = runs
     contribute: Callable[[Plan, BlockInputs], Mapping[str, np.ndarray]] | None = None
     fraction: Callable[[Plan, np.ndarray, np.ndarray], np.ndarray] | None = None

@@ -118,6 +118,7 @@ EFFECT = Effect(
     outputs=("signal_earthshine", "band_signal"),
     declares=(SIGNAL,),
     band=("signal_earthshine",),
+    reads=("earth_direction", "to_earth", "earth_albedo", "earth_range_km", "earth_phase_angle"),
     plan=_plan,
     contribute=_contribute,
     geometry=_geometry,

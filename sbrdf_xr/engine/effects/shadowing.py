@@ -68,6 +68,7 @@ EFFECT = Effect(
     when="asked",
     source=None,
     needs=("mesh",),
+    reads=("shadow_method", "shadow_density"),
     plan=_plan,
     fraction=_fraction,
 )

@@ -116,7 +116,7 @@ def thermal_to_reflected(scene: Scene, wl: np.ndarray) -> float:
     42.7
     """
     e_sun = solar_spectrum(wl).values
-    b = np.max([sources.planck(wl, temperature(scene, m)) for m in scene.tables], axis=0)
+    b = np.max([sources.planck(wl, temperature(scene, m)) for m in scene.material_data], axis=0)
     return float(np.max(b / np.maximum(e_sun / np.pi, 1e-300)))
 
 
@@ -185,6 +185,7 @@ EFFECT = Effect(
     source="facets",
     outputs=("thermal_intensity",),
     declares=(INTENSITY,),
+    reads=("temperature",),
     plan=_plan,
     contribute=_contribute,
 )
