@@ -364,7 +364,7 @@ NAME (one material for every facet) or --material-map MAP.toml (facet colour or 
 def _with_body(scene: Scene, args: argparse.Namespace) -> Scene:
     """The scene with the spacecraft of ``--spacecraft`` and the tables (or models) of
     ``--material``."""
-    from ..engine.builtin import load_materials
+    from ..engine.builtin import load_material_specs
 
     specs: dict[str, str] = {}
     for item in args.material or []:
@@ -394,7 +394,7 @@ def _with_body(scene: Scene, args: argparse.Namespace) -> Scene:
         else f"spacecraft {body.name!r}"
     )
     where = {m: "--material" if m in specs else named_in for m in wanted}
-    found = load_materials(wanted, where=where)
+    found = load_material_specs(wanted, where=where)
     old_models = {m: v for m, v in (scene.models or {}).items() if m not in wanted}
     return scene.with_options(
         spacecraft=body, materials={**kept, **found}, models=old_models or None

@@ -46,7 +46,7 @@ from .scene import EFFECTS, OUTPUTS, Scene
 from .scene_file import (
     MAX_SCENE_COUNT,
     MAX_SHADOW_DENSITY,
-    load_materials,
+    load_material_specs,
     load_scene,
     material_tables,
     scene_from_dict,
@@ -85,7 +85,7 @@ __all__ = [
     "finish",
     "knob_table",
     "knobs",
-    "load_materials",
+    "load_material_specs",
     "load_scene",
     "material_tables",
     "plan",

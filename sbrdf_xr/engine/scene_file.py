@@ -26,7 +26,7 @@ from .schema import ATTITUDE_KEYS, GEOMETRY_KEYS, SCENE_KEYS, SPACECRAFT_KEYS, t
 __all__ = [
     "MAX_SCENE_COUNT",
     "MAX_SHADOW_DENSITY",
-    "load_materials",
+    "load_material_specs",
     "load_scene",
     "material_tables",
     "scene_from_dict",
@@ -272,7 +272,7 @@ def material_tables(
         raise SceneError(str(exc)) from None
 
 
-def load_materials(
+def load_material_specs(
     specs: Mapping[str, str | Path],
     base_dir: str | Path | None = None,
     where: Mapping[str, str] | None = None,
@@ -291,8 +291,8 @@ def load_materials(
 
     Examples
     --------
-    >>> from sbrdf_xr.engine.scene_file import load_materials
-    >>> found = load_materials({"paint": "lambertian-grey-50", "cell": "tjpv-cell-model"})
+    >>> from sbrdf_xr.engine.scene_file import load_material_specs
+    >>> found = load_material_specs({"paint": "lambertian-grey-50", "cell": "tjpv-cell-model"})
     >>> {m: type(v).__name__ for m, v in found.items()}
     {'paint': 'DataArray', 'cell': 'Dataset'}
     """
@@ -439,7 +439,7 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
                 f"string), got {_show(spec)}"
             )
         specs[mat] = spec
-    materials = load_materials(specs, base_dir, where)
+    materials = load_material_specs(specs, base_dir, where)
     try:
         return Scene(sc, materials=materials, **kw)
     except SceneError:
