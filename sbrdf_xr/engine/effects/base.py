@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..._names import BAND, MATERIAL, WAVELENGTH
+from ...errors import ValidationError
 from ...kernels import anisotropic as _aniso_kernels
 from ...kernels import sums as _kernels
 
@@ -351,7 +352,7 @@ class Effect:
 
     def __post_init__(self) -> None:
         if self.when not in WHEN:
-            raise ValueError(f"effect {self.name!r}: when={self.when!r}; allowed: {WHEN}")
+            raise ValidationError(f"effect {self.name!r}: when={self.when!r}; allowed: {WHEN}")
 
     @property
     def reflects(self) -> bool:
