@@ -20,10 +20,10 @@ from typing import Any
 
 import numpy as np
 
+from .. import kernels as _kernels
 from .. import sources
 from .._names import BAND, MATERIAL, WAVELENGTH
 from ..kernels import anisotropic as _aniso_kernels
-from ..kernels import sums as _kernels
 
 #: The compiled plan effects run on (:class:`sbrdf_xr.engine.plan.Plan`, which imports this module).
 Plan = Any

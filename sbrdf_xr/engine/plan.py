@@ -32,7 +32,7 @@ import numpy as np
 from .._names import BAND, MATERIAL, PSI, WAVELENGTH
 from .._version import __version__
 from ..errors import SceneError
-from ..kernels.sums import PackedTables, normal_rows
+from ..kernels import PackedTables, normal_rows
 from ..store.fingerprint import scene_fingerprint
 from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, BlockInputs
 from .spectral import spectral_stage
