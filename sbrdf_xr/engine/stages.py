@@ -18,7 +18,7 @@ from .._names import MATERIAL, PSI
 from ..anisotropy import psi_average
 from ..body.imperfections import tilt_quadrature, tilted_normals
 from ..errors import SceneError
-from ..materials.tables import hemispherical_reflectance
+from ..materials.energy import hemispherical_reflectance
 from ..photometry import solar_spectrum
 from .spectral import table_on
 
