@@ -37,8 +37,9 @@ from .angles import (
     chunk_angles,
     facet_frame,
     forward_direction,
+    frame_angles,
     in_plane,
-    observer_angles,
+    observer_components,
     tangent_azimuth,
 )
 from .anisotropic import AnisotropicTable, anisotropic_sums, pack_anisotropic, plan_step, reflected
@@ -103,6 +104,7 @@ __all__ = [
     "clip",
     "facet_frame",
     "forward_direction",
+    "frame_angles",
     "fused_sums",
     "hemispherical_reflectance_kernel",
     "hull",
@@ -114,7 +116,7 @@ __all__ = [
     "material_sums",
     "normal_incidence_weight",
     "normal_rows",
-    "observer_angles",
+    "observer_components",
     "pack_anisotropic",
     "pack_tables",
     "packing",

@@ -7,7 +7,9 @@ compiled parts, shared by the isotropic and the anisotropic kernels:
 * :func:`in_plane`, the part of a vector in the facet plane (projected twice);
 * :func:`forward_direction`, the in-plane forward vector ``e_f`` (at normal incidence
   through the observer, or through the axis least aligned with the normal);
-* :func:`observer_angles`, the observer's projected polar angle and ``phi`` from ``e_f``;
+* :func:`observer_components`, the observer's components along ``e_f`` and out of the
+  plane, and :func:`frame_angles`, the angles from them (branch-free arc tangents for
+  the vectorised loop, ``libm``'s for one pair);
 * :func:`facet_frame`, the three together for one lit and seen pair;
 * :func:`chunk_angles`, the same for a chunk of geometries x terms in one vectorisable
   pass (the first stage of :func:`sbrdf_xr.kernels.sums.fused_sums`);
@@ -38,8 +40,9 @@ __all__ = [
     "chunk_angles",
     "facet_frame",
     "forward_direction",
+    "frame_angles",
     "in_plane",
-    "observer_angles",
+    "observer_components",
     "tangent_azimuth",
 ]
 
@@ -169,27 +172,50 @@ def forward_direction(
 
 
 @numba.njit(nogil=True, cache=True, inline="always")
-def observer_angles(
-    n: Vec, e: Vec, o: Vec, no: float
-) -> tuple[float, float, float]:  # pragma: no cover - compiled
-    """The observer's polar angle projected on the plane ``(e_f, N)`` and ``phi``, its
-    angle out of that plane [rad], and its out-of-plane component ``o.(N x e_f)`` [1],
-    for an observer above the facet (``no = N.o > 0``: :func:`atan2_pos` serves).
+def observer_components(n: Vec, e: Vec, o: Vec) -> tuple[float, float]:  # pragma: no cover
+    """The observer's components along the forward vector ``e_f`` and out of the plane
+    ``(e_f, N)``, along ``p = N x e_f`` [1].
 
     Examples
     --------
-    The observer 45 deg out of the plane ``(+x, +z)``, over the normal:
-
     >>> import numpy as np
-    >>> from sbrdf_xr.kernels.angles import observer_angles
+    >>> from sbrdf_xr.kernels.angles import observer_components
     >>> h = float(np.sqrt(0.5))
-    >>> theta_r, phi, op = observer_angles((0.0, 0.0, 1.0), (1.0, 0.0, 0.0), (0.0, h, h), h)
-    >>> round(theta_r, 12), round(float(np.degrees(phi)), 12), round(op, 12)
-    (0.0, 45.0, 0.707106781187)
+    >>> [round(v, 12) for v in observer_components((0.0, 0.0, 1.0), (1.0, 0.0, 0.0), (0.0, h, h))]
+    [0.0, 0.707106781187]
     """
-    of = _dot(o, e)
-    op = _dot(o, _cross(n, e))
-    return atan2_pos(of, no), atan2_pos(abs(op), np.sqrt(of * of + no * no)), op
+    return _dot(o, e), _dot(o, _cross(n, e))
+
+
+@numba.njit(nogil=True, cache=True, inline="always")
+def frame_angles(
+    st_len: float, ns: float, of: float, op: float, no: float, simd: bool
+) -> tuple[float, float, float]:  # pragma: no cover - compiled
+    """``theta_i``, the observer's polar angle projected on the plane ``(e_f, N)`` and
+    ``phi`` [rad] of a lit and seen pair (``ns = N.s > 0``, ``no = N.o > 0``) from the
+    Sun's in-plane length ``|s_t|`` and :func:`observer_components`: the arc tangents of
+    :func:`sbrdf_xr.geometry.facet_angles`.
+
+    ``simd`` picks the arc tangent: :func:`atan2_pos` (branch-free, so a loop over
+    geometries vectorises) or ``libm``'s (faster one pair at a time).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.angles import frame_angles
+    >>> h = float(np.sqrt(0.5))
+    >>> a = frame_angles(0.5, np.sqrt(0.75), 0.0, h, h, False)
+    >>> b = frame_angles(0.5, np.sqrt(0.75), 0.0, h, h, True)
+    >>> [round(float(np.degrees(v)), 9) for v in a], bool(np.allclose(a, b, rtol=1e-15))
+    ([30.0, 0.0, 45.0], True)
+    """
+    if simd:
+        return (
+            atan2_pos(st_len, ns),
+            atan2_pos(of, no),
+            atan2_pos(abs(op), np.sqrt(of * of + no * no)),
+        )
+    return np.arctan2(st_len, ns), np.arctan2(of, no), np.arctan2(abs(op), np.hypot(of, no))
 
 
 @numba.njit(nogil=True, cache=True, error_model="numpy")
@@ -248,10 +274,10 @@ def chunk_angles(
             ns = _dot(n, s)
             no = _dot(n, o)
             st, st_len = in_plane(n, s, ns)
-            ti = atan2_pos(st_len, ns)
             # e_f away from normal incidence, without forward_direction's branches (SIMD)
             inv = 1.0 / st_len
-            trp, phi, _ = observer_angles(n, (-st[0] * inv, -st[1] * inv, -st[2] * inv), o, no)
+            of, op = observer_components(n, (-st[0] * inv, -st[1] * inv, -st[2] * inv), o)
+            ti, trp, phi = frame_angles(st_len, ns, of, op, no, True)
             ns_out[t, j] = ns
             no_out[t, j] = no
             st_out[t, j] = st_len
@@ -295,9 +321,9 @@ def facet_frame(
     [0.0, 40.0, 0.0, 1.0, 0.0, 0.0, 0.0]
     """
     st, st_len = in_plane(n, s, ns)
-    ti = atan2_pos(st_len, ns)
     e = forward_direction(n, st, st_len, o, no, tol)
-    trp, phi, op = observer_angles(n, e, o, no)
+    of, op = observer_components(n, e, o)
+    ti, trp, phi = frame_angles(st_len, ns, of, op, no, False)
     return ti * _RAD2DEG, trp * _RAD2DEG - ti * _RAD2DEG, phi * _RAD2DEG, e, op
 
 

@@ -41,7 +41,7 @@ from ..anisotropy import PSI_PERIOD, illumination_azimuth, psi_weights
 from ..geometry import normal_incidence_tolerance
 from . import lut as _lut
 from .angles import facet_frame, tangent_azimuth
-from .lookup import _add_areas, _gather, _lookup_rows, _material_axes, _outside, _psi_cell, _scratch
+from .lookup import _gather, _lookup_rows, _material_axes, _outside, _psi_cell, _range_limits
 from .packing import Facets, KernelOptions, PackedTables, pack_tables, typed_values
 from .reference import MaterialSums, material_sums
 from .sums import METHOD_CODES, FusedSums, fused_sums
@@ -298,34 +298,46 @@ def anisotropic_sums(
 def _aniso_fused(s, o, facets, values, grids, psi, closed, opts, out):  # pragma: no cover
     """One anisotropic material, nearest or linear in the angles, linear in psi: the
     slices share the grids of material 0 of ``grids``."""
-    n_wl = out.signal.shape[1]
-    has_frac = facets.fraction.shape[0] > 0
-    tol = opts.tol
-    sc = _scratch(8, n_wl, out.signal.dtype)
-    axes = _material_axes(grids, 0)
-    edges = grids.edges[0]
+    # the bundles unpacked once: the loops below hand plain arrays to the helpers
+    normals, area, _, _, tangents, frac = facets
+    tgrid, t_off, dgrid, d_off, pgrid, p_off, edges, _, bmap, b_off, binv = grids
+    method, tol, edge_tol = opts
+    out_sig, out_pap, out_area, out_lit = out
+    has_frac = frac.shape[0] > 0
+    idx = np.empty((3, 4), dtype=np.int64)
+    w = np.empty((3, 4))
+    rows = np.empty(8, dtype=np.int64)
+    wn = np.empty(8, dtype=out_sig.dtype)
+    f = np.empty(out_sig.shape[1], dtype=out_sig.dtype)
+    axes = _material_axes(t_off, d_off, p_off, b_off, binv, 0)
+    limits = _range_limits(dgrid, pgrid, axes, edges, 0)
     for g in range(s.shape[0]):
         sg = (s[g, 0], s[g, 1], s[g, 2])
         og = (o[g, 0], o[g, 1], o[g, 2])
-        for tt in range(facets.normal.shape[0]):
-            n = (facets.normal[tt, 0], facets.normal[tt, 1], facets.normal[tt, 2])
+        for tt in range(normals.shape[0]):
+            n = (normals[tt, 0], normals[tt, 1], normals[tt, 2])
             ns = n[0] * sg[0] + n[1] * sg[1] + n[2] * sg[2]
             no = n[0] * og[0] + n[1] * og[1] + n[2] * og[2]
             if not (ns > 0.0 and no > 0.0):
                 continue
-            a2d = _add_areas(out, facets, has_frac, g, tt, no)
+            a_eff = area[tt] * frac[g, tt] if has_frac else area[tt]
+            a2d = a_eff * no  # a_2D = a c cos(theta_r)
+            out_area[g] += a2d
+            out_lit[g] += a_eff
             ti, dt, phi, e, op = facet_frame(n, sg, og, ns, no, tol)
-            if _outside(axes, edges, dt, phi, opts.edge_tol):
+            if _outside(limits, dt, phi, edge_tol):
                 continue
-            tangent = (facets.tangent[tt, 0], facets.tangent[tt, 1], facets.tangent[tt, 2])
+            tangent = (tangents[tt, 0], tangents[tt, 1], tangents[tt, 2])
             k0, k1, w1 = _psi_cell(psi, closed, tangent_azimuth(n, tangent, e, op, tol))
-            nk = _lookup_rows(axes, ti, dt, phi, opts.method, sc, 1.0)
-            sig, pap = out.signal[g], out.paper[g]
+            nk = _lookup_rows(
+                tgrid, dgrid, pgrid, bmap, axes, ti, dt, phi, method, idx, w, rows, wn, 1.0
+            )
+            sig, pap = out_sig[g], out_pap[g]
             if w1 < 1.0:
                 w0 = 1.0 - w1
-                _gather(values[k0], sc.rows, sc.wn, nk, sc.f, sig, pap, a2d * ns * w0, a2d * w0)
+                _gather(values[k0], rows, wn, nk, f, sig, pap, a2d * ns * w0, a2d * w0)
             if w1 > 0.0:
-                _gather(values[k1], sc.rows, sc.wn, nk, sc.f, sig, pap, a2d * ns * w1, a2d * w1)
+                _gather(values[k1], rows, wn, nk, f, sig, pap, a2d * ns * w1, a2d * w1)
 
 
 def _compiled_sums(s, o, n, tangents, areas, table, method, fraction):

@@ -4,13 +4,20 @@
 * an axis of a material's table (:class:`_Axis`, read from the packed grids by
   :func:`_material_axes`), the cell of an angle from its bucket map and the node
   weights of ``lut.axis_weights`` along it (:func:`_cell`, :func:`_axis`);
-* the out-of-range policy of ``lut.lookup_matrix`` (:func:`_outside`);
+
+* the out-of-range policy of ``lut.lookup_matrix`` (:func:`_range_limits` once per
+  material, :func:`_outside` per pair);
 * the table rows and weights of one look-up in ``(theta_i, delta_theta, phi)``
   (:func:`_lookup_rows`) and the periodic linear cell in ``psi``
   (``anisotropy.psi_weights``, :func:`_psi_cell`);
-* the accumulation: the lit-and-visible areas of a pair (:func:`_add_areas`), and the
-  weighted sum of table rows into the spectral accumulators (:func:`_gather`,
-  :func:`_gather8`).
+* the accumulation: the weighted sum of table rows into the spectral accumulators
+  (:func:`_gather`, :func:`_gather8`).
+
+The kernels take their arguments as named tuples (:mod:`sbrdf_xr.kernels.packing`) and
+unpack them once.  What runs per (geometry, term) pair takes scalars and as few arrays
+as it can: an array handed to an inlined helper costs a reference count on every call
+(measured: a helper adding a pair's areas into the output arrays made the band-only
+kernel 30 % slower), so the pair's areas are added in the kernels' own loops.
 """
 
 from __future__ import annotations
@@ -18,7 +25,6 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numba
-import numpy as np
 
 from ..anisotropy import PSI_PERIOD
 
@@ -26,121 +32,77 @@ __all__: list[str] = []
 
 
 class _Axis(NamedTuple):
-    """One axis of one material's table as the kernels read it: the nodes
-    ``grid[lo : lo + n]`` and the bucket map ``bmap[blo : blo + nb]`` of inverse bucket
-    width ``binv`` (:func:`sbrdf_xr.kernels.packing.bucket_map`)."""
+    """Axis ``axis`` (0, 1, 2: ``theta_i``, ``delta_theta``, ``phi``) of one material's
+    table: the nodes ``grid[lo : lo + n]`` and the bucket map
+    ``bmap[axis, blo : blo + nb]`` of inverse bucket width ``binv``
+    (:func:`sbrdf_xr.kernels.packing.bucket_map`) of the packed grid and map arrays,
+    which travel beside it (a named tuple of arrays passed to a helper costs a reference
+    count per array on every call)."""
 
-    grid: np.ndarray
+    axis: int
     lo: int
     n: int
-    bmap: np.ndarray
     blo: int
     nb: int
     binv: float
 
 
-class _Scratch(NamedTuple):
-    """A kernel's work buffers: node indices and weights of the three axes (up to 4
-    each), the rows and weights of one look-up and a spectrum."""
-
-    it: np.ndarray
-    wt: np.ndarray
-    idt: np.ndarray
-    wdt: np.ndarray
-    iph: np.ndarray
-    wph: np.ndarray
-    rows: np.ndarray
-    wn: np.ndarray
-    f: np.ndarray
-
-
-@numba.njit(nogil=True, cache=True)
-def _scratch(n_rows, n_wl, dtype):  # pragma: no cover - compiled
-    """Buffers for ``n_rows`` rows per look-up and ``n_wl`` wavelengths (weights of the
-    rows and the spectrum in ``dtype``, the dtype of the tables)."""
-    return _Scratch(
-        np.empty(4, dtype=np.int64),
-        np.empty(4),
-        np.empty(4, dtype=np.int64),
-        np.empty(4),
-        np.empty(4, dtype=np.int64),
-        np.empty(4),
-        np.empty(n_rows, dtype=np.int64),
-        np.empty(n_rows, dtype=dtype),
-        np.empty(n_wl, dtype=dtype),
-    )
-
-
 @numba.njit(nogil=True, cache=True, inline="always")
-def _material_axes(grids, m):  # pragma: no cover - compiled
+def _material_axes(t_off, d_off, p_off, b_off, binv, m):  # pragma: no cover - compiled
     """The ``(theta_i, delta_theta, phi)`` axes of material ``m`` of packed grids
     (:class:`sbrdf_xr.kernels.packing.TableGrids`)."""
-    b = grids.b_off
     return (
         _Axis(
-            grids.tgrid,
-            grids.t_off[m],
-            grids.t_off[m + 1] - grids.t_off[m],
-            grids.bmap[0],
-            b[0, m],
-            b[0, m + 1] - b[0, m],
-            grids.binv[0, m],
+            0,
+            t_off[m],
+            t_off[m + 1] - t_off[m],
+            b_off[0, m],
+            b_off[0, m + 1] - b_off[0, m],
+            binv[0, m],
         ),
         _Axis(
-            grids.dgrid,
-            grids.d_off[m],
-            grids.d_off[m + 1] - grids.d_off[m],
-            grids.bmap[1],
-            b[1, m],
-            b[1, m + 1] - b[1, m],
-            grids.binv[1, m],
+            1,
+            d_off[m],
+            d_off[m + 1] - d_off[m],
+            b_off[1, m],
+            b_off[1, m + 1] - b_off[1, m],
+            binv[1, m],
         ),
         _Axis(
-            grids.pgrid,
-            grids.p_off[m],
-            grids.p_off[m + 1] - grids.p_off[m],
-            grids.bmap[2],
-            b[2, m],
-            b[2, m + 1] - b[2, m],
-            grids.binv[2, m],
+            2,
+            p_off[m],
+            p_off[m + 1] - p_off[m],
+            b_off[2, m],
+            b_off[2, m + 1] - b_off[2, m],
+            binv[2, m],
         ),
     )
 
 
 @numba.njit(nogil=True, cache=True, inline="always")
-def _first(ax):  # pragma: no cover - compiled
-    return ax.grid[ax.lo]
-
-
-@numba.njit(nogil=True, cache=True, inline="always")
-def _last(ax):  # pragma: no cover - compiled
-    return ax.grid[ax.lo + ax.n - 1]
-
-
-@numba.njit(nogil=True, cache=True, inline="always")
-def _clip(ax, x: float) -> float:  # pragma: no cover - compiled
+def _clip(grid, ax, x: float) -> float:  # pragma: no cover - compiled
     """``x`` clipped to the axis' first and last node."""
-    if x < ax.grid[ax.lo]:
-        return ax.grid[ax.lo]
-    if x > ax.grid[ax.lo + ax.n - 1]:
-        return ax.grid[ax.lo + ax.n - 1]
+    if x < grid[ax.lo]:
+        return grid[ax.lo]
+    if x > grid[ax.lo + ax.n - 1]:
+        return grid[ax.lo + ax.n - 1]
     return x
 
 
 @numba.njit(nogil=True, cache=True, inline="always")
-def _cell(ax, x: float) -> tuple[int, float]:  # pragma: no cover - compiled
+def _cell(grid, bmap, ax, x: float) -> tuple[int, float]:  # pragma: no cover - compiled
     """The cell ``i`` of ``x`` (clipped to the grid) on an axis of ``n >= 2`` nodes and
     the fraction ``t`` within it: ``searchsorted(grid, x, "right") - 1`` clipped to
     ``[0, n - 2]``, from the bucket map (:func:`bucket_map`) and comparisons with the
     nodes (no binary search's unpredictable branches)."""
-    grid, lo, n = ax.grid, ax.lo, ax.n
-    x = _clip(ax, x)
+    lo, n = ax.lo, ax.n
+    x = _clip(grid, ax, x)
     kb = int((x - grid[lo]) * ax.binv)
     if kb < 0:
         kb = 0
     elif kb > ax.nb - 1:
         kb = ax.nb - 1
-    i = ax.bmap[ax.blo + kb]
+    i = bmap[ax.axis, ax.blo + kb]
     while i < n - 1 and grid[lo + i + 1] <= x:
         i += 1
     while i > 0 and grid[lo + i] > x:
@@ -151,29 +113,30 @@ def _cell(ax, x: float) -> tuple[int, float]:  # pragma: no cover - compiled
 
 
 @numba.njit(nogil=True, cache=True, inline="always")
-def _axis(ax, x: float, method: int, idx: np.ndarray, w: np.ndarray) -> int:  # pragma: no cover
-    """Node indices and weights along one axis (``lut.axis_weights``); returns the count.
+def _axis(grid, bmap, ax, x, method, idx, w):  # pragma: no cover - compiled
+    """Node indices and weights along one axis (``lut.axis_weights``) into the axis' row
+    of the ``(3, 4)`` arrays ``idx`` and ``w``; returns the count.
 
     The cell is found from the axis' bucket map (:func:`bucket_map`) and corrected by
     comparisons with the nodes, so it is exactly ``searchsorted(grid, x, "right") - 1``
     without a binary search's unpredictable branches.
     """
-    x = _clip(ax, x)
-    n = ax.n
+    x = _clip(grid, ax, x)
+    n, a = ax.n, ax.axis
     if n == 1:
-        idx[0] = 0
-        w[0] = 1.0
+        idx[a, 0] = 0
+        w[a, 0] = 1.0
         return 1
-    i, t = _cell(ax, x)
+    i, t = _cell(grid, bmap, ax, x)
     if method == 0:
-        idx[0] = i + 1 if t >= 0.5 else i
-        w[0] = 1.0
+        idx[a, 0] = i + 1 if t >= 0.5 else i
+        w[a, 0] = 1.0
         return 1
     if method == 1:
-        idx[0] = i
-        idx[1] = i + 1
-        w[0] = 1.0 - t
-        w[1] = t
+        idx[a, 0] = i
+        idx[a, 1] = i + 1
+        w[a, 0] = 1.0 - t
+        w[a, 1] = t
         return 2
     k = 4 if n >= 4 else n
     j0 = i - 1
@@ -182,46 +145,64 @@ def _axis(ax, x: float, method: int, idx: np.ndarray, w: np.ndarray) -> int:  # 
     elif j0 > n - k:
         j0 = n - k
     for p in range(k):
-        idx[p] = j0 + p
-        w[p] = 1.0
+        idx[a, p] = j0 + p
+        w[a, p] = 1.0
     for p in range(k):
-        xp = ax.grid[ax.lo + j0 + p]
+        xp = grid[ax.lo + j0 + p]
         for q in range(k):
             if p != q:
-                xq = ax.grid[ax.lo + j0 + q]
-                w[p] *= (x - xq) / (xp - xq)
+                xq = grid[ax.lo + j0 + q]
+                w[a, p] *= (x - xq) / (xp - xq)
     return k
 
 
 @numba.njit(nogil=True, cache=True, inline="always")
-def _outside(axes, edges, dt: float, phi: float, edge_tol: float) -> bool:  # pragma: no cover
-    """The out-of-range policy of ``lut.lookup_matrix``: zero beyond the
-    ``delta_theta`` grid below or above, or beyond the ``phi`` grid, where the
-    material's ``edges`` (three flags) say so."""
+def _range_limits(dgrid, pgrid, axes, edges, m):  # pragma: no cover - compiled
+    """Material ``m``'s out-of-range policy as scalars for :func:`_outside`: its three
+    flags (zero beyond ``delta_theta`` below, above, beyond ``phi`` above) and the grid
+    ends they refer to [degree]."""
+    d, p = axes[1], axes[2]
     return (
-        (edges[0] and dt < _first(axes[1]) - edge_tol)
-        or (edges[1] and dt > _last(axes[1]) + edge_tol)
-        or (edges[2] and phi > _last(axes[2]) + edge_tol)
+        edges[m, 0],
+        edges[m, 1],
+        edges[m, 2],
+        dgrid[d.lo],
+        dgrid[d.lo + d.n - 1],
+        pgrid[p.lo + p.n - 1],
     )
 
 
 @numba.njit(nogil=True, cache=True, inline="always")
-def _lookup_rows(axes, ti, dt, phi, method, sc, scale):  # pragma: no cover - compiled
+def _outside(limits, dt, phi, edge_tol):  # pragma: no cover - compiled
+    """The out-of-range policy of ``lut.lookup_matrix`` at ``(delta_theta, phi)``
+    [degree] with the :func:`_range_limits` of the material."""
+    e_lo, e_hi, e_phi, d_lo, d_hi, p_hi = limits
+    return (
+        (e_lo and dt < d_lo - edge_tol)
+        or (e_hi and dt > d_hi + edge_tol)
+        or (e_phi and phi > p_hi + edge_tol)
+    )
+
+
+@numba.njit(nogil=True, cache=True)
+def _lookup_rows(
+    tgrid, dgrid, pgrid, bmap, axes, ti, dt, phi, method, idx, w, rows, wn, scale
+):  # pragma: no cover - compiled
     """The rows of one look-up at ``(theta_i, delta_theta, phi)`` [degree] and their
-    weights times ``scale``, into ``sc.rows`` and ``sc.wn`` from the start; returns the
-    count."""
-    kt = _axis(axes[0], ti, method, sc.it, sc.wt)
-    kd = _axis(axes[1], dt, method, sc.idt, sc.wdt)
-    kp = _axis(axes[2], phi, method, sc.iph, sc.wph)
+    weights times ``scale``, into ``rows`` and ``wn`` from the start (``idx``, ``w``:
+    ``(3, 4)`` work arrays of the axes); returns the count."""
+    kt = _axis(tgrid, bmap, axes[0], ti, method, idx, w)
+    kd = _axis(dgrid, bmap, axes[1], dt, method, idx, w)
+    kp = _axis(pgrid, bmap, axes[2], phi, method, idx, w)
     nd, npp = axes[1].n, axes[2].n
     nk = 0
     for a in range(kt):
         for b in range(kd):
-            row0 = (sc.it[a] * nd + sc.idt[b]) * npp
-            wab = sc.wt[a] * sc.wdt[b] * scale
+            row0 = (idx[0, a] * nd + idx[1, b]) * npp
+            wab = w[0, a] * w[1, b] * scale
             for c in range(kp):
-                sc.rows[nk] = row0 + sc.iph[c]
-                sc.wn[nk] = wab * sc.wph[c]
+                rows[nk] = row0 + idx[2, c]
+                wn[nk] = wab * w[2, c]
                 nk += 1
     return nk
 
@@ -249,19 +230,6 @@ def _psi_cell(nodes, closed, psi):  # pragma: no cover - compiled
     elif w1 > 1.0:
         w1 = 1.0
     return k0, k1, w1
-
-
-@numba.njit(nogil=True, cache=True, inline="always")
-def _add_areas(out, facets, has_frac, g, tt, no):  # pragma: no cover - compiled
-    """Add a lit and seen pair's areas to ``out.area`` (``a_2D = a c cos(theta_r)``) and
-    ``out.lit_visible_area`` (``a c``) of geometry ``g``; returns ``a_2D`` [m2]."""
-    a_eff = facets.area[tt]
-    if has_frac:
-        a_eff = a_eff * facets.fraction[g, tt]
-    a2d = a_eff * no
-    out.area[g] += a2d
-    out.lit_visible_area[g] += a_eff
-    return a2d
 
 
 @numba.njit(nogil=True, cache=True, inline="always")

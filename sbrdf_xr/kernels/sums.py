@@ -21,17 +21,14 @@ from ..geometry import normal_incidence_tolerance
 from . import lut as _lut
 from .angles import _RAD2DEG, chunk_angles, facet_frame
 from .lookup import (
-    _add_areas,
     _axis,
     _cell,
-    _first,
     _gather,
     _gather8,
-    _last,
     _lookup_rows,
     _material_axes,
     _outside,
-    _scratch,
+    _range_limits,
 )
 from .packing import Facets, KernelOptions, PackedTables, typed_values
 
@@ -67,7 +64,9 @@ def _blend_weight(b_m: float, ti: float) -> float:  # pragma: no cover - compile
 
 
 @numba.njit(nogil=True, cache=True, inline="always")
-def _blend_rows(axes, edges, dt, phi, method, sc, w_n, nk, edge_tol):  # pragma: no cover
+def _blend_rows(
+    dgrid, pgrid, bmap, axes, edges, m, dt, phi, method, idx, w, rows, wn, w_n, nk, edge_tol
+):  # pragma: no cover - compiled
     """Append the rows of the normal-incidence blend: the ``theta_i = 0`` row along its
     in-plane profile at ``+-gamma``, the angle from the specular direction
     (``lut.observer_polar_angle(0, dt, phi)``), weight ``w_n`` shared by the sides in
@@ -76,57 +75,49 @@ def _blend_rows(axes, edges, dt, phi, method, sc, w_n, nk, edge_tol):  # pragma:
     tr = dt / _RAD2DEG
     cp = np.cos(pr)
     gam = np.arctan2(np.hypot(np.sin(pr), cp * np.sin(tr)), abs(cp * np.cos(tr))) * _RAD2DEG
-    ok_hi = (gam <= _last(axes[1]) + edge_tol) or not edges[1]
-    ok_lo = (-gam >= _first(axes[1]) - edge_tol) or not edges[0]
+    d = axes[1]
+    ok_hi = (gam <= dgrid[d.lo + d.n - 1] + edge_tol) or not edges[m, 1]
+    ok_lo = (-gam >= dgrid[d.lo] - edge_tol) or not edges[m, 0]
     n_ok = (1 if ok_hi else 0) + (1 if ok_lo else 0)
     if n_ok == 0:
         return nk
     base_w = w_n / n_ok
     npp = axes[2].n
-    kp = _axis(axes[2], 0.0, method, sc.iph, sc.wph)
+    kp = _axis(pgrid, bmap, axes[2], 0.0, method, idx, w)
     for side in range(2):
         if (side == 0 and not ok_hi) or (side == 1 and not ok_lo):
             continue
-        kd = _axis(axes[1], gam if side == 0 else -gam, method, sc.idt, sc.wdt)
+        kd = _axis(dgrid, bmap, d, gam if side == 0 else -gam, method, idx, w)
         for b in range(kd):
             for c in range(kp):
-                sc.rows[nk] = sc.idt[b] * npp + sc.iph[c]
-                sc.wn[nk] = base_w * sc.wdt[b] * sc.wph[c]
+                rows[nk] = idx[1, b] * npp + idx[2, c]
+                wn[nk] = base_w * w[1, b] * w[2, c]
                 nk += 1
     return nk
 
 
-@numba.njit(nogil=True, cache=True, inline="always")
-def _linear8(axes, ti, dt, phi, wn):  # pragma: no cover - compiled
-    """The corner row of the trilinear cell of ``(theta_i, delta_theta, phi)`` and its
-    8 weights into ``wn`` (the order of :func:`_gather8`)."""
-    i0, u0 = _cell(axes[0], ti)
-    i1, u1 = _cell(axes[1], dt)
-    i2, u2 = _cell(axes[2], phi)
-    r = (i0 * axes[1].n + i1) * axes[2].n + i2
-    wa0, wa1 = 1.0 - u0, u0
-    wb0, wb1 = 1.0 - u1, u1
-    wc0, wc1 = 1.0 - u2, u2
-    w00, w01, w10, w11 = wa0 * wb0, wa0 * wb1, wa1 * wb0, wa1 * wb1
-    wn[0], wn[1], wn[2], wn[3] = w00 * wc0, w00 * wc1, w01 * wc0, w01 * wc1
-    wn[4], wn[5], wn[6], wn[7] = w10 * wc0, w10 * wc1, w11 * wc0, w11 * wc1
-    return r
-
-
 @numba.njit(nogil=True, cache=True)
 def _fused_sums(s, o, facets, values, grids, opts, out):  # pragma: no cover - compiled
+    # the bundles unpacked once: the loops below hand plain arrays to the helpers
+    normals, area, term_mat, uniq, _, frac = facets
+    tgrid, t_off, dgrid, d_off, pgrid, p_off, edges, blend, bmap, b_off, binv = grids
+    method, tol, edge_tol = opts
+    out_sig, out_pap, out_area, out_lit, out_pm = out
     n_geom = s.shape[0]
-    n_term = facets.normal.shape[0]
-    n_wl = out.signal.shape[1]
-    has_frac = facets.fraction.shape[0] > 0
-    want_pm = out.per_material.shape[0] > 0
-    method, tol, edge_tol = opts.method, opts.tol, opts.edge_tol
-    normals, uniq, term_mat = facets.normal, facets.row, facets.material
-    sc = _scratch(96, n_wl, out.signal.dtype)
-    acc_s = np.empty(n_wl, dtype=out.signal.dtype)
-    acc_p = np.empty(n_wl, dtype=out.signal.dtype)
+    n_term = normals.shape[0]
+    n_wl = out_sig.shape[1]
+    has_frac = frac.shape[0] > 0
+    want_pm = out_pm.shape[0] > 0
+    dtype = out_sig.dtype
+    idx = np.empty((3, 4), dtype=np.int64)
+    w = np.empty((3, 4))
+    rows = np.empty(96, dtype=np.int64)
+    wn = np.empty(96, dtype=dtype)
+    f = np.empty(n_wl, dtype=dtype)
+    acc_s = np.empty(n_wl, dtype=dtype)
+    acc_p = np.empty(n_wl, dtype=dtype)
     # the pair's weights rounded to the tables' dtype, as the reference weights them
-    wbuf = np.empty(2, dtype=out.signal.dtype)
+    wbuf = np.empty(2, dtype=dtype)
     # stage 1 (chunk_angles): the angles of a chunk of geometries against every term in
     # one vectorised pass; stage 2: per material of the chunk, per geometry, the look-ups
     # of its lit and seen pairs (terms in order, so that terms of one face read the same
@@ -156,11 +147,11 @@ def _fused_sums(s, o, facets, values, grids, opts, out):  # pragma: no cover - c
             while stop < n_term and term_mat[stop] == m:
                 stop += 1
             vals = values[m]  # once per chunk and material (an item of a typed list costs)
-            axes = _material_axes(grids, m)
-            edges = grids.edges[m]
+            axes = _material_axes(t_off, d_off, p_off, b_off, binv, m)
             nd, npp = axes[1].n, axes[2].n
             linear8 = method == 1 and axes[0].n > 1 and nd > 1 and npp > 1
-            b_m = grids.blend[m] if _first(axes[0]) == 0.0 else 0.0
+            b_m = blend[m] if tgrid[axes[0].lo] == 0.0 else 0.0
+            limits = _range_limits(dgrid, pgrid, axes, edges, m)
             for j in range(nc):
                 g = c0 + j
                 any_lookup = False
@@ -170,7 +161,10 @@ def _fused_sums(s, o, facets, values, grids, opts, out):  # pragma: no cover - c
                     no = b_no[u, j]
                     if not (ns > 0.0 and no > 0.0):
                         continue
-                    a2d = _add_areas(out, facets, has_frac, g, tt, no)
+                    a_eff = area[tt] * frac[g, tt] if has_frac else area[tt]
+                    a2d = a_eff * no  # a_2D = a c cos(theta_r)
+                    out_area[g] += a2d
+                    out_lit[g] += a_eff
                     if b_st[u, j] > tol:
                         ti, dt, phi = b_ti[u, j], b_dt[u, j], b_ph[u, j]
                     else:  # normal incidence: the plane through the observer or an axis
@@ -182,7 +176,7 @@ def _fused_sums(s, o, facets, values, grids, opts, out):  # pragma: no cover - c
                             no,
                             tol,
                         )
-                    outside = _outside(axes, edges, dt, phi, edge_tol)
+                    outside = _outside(limits, dt, phi, edge_tol)
                     w_n = _blend_weight(b_m, ti)
                     wbuf[0] = a2d * ns
                     wbuf[1] = a2d
@@ -190,9 +184,15 @@ def _fused_sums(s, o, facets, values, grids, opts, out):  # pragma: no cover - c
                     nk = 0
                     if not fast:
                         if not outside and w_n < 1.0:
-                            nk = _lookup_rows(axes, ti, dt, phi, method, sc, 1.0 - w_n)
+                            nk = _lookup_rows(
+                                tgrid, dgrid, pgrid, bmap, axes, ti, dt, phi, method, idx, w,
+                                rows, wn, 1.0 - w_n,
+                            )  # fmt: skip
                         if w_n > 0.0:
-                            nk = _blend_rows(axes, edges, dt, phi, method, sc, w_n, nk, edge_tol)
+                            nk = _blend_rows(
+                                dgrid, pgrid, bmap, axes, edges, m, dt, phi, method, idx, w,
+                                rows, wn, w_n, nk, edge_tol,
+                            )  # fmt: skip
                         if nk == 0:
                             continue
                     if not any_lookup:
@@ -201,10 +201,19 @@ def _fused_sums(s, o, facets, values, grids, opts, out):  # pragma: no cover - c
                         any_lookup = True
                     if fast:
                         # linear in all three axes, no blend: the 8 rows straight from the cells
-                        r = _linear8(axes, ti, dt, phi, sc.wn)
-                        _gather8(vals, r, npp, nd * npp, sc.wn, acc_s, acc_p, wbuf[0], wbuf[1])
+                        i0, u0 = _cell(tgrid, bmap, axes[0], ti)
+                        i1, u1 = _cell(dgrid, bmap, axes[1], dt)
+                        i2, u2 = _cell(pgrid, bmap, axes[2], phi)
+                        r = (i0 * nd + i1) * npp + i2
+                        wa0, wa1 = 1.0 - u0, u0
+                        wb0, wb1 = 1.0 - u1, u1
+                        wc0, wc1 = 1.0 - u2, u2
+                        w00, w01, w10, w11 = wa0 * wb0, wa0 * wb1, wa1 * wb0, wa1 * wb1
+                        wn[0], wn[1], wn[2], wn[3] = w00 * wc0, w00 * wc1, w01 * wc0, w01 * wc1
+                        wn[4], wn[5], wn[6], wn[7] = w10 * wc0, w10 * wc1, w11 * wc0, w11 * wc1
+                        _gather8(vals, r, npp, nd * npp, wn, acc_s, acc_p, wbuf[0], wbuf[1])
                     else:
-                        _gather(vals, sc.rows, sc.wn, nk, sc.f, acc_s, acc_p, wbuf[0], wbuf[1])
+                        _gather(vals, rows, wn, nk, f, acc_s, acc_p, wbuf[0], wbuf[1])
                 if any_lookup:
                     if method == 2:
                         for k in range(n_wl):
@@ -213,11 +222,11 @@ def _fused_sums(s, o, facets, values, grids, opts, out):  # pragma: no cover - c
                             if acc_p[k] < 0.0:
                                 acc_p[k] = 0.0
                     for k in range(n_wl):
-                        out.signal[g, k] += acc_s[k]
-                        out.paper[g, k] += acc_p[k]
+                        out_sig[g, k] += acc_s[k]
+                        out_pap[g, k] += acc_p[k]
                     if want_pm:
                         for k in range(n_wl):
-                            out.per_material[g, m, k] += acc_s[k]
+                            out_pm[g, m, k] += acc_s[k]
             t = stop
 
 

@@ -227,10 +227,12 @@ def test_bucket_map_finds_the_same_cell_as_searchsorted(nodes, xs, method):
     grid = np.unique(np.round(np.asarray(nodes, dtype=float), 6))
     n = grid.size
     bmap, inv = bucket_map(grid)
+    bmap = np.stack([np.zeros_like(bmap), bmap, np.zeros_like(bmap)])  # the delta_theta row
     probes = np.concatenate([np.asarray(xs, dtype=float), grid, np.nextafter(grid, -np.inf)])
-    idx, w = np.zeros(4, dtype=np.int64), np.zeros(4)
+    idx2, w2 = np.zeros((3, 4), dtype=np.int64), np.zeros((3, 4))
+    idx, w = idx2[1], w2[1]
     for x in probes:
-        k = _axis(_Axis(grid, 0, n, bmap, 0, bmap.size, inv), x, method, idx, w)
+        k = _axis(grid, bmap, _Axis(1, 0, n, 0, bmap.shape[1], inv), x, method, idx2, w2)
         if n == 1:
             assert (k, idx[0]) == (1, 0)
             continue
