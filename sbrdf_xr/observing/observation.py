@@ -290,7 +290,7 @@ class Observation:
         return state
 
     def context(self) -> _att.Context:
-        """The :class:`~sbrdf_xr.observing.attitude.Context` the attitude law sees.
+        """The :class:`~sbrdf_xr.observing.frames.Context` the attitude law sees.
 
         Examples
         --------

@@ -9,14 +9,14 @@ uniform density (:meth:`Tumble.from_spacecraft`).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import AttitudeError
+from .attitude import AttitudeLaw
 from .frames import Context, check_epoch, check_quaternion, seconds_since
-from .pointing import AttitudeLaw
 
 __all__ = ["TUMBLE_RTOL", "Tumble"]
 
@@ -87,6 +87,9 @@ class Tumble(AttitudeLaw):
     >>> np.round(q[-1], 9)  # 90 degree about z after 9 s
     array([0.        , 0.        , 0.70710678, 0.70710678])
     """
+
+    law_name: ClassVar[str] = "tumble"
+    law_parameters: ClassVar[tuple[str, ...]] = ("inertia", "omega_deg_s", "initial", "epoch")
 
     inertia: Any = (1.0, 1.0, 1.0)
     omega_deg_s: Any = (0.0, 0.0, 1.0)

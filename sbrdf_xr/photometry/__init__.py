@@ -106,7 +106,17 @@ magnitude are NaN (the colour is undefined).  A negative band signal (possible o
 with noisy tables) gives a NaN magnitude.
 """
 
-from . import atmosphere
+from . import (
+    atmosphere,
+    bands,
+    colour,
+    files,
+    lightcurves,
+    magnitude,
+    measured,
+    spectra,
+    standard,
+)
 from .atmosphere import (
     AIRMASS_MODELS,
     airmass,
@@ -178,16 +188,22 @@ __all__ = [
     "atmosphere",
     "band_signal",
     "band_weights",
+    "bands",
     "cf_decode",
     "cf_encode",
     "check_system",
+    "colour",
     "colour_indices",
     "compare_light_curves",
     "extinction_coefficients",
+    "files",
     "filters",
     "hat_integrals",
     "lambert_sphere_phase",
+    "lightcurves",
+    "magnitude",
     "magnitudes",
+    "measured",
     "open_photometry",
     "photometry",
     "plot_comparison",
@@ -197,8 +213,10 @@ __all__ = [
     "reference_flux",
     "solar_spectrum",
     "speclite_names",
+    "spectra",
     "specular_sphere_phase",
     "srgb",
+    "standard",
     "standard_magnitude",
     "sun_distance_au",
     "sun_magnitudes",
