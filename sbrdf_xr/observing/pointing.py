@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from ..errors import AttitudeError
+from ..units import to_unit
 from .frames import (
     Context,
     axis_vector,
@@ -124,6 +125,7 @@ class Nadir(AttitudeLaw):
     _axes: tuple[np.ndarray, np.ndarray] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "yaw_deg", to_unit(self.yaw_deg, "deg", "yaw_deg"))
         if not np.isfinite(self.yaw_deg):
             raise AttitudeError(f"nadir yaw_deg: must be finite, got {self.yaw_deg}")
         a, b = perpendicular_pair(
