@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import constants
 
-from .units import check_plausible, check_wavelengths, to_unit
+from .units import check_plausible, to_unit
 
 __all__ = [
     "EARTH_RADIUS_KM",
@@ -60,7 +60,6 @@ def planck(wavelength_nm: ArrayLike, temperature: float) -> NDArray[np.float64]:
     """
     h, c, k = constants.h, constants.c, constants.k
     wl = to_unit(wavelength_nm, "nm", "wavelength_nm", spectral=True)
-    check_wavelengths(wl, "wavelength_nm")
     lam = np.asarray(wl, dtype=np.float64) * 1e-9
     x = h * c / (lam * k * float(to_unit(temperature, "K", "temperature")))
     with np.errstate(under="ignore", over="ignore"):
