@@ -265,6 +265,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         scene = scene.with_options(preset=args.preset, **changes)
     elif changes:
         scene = scene.with_options(**changes)
+    if scene.materials is None:  # the catalog's tables, those to build labelled as one batch
+        catalog.load_materials(scene.spacecraft.materials, dtype=scene.dtype)
     plan = scene.plan()
     print(plan)
     if args.plan:
