@@ -358,7 +358,7 @@ def _curve(
             attrs("time", long_name="measured time of each simulated node (shifted)"),
         )
         return
-    ang = np.mod(al.grid - x, 360.0)
+    ang = np.mod(al.grid, 360.0)  # the figure's abscissa is the simulated angle
     order = np.argsort(ang)
     data["model_curve"] = (
         ("curve", BAND),
@@ -368,5 +368,5 @@ def _curve(
     coords["curve_angle"] = (
         "curve",
         ang[order],
-        attrs("rotation_angle", long_name="measured rotation angle of each simulated node"),
+        attrs("rotation_angle", long_name="simulated rotation angle of each node"),
     )

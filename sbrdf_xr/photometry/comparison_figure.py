@@ -183,8 +183,8 @@ def plot_comparison(comparison: xr.Dataset, *, title: str | None = None) -> Any:
     ax.set_title(
         title
         or (
-            f"measured vs simulated {'pass' if pass_ else 'rotation sweep'}: "
-            f"{comparison.attrs.get('zero_points', '')} zero point(s), extinction "
+            f"measured vs simulated {'pass' if pass_ else 'rotation sweep'}: zero points "
+            f"{comparison.attrs.get('zero_points', '')}, extinction "
             f"{comparison.attrs.get('extinction', 'none')}"
         )
     )

@@ -302,3 +302,45 @@ def test_plot_comparison_of_a_pass(tmp_path):
     assert fig.axes[1].get_xlabel() == "UTC (2024-03-17)"
     fig.savefig(tmp_path / "pass.png", dpi=80)
     assert (tmp_path / "pass.png").stat().st_size > 10_000
+
+
+def test_the_figures_curve_passes_through_the_model_at_the_observations():
+    """model_curve (the fitted model at the simulated nodes, on the figure's abscissa) meets
+    model_magnitude at every observation, for a pass and for a rotation sweep."""
+    meas = _measured({"V": 0.3, "R": 0.1}, {"V": 0.2, "R": 0.1}, shift=1.2, sigma=0.02)
+    fit = P.compare(meas, _sim(), extinction="fit", fit_time_shift=True)
+    secs = (fit.time.values - T0) / np.timedelta64(1, "s")
+    curve_s = (fit.curve_time.values - T0) / np.timedelta64(1, "s")
+    for i, b in enumerate(fit.band.values):
+        sel = fit.obs_band.values == b
+        at = np.interp(secs[sel], curve_s, fit.model_curve.values[:, i])
+        # linear in magnitude between 0.25 s nodes against linear in flux: < 1e-3 mag
+        np.testing.assert_allclose(at, fit.model_magnitude.values[sel], atol=1e-3)
+    ang = np.arange(0.0, 360.0, 1.0)
+    sim = xr.DataArray(
+        np.stack([12 + 0.5 * np.cos(np.radians(2 * ang)), 12.3 + np.sin(np.radians(ang))], 1),
+        dims=("attitude", "band"),
+        coords={"attitude_angle": ("attitude", ang), "band": ["B", "V"]},
+    )
+    theta = np.arange(0.0, 720.0, 7.0)
+    band = np.where(np.arange(theta.size) % 2, "B", "V")
+    m = np.where(
+        band == "B",
+        12 + 0.5 * np.cos(np.radians(2 * (theta + 33))) + 0.2,
+        12.3 + np.sin(np.radians(theta + 33)) - 0.1,
+    )
+    lc = xr.Dataset(
+        {"magnitude": ("obs", m), "uncertainty": ("obs", np.full(m.size, 0.01))},
+        coords={"rotation_angle": ("obs", theta), "band": ("obs", band)},
+    )
+    fit = P.compare(lc, sim)
+    assert float(fit.phase_offset) == pytest.approx(33.0, abs=0.01)
+    for i, b in enumerate(fit.band.values):
+        sel = fit.obs_band.values == b
+        at = np.interp(
+            fit.model_rotation_angle.values[sel],
+            fit.curve_angle.values,
+            fit.model_curve.values[:, i],
+            period=360.0,
+        )
+        np.testing.assert_allclose(at, fit.model_magnitude.values[sel], atol=1e-3)
