@@ -62,7 +62,9 @@ def add_observe_parser(sub: Any, mesh_options: Any) -> argparse.ArgumentParser:
     po = sub.add_parser(
         "observe",
         help="simulate a real pass: elements, a site, a UTC window, an attitude law",
-        description=__doc__.split("\n\n")[1] if __doc__ else None,
+        description="Simulate a real pass - elements (a TLE or OMM file, or a catalog orbit), "
+        "a site, a UTC window and step, an attitude law - and write its cube (and, with "
+        "--plot, its light curve); no scene file.",
     )
     g = po.add_argument_group("orbit and site")
     g.add_argument(
