@@ -49,6 +49,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from ..errors import AttitudeError, did_you_mean
+from ..units import to_unit
 from .frames import (
     Context,
     axis_vector,
@@ -198,6 +199,7 @@ class Nadir(AttitudeLaw):
     _axes: tuple[np.ndarray, np.ndarray] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "yaw_deg", to_unit(self.yaw_deg, "deg", "yaw_deg"))
         if not np.isfinite(self.yaw_deg):
             raise AttitudeError(f"nadir yaw_deg: must be finite, got {self.yaw_deg}")
         a, b = perpendicular_pair(
@@ -339,8 +341,9 @@ class Spin(AttitudeLaw):
     _axis_vec: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        for name in ("rate_deg_s", "phase_deg"):
-            val = getattr(self, name)
+        for name, unit in (("rate_deg_s", "deg / s"), ("phase_deg", "deg")):
+            val = to_unit(getattr(self, name), unit, name)
+            object.__setattr__(self, name, val)
             if not isinstance(val, int | float | np.floating | np.integer) or not np.isfinite(val):
                 raise AttitudeError(f"spin {name}: must be a finite number [degree], got {val!r}")
         object.__setattr__(self, "_axis_vec", axis_vector(self.axis_body, "axis_body"))

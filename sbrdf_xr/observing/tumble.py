@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import AttitudeError
+from ..units import to_unit
 from .attitude import AttitudeLaw
 from .frames import Context, check_epoch, check_quaternion, seconds_since
 
@@ -98,7 +99,7 @@ class Tumble(AttitudeLaw):
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "inertia", _inertia(self.inertia))
-        w = np.asarray(self.omega_deg_s, dtype=np.float64)
+        w = np.asarray(to_unit(self.omega_deg_s, "deg / s", "omega_deg_s"), dtype=np.float64)
         if w.shape != (3,) or not np.all(np.isfinite(w)):
             raise AttitudeError(
                 "tumble omega_deg_s: expected 3 finite body rates [degree s-1], "
