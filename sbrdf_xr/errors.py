@@ -20,6 +20,7 @@ __all__ = [
     "CubeWriteError",
     "EpochGapWarning",
     "InversionError",
+    "LightCurveError",
     "MeshError",
     "MeshRepairWarning",
     "NonPhysicalWarning",
@@ -30,6 +31,8 @@ __all__ = [
     "SbrdfWarning",
     "SceneError",
     "SchedulerError",
+    "UnitError",
+    "UnitWarning",
     "ValidationError",
     "WorkersLostError",
     "did_you_mean",
@@ -138,6 +141,17 @@ class SchedulerError(SbrdfError):
     """A Dask scheduler address that is malformed or cannot be reached."""
 
 
+class LightCurveError(ValidationError):
+    """A measured light curve that cannot be read, or compared with a simulation as given:
+    times outside the simulated window, bands not simulated, NaN rows, bad uncertainties,
+    fewer observations than fitted parameters."""
+
+
+class UnitError(ValidationError):
+    """An astropy Quantity whose unit cannot be converted to the unit of the argument
+    (a mass for a length, an ambiguous length unit)."""
+
+
 class SbrdfWarning(UserWarning):
     """Base class of the warnings issued by sbrdf_xr."""
 
@@ -153,6 +167,12 @@ class MeshRepairWarning(SbrdfWarning):
 class CacheWarning(SbrdfWarning):
     """The table cache could not be used: a damaged file was built again, or the directory
     is not writable (or full), so the table was built without being kept."""
+
+
+class UnitWarning(SbrdfWarning):
+    """A bare number outside the plausible bounds of its documented unit: most likely a
+    value in another unit (wavelengths in micrometres on a nanometre axis, a range in
+    metres given in kilometres)."""
 
 
 class EpochGapWarning(SbrdfWarning):
