@@ -17,6 +17,7 @@ __all__ = [
     "CacheWarning",
     "CatalogError",
     "EpochGapWarning",
+    "FitQualityWarning",
     "InversionError",
     "MeshError",
     "MeshRepairWarning",
@@ -129,3 +130,10 @@ class CacheWarning(SbrdfWarning):
 
 class EpochGapWarning(SbrdfWarning):
     """Observation times far from the epoch of the orbital elements (SGP4 accuracy degrades)."""
+
+
+class FitQualityWarning(SbrdfWarning):
+    """A fit whose chi-square lies beyond the 99.9 % point of its chi-square distribution (or
+    below its 0.1 % point): the model does not describe the data within their uncertainties
+    (or the uncertainties are overstated), so the fitted values and their uncertainties are
+    not to be taken at face value."""

@@ -31,26 +31,45 @@ magnitudes are converted to relative fluxes ``10**(-0.4 m)`` with uncertainties
 
 from __future__ import annotations
 
-from ..errors import InversionError
+from ..errors import FitQualityWarning, InversionError
 from ._bench import benchmark_spin_search
-from ._data import band_terms, magnitudes_to_signal, read_spectrum
-from ._spin import axis_separation, axis_vector, fit_spin
-from ._spin_search import fibonacci_sphere, light_curve_fluxes, spin_model
-from ._unmix import DEGENERACY_THRESHOLD, material_areas, unmix
+from ._data import band_terms, magnitudes_to_signal, measured_kind, read_spectrum
+from ._spin import (
+    SEARCH_BYTES_LIMIT,
+    SEARCH_WORK_LIMIT,
+    axis_separation,
+    axis_vector,
+    check_search_size,
+    fit_spin,
+    search_size,
+)
+from ._spin_data import light_curve_fluxes
+from ._spin_search import fibonacci_sphere, spin_model
+from ._studies import spin_recovery, unmix_calibration
+from ._unmix import DEGENERACY_THRESHOLD, DROP_BIAS, material_areas, unmix
 
 __all__ = [
     "DEGENERACY_THRESHOLD",
+    "DROP_BIAS",
+    "SEARCH_BYTES_LIMIT",
+    "SEARCH_WORK_LIMIT",
+    "FitQualityWarning",
     "InversionError",
     "axis_separation",
     "axis_vector",
     "band_terms",
     "benchmark_spin_search",
+    "check_search_size",
     "fibonacci_sphere",
     "fit_spin",
     "light_curve_fluxes",
     "magnitudes_to_signal",
     "material_areas",
+    "measured_kind",
     "read_spectrum",
+    "search_size",
     "spin_model",
+    "spin_recovery",
     "unmix",
+    "unmix_calibration",
 ]
