@@ -41,6 +41,7 @@ from ._spin import (
     axis_vector,
     check_search_size,
     fit_spin,
+    period_grid,
     search_size,
 )
 from ._spin_data import light_curve_fluxes
@@ -66,6 +67,7 @@ __all__ = [
     "magnitudes_to_signal",
     "material_areas",
     "measured_kind",
+    "period_grid",
     "read_spectrum",
     "search_size",
     "spin_model",

@@ -154,6 +154,11 @@ def measured_kind(path: str | os.PathLike[str]) -> str:
                 if line.strip() and not line.lstrip().startswith("#"):
                     head = line
                     break
+        if not head:
+            raise InversionError(
+                f"{path}: empty; expected a spectrum (a header wavelength,signal,uncertainty "
+                "and one row per wavelength) or band magnitudes (time,band,magnitude,uncertainty)"
+            )
         names = {c.strip().strip('"').lower() for c in head.split(",")}
     if "wavelength" in names:
         return "spectrum"
@@ -178,7 +183,7 @@ def _column(df: Any, name: str, path: Path) -> np.ndarray:
     import pandas as pd
 
     values = pd.to_numeric(df[name], errors="coerce").to_numpy(dtype=np.float64)
-    text = df[name].astype(str).str.strip()
+    text = df[name].fillna("nan").astype(str).str.strip()
     bad = np.isnan(values) & ~text.str.lower().isin(["nan", "", "none"]).to_numpy()
     if bad.any():
         rows = np.flatnonzero(bad)
@@ -236,7 +241,9 @@ def read_spectrum(path: str | os.PathLike[str]) -> tuple[xr.DataArray, xr.DataAr
             ) from None
     else:
         try:
-            df = pd.read_csv(path, skipinitialspace=True, comment="#", dtype=str)
+            df = pd.read_csv(
+                path, skipinitialspace=True, comment="#", dtype=str, keep_default_na=False
+            )
         except pd.errors.EmptyDataError:
             raise InversionError(
                 f"{path}: empty; a spectrum needs a header wavelength,signal,uncertainty and "

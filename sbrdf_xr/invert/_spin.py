@@ -38,6 +38,7 @@ __all__ = [
     "axis_vector",
     "check_search_size",
     "fit_spin",
+    "period_grid",
     "search_size",
 ]
 
@@ -138,6 +139,10 @@ def check_search_size(
     ...
     sbrdf_xr.errors.InversionError: spin search of 300 axes x 1e+12 periods ... 8.64e+04 TB ...
     """
+    if not (isinstance(size_limit, int | float) and np.isfinite(size_limit) and size_limit > 0):
+        raise InversionError(
+            f"size_limit (--size-limit): {size_limit!r}; allowed a finite number > 0"
+        )
     sizes = [
         search_size(n_axes, n_periods, n_phases, n_times, n_bands, n_values, m, n_angles)
         for m in ("direct", "table")
@@ -481,7 +486,34 @@ def _solve(
         if lowest.chi2 >= best.chi2 - 1e-9 * max(1.0, best.chi2):
             break
         best = lowest
+    best = min([best, *minima], key=lambda m: m.chi2)  # the lowest found, whatever the loop did
     return best, minima, alts
+
+
+def period_grid(p_min: float, p_max: float, span_s: float, n_phases: int = 16) -> np.ndarray:
+    """Candidate periods [s] from ``p_min`` to (at least) ``p_max``, spaced so that over a
+    light curve of ``span_s`` seconds the phase slips by at most half a phase step of a
+    ``n_phases`` grid between neighbours: ``dP = P**2 / (n_phases span_s)`` (the search
+    defines the phase at the middle of the light curve), growing with ``P``.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.invert import period_grid
+    >>> grid = period_grid(60.0, 70.0, 240.0)
+    >>> grid.size, grid[:3].round(3).tolist()
+    (11, [60.0, 60.938, 61.905])
+    """
+    if not (0 < p_min <= p_max and np.isfinite(p_max) and span_s > 0 and n_phases >= 1):
+        raise InversionError(
+            f"period_grid: need 0 < p_min <= p_max, span_s > 0 and n_phases >= 1, got "
+            f"{p_min!r}, {p_max!r}, {span_s!r}, {n_phases!r}"
+        )
+    out = [float(p_min)]
+    while out[-1] < p_max:
+        if len(out) > 10**6:
+            raise InversionError("period_grid: more than 1e6 periods; narrow the range")
+        out.append(out[-1] + out[-1] ** 2 / (n_phases * span_s))
+    return np.array(out)
 
 
 def axis_vector(longitude: ArrayLike, latitude: ArrayLike) -> np.ndarray:

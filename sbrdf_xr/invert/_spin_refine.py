@@ -146,4 +146,5 @@ def lonlat_covariance(m: Minimum) -> tuple[float, float, np.ndarray]:
     jac = np.eye(4)
     jac[0, :2] = [np.dot(e, east0) / c, np.dot(n, east0) / c]
     jac[1, :2] = [np.dot(e, north0), np.dot(n, north0)]
-    return lon, lat, jac @ m.cov @ jac.T
+    with np.errstate(invalid="ignore"):  # an unconstrained parameter: inf stays inf or NaN
+        return lon, lat, jac @ m.cov @ jac.T
