@@ -133,7 +133,7 @@ class EpochGapWarning(SbrdfWarning):
 
 
 class FitQualityWarning(SbrdfWarning):
-    """A fit whose chi-square lies beyond the 99.9 % point of its chi-square distribution (or
-    below its 0.1 % point): the model does not describe the data within their uncertainties
-    (or the uncertainties are overstated), so the fitted values and their uncertainties are
-    not to be taken at face value."""
+    """A fit not to be taken at face value: its chi-square lies beyond the 99.9 % point of
+    its chi-square distribution (the model does not describe the data within their
+    uncertainties) or below its 0.1 % point (the uncertainties are overstated), or another
+    solution (a mirror or period-alias twin) fits about as well as the one reported."""

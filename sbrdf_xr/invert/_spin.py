@@ -8,6 +8,7 @@ searches are in :mod:`sbrdf_xr.invert._spin_search`; refinement and the ambiguou
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Mapping
 from typing import Any
 
@@ -15,7 +16,7 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from ..errors import InversionError
+from ..errors import FitQualityWarning, InversionError
 from ._quality import fit_quality
 from ._spin_data import light_curve_fluxes, spin_geometry
 from ._spin_refine import Minimum, axis_angle, exact_minimum, twins
@@ -32,6 +33,7 @@ from ._spin_search import (
 )
 
 __all__ = [
+    "AMBIGUITY_CHI2",
     "SEARCH_BYTES_LIMIT",
     "SEARCH_WORK_LIMIT",
     "axis_separation",
@@ -48,6 +50,10 @@ SEARCH_BYTES_LIMIT = 2 * 2**30
 #: Spin searches that would compute more model values than this (candidates x values, or
 #: table entries) are refused, about a day on two cores (raise with ``size_limit``).
 SEARCH_WORK_LIMIT = 1e11
+
+#: A twin whose chi-square exceeds the solution's by less than this fits about as well (a
+#: likelihood ratio above exp(-4.5) = 1.1 %): the fit warns that the solution is ambiguous.
+AMBIGUITY_CHI2 = 9.0
 
 #: Cost of a kernel geometry and of one interpolated model value, relative (for ``auto``).
 _COST_KERNEL, _COST_GATHER = 1.0, 0.03
@@ -165,22 +171,25 @@ def _positive_int(value: Any, name: str, low: int = 1) -> int:
     return int(value)
 
 
-def _chain(method: str, prob: Problem, size: dict[str, dict[str, float]]) -> list[str]:
+def _chain(
+    method: str, fixed: bool, size: dict[str, dict[str, float]], n_times: int, n_values: int
+) -> list[str]:
     """The searches to try in turn: an approximation first where it is cheaper, then exact."""
     if method == "direct":
         return ["direct"]
     if method == "table":
         return ["table", "direct"]
     if method == "shift":
-        return ["shift", "direct"] if prob.fixed else ["shift", "table", "direct"]
-    if prob.fixed:
+        return ["shift", "direct"] if fixed else ["shift", "table", "direct"]
+    if fixed:
         return ["shift", "direct"]
+    n_bands = max(1, round(n_values / max(1, n_times)))
 
     def cost(m: str) -> float:
         if m == "direct":
-            return size[m]["cells"] * prob.times.size * _COST_KERNEL
-        table = size[m]["work"] - size[m]["cells"] * prob.y.size
-        return table / prob.n_bands * _COST_KERNEL + size[m]["cells"] * prob.y.size * _COST_GATHER
+            return size[m]["cells"] * n_times * _COST_KERNEL
+        table = size[m]["work"] - size[m]["cells"] * n_values
+        return table / n_bands * _COST_KERNEL + size[m]["cells"] * n_values * _COST_GATHER
 
     return ["table", "direct"] if cost("table") < cost("direct") else ["direct"]
 
@@ -291,7 +300,9 @@ def fit_spin(
     -----
     FitQualityWarning
         When the chi-square lies beyond the 99.9 % point of its distribution (or below its
-        0.1 % point), naming the likely causes.
+        0.1 % point), naming the likely causes; or when a twin (another axis or period)
+        fits about as well as the solution (chi-square gap below :data:`AMBIGUITY_CHI2`),
+        naming it (also in ``attrs["ambiguity"]``).
 
     Raises
     ------
@@ -304,8 +315,11 @@ def fit_spin(
     A 1 x 2 x 3 m box of the catalog's Lambertian grey spinning about its long axis with
     a period of 20 s, seen in V and R for 40 s at 30 deg phase with 1 % noise; a search
     over 30 axes x 11 periods x 12 phases (at fixed directions, by spin-angle tables
-    checked against the exact model) and two refinements find the period:
+    checked against the exact model) and two refinements find the period.  A box at a
+    fixed geometry cannot tell its axis from the antipode or the mirror twin, and the fit
+    says so:
 
+    >>> import warnings
     >>> import numpy as np, trimesh, xarray as xr
     >>> from sbrdf_xr import Scene, geometry, load_spacecraft, simulate
     >>> from sbrdf_xr.invert import axis_vector, fit_spin, spin_model
@@ -322,15 +336,17 @@ def fit_spin(
     ...     coords={"time": ("obs", np.repeat(t, 2)), "band": ("obs", ["V", "R"] * t.size)},
     ... )
     >>> to_sun, to_observer = geometry.observation_plane([30.0], (1, 0, 0), (0, 0, 1))
-    >>> fit = fit_spin(lc, box, to_sun=to_sun[0], to_observer=to_observer[0],
-    ...                periods=np.linspace(15.0, 25.0, 11), n_axes=30, n_phases=12,
-    ...                n_starts=2, n_threads=1)
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     fit = fit_spin(lc, box, to_sun=to_sun[0], to_observer=to_observer[0],
+    ...                    periods=np.linspace(15.0, 25.0, 11), n_axes=30, n_phases=12,
+    ...                    n_starts=2, n_threads=1)
     >>> round(float(fit.period), 2), fit.attrs["n_candidates"], fit.attrs["search_method"]
-    (20.0, 3960, 'shift')
+    (19.99, 3960, 'shift')
     >>> fit.attrs["fit_quality"], bool(fit.chi2_gap.min() >= 0)
     ('consistent', True)
-    >>> fit.solution.values.tolist()
-    ['antipode', 'mirror', 'half_period', 'double_period']
+    >>> [w.category.__name__ for w in caught], fit.attrs["ambiguity"][:48]
+    (['FitQualityWarning'], 'the data do not tell the solution from its twins')
     """
     t_start = time.perf_counter()
     if method not in ("auto", *METHODS):
@@ -355,6 +371,8 @@ def fit_spin(
             f"periods (--periods): must be a non-empty list of finite values > 0 [s], got "
             f"{per.size} values" + (f" from {per.min():g} to {per.max():g}" if per.size else "")
         )
+    if offset not in ("band", "common"):
+        raise InversionError(f"offset (--offset): {offset!r}; allowed 'band', 'common'")
     lc = light_curve_fluxes(light_curve)
     geo = spin_geometry(lc["time"], geometry, to_sun, to_observer)
     n_par = 4 + (1 if offset == "common" else len(lc["labels"]))
@@ -383,11 +401,14 @@ def fit_spin(
         f"{n_axes} axes x {per.size:.4g} periods x {n_phases} phases x {n_search} times x "
         f"{len(lc['labels'])} bands"
     )
+    fixed = bool(
+        np.allclose(geo.to_sun, geo.to_sun[0]) and np.allclose(geo.to_observer, geo.to_observer[0])
+    )
+    chain = _chain(method, fixed, sizes, n_search, n_search_values)
+    _check_size(sizes[chain[0]], what, size_limit)  # before the kernel or any allocation
     kern = Kernel(spacecraft, list(lc["labels"]), materials)
     prob = Problem(lc, geo, kern, ab, offset)
     grid_prob = prob.subset(n_search)
-    chain = _chain(method, grid_prob, sizes)
-    _check_size(sizes[chain[0]], what, size_limit)
     axes = fibonacci_sphere(n_axes)
     phases = np.arange(n_phases) * 360.0 / n_phases
     t0 = time.perf_counter()
@@ -407,11 +428,13 @@ def fit_spin(
         )
         if ok:
             break
+    if checks and used != chain[0]:
+        checks.append(f"the {used} search was run instead")
     t_search = time.perf_counter() - t0
     best, minima, alts = _solve(prob, axes, grid, per, phases, n_starts, n_phases, refine)
     dof = prob.y.size - n_par
     quality = fit_quality(best.chi2, dof, "spin fit", SPIN_CAUSES)
-    return result_dataset(
+    ds = result_dataset(
         prob=prob,
         geo=geo,
         best=best,
@@ -438,6 +461,34 @@ def fit_spin(
             "n_values": int(prob.y.size),
             "bands": ", ".join(lc["labels"]),
         },
+    )
+    ds.attrs["ambiguity"] = _ambiguity(ds)
+    if ds.attrs["ambiguity"] != "none":
+        warnings.warn(f"spin fit: {ds.attrs['ambiguity']}", FitQualityWarning, stacklevel=2)
+    return ds
+
+
+def _ambiguity(ds: xr.Dataset) -> str:
+    """The twins that fit about as well as the solution (chi-square gap below
+    :data:`AMBIGUITY_CHI2`) and are other solutions (another axis or period)."""
+    rows = []
+    for name in ds["solution"].values:
+        row = ds.sel(solution=name)
+        sep = float(row["solution_axis_separation"])
+        dper = abs(float(row["solution_period"]) - float(ds["period"]))
+        other = sep > 1.0 or dper > 3 * max(float(ds["period_uncertainty"]), 1e-9 * dper)
+        if float(row["chi2_gap"]) < AMBIGUITY_CHI2 and other:
+            rows.append(
+                f"{name} (axis {sep:.1f} deg away, period {float(row['solution_period']):.6g} s, "
+                f"chi2 gap {float(row['chi2_gap']):.3g})"
+            )
+    if not rows:
+        return "none"
+    return (
+        f"the data do not tell the solution from its twins {'; '.join(rows)}: they fit about "
+        f"as well (chi2 gap < {AMBIGUITY_CHI2:g}); the stated uncertainties describe the "
+        "neighbourhood of one solution only. More change of geometry (a longer pass, another "
+        "pass or site) tells them apart"
     )
 
 

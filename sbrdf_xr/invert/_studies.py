@@ -145,8 +145,9 @@ def spin_recovery(
     xarray.Dataset
         Over ``draw``: ``axis_error`` [degree], ``axis_uncertainty`` [degree], ``period``,
         ``period_uncertainty`` [s], ``period_pull`` [1], ``reduced_chi2``, ``success``,
-        ``seconds`` (wall time of the fit); attributes ``truth_axis``, ``truth_period``,
-        ``success_rate``, ``load_average`` (1-minute, before and after).
+        ``ambiguous`` (a twin fitted about as well), ``seconds`` (wall time of the fit);
+        attributes ``truth_axis``, ``truth_period``, ``success_rate``, ``search_methods``
+        and ``load_average`` (1-minute, before and after).
 
     Examples
     --------
@@ -201,9 +202,11 @@ def spin_recovery(
             "period_pull",
             "reduced_chi2",
             "success",
+            "ambiguous",
             "seconds",
         )
     }
+    methods: list[str] = []
     load0 = os.getloadavg()[0]
     for _ in range(n_draws):
         noisy = flux + sigma * rng.normal(size=flux.shape)
@@ -222,6 +225,7 @@ def spin_recovery(
         err = axis_separation(fit["axis_vector"].values, truth_axis)
         pull = (float(fit["period"]) - truth_period) / float(fit["period_uncertainty"])
         ok = err <= axis_tolerance_deg and abs(pull) <= period_tolerance_sigma
+        methods.append(str(fit.attrs["search_method"]))
         for k, v in (
             ("axis_error", err),
             ("axis_uncertainty", float(fit["axis_uncertainty"])),
@@ -230,6 +234,7 @@ def spin_recovery(
             ("period_pull", pull),
             ("reduced_chi2", float(fit["reduced_chi2"])),
             ("success", float(ok)),
+            ("ambiguous", float(fit.attrs["ambiguity"] != "none")),
             ("seconds", dt),
         ):
             rows[k].append(v)
@@ -253,6 +258,7 @@ def spin_recovery(
         "load_average": f"{load0:.2f} before, {os.getloadavg()[0]:.2f} after",
         "n_values": int(flux.size),
         "relative_noise": relative_noise,
+        "search_methods": ", ".join(f"{m} x {methods.count(m)}" for m in dict.fromkeys(methods)),
     }
     return ds
 

@@ -182,7 +182,8 @@ def test_calibration_small(per_material, geoms):
 )
 def test_calibration_study(per_material, geoms, truth):
     """400 draws per case: the pulls of the materials present have width 1 +- 0.15, and
-    the stated 2-sigma intervals of every material cover the truth in >= 93 % of draws."""
+    the stated 2-sigma intervals of every material cover the truth in >= 91.5 % of draws
+    (95.4 % expected, binomial spread 1.05 %: 3.7 spreads below, for 36 such numbers)."""
     terms = per_material.isel(geometry=geoms)
     names = [AL, CELL, PAINT]
     study = invert.unmix_calibration(
@@ -190,7 +191,7 @@ def test_calibration_study(per_material, geoms, truth):
     )
     present = np.array(truth) > 0
     np.testing.assert_allclose(study["pull_width"].values[present], 1.0, atol=0.15)
-    assert np.all(study["coverage_2sigma"].values >= 0.93)
+    assert np.all(study["coverage_2sigma"].values >= 0.915)
 
 
 def test_unmix_bad_input(per_material):
