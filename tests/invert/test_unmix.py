@@ -189,10 +189,8 @@ def test_calibration_study(per_material, geoms, truth):
     study = invert.unmix_calibration(
         terms, dict(zip(names, truth, strict=True)), relative_noise=0.03, n_draws=400, seed=2
     )
-    print(
-        f"\ngeometries {geoms}, truth {truth}, {int(study.n_draws)} draws:\n"
-        f"{study.drop_vars(['n_draws', 'quality_warnings', 'seconds_per_fit']).to_dataframe()}"
-    )
+    table = study.drop_vars(["n_draws", "quality_warnings", "seconds_per_fit"]).to_dataframe()
+    print(f"\ngeometries {geoms}, truth {truth}, {int(study.n_draws)} draws:\n{table.to_string()}")
     present = np.array(truth) > 0
     np.testing.assert_allclose(study["pull_width"].values[present], 1.0, atol=0.15)
     assert np.all(study["coverage_2sigma"].values >= 0.915)
