@@ -19,7 +19,7 @@ Sub-commands::
                         [--colours V-R,R-I]
              [--system ab|vega] [-o PHOT.nc] [--csv PHOT.csv]
     sbrdf-xr invert unmix MEASURED --cube CUBE.nc [--range-km R] [-o OUT.nc]   material areas
-    sbrdf-xr invert spin CURVE --spacecraft canx1 --to-sun X Y Z --to-observer X Y Z
+    sbrdf-xr invert spin CURVE (--cube CUBE.nc | --scene SCENE | --to-sun X Y Z --to-observer X Y Z)
              --periods MIN MAX N [-o OUT.nc]                                      spin state
 
 Wherever a spacecraft or a material is named, a file may stand instead: a mesh file
@@ -256,21 +256,28 @@ def build_parser() -> argparse.ArgumentParser:
     pu.add_argument("--criterion", choices=("bic", "aic"), default="bic")
     pspin = isub.add_parser("spin", help="spin axis, period and phase from a colour light curve")
     pspin.add_argument(
-        "measured", help="light curve CSV/netCDF (read_light_curve format, times in s)"
+        "measured", help="light curve CSV/ECSV/netCDF (read_light_curve format; UTC times or s)"
     )
     pspin.add_argument(
-        "--spacecraft", default="canx1", help="a catalog name (default canx1) or a mesh file"
+        "--spacecraft",
+        default=None,
+        help="a catalog name or a mesh file (default: the --scene's, else canx1)",
     )
     _mesh_options(pspin)
     pspin.add_argument(
-        "--to-sun", type=float, nargs=3, required=True, help="inertial direction to the Sun"
+        "--cube",
+        help="the geometry: a netCDF cube over time with to_sun, to_observer, quaternion "
+        "(simulate of an observation)",
     )
     pspin.add_argument(
-        "--to-observer",
-        type=float,
-        nargs=3,
-        required=True,
-        help="inertial direction to the observer",
+        "--scene",
+        help="the geometry: a built-in scene name or a scene TOML file with an observation",
+    )
+    pspin.add_argument(
+        "--to-sun", type=float, nargs=3, help="the geometry: inertial direction to the Sun"
+    )
+    pspin.add_argument(
+        "--to-observer", type=float, nargs=3, help="inertial direction to the observer"
     )
     pspin.add_argument(
         "--periods",
@@ -283,9 +290,21 @@ def build_parser() -> argparse.ArgumentParser:
     pspin.add_argument(
         "--axis-body", type=float, nargs=3, default=(0.0, 0.0, 1.0), help="body spin axis"
     )
-    pspin.add_argument("--n-axes", type=int, default=300)
-    pspin.add_argument("--n-phases", type=int, default=36)
+    pspin.add_argument("--n-axes", type=int, default=120, help="axes of the search grid")
+    pspin.add_argument("--n-phases", type=int, default=16, help="phases of the search grid")
     pspin.add_argument("--offset", choices=("band", "common"), default="band")
+    pspin.add_argument(
+        "--method",
+        choices=("auto", "direct", "table", "shift"),
+        default="auto",
+        help="grid evaluation: exact (direct), or spin-angle tables checked against it",
+    )
+    pspin.add_argument(
+        "--size-limit",
+        type=float,
+        default=1.0,
+        help="factor on the size and work limits of the search (default 1)",
+    )
     for q in (pu, pspin):
         q.add_argument("-o", "--output", help="write the result Dataset to this netCDF file")
         q.add_argument("--overwrite", action="store_true", help="replace an existing output file")
