@@ -84,7 +84,7 @@ class _Plotter:
         from . import plot as _plot
 
         if isinstance(self._obj, xr.Dataset):
-            return _plot.plot_cube(self._obj, **kwargs)
+            return _plot.cube_figure(self._obj, **kwargs)
         if "band" in self._obj.dims:
             return _plot.magnitudes(self._obj, **kwargs)
         raise AttributeError(
