@@ -160,6 +160,13 @@ class SbrdfDatasetAccessor:
 
         return _phot.srgb(self._ds, **kwargs)
 
+    def to_colour(self, variable: str = "signal") -> Any:
+        """:func:`sbrdf_xr.photometry.to_colour` of this cube's ``variable``: colour-science
+        spectra, one per geometry."""
+        from . import photometry as _phot
+
+        return _phot.to_colour(self._ds, variable)
+
     @property
     def plot(self) -> _Plotter:
         """Figures of this cube: ``ds.sbrdf.plot()`` (its natural figure), ``.light_curve()``,

@@ -25,9 +25,20 @@ The chain from a simulation cube to what a telescope measures:
    the band weights); :func:`standard_magnitude` (to a range, a phase angle, 1 AU),
    :func:`sun_distance_au`, :func:`at_resolution` (a spectrograph's resolution).
 7. :func:`to_netcdf` / :func:`open_photometry` - CF-1.10 photometry files.
+8. :mod:`~sbrdf_xr.photometry.colour_science` - colour-science spectra in and out: a
+   ``SpectralDistribution`` or ``MultiSpectralDistributions`` is accepted as a filter,
+   a solar spectrum (:func:`solar_name`) or a spectrum, and :func:`to_colour` exports
+   any spectrum or cube variable to them.
+
+Which library does what: speclite ships the filter curves; pvlib (ASTM G173) and pyphot
+(CALSPEC, Kurucz) ship the solar and Vega spectra; the band integrals are this package's
+own exact quadrature (:func:`hat_integrals`, cross-checked against colour-science's
+integration in the tests); colour-science does the colorimetry of :func:`srgb` and the
+conversions of ``colour_science``.
 
 Modules: ``spectra`` (reference spectra, quadrature), ``bands``, ``magnitude``,
-``atmosphere``, ``standard``, ``colour``, ``measured``, ``lightcurves``, ``files``.
+``atmosphere``, ``standard``, ``colour``, ``colour_science``, ``measured``,
+``lightcurves``, ``files``.
 
 Conventions
 -----------
@@ -106,7 +117,7 @@ magnitude are NaN (the colour is undefined).  A negative band signal (possible o
 with noisy tables) gives a NaN magnitude.
 """
 
-from . import atmosphere
+from . import atmosphere, colour_science
 from .atmosphere import (
     AIRMASS_MODELS,
     airmass,
@@ -126,6 +137,7 @@ from .bands import (
     speclite_names,
 )
 from .colour import srgb
+from .colour_science import from_colour, to_colour
 from .files import cf_decode, cf_encode, open_photometry, to_netcdf
 from .lightcurves import compare_light_curves, plot_comparison
 from .magnitude import band_signal, colour_indices, magnitudes, photometry, sun_magnitudes
@@ -144,6 +156,7 @@ from .spectra import (
     check_system,
     hat_integrals,
     reference_flux,
+    solar_name,
     solar_spectrum,
     trapezoid_weights,
     vega_spectrum,
@@ -182,9 +195,11 @@ __all__ = [
     "cf_encode",
     "check_system",
     "colour_indices",
+    "colour_science",
     "compare_light_curves",
     "extinction_coefficients",
     "filters",
+    "from_colour",
     "hat_integrals",
     "lambert_sphere_phase",
     "magnitudes",
@@ -195,6 +210,7 @@ __all__ = [
     "rayleigh_optical_depth",
     "read_light_curve",
     "reference_flux",
+    "solar_name",
     "solar_spectrum",
     "speclite_names",
     "specular_sphere_phase",
@@ -202,6 +218,7 @@ __all__ = [
     "standard_magnitude",
     "sun_distance_au",
     "sun_magnitudes",
+    "to_colour",
     "to_netcdf",
     "transmission",
     "trapezoid_weights",
