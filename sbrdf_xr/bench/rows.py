@@ -198,7 +198,7 @@ def plot_front(rows: list[BenchRow], ax: Any = None) -> Any:
     >>> fig = plot_front(rows)
     >>> ax = fig.axes[0]
     >>> ax.get_xscale(), ax.get_xlabel()
-    ('log', 'band error against the reference [mmag]')
+    ('log', 'band error against the baseline [mmag]')
     >>> plt.close(fig)
     """
     from ..plot import accuracy_front

@@ -26,7 +26,8 @@ UNIT_RULE = (
     "every axis that shows tick labels (x, y, z and colour bars) has a label, and the label "
     "carries its unit in square brackets ('wavelength [nm]', 'magnitude [AB mag]', "
     "'time [UTC]', '[1]' for a dimensionless quantity), or is unitless by design: a ratio of "
-    "like quantities written 'a / b', or a count 'number of ...'"
+    "like quantities written 'a / b', or a count 'number of ...'; an axis whose ticks are "
+    "names (categories, not numbers) needs no label"
 )
 
 _UNIT = re.compile(r"\[[^\[\]]+\]")
@@ -86,6 +87,18 @@ def _name_of(text: Any, fig: Any) -> str:
     if not where and text is getattr(fig, "_suptitle", None):
         where = "figure title"
     return f"{where or type(text).__name__.lower()} {text.get_text()!r}"
+
+
+def _named(axis: Any) -> bool:
+    """True for an axis whose ticks are names (categories) rather than numbers or dates."""
+    from matplotlib import dates
+
+    formatter = axis.get_major_formatter()
+    if isinstance(formatter, (dates.DateFormatter, dates.AutoDateFormatter)):
+        return False
+    texts = [re.sub(r"\\[A-Za-z]+", "", t.get_text()) for t in axis.get_majorticklabels()]
+    texts = [t for t in texts if t.strip()]
+    return bool(texts) and all(any(c.isalpha() for c in t) for t in texts)
 
 
 def _ticks(axis: Any) -> list[Any]:
@@ -176,7 +189,7 @@ def figure_problems(fig: Any, *, tolerance: float = 1.0, inside: bool = True) ->
         for name, axis in axes.items():
             shown = any(id(t.label1) in drawn or id(t.label2) in drawn for t in _ticks(axis))
             text = axis.label.get_text() if id(axis.label) in drawn else ""
-            if shown and not label_has_unit(text):
+            if shown and not _named(axis) and not label_has_unit(text):
                 what = f"label {text!r} has no unit in brackets" if text else "no label"
                 problems.append(f"{name} axis of axes {k}: {what}")
     return problems
