@@ -16,6 +16,7 @@ from __future__ import annotations
 import ast
 import hashlib
 import os
+import re
 import warnings
 from collections.abc import Callable, Iterable
 from functools import cache
@@ -25,7 +26,7 @@ import xarray as xr
 
 from .errors import CacheWarning
 
-__all__ = ["build_modules", "cache_dir", "cached_table", "source_digest"]
+__all__ = ["build_modules", "cache_dir", "cache_file", "cached_table", "source_digest"]
 
 
 def cache_dir() -> Path | None:
@@ -37,8 +38,30 @@ def cache_dir() -> Path | None:
     return Path(base) / "sbrdf_xr"
 
 
-#: The modules whose code builds a catalog table: the import closure of these.
-_BUILD_ROOTS = ("sbrdf_xr.catalog",)
+#: The modules whose code builds a catalog table from its entry: the import closure of
+#: these (the construction, the models and their Fresnel terms, the table files).
+_BUILD_ROOTS = (
+    "sbrdf_xr.materials.tables",
+    "sbrdf_xr.materials.models",
+    "sbrdf_xr._catalog_index",
+)
+#: Definitions of modules outside the closure that take part in a build: only their own
+#: source counts (the catalog's loader that builds a table, not the rest of the catalog).
+_BUILD_DEFINITIONS: dict[str, tuple[str, ...]] = {
+    "catalog.py": (
+        "LOADERS",
+        "_FILE_ATTRS",
+        "_built_material",
+        "_load_material",
+        "_progress_bar",
+        "_table_dtype",
+        "_table_inputs",
+        "load",
+    ),
+}
+
+_FROM = re.compile(r"^[ \t]*from[ \t]+([.\w]+)[ \t]+import[ \t]+(\([^)]*\)|[^\n]*)", re.M)
+_IMPORT = re.compile(r"^[ \t]*import[ \t]+([^\n]*)", re.M)
 
 
 def _module_file(root: Path, name: str) -> Path | None:
@@ -50,45 +73,55 @@ def _module_file(root: Path, name: str) -> Path | None:
     return None
 
 
+def _names(text: str) -> list[str]:
+    """The names of an import list: ``a as b, c`` or ``(a,\n b)``."""
+    return [n.split()[0] for n in text.strip("()\\ \n").split(",") if n.split()]
+
+
 def _package_imports(root: Path, name: str) -> set[str]:
-    """The package modules that module ``name`` imports, anywhere in its code (``ast``)."""
+    """The package modules that module ``name`` imports, anywhere in its code.
+
+    A textual scan (an ``import`` line at any indentation, comments dropped): it may
+    find more than the code runs (an import in a docstring's prose), never less.
+    """
     f = _module_file(root, name)
     if f is None:
         return set()
     pkg = name if f.name == "__init__.py" else name.rpartition(".")[0]
+    text = re.sub(r"#[^\n]*", "", f.read_text(encoding="utf-8"))
     out: set[str] = set()
-    for node in ast.walk(ast.parse(f.read_bytes())):
-        if isinstance(node, ast.Import):
-            out.update(
-                a.name
-                for a in node.names
-                if a.name.startswith("sbrdf_xr") and _module_file(root, a.name)
-            )
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                parts = pkg.split(".")[: len(pkg.split(".")) - node.level + 1]
-                base = ".".join(parts + ([node.module] if node.module else []))
-            elif node.module and node.module.startswith("sbrdf_xr"):
-                base = node.module
-            else:
-                continue
-            subs = [f"{base}.{a.name}" for a in node.names]
-            subs = [n for n in subs if _module_file(root, n)]
-            out.update(subs)
-            if len(subs) < len(node.names) and _module_file(root, base):
-                out.add(base)  # names taken from the module itself
+    for match in _IMPORT.finditer(text):
+        out.update(
+            n for n in _names(match[1]) if n.startswith("sbrdf_xr") and _module_file(root, n)
+        )
+    for match in _FROM.finditer(text):
+        module, names = match[1], _names(match[2])
+        level = len(module) - len(module.lstrip("."))
+        if level:
+            parts = pkg.split(".")[: len(pkg.split(".")) - level + 1]
+            base = ".".join(parts + ([module[level:]] if module[level:] else []))
+        elif module.startswith("sbrdf_xr"):
+            base = module
+        else:
+            continue
+        subs = [n for n in (f"{base}.{a}" for a in names) if _module_file(root, n)]
+        out.update(subs)
+        if len(subs) < len(names) and _module_file(root, base):
+            out.add(base)  # names taken from the module itself
     return out
 
 
-def build_modules(roots: Iterable[str] = _BUILD_ROOTS) -> list[Path]:
+def build_modules(roots: Iterable[str] = _BUILD_ROOTS, root: Path | None = None) -> list[Path]:
     """Source files of the modules that can take part in building a catalog table.
 
     The import closure of ``roots`` (every ``import`` in a module's code, at its top or
-    inside a function), plus the ``__init__.py`` of every package on the way, whose code
-    runs on any import below it.  The engine, the writers, the benchmarks and the
-    command line are outside it, so changing them keeps the built tables.
+    inside a function), plus the ``__init__.py`` of every subpackage on the way, whose
+    code runs on any import below it.  The catalog (beyond its table loader,
+    :data:`_BUILD_DEFINITIONS`), the spacecraft, the observing and photometry
+    packages, the engine, the writers, the benchmarks and the command line are outside
+    it, so changing them keeps the built tables.
     """
-    root = Path(__file__).resolve().parent
+    root = Path(__file__).resolve().parent if root is None else root
     seen: set[str] = set()
     todo = list(roots)
     while todo:
@@ -97,25 +130,54 @@ def build_modules(roots: Iterable[str] = _BUILD_ROOTS) -> list[Path]:
             seen.add(name)
             todo.extend(_package_imports(root, name) - seen)
     files = {f for n in seen if (f := _module_file(root, n)) is not None}
-    for n in seen:  # the packages' own __init__, without following their imports
+    for n in seen:  # the subpackages' own __init__, without following their imports
         parts = n.split(".")
-        for k in range(1, len(parts)):
+        for k in range(2, len(parts)):
             init = _module_file(root, ".".join(parts[:k]))
             if init is not None and init.name == "__init__.py":
                 files.add(init)
     return sorted(files)
 
 
-@cache
-def source_digest() -> str:
-    """SHA-256 of the sources that build a table (:func:`build_modules`): a change to
-    one of them invalidates the cache."""
-    root = Path(__file__).resolve().parent
+def _definitions(path: Path, names: tuple[str, ...]) -> str:
+    """The source of the top-level definitions ``names`` of a module (function, class or
+    assignment), in file order; a name that is missing counts as its absence."""
+    src = path.read_text(encoding="utf-8")
+    out: list[str] = []
+    for node in ast.parse(src).body:
+        targets = (
+            [node.name]
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef)
+            else [
+                t.id
+                for t in getattr(node, "targets", [getattr(node, "target", None)])
+                if isinstance(t, ast.Name)
+            ]
+        )
+        if any(t in names for t in targets):
+            parts = [*getattr(node, "decorator_list", []), node]
+            out.extend(ast.get_source_segment(src, p) or "" for p in parts)
+    return "\n".join(out)
+
+
+def _digest(root: Path) -> str:
+    """:func:`source_digest` of the package at ``root``."""
     h = hashlib.sha256()
-    for p in build_modules():
+    for p in build_modules(root=root):
         h.update(str(p.relative_to(root)).encode())
         h.update(p.read_bytes())
+    for rel, names in sorted(_BUILD_DEFINITIONS.items()):
+        h.update(rel.encode())
+        h.update(_definitions(root / rel, names).encode())
     return h.hexdigest()
+
+
+@cache
+def source_digest() -> str:
+    """SHA-256 of the sources that build a table (:func:`build_modules` and the
+    definitions of :data:`_BUILD_DEFINITIONS`): a change to one of them invalidates
+    the cache."""
+    return _digest(Path(__file__).resolve().parent)
 
 
 def _file_digest(path: Path) -> str:
@@ -124,6 +186,18 @@ def _file_digest(path: Path) -> str:
         for chunk in iter(lambda: f.read(2**20), b""):
             h.update(chunk)
     return h.hexdigest()
+
+
+def cache_file(name: str, inputs: Iterable[Path], options: str) -> Path | None:
+    """The cache file of table ``name`` built from ``inputs`` with ``options`` (it may not
+    exist yet), or None when the cache is switched off."""
+    d = cache_dir()
+    if d is None:
+        return None
+    key = hashlib.sha256(
+        "\n".join([name, options, source_digest(), *(_file_digest(p) for p in inputs)]).encode()
+    ).hexdigest()[:32]
+    return d / f"{name}-{key}.nc"
 
 
 def cached_table(
@@ -140,13 +214,10 @@ def cached_table(
     works), so a first, building load and a later, cached load give identical tables
     (values and attributes), and so identical content fingerprints.
     """
-    d = cache_dir()
-    if d is None:
+    path = cache_file(name, inputs, options)
+    if path is None:
         return build()
-    key = hashlib.sha256(
-        "\n".join([name, options, source_digest(), *(_file_digest(p) for p in inputs)]).encode()
-    ).hexdigest()[:32]
-    path = d / f"{name}-{key}.nc"
+    d = path.parent
     if path.is_file():
         try:
             return read(path)

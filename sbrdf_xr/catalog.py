@@ -19,9 +19,10 @@ material table or model netCDF file).
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import os
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -30,7 +31,7 @@ import trimesh
 import xarray as xr
 from numpy.typing import DTypeLike
 
-from ._cache import cached_table
+from ._cache import cache_file, cached_table
 from ._catalog_index import (
     CATALOG_PATH_ENV,
     KINDS,
@@ -67,9 +68,11 @@ __all__ = [
     "is_file_spec",
     "load",
     "load_material_spec",
+    "load_materials",
     "load_spacecraft_spec",
     "material_tables",
     "names",
+    "to_build",
     "user_catalog_dirs",
 ]
 
@@ -124,13 +127,25 @@ def _built_material(
     cached here, so a process that asks only for float32 holds no float64 copy.
     """
     kw = dict(options)
-    inputs = [entry(measurements).file] + ([entry(kw["fit"]).file] if "fit" in kw else [])
+    bar: list[Any] = []  # the progress bar of a build, if there is one
 
     def build() -> xr.DataArray:
         opts = dict(kw)
         if "fit" in opts:  # a model entry that fills the unmeasurable range
             opts["model"] = load(opts.pop("fit"))
-        return material.build_lut(load(measurements), material=name, **opts)
+        bar.append(_progress_bar(name))
+
+        def report(fraction: float, step: str) -> None:
+            bar[0].n = round(90.0 * fraction, 1)
+            bar[0].set_postfix_str(step, refresh=False)
+            bar[0].refresh()
+
+        return material.build_lut(load(measurements), material=name, progress=report, **opts)
+
+    def write(da: xr.DataArray, path: Any) -> None:
+        if bar:
+            bar[0].set_postfix_str("writing the cache")
+        material.to_netcdf(da, path, overwrite=True)
 
     def read(path: Any) -> xr.DataArray:
         da = material.open_material(path)
@@ -138,14 +153,14 @@ def _built_material(
             da.attrs.pop(k, None)
         return da
 
-    da = cached_table(
-        name,
-        inputs,
-        repr(options),
-        build,
-        lambda da, path: material.to_netcdf(da, path, overwrite=True),
-        read,
-    )
+    try:
+        da = cached_table(name, _table_inputs(measurements, kw), repr(options), build, write, read)
+    finally:
+        if bar:
+            bar[0].n = 100.0 if bar[0].n >= 90.0 else bar[0].n
+            bar[0].set_postfix_str("done" if bar[0].n >= 100.0 else "failed")
+            bar[0].close()
+    _LOADED.add(name)
     if dtype is not None and da.dtype != np.dtype(dtype):
         da = da.astype(dtype)
     base: Any = da.values  # read-only through and through (also the array it views), so that
@@ -157,6 +172,111 @@ def _built_material(
 
 #: Attributes the netCDF writer adds to a file (CF/ACDD basics) that a built table lacks.
 _FILE_ATTRS = ("title", "history")
+
+#: Built tables this process has loaded (and will not build again).
+_LOADED: set[str] = set()
+#: The tables a batch load (:func:`material_tables`) will build, in order: for the labels
+#: of their progress bars ("building table tjpv-cell (1 of 3)").
+_BATCH: list[str] = []
+
+
+def _table_inputs(measurements: str, kw: Mapping[str, Any]) -> list[Path]:
+    """The files a built table depends on: its measurement set and its fit's model."""
+    return [entry(measurements).file] + ([entry(kw["fit"]).file] if "fit" in kw else [])
+
+
+def _progress_bar(name: str) -> Any:
+    """A progress bar of the build of table ``name`` (tqdm.auto: a widget in Jupyter),
+    labelled with its place in the batch being built."""
+    from tqdm.auto import tqdm
+
+    label = f"building table {name}"
+    if name in _BATCH:
+        label += f" ({_BATCH.index(name) + 1} of {len(_BATCH)})"
+    return tqdm(
+        total=100.0,
+        desc=label,
+        bar_format="{desc}: {percentage:3.0f}%|{bar}| {elapsed}<{remaining}{postfix}",
+        leave=True,
+    )
+
+
+def to_build(wanted: Iterable[str]) -> list[str]:
+    """The built tables among catalog entries ``names`` that loading them would build.
+
+    A material with ``build_from`` in its entry is built from its measurements on its
+    first load and then read from the table cache (:mod:`sbrdf_xr._cache`); these are
+    the ones neither in the cache nor loaded in this process (with the cache switched off,
+    every one not loaded yet).
+
+    Parameters
+    ----------
+    wanted : iterable of str
+        Catalog names (other kinds and unknown names are skipped).
+
+    Returns
+    -------
+    list of str
+        In the order given, without repeats.
+
+    Examples
+    --------
+    >>> to_build(["lambertian-grey-50", "canx1", "no-such-entry"])  # nothing to build
+    []
+    """
+    out = []
+    known = names()
+    for name in dict.fromkeys(wanted):
+        if name not in known or name in _LOADED:
+            continue
+        e = entry(name)
+        source = e.extra.get("build_from")
+        if e.kind != "material" or source is None:
+            continue
+        kw = dict(e.extra.get("build", {}))
+        options = tuple(sorted(kw.items()))
+        path = cache_file(name, _table_inputs(source, kw), repr(options))
+        if path is None or not path.is_file():
+            out.append(name)
+    return out
+
+
+def load_materials(wanted: Iterable[str], dtype: DTypeLike | None = None) -> dict[str, Any]:
+    """Load several material entries, the tables to build labelled as one batch.
+
+    Every table that has to be built shows a progress bar "building table NAME (k of
+    n)" (:func:`to_build`); loading from the cache shows nothing.
+
+    Parameters
+    ----------
+    wanted : iterable of str
+        Names of ``material`` entries.
+    dtype : {None, "float32", "float64"}, optional
+        As :func:`load`.
+
+    Returns
+    -------
+    dict of str to xarray.DataArray
+
+    Examples
+    --------
+    >>> tables = load_materials(["lambertian-grey-50"], dtype="float32")
+    >>> {k: v.dtype.name for k, v in tables.items()}
+    {'lambertian-grey-50': 'float32'}
+    """
+    wanted = list(dict.fromkeys(wanted))
+    with _batch(to_build(wanted)):
+        return {name: load(name, dtype) for name in wanted}
+
+
+@contextlib.contextmanager
+def _batch(names: list[str]) -> Iterator[None]:
+    """Label the builds of ``names`` as one batch while the block runs."""
+    _BATCH[:] = names
+    try:
+        yield
+    finally:
+        _BATCH.clear()
 
 
 def _load_paint_parameters(e: CatalogEntry) -> xr.Dataset:
@@ -503,17 +623,21 @@ def material_tables(
     """
     tables: dict[str, xr.DataArray] = {}
     given: dict[str, xr.Dataset] = {}
-    for mat, spec in specs.items():
-        try:
-            obj = load_material_spec(spec, base_dir=base_dir)
-            if isinstance(obj, xr.Dataset):
-                given[mat] = obj
-                obj = models.render(obj)
-        except CatalogError as exc:
-            raise CatalogError(f"{(where or {}).get(mat, '[materials]')} {mat!r}: {exc}") from None
-        except ValidationError as exc:
-            raise ValidationError(
-                f"{(where or {}).get(mat, '[materials]')} {mat!r}: {exc}"
-            ) from None
-        tables[mat] = obj
+    building = to_build(s for s in specs.values() if isinstance(s, str) and not is_file_spec(s))
+    with _batch(building):
+        for mat, spec in specs.items():
+            try:
+                obj = load_material_spec(spec, base_dir=base_dir)
+                if isinstance(obj, xr.Dataset):
+                    given[mat] = obj
+                    obj = models.render(obj)
+            except CatalogError as exc:
+                raise CatalogError(
+                    f"{(where or {}).get(mat, '[materials]')} {mat!r}: {exc}"
+                ) from None
+            except ValidationError as exc:
+                raise ValidationError(
+                    f"{(where or {}).get(mat, '[materials]')} {mat!r}: {exc}"
+                ) from None
+            tables[mat] = obj
     return tables, given

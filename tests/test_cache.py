@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ast
 import os
 import subprocess
 import sys
@@ -58,30 +59,115 @@ def test_the_cache_key_covers_every_module_a_build_runs(monkeypatch):
     monkeypatch.setenv("SBRDF_XR_CACHE_DIR", "off")
     root = Path(sbrdf_xr.__file__).resolve().parent
     meas = catalog.load("example-lobe-measurements").isel(wavelength=slice(0, 131, 40))
-    model = catalog.load("aluminium-6061-t6-microfacet-fit")
-    called: set[str] = set()
+    wl = meas.wavelength.values
+    called: set[tuple[str, int]] = set()
 
     def profile(frame, event, arg):
         if event == "call":
-            called.add(frame.f_code.co_filename)
+            called.add((frame.f_code.co_filename, frame.f_code.co_firstlineno))
 
     sys.setprofile(profile)
     threading.setprofile(profile)
     try:
         material.build_lut(meas, material="plain")
-        material.build_lut(
-            meas, material="filled", model=model, extrapolation="model", below_noise="model"
-        )
+        for fit in ("aluminium-6061-t6-microfacet-fit", "tjpv-cell-coated-fit"):  # bare, coated
+            model = catalog.load(fit).interp(wavelength=wl)
+            material.build_lut(
+                meas,
+                material="filled",
+                model=model,
+                extrapolation="model",
+                below_noise="model",
+                theta_i=[0.0, 3.0, 40.0, 89.0],
+            )
+        # the catalog's own part of a build (the cache is off: no file is read or written)
+        e = catalog.entry("example-lobe")
+        catalog._built_material.__wrapped__(e.name, e.extra["build_from"], ())
     finally:
         sys.setprofile(None)
         threading.setprofile(None)
-    ran = {Path(f).resolve() for f in called if f.startswith(str(root))}
+    ran = {Path(f).resolve() for f, _ in called if f.startswith(str(root))}
+    key = set(_cache.build_modules())
     assert len(ran) > 5  # the tracing saw the build
-    assert ran <= set(_cache.build_modules())
-    # ... and the engine is outside the key
-    rel = {str(p.relative_to(root)) for p in _cache.build_modules()}
-    assert not {n for n in rel if n.startswith(("engine/", "store/", "bench/", "cli/"))}
-    assert "kernels/sums.py" not in rel
+    assert root / "brdf" / "_fresnel_kernels.py" in ran
+    # the cache's own code stores and reads the table; what it stores is the build's
+    # (test_built_tables_are_cached_and_identical): it need not be in the key
+    outside = ran - key - {root / "_cache.py"}
+    assert outside == {root / "catalog.py"}
+    # ... of the catalog, only the definitions hashed in the key ran
+    src = (root / "catalog.py").read_text()
+    spans = [
+        (
+            min([node.lineno] + [d.lineno for d in getattr(node, "decorator_list", [])]),
+            node.end_lineno,
+        )
+        for node in ast.parse(src).body
+        if any(n in _cache._BUILD_DEFINITIONS["catalog.py"] for n in _defined(node))
+    ]
+    lines = {line for f, line in called if Path(f).resolve() == root / "catalog.py"}
+    assert lines and all(any(a <= x <= b for a, b in spans) for x in lines), (lines, spans)
+    # ... and the engine, the catalog's other kinds and the writers are outside the key
+    rel = {str(p.relative_to(root)) for p in key}
+    for pkg in ("engine/", "store/", "bench/", "cli/", "observing/", "photometry/", "body/"):
+        assert not {n for n in rel if n.startswith(pkg)}, pkg
+    assert not {"kernels/sums.py", "catalog.py", "__init__.py", "plot.py"} & rel
+
+
+def _defined(node):
+    """The names a top-level statement defines."""
+    if isinstance(node, ast.FunctionDef | ast.ClassDef):
+        return [node.name]
+    targets = getattr(node, "targets", [getattr(node, "target", None)])
+    return [t.id for t in targets if isinstance(t, ast.Name)]
+
+
+def _edited(tmp_path, rel, old, new):
+    """The digest of a copy of the package with ``old`` replaced by ``new`` in file ``rel``."""
+    import shutil
+
+    import sbrdf_xr
+
+    copy = tmp_path / "pkg"
+    if not copy.exists():
+        shutil.copytree(
+            Path(sbrdf_xr.__file__).parent, copy, ignore=shutil.ignore_patterns("__pycache__")
+        )
+    path = copy / rel
+    text = path.read_text()
+    assert text.count(old) >= 1, (rel, old)
+    path.write_text(text.replace(old, new, 1))
+    try:
+        return _cache._digest(copy)
+    finally:
+        path.write_text(text)
+
+
+@pytest.mark.parametrize(
+    ("rel", "old", "new", "changes"),
+    [
+        # code that makes the values: a new key
+        ("brdf/optics.py", "HC_EV_NM = 1239.8", "HC_EV_NM = 1239.9", True),
+        ("brdf/_fresnel_kernels.py", "0.5 * kd[j, w] * qr", "0.5 * qr * kd[j, w]", True),
+        ("materials/build.py", "blend: float = 10.0", "blend: float = 11.0", True),
+        ("kernels/lut.py", "_MAX_STEP_DEG = 5.0", "_MAX_STEP_DEG = 4.0", True),
+        ("materials/files.py", "complevel=4", "complevel=5", True),
+        ("catalog.py", "overwrite=True)", "overwrite=True)  # x", True),
+        ("catalog.py", "_FILE_ATTRS = (", "_FILE_ATTRS = ('x', ", True),
+        ("_catalog_index.py", "def ", "def  ", True),
+        # code that does not: the same key
+        ("observing/orbits.py", "def ", "def  ", False),
+        ("photometry/bands.py", "def ", "def  ", False),
+        ("body/spacecraft.py", "def ", "def  ", False),
+        ("engine/run.py", "def ", "def  ", False),
+        ("__init__.py", '"""', '""" ', False),
+        ("catalog.py", "def load_spacecraft_spec(", "def  load_spacecraft_spec(", False),
+    ],
+)
+def test_a_change_that_can_change_a_table_changes_the_key(tmp_path, rel, old, new, changes):
+    import sbrdf_xr
+
+    assert _cache._digest(Path(sbrdf_xr.__file__).parent) == _cache.source_digest()
+    assert (_edited(tmp_path, rel, old, new) != _cache.source_digest()) is changes
 
 
 def test_an_unusable_cache_directory_builds_the_table_with_a_warning(tmp_path, monkeypatch):

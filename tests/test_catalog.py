@@ -266,3 +266,35 @@ def test_names_come_before_files():
     assert not catalog.is_file_spec("canx1")
     assert catalog.is_file_spec("canx1.ply") and catalog.is_file_spec(Path("canx1"))
     assert catalog.is_file_spec("meshes/bus") and not catalog.is_file_spec("bus")
+
+
+def test_building_tables_shows_progress_and_a_warm_load_is_quiet(tmp_path, monkeypatch, capfd):
+    """Every table a batch builds shows a progress bar on stderr that says which and how
+    many ("building table x (1 of 2)"); loading them from the cache shows nothing."""
+    monkeypatch.setenv("SBRDF_XR_CACHE_DIR", str(tmp_path))
+    wanted = ["lambertian-grey-50", "example-lobe", "aluminium-6061-t6-paper"]
+    catalog._built_material.cache_clear()
+    monkeypatch.setattr(catalog, "_LOADED", set())
+    assert catalog.to_build(wanted) == ["example-lobe", "aluminium-6061-t6-paper"]
+    capfd.readouterr()
+    cold = catalog.load_materials(wanted)
+    err = capfd.readouterr().err
+    assert "building table example-lobe (1 of 2)" in err
+    assert "building table aluminium-6061-t6-paper (2 of 2)" in err
+    assert "model reflectance" not in err  # the paper's construction uses no model
+    assert "100%" in err and "done" in err
+    assert catalog.to_build(wanted) == []
+    catalog._built_material.cache_clear()
+    monkeypatch.setattr(catalog, "_LOADED", set())
+    assert catalog.to_build(wanted) == []  # in the cache
+    warm = catalog.load_materials(wanted)
+    assert capfd.readouterr().err == ""
+    for name in wanted:
+        xr.testing.assert_identical(cold[name], warm[name])
+    # a scene's materials (the path of scene files and the built-in scenes) are one batch
+    catalog._built_material.cache_clear()
+    monkeypatch.setattr(catalog, "_LOADED", set())
+    monkeypatch.setenv("SBRDF_XR_CACHE_DIR", str(tmp_path / "empty"))
+    catalog.material_tables({"paint": "example-lobe", "rail": "lambertian-grey-50"})
+    assert "building table example-lobe (1 of 1)" in capfd.readouterr().err
+    catalog._built_material.cache_clear()

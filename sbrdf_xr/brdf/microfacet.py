@@ -247,9 +247,15 @@ def brdf(
     wl = _check_wavelength(wavelength)
     p = MODEL.check_params(wl, **params)
     n, s, o, cos_i, cos_r, mask, dtype = _facet_frame(normal, to_sun, to_observer)
-    geo, cos_hs = _specular_parts(n, s, o, cos_i, cos_r, p["roughness"])
+    geo, cos_hs = _specular_parts(n, s, o, cos_i, cos_r, _shared(p["roughness"]))
     f = _fresnel(cos_hs, wl, p, layers) * geo + p["rho_d"] / np.pi
     return _cast_out(np.where(mask[..., None], f, 0.0), dtype)
+
+
+def _shared(values: np.ndarray) -> np.ndarray:
+    """``values`` (n_wl,), or its first element (1,) when every wavelength has the same value:
+    the geometry of every wavelength is then computed once (the same numbers)."""
+    return values[:1] if values.size > 1 and np.all(values == values[0]) else values
 
 
 def _half_vector_pieces(
@@ -330,7 +336,7 @@ def directional_hemispherical_reflectance(
     tp, wp = np.polynomial.legendre.leggauss(_N_PHI)
     ph = 0.5 * np.pi * (tp + 1.0)  # symmetric: [0, pi], doubled
     wp = 0.5 * np.pi * wp
-    a2 = p["roughness"] ** 2  # (n_wl,)
+    a2 = _shared(p["roughness"]) ** 2  # (n_wl,), or (1,) when the same at every wavelength
     cph = np.cos(ph)[:, None, None]  # axes: (phi, u, wl)
     flat = np.radians(ti.ravel())
     out = np.empty((flat.size, wl.size))

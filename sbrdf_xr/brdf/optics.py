@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ValidationError
+from . import _fresnel_kernels
 from ._model import Parameter
 
 __all__ = [
@@ -334,6 +335,16 @@ def fresnel_conductor(cos_theta: ArrayLike, n_complex: ArrayLike) -> NDArray[np.
     """
     c = _check_cos(cos_theta)
     n_c = _check_index(n_complex, "n_complex")
+    if n_c.ndim == 1 and c.ndim >= 1 and c.shape[-1] in (1, n_c.size):
+        # cosines (..., 1 | n_wl) against a spectrum: the compiled kernel, row by row
+        flat = c.reshape(-1, c.shape[-1])
+        out = _fresnel_kernels.conductor_reflectance(flat, n_c * n_c)
+        return out.reshape(*c.shape[:-1], n_c.size)
+    return _fresnel_conductor_numpy(c, n_c)
+
+
+def _fresnel_conductor_numpy(c: np.ndarray, n_c: np.ndarray) -> NDArray[np.float64]:
+    """:func:`fresnel_conductor` in numpy on checked inputs: the reference of the kernel."""
     c, n_c = np.broadcast_arrays(c, n_c)
     n2 = n_c * n_c
     q = _q(n2, 1.0 - c * c)
@@ -425,14 +436,14 @@ def fresnel_thin_film_stack(
     return _stack_reflectance(c, wavelength, layers, substrate, ambient)
 
 
-def _stack_reflectance(
-    c: np.ndarray,
+def _stack_inputs(
     wavelength: ArrayLike,
     layers: Sequence[tuple[ArrayLike, float]],
     substrate: ArrayLike,
-    ambient: float = 1.0,
-) -> NDArray[np.float64]:
-    """Stack reflectance for cosines ``c`` whose last axis is 1 or aligned with wavelength."""
+    ambient: float,
+) -> tuple[np.ndarray, list[tuple[np.ndarray, float]], np.ndarray, float]:
+    """The checked inputs of a stack: wavelengths, ``(index, thickness)`` per layer (ambient
+    side first, indices broadcast to the wavelengths), the substrate's index and ``n0``."""
     wl = np.atleast_1d(np.asarray(wavelength, dtype=np.float64))
     if wl.ndim != 1 or not np.all(np.isfinite(wl)) or np.any(wl <= 0):
         raise ValidationError(
@@ -451,10 +462,58 @@ def _stack_reflectance(
             )
         return np.broadcast_to(arr, (n_wl,))
 
-    n0 = float(ambient)
+    checked = []
+    for j, layer in enumerate(layers):
+        try:
+            index, thickness = layer
+        except (TypeError, ValueError) as exc:
+            raise ValidationError(
+                f"layers[{j}]: expected (index, thickness [nm]), got {layer!r}"
+            ) from exc
+        d = float(thickness)
+        if not (np.isfinite(d) and d >= 0):
+            raise ValidationError(
+                f"layers[{j}] thickness: got {thickness!r}; allowed domain is thickness >= 0 [nm]"
+            )
+        checked.append((spectral(index, f"layers[{j}] index"), d))
+    return wl, checked, spectral(substrate, "substrate"), float(ambient)
+
+
+def _stack_reflectance(
+    c: np.ndarray,
+    wavelength: ArrayLike,
+    layers: Sequence[tuple[ArrayLike, float]],
+    substrate: ArrayLike,
+    ambient: float = 1.0,
+) -> NDArray[np.float64]:
+    """Stack reflectance for cosines ``c`` whose last axis is 1 or aligned with wavelength
+    (the compiled kernel, :mod:`sbrdf_xr.brdf._fresnel_kernels`)."""
+    wl, checked, n_sub, n0 = _stack_inputs(wavelength, layers, substrate, ambient)
+    c = np.asarray(c, dtype=np.float64)
+    if c.ndim == 0 or c.shape[-1] not in (1, wl.size):
+        raise ValidationError(
+            f"cos_theta: expected a last axis of 1 or {wl.size} (the wavelengths), got shape "
+            f"{c.shape}"
+        )
+    k0 = 2.0 * np.pi / wl
+    kd = np.array([2.0 * k0 * d for _, d in checked]).reshape(len(checked), wl.size)
+    n2l = np.array([n * n for n, _ in checked], dtype=np.complex128).reshape(kd.shape)
+    out = _fresnel_kernels.stack_reflectance(c.reshape(-1, c.shape[-1]), kd, n2l, n_sub**2, n0)
+    return out.reshape(*c.shape[:-1], wl.size)
+
+
+def _stack_reflectance_numpy(
+    c: np.ndarray,
+    wavelength: ArrayLike,
+    layers: Sequence[tuple[ArrayLike, float]],
+    substrate: ArrayLike,
+    ambient: float = 1.0,
+) -> NDArray[np.float64]:
+    """:func:`_stack_reflectance` in numpy over whole arrays: the reference of the kernel."""
+    wl, checked, n_sub, n0 = _stack_inputs(wavelength, layers, substrate, ambient)
+    n_wl = wl.size
     sin2 = (n0 * n0) * (1.0 - c * c)  # n0^2 sin^2 theta0, shape (..., 1)
     q0 = n0 * c + 0j
-    n_sub = spectral(substrate, "substrate")
     n2_sub = n_sub * n_sub
     q_sub = _q(n2_sub, sin2)
     # initial vectors [B, C]: s: [1, q_sub]; p: q_sub * [1, N^2/q_sub] = [q_sub, N^2]
@@ -464,20 +523,7 @@ def _stack_reflectance(
     bp = np.broadcast_to(q_sub, shape).astype(np.complex128)
     cp = np.broadcast_to(n2_sub, shape).astype(np.complex128)
     k0 = 2.0 * np.pi / wl
-    for j, layer in enumerate(reversed(list(layers))):  # loop over layers, not samples
-        try:
-            index, thickness = layer
-        except (TypeError, ValueError) as exc:
-            raise ValidationError(
-                f"layers[{len(layers) - 1 - j}]: expected (index, thickness [nm]), got {layer!r}"
-            ) from exc
-        d = float(thickness)
-        if not (np.isfinite(d) and d >= 0):
-            raise ValidationError(
-                f"layers[{len(layers) - 1 - j}] thickness: got {thickness!r}; allowed domain "
-                "is thickness >= 0 [nm]"
-            )
-        n_j = spectral(index, f"layers[{len(layers) - 1 - j}] index")
+    for n_j, d in reversed(checked):  # loop over layers, not samples
         n2 = n_j * n_j
         q = _q(n2, sin2)
         two_i_delta = 2j * k0 * d * q

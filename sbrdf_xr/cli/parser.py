@@ -36,6 +36,7 @@ from pathlib import Path
 from .. import catalog
 from .._version import __version__
 from ..engine.builtin import builtin_scenes
+from ..engine.knobs import KNOBS, PRESETS
 from ..errors import SbrdfError
 from ..store.writer import DEFAULT_COMPLEVEL, LOG_SUFFIX, PART_SUFFIX, command_line_messages
 from .analysis import cmd_invert, cmd_photometry
@@ -126,13 +127,20 @@ def build_parser() -> argparse.ArgumentParser:
     psim.add_argument(
         "--scheduler", help="address of a dask.distributed scheduler (default: threads)"
     )
-    psim.add_argument("--preset", help="numerical preset: fast, balanced or reference")
+    psim.add_argument(
+        "--preset",
+        help=f"numerical preset: {', '.join(PRESETS)} (knob values; 'sbrdf-xr knobs' shows them)",
+    )
     psim.add_argument(
         "--set",
         action="append",
         metavar="KNOB=VALUE",
-        help="set a numerical knob (repeatable; 'sbrdf-xr knobs' lists them), e.g. "
-        "--set method=cubic --set dtype=float32",
+        help="set a numerical knob (repeatable; 'sbrdf-xr knobs' says what each trades): "
+        + "; ".join(
+            f"{k.name}: {k.domain()} (default {'none' if k.default is None else k.default})"
+            for k in KNOBS.values()
+        )
+        + "; e.g. --set method=cubic --set dtype=float32",
     )
     psim.add_argument(
         "--complevel",

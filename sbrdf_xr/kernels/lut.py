@@ -653,6 +653,7 @@ def hemispherical_reflectance_kernel(
         phi_breaks = np.append(phi_breaks, 90.0)
     phi_full = phi_breaks if phi_breaks[-1] >= 90.0 else np.append(phi_breaks, 90.0)
     out = np.empty((ti_all.size, values.shape[-1]))
+    v2 = values.reshape(-1, values.shape[-1]).astype(np.float64, copy=False)  # once, not per row
     for k, ti in enumerate(ti_all):
         # The normal-incidence profile reaches beyond the table's extents: integrate the
         # whole hemisphere where it has weight.
@@ -680,8 +681,8 @@ def hemispherical_reflectance_kernel(
             zero_edges=zero_edges,
             normal_blend=normal_blend,
         )
-        spectra = np.asarray(m.sum(axis=0)) @ values.reshape(-1, values.shape[-1]).astype(
-            np.float64
-        )
+        w_nodes = np.asarray(m.sum(axis=0)).ravel()
+        used = np.flatnonzero(w_nodes)  # the nodes around theta_i: a few rows of the table
+        spectra = w_nodes[used] @ v2[used]
         out[k] = 2.0 * np.radians(1.0) ** 2 * spectra.ravel()
     return out

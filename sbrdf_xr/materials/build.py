@@ -10,7 +10,9 @@ and every row can be renormalised to the model's directional-hemispherical refle
 
 from __future__ import annotations
 
+import itertools
 import warnings
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -67,6 +69,7 @@ def build_lut(
     duplicates: str = "error",
     check_energy: bool = True,
     renormalise: str = "auto",
+    progress: Callable[[float, str], None] | None = None,
 ) -> xr.DataArray:
     """Look-up table from sparse measurements, by the construction of paper 000 §3.2.
 
@@ -198,6 +201,10 @@ def build_lut(
         Name; default the ``material`` attribute of ``measurements``.
     dtype : numpy dtype, default float64
         dtype of the table values.
+    progress : callable, optional
+        ``progress(fraction, step)``, called as the construction goes on with the
+        fraction of its work done (0 to 1) and what it is doing (``"model on the
+        grid"``, ``"model reflectance"``, ...): for a progress bar.
 
     Returns
     -------
@@ -258,6 +265,8 @@ def build_lut(
             "renormalise: 'model' corrects a table made of a model times a ratio and needs "
             f"below_noise='model', got below_noise={below_noise!r}"
         )
+    report = progress or _no_progress
+    report(0.0, "measurements")
     ref = reference_mask(ds)
     ti_s = np.asarray(ds[THETA_I].values, dtype=np.float64)
     dt_s = np.asarray(ds[DELTA_THETA].values, dtype=np.float64)
@@ -298,6 +307,7 @@ def build_lut(
             w = blend_weights(ti_out, measured_ti[0], measured_ti[-1], blend)
             rows = np.flatnonzero(w > 0)
             if rows.size:
+                report(0.1, "model on the grid")
                 filled = _model_rows(fit_model, ti_out[rows], dt_grid, phi_grid, wl)
                 wr = w[rows][:, None, None, None]
                 lut[rows] = (1.0 - wr) * lut[rows] + wr * filled
@@ -311,6 +321,7 @@ def build_lut(
             "edge_delta_theta_max": "zero",
             "edge_phi_max": "zero",
         }
+        report(0.02, "ratio to the model")
         truth_s = _model_at(fit_model, ti_s, dt_s, ph_s, wl)
         ok = ~ref
         ratio = np.divide(spectra, truth_s, out=np.ones_like(spectra), where=truth_s > 0)
@@ -333,9 +344,13 @@ def build_lut(
             # Towards grazing incidence the measured ratio does not carry over (the
             # lobe meets the horizon): the model alone, reached over ``blend`` degrees.
             w = blend_weights(ti_out, -np.inf, measured_ti[-1], blend)[:, None, None, None]
-            r_lut = (1.0 - w) * r_lut + w
-        base = _model_rows(fit_model, ti_out, dt_grid, phi_grid, wl)
-        lut = base * r_lut
+            r_lut *= 1.0 - w  # in place: (1 - w) r + w, one table in memory
+            r_lut += w
+        base = _model_rows(
+            fit_model, ti_out, dt_grid, phi_grid, wl, _part(report, 0.05, 0.25, "model on the grid")
+        )
+        lut = np.multiply(base, r_lut, out=r_lut)
+        del r_lut
         if extrapolation == "model" and renormalise == "none":
             _bound_grazing_rows(lut, ti_out, dt_grid, phi_grid, wl, fit_model, measured_ti[-1])
     if fit_model is not None and (extrapolation == "model" or below_noise == "model"):
@@ -361,13 +376,14 @@ def build_lut(
             fit_model,
             lut_edges(edges),
             extra.get("normal_incidence_blend", 0.0),
+            report,
         )
         extra["renormalise"] = "model"
 
     name = material or ds.attrs.get("material", "unnamed")
     prov = ds.attrs.get("provenance", "")
     out = new_material(
-        lut.astype(dtype),
+        lut.astype(dtype, copy=False),
         ti_out,
         dt_grid,
         phi_grid,
@@ -389,6 +405,7 @@ def build_lut(
         **extra,
     )
     if check_energy:
+        report(0.95, "energy check")
         check_ti = np.unique(np.concatenate([ti_out[::5], ti_out[-1:]]))
         rho = hemispherical_reflectance(out, check_ti, warn=False).values
         if np.any(rho > 1.0 + ENERGY_TOL):
@@ -403,7 +420,33 @@ def build_lut(
                 NonPhysicalWarning,
                 stacklevel=2,
             )
+    report(1.0, "built")
     return out
+
+
+def _no_progress(fraction: float, step: str) -> None:
+    """The progress report of a build that shows none."""
+
+
+def _part(
+    report: Callable[[float, str], None], lo: float, hi: float, step: str
+) -> Callable[[float], None]:
+    """A report of the fraction done of one step, which spans ``lo`` to ``hi`` of the build."""
+    return lambda f: report(lo + (hi - lo) * f, step)
+
+
+def _by_rows(
+    func: Callable[[np.ndarray], np.ndarray], ti: np.ndarray, done: Callable[[float], None]
+) -> np.ndarray:
+    """``func(ti)`` (one result row per incidence angle) a few rows at a time, reporting the
+    fraction done: the rows are computed independently, so the result is the same."""
+    bounds = np.unique(np.linspace(0, ti.size, min(ti.size, 12) + 1).astype(int))
+    out = []
+    for a, b in itertools.pairwise(bounds):
+        done(a / ti.size)
+        out.append(func(ti[a:b]))
+    done(1.0)
+    return np.concatenate(out)
 
 
 def _bound_grazing_rows(
@@ -438,6 +481,7 @@ def _renormalise_rows(
     model: xr.Dataset,
     zero_edges: tuple[bool, bool, bool],
     normal_blend: float,
+    report: Callable[[float, str], None] = _no_progress,
 ) -> None:
     """Scale every row ``(theta_i, wavelength)`` of ``lut`` (in place) by the energy its
     model loses or gains on the grid: ``rho_model / rho_grid``, with ``rho_model`` the
@@ -446,10 +490,18 @@ def _renormalise_rows(
     interpolant (:func:`sbrdf_xr.kernels.lut.hemispherical_reflectance_kernel`)."""
     ti = grids[0]
     mod, _, kw = models.model_parameters(_model_for(model, wl))
-    rho_m = mod.directional_hemispherical_reflectance(np.minimum(ti, 90.0), wl, **kw)
+    rho_m = _by_rows(
+        lambda t: mod.directional_hemispherical_reflectance(np.minimum(t, 90.0), wl, **kw),
+        ti,
+        _part(report, 0.25, 0.8, "model reflectance"),
+    )
     tg, dg, pg = grids
-    rho_g = _lut.hemispherical_reflectance_kernel(
-        base, tg, dg, pg, ti, "linear", zero_edges=zero_edges, normal_blend=normal_blend
+    rho_g = _by_rows(
+        lambda t: _lut.hemispherical_reflectance_kernel(
+            base, tg, dg, pg, t, "linear", zero_edges=zero_edges, normal_blend=normal_blend
+        ),
+        ti,
+        _part(report, 0.8, 0.92, "table reflectance"),
     )
     scale = np.divide(rho_m, rho_g, out=np.ones_like(rho_m), where=rho_g > 0)
     # Below ``normal_blend`` a look-up mixes the row with the theta_i = 0 profile: with
@@ -478,13 +530,28 @@ def _model_for(model: xr.Dataset, wl: np.ndarray) -> xr.Dataset:
 
 
 def _model_rows(
-    model: xr.Dataset, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, wl: np.ndarray
+    model: xr.Dataset,
+    ti: np.ndarray,
+    dt: np.ndarray,
+    ph: np.ndarray,
+    wl: np.ndarray,
+    done: Callable[[float], None] | None = None,
 ) -> np.ndarray:
     """A model material rendered on the table grid (rows ``ti``) at wavelengths ``wl``
     (below-horizon nodes carry the limit from the hemisphere,
     :func:`sbrdf_xr.materials.models.render`)."""
     mod, _, kw = models.model_parameters(_model_for(model, wl))
-    return models.render_values(mod, ti, dt, ph, wl, kw)
+    out = np.empty((ti.size, dt.size, ph.size, wl.size))
+    step = max(1, _RENDER_CHUNK // (dt.size * ph.size * wl.size))
+    for a in range(0, ti.size, step):  # a few rows at a time: bounded temporaries
+        if done is not None:
+            done(a / ti.size)
+        out[a : a + step] = models.render_values(mod, ti[a : a + step], dt, ph, wl, kw)
+    return out
+
+
+#: Table values rendered at once by :func:`_model_rows` (bounds its temporaries).
+_RENDER_CHUNK = 2_000_000
 
 
 def _model_at(
