@@ -180,7 +180,9 @@ def rows_to_dataset(rows: list[BenchRow]) -> xr.Dataset:
 
 
 def plot_front(rows: list[BenchRow], ax: Any = None) -> Any:
-    """The accuracy/time front: worst band error against relative time, per sweep.
+    """The accuracy/time figure of the rows (:func:`sbrdf_xr.plot.accuracy_front`).
+
+    ``ax`` is not used (the figure has its own two panels); kept for callers that pass it.
 
     Examples
     --------
@@ -195,24 +197,10 @@ def plot_front(rows: list[BenchRow], ax: Any = None) -> Any:
     >>> from sbrdf_xr.bench.rows import plot_front
     >>> fig = plot_front(rows)
     >>> ax = fig.axes[0]
-    >>> ax.get_xscale(), ax.get_yscale(), ax.get_xlabel()
-    ('log', 'log', 'wall time / reference wall time')
+    >>> ax.get_xscale(), ax.get_xlabel()
+    ('log', 'band error against the baseline [mmag]')
     >>> plt.close(fig)
     """
-    import matplotlib.pyplot as plt
+    from ..plot import accuracy_front
 
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(7, 4.5), layout="constrained")
-    else:
-        fig = ax.figure
-    for sweep in dict.fromkeys(r.sweep for r in rows if np.isfinite(r.mmag_max)):
-        pts = [r for r in rows if r.sweep == sweep and np.isfinite(r.mmag_max)]
-        ax.scatter([r.ratio for r in pts], [max(r.mmag_max, 1e-6) for r in pts], label=sweep)
-        for r in pts:
-            ax.annotate(r.name.split(": ", 1)[-1], (r.ratio, max(r.mmag_max, 1e-6)), fontsize=6)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("wall time / reference wall time")
-    ax.set_ylabel("largest band error [mmag]")
-    ax.legend(fontsize=7)
-    return fig
+    return accuracy_front(rows_to_dataset(rows))

@@ -454,25 +454,30 @@ def _save_figure(cube_path: str | Path, figure_path: str) -> None:
 
     matplotlib.use("Agg")
 
-    from ..plot import plot_cube
+    from ..plot import cube_figure
 
     cube = open_cube(cube_path)
     try:
-        fig = plot_cube(cube)
+        fig = cube_figure(cube)
     except (KeyError, ValueError, IndexError) as exc:
         raise ValidationError(
             f"{cube_path}: cannot be drawn ({type(exc).__name__}: {exc})"
         ) from None
+    import matplotlib.pyplot as plt
+
     try:
         fig.savefig(figure_path, dpi=120)
     except ValueError as exc:  # an unknown image format
         raise ValidationError(f"{figure_path}: {exc}") from None
+    finally:
+        plt.close(fig)
     print(f"wrote {figure_path}")
 
 
 def cmd_plot(args: argparse.Namespace) -> int:
-    """``sbrdf-xr plot CUBE -o FIG``: the cube's figure (:func:`sbrdf_xr.plot.plot_cube`) in
-    an image file; returns 0.
+    """``sbrdf-xr plot CUBE -o FIG``: the cube's figure (:func:`sbrdf_xr.plot.cube_figure`,
+    chosen by the cube: an observation, a rotation sweep or spectra) in an image file;
+    returns 0.
 
     Examples
     --------

@@ -14,7 +14,8 @@ Sub-commands::
              --elements TLE|OMM|NAME (--site NAME | --lat D --lon D [--height M])
              --start UTC (--stop UTC | --duration S) [--step S] [--attitude LAW ...]
              [--spacecraft NAME|MESH] [--bands V R I] [--plot FIG.png]   attitude law
-    sbrdf-xr plot CUBE.nc -o FIG.png        the cube's natural figure (light curve or spectra)
+    sbrdf-xr plot CUBE.nc -o FIG.png        the cube's figure: a pass against UTC, a rotation's
+                                            BRDF and magnitudes, or a few labelled spectra
     sbrdf-xr photometry CUBE.nc [--bands V R I] [--range-km KM] [--extinction V=0.2 ...]
                         [--colours V-R,R-I]
              [--system ab|vega] [-o PHOT.nc] [--csv PHOT.csv]
@@ -155,7 +156,11 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"zlib compression level of the netCDF cube (default {DEFAULT_COMPLEVEL}; 0: "
         "none, fastest, and resumable after a kill at any instant)",
     )
-    psim.add_argument("--plot", help="also write the cube's figure to this PNG file")
+    psim.add_argument(
+        "--plot",
+        help="also write the cube's figure to this PNG file (chosen by the cube: a pass "
+        "against UTC, a rotation's BRDF and V, R, I magnitudes, or a few spectra)",
+    )
     psim.add_argument(
         "--overwrite",
         action="store_true",
@@ -312,9 +317,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     add_observe_parser(sub, _mesh_options)
 
-    pp = sub.add_parser("plot", help="draw a cube's figure")
-    pp.add_argument("cube")
-    pp.add_argument("-o", "--output", required=True)
+    pp = sub.add_parser(
+        "plot",
+        help="draw a cube's figure",
+        description="Draw the figure of a cube, chosen by what it is: an observation over "
+        "time (magnitudes and colours against UTC with the geometry and the Earth's shadow), "
+        "a rotation sweep (broadband BRDF and V, R, I magnitudes), or a few labelled spectra.",
+    )
+    pp.add_argument("cube", help="a cube file (netCDF or Zarr)")
+    pp.add_argument("-o", "--output", required=True, help="the image file (PNG, PDF, SVG, ...)")
     pp.set_defaults(func=cmd_plot)
     return p
 
