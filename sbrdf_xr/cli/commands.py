@@ -449,7 +449,9 @@ def cmd_knobs(args: argparse.Namespace) -> int:
     return 0
 
 
-def _save_figure(cube_path: str | Path, figure_path: str) -> None:
+def _save_figure(
+    cube_path: str | Path, figure_path: str, bands: tuple[str, ...] = ("V", "R", "I")
+) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -458,7 +460,7 @@ def _save_figure(cube_path: str | Path, figure_path: str) -> None:
 
     cube = open_cube(cube_path)
     try:
-        fig = cube_figure(cube)
+        fig = cube_figure(cube, bands=bands)
     except (KeyError, ValueError, IndexError) as exc:
         raise ValidationError(
             f"{cube_path}: cannot be drawn ({type(exc).__name__}: {exc})"
