@@ -145,7 +145,7 @@ def _built_material(
     def write(da: xr.DataArray, path: Any) -> None:
         if bar:
             bar[0].set_postfix_str("writing the cache")
-        material.to_netcdf(da, path, overwrite=True)
+        material.to_netcdf(da, path, overwrite=True, complevel=0)  # fast to write and read
 
     def read(path: Any) -> xr.DataArray:
         da = material.open_material(path)

@@ -165,12 +165,24 @@ def render(
                 f"{name}: expected a non-empty 1-D grid [degree], got shape {g.shape}"
             )
     _require_isotropic(m)
-    vals = m.render_grid(ti, dt, ph, wl, horizon="limit", **kw)
+    vals = np.empty((ti.size, dt.size, ph.size, wl.size), dtype=dtype)
+    step = max(1, _RENDER_CHUNK // (dt.size * ph.size * wl.size))  # bounded temporaries
+    from tqdm.auto import tqdm
+
+    with tqdm(
+        total=ti.size,
+        desc=f"rendering model {spec.attrs['material']}",
+        unit="row",
+        disable=vals.size < _PROGRESS_MIN,
+    ) as bar:
+        for a in range(0, ti.size, step):
+            vals[a : a + step] = m.render_grid(ti[a : a + step], dt, ph, wl, horizon="limit", **kw)
+            bar.update(min(step, ti.size - a))
     # Where the grid stops inside the hemisphere the model goes on: hold the edge
     # (exact for a Lambertian surface) rather than drop to zero.
     blend = min(float(ti[1] - ti[0]), 1.0) if ti.size > 1 and ti[0] == 0.0 else 0.0
     return new_material(
-        vals.astype(dtype),
+        vals,
         ti,
         dt,
         ph,
@@ -185,6 +197,12 @@ def render(
         normal_incidence_blend=blend,
         **_edges(dt, ph),
     )
+
+
+#: Table values :func:`render` computes at once (bounds its temporaries).
+_RENDER_CHUNK = 2_000_000
+#: Table values from which :func:`render` shows a progress bar (a few seconds' work).
+_PROGRESS_MIN = 20_000_000
 
 
 def _edges(dt: np.ndarray, ph: np.ndarray) -> dict[str, str]:
