@@ -72,6 +72,7 @@ __all__ = [
     "load_spacecraft_spec",
     "material_tables",
     "names",
+    "showing_progress",
     "to_build",
     "user_catalog_dirs",
 ]
@@ -178,6 +179,30 @@ _LOADED: set[str] = set()
 #: The tables a batch load (:func:`material_tables`) will build, in order: for the labels
 #: of their progress bars ("building table tjpv-cell (1 of 3)").
 _BATCH: list[str] = []
+#: Whether builds show their progress bars (:func:`showing_progress`).
+_SHOW_PROGRESS = [True]
+
+
+@contextlib.contextmanager
+def showing_progress(show: bool) -> Iterator[None]:
+    """Show (or, ``show=False``, hide) the progress bars of table builds while the block runs.
+
+    The command line hides them with ``--quiet``.
+
+    Examples
+    --------
+    >>> with showing_progress(False):
+    ...     _SHOW_PROGRESS[0]
+    False
+    >>> _SHOW_PROGRESS[0]
+    True
+    """
+    before = _SHOW_PROGRESS[0]
+    _SHOW_PROGRESS[0] = bool(show)
+    try:
+        yield
+    finally:
+        _SHOW_PROGRESS[0] = before
 
 
 def _table_inputs(measurements: str, kw: Mapping[str, Any]) -> list[Path]:
@@ -198,6 +223,7 @@ def _progress_bar(name: str) -> Any:
         desc=label,
         bar_format="{desc}: {percentage:3.0f}%|{bar}| {elapsed}<{remaining}{postfix}",
         leave=True,
+        disable=not _SHOW_PROGRESS[0],
     )
 
 
@@ -630,7 +656,7 @@ def material_tables(
                 obj = load_material_spec(spec, base_dir=base_dir)
                 if isinstance(obj, xr.Dataset):
                     given[mat] = obj
-                    obj = models.render(obj)
+                    obj = models.render(obj, progress=_SHOW_PROGRESS[0])
             except CatalogError as exc:
                 raise CatalogError(
                     f"{(where or {}).get(mat, '[materials]')} {mat!r}: {exc}"

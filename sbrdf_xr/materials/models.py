@@ -123,6 +123,7 @@ def render(
     delta_theta: ArrayLike | None = None,
     phi: ArrayLike | None = None,
     dtype: type | np.dtype = np.float64,
+    progress: bool = True,
 ) -> xr.DataArray:
     """Render a model material to a look-up table.
 
@@ -135,6 +136,9 @@ def render(
         3-degree steps (the whole visible hemisphere; with 141 wavelengths that is
         already 290 MB in float64: pass narrower grids for narrow lobes).
     dtype : numpy dtype
+    progress : bool, default True
+        Show a progress bar (tqdm.auto) while rendering a large table (2e7 values and
+        more: seconds).
 
     Returns
     -------
@@ -173,7 +177,7 @@ def render(
         total=ti.size,
         desc=f"rendering model {spec.attrs['material']}",
         unit="row",
-        disable=vals.size < _PROGRESS_MIN,
+        disable=not progress or vals.size < _PROGRESS_MIN,
     ) as bar:
         for a in range(0, ti.size, step):
             vals[a : a + step] = m.render_grid(ti[a : a + step], dt, ph, wl, horizon="limit", **kw)
