@@ -1,4 +1,5 @@
-"""Physics of the light sources besides the Sun's spectrum: Planck, earthshine, Kirchhoff.
+"""Physics of the light sources besides the Sun's spectrum: Planck, earthshine, moonlight,
+Kirchhoff.
 
 Pure numpy (no xarray, no I/O).  The Sun's spectral irradiance lives with the
 photometry (it is a data set); here are the closed forms the effects of a
@@ -7,6 +8,9 @@ simulation need:
 * :func:`planck`: blackbody spectral radiance (thermal emission of the facets);
 * :func:`earthshine_irradiance_ratio`: light reflected by a Lambertian Earth onto the
   spacecraft, relative to the Sun's;
+* :func:`moon_v_magnitude` and :func:`moonlight_irradiance_ratio`: the Moon's brightness
+  against its phase angle (Allen's law as used by Krisciunas & Schaefer 1991) and its
+  light at the spacecraft, relative to the Sun's;
 * :func:`kirchhoff_emissivity`: directional emissivity from directional-hemispherical
   reflectance, and :func:`emissivity_at`, its linear interpolation in the emission
   angle.
@@ -18,16 +22,31 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import constants
 
+from .units import check_plausible, to_unit
+
 __all__ = [
     "EARTH_RADIUS_KM",
+    "MOON_MEAN_DISTANCE_KM",
+    "MOON_RADIUS_KM",
+    "SUN_V_MAGNITUDE",
     "earthshine_irradiance_ratio",
     "emissivity_at",
     "kirchhoff_emissivity",
+    "moon_v_magnitude",
+    "moonlight_irradiance_ratio",
     "planck",
 ]
 
 #: Earth's mean radius [km].
 EARTH_RADIUS_KM = 6371.0
+#: The Moon's mean distance from the Earth's centre [km], the distance its magnitude law
+#: refers to (Allen 1973; Krisciunas & Schaefer 1991).
+MOON_MEAN_DISTANCE_KM = 384400.0
+#: The Moon's mean radius [km] (IAU).
+MOON_RADIUS_KM = 1737.4
+#: The Sun's apparent V magnitude at 1 au (Allen 1973, *Astrophysical Quantities*, 3rd ed.),
+#: the zero point of the Moon's magnitude law.
+SUN_V_MAGNITUDE = -26.74
 
 
 def planck(wavelength_nm: ArrayLike, temperature: float) -> NDArray[np.float64]:
@@ -57,8 +76,9 @@ def planck(wavelength_nm: ArrayLike, temperature: float) -> NDArray[np.float64]:
     0.009924...
     """
     h, c, k = constants.h, constants.c, constants.k
-    lam = np.asarray(wavelength_nm, dtype=np.float64) * 1e-9
-    x = h * c / (lam * k * float(temperature))
+    wl = to_unit(wavelength_nm, "nm", "wavelength_nm", spectral=True)
+    lam = np.asarray(wl, dtype=np.float64) * 1e-9
+    x = h * c / (lam * k * float(to_unit(temperature, "K", "temperature")))
     with np.errstate(under="ignore", over="ignore"):
         return 2.0 * h * c**2 / lam**5 * np.exp(-x) / -np.expm1(-x) * 1e-9
 
@@ -93,7 +113,9 @@ def earthshine_irradiance_ratio(albedo: float, range_km: float, phase_angle_deg:
     >>> round(earthshine_irradiance_ratio(0.3, 42164.0, 0.0), 5)  # full Earth from GEO
     0.00457
     """
-    a = np.radians(phase_angle_deg)
+    a = np.radians(to_unit(phase_angle_deg, "deg", "phase_angle_deg"))
+    range_km = to_unit(range_km, "km", "range_km")
+    check_plausible(range_km, "range_km", "range_km")
     return float(
         2.0
         / 3.0
@@ -102,6 +124,81 @@ def earthshine_irradiance_ratio(albedo: float, range_km: float, phase_angle_deg:
         * ((np.pi - a) * np.cos(a) + np.sin(a))
         / np.pi
     )
+
+
+def moon_v_magnitude(phase_angle_deg: ArrayLike) -> NDArray[np.float64]:
+    """The Moon's V magnitude at its mean distance and 1 au from the Sun, by phase angle.
+
+    ``m(alpha) = -12.73 + 0.026 |alpha| + 4e-9 alpha^4`` (``alpha`` in degree), the fit of
+    Allen (1973, *Astrophysical Quantities*, 3rd ed., p. 144) to the lunar phase curve
+    that Krisciunas & Schaefer (1991, PASP 103, 1033, §3) use for moonlight.  It does not
+    follow the opposition surge within a few degrees of full Moon, nor the difference
+    between waxing and waning phases (a few tenths of a magnitude).
+
+    Parameters
+    ----------
+    phase_angle_deg : array_like
+        Sun-Moon-observer angle [degree], 0 at full Moon.
+
+    Returns
+    -------
+    ndarray
+        V magnitude [mag].
+
+    Examples
+    --------
+    >>> from sbrdf_xr.sources import moon_v_magnitude
+    >>> moon_v_magnitude([0.0, 90.0, -90.0]).round(2).tolist()  # full and quarter Moons
+    [-12.73, -10.13, -10.13]
+    """
+    a = np.abs(np.asarray(phase_angle_deg, dtype=np.float64))
+    return -12.73 + 0.026 * a + 4e-9 * a**4
+
+
+def moonlight_irradiance_ratio(
+    phase_angle_deg: ArrayLike,
+    distance_km: ArrayLike,
+    sun_distance_ratio: ArrayLike = 1.0,
+) -> NDArray[np.float64]:
+    """Irradiance from the Moon relative to the Sun's at the observer.
+
+    ``E_moon / E_sun = 10^(-0.4 (m(alpha) - m_sun)) (D / d)^2 (r_obs / r_moon)^2``: the
+    Moon's V magnitude law (:func:`moon_v_magnitude`) against the Sun's
+    (:data:`SUN_V_MAGNITUDE`), moved from the mean distance ``D``
+    (:data:`MOON_MEAN_DISTANCE_KM`) to the observer's distance ``d``, and from the
+    observer's distance to the Sun to the Moon's (``sun_distance_ratio = r_obs /
+    r_moon``).  The ratio holds at every wavelength for a grey Moon; the real Moon is
+    redder than the Sun (B - V 0.92 against 0.65, Allen 1973), which a V-band ratio
+    leaves out.
+
+    Parameters
+    ----------
+    phase_angle_deg : array_like
+        Sun-Moon-observer angle [degree].
+    distance_km : array_like
+        Moon-observer distance (centre to centre) [km].
+    sun_distance_ratio : array_like
+        Sun-observer distance over Sun-Moon distance [1].
+
+    Returns
+    -------
+    ndarray
+        ``E_moon / E_sun`` [1].
+
+    Examples
+    --------
+    The full Moon at its mean distance gives 2.5 millionths of the Sun's light (14.01
+    magnitudes fainter); a quarter Moon gives 9 % of that:
+
+    >>> from sbrdf_xr.sources import moonlight_irradiance_ratio
+    >>> full, quarter = moonlight_irradiance_ratio([0.0, 90.0], 384400.0)
+    >>> f"{full:.3e}", round(float(quarter / full), 3)
+    ('2.489e-06', 0.091)
+    """
+    d = np.asarray(distance_km, dtype=np.float64)
+    m = moon_v_magnitude(phase_angle_deg)
+    ratio = 10.0 ** (-0.4 * (m - SUN_V_MAGNITUDE))
+    return ratio * (MOON_MEAN_DISTANCE_KM / d) ** 2 * np.asarray(sun_distance_ratio) ** 2
 
 
 def kirchhoff_emissivity(reflectance: ArrayLike) -> NDArray[np.float64]:

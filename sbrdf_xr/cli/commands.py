@@ -9,13 +9,16 @@ import argparse
 import signal
 import textwrap
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .. import catalog
 from .._version import __version__
 from ..errors import ValidationError, did_you_mean
 from ..store.writer import PART_SUFFIX
 from .output import escape, escaped_attrs, open_cube, open_dataset
+
+if TYPE_CHECKING:
+    from ..engine import Scene
 
 __all__ = [
     "cmd_bench",
@@ -366,9 +369,10 @@ NAME (one material for every facet) or --material-map MAP.toml (facet colour or 
     return catalog.load_spacecraft_spec(args.spacecraft, **options)
 
 
-def _with_body(scene: Any, args: argparse.Namespace) -> Any:
-    """The scene with the spacecraft of ``--spacecraft`` and the tables of ``--material``."""
-    from ..engine.builtin import material_tables
+def _with_body(scene: Scene, args: argparse.Namespace) -> Scene:
+    """The scene with the spacecraft of ``--spacecraft`` and the tables (or models) of
+    ``--material``."""
+    from ..engine.builtin import load_material_specs
 
     specs: dict[str, str] = {}
     for item in args.material or []:
@@ -398,12 +402,10 @@ def _with_body(scene: Any, args: argparse.Namespace) -> Any:
         else f"spacecraft {body.name!r}"
     )
     where = {m: "--material" if m in specs else named_in for m in wanted}
-    tables, models = material_tables(wanted, where=where)
+    found = load_material_specs(wanted, where=where)
     old_models = {m: v for m, v in (scene.models or {}).items() if m not in wanted}
     return scene.with_options(
-        spacecraft=body,
-        materials={**kept, **tables},
-        models={**old_models, **models} or None,
+        spacecraft=body, materials={**kept, **found}, models=old_models or None
     )
 
 

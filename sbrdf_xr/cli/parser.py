@@ -10,6 +10,10 @@ Sub-commands::
              [--scheduler ADDR] [--preset NAME] [--plot FIG.png] [--overwrite | --resume] [--plan]
              [--spacecraft NAME|MESH [--mesh-material M | --material-map MAP.toml]]
              [--material M=NAME|FILE.nc ...]
+    sbrdf-xr observe -o CUBE.nc             a real pass: elements, a site, a UTC window, an
+             --elements TLE|OMM|NAME (--site NAME | --lat D --lon D [--height M])
+             --start UTC (--stop UTC | --duration S) [--step S] [--attitude LAW ...]
+             [--spacecraft NAME|MESH] [--bands V R I] [--plot FIG.png]   attitude law
     sbrdf-xr plot CUBE.nc -o FIG.png        the cube's natural figure (light curve or spectra)
     sbrdf-xr photometry CUBE.nc [--bands V R I] [--range-km KM] [--extinction V=0.2 ...]
                         [--colours V-R,R-I]
@@ -35,6 +39,7 @@ from pathlib import Path
 from .. import catalog
 from .._version import __version__
 from ..engine.builtin import builtin_scenes
+from ..engine.knobs import KNOBS, PRESETS
 from ..errors import SbrdfError
 from ..store.writer import DEFAULT_COMPLEVEL, LOG_SUFFIX, PART_SUFFIX, command_line_messages
 from .analysis import cmd_invert, cmd_photometry
@@ -47,6 +52,7 @@ from .commands import (
     cmd_plot,
     cmd_simulate,
 )
+from .observe import add_observe_parser
 from .output import escape
 
 __all__ = ["main"]
@@ -138,13 +144,20 @@ def build_parser() -> argparse.ArgumentParser:
     psim.add_argument(
         "--scheduler", help="address of a dask.distributed scheduler (default: threads)"
     )
-    psim.add_argument("--preset", help="numerical preset: fast, balanced or reference")
+    psim.add_argument(
+        "--preset",
+        help=f"numerical preset: {', '.join(PRESETS)} (knob values; 'sbrdf-xr knobs' shows them)",
+    )
     psim.add_argument(
         "--set",
         action="append",
         metavar="KNOB=VALUE",
-        help="set a numerical knob (repeatable; 'sbrdf-xr knobs' lists them), e.g. "
-        "--set method=cubic --set dtype=float32",
+        help="set a numerical knob (repeatable; 'sbrdf-xr knobs' says what each trades): "
+        + "; ".join(
+            f"{k.name}: {k.domain()} (default {'none' if k.default is None else k.default})"
+            for k in KNOBS.values()
+        )
+        + "; e.g. --set method=cubic --set dtype=float32",
     )
     psim.add_argument(
         "--complevel",
@@ -290,6 +303,8 @@ def build_parser() -> argparse.ArgumentParser:
         q.add_argument("-o", "--output", help="write the result Dataset to this netCDF file")
         q.add_argument("--overwrite", action="store_true", help="replace an existing output file")
         q.set_defaults(func=cmd_invert)
+
+    add_observe_parser(sub, _mesh_options)
 
     pp = sub.add_parser("plot", help="draw a cube's figure")
     pp.add_argument("cube")

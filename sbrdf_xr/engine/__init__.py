@@ -9,11 +9,13 @@ Modules
 ``knobs``
     Every numerical knob of a simulation, and the presets, in one table.
 ``effects``
-    The effects a simulation can include and the outputs of a cube.
+    The effects a simulation can include, one module and one registry entry each, and
+    the outputs of a cube; the rest of the engine reads the entries.
 ``sweep``
     The geometry of a sweep: where the Sun and the observer are, in the body frame.
-``scene``, ``scene_file`` and ``builtin``
-    :class:`Scene`, scene files (TOML) and the built-in scenes.
+``scene``, ``scene_file``, ``schema`` and ``builtin``
+    :class:`Scene`, scene files (TOML), every key of a scene file (its type, default and
+    meaning, and the reference rendered from them) and the built-in scenes.
 ``plan``, ``stages`` and ``spectral``
     The plan and its stages.
 ``run``
@@ -22,7 +24,19 @@ Modules
 """
 
 from ..errors import SceneError
-from . import builtin, effects, knobs, plan, run, scene, scene_file, spectral, stages, sweep
+from . import (
+    builtin,
+    effects,
+    knobs,
+    plan,
+    run,
+    scene,
+    scene_file,
+    schema,
+    spectral,
+    stages,
+    sweep,
+)
 from .builtin import builtin_scene, builtin_scenes, resolve_scene
 from .effects import SPECTRAL_OUTPUTS, BlockInputs, Effect, Output, finish, reflected
 from .knobs import KNOBS, PRESETS, Knob, apply_preset, check_knob, knob_table
@@ -32,6 +46,7 @@ from .scene import EFFECTS, OUTPUTS, Scene
 from .scene_file import (
     MAX_SCENE_COUNT,
     MAX_SHADOW_DENSITY,
+    load_material_specs,
     load_scene,
     material_tables,
     scene_from_dict,
@@ -70,6 +85,7 @@ __all__ = [
     "finish",
     "knob_table",
     "knobs",
+    "load_material_specs",
     "load_scene",
     "material_tables",
     "plan",
@@ -80,6 +96,7 @@ __all__ = [
     "scene",
     "scene_file",
     "scene_from_dict",
+    "schema",
     "simulate",
     "spectral",
     "stages",

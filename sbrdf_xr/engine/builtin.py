@@ -20,6 +20,7 @@ from .scene import Scene
 from .scene_file import (
     MAX_SCENE_COUNT,
     MAX_SHADOW_DENSITY,
+    load_material_specs,
     load_scene,
     material_tables,
     scene_from_dict,
@@ -30,6 +31,7 @@ __all__ = [
     "MAX_SHADOW_DENSITY",
     "builtin_scene",
     "builtin_scenes",
+    "load_material_specs",
     "load_scene",
     "material_tables",
     "resolve_scene",

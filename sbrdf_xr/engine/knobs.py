@@ -2,10 +2,13 @@
 
 A *knob* is an approximation with a price: interpolation order, precision,
 wavelength sampling, band pre-integration, shadowing method and density, table
-resolution, tabulated versus analytic material evaluation.  Each is declared once
-here (name, allowed values, default, what it trades) and read by
-:class:`~sbrdf_xr.engine.Scene` (its fields), :mod:`sbrdf_xr.engine.plan` (which resolves
-them), :mod:`sbrdf_xr.body.visibility`, :mod:`sbrdf_xr.bench` and the command line.
+resolution, tabulated versus analytic material evaluation.  Each is declared once here
+(:class:`Knob`: name, default, type, allowed values or range, what it trades) and read
+everywhere else: :class:`~sbrdf_xr.engine.Scene` takes its fields' defaults from here and
+checks every value with :func:`check_knob`, the scene files take their TOML types and the
+reference of their keys (:mod:`sbrdf_xr.engine.schema`) from here, and so do
+:mod:`sbrdf_xr.engine.plan` (which resolves them), :mod:`sbrdf_xr.bench` and the command
+line's ``--set`` help.
 
 The presets ``fast``, ``balanced`` and ``reference`` are chosen from the
 accuracy/cost table of ``sbrdf-xr bench`` (README): against ``reference``, linear
@@ -20,7 +23,7 @@ bodies no sampled density up to 32 reaches 1% worst error, and on meshes below a
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -31,58 +34,95 @@ __all__ = ["KNOBS", "PRESETS", "Knob", "apply_preset", "check_knob", "knob_table
 
 @dataclass(frozen=True)
 class Knob:
-    """One numerical knob.
+    """One numerical knob: the one declaration of its default, type, domain and meaning.
+
+    :class:`~sbrdf_xr.engine.Scene` takes its field's default from here and checks every
+    value with :meth:`check`; the scene files take its TOML type (:attr:`toml`); the
+    command line and the scene-file reference (:mod:`sbrdf_xr.engine.schema`) its
+    :meth:`domain` and :attr:`trades`.
 
     Attributes
     ----------
     name : str
-        The Scene field that holds it.
+        The Scene field (and scene-file key) that holds it.
     default : object
         Its value when not set.
-    allowed : tuple or None
-        The allowed values, or None for a value checked by ``check``.
-    check : callable or None
-        ``check(value)`` returns an error text, or None when the value is fine.
+    kind : type
+        ``str``, ``int`` or ``float`` (a float knob takes integers too).
     trades : str
         What the knob trades, for people (``sbrdf-xr bench`` measures it).
+    allowed : tuple or None
+        The allowed values, or None for a number in ``[low, high]``.
+    low, high : float or None
+        Bounds of a number, inclusive (``low`` excluded with ``low_open``).
+    none : str or None
+        What None means, when None is allowed.
+    unit : str
+        Unit of a number (``"degree"``, ``"byte"``).
 
     Examples
     --------
     >>> from sbrdf_xr.engine.knobs import KNOBS
     >>> k = KNOBS["method"]
-    >>> k.default, k.allowed
-    ('linear', ('nearest', 'linear', 'cubic'))
-    >>> KNOBS["shadow_density"].check(0)  # a knob checked by a function
+    >>> k.default, k.allowed, k.toml
+    ('linear', ('nearest', 'linear', 'cubic'), (<class 'str'>,))
+    >>> KNOBS["shadow_density"].check(0)  # a number checked against its range
     'expected an integer from 1 to 64'
+    >>> KNOBS["table_theta_step"].domain()
+    "none (the table's own nodes) or a number in (0, 45] degree"
     """
 
     name: str
     default: Any
-    allowed: tuple[Any, ...] | None
-    check: Callable[[Any], str | None] | None
+    kind: type
     trades: str
+    allowed: tuple[Any, ...] | None = None
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = False
+    none: str | None = None
+    unit: str = ""
+
+    @property
+    def toml(self) -> tuple[type, ...]:
+        """The TOML types a scene file may give it in."""
+        return (int, float) if self.kind is float else (self.kind,)
+
+    def _range(self) -> str:
+        unit = f" {self.unit}" if self.unit else ""
+        low, high = _number(self.low), _number(self.high)
+        if self.kind is int:
+            return f"an integer from {low} to {high}{unit}"
+        return f"a number in {'(' if self.low_open else '['}{low}, {high}]{unit}"
+
+    def domain(self) -> str:
+        """Its allowed values, in words."""
+        what = ", ".join(map(str, self.allowed)) if self.allowed is not None else self._range()
+        return what if self.none is None else f"none ({self.none}) or {what}"
+
+    def check(self, value: Any) -> str | None:
+        """An error text for ``value``, or None when the value is allowed."""
+        if value is None and self.none is not None:
+            return None
+        if self.allowed is not None:
+            if value in self.allowed:
+                return None
+            return f"allowed: {', '.join(map(str, self.allowed))}"
+        number = not isinstance(value, bool) and isinstance(
+            value, int if self.kind is int else int | float
+        )
+        low, high = self.low if self.low is not None else -float("inf"), self.high
+        if number and (value > low if self.low_open else value >= low):
+            if high is None or value <= high:
+                return None
+        nothing = f"None ({self.none}) or " if self.none is not None else ""
+        return f"expected {nothing}{self._range()}"
 
 
-def _positive_int(limit: int) -> Callable[[Any], str | None]:
-    def check(v: Any) -> str | None:
-        if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= limit:
-            return f"expected an integer from 1 to {limit}"
-        return None
-
-    return check
-
-
-def _optional_positive_int(limit: int) -> Callable[[Any], str | None]:
-    inner = _positive_int(limit)
-    return lambda v: None if v is None else inner(v)
-
-
-def _optional_step(v: Any) -> str | None:
-    if v is None:
-        return None
-    if isinstance(v, bool) or not isinstance(v, int | float) or not 0 < float(v) <= 45:
-        return "expected None (the table's own nodes) or a step in (0, 45] degree"
-    return None
+def _number(x: float | None) -> str:
+    if x is None:
+        return "-"
+    return str(int(x)) if float(x).is_integer() else f"{x:g}"
 
 
 #: The knob table (one entry a knob).
@@ -92,90 +132,102 @@ KNOBS: dict[str, Knob] = {
         Knob(
             "method",
             "linear",
-            ("nearest", "linear", "cubic"),
-            None,
+            str,
             "look-up interpolation order: "
             "nearest (the paper's) < linear < cubic in accuracy and cost",
+            allowed=("nearest", "linear", "cubic"),
         ),
         Knob(
             "dtype",
             "float64",
-            ("float32", "float64"),
-            None,
+            str,
             "precision of the spectra (geometry is always float64)",
+            allowed=("float32", "float64"),
         ),
         Knob(
             "wavelength_stride",
             1,
-            None,
-            _positive_int(1000),
+            int,
             "use every n-th wavelength of the materials' common grid",
+            low=1,
+            high=1000,
         ),
         Knob(
             "band_integration",
             "auto",
-            ("auto", "spectral"),
-            None,
+            str,
             "auto: band-only scenes pre-integrate the tables over the bands (exact for nearest "
             "and linear); spectral: integrate the spectral signal instead",
+            allowed=("auto", "spectral"),
         ),
         Knob(
             "shadow_method",
             "exact",
-            ("exact", "sampled"),
-            None,
-            "self-shadowing and occlusion: exact polygon clipping, or sub-facet ray sampling",
+            str,
+            "facets hiding each other from the Sun and the observer: exact polygon clipping, "
+            "or sub-facet ray sampling",
+            allowed=("exact", "sampled"),
         ),
         Knob(
             "shadow_density",
             4,
-            None,
-            _positive_int(64),
-            "sampled shadowing: samples per facet side (density**2 per facet)",
+            int,
+            "shadow_method sampled: samples per facet side (density**2 per facet)",
+            low=1,
+            high=64,
         ),
         Knob(
             "table_theta_step",
             None,
-            None,
-            _optional_step,
+            float,
             "resample the tables' theta_i axis to this step [degree] (None: as given)",
+            low=0,
+            high=45,
+            low_open=True,
+            none="the table's own nodes",
+            unit="degree",
         ),
         Knob(
             "evaluation",
             "table",
-            ("table", "analytic"),
-            None,
+            str,
             "table: look-up tables; analytic: each material's generating BRDF model "
             "(no table error, much slower)",
+            allowed=("table", "analytic"),
         ),
         Knob(
             "tilt_nodes",
             5,
-            None,
-            _positive_int(32),
+            int,
             "surface imperfections: Gauss-Hermite nodes per tangent axis of the normal-tilt "
             "distribution (tilt_nodes**2 copies of every term)",
+            low=1,
+            high=32,
         ),
         Knob(
             "kernel",
             "fused",
-            ("fused", "numpy"),
-            None,
+            str,
             "fused: the compiled one-pass kernel; numpy: the reference implementation (same sums)",
+            allowed=("fused", "numpy"),
         ),
         Knob(
             "chunk",
             None,
-            None,
-            _optional_positive_int(10**9),
+            int,
             "geometries per block (None: from the memory budget)",
+            low=1,
+            high=10**9,
+            none="from block_bytes",
         ),
         Knob(
             "block_bytes",
             32 * 2**20,
-            None,
-            _positive_int(2**34),
+            int,
             "memory budget of one block's outputs [byte], sets the default chunk",
+            low=1,
+            high=2**34,
+            unit="byte",
         ),
     )
 }
@@ -210,12 +262,9 @@ def check_knob(name: str, value: Any) -> Any:
         knob = KNOBS[name]
     except KeyError:
         raise SceneError(f"unknown knob {name!r}; knobs: {', '.join(KNOBS)}") from None
-    if knob.allowed is not None and value not in knob.allowed:
-        raise SceneError(f"{name}: got {value!r}; allowed: {', '.join(map(str, knob.allowed))}")
-    if knob.check is not None:
-        why = knob.check(value)
-        if why:
-            raise SceneError(f"{name}: got {value!r}; {why}")
+    why = knob.check(value)
+    if why:
+        raise SceneError(f"{name}: got {value!r}; {why}")
     return value
 
 

@@ -25,29 +25,25 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import xarray as xr
 
 from .._names import BAND, MATERIAL, PSI, WAVELENGTH
 from .._version import __version__
 from ..errors import SceneError
-from ..kernels.sums import PackedTables, normal_rows
+from ..kernels import PackedTables, normal_rows
+from ..materials.models import model_parameters
 from ..store.fingerprint import scene_fingerprint
-from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, BlockInputs
+from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, BlockInputs, Effect, PlanInputs, readonly
 from .spectral import spectral_stage
-from .stages import (
-    contributing_terms,
-    describe_bytes,
-    effect_stage,
-    facet_terms,
-    readonly,
-    shadow_stage,
-    tilted_terms,
-)
+from .stages import contributing_terms, describe_bytes, effect_stage, facet_terms, tilted_terms
 
-#: The scene being compiled (:class:`sbrdf_xr.engine.Scene`, which imports this module).
-Scene = Any
+if TYPE_CHECKING:
+    from ..body.spacecraft import Spacecraft
+    from .scene import Scene
+    from .sweep import GridGeometry, PairGeometry
 
 __all__ = ["BlockInputs", "Estimate", "Plan", "PlannedOutput", "Terms", "compile_plan"]
 
@@ -194,7 +190,9 @@ class Plan:
     """A compiled scene: everything a simulation computes (see the module docstring).
 
     Build with :meth:`from_scene` (or :meth:`sbrdf_xr.engine.Scene.plan`).  Fields are
-    read-only; arrays are not writeable.
+    read-only; arrays are not writeable.  ``effects`` names the effects that run
+    (:data:`sbrdf_xr.engine.effects.EFFECTS`), ``effect_params`` holds their parameters,
+    and ``plan.<effect>`` (``plan.shadowing``, ``plan.thermal``, ...) says whether one runs.
 
     Examples
     --------
@@ -212,6 +210,8 @@ class Plan:
     ('linear', ('grey',), [500.0, 600.0, 700.0])
     >>> plan.merged, plan.shadowing, plan.effects
     (True, False, ('sunlight',))
+    >>> plan.active_effects[0].description
+    'reflected sunlight: paper 000 Eqs. 3-4 and the radiometric signal'
     >>> print(plan)  # doctest: +ELLIPSIS
     plan for scene 'scene':
       geometry       2 attitudes x 2 phase angles = 4 geometries
@@ -229,8 +229,8 @@ class Plan:
 
     name: str
     description: str
-    spacecraft: Any
-    geometry: Any
+    spacecraft: Spacecraft
+    geometry: GridGeometry | PairGeometry
     terms: Terms
     materials: tuple[str, ...]
     tables: PackedTables
@@ -239,9 +239,7 @@ class Plan:
     band_weights: np.ndarray | None
     band_coords: Mapping[str, Any]
     pre_integrated: bool
-    shadowing: bool
     merged: bool
-    shadow_options: Mapping[str, Any]
     effects: tuple[str, ...]
     effect_params: Mapping[str, Mapping[str, Any]]
     models: Mapping[int, tuple[Any, Mapping[str, Any]]]
@@ -257,6 +255,17 @@ class Plan:
     cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     # ----------------------------------------------------------- derived
+    def __getattr__(self, name: str) -> bool:
+        """``plan.<effect>``: whether that effect runs (``plan.shadowing``)."""
+        if name in EFFECTS:
+            return name in self.__dict__.get("effects", ())
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    @cached_property
+    def active_effects(self) -> tuple[Effect, ...]:
+        """The entries of the effects that run (:data:`sbrdf_xr.engine.effects.EFFECTS`)."""
+        return tuple(EFFECTS[e] for e in self.effects)
+
     @property
     def output_names(self) -> tuple[str, ...]:
         """Names of the output variables."""
@@ -325,6 +334,13 @@ class Plan:
 # ------------------------------------------------------------------ compiler
 
 
+def _anisotropic(material: xr.DataArray | xr.Dataset) -> bool:
+    """A table with a psi axis, or a model of an anisotropic BRDF."""
+    if isinstance(material, xr.Dataset):
+        return bool(getattr(model_parameters(material)[0], "anisotropic", False))
+    return PSI in material.dims
+
+
 def compile_plan(scene: Scene) -> Plan:
     """Compile a scene into its :class:`Plan` (see the module docstring).
 
@@ -364,11 +380,12 @@ def compile_plan(scene: Scene) -> Plan:
     geo = scene.geometry
     steps: list[tuple[str, str]] = [("geometry", geo.describe())]
 
-    # ---- effects that change what terms are needed
-    shadowing, shadow_options = shadow_stage(scene, knobs, steps)
+    # ---- effects that change what terms are needed (per facet)
+    early, params = effect_stage(PlanInputs(scene, knobs), True, steps)
+    per_facet = tuple(EFFECTS[e].title for e in early)
 
-    aniso_names = frozenset(m for m, da in scene.tables.items() if PSI in da.dims)
-    raw, merged = facet_terms(scene, shadowing, steps, aniso_names)
+    aniso_names = frozenset(m for m, v in scene.material_data.items() if _anisotropic(v))
+    raw, merged = facet_terms(scene, per_facet, steps, aniso_names)
     raw = tilted_terms(scene, raw, knobs["tilt_nodes"], steps)
     keep = contributing_terms(scene, raw["normal"])
     if not keep.all():
@@ -405,20 +422,20 @@ def compile_plan(scene: Scene) -> Plan:
     sx = spectral_stage(scene, used, knobs, steps)
     wl, bw, pre, dtype = sx.wavelength, sx.band_weights, sx.pre_integrated, sx.dtype
 
-    # ---- effects
-    active, params = effect_stage(scene, wl, used, pre, shadowing, steps)
+    # ---- the other effects
+    late, late_params = effect_stage(PlanInputs(scene, knobs, wl, tuple(used), pre), False, steps)
+    active = [e for e in EFFECTS if e in early or e in late]
+    params.update(late_params)
 
-    # ---- outputs
+    # ---- outputs: the scene's, then those of the effects that run
     names = []
-    for o in scene.outputs:
-        v = SCENE_OUTPUTS[o]
+    wanted = [SCENE_OUTPUTS[o] for o in scene.outputs]
+    wanted += [o.name for e in active for o in EFFECTS[e].declares]
+    for v in wanted:
         if pre and OUTPUTS[v].tail and OUTPUTS[v].tail[-1] == WAVELENGTH:
             continue
-        names.append(v)
-    for e in active:
-        for v in EFFECTS[e].outputs:
-            if v in ("signal_earthshine", "thermal_intensity") and not pre and v not in names:
-                names.append(v)
+        if v not in names:
+            names.append(v)
     sizes = {WAVELENGTH: wl.size, BAND: len(scene.bands), MATERIAL: len(used)}
     lead_dims, lead_shape = geo.dims, geo.shape
     outputs = []
@@ -447,7 +464,7 @@ def compile_plan(scene: Scene) -> Plan:
     out_bytes = sum(o.nbytes for o in outputs)
     nodes = {"nearest": 1, "linear": 8, "cubic": 64}[knobs["method"]]
     n_spec = len(scene.bands) if pre else wl.size
-    n_src = 1 + ("earthshine" in active)
+    n_src = sum(EFFECTS[e].reflects for e in active)  # one kernel pass per reflected source
     work = float(geo.n_geometries) * terms.size * nodes * n_spec * n_src
     est = Estimate(geo.n_geometries, terms.size, int(out_bytes), int(per_lead * chunk), work)
     limit = scene.size_limit
@@ -469,7 +486,7 @@ def compile_plan(scene: Scene) -> Plan:
         )
     )
 
-    provenance = {m: scene.tables[m].attrs.get("provenance", "") for m in used}
+    provenance = {m: scene.material_data[m].attrs.get("provenance", "") for m in used}
     attrs = {
         "Conventions": "CF-1.10",
         "title": f"sbrdf_xr simulation of scene {scene.name}",
@@ -512,9 +529,7 @@ def compile_plan(scene: Scene) -> Plan:
         band_weights=None if bw is None else readonly(bw),
         band_coords=MappingProxyType(sx.band_coords),
         pre_integrated=pre,
-        shadowing=shadowing,
         merged=merged,
-        shadow_options=MappingProxyType(shadow_options),
         effects=tuple(active),
         effect_params=MappingProxyType(params),
         models=MappingProxyType(sx.models),

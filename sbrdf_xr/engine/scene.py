@@ -8,7 +8,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import xarray as xr
@@ -17,18 +17,44 @@ from numpy.typing import ArrayLike
 from .. import catalog, geometry
 from ..errors import CatalogError, SceneError, ValidationError
 from ..materials.tables import validate_material
-from .effects import SCENE_OUTPUTS, SPECTRAL_OUTPUTS
+from .effects import DEFAULT_EFFECTS, SCENE_EFFECTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS, scene_effects
 from .knobs import KNOBS, PRESETS, apply_preset, check_knob
 from .plan import Plan, compile_plan
 from .sweep import GridGeometry, PairGeometry
+
+if TYPE_CHECKING:
+    from ..body.spacecraft import Spacecraft
+    from ..observing.observation import Observation
 
 __all__ = ["EFFECTS", "OUTPUTS", "PRESETS", "GridGeometry", "PairGeometry", "Scene"]
 
 #: Outputs a scene may ask for.
 OUTPUTS = tuple(SCENE_OUTPUTS)
-#: Effects a scene may ask for (the Earth's shadow comes with an observation).
-EFFECTS = ("sunlight", "shadowing", "earthshine", "thermal")
+#: Effects a scene may ask for (:data:`sbrdf_xr.engine.effects.EFFECTS` but those the
+#: geometry brings, such as the Earth's shadow of an observation).
+EFFECTS = SCENE_EFFECTS
 _ = SPECTRAL_OUTPUTS  # re-exported
+
+
+def _needs_to_earth(scene: Scene, effect: str) -> None:
+    if not scene.is_grid and scene.observation is None and scene.to_earth is None:
+        raise SceneError(
+            f"to_earth: explicit geometry with {effect} needs body-frame to_earth vectors"
+        )
+
+
+def _needs_observation(scene: Scene, effect: str) -> None:
+    if scene.observation is None:
+        raise SceneError(
+            f"effects: {effect} needs an observation (Scene(observation=...) or an "
+            "[observation] table): its source comes from the ephemeris at the observation's "
+            "times"
+        )
+
+
+#: What an effect may need from a scene (:attr:`sbrdf_xr.engine.effects.Effect.needs`),
+#: and the check that the scene has it.
+_NEEDS = {"to_earth": _needs_to_earth, "observation": _needs_observation}
 
 
 _UNIT_TOL = 1e-6
@@ -68,9 +94,13 @@ class Scene:
     ----------
     spacecraft : sbrdf_xr.body.spacecraft.Spacecraft
         The body.
-    materials : mapping of str to DataArray, optional
-        Material tables by name; default: every material of the spacecraft, loaded
-        from the catalog when first needed (:attr:`tables`), not by the constructor.
+    materials : mapping of str to DataArray or Dataset, optional
+        Material tables by name, or BRDF models (a model material of
+        :mod:`sbrdf_xr.materials.models`, as a scene file's model file), which move to
+        ``models``: a model is rendered to a table when the plan needs one, and evaluated
+        exactly with ``evaluation="analytic"``.  Default: every material of the
+        spacecraft, loaded from the catalog when first needed (:attr:`tables`), not by
+        the constructor.
     attitudes : array_like, shape (n, 4), optional
         Attitudes (body -> reference frame, scalar-last unit quaternions).
     phase_angles : array_like, shape (m,), optional
@@ -136,7 +166,8 @@ class Scene:
         Facet temperature [K] of the ``thermal`` effect, one for all or per material.
     models : mapping of str to Dataset, optional
         BRDF model parameters per material for ``evaluation="analytic"`` (default:
-        the catalog entry ``<material>-model``).
+        the catalog entry ``<material>-model``); a material with a model needs no table
+        for analytic evaluation.
     size_limit : float
         Factor on the limits of output size and work beyond which a plan is refused
         (:data:`sbrdf_xr.engine.plan.SIZE_LIMIT_BYTES`, :data:`sbrdf_xr.engine.plan.WORK_LIMIT`).
@@ -176,32 +207,32 @@ class Scene:
     sbrdf_xr.errors.SceneError: outputs: unknown ['colour']; allowed: spacecraft_sbrdf, signal, ...
     """
 
-    spacecraft: Any
-    materials: Mapping[str, xr.DataArray] | None = None
+    spacecraft: Spacecraft
+    materials: Mapping[str, xr.DataArray | xr.Dataset] | None = None
     attitudes: ArrayLike | None = None
     phase_angles: ArrayLike | None = None
     bisector: tuple[float, float, float] = (1.0, 0.0, 0.0)
     plane_normal: tuple[float, float, float] = (0.0, 0.0, 1.0)
     to_sun: ArrayLike | None = None
     to_observer: ArrayLike | None = None
-    observation: Any = None
+    observation: Observation | None = None
     attitude_angle: ArrayLike | None = None
     outputs: Sequence[str] = ("spacecraft_sbrdf", "signal", "brdf", "area")
-    effects: Sequence[str] = ("sunlight",)
-    method: str = "linear"
-    dtype: str = "float64"
+    effects: Sequence[str] = DEFAULT_EFFECTS
+    method: str = KNOBS["method"].default
+    dtype: str = KNOBS["dtype"].default
     merge: bool | None = None
-    shadow_method: str = "exact"
-    shadow_density: int = 4
-    wavelength_stride: int = 1
-    band_integration: str = "auto"
-    table_theta_step: float | None = None
-    evaluation: str = "table"
-    kernel: str = "fused"
-    tilt_nodes: int = 5
+    shadow_method: str = KNOBS["shadow_method"].default
+    shadow_density: int = KNOBS["shadow_density"].default
+    wavelength_stride: int = KNOBS["wavelength_stride"].default
+    band_integration: str = KNOBS["band_integration"].default
+    table_theta_step: float | None = KNOBS["table_theta_step"].default
+    evaluation: str = KNOBS["evaluation"].default
+    kernel: str = KNOBS["kernel"].default
+    tilt_nodes: int = KNOBS["tilt_nodes"].default
     surface_tilt: float | Mapping[str, float] = 0.0
-    chunk: int | None = None
-    block_bytes: int = 32 * 2**20
+    chunk: int | None = KNOBS["chunk"].default
+    block_bytes: int = KNOBS["block_bytes"].default
     bands: Sequence[str] = ()
     band_extrapolate: str | None = None
     earth_direction: tuple[float, float, float] = (0.0, -1.0, 0.0)
@@ -317,45 +348,91 @@ class Scene:
                 if e.shape != s.shape:
                     raise SceneError(f"to_earth {e.shape} and to_sun {s.shape} differ in shape")
                 object.__setattr__(self, "to_earth", e)
-            elif "earthshine" in self.effects:
-                raise SceneError(
-                    "to_earth: explicit geometry with earthshine needs body-frame to_earth vectors"
-                )
+        for effect in scene_effects(self.effects):
+            for need in effect.needs:
+                if need in _NEEDS:
+                    _NEEDS[need](self, effect.name)
         if self.materials is not None:
             self._check_tables(self.materials)
+            given = {m: v for m, v in self.materials.items() if isinstance(v, xr.Dataset)}
+            if given:  # a model given as a material is the material's model
+                tables = {m: v for m, v in self.materials.items() if m not in given}
+                object.__setattr__(self, "materials", tables)
+                object.__setattr__(self, "models", {**(self.models or {}), **given})
 
-    def _check_tables(self, materials: Mapping[str, xr.DataArray]) -> None:
-        missing = [m for m in self.spacecraft.materials if m not in materials]
+    def _check_tables(self, materials: Mapping[str, xr.DataArray | xr.Dataset]) -> None:
+        from ..materials.models import model_parameters
+
+        given_models = self.models or {}
+        missing = [
+            m for m in self.spacecraft.materials if m not in materials and m not in given_models
+        ]
         if missing:
-            raise SceneError(f"materials: no table for {missing}; given: {sorted(materials)}")
+            raise SceneError(
+                f"materials: no table for {missing} (nor a model); given: {sorted(materials)}"
+            )
         for name, da in materials.items():
             try:
-                validate_material(da, check_values=True)
+                if isinstance(da, xr.Dataset):
+                    if name in given_models:
+                        raise SceneError(
+                            f"material {name!r}: a model in both materials and models; give it once"
+                        )
+                    model_parameters(da)
+                else:
+                    validate_material(da, check_values=True)
             except ValidationError as exc:
                 raise SceneError(f"material {name!r}: {exc}") from None
 
     @cached_property
+    def material_data(self) -> Mapping[str, xr.DataArray | xr.Dataset]:
+        """What stands for each material, without rendering anything: its table (given, or
+        the catalog's when ``materials`` is not given) or, lacking one, its BRDF model
+        (given in ``materials`` or ``models``).
+
+        Raises
+        ------
+        SceneError
+            When a material of the spacecraft has neither (:attr:`tables`).
+        """
+        if self.materials is not None:
+            out = dict(self.materials)
+            models = self.models or {}
+            out.update({m: models[m] for m in self.spacecraft.materials if m not in out})
+            return out
+        out = {}
+        for m in self.spacecraft.materials:
+            try:  # in the scene's precision: a float32 scene holds no float64 copy of its tables
+                out[m] = catalog.load(m, dtype=self.dtype)
+            except CatalogError as exc:
+                if m in (self.models or {}):
+                    out[m] = (self.models or {})[m]
+                    continue
+                raise SceneError(
+                    f"materials: not given, and the catalog has no table for a material of "
+                    f"{self.spacecraft.name!r}: {exc}"
+                ) from None
+        self._check_tables({m: v for m, v in out.items() if isinstance(v, xr.DataArray)})
+        return out
+
+    @cached_property
     def tables(self) -> Mapping[str, xr.DataArray]:
         """The material tables by name: ``materials`` as given, or else every material of
-        the spacecraft loaded from the catalog on first use (the constructor reads no file).
+        the spacecraft loaded from the catalog on first use (the constructor reads no file);
+        a material given only as a BRDF model (in ``materials`` or ``models``) is rendered
+        to a table here, on first use (:func:`sbrdf_xr.materials.models.render`).
 
         Raises
         ------
         SceneError
             When a material of the spacecraft is neither given nor in the catalog.
         """
-        if self.materials is not None:
-            return self.materials
-        try:
-            # in the scene's precision: a float32 scene holds no float64 copy of its tables
-            tables = {m: catalog.load(m, dtype=self.dtype) for m in self.spacecraft.materials}
-        except CatalogError as exc:
-            raise SceneError(
-                f"materials: not given, and the catalog has no table for a material of "
-                f"{self.spacecraft.name!r}: {exc}"
-            ) from None
-        self._check_tables(tables)
-        return tables
+        from ..materials.models import render
+
+        out: dict[str, xr.DataArray] = {}
+        for m, v in self.material_data.items():
+            out[m] = render(v, dtype=np.dtype(self.dtype)) if isinstance(v, xr.Dataset) else v
+        return out
 
     # ----------------------------------------------------------- geometry
     @property
@@ -371,29 +448,33 @@ class Scene:
     @cached_property
     def geometry(self) -> GridGeometry | PairGeometry:
         """The sweep's geometry (:class:`GridGeometry` or :class:`PairGeometry`)."""
+        observed = None
         if self.observation is not None:
             from ..errors import ObservationError
 
             try:
-                g = self.observation.geometry()
+                observed = self.observation.geometry()
             except ObservationError as exc:
                 raise SceneError(f"observation: {exc}") from exc
-            return PairGeometry.from_observation(g, "earthshine" in self.effects, self.earth_albedo)
+        # the other sources of the effects asked for (their entries' geometry)
+        sources: dict[str, np.ndarray] = {}
+        for effect in scene_effects(self.effects):
+            if effect.geometry is not None:
+                sources.update(effect.geometry(self, observed))
+        if observed is not None:
+            return PairGeometry.from_observation(observed, sources)
         if self.is_grid:
             phase = np.asarray(self.phase_angles)
             s, o = geometry.observation_plane(phase, self.bisector, self.plane_normal)
-            e = None
-            if "earthshine" in self.effects:
-                e = geometry.normalize(self.earth_direction, "earth_direction")
-                e = np.broadcast_to(e, (len(phase), 3)).copy()
             return GridGeometry(
-                np.asarray(self.attitudes), phase, s, o, e, _optional_array(self.attitude_angle)
+                np.asarray(self.attitudes),
+                phase,
+                s,
+                o,
+                sources,
+                _optional_array(self.attitude_angle),
             )
-        return PairGeometry(
-            np.asarray(self.to_sun),
-            np.asarray(self.to_observer),
-            _optional_array(self.to_earth),
-        )
+        return PairGeometry(np.asarray(self.to_sun), np.asarray(self.to_observer), sources)
 
     def body_vectors(self, attitude_slice: slice | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Sun and observer unit vectors in the body frame.
@@ -410,7 +491,9 @@ class Scene:
     def earth_vectors(self, attitude_slice: slice | None = None) -> np.ndarray | None:
         """Unit vectors to the Earth in the body frame (shaped like :meth:`body_vectors`)."""
         if not self.is_grid:
-            return self.geometry.block(attitude_slice or slice(None)).to_earth
+            if self.to_earth is not None:
+                return np.asarray(self.to_earth)[attitude_slice or slice(None)]
+            return self.geometry.block(attitude_slice or slice(None)).sources.get("to_earth")
         att = np.asarray(self.attitudes)
         q = att if attitude_slice is None else att[attitude_slice]
         e = geometry.normalize(self.earth_direction, "earth_direction")
@@ -433,8 +516,9 @@ class Scene:
         same = not {"materials", "spacecraft"} & set(changes) and (
             self.materials is not None or new.dtype == self.dtype
         )
-        if "tables" in self.__dict__ and same:
-            new.__dict__["tables"] = self.__dict__["tables"]  # loaded once per scene family
+        for loaded in ("material_data", "tables"):
+            if loaded in self.__dict__ and same and "models" not in changes:
+                new.__dict__[loaded] = self.__dict__[loaded]  # loaded once per scene family
         return new
 
     def plan(self) -> Plan:

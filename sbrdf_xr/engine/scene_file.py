@@ -21,80 +21,22 @@ from .. import geometry
 from ..errors import CatalogError, SceneError, ValidationError, did_you_mean
 from .knobs import KNOBS
 from .scene import Scene
+from .schema import ATTITUDE_KEYS, GEOMETRY_KEYS, SCENE_KEYS, SPACECRAFT_KEYS, toml_types
 
 __all__ = [
     "MAX_SCENE_COUNT",
     "MAX_SHADOW_DENSITY",
+    "load_material_specs",
     "load_scene",
     "material_tables",
     "scene_from_dict",
 ]
 
 
-_SCENE_KEYS = {
-    "name": str,
-    "description": str,
-    "spacecraft": (str, dict),
-    "materials": dict,
-    "attitude": dict,
-    "phase_angles": list,
-    "bisector": list,
-    "plane_normal": list,
-    "geometry": dict,
-    "outputs": list,
-    "effects": list,
-    "method": str,
-    "dtype": str,
-    "merge": bool,
-    "shadow_method": str,
-    "shadow_density": int,
-    "chunk": int,
-    "wavelength_stride": int,
-    "band_integration": str,
-    "table_theta_step": (int, float),
-    "evaluation": str,
-    "kernel": str,
-    "block_bytes": int,
-    "size_limit": (int, float),
-    "tilt_nodes": int,
-    "surface_tilt": (int, float, dict),
-    "observation": dict,
-    "bands": list,
-    "band_extrapolate": str,
-    "earth_direction": list,
-    "earth_albedo": (int, float),
-    "earth_range_km": (int, float),
-    "earth_phase_angle": (int, float),
-    "temperature": (int, float, dict),
-}
-
-
-#: Keys of a ``[spacecraft]`` table (a mesh file; see :func:`load_scene`).
-_SPACECRAFT_KEYS = {
-    "path": str,
-    "material": str,
-    "material_map": (str, dict),
-    "length_unit": str,
-    "face_property": str,
-    "repair": bool,
-    "name": str,
-}
-
-
-_ATTITUDE_KEYS = {
-    "kind": str,
-    "axis": list,
-    "start": (int, float),
-    "stop": (int, float),
-    "step": (int, float),
-    "initial_axis": list,
-    "initial_angle": (int, float),
-    "n": int,
-    "seed": int,
-    "sequence": str,
-    "angles": list,
-    "quaternions": list,
-}
+_SCENE_KEYS = toml_types(SCENE_KEYS)
+_SPACECRAFT_KEYS = toml_types(SPACECRAFT_KEYS)
+_ATTITUDE_KEYS = toml_types(ATTITUDE_KEYS)
+_GEOMETRY_KEYS = toml_types(GEOMETRY_KEYS)
 
 
 def _check_keys(table: Any, allowed: Mapping[str, Any], where: str) -> None:
@@ -106,10 +48,9 @@ def _check_keys(table: Any, allowed: Mapping[str, Any], where: str) -> None:
                 f"{where}: unknown key {k!r}; {did_you_mean(k, allowed, 'allowed keys')}"
             )
         types = allowed[k]
-        if not isinstance(v, types) or (isinstance(v, bool) and types in (int, (int, float))):
-            names = " or ".join(
-                t.__name__ for t in (types if isinstance(types, tuple) else (types,))
-            )
+        types = types if isinstance(types, tuple) else (types,)
+        if not isinstance(v, types) or (isinstance(v, bool) and bool not in types):
+            names = " or ".join(t.__name__ for t in types)
             raise SceneError(
                 f"{where}: key {k!r} has type {type(v).__name__} ({_show(v)}); expected {names}"
             )
@@ -123,8 +64,9 @@ MAX_SCENE_COUNT = 10_000_000
 _MAX_COMPONENT = 1e100
 
 
-#: Largest shadow-sampling density a scene file may ask for (sub-facet samples per side).
-MAX_SHADOW_DENSITY = 64
+#: Largest shadow-sampling density a scene may ask for (sub-facet samples per side; the knob
+#: table's bound).
+MAX_SHADOW_DENSITY = int(KNOBS["shadow_density"].high or 0)
 
 
 def _show(v: Any) -> str:
@@ -330,6 +272,44 @@ def material_tables(
         raise SceneError(str(exc)) from None
 
 
+def load_material_specs(
+    specs: Mapping[str, str | Path],
+    base_dir: str | Path | None = None,
+    where: Mapping[str, str] | None = None,
+) -> dict[str, xr.DataArray | xr.Dataset]:
+    """Material tables and BRDF models from catalog names or netCDF files, nothing rendered:
+    what ``Scene(materials=...)`` takes (a model becomes a table only when a plan needs
+    one).  An error names where each material was given (``where``; default
+    ``"[materials]"``).
+
+    Raises
+    ------
+    CatalogError
+        For an unknown name or a file that does not exist.
+    SceneError
+        For an entry of another kind or a file that is neither a table nor a model.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.engine.scene_file import load_material_specs
+    >>> found = load_material_specs({"paint": "lambertian-grey-50", "cell": "tjpv-cell-model"})
+    >>> {m: type(v).__name__ for m, v in found.items()}
+    {'paint': 'DataArray', 'cell': 'Dataset'}
+    """
+    from .. import catalog
+
+    out: dict[str, xr.DataArray | xr.Dataset] = {}
+    for mat, spec in specs.items():
+        named = f"{(where or {}).get(mat, '[materials]')} {mat!r}"
+        try:
+            out[mat] = catalog.load_material_spec(spec, base_dir=base_dir)
+        except CatalogError as exc:
+            raise CatalogError(f"{named}: {exc}") from None
+        except ValidationError as exc:
+            raise SceneError(f"{named}: {exc}") from None
+    return out
+
+
 def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) -> Scene:
     """Build a scene from the contents of a scene file (see :func:`load_scene`); relative
     file names in it (mesh, material map and material files, an ``[observation]``'s
@@ -367,14 +347,10 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
     _check_keys(d, _SCENE_KEYS, "scene")
 
     kw: dict[str, Any] = {
-        k: d[k]
-        for k in ("name", "description", "method", "dtype", "merge", "band_extrapolate")
-        if k in d
+        k: d[k] for k in ("name", "description", "merge", "band_extrapolate") if k in d
     }
-    # the other numerical knobs (checked by the Scene against the knob table)
-    kw.update(
-        {k: d[k] for k in KNOBS if k in d and k not in kw and k not in ("chunk", "shadow_density")}
-    )
+    # the numerical knobs, checked by the Scene against the knob table
+    kw.update({k: d[k] for k in KNOBS if k in d})
     if "size_limit" in d:
         kw["size_limit"] = _number(d["size_limit"], "size_limit")
     if "surface_tilt" in d:
@@ -387,15 +363,6 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
     for k in ("earth_albedo", "earth_range_km", "earth_phase_angle"):
         if k in d:
             kw[k] = _number(d[k], k)
-    if "chunk" in d:
-        kw["chunk"] = _count(d["chunk"], "chunk")
-    if "shadow_density" in d:
-        sd = d["shadow_density"]
-        if not 1 <= sd <= MAX_SHADOW_DENSITY:
-            raise SceneError(
-                f"shadow_density: expected an integer from 1 to {MAX_SHADOW_DENSITY}, got {sd}"
-            )
-        kw["shadow_density"] = sd
     if "temperature" in d:
         t = d["temperature"]
         if isinstance(t, Mapping):
@@ -412,7 +379,7 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
             kw[k] = _vector(d[k], k)
     if "geometry" in d:
         g = d["geometry"]
-        _check_keys(g, {"to_sun": list, "to_observer": list, "to_earth": list}, "[geometry]")
+        _check_keys(g, _GEOMETRY_KEYS, "[geometry]")
         for k in ("to_sun", "to_observer"):
             if k not in g:
                 raise SceneError(f"[geometry]: key {k!r} is required (rows of 3 numbers)")
@@ -472,9 +439,7 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
                 f"string), got {_show(spec)}"
             )
         specs[mat] = spec
-    materials, given_models = material_tables(specs, base_dir, where)
-    if given_models:
-        kw["models"] = given_models
+    materials = load_material_specs(specs, base_dir, where)
     try:
         return Scene(sc, materials=materials, **kw)
     except SceneError:

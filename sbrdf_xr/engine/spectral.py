@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import xarray as xr
@@ -18,16 +18,16 @@ import xarray as xr
 from .. import catalog
 from .._names import ANGLE_DIMS, BAND, PSI, WAVELENGTH
 from ..errors import CatalogError, SceneError, ValidationError
+from ..kernels import PackedTables, pack_tables
 from ..kernels import anisotropic as _aniso_kernels
 from ..kernels.anisotropic import pack_anisotropic
 from ..kernels.lut import table_edges, table_normal_blend
-from ..kernels.sums import PackedTables, pack_tables
 from ..materials import models
 from ..photometry import band_weights
-from .effects import SPECTRAL_OUTPUTS
+from .effects.base import SPECTRAL_OUTPUTS
 
-#: The scene being compiled (:class:`sbrdf_xr.engine.Scene`).
-Scene = Any
+if TYPE_CHECKING:
+    from .scene import Scene
 
 
 def common_wavelength(scene: Scene, used: list[str]) -> np.ndarray:
@@ -54,9 +54,10 @@ def common_wavelength(scene: Scene, used: list[str]) -> np.ndarray:
     ...
     sbrdf_xr.errors.SceneError: materials 'grey' and 'far' have no wavelengths in common
     """
-    wl = np.asarray(scene.tables[used[0]][WAVELENGTH].values) if used else np.array([550.0])
+    data = scene.material_data  # tables, or models (the tables they render to share the grid)
+    wl = np.asarray(data[used[0]][WAVELENGTH].values) if used else np.array([550.0])
     for m in used[1:]:
-        other = np.asarray(scene.tables[m][WAVELENGTH].values)
+        other = np.asarray(data[m][WAVELENGTH].values)
         if other.shape != wl.shape or not np.allclose(other, wl, rtol=0, atol=1e-9):
             lo, hi = max(wl[0], other[0]), min(wl[-1], other[-1])
             if lo >= hi:
@@ -253,7 +254,7 @@ def spectral_stage(
     bands: skipped: no band output requested
     wavelength: 3 wavelengths 500-700 nm (every 2th)
     """
-    wl_full = common_wavelength(scene, used or list(scene.tables))
+    wl_full = common_wavelength(scene, used or list(scene.material_data))
     wl = wl_full[:: knobs["wavelength_stride"]]
     bw = None
     band_coords: dict[str, Any] = {}

@@ -1,120 +1,109 @@
-"""The stages of :func:`sbrdf_xr.engine.plan.compile_plan`: facet terms, the spectral axis and
-the material tables, thermal emission.
+"""The stages of :func:`sbrdf_xr.engine.plan.compile_plan`: the effects, the facet terms and
+the terms that contribute.
 
 Pure functions of a scene; the plan module assembles their results into the frozen
-:class:`~sbrdf_xr.engine.plan.Plan`.
+:class:`~sbrdf_xr.engine.plan.Plan`.  What each effect does is read from its entry of
+:data:`sbrdf_xr.engine.effects.EFFECTS`; no effect is named here.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .. import sources
-from .._names import MATERIAL, PSI
-from ..anisotropy import psi_average
+from .._names import MATERIAL
 from ..body.imperfections import tilt_quadrature, tilted_normals
 from ..errors import SceneError
-from ..materials.tables import hemispherical_reflectance
-from ..photometry import solar_spectrum
-from .spectral import table_on
+from .effects import EFFECTS, PlanInputs, scene_effects
 
-#: The scene being compiled (:class:`sbrdf_xr.engine.Scene`).
-Scene = Any
+if TYPE_CHECKING:
+    from .scene import Scene
 
-#: Thermal emission below this fraction of the reflected sunlight is not computed.
-THERMAL_NEGLIGIBLE = 1e-6
+__all__ = [
+    "DROP_BLOCK",
+    "contributing_terms",
+    "describe_bytes",
+    "effect_stage",
+    "facet_terms",
+    "tilted_terms",
+]
+
 #: Largest number of (geometry x term) dot products evaluated at once when
 #: searching for terms never lit and visible.
 DROP_BLOCK = 2_000_000
 
 
-def readonly(a: np.ndarray) -> np.ndarray:
-    """A C-contiguous, read-only copy (or view) of ``a``, for the frozen plan.
+def effect_stage(
+    inputs: PlanInputs, per_facet: bool, steps: list[tuple[str, str]]
+) -> tuple[list[str], dict[str, Mapping[str, Any]]]:
+    """Plan the per-facet effects (``per_facet=True``: they decide how the facets are
+    evaluated, so they come before the facet terms) or the others (after the spectral
+    axis): each effect's :attr:`~sbrdf_xr.engine.effects.Effect.plan` decides whether it
+    runs and gives its plan line and parameters; an effect the scene could ask for and
+    does not gets ``skipped: not requested``.
+
+    Returns
+    -------
+    active : list of str
+        The effects that run, in the order of :data:`~sbrdf_xr.engine.effects.EFFECTS`.
+    params : dict
+        Their parameters (read-only), by name.
 
     Examples
     --------
+    Thermal emission at 2-4 um, asked for, is not negligible: it runs with its
+    emissivity tables; earthshine, which the scene could ask for, is skipped:
+
     >>> import numpy as np
-    >>> from sbrdf_xr.engine.stages import readonly
-    >>> every_other = np.arange(6).reshape(2, 3)[:, ::2]
-    >>> r = readonly(every_other)
-    >>> r.tolist(), r.flags.c_contiguous, r.flags.writeable
-    ([[0, 2], [3, 5]], True, False)
-    >>> r[0, 0] = 1
-    Traceback (most recent call last):
-    ...
-    ValueError: assignment destination is read-only
-    """
-    a = np.ascontiguousarray(a)
-    a.flags.writeable = False
-    return a
-
-
-def shadow_stage(
-    scene: Scene, knobs: Mapping[str, Any], steps: list[tuple[str, str]]
-) -> tuple[bool, dict[str, Any]]:
-    """Whether the plan shadows (asked for, and the body is not convex), and how.
-
-    Examples
-    --------
-    >>> from sbrdf_xr import Scene
-    >>> from sbrdf_xr.engine.stages import shadow_stage
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.engine.effects import PlanInputs
+    >>> from sbrdf_xr.engine.stages import effect_stage
     >>> from sbrdf_xr.materials.schema import lambertian
-    >>> from sbrdf_xr.testing import cube_spacecraft, l_shaped_spacecraft
-    >>> paint = {"white-paint-a276": lambertian(0.8, [500.0, 600.0], material="white-paint-a276")}
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> wl = np.array([2000.0, 3000.0, 4000.0])
+    >>> grey = lambertian(0.5, wl, material="grey")
     >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
-    >>> def shadows(body):
-    ...     scene = Scene(body, paint, to_sun=x, to_observer=x, effects=("sunlight", "shadowing"))
-    ...     steps = []
-    ...     knobs = {k: getattr(scene, k) for k in scene.knob_names()}
-    ...     return shadow_stage(scene, knobs, steps), steps[0][1]
-    >>> shadows(cube_spacecraft())
-    ((False, {}), 'skipped: the body is convex, no facet can shadow another')
-    >>> shadows(l_shaped_spacecraft())
-    ((True, {'method': 'exact'}), 'exact self-shadowing and self-occlusion by polygon clipping \
-(non-convex body)')
+    >>> warm = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, effects=("sunlight", "thermal"))
+    >>> steps = []
+    >>> active, params = effect_stage(PlanInputs(warm, {}, wl, ("grey",)), False, steps)
+    >>> active, sorted(params)
+    (['sunlight', 'thermal'], ['thermal'])
+    >>> lines = dict(steps)
+    >>> lines["earthshine"], lines["thermal"].split("; ")[-1]
+    ('skipped: not requested', 'up to 1.8e-01 of reflected sunlight')
     """
-    want_shadow = "shadowing" in scene.effects
-    convex = bool(scene.spacecraft.is_convex) if want_shadow else None
-    shadowing = want_shadow and not convex
-    shadow_options: dict[str, Any] = {}
-    if not want_shadow:
-        steps.append(("shadowing", "skipped: not requested"))
-    elif convex:
-        steps.append(("shadowing", "skipped: the body is convex, no facet can shadow another"))
-    else:
-        shadow_options = {"method": knobs["shadow_method"]}
-        if knobs["shadow_method"] == "sampled":
-            shadow_options["density"] = knobs["shadow_density"]
-            steps.append(
-                (
-                    "shadowing",
-                    f"sampled self-shadowing and self-occlusion, "
-                    f"{knobs['shadow_density']}**2 samples per facet (non-convex body)",
-                )
-            )
-        else:
-            steps.append(
-                (
-                    "shadowing",
-                    "exact self-shadowing and self-occlusion by polygon clipping (non-convex body)",
-                )
-            )
-    return shadowing, shadow_options
+    scene = inputs.scene
+    active: list[str] = []
+    params: dict[str, Mapping[str, Any]] = {}
+    for e in EFFECTS.values():
+        if e.per_facet != per_facet:
+            continue
+        if e.when == "asked" and e.name not in scene.effects:
+            steps.append((e.name, "skipped: not requested"))
+            continue
+        d = e.plan(inputs)
+        if d.line:
+            steps.append((e.name, d.line))
+        if d.active:
+            active.append(e.name)
+            if d.params:
+                params[e.name] = MappingProxyType(dict(d.params))
+    return active, params
 
 
 def facet_terms(
     scene: Scene,
-    shadowing: bool,
+    per_facet: Sequence[str],
     steps: list[tuple[str, str]],
     aniso: frozenset[str] = frozenset(),
 ) -> tuple[dict[str, np.ndarray], bool]:
     """The facet terms (normal, area, material, first facet, facet count, tangent) and
     whether the facets were merged by (normal, material); merging is the default unless
-    the plan shadows.
+    a per-facet effect runs (``per_facet``: their titles).
 
     Examples
     --------
@@ -129,28 +118,29 @@ def facet_terms(
     >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
     >>> scene = Scene(box, {"grey": grey}, to_sun=x, to_observer=x)
     >>> steps = []
-    >>> terms, merged = facet_terms(scene, False, steps)
+    >>> terms, merged = facet_terms(scene, (), steps)
     >>> merged, sorted(terms), terms["area"].tolist(), terms["n_facets"].tolist()
     (True, ['area', 'facet', 'material', 'n_facets', 'normal', 'tangent'], \
 [1.0, 1.0, 1.0, 1.0, 1.0, 1.0], [2, 2, 2, 2, 2, 2])
     >>> steps[0][1]
     '12 facets -> 6 terms, merged by (normal, material): exact for flat facets, no per-facet \
 effect is on'
-    >>> facet_terms(scene, True, [])[0]["area"].shape  # shadowing: one term per facet
+    >>> facet_terms(scene, ("self-shadowing",), [])[0]["area"].shape  # one term per facet
     (12,)
     >>> merging = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, merge=True)
-    >>> facet_terms(merging, True, [])
+    >>> facet_terms(merging, ("self-shadowing",), [])
     Traceback (most recent call last):
     ...
     sbrdf_xr.errors.SceneError: merge: facets cannot be merged while self-shadowing is on \
 (a per-facet effect)
     """
     sc = scene.spacecraft
-    may_merge = not shadowing
+    may_merge = not per_facet
     merge = may_merge if scene.merge is None else bool(scene.merge)
     if merge and not may_merge:
         raise SceneError(
-            "merge: facets cannot be merged while self-shadowing is on (a per-facet effect)"
+            f"merge: facets cannot be merged while {' and '.join(per_facet)} is on "
+            "(a per-facet effect)"
         )
     f = sc.facets()
     n_fac = f.sizes["facet"]
@@ -175,7 +165,11 @@ effect is on'
             )
         )
     else:
-        why = "self-shadowing is per facet" if shadowing else "merging disabled by the scene"
+        why = (
+            f"{' and '.join(per_facet)} is per facet"
+            if per_facet
+            else "merging disabled by the scene"
+        )
         t = {
             "normal": np.asarray(f["normal"].values),
             "area": np.asarray(f["area"].values),
@@ -207,7 +201,7 @@ def tilted_terms(
     >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
     >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
     >>> flat = Scene(box, {"grey": grey}, to_sun=x, to_observer=x)
-    >>> raw, _ = facet_terms(flat, False, [])
+    >>> raw, _ = facet_terms(flat, (), [])
     >>> tilted_terms(flat, raw, 3, []) is raw  # no tilt: the terms as they were
     True
     >>> rough = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, surface_tilt=5.0)
@@ -255,8 +249,13 @@ def tilted_terms(
 
 
 def contributing_terms(scene: Scene, normals: np.ndarray) -> np.ndarray:
-    """Boolean per term: lit (by the Sun, or the Earth with earthshine) and visible for
-    at least one geometry of the sweep; with thermal emission, visible is enough.
+    """Boolean per term: lit by a source of the scene's effects and visible for at least
+    one geometry of the sweep; an emitting source (``source="facets"``) needs only
+    visible.
+
+    A distant source lights a term where its direction (:meth:`BlockInputs.direction
+    <sbrdf_xr.engine.effects.BlockInputs.direction>`) is above the term and its scale,
+    if any, is above 0 (the Sun in the Earth's umbra lights nothing).
 
     Examples
     --------
@@ -272,7 +271,7 @@ def contributing_terms(scene: Scene, normals: np.ndarray) -> np.ndarray:
     >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
     >>> y = [[0.0, 1.0, 0.0]]
     >>> scene = Scene(box, {"grey": grey}, to_sun=x, to_observer=y)
-    >>> raw, _ = facet_terms(scene, False, [])
+    >>> raw, _ = facet_terms(scene, (), [])
     >>> raw["normal"].tolist()
     [[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0], \
 [1.0, 0.0, 0.0]]
@@ -289,78 +288,26 @@ def contributing_terms(scene: Scene, normals: np.ndarray) -> np.ndarray:
     keep = np.zeros(len(normals), dtype=bool)
     per = max(1, geo.n_geometries // max(1, geo.n_lead))
     step = max(1, DROP_BLOCK // max(1, per * len(normals)))
-    thermal = "thermal" in scene.effects
+    lights = [e.source for e in scene_effects(scene.effects) if e.source is not None]
+    emits = "facets" in lights
     for start in range(0, geo.n_lead, step):
         b = geo.block(slice(start, start + step))
         visible = b.to_observer @ normals.T > 0
-        if thermal:
-            lit = True
-        else:
-            lit = b.to_sun @ normals.T > 0
-            if b.sun_scale is not None:
-                lit = lit & (b.sun_scale > 0)[:, None]
-            if "earthshine" in scene.effects and b.to_earth is not None:
-                lit = lit | (b.to_earth @ normals.T > 0)
+        lit: np.ndarray | bool = emits
+        if not emits:
+            for source in lights:
+                d = b.direction(source)
+                if d is None:
+                    continue
+                on = d @ normals.T > 0
+                scale = b.scale(source)
+                if scale is not None:
+                    on = on & (scale > 0)[:, None]
+                lit = lit | on
         keep |= (visible & lit).any(axis=0)
         if keep.all():
             break
     return keep
-
-
-def temperature(scene: Scene, material: str) -> float:
-    """The temperature [K] of a material: the scene's one value, or its entry in the
-    scene's mapping (300 K if it has none).
-
-    Examples
-    --------
-    >>> import trimesh
-    >>> from sbrdf_xr import Scene, load_spacecraft
-    >>> from sbrdf_xr.materials.schema import lambertian
-    >>> from sbrdf_xr.engine.stages import temperature
-    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
-    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
-    >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
-    >>> temperature(Scene(box, {"grey": grey}, to_sun=x, to_observer=x), "grey")
-    300.0
-    >>> hot = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, temperature={"grey": 350.0})
-    >>> temperature(hot, "grey"), temperature(hot, "paint")
-    (350.0, 300.0)
-    """
-    t = scene.temperature
-    return float(t.get(material, 300.0)) if isinstance(t, Mapping) else float(t)
-
-
-def thermal_to_reflected(scene: Scene, wl: np.ndarray) -> float:
-    """Largest ratio of blackbody radiance (emissivity 1) to the radiance of a white
-    Lambertian surface in sunlight, E_sun / pi, over the scene's wavelengths.
-
-    Examples
-    --------
-    At 300 K the emission is negligible in the visible but not at 2-4 um; at 600 K it
-    outshines the reflected sunlight there:
-
-    >>> import numpy as np
-    >>> import trimesh
-    >>> from sbrdf_xr import Scene, load_spacecraft
-    >>> from sbrdf_xr.materials.schema import lambertian
-    >>> from sbrdf_xr.engine.stages import THERMAL_NEGLIGIBLE, thermal_to_reflected
-    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
-    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
-    >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
-    >>> scene = Scene(box, {"grey": grey}, to_sun=x, to_observer=x)
-    >>> visible, infrared = np.array([500.0, 600.0, 700.0]), np.array([2000.0, 4000.0])
-    >>> ratio = thermal_to_reflected(scene, visible)
-    >>> f"{ratio:.1e}", ratio < THERMAL_NEGLIGIBLE
-    ('2.6e-24', True)
-    >>> round(thermal_to_reflected(scene, infrared), 3)
-    0.106
-    >>> hot = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, temperature=600.0)
-    >>> round(thermal_to_reflected(hot, infrared), 1)
-    42.7
-    """
-    e_sun = solar_spectrum(wl).values
-    b = np.max([sources.planck(wl, temperature(scene, m)) for m in scene.tables], axis=0)
-    return float(np.max(b / np.maximum(e_sun / np.pi, 1e-300)))
 
 
 def describe_bytes(n: float) -> str:
@@ -376,139 +323,3 @@ def describe_bytes(n: float) -> str:
         if n >= scale:
             return f"{n / scale:.3g} {unit}"
     return f"{n:.0f} B"
-
-
-def effect_stage(
-    scene: Scene,
-    wl: np.ndarray,
-    used: list[str],
-    pre: bool,
-    shadowing: bool,
-    steps: list[tuple[str, str]],
-) -> tuple[list[str], dict[str, Any]]:
-    """The effects a scene calls for (:data:`sbrdf_xr.engine.effects.EFFECTS` names) and their
-    parameters: sunlight always; shadowing, the Earth's shadow, earthshine and thermal
-    emission only where asked for and not negligible.  Appends the plan's lines.
-
-    Examples
-    --------
-    Thermal emission at 2-4 um: its emissivity is ``1 - rho`` (Kirchhoff), 0.5 for
-    a Lambertian of albedo 0.5; it is skipped when only bands of reflected light are
-    computed (``pre=True``):
-
-    >>> import numpy as np
-    >>> import trimesh
-    >>> from sbrdf_xr import Scene, load_spacecraft
-    >>> from sbrdf_xr.materials.schema import lambertian
-    >>> from sbrdf_xr.engine.stages import effect_stage
-    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
-    >>> wl = np.array([2000.0, 3000.0, 4000.0])
-    >>> grey = lambertian(0.5, wl, material="grey")
-    >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
-    >>> warm = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, effects=("sunlight", "thermal"))
-    >>> steps = []
-    >>> active, params = effect_stage(warm, wl, ["grey"], False, False, steps)
-    >>> active, sorted(params["thermal"])
-    (['sunlight', 'thermal'], ['emissivity', 'radiance', 'theta'])
-    >>> params["thermal"]["emissivity"][0].tolist(), params["thermal"]["theta"][0].tolist()
-    ([[0.5, 0.5, 0.5], [0.5, 0.5, 0.5]], [0.0, 90.0])
-    >>> effect_stage(warm, wl, ["grey"], True, False, [])
-    (['sunlight'], {})
-    >>> for name, line in steps:
-    ...     print(f"{name}: {line.split('; ')[-1]}")
-    earthshine: skipped: not requested
-    thermal: up to 1.8e-01 of reflected sunlight
-    """
-    geo = scene.geometry
-    active = ["sunlight"]
-    params: dict[str, Mapping[str, Any]] = {}
-    if shadowing:
-        active.append("shadowing")
-    if geo.sun_scale is not None:
-        active.append("eclipse")
-        dark = int(np.sum(geo.sun_scale <= 0))
-        part = int(np.sum((geo.sun_scale > 0) & (geo.sun_scale < 1)))
-        steps.append(
-            (
-                "eclipse",
-                f"Earth shadow: {dark} geometries in umbra skipped (no sunlight), "
-                f"{part} in penumbra scaled by the sunlit fraction of the solar disc",
-            )
-        )
-    if "earthshine" in scene.effects and getattr(geo, "earth_scale", None) is not None:
-        active.append("earthshine")
-        es = geo.earth_scale
-        params["earthshine"] = MappingProxyType({"ratio": float(np.max(es)) if es.size else 0.0})
-        steps.append(
-            (
-                "earthshine",
-                f"Lambertian Earth (albedo {scene.earth_albedo:g}) at the observation's "
-                f"distance and phase at every time: irradiance {np.min(es):.3g}-{np.max(es):.3g} "
-                "of the Sun's, a second distant source",
-            )
-        )
-    elif "earthshine" in scene.effects:
-        ratio = sources.earthshine_irradiance_ratio(
-            scene.earth_albedo, scene.earth_range_km, scene.earth_phase_angle
-        )
-        active.append("earthshine")
-        params["earthshine"] = MappingProxyType({"ratio": ratio})
-        steps.append(
-            (
-                "earthshine",
-                f"Lambertian Earth (albedo {scene.earth_albedo:g}, range "
-                f"{scene.earth_range_km:g} km, phase {scene.earth_phase_angle:g} deg): irradiance "
-                f"{ratio:.3g} of the Sun's, a second distant source",
-            )
-        )
-    else:
-        steps.append(("earthshine", "skipped: not requested"))
-    if "thermal" not in scene.effects:
-        steps.append(("thermal", "skipped: not requested"))
-    else:
-        worst = thermal_to_reflected(scene, wl)
-        if worst < THERMAL_NEGLIGIBLE:
-            steps.append(
-                (
-                    "thermal",
-                    f"skipped: negligible, at most {worst:.1e} of reflected sunlight "
-                    f"at {wl[0]:g}-{wl[-1]:g} nm",
-                )
-            )
-        elif pre:
-            steps.append(
-                (
-                    "thermal",
-                    f"skipped: up to {worst:.1e} of reflected sunlight, but only band "
-                    "outputs of reflected light are asked for; add the 'signal' output for "
-                    "thermal_intensity",
-                )
-            )
-        else:
-            active.append("thermal")
-            eps, thetas, rad = [], [], []
-            for m in used:
-                da = table_on(scene.tables[m], wl, None)
-                th = np.asarray(da["theta_i"].values, dtype=np.float64)
-                rho_da = hemispherical_reflectance(da, th, warn=False)
-                rho = (
-                    psi_average(rho_da.values, da[PSI].values, 1)
-                    if PSI in rho_da.dims
-                    else rho_da.values
-                )
-                eps.append(readonly(sources.kirchhoff_emissivity(rho)))
-                thetas.append(readonly(th))
-                rad.append(readonly(sources.planck(wl, temperature(scene, m))))
-            params["thermal"] = MappingProxyType(
-                {"emissivity": tuple(eps), "theta": tuple(thetas), "radiance": tuple(rad)}
-            )
-            steps.append(
-                (
-                    "thermal",
-                    "epsilon(lambda, theta) B(lambda, T) per term, epsilon = 1 - rho "
-                    "(Kirchhoff) from each table's hemispherical reflectance at its theta_i nodes, "
-                    f"linear in the emission angle; up to {worst:.1e} of reflected sunlight",
-                )
-            )
-
-    return active, params

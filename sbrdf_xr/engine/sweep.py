@@ -8,22 +8,27 @@ A scene's geometry is one of
   body frame, one per geometry, or per time of an observation (with the sunlit
   fraction of the Earth's shadow and the observation's coordinates).
 
-Both hand the engine blocks of body-frame directions (:meth:`block`) and the cube
-its coordinates (:meth:`coords`).
+Both hand the engine blocks of body-frame directions (:meth:`block`), with the other
+sources' directions and scales that the effects put in their ``sources``
+(:attr:`sbrdf_xr.engine.effects.Effect.geometry`), and the cube its coordinates
+(:meth:`coords`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from .. import geometry
 from .._names import ATTITUDE, GEOMETRY, PHASE_ANGLE, VECTOR, attrs
-from .effects import BlockInputs
+from .effects.base import BlockInputs
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 __all__ = ["QUATERNION_COMPONENTS", "GridGeometry", "PairGeometry"]
 
@@ -48,12 +53,14 @@ class GridGeometry:
     >>> from sbrdf_xr.engine.sweep import GridGeometry
     >>> to_sun, to_observer = observation_plane([10.0, 90.0])
     >>> grid = GridGeometry(axis_rotation([0, 0, 1], [0.0, 90.0, 180.0]), np.array([10.0, 90.0]),
-    ...                     to_sun, to_observer, None)
+    ...                     to_sun, to_observer, {"to_moon": to_sun[::-1]})
     >>> grid.dims, grid.shape, grid.describe()
     (('attitude', 'phase_angle'), (3, 2), '3 attitudes x 2 phase angles = 6 geometries')
     >>> block = grid.block(slice(1, 2))  # the second attitude, in the body frame
     >>> block.lead_shape, np.round(block.to_sun[1], 6) + 0.0
     ((1, 2), array([ 0.707107, -0.707107,  0.      ]))
+    >>> np.round(block.sources["to_moon"][0], 6) + 0.0  # turned like the Sun
+    array([ 0.707107, -0.707107,  0.      ])
     >>> sorted(grid.coords())
     ['attitude', 'component', 'phase_angle', 'quaternion', 'to_observer', 'to_sun']
     """
@@ -62,7 +69,8 @@ class GridGeometry:
     phase_angles: np.ndarray  #: (P,) [degree]
     sun_ref: np.ndarray  #: (P, 3)
     obs_ref: np.ndarray  #: (P, 3)
-    earth_ref: np.ndarray | None  #: (P, 3), with earthshine
+    #: Other sources per phase angle: (P, 3) reference-frame directions, (P,) scales.
+    sources: Mapping[str, np.ndarray] = field(default_factory=dict)
     attitude_angle: np.ndarray | None = None
     sun_scale: None = None
 
@@ -106,8 +114,11 @@ class GridGeometry:
             return (v[:, :, 0] * r0 + v[:, :, 1] * r1 + v[:, :, 2] * r2).reshape(-1, 3)
 
         s, o = body(self.sun_ref), body(self.obs_ref)
-        e = None if self.earth_ref is None else body(self.earth_ref)
-        return BlockInputs(s, o, e, None, (len(q), p))
+        extra = {
+            k: body(v) if v.ndim == 2 else np.broadcast_to(v, (len(q), p)).reshape(-1)
+            for k, v in self.sources.items()
+        }
+        return BlockInputs(s, o, None, (len(q), p), extra)
 
     def coords(self) -> dict[str, Any]:
         """Coordinates of a cube over this geometry."""
@@ -134,6 +145,7 @@ class GridGeometry:
 class PairGeometry:
     """Explicit ``(to_sun, to_observer)`` pairs in the body frame, one per geometry.
 
+    ``sources`` are the other sources' body-frame directions (n, 3) and scales (n,);
     ``dim`` names the dimension (``geometry``, or ``time`` for an observation);
     ``sun_scale`` is the sunlit fraction of the solar disc per geometry (the Earth's
     shadow), or None; ``extra_coords`` are further coordinates along ``dim``.
@@ -153,9 +165,8 @@ class PairGeometry:
 
     to_sun: np.ndarray
     to_observer: np.ndarray
-    to_earth: np.ndarray | None = None
+    sources: Mapping[str, np.ndarray] = field(default_factory=dict)
     sun_scale: np.ndarray | None = None
-    earth_scale: np.ndarray | None = None
     dim: str = GEOMETRY
     index: Any = None
     extra_coords: Mapping[str, Any] = field(default_factory=dict)
@@ -191,11 +202,10 @@ class PairGeometry:
         )
 
     def block(self, sl: slice) -> BlockInputs:
-        e = None if self.to_earth is None else self.to_earth[sl]
         sc = None if self.sun_scale is None else self.sun_scale[sl]
-        es = None if self.earth_scale is None else self.earth_scale[sl]
         s = self.to_sun[sl]
-        return BlockInputs(s, self.to_observer[sl], e, sc, (s.shape[0],), es)
+        extra = {k: v[sl] for k, v in self.sources.items()}
+        return BlockInputs(s, self.to_observer[sl], sc, (s.shape[0],), extra)
 
     def coords(self) -> dict[str, Any]:
         """Coordinates of a cube over these geometries (an observation adds its own)."""
@@ -214,32 +224,19 @@ class PairGeometry:
         return c
 
     @classmethod
-    def from_observation(cls, g: Any, with_earth: bool, earth_albedo: float = 0.3) -> PairGeometry:
+    def from_observation(cls, g: xr.Dataset, sources: Mapping[str, np.ndarray]) -> PairGeometry:
         """The geometry of an observation (:meth:`sbrdf_xr.observing.observe.Observation.geometry`):
-        a ``time`` dimension, the sunlit fraction as the Sun's scale, and, with
-        earthshine, the Earth's irradiance per time from its distance and phase."""
-        from ..sources import earthshine_irradiance_ratio
-
+        a ``time`` dimension, the sunlit fraction as the Sun's scale, and the other
+        sources per time (from the effects that ask for them)."""
         dim = "time"
         extra = {str(k): g[k].variable for k in g.coords if k not in ("xyz", "component")}
         extra["quaternion"] = g["quaternion"].variable
         extra["component"] = g["component"].variable
-        earth_scale = None
-        if with_earth:
-            earth_scale = np.array(
-                [
-                    earthshine_irradiance_ratio(earth_albedo, r, a)
-                    for r, a in zip(
-                        g["earth_distance"].values, g["earth_phase_angle"].values, strict=True
-                    )
-                ]
-            )
         return cls(
             np.ascontiguousarray(g["to_sun"].values),
             np.ascontiguousarray(g["to_observer"].values),
-            np.ascontiguousarray(g["to_earth"].values) if with_earth else None,
+            dict(sources),
             np.asarray(g["sunlit_fraction"].values, dtype=np.float64),
-            earth_scale,
             dim,
             g[dim].variable,
             extra,

@@ -37,15 +37,14 @@ import re
 import threading
 import weakref
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .._version import __version__
 
-#: The scene being fingerprinted (:class:`sbrdf_xr.engine.Scene`, two layers up, which
-#: imports this module; not imported here, even for type checking, to keep the flow).
-Scene = Any
+if TYPE_CHECKING:  # the engine imports this module
+    from ..engine.scene import Scene
 
 __all__ = ["PREFIX", "changes", "scene_fingerprint"]
 
@@ -181,7 +180,12 @@ def _sha(*parts: str) -> str:
 
 
 def _table_sha(da: Any) -> str:
-    """Values, dims, every coordinate and the attributes of one material table."""
+    """Values, dims, every coordinate and the attributes of one material table (or of each
+    variable of a model material)."""
+    if hasattr(da, "data_vars"):  # a model (Dataset): every variable, and its attributes
+        parts = [f"{k}={_table_sha(da[k])}" for k in sorted(map(str, da.data_vars))]
+        attrs = {k: v for k, v in da.attrs.items() if k not in _VOLATILE_TABLE_ATTRS}
+        return _sha(*parts, _json(attrs))
     parts = [_array_sha(np.asarray(da.values)), _json(list(map(str, da.dims)))]
     for name in sorted(map(str, da.coords)):
         c = da.coords[name]
@@ -282,7 +286,7 @@ def scene_fingerprint(scene: Scene) -> dict[str, str]:
     >>> scene_fingerprint(same) == fp
     True
     """
-    materials = dict(scene.tables)
+    materials = dict(scene.material_data)  # a table, or the model of a material without one
     names = sorted(materials)
     suffix = _attr_suffixes(names)
     out: dict[str, str] = {}
@@ -295,7 +299,7 @@ def scene_fingerprint(scene: Scene) -> dict[str, str]:
                 n: {
                     "material": materials[n].attrs.get("material"),
                     "source": materials[n].attrs.get("source"),
-                    "name": materials[n].name,
+                    "name": getattr(materials[n], "name", None),
                 }
                 for n in names
             }

@@ -1,37 +1,55 @@
-"""The effects a simulation can include, each declared once, and the outputs of a cube.
+"""What every effect is made of: the :class:`Effect` record, the outputs of a cube, what
+a block of geometries hands an effect, and the facet sums of a distant source.
 
-Every effect is one :class:`Effect` entry of :data:`EFFECTS` (in the manner of
-flox's ``Aggregation`` table): what it needs from the scene, the source it adds
-(its direction and irradiance relative to the Sun), how a term contributes (a
-function run on every block), the outputs it fills, and the line it writes in
-the plan.  :mod:`sbrdf_xr.engine.plan` resolves the entries a scene asks for and
-:mod:`sbrdf_xr.engine.run` runs them generically; adding an effect is one entry
-here plus its tests.
-
-Every variable a cube can hold is one :class:`Output` of :data:`OUTPUTS`, with its
-dimensions and CF attributes, defined once.
+An effect lives in its own module of :mod:`sbrdf_xr.engine.effects` as one
+:class:`Effect`; the registry there lists them.  Every variable a cube can hold is one
+:class:`Output`: the core ones here (:data:`CORE_OUTPUTS`), an effect's own in its
+:attr:`Effect.declares`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .. import sources
-from .._names import BAND, MATERIAL, WAVELENGTH
-from ..kernels import anisotropic as _aniso_kernels
-from ..kernels import sums as _kernels
+from ... import kernels as _kernels
+from ..._names import BAND, MATERIAL, WAVELENGTH
+from ...errors import ValidationError
+from ...kernels import anisotropic as _aniso_kernels
 
-#: The compiled plan effects run on (:class:`sbrdf_xr.engine.plan.Plan`, which imports this module).
-Plan = Any
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from ..plan import Plan
+    from ..scene import Scene
+
+__all__ = [
+    "CORE_OUTPUTS",
+    "SCENE_OUTPUTS",
+    "SPECTRAL_OUTPUTS",
+    "WHEN",
+    "BlockInputs",
+    "Decision",
+    "Effect",
+    "Output",
+    "PlanInputs",
+    "facet_fraction",
+    "finish",
+    "readonly",
+    "reflected",
+]
 
 
 @dataclass(frozen=True)
 class BlockInputs:
     """Body-frame directions of one block of geometries, flattened to (G, 3).
+
+    ``sources`` holds what the effects' geometry adds per geometry (their
+    :attr:`Effect.geometry`): a source's direction as ``to_<source>`` (G, 3) and its
+    irradiance relative to the Sun's as ``<source>_scale`` (G,).
 
     Examples
     --------
@@ -49,28 +67,25 @@ class BlockInputs:
     ((1, 2), (2, 3))
     >>> block.to_sun.round(4).tolist()  # phase 0 and 60 deg about the bisector +x
     [[1.0, 0.0, 0.0], [0.866, 0.5, 0.0]]
-    >>> block.sun_scale is None  # no Earth shadow: the whole solar disc
-    True
+    >>> block.sun_scale is None, dict(block.sources)  # no Earth shadow, no other source
+    (True, {})
+    >>> block.direction("sun") is block.to_sun, block.direction("earth")
+    (True, None)
     """
 
     to_sun: np.ndarray
     to_observer: np.ndarray
-    to_earth: np.ndarray | None
     sun_scale: np.ndarray | None  #: (G,) sunlit fraction of the solar disc, or None (1)
     lead_shape: tuple[int, ...]  #: the block's geometry dimensions before flattening
-    earth_scale: np.ndarray | None = None  #: (G,) earthshine irradiance / the Sun's, or None
+    sources: Mapping[str, np.ndarray] = field(default_factory=dict)
 
+    def direction(self, source: str) -> np.ndarray | None:
+        """Unit vectors (G, 3) towards ``source`` (``"sun"`` or a key of :attr:`sources`)."""
+        return self.to_sun if source == "sun" else self.sources.get(f"to_{source}")
 
-__all__ = [
-    "EFFECTS",
-    "OUTPUTS",
-    "SPECTRAL_OUTPUTS",
-    "BlockInputs",
-    "Effect",
-    "Output",
-    "finish",
-    "reflected",
-]
+    def scale(self, source: str) -> np.ndarray | None:
+        """Irradiance of ``source`` relative to the Sun's unshadowed (G,), or None (constant)."""
+        return self.sun_scale if source == "sun" else self.sources.get(f"{source}_scale")
 
 
 @dataclass(frozen=True)
@@ -111,8 +126,8 @@ class Output:
         return {"units": self.units, "long_name": self.long_name}
 
 
-#: Every output variable a cube may hold.
-OUTPUTS: dict[str, Output] = {
+#: The variables of a cube that no single effect owns (an effect's own are in its entry).
+CORE_OUTPUTS: dict[str, Output] = {
     o.name: o
     for o in (
         Output(
@@ -151,22 +166,6 @@ OUTPUTS: dict[str, Output] = {
             "radiometric signal of each material's facets",
         ),
         Output(
-            "signal_earthshine",
-            (WAVELENGTH,),
-            True,
-            "m2 sr-1",
-            "radiometric signal of the light reflected from a Lambertian Earth, per unit solar "
-            "irradiance",
-        ),
-        Output(
-            "thermal_intensity",
-            (WAVELENGTH,),
-            True,
-            "W sr-1 nm-1",
-            "thermal emission intensity "
-            "sum_j A_j cos(theta_r) epsilon(lambda, theta_r) B(lambda, T)",
-        ),
-        Output(
             "band_signal",
             (BAND,),
             True,
@@ -191,7 +190,207 @@ SCENE_OUTPUTS: dict[str, str] = {
 SPECTRAL_OUTPUTS = ("spacecraft_sbrdf", "signal", "brdf", "per_material")
 
 
+# ------------------------------------------------------------------ the record
+
+
+def readonly(a: np.ndarray) -> np.ndarray:
+    """A C-contiguous, read-only copy (or view) of ``a``, for the frozen plan.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.engine.effects import readonly
+    >>> every_other = np.arange(6).reshape(2, 3)[:, ::2]
+    >>> r = readonly(every_other)
+    >>> r.tolist(), r.flags.c_contiguous, r.flags.writeable
+    ([[0, 2], [3, 5]], True, False)
+    >>> r[0, 0] = 1
+    Traceback (most recent call last):
+    ...
+    ValueError: assignment destination is read-only
+    """
+    a = np.ascontiguousarray(a)
+    a.flags.writeable = False
+    return a
+
+
+@dataclass(frozen=True)
+class PlanInputs:
+    """What an effect's planner (:attr:`Effect.plan`) is given.
+
+    Per-facet effects are planned before the facet terms exist (``wavelength`` None,
+    ``materials`` empty); the others once the spectral axis is known.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.engine.effects import EFFECTS, PlanInputs
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> x = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x
+    >>> scene = Scene(box, {"grey": grey}, to_sun=x, to_observer=x, effects=("shadowing",))
+    >>> inputs = PlanInputs(scene, {"shadow_method": "exact"})
+    >>> EFFECTS["shadowing"].plan(inputs)  # a box is convex
+    Decision(active=False, line='skipped: the body is convex, no facet can shadow another', \
+params={})
+    """
+
+    scene: Scene
+    knobs: Mapping[str, Any]
+    wavelength: np.ndarray | None = None  #: [nm], None before the spectral stage
+    materials: tuple[str, ...] = ()  #: the materials of the contributing terms
+    pre_integrated: bool = False  #: the tables are integrated over the bands
+
+
+@dataclass(frozen=True)
+class Decision:
+    """What an effect's planner decided: whether it runs, its plan line, its parameters.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.engine.effects import Decision
+    >>> Decision(True, "a second distant source", {"ratio": 0.01}).active
+    True
+    """
+
+    active: bool
+    line: str | None = None  #: the plan's line for the effect (None: none)
+    params: Mapping[str, Any] = field(default_factory=dict)  #: ``plan.effect_params[name]``
+
+
+def runs(inputs: PlanInputs) -> Decision:
+    """The planner of an effect that always runs as asked, without a plan line."""
+    return Decision(True)
+
+
+#: Who turns an effect on: the engine always, the scene (``Scene(effects=...)``), or the
+#: geometry (an observation brings the Earth's shadow).
+WHEN = ("always", "asked", "automatic")
+
+
+@dataclass(frozen=True)
+class Effect:
+    """One effect a simulation can include: everything the engine knows about it.
+
+    Attributes
+    ----------
+    name : str
+        Name used in ``Scene(effects=...)`` and in the plan.
+    title : str
+        A short name for sentences (``"self-shadowing"``).
+    description : str
+        What it computes, with the equation it follows.
+    when : {"always", "asked", "automatic"}
+        Who turns it on (:data:`WHEN`); an ``asked`` effect the scene does not ask for
+        gets the plan line ``skipped: not requested``.
+    source : str or None
+        The light it adds: a distant source whose light the facets reflect (``"sun"``,
+        ``"earth"``, ``"moon"``; one kernel pass per block each, its direction and scale
+        in :class:`BlockInputs`), ``"facets"`` for their own emission (every visible
+        term contributes), or None for an effect that changes the others (shadowing,
+        the Earth's shadow).
+    needs : tuple of str
+        What it needs from the scene: ``"to_earth"`` (explicit geometry pairs must give
+        body-frame Earth vectors), ``"observation"`` (only an observation's geometry
+        will do), ``"mesh"``, ``"sunlit_fraction"``; :class:`~sbrdf_xr.engine.Scene`
+        refuses a scene without them.
+    outputs : tuple of str
+        The :data:`OUTPUTS <sbrdf_xr.engine.effects.OUTPUTS>` it fills.
+    declares : tuple of Output
+        Its own variables, added to the cube whenever it runs (those over wavelength
+        only when the plan keeps the spectrum).
+    band : tuple of str
+        Its sums that add up to ``band_signal``.
+    plan : callable
+        ``plan(PlanInputs) -> Decision``: whether it runs (asked, and not negligible),
+        its plan line and its parameters (``plan.effect_params[name]``).
+    contribute : callable or None
+        ``contribute(plan, block) -> {name: array}`` on every block; sums of the same
+        name from several effects add up.
+    fraction : callable or None
+        ``fraction(plan, to_source, to_observer) -> (G, T) array``: the lit-and-visible
+        fraction of every term that it applies to every reflected source.  Such an
+        effect is per facet: it is planned before the facet terms and facets are not
+        merged while it runs.
+    reads : tuple of str
+        The scene fields (and scene-file keys) that are its parameters, for the
+        reference of the scene files (:func:`sbrdf_xr.engine.schema.reference`).
+    geometry : callable or None
+        ``geometry(scene, observed) -> {name: array}``: its source's directions and
+        scales for the sweep (``observed`` is the observation's geometry, or None for a
+        grid or explicit pairs): (P, 3) reference-frame directions and (P,) scales per
+        phase angle for a grid, (n, 3) body-frame directions and (n,) scales otherwise.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.engine.effects import EFFECTS
+    >>> e = EFFECTS["earthshine"]
+    >>> e.needs, e.source, e.when
+    (('to_earth',), 'earth', 'asked')
+    >>> e.outputs, e.reflects
+    (('signal_earthshine', 'band_signal'), True)
+    >>> EFFECTS["shadowing"].contribute is None, EFFECTS["shadowing"].per_facet
+    (True, True)
+    """
+
+    name: str
+    title: str
+    description: str
+    when: str
+    source: str | None
+    needs: tuple[str, ...] = ()
+    outputs: tuple[str, ...] = ()
+    declares: tuple[Output, ...] = ()
+    band: tuple[str, ...] = ()
+    reads: tuple[str, ...] = ()
+    plan: Callable[[PlanInputs], Decision] = runs
+    contribute: Callable[[Plan, BlockInputs], Mapping[str, np.ndarray]] | None = None
+    fraction: Callable[[Plan, np.ndarray, np.ndarray], np.ndarray] | None = None
+    geometry: Callable[[Scene, xr.Dataset | None], Mapping[str, np.ndarray]] | None = None
+
+    def __post_init__(self) -> None:
+        if self.when not in WHEN:
+            raise ValidationError(f"effect {self.name!r}: when={self.when!r}; allowed: {WHEN}")
+
+    @property
+    def reflects(self) -> bool:
+        """Its light comes from a distant source and the facets reflect it (a kernel pass)."""
+        return self.source is not None and self.source != "facets"
+
+    @property
+    def per_facet(self) -> bool:
+        """It changes each facet's lit-and-visible fraction (facets are not merged)."""
+        return self.fraction is not None
+
+
 # ------------------------------------------------------------- contributions
+
+
+def facet_fraction(plan: Plan, to_source: np.ndarray, to_observer: np.ndarray) -> np.ndarray | None:
+    """The lit-and-visible fraction (G, T) of every term for a source in ``to_source``:
+    the product of the plan's per-facet effects (:attr:`Effect.fraction`), or None (1).
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.engine.effects import facet_fraction
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> plan = Scene(box, {"grey": grey}, attitudes=[[0, 0, 0, 1.0]], phase_angles=[0]).plan()
+    >>> block = plan.geometry.block(slice(None))
+    >>> facet_fraction(plan, block.to_sun, block.to_observer) is None  # no shadowing
+    True
+    """
+    frac = None
+    for effect in plan.active_effects:
+        if effect.fraction is not None:
+            f = effect.fraction(plan, to_source, to_observer)
+            frac = f if frac is None else frac * f
+    return frac
 
 
 def reflected(
@@ -296,7 +495,9 @@ def _analytic_sums(
             continue
         eff = t.area[j] * (1.0 if fraction is None else fraction[on, j])
         model, kw = plan.models[t.material[j]]
-        tangent = {"tangent": t.tangent[j]} if getattr(model, "anisotropic", False) else {}
+        tangent = {}
+        if getattr(model, "anisotropic", False) and t.tangent is not None:
+            tangent = {"tangent": t.tangent[j]}
         f = model.brdf(n, s[on], o[on], wl, **kw, **tangent)
         a2d = eff * cr[on]
         area[on] += a2d
@@ -306,180 +507,13 @@ def _analytic_sums(
         pap[on] += a2d[:, None] * f
         if pm is not None:
             pm[on, t.material[j]] += contrib
-    if plan.pre_integrated:
-        sig, pap = sig @ plan.band_weights.T, pap @ plan.band_weights.T
-        pm = None if pm is None else pm @ plan.band_weights.T
+    if plan.pre_integrated and plan.band_weights is not None:
+        bw = plan.band_weights
+        sig, pap = sig @ bw.T, pap @ bw.T
+        pm = None if pm is None else pm @ bw.T
     return _kernels.FusedSums(
         sig.astype(dt), pap.astype(dt), area, lit, None if pm is None else pm.astype(dt)
     )
-
-
-def _shadow_fraction(
-    plan: Plan, to_source: np.ndarray, to_observer: np.ndarray
-) -> np.ndarray | None:
-    if not plan.shadowing:
-        return None
-    from ..body.visibility import lit_visible_fraction
-
-    frac = lit_visible_fraction(plan.spacecraft, to_source, to_observer, **plan.shadow_options)
-    return np.ascontiguousarray(np.asarray(frac)[:, plan.terms.facet])
-
-
-def _sunlight(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
-    """Reflected sunlight; in the Earth's umbra nothing is evaluated (the sums are 0), in
-    the penumbra the signal is scaled by the sunlit fraction of the solar disc."""
-    scale = block.sun_scale
-    if scale is not None and not np.all(scale > 0):
-        lit = np.flatnonzero(scale > 0)
-        sub = BlockInputs(block.to_sun[lit], block.to_observer[lit], None, scale[lit], (lit.size,))
-        part = _sunlight(plan, sub) if lit.size else None
-        g, n = (
-            block.to_sun.shape[0],
-            plan.tables.n_spectral
-            if plan.knobs["evaluation"] == "table"
-            else (len(plan.bands) if plan.pre_integrated else plan.wavelength.size),
-        )
-        dt = np.dtype(plan.knobs["dtype"])
-        out = {"signal": np.zeros((g, n), dt), "paper": np.zeros((g, n), dt), "area": np.zeros(g)}
-        if "signal_material" in plan.output_names:
-            out["signal_material"] = np.zeros((g, len(plan.materials), n), dt)
-        if part is not None:
-            for k in out:
-                out[k][lit] = part[k]
-        return out
-    frac = _shadow_fraction(plan, block.to_sun, block.to_observer)
-    r = reflected(plan, block, block.to_sun, frac, "signal_material" in plan.output_names)
-    out = {"signal": r.signal, "paper": r.paper, "area": r.area}
-    if r.per_material is not None:
-        out["signal_material"] = r.per_material
-    if scale is not None:  # the Earth's penumbra scales the irradiance, not the geometry
-        sc = scale.astype(r.signal.dtype)
-        out["signal"] = r.signal * sc[:, None]
-        if r.per_material is not None:
-            out["signal_material"] = r.per_material * sc[:, None, None]
-    return out
-
-
-def _earthshine(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
-    to_earth = block.to_earth
-    assert to_earth is not None  # blocks carry Earth vectors whenever earthshine is on
-    frac = _shadow_fraction(plan, to_earth, block.to_observer)
-    r = reflected(plan, block, to_earth, frac, False)
-    if block.earth_scale is not None:  # per geometry (an observation's Earth distance and phase)
-        return {"signal_earthshine": (block.earth_scale[:, None] * r.signal).astype(r.signal.dtype)}
-    ratio = plan.effect_params["earthshine"]["ratio"]
-    return {"signal_earthshine": (ratio * r.signal).astype(r.signal.dtype)}
-
-
-def _thermal(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
-    """``sum_j A_j cos(theta_r) epsilon_j(lambda, theta_r) B(lambda, T_j)`` over the visible
-    terms [W sr-1 nm-1] (the emission term of paper 001's signature model)."""
-    t = plan.terms
-    p = plan.effect_params["thermal"]
-    o = block.to_observer
-    out = np.zeros((o.shape[0], plan.wavelength.size))
-    for m in range(len(plan.materials)):
-        sel = t.material == m
-        cos_r = o @ t.normal[sel].T  # (G, T_m)
-        vis = cos_r > 0
-        theta_r = np.degrees(np.arctan2(np.sqrt(np.clip(1 - cos_r**2, 0, None)), cos_r))
-        eps = sources.emissivity_at(p["emissivity"][m], p["theta"][m], np.where(vis, theta_r, 0.0))
-        w = np.where(vis, cos_r, 0.0) * t.area[sel]
-        out += np.einsum("gf,gfl->gl", w, eps) * p["radiance"][m]
-    return {"thermal_intensity": out.astype(np.dtype(plan.knobs["dtype"]))}
-
-
-# ------------------------------------------------------------------ registry
-
-
-@dataclass(frozen=True)
-class Effect:
-    """One effect a scene may ask for.
-
-    Attributes
-    ----------
-    name : str
-        Name used in ``Scene(effects=...)``.
-    needs : tuple of str
-        Scene inputs it requires (``"to_earth"``: Earth directions; ``"mesh"``: the
-        facets themselves rather than merged terms).
-    source : str or None
-        The light source it adds (``"sun"``, ``"earth"``, ``"facets"`` for emission),
-        or None for an effect that modifies others (shadowing, eclipse).
-    outputs : tuple of str
-        The :data:`OUTPUTS` it fills.
-    contribute : callable or None
-        ``contribute(plan, block) -> {name: array}`` on every block.
-    description : str
-        The plan line when it runs (details are added by the planner).
-
-    Examples
-    --------
-    >>> from sbrdf_xr.engine.effects import EFFECTS
-    >>> e = EFFECTS["earthshine"]
-    >>> e.needs, e.source
-    (('to_earth',), 'earth')
-    >>> e.outputs
-    ('signal_earthshine', 'band_signal')
-    >>> EFFECTS["shadowing"].contribute is None  # it modifies the others' sums
-    True
-    """
-
-    name: str
-    needs: tuple[str, ...]
-    source: str | None
-    outputs: tuple[str, ...]
-    contribute: Callable[[Plan, BlockInputs], Mapping[str, np.ndarray]] | None
-    description: str
-    params: Mapping[str, Any] = field(default_factory=dict)
-
-
-#: The effects, by name.
-EFFECTS: dict[str, Effect] = {
-    e.name: e
-    for e in (
-        Effect(
-            "sunlight",
-            (),
-            "sun",
-            ("spacecraft_sbrdf", "signal", "brdf", "area", "signal_material", "band_signal"),
-            _sunlight,
-            "reflected sunlight: paper 000 Eqs. 3-4 and the radiometric signal",
-        ),
-        Effect(
-            "shadowing",
-            ("mesh",),
-            None,
-            (),
-            None,
-            "self-shadowing and self-occlusion of the facets",
-        ),
-        Effect(
-            "earthshine",
-            ("to_earth",),
-            "earth",
-            ("signal_earthshine", "band_signal"),
-            _earthshine,
-            "sunlight reflected by a Lambertian Earth, a second distant source",
-        ),
-        Effect(
-            "thermal",
-            (),
-            "facets",
-            ("thermal_intensity",),
-            _thermal,
-            "thermal emission epsilon(lambda, theta) B(lambda, T), epsilon = 1 - rho (Kirchhoff)",
-        ),
-        Effect(
-            "eclipse",
-            ("sunlit_fraction",),
-            None,
-            (),
-            None,
-            "the Earth's shadow: sunlight scaled by the sunlit fraction of the solar disc",
-        ),
-    )
-}
 
 
 def _trapezoid_weights(plan: Plan) -> np.ndarray:
@@ -504,7 +538,9 @@ def finish(
 
     ``spacecraft_sbrdf`` is paper 000 Eq. 4 (0 where no area contributes, the 0/0 of
     Eq. 4), ``brdf`` its trapezoid integral over wavelength (Eq. 2), ``band_signal``
-    the band-weighted total signal (Sun plus Earth), or the pre-integrated sums.
+    the band-weighted total signal (the sums every running effect adds to it,
+    :attr:`Effect.band`), or the pre-integrated sums; every other output is the sum of
+    that name.
 
     Examples
     --------
@@ -550,14 +586,15 @@ def finish(
             out["spacecraft_sbrdf"] = sbrdf
         if "brdf" in names:
             out["brdf"] = np.einsum("gl,l->g", sbrdf, _trapezoid_weights(plan)).astype(dt)
-    for k in ("signal", "signal_material", "signal_earthshine", "thermal_intensity"):
-        if k in names:
+    for k in names:
+        if k not in out and k in sums:
             out[k] = sums[k]
     if "band_signal" in names:
-        total = sums["signal"]
-        if "signal_earthshine" in sums:
-            total = total + sums["signal_earthshine"]
-        if not plan.pre_integrated:
+        band = [k for e in plan.active_effects for k in e.band if k in sums]
+        total = sums[band[0]]
+        for k in band[1:]:
+            total = total + sums[k]
+        if not plan.pre_integrated and plan.band_weights is not None:
             total = np.einsum("gl,bl->gb", total, plan.band_weights)
         out["band_signal"] = total.astype(dt)
     return {k: v.reshape(*lead_shape, *v.shape[1:]) for k, v in out.items()}
