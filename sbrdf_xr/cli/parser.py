@@ -109,7 +109,9 @@ def build_parser() -> argparse.ArgumentParser:
     pi.add_argument("file", nargs="?")
     pi.set_defaults(func=cmd_info)
 
-    pk = sub.add_parser("knobs", help="the numerical knobs, their defaults and the presets")
+    pk = sub.add_parser(
+        "knobs", help="the numerical knobs, their defaults, the presets and their measured cost"
+    )
     pk.set_defaults(func=cmd_knobs)
 
     pb = sub.add_parser("bench", help="accuracy/cost benchmarks (timings as ratios)")
@@ -122,6 +124,17 @@ def build_parser() -> argparse.ArgumentParser:
     pb.add_argument("-o", "--output", help="write the table to this netCDF file")
     pb.add_argument("--csv", help="write the table to this CSV file")
     pb.add_argument("--plot", help="draw the accuracy/time front to this PNG file")
+    pb.add_argument(
+        "--repeat",
+        type=int,
+        help="timing runs of every row, the best kept (default 5, 3 with --quick)",
+    )
+    pb.add_argument(
+        "--record-presets",
+        action="store_true",
+        help="write the presets' rows to the package's sbrdf_xr/bench/presets.json, which "
+        "'sbrdf-xr knobs' shows (run it in a source checkout and commit the file)",
+    )
     pb.set_defaults(func=cmd_bench)
 
     psim = sub.add_parser("simulate", help="run a scene into a netCDF cube")
@@ -377,7 +390,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     level = logger.level
     logger.setLevel(logging.WARNING)
     try:
-        with command_line_messages():
+        # --quiet: no progress bars, of the writer nor of the tables the command builds
+        with command_line_messages(), catalog.showing_progress(not getattr(args, "quiet", False)):
             return int(args.func(args))
     except (SbrdfError, OSError) as exc:
         print(f"sbrdf-xr: error: {_one_line(exc)}", file=sys.stderr)
