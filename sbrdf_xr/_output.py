@@ -56,6 +56,7 @@ __all__ = [
     "holds_nothing",
     "libc_function",
     "make_marked_dir",
+    "netcdf_encoding",
     "open_regular",
     "option",
     "read_marker",
@@ -64,6 +65,7 @@ __all__ = [
     "rename_no_replace",
     "replace_dir",
     "write_marker",
+    "write_netcdf",
 ]
 
 #: File that marks a directory written by this package (a Zarr store, or its ``.part``).
@@ -347,6 +349,77 @@ def atomic_file(
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
+
+
+def netcdf_encoding(ds: Any, complevel: int = 4) -> dict[str, dict[str, Any]]:
+    """The netCDF encoding of :func:`write_netcdf`: no fill values anywhere; lossless zlib
+    compression with byte shuffle of the floating-point data variables (none for
+    ``complevel`` 0).
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> from sbrdf_xr._output import netcdf_encoding
+    >>> ds = xr.Dataset({"v": ("x", [1.0, 2.0])}, coords={"x": [0, 1]})
+    >>> netcdf_encoding(ds)["v"]
+    {'_FillValue': None, 'zlib': True, 'complevel': 4, 'shuffle': True}
+    >>> netcdf_encoding(ds, complevel=0)["v"], netcdf_encoding(ds)["x"]
+    ({'_FillValue': None}, {'_FillValue': None})
+    """
+    import numpy as np
+
+    enc: dict[str, dict[str, Any]] = {str(name): {"_FillValue": None} for name in ds.variables}
+    for name, var in ds.data_vars.items():
+        if var.ndim and np.issubdtype(var.dtype, np.floating) and complevel > 0:
+            enc[str(name)].update(zlib=True, complevel=complevel, shuffle=True)
+    return enc
+
+
+def write_netcdf(
+    ds: Any,
+    path: str | os.PathLike[str],
+    *,
+    overwrite: bool = False,
+    complevel: int = 4,
+    error: type[OutputError] = OutputError,
+) -> Path:
+    """Write the xarray Dataset ``ds`` as CF netCDF-4 through :func:`atomic_file`: the CF
+    and ACDD attributes completed (:func:`sbrdf_xr._names.cf_finish`), the encoding of
+    :func:`netcdf_encoding`, the output checked first (:func:`check_output`).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Examples
+    --------
+    >>> import os
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import xarray as xr
+    >>> from sbrdf_xr._output import write_netcdf
+    >>> from sbrdf_xr.errors import OutputError
+    >>> ds = xr.Dataset({"v": ("x", [1.0, 2.0])})
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     out = write_netcdf(ds, Path(tmp) / "v.nc")
+    ...     with xr.open_dataset(out) as back:
+    ...         print(back.v.values.tolist(), back.attrs["Conventions"])
+    ...     os.mkfifo(Path(tmp) / "pipe.nc")
+    ...     try:
+    ...         write_netcdf(ds, Path(tmp) / "pipe.nc", overwrite=True)
+    ...     except OutputError as exc:
+    ...         print(str(exc).split(tmp)[1].split(";")[0])
+    [1.0, 2.0] CF-1.10
+    /pipe.nc is a FIFO (named pipe), not a regular file
+    """
+    from ._names import cf_finish
+
+    path = check_output(path, overwrite=overwrite, error=error)
+    ds = cf_finish(ds)  # Conventions, title, source, history, flags, ancillary links
+    with atomic_file(path, overwrite=overwrite, error=error) as tmp:
+        ds.to_netcdf(tmp, engine="netcdf4", encoding=netcdf_encoding(ds, complevel))
+    return path
 
 
 _NOFOLLOW = getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)

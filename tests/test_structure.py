@@ -434,11 +434,12 @@ def test_the_private_check_catches_imports_and_attributes(tmp_path):
 # ------------------------------------------------------------------ the package graph
 
 #: Bounds of the import graph with each package counted as one node.  The depth is that
-#: of the chain cli -> invert -> engine -> catalog -> observing -> photometry -> materials
-#: -> kernels -> anisotropy -> geometry -> rotations -> units -> errors: ``units`` (every
-#: argument with a unit converted at the door, the rotations' angles too) is its one link
-#: below the root modules.
-GRAPH_LIMITS = {"nodes": 30, "depth": 13, "edges": 110}
+#: of the chain cli -> bench -> engine -> catalog -> body -> kernels -> anisotropy ->
+#: geometry -> rotations -> units -> errors (11): ``units`` (every argument with a unit
+#: converted at the door, the rotations' angles too) is its one link below the root
+#: modules.  The edges include one from every package that writes a file (materials,
+#: photometry, store, bench, cli, ``_cache``) to ``_output``, the one safe output.
+GRAPH_LIMITS = {"nodes": 30, "depth": 12, "edges": 116}
 
 
 def node_of(mod: str, root: Path = PACKAGE) -> str:

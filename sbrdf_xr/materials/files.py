@@ -4,13 +4,11 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
 
-import numpy as np
 import xarray as xr
 
 from .._names import SBRDF
-from .._output import atomic_file, check_output
+from .._output import write_netcdf
 from ..errors import ValidationError
 from .schema import validate_material, validate_measurements
 
@@ -20,24 +18,14 @@ __all__ = ["open_material", "open_measurements", "to_netcdf", "write_netcdf_atom
 # --------------------------------------------------------------------- I/O
 
 
-def _encoding(obj: xr.Dataset) -> dict[str, dict[str, Any]]:
-    """No fill values anywhere; lossless zlib compression of the data variables."""
-    enc: dict[str, dict[str, Any]] = {
-        str(name): {"_FillValue": None} for name in list(obj.variables)
-    }
-    for name, var in obj.data_vars.items():
-        if var.ndim and np.issubdtype(var.dtype, np.floating):
-            enc[str(name)].update(zlib=True, complevel=4, shuffle=True)
-    return enc
-
-
 def write_netcdf_atomic(
-    ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False
+    ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False, complevel: int = 4
 ) -> Path:
     """Write ``ds`` to ``path`` atomically (a temporary file beside it, then a rename).
 
-    The package's safe output (:mod:`sbrdf_xr._output`): only a regular file is ever
-    replaced; a FIFO, socket, device, symbolic link or directory at ``path`` is refused.
+    The package's safe output (:func:`sbrdf_xr._output.write_netcdf`): only a regular file
+    is ever replaced; a FIFO, socket, device, symbolic link or directory at ``path`` is
+    refused.
 
     Parameters
     ----------
@@ -48,6 +36,9 @@ def write_netcdf_atomic(
     overwrite : bool, default False
         Replace an existing file; otherwise an existing file is an error and is left
         untouched.
+    complevel : int, default 4
+        zlib level (with the shuffle filter) of the floating-point data variables; 0
+        writes them uncompressed (several times faster to write and read, twice the size).
 
     Returns
     -------
@@ -75,17 +66,15 @@ def write_netcdf_atomic(
     >>> names, again.x.values.tolist(), again.attrs["Conventions"]
     (['example.nc'], [1.0, 2.0], 'CF-1.10')
     """
-    from .._names import cf_finish
-
-    path = check_output(path, overwrite=overwrite)
-    ds = cf_finish(ds)  # Conventions, title, source, history, flags, ancillary links
-    with atomic_file(path, overwrite=overwrite) as tmp:
-        ds.to_netcdf(tmp, engine="netcdf4", encoding=_encoding(ds))
-    return path
+    return write_netcdf(ds, path, overwrite=overwrite, complevel=complevel)
 
 
 def to_netcdf(
-    obj: xr.DataArray | xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False
+    obj: xr.DataArray | xr.Dataset,
+    path: str | os.PathLike[str],
+    *,
+    overwrite: bool = False,
+    complevel: int = 4,
 ) -> Path:
     """Write a material table or a measurement set to netCDF, losslessly and atomically.
 
@@ -101,6 +90,8 @@ def to_netcdf(
         Destination.
     overwrite : bool, default False
         Replace an existing file.
+    complevel : int, default 4
+        As :func:`write_netcdf_atomic`.
 
     Returns
     -------
@@ -125,7 +116,7 @@ def to_netcdf(
         validate_measurements(obj, duplicates="mean")
     obj = obj.copy()
     obj.attrs.setdefault("Conventions", "CF-1.10")
-    return write_netcdf_atomic(obj, path, overwrite=overwrite)
+    return write_netcdf_atomic(obj, path, overwrite=overwrite, complevel=complevel)
 
 
 def open_material(path: str | os.PathLike[str]) -> xr.DataArray:

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from .._output import atomic_file, check_output
+from .._output import atomic_file, check_output, write_netcdf
 from ..errors import ValidationError
 
 __all__ = ["cf_decode", "cf_encode", "open_photometry", "to_csv", "to_netcdf"]
@@ -100,8 +100,6 @@ def to_netcdf(ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool =
     >>> path.name, open_photometry(path).attrs["Conventions"]
     ('phot.nc', 'CF-1.10')
     """
-    from ..materials.tables import write_netcdf_atomic
-
     if not isinstance(ds, xr.Dataset):
         raise ValidationError(f"ds: expected an xarray Dataset, got {type(ds).__name__}")
     enc = cf_encode(ds)
@@ -110,7 +108,7 @@ def to_netcdf(ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool =
             enc[name].attrs.setdefault(
                 "comment", "+inf where nothing reflects toward the observer; NaN where undefined"
             )
-    return write_netcdf_atomic(enc, path, overwrite=overwrite)
+    return write_netcdf(enc, path, overwrite=overwrite)
 
 
 def to_csv(ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
