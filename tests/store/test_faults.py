@@ -615,13 +615,13 @@ def zarr_kill_trials(tmp_path: Path, reference: xr.Dataset, n: int, seed: int) -
         path.parent.mkdir()
         # the instant: while the store is created (-1), or after a random number of blocks
         # were stored and a random part of the next 0.1 s block (24: during the rename)
-        after = rng.randint(-1, 24)
+        after = rng.randint(-1, 24) if trial else -1  # the first while the store is created
         proc = zarr_writer(path.parent, path=str(path), delay=0.1)
         deadline = time.monotonic() + TIMEOUT
         while after > 0 and zarr_marks(path) < after and proc.poll() is None:
             assert time.monotonic() < deadline, "the writer made no progress"
             time.sleep(0.002)
-        time.sleep(rng.uniform(0.0, 0.3 if after < 0 else 0.1))
+        time.sleep(rng.uniform(0.0, 0.05 if after < 0 else 0.1))  # the store's creation: ~0.1 s
         with contextlib.suppress(ProcessLookupError):
             os.kill(proc.pid, signal.SIGKILL)
         proc.wait(timeout=TIMEOUT)
