@@ -8,8 +8,9 @@ points: :func:`build_lut` and :func:`lookup` (materials), :func:`load_spacecraft
 
 The packages are the layers, lowest first; a package imports only from lower ones:
 
-* shared by every layer: :mod:`~sbrdf_xr.errors`, :mod:`~sbrdf_xr.rotations`,
-  :mod:`~sbrdf_xr.geometry`, :mod:`~sbrdf_xr.anisotropy`, :mod:`~sbrdf_xr.sources`;
+* shared by every layer: :mod:`~sbrdf_xr.errors`, :mod:`~sbrdf_xr.units`,
+  :mod:`~sbrdf_xr.rotations`, :mod:`~sbrdf_xr.geometry`, :mod:`~sbrdf_xr.anisotropy`,
+  :mod:`~sbrdf_xr.sources`;
 * :mod:`~sbrdf_xr.kernels` (compiled and numpy kernels), :mod:`~sbrdf_xr.brdf`
   (analytic BRDF models);
 * :mod:`~sbrdf_xr.materials` (tables, models, measurements), :mod:`~sbrdf_xr.body`
@@ -64,6 +65,7 @@ _SUBMODULES = (
     "sources",
     "store",
     "testing",
+    "units",
 )
 
 __all__ = [
@@ -101,6 +103,7 @@ __all__ = [
     "sources",
     "store",
     "testing",
+    "units",
     "write",
 ]
 

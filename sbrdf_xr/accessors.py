@@ -11,6 +11,7 @@ from typing import Any
 import xarray as xr
 from numpy.typing import ArrayLike
 
+from .materials import energy as _energy
 from .materials import tables as _material
 
 __all__ = ["SbrdfDataArrayAccessor", "SbrdfDatasetAccessor"]
@@ -57,8 +58,8 @@ class SbrdfDataArrayAccessor:
     def hemispherical_reflectance(
         self, theta_i: ArrayLike | None = None, **kwargs: Any
     ) -> xr.DataArray:
-        """:func:`sbrdf_xr.materials.tables.hemispherical_reflectance` of this table."""
-        return _material.hemispherical_reflectance(self._da, theta_i, **kwargs)
+        """:func:`sbrdf_xr.materials.energy.hemispherical_reflectance` of this table."""
+        return _energy.hemispherical_reflectance(self._da, theta_i, **kwargs)
 
     def to_netcdf(self, path: Any, **kwargs: Any) -> Any:
         """:func:`sbrdf_xr.materials.tables.to_netcdf` of this table."""

@@ -37,7 +37,6 @@ from ._catalog_index import (
     KINDS,
     SOURCES,
     CatalogEntry,
-    _read_index,  # noqa: F401  (re-exported: tools clear its cache after writing an index)
     catalog_dir,
     data_path,
     entries,

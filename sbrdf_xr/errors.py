@@ -18,6 +18,7 @@ __all__ = [
     "CatalogError",
     "EpochGapWarning",
     "InversionError",
+    "LightCurveError",
     "MeshError",
     "MeshRepairWarning",
     "NonPhysicalWarning",
@@ -26,6 +27,8 @@ __all__ = [
     "SbrdfError",
     "SbrdfWarning",
     "SceneError",
+    "UnitError",
+    "UnitWarning",
     "ValidationError",
     "did_you_mean",
 ]
@@ -110,6 +113,17 @@ class InversionError(ValidationError):
     """Measured data, uncertainties or a model library that an inversion cannot use."""
 
 
+class LightCurveError(ValidationError):
+    """A measured light curve that cannot be read, or compared with a simulation as given:
+    times outside the simulated window, bands not simulated, NaN rows, bad uncertainties,
+    fewer observations than fitted parameters."""
+
+
+class UnitError(ValidationError):
+    """An astropy Quantity whose unit cannot be converted to the unit of the argument
+    (a mass for a length, an ambiguous length unit)."""
+
+
 class SbrdfWarning(UserWarning):
     """Base class of the warnings issued by sbrdf_xr."""
 
@@ -125,6 +139,12 @@ class MeshRepairWarning(SbrdfWarning):
 class CacheWarning(SbrdfWarning):
     """The table cache could not be used: a damaged file was built again, or the directory
     is not writable (or full), so the table was built without being kept."""
+
+
+class UnitWarning(SbrdfWarning):
+    """A bare number outside the plausible bounds of its documented unit: most likely a
+    value in another unit (wavelengths in micrometres on a nanometre axis, a range in
+    metres given in kilometres)."""
 
 
 class EpochGapWarning(SbrdfWarning):

@@ -59,6 +59,7 @@ from .rotations import (
     to_body_frame,
     uniform_attitudes,
 )
+from .units import to_unit
 
 __all__ = [
     "QUATERNION_NORM_TOL",
@@ -570,7 +571,7 @@ def observation_plane(
     >>> np.round(to_sun[1], 6), np.round(to_observer[1], 6)
     (array([0.707107, 0.707107, 0.      ]), array([ 0.707107, -0.707107,  0.      ]))
     """
-    beta = np.asarray(phase_angle_deg, dtype=np.float64)
+    beta = np.asarray(to_unit(phase_angle_deg, "deg", "phase_angle_deg"), dtype=np.float64)
     if np.any((beta < 0) | (beta > 180)) or not np.all(np.isfinite(beta)):
         raise ValidationError(f"phase_angle: must lie in [0, 180] degree, got {beta.ravel()[:5]}")
     b = normalize(bisector, "bisector")

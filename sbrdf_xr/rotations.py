@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from .errors import ValidationError
+from .units import to_unit
 
 __all__ = [
     "QUATERNION_NORM_TOL",
@@ -188,7 +189,7 @@ def axis_rotation(axis: ArrayLike, angle: ArrayLike) -> NDArray[np.float64]:
     (2, 5, 4)
     """
     a = _unit_axis(axis)
-    half = np.radians(np.asarray(angle, dtype=np.float64)) / 2.0
+    half = np.radians(np.asarray(to_unit(angle, "deg", "angle"), dtype=np.float64)) / 2.0
     return np.concatenate([np.sin(half)[..., None] * a, np.cos(half)[..., None]], axis=-1)
 
 

@@ -22,6 +22,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import constants
 
+from .units import check_plausible, to_unit
+
 __all__ = [
     "EARTH_RADIUS_KM",
     "MOON_MEAN_DISTANCE_KM",
@@ -74,8 +76,9 @@ def planck(wavelength_nm: ArrayLike, temperature: float) -> NDArray[np.float64]:
     0.009924...
     """
     h, c, k = constants.h, constants.c, constants.k
-    lam = np.asarray(wavelength_nm, dtype=np.float64) * 1e-9
-    x = h * c / (lam * k * float(temperature))
+    wl = to_unit(wavelength_nm, "nm", "wavelength_nm", spectral=True)
+    lam = np.asarray(wl, dtype=np.float64) * 1e-9
+    x = h * c / (lam * k * float(to_unit(temperature, "K", "temperature")))
     with np.errstate(under="ignore", over="ignore"):
         return 2.0 * h * c**2 / lam**5 * np.exp(-x) / -np.expm1(-x) * 1e-9
 
@@ -110,7 +113,9 @@ def earthshine_irradiance_ratio(albedo: float, range_km: float, phase_angle_deg:
     >>> round(earthshine_irradiance_ratio(0.3, 42164.0, 0.0), 5)  # full Earth from GEO
     0.00457
     """
-    a = np.radians(phase_angle_deg)
+    a = np.radians(to_unit(phase_angle_deg, "deg", "phase_angle_deg"))
+    range_km = to_unit(range_km, "km", "range_km")
+    check_plausible(range_km, "range_km", "range_km")
     return float(
         2.0
         / 3.0

@@ -13,6 +13,7 @@ import xarray as xr
 
 from sbrdf_xr import catalog
 from sbrdf_xr.errors import CatalogError, ValidationError
+from sbrdf_xr.materials import energy
 from sbrdf_xr.materials import tables as material
 
 
@@ -39,7 +40,7 @@ def test_unknown_names_and_kinds():
 
 
 def test_lambertian_reference_integrates_to_its_albedo():
-    rho = material.hemispherical_reflectance(catalog.load("lambertian-grey-50"), [0.0, 45.0, 80.0])
+    rho = energy.hemispherical_reflectance(catalog.load("lambertian-grey-50"), [0.0, 45.0, 80.0])
     np.testing.assert_allclose(rho.values, 0.5, rtol=1e-6)  # float32 table: 1e-7 relative
 
 

@@ -101,14 +101,14 @@ def find_passes(
 
 
 def main() -> None:
-    from sbrdf_xr import catalog
+    from sbrdf_xr import _catalog_index
     from sbrdf_xr.observing import observe
 
     l1, l2 = example_tle()
     path = Path(__file__).resolve().parent.parent / "catalogs" / "observe" / "canx1-example.tle"
     path.write_text(f"CANX-1 (example elements)\n{l1}\n{l2}\n", encoding="utf-8")
     print(path.read_text())
-    catalog._read_index.cache_clear()
+    _catalog_index._read_index.cache_clear()  # the index was just written
     orbit = observe.Orbit.from_tle(l1, l2, "CANX-1")
     site = observe.Site.from_catalog(observe.CANX1_PASS["site"])
     for p in find_passes(orbit, site, "2024-03-14T12:00", "2024-03-17T12:00"):

@@ -6,7 +6,7 @@ material of the catalog).  For every table it prints
 * the relative error of its directional-hemispherical reflectance against the
   generating model's, worst over wavelengths (signed), at theta_i = 0, 10, ..., 80, 85
   deg: the table's by the package's own quadrature
-  (:func:`sbrdf_xr.materials.tables.hemispherical_reflectance`), the model's by direct
+  (:func:`sbrdf_xr.materials.energy.hemispherical_reflectance`), the model's by direct
   quadrature of the model function (:func:`sbrdf_xr.testing.reference_reflectance`,
   independent of any table grid; ``--fast`` uses the model's own half-vector
   quadrature instead);
@@ -30,8 +30,7 @@ import numpy as np
 
 from sbrdf_xr import catalog, testing
 from sbrdf_xr.errors import NonPhysicalWarning
-from sbrdf_xr.materials import models
-from sbrdf_xr.materials import tables as material
+from sbrdf_xr.materials import energy, models
 
 #: Incidence angles of the report [degree].
 THETA_I = np.array([0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 85.0])
@@ -80,8 +79,8 @@ def report(name: str, fast: bool = False) -> dict:
     func, dhr = generating_function(name, wl)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", NonPhysicalWarning)
-        rho_t = material.hemispherical_reflectance(table, THETA_I, warn=False).values
-        rho_all = material.hemispherical_reflectance(table, warn=False).values
+        rho_t = energy.hemispherical_reflectance(table, THETA_I, warn=False).values
+        rho_all = energy.hemispherical_reflectance(table, warn=False).values
     rho_m = (
         dhr(THETA_I) if (fast and dhr is not None) else testing.reference_reflectance(func, THETA_I)
     )

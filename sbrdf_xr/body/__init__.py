@@ -11,8 +11,11 @@ Modules
     Facet tables: one row per facet, or facets merged by (normal, material).
 ``imperfections``
     Surface imperfections of CAD facets, a distribution of normal tilts (paper 000 §5).
-``visibility`` and ``rays``
-    Self-shadowing and self-occlusion: exact polygon clipping, or sampled rays.
+``visibility``
+    Self-shadowing and self-occlusion: exact polygon clipping, or sampled rays, beside
+    the mesh access both methods read.
+``rays``
+    The sampled method's tools: sampling densities, point sets on facets, ray engines.
 ``picture``
     A 3-D picture of a spacecraft, each facet coloured by its material.
 """
@@ -42,23 +45,24 @@ from .rays import (
     available_engines,
     check_density,
     engine_name,
-    escape_masks,
     intersector,
-    is_convex,
-    mesh_of,
     sample_triangle,
     sample_uv,
     samples_per_facet,
-    supporting,
     to_triangle,
 )
 from .repair import MERGE_DISTANCE, ZERO_AREA_FACTOR, clean_mesh
 from .spacecraft import CANX1_MATERIALS, Spacecraft, canx1, load_spacecraft
 from .visibility import (
     METHODS,
+    PLANE_TOLERANCE,
+    escape_masks,
     facet_visibility,
+    is_convex,
     lit_fraction,
     lit_visible_fraction,
+    mesh_of,
+    supporting,
     visible_fraction,
 )
 
@@ -72,6 +76,7 @@ __all__ = [
     "METHODS",
     "NORMAL_TOLERANCE",
     "OFFSET_FACTOR",
+    "PLANE_TOLERANCE",
     "SEED",
     "TANGENT_ATTRIBUTE",
     "ZERO_AREA_FACTOR",

@@ -20,6 +20,7 @@ import numpy as np
 import trimesh
 
 from ..errors import MeshError, ValidationError
+from ..units import LENGTH_UNITS, metres_per
 from .facets import NORMAL_TOLERANCE
 from .repair import MERGE_DISTANCE, ZERO_AREA_FACTOR, clean_mesh
 
@@ -39,38 +40,18 @@ __all__ = [
     "read_mesh",
 ]
 
-#: Length units accepted by :func:`load_spacecraft` and their size in metres [m].
-LENGTH_UNITS: dict[str, float] = {
-    "m": 1.0,
-    "meter": 1.0,
-    "metre": 1.0,
-    "km": 1.0e3,
-    "cm": 1.0e-2,
-    "centimeter": 1.0e-2,
-    "centimetre": 1.0e-2,
-    "mm": 1.0e-3,
-    "millimeter": 1.0e-3,
-    "millimetre": 1.0e-3,
-    "um": 1.0e-6,
-    "micrometer": 1.0e-6,
-    "micrometre": 1.0e-6,
-    "in": 0.0254,
-    "inch": 0.0254,
-    "ft": 0.3048,
-    "foot": 0.3048,
-}
-
-
 Color = tuple[int, int, int]
 
 
-def length_factor(length_unit: str) -> float:
-    """Size of one ``length_unit`` in metres.
+def length_factor(length_unit: Any) -> float:
+    """Size of one ``length_unit`` in metres (:func:`sbrdf_xr.units.metres_per`).
 
     Parameters
     ----------
-    length_unit : str
-        A key of :data:`LENGTH_UNITS` (case-insensitive), e.g. ``"m"``, ``"mm"``, ``"in"``.
+    length_unit : str, astropy unit or Quantity
+        A key of :data:`LENGTH_UNITS` (exact, else any case; SI symbols whose case
+        changes their meaning are read as written: ``"Mm"`` is the megametre and is
+        refused), an astropy length unit or a length Quantity.
 
     Returns
     -------
@@ -79,21 +60,15 @@ def length_factor(length_unit: str) -> float:
 
     Raises
     ------
-    ValidationError
-        If the unit is not a known length unit.
+    UnitError
+        If the unit is not a known length unit, or is the megametre.
 
     Examples
     --------
-    >>> length_factor("mm"), length_factor("in")
-    (0.001, 0.0254)
+    >>> length_factor("mm"), length_factor("in"), length_factor("MM")
+    (0.001, 0.0254, 0.001)
     """
-    key = length_unit.strip().lower() if isinstance(length_unit, str) else None
-    if key not in LENGTH_UNITS:
-        raise ValidationError(
-            f"length_unit: got {length_unit!r}, which is not a length unit; "
-            f"allowed: {', '.join(LENGTH_UNITS)}"
-        )
-    return LENGTH_UNITS[key]
+    return metres_per(length_unit, "length_unit")
 
 
 def read_material_map(path: str | Path) -> dict[Any, str]:
@@ -255,6 +230,7 @@ class _Labelled:
         self.tangent = np.zeros((0, 3))
         self.rgb_bits = 8
         self.offset = 0
+        self.units: str | None = None  # the length unit the file states, if any
 
     def add(
         self,
@@ -444,6 +420,8 @@ def read_mesh(
                 f"{path}: could not be read as a mesh ({type(exc).__name__}: {exc}); "
                 "expected a format trimesh reads (STL, OBJ, PLY, glTF/GLB, OFF, ...)"
             ) from exc
+    stated = getattr(obj, "units", None)
+    out.units = str(stated) if stated else None
     if isinstance(obj, trimesh.Scene):
         if not obj.geometry:
             raise MeshError("the mesh source is an empty scene: it holds no geometry")

@@ -1,9 +1,11 @@
-"""The sampled method of :mod:`sbrdf_xr.body.visibility`: point sets on facets and ray engines.
+"""The tools of the sampled shadow method: sampling densities, point sets on facets and
+ray engines.
 
-Also the mesh access both methods share (the mesh and per-spacecraft cache of a
-:class:`~sbrdf_xr.body.spacecraft.Spacecraft` or a bare :class:`trimesh.Trimesh`, the facets whose
-plane supports the whole mesh).  The public names are re-exported by
-:mod:`sbrdf_xr.body.visibility`, which documents the methods.
+:mod:`sbrdf_xr.body.visibility` documents the method and casts the rays
+(:func:`~sbrdf_xr.body.visibility.escape_masks`); here are the named densities
+(:data:`DENSITY_PRESETS`), the scrambled Sobol' points mapped to a triangle
+(:func:`sample_triangle`, Shirley and Chiu 1997) and the ray engines (:data:`ENGINES`,
+:func:`intersector`), cached per spacecraft.
 """
 
 from __future__ import annotations
@@ -16,7 +18,6 @@ import trimesh
 from numpy.typing import NDArray
 
 from ..errors import ValidationError
-from .spacecraft import Spacecraft
 
 __all__ = [
     "DENSITY_PRESETS",
@@ -27,14 +28,10 @@ __all__ = [
     "available_engines",
     "check_density",
     "engine_name",
-    "escape_masks",
     "intersector",
-    "is_convex",
-    "mesh_of",
     "sample_triangle",
     "sample_uv",
     "samples_per_facet",
-    "supporting",
     "to_triangle",
 ]
 
@@ -216,52 +213,6 @@ def to_triangle(uv: np.ndarray) -> np.ndarray:
     return np.stack([1.0 - r, r * (1.0 - uv[..., 1]), r * uv[..., 1]], axis=-1)
 
 
-def mesh_of(spacecraft: Spacecraft | trimesh.Trimesh) -> tuple[trimesh.Trimesh, dict[str, Any]]:
-    """The mesh of a spacecraft (or bare mesh) and its per-spacecraft cache.
-
-    Examples
-    --------
-    >>> import trimesh
-    >>> from sbrdf_xr.body.rays import mesh_of
-    >>> from sbrdf_xr.testing import cube_spacecraft
-    >>> body = cube_spacecraft()
-    >>> mesh, cache = mesh_of(body)
-    >>> mesh is body.mesh, cache is body._cache
-    (True, True)
-    >>> box = trimesh.creation.box()
-    >>> mesh_of(box)[0] is box, mesh_of(box)[1]  # a bare mesh gets a fresh, empty cache
-    (True, {})
-    >>> mesh_of("cube.stl")
-    Traceback (most recent call last):
-    ...
-    sbrdf_xr.errors.ValidationError: spacecraft: expected a Spacecraft or trimesh.Trimesh, got str
-    """
-    if isinstance(spacecraft, Spacecraft):
-        return spacecraft.mesh, spacecraft._cache
-    if isinstance(spacecraft, trimesh.Trimesh):
-        return spacecraft, {}
-    raise ValidationError(
-        f"spacecraft: expected a Spacecraft or trimesh.Trimesh, got {type(spacecraft).__name__}"
-    )
-
-
-def is_convex(spacecraft: Spacecraft | trimesh.Trimesh) -> bool:
-    """Whether the surface is convex (cached on a Spacecraft).
-
-    Examples
-    --------
-    >>> from sbrdf_xr.body.rays import is_convex
-    >>> from sbrdf_xr.testing import cube_spacecraft, l_shaped_spacecraft
-    >>> is_convex(cube_spacecraft()), is_convex(l_shaped_spacecraft())
-    (True, False)
-    >>> is_convex(l_shaped_spacecraft().mesh)  # a bare mesh too
-    False
-    """
-    if isinstance(spacecraft, Spacecraft):
-        return spacecraft.is_convex
-    return bool(spacecraft.is_convex)
-
-
 def intersector(
     mesh: trimesh.Trimesh, cache: dict[str, Any], engine: str
 ) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
@@ -315,115 +266,3 @@ def intersector(
 
     cache[key] = hits
     return hits
-
-
-def supporting(mesh: trimesh.Trimesh, cache: dict[str, Any], tol: float) -> np.ndarray:
-    """Facets whose plane has the whole mesh on or behind it (cannot be shadowed).
-
-    Examples
-    --------
-    Every facet of a box supports it; of the L-shaped body's 20 facets, the four on the
-    inner faces of the corner (the floor and the wall it shades) do not:
-
-    >>> import trimesh
-    >>> from sbrdf_xr.body.rays import supporting
-    >>> from sbrdf_xr.testing import l_shaped_spacecraft
-    >>> bool(supporting(trimesh.creation.box(), {}, 1e-9).all())
-    True
-    >>> body = l_shaped_spacecraft()
-    >>> s = supporting(body.mesh, {}, 1e-9)
-    >>> s.shape, int((~s).sum())
-    ((20,), 4)
-    """
-    key = f"supporting:{tol!r}"
-    if key not in cache:
-        try:
-            pts = np.asarray(mesh.convex_hull.vertices)
-        except Exception:  # pragma: no cover - degenerate (flat) meshes
-            pts = np.asarray(mesh.vertices)
-        normals = np.asarray(mesh.face_normals)
-        origin = np.asarray(mesh.triangles[:, 0])
-        height = np.full(len(normals), -np.inf)
-        step = max(1, (1 << 22) // max(len(pts), 1))
-        for s in range(0, len(normals), step):  # chunks of facets, bounded memory
-            n, o = normals[s : s + step], origin[s : s + step]
-            height[s : s + step] = (pts @ n.T - np.einsum("ij,ij->i", n, o)).max(axis=0)
-        cache[key] = height <= tol
-    return cache[key]
-
-
-# ----------------------------------------------------------------------------- sampled method
-
-
-def escape_masks(
-    spacecraft: Spacecraft | trimesh.Trimesh,
-    directions: list[np.ndarray],
-    density: int | str,
-    engine: str | None,
-    offset: float | None,
-    convex_shortcut: bool,
-    seed: int,
-) -> np.ndarray:
-    """Per-sample escape flags, shape (len(directions), n_geometries, n_facets, n_samples).
-
-    Examples
-    --------
-    The wall of the L-shaped body shades half of its floor for a Sun at ``(-1, 2, 0)``;
-    at density 2 (four samples per facet) half the floor's samples escape towards it:
-
-    >>> import numpy as np
-    >>> from sbrdf_xr.body.rays import SEED, escape_masks
-    >>> from sbrdf_xr.testing import l_shaped_spacecraft
-    >>> body = l_shaped_spacecraft()
-    >>> sun = np.array([[-1.0, 2.0, 0.0]]) / np.sqrt(5.0)
-    >>> m = escape_masks(body, [sun], 2, "triangle", None, True, SEED)
-    >>> m.shape, m.dtype
-    ((1, 1, 20, 4), dtype('bool'))
-    >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
-    ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
-    >>> float(m[0, 0, floor].mean())
-    0.5
-    >>> facing_away = body.mesh.face_normals @ sun[0] <= 0
-    >>> bool(m[0, 0, facing_away].any())  # facets facing away from the Sun never escape
-    False
-    """
-    mesh, cache = mesh_of(spacecraft)
-    n = check_density(density)
-    engine = engine_name(engine)
-    scale = float(mesh.scale)
-    if offset is None:
-        offset = OFFSET_FACTOR * scale
-    if not (np.isfinite(offset) and offset > 0):
-        raise ValidationError(f"offset: got {offset!r}; expected a positive length [m]")
-    normals = np.asarray(mesh.face_normals, dtype=np.float64)
-    n_geom = len(directions[0])
-    n_fac = len(normals)
-    n_s = n * n
-    front = [d @ normals.T > 0 for d in directions]  # (n_geom, n_facets) each
-    out = np.stack([np.broadcast_to(f[:, :, None], (n_geom, n_fac, n_s)) for f in front]).copy()
-    if convex_shortcut and is_convex(spacecraft):
-        return out
-    candidates = np.flatnonzero(~supporting(mesh, cache, 0.1 * offset))
-    if len(candidates) == 0:
-        return out
-    hits = intersector(mesh, cache, engine)
-    key = f"samples:{n_s}:{seed}"
-    if key not in cache:
-        cache[key] = sample_uv(n_s, n_fac, seed)
-    base, shift = cache[key]
-    bary = to_triangle(base[None, :, :] + shift[candidates, None, :])
-    tri = np.asarray(mesh.triangles, dtype=np.float64)[candidates]
-    points = np.einsum("fsk,fkx->fsx", bary, tri) + offset * normals[candidates, None, :]
-    per_geom = max(1, len(candidates) * n_s)
-    chunk = max(1, MAX_RAYS_PER_CALL // per_geom)
-    for k, d in enumerate(directions):
-        for g0 in range(0, n_geom, chunk):  # chunks of directions, not facets
-            sub = front[k][g0 : g0 + chunk][:, candidates]
-            gi, fi = np.nonzero(sub)
-            if len(gi) == 0:
-                continue
-            origins = points[fi].reshape(-1, 3)
-            dirs = np.repeat(d[g0 + gi], n_s, axis=0)
-            escaped = ~hits(origins, dirs).reshape(len(gi), n_s)
-            out[k, g0 + gi, candidates[fi], :] = escaped
-    return out

@@ -36,6 +36,7 @@ The facet tables are built by :mod:`sbrdf_xr.body.facets` and the picture by
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -47,7 +48,8 @@ from numpy.typing import NDArray
 
 from .. import _catalog_index
 from ..anisotropy import DEFAULT_TANGENT_DIRECTION, project_tangents
-from ..errors import CatalogError, MeshError, MeshRepairWarning, ValidationError
+from ..errors import CatalogError, MeshError, MeshRepairWarning, UnitWarning, ValidationError
+from ..units import check_plausible
 from .facets import NORMAL_TOLERANCE, check_facet_material, facet_table, merge_facets
 from .meshes import (
     LENGTH_UNITS,
@@ -101,7 +103,7 @@ def load_spacecraft(
     material_map: Mapping[Any, str] | str | Path | None = None,
     *,
     material: str | None = None,
-    length_unit: str = "m",
+    length_unit: Any = None,
     repair: bool = False,
     name: str | None = None,
     known_materials: Iterable[str] | None = None,
@@ -125,9 +127,13 @@ def load_spacecraft(
     material : str, optional
         Instead of ``material_map``: the one material of every facet (a one-material
         body; the mesh needs no colours or labels).
-    length_unit : str
-        Length unit of the file's coordinates (see :data:`LENGTH_UNITS`); converted to
-        metres.  CAD exports are often in ``"mm"``.
+    length_unit : str, astropy unit or Quantity, optional
+        Length unit of the file's coordinates (see :data:`LENGTH_UNITS`, or an astropy
+        length unit); converted to metres.  CAD exports are often in ``"mm"``.  Default:
+        the unit the file states (glTF: metres; 3MF and others that record one), else
+        metres.  A unit that contradicts the file's statement warns
+        (:class:`~sbrdf_xr.errors.UnitWarning`), as does a body whose largest side is
+        outside 1 mm - 1 km (:data:`sbrdf_xr.units.PLAUSIBLE`).
     repair : bool
         Repair the problems listed in :mod:`sbrdf_xr.body.repair` (with a
         :class:`MeshRepairWarning` for each) instead of raising :class:`MeshError`.
@@ -174,7 +180,7 @@ def load_spacecraft(
     >>> round(float(sc.mesh.area), 6)
     0.06
     """
-    factor = length_factor(length_unit)
+    factor = None if length_unit is None else length_factor(length_unit)
     if (material_map is None) == (material is None):
         raise ValidationError(
             "load_spacecraft: give exactly one of material_map (facet label -> material) and "
@@ -202,8 +208,18 @@ def load_spacecraft(
         if material is not None
         else label_faces(labelled, rgb, names, colours, name_map)
     )
+    factor = _unit_factor(factor, length_unit, labelled.units)
     with np.errstate(invalid="ignore", over="ignore"):
         vertices = vertices * factor
+    finite = vertices[np.isfinite(vertices).all(axis=1)]
+    if len(finite):
+        side = float(np.max(np.ptp(finite, axis=0)))
+        check_plausible(
+            side,
+            "mesh_size_m",
+            f"mesh {name or default_name or 'spacecraft'}: largest side",
+            fix="give the file's unit as length_unit (e.g. length_unit='mm')",
+        )
     source = "default"
     if tangent is not None:
         direction = _tangent_directions(tangent, len(faces))
@@ -227,6 +243,27 @@ def load_spacecraft(
         tangent=direction[origin],
         tangent_source=source,
     )
+
+
+def _unit_factor(factor: float | None, length_unit: Any, stated: str | None) -> float:
+    """Metres per file unit: the one given, else the one the file states, else 1; a given
+    unit that contradicts the file's statement warns."""
+    try:
+        from_file = None if stated is None else length_factor(stated)
+    except ValidationError:  # a statement the table does not know: not used
+        from_file = None
+    if factor is None:
+        return 1.0 if from_file is None else from_file
+    if from_file is not None and not np.isclose(factor, from_file, rtol=1e-9):
+        warnings.warn(
+            f"length_unit={length_unit!r} reads the coordinates in {factor:g} m units, but "
+            f"the file states they are in {stated!r} ({from_file:g} m): the body comes out "
+            f"{factor / from_file:g} times the size the file means; leave length_unit out "
+            "to follow the file",
+            UnitWarning,
+            stacklevel=3,
+        )
+    return factor
 
 
 class Spacecraft:
@@ -530,7 +567,8 @@ def load_catalog_entry(entry: _catalog_index.CatalogEntry) -> Spacecraft:
     """Load a ``kind = "spacecraft"`` catalog entry.
 
     The entry's ``path`` is the mesh; extra fields: ``material_map`` (path of the TOML map,
-    relative to the catalog directory; required), ``length_unit`` (default ``"m"``),
+    relative to the catalog directory; required), ``length_unit`` (default: the unit the
+    file states, else ``"m"``),
     ``face_property`` (optional).
 
     Examples
@@ -548,7 +586,7 @@ def load_catalog_entry(entry: _catalog_index.CatalogEntry) -> Spacecraft:
     return load_spacecraft(
         entry.file,
         read_material_map(entry.data_path(map_file)),
-        length_unit=entry.extra.get("length_unit", "m"),
+        length_unit=entry.extra.get("length_unit"),
         name=entry.name,
         face_property=entry.extra.get("face_property"),
     )

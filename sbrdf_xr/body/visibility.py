@@ -22,7 +22,8 @@ Methods (:data:`METHODS`)
     again a convex clip; an empty intersection prunes all its supersets); past 64 shadows or
     a work budget it is summed over vertical slabs bounded by every vertex and edge
     crossing (in each slab the covered length is linear in x); a facet with more than
-    :data:`MAX_SHADOWS` shadows is united by GEOS (:func:`shapely.union_all`).  Candidate
+    :data:`~sbrdf_xr.kernels.shadow.MAX_SHADOWS` shadows is united by GEOS
+    (:func:`shapely.union_all`).  Candidate
     occluders come from a uniform grid over the bounding boxes in the plane perpendicular
     to ``d`` (a facet whose box does not overlap,
     or that lies wholly behind the receiver along ``d``, cannot shadow it), so the cost grows
@@ -39,20 +40,24 @@ Methods (:data:`METHODS`)
     with no stalls at special densities.  ``return_error=True`` also gives the binomial
     standard error ``sqrt(f (1 - f) / N)`` of every fraction (a bound for independent
     samples; the QMC error is usually smaller).  Ray origins are lifted off the facet along
-    its normal by ``offset`` (default :data:`OFFSET_FACTOR` = 1e-6 times the bounding-box
-    diagonal) so that a ray never hits its own facet or a coplanar neighbour.
+    its normal by ``offset`` (default :data:`~sbrdf_xr.body.rays.OFFSET_FACTOR` = 1e-6 times
+    the bounding-box diagonal) so that a ray never hits its own facet or a coplanar
+    neighbour.  The densities, point sets and ray engines are in :mod:`sbrdf_xr.body.rays`.
 
 In both methods a facet facing away from a direction (``N.d <= 0``) gets 0; a facet whose
 plane supports the whole mesh (every vertex on or behind it, like every facet of a convex
-body) cannot be shadowed and gets 1 without further work, and a convex spacecraft
-(:attr:`~sbrdf_xr.body.spacecraft.Spacecraft.is_convex`) skips the computation entirely.
+body; :func:`supporting`) cannot be shadowed and gets 1 without further work, and a
+convex spacecraft (:attr:`~sbrdf_xr.body.spacecraft.Spacecraft.is_convex`) skips the
+computation entirely.
 
-Ray engines of the sampled method (:data:`ENGINES`): ``"embree"`` is
+Ray engines of the sampled method (:data:`~sbrdf_xr.body.rays.ENGINES`): ``"embree"`` is
 :mod:`trimesh.ray.ray_pyembree` (Intel Embree through the ``embreex`` package, float32,
 fast); ``"triangle"`` is trimesh's pure-numpy :mod:`trimesh.ray.ray_triangle` (float64, slow;
 only hits in front of the origin count); ``"auto"`` (or None) picks embree when installed.
 
-All functions take directions in the body frame of the spacecraft.
+This module holds both methods beside the mesh access they share (:func:`mesh_of`,
+:func:`is_convex`, :func:`supporting`), then the public functions.  All functions take
+directions in the body frame of the spacecraft.
 
 References
 ----------
@@ -76,36 +81,30 @@ from numpy.typing import ArrayLike, NDArray
 from .._names import FACET, GEOMETRY, VECTOR, attrs
 from ..errors import ValidationError
 from ..geometry import normalize
-from ..kernels.shadow import MAX_SHADOWS, exact_kernel, facet_shadows
+from ..kernels.shadow import exact_kernel, facet_shadows
 from .rays import (
-    DENSITY_PRESETS,
-    ENGINES,
+    MAX_RAYS_PER_CALL,
     OFFSET_FACTOR,
     SEED,
-    available_engines,
     check_density,
     engine_name,
-    escape_masks,
-    is_convex,
-    mesh_of,
-    sample_triangle,
+    intersector,
+    sample_uv,
     samples_per_facet,
-    supporting,
+    to_triangle,
 )
 from .spacecraft import Spacecraft
 
 __all__ = [
-    "DENSITY_PRESETS",
-    "ENGINES",
-    "MAX_SHADOWS",
     "METHODS",
-    "OFFSET_FACTOR",
-    "available_engines",
+    "PLANE_TOLERANCE",
+    "escape_masks",
     "facet_visibility",
+    "is_convex",
     "lit_fraction",
     "lit_visible_fraction",
-    "sample_triangle",
-    "samples_per_facet",
+    "mesh_of",
+    "supporting",
     "visible_fraction",
 ]
 
@@ -129,6 +128,90 @@ def _method(method: str) -> str:
 def _directions(directions: ArrayLike, name: str) -> tuple[np.ndarray, tuple[int, ...]]:
     d = normalize(np.asarray(directions, dtype=np.float64), name)
     return d.reshape(-1, 3), d.shape[:-1]
+
+
+# ------------------------------------------------------------- the mesh both methods read
+
+
+def mesh_of(spacecraft: Spacecraft | trimesh.Trimesh) -> tuple[trimesh.Trimesh, dict[str, Any]]:
+    """The mesh of a spacecraft (or bare mesh) and its per-spacecraft cache.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr.body.visibility import mesh_of
+    >>> from sbrdf_xr.testing import cube_spacecraft
+    >>> body = cube_spacecraft()
+    >>> mesh, cache = mesh_of(body)
+    >>> mesh is body.mesh, cache is body._cache
+    (True, True)
+    >>> box = trimesh.creation.box()
+    >>> mesh_of(box)[0] is box, mesh_of(box)[1]  # a bare mesh gets a fresh, empty cache
+    (True, {})
+    >>> mesh_of("cube.stl")
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.ValidationError: spacecraft: expected a Spacecraft or trimesh.Trimesh, got str
+    """
+    if isinstance(spacecraft, Spacecraft):
+        return spacecraft.mesh, spacecraft._cache
+    if isinstance(spacecraft, trimesh.Trimesh):
+        return spacecraft, {}
+    raise ValidationError(
+        f"spacecraft: expected a Spacecraft or trimesh.Trimesh, got {type(spacecraft).__name__}"
+    )
+
+
+def is_convex(spacecraft: Spacecraft | trimesh.Trimesh) -> bool:
+    """Whether the surface is convex (cached on a Spacecraft).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.body.visibility import is_convex
+    >>> from sbrdf_xr.testing import cube_spacecraft, l_shaped_spacecraft
+    >>> is_convex(cube_spacecraft()), is_convex(l_shaped_spacecraft())
+    (True, False)
+    >>> is_convex(l_shaped_spacecraft().mesh)  # a bare mesh too
+    False
+    """
+    if isinstance(spacecraft, Spacecraft):
+        return spacecraft.is_convex
+    return bool(spacecraft.is_convex)
+
+
+def supporting(mesh: trimesh.Trimesh, cache: dict[str, Any], tol: float) -> np.ndarray:
+    """Facets whose plane has the whole mesh on or behind it (cannot be shadowed).
+
+    Examples
+    --------
+    Every facet of a box supports it; of the L-shaped body's 20 facets, the four on the
+    inner faces of the corner (the floor and the wall it shades) do not:
+
+    >>> import trimesh
+    >>> from sbrdf_xr.body.visibility import supporting
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> bool(supporting(trimesh.creation.box(), {}, 1e-9).all())
+    True
+    >>> body = l_shaped_spacecraft()
+    >>> s = supporting(body.mesh, {}, 1e-9)
+    >>> s.shape, int((~s).sum())
+    ((20,), 4)
+    """
+    key = f"supporting:{tol!r}"
+    if key not in cache:
+        try:
+            pts = np.asarray(mesh.convex_hull.vertices)
+        except Exception:  # pragma: no cover - degenerate (flat) meshes
+            pts = np.asarray(mesh.vertices)
+        normals = np.asarray(mesh.face_normals)
+        origin = np.asarray(mesh.triangles[:, 0])
+        height = np.full(len(normals), -np.inf)
+        step = max(1, (1 << 22) // max(len(pts), 1))
+        for s in range(0, len(normals), step):  # chunks of facets, bounded memory
+            n, o = normals[s : s + step], origin[s : s + step]
+            height[s : s + step] = (pts @ n.T - np.einsum("ij,ij->i", n, o)).max(axis=0)
+        cache[key] = height <= tol
+    return cache[key]
 
 
 # ----------------------------------------------------------------------------- exact method
@@ -229,6 +312,84 @@ def _exact(
     return np.where(front, frac, 0.0)
 
 
+# ----------------------------------------------------------------------------- sampled method
+
+
+def escape_masks(
+    spacecraft: Spacecraft | trimesh.Trimesh,
+    directions: list[np.ndarray],
+    density: int | str,
+    engine: str | None,
+    offset: float | None,
+    convex_shortcut: bool,
+    seed: int,
+) -> np.ndarray:
+    """Per-sample escape flags, shape (len(directions), n_geometries, n_facets, n_samples).
+
+    Examples
+    --------
+    The wall of the L-shaped body shades half of its floor for a Sun at ``(-1, 2, 0)``;
+    at density 2 (four samples per facet) half the floor's samples escape towards it:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.body.rays import SEED
+    >>> from sbrdf_xr.body.visibility import escape_masks
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> body = l_shaped_spacecraft()
+    >>> sun = np.array([[-1.0, 2.0, 0.0]]) / np.sqrt(5.0)
+    >>> m = escape_masks(body, [sun], 2, "triangle", None, True, SEED)
+    >>> m.shape, m.dtype
+    ((1, 1, 20, 4), dtype('bool'))
+    >>> floor = np.flatnonzero(np.isclose(body.facets().centroid[:, 1], 1.0)
+    ...                        & np.isclose(body.mesh.face_normals[:, 1], 1.0))
+    >>> float(m[0, 0, floor].mean())
+    0.5
+    >>> facing_away = body.mesh.face_normals @ sun[0] <= 0
+    >>> bool(m[0, 0, facing_away].any())  # facets facing away from the Sun never escape
+    False
+    """
+    mesh, cache = mesh_of(spacecraft)
+    n = check_density(density)
+    engine = engine_name(engine)
+    scale = float(mesh.scale)
+    if offset is None:
+        offset = OFFSET_FACTOR * scale
+    if not (np.isfinite(offset) and offset > 0):
+        raise ValidationError(f"offset: got {offset!r}; expected a positive length [m]")
+    normals = np.asarray(mesh.face_normals, dtype=np.float64)
+    n_geom = len(directions[0])
+    n_fac = len(normals)
+    n_s = n * n
+    front = [d @ normals.T > 0 for d in directions]  # (n_geom, n_facets) each
+    out = np.stack([np.broadcast_to(f[:, :, None], (n_geom, n_fac, n_s)) for f in front]).copy()
+    if convex_shortcut and is_convex(spacecraft):
+        return out
+    candidates = np.flatnonzero(~supporting(mesh, cache, 0.1 * offset))
+    if len(candidates) == 0:
+        return out
+    hits = intersector(mesh, cache, engine)
+    key = f"samples:{n_s}:{seed}"
+    if key not in cache:
+        cache[key] = sample_uv(n_s, n_fac, seed)
+    base, shift = cache[key]
+    bary = to_triangle(base[None, :, :] + shift[candidates, None, :])
+    tri = np.asarray(mesh.triangles, dtype=np.float64)[candidates]
+    points = np.einsum("fsk,fkx->fsx", bary, tri) + offset * normals[candidates, None, :]
+    per_geom = max(1, len(candidates) * n_s)
+    chunk = max(1, MAX_RAYS_PER_CALL // per_geom)
+    for k, d in enumerate(directions):
+        for g0 in range(0, n_geom, chunk):  # chunks of directions, not facets
+            sub = front[k][g0 : g0 + chunk][:, candidates]
+            gi, fi = np.nonzero(sub)
+            if len(gi) == 0:
+                continue
+            origins = points[fi].reshape(-1, 3)
+            dirs = np.repeat(d[g0 + gi], n_s, axis=0)
+            escaped = ~hits(origins, dirs).reshape(len(gi), n_s)
+            out[k, g0 + gi, candidates[fi], :] = escaped
+    return out
+
+
 # ----------------------------------------------------------------------------- public API
 
 
@@ -286,12 +447,13 @@ def lit_fraction(
         Area-exact polygon clipping or sampled rays (see :data:`METHODS`).
     density : int or str
         Sampled method: ``density**2`` rays per facet (``density >= 1``) or a preset of
-        :data:`DENSITY_PRESETS`; checked but unused by the exact method.
+        :data:`~sbrdf_xr.body.rays.DENSITY_PRESETS`; checked but unused by the exact method.
     engine : {"auto", "embree", "triangle"} or None
-        Ray engine of the sampled method (see :data:`ENGINES`); None is ``"auto"``.
+        Ray engine of the sampled method (see :data:`~sbrdf_xr.body.rays.ENGINES`); None
+        is ``"auto"``.
     offset : float, optional
         Sampled method: lift of the ray origins along the facet normal [m]; default
-        :data:`OFFSET_FACTOR` times the bounding-box diagonal.
+        :data:`~sbrdf_xr.body.rays.OFFSET_FACTOR` times the bounding-box diagonal.
     convex_shortcut : bool
         Skip the computation for convex spacecraft (the result is the same; False forces it,
         for testing).

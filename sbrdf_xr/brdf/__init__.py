@@ -33,9 +33,14 @@ keyword (a table with an extra ``psi`` axis).
     metals; equal to ``"microfacet"`` when ``alpha_x = alpha_y``.
 """
 
-from __future__ import annotations
-
-from . import anisotropic, lambert, microfacet, optics, robertson_sandford
+from . import (
+    anisotropic,
+    lambert,
+    microfacet,
+    optics,
+    robertson_sandford,
+    robertson_sandford_angular,
+)
 from ._model import Model, ModelRegistry, Parameter
 
 __all__ = [
@@ -52,6 +57,7 @@ __all__ = [
     "optics",
     "register_model",
     "robertson_sandford",
+    "robertson_sandford_angular",
     "unregister_model",
 ]
 

@@ -8,11 +8,13 @@ Modules
     The sub-commands that list, run and draw.
 ``analysis``
     The sub-commands that analyse a cube or measured data.
+``observe``
+    The sub-command that simulates a real pass from elements, a site and a window.
 ``output``
     What the command line reads and prints.
 """
 
-from . import analysis, commands, output, parser
+from . import analysis, commands, observe, output, parser
 from .analysis import cmd_invert, cmd_photometry
 from .commands import (
     cmd_bench,
@@ -24,6 +26,7 @@ from .commands import (
     cmd_simulate,
     spacecraft_of,
 )
+from .observe import cmd_observe
 from .output import escape, escaped_attrs, open_cube, open_dataset
 from .parser import main
 
@@ -35,6 +38,7 @@ __all__ = [
     "cmd_info",
     "cmd_invert",
     "cmd_knobs",
+    "cmd_observe",
     "cmd_photometry",
     "cmd_plot",
     "cmd_simulate",
@@ -42,6 +46,7 @@ __all__ = [
     "escape",
     "escaped_attrs",
     "main",
+    "observe",
     "open_cube",
     "open_dataset",
     "output",

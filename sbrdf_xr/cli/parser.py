@@ -10,6 +10,10 @@ Sub-commands::
              [--scheduler ADDR] [--preset NAME] [--plot FIG.png] [--overwrite | --resume] [--plan]
              [--spacecraft NAME|MESH [--mesh-material M | --material-map MAP.toml]]
              [--material M=NAME|FILE.nc ...]
+    sbrdf-xr observe -o CUBE.nc             a real pass: elements, a site, a UTC window, an
+             --elements TLE|OMM|NAME (--site NAME | --lat D --lon D [--height M])
+             --start UTC (--stop UTC | --duration S) [--step S] [--attitude LAW ...]
+             [--spacecraft NAME|MESH] [--bands V R I] [--plot FIG.png]   attitude law
     sbrdf-xr plot CUBE.nc -o FIG.png        the cube's natural figure (light curve or spectra)
     sbrdf-xr photometry CUBE.nc [--bands V R I] [--range-km KM] [--extinction V=0.2 ...]
                         [--colours V-R,R-I]
@@ -48,6 +52,7 @@ from .commands import (
     cmd_plot,
     cmd_simulate,
 )
+from .observe import add_observe_parser
 from .output import escape
 
 __all__ = ["main"]
@@ -285,6 +290,8 @@ def build_parser() -> argparse.ArgumentParser:
         q.add_argument("-o", "--output", help="write the result Dataset to this netCDF file")
         q.add_argument("--overwrite", action="store_true", help="replace an existing output file")
         q.set_defaults(func=cmd_invert)
+
+    add_observe_parser(sub, _mesh_options)
 
     pp = sub.add_parser("plot", help="draw a cube's figure")
     pp.add_argument("cube")

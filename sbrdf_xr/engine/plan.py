@@ -33,7 +33,7 @@ import xarray as xr
 from .._names import BAND, MATERIAL, PSI, WAVELENGTH
 from .._version import __version__
 from ..errors import SceneError
-from ..kernels.sums import PackedTables, normal_rows
+from ..kernels import PackedTables, normal_rows
 from ..materials.models import model_parameters
 from ..store.fingerprint import PREFIX, scene_fingerprint
 from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, BlockInputs, Effect, PlanInputs, readonly

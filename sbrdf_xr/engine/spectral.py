@@ -18,10 +18,10 @@ import xarray as xr
 from .. import catalog
 from .._names import ANGLE_DIMS, BAND, PSI, WAVELENGTH
 from ..errors import CatalogError, SceneError, ValidationError
+from ..kernels import PackedTables, pack_tables
 from ..kernels import anisotropic as _aniso_kernels
 from ..kernels.anisotropic import pack_anisotropic
 from ..kernels.lut import table_edges, table_normal_blend
-from ..kernels.sums import PackedTables, pack_tables
 from ..materials import models
 from ..photometry import band_weights
 from ..store.fingerprint import PREFIX

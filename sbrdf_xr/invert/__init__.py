@@ -29,8 +29,6 @@ magnitudes are converted to relative fluxes ``10**(-0.4 m)`` with uncertainties
 ``sigma_F = F ln(10)/2.5 sigma_m`` (first order).
 """
 
-from __future__ import annotations
-
 from ..errors import InversionError
 from ._bench import benchmark_spin_search
 from ._data import band_terms, magnitudes_to_signal, read_spectrum

@@ -9,24 +9,39 @@ Modules
     Table look-up, smoothing splines and quadrature behind :mod:`sbrdf_xr.materials`
     (paper 000 §3.2-3.3).
 ``angles``
-    The facet angles of paper 000 Fig. 4 for a chunk of geometries x terms (vectorised).
+    The angle convention of paper 000 Fig. 4 in compiled code, one place for every
+    kernel: the facet frame, its angles (one pair, or a chunk of geometries x terms
+    vectorised) and the tangent's azimuth ``psi``.
 ``lookup``
-    Cells, weights and row sums of the compiled look-up.
+    The look-up and the accumulation the compiled kernels share: cells, weights, the
+    out-of-range policy, the lit-and-visible areas and the row sums.
 ``packing``
-    Material tables packed for the fused kernel (:class:`PackedTables`).
+    What the compiled kernels take, as typed bundles: the tables
+    (:class:`PackedTables`, :class:`TableGrids`), the terms (:class:`Facets`) and the
+    options (:class:`KernelOptions`).
 ``reference``
     The numpy reference kernel of the spacecraft sum of paper 000 §3.4 (Eqs. 3-4).
 ``sums``
     The fused numba kernel of the same sum, and the dispatch between the two.
 ``anisotropic``
-    The facet sums of anisotropic tables (a ``psi`` axis).
+    The facet sums of anisotropic tables (a ``psi`` axis), on the same angles, look-up
+    and accumulation.
 ``polygon`` and ``shadow``
     Plane-polygon clipping and the exact shadow kernel of :mod:`sbrdf_xr.body.visibility`.
 """
 
 from ..errors import ValidationError
 from . import angles, anisotropic, lookup, lut, packing, polygon, reference, shadow, sums
-from .angles import atan2_pos, chunk_angles, facet_frame
+from .angles import (
+    atan2_pos,
+    chunk_angles,
+    facet_frame,
+    forward_direction,
+    frame_angles,
+    in_plane,
+    observer_components,
+    tangent_azimuth,
+)
 from .anisotropic import AnisotropicTable, anisotropic_sums, pack_anisotropic, plan_step, reflected
 from .lut import (
     LOOKUP_METHODS,
@@ -39,7 +54,16 @@ from .lut import (
     table_edges,
     table_normal_blend,
 )
-from .packing import MAX_BUCKETS, PackedTables, bucket_map, pack_tables, typed_values
+from .packing import (
+    MAX_BUCKETS,
+    Facets,
+    KernelOptions,
+    PackedTables,
+    TableGrids,
+    bucket_map,
+    pack_tables,
+    typed_values,
+)
 from .polygon import (
     BUDGET,
     MAXM,
@@ -62,9 +86,12 @@ __all__ = [
     "MAX_BUCKETS",
     "METHOD_CODES",
     "AnisotropicTable",
+    "Facets",
     "FusedSums",
+    "KernelOptions",
     "MaterialSums",
     "PackedTables",
+    "TableGrids",
     "ValidationError",
     "angles",
     "anisotropic",
@@ -76,9 +103,12 @@ __all__ = [
     "chunk_angles",
     "clip",
     "facet_frame",
+    "forward_direction",
+    "frame_angles",
     "fused_sums",
     "hemispherical_reflectance_kernel",
     "hull",
+    "in_plane",
     "lookup",
     "lookup_kernel",
     "lookup_matrix",
@@ -86,6 +116,7 @@ __all__ = [
     "material_sums",
     "normal_incidence_weight",
     "normal_rows",
+    "observer_components",
     "pack_anisotropic",
     "pack_tables",
     "packing",
@@ -99,6 +130,7 @@ __all__ = [
     "sums",
     "table_edges",
     "table_normal_blend",
+    "tangent_azimuth",
     "typed_values",
     "union_area",
     "union_area_slabs",

@@ -1,5 +1,22 @@
-"""The facet angles of paper 000 Fig. 4 for a chunk of geometries x terms, in one
-vectorisable pass (the first stage of :func:`sbrdf_xr.kernels.sums.fused_sums`).
+"""The angle convention of paper 000 Fig. 4 in compiled code: the one place the kernels
+compute a facet's frame and angles.
+
+:func:`sbrdf_xr.geometry.facet_angles` (numpy) is the specification; here are its
+compiled parts, shared by the isotropic and the anisotropic kernels:
+
+* :func:`in_plane`, the part of a vector in the facet plane (projected twice);
+* :func:`forward_direction`, the in-plane forward vector ``e_f`` (at normal incidence
+  through the observer, or through the axis least aligned with the normal);
+* :func:`observer_components`, the observer's components along ``e_f`` and out of the
+  plane, and :func:`frame_angles`, the angles from them (branch-free arc tangents for
+  the vectorised loop, ``libm``'s for one pair);
+* :func:`facet_frame`, the three together for one lit and seen pair;
+* :func:`chunk_angles`, the same for a chunk of geometries x terms in one vectorisable
+  pass (the first stage of :func:`sbrdf_xr.kernels.sums.fused_sums`);
+* :func:`tangent_azimuth`, the azimuth ``psi`` of the illumination plane from a facet
+  tangent (:func:`sbrdf_xr.anisotropy.illumination_azimuth`).
+
+Vectors travel as 3-tuples of floats (numba keeps them in registers).
 
 ``libm``'s ``atan2`` is a scalar call (about 60 ns here) and three of them per
 (geometry, term) pair were most of the fused kernel's wavelength-independent time.
@@ -18,7 +35,18 @@ import math
 import numba
 import numpy as np
 
-__all__ = ["atan2_pos", "chunk_angles", "facet_frame"]
+__all__ = [
+    "atan2_pos",
+    "chunk_angles",
+    "facet_frame",
+    "forward_direction",
+    "frame_angles",
+    "in_plane",
+    "observer_components",
+    "tangent_azimuth",
+]
+
+Vec = tuple[float, float, float]
 
 # Cephes atan.c, double precision
 _P0 = -8.750608600031904122785e-1
@@ -73,6 +101,123 @@ def atan2_pos(y: float, x: float) -> float:  # pragma: no cover - compiled
     return math.copysign(v, y)
 
 
+@numba.njit(nogil=True, cache=True, inline="always")
+def _dot(a: Vec, b: Vec) -> float:  # pragma: no cover - compiled
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@numba.njit(nogil=True, cache=True, inline="always")
+def _cross(a: Vec, b: Vec) -> Vec:  # pragma: no cover - compiled
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+@numba.njit(nogil=True, cache=True, inline="always")
+def in_plane(n: Vec, v: Vec, vn: float) -> tuple[Vec, float]:  # pragma: no cover - compiled
+    """The part of ``v`` in the plane of the unit normal ``n`` (``vn = n.v``) and its
+    length, projected twice as :func:`sbrdf_xr.geometry.facet_angles` does (the second
+    projection brings the normal component left by rounding to ``eps |v_t|``).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.kernels.angles import in_plane
+    >>> in_plane((0.0, 0.0, 1.0), (0.6, 0.0, 0.8), 0.8)
+    ((0.6, 0.0, 0.0), 0.6)
+    """
+    tx, ty, tz = v[0] - vn * n[0], v[1] - vn * n[1], v[2] - vn * n[2]
+    d = tx * n[0] + ty * n[1] + tz * n[2]
+    tx, ty, tz = tx - d * n[0], ty - d * n[1], tz - d * n[2]
+    return (tx, ty, tz), np.sqrt(tx * tx + ty * ty + tz * tz)
+
+
+@numba.njit(nogil=True, cache=True, inline="always")
+def forward_direction(
+    n: Vec, s_t: Vec, s_t_len: float, o: Vec, no: float, tol: float
+) -> Vec:  # pragma: no cover - compiled
+    """The in-plane forward unit vector ``e_f`` of paper 000 Fig. 4.
+
+    ``-s_t / |s_t|`` from the Sun's in-plane part :func:`in_plane`; at normal incidence
+    (``|s_t| <= tol``) the observer's in-plane direction (so ``phi = 0``), or with the
+    observer on the normal too the perpendicular through the axis least aligned with
+    ``n`` (as :func:`sbrdf_xr.geometry.facet_angles`).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.kernels.angles import forward_direction
+    >>> z = (0.0, 0.0, 1.0)
+    >>> def e_f(s_t, s_t_len, o, no):
+    ...     return [v + 0.0 for v in forward_direction(z, s_t, s_t_len, o, no, 1e-12)]
+    >>> e_f((0.5, 0.0, 0.0), 0.5, (0.0, 0.6, 0.8), 0.8)  # away from the Sun
+    [-1.0, 0.0, 0.0]
+    >>> e_f((0.0, 0.0, 0.0), 0.0, (0.0, 0.6, 0.8), 0.8)  # towards the observer
+    [0.0, 1.0, 0.0]
+    >>> e_f((0.0, 0.0, 0.0), 0.0, z, 1.0)  # z x (the axis least aligned with z, +x)
+    [0.0, 1.0, 0.0]
+    """
+    if s_t_len > tol:
+        inv = 1.0 / s_t_len
+        return (-s_t[0] * inv, -s_t[1] * inv, -s_t[2] * inv)
+    o_t, o_t_len = in_plane(n, o, no)
+    if o_t_len > tol:
+        return (o_t[0] / o_t_len, o_t[1] / o_t_len, o_t[2] / o_t_len)
+    # a perpendicular: cross with the axis least aligned with n
+    ax, ay, az = abs(n[0]), abs(n[1]), abs(n[2])
+    if ax <= ay and ax <= az:
+        e = (0.0, n[2], -n[1])
+    elif ay <= az:
+        e = (-n[2], 0.0, n[0])
+    else:
+        e = (n[1], -n[0], 0.0)
+    el = np.sqrt(_dot(e, e))
+    return (e[0] / el, e[1] / el, e[2] / el)
+
+
+@numba.njit(nogil=True, cache=True, inline="always")
+def observer_components(n: Vec, e: Vec, o: Vec) -> tuple[float, float]:  # pragma: no cover
+    """The observer's components along the forward vector ``e_f`` and out of the plane
+    ``(e_f, N)``, along ``p = N x e_f`` [1].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.angles import observer_components
+    >>> h = float(np.sqrt(0.5))
+    >>> [round(v, 12) for v in observer_components((0.0, 0.0, 1.0), (1.0, 0.0, 0.0), (0.0, h, h))]
+    [0.0, 0.707106781187]
+    """
+    return _dot(o, e), _dot(o, _cross(n, e))
+
+
+@numba.njit(nogil=True, cache=True, inline="always")
+def frame_angles(
+    st_len: float, ns: float, of: float, op: float, no: float, simd: bool
+) -> tuple[float, float, float]:  # pragma: no cover - compiled
+    """``theta_i``, the observer's polar angle projected on the plane ``(e_f, N)`` and
+    ``phi`` [rad] of a lit and seen pair (``ns = N.s > 0``, ``no = N.o > 0``) from the
+    Sun's in-plane length ``|s_t|`` and :func:`observer_components`: the arc tangents of
+    :func:`sbrdf_xr.geometry.facet_angles`.
+
+    ``simd`` picks the arc tangent: :func:`atan2_pos` (branch-free, so a loop over
+    geometries vectorises) or ``libm``'s (faster one pair at a time).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.angles import frame_angles
+    >>> h = float(np.sqrt(0.5))
+    >>> a = frame_angles(0.5, np.sqrt(0.75), 0.0, h, h, False)
+    >>> b = frame_angles(0.5, np.sqrt(0.75), 0.0, h, h, True)
+    >>> [round(float(np.degrees(v)), 9) for v in a], bool(np.allclose(a, b, rtol=1e-15))
+    ([30.0, 0.0, 45.0], True)
+    """
+    if simd:
+        return (
+            atan2_pos(st_len, ns),
+            atan2_pos(of, no),
+            atan2_pos(abs(op), np.sqrt(of * of + no * no)),
+        )
+    return np.arctan2(st_len, ns), np.arctan2(of, no), np.arctan2(abs(op), np.hypot(of, no))
+
+
 @numba.njit(nogil=True, cache=True, error_model="numpy")
 def chunk_angles(
     s_t: np.ndarray,
@@ -120,34 +265,22 @@ def chunk_angles(
     >>> (dt[:, :2].round(6) + 0.0).tolist(), (phi[:, :2].round(6) + 0.0).tolist()
     ([[-30.0, -30.0]], [[0.0, 45.0]])
     """
-    sx, sy, sz = s_t[0], s_t[1], s_t[2]
-    ox, oy, oz = o_t[0], o_t[1], o_t[2]
     for t in range(normals.shape[0]):
-        nx, ny, nz = normals[t, 0], normals[t, 1], normals[t, 2]
+        n = (normals[t, 0], normals[t, 1], normals[t, 2])
         for j in range(nc):
             g = g0 + j
-            a, b, c = sx[g], sy[g], sz[g]
-            u, v, w = ox[g], oy[g], oz[g]
-            ns = nx * a + ny * b + nz * c
-            no = nx * u + ny * v + nz * w
-            stx, sty, stz = a - ns * nx, b - ns * ny, c - ns * nz
-            # projected twice, as geometry._tangential: in the plane to eps |s_t|
-            d = stx * nx + sty * ny + stz * nz
-            stx, sty, stz = stx - d * nx, sty - d * ny, stz - d * nz
-            st = np.sqrt(stx * stx + sty * sty + stz * stz)
-            ti = atan2_pos(st, ns)
-            inv = 1.0 / st
-            ex, ey, ez = -stx * inv, -sty * inv, -stz * inv
-            px = ny * ez - nz * ey
-            py = nz * ex - nx * ez
-            pz = nx * ey - ny * ex
-            of = u * ex + v * ey + w * ez
-            op = u * px + v * py + w * pz
-            trp = atan2_pos(of, no)
-            phi = atan2_pos(abs(op), np.sqrt(of * of + no * no))
+            s = (s_t[0, g], s_t[1, g], s_t[2, g])
+            o = (o_t[0, g], o_t[1, g], o_t[2, g])
+            ns = _dot(n, s)
+            no = _dot(n, o)
+            st, st_len = in_plane(n, s, ns)
+            # e_f away from normal incidence, without forward_direction's branches (SIMD)
+            inv = 1.0 / st_len
+            of, op = observer_components(n, (-st[0] * inv, -st[1] * inv, -st[2] * inv), o)
+            ti, trp, phi = frame_angles(st_len, ns, of, op, no, True)
             ns_out[t, j] = ns
             no_out[t, j] = no
-            st_out[t, j] = st
+            st_out[t, j] = st_len
             ti_out[t, j] = ti * _RAD2DEG
             dt_out[t, j] = trp * _RAD2DEG - ti * _RAD2DEG
             phi_out[t, j] = phi * _RAD2DEG
@@ -155,78 +288,67 @@ def chunk_angles(
 
 @numba.njit(nogil=True, cache=True, inline="always")
 def facet_frame(
-    nx: float,
-    ny: float,
-    nz: float,
-    sx: float,
-    sy: float,
-    sz: float,
-    ox: float,
-    oy: float,
-    oz: float,
-    ns: float,
-    no: float,
-    tol: float,
-) -> tuple[float, float, float, float, float, float, float]:  # pragma: no cover - compiled
+    n: Vec, s: Vec, o: Vec, ns: float, no: float, tol: float
+) -> tuple[float, float, float, Vec, float]:  # pragma: no cover - compiled
     """The angles of paper 000 Fig. 4 of one lit and seen pair, as
     :func:`sbrdf_xr.geometry.facet_angles`: ``(theta_i, delta_theta, phi)`` [degree], the
-    forward in-plane unit vector ``e`` and the observer's out-of-plane component ``o.p``.
+    forward in-plane unit vector ``e_f`` and the observer's out-of-plane component ``o.p``.
 
-    ``ns``, ``no`` are ``N.s`` and ``N.o``; at normal incidence (in-plane Sun component
-    under ``tol``) the plane is taken through the observer, or through the axis least
-    aligned with ``N`` when the observer is on the normal too.
+    ``ns``, ``no`` are ``N.s`` and ``N.o`` (both positive); at normal incidence (in-plane
+    Sun component under ``tol``) the plane is taken through the observer, or through the
+    axis least aligned with ``N`` when the observer is on the normal too
+    (:func:`forward_direction`).
 
     Examples
     --------
     The Sun 30 deg from the normal ``+z`` and the observer at the specular direction:
-    ``delta_theta = phi = 0`` and the forward vector ``e`` points away from the Sun.
+    ``delta_theta = phi = 0`` and the forward vector ``e_f`` points away from the Sun.
 
     >>> import numpy as np
     >>> from sbrdf_xr.kernels.angles import facet_frame
     >>> c, s = np.cos(np.radians(30)), np.sin(np.radians(30))
-    >>> r = facet_frame(0.0, 0.0, 1.0, s, 0.0, c, -s, 0.0, c, c, c, 1e-12)
-    >>> [round(v, 6) + 0.0 for v in r]  # theta_i, delta_theta, phi, e, o.p
+    >>> ti, dt, phi, e, op = facet_frame((0.0, 0.0, 1.0), (s, 0.0, c), (-s, 0.0, c), c, c, 1e-12)
+    >>> [round(v, 6) + 0.0 for v in (ti, dt, phi, *e, op)]
     [30.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0]
 
     At normal incidence the plane goes through the observer (here 40 deg off the normal
     towards ``+x``), so ``delta_theta`` is the observer's polar angle:
 
     >>> c4, s4 = np.cos(np.radians(40)), np.sin(np.radians(40))
-    >>> r = facet_frame(0.0, 0.0, 1.0, 0.0, 0.0, 1.0, s4, 0.0, c4, 1.0, c4, 1e-12)
-    >>> [round(v, 6) + 0.0 for v in r]
+    >>> z = (0.0, 0.0, 1.0)
+    >>> ti, dt, phi, e, op = facet_frame(z, z, (s4, 0.0, c4), 1.0, c4, 1e-12)
+    >>> [round(v, 6) + 0.0 for v in (ti, dt, phi, *e, op)]
     [0.0, 40.0, 0.0, 1.0, 0.0, 0.0, 0.0]
     """
-    stx, sty, stz = sx - ns * nx, sy - ns * ny, sz - ns * nz
-    d = stx * nx + sty * ny + stz * nz  # projected twice, as geometry._tangential
-    stx, sty, stz = stx - d * nx, sty - d * ny, stz - d * nz
-    st_len = np.sqrt(stx * stx + sty * sty + stz * stz)
-    theta_i = np.arctan2(st_len, ns)
-    if st_len <= tol:
-        otx, oty, otz = ox - no * nx, oy - no * ny, oz - no * nz
-        d = otx * nx + oty * ny + otz * nz
-        otx, oty, otz = otx - d * nx, oty - d * ny, otz - d * nz
-        ot_len = np.sqrt(otx * otx + oty * oty + otz * otz)
-        if ot_len > tol:
-            ex, ey, ez = otx / ot_len, oty / ot_len, otz / ot_len
-        else:
-            # a perpendicular: cross with the axis least aligned with n
-            ax, ay, az = abs(nx), abs(ny), abs(nz)
-            if ax <= ay and ax <= az:
-                ex, ey, ez = 0.0, nz, -ny
-            elif ay <= az:
-                ex, ey, ez = -nz, 0.0, nx
-            else:
-                ex, ey, ez = ny, -nx, 0.0
-            el = np.sqrt(ex * ex + ey * ey + ez * ez)
-            ex, ey, ez = ex / el, ey / el, ez / el
-    else:
-        ex, ey, ez = -stx / st_len, -sty / st_len, -stz / st_len
-    px = ny * ez - nz * ey
-    py = nz * ex - nx * ez
-    pz = nx * ey - ny * ex
-    of = ox * ex + oy * ey + oz * ez
-    op = ox * px + oy * py + oz * pz
-    trp = np.arctan2(of, no)
-    phi = np.arctan2(abs(op), np.hypot(of, no)) * _RAD2DEG
-    dt = trp * _RAD2DEG - theta_i * _RAD2DEG
-    return theta_i * _RAD2DEG, dt, phi, ex, ey, ez, op
+    st, st_len = in_plane(n, s, ns)
+    e = forward_direction(n, st, st_len, o, no, tol)
+    of, op = observer_components(n, e, o)
+    ti, trp, phi = frame_angles(st_len, ns, of, op, no, False)
+    return ti * _RAD2DEG, trp * _RAD2DEG - ti * _RAD2DEG, phi * _RAD2DEG, e, op
+
+
+@numba.njit(nogil=True, cache=True, inline="always")
+def tangent_azimuth(
+    n: Vec, tangent: Vec, e: Vec, op: float, tol: float
+) -> float:  # pragma: no cover - compiled
+    """``psi`` [degree], the azimuth of the illumination plane (``e_f`` of
+    :func:`facet_frame`) from the facet tangent, before its reduction to ``[0, 180)``:
+    :func:`sbrdf_xr.anisotropy.illumination_azimuth` (the tangent made orthogonal to the
+    normal; mirrored when the observer is below the plane, ``o.p < -tol``).
+
+    Examples
+    --------
+    The plane runs along ``+x``; tangents ``+x``, ``+y`` and along the diagonal:
+
+    >>> from sbrdf_xr.kernels.angles import tangent_azimuth
+    >>> z, x = (0.0, 0.0, 1.0), (1.0, 0.0, 0.0)
+    >>> tangents = (x, (0.0, 1.0, 0.0), (1.0, 1.0, 0.3))
+    >>> [round(tangent_azimuth(z, t, x, 0.0, 1e-12), 9) + 0.0 for t in tangents]
+    [0.0, -90.0, -45.0]
+    """
+    tn = _dot(tangent, n)
+    t = (tangent[0] - tn * n[0], tangent[1] - tn * n[1], tangent[2] - tn * n[2])
+    t_len = np.sqrt(_dot(t, t))
+    t = (t[0] / t_len, t[1] / t_len, t[2] / t_len)
+    psi = np.arctan2(_dot(e, _cross(n, t)), _dot(e, t)) * _RAD2DEG
+    return -psi if op < -tol else psi

@@ -12,7 +12,7 @@ with ``w_k(g, j)`` the ``psi`` weight of node ``k`` (two non-zero per geometry a
 facet, summing to one) and ``f_k`` the look-up in slice ``k``: each slice is an
 isotropic material whose facets carry the extra area fraction ``w_k``.  That is
 how the isotropic kernels are reused here, without a change: :func:`anisotropic_sums`
-calls :func:`sbrdf_xr.kernels.sums.material_sums` (the numpy reference) once per slice
+calls :func:`sbrdf_xr.kernels.reference.material_sums` (the numpy reference) once per slice
 that any facet needs, or :func:`sbrdf_xr.kernels.sums.fused_sums` (compiled, ``nogil``)
 once over the slices packed as materials.  Consequences, stated once:
 
@@ -40,20 +40,11 @@ from numpy.typing import DTypeLike, NDArray
 from ..anisotropy import PSI_PERIOD, illumination_azimuth, psi_weights
 from ..geometry import normal_incidence_tolerance
 from . import lut as _lut
-from .angles import facet_frame
-from .lookup import _axis, _gather
-from .packing import typed_values
-from .sums import (
-    METHOD_CODES,
-    FusedSums,
-    MaterialSums,
-    PackedTables,
-    fused_sums,
-    material_sums,
-    pack_tables,
-)
-
-_RAD2DEG = 180.0 / np.pi
+from .angles import facet_frame, tangent_azimuth
+from .lookup import _gather, _lookup_rows, _material_axes, _outside, _psi_cell, _range_limits
+from .packing import Facets, KernelOptions, PackedTables, pack_tables, typed_values
+from .reference import MaterialSums, material_sums
+from .sums import METHOD_CODES, FusedSums, fused_sums
 
 __all__ = ["AnisotropicTable", "anisotropic_sums", "pack_anisotropic", "plan_step", "reflected"]
 
@@ -192,7 +183,7 @@ def anisotropic_sums(
     fraction : ndarray, shape (G, F), optional
         Lit-and-visible area fraction of each facet [1]; default 1.
     kernel : {"numpy", "fused"}
-        :func:`sbrdf_xr.kernels.sums.material_sums` per slice (the reference), or
+        :func:`sbrdf_xr.kernels.reference.material_sums` per slice (the reference), or
         compiled: for ``nearest`` and ``linear`` a dedicated ``nogil`` numba kernel
         (angles, ``psi``, the lit-and-visible test and the out-of-range policy per
         geometry and facet, then the two ``psi`` slices gathered; it is tested against
@@ -304,174 +295,70 @@ def anisotropic_sums(
 
 
 @numba.njit(nogil=True, cache=True)
-def _aniso_fused(
-    s,
-    o,
-    normals,
-    tangents,
-    areas,
-    frac,
-    tables,
-    tgrid,
-    dgrid,
-    pgrid,
-    bt,
-    bd,
-    bp,
-    binv,
-    psi_nodes,
-    closed,
-    edges,
-    method,
-    tol,
-    edge_tol,
-    out_sig,
-    out_pap,
-    out_area,
-    out_lit,
-):  # pragma: no cover - compiled
-    """One anisotropic material, nearest or linear in the angles, linear in psi."""
-    n_geom = s.shape[0]
-    n_term = normals.shape[0]
-    n_wl = out_sig.shape[1]
+def _aniso_fused(s, o, facets, values, grids, psi, closed, opts, out):  # pragma: no cover
+    """One anisotropic material, nearest or linear in the angles, linear in psi: the
+    slices share the grids of material 0 of ``grids``."""
+    # the bundles unpacked once: the loops below hand plain arrays to the helpers
+    normals, area, _, _, tangents, frac = facets
+    tgrid, t_off, dgrid, d_off, pgrid, p_off, edges, _, bmap, b_off, binv = grids
+    method, tol, edge_tol = opts
+    out_sig, out_pap, out_area, out_lit = out
     has_frac = frac.shape[0] > 0
-    nt, nd, npp = tgrid.size, dgrid.size, pgrid.size
-    n_psi = psi_nodes.size
-    f = np.empty(n_wl, dtype=out_sig.dtype)
+    idx = np.empty((3, 4), dtype=np.int64)
+    w = np.empty((3, 4))
     rows = np.empty(8, dtype=np.int64)
     wn = np.empty(8, dtype=out_sig.dtype)
-    it = np.empty(4, dtype=np.int64)
-    idt = np.empty(4, dtype=np.int64)
-    iph = np.empty(4, dtype=np.int64)
-    wt = np.empty(4)
-    wdt = np.empty(4)
-    wph = np.empty(4)
-    for g in range(n_geom):
-        sx, sy, sz = s[g, 0], s[g, 1], s[g, 2]
-        ox, oy, oz = o[g, 0], o[g, 1], o[g, 2]
-        area_g = 0.0
-        lit_g = 0.0
-        for tt in range(n_term):
-            nx, ny, nz = normals[tt, 0], normals[tt, 1], normals[tt, 2]
-            ns = nx * sx + ny * sy + nz * sz
-            no = nx * ox + ny * oy + nz * oz
+    f = np.empty(out_sig.shape[1], dtype=out_sig.dtype)
+    axes = _material_axes(t_off, d_off, p_off, b_off, binv, 0)
+    limits = _range_limits(dgrid, pgrid, axes, edges, 0)
+    for g in range(s.shape[0]):
+        sg = (s[g, 0], s[g, 1], s[g, 2])
+        og = (o[g, 0], o[g, 1], o[g, 2])
+        for tt in range(normals.shape[0]):
+            n = (normals[tt, 0], normals[tt, 1], normals[tt, 2])
+            ns = n[0] * sg[0] + n[1] * sg[1] + n[2] * sg[2]
+            no = n[0] * og[0] + n[1] * og[1] + n[2] * og[2]
             if not (ns > 0.0 and no > 0.0):
                 continue
-            a_eff = areas[tt]
-            if has_frac:
-                a_eff = a_eff * frac[g, tt]
-            a2d = a_eff * no
-            area_g += a2d
-            lit_g += a_eff
-            # angles of paper 000 Fig. 4, as geometry.facet_angles
-            ti, dt, phi, ex, ey, ez, op = facet_frame(
-                nx, ny, nz, sx, sy, sz, ox, oy, oz, ns, no, tol
-            )
-            if (
-                (edges[0] and dt < dgrid[0] - edge_tol)
-                or (edges[1] and dt > dgrid[nd - 1] + edge_tol)
-                or (edges[2] and phi > pgrid[npp - 1] + edge_tol)
-            ):
+            a_eff = area[tt] * frac[g, tt] if has_frac else area[tt]
+            a2d = a_eff * no  # a_2D = a c cos(theta_r)
+            out_area[g] += a2d
+            out_lit[g] += a_eff
+            ti, dt, phi, e, op = facet_frame(n, sg, og, ns, no, tol)
+            if _outside(limits, dt, phi, edge_tol):
                 continue
-            # psi (anisotropy.illumination_azimuth): tangent made orthogonal to the normal
-            tx, ty, tz = tangents[tt, 0], tangents[tt, 1], tangents[tt, 2]
-            tn = tx * nx + ty * ny + tz * nz
-            tx, ty, tz = tx - tn * nx, ty - tn * ny, tz - tn * nz
-            tl = np.sqrt(tx * tx + ty * ty + tz * tz)
-            tx, ty, tz = tx / tl, ty / tl, tz / tl
-            bx = ny * tz - nz * ty
-            by = nz * tx - nx * tz
-            bz = nx * ty - ny * tx
-            psi = np.arctan2(ex * bx + ey * by + ez * bz, ex * tx + ey * ty + ez * tz) * _RAD2DEG
-            if op < -tol:
-                psi = -psi
-            # periodic linear weights (anisotropy.psi_weights)
-            x = psi_nodes[0] + (psi - psi_nodes[0]) % PSI_PERIOD
-            if x >= psi_nodes[0] + PSI_PERIOD:
-                x = psi_nodes[0]
-            if n_psi == 1:
-                k0, k1, w1 = 0, 0, 0.0
-            else:
-                last = n_psi - 1 if closed else n_psi
-                k0 = 0
-                while k0 + 1 < last and psi_nodes[k0 + 1] <= x:
-                    k0 += 1
-                lo = psi_nodes[k0]
-                hi = psi_nodes[k0 + 1] if k0 + 1 < n_psi else psi_nodes[0] + PSI_PERIOD
-                k1 = k0 + 1 if k0 + 1 < n_psi else 0
-                w1 = (x - lo) / (hi - lo)
-                if w1 < 0.0:
-                    w1 = 0.0
-                elif w1 > 1.0:
-                    w1 = 1.0
-            kt = _axis(tgrid, 0, nt, ti, method, it, wt, bt, 0, bt.size, binv[0])
-            kd = _axis(dgrid, 0, nd, dt, method, idt, wdt, bd, 0, bd.size, binv[1])
-            kp = _axis(pgrid, 0, npp, phi, method, iph, wph, bp, 0, bp.size, binv[2])
-            nk = 0
-            for a in range(kt):
-                for b in range(kd):
-                    row0 = (it[a] * nd + idt[b]) * npp
-                    wab = wt[a] * wdt[b]
-                    for c in range(kp):
-                        rows[nk] = row0 + iph[c]
-                        wn[nk] = wab * wph[c]
-                        nk += 1
+            tangent = (tangents[tt, 0], tangents[tt, 1], tangents[tt, 2])
+            k0, k1, w1 = _psi_cell(psi, closed, tangent_azimuth(n, tangent, e, op, tol))
+            nk = _lookup_rows(
+                tgrid, dgrid, pgrid, bmap, axes, ti, dt, phi, method, idx, w, rows, wn, 1.0
+            )
+            sig, pap = out_sig[g], out_pap[g]
             if w1 < 1.0:
-                _gather(
-                    tables[k0],
-                    rows,
-                    wn,
-                    nk,
-                    f,
-                    out_sig[g],
-                    out_pap[g],
-                    a2d * ns * (1.0 - w1),
-                    a2d * (1.0 - w1),
-                )
+                w0 = 1.0 - w1
+                _gather(values[k0], rows, wn, nk, f, sig, pap, a2d * ns * w0, a2d * w0)
             if w1 > 0.0:
-                _gather(
-                    tables[k1], rows, wn, nk, f, out_sig[g], out_pap[g], a2d * ns * w1, a2d * w1
-                )
-        out_area[g] = area_g
-        out_lit[g] = lit_g
+                _gather(values[k1], rows, wn, nk, f, sig, pap, a2d * ns * w1, a2d * w1)
 
 
 def _compiled_sums(s, o, n, tangents, areas, table, method, fraction):
     """:func:`anisotropic_sums` with ``kernel="fused"`` and nearest or linear look-up."""
     p = table.slices
     g = s.shape[0]
-    dt = p.dtype
-    out_sig = np.zeros((g, p.n_spectral), dt)
-    out_pap = np.zeros((g, p.n_spectral), dt)
-    out_area, out_lit = np.zeros(g), np.zeros(g)
-    frac = np.zeros((0, 0)) if fraction is None else np.ascontiguousarray(fraction, np.float64)
+    out = MaterialSums(
+        np.zeros((g, p.n_spectral), p.dtype),
+        np.zeros((g, p.n_spectral), p.dtype),
+        np.zeros(g),
+        np.zeros(g),
+    )
     psi = np.ascontiguousarray(table.psi, dtype=np.float64)
     closed = bool(psi.size > 1 and np.isclose(psi[-1] - psi[0], PSI_PERIOD, rtol=0.0, atol=1e-9))
-    _aniso_fused(
-        np.ascontiguousarray(s),
-        np.ascontiguousarray(o),
-        np.ascontiguousarray(n),
-        np.ascontiguousarray(tangents, dtype=np.float64),
-        np.ascontiguousarray(areas, dtype=np.float64),
-        frac,
-        typed_values(p),
-        p.tgrid[p.t_off[0] : p.t_off[1]],
-        p.dgrid[p.d_off[0] : p.d_off[1]],
-        p.pgrid[p.p_off[0] : p.p_off[1]],
-        *(p.bmap[a, p.b_off[a, 0] : p.b_off[a, 1]] for a in range(3)),
-        np.ascontiguousarray(p.binv[:, 0]),
-        psi,
-        closed,
-        np.array(table.zero_edges, dtype=np.bool_),
-        METHOD_CODES[method],
-        normal_incidence_tolerance(np.float64),
-        _lut.EDGE_TOL_DEG,
-        out_sig,
-        out_pap,
-        out_area,
-        out_lit,
+    facets = Facets.of(n, areas, tangent=tangents, fraction=fraction)
+    opts = KernelOptions(
+        METHOD_CODES[method], normal_incidence_tolerance(np.float64), _lut.EDGE_TOL_DEG
     )
-    return MaterialSums(out_sig, out_pap, out_area, out_lit)
+    s, o = np.ascontiguousarray(s), np.ascontiguousarray(o)
+    _aniso_fused(s, o, facets, typed_values(p), p.grids, psi, closed, opts, out)
+    return out
 
 
 def reflected(

@@ -1,7 +1,17 @@
-"""Material tables packed for the fused kernel (:func:`sbrdf_xr.kernels.sums.fused_sums`):
-one ``(nodes, L)`` view per material, the concatenated grids with offsets, the
-out-of-range policy and normal-incidence blend per material, and bucket maps that find
-an axis cell without a binary search.
+"""What the compiled kernels take, as a few typed bundles (numba named tuples).
+
+* :class:`PackedTables`, the material tables (:func:`pack_tables`): one ``(nodes, L)``
+  view per material, the concatenated grids with offsets, the out-of-range policy and
+  normal-incidence blend per material, and bucket maps that find an axis cell without a
+  binary search (:func:`bucket_map`); :class:`TableGrids` is all of it but the values,
+  as the kernels read it (the values travel as a ``numba.typed.List``,
+  :func:`typed_values`);
+* :class:`Facets`, the terms of a block (normals, areas, materials, tangents, fractions);
+* :class:`KernelOptions`, the look-up method and the tolerances.
+
+The outputs travel as the named tuples the kernels return
+(:class:`sbrdf_xr.kernels.sums.FusedSums`, :class:`sbrdf_xr.kernels.reference.MaterialSums`),
+filled in place.
 """
 
 from __future__ import annotations
@@ -13,7 +23,16 @@ import numba.typed
 import numpy as np
 from numpy.typing import DTypeLike, NDArray
 
-__all__ = ["MAX_BUCKETS", "PackedTables", "bucket_map", "pack_tables", "typed_values"]
+__all__ = [
+    "MAX_BUCKETS",
+    "Facets",
+    "KernelOptions",
+    "PackedTables",
+    "TableGrids",
+    "bucket_map",
+    "pack_tables",
+    "typed_values",
+]
 
 
 #: Most buckets of an axis' bucket map (a grid with very uneven spacing gets fewer
@@ -56,6 +75,112 @@ def bucket_map(grid: np.ndarray) -> tuple[np.ndarray, float]:
     starts = g[0] + np.arange(nb) / inv
     bmap = np.clip(np.searchsorted(g, starts, side="right") - 1, 0, g.size - 1)
     return bmap.astype(np.int64), inv
+
+
+class TableGrids(NamedTuple):
+    """The grids, offsets, policies and bucket maps of :class:`PackedTables`, the values
+    left out: the bundle of table arrays a compiled kernel takes (material ``m``'s
+    ``theta_i`` nodes are ``tgrid[t_off[m] : t_off[m + 1]]``, and so on).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.packing import TableGrids, pack_tables
+    >>> g = np.array([0.0, 90.0])
+    >>> grids = pack_tables([(np.ones((2, 2, 2, 3)), g, g - 90, g, (True, True, True))]).grids
+    >>> isinstance(grids, TableGrids), grids.dgrid.tolist(), grids.b_off.shape
+    (True, [-90.0, 0.0], (3, 2))
+    """
+
+    tgrid: NDArray[np.float64]  #: theta_i nodes of every material [degree]
+    t_off: NDArray[np.int64]  #: (M + 1,)
+    dgrid: NDArray[np.float64]  #: delta_theta nodes [degree]
+    d_off: NDArray[np.int64]
+    pgrid: NDArray[np.float64]  #: phi nodes [degree]
+    p_off: NDArray[np.int64]
+    edges: NDArray[np.bool_]  #: (M, 3)
+    blend: NDArray[np.float64]  #: (M,) [degree]
+    bmap: NDArray[np.int64]  #: (3, total)
+    b_off: NDArray[np.int64]  #: (3, M + 1)
+    binv: NDArray[np.float64]  #: (3, M)
+
+
+class Facets(NamedTuple):
+    """The terms of a block as a compiled kernel takes them (float64 and int64, C order).
+
+    Examples
+    --------
+    An empty tangent or fraction array stands for none (isotropic terms; every term
+    wholly lit and visible):
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.packing import Facets
+    >>> f = Facets.of(np.array([[0.0, 0, 1]]), np.array([2.0]))
+    >>> f.row.tolist(), f.material.tolist(), f.tangent.shape, f.fraction.shape
+    ([0], [0], (0, 3), (0, 0))
+    """
+
+    normal: NDArray[np.float64]  #: (T, 3) unit normals [1]
+    area: NDArray[np.float64]  #: (T,) [m2]
+    material: NDArray[np.int64]  #: (T,) material of each term, sorted
+    row: NDArray[np.int64]  #: (T,) the term's row among the distinct normals
+    tangent: NDArray[np.float64]  #: (T, 3) unit tangents [1], or (0, 3)
+    fraction: NDArray[np.float64]  #: (G, T) lit-and-visible fraction [1], or (0, 0)
+
+    @classmethod
+    def of(
+        cls,
+        normal: NDArray[np.floating],
+        area: NDArray[np.floating],
+        material: NDArray[np.integer] | None = None,
+        row: NDArray[np.integer] | None = None,
+        tangent: NDArray[np.floating] | None = None,
+        fraction: NDArray[np.floating] | None = None,
+    ) -> Facets:
+        """The bundle, arrays made contiguous in the kernels' dtypes; ``material`` and
+        ``row`` default to 0 and to one row per term.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from sbrdf_xr.kernels.packing import Facets
+        >>> Facets.of(np.array([[0.0, 0, 1], [1, 0, 0]]), np.ones(2)).row.tolist()
+        [0, 1]
+        """
+        n = np.ascontiguousarray(normal, dtype=np.float64)
+        t = n.shape[0]
+
+        def ints(a: NDArray[np.integer] | None, default: NDArray[np.int64]) -> NDArray[np.int64]:
+            return default if a is None else np.ascontiguousarray(a, dtype=np.int64)
+
+        def floats(a: NDArray[np.floating] | None, empty: tuple[int, ...]) -> NDArray[np.float64]:
+            return np.zeros(empty) if a is None else np.ascontiguousarray(a, dtype=np.float64)
+
+        return cls(
+            n,
+            np.ascontiguousarray(area, dtype=np.float64),
+            ints(material, np.zeros(t, dtype=np.int64)),
+            ints(row, np.arange(t, dtype=np.int64)),
+            floats(tangent, (0, 3)),
+            floats(fraction, (0, 0)),
+        )
+
+
+class KernelOptions(NamedTuple):
+    """How a compiled kernel looks up: the method code (0 nearest, 1 linear, 2 cubic),
+    the normal-incidence tolerance [1] and the tolerance of the out-of-range policy
+    [degree].
+
+    Examples
+    --------
+    >>> from sbrdf_xr.kernels.packing import KernelOptions
+    >>> KernelOptions(1, 1e-12, 1e-9).method
+    1
+    """
+
+    method: int
+    tol: float
+    edge_tol: float
 
 
 class PackedTables(NamedTuple):
@@ -102,6 +227,23 @@ class PackedTables(NamedTuple):
     bmap: NDArray[np.int64] = np.zeros((3, 1), dtype=np.int64)
     b_off: NDArray[np.int64] = np.zeros((3, 1), dtype=np.int64)
     binv: NDArray[np.float64] = np.zeros((3, 0))
+
+    @property
+    def grids(self) -> TableGrids:
+        """Everything but the values, as the compiled kernels take it."""
+        return TableGrids(
+            self.tgrid,
+            self.t_off,
+            self.dgrid,
+            self.d_off,
+            self.pgrid,
+            self.p_off,
+            self.edges,
+            self.blend,
+            self.bmap,
+            self.b_off,
+            self.binv,
+        )
 
 
 def pack_tables(

@@ -20,30 +20,29 @@ from numpy.typing import NDArray
 from ..geometry import normal_incidence_tolerance
 from . import lut as _lut
 from .angles import _RAD2DEG, chunk_angles, facet_frame
-from .lookup import _axis, _cell, _gather, _gather8
-from .packing import PackedTables, pack_tables, typed_values
-from .reference import MaterialSums, material_sums
+from .lookup import (
+    _axis,
+    _cell,
+    _gather,
+    _gather8,
+    _lookup_rows,
+    _material_axes,
+    _outside,
+    _range_limits,
+)
+from .packing import Facets, KernelOptions, PackedTables, typed_values
 
-__all__ = [
-    "METHOD_CODES",
-    "FusedSums",
-    "MaterialSums",
-    "PackedTables",
-    "fused_sums",
-    "material_sums",
-    "normal_rows",
-    "pack_tables",
-]
+__all__ = ["METHOD_CODES", "FusedSums", "fused_sums", "normal_rows"]
 
 
 # ---------------------------------------------------------------- fused kernel
 #
-# One compiled pass over (geometry x term) for a block: the angles exactly as
-# geometry.facet_angles (arctan2 throughout, the same normal-incidence rule), the
-# lit/visible test before any look-up, the out-of-range policy of
-# _lut.lookup_matrix, the interpolation weights of _lut.axis_weights, and the
-# accumulation of the outputs of material_sums.  material_sums above is its
-# specification; tests/test_kernels.py checks one against the other.
+# One compiled pass over (geometry x term) for a block: the angles of angles.py (the
+# convention of geometry.facet_angles), the lit/visible test before any look-up, the
+# out-of-range policy and interpolation weights of lookup.py (those of
+# lut.lookup_matrix and lut.axis_weights), and the accumulation of the outputs of
+# reference.material_sums, its specification (tests/kernels/test_kernels.py checks one
+# against the other).
 
 #: Look-up method codes of the fused kernel.
 METHOD_CODES: dict[str, int] = {"nearest": 0, "linear": 1, "cubic": 2}
@@ -52,54 +51,73 @@ METHOD_CODES: dict[str, int] = {"nearest": 0, "linear": 1, "cubic": 2}
 _CHUNK = 64
 
 
-@numba.njit(nogil=True, cache=True)
-def _fused_sums(
-    s,
-    o,
-    normals,
-    uniq,
-    areas,
-    term_mat,
-    frac,
-    tables,
-    tgrid,
-    t_off,
-    dgrid,
-    d_off,
-    pgrid,
-    p_off,
-    edges,
-    blend,
-    bmap,
-    b_off,
-    binv,
-    method,
-    tol,
-    edge_tol,
-    out_sig,
-    out_pap,
-    out_area,
-    out_lit,
-    out_pm,
+@numba.njit(nogil=True, cache=True, inline="always")
+def _blend_weight(b_m: float, ti: float) -> float:  # pragma: no cover - compiled
+    """Weight of the ``theta_i = 0`` profile in the normal-incidence blend of width
+    ``b_m`` [degree] (``lut.lookup_matrix``)."""
+    if b_m > 0.0 and ti < b_m:
+        x = ti / b_m
+        if x < 0.0:
+            x = 0.0
+        return 1.0 - x * x * (3.0 - 2.0 * x)
+    return 0.0
+
+
+@numba.njit(nogil=True, cache=True, inline="always")
+def _blend_rows(
+    dgrid, pgrid, bmap, axes, edges, m, dt, phi, method, idx, w, rows, wn, w_n, nk, edge_tol
 ):  # pragma: no cover - compiled
+    """Append the rows of the normal-incidence blend: the ``theta_i = 0`` row along its
+    in-plane profile at ``+-gamma``, the angle from the specular direction
+    (``lut.observer_polar_angle(0, dt, phi)``), weight ``w_n`` shared by the sides in
+    range; returns the new count."""
+    pr = phi / _RAD2DEG
+    tr = dt / _RAD2DEG
+    cp = np.cos(pr)
+    gam = np.arctan2(np.hypot(np.sin(pr), cp * np.sin(tr)), abs(cp * np.cos(tr))) * _RAD2DEG
+    d = axes[1]
+    ok_hi = (gam <= dgrid[d.lo + d.n - 1] + edge_tol) or not edges[m, 1]
+    ok_lo = (-gam >= dgrid[d.lo] - edge_tol) or not edges[m, 0]
+    n_ok = (1 if ok_hi else 0) + (1 if ok_lo else 0)
+    if n_ok == 0:
+        return nk
+    base_w = w_n / n_ok
+    npp = axes[2].n
+    kp = _axis(pgrid, bmap, axes[2], 0.0, method, idx, w)
+    for side in range(2):
+        if (side == 0 and not ok_hi) or (side == 1 and not ok_lo):
+            continue
+        kd = _axis(dgrid, bmap, d, gam if side == 0 else -gam, method, idx, w)
+        for b in range(kd):
+            for c in range(kp):
+                rows[nk] = idx[1, b] * npp + idx[2, c]
+                wn[nk] = base_w * w[1, b] * w[2, c]
+                nk += 1
+    return nk
+
+
+@numba.njit(nogil=True, cache=True)
+def _fused_sums(s, o, facets, values, grids, opts, out):  # pragma: no cover - compiled
+    # the bundles unpacked once: the loops below hand plain arrays to the helpers
+    normals, area, term_mat, uniq, _, frac = facets
+    tgrid, t_off, dgrid, d_off, pgrid, p_off, edges, blend, bmap, b_off, binv = grids
+    method, tol, edge_tol = opts
+    out_sig, out_pap, out_area, out_lit, out_pm = out
     n_geom = s.shape[0]
     n_term = normals.shape[0]
     n_wl = out_sig.shape[1]
     has_frac = frac.shape[0] > 0
     want_pm = out_pm.shape[0] > 0
-    f = np.empty(n_wl, dtype=out_sig.dtype)
-    acc_s = np.empty(n_wl, dtype=out_sig.dtype)
-    acc_p = np.empty(n_wl, dtype=out_sig.dtype)
-    wbuf = np.empty(2, dtype=out_sig.dtype)
+    dtype = out_sig.dtype
+    idx = np.empty((3, 4), dtype=np.int64)
+    w = np.empty((3, 4))
     rows = np.empty(96, dtype=np.int64)
-    wn = np.empty(96, dtype=out_sig.dtype)
-    it = np.empty(4, dtype=np.int64)
-    idt = np.empty(4, dtype=np.int64)
-    iph = np.empty(4, dtype=np.int64)
-    wt = np.empty(4)
-    wdt = np.empty(4)
-    wph = np.empty(4)
-    bt, bd, bp = bmap[0], bmap[1], bmap[2]
+    wn = np.empty(96, dtype=dtype)
+    f = np.empty(n_wl, dtype=dtype)
+    acc_s = np.empty(n_wl, dtype=dtype)
+    acc_p = np.empty(n_wl, dtype=dtype)
+    # the pair's weights rounded to the tables' dtype, as the reference weights them
+    wbuf = np.empty(2, dtype=dtype)
     # stage 1 (chunk_angles): the angles of a chunk of geometries against every term in
     # one vectorised pass; stage 2: per material of the chunk, per geometry, the look-ups
     # of its lit and seen pairs (terms in order, so that terms of one face read the same
@@ -128,21 +146,12 @@ def _fused_sums(
             stop = t
             while stop < n_term and term_mat[stop] == m:
                 stop += 1
-            values = tables[m]  # once per chunk and material (an item of a typed list costs)
-            d0 = d_off[m]
-            nd = d_off[m + 1] - d0
-            p0 = p_off[m]
-            npp = p_off[m + 1] - p0
-            t0 = t_off[m]
-            nt = t_off[m + 1] - t0
-            bt0, nbt, bit = b_off[0, m], b_off[0, m + 1] - b_off[0, m], binv[0, m]
-            bd0, nbd, bid = b_off[1, m], b_off[1, m + 1] - b_off[1, m], binv[1, m]
-            bp0, nbp, bip = b_off[2, m], b_off[2, m + 1] - b_off[2, m], binv[2, m]
-            linear8 = method == 1 and nt > 1 and nd > 1 and npp > 1
-            # the material's edges: delta_theta below, above; phi above; the blend width
-            e_dlo, e_dhi, e_phi = edges[m, 0], edges[m, 1], edges[m, 2]
-            d_lo, d_hi, p_hi = dgrid[d0], dgrid[d0 + nd - 1], pgrid[p0 + npp - 1]
-            b_m = blend[m] if tgrid[t0] == 0.0 else 0.0
+            vals = values[m]  # once per chunk and material (an item of a typed list costs)
+            axes = _material_axes(t_off, d_off, p_off, b_off, binv, m)
+            nd, npp = axes[1].n, axes[2].n
+            linear8 = method == 1 and axes[0].n > 1 and nd > 1 and npp > 1
+            b_m = blend[m] if tgrid[axes[0].lo] == 0.0 else 0.0
+            limits = _range_limits(dgrid, pgrid, axes, edges, m)
             for j in range(nc):
                 g = c0 + j
                 any_lookup = False
@@ -152,47 +161,49 @@ def _fused_sums(
                     no = b_no[u, j]
                     if not (ns > 0.0 and no > 0.0):
                         continue
-                    a_eff = areas[tt]
-                    if has_frac:
-                        a_eff = a_eff * frac[g, tt]
-                    a2d = a_eff * no
+                    a_eff = area[tt] * frac[g, tt] if has_frac else area[tt]
+                    a2d = a_eff * no  # a_2D = a c cos(theta_r)
                     out_area[g] += a2d
                     out_lit[g] += a_eff
-                    # angles of paper 000 Fig. 4, as geometry.facet_angles
                     if b_st[u, j] > tol:
                         ti, dt, phi = b_ti[u, j], b_dt[u, j], b_ph[u, j]
                     else:  # normal incidence: the plane through the observer or an axis
-                        ti, dt, phi, _, _, _, _ = facet_frame(
-                            normals[tt, 0],
-                            normals[tt, 1],
-                            normals[tt, 2],
-                            s[g, 0],
-                            s[g, 1],
-                            s[g, 2],
-                            o[g, 0],
-                            o[g, 1],
-                            o[g, 2],
+                        ti, dt, phi, _, _ = facet_frame(
+                            (normals[tt, 0], normals[tt, 1], normals[tt, 2]),
+                            (s[g, 0], s[g, 1], s[g, 2]),
+                            (o[g, 0], o[g, 1], o[g, 2]),
                             ns,
                             no,
                             tol,
                         )
-                    outside = (
-                        (e_dlo and dt < d_lo - edge_tol)
-                        or (e_dhi and dt > d_hi + edge_tol)
-                        or (e_phi and phi > p_hi + edge_tol)
-                    )
-                    # normal-incidence blend (_lut.lookup_matrix): weight of the theta_i = 0 profile
-                    w_n = 0.0
-                    if b_m > 0.0 and ti < b_m:
-                        x = ti / b_m
-                        if x < 0.0:
-                            x = 0.0
-                        w_n = 1.0 - x * x * (3.0 - 2.0 * x)
-                    if linear8 and w_n == 0.0 and not outside:
+                    outside = _outside(limits, dt, phi, edge_tol)
+                    w_n = _blend_weight(b_m, ti)
+                    wbuf[0] = a2d * ns
+                    wbuf[1] = a2d
+                    fast = linear8 and w_n == 0.0 and not outside
+                    nk = 0
+                    if not fast:
+                        if not outside and w_n < 1.0:
+                            nk = _lookup_rows(
+                                tgrid, dgrid, pgrid, bmap, axes, ti, dt, phi, method, idx, w,
+                                rows, wn, 1.0 - w_n,
+                            )  # fmt: skip
+                        if w_n > 0.0:
+                            nk = _blend_rows(
+                                dgrid, pgrid, bmap, axes, edges, m, dt, phi, method, idx, w,
+                                rows, wn, w_n, nk, edge_tol,
+                            )  # fmt: skip
+                        if nk == 0:
+                            continue
+                    if not any_lookup:
+                        acc_s[:] = 0.0
+                        acc_p[:] = 0.0
+                        any_lookup = True
+                    if fast:
                         # linear in all three axes, no blend: the 8 rows straight from the cells
-                        i0, u0 = _cell(tgrid, t0, nt, ti, bt, bt0, nbt, bit)
-                        i1, u1 = _cell(dgrid, d0, nd, dt, bd, bd0, nbd, bid)
-                        i2, u2 = _cell(pgrid, p0, npp, phi, bp, bp0, nbp, bip)
+                        i0, u0 = _cell(tgrid, bmap, axes[0], ti)
+                        i1, u1 = _cell(dgrid, bmap, axes[1], dt)
+                        i2, u2 = _cell(pgrid, bmap, axes[2], phi)
                         r = (i0 * nd + i1) * npp + i2
                         wa0, wa1 = 1.0 - u0, u0
                         wb0, wb1 = 1.0 - u1, u1
@@ -200,75 +211,9 @@ def _fused_sums(
                         w00, w01, w10, w11 = wa0 * wb0, wa0 * wb1, wa1 * wb0, wa1 * wb1
                         wn[0], wn[1], wn[2], wn[3] = w00 * wc0, w00 * wc1, w01 * wc0, w01 * wc1
                         wn[4], wn[5], wn[6], wn[7] = w10 * wc0, w10 * wc1, w11 * wc0, w11 * wc1
-                        if not any_lookup:
-                            acc_s[:] = 0.0
-                            acc_p[:] = 0.0
-                            any_lookup = True
-                        wbuf[0] = a2d * ns
-                        wbuf[1] = a2d
-                        _gather8(values, r, npp, nd * npp, wn, acc_s, acc_p, wbuf[0], wbuf[1])
-                        continue
-                    nk = 0
-                    if not outside and w_n < 1.0:
-                        kt = _axis(tgrid, t0, nt, ti, method, it, wt, bt, bt0, nbt, bit)
-                        kd = _axis(dgrid, d0, nd, dt, method, idt, wdt, bd, bd0, nbd, bid)
-                        kp = _axis(pgrid, p0, npp, phi, method, iph, wph, bp, bp0, nbp, bip)
-                        for a in range(kt):
-                            for b in range(kd):
-                                row0 = (it[a] * nd + idt[b]) * npp
-                                wab = wt[a] * wdt[b] * (1.0 - w_n)
-                                for c in range(kp):
-                                    rows[nk] = row0 + iph[c]
-                                    wn[nk] = wab * wph[c]
-                                    nk += 1
-                    if w_n > 0.0:
-                        # the theta_i = 0 row along its in-plane profile at +-gamma, the angle from
-                        # the specular direction (_lut.observer_polar_angle(0, dt, phi))
-                        pr = phi / _RAD2DEG
-                        tr = dt / _RAD2DEG
-                        cp = np.cos(pr)
-                        gam = (
-                            np.arctan2(np.hypot(np.sin(pr), cp * np.sin(tr)), abs(cp * np.cos(tr)))
-                            * _RAD2DEG
-                        )
-                        ok_hi = (gam <= d_hi + edge_tol) or not e_dhi
-                        ok_lo = (-gam >= d_lo - edge_tol) or not e_dlo
-                        n_ok = (1 if ok_hi else 0) + (1 if ok_lo else 0)
-                        if n_ok > 0:
-                            base_w = w_n / n_ok
-                            kp = _axis(pgrid, p0, npp, 0.0, method, iph, wph, bp, bp0, nbp, bip)
-                            for side in range(2):
-                                if (side == 0 and not ok_hi) or (side == 1 and not ok_lo):
-                                    continue
-                                kd = _axis(
-                                    dgrid,
-                                    d0,
-                                    nd,
-                                    gam if side == 0 else -gam,
-                                    method,
-                                    idt,
-                                    wdt,
-                                    bd,
-                                    bd0,
-                                    nbd,
-                                    bid,
-                                )
-                                for b in range(kd):
-                                    for c in range(kp):
-                                        rows[nk] = idt[b] * npp + iph[c]
-                                        wn[nk] = base_w * wdt[b] * wph[c]
-                                        nk += 1
-                    if nk == 0:
-                        continue
-                    if not any_lookup:
-                        acc_s[:] = 0.0
-                        acc_p[:] = 0.0
-                        any_lookup = True
-                    wbuf[0] = a2d * ns
-                    wbuf[1] = a2d
-                    ws = wbuf[0]
-                    wp = wbuf[1]
-                    _gather(values, rows, wn, nk, f, acc_s, acc_p, ws, wp)
+                        _gather8(vals, r, npp, nd * npp, wn, acc_s, acc_p, wbuf[0], wbuf[1])
+                    else:
+                        _gather(vals, rows, wn, nk, f, acc_s, acc_p, wbuf[0], wbuf[1])
                 if any_lookup:
                     if method == 2:
                         for k in range(n_wl):
@@ -311,7 +256,8 @@ class FusedSums(NamedTuple):
     material, ``None`` unless asked for (a block without terms, so nothing to compile):
 
     >>> import numpy as np
-    >>> from sbrdf_xr.kernels.sums import FusedSums, fused_sums, pack_tables
+    >>> from sbrdf_xr.kernels.packing import pack_tables
+    >>> from sbrdf_xr.kernels.sums import FusedSums, fused_sums
     >>> g = np.array([0.0, 90.0])
     >>> tables = pack_tables([(np.ones((2, 2, 2, 3)), g, g - 90, g, (True, True, True))])
     >>> s = o = np.array([[0.0, 0, 1], [1, 0, 0]])
@@ -344,7 +290,8 @@ def fused_sums(
     per_material: bool = False,
     rows: NDArray[np.int64] | None = None,
 ) -> FusedSums:
-    """The facet sums of :func:`material_sums`, over all materials at once, compiled.
+    """The facet sums of :func:`~sbrdf_xr.kernels.reference.material_sums`, over all
+    materials at once, compiled.
 
     Parameters
     ----------
@@ -358,7 +305,8 @@ def fused_sums(
         Material index of each term into ``tables``; terms of one material must be
         contiguous (sorted).
     tables : PackedTables
-        From :func:`pack_tables`; its dtype is the dtype of the spectral outputs.
+        From :func:`~sbrdf_xr.kernels.packing.pack_tables`; its dtype is the dtype of the
+        spectral outputs.
     method : {"nearest", "linear", "cubic"}
         Look-up method.
     fraction : ndarray, shape (G, T), optional
@@ -374,7 +322,7 @@ def fused_sums(
     FusedSums
         The spectral sums in the dtype of the tables (no promotion of float32);
         ``area`` and ``lit_visible_area`` in float64.  For ``cubic`` each material's
-        sums are clipped at 0 as in :func:`material_sums`.
+        sums are clipped at 0 as in :func:`~sbrdf_xr.kernels.reference.material_sums`.
 
     Examples
     --------
@@ -382,7 +330,8 @@ def fused_sums(
     block without terms returns zeros without running the compiled kernel):
 
     >>> import numpy as np
-    >>> from sbrdf_xr.kernels.sums import fused_sums, pack_tables
+    >>> from sbrdf_xr.kernels.packing import pack_tables
+    >>> from sbrdf_xr.kernels.sums import fused_sums
     >>> g = np.array([0.0, 90.0])
     >>> one = (np.ones((2, 2, 2, 3)), g, g - 90, g, (True, True, True))
     >>> tables = pack_tables([one, one], dtype=np.float32)
@@ -402,47 +351,21 @@ def fused_sums(
     s = np.ascontiguousarray(to_sun, dtype=np.float64)
     o = np.ascontiguousarray(to_observer, dtype=np.float64)
     g = s.shape[0]
-    n_wl = tables.n_spectral
-    dt = tables.dtype
-    n_mat = tables.edges.shape[0]
-    out_sig = np.zeros((g, n_wl), dtype=dt)
-    out_pap = np.zeros((g, n_wl), dtype=dt)
-    out_area = np.zeros(g)
-    out_lit = np.zeros(g)
-    out_pm = np.zeros((g, n_mat, n_wl) if per_material else (0, 0, 0), dtype=dt)
-    frac = (
-        np.zeros((0, 0)) if fraction is None else np.ascontiguousarray(fraction, dtype=np.float64)
+    n_wl, dt, n_mat = tables.n_spectral, tables.dtype, tables.edges.shape[0]
+    out = FusedSums(
+        np.zeros((g, n_wl), dtype=dt),
+        np.zeros((g, n_wl), dtype=dt),
+        np.zeros(g),
+        np.zeros(g),
+        np.zeros((g, n_mat, n_wl) if per_material else (0, 0, 0), dtype=dt),
     )
     if g and normals.shape[0]:
-        typed = typed_values(tables)
         nrm = np.ascontiguousarray(normals, dtype=np.float64)
-        _fused_sums(
-            s,
-            o,
-            nrm,
-            normal_rows(nrm) if rows is None else rows,
-            np.ascontiguousarray(areas, dtype=np.float64),
-            tm,
-            frac,
-            typed,
-            tables.tgrid,
-            tables.t_off,
-            tables.dgrid,
-            tables.d_off,
-            tables.pgrid,
-            tables.p_off,
-            tables.edges,
-            tables.blend,
-            tables.bmap,
-            tables.b_off,
-            tables.binv,
-            METHOD_CODES[method],
-            normal_incidence_tolerance(np.float64),
-            _lut.EDGE_TOL_DEG,
-            out_sig,
-            out_pap,
-            out_area,
-            out_lit,
-            out_pm,
+        facets = Facets.of(
+            nrm, areas, tm, normal_rows(nrm) if rows is None else rows, None, fraction
         )
-    return FusedSums(out_sig, out_pap, out_area, out_lit, out_pm if per_material else None)
+        opts = KernelOptions(
+            METHOD_CODES[method], normal_incidence_tolerance(np.float64), _lut.EDGE_TOL_DEG
+        )
+        _fused_sums(s, o, facets, typed_values(tables), tables.grids, opts, out)
+    return out if per_material else out._replace(per_material=None)

@@ -68,7 +68,7 @@ def hemispherical_reflectance(
     The directional-hemispherical reflectance of a Lambertian table is its albedo:
 
     >>> import numpy as np
-    >>> from sbrdf_xr.materials.tables import hemispherical_reflectance, lambertian
+    >>> from sbrdf_xr.materials import hemispherical_reflectance, lambertian
     >>> rho = hemispherical_reflectance(lambertian(0.5, [550.0]), [0.0, 30.0, 60.0])
     >>> rho.dims, rho.attrs["units"]
     (('theta_i', 'wavelength'), '1')

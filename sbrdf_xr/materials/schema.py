@@ -32,6 +32,7 @@ from .._names import (
     attrs,
 )
 from ..errors import ValidationError
+from ..units import check_wavelengths, to_unit
 
 __all__ = [
     "DUPLICATES",
@@ -170,6 +171,7 @@ def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.Data
             raise ValidationError(f"psi: must lie in [0, 180] degree, got [{ps[0]}, {ps[-1]}]")
     if da[WAVELENGTH].values[0] <= 0:
         raise ValidationError("wavelength: must be positive")
+    check_wavelengths(da[WAVELENGTH].values, "wavelength")
     if "source" in da.attrs:
         _check_source(da.attrs["source"])
     if check_values:
@@ -238,10 +240,13 @@ def new_material(
     """
     _check_source(source)
     coords = {
-        THETA_I: (THETA_I, np.asarray(theta_i, dtype=np.float64), attrs(THETA_I)),
-        DELTA_THETA: (DELTA_THETA, np.asarray(delta_theta, dtype=np.float64), attrs(DELTA_THETA)),
-        PHI: (PHI, np.asarray(phi, dtype=np.float64), attrs(PHI)),
-        WAVELENGTH: (WAVELENGTH, np.asarray(wavelength, dtype=np.float64), attrs(WAVELENGTH)),
+        name: (name, np.asarray(to_unit(v, unit, name, spectral=unit == NM), float), attrs(name))
+        for name, v, unit in (
+            (THETA_I, theta_i, DEGREE),
+            (DELTA_THETA, delta_theta, DEGREE),
+            (PHI, phi, DEGREE),
+            (WAVELENGTH, wavelength, NM),
+        )
     }
     a = attrs(SBRDF, material=material, source=source, provenance=provenance)
     a.update({k: _attr_value(v) for k, v in parameters.items()})
@@ -295,7 +300,7 @@ def constant_material(
     >>> table.sel(wavelength=600.0).values.ravel().tolist()
     [0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2]
     """
-    wl = np.atleast_1d(np.asarray(wavelength, dtype=np.float64))
+    wl = np.atleast_1d(np.asarray(to_unit(wavelength, NM, WAVELENGTH, spectral=True), float))
     v = np.asarray(value, dtype=np.float64)
     if v.ndim > 1 or (v.ndim == 1 and v.size not in (1, wl.size)):
         raise ValidationError(
@@ -350,7 +355,7 @@ def lambertian(
     """
     from ..brdf import lambert
 
-    wl = np.atleast_1d(np.asarray(wavelength, dtype=np.float64))
+    wl = np.atleast_1d(np.asarray(to_unit(wavelength, NM, WAVELENGTH, spectral=True), float))
     rho = lambert.check_params(wl, rho=albedo)["rho"]
     alb = np.asarray(albedo, dtype=np.float64)
     scalar = alb.ndim == 0
@@ -520,6 +525,7 @@ def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Da
     if WAVELENGTH not in ds.coords:
         raise ValidationError("wavelength: coordinate is missing")
     check_coord(WAVELENGTH, np.asarray(ds[WAVELENGTH].values))
+    check_wavelengths(ds[WAVELENGTH].values, "wavelength")
     if ds[WAVELENGTH].attrs.get("units") != NM:
         raise ValidationError(
             f"wavelength: units must be 'nm', got {ds[WAVELENGTH].attrs.get('units')!r}"

@@ -48,7 +48,6 @@ from ..errors import ValidationError
 from ..kernels import lut as _lut
 from .build import build_lut
 from .construction import paper_delta_theta_grid, paper_phi_grid
-from .energy import ENERGY_TOL, hemispherical_reflectance  # noqa: F401  (re-exported)
 from .files import open_material, open_measurements, to_netcdf, write_netcdf_atomic
 from .schema import (
     constant_material,
@@ -63,7 +62,6 @@ __all__ = [
     "build_lut",
     "build_lut_anisotropic",
     "constant_material",
-    "hemispherical_reflectance",
     "lambertian",
     "lookup",
     "lookup_anisotropic",

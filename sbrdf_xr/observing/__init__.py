@@ -8,9 +8,12 @@ Modules
     SGP4 elements, WGS84 sites and the air mass seen from them.
 ``earth_shadow``
     The sunlit fraction of the solar disc seen from the spacecraft.
-``frames``, ``pointing``, ``tumble``, ``series`` and ``attitude``
+``attitude``
     Attitude laws: the orientation of a spacecraft as a function of time
-    (:class:`AttitudeLaw` and its laws, :data:`LAWS`).
+    (:class:`AttitudeLaw`, the table :data:`LAWS`, the pointing laws, spin and
+    composition); ``tumble`` and ``series`` hold the torque-free tumble and the
+    user time series, and ``frames`` the body axes, triads, times and the
+    :class:`Context` the laws read.
 ``observation`` and ``observe``
     :class:`Observation`: an orbit, a site, UTC times and an attitude law, as the
     body-frame geometry of a pass; observations from TOML tables.
@@ -24,12 +27,21 @@ from . import (
     observation,
     observe,
     orbits,
-    pointing,
     series,
     timescales,
     tumble,
 )
-from .attitude import LAWS, Spin, compose, law_from_dict
+from .attitude import (
+    LAWS,
+    AttitudeLaw,
+    Composed,
+    Inertial,
+    Nadir,
+    Spin,
+    SunPointing,
+    compose,
+    law_from_dict,
+)
 from .earth_shadow import (
     EARTH_MODELS,
     EARTH_RADIUS_KM,
@@ -52,7 +64,6 @@ from .orbits import (
     load_site_entry,
     tle_checksum,
 )
-from .pointing import AttitudeLaw, Composed, Inertial, Nadir, SunPointing
 from .series import QuaternionSeries
 from .timescales import (
     KNOT_S,
@@ -112,7 +123,6 @@ __all__ = [
     "observation_from_dict",
     "observe",
     "orbits",
-    "pointing",
     "series",
     "shadow_events",
     "skyfield_data",

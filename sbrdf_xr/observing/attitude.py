@@ -1,16 +1,17 @@
 """Attitude laws: the orientation of a spacecraft as a function of time.
 
-Every law is an object with ``quaternions(times, context=None) -> (n, 4)``: unit
-quaternions, scalar-last ``(x, y, z, w)``, of the rotation that takes body-frame
-vectors to the inertial reference frame (the convention of :mod:`sbrdf_xr.geometry`).
-The inertial frame of :mod:`sbrdf_xr.observing.observe` is the GCRS (geocentric, ICRF axes).
+Every law is an :class:`AttitudeLaw`: ``law.quaternions(times, context=None) -> (n, 4)``,
+unit quaternions, scalar-last ``(x, y, z, w)``, of the rotation that takes body-frame
+vectors to the inertial reference frame (the convention of :mod:`sbrdf_xr.geometry`),
+and ``outer * inner`` composes two laws.  The inertial frame of
+:mod:`sbrdf_xr.observing.observe` is the GCRS (geocentric, ICRF axes).
 
 Times are either ``datetime64`` (UTC) or float seconds.  Float seconds count from the
 law's ``epoch``; a law without an ``epoch`` counts from ``context.epoch`` (the start of
 the observation), or from the first requested time.  Laws that follow the orbit
-(:class:`~sbrdf_xr.observing.pointing.Nadir`, :class:`~sbrdf_xr.observing.pointing.SunPointing`)
-need a :class:`~sbrdf_xr.observing.frames.Context` with the spacecraft's position and
-velocity and the direction of the Sun at the requested times.
+(:class:`Nadir`, :class:`SunPointing`) need a :class:`~sbrdf_xr.observing.frames.Context`
+with the spacecraft's position and velocity and the direction of the Sun at the
+requested times.
 
 Laws
 ----
@@ -21,69 +22,273 @@ SunPointing         a body axis on the Sun, a second body axis as close as possi
                     target direction (orbit normal, nadir, velocity, north or a vector)
 Spin                rotation about a body axis at a constant rate from an initial attitude
                     (a quaternion or another law)
+Composed            ``outer * inner``: ``R(t) = R_outer(t) R_inner(t)`` (:func:`compose`)
 Tumble              torque-free rigid body: Euler's equations for an inertia tensor
                     (given, or :meth:`Spacecraft.inertia` at uniform density), integrated
                     with :func:`scipy.integrate.solve_ivp` (DOP853, rtol 1e-12)
 QuaternionSeries    a user time series (arrays, CSV or netCDF), slerp-interpolated
-Composed            ``outer * inner``: ``R(t) = R_outer(t) R_inner(t)``
 ==================  ========================================================================
 
-:func:`law_from_dict` builds a law from a TOML table (``[observation.attitude]``);
-:func:`compose` and :class:`Spin` take a law, a quaternion or such a table, so they
-stand here with it.  The other laws are defined by job and importable from here too:
-the :class:`~sbrdf_xr.observing.pointing.AttitudeLaw` interface, its composition and the
-pointing laws in :mod:`sbrdf_xr.observing.pointing`, the tumble in
-:mod:`sbrdf_xr.observing.tumble`, the time series in :mod:`sbrdf_xr.observing.series`, and
-the frames, :class:`~sbrdf_xr.observing.frames.Context` and :func:`triad` in
-:mod:`sbrdf_xr.observing.frames`.
+This module holds the interface, the table of laws and every law but the last two,
+which have their own modules (:mod:`sbrdf_xr.observing.tumble`,
+:mod:`sbrdf_xr.observing.series`).  A law enters the table :data:`LAWS` by its class
+definition (its ``law_name`` and ``law_parameters``), and :func:`law_from_dict` builds any
+law of the table from a TOML table (``[observation.attitude]``) through the class's
+``from_table``.  The frames, :class:`~sbrdf_xr.observing.frames.Context` and
+:func:`~sbrdf_xr.observing.frames.triad` are in :mod:`sbrdf_xr.observing.frames`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from ..errors import AttitudeError, did_you_mean
+from ..units import to_unit
 from .frames import (
     Context,
     axis_vector,
     check_epoch,
+    check_quaternion,
+    context_fields,
+    perpendicular_pair,
     seconds_since,
     triad,
 )
-from .pointing import AttitudeLaw, Composed, Inertial, Nadir, SunPointing
-from .series import QuaternionSeries
-from .tumble import Tumble
 
 __all__ = [
     "LAWS",
     "AttitudeLaw",
     "Composed",
-    "Context",
     "Inertial",
     "Nadir",
-    "QuaternionSeries",
     "Spin",
     "SunPointing",
-    "Tumble",
     "compose",
     "law_from_dict",
-    "triad",
 ]
 
+#: Law name -> (class, allowed parameters); each law's class definition enters it
+#: (:class:`AttitudeLaw`).
+LAWS: dict[str, tuple[type[AttitudeLaw], tuple[str, ...]]] = {}
 
-def _law_or_quaternion(value: Any, name: str) -> AttitudeLaw:
-    if isinstance(value, AttitudeLaw):
-        return value
-    if isinstance(value, Mapping):
-        return law_from_dict(value)
-    return Inertial(value)
+
+class AttitudeLaw:
+    """Base of the attitude laws: ``law.quaternions(times, context) -> (n, 4)``.
+
+    ``outer * inner`` composes two laws (:class:`Composed`).  A subclass that sets
+    ``law_name`` (the ``law`` of a TOML table) and ``law_parameters`` (its other keys)
+    enters :data:`LAWS`; :meth:`from_table` builds it from such a table.
+
+    Examples
+    --------
+    >>> law = Spin(axis_body="+z", rate_deg_s=90.0)
+    >>> isinstance(law, AttitudeLaw), law.quaternions([0.0, 1.0]).shape
+    (True, (2, 4))
+    """
+
+    law_name: ClassVar[str] = ""
+    law_parameters: ClassVar[tuple[str, ...]] = ()
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        if cls.__dict__.get("law_name"):
+            LAWS[cls.law_name] = (cls, cls.law_parameters)
+
+    @classmethod
+    def from_table(cls, params: dict[str, Any]) -> AttitudeLaw:
+        """The law of a TOML table's parameters (its keys but ``law``, already checked
+        against ``law_parameters``).
+
+        Examples
+        --------
+        >>> Inertial.from_table({"q": [0.0, 0.0, 1.0, 0.0]})
+        Inertial(q=(0.0, 0.0, 1.0, 0.0))
+        """
+        try:
+            return cls(**params)
+        except TypeError as exc:
+            raise AttitudeError(f"attitude law {cls.law_name!r}: {exc}") from None
+
+    def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
+        """Attitudes (body -> inertial, scalar-last) at ``times``; shape ``(n, 4)``.
+
+        Examples
+        --------
+        >>> np.round(Spin(rate_deg_s=180.0).quaternions([0.0, 1.0]), 6)  # half a turn in 1 s
+        array([[0., 0., 0., 1.],
+               [0., 0., 1., 0.]])
+        """
+        raise NotImplementedError
+
+    def __mul__(self, other: AttitudeLaw) -> Composed:
+        if not isinstance(other, AttitudeLaw):
+            return NotImplemented
+        return Composed(self, other)
+
+
+@dataclass(frozen=True)
+class Inertial(AttitudeLaw):
+    """A fixed orientation in the inertial frame.
+
+    Parameters
+    ----------
+    q : array_like, shape (4,)
+        Unit quaternion, scalar-last, body -> inertial [1].
+
+    Examples
+    --------
+    >>> s = float(np.sqrt(0.5))
+    >>> Inertial((0.0, 0.0, s, s)).quaternions(np.zeros(2)).round(6)  # 90 degree about z, always
+    array([[0.      , 0.      , 0.707107, 0.707107],
+           [0.      , 0.      , 0.707107, 0.707107]])
+    """
+
+    law_name: ClassVar[str] = "inertial"
+    law_parameters: ClassVar[tuple[str, ...]] = ("q",)
+
+    q: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "q", tuple(check_quaternion(self.q, "inertial q").tolist()))
+
+    def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
+        n = np.atleast_1d(np.asarray(times)).shape[0]
+        return np.tile(np.asarray(self.q), (n, 1))
+
+
+@dataclass(frozen=True)
+class Nadir(AttitudeLaw):
+    """Nadir pointing in the local-vertical local-horizontal (LVLH) frame, with a yaw.
+
+    At yaw 0 the body ``nadir_axis`` points from the spacecraft to the Earth's centre
+    (``-r/|r|``) and ``velocity_axis`` along the along-track direction (the part of
+    the velocity perpendicular to ``r``).  The yaw then turns the body about the nadir
+    axis by ``yaw_deg`` (right-handed about ``nadir_axis``), so the nadir axis stays on
+    the geocentre.
+
+    Parameters
+    ----------
+    yaw_deg : float
+        Yaw about the nadir axis [degree].
+    nadir_axis, velocity_axis : str or array_like
+        Perpendicular body axes (``"+z"``, ``"-x"``, ... or 3 components).
+
+    Examples
+    --------
+    >>> from scipy.spatial.transform import Rotation
+    >>> from sbrdf_xr.observing import Context
+    >>> ctx = Context(position_km=np.array([[7000.0, 0.0, 0.0]]),
+    ...               velocity_km_s=np.array([[0.0, 7.5, 0.0]]))
+    >>> q = Nadir(nadir_axis="+z", velocity_axis="+x").quaternions([0.0], ctx)
+    >>> np.round(Rotation.from_quat(q).apply([0.0, 0.0, 1.0]), 6) + 0.0  # +z on the geocentre
+    array([[-1.,  0.,  0.]])
+    """
+
+    law_name: ClassVar[str] = "nadir"
+    law_parameters: ClassVar[tuple[str, ...]] = ("yaw_deg", "nadir_axis", "velocity_axis")
+
+    yaw_deg: float = 0.0
+    nadir_axis: Any = "+z"
+    velocity_axis: Any = "+x"
+    _axes: tuple[np.ndarray, np.ndarray] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "yaw_deg", to_unit(self.yaw_deg, "deg", "yaw_deg"))
+        if not np.isfinite(self.yaw_deg):
+            raise AttitudeError(f"nadir yaw_deg: must be finite, got {self.yaw_deg}")
+        a, b = perpendicular_pair(
+            axis_vector(self.nadir_axis, "nadir_axis"),
+            axis_vector(self.velocity_axis, "velocity_axis"),
+            "nadir",
+        )
+        object.__setattr__(self, "_axes", (a, b))
+
+    def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
+        n = np.atleast_1d(np.asarray(times)).shape[0]
+        r, v = context_fields(context, n, "nadir", "position_km", "velocity_km_s")
+        a, b = self._axes
+        q = triad(a, b, -r, v)
+        if self.yaw_deg:
+            yaw = Rotation.from_rotvec(np.radians(self.yaw_deg) * a)
+            q = (Rotation.from_quat(q) * yaw).as_quat().reshape(-1, 4)
+        return q
+
+
+_SECONDARY_TARGETS = ("orbit_normal", "nadir", "velocity", "north")
+
+
+@dataclass(frozen=True)
+class SunPointing(AttitudeLaw):
+    """A body axis on the Sun, a second body axis as near a target direction as allowed.
+
+    Parameters
+    ----------
+    axis : str or array_like
+        Body axis pointed at the Sun.
+    secondary_axis : str or array_like
+        Body axis perpendicular to ``axis``, turned toward ``secondary_target``.
+    secondary_target : str or array_like
+        ``orbit_normal`` (``r x v``), ``nadir``, ``velocity``, ``north`` (inertial +z) or
+        three components in the inertial frame.  Where the target is parallel to the Sun
+        direction the attitude is undefined and an :class:`AttitudeError` is raised.
+
+    Examples
+    --------
+    >>> from scipy.spatial.transform import Rotation
+    >>> from sbrdf_xr.observing import Context
+    >>> ctx = Context(position_km=np.array([[7000.0, 0.0, 0.0]]),
+    ...               velocity_km_s=np.array([[0.0, 7.5, 0.0]]),
+    ...               sun_km=np.array([[0.0, 1.5e8, 0.0]]))
+    >>> q = SunPointing(axis="+z", secondary_axis="+x").quaternions([0.0], ctx)
+    >>> R = Rotation.from_quat(q)
+    >>> np.round(R.apply([0.0, 0.0, 1.0]), 6) + 0.0, np.round(R.apply([1.0, 0.0, 0.0]), 6) + 0.0
+    (array([[0., 1., 0.]]), array([[0., 0., 1.]]))
+    """
+
+    law_name: ClassVar[str] = "sun_pointing"
+    law_parameters: ClassVar[tuple[str, ...]] = ("axis", "secondary_axis", "secondary_target")
+
+    axis: Any = "+z"
+    secondary_axis: Any = "+x"
+    secondary_target: Any = "orbit_normal"
+    _axes: tuple[np.ndarray, np.ndarray, str | np.ndarray] = field(
+        init=False, repr=False, compare=False
+    )
+
+    def __post_init__(self) -> None:
+        a, b = perpendicular_pair(
+            axis_vector(self.axis, "axis"),
+            axis_vector(self.secondary_axis, "secondary_axis"),
+            "sun_pointing",
+        )
+        tgt = self.secondary_target
+        if isinstance(tgt, str):
+            if tgt not in _SECONDARY_TARGETS:
+                raise AttitudeError(
+                    f"sun_pointing secondary_target: got {tgt!r}; "
+                    f"allowed: {', '.join(_SECONDARY_TARGETS)} "
+                    "or 3 components"
+                )
+        else:
+            tgt = axis_vector(tgt, "secondary_target")
+        object.__setattr__(self, "_axes", (a, b, tgt))
+
+    def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
+        n = np.atleast_1d(np.asarray(times)).shape[0]
+        a, b, tgt = self._axes
+        (sun,) = context_fields(context, n, "sun_pointing", "sun_km")
+        if isinstance(tgt, str) and tgt != "north":
+            r, v = context_fields(context, n, "sun_pointing", "position_km", "velocity_km_s")
+            target = {"orbit_normal": np.cross(r, v), "nadir": -r, "velocity": v}[tgt]
+        else:
+            target = np.tile([0.0, 0.0, 1.0] if isinstance(tgt, str) else tgt, (n, 1))
+        return triad(a, b, sun, target)
 
 
 @dataclass(frozen=True)
@@ -119,6 +324,15 @@ class Spin(AttitudeLaw):
     array([[0.      , 0.      , 0.043619, 0.999048]])
     """
 
+    law_name: ClassVar[str] = "spin"
+    law_parameters: ClassVar[tuple[str, ...]] = (
+        "axis_body",
+        "rate_deg_s",
+        "phase_deg",
+        "initial",
+        "epoch",
+    )
+
     axis_body: Any = "+z"
     rate_deg_s: float = 1.0
     phase_deg: float = 0.0
@@ -127,8 +341,9 @@ class Spin(AttitudeLaw):
     _axis_vec: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        for name in ("rate_deg_s", "phase_deg"):
-            val = getattr(self, name)
+        for name, unit in (("rate_deg_s", "deg / s"), ("phase_deg", "deg")):
+            val = to_unit(getattr(self, name), unit, name)
+            object.__setattr__(self, name, val)
             if not isinstance(val, int | float | np.floating | np.integer) or not np.isfinite(val):
                 raise AttitudeError(f"spin {name}: must be a finite number [degree], got {val!r}")
         object.__setattr__(self, "_axis_vec", axis_vector(self.axis_body, "axis_body"))
@@ -152,6 +367,62 @@ class Spin(AttitudeLaw):
         return (Rotation.from_quat(q0) * spin).as_quat().reshape(-1, 4)
 
 
+@dataclass(frozen=True)
+class Composed(AttitudeLaw):
+    """``R(t) = R_outer(t) R_inner(t)``: the inner law expressed in the outer law's frame.
+
+    Examples
+    --------
+    >>> s = float(np.sqrt(0.5))
+    >>> law = Composed(Inertial((0.0, 0.0, s, s)), Spin(rate_deg_s=90.0))
+    >>> np.round(law.quaternions([1.0]), 6)  # 90 degree then 90 degree about z
+    array([[0., 0., 1., 0.]])
+    """
+
+    law_name: ClassVar[str] = "compose"
+    law_parameters: ClassVar[tuple[str, ...]] = ("outer", "inner")
+
+    outer: AttitudeLaw
+    inner: AttitudeLaw
+
+    def __post_init__(self) -> None:
+        for name in ("outer", "inner"):
+            if not isinstance(getattr(self, name), AttitudeLaw):
+                raise AttitudeError(
+                    f"compose {name}: expected an attitude law, "
+                    f"got {type(getattr(self, name)).__name__}"
+                )
+
+    def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
+        a = Rotation.from_quat(self.outer.quaternions(times, context))
+        b = Rotation.from_quat(self.inner.quaternions(times, context))
+        return (a * b).as_quat().reshape(-1, 4)
+
+    @classmethod
+    def from_table(cls, params: dict[str, Any]) -> AttitudeLaw:
+        """:func:`compose` of the table's ``outer`` and ``inner`` (laws, quaternions or
+        tables).
+
+        Examples
+        --------
+        >>> law = Composed.from_table({"outer": [0.0, 0.0, 1.0, 0.0], "inner": {"law": "spin"}})
+        >>> type(law.outer).__name__, type(law.inner).__name__
+        ('Inertial', 'Spin')
+        """
+        missing = [k for k in ("outer", "inner") if k not in params]
+        if missing:
+            raise AttitudeError(f"attitude law 'compose': needs {missing}")
+        return compose(params["outer"], params["inner"])
+
+
+def _law_or_quaternion(value: Any, name: str) -> AttitudeLaw:
+    if isinstance(value, AttitudeLaw):
+        return value
+    if isinstance(value, Mapping):
+        return law_from_dict(value)
+    return Inertial(value)
+
+
 def compose(outer: AttitudeLaw | ArrayLike, inner: AttitudeLaw | ArrayLike) -> Composed:
     """Compose two laws (or a law and a fixed quaternion): ``R_outer(t) R_inner(t)``.
 
@@ -163,23 +434,6 @@ def compose(outer: AttitudeLaw | ArrayLike, inner: AttitudeLaw | ArrayLike) -> C
     ('Composed', array([[0., 0., 1., 0.]]))
     """
     return Composed(_law_or_quaternion(outer, "outer"), _law_or_quaternion(inner, "inner"))
-
-
-# --------------------------------------------------------------------------- tables
-
-#: Law name -> (class, allowed parameters).
-LAWS: dict[str, tuple[type[AttitudeLaw], tuple[str, ...]]] = {
-    "inertial": (Inertial, ("q",)),
-    "nadir": (Nadir, ("yaw_deg", "nadir_axis", "velocity_axis")),
-    "sun_pointing": (SunPointing, ("axis", "secondary_axis", "secondary_target")),
-    "spin": (Spin, ("axis_body", "rate_deg_s", "phase_deg", "initial", "epoch")),
-    "tumble": (Tumble, ("inertia", "omega_deg_s", "initial", "epoch")),
-    "quaternion_series": (
-        QuaternionSeries,
-        ("path", "time_column", "columns", "variable", "epoch"),
-    ),
-    "compose": (Composed, ("outer", "inner")),
-}
 
 
 def law_from_dict(table: Mapping[str, Any]) -> AttitudeLaw:
@@ -213,7 +467,8 @@ def law_from_dict(table: Mapping[str, Any]) -> AttitudeLaw:
     """
     if not isinstance(table, Mapping) or "law" not in table:
         raise AttitudeError(
-            f"attitude: expected a table with a 'law' key (one of {', '.join(LAWS)}), got {table!r}"
+            f"attitude: expected a table with a 'law' key (one of {', '.join(sorted(LAWS))}), "
+            f"got {table!r}"
         )
     name = table["law"]
     if name not in LAWS:
@@ -228,24 +483,4 @@ def law_from_dict(table: Mapping[str, Any]) -> AttitudeLaw:
             f"attitude law {name!r}: unknown parameter(s) {bad}; "
             + did_you_mean(bad[0], allowed, "allowed parameters")
         )
-    if name == "compose":
-        missing = [k for k in ("outer", "inner") if k not in params]
-        if missing:
-            raise AttitudeError(f"attitude law 'compose': needs {missing}")
-        return compose(params["outer"], params["inner"])
-    if name == "quaternion_series":
-        if "path" not in params:
-            raise AttitudeError("attitude law 'quaternion_series': needs a path (.csv or .nc)")
-        path = Path(params.pop("path"))
-        if path.suffix.lower() == ".csv":
-            kw: dict[str, Any] = {k: params[k] for k in ("time_column", "epoch") if k in params}
-            if "columns" in params:
-                kw["columns"] = tuple(params["columns"])
-            return QuaternionSeries.from_csv(path, **kw)
-        return QuaternionSeries.from_netcdf(
-            path, **({"variable": params["variable"]} if "variable" in params else {})
-        )
-    try:
-        return cls(**params)
-    except TypeError as exc:
-        raise AttitudeError(f"attitude law {name!r}: {exc}") from None
+    return cls.from_table(params)

@@ -53,6 +53,7 @@ from numpy.typing import NDArray
 from .._names import VECTOR, attrs
 from ..errors import AttitudeError, EpochGapWarning, NotObservableError, ObservationError
 from ..geometry import rotation_matrices
+from ..units import to_unit
 from . import attitude as _att
 from .earth_shadow import (
     EARTH_MODELS,
@@ -238,6 +239,8 @@ class Observation:
             )
         if self.earth not in EARTH_MODELS:
             raise ObservationError(f"earth: got {self.earth!r}; allowed: {', '.join(EARTH_MODELS)}")
+        min_el = to_unit(self.min_elevation_deg, "deg", "min_elevation_deg")
+        object.__setattr__(self, "min_elevation_deg", min_el)
         if not -90.0 <= float(self.min_elevation_deg) <= 90.0:
             raise ObservationError(
                 f"min_elevation_deg: must lie in [-90, 90], got {self.min_elevation_deg}"
@@ -290,7 +293,7 @@ class Observation:
         return state
 
     def context(self) -> _att.Context:
-        """The :class:`~sbrdf_xr.observing.attitude.Context` the attitude law sees.
+        """The :class:`~sbrdf_xr.observing.frames.Context` the attitude law sees.
 
         Examples
         --------
@@ -404,7 +407,7 @@ class Observation:
             i = int(np.argmax(elevation))
             reasons.append(
                 f"below {self.min_elevation_deg:g} deg elevation at every time "
-                f"(highest {elevation[i]:.2f} deg at {self.times[i]})"
+                f"(highest {elevation[i]:.2f} deg at {self.times[i]}); " + self.next_pass()
             )
         if np.all(sunlit == 0):
             reasons.append(
@@ -456,6 +459,61 @@ class Observation:
             ds.attrs["unobservable"] = "; ".join(reasons)
         return ds
 
+    def next_pass(self, days: float = 3.0) -> str:
+        """When the object next rises above ``min_elevation_deg`` after the first time.
+
+        From skyfield's :meth:`~skyfield.sgp4lib.EarthSatellite.find_events` over
+        ``days`` from the first time of the observation.
+
+        Parameters
+        ----------
+        days : float
+            How far ahead to look [day].
+
+        Returns
+        -------
+        str
+            ``"it rises above 0 deg at ... UTC (highest ... deg at ... UTC, sets at ...
+            UTC)"``, or that it does not within ``days``.
+
+        Examples
+        --------
+        >>> from sbrdf_xr.observing.timescales import times
+        >>> obs = Observation(Orbit.from_catalog("canx1-example"), Site.from_catalog("haleakala"),
+        ...                   times("2024-03-17T01:20:00", "2024-03-17T01:25:00", 60.0))
+        >>> print(obs.next_pass())  # doctest: +NORMALIZE_WHITESPACE
+        it next rises above 0 deg at 2024-03-17T06:13:16 UTC (highest 22.0 deg at
+        2024-03-17T06:20:04 UTC, sets at 2024-03-17T06:26:51 UTC)
+        """
+        from .timescales import skyfield_utc
+
+        t64 = np.array([self.times[0], self.times[0] + np.timedelta64(round(days * 86400), "s")])
+        t0, t1 = skyfield_utc(t64)
+        when, kind = self.orbit.satellite.find_events(
+            self.site.position, t0, t1, altitude_degrees=float(self.min_elevation_deg)
+        )
+        if not len(when):
+            return (
+                f"it does not rise above {self.min_elevation_deg:g} deg within {days:g} days "
+                f"after {self.times[0]}"
+            )
+        stamps = [str(np.datetime64(t.replace(tzinfo=None), "s")) for t in when.utc_datetime()]
+        kinds = [int(k) for k in kind]
+        start = kinds.index(0) if 0 in kinds else 0
+        text = f"it next rises above {self.min_elevation_deg:g} deg at {stamps[start]} UTC"
+        rest = list(zip(kinds[start + 1 :], stamps[start + 1 :], strict=True))
+        culm = next((s for k, s in rest if k == 1), None)
+        sets = next((s for k, s in rest if k == 2), None)
+        if culm is not None:
+            alt = self._altitude_at(when[kinds.index(1, start)])
+            text += f" (highest {alt:.1f} deg at {culm} UTC"
+            text += f", sets at {sets} UTC)" if sets is not None else ")"
+        return text
+
+    def _altitude_at(self, t: Any) -> float:
+        topo = (self.orbit.satellite - self.site.position).at(t)
+        return float(topo.altaz()[0].degrees)
+
     def _attrs(self) -> dict[str, Any]:
         import skyfield
         import skyfield_data
@@ -470,6 +528,7 @@ class Observation:
             "site_latitude": self.site.latitude_deg,
             "site_longitude": self.site.longitude_deg,
             "site_height": self.site.height_m,
+            "site_source": self.site.source,
             "site_coordinates": (
                 "WGS84 geodetic latitude and east longitude [degree], "
                 "height above the ellipsoid [m]"

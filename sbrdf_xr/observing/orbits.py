@@ -23,6 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _catalog_index
 from ..errors import CatalogError, ObservationError
 from ..photometry import atmosphere
+from ..units import to_unit
 from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, disc_overlap_fraction, sunlit_fraction
 from .timescales import (
     KNOT_S,
@@ -273,6 +274,79 @@ class Orbit:
             raise ObservationError(f"catalog entry {name!r} is a {e.kind}, not an orbit")
         return load_orbit_entry(e)
 
+    @classmethod
+    def from_file(cls, path: str | Path, name: str | None = None) -> Orbit:
+        """An orbit from a file: TLEs (2- or 3-line sets, one or many) or an OMM.
+
+        Parameters
+        ----------
+        path : str or Path
+            ``.json``, ``.xml`` or ``.csv``: an Orbit Mean-Elements Message
+            (:meth:`from_omm`); anything else: text of two-line element sets, each
+            optionally preceded by a name line (CelesTrak's format).
+        name : str, optional
+            Which satellite of a file holding several: its name (any case) or catalog
+            number.
+
+        Raises
+        ------
+        ObservationError
+            For an unreadable file, no or several element sets without ``name``, or a
+            ``name`` the file does not hold (the names it holds are listed).
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> l1 = "1 27847U 03031H   24075.50000000  .00000015  00000-0  21000-4 0  9991"
+        >>> l2 = "2 27847  98.7200 129.5000 0012000  95.0000 265.0000 14.21950000109836"
+        >>> path = Path(tempfile.mkdtemp()) / "canx1.tle"
+        >>> _ = path.write_text(f"CANX-1\\n{l1}\\n{l2}\\n")
+        >>> Orbit.from_file(path).name, Orbit.from_file(path, name="27847").name
+        ('CANX-1', 'CANX-1')
+        """
+        path = Path(path)
+        if path.suffix.lower() in (".json", ".xml", ".csv"):
+            return cls.from_omm(path, provenance=f"OMM file {path}")
+        try:
+            lines = [ln.rstrip() for ln in path.read_text(encoding="utf-8").splitlines()]
+        except (OSError, UnicodeDecodeError) as exc:
+            raise ObservationError(f"orbit file {path}: cannot be read: {exc}") from None
+        lines = [ln for ln in lines if ln.strip()]
+        sets: list[tuple[str, str, str]] = []
+        k = 0
+        while k < len(lines):
+            if lines[k].startswith("1 ") and k + 1 < len(lines) and lines[k + 1].startswith("2 "):
+                sets.append((lines[k][2:7].strip(), lines[k], lines[k + 1]))
+                k += 2
+            elif k + 2 < len(lines) and lines[k + 1].startswith("1 "):
+                sets.append((lines[k].removeprefix("0 ").strip(), lines[k + 1], lines[k + 2]))
+                k += 3
+            else:
+                raise ObservationError(
+                    f"orbit file {path}: line {k + 1} ({lines[k][:30]!r}) starts no element "
+                    "set; expected TLEs (an optional name line, then lines '1 ...' and "
+                    "'2 ...') or an OMM file (.json, .xml, .csv)"
+                )
+        if not sets:
+            raise ObservationError(f"orbit file {path}: holds no element set")
+        if name is not None:
+            want = str(name).strip().lower()
+            hit = [s for s in sets if want in (s[0].lower(), s[1][2:7].strip().lower())]
+            if not hit:
+                raise ObservationError(
+                    f"orbit file {path}: no satellite {name!r}; it holds "
+                    f"{', '.join(s[0] for s in sets[:20])}{' ...' if len(sets) > 20 else ''}"
+                )
+            sets = hit[:1]
+        if len(sets) > 1:
+            raise ObservationError(
+                f"orbit file {path}: holds {len(sets)} element sets "
+                f"({', '.join(s[0] for s in sets[:10])}{' ...' if len(sets) > 10 else ''}); "
+                "choose one by name or catalog number"
+            )
+        label, l1, l2 = sets[0]
+        return cls.from_tle(l1, l2, label, provenance=f"TLE file {path}")
+
     @property
     def epoch(self) -> np.datetime64:
         """Epoch of the elements (UTC).
@@ -309,6 +383,10 @@ class Site:
     height_m : float
         Height above the ellipsoid [m], in [-500, 9000].
     name : str
+    source : str
+        Where the coordinates come from (a catalog site cites its publication).
+
+    Each coordinate may be an astropy Quantity (an ``Angle``, ``1.2 * u.km``), converted.
 
     Examples
     --------
@@ -325,15 +403,16 @@ class Site:
     longitude_deg: float
     height_m: float = 0.0
     name: str = ""
+    source: str = ""
 
     def __post_init__(self) -> None:
         checks = (
-            ("latitude_deg", -90.0, 90.0),
-            ("longitude_deg", -180.0, 360.0),
-            ("height_m", -500.0, 9000.0),
+            ("latitude_deg", -90.0, 90.0, "deg"),
+            ("longitude_deg", -180.0, 360.0, "deg"),
+            ("height_m", -500.0, 9000.0, "m"),
         )
-        for attr, lo, hi in checks:
-            v = getattr(self, attr)
+        for attr, lo, hi, unit in checks:
+            v = to_unit(getattr(self, attr), unit, f"site {attr}")
             try:
                 x = float(v)
             except (TypeError, ValueError):
@@ -400,7 +479,7 @@ def airmass(elevation_deg: ArrayLike, model: str = "kastenyoung1989") -> NDArray
         )
     from pvlib.atmosphere import get_relative_airmass
 
-    el = np.asarray(elevation_deg, dtype=np.float64)
+    el = np.asarray(to_unit(elevation_deg, "deg", "elevation_deg"), dtype=np.float64)
     zen = np.where(el >= 0, 90.0 - el, 90.0)
     am = np.asarray(get_relative_airmass(zen, model=model), dtype=np.float64)
     return np.where(el >= 0, am, np.nan)
@@ -443,4 +522,14 @@ def load_site_entry(entry: _catalog_index.CatalogEntry) -> Site:
     key = entry.extra.get("key", entry.name)
     if key not in sites:
         raise CatalogError(f"site entry {entry.name!r}: {entry.path} has no table [{key}]")
-    return Site(name=entry.name, **sites[key])
+    table = dict(sites[key])
+    table.pop("mpc", None)  # the published parallax constants the coordinates come from
+    known = {"latitude_deg", "longitude_deg", "height_m", "source"}
+    extra = sorted(set(table) - known)
+    if extra:
+        raise CatalogError(
+            f"site entry {entry.name!r}: table [{key}] of {entry.path} has unknown key(s) "
+            f"{extra}; allowed: {sorted(known | {'mpc'})}"
+        )
+    table.setdefault("source", entry.provenance)
+    return Site(name=entry.name, **table)

@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -18,8 +18,8 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from ..errors import AttitudeError
 from ..geometry import check_quaternions
+from .attitude import AttitudeLaw
 from .frames import NS_PER_S, Context, check_epoch, seconds_since
-from .pointing import AttitudeLaw
 
 __all__ = ["QuaternionSeries"]
 
@@ -50,6 +50,15 @@ class QuaternionSeries(AttitudeLaw):
     sbrdf_xr.errors.AttitudeError: quaternion_series: requested times span [11, 11] s, outside ...
     """
 
+    law_name: ClassVar[str] = "quaternion_series"
+    law_parameters: ClassVar[tuple[str, ...]] = (
+        "path",
+        "time_column",
+        "columns",
+        "variable",
+        "epoch",
+    )
+
     times: Any
     samples: Any = None
     epoch: Any = None
@@ -76,6 +85,31 @@ class QuaternionSeries(AttitudeLaw):
         object.__setattr__(self, "epoch", epoch)
         object.__setattr__(self, "_secs", secs)
         object.__setattr__(self, "_slerp", Slerp(secs, Rotation.from_quat(q)))
+
+    @classmethod
+    def from_table(cls, params: dict[str, Any]) -> QuaternionSeries:
+        """The series of a TOML table: ``path`` (``.csv``, read by :meth:`from_csv` with
+        ``time_column``, ``columns`` and ``epoch``, or netCDF, read by :meth:`from_netcdf`
+        with ``variable``).
+
+        Examples
+        --------
+        >>> QuaternionSeries.from_table({"time_column": "t"})
+        Traceback (most recent call last):
+            ...
+        sbrdf_xr.errors.AttitudeError: attitude law 'quaternion_series': needs a path (.csv or .nc)
+        """
+        if "path" not in params:
+            raise AttitudeError("attitude law 'quaternion_series': needs a path (.csv or .nc)")
+        path = Path(params["path"])
+        if path.suffix.lower() == ".csv":
+            kw: dict[str, Any] = {k: params[k] for k in ("time_column", "epoch") if k in params}
+            if "columns" in params:
+                kw["columns"] = tuple(params["columns"])
+            return cls.from_csv(path, **kw)
+        return cls.from_netcdf(
+            path, **({"variable": params["variable"]} if "variable" in params else {})
+        )
 
     @classmethod
     def from_csv(

@@ -11,6 +11,7 @@ slowly varying nutation splined on knots every :data:`KNOT_S` (:func:`skyfield_t
 from __future__ import annotations
 
 import datetime as _dt
+import sys
 import warnings
 from functools import cache
 from typing import Any
@@ -19,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import ObservationError
+from ..units import to_unit
 
 __all__ = [
     "KNOT_S",
@@ -32,6 +34,14 @@ __all__ = [
 ]
 
 _NS = np.dtype("datetime64[ns]")
+
+
+def _astropy_utc(value: Any) -> Any:
+    """An astropy ``Time`` (any scale) as UTC datetime64[ns]; anything else unchanged."""
+    time_mod = sys.modules.get("astropy.time")
+    if time_mod is not None and isinstance(value, time_mod.Time):
+        return np.asarray(value.utc.datetime64, dtype=_NS)
+    return value
 
 
 @cache
@@ -145,7 +155,8 @@ def skyfield_time(t64: np.ndarray) -> Any:
 
 
 def to_datetime64(value: Any, name: str) -> np.datetime64:
-    """One UTC time (ISO 8601, ``Z`` allowed; datetime, naive is UTC; datetime64) as datetime64[ns].
+    """One UTC time (ISO 8601, ``Z`` allowed; datetime, naive is UTC; datetime64; astropy
+    ``Time`` in any scale) as datetime64[ns].
 
     Examples
     --------
@@ -155,11 +166,17 @@ def to_datetime64(value: Any, name: str) -> np.datetime64:
     >>> cest = datetime.timezone(datetime.timedelta(hours=2))
     >>> to_datetime64(datetime.datetime(2024, 3, 17, 3, 20, tzinfo=cest), "start")
     np.datetime64('2024-03-17T01:20:00.000000000')
+    >>> from astropy.time import Time
+    >>> to_datetime64(Time("2024-03-17T01:20:37", scale="tai"), "start")  # TAI - UTC = 37 s
+    np.datetime64('2024-03-17T01:20:00.000000000')
     >>> to_datetime64("yesterday", "start")
     Traceback (most recent call last):
         ...
     sbrdf_xr.errors.ObservationError: start: got 'yesterday'; expected a UTC time (ISO 8601, ...
     """
+    value = _astropy_utc(value)
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]
     if isinstance(value, _dt.datetime) and value.tzinfo is not None:
         value = value.astimezone(_dt.UTC).replace(tzinfo=None)
     if isinstance(value, str) and value.endswith("Z"):
@@ -180,10 +197,10 @@ def times(start: Any, stop: Any, step_s: float = 1.0) -> NDArray[np.datetime64]:
 
     Parameters
     ----------
-    start, stop : str, datetime or datetime64
+    start, stop : str, datetime, datetime64 or astropy Time
         UTC times (naive datetimes and ISO strings without a zone are UTC).
-    step_s : float
-        Step [s], > 0.
+    step_s : float or Quantity
+        Step [s], > 0 (a time Quantity is converted).
 
     Returns
     -------
@@ -196,6 +213,7 @@ def times(start: Any, stop: Any, step_s: float = 1.0) -> NDArray[np.datetime64]:
     (5, '2024-03-17T01:20:00.000000000', '2024-03-17T01:20:02.000000000')
     """
     t0, t1 = to_datetime64(start, "start"), to_datetime64(stop, "stop")
+    step_s = to_unit(step_s, "s", "step_s")
     if not (np.isfinite(step_s) and step_s > 0):
         raise ObservationError(f"step_s: must be a positive number of seconds, got {step_s!r}")
     if t1 < t0:
@@ -218,7 +236,7 @@ def check_times(value: Any) -> NDArray[np.datetime64]:
         ...
     sbrdf_xr.errors.ObservationError: times: must be strictly increasing
     """
-    t = np.atleast_1d(np.asarray(value))
+    t = np.atleast_1d(np.asarray(_astropy_utc(value)))
     if t.dtype.kind in "US" or t.dtype == object:
         try:
             t = np.array([to_datetime64(x, "times") for x in t.ravel()]).reshape(t.shape)

@@ -9,14 +9,15 @@ uniform density (:meth:`Tumble.from_spacecraft`).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import AttitudeError
+from ..units import to_unit
+from .attitude import AttitudeLaw
 from .frames import Context, check_epoch, check_quaternion, seconds_since
-from .pointing import AttitudeLaw
 
 __all__ = ["TUMBLE_RTOL", "Tumble"]
 
@@ -88,6 +89,9 @@ class Tumble(AttitudeLaw):
     array([0.        , 0.        , 0.70710678, 0.70710678])
     """
 
+    law_name: ClassVar[str] = "tumble"
+    law_parameters: ClassVar[tuple[str, ...]] = ("inertia", "omega_deg_s", "initial", "epoch")
+
     inertia: Any = (1.0, 1.0, 1.0)
     omega_deg_s: Any = (0.0, 0.0, 1.0)
     initial: Any = (0.0, 0.0, 0.0, 1.0)
@@ -95,7 +99,7 @@ class Tumble(AttitudeLaw):
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "inertia", _inertia(self.inertia))
-        w = np.asarray(self.omega_deg_s, dtype=np.float64)
+        w = np.asarray(to_unit(self.omega_deg_s, "deg / s", "omega_deg_s"), dtype=np.float64)
         if w.shape != (3,) or not np.all(np.isfinite(w)):
             raise AttitudeError(
                 "tumble omega_deg_s: expected 3 finite body rates [degree s-1], "

@@ -18,8 +18,11 @@ The chain from a simulation cube to what a telescope measures:
    band numbers to float rounding.
 4. :func:`band_signal` and :func:`magnitudes` from a cube; :func:`colour_indices`;
    :func:`srgb` swatches; :func:`photometry` bundles them (``ds.sbrdf.photometry``).
-5. :func:`read_light_curve` (CSV, ECSV, FITS, VOTable, netCDF; units, UTC times),
-   :func:`compare_light_curves`, :func:`plot_comparison` for measured light curves.
+5. :func:`read_light_curve` (CSV, ECSV, FITS, VOTable, netCDF; long or wide tables in
+   any row order, magnitudes or fluxes, UTC times or Julian dates; filter names mapped
+   by :func:`band_label`), :func:`compare` (a measured light curve against a simulated
+   pass or rotation sweep: zero points, extinction, time shift or rotation phase, with
+   uncertainties) and :func:`plot_comparison`.
 6. :mod:`~sbrdf_xr.photometry.atmosphere` - air mass (:func:`airmass`, pvlib's
    models), extinction (:func:`apply_extinction`, :func:`transmission` folded into
    the band weights); :func:`standard_magnitude` (to a range, a phase angle, 1 AU),
@@ -27,7 +30,8 @@ The chain from a simulation cube to what a telescope measures:
 7. :func:`to_netcdf` / :func:`open_photometry` - CF-1.10 photometry files.
 
 Modules: ``spectra`` (reference spectra, quadrature), ``bands``, ``magnitude``,
-``atmosphere``, ``standard``, ``colour``, ``measured``, ``lightcurves``, ``files``.
+``atmosphere``, ``standard``, ``colour``, ``filter_names``, ``measured``,
+``lightcurves``, ``files``.
 
 Conventions
 -----------
@@ -106,7 +110,17 @@ magnitude are NaN (the colour is undefined).  A negative band signal (possible o
 with noisy tables) gives a NaN magnitude.
 """
 
-from . import atmosphere
+from . import (
+    atmosphere,
+    bands,
+    colour,
+    files,
+    lightcurves,
+    magnitude,
+    measured,
+    spectra,
+    standard,
+)
 from .atmosphere import (
     AIRMASS_MODELS,
     airmass,
@@ -127,7 +141,8 @@ from .bands import (
 )
 from .colour import srgb
 from .files import cf_decode, cf_encode, open_photometry, to_netcdf
-from .lightcurves import compare_light_curves, plot_comparison
+from .filter_names import band_label
+from .lightcurves import compare, compare_light_curves, plot_comparison
 from .magnitude import band_signal, colour_indices, magnitudes, photometry, sun_magnitudes
 from .measured import (
     LIGHT_CURVE_ABSCISSAE,
@@ -176,18 +191,26 @@ __all__ = [
     "apply_extinction",
     "at_resolution",
     "atmosphere",
+    "band_label",
     "band_signal",
     "band_weights",
+    "bands",
     "cf_decode",
     "cf_encode",
     "check_system",
+    "colour",
     "colour_indices",
+    "compare",
     "compare_light_curves",
     "extinction_coefficients",
+    "files",
     "filters",
     "hat_integrals",
     "lambert_sphere_phase",
+    "lightcurves",
+    "magnitude",
     "magnitudes",
+    "measured",
     "open_photometry",
     "photometry",
     "plot_comparison",
@@ -197,8 +220,10 @@ __all__ = [
     "reference_flux",
     "solar_spectrum",
     "speclite_names",
+    "spectra",
     "specular_sphere_phase",
     "srgb",
+    "standard",
     "standard_magnitude",
     "sun_distance_au",
     "sun_magnitudes",

@@ -4,12 +4,13 @@ A cube of a pass carries, over ``time``, the observer ``range`` [km], the Sun di
 ``sun_distance`` [au] and the relative ``airmass`` [1] (coordinates or variables).  The
 magnitudes use them unless an argument overrides them; an override is noted in the
 attributes with the value the cube had.  ``range_km`` and ``sun_distance_au`` accept
-astropy Quantities of length (converted); bare numbers are in km and au.
+astropy Quantities of length (converted, :func:`sbrdf_xr.units.to_unit`); bare numbers
+are in km and au, and warn when implausible for their unit
+(:func:`sbrdf_xr.units.check_plausible`).
 """
 
 from __future__ import annotations
 
-import sys
 from typing import Any
 
 import numpy as np
@@ -17,20 +18,8 @@ import xarray as xr
 
 from .._names import BAND
 from ..errors import ValidationError
+from ..units import check_plausible, to_unit
 from .bands import _canonical
-
-
-def _to_unit(value: Any, what: str, unit: str) -> Any:
-    """``value`` in ``unit``: an astropy Quantity of length converted, anything else as given."""
-    units_mod = sys.modules.get("astropy.units")
-    if units_mod is None or not isinstance(value, units_mod.Quantity):
-        return value
-    if value.unit.physical_type != "length":
-        raise ValidationError(
-            f"{what}: a Quantity in {value.unit!s} ({value.unit.physical_type}) is not a length; "
-            f"give a length (e.g. 1000 * u.km) or a bare number in {unit}"
-        )
-    return np.asarray(value.to_value(units_mod.Unit(unit)), dtype=np.float64)
 
 
 def _recorded(cube: Any, name: str, unit: str | None) -> xr.DataArray | None:
@@ -64,7 +53,7 @@ def _describe(v: Any, unit: str) -> str:
 
 def _range_m(range_km: Any) -> xr.DataArray | np.ndarray:
     r: xr.DataArray | np.ndarray
-    range_km = _to_unit(range_km, "range_km", "km")
+    range_km = to_unit(range_km, "km", "range_km")
     if isinstance(range_km, xr.DataArray):
         vals = np.asarray(range_km.values, dtype=np.float64)
         r = range_km.astype(np.float64) * 1e3
@@ -79,7 +68,7 @@ def _range_m(range_km: Any) -> xr.DataArray | np.ndarray:
 
 
 def _positive(value: Any, what: str) -> Any:
-    value = _to_unit(value, what, "au")
+    value = to_unit(value, "au", what)
     vals = np.asarray(value.values if isinstance(value, xr.DataArray) else value, dtype=np.float64)
     if vals.size == 0 or not np.all(np.isfinite(vals)) or np.any(vals <= 0):
         raise ValidationError(f"{what}: must be finite and > 0, got {vals.ravel()[:5].tolist()}")
@@ -93,7 +82,8 @@ def _term(cube: Any, value: Any, name: str, arg: str, unit: str, attrs: dict[str
         if rec is not None:
             attrs[f"{name}_source"] = f"the cube's {name!r} ({_describe(rec, unit)})"
         return rec
-    given = _to_unit(value, arg, unit)
+    given = to_unit(value, unit, arg)
+    check_plausible(given, arg, arg)
     attrs[f"{name}_source"] = f"argument {arg} ({_describe(given, unit)})"
     if rec is not None:
         attrs[f"{name}_override"] = (

@@ -25,6 +25,7 @@ from numpy.typing import ArrayLike
 
 from .._names import BAND, WAVELENGTH, attrs
 from ..errors import ValidationError
+from ..units import to_unit
 from .spectra import _check_grid, _choose
 
 #: Relative air-mass models (pvlib ``get_relative_airmass``): name -> description.
@@ -80,7 +81,7 @@ def airmass(elevation: ArrayLike | xr.DataArray, model: str = "kastenyoung1989")
     from pvlib.atmosphere import get_relative_airmass
 
     _choose(model, AIRMASS_MODELS, "airmass model")
-    el = _values(elevation)
+    el = _values(to_unit(elevation, "deg", "elevation"))
     bad = ~np.isfinite(el) | (el <= 0.0) | (el > 90.0)
     if np.any(bad):
         first = el.ravel()[np.flatnonzero(bad.ravel())[0]]

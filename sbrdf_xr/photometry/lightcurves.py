@@ -1,500 +1,346 @@
-"""Measured light curves: reading, fitting a simulated curve, the comparison figure."""
+"""A measured light curve against a simulated one: one fit for passes and rotation sweeps.
+
+:func:`compare` aligns the measured observations with the simulation - UTC times along a
+simulated pass (a cube over ``time``), or rotation angles (or times over a period) along
+a rotation sweep (over ``attitude``) - and fits, by weighted linear least squares, a
+zero point per band (or one common offset) and optionally first-order extinction
+coefficients, profiled over a time shift or a rotation-phase offset when asked:
+
+    m_obs,i = m_sim,b(i)(t_i + dt) + ZP_b(i) + k_b(i) X_i + f_i
+
+(``X`` the air mass, ``f`` fixed terms: a per-row range for a sweep, extinction with
+given coefficients).  Uncertainties are the Gauss-Newton covariance of all fitted
+parameters with the stated measurement uncertainties.  :func:`plot_comparison` draws
+the result.
+"""
 
 from __future__ import annotations
 
-from itertools import pairwise
+import warnings
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from .._names import ATTITUDE, BAND, PHASE_ANGLE, attrs
-from ..errors import ValidationError
+from .._names import ATTITUDE, BAND, PHASE_ANGLE
+from ..errors import LightCurveError
+from ..units import to_unit
+from . import _alignment as align
+from ._comparison import fit_and_report
 from .bands import _canonical
+from .comparison_figure import plot_comparison
 from .measured import MIN_UNCERTAINTY
 
+__all__ = ["compare", "compare_light_curves", "plot_comparison"]
 
-def _periodic_model_flux(angles: np.ndarray, flux: np.ndarray, at: np.ndarray) -> np.ndarray:
-    """Linear interpolation of a light curve periodic in 360 degrees."""
-    return np.interp(np.mod(at, 360.0), np.mod(angles, 360.0), flux, period=360.0)
+ZERO_POINTS = ("band", "common")
+AIRMASS_SOURCES = ("auto", "measured", "simulated")
 
 
-def compare_light_curves(
+def _check_measured(measured: Any) -> None:
+    if not isinstance(measured, xr.Dataset) or not {"magnitude", "uncertainty"} <= set(measured):
+        raise LightCurveError("measured: expected a light-curve Dataset from read_light_curve")
+    if BAND not in measured.coords:
+        raise LightCurveError("measured: needs a 'band' coordinate over its observations")
+    m = np.asarray(measured["magnitude"].values, dtype=np.float64)
+    s = np.asarray(measured["uncertainty"].values, dtype=np.float64)
+    rows = measured["file_row"].values if "file_row" in measured.coords else np.arange(m.size)
+    for what, bad, rule in (
+        ("magnitude", ~np.isfinite(m), "is not a finite number (a NaN row)"),
+        ("uncertainty", ~np.isfinite(s), "is not a finite number (a NaN row)"),
+        ("uncertainty", s < 0, "is negative"),
+        ("uncertainty", (s >= 0) & (s < MIN_UNCERTAINTY), f"is below {MIN_UNCERTAINTY:g} mag"),
+    ):
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            v = (m if what == "magnitude" else s)[k]
+            raise LightCurveError(
+                f"measured: observation {k} (row {int(rows[k])}) has {what} {v:g}, which "
+                f"{rule}; {int(bad.sum())} such observation(s): drop them "
+                "(measured.where(np.isfinite(...), drop=True)) or fix the uncertainties "
+                f"(finite, >= {MIN_UNCERTAINTY:g} mag)"
+            )
+
+
+def _simulated(simulated: Any, measured: xr.Dataset, phase_angle: Any) -> xr.DataArray:
+    """Magnitudes over (time or attitude, band): given, or computed from a cube."""
+    if isinstance(simulated, xr.Dataset):
+        from .magnitude import magnitudes
+
+        labels = sorted({str(b) for b in measured[BAND].values})
+        system = str(measured.attrs.get("magnitude_system", "unstated"))
+        simulated = magnitudes(
+            simulated, labels, system=system if system in ("AB", "Vega") else "AB"
+        )
+    if not isinstance(simulated, xr.DataArray) or BAND not in simulated.dims:
+        raise LightCurveError(
+            "simulated: expected magnitudes over (time, band) or (attitude, band) from "
+            f"magnitudes(), or a cube; got {type(simulated).__name__}"
+            + (f" with dims {simulated.dims}" if hasattr(simulated, "dims") else "")
+        )
+    sim = simulated
+    if PHASE_ANGLE in sim.dims:
+        if phase_angle is not None:
+            sim = sim.sel({PHASE_ANGLE: to_unit(phase_angle, "deg", "phase_angle")}, "nearest")
+        elif sim.sizes[PHASE_ANGLE] == 1:
+            sim = sim.isel({PHASE_ANGLE: 0})
+        else:
+            raise LightCurveError(
+                f"phase_angle: the simulation has {sim.sizes[PHASE_ANGLE]} phase angles "
+                f"{sim[PHASE_ANGLE].values.tolist()}; choose one"
+            )
+    main = [d for d in (align.TIME, ATTITUDE) if d in sim.dims]
+    extra = [d for d in sim.dims if d not in (align.TIME, ATTITUDE, BAND)]
+    if len(main) != 1 or extra:
+        raise LightCurveError(
+            f"simulated: expected dims (time, band) of a pass or (attitude, band) of a "
+            f"rotation sweep, got {sim.dims}"
+        )
+    return sim.load()
+
+
+def _band_columns(measured: xr.Dataset, sim: xr.DataArray) -> np.ndarray:
+    labels = [str(b) for b in sim[BAND].values]
+    filters = [str(f) for f in sim["filter"].values] if "filter" in sim.coords else labels
+    obs = [str(b) for b in measured[BAND].values]
+    col = np.empty(len(obs), dtype=np.int64)
+    missing: list[str] = []
+    for k, b in enumerate(obs):
+        if b in labels:
+            col[k] = labels.index(b)
+        elif _canonical(b) in filters:
+            col[k] = filters.index(_canonical(b))
+        elif b not in missing:
+            missing.append(b)
+    if missing:
+        raise LightCurveError(
+            f"simulated: the measured bands {missing} are not simulated (simulated bands: "
+            f"{labels}); compute the magnitudes in every measured band "
+            f"(bands={sorted(set(obs))}) or pass the cube itself"
+        )
+    return col
+
+
+def _system(measured: xr.Dataset, sim: xr.DataArray) -> str:
+    have = str(measured.attrs.get("magnitude_system", "unstated"))
+    want = str(sim.attrs.get("magnitude_system", "unstated"))
+    if "unstated" not in (have, want) and have != want:
+        raise LightCurveError(
+            f"measured: magnitudes are in the {have} system but the simulation is in {want}; "
+            f"simulate with system={have!r}"
+        )
+    return have if have != "unstated" else want
+
+
+def compare(
     measured: xr.Dataset,
-    simulated_mags: xr.DataArray,
+    simulated: xr.DataArray | xr.Dataset,
     *,
+    zero_points: str = "band",
+    extinction: str | Mapping[str, float] | None = None,
+    airmass: str = "auto",
+    fit_time_shift: bool = False,
+    max_time_shift_s: Any = 10.0,
     fit_phase: bool = True,
-    period_s: float | None = None,
-    phase_angle: float | None = None,
-    n_scan: int = 720,
+    period_s: Any = None,
     epoch: Any = None,
-    extinction: Any = None,
+    phase_angle: Any = None,
+    n_scan: int = 720,
 ) -> xr.Dataset:
-    """Fit a simulated light curve to a measured one: magnitude and rotation-phase offsets.
+    """Fit a simulated light curve - a pass or a rotation sweep - to a measured one.
 
-    Model: ``m_meas,i = m_sim,b_i(theta_i + phi) + dm`` with the simulated curve
-    interpolated linearly in flux, periodic in 360 degrees.  For a given ``phi`` the
-    offset is the analytic weighted mean ``dm = sum w r / sum w`` (``w = 1/sigma**2``,
-    ``r = m_meas - m_sim``), minimising ``chi2 = sum w (r - dm)**2``.  ``phi`` is found
-    by a scan of ``n_scan`` equally spaced values over [0, 360) and a bounded Brent
-    refinement within one scan step of the best; it is reported in [0, 360).
-    Observations where the model reflects nothing (infinite magnitude) are excluded
-    and counted.  Per-row geometry in ``measured`` enters the model: a ``range_km``
-    column adds ``5 log10(range / range_sim)`` (``range_sim`` the ``range_km``
-    attribute of the simulated magnitudes), an ``airmass`` column with ``extinction``
-    adds ``k_band X``; absolute times from several nights share one rotation phase.
+    Model (per observation ``i`` in band ``b``, weights ``1 / sigma_i^2``)::
+
+        m_obs,i = m_sim,b(t_i + dt) + ZP_b + k_b X_i + f_i
+
+    * a **pass** (``simulated`` over ``time``): the simulated flux is interpolated
+      linearly in time at the measured UTC times; a measured time outside the simulated
+      window is an error.  ``dt`` is fitted when ``fit_time_shift`` (within
+      ``max_time_shift_s``, the shifted times inside the window), else 0.
+    * a **rotation sweep** (over ``attitude`` with ``attitude_angle``): the curve is
+      periodic in 360 degree, the measured rotation angles (or times times
+      ``360 / period_s``) are offset by a fitted phase (``fit_phase``); a ``range_km``
+      column adds ``5 log10(range / range_sim)``.
+
+    ``ZP_b`` is a zero point per band (``zero_points="band"``; their differences are
+    the colour offsets) or one for all (``"common"``).  ``k_b X_i`` is first-order
+    extinction: fitted (``extinction="fit"``), given (``{band: k}``) or absent; ``X`` is
+    the measured ``airmass`` column or the pass's own (``airmass``).  The linear terms
+    are solved exactly for each trial shift (``chi2`` profiled over them); the shift is
+    found on a scan of ``n_scan`` points refined by bounded Brent.  Where the model
+    reflects no light (the Earth's umbra) observations are excluded and counted.  The
+    uncertainties are the Gauss-Newton covariance of every fitted parameter with the
+    stated measurement uncertainties (not rescaled by the reduced chi-square).
 
     Parameters
     ----------
     measured : xarray.Dataset
-        From :func:`read_light_curve`.
-    simulated_mags : xarray.DataArray
-        Magnitudes over ``attitude`` (with the coordinate ``attitude_angle`` [degree],
-        a rotation sweep) and ``band`` (and optionally a ``phase_angle`` dim).
+        From :func:`~sbrdf_xr.photometry.read_light_curve` (or alike: ``magnitude``,
+        ``uncertainty`` and coordinates ``band`` and ``time`` or ``rotation_angle``).
+    simulated : xarray.DataArray or xarray.Dataset
+        Magnitudes from :func:`~sbrdf_xr.photometry.magnitudes` over ``(time, band)``
+        or ``(attitude, band)``, or a simulated cube (its magnitudes are computed in the
+        measured bands and system).
+    zero_points : {"band", "common"}
+    extinction : {"fit"} or mapping of band -> k [mag per airmass], optional
+    airmass : {"auto", "measured", "simulated"}
+        Where ``X`` comes from: ``auto`` is the measured column if there is one, else
+        the simulated pass's ``airmass`` coordinate.
+    fit_time_shift : bool
+        A pass: fit ``dt`` [s].
+    max_time_shift_s : float or Quantity
+        Bound of ``|dt|`` [s].
     fit_phase : bool
-        Fit the rotation-phase offset (else ``phi = 0``).
-    period_s : float, optional
-        Rotation period [s], needed when ``measured`` is indexed by time:
-        ``theta = 360 t / period_s``.
+        A rotation sweep: fit the phase offset [degree].
+    period_s : float or Quantity, optional
+        A rotation sweep compared over times: the rotation period [s].
+    epoch : datetime64 or str, optional
+        A rotation sweep compared over UTC times: the time of rotation angle 0
+        (default the first observation).
     phase_angle : float, optional
         Selects the simulated phase angle [degree] (nearest) when there are several.
     n_scan : int
-        Number of scan points, >= 1.
-    epoch : datetime64 or str, optional
-        Time of rotation angle 0 for absolute (UTC) times; default the first observation.
-    extinction : mapping or DataArray, optional
-        Extinction coefficients per band (:func:`~sbrdf_xr.photometry.apply_extinction`)
-        applied with the ``airmass`` column of ``measured``.
+        Points of the scan of the shift, >= 1.
 
     Returns
     -------
     xarray.Dataset
-        Over ``obs``: ``measured_magnitude``, ``uncertainty``, ``model_magnitude``
-        (offsets applied), ``residual``, ``normalized_residual``; scalars
-        ``magnitude_offset`` (+ ``magnitude_offset_uncertainty``), ``phase_offset``,
-        ``chi_square``, ``reduced_chi_square``, ``degrees_of_freedom``, ``n_excluded``;
-        over ``band``: ``band_mean_residual``; over ``colour``:
-        ``colour_index_difference`` (measured minus simulated, consecutive bands);
-        over ``phase_scan``: ``chi_square_scan``.
+        Over ``obs``: ``measured_magnitude``, ``uncertainty``, ``simulated_magnitude``
+        (aligned, before the fitted terms), ``model_magnitude``, ``residual``,
+        ``normalized_residual``, ``excluded``, ``model_time`` (pass) or
+        ``model_rotation_angle`` (sweep), ``airmass`` (with extinction).  Over
+        ``band``: ``zero_point``, ``extinction_coefficient`` and their
+        ``*_uncertainty``, ``n_observations``, ``band_mean_residual``.  Over ``colour``
+        (consecutive bands): ``colour_index_difference`` (measured minus simulated) and
+        its uncertainty.  Over ``parameter``: ``estimate``, ``standard_error``,
+        ``covariance``.  Scalars: ``chi_square``, ``degrees_of_freedom``,
+        ``reduced_chi_square``, ``n_excluded``; ``time_shift`` or ``phase_offset``
+        (with uncertainties); ``magnitude_offset`` for a common zero point.  Over
+        ``curve_time`` or ``curve_angle``: ``model_curve`` (the fitted model at the
+        simulated nodes, for the figure), and ``chi_square_scan`` when a shift is fitted.
+
+    Raises
+    ------
+    LightCurveError
+        Measured times outside the simulated window (or no overlap), bands not
+        simulated, NaN rows, negative or too small uncertainties, different magnitude
+        systems, fewer observations than fitted parameters (or a band with fewer than
+        its own), parameters the data cannot tell apart (an extinction fit over a
+        constant air mass).
 
     Examples
     --------
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> rows = ["rotation_angle,band,magnitude,uncertainty,system"]
-    >>> for a in (0, 30, 60, 90):  # a double-peaked curve, 0.2 mag fainter, 20 degree later
-    ...     for b, m0 in (("B", 10.2), ("V", 9.8)):
-    ...         rows.append(f"{a},{b},{m0 + 0.5 * np.cos(np.radians(2 * (a + 20))):.4f},0.01,AB")
-    >>> path = Path(tempfile.mkdtemp()) / "curve.csv"
-    >>> _ = path.write_text("\\n".join(rows))
-    >>> from sbrdf_xr.photometry import read_light_curve
-    >>> ang = np.arange(0.0, 360.0, 10.0)
-    >>> wave = 0.5 * np.cos(np.radians(2 * ang))
-    >>> simulated = xr.DataArray(np.stack([10 + wave, 9.6 + wave], 1), dims=("attitude", "band"),
-    ...                          coords={"attitude_angle": ("attitude", ang), "band": ["B", "V"]},
-    ...                          attrs={"units": "1"})
-    >>> fit = compare_light_curves(read_light_curve(path), simulated)
-    >>> round(float(fit.magnitude_offset), 3), round(float(fit.phase_offset), 1)
-    (0.2, 20.0)
-    >>> int(fit.degrees_of_freedom), bool(fit.reduced_chi_square < 1)
-    (6, True)
-    """
-    from scipy.optimize import minimize_scalar
+    A pass of 60 s seen in V and R: the measurements are the simulation plus a zero
+    point per band and 0.1 mag per airmass in V.
 
-    if (
-        not isinstance(measured, xr.Dataset)
-        or "magnitude" not in measured
-        or "uncertainty" not in measured
-    ):
-        raise ValidationError("measured: expected a light-curve Dataset from read_light_curve")
+    >>> t = np.datetime64("2024-03-17T01:21:00", "ns") + np.arange(61) * np.timedelta64(1, "s")
+    >>> x = np.linspace(1.9, 1.1, 61)  # the pass rises: airmass falls
+    >>> curve = 12.0 + 0.3 * np.sin(np.arange(61) / 5.0)
+    >>> sim = xr.DataArray(np.stack([curve, curve - 0.4], 1), dims=("time", "band"),
+    ...                    coords={"time": t, "band": ["V", "R"], "airmass": ("time", x)},
+    ...                    attrs={"magnitude_system": "AB"})
+    >>> k = np.arange(0, 60, 3)
+    >>> measured = xr.Dataset(
+    ...     {"magnitude": ("obs", np.r_[curve[k] + 0.25 + 0.1 * x[k], curve[k] - 0.4 - 0.1]),
+    ...      "uncertainty": ("obs", np.full(2 * k.size, 0.01))},
+    ...     coords={"time": ("obs", np.r_[t[k], t[k]]),
+    ...             "band": ("obs", ["V"] * k.size + ["R"] * k.size)},
+    ...     attrs={"magnitude_system": "AB"})
+    >>> fit = compare(measured, sim, extinction="fit")
+    >>> np.round(fit.zero_point.values, 6).tolist()  # V, R [mag]
+    [0.25, -0.1]
+    >>> (np.round(fit.extinction_coefficient.values, 6) + 0.0).tolist()  # [mag per airmass]
+    [0.1, 0.0]
+    >>> int(fit.degrees_of_freedom), float(fit.chi_square) < 1e-20
+    (36, True)
+    >>> compare(measured, sim.isel(time=slice(0, 30)))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.LightCurveError: measured: 20 observation(s) outside the simulated window ...
+    """
+    _check_measured(measured)
+    if zero_points not in ZERO_POINTS:
+        raise LightCurveError(f"zero_points: got {zero_points!r}; allowed: {ZERO_POINTS}")
+    if airmass not in AIRMASS_SOURCES:
+        raise LightCurveError(f"airmass: got {airmass!r}; allowed: {AIRMASS_SOURCES}")
+    if extinction is not None and extinction != "fit" and not isinstance(extinction, Mapping):
+        raise LightCurveError(
+            f"extinction: expected None, 'fit' or a mapping band -> k, got {extinction!r}"
+        )
     if isinstance(n_scan, bool) or not isinstance(n_scan, int | np.integer) or n_scan < 1:
-        raise ValidationError(
-            f"n_scan: must be an integer >= 1 (trial phase offsets over 360 degree), got {n_scan!r}"
+        raise LightCurveError(
+            f"n_scan: must be an integer >= 1 (trial shifts of the scan), got {n_scan!r}"
         )
-    sim = _simulated_curve(simulated_mags, phase_angle)
-    have = str(
-        measured.attrs.get(
-            "magnitude_system", measured["magnitude"].attrs.get("magnitude_system", "unstated")
-        )
-    )
-    want = str(sim.attrs.get("magnitude_system", "unstated"))
-    if "unstated" not in (have, want) and have != want:
-        raise ValidationError(
-            f"measured: magnitudes are in the {have} system but the simulation is in {want}; "
-            f"simulate with system={have!r}"
-        )
-    if "rotation_angle" in measured.coords:
-        theta = np.asarray(measured["rotation_angle"].values, dtype=np.float64)
-    elif "time" in measured.coords:
-        if period_s is None or not np.isfinite(period_s) or period_s <= 0:
-            raise ValidationError(
-                "period_s: the measured light curve is indexed by time; give the rotation "
-                "period [s] (> 0) to convert it to rotation angle"
-            )
-        tv = measured["time"].values
-        if np.issubdtype(tv.dtype, np.datetime64):
-            t0 = tv[0] if epoch is None else np.datetime64(epoch, "ns")
-            secs = (tv.astype("datetime64[ns]") - t0) / np.timedelta64(1, "s")
-        else:
-            secs = np.asarray(tv, dtype=np.float64)
-        theta = 360.0 * np.asarray(secs, dtype=np.float64) / period_s
+    max_shift = float(to_unit(max_time_shift_s, "s", "max_time_shift_s"))
+    if not (np.isfinite(max_shift) and max_shift > 0):
+        raise LightCurveError(f"max_time_shift_s: must be > 0 s, got {max_time_shift_s!r}")
+    sim = _simulated(simulated, measured, phase_angle)
+    system = _system(measured, sim)
+    col = _band_columns(measured, sim)
+    if align.TIME in sim.dims:
+        al = align.observation(measured, sim, fit_time_shift, max_shift)
+        fit_x = bool(fit_time_shift)
     else:
-        raise ValidationError("measured: needs a 'rotation_angle' or 'time' coordinate")
-    m_obs = np.asarray(measured["magnitude"].values, dtype=np.float64)
-    sig = np.asarray(measured["uncertainty"].values, dtype=np.float64)
-    bad = np.flatnonzero(~np.isfinite(sig) | (sig < MIN_UNCERTAINTY))
-    if bad.size:
-        raise ValidationError(
-            f"measured: observation {int(bad[0])} has uncertainty {sig[bad[0]]:g}; must be "
-            f"finite and >= {MIN_UNCERTAINTY:g} mag"
-        )
-    sim_labels = [str(b) for b in sim[BAND].values]
-    sim_filters = [str(f) for f in sim["filter"].values] if "filter" in sim.coords else sim_labels
-    obs_band = [str(b) for b in measured[BAND].values]
-    col = np.empty(len(obs_band), dtype=np.int64)
-    for k, b in enumerate(obs_band):
-        if b in sim_labels:
-            col[k] = sim_labels.index(b)
-        elif _canonical(b) in sim_filters:
-            col[k] = sim_filters.index(_canonical(b))
-        else:
-            raise ValidationError(
-                f"measured: observation {k} is in band {b!r}, which the simulation does "
-                f"not have (bands {sim_labels})"
+        if fit_time_shift:
+            raise LightCurveError(
+                "fit_time_shift: a rotation sweep has no time axis; its phase offset is "
+                "fitted with fit_phase"
             )
-    angles = np.asarray(sim["attitude_angle"].values, dtype=np.float64)
-    sim_m = np.asarray(sim.transpose(ATTITUDE, BAND).values, dtype=np.float64)
-    with np.errstate(over="ignore"):
-        flux = np.where(
-            np.isfinite(sim_m), 10.0 ** (-0.4 * np.where(np.isfinite(sim_m), sim_m, 0.0)), 0.0
-        )
-    w = 1.0 / sig**2
-    extra = np.zeros(theta.size)  # per-observation geometry terms of the model [mag]
-    if "range_km" in measured:
-        if "range_km" not in sim.attrs:
-            raise ValidationError(
-                "measured: has a range_km column but simulated_mags has no range_km "
-                "attribute (the range it was computed at); compute it at one range"
-            )
-        extra += 5.0 * np.log10(
-            np.asarray(measured["range_km"].values, dtype=np.float64) / float(sim.attrs["range_km"])
-        )
+        period = None if period_s is None else float(to_unit(period_s, "s", "period_s"))
+        al = align.sweep(measured, sim, period, epoch)
+        fit_x = bool(fit_phase)
+    fixed_k = None
     if extinction is not None:
-        if "airmass" not in measured:
-            raise ValidationError("extinction: the measured light curve has no airmass column")
-        from .atmosphere import apply_extinction
+        align.with_airmass(al, measured, sim, airmass)
+    if isinstance(extinction, Mapping):
+        from ._observed import _coefficient
 
-        labels = sorted({str(b) for b in measured[BAND].values})
-        zero = xr.DataArray(np.zeros(len(labels)), dims=(BAND,), coords={BAND: labels})
-        k_band = apply_extinction(zero, 1.0, extinction)
-        kb = dict(zip(labels, k_band.values.tolist(), strict=True))
-        extra += np.array([kb[str(b)] for b in measured[BAND].values]) * np.asarray(
-            measured["airmass"].values, dtype=np.float64
-        )
-
-    def model(phi: float) -> tuple[np.ndarray, np.ndarray]:
-        f = np.empty(theta.size)
-        for b in np.unique(col):
-            sel = col == b
-            f[sel] = _periodic_model_flux(angles, flux[:, b], theta[sel] + phi)
-        ok = f > 0
-        mm = np.full(theta.size, np.inf)
-        mm[ok] = -2.5 * np.log10(f[ok]) + extra[ok]
-        return mm, ok
-
-    def fit(phi: float) -> tuple[float, float, np.ndarray, np.ndarray]:
-        mm, ok = model(phi)
-        if not ok.any():
-            return np.inf, np.nan, mm, ok
-        r = m_obs[ok] - mm[ok]
-        dm = float(np.sum(w[ok] * r) / np.sum(w[ok]))
-        return float(np.sum(w[ok] * (r - dm) ** 2)), dm, mm, ok
-
-    scan = np.arange(n_scan) * (360.0 / n_scan)
-    if fit_phase:
-        chi_scan = np.array([fit(p)[0] for p in scan])
-        if not np.isfinite(chi_scan).any():
-            raise ValidationError(
-                "simulated_mags: the model reflects nothing at any measured angle"
+        labels = [str(b) for b in sim[BAND].values]
+        ks = np.full(len(labels), np.nan)
+        for i in np.unique(col):  # the measured bands need a coefficient, the others not
+            ks[i] = _coefficient(
+                sim.isel({BAND: np.unique(col)}),
+                dict(extinction),
+                labels[i],
+                int(np.flatnonzero(np.unique(col) == i)[0]),
             )
-        k = int(np.nanargmin(chi_scan))
-        step = 360.0 / n_scan
-        res = minimize_scalar(
-            lambda p: fit(p)[0],
-            bounds=(scan[k] - step, scan[k] + step),
-            method="bounded",
-            options={"xatol": 1e-7},
+        used = ks[np.unique(col)]
+        if not np.all(np.isfinite(used)) or np.any(used < 0):
+            raise LightCurveError(f"extinction: coefficients must be finite and >= 0, got {used}")
+        fixed_k = ks[col]
+        al.notes["extinction"] = "given: " + ", ".join(
+            f"{labels[i]}: {ks[i]:g}" for i in np.unique(col)
         )
-        phi = float(res.x) if res.fun <= chi_scan[k] else float(scan[k])
-        phi = float(np.mod(phi, 360.0))
-    else:
-        chi_scan = np.array([fit(p)[0] for p in scan])
-        phi = 0.0
-    chi2, dm, mm, ok = fit(phi)
-    if not ok.any():
-        raise ValidationError("simulated_mags: the model reflects nothing at any measured angle")
-    # The best phase farther than 30 deg from the fitted one: a symmetric body (a cube
-    # turning about an axis) fits nearly as well half a turn away.
-    far = np.abs(((scan - phi + 180.0) % 360.0) - 180.0) > 30.0
-    if fit_phase and np.isfinite(chi_scan[far]).any():
-        k_alt = int(np.nanargmin(np.where(far, chi_scan, np.nan)))
-        phi_alt, dchi_alt = float(scan[k_alt]), float(chi_scan[k_alt] - chi2)
-    else:
-        phi_alt, dchi_alt = np.nan, np.nan
-    n_par = 2 if fit_phase else 1
-    dof = int(ok.sum()) - n_par
-    if dof < 1:
-        raise ValidationError(
-            f"measured: {int(ok.sum())} observation(s) where the model reflects light; fitting "
-            f"{n_par} parameter(s) (magnitude{' and phase' if fit_phase else ''} offset) needs "
-            f"at least {n_par + 1}"
-        )
-    resid = np.where(ok, m_obs - (mm + dm), np.nan)
-    labels_present = [lab for j, lab in enumerate(sim_labels) if np.any(col[ok] == j)]
-    band_mean = []
-    for lab in labels_present:
-        sel = ok & (col == sim_labels.index(lab))
-        band_mean.append(float(np.sum(w[sel] * resid[sel]) / np.sum(w[sel])))
-    colours = [f"{a}-{b}" for a, b in pairwise(labels_present)]
-    ci_diff = [band_mean[i] - band_mean[i + 1] for i in range(len(colours))]
-    obs_coords = {
-        ("obs_band" if k == BAND else k): v
-        for k, v in measured.coords.items()
-        if v.dims == ("obs",)
-    }
-    ds = xr.Dataset(
-        {
-            "measured_magnitude": (
-                "obs",
-                m_obs,
-                attrs("magnitude", long_name="measured magnitude"),
-            ),
-            "uncertainty": ("obs", sig, attrs("magnitude_uncertainty")),
-            "model_magnitude": (
-                "obs",
-                np.where(ok, mm + dm, np.inf),
-                attrs("magnitude", long_name="simulated magnitude with the fitted offsets"),
-            ),
-            "residual": (
-                "obs",
-                resid,
-                attrs("magnitude", long_name="measured minus fitted simulated magnitude"),
-            ),
-            "normalized_residual": (
-                "obs",
-                resid / sig,
-                {"units": "1", "long_name": "residual / uncertainty"},
-            ),
-            "model_rotation_angle": (
-                "obs",
-                np.mod(theta + phi, 360.0),
-                attrs(
-                    "rotation_angle",
-                    long_name="simulated rotation angle matched to "
-                    "each observation (measured angle + phase offset, mod 360)",
-                ),
-            ),
-            "magnitude_offset": (
-                (),
-                dm,
-                attrs(
-                    "magnitude",
-                    long_name="fitted magnitude offset (measured - "
-                    "simulated), analytic weighted mean",
-                ),
-            ),
-            "magnitude_offset_uncertainty": (
-                (),
-                float(1.0 / np.sqrt(np.sum(w[ok]))),
-                attrs("magnitude", long_name="1-sigma uncertainty of the magnitude offset"),
-            ),
-            "phase_offset": (
-                (),
-                phi,
-                attrs(
-                    "rotation_angle",
-                    long_name="fitted rotation-phase offset "
-                    "(simulated angle = measured angle + offset), in [0, 360)",
-                ),
-            ),
-            "chi_square": ((), chi2, {"units": "1", "long_name": "chi-square of the fit"}),
-            "alternative_phase_offset": (
-                (),
-                phi_alt,
-                attrs(
-                    "rotation_angle",
-                    long_name="best phase offset more "
-                    "than 30 deg from the fitted one (scan resolution)",
-                ),
-            ),
-            "alternative_delta_chi_square": (
-                (),
-                dchi_alt,
-                {
-                    "units": "1",
-                    "long_name": "chi-square at the "
-                    "alternative phase minus the best; below ~4 the two "
-                    "phases are not distinguished at 2 sigma",
-                },
-            ),
-            "degrees_of_freedom": (
-                (),
-                dof,
-                {"units": "1", "long_name": "observations used minus fitted parameters"},
-            ),
-            "reduced_chi_square": (
-                (),
-                chi2 / dof if dof > 0 else np.nan,
-                {"units": "1", "long_name": "chi-square per degree of freedom"},
-            ),
-            "n_excluded": (
-                (),
-                int((~ok).sum()),
-                {
-                    "units": "1",
-                    "long_name": "observations where the model reflects nothing (excluded)",
-                },
-            ),
-            "band_mean_residual": (
-                BAND,
-                np.array(band_mean),
-                attrs(
-                    "magnitude", long_name="weighted mean residual per band after the common offset"
-                ),
-            ),
-            "colour_index_difference": (
-                "colour",
-                np.array(ci_diff),
-                attrs("colour_index", long_name="measured minus simulated colour index"),
-            ),
-            "chi_square_scan": (
-                "phase_scan",
-                chi_scan,
-                {"units": "1", "long_name": "chi-square versus trial phase offset"},
-            ),
-        },
-        coords={
-            **obs_coords,
-            BAND: (BAND, labels_present, attrs(BAND)),
-            "colour": ("colour", colours, attrs("colour")),
-            "phase_scan": (
-                "phase_scan",
-                scan,
-                attrs("rotation_angle", long_name="trial phase offset"),
-            ),
-        },
+    return fit_and_report(
+        measured, sim, al, col, zero_points, extinction == "fit", fixed_k, fit_x, n_scan, system
     )
-    ds.attrs = {
-        "fit_phase": int(fit_phase),
-        "title": "comparison of a measured and a simulated light curve",
-        "model": "m_meas(theta) = m_sim(theta + phase_offset) + magnitude_offset",
-        "abscissa": "rotation_angle"
-        if "rotation_angle" in measured.coords
-        else f"time converted with period_s = {period_s}",
-    }
-    return ds
 
 
-def _simulated_curve(sim: xr.DataArray, phase_angle: float | None) -> xr.DataArray:
-    if not isinstance(sim, xr.DataArray) or BAND not in sim.dims:
-        raise ValidationError(
-            "simulated_mags: expected magnitudes over (attitude, band) from magnitudes()"
-        )
-    if PHASE_ANGLE in sim.dims:
-        if phase_angle is not None:
-            sim = sim.sel({PHASE_ANGLE: phase_angle}, method="nearest")
-        elif sim.sizes[PHASE_ANGLE] == 1:
-            sim = sim.isel({PHASE_ANGLE: 0})
-        else:
-            raise ValidationError(
-                f"phase_angle: the simulation has {sim.sizes[PHASE_ANGLE]} phase angles "
-                f"{sim[PHASE_ANGLE].values.tolist()}; choose one"
-            )
-    extra = [d for d in sim.dims if d not in (ATTITUDE, BAND)]
-    if ATTITUDE not in sim.dims or extra:
-        raise ValidationError(f"simulated_mags: expected dims (attitude, band), got {sim.dims}")
-    if "attitude_angle" not in sim.coords:
-        raise ValidationError(
-            "simulated_mags: needs the 'attitude_angle' coordinate of a rotation sweep"
-        )
-    ang = np.mod(np.asarray(sim["attitude_angle"].values, dtype=np.float64), 360.0)
-    if np.unique(ang).size != ang.size:
-        raise ValidationError("simulated_mags: attitude angles repeat modulo 360 degree")
-    return sim.load()
-
-
-def plot_comparison(comparison: xr.Dataset, *, title: str | None = None) -> Any:
-    """Figure of a :func:`compare_light_curves` result.
-
-    Top: measured magnitudes (error bars) and the fitted simulated curve against the
-    simulated rotation angle, per band; bottom: residuals.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
+def compare_light_curves(measured: xr.Dataset, simulated_mags: xr.DataArray, **kwargs: Any) -> Any:
+    """Deprecated: :func:`compare` with one common zero point (``zero_points="common"``).
 
     Examples
     --------
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> rows = ["rotation_angle,band,magnitude,uncertainty,system"]
-    >>> for a in (0, 30, 60, 90):  # a double-peaked curve, 0.2 mag fainter, 20 degree later
-    ...     for b, m0 in (("B", 10.2), ("V", 9.8)):
-    ...         rows.append(f"{a},{b},{m0 + 0.5 * np.cos(np.radians(2 * (a + 20))):.4f},0.01,AB")
-    >>> path = Path(tempfile.mkdtemp()) / "curve.csv"
-    >>> _ = path.write_text("\\n".join(rows))
-    >>> from sbrdf_xr.photometry import read_light_curve
+    >>> import warnings
     >>> ang = np.arange(0.0, 360.0, 10.0)
-    >>> wave = 0.5 * np.cos(np.radians(2 * ang))
-    >>> simulated = xr.DataArray(np.stack([10 + wave, 9.6 + wave], 1), dims=("attitude", "band"),
-    ...                          coords={"attitude_angle": ("attitude", ang), "band": ["B", "V"]},
-    ...                          attrs={"units": "1"})
-    >>> import matplotlib
-    >>> matplotlib.use("Agg")
-    >>> fig = plot_comparison(compare_light_curves(read_light_curve(path), simulated))
-    >>> type(fig).__name__, len(fig.axes)
-    ('Figure', 2)
+    >>> sim = xr.DataArray(np.stack([10 + np.cos(np.radians(ang))], 1),
+    ...                    dims=("attitude", "band"),
+    ...                    coords={"attitude_angle": ("attitude", ang), "band": ["V"]})
+    >>> lc = xr.Dataset({"magnitude": ("obs", 10.5 + np.cos(np.radians(ang[:9]))),
+    ...                  "uncertainty": ("obs", np.full(9, 0.01))},
+    ...                 coords={"rotation_angle": ("obs", ang[:9]), "band": ("obs", ["V"] * 9)})
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     fit = compare_light_curves(lc, sim, fit_phase=False)
+    >>> round(float(fit.magnitude_offset), 6), caught[0].category.__name__
+    (0.5, 'DeprecationWarning')
     """
-    from matplotlib.figure import Figure
-
-    if not isinstance(comparison, xr.Dataset) or "residual" not in comparison:
-        raise ValidationError("comparison: expected the Dataset returned by compare_light_curves")
-    fig = Figure(figsize=(8, 6), layout="constrained")
-    ax, axr = fig.subplots(2, 1, sharex=True, height_ratios=(3, 1))
-    x = comparison["model_rotation_angle"].values
-    bands = [str(b) for b in comparison[BAND].values]
-    obs_band = np.asarray([str(b) for b in comparison["obs_band"].values])
-    for b in bands:
-        sel = obs_band == b
-        order = np.argsort(x[sel])
-        line = ax.errorbar(
-            x[sel],
-            comparison["measured_magnitude"].values[sel],
-            comparison["uncertainty"].values[sel],
-            fmt="o",
-            ms=3,
-            label=f"{b} measured",
-        )
-        ax.plot(
-            x[sel][order],
-            comparison["model_magnitude"].values[sel][order],
-            "-",
-            color=line[0].get_color(),
-            label=f"{b} simulated",
-        )
-        axr.plot(x[sel], comparison["residual"].values[sel], "o", ms=3, color=line[0].get_color())
-    ax.invert_yaxis()
-    ax.set_ylabel("magnitude [mag]")
-    ax.legend(fontsize="small", ncol=2)
-    axr.axhline(0.0, color="k", lw=0.8)
-    axr.set_xlabel("simulated rotation angle [degree]")
-    axr.set_ylabel("residual [mag]")
-    ax.set_title(
-        title
-        or (
-            f"offset {float(comparison.magnitude_offset):.3f} mag, phase "
-            f"{float(comparison.phase_offset):.2f} deg, reduced chi2 "
-            f"{float(comparison.reduced_chi_square):.2f}"
-        )
+    warnings.warn(
+        "compare_light_curves is deprecated: use sbrdf_xr.photometry.compare (with "
+        "zero_points='common' for one offset)",
+        DeprecationWarning,
+        stacklevel=2,
     )
-    return fig
+    kwargs.setdefault("zero_points", "common")
+    return compare(measured, simulated_mags, **kwargs)

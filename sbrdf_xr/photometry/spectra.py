@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike
 
 from .._names import WAVELENGTH, attrs
 from ..errors import ValidationError
+from ..units import check_wavelengths, to_unit
 
 # ---------------------------------------------------------------- constants
 
@@ -150,7 +151,8 @@ def _weighting(wl: np.ndarray, weighting: str) -> np.ndarray:
 
 
 def _check_grid(wavelength: ArrayLike, what: str) -> np.ndarray:
-    wl = np.atleast_1d(np.asarray(wavelength, dtype=np.float64))
+    """A wavelength grid [nm]: a Quantity converted, bare numbers checked for their unit."""
+    wl = np.atleast_1d(np.asarray(to_unit(wavelength, "nm", what, spectral=True), dtype=np.float64))
     if wl.ndim != 1 or wl.size < 1:
         raise ValidationError(f"{what}: expected a 1-D array, got shape {wl.shape}")
     if not np.all(np.isfinite(wl)) or np.any(wl <= 0):
@@ -160,6 +162,7 @@ def _check_grid(wavelength: ArrayLike, what: str) -> np.ndarray:
         raise ValidationError(
             f"{what}: must be strictly increasing; {wl[k]:g} nm is followed by {wl[k + 1]:g} nm"
         )
+    check_wavelengths(wl, what)
     return wl
 
 

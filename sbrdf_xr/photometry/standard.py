@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike
 
 from .._names import WAVELENGTH, attrs
 from ..errors import ValidationError
+from ..units import check_plausible, to_unit
 from .spectra import _check_grid, _choose, trapezoid_weights
 
 
@@ -44,7 +45,7 @@ def lambert_sphere_phase(alpha_deg: ArrayLike) -> np.ndarray:
     >>> np.round(lambert_sphere_phase([0.0, 90.0, 180.0]), 6)  # 1, 1/pi, 0
     array([1.     , 0.31831, 0.     ])
     """
-    a = np.radians(np.asarray(alpha_deg, dtype=np.float64))
+    a = np.radians(np.asarray(to_unit(alpha_deg, "deg", "alpha_deg"), dtype=np.float64))
     return ((np.pi - a) * np.cos(a) + np.sin(a)) / np.pi
 
 
@@ -128,6 +129,12 @@ def standard_magnitude(
     """
     if not isinstance(mags, xr.DataArray):
         raise ValidationError(f"mags: expected a DataArray, got {type(mags).__name__}")
+    range_km = to_unit(range_km, "km", "range_km")
+    to_range_km = to_unit(to_range_km, "km", "to_range_km")
+    phase_angle = to_unit(phase_angle, "deg", "phase_angle")
+    to_phase_angle = to_unit(to_phase_angle, "deg", "to_phase_angle")
+    sun_distance_au = to_unit(sun_distance_au, "au", "sun_distance_au")
+    check_plausible(range_km, "range_km", "range_km")
     _positive(range_km, "range_km")
     _positive(to_range_km, "to_range_km")
     d = (
@@ -292,6 +299,7 @@ def at_resolution(
         raise ValidationError(
             "spectrum: expected a DataArray with a 'wavelength' dimension and coordinate"
         )
+    fwhm_nm = to_unit(fwhm_nm, "nm", "fwhm_nm")
     if (resolving_power is None) == (fwhm_nm is None):
         raise ValidationError("give exactly one of resolving_power (lambda / FWHM) and fwhm_nm")
     x = _check_grid(spectrum[WAVELENGTH].values, "spectrum wavelength")

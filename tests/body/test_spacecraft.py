@@ -427,10 +427,18 @@ def test_load_trimesh_object_and_scene_transform():
 # ----------------------------------------------------------------------------- bad input
 
 
-@pytest.mark.parametrize("unit", ["parsec", "", "M M", None])
+@pytest.mark.parametrize("unit", ["parsec", "", "M M", 3])
 def test_bad_length_unit(unit):
-    with pytest.raises(ValidationError, match=r"length_unit.*allowed: m, meter"):
+    with pytest.raises(ValidationError, match=r"length_unit.*(allowed: m, meter|length unit name)"):
         sc.load_spacecraft(coloured_box(), BOX_MAP, length_unit=unit)
+
+
+def test_no_length_unit_is_the_files_own_else_metres():
+    box = sc.load_spacecraft(coloured_box(), BOX_MAP)  # a trimesh object states none
+    assert (
+        box.mesh.extents.tolist()
+        == sc.load_spacecraft(coloured_box(), BOX_MAP, length_unit="m").mesh.extents.tolist()
+    )
 
 
 def test_length_units_convert():

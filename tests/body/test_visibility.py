@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from hypothesis_profiles import examples
 from shapely.geometry import MultiPoint, Polygon
 
+from sbrdf_xr.body import rays
 from sbrdf_xr.body import spacecraft as sc
 from sbrdf_xr.body import visibility as vis
 from sbrdf_xr.errors import ValidationError
@@ -24,7 +25,7 @@ from sbrdf_xr.testing import (
     plate_with_fin_spacecraft,
 )
 
-HAVE_EMBREE = "embree" in vis.available_engines()
+HAVE_EMBREE = "embree" in rays.available_engines()
 needs_embree = pytest.mark.skipif(not HAVE_EMBREE, reason="embreex is not installed")
 
 #: Agreement of the exact method with the independent reference below.  Both are float64
@@ -344,11 +345,11 @@ def test_sampled_error_estimate():
 
 def test_sample_triangle_points():
     """Independent, deterministic, area-uniform point sets inside the triangle."""
-    b = vis.sample_triangle(64, n_facets=50, seed=1)
+    b = rays.sample_triangle(64, n_facets=50, seed=1)
     assert b.shape == (50, 64, 3)
     np.testing.assert_allclose(b.sum(axis=-1), 1.0, rtol=1e-15)
     assert b.min() >= 0
-    np.testing.assert_array_equal(b, vis.sample_triangle(64, n_facets=50, seed=1))
+    np.testing.assert_array_equal(b, rays.sample_triangle(64, n_facets=50, seed=1))
     assert not np.allclose(b[0], b[1])
     # area-uniform: the mean of the weights over all points is the centroid (1/3 each), the
     # standard error of the mean of 3200 points of variance 1/18 is 0.004

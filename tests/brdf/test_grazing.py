@@ -28,7 +28,7 @@ from sbrdf_xr import geometry
 from sbrdf_xr.brdf import BRDF_MODELS, get_model, optics
 from sbrdf_xr.brdf import robertson_sandford as RS
 from sbrdf_xr.errors import ValidationError
-from sbrdf_xr.kernels.sums import fused_sums, pack_tables
+from sbrdf_xr.kernels import fused_sums, pack_tables
 
 TOL_RECIPROCITY = 1e-13
 TOL_SUM = 1e-13

@@ -1,4 +1,5 @@
-"""The fused kernel's vectorised angle stage against numpy and geometry.facet_angles."""
+"""The compiled angle convention (kernels.angles) against numpy, geometry.facet_angles and
+anisotropy.illumination_azimuth."""
 
 from __future__ import annotations
 
@@ -10,8 +11,9 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 from hypothesis_profiles import examples
 
+from sbrdf_xr.anisotropy import PSI_PERIOD, illumination_azimuth
 from sbrdf_xr.geometry import facet_angles, normal_incidence_tolerance
-from sbrdf_xr.kernels.angles import atan2_pos, chunk_angles
+from sbrdf_xr.kernels.angles import atan2_pos, chunk_angles, facet_frame, tangent_azimuth
 
 
 @numba.njit
@@ -98,6 +100,37 @@ def test_chunk_angles_equal_facet_angles(normals, geometries):
     assert np.all(np.abs(dt[use] - ref.delta_theta[use]) <= 1e-12 + conditioning)
 
 
+@settings(max_examples=examples(200), deadline=None)
+@given(unit, unit, unit, unit, st.sampled_from(["any", "sun_on_normal", "both_on_normal"]))
+def test_facet_frame_and_psi_equal_the_numpy_specification(n, s, o, t, case):
+    """One lit and seen pair through ``facet_frame`` (the anisotropic kernel's and the
+    normal-incidence path of the fused kernel) gets the angles of
+    ``geometry.facet_angles``, and ``tangent_azimuth`` the ``psi`` of
+    ``anisotropy.illumination_azimuth``, also at normal incidence (the plane through the
+    observer, or through the axis least aligned with the normal).  Bounds as in
+    :func:`test_chunk_angles_equal_facet_angles`; ``psi`` is an angle between unit
+    vectors built from the same frame (1e-12 degree), compared modulo 180 degree."""
+    n = n / np.linalg.norm(n)
+    s = n if case != "any" else s / np.linalg.norm(s)
+    o = n if case == "both_on_normal" else o / np.linalg.norm(o)
+    ns, no = float(n @ s), float(n @ o)
+    if not (ns > 1e-6 and no > 1e-6):
+        return
+    tol = normal_incidence_tolerance(np.float64)
+    ti, dt, phi, e, op = facet_frame(tuple(n), tuple(s), tuple(o), ns, no, tol)
+    ref = facet_angles(n, s, o, check=False)
+    assert abs(ti - ref.theta_i) <= 1e-12 and abs(phi - ref.phi) <= 1e-12
+    conditioning = np.degrees(64 * np.finfo(float).eps) / np.cos(np.radians(float(ref.phi)))
+    assert abs(dt - ref.delta_theta) <= 1e-12 + conditioning
+    tt = t - (t @ n) * n
+    if np.linalg.norm(tt) < 1e-3:
+        return
+    psi = tangent_azimuth(tuple(n), tuple(t), e, op, tol)
+    want = float(illumination_azimuth(n, t, s, o, check=False))
+    gap = (psi - want) % PSI_PERIOD
+    assert min(gap, PSI_PERIOD - gap) <= 1e-12 + conditioning
+
+
 def test_chunk_angles_fills_only_its_chunk():
     """Geometries ``g0 .. g0 + nc - 1`` go to columns ``0 .. nc - 1``; the rest stay."""
     rng = np.random.default_rng(3)
@@ -117,7 +150,7 @@ def test_fused_kernel_normal_incidence_pairs_take_the_exact_path(dtype):
     """A Sun on the normal (in-plane component 0) is recomputed by ``facet_frame``:
     the fused kernel then agrees with the numpy reference (checked in test_kernels for
     random scenes; here the pair the vectorised stage cannot serve)."""
-    from sbrdf_xr.kernels.sums import fused_sums, material_sums, pack_tables
+    from sbrdf_xr.kernels import fused_sums, material_sums, pack_tables
 
     th = np.array([0.0, 10.0, 30.0, 60.0, 89.0])
     dth = np.array([-40.0, -10.0, 0.0, 10.0, 40.0])

@@ -17,7 +17,7 @@ from sbrdf_xr.engine import Scene
 from sbrdf_xr.engine.plan import compile_plan
 from sbrdf_xr.engine.run import simulate
 from sbrdf_xr.kernels import anisotropic as AK
-from sbrdf_xr.materials import models
+from sbrdf_xr.materials import energy, models
 from sbrdf_xr.materials import tables as material
 
 WL = np.array([500.0, 700.0])
@@ -139,7 +139,7 @@ def test_rendered_table_energy_and_reciprocity(rough_table):
     # and 4.9% at 80 deg (an isotropic table of roughness 0.3 on the same grid: 0.85%
     # and 4.4%): tolerances 0.6% and 6%.
     th = np.array([0.0, 20.0, 40.0, 60.0, 80.0])
-    rho = material.hemispherical_reflectance(rough_table, th)
+    rho = energy.hemispherical_reflectance(rough_table, th)
     assert rho.dims == ("theta_i", "psi", "wavelength")
     assert float(rho.max()) <= 1.0
     spec = aniso_spec(0.2, 0.5)

@@ -24,7 +24,7 @@ from hypothesis_profiles import examples
 
 from sbrdf_xr import geometry
 from sbrdf_xr import testing as T
-from sbrdf_xr.kernels.sums import fused_sums, material_sums, pack_tables
+from sbrdf_xr.kernels import fused_sums, material_sums, pack_tables
 
 RTOL = {"float64": 1e-12, "float32": 1e-5}
 
@@ -219,7 +219,7 @@ def test_bucket_map_finds_the_same_cell_as_searchsorted(nodes, xs, method):
     """The kernel's axis look-up (bucket map + correcting steps) is exactly the clipped
     ``searchsorted(grid, x, "right") - 1`` of ``_lut.axis_weights``, also at nodes,
     between nodes closer than the bucket width and outside the grid."""
-    from sbrdf_xr.kernels.lookup import _axis
+    from sbrdf_xr.kernels.lookup import _Axis, _axis
     from sbrdf_xr.kernels.packing import bucket_map
 
     # nodes at least 1e-6 degree apart (table grids are; closer nodes make the cubic
@@ -227,10 +227,12 @@ def test_bucket_map_finds_the_same_cell_as_searchsorted(nodes, xs, method):
     grid = np.unique(np.round(np.asarray(nodes, dtype=float), 6))
     n = grid.size
     bmap, inv = bucket_map(grid)
+    bmap = np.stack([np.zeros_like(bmap), bmap, np.zeros_like(bmap)])  # the delta_theta row
     probes = np.concatenate([np.asarray(xs, dtype=float), grid, np.nextafter(grid, -np.inf)])
-    idx, w = np.zeros(4, dtype=np.int64), np.zeros(4)
+    idx2, w2 = np.zeros((3, 4), dtype=np.int64), np.zeros((3, 4))
+    idx, w = idx2[1], w2[1]
     for x in probes:
-        k = _axis(grid, 0, n, x, method, idx, w, bmap, 0, bmap.size, inv)
+        k = _axis(grid, bmap, _Axis(1, 0, n, 0, bmap.shape[1], inv), x, method, idx2, w2)
         if n == 1:
             assert (k, idx[0]) == (1, 0)
             continue

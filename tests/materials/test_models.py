@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from sbrdf_xr import catalog
-from sbrdf_xr.materials import models
+from sbrdf_xr.materials import energy, models
 from sbrdf_xr.materials import tables as material
 
 WL = np.linspace(400.0, 1100.0, 15)
@@ -39,7 +39,7 @@ def test_render_equals_direct_evaluation_and_conserves_energy():
     # piecewise-linear interpolant of a smooth lobe (e = 0.35) is good to ~1e-3.
     from sbrdf_xr.brdf import robertson_sandford as rs
 
-    rho = material.hemispherical_reflectance(lut, warn=False).values
+    rho = energy.hemispherical_reflectance(lut, warn=False).values
     p = {k: spec[k].values for k in ("rho_D", "epsilon", "b", "e")}
     expected = rs.directional_hemispherical_reflectance(np.array([0.0, 30.0, 60.0]), WL, **p)
     np.testing.assert_allclose(rho, expected, rtol=5e-3)

@@ -11,9 +11,9 @@ from hypothesis_profiles import examples
 from scipy.spatial.transform import Rotation
 
 from sbrdf_xr import geometry
+from sbrdf_xr import observing as att
 from sbrdf_xr.body.spacecraft import Spacecraft
 from sbrdf_xr.errors import AttitudeError
-from sbrdf_xr.observing import attitude as att
 
 # Rotations built from the same float64 quaternion algebra agree to a few ulps; 1e-12
 # leaves room for the products of several rotations.

@@ -19,6 +19,7 @@ from hypothesis_profiles import examples
 from scipy.optimize import brentq
 
 from sbrdf_xr import catalog, geometry
+from sbrdf_xr import observing as att
 from sbrdf_xr.errors import (
     AttitudeError,
     EpochGapWarning,
@@ -26,7 +27,6 @@ from sbrdf_xr.errors import (
     ObservationError,
     ValidationError,
 )
-from sbrdf_xr.observing import attitude as att
 from sbrdf_xr.observing import observe, orbits
 
 REPO = Path(__file__).resolve().parents[2]

@@ -317,11 +317,16 @@ def test_band_pre_integration_equals_integrating_the_full_spectrum_canx1():
         b = P.pre_integrate(t, bands, **kw)
         assert b.dims == ("theta_i", "delta_theta", "phi", "band") and b.attrs["units"] == "sr-1"
         # run the band table through the simulation as if 'band' were a wavelength axis
+        # (pseudo-wavelengths at 1001-1006 nm: any values do; these are plausible nanometres)
         pseudo[m] = (
             b.drop_vars(["band", "filter", "filter_source"])
             .rename(band="wavelength")
             .assign_coords(
-                wavelength=("wavelength", np.arange(1.0, len(bands) + 1.0), {"units": "nm"})
+                wavelength=(
+                    "wavelength",
+                    1000.0 + np.arange(1.0, len(bands) + 1.0),
+                    {"units": "nm"},
+                )
             )
         )
     banded = simulate(scene.with_options(materials=pseudo)).compute()
@@ -493,7 +498,7 @@ def _write_curve(path, phi0=47.3, dm0=1.234, sigma=0.01, extra_b=0.0, seed=3, n=
 def test_light_curve_fit_recovers_injected_offsets(tmp_path):
     lc = P.read_light_curve(_write_curve(tmp_path / "lc.csv", extra_b=0.05))
     assert lc.magnitude.attrs["units"] == "1" and lc.rotation_angle.attrs["units"] == "degree"
-    res = P.compare_light_curves(lc, _sim_curve())
+    res = P.compare(lc, _sim_curve(), zero_points="common")
     # The 0.05 mag extra in B moves the common offset by about half of it and appears as the
     # B-V difference.  Unmodelled, it leaves +-0.025 mag band residuals (>> the noise) that
     # leak into the phase (bias ~0.2 deg over seeds 3-5), hence the looser phase bound here.
@@ -501,24 +506,65 @@ def test_light_curve_fit_recovers_injected_offsets(tmp_path):
     assert float(res.magnitude_offset) == pytest.approx(1.234 + 0.025, abs=0.01)
     assert float(res.colour_index_difference.sel(colour="B-V")) == pytest.approx(0.05, abs=0.005)
     assert res.degrees_of_freedom == 298
-    clean = P.compare_light_curves(
-        P.read_light_curve(_write_curve(tmp_path / "c.csv")), _sim_curve()
+    clean = P.compare(
+        P.read_light_curve(_write_curve(tmp_path / "c.csv")), _sim_curve(), zero_points="common"
     )
     # 300 points of 0.01 mag on a curve of slope ~0.8 mag/rad: sigma(phase) ~ 0.03 deg,
     # sigma(offset) ~ 0.0006 mag; bounds at ~3 sigma.  chi2/dof of 298 dof: 1 +- 0.08 (1 sigma).
     assert float(clean.phase_offset) == pytest.approx(47.3, abs=0.1)
     assert float(clean.magnitude_offset) == pytest.approx(1.234, abs=0.003)
     assert 0.75 < float(clean.reduced_chi_square) < 1.25
-    assert float(clean.magnitude_offset_uncertainty) == pytest.approx(0.01 / np.sqrt(300), rel=1e-9)
+    # the covariance of the offset and the phase against scipy's curve_fit of the same model
+    lc = P.read_light_curve(_write_curve(tmp_path / "c.csv"))
+    pars, pcov = _curve_fit_offset_and_phase(lc, float(clean.phase_offset))
+    assert float(clean.magnitude_offset) == pytest.approx(pars[0], abs=1e-7)
+    assert float(clean.phase_offset) == pytest.approx(pars[1], abs=1e-5)
+    # compare differentiates the piecewise-linear model across half a node (0.5 deg),
+    # curve_fit within one linear piece: slopes differ by the curvature over 0.5 deg,
+    # 0.1-0.2 % here; hence 5e-3
+    assert float(clean.magnitude_offset_uncertainty) == pytest.approx(np.sqrt(pcov[0, 0]), rel=5e-3)
+    assert float(clean.phase_offset_uncertainty) == pytest.approx(np.sqrt(pcov[1, 1]), rel=5e-3)
+    # the correlation with the phase makes it a little larger than 1 / sqrt(sum w)
+    assert float(clean.magnitude_offset_uncertainty) > 0.01 / np.sqrt(300)
     for v in ("residual", "phase_offset", "chi_square", "reduced_chi_square", "magnitude_offset"):
         assert clean[v].attrs["units"] and clean[v].attrs["long_name"]
+
+
+def _curve_fit_offset_and_phase(lc, phase0):
+    """Offset and phase of the _sim_curve model by scipy's curve_fit (absolute sigma)."""
+    from scipy.optimize import curve_fit
+
+    sim = _sim_curve()
+    ang = sim.attitude_angle.values
+    flux = 10.0 ** (-0.4 * sim.transpose("attitude", "band").values)
+    col = np.array([0 if b == "B" else 1 for b in lc.band.values])
+    theta = lc.rotation_angle.values
+
+    def model(_, dm, phi):
+        f = np.array(
+            [
+                np.interp(np.mod(t + phi, 360.0), ang, flux[:, c], period=360.0)
+                for t, c in zip(theta, col, strict=True)
+            ]
+        )
+        return -2.5 * np.log10(f) + dm
+
+    return curve_fit(
+        model,
+        theta,
+        lc.magnitude.values,
+        p0=(1.0, phase0),
+        sigma=lc.uncertainty.values,
+        absolute_sigma=True,
+        epsfcn=1e-10,
+    )
 
 
 def test_light_curve_without_phase_fit_is_the_weighted_mean(tmp_path):
     lc = P.read_light_curve(_write_curve(tmp_path / "lc.csv", phi0=0.0, dm0=-0.5, n=50, sigma=0.05))
     sig = np.linspace(0.01, 0.2, 50)  # unequal uncertainties: weighted != plain mean
     lc["uncertainty"] = ("obs", sig, lc.uncertainty.attrs)
-    res = P.compare_light_curves(lc, _sim_curve(0.5), fit_phase=False)
+    res = P.compare(lc, _sim_curve(0.5), fit_phase=False, zero_points="common")
     model = np.array(
         [
             _sim_at(None, b, np.array([t]))[0]
@@ -542,8 +588,8 @@ def test_light_curve_by_time_needs_a_period_and_netcdf_reads(tmp_path):
     lc = P.read_light_curve(path)
     assert lc.time.attrs["units"] == "s"
     with pytest.raises(ValidationError, match="period_s"):
-        P.compare_light_curves(lc, _sim_curve())
-    res = P.compare_light_curves(lc, _sim_curve(), period_s=600.0)
+        P.compare(lc, _sim_curve())
+    res = P.compare(lc, _sim_curve(), period_s=600.0, zero_points="common")
     assert float(res.phase_offset) == pytest.approx(47.3, abs=0.1)
     nc = tmp_path / "lc.nc"
     lc.reset_coords().rename(obs="row").to_netcdf(nc)
@@ -555,9 +601,7 @@ def test_light_curve_by_time_needs_a_period_and_netcdf_reads(tmp_path):
 def test_plot_comparison_returns_a_figure(tmp_path):
     from matplotlib.figure import Figure
 
-    res = P.compare_light_curves(
-        P.read_light_curve(_write_curve(tmp_path / "lc.csv", n=60)), _sim_curve()
-    )
+    res = P.compare(P.read_light_curve(_write_curve(tmp_path / "lc.csv", n=60)), _sim_curve())
     fig = P.plot_comparison(res)
     assert isinstance(fig, Figure) and len(fig.axes) == 2
     fig.savefig(tmp_path / "cmp.png")
@@ -569,11 +613,12 @@ def test_plot_comparison_returns_a_figure(tmp_path):
         ("rotation_angle,band,magnitude\n0,V,12.0\n", r"missing column\(s\) \['uncertainty'\]"),
         (
             "band,magnitude,uncertainty\nV,12.0,0.1\n",
-            "exactly one of the columns 'time' or 'rotation_angle'",
+            "need exactly one column of time .* or rotation_angle, found none",
         ),
         (
             "rotation_angle,band,magnitude,uncertainty\n0,V,12.0,0.1\n5,Q,12.0,0.1\n",
-            r"row 2 \(line 3 of the file\), column 'band': unknown band 'Q'",
+            r"row 2 \(line 3 of the file\), column 'band': filter 'Q': not a band the "
+            "package knows; known: U B V R I",
         ),
         (
             "rotation_angle,band,magnitude,uncertainty\n0,V,12.0,0.1\n5,V,nan,0.1\n",
@@ -584,8 +629,8 @@ def test_plot_comparison_returns_a_figure(tmp_path):
             "row 2.*'magnitude'",
         ),
         (
-            "time,band,magnitude,uncertainty\n10,V,12.0,0.1\n20,V,12.1,0.1\n15,V,12.0,0.1\n",
-            r"row 3 \(line 4 of the file\), column 'time': values must be non-decreasing",
+            "time,band,magnitude,uncertainty\n10,V,12.0,0.1\n20,H-alpha,12.1,0.1\n",
+            r"row 2 \(line 3 of the file\), column 'band': filter 'H-alpha'",
         ),
         (
             "rotation_angle,band,magnitude,uncertainty\n0,V,12.0,0\n",
@@ -610,7 +655,7 @@ def test_light_curve_iso_times_and_band_whitelist(tmp_path):
         "time,band,magnitude,uncertainty\n2024-01-01T00:00:00Z,V,12,0.1\n"
         "2024-01-01T00:01:00Z,my-band,12,0.1\n"
     )
-    with pytest.raises(ValidationError, match="unknown band 'my-band'"):
+    with pytest.raises(ValidationError, match="filter 'my-band': not a band the package knows"):
         P.read_light_curve(path)
     lc = P.read_light_curve(path, bands=["V", "my-band"])
     assert lc.time.dtype == np.dtype("datetime64[ns]")  # absolute UTC times are kept
@@ -618,8 +663,8 @@ def test_light_curve_iso_times_and_band_whitelist(tmp_path):
         lc.time.values,
         np.array(["2024-01-01T00:00:00", "2024-01-01T00:01:00"], dtype="datetime64[ns]"),
     )
-    with pytest.raises(ValidationError, match="does not have"):
-        P.compare_light_curves(lc, _sim_curve(), period_s=600.0)
+    with pytest.raises(ValidationError, match=r"measured bands \['my-band'\] are not simulated"):
+        P.compare(lc, _sim_curve(), period_s=600.0)
 
 
 def test_light_curve_fit_reports_the_half_turn_ambiguity_of_a_symmetric_body(tmp_path):
@@ -654,13 +699,13 @@ def test_light_curve_fit_reports_the_half_turn_ambiguity_of_a_symmetric_body(tmp
             "uncertainty": 0.01,
         }
     ).to_csv(path, index=False)
-    res = P.compare_light_curves(P.read_light_curve(path), sim)
+    res = P.compare(P.read_light_curve(path), sim, zero_points="common")
     best = float(res.phase_offset)
     assert min(abs(best - 20.0), abs(best - 200.0)) < 0.5
     alt = float(res.alternative_phase_offset)
     assert abs(((alt - best) % 360) - 180) < 1.0  # the other minimum is half a turn away ...
     assert float(res.alternative_delta_chi_square) < 4.0  # ... and not distinguished
-    asym = P.compare_light_curves(
-        P.read_light_curve(_write_curve(tmp_path / "a.csv")), _sim_curve()
+    asym = P.compare(
+        P.read_light_curve(_write_curve(tmp_path / "a.csv")), _sim_curve(), zero_points="common"
     )
     assert float(asym.alternative_delta_chi_square) > 100.0

@@ -115,7 +115,9 @@ def test_tables_with_units_and_absolute_utc_times(tmp_path, suffix, fmt):
     np.testing.assert_allclose(lc.range_km.values, 1000.0, rtol=1e-12)  # m -> km
     assert lc.attrs["magnitude_system"] == "Vega"
     assert lc.magnitude.attrs["ancillary_variables"] == "uncertainty"
-    res = P.compare_light_curves(lc, _sim(range_km=1000.0, system="Vega"), period_s=PERIOD_S)
+    res = P.compare(
+        lc, _sim(range_km=1000.0, system="Vega"), period_s=PERIOD_S, zero_points="common"
+    )
     # 240 points over three nights: sigma(phase) ~ 0.04 deg, sigma(offset) ~ 0.0007 mag
     assert float(res.phase_offset) == pytest.approx(PHI0, abs=0.15)
     assert float(res.magnitude_offset) == pytest.approx(DM0, abs=0.003)
@@ -138,8 +140,12 @@ def test_csv_iso_times_need_a_zone_or_a_stated_scale(tmp_path):
     off = tmp_path / "offset.csv"
     off.write_text("time,band,magnitude,uncertainty\n2024-01-01T02:00:00+02:00,V,12,0.1\n")
     assert P.read_light_curve(off).time.values[0] == np.datetime64("2024-01-01T00:00:00", "ns")
-    with pytest.raises(ValidationError, match="time_scale: only 'utc'"):
-        P.read_light_curve(path, time_scale="tai")
+    with pytest.raises(ValidationError, match="time_scale: got 'ut1'; allowed: utc, tai"):
+        P.read_light_curve(path, time_scale="ut1")
+    # a stated scale converts the zone-less times (TAI - UTC = 37 s in 2024); 'Z' stays UTC
+    tai = P.read_light_curve(path, time_scale="tai")
+    assert tai.time.values[0] == np.datetime64("2024-01-01T00:00:00", "ns")
+    assert tai.time.values[1] == np.datetime64("2024-01-01T00:00:23", "ns")
 
 
 def test_mixed_systems_missing_columns_and_bad_units_are_named(tmp_path):
@@ -193,15 +199,17 @@ def test_the_fit_uses_per_row_range_and_refuses_a_system_mismatch(tmp_path):
     tab, _, _ = _table(range_km=lambda n, rng: rng.uniform(800.0, 3000.0, n))
     tab.write(tmp_path / "r.ecsv")
     lc = P.read_light_curve(tmp_path / "r.ecsv")
-    res = P.compare_light_curves(lc, _sim(range_km=1000.0, system="Vega"), period_s=PERIOD_S)
+    res = P.compare(
+        lc, _sim(range_km=1000.0, system="Vega"), period_s=PERIOD_S, zero_points="common"
+    )
     assert float(res.magnitude_offset) == pytest.approx(
         DM0, abs=0.003
     )  # the 5 log10 d term is modelled
     assert 0.7 < float(res.reduced_chi_square) < 1.3
     with pytest.raises(ValidationError, match="in the Vega system but the simulation is in AB"):
-        P.compare_light_curves(lc, _sim(range_km=1000.0, system="AB"), period_s=PERIOD_S)
+        P.compare(lc, _sim(range_km=1000.0, system="AB"), period_s=PERIOD_S, zero_points="common")
     with pytest.raises(ValidationError, match="no range_km attribute"):
-        P.compare_light_curves(lc, _sim(system="Vega"), period_s=PERIOD_S)
+        P.compare(lc, _sim(system="Vega"), period_s=PERIOD_S, zero_points="common")
 
 
 def test_extinction_with_an_airmass_column(tmp_path):
@@ -223,9 +231,9 @@ def test_extinction_with_an_airmass_column(tmp_path):
         {"rotation_angle": theta, "band": band, "magnitude": mag, "uncertainty": 0.01, "airmass": x}
     ).to_csv(path, index=False)
     lc = P.read_light_curve(path)
-    res = P.compare_light_curves(lc, _sim(), extinction=k)
+    res = P.compare(lc, _sim(), extinction=k, zero_points="common")
     assert float(res.magnitude_offset) == pytest.approx(DM0, abs=0.004)
-    naive = P.compare_light_curves(lc, _sim())
+    naive = P.compare(lc, _sim(), zero_points="common")
     assert float(naive.reduced_chi_square) > 5 * float(res.reduced_chi_square)  # the test can tell
 
 
@@ -240,21 +248,23 @@ def test_fit_bad_inputs_get_named_errors(tmp_path):
     lc = P.read_light_curve(_small(tmp_path, 5))
     for bad in (0, -3, 2.5, True):
         with pytest.raises(ValidationError, match="n_scan: must be an integer >= 1"):
-            P.compare_light_curves(lc, _sim(), n_scan=bad)
-    assert np.isfinite(float(P.compare_light_curves(lc, _sim(), n_scan=1).chi_square))
+            P.compare(lc, _sim(), n_scan=bad, zero_points="common")
+    assert np.isfinite(float(P.compare(lc, _sim(), n_scan=1, zero_points="common").chi_square))
     one = P.read_light_curve(_small(tmp_path, 1))
     with pytest.raises(ValidationError, match=r"1 observation\(s\).*needs at least 3"):
-        P.compare_light_curves(one, _sim())
+        P.compare(one, _sim(), zero_points="common")
     with pytest.raises(ValidationError, match=r"1 observation\(s\).*needs at least 2"):
-        P.compare_light_curves(one, _sim(), fit_phase=False)
+        P.compare(one, _sim(), fit_phase=False, zero_points="common")
     two = P.read_light_curve(_small(tmp_path, 2))
-    assert int(P.compare_light_curves(two, _sim(), fit_phase=False).degrees_of_freedom) == 1
+    assert (
+        int(P.compare(two, _sim(), fit_phase=False, zero_points="common").degrees_of_freedom) == 1
+    )
     with pytest.raises(ValidationError, match=r"column 'uncertainty': must be >= 1e-06 mag"):
         P.read_light_curve(_small(tmp_path, 5, sigma="1e-300"))
     tiny = lc.copy()
     tiny["uncertainty"] = ("obs", np.full(5, 1e-300))
-    with pytest.raises(ValidationError, match="observation 0 has uncertainty 1e-300"):
-        P.compare_light_curves(tiny, _sim())
+    with pytest.raises(ValidationError, match=r"observation 0 \(row 1\) has uncertainty 1e-300"):
+        P.compare(tiny, _sim(), zero_points="common")
 
 
 def test_netcdf_round_trip_keeps_absolute_times(tmp_path):

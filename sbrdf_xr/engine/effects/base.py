@@ -15,10 +15,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ... import kernels as _kernels
 from ..._names import BAND, MATERIAL, WAVELENGTH
 from ...errors import ValidationError
 from ...kernels import anisotropic as _aniso_kernels
-from ...kernels import sums as _kernels
 
 if TYPE_CHECKING:
     import xarray as xr

@@ -1,0 +1,446 @@
+"""``sbrdf-xr observe``: a real pass from the command line, no scene file to write.
+
+Elements (a TLE or OMM file, or a catalog orbit), a site (a catalog observatory or
+latitude, longitude and height), a UTC window and step, an attitude law with its
+parameters, a spacecraft and its materials, and bands: the observation cube is
+simulated, written by :func:`sbrdf_xr.engine.run.write` and drawn with ``--plot``::
+
+    sbrdf-xr observe --elements canx1-example --site mont-megantic \\
+        --start 2024-03-17T01:20:00 --duration 300 --step 1 \\
+        --attitude spin --spin-axis 0.3,0.4,0.866 --period 90 -o pass.nc --plot pass.png
+
+The attitude laws are those of :mod:`sbrdf_xr.observing.attitude`: ``inertial``
+(``--quaternion``), ``nadir`` (``--yaw``, ``--nadir-axis``, ``--velocity-axis``),
+``sun-pointing`` (``--sun-axis``, ``--secondary-axis``, ``--secondary-target``),
+``spin`` (``--spin-axis``, ``--period`` or ``--rate``, ``--phase``, ``--initial``),
+``tumble`` (``--omega``, ``--inertia`` or ``--density`` of the mesh, ``--initial``) and
+``series`` (``--series FILE``: quaternions over time).
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from ..errors import AttitudeError, ValidationError
+
+__all__ = [
+    "add_observe_parser",
+    "attitude_of",
+    "cmd_observe",
+    "light_curve_figure",
+    "observation_of",
+]
+
+LAW_NAMES = ("inertial", "nadir", "sun-pointing", "spin", "tumble", "series")
+
+
+def _axis(text: str) -> Any:
+    """``"+z"`` or ``"0.3,0.4,0.866"`` (comma- or space-separated components)."""
+    parts = text.replace(",", " ").split()
+    if len(parts) == 3:
+        try:
+            return [float(p) for p in parts]
+        except ValueError:
+            pass
+    return text
+
+
+def add_observe_parser(sub: Any, mesh_options: Any) -> argparse.ArgumentParser:
+    """Add the ``observe`` sub-command to the sub-parsers ``sub``.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.cli.parser import build_parser
+    >>> args = build_parser().parse_args(
+    ...     ["observe", "--elements", "canx1-example", "--site", "haleakala",
+    ...      "--start", "2024-03-17T06:14:00", "--duration", "600", "-o", "pass.nc"])
+    >>> args.command, args.attitude, args.step, args.bands
+    ('observe', 'nadir', 1.0, ['V', 'R', 'I'])
+    """
+    po = sub.add_parser(
+        "observe",
+        help="simulate a real pass: elements, a site, a UTC window, an attitude law",
+        description="Simulate a real pass - elements (a TLE or OMM file, or a catalog orbit), "
+        "a site, a UTC window and step, an attitude law - and write its cube (and, with "
+        "--plot, its light curve); no scene file.",
+    )
+    g = po.add_argument_group("orbit and site")
+    g.add_argument(
+        "--elements",
+        required=True,
+        metavar="FILE|NAME",
+        help="a TLE file (2- or 3-line sets), an OMM file (.json, .xml, .csv) or "
+        "a catalog orbit ('sbrdf-xr catalog list --kind orbit')",
+    )
+    g.add_argument(
+        "--satellite",
+        metavar="NAME|NUMBER",
+        help="which satellite of an element file holding several",
+    )
+    g.add_argument(
+        "--site", metavar="NAME", help="a catalog observatory ('sbrdf-xr catalog list --kind site')"
+    )
+    g.add_argument("--lat", type=float, metavar="DEG", help="geodetic latitude [degree]")
+    g.add_argument("--lon", type=float, metavar="DEG", help="east longitude [degree]")
+    g.add_argument(
+        "--height",
+        type=float,
+        default=0.0,
+        metavar="M",
+        help="height above the WGS84 ellipsoid [m] (default 0)",
+    )
+    g.add_argument(
+        "--min-elevation",
+        type=float,
+        default=0.0,
+        metavar="DEG",
+        help="elevation below which the object counts as not observable",
+    )
+    g.add_argument(
+        "--earth",
+        choices=("wgs84", "sphere"),
+        default="wgs84",
+        help="the Earth that casts the shadow (default wgs84)",
+    )
+    w = po.add_argument_group("UTC window")
+    w.add_argument("--start", required=True, metavar="UTC", help="first time, ISO 8601 UTC")
+    w.add_argument("--stop", metavar="UTC", help="last time (or --duration)")
+    w.add_argument("--duration", type=float, metavar="S", help="length of the window [s]")
+    w.add_argument("--step", type=float, default=1.0, metavar="S", help="time step [s]")
+    a = po.add_argument_group("attitude law")
+    a.add_argument(
+        "--attitude",
+        choices=LAW_NAMES,
+        default="nadir",
+        help="the law of sbrdf_xr.observing.attitude (default nadir)",
+    )
+    a.add_argument(
+        "--quaternion",
+        type=float,
+        nargs=4,
+        metavar=("X", "Y", "Z", "W"),
+        help="inertial: body-to-GCRS quaternion, scalar last",
+    )
+    a.add_argument("--yaw", type=float, default=0.0, metavar="DEG", help="nadir: yaw [degree]")
+    a.add_argument(
+        "--nadir-axis",
+        default="+z",
+        metavar="AXIS",
+        help="nadir: body axis on the geocentre (+z, or x,y,z; a negative one as --nadir-axis=-z)",
+    )
+    a.add_argument(
+        "--velocity-axis", default="+x", metavar="AXIS", help="nadir: body axis along track"
+    )
+    a.add_argument(
+        "--sun-axis", default="+z", metavar="AXIS", help="sun-pointing: body axis on the Sun"
+    )
+    a.add_argument(
+        "--secondary-axis",
+        default="+x",
+        metavar="AXIS",
+        help="sun-pointing: body axis turned to the secondary target",
+    )
+    a.add_argument(
+        "--secondary-target",
+        default="orbit_normal",
+        metavar="orbit_normal|nadir|velocity|north",
+        help="sun-pointing: the secondary target",
+    )
+    a.add_argument("--spin-axis", default="+z", metavar="AXIS", help="spin: body axis")
+    a.add_argument("--period", type=float, metavar="S", help="spin: rotation period [s]")
+    a.add_argument("--rate", type=float, metavar="DEG_S", help="spin: rate [degree s-1]")
+    a.add_argument(
+        "--phase", type=float, default=0.0, metavar="DEG", help="spin: angle at the epoch [degree]"
+    )
+    a.add_argument(
+        "--initial",
+        metavar="LAW|X,Y,Z,W",
+        help="spin, tumble: the attitude at angle 0: a quaternion, or (spin) "
+        "'nadir' or 'sun-pointing' to spin about a pointing law",
+    )
+    a.add_argument("--epoch", metavar="UTC", help="spin, tumble: time of --phase / --initial")
+    a.add_argument(
+        "--omega",
+        type=float,
+        nargs=3,
+        metavar=("WX", "WY", "WZ"),
+        help="tumble: initial body rates [degree s-1]",
+    )
+    a.add_argument(
+        "--inertia",
+        type=float,
+        nargs=3,
+        metavar=("IXX", "IYY", "IZZ"),
+        help="tumble: principal moments [kg m2] (or --density)",
+    )
+    a.add_argument(
+        "--density",
+        type=float,
+        metavar="KG_M3",
+        help="tumble: inertia of the mesh filled at this uniform density",
+    )
+    a.add_argument("--series", metavar="FILE", help="series: quaternions over time (.csv, .nc)")
+    s = po.add_argument_group("spacecraft and output")
+    s.add_argument(
+        "--spacecraft",
+        default="canx1",
+        metavar="NAME|MESH",
+        help="a catalog spacecraft (default canx1) or a mesh file",
+    )
+    mesh_options(s)
+    s.add_argument(
+        "--material",
+        action="append",
+        metavar="MATERIAL=NAME|FILE.nc",
+        help="the table of a material: a catalog name or a netCDF file (repeatable)",
+    )
+    s.add_argument(
+        "--bands",
+        nargs="+",
+        default=["V", "R", "I"],
+        help="bands of the band signal (default V R I); 'none' for spectra only",
+    )
+    s.add_argument("--name", help="name of the observation (default: satellite at site)")
+    s.add_argument("-o", "--output", required=True, help="cube file to write (.nc or .zarr)")
+    s.add_argument("--plot", metavar="FIG.png", help="also write the light-curve figure")
+    s.add_argument("--overwrite", action="store_true", help="replace an existing output file")
+    s.add_argument("--plan", action="store_true", help="print the plan and stop")
+    s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    po.set_defaults(func=cmd_observe)
+    return po
+
+
+def _quaternion(text: str, what: str) -> list[float]:
+    parts = text.replace(",", " ").split()
+    try:
+        q = [float(p) for p in parts]
+    except ValueError:
+        q = []
+    if len(q) != 4:
+        raise AttitudeError(f"{what}: got {text!r}; expected a quaternion x,y,z,w")
+    return q
+
+
+def attitude_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
+    """The attitude law of the ``observe`` options.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.cli.parser import build_parser
+    >>> base = ["observe", "--elements", "canx1-example", "--site", "haleakala",
+    ...         "--start", "2024-03-17T06:14:00", "--duration", "60", "-o", "p.nc"]
+    >>> args = build_parser().parse_args([*base, "--attitude", "spin", "--period", "90",
+    ...                                   "--spin-axis", "0,0,1", "--initial", "nadir"])
+    >>> law = attitude_of(args)
+    >>> type(law).__name__, law.rate_deg_s, type(law.initial).__name__
+    ('Spin', 4.0, 'Nadir')
+    >>> attitude_of(build_parser().parse_args([*base, "--attitude", "spin"]))
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.AttitudeError: --attitude spin: give --period S or --rate DEG_S
+    """
+    from .. import observing as law
+
+    kind = args.attitude
+    if kind == "inertial":
+        if args.quaternion is None:
+            raise AttitudeError("--attitude inertial: give --quaternion X Y Z W")
+        return law.Inertial(tuple(args.quaternion))
+    if kind == "nadir":
+        return law.Nadir(args.yaw, _axis(args.nadir_axis), _axis(args.velocity_axis))
+    if kind == "sun-pointing":
+        target = args.secondary_target
+        return law.SunPointing(
+            _axis(args.sun_axis),
+            _axis(args.secondary_axis),
+            target if target in ("orbit_normal", "nadir", "velocity", "north") else _axis(target),
+        )
+    if kind == "series":
+        if not args.series:
+            raise AttitudeError("--attitude series: give --series FILE (.csv or .nc)")
+        return law.law_from_dict({"law": "quaternion_series", "path": args.series})
+    initial: Any = (0.0, 0.0, 0.0, 1.0)
+    if args.initial:
+        if kind == "spin" and args.initial in ("nadir", "sun-pointing"):
+            initial = law.Nadir() if args.initial == "nadir" else law.SunPointing()
+        else:
+            initial = _quaternion(args.initial, "--initial")
+    if kind == "spin":
+        if (args.period is None) == (args.rate is None):
+            raise AttitudeError("--attitude spin: give --period S or --rate DEG_S")
+        if args.period is not None and not args.period > 0:
+            raise AttitudeError(f"--period: must be > 0 s, got {args.period}")
+        rate = args.rate if args.rate is not None else 360.0 / args.period
+        return law.Spin(_axis(args.spin_axis), rate, args.phase, initial, args.epoch)
+    if args.omega is None:
+        raise AttitudeError("--attitude tumble: give --omega WX WY WZ [degree s-1]")
+    if (args.inertia is None) == (args.density is None):
+        raise AttitudeError("--attitude tumble: give --inertia IXX IYY IZZ or --density KG_M3")
+    if args.inertia is not None:
+        return law.Tumble(tuple(args.inertia), tuple(args.omega), initial, args.epoch)
+    return law.Tumble.from_spacecraft(
+        spacecraft, args.density, tuple(args.omega), initial, args.epoch
+    )
+
+
+def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
+    """The :class:`~sbrdf_xr.observing.observation.Observation` of the ``observe`` options.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.cli.parser import build_parser
+    >>> args = build_parser().parse_args(
+    ...     ["observe", "--elements", "canx1-example", "--lat", "20.7", "--lon", "-156.26",
+    ...      "--height", "3050", "--start", "2024-03-17T06:14:00", "--duration", "60",
+    ...      "--step", "30", "-o", "p.nc"])
+    >>> obs = observation_of(args)
+    >>> obs.times.size, obs.site.height_m, type(obs.attitude).__name__
+    (3, 3050.0, 'Nadir')
+    """
+    import numpy as np
+
+    from ..observing.observe import Observation, Orbit, Site, times, to_datetime64
+
+    spec = args.elements
+    if Path(spec).is_file():
+        orbit = Orbit.from_file(spec, args.satellite)
+    else:
+        if args.satellite:
+            raise ValidationError("--satellite picks from an element file; --elements is a name")
+        orbit = Orbit.from_catalog(spec)
+    latlon = [args.lat is not None, args.lon is not None]
+    if args.site is not None and any(latlon):
+        raise ValidationError("give --site NAME or --lat/--lon/--height, not both")
+    if args.site is not None:
+        site = Site.from_catalog(args.site)
+    elif all(latlon):
+        site = Site(args.lat, args.lon, args.height, name=f"{args.lat:g}, {args.lon:g}")
+    else:
+        raise ValidationError("give --site NAME (a catalog observatory) or both --lat and --lon")
+    if (args.stop is None) == (args.duration is None):
+        raise ValidationError("give --stop UTC or --duration S (the end of the window)")
+    start = to_datetime64(args.start, "--start")
+    if args.duration is not None:
+        if not args.duration > 0:
+            raise ValidationError(f"--duration: must be > 0 s, got {args.duration}")
+        stop = start + np.timedelta64(round(args.duration * 1e9), "ns")
+    else:
+        stop = to_datetime64(args.stop, "--stop")
+    return Observation(
+        orbit,
+        site,
+        times(start, stop, args.step),
+        attitude_of(args, spacecraft),
+        min_elevation_deg=args.min_elevation,
+        name=args.name or f"{orbit.name} from {site.name}",
+        earth=args.earth,
+    )
+
+
+def cmd_observe(args: argparse.Namespace) -> int:
+    """``sbrdf-xr observe``: simulate a pass and write its cube (and figure); returns 0.
+
+    Examples
+    --------
+    A site where the object is below the horizon for the whole window is refused, with
+    the time it next rises:
+
+    >>> from sbrdf_xr.cli import main
+    >>> main(["observe", "--elements", "canx1-example", "--site", "haleakala",
+    ...       "--start", "2024-03-17T01:20:00", "--duration", "300", "-o", "p.nc",
+    ...       "--plan"])  # doctest: +SKIP
+    sbrdf-xr: error: ... below 0 deg elevation at every time ...; it next rises above 0 deg
+    at 2024-03-17T06:13:16 UTC ...
+    2
+    """
+    from ..engine import Scene
+    from ..engine.run import simulate, write
+    from .commands import _save_figure, _with_body, spacecraft_of
+
+    body = spacecraft_of(args)
+    obs = observation_of(args, body)
+    bands = () if [b.lower() for b in args.bands] == ["none"] else tuple(args.bands)
+    outputs = ("spacecraft_sbrdf", "signal", "brdf", "area") + (("band_signal",) if bands else ())
+    scene = Scene(
+        body,
+        observation=obs,
+        outputs=outputs,
+        bands=bands,
+        name=obs.name,
+        description=f"sbrdf-xr observe: {obs!r}",
+    )
+    if args.material:  # the tables of --material for the body already loaded
+        keep = {"spacecraft": None, "mesh_material": None, "material_map": None}
+        scene = _with_body(scene, argparse.Namespace(**{**vars(args), **keep, "length_unit": None}))
+    plan = scene.plan()
+    print(plan)
+    if args.plan:
+        return 0
+    path = write(
+        simulate(plan), Path(args.output), overwrite=args.overwrite, progress=not args.quiet
+    )
+    print(f"wrote {path}")
+    if args.plot and bands:
+        light_curve_figure(path, bands).savefig(args.plot, dpi=110)
+        print(f"wrote {args.plot}")
+    elif args.plot:
+        _save_figure(path, args.plot)
+    return 0
+
+
+def light_curve_figure(cube_path: str | Path, bands: tuple[str, ...]) -> Any:
+    """The light curve of a pass cube: magnitudes against UTC (the Earth's umbra and
+    penumbra shaded) above the elevation.
+
+    Examples
+    --------
+    >>> callable(light_curve_figure)  # drawn by 'sbrdf-xr observe --plot'; see its tests
+    True
+    """
+    import matplotlib.dates as mdates
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    from ..photometry import magnitudes
+    from .output import open_cube
+
+    cube = open_cube(cube_path)
+    mags = magnitudes(cube, list(bands))
+    t = cube.time.values
+    fig = Figure(figsize=(9, 5.5), layout="constrained")
+    ax, el = fig.subplots(2, 1, sharex=True, height_ratios=(3, 1))
+    f = cube.sunlit_fraction.values
+    for a in (ax, el):
+        for where, colour, label in (
+            (f == 0, "0.85", "umbra"),
+            ((f > 0) & (f < 1), "khaki", "penumbra"),
+        ):
+            if where.any():
+                a.fill_between(
+                    t,
+                    0,
+                    1,
+                    where=where,
+                    transform=a.get_xaxis_transform(),
+                    color=colour,
+                    label=label if a is ax else None,
+                )
+    for b in mags.band.values:
+        m = mags.sel(band=b).values
+        ax.plot(t, np.where(np.isfinite(m), m, np.nan), lw=1, label=str(b))
+    ax.invert_yaxis()
+    ax.set_ylabel(f"{mags.attrs.get('magnitude_system', 'AB')} magnitude")
+    law = str(cube.attrs.get("attitude_law", "")).split("(")[0]
+    ax.set_title(
+        f"{cube.attrs.get('orbit_name', '')} from {cube.attrs.get('site_name', '')}, "
+        f"attitude {law}, {t.size} times",
+        fontsize=10,
+    )
+    ax.legend(fontsize=8, ncol=6, loc="best")
+    el.plot(t, cube.elevation, color="k", lw=1)
+    el.set_ylabel("elevation [degree]")
+    el.set_xlabel(f"UTC ({str(t[0])[:10]})")
+    el.xaxis.set_major_formatter(mdates.DateFormatter("%H:%M:%S"))
+    return fig
