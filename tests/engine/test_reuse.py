@@ -184,3 +184,11 @@ def test_what_is_kept_is_bounded_and_let_go():
     del first, table
     gc.collect()
     assert gone() is None  # no memo holds the first table's memory any more
+
+
+def test_phase_angles_changed_in_place_before_planning_are_used():
+    beta = np.array([20.0, 60.0])
+    scene = box_scene(read_only(lambertian(0.5, WL, material="grey")), phase_angles=beta)
+    beta[0] = 40.0  # the scene holds this array: its plane, kept when checked, is stale
+    cube = simulate(scene)
+    np.testing.assert_allclose(cube.signal[0, :, 0], closed_form([40.0, 60.0], 0.5), rtol=RTOL)
