@@ -18,6 +18,9 @@ Modules
     meaning, and the reference rendered from them) and the built-in scenes.
 ``plan``, ``stages`` and ``spectral``
     The plan and its stages.
+``reuse``
+    What a plan computes from the tables, the spacecraft and the knobs alone (packed
+    tables, merged facets), kept by content for the next plans.
 ``run``
     Executing a plan: blocks of geometries through the kernel into an xarray cube
     (:func:`simulate`; :func:`sbrdf_xr.store.write` writes it).
@@ -29,6 +32,7 @@ from . import (
     effects,
     knobs,
     plan,
+    reuse,
     run,
     scene,
     scene_file,
@@ -91,6 +95,7 @@ __all__ = [
     "plan",
     "reflected",
     "resolve_scene",
+    "reuse",
     "run",
     "run_block",
     "scene",

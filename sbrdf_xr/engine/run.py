@@ -43,6 +43,7 @@ import os
 import threading
 import uuid
 from concurrent.futures import ThreadPoolExecutor
+from functools import partial
 from typing import Any
 
 import dask.array as dsa
@@ -50,12 +51,14 @@ import numpy as np
 import xarray as xr
 from dask.highlevelgraph import HighLevelGraph
 from dask.typing import Key
+from xarray.indexes import PandasIndex
 
 from .._names import WAVELENGTH, attrs
 from ..errors import SceneError
 from .builtin import resolve_scene
 from .effects import EFFECTS, finish
 from .plan import Plan
+from .reuse import INDEXES
 from .scene import Scene
 
 __all__ = ["IN_PROCESS_BYTES", "run_block", "simulate"]
@@ -209,8 +212,49 @@ def _template(plan: Plan) -> xr.Dataset:
         coords.update(plan.band_coords)
     if "material" in dims:
         coords["material"] = ("material", list(plan.materials), attrs("material"))
-    plan.cache["template"] = xr.Dataset(coords=coords, attrs=dict(plan.attrs))
+    plan.cache["template"] = _coordinates_only(coords, dict(plan.attrs))
     return plan.cache["template"]
+
+
+def _coordinates_only(coords: dict[str, Any], attributes: dict[str, Any]) -> xr.Dataset:
+    """``xr.Dataset(coords=coords, attrs=attributes)`` built directly: a default (pandas)
+    index for each dimension coordinate, no alignment or merging (the coordinates come
+    from one geometry and agree by construction), in the same order."""
+    arrays = [c.coords for c in coords.values() if isinstance(c, xr.DataArray)]
+    if any(k not in coords for a in arrays for k in a):  # coordinates that come with them
+        return xr.Dataset(coords=coords, attrs=attributes)
+    variables: dict[str, xr.Variable] = {}
+    indexes: dict[str, Any] = {}
+    # xarray puts the coordinates of DataArray-valued entries first
+    for name in dict.fromkeys([*(str(k) for a in arrays for k in a), *coords]):
+        spec = coords[name]
+        if isinstance(spec, xr.DataArray):
+            var = spec.variable
+        else:
+            var = xr.as_variable(spec, name=name, auto_convert=False)
+        if var.dims == (name,):
+            index = INDEXES.get(_index_key(name, var), partial(_pandas_index, name, var))
+            indexes[name] = index
+            var = index.create_variables({name: var})[name]
+        variables[name] = var
+    return xr.Dataset._construct_direct(variables, set(variables), None, attributes, indexes)
+
+
+def _pandas_index(name: str, var: xr.Variable) -> PandasIndex:
+    """A default index over a copy of ``var``'s values (kept: it must own its memory)."""
+    return PandasIndex.from_variables({name: var.copy(deep=True)}, options={})
+
+
+#: Largest dimension coordinate whose index is kept for later cubes (:data:`INDEXES`).
+_INDEX_KEEP_SIZE = 4096
+
+
+def _index_key(name: str, var: xr.Variable) -> tuple | None:
+    """The content of a small numeric or string dimension coordinate (None: not kept)."""
+    values = var.values
+    if values.size > _INDEX_KEEP_SIZE or values.dtype.kind not in "biufcmMUS":
+        return None
+    return (name, var.dims, values.dtype.str, values.shape, values.tobytes())
 
 
 def _dataset(plan: Plan, arrays: dict[str, Any]) -> xr.Dataset:
