@@ -61,8 +61,15 @@ def make_special(p: Path, kind: str) -> object:
         target = p.with_name(p.name + ".target")
         target.write_bytes(b"someone else's file")
         p.symlink_to(target)
+    elif kind == "symlink-to-dir":
+        target = p.with_name(p.name + ".target")
+        target.mkdir()
+        (target / "kept.txt").write_text("a user's file")
+        p.symlink_to(target, target_is_directory=True)
     elif kind == "dangling-symlink":
         p.symlink_to(p.with_name("nowhere"))
+    elif kind == "devnull-symlink":
+        p.symlink_to("/dev/null")
     elif kind == "char-device":
         try:
             os.mknod(p, 0o600 | stat.S_IFCHR, os.makedev(1, 3))  # like /dev/null
@@ -85,7 +92,16 @@ def make_special(p: Path, kind: str) -> object:
     return None
 
 
-KINDS = ["fifo", "symlink", "dangling-symlink", "char-device", "socket", "directory"]
+KINDS = [
+    "fifo",
+    "symlink",
+    "symlink-to-dir",
+    "dangling-symlink",
+    "char-device",
+    "devnull-symlink",
+    "socket",
+    "directory",
+]
 
 
 def snapshot(d: Path) -> list[tuple[str, int, bytes | None]]:

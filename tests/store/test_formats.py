@@ -3,11 +3,14 @@ refusing every kind of special file at its output and at its siblings.
 
 Each entry of :data:`~sbrdf_xr.store.formats.FORMATS` is called with ``overwrite`` false
 and true on an output path (or a sibling: ``.part``, ``.part.jsonl``, ``.lock``) that
-holds a FIFO, a symbolic link, a dangling symbolic link, a character device, a socket or
-a directory (a foreign directory, for a Zarr store): the write must be refused with an
-:class:`~sbrdf_xr.errors.OutputError` naming the path, without blocking and without
-changing anything on disk.  The command line's ``photometry -o/--csv`` and ``invert -o``
-are tried the same way.  A table of the outcomes is printed at the end of the module.
+holds a FIFO, a symbolic link (to a file, to a directory, dangling, to ``/dev/null``), a
+character device, a socket or a directory (a foreign directory, for a Zarr store): the
+write must be refused with an :class:`~sbrdf_xr.errors.OutputError` naming the path,
+without blocking and without changing anything on disk.  A foreign directory at
+``<output>.part`` is refused by the cube writers and left alone by the others.  The
+command line's outputs (``simulate -o/--plot``, ``observe -o/--plot``, ``photometry
+-o/--csv``, ``invert -o``, ``bench -o/--csv/--plot``, ``plot -o``) and the table cache
+are tried the same way.  A table of writers x kinds is printed at the end of the module.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ from __future__ import annotations
 import contextlib
 import os
 import sys
+import warnings
 from collections import Counter
 from pathlib import Path
 
@@ -22,6 +26,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
+from sbrdf_xr._output import file_kind
 from sbrdf_xr.errors import OutputError, ValidationError
 from sbrdf_xr.store import formats
 from sbrdf_xr.store.formats import FORMATS, format_for
@@ -31,18 +36,52 @@ sys.path[:0] = [str(HERE), str(HERE.parent)]
 from test_output import KINDS, make_special, no_hang  # noqa: E402
 from test_writer import make_cube  # noqa: E402
 
-#: (writer, where) -> Counter of outcomes ("refused", "hang", "changed", "replaced").
-OUTCOMES: dict[tuple[str, str], Counter] = {}
+#: (writer, where, kind) -> Counter of outcomes: "refused" (an OutputError naming the
+#: path, nothing on disk changed), "written" (the output written beside an untouched
+#: foreign directory), or a failure ("hang", "changed", "replaced", "named another path").
+OUTCOMES: dict[tuple[str, str, str], Counter] = {}
+#: A directory without the package's marker at ``<output>.part``.
+FOREIGN_PART = "foreign-part-dir"
 
 
 @pytest.fixture(scope="module", autouse=True)
 def special_file_table(request):
+    """Print writers x kinds of special file after the module: in each cell the trials
+    whose outcome was the safe one (R: refused by name, nothing changed; W: written,
+    the foreign directory left as it was) over all trials of the cell."""
     yield
-    lines = [f"{'special files':<34}{'where':<14}{'refused':>9}{'total':>7}"]
-    for (writer, where), c in sorted(OUTCOMES.items()):
-        lines.append(f"{writer:<34}{where:<14}{c['refused']:>9}{sum(c.values()):>7}")
-    total = sum((c for c in OUTCOMES.values()), Counter())
-    lines.append(f"{'all':<34}{'':<14}{total['refused']:>9}{sum(total.values()):>7}")
+    kinds = [*KINDS, FOREIGN_PART]
+    rows = sorted({(w, where) for w, where, _ in OUTCOMES})
+    short = {  # column heads
+        "symlink": "link>file",
+        "symlink-to-dir": "link>dir",
+        "dangling-symlink": "dangling",
+        "char-device": "chardev",
+        "devnull-symlink": "link>null",
+        "directory": "dir",
+        FOREIGN_PART: "alien.part",
+    }
+    head = f"{'special files: writer':<30}{'where':<12}" + "".join(
+        f"{short.get(k, k):>11}" for k in kinds
+    )
+    lines = [head]
+    total = Counter()
+    for writer, where in rows:
+        cells = []
+        for k in kinds:
+            c = OUTCOMES.get((writer, where, k))
+            if not c:
+                cells.append(f"{'-':>11}")
+                continue
+            total += c
+            good, tag = (c["written"], "W") if c["written"] else (c["refused"], "R")
+            cells.append(f"{f'{tag} {good}/{sum(c.values())}':>11}")
+        lines.append(f"{writer:<30}{where:<12}" + "".join(cells))
+    bad = sum(total.values()) - total["refused"] - total["written"]
+    lines.append(
+        f"all: {total['refused']} refused, {total['written']} written beside a foreign "
+        f"directory, {bad} other (hang, changed, replaced) of {sum(total.values())} trials"
+    )
     reporter = request.config.pluginmanager.get_plugin("terminalreporter")
     capman = request.config.pluginmanager.getplugin("capturemanager")
     with capman.global_and_fixture_disabled() if capman else contextlib.nullcontext():
@@ -157,16 +196,117 @@ def test_every_writer_refuses_every_special_file(tmp_path, name, where, kind, ov
             plt.close(obj)
     if outcome == "refused" and tree(tmp_path) != before:
         outcome = "changed"
-    OUTCOMES.setdefault((name, where), Counter())[outcome] += 1
+    OUTCOMES.setdefault((name, where, kind), Counter())[outcome] += 1
     assert outcome == "refused"
 
 
+@pytest.mark.parametrize("overwrite", [False, True])
+@pytest.mark.parametrize("name", list(OBJECTS))
+def test_a_foreign_part_directory_beside_every_output(tmp_path, name, overwrite):
+    """A directory the package did not write at ``<output>.part``: the cube writers, whose
+    ``.part`` it is, refuse it by name; the others write through a temporary file of
+    their own and leave it as it is.  Nothing of it is ever deleted."""
+    factory, filename = OBJECTS[name]
+    obj = factory()
+    out = tmp_path / filename
+    part = out.with_name(out.name + ".part")
+    part.mkdir()
+    (part / "kept.txt").write_text("a user's file")
+    before = tree(part)
+    outcome = "replaced"
+    try:
+        with no_hang():
+            FORMATS[name].writer(obj, out, overwrite=overwrite)
+        outcome = "written" if file_kind(out) is not None else "nothing written"
+    except OutputError as exc:
+        outcome = "refused" if str(part) in str(exc) else "named another path"
+    except TimeoutError:
+        outcome = "hang"
+    finally:
+        if name == "figure":
+            import matplotlib.pyplot as plt
+
+            plt.close(obj)
+    if tree(part) != before:
+        outcome = "changed"
+    OUTCOMES.setdefault((name, "output", FOREIGN_PART), Counter())[outcome] += 1
+    assert outcome == ("refused" if FORMATS[name].kind == "cube" else "written"), outcome
+    if outcome == "written":
+        names = sorted(p.name for p in tmp_path.iterdir())
+        assert names == sorted([out.name, part.name]), names  # no temporary file left
+
+
+@pytest.mark.parametrize("kind", [*KINDS, FOREIGN_PART])
+def test_the_table_cache_never_writes_through_a_special_file(tmp_path, monkeypatch, kind):
+    """A special file at a table's cache file: the table is built and returned, with a
+    CacheWarning naming the file, and the special file is left as it is."""
+    from sbrdf_xr import _cache
+    from sbrdf_xr.errors import CacheWarning
+    from sbrdf_xr.materials import tables
+
+    monkeypatch.setenv("SBRDF_XR_CACHE_DIR", str(tmp_path))
+    built = material()
+    path = _cache.cache_file("grey", [], "()")
+    target = path.with_name(path.name + ".part") if kind == FOREIGN_PART else path
+    if kind == FOREIGN_PART:
+        target.mkdir()
+        (target / "kept.txt").write_text("a user's file")
+        keep = None
+    else:
+        keep = make_special(target, kind)
+    before = tree(target if kind == FOREIGN_PART else tmp_path)
+
+    def write(da, p):
+        tables.to_netcdf(da, p, overwrite=True, complevel=0)
+
+    with no_hang(), warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        got = _cache.cached_table("grey", [], "()", lambda: built, write, tables.open_material)
+    del keep
+    warned = [str(w.message) for w in caught if issubclass(w.category, CacheWarning)]
+    if kind == FOREIGN_PART:  # not the cache's name: the table is cached beside it
+        ok = file_kind(path) == "file" and not warned and tree(target) == before
+        outcome = "written" if ok else "changed"
+    else:
+        ok = len(warned) == 1 and str(path) in warned[0] and tree(tmp_path) == before
+        outcome = "refused" if ok else "changed"
+    assert np.array_equal(got.values, built.values)
+    OUTCOMES.setdefault(("table-cache", "output", kind), Counter())[outcome] += 1
+    assert ok, (warned, kind)
+
+
 CLI_OUTPUTS = [
+    ("simulate", "-o", "cube.nc"),
+    ("simulate", "-o", "cube.zarr"),
+    ("simulate", "--plot", "fig.png"),
+    ("observe", "-o", "pass.nc"),
+    ("observe", "--plot", "pass.png"),
     ("photometry", "-o", "phot.nc"),
     ("photometry", "--csv", "phot.csv"),
     ("invert", "-o", "fit.nc"),
-    ("simulate", "--plot", "fig.png"),
+    ("bench", "-o", "bench.nc"),
+    ("bench", "--csv", "bench.csv"),
+    ("bench", "--plot", "front.png"),
     ("plot", "-o", "fig.png"),
+]
+#: Commands that take minutes to run through (their refusals come first, in moments).
+LONG_COMMANDS = ("simulate", "bench")
+#: A short pass (5 times) for ``sbrdf-xr observe``.
+OBSERVE = [
+    "observe",
+    "--elements",
+    "canx1-example",
+    "--site",
+    "socorro-ets",
+    "--start",
+    "2024-03-17T03:02:20",
+    "--duration",
+    "20",
+    "--step",
+    "5",
+    "--bands",
+    "V",
+    "-q",
 ]
 
 
@@ -216,8 +356,16 @@ def cli_argv(command: str, flag: str, out: Path, d: Path, cube: Path) -> list[st
             flag,
             str(out),
         ]
+    if command == "simulate" and flag == "-o":
+        return ["simulate", "canx1-rotation", "-o", str(out), "-q"]
     if command == "simulate":
         return ["simulate", "canx1-rotation", "-o", str(out.with_name("c.nc")), flag, str(out)]
+    if command == "observe" and flag == "-o":
+        return [*OBSERVE, "-o", str(out)]
+    if command == "observe":
+        return [*OBSERVE, "-o", str(out.with_name("c.nc")), flag, str(out)]
+    if command == "bench":
+        return ["bench", "--quick", flag, str(out)]
     return ["plot", str(cube), flag, str(out)]
 
 
@@ -239,7 +387,8 @@ def test_command_line_outputs_refuse_special_files(
     del keep
     refused = status == 2 and len(err) == 1 and str(out) in err[0] and tree(tmp_path) == before
     outcome = "refused" if refused else "replaced"
-    OUTCOMES.setdefault((f"sbrdf-xr {command} {flag}", "output"), Counter())[outcome] += 1
+    writer = f"cli {command} {flag} {Path(filename).suffix}"
+    OUTCOMES.setdefault((writer, "output", kind), Counter())[outcome] += 1
     assert refused, (status, err)
 
 
@@ -261,7 +410,7 @@ def test_command_line_outputs_are_written_and_replaced_only_when_asked(
 
     d, cube = analysis_files
     for command, flag, filename in CLI_OUTPUTS:
-        if command == "simulate":
+        if command in LONG_COMMANDS:
             continue
         out = tmp_path / filename
         argv = cli_argv(command, flag, out, d, cube)
