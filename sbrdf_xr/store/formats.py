@@ -37,7 +37,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from .._output import atomic_file, check_output, refuse_special
+from .._output import atomic_file, check_output, file_kind, option, refuse_special
 from ..errors import CubeWriteError, OutputError, ValidationError
 from .files import LOG_SUFFIX, PART_SUFFIX, read_log
 from .files import check_destination as cube_destination
@@ -436,7 +436,30 @@ def check(
         fmt.destination(p, overwrite, resume)
     else:
         check_output(p, overwrite=overwrite)
+    if resume and not overwrite:
+        _resume_keeps_the_format(p, fmt)
     return fmt
+
+
+def _resume_keeps_the_format(path: Path, fmt: Format) -> None:
+    """Refuse a resume of ``path`` that has nothing to resume while the same cube in
+    another format (the same name, another suffix) is unfinished: a resume keeps the
+    format it was started in, so the change is named instead of starting afresh."""
+    if fmt.unfinished is None or file_kind(path) is not None or fmt.unfinished(path):
+        return
+    for other in FORMATS.values():
+        if other.kind != fmt.kind or other is fmt or other.unfinished is None:
+            continue
+        for suffix in other.suffixes:
+            candidate = path.with_name((path.stem if path.suffix else path.name) + suffix)
+            kept = other.unfinished(candidate)
+            if kept:
+                raise CubeWriteError(
+                    f"{path}: nothing to resume, but the {other.label} cube {candidate} is "
+                    f"unfinished ({kept}); a resume keeps the format it was started in. "
+                    f"Resume {candidate} instead, or write {path} afresh without "
+                    f"{option('resume')}"
+                )
 
 
 def write(obj: Any, path: str | os.PathLike[str], *, kind: str = "cube", **options: Any) -> Path:

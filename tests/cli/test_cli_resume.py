@@ -3,8 +3,9 @@
 A run is interrupted (``KeyboardInterrupt`` from the block callback, as Ctrl-C would)
 after two of five blocks; the command line's ``--resume`` then prints what the ``.part``
 keeps (blocks, complevel, chunks) and finishes the cube, or refuses a resume whose
-complevel, chunking or format differ from the ``.part``'s, in one line that names the
-difference, leaving the ``.part`` as it was.
+complevel, chunking or format differ from the ``.part``'s (a ``.part`` of the other
+format under the name, or the cube unfinished under the other format's suffix), in one
+line that names the difference, leaving the ``.part`` as it was.
 """
 
 from __future__ import annotations
@@ -124,3 +125,27 @@ def test_resume_refuses_the_part_of_another_format(tmp_path, scene, capsys):
         err = capsys.readouterr().err
         assert "cube.zarr.part is a regular file, not a directory" in err, err
     assert (tmp_path / "cube.zarr.part").is_file()
+
+
+@pytest.mark.parametrize(("started", "resumed"), [(".nc", ".zarr"), (".zarr", ".nc")])
+def test_resume_in_another_format_names_the_unfinished_cube(
+    tmp_path, scene, capsys, started, resumed
+):
+    """``--resume`` under the other format's suffix, with the cube unfinished in the
+    format it was started in: refused in one line naming that cube, nothing written."""
+    pytest.importorskip("zarr")
+    first = tmp_path / f"cube{started}"
+    interrupted(scene, first, complevel=2)
+    part = first.with_name(first.name + PART_SUFFIX)
+    before = snapshot(part)
+    listing = sorted(p.name for p in tmp_path.iterdir())
+    out = tmp_path / f"cube{resumed}"
+    assert main(["simulate", str(scene), "-o", str(out), "--resume", "-q"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"the {'netCDF' if started == '.nc' else 'Zarr'} cube" in err[0]
+    assert f"{first} is unfinished ({part}: " in err[0], err
+    assert "a resume keeps the format it was started in" in err[0]
+    assert snapshot(part) == before and sorted(p.name for p in tmp_path.iterdir()) == listing
+    # without --resume the other format is written afresh, the unfinished cube kept
+    assert main(["simulate", str(scene), "-o", str(out), "-q"]) == 0
+    assert out.exists() and snapshot(part) == before
