@@ -91,7 +91,8 @@ def sweep_job(
     ['blocks', 'rss', 'seconds']
     """
 
-    from ..engine.run import default_n_threads, run_block, simulate, write
+    from ..engine.run import default_n_threads, run_block, simulate
+    from ..store import write
 
     scene = _sweep_scene(n, bands)
     plan = scene.plan()

@@ -7,10 +7,10 @@ few threads (the compiled kernel releases the GIL), without building a Dask grap
 the cube comes back numpy-backed.  Larger ones, or any call with ``chunk``,
 ``lazy=True`` or a ``client``, return a *lazy* cube: one Dask task per block, built
 directly (the plan enters the graph once), chunked over the first geometry
-dimension with the spectral dimension whole.  :func:`write` streams a cube to
-netCDF block by block (atomic, resumable; see :mod:`sbrdf_xr.store.writer`), or to a
-Zarr store whose blocks the Dask workers write themselves.  This module and the
-writer are the only ones that know about Dask scheduling.
+dimension with the spectral dimension whole.  :func:`sbrdf_xr.store.write` writes a
+cube (netCDF block by block, or a Zarr store whose blocks the Dask workers store
+themselves; atomic, resumable).  This module and the writers are the only ones that
+know about Dask scheduling.
 
 The cube (DESIGN.md data model)
 -------------------------------
@@ -44,7 +44,6 @@ import threading
 import uuid
 from concurrent.futures import ThreadPoolExecutor
 from functools import partial
-from pathlib import Path
 from typing import Any
 
 import dask.array as dsa
@@ -56,14 +55,13 @@ from xarray.indexes import PandasIndex
 
 from .._names import WAVELENGTH, attrs
 from ..errors import SceneError
-from ..store.writer import write_cube
 from .builtin import resolve_scene
 from .effects import EFFECTS, finish
 from .plan import Plan
 from .reuse import INDEXES
 from .scene import Scene
 
-__all__ = ["IN_PROCESS_BYTES", "run_block", "simulate", "write"]
+__all__ = ["IN_PROCESS_BYTES", "run_block", "simulate"]
 
 #: Scenes whose outputs are smaller than this [byte] run in-process, without Dask
 #: (unless ``chunk``, ``lazy=True`` or a client is given).
@@ -378,107 +376,3 @@ def simulate(
             )
         arrays = _in_process(the_plan)
     return _dataset(the_plan, arrays)
-
-
-def write(cube: xr.Dataset, path: str | os.PathLike[str], **kwargs: Any) -> Path:
-    """Write a cube: netCDF block by block, or a Zarr store for a path ending in ``.zarr``.
-
-    netCDF (the default): :func:`sbrdf_xr.store.writer.write_cube` (atomic, resumable, the
-    calling process writes; see it for the keyword arguments).  Zarr: every block is
-    computed *and written* by the Dask worker (or thread) that computes it, so adding
-    workers to a cluster speeds the whole sweep up; the store is written as
-    ``<path>.part`` and renamed when complete (keywords ``overwrite``, ``client``,
-    ``progress``).
-
-    Returns
-    -------
-    pathlib.Path
-        ``path``.
-
-    Examples
-    --------
-    >>> import trimesh
-    >>> from sbrdf_xr import Scene, geometry, load_spacecraft, simulate
-    >>> from sbrdf_xr.materials.schema import lambertian
-    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
-    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
-    >>> turns = geometry.axis_rotation([0, 0, 1], [0.0, 45.0])  # two attitudes about z
-    >>> scene = Scene(box, {"grey": grey}, attitudes=turns, phase_angles=[0.0, 60.0])
-    >>> import tempfile, xarray as xr
-    >>> from pathlib import Path
-    >>> from sbrdf_xr import write
-    >>> cube = simulate(scene)
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     path = write(cube, Path(tmp) / "cube.nc")
-    ...     with xr.open_dataset(path) as back:
-    ...         print(path.name, back.signal.shape, round(float(back.signal[1, 0, 0]), 6))
-    cube.nc (2, 2, 3) 0.159155
-    """
-    if str(path).rstrip("/").endswith(".zarr"):
-        return _write_zarr(cube, Path(path), **kwargs)
-    return write_cube(_encode_times(cube), path, **kwargs)
-
-
-def _encode_times(cube: xr.Dataset) -> xr.Dataset:
-    """datetime64 coordinates as CF numbers with ``units`` and ``calendar`` (xarray's own
-    encoder, the one ``open_dataset`` decodes), for the netCDF writer."""
-    times = [k for k, v in cube.coords.items() if v.dtype.kind in "mM"]
-    if not times:
-        return cube
-    encoded = {}
-    for k in times:
-        v = xr.conventions.encode_cf_variable(cube[k].variable, name=str(k))
-        v.attrs.pop("_FillValue", None)  # CF 2.5.1: no fill value on a coordinate variable
-        encoded[k] = v
-    return cube.assign_coords(encoded)
-
-
-def _write_zarr(
-    cube: xr.Dataset,
-    path: Path,
-    *,
-    overwrite: bool = False,
-    client: Any = None,
-    progress: bool = False,
-    resume: bool = False,
-    scheduler: str | None = None,
-) -> Path:
-    import shutil
-
-    from ..errors import ValidationError
-
-    if resume:
-        raise ValidationError("resume: supported for netCDF cubes; a Zarr store is rewritten whole")
-    if scheduler is not None and client is None:
-        raise ValidationError(
-            "scheduler: for a Zarr store pass client= (a dask.distributed.Client)"
-        )
-    if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass --overwrite (overwrite=True) to replace it")
-    if path.exists() and not path.is_dir():
-        raise ValidationError(f"{path} exists and is not a Zarr store (a directory); not replaced")
-    part = path.with_name(path.name + ".part")
-    if part.exists():
-        shutil.rmtree(part)
-    ds = cube.copy()
-    for v in ds.variables.values():
-        v.encoding = {}
-    job = ds.to_zarr(part, mode="w", compute=False, consolidated=True, zarr_format=2)
-    if client is not None:
-        fut = client.compute(job)
-        if progress:
-            from distributed import progress as dist_progress
-
-            dist_progress(fut)
-        fut.result()
-    elif progress:
-        from dask.diagnostics import ProgressBar
-
-        with ProgressBar():
-            job.compute()
-    else:
-        job.compute()
-    if path.exists():
-        shutil.rmtree(path)
-    os.replace(part, path)
-    return path

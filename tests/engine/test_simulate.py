@@ -280,7 +280,7 @@ def test_thermal_emission_is_kirchhoff_times_planck_and_skipped_when_negligible(
 def test_simulation_on_a_local_cluster_equals_the_threaded_run(tmp_path):
     """The tables are scattered to the workers once; the cube is identical to the threaded one."""
     distributed = pytest.importorskip("distributed")
-    from sbrdf_xr.engine.run import write
+    from sbrdf_xr.store import write
 
     scene = cube_scene(
         table=catalog.load("example-lobe"),
