@@ -1,4 +1,5 @@
-"""Dimension names, units and the attribute table of every variable the package emits.
+"""The package version, dimension names, units and the attribute table of every variable
+the package emits.
 
 Names are defined here once and imported everywhere else; attributes of output
 variables come from :data:`ATTRS` so that every array that leaves the package
@@ -8,6 +9,9 @@ carries CF-style ``units`` and ``long_name``.
 from __future__ import annotations
 
 from typing import Any
+
+#: The package version (read by hatch; re-exported as ``sbrdf_xr.__version__``).
+__version__ = "0.1.0"
 
 # --- dimensions -----------------------------------------------------------
 THETA_I = "theta_i"
@@ -241,8 +245,6 @@ def cf_finish(ds: Any, *, history: str | None = None) -> Any:
 
     import numpy as np
 
-    from ._version import __version__
-
     out = ds.copy()
     bad = re.compile(r"[^A-Za-z0-9_]")
 
@@ -289,3 +291,19 @@ def cf_finish(ds: Any, *, history: str | None = None) -> Any:
     line = f"{stamp} sbrdf_xr {__version__}: {history or 'written'}"
     a["history"] = f"{a['history']}\n{line}" if a.get("history") else line
     return out
+
+
+# --- names of models and events shared by layers ----------------------------
+#: Relative air-mass models (pvlib ``get_relative_airmass``): name -> description.
+AIRMASS_MODELS: dict[str, str] = {
+    "simple": "secant of the zenith angle (plane-parallel atmosphere)",
+    "kasten1966": "Kasten 1966, CRREL Technical Report 136",
+    "youngirvine1967": "Young & Irvine 1967, AJ 72, 945",
+    "kastenyoung1989": "Kasten & Young 1989, Appl. Opt. 28, 4735 (default)",
+    "gueymard1993": "Gueymard 1993, Sol. Energy 51, 121",
+    "young1994": "Young 1994, Appl. Opt. 33, 1108",
+    "pickering2002": "Pickering 2002, DIO 12, 3",
+    "gueymard2003": "Gueymard 2003, Sol. Energy 74, 355",
+}
+#: Names of the Earth-shadow events of an observation, in the order of an eclipse.
+SHADOW_EVENTS = ("penumbra_entry", "umbra_entry", "umbra_exit", "penumbra_exit")

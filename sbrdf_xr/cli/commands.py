@@ -12,8 +12,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from .. import catalog
+from .._names import __version__
 from .._output import file_kind
-from .._version import __version__
 from ..errors import ValidationError, did_you_mean
 from ..store import PART_SUFFIX, formats
 from .output import escape, escaped_attrs, open_cube, open_dataset

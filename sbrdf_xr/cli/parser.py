@@ -38,8 +38,8 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from .. import catalog
+from .._names import __version__
 from .._output import command_line_messages
-from .._version import __version__
 from ..engine.builtin import builtin_scenes
 from ..engine.knobs import KNOBS, PRESETS
 from ..errors import SbrdfError

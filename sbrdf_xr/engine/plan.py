@@ -30,8 +30,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import xarray as xr
 
-from .._names import BAND, MATERIAL, PSI, WAVELENGTH
-from .._version import __version__
+from .._names import BAND, MATERIAL, PSI, WAVELENGTH, __version__
 from ..errors import SceneError
 from ..kernels import PackedTables, normal_rows
 from ..materials.models import model_parameters

@@ -22,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .._names import SHADOW_EVENTS
 from ..errors import ObservationError
 
 __all__ = [
@@ -221,10 +222,6 @@ def sunlit_fraction(
     return disc_overlap_fraction(
         *shadow_angles(position_km, sun_km, earth, pole, earth_radius_km, sun_radius_km)
     )
-
-
-#: Names of the shadow events of :func:`shadow_events`, in the order of an eclipse.
-SHADOW_EVENTS = ("penumbra_entry", "umbra_entry", "umbra_exit", "penumbra_exit")
 
 
 def shadow_events(

@@ -21,8 +21,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _catalog_index
+from .._names import AIRMASS_MODELS as AIRMASS_NAMES
 from ..errors import CatalogError, ObservationError
-from ..photometry import atmosphere
 from ..units import to_unit
 from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, disc_overlap_fraction, sunlit_fraction
 from .timescales import (
@@ -70,8 +70,8 @@ EPOCH_GAP_DAYS = 7.0
 
 
 #: Relative air-mass models of :func:`pvlib.atmosphere.get_relative_airmass`, those of
-#: :data:`sbrdf_xr.photometry.atmosphere.AIRMASS_MODELS` (declared there, once).
-AIRMASS_MODELS = tuple(atmosphere.AIRMASS_MODELS)
+#: :data:`sbrdf_xr._names.AIRMASS_MODELS` (declared there, once).
+AIRMASS_MODELS = tuple(AIRMASS_NAMES)
 
 
 def tle_checksum(line: str) -> int:

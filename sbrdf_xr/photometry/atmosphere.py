@@ -23,22 +23,10 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from .._names import BAND, WAVELENGTH, attrs
+from .._names import AIRMASS_MODELS, BAND, WAVELENGTH, attrs
 from ..errors import ValidationError
 from ..units import to_unit
 from .spectra import _check_grid, _choose
-
-#: Relative air-mass models (pvlib ``get_relative_airmass``): name -> description.
-AIRMASS_MODELS: dict[str, str] = {
-    "simple": "secant of the zenith angle (plane-parallel atmosphere)",
-    "kasten1966": "Kasten 1966, CRREL Technical Report 136",
-    "youngirvine1967": "Young & Irvine 1967, AJ 72, 945",
-    "kastenyoung1989": "Kasten & Young 1989, Appl. Opt. 28, 4735 (default)",
-    "gueymard1993": "Gueymard 1993, Sol. Energy 51, 121",
-    "young1994": "Young 1994, Appl. Opt. 33, 1108",
-    "pickering2002": "Pickering 2002, DIO 12, 3",
-    "gueymard2003": "Gueymard 2003, Sol. Energy 74, 355",
-}
 
 #: Standard sea-level pressure [hPa].
 SEA_LEVEL_HPA = 1013.25

@@ -18,8 +18,8 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from .._names import SHADOW_EVENTS
 from ..errors import ValidationError
-from ..observing.earth_shadow import SHADOW_EVENTS
 from ._labels import STYLES, band_colour, finite, label, outside_legend, spread_indices
 from .curves import light_curve, magnitude_label, spectra
 

@@ -45,7 +45,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import xarray as xr
 
-from .._version import __version__
+from .._names import __version__
 
 if TYPE_CHECKING:  # the engine imports this module
     from ..engine.scene import Scene
