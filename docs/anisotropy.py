@@ -13,6 +13,7 @@ across the illumination plane with the brushing along it and across it.  Run
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
@@ -27,7 +28,8 @@ from sbrdf_xr.engine import Scene
 from sbrdf_xr.engine.run import simulate
 from sbrdf_xr.materials import models
 
-OUT = Path(__file__).parent / "img" / "brushed_panel.png"
+OUT = Path(__file__).parent / "img"
+DPI = 80
 WAVELENGTH = 560.0  # [nm]
 THETA_I = 40.0  # [degree]
 
@@ -58,7 +60,8 @@ def signals(table, spec, chi, s, o, evaluation):
     return np.array(out)
 
 
-def main() -> None:
+def figures() -> dict[str, Any]:
+    """The figure by file name."""
     spec = catalog.load("brushed-aluminium-model").sel(wavelength=[WAVELENGTH])
     table = models.render_anisotropic(
         spec,
@@ -67,7 +70,7 @@ def main() -> None:
         np.arange(0.0, 20.5, 1.0),
         np.arange(0.0, 180.5, 5.0),
     )
-    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 4.0))
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 4.0), layout="constrained")
     chi = np.arange(0.0, 180.1, 2.5)
     for (dt, ph), colour in (((4.0, 0.0), "tab:blue"), ((0.0, 4.0), "tab:orange")):
         _, s, o = geometry.facet_vectors(THETA_I, dt, ph)  # facet frame: the panel's top face
@@ -77,7 +80,7 @@ def main() -> None:
         where = "delta_theta = 4 deg" if ph == 0 else "phi = 4 deg"
         ax.plot(chi, ana, color=colour, lw=1.5, label=f"model, observer at {where}")
         ax.plot(chi, tab, color=colour, lw=0, marker=".", ms=4, label="table, through simulate")
-    ax.set_xlabel("brushing: tangent's azimuth from the Sun's plane [degree]")
+    ax.set_xlabel("brushing: tangent's azimuth from the Sun's plane [deg]")
     ax.set_ylabel(f"signal at {WAVELENGTH:g} nm [m2 sr-1]")
     ax.set_yscale("log")
     ax.set_xlim(0, 180)
@@ -89,15 +92,20 @@ def main() -> None:
         _, s, o = geometry.facet_vectors(np.full(phi.shape, THETA_I), 0.0 * phi, phi)
         sig = signals(table, spec, [c], s, o, "table")[0]
         ax2.plot(phi, sig, color=colour, lw=1.5, marker=".", ms=3, label=f"brushed {name}")
-    ax2.set_xlabel("phi: observer's angle from the illumination plane [degree]")
+    ax2.set_xlabel("phi: observer's angle from the illumination plane [deg]")
     ax2.set_ylabel(f"signal at {WAVELENGTH:g} nm [m2 sr-1]")
     ax2.set_yscale("log")
     ax2.set_title("the glint across the plane (delta_theta = 0)", fontsize=10)
     ax2.legend(fontsize=8)
-    fig.tight_layout()
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(OUT, dpi=110)
-    print(f"wrote {OUT}")
+    return {"brushed_panel.png": fig}
+
+
+def main() -> None:
+    OUT.mkdir(parents=True, exist_ok=True)
+    for name, fig in figures().items():
+        fig.savefig(OUT / name, dpi=DPI)
+        plt.close(fig)
+        print(f"wrote {OUT / name}")
 
 
 if __name__ == "__main__":

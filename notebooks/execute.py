@@ -9,7 +9,8 @@ Each notebook runs top to bottom in a fresh ``python3`` kernel of the running in
 (working directory: a temporary directory, so nothing is left behind), and is written back
 with its outputs only if every cell succeeded.  The repository root is put on the kernel's
 ``PYTHONPATH`` so that a source checkout works without installing the package.  Needs
-``nbformat``, ``nbclient`` and ``ipykernel`` (the ``test`` extra).
+``nbformat``, ``nbclient`` and ``ipykernel``: ``pip install ".[notebooks]"`` (or the
+``test`` extra).
 """
 
 from __future__ import annotations

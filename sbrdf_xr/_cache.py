@@ -14,11 +14,12 @@ The directory is ``$SBRDF_XR_CACHE_DIR`` if set (``off`` disables the cache), el
 from __future__ import annotations
 
 import ast
+import contextlib
 import hashlib
 import os
 import re
 import warnings
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from functools import cache
 from pathlib import Path
 
@@ -229,17 +230,52 @@ def cached_table(
                 stacklevel=2,
             )
             path.unlink(missing_ok=True)
-    table = build()
+    with _building(d):  # one builder at a time: another process's build is read, not redone
+        if path.is_file():
+            try:
+                return read(path)
+            except (OSError, ValueError):  # a damaged file (warned above): build it anew
+                path.unlink(missing_ok=True)
+        table = build()
+        try:
+            d.mkdir(parents=True, exist_ok=True)
+            write(table, path)  # atomic: a temporary file renamed, so two builders cannot clash
+            return read(path)
+        except OSError as exc:  # read-only or full: the built table, uncached
+            _unusable(d, name, exc)
+            return table
+
+
+def _unusable(d: Path, name: str, exc: OSError) -> None:
+    warnings.warn(
+        f"table cache {d} is not usable ({type(exc).__name__}: {exc}); table {name} "
+        "was built but not kept (set SBRDF_XR_CACHE_DIR to a writable directory, or "
+        "'off' to build every time without this warning)",
+        CacheWarning,
+        stacklevel=3,
+    )
+
+
+@contextlib.contextmanager
+def _building(d: Path) -> Iterator[None]:
+    """Hold the build lock of cache directory ``d`` (an advisory lock of the directory
+    itself, released by the system if the process dies) while the block runs: a second
+    process that wants a table being built waits for it and reads the file.  Without a
+    usable directory (or ``fcntl``) the block runs unlocked; the atomic write keeps the
+    file whole either way."""
+    fd = None
     try:
+        import fcntl
+
         d.mkdir(parents=True, exist_ok=True)
-        write(table, path)  # atomic: a temporary file renamed, so two builders cannot clash
-        return read(path)
-    except OSError as exc:  # read-only or full: the built table, uncached
-        warnings.warn(
-            f"table cache {d} is not usable ({type(exc).__name__}: {exc}); table {name} "
-            "was built but not kept (set SBRDF_XR_CACHE_DIR to a writable directory, or "
-            "'off' to build every time without this warning)",
-            CacheWarning,
-            stacklevel=2,
-        )
-        return table
+        fd = os.open(d, os.O_RDONLY)
+        fcntl.flock(fd, fcntl.LOCK_EX)
+    except (ImportError, OSError):
+        if fd is not None:
+            os.close(fd)
+        fd = None
+    try:
+        yield
+    finally:
+        if fd is not None:
+            os.close(fd)  # closing releases the lock

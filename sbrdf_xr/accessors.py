@@ -85,7 +85,7 @@ class _Plotter:
         from . import plot as _plot
 
         if isinstance(self._obj, xr.Dataset):
-            return _plot.plot_cube(self._obj, **kwargs)
+            return _plot.cube_figure(self._obj, **kwargs)
         if "band" in self._obj.dims:
             return _plot.magnitudes(self._obj, **kwargs)
         raise AttributeError(
@@ -160,6 +160,13 @@ class SbrdfDatasetAccessor:
         from . import photometry as _phot
 
         return _phot.srgb(self._ds, **kwargs)
+
+    def to_colour(self, variable: str = "signal") -> Any:
+        """:func:`sbrdf_xr.photometry.to_colour` of this cube's ``variable``: colour-science
+        spectra, one per geometry."""
+        from . import photometry as _phot
+
+        return _phot.to_colour(self._ds, variable)
 
     @property
     def plot(self) -> _Plotter:

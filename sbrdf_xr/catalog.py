@@ -71,6 +71,7 @@ __all__ = [
     "load_spacecraft_spec",
     "material_tables",
     "names",
+    "showing_progress",
     "to_build",
     "user_catalog_dirs",
 ]
@@ -144,7 +145,7 @@ def _built_material(
     def write(da: xr.DataArray, path: Any) -> None:
         if bar:
             bar[0].set_postfix_str("writing the cache")
-        material.to_netcdf(da, path, overwrite=True)
+        material.to_netcdf(da, path, overwrite=True, complevel=0)  # fast to write and read
 
     def read(path: Any) -> xr.DataArray:
         da = material.open_material(path)
@@ -177,6 +178,30 @@ _LOADED: set[str] = set()
 #: The tables a batch load (:func:`material_tables`) will build, in order: for the labels
 #: of their progress bars ("building table tjpv-cell (1 of 3)").
 _BATCH: list[str] = []
+#: Whether builds show their progress bars (:func:`showing_progress`).
+_SHOW_PROGRESS = [True]
+
+
+@contextlib.contextmanager
+def showing_progress(show: bool) -> Iterator[None]:
+    """Show (or, ``show=False``, hide) the progress bars of table builds while the block runs.
+
+    The command line hides them with ``--quiet``.
+
+    Examples
+    --------
+    >>> with showing_progress(False):
+    ...     _SHOW_PROGRESS[0]
+    False
+    >>> _SHOW_PROGRESS[0]
+    True
+    """
+    before = _SHOW_PROGRESS[0]
+    _SHOW_PROGRESS[0] = bool(show)
+    try:
+        yield
+    finally:
+        _SHOW_PROGRESS[0] = before
 
 
 def _table_inputs(measurements: str, kw: Mapping[str, Any]) -> list[Path]:
@@ -197,6 +222,7 @@ def _progress_bar(name: str) -> Any:
         desc=label,
         bar_format="{desc}: {percentage:3.0f}%|{bar}| {elapsed}<{remaining}{postfix}",
         leave=True,
+        disable=not _SHOW_PROGRESS[0],
     )
 
 
@@ -629,7 +655,7 @@ def material_tables(
                 obj = load_material_spec(spec, base_dir=base_dir)
                 if isinstance(obj, xr.Dataset):
                     given[mat] = obj
-                    obj = models.render(obj)
+                    obj = models.render(obj, progress=_SHOW_PROGRESS[0])
             except CatalogError as exc:
                 raise CatalogError(
                     f"{(where or {}).get(mat, '[materials]')} {mat!r}: {exc}"

@@ -17,6 +17,7 @@ __all__ = [
     "CacheWarning",
     "CatalogError",
     "EpochGapWarning",
+    "FitQualityWarning",
     "InversionError",
     "LightCurveError",
     "MeshError",
@@ -149,3 +150,10 @@ class UnitWarning(SbrdfWarning):
 
 class EpochGapWarning(SbrdfWarning):
     """Observation times far from the epoch of the orbital elements (SGP4 accuracy degrades)."""
+
+
+class FitQualityWarning(SbrdfWarning):
+    """A fit not to be taken at face value: its chi-square lies beyond the 99.9 % point of
+    its chi-square distribution (the model does not describe the data within their
+    uncertainties) or below its 0.1 % point (the uncertainties are overstated), or another
+    solution (a mirror or period-alias twin) fits about as well as the one reported."""

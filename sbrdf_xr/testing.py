@@ -560,3 +560,98 @@ def canx1_with_antennas(subdivisions: int = 1, tilt: float = 30.0):
         mesh = mesh.subdivide()
         label = np.repeat(label, 4)  # trimesh.subdivide keeps each face's 4 children together
     return Spacecraft(mesh, label, name="canx1-antennas", colors=base.colors)
+
+
+# ---------------------------------------------------------------- cubes
+
+
+def _spectrum(wavelength: np.ndarray) -> np.ndarray:
+    """A smooth reddish reflectance shape (1 at 550 nm) with a dip near 700 nm."""
+    w = np.asarray(wavelength, dtype=np.float64)
+    return (1.0 + 4e-4 * (w - 550.0)) * (1.0 - 0.3 * np.exp(-(((w - 700.0) / 40.0) ** 2)))
+
+
+def rotation_cube(n_attitudes: int = 72, phase_angles=(10.0,)) -> xr.Dataset:
+    """A synthetic rotation sweep with four glints, shaped like a simulated cube.
+
+    ``brdf`` [sr-1 nm], ``signal`` and ``spacecraft_sbrdf`` over 400-1100 nm, ``area``;
+    the glints at 25, 115, 205 and 295 deg rise a hundredfold over a diffuse base.  For
+    tests and examples of figures: no catalog table is read.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import rotation_cube
+    >>> cube = rotation_cube()
+    >>> dict(cube.sizes), cube.brdf.attrs["units"]
+    ({'attitude': 72, 'phase_angle': 1, 'wavelength': 36}, 'sr-1 nm')
+    """
+    ang = np.arange(n_attitudes) * 360.0 / n_attitudes
+    beta = np.asarray(phase_angles, dtype=np.float64)
+    wl = np.arange(400.0, 1101.0, 20.0)
+    d = (ang[:, None] - 25.0 + 45.0) % 90.0 - 45.0  # angle from the nearest glint [degree]
+    level = 0.01 * (1.0 + 100.0 * np.exp(-((d / 3.0) ** 2))) * np.cos(np.radians(beta / 2.0))
+    sig = level[..., None] * _spectrum(wl)  # (attitude, phase_angle, wavelength) [m2 sr-1]
+    area = np.full(level.shape, 0.02)
+    sbrdf = sig / area[..., None]
+    dims = ("attitude", "phase_angle", "wavelength")
+    return xr.Dataset(
+        {
+            "spacecraft_sbrdf": (dims, sbrdf, {"units": "sr-1", "long_name": "overall sBRDF"}),
+            "signal": (dims, sig, {"units": "m2 sr-1", "long_name": "radiometric signal"}),
+            "brdf": (dims[:2], np.trapezoid(sbrdf, wl, axis=-1), {"units": "sr-1 nm"}),
+            "area": (dims[:2], area, {"units": "m2", "long_name": "contributing area"}),
+        },
+        coords={
+            "attitude": np.arange(n_attitudes),
+            "attitude_angle": ("attitude", ang, {"units": "degree"}),
+            "phase_angle": ("phase_angle", beta, {"units": "degree"}),
+            "wavelength": ("wavelength", wl, {"units": "nm"}),
+        },
+        attrs={"scene": "synthetic-rotation"},
+    )
+
+
+def pass_cube(n_times: int = 121) -> xr.Dataset:
+    """A synthetic pass over time that leaves the Earth's shadow, shaped like a simulated cube.
+
+    One sample a second from 2024-03-17T01:20:00 UTC: umbra for the first 20 s, penumbra
+    for 10 s (``umbra_exit``, ``penumbra_exit`` attributes), then sunlight; ``range``
+    [km], ``phase_angle``, ``elevation`` [degree], ``sunlit_fraction`` and ``signal``
+    over 400-1100 nm.  No orbit is propagated and no table read.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import pass_cube
+    >>> cube = pass_cube()
+    >>> cube.sizes["time"], cube.attrs["umbra_exit"], float(cube.sunlit_fraction[-1])
+    (121, '2024-03-17T01:20:20.000', 1.0)
+    """
+    s = np.arange(n_times, dtype=np.float64)
+    t = np.datetime64("2024-03-17T01:20:00", "ns") + (s * 1e9).astype("timedelta64[ns]")
+    frac = np.clip((s - 20.0) / 10.0, 0.0, 1.0)
+    elevation = 20.0 + 50.0 * np.sin(np.pi * s / max(n_times - 1, 1))
+    phase = 50.0 + 60.0 * s / max(n_times - 1, 1)
+    wl = np.arange(400.0, 1101.0, 20.0)
+    level = 1e-4 * frac * (1.5 + np.cos(2 * np.pi * s / 30.0)) * np.cos(np.radians(phase / 2))
+    sig = level[:, None] * _spectrum(wl)
+    coord = {"units": "degree"}
+    return xr.Dataset(
+        {"signal": (("time", "wavelength"), sig, {"units": "m2 sr-1"})},
+        coords={
+            "time": ("time", t),
+            "wavelength": ("wavelength", wl, {"units": "nm"}),
+            "range": ("time", 1500.0 - 8.0 * elevation, {"units": "km"}),
+            "phase_angle": ("time", phase, coord),
+            "elevation": ("time", elevation, coord),
+            "sunlit_fraction": ("time", frac, {"units": "1"}),
+        },
+        attrs={
+            "scene": "synthetic-pass",
+            "orbit_name": "a synthetic orbit",
+            "site_name": "a synthetic site",
+            "penumbra_entry": "",
+            "umbra_entry": "",
+            "umbra_exit": "2024-03-17T01:20:20.000",
+            "penumbra_exit": "2024-03-17T01:20:30.000",
+        },
+    )

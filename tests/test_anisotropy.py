@@ -120,7 +120,7 @@ def test_psi_at_normal_incidence_follows_the_observer():
     assert np.isfinite(psi) and 0 <= psi < 180
 
 
-@settings(max_examples=examples(300), deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(n=unit, t=unit, s=unit, o=unit)
 def test_psi_range_and_dtype(n, t, s, o):
     n, t = n / np.linalg.norm(n), t / np.linalg.norm(t)
@@ -145,7 +145,7 @@ def test_tangent_near_the_normal_is_refused_only_where_the_precision_cannot_tell
         AN.illumination_azimuth(n.astype(np.float32), t, z.astype(np.float32), z.astype(np.float32))
 
 
-@settings(max_examples=examples(300), deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(n=unit, t=unit, s=unit, o=unit, axis_angle=st.floats(-360, 360), full=unit)
 def test_psi_invariant_under_rotations(n, t, s, o, axis_angle, full):
     assume(np.linalg.norm(np.cross(n, t)) > 1e-3)
@@ -162,7 +162,7 @@ def test_psi_invariant_under_rotations(n, t, s, o, axis_angle, full):
     assert float(circ(got, psi)) < 1e-8
 
 
-@settings(max_examples=examples(300), deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(n=unit, t=unit, s=unit, o=unit, ds=unit, do=unit)
 def test_psi_continuous_away_from_normal_incidence(n, t, s, o, ds, do):
     # Lipschitz away from normal incidence (theta_i > 1 deg) and from the

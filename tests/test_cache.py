@@ -150,8 +150,8 @@ def _edited(tmp_path, rel, old, new):
         ("brdf/_fresnel_kernels.py", "0.5 * kd[j, w] * qr", "0.5 * qr * kd[j, w]", True),
         ("materials/build.py", "blend: float = 10.0", "blend: float = 11.0", True),
         ("kernels/lut.py", "_MAX_STEP_DEG = 5.0", "_MAX_STEP_DEG = 4.0", True),
-        ("materials/files.py", "complevel=4", "complevel=5", True),
-        ("catalog.py", "overwrite=True)", "overwrite=True)  # x", True),
+        ("materials/files.py", '"_FillValue": None', '"_FillValue": 0.0', True),
+        ("catalog.py", "complevel=0)", "complevel=1)", True),
         ("catalog.py", "_FILE_ATTRS = (", "_FILE_ATTRS = ('x', ", True),
         ("_catalog_index.py", "def ", "def  ", True),
         # code that does not: the same key
@@ -193,8 +193,8 @@ print(_table_sha(catalog.load("example-lobe")))
 
 
 def test_two_processes_building_one_table_at_once_agree(tmp_path, monkeypatch):
-    """Two processes that build the same table into one empty cache at the same time both
-    get the table, and the cache holds one complete file and no temporary ones."""
+    """Two processes that load the same table from one empty cache at the same time both
+    get the table, built once, and the cache holds one complete file and no temporary ones."""
     env = {**os.environ, "SBRDF_XR_CACHE_DIR": str(tmp_path), "PYTHONPATH": str(ROOT)}
     env.pop("SBRDF_XR_CATALOG_PATH", None)
     procs = [
@@ -211,6 +211,8 @@ def test_two_processes_building_one_table_at_once_agree(tmp_path, monkeypatch):
     outs = [p.communicate("go\n", timeout=300) for p in procs]
     assert [p.returncode for p in procs] == [0, 0], [e for _, e in outs]
     assert not [e for _, e in outs if "CacheWarning" in e]  # neither fell back to uncached
+    # one built it (its progress bar), the other waited for the build lock and read the file
+    assert sorted("building table example-lobe" in e for _, e in outs) == [False, True]
     shas = {o.strip() for o, _ in outs}
     assert len(shas) == 1
     assert sorted(p.name for p in tmp_path.iterdir() if p.suffix != ".nc") == []

@@ -7,7 +7,9 @@ outputs) and checks that the key pages exist.
 
 from __future__ import annotations
 
+import contextlib
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -42,11 +44,38 @@ def test_every_public_module_has_an_api_page():
     assert not unlisted, f"modules missing from the toctree of docs/api/index.md: {unlisted}"
 
 
+@contextlib.contextmanager
+def _locked(path: Path):
+    """An exclusive lock on ``path`` (a lock file) while the block runs."""
+    import fcntl
+
+    with open(path, "a") as f:
+        fcntl.flock(f, fcntl.LOCK_EX)
+        yield
+
+
 @pytest.fixture(scope="module")
 def html(tmp_path_factory) -> Path:
+    """The built documentation: built once per test run, also with ``-n`` (pytest-xdist):
+    the first worker builds it into the run's shared temporary directory, under a lock,
+    and the others wait for it and read it."""
     for name in DOCS_REQUIREMENTS:
         pytest.importorskip(name)
-    out = tmp_path_factory.mktemp("html")
+    base = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        base = base.parent  # the run's directory, shared by its workers
+    out = base / "sphinx-html"
+    with _locked(base / "sphinx-html.lock"):
+        if (out / ".built").is_file():
+            return out
+        shutil.rmtree(out, ignore_errors=True)  # what a failed build left
+        out.mkdir()
+        _build(out)
+        (out / ".built").touch()
+    return out
+
+
+def _build(out: Path) -> None:
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
     env["MPLBACKEND"] = "Agg"
@@ -66,7 +95,6 @@ def html(tmp_path_factory) -> Path:
         print(proc.stdout[-5000:])
         print(proc.stderr)
     assert proc.returncode == 0, f"sphinx-build failed ({proc.returncode}):\n{proc.stderr[-5000:]}"
-    return out
 
 
 @pytest.mark.parametrize(

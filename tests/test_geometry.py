@@ -131,7 +131,7 @@ def test_half_vector_forward_scatter_is_finite_unit_and_perpendicular():
     np.testing.assert_allclose(np.einsum("ij,ij->i", h, s), 0.0, atol=1e-15)
 
 
-@settings(max_examples=examples(200), deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(
     s=arrays(np.float64, 3, elements=st.floats(-1, 1)).filter(lambda v: v @ v > 1e-6),
     k=st.floats(-20.0, 0.0),
@@ -262,7 +262,7 @@ finite = st.floats(-1.0, 1.0, allow_nan=False, allow_infinity=False, width=64)
 vec = arrays(np.float64, 3, elements=finite).filter(lambda v: np.linalg.norm(v) > 1e-3)
 
 
-@settings(max_examples=examples(300), deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(n=vec, s=vec, o=vec)
 @example(  # near normal incidence (|s_t| = 1.2e-9): one projection tilted e_f by 2e-7
     n=np.array([0.0, 1.0, 1.0]),
@@ -282,7 +282,7 @@ def test_round_trip_random_directions(n, s, o):
     assert np.dot(s2, o2) == pytest.approx(np.dot(s, o), abs=1e-9)
 
 
-@settings(max_examples=examples(300), deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(ti=st.floats(1e-6, 89.999), trp=st.floats(-89.999, 89.999), ph=st.floats(0, 89.999))
 def test_round_trip_random_angles(ti, trp, ph):
     dt = trp - ti

@@ -57,13 +57,18 @@ def test_cube_figures_have_short_labels_with_units(sweep):
     for fig in (
         plot.light_curve(sweep),
         plot.spectra(sweep, "signal", attitude=0),
-        plot.plot_cube(sweep),
     ):
         for text in _labels(fig):
             assert 0 < len(text) <= MAX_LABEL and "[" in text, text
         legend = fig.axes[0].get_legend()
         if legend is not None:
             assert all("deg" in t.get_text() for t in legend.get_texts())
+    fig = plot.cube_figure(sweep)  # the rotation's BRDF and magnitudes
+    assert [ax.get_ylabel() for ax in fig.axes] == [
+        "broadband BRDF [sr-1 nm]",
+        "magnitude at 1000 km [AB mag]",
+    ]
+    assert plot.figure_problems(fig) == []
 
 
 def test_log_axis_where_the_range_is_large():
@@ -96,7 +101,7 @@ def test_magnitudes_per_band_brighter_up_and_the_accessor(sweep):
         "R",
         "I",
     ]
-    assert ax.get_ylabel() == "magnitude (Vega, 1000 km)"
+    assert ax.get_ylabel() == "magnitude at 1000 km [Vega mag]"
     with pytest.raises(ValueError, match="select the others"):
         plot.magnitudes(mags)
     f2 = mags.sbrdf.plot(phase_angle=10.0)
@@ -112,7 +117,7 @@ def test_colour_colour_marks_the_sun(sweep):
     fig = ph.sbrdf.plot.colour_colour("V-R", "R-I")
     ax = fig.axes[0]
     assert ax.get_xlabel() == "V-R [Vega mag]" and ax.get_ylabel() == "R-I [Vega mag]"
-    sun = next(line for line in ax.get_lines() if line.get_label().startswith("Sun"))
+    sun = next(line for line in ax.get_lines() if line.get_label().startswith("the Sun"))
     sm = P.sun_magnitudes(["V", "R", "I"], system="vega").values
     assert sun.get_xdata()[0] == pytest.approx(sm[0] - sm[1]) and sun.get_ydata()[
         0

@@ -15,12 +15,15 @@ Modules
     What a sweep costs end to end.
 ``shadowing``
     Accuracy and cost of the shadowing methods against the exact method.
+``presets``
+    The presets' measured error and cost, recorded from a run and shipped.
 """
 
-from . import accuracy, engine, rows, shadowing, suite
+from . import accuracy, engine, presets, rows, shadowing, suite
 from .accuracy import BANDS, CANX1_MATERIALS, accuracy_cost, shadow_rows
 from .engine import disk_rate, engine_rows, sweep_job, thread_scaling
-from .rows import BenchRow, best_time, format_rows, plot_front, rows_to_dataset
+from .presets import load_presets, presets_record, presets_table, write_presets
+from .rows import BenchRow, best_time, format_rows, plot_front, rows_to_dataset, timed_runs
 from .shadowing import (
     ACCURACY_BODIES,
     CostRow,
@@ -55,8 +58,12 @@ __all__ = [
     "geometries",
     "kernel_throughput",
     "lambertian_signal",
+    "load_presets",
     "markdown",
     "plot_front",
+    "presets",
+    "presets_record",
+    "presets_table",
     "rows",
     "rows_to_dataset",
     "run",
@@ -66,4 +73,6 @@ __all__ = [
     "suite",
     "sweep_job",
     "thread_scaling",
+    "timed_runs",
+    "write_presets",
 ]

@@ -16,8 +16,9 @@ import numpy as np
 import xarray as xr
 
 from .. import catalog
+from ..engine.knobs import PRESETS
 from ..materials import tables as material
-from .rows import BenchRow, best_time
+from .rows import BenchRow, timed_runs
 
 __all__ = ["BANDS", "CANX1_MATERIALS", "accuracy_cost", "shadow_rows"]
 
@@ -76,15 +77,56 @@ def _errors(test: xr.DataArray, ref: xr.DataArray) -> tuple[float, float, float]
     return float(d.max()), float(np.median(d)), p99
 
 
-def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
-    """The accuracy/cost table: one knob at a time away from the reference.
+def _shipped_tables() -> dict[str, xr.DataArray]:
+    """The CanX-1 tables as the catalog ships them (built once, then read from the cache)."""
+    return catalog.load_materials(CANX1_MATERIALS)
+
+
+def _knobs(quick: bool, base: dict[str, xr.DataArray]) -> list[tuple[str, str, dict[str, Any]]]:
+    """``(knob, setting, options)`` of the sweep: one knob at a time, then the presets."""
+    knobs: list[tuple[str, str, dict[str, Any]]] = [
+        ("reference", "cubic look-up, 1-deg theta_i, 21x21, 5 nm, merged, float64", {}),
+        ("lookup method", "nearest (the paper's)", {"method": "nearest"}),
+        ("lookup method", "linear", {"method": "linear"}),
+        ("precision", "float32", {"dtype": "float32"}),
+        ("wavelength", "10 nm sampling", {"materials": _subsample_wavelengths(base, 2)}),
+        ("wavelength", "20 nm sampling", {"materials": _subsample_wavelengths(base, 4)}),
+        (
+            "wavelength",
+            "band pre-integration (V, R, I)",
+            {"outputs": ("band_signal", "area"), "bands": BANDS},
+        ),
+        ("facets", "not merged (684 facets)", {"merge": False}),
+    ]
+    if not quick:
+        for setting, build in (
+            ("theta_i every 2 deg", {"theta_i": np.arange(0.0, 91.0, 2.0)}),
+            ("theta_i every 5 deg", {"theta_i": np.arange(0.0, 91.0, 5.0)}),
+            ("11 x 11 delta_theta x phi", {"n_phi": 11, "n_delta_theta": 11}),
+            ("41 x 41 delta_theta x phi", {"n_phi": 41, "n_delta_theta": 41}),
+        ):
+            knobs.append(("table", setting, {"materials": _paper_tables(**build)}))
+    # the presets themselves: only the preset's knobs, the rest as the scene has them
+    knobs += [("preset", name, {"preset": name}) for name in PRESETS]
+    return knobs
+
+
+def accuracy_cost(quick: bool = False, repeat: int | None = None) -> list[BenchRow]:
+    """The accuracy/cost table: one knob at a time away from the reference, and the presets.
+
+    Every row's time is the best of ``repeat`` runs, the runs of all rows of a sweep
+    interleaved (:func:`sbrdf_xr.bench.rows.timed_runs`), as a ratio to the reference's
+    best, with the spread of its runs.  Errors are against the reference configuration;
+    the presets' rows and the analytic row also give the errors against the materials'
+    generating models (``evaluation="analytic"``: each material's catalog model).
 
     Parameters
     ----------
     quick : bool
-        Smaller sweeps and fewer knob settings (a smoke run, for CI).
-    repeat : int
-        Timing repeats (the best is kept).
+        A smaller random sweep (400 attitudes x 3 phase angles against 5000 x 3) and no
+        table-resolution knobs (which rebuild the CanX-1 tables).
+    repeat : int, optional
+        Timing runs of every row (default 3, or 5 without ``quick``).
 
     Returns
     -------
@@ -92,7 +134,7 @@ def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
 
     Examples
     --------
-    The table rebuilds the CanX-1 tables and runs minutes even with ``quick``; it is
+    Even ``quick`` runs every knob on two sweeps a few times (about half a minute); it is
     not run here:
 
     >>> import inspect
@@ -108,6 +150,7 @@ def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
     from ..engine import builtin_scene
     from ..engine.run import simulate
 
+    repeat = (3 if quick else 5) if repeat is None else repeat
     rot = builtin_scene("canx1-rotation")
     n_big = 400 if quick else 5000
     big = rot.with_options(
@@ -117,107 +160,84 @@ def accuracy_cost(quick: bool = False, repeat: int = 2) -> list[BenchRow]:
         chunk=500,
         name=f"random-{n_big}x3",
     )
-    sweeps = {"canx1-rotation": rot} if quick else {"canx1-rotation": rot, big.name: big}
-    if quick:
-        sweeps[big.name] = big
-    rows: list[BenchRow] = []
-    base_tables = _paper_tables()
+    base = _shipped_tables()
     reference = {
         "method": "cubic",
         "dtype": "float64",
         "merge": True,
-        "materials": base_tables,
+        "materials": base,
         "outputs": ("signal", "area"),
     }
-
-    def run_cube(scene: Any, **opts: Any) -> xr.Dataset:
-        return simulate(scene.with_options(**opts)).compute(scheduler="sync")
-
-    for sweep_name, sweep in sweeps.items():
-        ref_cube = run_cube(sweep, **reference)
-        ref = ref_cube.signal
-        t_ref = best_time(partial(run_cube, sweep, **reference), repeat)
-        knobs: list[tuple[str, str, dict[str, Any]]] = [
-            ("reference", "cubic look-up, 1-deg theta_i, 21x21, 5 nm, merged, float64", {}),
-            ("lookup method", "nearest (the paper's)", {"method": "nearest"}),
-            ("lookup method", "linear", {"method": "linear"}),
-            ("precision", "float32", {"dtype": "float32"}),
-            ("wavelength", "10 nm sampling", {"materials": _subsample_wavelengths(base_tables, 2)}),
-            ("wavelength", "20 nm sampling", {"materials": _subsample_wavelengths(base_tables, 4)}),
-            (
-                "wavelength",
-                "band pre-integration (V, R, I)",
-                {"outputs": ("band_signal", "area"), "bands": BANDS},
-            ),
-            ("facets", "not merged (684 facets)", {"merge": False}),
-        ]
-        if not quick:
-            knobs += [
-                (
-                    "table",
-                    "theta_i every 2 deg",
-                    {"materials": _paper_tables(theta_i=np.arange(0.0, 91.0, 2.0))},
-                ),
-                (
-                    "table",
-                    "theta_i every 5 deg",
-                    {"materials": _paper_tables(theta_i=np.arange(0.0, 91.0, 5.0))},
-                ),
-                (
-                    "table",
-                    "11 x 11 delta_theta x phi",
-                    {"materials": _paper_tables(n_phi=11, n_delta_theta=11)},
-                ),
-                (
-                    "table",
-                    "41 x 41 delta_theta x phi",
-                    {"materials": _paper_tables(n_phi=41, n_delta_theta=41)},
-                ),
-            ]
-        for knob, setting, opts in knobs:
-            cfg = {**reference, **opts}
-            if knob == "reference":
-                cube, t = ref_cube, t_ref
-            else:
-                cube = run_cube(sweep, **cfg)
-                t = best_time(partial(run_cube, sweep, **cfg), repeat)
+    knobs = _knobs(quick, base)
+    analytic = (
+        "materials",
+        "analytic generating models (ground truth)",
+        {"evaluation": "analytic"},
+    )
+    rows: list[BenchRow] = []
+    for sweep in (rot, big):
+        cubes: dict[str, xr.Dataset] = {}
+        cases = [*knobs, analytic]
+        timing = timed_runs(
+            {
+                f"{k}: {s}": partial(_run, simulate, sweep, reference, o, cubes, f"{k}: {s}")
+                for k, s, o in cases
+            },
+            repeat,
+        )
+        ref_name = f"{knobs[0][0]}: {knobs[0][1]}"
+        ref, truth = cubes[ref_name].signal, cubes[f"{analytic[0]}: {analytic[1]}"].signal
+        t_ref = timing[ref_name][0]
+        for knob, setting, _ in cases:
+            name = f"{knob}: {setting}"
+            cube = cubes[name]
             test = cube.band_signal if "band_signal" in cube else cube.signal
-            mx, med, p99 = _errors(test, ref)
+            model: tuple[float, ...] = (float("nan"),) * 3
+            extra = ""
+            if knob == "materials":  # the error column: the tabulated reference against them
+                mx, med, p99 = _errors(ref, truth)
+                extra = "error column: the tabulated reference against them"
+            else:
+                mx, med, p99 = _errors(test, ref)
+                if knob in ("preset", "reference"):
+                    model = _errors(test, truth)
             rows.append(
                 BenchRow(
-                    f"{knob}: {setting}",
-                    t,
+                    name,
+                    timing[name][0],
                     "reference",
-                    t / t_ref,
-                    sweep=sweep_name,
+                    timing[name][0] / t_ref,
+                    extra,
+                    sweep=sweep.name,
                     mmag_max=mx,
                     mmag_median=med,
                     rel_p99=p99,
                     knob=knob,
+                    spread=timing[name][1],
+                    model_mmag_max=model[0],
+                    model_mmag_median=model[1],
                 )
             )
-        # Tabulated vs analytic: the table method's own error, against the generating models
-        # (the simulation option evaluation="analytic", each material's catalog model).
-        an_cfg = {**reference, "evaluation": "analytic"}
-        an = run_cube(sweep, **an_cfg).signal
-        t_an = best_time(partial(run_cube, sweep, **an_cfg), 1)
-        mx, med, p99 = _errors(ref, an)
-        rows.append(
-            BenchRow(
-                "materials: analytic generating models (ground truth)",
-                t_an,
-                "reference",
-                t_an / t_ref,
-                "error column: the tabulated reference against them",
-                sweep=sweep_name,
-                mmag_max=mx,
-                mmag_median=med,
-                rel_p99=p99,
-                knob="materials",
-            )
-        )
     rows += shadow_rows(quick=quick, repeat=repeat)
     return rows
+
+
+#: What a preset's row keeps of the reference configuration: the tables and the outputs.
+_KEEP = ("materials", "outputs")
+
+
+def _run(
+    simulate: Any,
+    scene: Any,
+    reference: dict[str, Any],
+    opts: dict[str, Any],
+    cubes: dict[str, xr.Dataset],
+    name: str,
+) -> None:
+    """Simulate ``scene`` with the reference configuration changed by ``opts`` (a preset
+    keeps only :data:`_KEEP` of it) into ``cubes[name]``."""
+    cfg = {k: v for k, v in reference.items() if "preset" not in opts or k in _KEEP}
+    cubes[name] = simulate(scene.with_options(**{**cfg, **opts})).compute(scheduler="sync")
 
 
 def shadow_rows(quick: bool = False, repeat: int = 2) -> list[BenchRow]:

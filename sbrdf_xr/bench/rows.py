@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-__all__ = ["BenchRow", "best_time", "format_rows", "plot_front", "rows_to_dataset"]
+__all__ = ["BenchRow", "best_time", "format_rows", "plot_front", "rows_to_dataset", "timed_runs"]
 
 
 @dataclass
@@ -41,6 +41,11 @@ class BenchRow:
         Which sweep.
     mmag_max, mmag_median, rel_p99 : float
         Error against the reference (NaN when not applicable).
+    spread : float
+        ``max / min - 1`` of the repeated timings (NaN for a single run): how far the
+        machine moved the time of this row between repeats.
+    model_mmag_max, model_mmag_median : float
+        Error against the materials' generating models (NaN when not measured).
 
     Examples
     --------
@@ -60,6 +65,9 @@ class BenchRow:
     mmag_median: float = float("nan")
     rel_p99: float = float("nan")
     knob: str = field(default="", repr=False)
+    spread: float = float("nan")
+    model_mmag_max: float = float("nan")
+    model_mmag_median: float = float("nan")
 
 
 def best_time(func: Callable[[], object], repeat: int = 3, number: int = 1) -> float:
@@ -83,6 +91,44 @@ def best_time(func: Callable[[], object], repeat: int = 3, number: int = 1) -> f
     return float(best)
 
 
+def timed_runs(
+    funcs: dict[str, Callable[[], object]], repeat: int = 3
+) -> dict[str, tuple[float, float]]:
+    """Best wall time and spread of each function, the repeats interleaved.
+
+    Every function runs once untimed (a warm-up), then ``repeat`` rounds time each of
+    them in turn: a slow spell of a shared machine then slows every function of a
+    round, not all the repeats of one, so the ratios of the best times hold.
+
+    Returns
+    -------
+    dict of str to (float, float)
+        ``(best seconds, max / min - 1)`` per function (spread NaN for one repeat).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench.rows import timed_runs
+    >>> calls = []
+    >>> out = timed_runs({"a": lambda: calls.append("a"), "b": lambda: calls.append("b")}, 2)
+    >>> "".join(calls), sorted(out)  # warm-ups, then two interleaved rounds
+    ('ababab', ['a', 'b'])
+    >>> all(best >= 0.0 and spread >= 0.0 for best, spread in out.values())
+    True
+    """
+    for f in funcs.values():
+        f()
+    times: dict[str, list[float]] = {k: [] for k in funcs}
+    for _ in range(repeat):
+        for k, f in funcs.items():
+            t0 = time.perf_counter()
+            f()
+            times[k].append(time.perf_counter() - t0)
+    return {
+        k: (min(v), max(v) / min(v) - 1.0 if len(v) > 1 and min(v) > 0 else float("nan"))
+        for k, v in times.items()
+    }
+
+
 def format_rows(rows: list[BenchRow]) -> str:
     """A plain-text table of benchmark rows (time as a ratio to the row's baseline).
 
@@ -91,16 +137,21 @@ def format_rows(rows: list[BenchRow]) -> str:
     >>> from sbrdf_xr.bench.rows import BenchRow
     >>> rows = [
     ...     BenchRow("reference", 2.0, "reference", 1.0, sweep="demo",
-    ...              mmag_max=0.0, mmag_median=0.0, rel_p99=0.0),
+    ...              mmag_max=0.0, mmag_median=0.0, rel_p99=0.0, spread=0.05),
     ...     BenchRow("lookup method: linear", 0.6, "reference", 0.3, sweep="demo",
-    ...              mmag_max=12.0, mmag_median=0.4, rel_p99=0.01),
+    ...              mmag_max=12.0, mmag_median=0.4, rel_p99=0.01, spread=0.12),
+    ...     BenchRow("preset: fast", 0.5, "reference", 0.25, sweep="demo", mmag_max=12.0,
+    ...              mmag_median=0.4, model_mmag_max=900.0, model_mmag_median=40.0),
     ... ]
     >>> from sbrdf_xr.bench.rows import format_rows
     >>> print(format_rows(rows))
     [demo]
-    case                   time/baseline   mmag max   mmag med   rel p99  notes
-    reference                         1x          0          0         0  vs reference
-    lookup method: linear           0.3x         12        0.4      0.01  vs reference
+    case                   time/baseline spread    mmag max   mmag med   rel p99  notes
+    reference                         1x +5%             0          0         0  vs reference
+    lookup method: linear           0.3x +12%           12        0.4      0.01  vs reference
+    preset: fast                   0.25x                12        0.4       nan  vs generating ...
+
+    The spread is that of the repeated timings (:func:`timed_runs`).
     """
     w = max(len(r.name) for r in rows)
     out = []
@@ -111,7 +162,7 @@ def format_rows(rows: list[BenchRow]) -> str:
             out += [
                 "",
                 f"[{sweep}]",
-                f"{'case':<{w}}  {'time/baseline':>13}  "
+                f"{'case':<{w}}  {'time/baseline':>13} {'spread':<6}  "
                 f"{'mmag max':>9}  {'mmag med':>9}  {'rel p99':>8}  notes",
             ]
         err = (
@@ -120,7 +171,13 @@ def format_rows(rows: list[BenchRow]) -> str:
             else f"{'':>9}  {'':>9}  {'':>8}"
         )
         note = r.extra or f"vs {r.baseline}"
-        out.append(f"{r.name:<{w}}  {r.ratio:>12.3g}x  {err}  {note}")
+        if np.isfinite(r.model_mmag_max):
+            note = (
+                f"vs generating models: {r.model_mmag_max:.3g} / {r.model_mmag_median:.3g} mmag "
+                f"(worst / median); {note}"
+            )
+        spread = f"+{r.spread:.0%}" if np.isfinite(r.spread) else ""
+        out.append(f"{r.name:<{w}}  {r.ratio:>12.3g}x {spread:<6}  {err}  {note}")
     return "\n".join(out).lstrip("\n")
 
 
@@ -170,6 +227,21 @@ def rows_to_dataset(rows: list[BenchRow]) -> xr.Dataset:
                 col("rel_p99"),
                 {"units": "1", "long_name": "99th percentile relative spectral error"},
             ),
+            "time_spread": (
+                "case",
+                col("spread"),
+                {"units": "1", "long_name": "largest / smallest of the repeated wall times - 1"},
+            ),
+            "model_mmag_max": (
+                "case",
+                col("model_mmag_max"),
+                {"units": "mmag", "long_name": "largest band error against the generating models"},
+            ),
+            "model_mmag_median": (
+                "case",
+                col("model_mmag_median"),
+                {"units": "mmag", "long_name": "median band error against the generating models"},
+            ),
             "baseline": ("case", col("baseline"), {"long_name": "baseline of the time ratio"}),
             "sweep": ("case", col("sweep"), {"long_name": "sweep"}),
             "notes": ("case", col("extra"), {"long_name": "notes"}),
@@ -180,7 +252,9 @@ def rows_to_dataset(rows: list[BenchRow]) -> xr.Dataset:
 
 
 def plot_front(rows: list[BenchRow], ax: Any = None) -> Any:
-    """The accuracy/time front: worst band error against relative time, per sweep.
+    """The accuracy/time figure of the rows (:func:`sbrdf_xr.plot.accuracy_front`).
+
+    ``ax`` is not used (the figure has its own two panels); kept for callers that pass it.
 
     Examples
     --------
@@ -195,24 +269,10 @@ def plot_front(rows: list[BenchRow], ax: Any = None) -> Any:
     >>> from sbrdf_xr.bench.rows import plot_front
     >>> fig = plot_front(rows)
     >>> ax = fig.axes[0]
-    >>> ax.get_xscale(), ax.get_yscale(), ax.get_xlabel()
-    ('log', 'log', 'wall time / reference wall time')
+    >>> ax.get_xscale(), ax.get_xlabel()
+    ('log', 'band error against the baseline [mmag]')
     >>> plt.close(fig)
     """
-    import matplotlib.pyplot as plt
+    from ..plot import accuracy_front
 
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(7, 4.5), layout="constrained")
-    else:
-        fig = ax.figure
-    for sweep in dict.fromkeys(r.sweep for r in rows if np.isfinite(r.mmag_max)):
-        pts = [r for r in rows if r.sweep == sweep and np.isfinite(r.mmag_max)]
-        ax.scatter([r.ratio for r in pts], [max(r.mmag_max, 1e-6) for r in pts], label=sweep)
-        for r in pts:
-            ax.annotate(r.name.split(": ", 1)[-1], (r.ratio, max(r.mmag_max, 1e-6)), fontsize=6)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("wall time / reference wall time")
-    ax.set_ylabel("largest band error [mmag]")
-    ax.legend(fontsize=7)
-    return fig
+    return accuracy_front(rows_to_dataset(rows))

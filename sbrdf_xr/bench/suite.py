@@ -29,7 +29,7 @@ from ..materials import tables as material
 from ..materials.goniometer import measure
 from ..testing import lobe_function
 from .accuracy import CANX1_MATERIALS, accuracy_cost
-from .rows import BenchRow, best_time, format_rows, rows_to_dataset
+from .rows import BenchRow, best_time, format_rows, rows_to_dataset, timed_runs
 
 __all__ = [
     "BenchRow",
@@ -148,13 +148,15 @@ def bench_lookup(
 # ------------------------------------------------------ kernel speed
 
 
-def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
+def kernel_throughput(repeat: int = 3, attitude_step: int = 1) -> list[BenchRow]:
     """Geometry-facet-spectra per second of the simulation against a per-facet loop.
 
     The baseline is the straightforward numpy evaluation: for every facet, its angles
     for all geometries (:func:`sbrdf_xr.geometry.facet_angles`), its spectra by the
     public ``linear`` look-up (:func:`sbrdf_xr.materials.tables.lookup`) and the weighted sum.
-    Both evaluate the CanX-1 rotation (360 geometries x 684 facets x 141 wavelengths).
+    Both evaluate the CanX-1 rotation (360 geometries x 684 facets x 141 wavelengths;
+    every ``attitude_step``-th attitude).  Times are the best of ``repeat`` interleaved
+    runs (:func:`sbrdf_xr.bench.rows.timed_runs`).
     The machine limit is estimated from the bytes each geometry-facet must gather
     (8 table rows of the spectrum) and a measured memory bandwidth (a large
     ``numpy`` copy).
@@ -167,7 +169,7 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
     >>> import inspect
     >>> from sbrdf_xr.bench import kernel_throughput
     >>> list(inspect.signature(kernel_throughput).parameters)
-    ['repeat']
+    ['repeat', 'attitude_step']
     >>> rows = kernel_throughput(repeat=1)  # doctest: +SKIP
     >>> rows[0].name  # doctest: +SKIP
     'per-facet numpy loop (baseline)'
@@ -176,8 +178,12 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
     from ..engine import builtin_scene
     from ..engine.run import simulate
 
-    scene = builtin_scene("canx1-rotation").with_options(
-        outputs=("signal", "area"), method="linear"
+    rot = builtin_scene("canx1-rotation")
+    scene = rot.with_options(
+        outputs=("signal", "area"),
+        method="linear",
+        attitudes=np.asarray(rot.attitudes)[::attitude_step],
+        attitude_angle=np.asarray(rot.attitude_angle)[::attitude_step],
     )
     facets = scene.spacecraft.facets()
     s, o = scene.body_vectors()
@@ -207,12 +213,20 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
     def sim(merge: bool) -> np.ndarray:
         return simulate(scene.with_options(merge=merge)).signal.compute(scheduler="sync").values
 
-    base, fast, unmerged = per_facet_loop(), sim(True), sim(False)
+    out: dict[str, np.ndarray] = {}
+    timing = timed_runs(
+        {
+            "loop": lambda: out.__setitem__("loop", per_facet_loop()),
+            "merged": lambda: out.__setitem__("merged", sim(True)),
+            "unmerged": lambda: out.__setitem__("unmerged", sim(False)),
+        },
+        repeat,
+    )
+    base, fast, unmerged = out["loop"], out["merged"], out["unmerged"]
     agree = float(np.max(np.abs(fast.reshape(base.shape) - base)) / np.abs(base).max())
     agree2 = float(np.max(np.abs(unmerged.reshape(base.shape) - base)) / np.abs(base).max())
-    t_base = best_time(per_facet_loop, 1)
-    t_merged = best_time(lambda: sim(True), repeat)
-    t_unmerged = best_time(lambda: sim(False), repeat)
+    (t_base, s_base), (t_merged, s_merged) = timing["loop"], timing["merged"]
+    t_unmerged, s_unmerged = timing["unmerged"]
     work = n_geom * n_fac  # geometry-facet pairs, each a full spectrum
     big = np.ones(2**25)  # 256 MiB
     t_copy = best_time(lambda: big.copy(), 2)
@@ -232,6 +246,7 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
             1.0,
             f"{work / t_base:,.0f} geometry-facet-spectra/s",
             sweep="canx1-rotation",
+            spread=s_base,
         ),
         BenchRow(
             "simulate, facets not merged",
@@ -241,6 +256,7 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
             f"{work / t_unmerged:,.0f} g-f-spectra/s; speed-up {t_base / t_unmerged:.1f}x; "
             f"agrees to {agree2:.1e}",
             sweep="canx1-rotation",
+            spread=s_unmerged,
         ),
         BenchRow(
             "simulate, merged (684 facets -> 20 terms)",
@@ -251,6 +267,7 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
             f"speed-up {t_base / t_merged:.1f}x; "
             f"agrees to {agree:.1e}",
             sweep="canx1-rotation",
+            spread=s_merged,
         ),
         BenchRow(
             "DRAM-bandwidth estimate (no cache reuse)",
@@ -277,12 +294,16 @@ def kernel_throughput(repeat: int = 3) -> list[BenchRow]:
     return rows
 
 
-def run(quick: bool = False) -> list[BenchRow]:
+def run(quick: bool = False, repeat: int | None = None) -> list[BenchRow]:
     """All benchmarks (``quick``: smaller problems, a smoke run).
+
+    ``repeat``: timing runs of every row of the accuracy/cost table (default 5, 3 with
+    ``quick``; :func:`accuracy_cost`) and of the kernel throughput (default 3, 2 with
+    ``quick``).
 
     Examples
     --------
-    Minutes even with ``quick`` (``sbrdf-xr bench --quick`` runs it); not run here:
+    About a minute with ``quick`` (``sbrdf-xr bench --quick`` runs it); not run here:
 
     >>> from sbrdf_xr.bench import format_rows, run
     >>> rows = run(quick=True)  # doctest: +SKIP
@@ -290,10 +311,10 @@ def run(quick: bool = False) -> list[BenchRow]:
     'build_lut (150 samples, 105 measured, 131 wl)'
     >>> print(format_rows(rows))  # doctest: +SKIP
     """
-    rows = bench_build_lut(repeat=1 if quick else 3)
-    rows += bench_lookup(n_geometries=2000 if quick else 20000, repeat=1 if quick else 3)
-    rows += accuracy_cost(quick=quick, repeat=1 if quick else 2)
-    rows += kernel_throughput(repeat=1 if quick else 3)
+    rows = bench_build_lut(repeat=3)
+    rows += bench_lookup(n_geometries=2000 if quick else 20000, repeat=3)
+    rows += accuracy_cost(quick=quick, repeat=repeat or (3 if quick else 5))
+    rows += kernel_throughput(repeat=repeat or (2 if quick else 3), attitude_step=4 if quick else 1)
     return rows
 
 

@@ -64,6 +64,12 @@ def plot_facets(
     ValidationError
         If ``facet_material`` does not have one name per facet.
 
+    Notes
+    -----
+    Facets are shaded by their orientation to a light from the upper left of the view (so
+    that white paint shows as light greys against the pale blue-grey panes), and the
+    legend sits below the model.
+
     Examples
     --------
     >>> import matplotlib
@@ -71,13 +77,14 @@ def plot_facets(
     >>> import matplotlib.pyplot as plt
     >>> fig = plot_facets(trimesh.creation.box(), ["paint"] * 12, name="cube",
     ...                   rgb={"paint": (255, 255, 255)})
-    >>> fig.axes[0].get_title(), len(fig.axes[0].get_legend().get_texts())
-    ('cube: 12 facets', 1)
+    >>> fig.axes[0].get_title(), len(fig.legends[0].get_texts()), fig.axes[0].get_zlabel()
+    ('cube: 12 facets', 1, 'z [m]')
     >>> plt.close(fig)
     """
     import matplotlib.pyplot as plt
-    from matplotlib.colors import to_rgba
+    from matplotlib.colors import LightSource, to_rgba
     from matplotlib.patches import Patch
+    from matplotlib.ticker import MaxNLocator
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     labels = check_facet_material(facet_material, len(mesh.faces))
@@ -100,22 +107,39 @@ def plot_facets(
     names, code = np.unique(labels, return_inverse=True)
     face_rgba = np.array([palette[n] for n in names])[code.reshape(-1)]
     tri = np.asarray(mesh.triangles)
-    coll = Poly3DCollection(tri, facecolors=face_rgba, edgecolors=edgecolor, linewidths=linewidth)
+    light = LightSource(azdeg=azim + 135.0, altdeg=45.0)
+    coll = Poly3DCollection(
+        tri,
+        facecolors=face_rgba,
+        edgecolors=edgecolor,
+        linewidths=linewidth,
+        shade=True,
+        lightsource=light,
+    )
     ax.add_collection3d(coll)
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_pane_color((0.78, 0.82, 0.88, 1.0))
     lo, hi = mesh.bounds
     centre, half = (lo + hi) / 2, float(np.max(hi - lo)) / 2
     ax.set_xlim(centre[0] - half, centre[0] + half)
     ax.set_ylim(centre[1] - half, centre[1] + half)
     ax.set_zlim(centre[2] - half, centre[2] + half)
     ax.set_box_aspect((1, 1, 1))
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_zlabel("z [m]")
+    for axis, c in zip((ax.xaxis, ax.yaxis, ax.zaxis), centre, strict=True):
+        # ticks short of the box's corners, where the labels of two axes would meet
+        ticks = MaxNLocator(nbins=4).tick_values(c - 0.8 * half, c + 0.8 * half)
+        axis.set_ticks(ticks[np.abs(ticks - c) <= 0.8 * half])
+    ax.set_xlabel("x [m]", labelpad=8)
+    ax.set_ylabel("y [m]", labelpad=8)
+    ax.zaxis.set_rotate_label(False)  # mplot3d would turn "z [m]" upside down
+    ax.set_zlabel("z [m]", rotation=90, labelpad=8)
     ax.view_init(elev=elev, azim=azim)
     ax.set_title(f"{name}: {len(labels)} facets")
     if legend:
-        ax.legend(
+        fig.legend(
             handles=[Patch(facecolor=palette[m], edgecolor="0.3", label=m) for m in materials],
-            loc="upper left",
+            loc="lower center",
+            ncols=min(len(materials), 3),
+            fontsize="small",
         )
     return fig

@@ -340,7 +340,9 @@ def directional_hemispherical_reflectance(
     cph = np.cos(ph)[:, None, None]  # axes: (phi, u, wl)
     flat = np.radians(ti.ravel())
     out = np.empty((flat.size, wl.size))
-    chunk = max(1, 2_000_000 // (_N_U * _N_PHI * wl.size))
+    # a bounded number of (node, wavelength) values at once: fewer when every wavelength
+    # has its own nodes (a dozen arrays of that size) than when they share them (one)
+    chunk = max(1, (8_000_000 if a2.size == 1 else 2_000_000) // (_N_U * _N_PHI * wl.size))
     for start in range(0, flat.size, chunk):  # memory bound, not a per-sample loop
         t = flat[start : start + chunk][:, None, None, None]
         ci, si = np.cos(t), np.sin(t)
@@ -362,8 +364,14 @@ def directional_hemispherical_reflectance(
                 fres = optics.fresnel_conductor(hs_c, p["n"] + 1j * p["k"])
             else:
                 fres = optics._stack_reflectance(hs_c, wl, layers, p["n"] + 1j * p["k"])
-            integrand = fres * g2_over_ci * hs_c / cos_h * du
-            val = val + np.einsum("tpuw,u,p->tw", integrand, wu, wp) / np.pi  # 2 * (1/2pi)
+            # the quadrature weight of every node (t, p, u, 1 | n_wl), then the sum over nodes
+            weight = g2_over_ci * hs_c / cos_h * du * (wp[:, None, None] * wu[:, None])
+            if weight.shape[-1] == 1:  # one set of nodes for every wavelength: a product
+                nt, nodes = fres.shape[0], fres.shape[1] * fres.shape[2]
+                part = np.matmul(weight.reshape(nt, 1, nodes), fres.reshape(nt, nodes, -1))[:, 0]
+            else:
+                part = np.einsum("tpuw,tpuw->tw", fres, weight)
+            val = val + part / np.pi  # 2 * (1/2pi)
         out[start : start + chunk] = val
     return out.reshape((*ti.shape, wl.size)) + p["rho_d"]
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
 
 from ..errors import SbrdfError, ValidationError
 from .commands import spacecraft_of
@@ -189,16 +190,187 @@ def cmd_photometry(args: argparse.Namespace) -> int:
     return 0
 
 
+def _isel(terms, items: list[str] | None, cube: str):
+    """``terms`` at the ``--isel DIM=INDEX`` selections, each checked against the cube."""
+    from ..errors import InversionError
+
+    samples = [d for d in terms.dims if d not in ("material", "wavelength", "band")]
+    for item in items or []:
+        dim, sep, idx = item.partition("=")
+        dim = dim.strip()
+        if not sep or not dim:
+            raise InversionError(f"--isel {item!r}: expected DIM=INDEX (e.g. --isel geometry=0)")
+        if dim not in samples:
+            raise InversionError(
+                f"--isel {item!r}: {cube} has no sample dimension {dim!r}; allowed: "
+                f"{', '.join(f'{d} (0..{terms.sizes[d] - 1})' for d in samples) or 'none'}"
+            )
+        try:
+            i = int(idx)
+        except ValueError:
+            raise InversionError(
+                f"--isel {item!r}: the index {idx!r} is not an integer (0..{terms.sizes[dim] - 1})"
+            ) from None
+        n = terms.sizes[dim]
+        if not -n <= i < n:
+            raise InversionError(
+                f"--isel {item!r}: index {i} is out of range; {dim} of {cube} has {n} entries "
+                f"(0..{n - 1})"
+            )
+        terms = terms.isel({dim: i})
+        samples.remove(dim)
+    return terms
+
+
+def _unmix(args: argparse.Namespace):
+    from .. import invert
+    from ..errors import InversionError
+    from ..photometry import read_light_curve
+
+    with open_dataset(args.cube) as cube:
+        terms = cube.load()["signal_material"] if "signal_material" in cube else None
+    if terms is None:
+        raise InversionError(
+            f"{args.cube}: no signal_material; simulate with the per_material output"
+        )
+    terms = _isel(terms, args.isel, args.cube)
+    if invert.measured_kind(args.measured) == "spectrum":
+        y, sigma = invert.read_spectrum(args.measured)
+    else:
+        lc = read_light_curve(args.measured)
+        if args.range_km is None:
+            raise InversionError("--range-km: needed to turn measured magnitudes into signal")
+        y, sigma = invert.magnitudes_to_signal(lc, args.range_km)
+        terms = invert.band_terms(terms, [str(b) for b in y.band.values])
+    ds = invert.unmix(
+        y,
+        terms,
+        sigma,
+        select=None if args.select == "none" else args.select,
+        criterion=args.criterion,
+    )
+    print(
+        f"unmix {args.measured}: chi2 {float(ds.chi2):.4g} for {int(ds.dof)} degrees of "
+        f"freedom, reduced {float(ds.reduced_chi2):.4g} ({ds.attrs['fit_quality']}); "
+        f"{args.criterion} selection: {ds.attrs['selected_materials']}"
+    )
+    for m in ds.material.values:
+        kept = "" if bool(ds.selected.sel(material=m)) else "  (left out)"
+        print(
+            f"  {m!s:<24} scale {float(ds.scale.sel(material=m)):.4f} "
+            f"+- {float(ds.scale_uncertainty.sel(material=m)):.4f}{kept}"
+        )
+    print(f"  selection: {ds.attrs['selection_note']}")
+    print(f"  degenerate: {ds.attrs['degenerate']}")
+    return ds
+
+
+def _periods(args: argparse.Namespace, lc) -> Any:
+    """The candidate periods of ``--periods MIN MAX N``, after the size of the search is
+    checked (so that a huge N is refused before anything is allocated)."""
+    import numpy as np
+
+    from .. import invert
+    from ..errors import InversionError
+
+    lo, hi, n = args.periods
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo <= hi):
+        raise InversionError(
+            f"--periods {lo:g} {hi:g} {n:g}: MIN and MAX must be finite with 0 < MIN <= MAX [s]"
+        )
+    if not (np.isfinite(n) and n >= 1 and float(n) == int(n)):
+        raise InversionError(f"--periods {lo:g} {hi:g} {n:g}: N must be an integer >= 1")
+    d = invert.light_curve_fluxes(lc)
+    times = np.unique(d["time"])
+    invert.check_search_size(
+        max(1, args.n_axes),
+        int(n),
+        max(1, args.n_phases),
+        times.size,
+        len(d["labels"]),
+        d["flux"].size,
+        size_limit=args.size_limit,
+    )
+    return np.linspace(lo, hi, int(n))
+
+
+def _spin(args: argparse.Namespace):
+    from .. import invert
+    from ..engine import resolve_scene
+    from ..errors import InversionError
+    from ..photometry import read_light_curve
+
+    given = [
+        name
+        for name, v in (("--cube", args.cube), ("--scene", args.scene), ("--to-sun", args.to_sun))
+        if v is not None
+    ]
+    if len(given) != 1 or (args.to_sun is None) != (args.to_observer is None):
+        raise InversionError(
+            "invert spin: give the geometry once: --cube CUBE.nc (a cube over time), --scene "
+            "NAME|SCENE.toml (a scene with an observation), or --to-sun X Y Z with "
+            f"--to-observer X Y Z; got {', '.join(given) or 'none'}"
+        )
+    scene = geometry = None
+    if args.scene is not None:
+        scene = resolve_scene(args.scene)
+        if scene.observation is None:
+            raise InversionError(f"--scene {args.scene}: the scene has no observation")
+        geometry = scene.observation
+    elif args.cube is not None:
+        with open_dataset(args.cube) as cube:
+            geometry = cube.load()
+    if scene is not None and args.spacecraft is None:
+        sc = scene.spacecraft
+    else:
+        sc = spacecraft_of(
+            argparse.Namespace(**{**vars(args), "spacecraft": args.spacecraft or "canx1"})
+        )
+    lc = read_light_curve(args.measured)
+    ds = invert.fit_spin(
+        lc,
+        sc,
+        geometry,
+        to_sun=args.to_sun,
+        to_observer=args.to_observer,
+        periods=_periods(args, lc),
+        axis_body=args.axis_body,
+        n_axes=args.n_axes,
+        n_phases=args.n_phases,
+        offset=args.offset,
+        method=args.method,
+        size_limit=args.size_limit,
+    )
+    print(
+        f"spin fit of {args.measured}: {ds.attrs['n_candidates']} candidates by "
+        f"{ds.attrs['search_method']} in {ds.attrs['search_seconds']:.1f} s "
+        f"({ds.attrs['search_check']}); chi2 {float(ds.chi2):.4g}, reduced "
+        f"{float(ds.reduced_chi2):.4g} ({ds.attrs['fit_quality']}); epoch {ds.attrs['epoch']}"
+    )
+    for k in ("axis_longitude", "axis_latitude", "period", "phase"):
+        print(
+            f"  {k:<15} {float(ds[k]):10.4f} +- {float(ds[k + '_uncertainty']):.4f} "
+            f"{ds[k].attrs['units']}"
+        )
+    for sname in ds.solution.values:
+        print(
+            f"  alternative {sname!s:<14} chi2 gap {float(ds.chi2_gap.sel(solution=sname)):10.2f}"
+        )
+    return ds
+
+
 def cmd_invert(args: argparse.Namespace) -> int:
     """``sbrdf-xr invert unmix MEASURED --cube CUBE`` (the material areas of a measured
     spectrum or band magnitudes, :func:`sbrdf_xr.invert.unmix`) or ``sbrdf-xr invert spin
-    CURVE`` (spin axis, period and phase of a light curve, :func:`sbrdf_xr.invert.fit_spin`):
+    CURVE`` (spin axis, period and phase of a light curve, :func:`sbrdf_xr.invert.fit_spin`,
+    with the geometry of ``--cube``, ``--scene`` or ``--to-sun``/``--to-observer``):
     the fit printed and written to the file of ``--output``; returns 0.
 
     Examples
     --------
-    A measured spectrum twice the simulated signal of a unit box unmixes to twice its
-    area of the material, ``+- 0.01 / (0.5 / pi) / sqrt(3)`` for three wavelengths:
+    A measured spectrum twice the simulated signal of a unit box (with 1 % noise) unmixes
+    to twice its area of the material, ``+- 0.01 / (0.5 / pi) / sqrt(3)`` for three
+    wavelengths:
 
     >>> import contextlib
     >>> import io
@@ -216,7 +388,7 @@ def cmd_invert(args: argparse.Namespace) -> int:
     >>> scene = Scene(box, {"grey": grey}, to_sun=x, to_observer=x,
     ...               outputs=("signal", "per_material"), kernel="numpy")
     >>> rows = "wavelength,signal,uncertainty\\n" + "".join(
-    ...     f"{wl},0.3183099,0.01\\n" for wl in (500, 600, 700))
+    ...     f"{wl},{s},0.01\\n" for wl, s in ((500, 0.3283), (600, 0.3083), (700, 0.3183)))
     >>> out = io.StringIO()
     >>> with tempfile.TemporaryDirectory() as tmp, contextlib.redirect_stdout(out):
     ...     cube = write(simulate(scene), Path(tmp) / "cube.nc")
@@ -224,94 +396,24 @@ def cmd_invert(args: argparse.Namespace) -> int:
     ...     argv = ["invert", "unmix", str(Path(tmp) / "spectrum.csv"), "--cube", str(cube),
     ...             "--isel", "geometry=0", "--select", "none"]
     ...     status = cmd_invert(build_parser().parse_args(argv))
-    ...     _ = write(simulate(scene)[["signal"]], cube, overwrite=True)  # no per-material
     ...     try:
-    ...         cmd_invert(build_parser().parse_args(argv))
+    ...         cmd_invert(build_parser().parse_args(argv[:-3] + ["geometry=3"]))
     ...     except InversionError as exc:
     ...         error = str(exc).replace(tmp, "TMP")
     >>> status
     0
     >>> print(*out.getvalue().splitlines()[1:], sep="\\n")
       grey                     scale 2.0000 +- 0.0363
+      selection: the subset of lowest BIC (grey)
       degenerate: none
     >>> print(error)
-    TMP/cube.nc: no signal_material; simulate with the per_material output
+    --isel 'geometry=3': index 3 is out of range; geometry of TMP/cube.nc has 1 entries (0..0)
     """
-    import numpy as np
-    import xarray as xr
-
-    from .. import invert
-    from ..errors import InversionError
     from ..materials.tables import write_netcdf_atomic
-    from ..photometry import read_light_curve
 
-    if args.invert_command == "unmix":
-        with xr.open_dataset(args.cube) as cube:
-            terms = cube.load()["signal_material"] if "signal_material" in cube else None
-        if terms is None:
-            raise InversionError(
-                f"{args.cube}: no signal_material; simulate with the per_material output"
-            )
-        for item in args.isel or []:
-            dim, _, idx = item.partition("=")
-            terms = terms.isel({dim: int(idx)})
-        try:
-            y, sigma = invert.read_spectrum(args.measured)
-        except InversionError:
-            lc = read_light_curve(args.measured)
-            if args.range_km is None:
-                raise InversionError(
-                    "--range-km: needed to turn measured magnitudes into signal"
-                ) from None
-            y, sigma = invert.magnitudes_to_signal(lc, args.range_km)
-            terms = invert.band_terms(terms, [str(b) for b in y.band.values])
-        ds = invert.unmix(
-            y,
-            terms,
-            sigma,
-            select=None if args.select == "none" else args.select,
-            criterion=args.criterion,
-        )
-        print(
-            f"unmix {args.measured}: chi2 {float(ds.chi2):.4g}, "
-            f"reduced {float(ds.reduced_chi2):.4g}, "
-            f"{args.criterion} selection: {ds.attrs['selected_materials']}"
-        )
-        for m in ds.material.values:
-            print(
-                f"  {m!s:<24} scale {float(ds.scale.sel(material=m)):.4f} "
-                f"+- {float(ds.scale_uncertainty.sel(material=m)):.4f}"
-            )
-        print(f"  degenerate: {ds.attrs['degenerate']}")
-    else:
-        sc = spacecraft_of(args)
-        lo, hi, n = args.periods
-        ds = invert.fit_spin(
-            read_light_curve(args.measured),
-            sc,
-            to_sun=args.to_sun,
-            to_observer=args.to_observer,
-            periods=np.linspace(lo, hi, int(n)),
-            axis_body=args.axis_body,
-            n_axes=args.n_axes,
-            n_phases=args.n_phases,
-            offset=args.offset,
-        )
-        print(
-            f"spin fit of {args.measured}: {ds.attrs['n_candidates']} candidates in "
-            f"{ds.attrs['search_seconds']:.1f} s; chi2 {float(ds.chi2):.4g}, "
-            f"reduced {float(ds.reduced_chi2):.4g}"
-        )
-        for k in ("axis_longitude", "axis_latitude", "period", "phase"):
-            print(
-                f"  {k:<15} {float(ds[k]):10.4f} +- {float(ds[k + '_uncertainty']):.4f} "
-                f"{ds[k].attrs['units']}"
-            )
-        for sname in ds.solution.values:
-            print(
-                f"  alternative {sname!s:<14} "
-                f"chi2 gap {float(ds.chi2_gap.sel(solution=sname)):10.2f}"
-            )
+    if args.output and Path(args.output).exists() and not args.overwrite:
+        raise FileExistsError(f"{args.output} exists; pass --overwrite to replace it")
+    ds = _unmix(args) if args.invert_command == "unmix" else _spin(args)
     if args.output:
         write_netcdf_atomic(ds, args.output, overwrite=args.overwrite)
         print(f"wrote {args.output}")

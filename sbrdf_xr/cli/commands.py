@@ -170,7 +170,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     ``--engine`` the engine rows), their table printed and written to the files of
     ``--output`` (netCDF), ``--csv`` and ``--plot`` (PNG); returns 0.
 
-    Even with ``--quick`` the benchmarks run for minutes.
+    With ``--quick`` the benchmarks run for about a minute, without it for many.
 
     Examples
     --------
@@ -181,8 +181,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
     >>> args = build_parser().parse_args(["bench", "--quick", "--csv", "bench.csv"])
     >>> args.func is cmd_bench
     True
-    >>> args.quick, args.engine, args.output, args.csv, args.plot
-    (True, False, None, 'bench.csv', None)
+    >>> args.quick, args.engine, args.output, args.csv, args.plot, args.record_presets
+    (True, False, None, 'bench.csv', None, False)
     """
     from .. import bench
 
@@ -191,8 +191,14 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
         rows = engine_rows(quick=args.quick)
     else:
-        rows = bench.run(quick=args.quick)
+        if args.repeat is not None and args.repeat < 1:
+            raise ValidationError(f"--repeat: got {args.repeat}; expected a whole number >= 1")
+        rows = bench.run(quick=args.quick, repeat=args.repeat)
     print(bench.format_rows(rows))
+    if args.record_presets:
+        command = "sbrdf-xr bench" + (" --quick" if args.quick else "")
+        path = bench.write_presets(bench.presets_record(rows, command))
+        print(f"wrote {path}")
     ds = bench.rows_to_dataset(rows)
     if args.output:
         from ..materials.tables import write_netcdf_atomic
@@ -269,7 +275,9 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     elif changes:
         scene = scene.with_options(**changes)
     if scene.materials is None:  # the catalog's tables, those to build labelled as one batch
-        catalog.load_materials(scene.spacecraft.materials, dtype=scene.dtype)
+        known = set(catalog.names("material"))
+        wanted = [m for m in scene.spacecraft.materials if m in known]
+        catalog.load_materials(wanted, dtype=scene.dtype)
     plan = scene.plan()
     print(plan)
     if args.plan:
@@ -425,7 +433,9 @@ def _knob_values(items: list[str]) -> dict[str, object]:
 
 
 def cmd_knobs(args: argparse.Namespace) -> int:
-    """``sbrdf-xr knobs``: the table of :func:`sbrdf_xr.engine.knobs.knob_table`; returns 0.
+    """``sbrdf-xr knobs``: the table of :func:`sbrdf_xr.engine.knobs.knob_table`, then each
+    preset's measured cost and error from the benchmark run recorded in the package
+    (:func:`sbrdf_xr.bench.presets.presets_table`); returns 0.
 
     Examples
     --------
@@ -440,39 +450,51 @@ def cmd_knobs(args: argparse.Namespace) -> int:
     >>> lines = out.getvalue().splitlines()
     >>> status, lines[0].split()
     (0, ['knob', 'default', 'fast', '/', 'balanced', '/', 'reference', 'trades'])
-    >>> [line.split()[0] for line in lines[1:]] == list(KNOBS)  # one line per knob
+    >>> [line.split()[0] for line in lines[1 : len(KNOBS) + 1]] == list(KNOBS)  # one per knob
+    True
+    >>> lines[len(KNOBS) + 2].startswith("presets as measured by `sbrdf-xr bench")
     True
     """
+    from ..bench.presets import presets_table
     from ..engine.knobs import knob_table
 
     print(knob_table())
+    print()
+    print(presets_table())
     return 0
 
 
-def _save_figure(cube_path: str | Path, figure_path: str) -> None:
+def _save_figure(
+    cube_path: str | Path, figure_path: str, bands: tuple[str, ...] = ("V", "R", "I")
+) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
 
-    from ..plot import plot_cube
+    from ..plot import cube_figure
 
     cube = open_cube(cube_path)
     try:
-        fig = plot_cube(cube)
+        fig = cube_figure(cube, bands=bands)
     except (KeyError, ValueError, IndexError) as exc:
         raise ValidationError(
             f"{cube_path}: cannot be drawn ({type(exc).__name__}: {exc})"
         ) from None
+    import matplotlib.pyplot as plt
+
     try:
         fig.savefig(figure_path, dpi=120)
     except ValueError as exc:  # an unknown image format
         raise ValidationError(f"{figure_path}: {exc}") from None
+    finally:
+        plt.close(fig)
     print(f"wrote {figure_path}")
 
 
 def cmd_plot(args: argparse.Namespace) -> int:
-    """``sbrdf-xr plot CUBE -o FIG``: the cube's figure (:func:`sbrdf_xr.plot.plot_cube`) in
-    an image file; returns 0.
+    """``sbrdf-xr plot CUBE -o FIG``: the cube's figure (:func:`sbrdf_xr.plot.cube_figure`,
+    chosen by the cube: an observation, a rotation sweep or spectra) in an image file;
+    returns 0.
 
     Examples
     --------

@@ -29,7 +29,6 @@ __all__ = [
     "add_observe_parser",
     "attitude_of",
     "cmd_observe",
-    "light_curve_figure",
     "observation_of",
 ]
 
@@ -382,65 +381,6 @@ def cmd_observe(args: argparse.Namespace) -> int:
         simulate(plan), Path(args.output), overwrite=args.overwrite, progress=not args.quiet
     )
     print(f"wrote {path}")
-    if args.plot and bands:
-        light_curve_figure(path, bands).savefig(args.plot, dpi=110)
-        print(f"wrote {args.plot}")
-    elif args.plot:
-        _save_figure(path, args.plot)
+    if args.plot:
+        _save_figure(path, args.plot, bands=tuple(bands) or ("V", "R", "I"))
     return 0
-
-
-def light_curve_figure(cube_path: str | Path, bands: tuple[str, ...]) -> Any:
-    """The light curve of a pass cube: magnitudes against UTC (the Earth's umbra and
-    penumbra shaded) above the elevation.
-
-    Examples
-    --------
-    >>> callable(light_curve_figure)  # drawn by 'sbrdf-xr observe --plot'; see its tests
-    True
-    """
-    import matplotlib.dates as mdates
-    import numpy as np
-    from matplotlib.figure import Figure
-
-    from ..photometry import magnitudes
-    from .output import open_cube
-
-    cube = open_cube(cube_path)
-    mags = magnitudes(cube, list(bands))
-    t = cube.time.values
-    fig = Figure(figsize=(9, 5.5), layout="constrained")
-    ax, el = fig.subplots(2, 1, sharex=True, height_ratios=(3, 1))
-    f = cube.sunlit_fraction.values
-    for a in (ax, el):
-        for where, colour, label in (
-            (f == 0, "0.85", "umbra"),
-            ((f > 0) & (f < 1), "khaki", "penumbra"),
-        ):
-            if where.any():
-                a.fill_between(
-                    t,
-                    0,
-                    1,
-                    where=where,
-                    transform=a.get_xaxis_transform(),
-                    color=colour,
-                    label=label if a is ax else None,
-                )
-    for b in mags.band.values:
-        m = mags.sel(band=b).values
-        ax.plot(t, np.where(np.isfinite(m), m, np.nan), lw=1, label=str(b))
-    ax.invert_yaxis()
-    ax.set_ylabel(f"{mags.attrs.get('magnitude_system', 'AB')} magnitude")
-    law = str(cube.attrs.get("attitude_law", "")).split("(")[0]
-    ax.set_title(
-        f"{cube.attrs.get('orbit_name', '')} from {cube.attrs.get('site_name', '')}, "
-        f"attitude {law}, {t.size} times",
-        fontsize=10,
-    )
-    ax.legend(fontsize=8, ncol=6, loc="best")
-    el.plot(t, cube.elevation, color="k", lw=1)
-    el.set_ylabel("elevation [degree]")
-    el.set_xlabel(f"UTC ({str(t[0])[:10]})")
-    el.xaxis.set_major_formatter(mdates.DateFormatter("%H:%M:%S"))
-    return fig

@@ -14,12 +14,13 @@ Sub-commands::
              --elements TLE|OMM|NAME (--site NAME | --lat D --lon D [--height M])
              --start UTC (--stop UTC | --duration S) [--step S] [--attitude LAW ...]
              [--spacecraft NAME|MESH] [--bands V R I] [--plot FIG.png]   attitude law
-    sbrdf-xr plot CUBE.nc -o FIG.png        the cube's natural figure (light curve or spectra)
+    sbrdf-xr plot CUBE.nc -o FIG.png        the cube's figure: a pass against UTC, a rotation's
+                                            BRDF and magnitudes, or a few labelled spectra
     sbrdf-xr photometry CUBE.nc [--bands V R I] [--range-km KM] [--extinction V=0.2 ...]
                         [--colours V-R,R-I]
              [--system ab|vega] [-o PHOT.nc] [--csv PHOT.csv]
     sbrdf-xr invert unmix MEASURED --cube CUBE.nc [--range-km R] [-o OUT.nc]   material areas
-    sbrdf-xr invert spin CURVE --spacecraft canx1 --to-sun X Y Z --to-observer X Y Z
+    sbrdf-xr invert spin CURVE (--cube CUBE.nc | --scene SCENE | --to-sun X Y Z --to-observer X Y Z)
              --periods MIN MAX N [-o OUT.nc]                                      spin state
 
 Wherever a spacecraft or a material is named, a file may stand instead: a mesh file
@@ -108,7 +109,9 @@ def build_parser() -> argparse.ArgumentParser:
     pi.add_argument("file", nargs="?")
     pi.set_defaults(func=cmd_info)
 
-    pk = sub.add_parser("knobs", help="the numerical knobs, their defaults and the presets")
+    pk = sub.add_parser(
+        "knobs", help="the numerical knobs, their defaults, the presets and their measured cost"
+    )
     pk.set_defaults(func=cmd_knobs)
 
     pb = sub.add_parser("bench", help="accuracy/cost benchmarks (timings as ratios)")
@@ -121,6 +124,17 @@ def build_parser() -> argparse.ArgumentParser:
     pb.add_argument("-o", "--output", help="write the table to this netCDF file")
     pb.add_argument("--csv", help="write the table to this CSV file")
     pb.add_argument("--plot", help="draw the accuracy/time front to this PNG file")
+    pb.add_argument(
+        "--repeat",
+        type=int,
+        help="timing runs of every row, the best kept (default 5, 3 with --quick)",
+    )
+    pb.add_argument(
+        "--record-presets",
+        action="store_true",
+        help="write the presets' rows to the package's sbrdf_xr/bench/presets.json, which "
+        "'sbrdf-xr knobs' shows (run it in a source checkout and commit the file)",
+    )
     pb.set_defaults(func=cmd_bench)
 
     psim = sub.add_parser("simulate", help="run a scene into a netCDF cube")
@@ -155,7 +169,11 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"zlib compression level of the netCDF cube (default {DEFAULT_COMPLEVEL}; 0: "
         "none, fastest, and resumable after a kill at any instant)",
     )
-    psim.add_argument("--plot", help="also write the cube's figure to this PNG file")
+    psim.add_argument(
+        "--plot",
+        help="also write the cube's figure to this PNG file (chosen by the cube: a pass "
+        "against UTC, a rotation's BRDF and V, R, I magnitudes, or a few spectra)",
+    )
     psim.add_argument(
         "--overwrite",
         action="store_true",
@@ -256,21 +274,28 @@ def build_parser() -> argparse.ArgumentParser:
     pu.add_argument("--criterion", choices=("bic", "aic"), default="bic")
     pspin = isub.add_parser("spin", help="spin axis, period and phase from a colour light curve")
     pspin.add_argument(
-        "measured", help="light curve CSV/netCDF (read_light_curve format, times in s)"
+        "measured", help="light curve CSV/ECSV/netCDF (read_light_curve format; UTC times or s)"
     )
     pspin.add_argument(
-        "--spacecraft", default="canx1", help="a catalog name (default canx1) or a mesh file"
+        "--spacecraft",
+        default=None,
+        help="a catalog name or a mesh file (default: the --scene's, else canx1)",
     )
     _mesh_options(pspin)
     pspin.add_argument(
-        "--to-sun", type=float, nargs=3, required=True, help="inertial direction to the Sun"
+        "--cube",
+        help="the geometry: a netCDF cube over time with to_sun, to_observer, quaternion "
+        "(simulate of an observation)",
     )
     pspin.add_argument(
-        "--to-observer",
-        type=float,
-        nargs=3,
-        required=True,
-        help="inertial direction to the observer",
+        "--scene",
+        help="the geometry: a built-in scene name or a scene TOML file with an observation",
+    )
+    pspin.add_argument(
+        "--to-sun", type=float, nargs=3, help="the geometry: inertial direction to the Sun"
+    )
+    pspin.add_argument(
+        "--to-observer", type=float, nargs=3, help="inertial direction to the observer"
     )
     pspin.add_argument(
         "--periods",
@@ -283,9 +308,21 @@ def build_parser() -> argparse.ArgumentParser:
     pspin.add_argument(
         "--axis-body", type=float, nargs=3, default=(0.0, 0.0, 1.0), help="body spin axis"
     )
-    pspin.add_argument("--n-axes", type=int, default=300)
-    pspin.add_argument("--n-phases", type=int, default=36)
+    pspin.add_argument("--n-axes", type=int, default=120, help="axes of the search grid")
+    pspin.add_argument("--n-phases", type=int, default=16, help="phases of the search grid")
     pspin.add_argument("--offset", choices=("band", "common"), default="band")
+    pspin.add_argument(
+        "--method",
+        choices=("auto", "direct", "table", "shift"),
+        default="auto",
+        help="grid evaluation: exact (direct), or spin-angle tables checked against it",
+    )
+    pspin.add_argument(
+        "--size-limit",
+        type=float,
+        default=1.0,
+        help="factor on the size and work limits of the search (default 1)",
+    )
     for q in (pu, pspin):
         q.add_argument("-o", "--output", help="write the result Dataset to this netCDF file")
         q.add_argument("--overwrite", action="store_true", help="replace an existing output file")
@@ -293,9 +330,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     add_observe_parser(sub, _mesh_options)
 
-    pp = sub.add_parser("plot", help="draw a cube's figure")
-    pp.add_argument("cube")
-    pp.add_argument("-o", "--output", required=True)
+    pp = sub.add_parser(
+        "plot",
+        help="draw a cube's figure",
+        description="Draw the figure of a cube, chosen by what it is: an observation over "
+        "time (magnitudes and colours against UTC with the geometry and the Earth's shadow), "
+        "a rotation sweep (broadband BRDF and V, R, I magnitudes), or a few labelled spectra.",
+    )
+    pp.add_argument("cube", help="a cube file (netCDF or Zarr)")
+    pp.add_argument("-o", "--output", required=True, help="the image file (PNG, PDF, SVG, ...)")
     pp.set_defaults(func=cmd_plot)
     return p
 
@@ -347,7 +390,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     level = logger.level
     logger.setLevel(logging.WARNING)
     try:
-        with command_line_messages():
+        # --quiet: no progress bars, of the writer nor of the tables the command builds
+        with command_line_messages(), catalog.showing_progress(not getattr(args, "quiet", False)):
             return int(args.func(args))
     except (SbrdfError, OSError) as exc:
         print(f"sbrdf-xr: error: {_one_line(exc)}", file=sys.stderr)

@@ -9,14 +9,8 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ._spin_search import (
-    Kernel,
-    Problem,
-    fibonacci_sphere,
-    light_curve_fluxes,
-    search,
-    search_shift,
-)
+from ._spin_data import light_curve_fluxes, spin_geometry
+from ._spin_search import Kernel, Problem, fibonacci_sphere, run_search
 
 __all__ = ["benchmark_spin_search"]
 
@@ -30,14 +24,16 @@ def benchmark_spin_search(
     bands: Sequence[str] = ("V", "R", "I"),
     n_threads: int | None = None,
     spacecraft: Any = None,
-    methods: Sequence[str] = ("direct", "shift"),
+    methods: Sequence[str] = ("direct", "table", "shift"),
+    n_angles: int = 360,
 ) -> list[dict[str, Any]]:
     """Wall time of the spin-state search of :func:`fit_spin`.
 
-    A synthetic light curve of ``n_samples`` times in each band at fixed directions; the
-    candidates are Fibonacci axes x 10 periods x 10 phases (``n/100`` axes).  ``direct``
-    runs every candidate at every time through the kernel; ``shift`` evaluates the kernel
-    once per axis on the spin-angle grid.  Returns one row per method and size:
+    A synthetic light curve of ``n_samples`` times in each band, the observer moving
+    through 60 degrees; the candidates are Fibonacci axes x 10 periods x 10 phases
+    (``n/100`` axes).  ``direct`` runs every candidate at every time through the kernel;
+    ``table`` evaluates the kernel once per axis and time on ``n_angles`` spin angles;
+    ``shift`` once per axis at the mean directions.  Returns one row per method and size:
     ``method``, ``candidates``, ``samples``, ``bands``, ``seconds``, ``per_candidate_ms``.
 
     Examples
@@ -75,19 +71,19 @@ def benchmark_spin_search(
     )
     data = light_curve_fluxes(lc)
     kern = Kernel(sc, list(bands))
-    prob = Problem(
-        data, kern, [1.0, 0, 0], [np.cos(0.5), np.sin(0.5), 0.0], np.array([0.0, 0, 1]), "band"
-    )
+    az = np.radians(np.linspace(0.0, 60.0, n_samples))
+    to_obs = np.stack([np.cos(az), np.sin(az), np.zeros_like(az)], axis=-1)
+    geo = spin_geometry(data["time"], None, [0.3, 0.9, 0.3], to_obs)
+    prob = Problem(data, geo, kern, np.array([0.0, 0, 1]), "band")
     periods = np.linspace(20.0, 40.0, 10)
     phases = np.arange(10) * 36.0
-    search(prob, fibonacci_sphere(2), periods[:1], phases[:1], n_threads)  # compile, warm caches
+    run_search("direct", prob, fibonacci_sphere(2), periods[:1], phases[:1], n_threads, n_angles)
     rows = []
     for method in methods:
-        run = {"direct": search, "shift": search_shift}[method]
         for n in n_candidates:
             axes = fibonacci_sphere(max(1, int(n) // 100))
             t0 = time.perf_counter()
-            run(prob, axes, periods, phases, n_threads)
+            run_search(method, prob, axes, periods, phases, n_threads, n_angles)
             dt = time.perf_counter() - t0
             nc = len(axes) * 100
             rows.append(

@@ -4,14 +4,16 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 import xarray as xr
 
 from ..errors import InversionError
-from ._spin_search import LN10_2P5
+from ._spin_data import LN10_2P5
 
-__all__ = ["band_terms", "magnitudes_to_signal", "read_spectrum"]
+__all__ = ["band_terms", "magnitudes_to_signal", "measured_kind", "read_spectrum"]
 
 
 # ------------------------------------------------------------------------------ measured data
@@ -94,8 +96,18 @@ def magnitudes_to_signal(
         )
     msun = sun_magnitudes(bands).values
     m = np.asarray(light_curve["magnitude"].values, dtype=np.float64)
+    sm = np.asarray(light_curve["uncertainty"].values, dtype=np.float64)
+    if not np.all(np.isfinite(m)):
+        raise InversionError(
+            f"magnitudes: {int((~np.isfinite(m)).sum())} are NaN or infinite (bands "
+            f"{[b for b, v in zip(bands, m, strict=True) if not np.isfinite(v)]})"
+        )
+    if not np.all(np.isfinite(sm) & (sm > 0)):
+        raise InversionError(
+            f"magnitudes: uncertainties must be finite and > 0 [mag], got {sm.tolist()}"
+        )
     s = (range_km * 1e3) ** 2 * 10 ** (-0.4 * (m - msun))
-    sig = s * LN10_2P5 * np.asarray(light_curve["uncertainty"].values, dtype=np.float64)
+    sig = s * LN10_2P5 * sm
     coords = {"band": bands}
     return (
         xr.DataArray(
@@ -110,48 +122,182 @@ def magnitudes_to_signal(
     )
 
 
-def read_spectrum(path: str | os.PathLike[str]) -> tuple[xr.DataArray, xr.DataArray]:
-    """A measured spectrum from CSV or netCDF: columns ``wavelength`` [nm], ``signal``
-    [m2 sr-1] and ``uncertainty`` (same units, > 0).
+def measured_kind(path: str | os.PathLike[str]) -> str:
+    """What a measured file holds: ``"spectrum"`` (a ``wavelength`` column or variable) or
+    ``"light curve"`` (band magnitudes: a ``band`` column).
 
     Examples
     --------
     >>> import tempfile
     >>> from pathlib import Path
+    >>> from sbrdf_xr.invert import measured_kind
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     a, b = Path(tmp) / "a.csv", Path(tmp) / "b.csv"
+    ...     _ = a.write_text("wavelength,signal,uncertainty\\n500,1,0.1\\n")
+    ...     _ = b.write_text("time,band,magnitude,uncertainty\\n0,V,8.0,0.01\\n")
+    ...     measured_kind(a), measured_kind(b)
+    ('spectrum', 'light curve')
+    """
+    path = _regular_file(path, "measured")
+    if path.suffix.lower() in (".nc", ".nc4"):
+        try:
+            with xr.open_dataset(path) as ds:
+                names = set(map(str, ds.variables))
+        except (OSError, ValueError) as exc:
+            raise InversionError(
+                f"{path}: not a readable netCDF file ({type(exc).__name__})"
+            ) from None
+    else:
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            head = ""
+            for line in fh:
+                if line.strip() and not line.lstrip().startswith("#"):
+                    head = line
+                    break
+        if not head:
+            raise InversionError(
+                f"{path}: empty; expected a spectrum (a header wavelength,signal,uncertainty "
+                "and one row per wavelength) or band magnitudes (time,band,magnitude,uncertainty)"
+            )
+        names = {c.strip().strip('"').lower() for c in head.split(",")}
+    if "wavelength" in names:
+        return "spectrum"
+    if "band" in names:
+        return "light curve"
+    raise InversionError(
+        f"{path}: neither a spectrum (columns wavelength, signal, uncertainty) nor band "
+        "magnitudes (columns time, band, magnitude, uncertainty): no wavelength or band column"
+    )
+
+
+def _regular_file(path: str | os.PathLike[str], what: str) -> Path:
+    path = Path(path)
+    if not path.exists():
+        raise InversionError(f"{what}: file {path} does not exist")
+    if not path.is_file():
+        raise InversionError(f"{what}: {path} is not a regular file (a directory or a device)")
+    return path
+
+
+def _column(df: Any, name: str, path: Path) -> np.ndarray:
+    import pandas as pd
+
+    values = pd.to_numeric(df[name], errors="coerce").to_numpy(dtype=np.float64)
+    text = df[name].fillna("nan").astype(str).str.strip()
+    bad = np.isnan(values) & ~text.str.lower().isin(["nan", "", "none"]).to_numpy()
+    if bad.any():
+        rows = np.flatnonzero(bad)
+        raise InversionError(
+            f"{path}: column {name} has {rows.size} values that are not numbers (data rows "
+            f"{', '.join(str(r + 1) for r in rows[:5])}); allowed: decimal numbers"
+        )
+    return values
+
+
+def read_spectrum(path: str | os.PathLike[str]) -> tuple[xr.DataArray, xr.DataArray]:
+    """A measured spectrum from CSV or netCDF: columns ``wavelength`` [nm], ``signal``
+    [m2 sr-1] and ``uncertainty`` (same units, > 0), one row per wavelength.
+
+    Raises
+    ------
+    InversionError
+        A missing, empty or unreadable file, missing columns, values that are not numbers,
+        NaN values, wavelengths not > 0 or repeated, uncertainties not > 0: naming the
+        file, the column and the rows.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.errors import InversionError
     >>> from sbrdf_xr.invert import read_spectrum
     >>> rows = "wavelength,signal,uncertainty\\n500,0.10,0.01\\n600,0.12,0.01\\n700,0.11,0.01\\n"
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     path = Path(tmp) / "spectrum.csv"
     ...     _ = path.write_text(rows)
     ...     signal, sigma = read_spectrum(path)
+    ...     _ = path.write_text(rows.replace("0.01\\n700", "-0.01\\n700"))
+    ...     try:
+    ...         read_spectrum(path)
+    ...     except InversionError as exc:
+    ...         error = str(exc).replace(tmp, "TMP")
     >>> signal.dims, signal.wavelength.values.tolist(), signal.values.tolist()
     (('wavelength',), [500.0, 600.0, 700.0], [0.1, 0.12, 0.11])
     >>> sigma.values.tolist()
     [0.01, 0.01, 0.01]
+    >>> print(error)
+    TMP/spectrum.csv: uncertainty must be finite and > 0; data rows 2 are not (e.g. -0.01)
     """
-    from pathlib import Path
-
     import pandas as pd
 
-    path = Path(path)
-    if not path.is_file():
-        raise InversionError(f"spectrum: file {path} does not exist")
+    path = _regular_file(path, "spectrum")
     if path.suffix.lower() in (".nc", ".nc4"):
-        with xr.open_dataset(path) as ds:
-            df = ds.load().reset_coords().to_dataframe().reset_index()
+        try:
+            with xr.open_dataset(path) as ds:
+                df = ds.load().reset_coords().to_dataframe().reset_index()
+        except (OSError, ValueError) as exc:
+            raise InversionError(
+                f"{path}: not a readable netCDF file ({type(exc).__name__})"
+            ) from None
     else:
-        df = pd.read_csv(path, skipinitialspace=True)
+        try:
+            df = pd.read_csv(
+                path, skipinitialspace=True, comment="#", dtype=str, keep_default_na=False
+            )
+        except pd.errors.EmptyDataError:
+            raise InversionError(
+                f"{path}: empty; a spectrum needs a header wavelength,signal,uncertainty and "
+                "one row per wavelength"
+            ) from None
+        except (pd.errors.ParserError, UnicodeDecodeError) as exc:
+            raise InversionError(f"{path}: not a CSV table ({type(exc).__name__})") from None
         df.columns = [str(c).strip() for c in df.columns]
     missing = [c for c in ("wavelength", "signal", "uncertainty") if c not in df.columns]
     if missing:
         raise InversionError(
             f"{path}: missing columns {missing}; needs wavelength, signal, uncertainty"
         )
-    wl = df["wavelength"].to_numpy(dtype=np.float64)
-    y = xr.DataArray(
-        df["signal"].to_numpy(dtype=np.float64),
+    if len(df) == 0:
+        raise InversionError(f"{path}: no rows; a spectrum needs one row per wavelength")
+    wl, y, sig = (_column(df, c, path) for c in ("wavelength", "signal", "uncertainty"))
+    for name, v in (("wavelength", wl), ("signal", y)):
+        bad = ~np.isfinite(v)
+        if bad.any():
+            raise InversionError(
+                f"{path}: column {name} has NaN or infinite values in data rows {_rows(bad)}; "
+                "drop those rows"
+            )
+    checks = (
+        ("wavelength", wl, ~(wl > 0), "> 0 [nm]"),
+        ("uncertainty", sig, ~(np.isfinite(sig) & (sig > 0)), "finite and > 0"),
+    )
+    for name, v, bad, allowed in checks:
+        if bad.any():
+            raise InversionError(
+                f"{path}: {name} must be {allowed}; data rows {_rows(bad)} are not "
+                f"(e.g. {v[bad][0]:g})"
+            )
+    uniq, counts = np.unique(wl, return_counts=True)
+    if (counts > 1).any():
+        raise InversionError(
+            f"{path}: wavelengths {uniq[counts > 1][:5].tolist()} appear more than once; give "
+            "one row per wavelength"
+        )
+    order = np.argsort(wl)
+    y_da = xr.DataArray(
+        y[order],
         dims="wavelength",
-        coords={"wavelength": wl},
+        coords={
+            "wavelength": ("wavelength", wl[order], {"units": "nm", "long_name": "wavelength"})
+        },
         attrs={"units": "m2 sr-1", "long_name": "measured signal"},
     )
-    return y, y.copy(data=df["uncertainty"].to_numpy(dtype=np.float64))
+    sig_da = y_da.copy(data=sig[order])
+    sig_da.attrs = {"units": "m2 sr-1", "long_name": "1-sigma uncertainty of the measured signal"}
+    return y_da, sig_da
+
+
+def _rows(bad: np.ndarray) -> str:
+    idx = np.flatnonzero(bad) + 1
+    head = ", ".join(str(i) for i in idx[:5])
+    return head + (f", ... ({idx.size} in all)" if idx.size > 5 else "")

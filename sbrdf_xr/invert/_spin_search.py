@@ -1,44 +1,53 @@
-"""The spin-state model and its chi-square, and the global search over candidate spin states.
+"""The spin model, its chi-square, and the searches over a grid of candidate spin states.
 
-A spin state (inertial axis, period, phase) turns the Sun and observer directions into
-body-frame geometries; :class:`Kernel` gives the band signal there from pre-integrated
-tables; :class:`Problem` holds a light curve with its geometry and returns the chi-square
-of candidates, the flux scale of each band solved in closed form; :func:`search` and
-:func:`search_shift` evaluate it over a grid of candidates (see :func:`sbrdf_xr.invert.fit_spin`).
+See :func:`sbrdf_xr.invert.fit_spin`.  Three ways to evaluate the grid:
+
+``direct``
+    Every candidate (axis, period, phase) at every time through the compiled kernel: exact.
+``table``
+    Per axis, the kernel at every distinct time on ``n_angles`` spin angles; each (period,
+    phase) reads the band signal at its angle ``phase + 360 t / P`` by periodic cubic
+    (Catmull-Rom) interpolation.  The geometry is exact; only the spin angle is
+    interpolated.  Cheaper than ``direct`` when periods x phases exceed ``n_angles``.
+``shift``
+    One such table per axis at the mean Sun and observer directions: exact in the
+    geometry only when the directions are fixed.
+
+An approximate search is checked against the exact model (:func:`approximation_error`).
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
-import xarray as xr
 from numpy.typing import ArrayLike
 
 from ..errors import InversionError
 from ..kernels import sums as _kernels
+from ._spin_data import SpinGeometry
 
 __all__ = [
-    "LN10_2P5",
+    "METHODS",
     "Kernel",
     "Problem",
     "align_matrices",
+    "approximation_error",
     "body_vectors",
-    "directions",
     "fibonacci_sphere",
-    "light_curve_fluxes",
     "lonlat",
-    "search",
-    "search_shift",
+    "run_search",
     "spin_model",
     "vec",
 ]
 
-#: ln(10) / 2.5: d(flux) / flux per magnitude.
-LN10_2P5 = np.log(10.0) / 2.5
+#: Grid evaluations of :func:`run_search`.
+METHODS = ("direct", "table", "shift")
+#: Working memory of one block of the search (candidates x times, or periods x values).
+BLOCK_BYTES = 64 * 2**20
 
 
 def fibonacci_sphere(n: int) -> np.ndarray:
@@ -91,10 +100,13 @@ def align_matrices(axis_body: np.ndarray, axes: np.ndarray) -> np.ndarray:
     return Rotation.from_rotvec(u * ang[:, None]).as_matrix()
 
 
-def spin_model(axis_body: ArrayLike, axis: ArrayLike, period_s: float, phase_deg: float) -> Any:
+def spin_model(
+    axis_body: ArrayLike, axis: ArrayLike, period_s: float, phase_deg: float, epoch: Any = None
+) -> Any:
     """The :class:`sbrdf_xr.observing.attitude.Spin` law of a spin state: the body turns about
     ``axis_body`` at ``360/period_s`` degree s-1 from the attitude that takes
-    ``axis_body`` to the inertial ``axis`` by the shortest arc, angle ``phase_deg`` at t = 0.
+    ``axis_body`` to the inertial ``axis`` by the shortest arc, angle ``phase_deg`` at
+    ``epoch`` (UTC; default t = 0, or the start of an observation).
 
     Examples
     --------
@@ -120,6 +132,7 @@ def spin_model(axis_body: ArrayLike, axis: ArrayLike, period_s: float, phase_deg
         rate_deg_s=360.0 / float(period_s),
         phase_deg=float(phase_deg),
         initial=q,
+        epoch=epoch,
     )
 
 
@@ -177,127 +190,70 @@ class Kernel:
         return np.asarray(r.signal, dtype=np.float64).reshape(*s.shape[:-1], len(self.bands))
 
 
-def light_curve_fluxes(
-    light_curve: xr.Dataset, bands: Sequence[str] | None = None
-) -> dict[str, np.ndarray]:
-    """Times [s], band index, relative flux and its uncertainty from a light curve.
-
-    ``light_curve`` is what :func:`sbrdf_xr.photometry.read_light_curve` returns (over
-    ``obs``: ``magnitude``, ``uncertainty`` [mag], coords ``band``, ``time`` [s]) or the
-    same with ``flux`` and ``flux_uncertainty`` instead of magnitudes.
-
-    Examples
-    --------
-    Magnitudes become fluxes relative to the median magnitude (9.75 here),
-    ``10**(-0.4 (m - 9.75))``:
-
-    >>> import xarray as xr
-    >>> from sbrdf_xr.invert import light_curve_fluxes
-    >>> lc = xr.Dataset(
-    ...     {"magnitude": ("obs", [10.0, 9.5, 10.0, 9.0]), "uncertainty": ("obs", [0.01] * 4)},
-    ...     coords={"time": ("obs", [0.0, 0.0, 10.0, 10.0]), "band": ("obs", ["V", "R"] * 2)},
-    ... )
-    >>> d = light_curve_fluxes(lc)
-    >>> d["labels"].tolist(), d["band"].tolist()
-    (['V', 'R'], [0, 1, 0, 1])
-    >>> d["flux"].round(6).tolist()
-    [0.794328, 1.258925, 0.794328, 1.995262]
-    """
-    if not isinstance(light_curve, xr.Dataset) or (
-        "time" not in light_curve.coords and "time" not in light_curve
-    ):
-        raise InversionError(
-            "light curve: expected a Dataset with a time coordinate [s] (read_light_curve)"
-        )
-    t = np.asarray(light_curve["time"].values, dtype=np.float64)
-    band = np.asarray(light_curve["band"].values).astype(str)
-    labels = list(dict.fromkeys(band)) if bands is None else [str(b) for b in bands]
-    unknown = sorted(set(band) - set(labels))
-    if unknown:
-        raise InversionError(f"light curve bands {unknown} are not among the model bands {labels}")
-    if "flux" in light_curve:
-        f = np.asarray(light_curve["flux"].values, dtype=np.float64)
-        sf = np.asarray(light_curve["flux_uncertainty"].values, dtype=np.float64)
-    elif "magnitude" in light_curve:
-        m = np.asarray(light_curve["magnitude"].values, dtype=np.float64)
-        sm = np.asarray(light_curve["uncertainty"].values, dtype=np.float64)
-        if not np.all(np.isfinite(m)):
-            raise InversionError("light curve: magnitudes must be finite")
-        f = 10 ** (-0.4 * (m - np.nanmedian(m)))
-        sf = f * LN10_2P5 * sm
-    else:
-        raise InversionError(
-            f"light curve: needs magnitude/uncertainty or flux/flux_uncertainty, got "
-            f"{list(light_curve.data_vars)}"
-        )
-    bad = ~(np.isfinite(sf) & (sf > 0))
-    if bad.any():
-        raise InversionError(
-            f"light curve: {int(bad.sum())} uncertainties that are not finite and > 0"
-        )
-    if not np.all(np.isfinite(t)) or not np.all(np.isfinite(f)):
-        raise InversionError("light curve: times and values must be finite")
-    return {
-        "time": t,
-        "band": np.array([labels.index(b) for b in band]),
-        "flux": f,
-        "sigma": sf,
-        "labels": np.array(labels),
-    }
-
-
-def directions(v: Any, n_t: int, name: str) -> np.ndarray:
-    arr = np.asarray(v, dtype=np.float64)
-    if arr.shape == (3,):
-        arr = np.broadcast_to(arr, (n_t, 3))
-    if arr.shape != (n_t, 3):
-        raise InversionError(
-            f"{name}: expected shape (3,) or ({n_t}, 3) (one per distinct time), got {arr.shape}"
-        )
-    nrm = np.linalg.norm(arr, axis=-1)
-    if not np.all(nrm > 0):
-        raise InversionError(f"{name}: zero-length direction")
-    return arr / nrm[:, None]
-
-
 class Problem:
-    """A light curve, its geometry and the model: chi-square of spin states."""
+    """A light curve, its geometry and the model: chi-square of spin states.
+
+    Times are counted from ``t_ref`` (the middle of the light curve), where the phase of
+    the search is defined: this halves the phase slip of a period step and decorrelates
+    period and phase.
+    """
 
     def __init__(
         self,
-        lc: dict[str, np.ndarray],
+        lc: Mapping[str, np.ndarray],
+        geo: SpinGeometry,
         kernel: Kernel,
-        to_sun: Any,
-        to_observer: Any,
         axis_body: np.ndarray,
         offset: str,
     ) -> None:
-        self.times, self.t_index = np.unique(lc["time"], return_inverse=True)
-        self.band = lc["band"]
-        self.y, self.sigma = lc["flux"], lc["sigma"]
-        self.w = 1.0 / self.sigma**2
-        self.kernel = kernel
-        self.s = directions(to_sun, self.times.size, "to_sun")
-        self.o = directions(to_observer, self.times.size, "to_observer")
-        self.k = axis_body / np.linalg.norm(axis_body)
         if offset not in ("band", "common"):
             raise InversionError(
                 f"offset: {offset!r}; allowed 'band' (a free scale per band), 'common'"
             )
+        self.t_ref = 0.5 * float(geo.times[0] + geo.times[-1])
+        self.times = geo.times - self.t_ref
+        self.t_index = geo.t_index
+        self.band = np.asarray(lc["band"])
+        self.y, self.sigma = np.asarray(lc["flux"]), np.asarray(lc["sigma"])
+        self.w = 1.0 / self.sigma**2
+        self.kernel = kernel
+        self.s, self.o, self.factor = geo.to_sun, geo.to_observer, geo.factor
+        self.k = axis_body / np.linalg.norm(axis_body)
         self.offset = offset
         self.n_bands = len(lc["labels"])
+        self.fixed = bool(np.allclose(self.s, self.s[0]) and np.allclose(self.o, self.o[0]))
+
+    @property
+    def n_scales(self) -> int:
+        return 1 if self.offset == "common" else self.n_bands
+
+    def subset(self, max_times: int) -> Problem:
+        """The same problem on at most ``max_times`` distinct times spread evenly over the
+        light curve (every value at those times; the same reference time)."""
+        n = self.times.size
+        if n <= max_times:
+            return self
+        keep = np.unique(np.round(np.linspace(0, n - 1, max_times)).astype(np.int64))
+        rows = np.isin(self.t_index, keep)
+        other = object.__new__(Problem)
+        other.__dict__.update(self.__dict__)
+        other.times, other.s, other.o, other.factor = (
+            a[keep] for a in (self.times, self.s, self.o, self.factor)
+        )
+        other.t_index = np.searchsorted(keep, self.t_index[rows])
+        other.band, other.y, other.sigma, other.w = (
+            a[rows] for a in (self.band, self.y, self.sigma, self.w)
+        )
+        return other
 
     def model(self, axes: np.ndarray, periods: np.ndarray, phases: np.ndarray) -> np.ndarray:
-        """Band signal at every observation (C, N).
-
-        For candidates (C,) of axis (C, 3), period, phase.
-        """
+        """Band signal at every value (C, N) for candidates (C,) of axis (C, 3), period, phase."""
         align = align_matrices(self.k, axes)
         ang = np.radians(phases[:, None] + 360.0 * self.times[None, :] / periods[:, None])
-        sb = body_vectors(self.s, align, self.k, ang)
-        ob = body_vectors(self.o, align, self.k, ang)
-        sig = self.kernel(sb, ob)  # (C, T, B)
-        return sig[:, self.t_index, self.band]
+        sig = self.kernel(
+            body_vectors(self.s, align, self.k, ang), body_vectors(self.o, align, self.k, ang)
+        )  # (C, T, B)
+        return sig[:, self.t_index, self.band] * self.factor[self.t_index]
 
     def scales(self, mdl: np.ndarray) -> np.ndarray:
         """Analytic weighted least-squares flux scale per band (C, N)."""
@@ -313,99 +269,144 @@ class Problem:
             den[:, b] = (wm[:, sel] * mdl[:, sel]).sum(-1)
         return (num / np.maximum(den, 1e-300))[:, self.band]
 
-    def chi2(self, axes: np.ndarray, periods: np.ndarray, phases: np.ndarray) -> np.ndarray:
-        mdl = self.model(axes, periods, phases)
+    def chi2_of(self, mdl: np.ndarray) -> np.ndarray:
         r = (self.y - self.scales(mdl) * mdl) / self.sigma
         return (r * r).sum(-1)
 
-    def residuals(self, p: np.ndarray) -> np.ndarray:
-        mdl = self.model(vec(p[0], p[1])[None, :], np.array([p[2]]), np.array([p[3]]))
-        return ((self.y - self.scales(mdl) * mdl) / self.sigma)[0]
-
-    def at_mean_directions(self) -> Problem:
-        """The same problem with the Sun and observer fixed at their mean directions."""
-        other = object.__new__(Problem)
-        other.__dict__.update(self.__dict__)
-        for key in ("s", "o"):
-            m = getattr(self, key).mean(0)
-            setattr(other, key, np.broadcast_to(m / np.linalg.norm(m), getattr(self, key).shape))
-        return other
-
-    @property
-    def n_scales(self) -> int:
-        return 1 if self.offset == "common" else self.n_bands
+    def chi2(self, axes: np.ndarray, periods: np.ndarray, phases: np.ndarray) -> np.ndarray:
+        return self.chi2_of(self.model(axes, periods, phases))
 
 
-def search(
+def _threads(n_threads: int | None) -> int:
+    return max(1, n_threads or os.cpu_count() or 1)
+
+
+def _map(fn: Callable[[int], None], n: int, n_threads: int | None) -> None:
+    workers = _threads(n_threads)
+    if workers == 1 or n == 1:
+        for j in range(n):
+            fn(j)
+    else:
+        with ThreadPoolExecutor(workers, thread_name_prefix="sbrdf_xr-invert") as pool:
+            list(pool.map(fn, range(n)))
+
+
+def search_direct(
     prob: Problem,
     axes: np.ndarray,
     periods: np.ndarray,
     phases: np.ndarray,
     n_threads: int | None,
-    chunk: int = 256,
 ) -> np.ndarray:
-    """Chi-square over the grid (axes, periods, phases), threads over chunks of candidates."""
-    ia, ip, iq = (
-        g.ravel()
-        for g in np.meshgrid(
-            np.arange(len(axes)), np.arange(len(periods)), np.arange(len(phases)), indexing="ij"
-        )
-    )
-    out = np.empty(ia.size)
-    edges = [*list(range(0, ia.size, chunk)), ia.size]
+    """Chi-square over the grid (axes, periods, phases), every candidate through the kernel."""
+    shape = (len(axes), len(periods), len(phases))
+    total = int(np.prod(shape))
+    per = 8 * prob.times.size * (6 + 2 * prob.n_bands) + 8 * 4 * prob.y.size
+    chunk = max(1, min(4096, BLOCK_BYTES // per))
+    out = np.empty(total)
+    edges = [*range(0, total, chunk), total]
 
     def run(j: int) -> None:
-        sl = slice(edges[j], edges[j + 1])
-        out[sl] = prob.chi2(axes[ia[sl]], periods[ip[sl]], phases[iq[sl]])
+        ia, ip, iq = np.unravel_index(np.arange(edges[j], edges[j + 1]), shape)
+        out[edges[j] : edges[j + 1]] = prob.chi2(axes[ia], periods[ip], phases[iq])
 
-    workers = max(1, n_threads or os.cpu_count() or 1)
-    if workers == 1:
-        for j in range(len(edges) - 1):
-            run(j)
-    else:
-        with ThreadPoolExecutor(workers, thread_name_prefix="sbrdf_xr-invert") as pool:
-            list(pool.map(run, range(len(edges) - 1)))
-    return out.reshape(len(axes), len(periods), len(phases))
+    _map(run, len(edges) - 1, n_threads)
+    return out.reshape(shape)
 
 
-def search_shift(
+def _tables(prob: Problem, axis: np.ndarray, n_angles: int, mean: bool) -> np.ndarray:
+    """Band signal (T or 1, n_angles, B) of one axis on the spin-angle grid."""
+    align = align_matrices(prob.k, axis[None, :])[0]
+    ang = np.arange(n_angles) * (2 * np.pi / n_angles)
+    c, s = np.cos(ang)[None, :, None], np.sin(ang)[None, :, None]
+
+    def body(v: np.ndarray) -> np.ndarray:
+        if mean:
+            m = v.mean(0)
+            v = (m / np.linalg.norm(m))[None, :]
+        u = (v @ align)[:, None, :]  # align^T v, (T, 1, 3)
+        kd = (u @ prob.k)[..., None]
+        return u * c - np.cross(prob.k, u) * s + prob.k * (kd * (1 - c))
+
+    return prob.kernel(body(prob.s), body(prob.o))
+
+
+def _interpolate(
+    f: np.ndarray, prob: Problem, periods: np.ndarray, phases: np.ndarray, mean: bool
+) -> np.ndarray:
+    """The model of every (period, phase) from the tables ``f``: (P * Q, N)."""
+    n = f.shape[1]
+    rows = np.zeros_like(prob.t_index) if mean else prob.t_index
+    fo = f[rows, :, prob.band]  # (N, n_angles)
+    t = prob.times[prob.t_index]
+    x = ((phases[None, :, None] + 360.0 * t / periods[:, None, None]) % 360.0) * (n / 360.0)
+    j = np.floor(x).astype(np.int64)
+    w = x - j
+    i = np.arange(t.size)
+    p0, p1, p2, p3 = (fo[i, (j + d) % n] for d in (-1, 0, 1, 2))
+    m = p1 + 0.5 * w * (
+        p2 - p0 + w * (2 * p0 - 5 * p1 + 4 * p2 - p3 + w * (3 * (p1 - p2) + p3 - p0))
+    )
+    return m.reshape(-1, t.size) * prob.factor[prob.t_index]
+
+
+def search_table(
     prob: Problem,
     axes: np.ndarray,
     periods: np.ndarray,
     phases: np.ndarray,
     n_threads: int | None,
-    n_angles: int = 720,
+    n_angles: int,
+    mean: bool,
 ) -> np.ndarray:
-    """The same grid for fixed directions: the model depends on the spin angle only, so it
-    is evaluated once per axis on ``n_angles`` angles and every (period, phase) reads it
-    by linear interpolation at ``phase + 360 t / P``."""
-    grid_ang = np.arange(n_angles) * 360.0 / n_angles
-    step = 360.0 / n_angles
+    """Chi-square over the grid from per-axis spin-angle tables (``table``, or ``shift``)."""
     out = np.empty((len(axes), len(periods), len(phases)))
-    t = prob.times[prob.t_index]
+    per_period = 8 * 12 * len(phases) * prob.y.size
+    step = max(1, BLOCK_BYTES // per_period)
 
     def run(i: int) -> None:
-        align = align_matrices(prob.k, axes[i : i + 1])
-        ang = np.radians(grid_ang)[None, :]
-        f = prob.kernel(
-            body_vectors(prob.s[:1], align, prob.k, ang),
-            body_vectors(prob.o[:1], align, prob.k, ang),
-        )[0]
-        f = np.concatenate([f, f[:1]], axis=0)  # (n_angles + 1, B), periodic
-        theta = (phases[None, :, None] + 360.0 * t[None, None, :] / periods[:, None, None]) % 360.0
-        x = theta / step
-        j = np.minimum(x.astype(np.int64), n_angles - 1)
-        w = x - j
-        mdl = f[j, prob.band] * (1 - w) + f[j + 1, prob.band] * w
-        mdl = mdl.reshape(-1, t.size)
-        r = (prob.y - prob.scales(mdl) * mdl) / prob.sigma
-        out[i] = (r * r).sum(-1).reshape(len(periods), len(phases))
+        f = _tables(prob, axes[i], n_angles, mean)
+        for p0 in range(0, len(periods), step):
+            ps = periods[p0 : p0 + step]
+            out[i, p0 : p0 + step] = prob.chi2_of(_interpolate(f, prob, ps, phases, mean)).reshape(
+                ps.size, len(phases)
+            )
 
-    workers = max(1, n_threads or os.cpu_count() or 1)
-    if workers == 1:
-        for i in range(len(axes)):
-            run(i)
-    else:
-        with ThreadPoolExecutor(workers, thread_name_prefix="sbrdf_xr-invert") as pool:
-            list(pool.map(run, range(len(axes))))
+    _map(run, len(axes), n_threads)
     return out
+
+
+def run_search(
+    method: str,
+    prob: Problem,
+    axes: np.ndarray,
+    periods: np.ndarray,
+    phases: np.ndarray,
+    n_threads: int | None,
+    n_angles: int,
+) -> np.ndarray:
+    """The chi-square grid by ``method`` (one of :data:`METHODS`)."""
+    if method == "direct":
+        return search_direct(prob, axes, periods, phases, n_threads)
+    return search_table(prob, axes, periods, phases, n_threads, n_angles, method == "shift")
+
+
+def approximation_error(
+    method: str,
+    prob: Problem,
+    axes: np.ndarray,
+    cells: Sequence[tuple[int, float, float]],
+    n_angles: int,
+) -> float:
+    """Largest rms over the values of ``(approximate - exact model) / sigma`` at the
+    candidate ``cells`` (axis index, period, phase), each model with its exact flux scales.
+    """
+    worst = 0.0
+    for ia, per, ph in cells:
+        p, q = np.array([per]), np.array([ph])
+        exact = prob.model(axes[ia : ia + 1], p, q)
+        f = _tables(prob, axes[ia], n_angles, method == "shift")
+        approx = _interpolate(f, prob, p, q, method == "shift")
+        d = prob.scales(exact) * (approx - exact) / prob.sigma
+        worst = max(worst, float(np.sqrt(np.mean(d * d))))
+    return worst

@@ -1,4 +1,4 @@
-"""Material unmixing: non-negative least squares on the per-material terms.
+"""Material unmixing: weighted linear least squares on the per-material terms.
 
 See the package docstring.
 """
@@ -12,18 +12,35 @@ from typing import Any
 import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
-from scipy.optimize import nnls
 
 from ..errors import InversionError
+from ._library import MATERIAL, design, library
+from ._quality import fit_quality
 
-__all__ = ["DEGENERACY_THRESHOLD", "MATERIAL", "material_areas", "unmix"]
+__all__ = [
+    "DEGENERACY_THRESHOLD",
+    "DROP_BIAS",
+    "DROP_Z",
+    "MATERIAL",
+    "material_areas",
+    "unmix",
+]
 
-MATERIAL = "material"
 #: Default ``|correlation|`` between two materials' estimates above which they are degenerate.
 DEGENERACY_THRESHOLD = 0.95
+#: A material is left out of the model only if the bias its omission can cause on every other
+#: estimate stays below this fraction of that estimate's uncertainty.
+DROP_BIAS = 0.5
+#: The bias bound takes the left-out material's scale up to ``|estimate| + DROP_Z sigma``.
+DROP_Z = 2.0
 
-
-# ----------------------------------------------------------------------------- unmixing
+UNMIX_CAUSES = (
+    "the simulated geometry differs from that of the measurement (attitude, Sun or observer "
+    "direction: --isel or the cube)",
+    "a material of the spacecraft is missing from the candidate library",
+    "the material tables or the mesh do not describe the spacecraft",
+    "the uncertainties are understated (calibration, atmosphere, systematic errors)",
+)
 
 
 def material_areas(spacecraft: Any) -> dict[str, float]:
@@ -43,146 +60,55 @@ def material_areas(spacecraft: Any) -> dict[str, float]:
     return {str(m): float(areas[names == m].sum()) for m in np.unique(names)}
 
 
-def _library(simulated: Any) -> xr.DataArray:
-    """Per-material terms as one DataArray with a ``material`` dimension."""
-    if isinstance(simulated, xr.Dataset):
-        if "signal_material" not in simulated:
-            raise InversionError(
-                "simulated: a Dataset needs the variable signal_material "
-                f"(simulate with outputs=(..., 'per_material')); got {list(simulated.data_vars)}"
-            )
-        simulated = simulated["signal_material"]
-    if isinstance(simulated, Mapping):
-        items = list(simulated.items())
-        if not items:
-            raise InversionError("simulated: the candidate library is empty")
-        ref_name, ref = items[0]
-        for name, da in items[1:]:
-            for dim in ("wavelength", "band"):
-                if dim in ref.dims or dim in da.dims:
-                    a = ref[dim].values if dim in ref.coords else None
-                    b = da[dim].values if dim in da.coords else None
-                    if a is None or b is None or a.shape != b.shape or not np.array_equal(a, b):
-                        raise InversionError(
-                            f"candidate library: {name!r} has {dim} {_describe(b)}, "
-                            f"{ref_name!r} has "
-                            f"{_describe(a)}; every candidate must be on the same {dim} grid"
-                        )
-        simulated = xr.concat(
-            [da for _, da in items],
-            dim=xr.DataArray([str(k) for k, _ in items], dims=MATERIAL, name=MATERIAL),
-        )
-    if not isinstance(simulated, xr.DataArray) or MATERIAL not in simulated.dims:
-        raise InversionError(
-            "simulated: expected a DataArray with a material dimension "
-            "(signal_material), a Dataset holding one, or a mapping of name to DataArray"
-        )
-    return simulated
+def _wls(aw: np.ndarray, yw: np.ndarray, cols: list[int]) -> tuple[np.ndarray, np.ndarray, float]:
+    """Weighted least squares on the columns ``cols``: estimate, covariance, chi-square."""
+    a = aw[:, cols]
+    cov = np.linalg.pinv(a.T @ a)
+    x = np.linalg.lstsq(a, yw, rcond=None)[0]
+    r = yw - a @ x
+    return x, cov, float(r @ r)
 
 
-def _describe(grid: np.ndarray | None) -> str:
-    if grid is None:
-        return "none"
-    if grid.dtype.kind in "fi" and grid.size:
-        return f"{grid.size} values {grid.min():g}..{grid.max():g}"
-    return f"{list(grid)}"
+def _bias_ratio(
+    x_full: np.ndarray, cov_full: np.ndarray, cols: list[int], cov: np.ndarray
+) -> float:
+    """Largest bias the omission of the other columns can cause, over the uncertainty.
+
+    Leaving out the columns ``D`` shifts the estimates of the kept ones ``S`` by
+    ``-C_SD C_DD^-1 x_D`` (``C`` the covariance of the full fit, Seber & Lee 2003, *Linear
+    Regression Analysis*, §9.2); with ``|x_D|`` up to ``|estimate| + DROP_Z sigma`` of the
+    full fit, the bias on estimate ``i`` is at most ``sum_j |B_ij| (|x_j| + DROP_Z s_j)``.
+    """
+    k = x_full.size
+    dropped = [j for j in range(k) if j not in cols]
+    if not dropped:
+        return 0.0
+    b = cov_full[np.ix_(cols, dropped)] @ np.linalg.pinv(cov_full[np.ix_(dropped, dropped)])
+    reach = np.abs(x_full[dropped]) + DROP_Z * np.sqrt(np.clip(np.diag(cov_full)[dropped], 0, None))
+    bias = np.abs(b) @ reach
+    sig = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
+    return float(np.max(bias / sig))
 
 
-def _spectral_dim(da: xr.DataArray, what: str) -> str:
-    dims = [d for d in ("wavelength", "band") if d in da.dims]
-    if len(dims) != 1:
-        raise InversionError(
-            f"{what}: expected exactly one of the dimensions wavelength or band, got {da.dims}"
-        )
-    return dims[0]
-
-
-def _align(measured: xr.DataArray, lib: xr.DataArray) -> xr.DataArray:
-    """The library on the measured spectral grid (linear interpolation in wavelength)."""
-    dim = _spectral_dim(measured, "measured")
-    if dim not in lib.dims:
-        raise InversionError(
-            f"measured is over {dim} but the simulation is over {_spectral_dim(lib, 'simulated')}"
-        )
-    if dim == "band":
-        have = [str(b) for b in lib["band"].values]
-        missing = [str(b) for b in measured["band"].values if str(b) not in have]
-        if missing:
-            raise InversionError(
-                f"measured bands {missing} are not among the simulated bands {have}"
-            )
-        return lib.sel(band=measured["band"].values)
-    wl, mw = lib["wavelength"].values, measured["wavelength"].values
-    lo, hi = float(wl.min()), float(wl.max())
-    out = mw[(mw < lo - 1e-9) | (mw > hi + 1e-9)]
-    if out.size:
-        raise InversionError(
-            f"measured wavelengths {out.min():g}..{out.max():g} nm lie outside the simulated "
-            f"range {lo:g}..{hi:g} nm"
-        )
-    if wl.shape == mw.shape and np.allclose(wl, mw):
-        return lib.assign_coords(wavelength=mw)
-    return lib.interp(wavelength=mw)
-
-
-def _design(
-    measured: xr.DataArray, uncertainty: Any, lib: xr.DataArray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Rows (every sample and wavelength) of ``A``, ``y`` and ``sigma``."""
-    if not isinstance(measured, xr.DataArray):
-        raise InversionError(
-            f"measured: expected a DataArray over wavelength or band, got {type(measured).__name__}"
-        )
-    lib = _align(measured, lib)
-    sigma = (
-        uncertainty
-        if isinstance(uncertainty, xr.DataArray)
-        else xr.DataArray(
-            np.broadcast_to(np.asarray(uncertainty, dtype=np.float64), measured.shape),
-            dims=measured.dims,
-            coords=measured.coords,
-        )
-    )
-    y, sigma = xr.broadcast(measured, sigma)
-    extra = [d for d in lib.dims if d not in y.dims and d != MATERIAL]
-    if extra:
-        raise InversionError(
-            f"simulated has dimensions {extra} that measured lacks; select one geometry "
-            "or give measurements over them"
-        )
-    sample_dims = list(y.dims)
-    a = lib.transpose(*[d for d in sample_dims if d in lib.dims], MATERIAL)
-    a = a.broadcast_like(y).transpose(*sample_dims, MATERIAL)
-    yv, sv = y.values.reshape(-1).astype(np.float64), sigma.values.reshape(-1).astype(np.float64)
-    if not np.all(np.isfinite(yv)):
-        raise InversionError(f"measured: {int((~np.isfinite(yv)).sum())} NaN or infinite values")
-    bad = ~(np.isfinite(sv) & (sv > 0))
-    if bad.any():
-        raise InversionError(
-            f"uncertainty: must be finite and > 0, got {int(bad.sum())} values that are not "
-            f"(e.g. {sv[bad][0]!r})"
-        )
-    av = a.values.reshape(-1, lib.sizes[MATERIAL]).astype(np.float64)
-    if not np.all(np.isfinite(av)):
-        raise InversionError("simulated: per-material terms contain NaN or infinite values")
-    return av, yv, sv
-
-
-def _nnls_fit(aw: np.ndarray, yw: np.ndarray) -> tuple[np.ndarray, float]:
-    x, rnorm = nnls(aw, yw, maxiter=50 * aw.shape[1] + 100)
-    return x, float(rnorm) ** 2
-
-
-def _covariance(aw: np.ndarray, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Covariance of the active set, and marginal sigma of every column from the full matrix."""
-    k = aw.shape[1]
-    cov = np.full((k, k), np.nan)
-    if active.any():
-        fa = aw[:, active].T @ aw[:, active]
-        cov[np.ix_(active, active)] = np.linalg.pinv(fa)
-    sig = np.sqrt(np.clip(np.diag(np.linalg.pinv(aw.T @ aw)), 0, None))
-    sig[active] = np.sqrt(np.clip(np.diag(cov)[active], 0, None))
-    return cov, sig
+def _subsets(select: str | None, k: int, kmax: int, score: Any) -> list[tuple[int, ...]]:
+    """The subsets to score: all up to ``kmax``, a forward greedy path, or the full set."""
+    full = tuple(range(k))
+    if select is None:
+        return [full]
+    if select == "all":
+        every = [c for r in range(1, kmax + 1) for c in itertools.combinations(range(k), r)]
+        return every if full in every else [*every, full]
+    chosen: tuple[int, ...] = ()
+    out: list[tuple[int, ...]] = []
+    best = np.inf
+    while len(chosen) < kmax:  # forward greedy addition while the criterion drops
+        trial = [tuple(sorted((*chosen, j))) for j in range(k) if j not in chosen]
+        out.extend(trial)
+        cand = min(trial, key=score)
+        if score(cand) >= best:
+            break
+        chosen, best = cand, score(cand)
+    return list(dict.fromkeys([*out, full]))
 
 
 def unmix(
@@ -195,13 +121,28 @@ def unmix(
     max_materials: int | None = None,
     criterion: str = "bic",
     degeneracy_threshold: float = DEGENERACY_THRESHOLD,
+    drop_bias: float = DROP_BIAS,
 ) -> xr.Dataset:
     """Effective area scale factor of each material from a measured spectrum or band fluxes.
 
-    Solves ``min || W^1/2 (y - A a) ||^2`` subject to ``a >= 0`` (NNLS), where the
+    Solves ``min || W^1/2 (y - A a) ||^2`` (weighted linear least squares), where the
     columns of ``A`` are the simulated per-material signals (``signal_material``) at the
-    measured wavelengths or bands and samples, ``W = diag(sigma^-2)``.  ``a_m = 1``
-    means the material's area as simulated.
+    measured wavelengths or bands and samples, ``W = diag(sigma^-2)``; ``a_m = 1`` means
+    the material's area as simulated.  The covariance is ``(A^T W A)^-1``.  The estimates
+    are not bounded below: a negative one says the material is not detected (bounding it
+    at zero, as NNLS does, makes the other uncertainties conditional on the bound and no
+    longer calibrated).
+
+    Which materials are in the model: subsets of the candidates are scored by the
+    information criterion (``AIC = chi2 + 2k``, ``BIC = chi2 + k ln n``; Burnham &
+    Anderson 2002, §2.2, §6.4), with their Akaike or BIC weights ``exp(-delta/2)``
+    normalised (§2.9, §6.4).  A subset that leaves materials out is admissible only if
+    the bias that their omission can cause on every kept estimate (the leave-out shift
+    ``-C_SD C_DD^-1 x_D`` of the full fit, with each left-out scale up to its
+    ``|estimate| + 2 sigma``) stays below ``drop_bias`` times that estimate's uncertainty;
+    the chosen model is the admissible subset of lowest criterion (the full set is always
+    admissible).  So a material the data cannot pin down is kept, with the large
+    uncertainty it brings, rather than dropped with a confident and biased remainder.
 
     Parameters
     ----------
@@ -211,38 +152,52 @@ def unmix(
         signal [m2 sr-1] (or any multiple of them, then ``a`` carries the factor).
     simulated : DataArray, Dataset or mapping of str to DataArray
         Per-material terms with a ``material`` dimension (``simulate(..., outputs=(...,
-        "per_material"))``), or a candidate library: name to a term each, on one grid.
-        Simulated wavelengths are interpolated linearly to the measured ones.
+        "per_material"))``), or a candidate library: name to a term each.  Simulated
+        wavelengths are interpolated linearly to the measured ones (candidates of a
+        library on other wavelength grids too, with a note in ``attrs["library_note"]``).
     uncertainty : array_like or DataArray
         1-sigma measurement errors, broadcast against ``measured``; > 0.
     areas : mapping of str to float, optional
         Nominal area of each material [m2] (:func:`material_areas`): adds ``area`` [m2]
-        and ``area_fraction`` [1].
+        and ``area_fraction`` [1] with their uncertainties.
     select : {"all", "greedy", None}
-        Choose the materials present: every subset up to ``max_materials``, forward
-        greedy addition, or keep every candidate.
+        Subsets scored: every subset up to ``max_materials``, a forward greedy path, or
+        only the full set of candidates.
     max_materials : int, optional
-        Largest subset tried (default: all candidates).
+        Largest subset tried (default: all candidates); the full set is always scored.
     criterion : {"bic", "aic"}
         Information criterion minimised by the selection.
     degeneracy_threshold : float
         ``|correlation|`` of two estimates above which the pair is reported as degenerate.
+    drop_bias : float
+        Largest bias, in units of the kept estimates' uncertainties, that leaving
+        materials out may cause (default :data:`DROP_BIAS`).
 
     Returns
     -------
     xarray.Dataset
-        Over ``material``: ``scale`` and ``scale_uncertainty`` [1], ``selected`` (bool),
-        ``area``, ``area_uncertainty`` [m2] and ``area_fraction`` (with ``areas``),
-        ``correlation`` (material, material_b); scalars ``chi2``, ``reduced_chi2``,
-        ``aic``, ``bic``, ``condition_number``; over ``subset``: the criterion table;
-        attribute ``degenerate``: the pairs the data cannot tell apart.
+        Over ``material``: ``scale``, ``scale_uncertainty`` and ``significance`` [1],
+        ``selected`` (bool), ``importance`` (the summed weights of the subsets holding the
+        material), ``area``, ``area_uncertainty`` [m2], ``area_fraction`` and
+        ``area_fraction_uncertainty`` [1] (with ``areas``), ``correlation`` (material,
+        material_b); scalars ``chi2``, ``reduced_chi2``, ``dof``, ``fit_probability``,
+        ``aic``, ``bic``, ``condition_number``; over ``subset``: ``subset_chi2``,
+        ``subset_aic``, ``subset_bic``, ``subset_weight``, ``subset_bias_ratio``,
+        ``subset_admissible``; attributes ``selected_materials``, ``selection_note``,
+        ``degenerate``, ``fit_quality`` (and ``fit_quality_note``), ``library_note``.
+
+    Warns
+    -----
+    FitQualityWarning
+        When the chi-square lies beyond the 99.9 % point of its distribution (the model
+        does not describe the data: wrong geometry, a material missing from the library)
+        or below its 0.1 % point (uncertainties overstated).
 
     Raises
     ------
     InversionError
         Measured wavelengths outside the simulated range or bands not simulated, fewer
-        samples than parameters, candidates on different grids, uncertainties not > 0,
-        NaN data.
+        samples than parameters, uncertainties not > 0, NaN data.
 
     Examples
     --------
@@ -268,84 +223,148 @@ def unmix(
     >>> cube.signal_material.isel(geometry=0, wavelength=0).round(6).values.tolist()
     [0.076394, 0.015279]
 
-    A spectrum made of 0.8 times the grey area and 1.5 times the red gives back those
-    scale factors:
+    A spectrum made of 0.8 times the grey area and 1.5 times the red, with 1 % noise,
+    gives back those scale factors within their uncertainties:
 
     >>> from sbrdf_xr.invert import material_areas, unmix
     >>> terms = cube.signal_material
-    >>> measured = 0.8 * terms.sel(material="grey") + 1.5 * terms.sel(material="red")
-    >>> fit = unmix(measured, cube, 0.01 * float(measured.max()), select=None,
-    ...             areas=material_areas(box))
-    >>> fit.scale.round(6).values.tolist(), fit.area.round(6).values.tolist()  # [1], [m2]
-    ([0.8, 1.5], [3.2, 3.0])
-    >>> fit.attrs["degenerate"]
-    'none'
+    >>> truth = 0.8 * terms.sel(material="grey") + 1.5 * terms.sel(material="red")
+    >>> sigma = 0.01 * float(truth.max())
+    >>> measured = truth + sigma * np.random.default_rng(1).normal(size=truth.shape)
+    >>> fit = unmix(measured, cube, sigma, areas=material_areas(box))
+    >>> fit.scale.round(3).values.tolist(), fit.scale_uncertainty.round(3).values.tolist()
+    ([0.816, 1.488], [0.012, 0.008])
+    >>> fit.attrs["selected_materials"], fit.attrs["degenerate"], fit.attrs["fit_quality"]
+    ('grey, red', 'none', 'consistent')
+    >>> fit.area_fraction.attrs["long_name"]
+    'fraction of the summed effective area of the fitted candidate materials'
     """
-    lib = _library(simulated)
-    names = [str(m) for m in lib[MATERIAL].values]
-    a, y, s = _design(measured, uncertainty, lib)
-    n, k = a.shape
-    if n < k:
+    if not isinstance(measured, xr.DataArray):
         raise InversionError(
-            f"measured: {n} samples for {k} material parameters; need at least as many samples "
-            "as parameters"
+            f"measured: expected a DataArray over wavelength or band, got {type(measured).__name__}"
         )
     if criterion not in ("aic", "bic"):
         raise InversionError(f"criterion: {criterion!r}; allowed 'aic', 'bic'")
     if select not in ("all", "greedy", None):
         raise InversionError(f"select: {select!r}; allowed 'all', 'greedy', None")
+    if not (np.isfinite(drop_bias) and drop_bias >= 0):
+        raise InversionError(f"drop_bias: {drop_bias!r}; allowed a finite number >= 0")
+    lib, notes = library(simulated, measured)
+    names = [str(m) for m in lib[MATERIAL].values]
+    a, y, s = design(measured, uncertainty, lib)
+    n, k = a.shape
+    if n < k:
+        raise InversionError(
+            f"measured: {n} values for {k} material parameters ({', '.join(names)}); need at "
+            "least as many values as parameters (more wavelengths, bands or geometries, or "
+            "fewer candidates)"
+        )
+    if max_materials is not None and int(max_materials) < 1:
+        raise InversionError(f"max_materials: {max_materials!r}; allowed an integer >= 1")
     aw, yw = a / s[:, None], y / s
-    kmax = k if max_materials is None else max(1, min(int(max_materials), k))
+    kmax = k if max_materials is None else min(int(max_materials), k)
+    x_full, cov_full, _ = _wls(aw, yw, list(range(k)))
+    pen = 2.0 if criterion == "aic" else float(np.log(n))
+    fits: dict[tuple[int, ...], tuple[np.ndarray, np.ndarray, float, float]] = {}
 
-    def score(cols: tuple[int, ...]) -> tuple[float, float, float, np.ndarray]:
-        x, chi2 = _nnls_fit(aw[:, list(cols)], yw)
-        npar = int((x > 0).sum())
-        return chi2, chi2 + 2 * npar, chi2 + npar * np.log(n), x
+    def score(c: tuple[int, ...]) -> float:
+        if c not in fits:
+            x, cov, chi2 = _wls(aw, yw, list(c))
+            fits[c] = (x, cov, chi2, _bias_ratio(x_full, cov_full, list(c), cov))
+        return fits[c][2] + pen * len(c)
 
-    table: list[tuple[str, float, float, float]] = []
-    crit = 1 if criterion == "aic" else 2
-    if select == "all":
-        subsets = [c for r in range(1, kmax + 1) for c in itertools.combinations(range(k), r)]
-        results = {c: score(c) for c in subsets}
-        best = min(results, key=lambda c: results[c][crit])
-    elif select == "greedy":
-        results = {}
-        chosen: tuple[int, ...] = ()
-        best = chosen  # () until the first subset is scored
-        while len(chosen) < kmax:
-            trial = {tuple(sorted((*chosen, j))): None for j in range(k) if j not in chosen}
-            for c in trial:
-                results[c] = score(c)
-            cand = min(trial, key=lambda c: results[c][crit])
-            if best and results[cand][crit] >= results[best][crit]:
-                break
-            best = chosen = cand
-    else:
-        best = tuple(range(k))
-        results = {best: score(best)}
-    for c, (chi2, aic, bic, _) in results.items():
-        table.append(("+".join(names[j] for j in c), chi2, aic, bic))
+    subsets = _subsets(select, k, kmax, score)
+    for c in subsets:
+        score(c)
+    admissible = [c for c in subsets if fits[c][3] <= drop_bias]
+    best = min(admissible, key=score)
+    crit = np.array([score(c) for c in subsets])
+    w = np.exp(-(crit - crit.min()) / 2)
+    w /= w.sum()
+    lowest = subsets[int(np.argmin(crit))]
     cols = list(best)
-    chi2, aic, bic, xs = results[best]
+    xs, cov_s, chi2, _ = fits[best]
     x = np.zeros(k)
     x[cols] = xs
-    sub = aw[:, cols]
-    _cov_s, sig_s = _covariance(sub, xs > 0)
-    sig = np.full(k, np.nan)
-    sig[cols] = sig_s
-    # Correlations from the unconstrained covariance of the selected columns: it says
-    # whether the data could tell the materials apart, whatever the bound did.
-    full = np.linalg.pinv(sub.T @ sub)
-    d = np.sqrt(np.clip(np.diag(full), 1e-300, None))
+    cov = np.zeros((k, k))
+    cov[np.ix_(cols, cols)] = cov_s
+    sig = np.sqrt(np.clip(np.diag(cov_full), 0, None))  # left out: sigma of the full fit
+    sig[cols] = np.sqrt(np.clip(np.diag(cov_s), 0, None))
+    dof = n - len(cols)
+
+    def label(c: tuple[int, ...]) -> str:
+        return "+".join(names[j] for j in c)
+
+    if best == lowest:
+        sel_note = f"the subset of lowest {criterion.upper()} ({label(best)})"
+    else:
+        sel_note = (
+            f"{label(best)}: the subset of lowest {criterion.upper()} ({label(lowest)}) leaves "
+            f"out materials whose omission could bias the others by {fits[lowest][3]:.3g} sigma "
+            f"(more than drop_bias = {drop_bias:g}); the lowest admissible subset is used"
+        )
+    quality = fit_quality(chi2, dof, "unmix", UNMIX_CAUSES)
+    return _result(
+        names=names,
+        x=x,
+        sig=sig,
+        cov=cov,
+        cols=cols,
+        aw=aw,
+        areas=areas,
+        subsets=[
+            (
+                label(c),
+                fits[c][2],
+                fits[c][3],
+                fits[c][2] + 2 * len(c),
+                fits[c][2] + len(c) * np.log(n),
+                wi,
+            )
+            for c, wi in zip(subsets, w, strict=True)
+        ],
+        scalars={"chi2": chi2, "dof": dof, "n": n},
+        importance=np.array(
+            [sum(wi for c, wi in zip(subsets, w, strict=True) if j in c) for j in range(k)]
+        ),
+        attrs={
+            "selected_materials": ", ".join(names[j] for j in cols),
+            "criterion": criterion,
+            "selection": str(select),
+            "selection_note": sel_note,
+            "drop_bias": drop_bias,
+            "library_note": "; ".join(notes) if notes else "every candidate on the measured grid",
+            **{k_: v for k_, v in quality.items() if k_.startswith("fit_quality")},
+        },
+        quality=quality,
+        degeneracy_threshold=degeneracy_threshold,
+    )
+
+
+def _result(
+    *,
+    names: list[str],
+    x: np.ndarray,
+    sig: np.ndarray,
+    cov: np.ndarray,
+    cols: list[int],
+    aw: np.ndarray,
+    areas: Mapping[str, float] | None,
+    subsets: list[tuple[Any, ...]],
+    scalars: dict[str, Any],
+    importance: np.ndarray,
+    attrs: dict[str, Any],
+    quality: dict[str, Any],
+    degeneracy_threshold: float,
+) -> xr.Dataset:
+    """The result Dataset of :func:`unmix`."""
+    k = len(names)
+    d = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
     corr = np.full((k, k), np.nan)
-    corr[np.ix_(cols, cols)] = full / np.outer(d, d)
-    # Degeneracy over every candidate (the columns' cosine similarity in the weighted metric
-    # and the parameter correlation of all candidates together).
+    corr[np.ix_(cols, cols)] = (cov / np.outer(d, d))[np.ix_(cols, cols)]
     cand_full = np.linalg.pinv(aw.T @ aw)
     dc = np.sqrt(np.clip(np.diag(cand_full), 1e-300, None))
     cand_corr = cand_full / np.outer(dc, dc)
-    out_of_model = ~np.isin(np.arange(k), cols)
-    sig[out_of_model] = dc[out_of_model]  # left out: its sigma with every candidate fitted
     sv = np.linalg.svd(aw, compute_uv=False)
     cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else np.inf
     degenerate = [
@@ -354,36 +373,37 @@ def unmix(
         for j in range(i + 1, k)
         if abs(cand_corr[i, j]) > degeneracy_threshold
     ]
-    dof = n - int((xs > 0).sum())
+    selected = np.isin(np.arange(k), cols)
     ds = xr.Dataset(
         coords={
             MATERIAL: (MATERIAL, names, {"long_name": "material", "units": "1"}),
             "material_b": ("material_b", names, {"long_name": "material", "units": "1"}),
+            "subset": (
+                "subset",
+                [t[0] for t in subsets],
+                {"long_name": "materials fitted", "units": "1"},
+            ),
         }
     )
-    ds["scale"] = (
-        MATERIAL,
-        x,
-        {
-            "units": "1",
-            "long_name": "effective area scale factor of the material (1: its area as simulated)",
-        },
-    )
-    ds["scale_uncertainty"] = (
-        MATERIAL,
-        sig,
-        {
-            "units": "1",
-            "long_name": "1-sigma uncertainty of the scale "
-            "factor (active set: (A^T W A)^-1; at the bound: unconstrained; left out of the "
-            "chosen model: with every candidate fitted)",
-        },
-    )
-    ds["selected"] = (
-        MATERIAL,
-        np.isin(np.arange(k), cols) & (x > 0),
-        {"units": "1", "long_name": "material present in the chosen model"},
-    )
+    per_material = {
+        "scale": (x, "effective area scale factor of the material (1: its area as simulated)"),
+        "scale_uncertainty": (
+            sig,
+            "1-sigma uncertainty of the scale factor (the chosen model's (A^T W A)^-1; "
+            "left out of it: with every candidate fitted)",
+        ),
+        "significance": (
+            np.where(selected, x / np.where(sig > 0, sig, np.inf), 0.0),
+            "scale factor over its uncertainty (0 when left out)",
+        ),
+        "selected": (selected, "material in the chosen model"),
+        "importance": (
+            importance,
+            "summed information-criterion weights of the subsets holding the material",
+        ),
+    }
+    for key, (val, ln) in per_material.items():
+        ds[key] = (MATERIAL, val, {"units": "1", "long_name": ln})
     ds["correlation"] = (
         (MATERIAL, "material_b"),
         corr,
@@ -392,59 +412,53 @@ def unmix(
     ds["candidate_correlation"] = (
         (MATERIAL, "material_b"),
         cand_corr,
-        {
-            "units": "1",
-            "long_name": "correlation of the scale factors with every "
-            "candidate fitted (unconstrained)",
-        },
+        {"units": "1", "long_name": "correlation of the scale factors with every candidate fitted"},
     )
     if areas is not None:
-        missing = [m for m in names if m not in areas]
-        if missing:
-            raise InversionError(f"areas: no area for {missing}; have {sorted(areas)}")
-        nominal = np.array([float(areas[m]) for m in names])
-        ds["area"] = (
-            MATERIAL,
-            x * nominal,
-            {"units": "m2", "long_name": "effective area of the material"},
-        )
-        ds["area_uncertainty"] = (
-            MATERIAL,
-            sig * nominal,
-            {"units": "m2", "long_name": "1-sigma uncertainty of the effective area"},
-        )
-        tot = float((x * nominal).sum())
-        ds["area_fraction"] = (
-            MATERIAL,
-            x * nominal / tot if tot > 0 else np.zeros(k),
-            {"units": "1", "long_name": "fraction of the total effective area"},
-        )
+        _areas(ds, names, x, sig, cov, areas)
+    chi2, dof, n = (scalars[k_] for k_ in ("chi2", "dof", "n"))
+    npar = len(cols)
     scal = {
         "chi2": (chi2, "chi-square of the chosen model"),
+        "dof": (dof, "degrees of freedom (values minus fitted scale factors)"),
         "reduced_chi2": (chi2 / dof if dof > 0 else np.nan, "chi-square per degree of freedom"),
-        "aic": (aic, "Akaike information criterion chi2 + 2k"),
-        "bic": (bic, "Bayesian information criterion chi2 + k ln n"),
-        "condition_number": (
-            cond,
-            "condition number of the weighted design matrix of all candidates",
+        "fit_probability": (
+            quality["fit_probability"],
+            "probability of a chi-square at least this large for a right model",
         ),
+        "aic": (chi2 + 2 * npar, "Akaike information criterion chi2 + 2k"),
+        "bic": (chi2 + npar * np.log(n), "Bayesian information criterion chi2 + k ln n"),
+        "condition_number": (cond, "condition number of the weighted design of all candidates"),
+        "n_samples": (n, "number of measured values"),
     }
     for key, (val, ln) in scal.items():
-        ds[key] = ((), float(val), {"units": "1", "long_name": ln})
-    ds["n_samples"] = ((), n, {"units": "1", "long_name": "number of measured values"})
-    ds = ds.assign_coords(
-        subset=("subset", [t[0] for t in table], {"long_name": "materials fitted", "units": "1"})
-    )
-    for j, key in enumerate(("subset_chi2", "subset_aic", "subset_bic"), start=1):
+        ds[key] = ((), val, {"units": "1", "long_name": ln})
+    table = {
+        "subset_chi2": (1, "chi-square of the subset"),
+        "subset_bias_ratio": (
+            2,
+            "largest bias its left-out materials can cause on a kept estimate, in sigma",
+        ),
+        "subset_aic": (3, "Akaike information criterion of the subset"),
+        "subset_bic": (4, "Bayesian information criterion of the subset"),
+        "subset_weight": (5, "information-criterion weight of the subset (of the criterion used)"),
+    }
+    for key, (j, ln) in table.items():
         ds[key] = (
             "subset",
-            np.array([t[j] for t in table]),
-            {"units": "1", "long_name": f"{key[7:]} of the subset"},
+            np.array([t[j] for t in subsets], dtype=float),
+            {"units": "1", "long_name": ln},
         )
+    ds["subset_admissible"] = (
+        "subset",
+        ds["subset_bias_ratio"].values <= attrs["drop_bias"],
+        {
+            "units": "1",
+            "long_name": "left-out materials bias the others by at most drop_bias sigma",
+        },
+    )
     ds.attrs = {
-        "selected_materials": ", ".join(names[j] for j in cols if x[j] > 0),
-        "criterion": criterion,
-        "selection": str(select),
+        **attrs,
         "degenerate": "; ".join(degenerate) if degenerate else "none",
         "degeneracy_note": (
             f"the data cannot tell apart: {'; '.join(degenerate)}"
@@ -453,3 +467,57 @@ def unmix(
         ),
     }
     return ds
+
+
+def _areas(
+    ds: xr.Dataset,
+    names: list[str],
+    x: np.ndarray,
+    sig: np.ndarray,
+    cov: np.ndarray,
+    areas: Mapping[str, float],
+) -> None:
+    """``area``, ``area_fraction`` and their uncertainties (first-order propagation)."""
+    missing = [m for m in names if m not in areas]
+    if missing:
+        raise InversionError(f"areas: no area for {missing}; have {sorted(areas)}")
+    nominal = np.array([float(areas[m]) for m in names])
+    bad = ~(np.isfinite(nominal) & (nominal >= 0))
+    if bad.any():
+        given = {m: float(v) for m, v, b in zip(names, nominal, bad, strict=True) if b}
+        raise InversionError(f"areas: must be finite and >= 0 [m2], got {given}")
+    area = x * nominal
+    ds["area"] = (MATERIAL, area, {"units": "m2", "long_name": "effective area of the material"})
+    ds["area_uncertainty"] = (
+        MATERIAL,
+        sig * nominal,
+        {"units": "m2", "long_name": "1-sigma uncertainty of the effective area"},
+    )
+    tot = float(area.sum())
+    cov_a = cov * np.outer(nominal, nominal)
+    if tot > 0:
+        jac = (np.eye(len(names)) * tot - area[:, None]) / tot**2  # d f_i / d area_j
+        frac = area / tot
+        frac_sig = np.sqrt(np.clip(np.diag(jac @ cov_a @ jac.T), 0, None))
+    else:
+        frac = frac_sig = np.full(len(names), np.nan)
+    normalised = (
+        "the summed effective area of the candidate materials of this fit "
+        f"({', '.join(names)}): the spacecraft's total only if the library holds all of its "
+        "materials"
+    )
+    ds["area_fraction"] = (
+        MATERIAL,
+        frac,
+        {
+            "units": "1",
+            "long_name": "fraction of the summed effective area of the fitted candidate materials",
+            "normalisation": normalised,
+        },
+    )
+    ds["area_fraction_uncertainty"] = (
+        MATERIAL,
+        frac_sig,
+        {"units": "1", "long_name": "1-sigma uncertainty of the area fraction (first order)"},
+    )
+    ds.attrs["area_fraction_normalisation"] = normalised

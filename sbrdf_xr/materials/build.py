@@ -11,8 +11,10 @@ and every row can be renormalised to the model's directional-hemispherical refle
 from __future__ import annotations
 
 import itertools
+import threading
 import warnings
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
@@ -290,6 +292,8 @@ def build_lut(
     if (extrapolation == "model" or below_noise == "model") and fit_model is None:
         fit_model = models.fit_robertson_sandford(ds)
 
+    parts = _Parts(report, _MODEL_STEPS)
+    rho_job: _Job | None = None
     if below_noise == "zero":
         # Table edges: zero beyond them if the extreme samples are reference points.
         edges = {
@@ -321,7 +325,7 @@ def build_lut(
             "edge_delta_theta_max": "zero",
             "edge_phi_max": "zero",
         }
-        report(0.02, "ratio to the model")
+        report(0.0, "ratio to the model")
         truth_s = _model_at(fit_model, ti_s, dt_s, ph_s, wl)
         ok = ~ref
         ratio = np.divide(spectra, truth_s, out=np.ones_like(spectra), where=truth_s > 0)
@@ -346,9 +350,16 @@ def build_lut(
             w = blend_weights(ti_out, -np.inf, measured_ti[-1], blend)[:, None, None, None]
             r_lut *= 1.0 - w  # in place: (1 - w) r + w, one table in memory
             r_lut += w
-        base = _model_rows(
-            fit_model, ti_out, dt_grid, phi_grid, wl, _part(report, 0.05, 0.25, "model on the grid")
-        )
+        if renormalise == "model":  # the model's reflectance, while the grid is filled
+            rho_job = _Job(
+                _model_reflectance, fit_model, ti_out, wl, parts.part("model reflectance")
+            )
+        try:
+            base = _model_rows(fit_model, ti_out, dt_grid, phi_grid, wl, parts.part("model grid"))
+        except BaseException:
+            if rho_job is not None:
+                rho_job.cancel()
+            raise
         lut = np.multiply(base, r_lut, out=r_lut)
         del r_lut
         if extrapolation == "model" and renormalise == "none":
@@ -366,17 +377,16 @@ def build_lut(
             base[0] = azimuthal_average(base[0], dt_grid, phi_grid, lut_edges(edges))
         extra["normal_incidence_blend"] = float(blend_normal)
     if renormalise == "model":
-        if fit_model is None:  # pragma: no cover - below_noise="model" needs the model
+        if rho_job is None:  # pragma: no cover - below_noise="model" needs the model
             raise ValidationError("renormalise='model' needs the table's model")
         _renormalise_rows(
             lut,
             base,
             (ti_out, dt_grid, phi_grid),
-            wl,
-            fit_model,
+            rho_job,
             lut_edges(edges),
             extra.get("normal_incidence_blend", 0.0),
-            report,
+            parts,
         )
         extra["renormalise"] = "model"
 
@@ -428,21 +438,90 @@ def _no_progress(fraction: float, step: str) -> None:
     """The progress report of a build that shows none."""
 
 
-def _part(
-    report: Callable[[float, str], None], lo: float, hi: float, step: str
-) -> Callable[[float], None]:
-    """A report of the fraction done of one step, which spans ``lo`` to ``hi`` of the build."""
-    return lambda f: report(lo + (hi - lo) * f, step)
+#: The steps of a table made from a model (``below_noise="model"``) and their shares of
+#: its work, for the progress report.
+_MODEL_STEPS = {
+    "ratio to the model": 0.05,
+    "model grid": 0.2,
+    "model reflectance": 0.5,
+    "table reflectance": 0.2,
+    "energy check": 0.05,
+}
+
+
+class _Parts:
+    """The progress of a build made of weighted steps, one of which may run in a
+    background thread: ``part(step)(fraction)`` records a step's fraction done and, from
+    the building thread, reports the weighted total."""
+
+    def __init__(self, report: Callable[[float, str], None], weights: dict[str, float]):
+        self.report, self.weights = report, weights
+        self.done = dict.fromkeys(weights, 0.0)
+        self.thread = threading.get_ident()
+
+    def part(self, step: str) -> Callable[[float], None]:
+        def done(fraction: float) -> None:
+            self.done[step] = fraction
+            if threading.get_ident() == self.thread:
+                total = sum(w * self.done[k] for k, w in self.weights.items())
+                self.report(total / sum(self.weights.values()), step)
+
+        return done
+
+
+class _Job:
+    """``func(*args, stop=event)`` in a background thread; :meth:`result` waits for it."""
+
+    def __init__(self, func: Callable[..., np.ndarray], *args: Any) -> None:
+        self.stop = threading.Event()
+        self.pool = ThreadPoolExecutor(1, thread_name_prefix="sbrdf-build")
+        self.future = self.pool.submit(func, *args, stop=self.stop)
+        self.pool.shutdown(wait=False)
+
+    def result(self, tick: Callable[[], None]) -> np.ndarray:
+        """The result, calling ``tick()`` every quarter second while waiting."""
+        while True:
+            try:
+                return self.future.result(timeout=0.25)
+            except TimeoutError:
+                tick()
+
+    def cancel(self) -> None:
+        """Stop the job at its next row group (the build failed)."""
+        self.stop.set()
+
+
+def _model_reflectance(
+    model: xr.Dataset,
+    ti: np.ndarray,
+    wl: np.ndarray,
+    done: Callable[[float], None],
+    stop: threading.Event | None = None,
+) -> np.ndarray:
+    """The model's directional-hemispherical reflectance at every row ``(ti, wl)``."""
+    mod, _, kw = models.model_parameters(_model_for(model, wl))
+    return _by_rows(
+        lambda t: mod.directional_hemispherical_reflectance(np.minimum(t, 90.0), wl, **kw),
+        ti,
+        done,
+        stop,
+    )
 
 
 def _by_rows(
-    func: Callable[[np.ndarray], np.ndarray], ti: np.ndarray, done: Callable[[float], None]
+    func: Callable[[np.ndarray], np.ndarray],
+    ti: np.ndarray,
+    done: Callable[[float], None],
+    stop: threading.Event | None = None,
 ) -> np.ndarray:
     """``func(ti)`` (one result row per incidence angle) a few rows at a time, reporting the
-    fraction done: the rows are computed independently, so the result is the same."""
+    fraction done (and stopping when ``stop`` is set): the rows are computed
+    independently, so the result is the same."""
     bounds = np.unique(np.linspace(0, ti.size, min(ti.size, 12) + 1).astype(int))
     out = []
     for a, b in itertools.pairwise(bounds):
+        if stop is not None and stop.is_set():
+            raise RuntimeError("build_lut: stopped (the build failed)")
         done(a / ti.size)
         out.append(func(ti[a:b]))
     done(1.0)
@@ -477,32 +556,31 @@ def _renormalise_rows(
     lut: np.ndarray,
     base: np.ndarray,
     grids: tuple[np.ndarray, np.ndarray, np.ndarray],
-    wl: np.ndarray,
-    model: xr.Dataset,
+    rho_job: _Job,
     zero_edges: tuple[bool, bool, bool],
     normal_blend: float,
-    report: Callable[[float, str], None] = _no_progress,
+    parts: _Parts,
 ) -> None:
     """Scale every row ``(theta_i, wavelength)`` of ``lut`` (in place) by the energy its
     model loses or gains on the grid: ``rho_model / rho_grid``, with ``rho_model`` the
     model's own directional-hemispherical reflectance and ``rho_grid`` that of ``base``
     (the model rendered on the table grid) by the quadrature of the look-up's
-    interpolant (:func:`sbrdf_xr.kernels.lut.hemispherical_reflectance_kernel`)."""
+    interpolant (:func:`sbrdf_xr.kernels.lut.hemispherical_reflectance_kernel`), the
+    model's computed by ``rho_job`` in the background."""
     ti = grids[0]
-    mod, _, kw = models.model_parameters(_model_for(model, wl))
-    rho_m = _by_rows(
-        lambda t: mod.directional_hemispherical_reflectance(np.minimum(t, 90.0), wl, **kw),
-        ti,
-        _part(report, 0.25, 0.8, "model reflectance"),
-    )
     tg, dg, pg = grids
-    rho_g = _by_rows(
-        lambda t: _lut.hemispherical_reflectance_kernel(
-            base, tg, dg, pg, t, "linear", zero_edges=zero_edges, normal_blend=normal_blend
-        ),
-        ti,
-        _part(report, 0.8, 0.92, "table reflectance"),
-    )
+    try:
+        rho_g = _by_rows(
+            lambda t: _lut.hemispherical_reflectance_kernel(
+                base, tg, dg, pg, t, "linear", zero_edges=zero_edges, normal_blend=normal_blend
+            ),
+            ti,
+            parts.part("table reflectance"),
+        )
+    except BaseException:
+        rho_job.cancel()
+        raise
+    rho_m = rho_job.result(lambda: parts.part("model reflectance")(parts.done["model reflectance"]))
     scale = np.divide(rho_m, rho_g, out=np.ones_like(rho_m), where=rho_g > 0)
     # Below ``normal_blend`` a look-up mixes the row with the theta_i = 0 profile: with
     # that profile already scaled, the row's own part takes the rest.
@@ -547,6 +625,8 @@ def _model_rows(
         if done is not None:
             done(a / ti.size)
         out[a : a + step] = models.render_values(mod, ti[a : a + step], dt, ph, wl, kw)
+    if done is not None:
+        done(1.0)
     return out
 
 

@@ -123,6 +123,7 @@ def render(
     delta_theta: ArrayLike | None = None,
     phi: ArrayLike | None = None,
     dtype: type | np.dtype = np.float64,
+    progress: bool = True,
 ) -> xr.DataArray:
     """Render a model material to a look-up table.
 
@@ -135,6 +136,9 @@ def render(
         3-degree steps (the whole visible hemisphere; with 141 wavelengths that is
         already 290 MB in float64: pass narrower grids for narrow lobes).
     dtype : numpy dtype
+    progress : bool, default True
+        Show a progress bar (tqdm.auto) while rendering a large table (2e7 values and
+        more: seconds).
 
     Returns
     -------
@@ -165,12 +169,24 @@ def render(
                 f"{name}: expected a non-empty 1-D grid [degree], got shape {g.shape}"
             )
     _require_isotropic(m)
-    vals = m.render_grid(ti, dt, ph, wl, horizon="limit", **kw)
+    vals = np.empty((ti.size, dt.size, ph.size, wl.size), dtype=dtype)
+    step = max(1, _RENDER_CHUNK // (dt.size * ph.size * wl.size))  # bounded temporaries
+    from tqdm.auto import tqdm
+
+    with tqdm(
+        total=ti.size,
+        desc=f"rendering model {spec.attrs['material']}",
+        unit="row",
+        disable=not progress or vals.size < _PROGRESS_MIN,
+    ) as bar:
+        for a in range(0, ti.size, step):
+            vals[a : a + step] = m.render_grid(ti[a : a + step], dt, ph, wl, horizon="limit", **kw)
+            bar.update(min(step, ti.size - a))
     # Where the grid stops inside the hemisphere the model goes on: hold the edge
     # (exact for a Lambertian surface) rather than drop to zero.
     blend = min(float(ti[1] - ti[0]), 1.0) if ti.size > 1 and ti[0] == 0.0 else 0.0
     return new_material(
-        vals.astype(dtype),
+        vals,
         ti,
         dt,
         ph,
@@ -185,6 +201,12 @@ def render(
         normal_incidence_blend=blend,
         **_edges(dt, ph),
     )
+
+
+#: Table values :func:`render` computes at once (bounds its temporaries).
+_RENDER_CHUNK = 2_000_000
+#: Table values from which :func:`render` shows a progress bar (a few seconds' work).
+_PROGRESS_MIN = 20_000_000
 
 
 def _edges(dt: np.ndarray, ph: np.ndarray) -> dict[str, str]:

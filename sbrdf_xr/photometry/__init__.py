@@ -28,9 +28,19 @@ The chain from a simulation cube to what a telescope measures:
    the band weights); :func:`standard_magnitude` (to a range, a phase angle, 1 AU),
    :func:`sun_distance_au`, :func:`at_resolution` (a spectrograph's resolution).
 7. :func:`to_netcdf` / :func:`open_photometry` - CF-1.10 photometry files.
+8. :mod:`~sbrdf_xr.photometry.colour_science` - colour-science spectra in and out: a
+   ``SpectralDistribution`` or ``MultiSpectralDistributions`` is accepted as a filter,
+   a solar spectrum (:func:`solar_name`) or a spectrum, and :func:`to_colour` exports
+   any spectrum or cube variable to them.
+
+Which library does what: speclite ships the filter curves; pvlib (ASTM G173) and pyphot
+(CALSPEC, Kurucz) ship the solar and Vega spectra; the band integrals are this package's
+own exact quadrature (:func:`hat_integrals`, cross-checked against colour-science's
+integration in the tests); colour-science does the colorimetry of :func:`srgb` and the
+conversions of ``colour_science``.
 
 Modules: ``spectra`` (reference spectra, quadrature), ``bands``, ``magnitude``,
-``atmosphere``, ``standard``, ``colour``, ``filter_names``, ``measured``,
+``atmosphere``, ``standard``, ``colour``, ``colour_science``, ``filter_names``, ``measured``,
 ``lightcurves``, ``files``.
 
 Conventions
@@ -114,6 +124,7 @@ from . import (
     atmosphere,
     bands,
     colour,
+    colour_science,
     files,
     lightcurves,
     magnitude,
@@ -140,6 +151,7 @@ from .bands import (
     speclite_names,
 )
 from .colour import srgb
+from .colour_science import from_colour, to_colour
 from .files import cf_decode, cf_encode, open_photometry, to_netcdf
 from .filter_names import band_label
 from .lightcurves import compare, compare_light_curves, plot_comparison
@@ -159,6 +171,7 @@ from .spectra import (
     check_system,
     hat_integrals,
     reference_flux,
+    solar_name,
     solar_spectrum,
     trapezoid_weights,
     vega_spectrum,
@@ -200,11 +213,13 @@ __all__ = [
     "check_system",
     "colour",
     "colour_indices",
+    "colour_science",
     "compare",
     "compare_light_curves",
     "extinction_coefficients",
     "files",
     "filters",
+    "from_colour",
     "hat_integrals",
     "lambert_sphere_phase",
     "lightcurves",
@@ -218,6 +233,7 @@ __all__ = [
     "rayleigh_optical_depth",
     "read_light_curve",
     "reference_flux",
+    "solar_name",
     "solar_spectrum",
     "speclite_names",
     "spectra",
@@ -227,6 +243,7 @@ __all__ = [
     "standard_magnitude",
     "sun_distance_au",
     "sun_magnitudes",
+    "to_colour",
     "to_netcdf",
     "transmission",
     "trapezoid_weights",

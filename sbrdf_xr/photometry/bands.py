@@ -16,8 +16,8 @@ from numpy.typing import ArrayLike
 
 from .._names import BAND, WAVELENGTH, attrs
 from ..errors import ValidationError
+from .colour_science import as_bands, as_spectrum
 from .spectra import (
-    SOLAR_SPECTRA,
     _check_grid,
     _choose,
     _illumination,
@@ -25,6 +25,7 @@ from .spectra import (
     _solar_provenance,
     _weighting,
     hat_integrals,
+    solar_name,
 )
 
 #: Short band names -> speclite filter names.  Bessell (1990, PASP 102, 1181) UBVRI
@@ -168,6 +169,7 @@ def _user_band(label: str, spec: Any) -> _Band:
 
 def _resolve_bands(bands: Any) -> list[_Band]:
     """Normalise every accepted form of ``bands`` to a list of _Band."""
+    bands = as_bands(bands)  # colour-science filters
     items: list[tuple[str, Any]] = []
     if isinstance(bands, str):
         items = [(bands, None)]
@@ -248,7 +250,10 @@ def filters(bands: Any, wavelength: ArrayLike | None = None) -> xr.DataArray:
         ``"sdss2010-g"``, ``"decam2014-r"``, ...; :func:`speclite_names`) - and/or user
         bandpasses: ``(label, DataArray over wavelength [nm])`` or ``(label,
         (wavelength [nm], response))`` pairs, a mapping label -> bandpass, a named
-        DataArray, or a ``(band, wavelength)`` DataArray from this function.
+        DataArray, or a ``(band, wavelength)`` DataArray from this function.  A
+        colour-science ``SpectralDistribution`` (labelled by its name) or
+        ``MultiSpectralDistributions`` (one band per label) serves as a bandpass
+        anywhere (:mod:`~sbrdf_xr.photometry.colour_science`).
     wavelength : array_like, optional
         Common grid [nm]; default the union of the filters' own nodes.  Responses are
         interpolated linearly and are zero outside their tabulated range.
@@ -408,8 +413,9 @@ def band_weights(
         (computed with the same quadrature, continuing the Sun past the grid): then
         ``W @ x`` is the solar-weighted band mean of ``x`` in the units of ``x``, and
         ``W @ 1 = 1`` whenever the grid covers the band or ``extrapolate="constant"``.
-    solar : str
-        Solar spectrum, a key of :data:`~sbrdf_xr.photometry.SOLAR_SPECTRA`.
+    solar : str, colour.SpectralDistribution or xarray.DataArray
+        Solar spectrum, a key of :data:`~sbrdf_xr.photometry.SOLAR_SPECTRA` or a spectrum
+        at 1 AU [W m-2 nm-1] (:func:`~sbrdf_xr.photometry.spectra.solar_name`).
     transmission : xarray.DataArray, optional
         Atmospheric transmission over ``wavelength`` [1]
         (:func:`sbrdf_xr.photometry.atmosphere.transmission`), folded into the weights
@@ -442,7 +448,7 @@ def band_weights(
     _choose(extrapolate, EXTRAPOLATIONS, "extrapolate")
     t = _check_grid(wavelength, "wavelength")
     bl = _resolve_bands(bands)
-    _choose(solar, SOLAR_SPECTRA, "solar")
+    solar = solar_name(solar)
     rows, full = _band_rows(bl, t, weighting, quadrature, extrapolate, solar, transmission)
     if normalize:
         rows = rows / full[:, None]
@@ -531,6 +537,7 @@ def pre_integrate(
     >>> banded.dims, np.round(float(banded.max()), 6)  # 0.3 / pi in every band
     (('theta_i', 'delta_theta', 'phi', 'band'), np.float64(0.095493))
     """
+    table = as_spectrum(table)  # a colour-science spectrum
     if (
         not isinstance(table, xr.DataArray)
         or WAVELENGTH not in table.dims

@@ -8,6 +8,7 @@ import numpy as np
 import xarray as xr
 
 from .._names import WAVELENGTH, attrs
+from .colour_science import as_spectrum
 from .magnitude import _signal_of
 from .spectra import _choose, solar_spectrum
 
@@ -56,8 +57,9 @@ def srgb(
 
     Parameters
     ----------
-    source : xarray.Dataset or DataArray
-        A cube (its ``variable``) or spectra over ``wavelength``.
+    source : xarray.Dataset, DataArray or colour-science spectrum
+        A cube (its ``variable``), spectra over ``wavelength``, or a colour-science
+        ``SpectralDistribution`` / ``MultiSpectralDistributions``.
     variable : str
         Cube variable.
     white : {"sun", "D65"}
@@ -89,7 +91,7 @@ def srgb(
 
     _choose(white, {"sun": "", "D65": ""}, "white")
     _choose(normalise, {"each": "", "global": ""}, "normalise")
-    s = _signal_of(source, variable)
+    s = _signal_of(as_spectrum(source), variable)
     other = [d for d in s.dims if d != WAVELENGTH]
     s = s.transpose(*other, WAVELENGTH)
     wl = np.asarray(s[WAVELENGTH].values, dtype=np.float64)

@@ -15,6 +15,7 @@ from numpy.typing import ArrayLike
 from .._names import WAVELENGTH, attrs
 from ..errors import ValidationError
 from ..units import check_wavelengths, to_unit
+from .colour_science import from_colour, is_colour_spectrum
 
 # ---------------------------------------------------------------- constants
 
@@ -29,16 +30,33 @@ _SOLAR_FILE = "ASTMG173.csv"
 _SOLAR_COLUMN = "extraterrestrial"
 _FLAM = 1e-2  # 1 erg s-1 cm-2 A-1 = 1e-2 W m-2 nm-1
 
-#: Solar spectra at 1 AU selectable by name (``solar=`` of the band functions).
-SOLAR_SPECTRA: dict[str, str] = {
-    "astm_g173": "ASTM G173-03 extraterrestrial (AM0) spectrum, 280-4000 nm (shipped by pvlib); "
-    "Gueymard 2004, Sol. Energy 76, 423",
-    "calspec": "CALSPEC sun_reference_stis_001: Woods et al. 1996 (UV), Neckel & Labs 1984 "
-    "(410-870 nm), Arvesen et al. 1969, Castelli model beyond 960 nm; 119.5-2696 nm "
-    "(STScI CALSPEC, shipped by pyphot)",
-    "kurucz1993": "Kurucz (1993) model atmosphere of the Sun (Teff 5777 K, log g 4.44, "
-    "[M/H] 0) at 1 AU, CALSPEC grid file sun_kurucz93 (shipped by pyphot)",
-}
+
+class _SolarSpectra(dict[str, str]):
+    """The named solar spectra; a spectrum object looks up (and registers) its own name."""
+
+    def __missing__(self, key: Any) -> str:
+        if isinstance(key, str):
+            raise KeyError(key)
+        return str(self[solar_name(key)])
+
+    def __contains__(self, key: object) -> bool:
+        return dict.__contains__(self, key if isinstance(key, str) else solar_name(key))
+
+
+#: Solar spectra at 1 AU selectable by name (``solar=`` of the band functions); a spectrum
+#: given as ``solar=`` (:func:`solar_name`) is added under its own name.
+SOLAR_SPECTRA: dict[str, str] = _SolarSpectra(
+    {
+        "astm_g173": "ASTM G173-03 extraterrestrial (AM0) spectrum, 280-4000 nm "
+        "(shipped by pvlib); Gueymard 2004, Sol. Energy 76, 423",
+        "calspec": "CALSPEC sun_reference_stis_001: Woods et al. 1996 (UV), Neckel & Labs 1984 "
+        "(410-870 nm), Arvesen et al. 1969, Castelli model beyond 960 nm; 119.5-2696 nm "
+        "(STScI CALSPEC, shipped by pyphot)",
+        "kurucz1993": "Kurucz (1993) model atmosphere of the Sun (Teff 5777 K, log g 4.44, "
+        "[M/H] 0) at 1 AU, CALSPEC grid file sun_kurucz93 (shipped by pyphot)",
+    }
+)
+_USER_SOLAR: dict[str, tuple[np.ndarray, np.ndarray, str]] = {}
 
 #: Photometric systems (``system=`` of the magnitude functions): name -> definition.
 MAGNITUDE_SYSTEMS: dict[str, str] = {
@@ -202,9 +220,61 @@ def _read_calspec(name: str) -> tuple[np.ndarray, np.ndarray, str]:
     return wl, f, f"pyphot/libs/{name} (pyphot {_pkg_version('pyphot')})"
 
 
+def solar_name(solar: Any) -> str:
+    """The name of a solar spectrum: a key of :data:`SOLAR_SPECTRA`, or a spectrum's own.
+
+    A spectrum - a colour-science ``SpectralDistribution`` or a DataArray over
+    ``wavelength`` [nm], in W m-2 nm-1 at 1 AU - is registered under
+    ``user:<its name>:<hash of its values>`` and can be named by that from then on;
+    every ``solar=`` of the package goes through here.
+
+    Examples
+    --------
+    >>> solar_name("calspec")
+    'calspec'
+    >>> sun = xr.DataArray([1.8, 1.9, 1.7], dims="wavelength", name="my-sun",
+    ...                    coords={"wavelength": [400.0, 500.0, 600.0]})
+    >>> key = solar_name(sun)
+    >>> key.startswith("user:my-sun:"), SOLAR_SPECTRA[key][:22]
+    (True, 'user solar spectrum my')
+    """
+    if isinstance(solar, str):
+        return str(_choose(solar, SOLAR_SPECTRA, "solar"))
+    da = from_colour(solar, units="W m-2 nm-1") if is_colour_spectrum(solar) else solar
+    if not isinstance(da, xr.DataArray) or da.dims != (WAVELENGTH,) or WAVELENGTH not in da.coords:
+        allowed = ", ".join(repr(k) for k in SOLAR_SPECTRA)
+        raise ValidationError(
+            f"solar: expected one of {allowed}, a colour-science SpectralDistribution or a "
+            f"DataArray over '{WAVELENGTH}', got {type(solar).__name__}"
+        )
+    units = (da.attrs.get("units", "W m-2 nm-1"), da[WAVELENGTH].attrs.get("units", "nm"))
+    if units != ("W m-2 nm-1", "nm"):
+        raise ValidationError(f"solar: expected W m-2 nm-1 over nm, got {units[0]} over {units[1]}")
+    wl = _check_grid(da[WAVELENGTH].values, "solar wavelength")
+    e = np.array(da.values, dtype=np.float64)
+    if wl.size < 2 or not np.all(np.isfinite(e)) or np.any(e < 0):
+        raise ValidationError("solar: need >= 2 finite, non-negative irradiances")
+    import hashlib
+
+    digest = hashlib.sha256(wl.tobytes() + e.tobytes()).hexdigest()[:12]
+    key = f"user:{da.name or 'spectrum'}:{digest}"
+    if key not in _USER_SOLAR:
+        wl.setflags(write=False)
+        e.setflags(write=False)
+        src = str(da.attrs.get("source", "a user-supplied DataArray"))
+        _USER_SOLAR[key] = (wl, e, src)
+        dict.__setitem__(SOLAR_SPECTRA, key, f"user solar spectrum {da.name!s} ({src})")
+    return key
+
+
+def _solar_native(solar: Any = "astm_g173") -> tuple[np.ndarray, np.ndarray, str]:
+    return _solar_table(solar_name(solar))
+
+
 @cache
-def _solar_native(solar: str = "astm_g173") -> tuple[np.ndarray, np.ndarray, str]:
-    _choose(solar, SOLAR_SPECTRA, "solar")
+def _solar_table(solar: str) -> tuple[np.ndarray, np.ndarray, str]:
+    if solar in _USER_SOLAR:
+        return _USER_SOLAR[solar]
     if solar == "astm_g173":
         import pvlib
 
@@ -230,7 +300,8 @@ def _solar_native(solar: str = "astm_g173") -> tuple[np.ndarray, np.ndarray, str
     return wl, e, src
 
 
-def _solar_provenance(solar: str = "astm_g173") -> dict[str, str]:
+def _solar_provenance(solar: Any = "astm_g173") -> dict[str, str]:
+    solar = solar_name(solar)
     wl, e, src = _solar_native(solar)
     total = float(_integral(wl, e, wl[0], wl[-1]))
     return {
@@ -241,7 +312,7 @@ def _solar_provenance(solar: str = "astm_g173") -> dict[str, str]:
     }
 
 
-def _illumination(solar: str, transmission: Any = None) -> tuple[np.ndarray, np.ndarray]:
+def _illumination(solar: Any, transmission: Any = None) -> tuple[np.ndarray, np.ndarray]:
     """Solar nodes [nm] and irradiance [W m-2 nm-1], times an atmospheric transmission if given."""
     ws, es, _ = _solar_native(solar)
     if transmission is None:
@@ -373,7 +444,7 @@ def reference_nodes(system: str) -> np.ndarray:
 
 
 def solar_spectrum(
-    wavelength: ArrayLike | None = None, *, method: str = "average", solar: str = "astm_g173"
+    wavelength: ArrayLike | None = None, *, method: str = "average", solar: Any = "astm_g173"
 ) -> xr.DataArray:
     """The extraterrestrial solar spectral irradiance at 1 AU.
 
@@ -392,8 +463,9 @@ def solar_spectrum(
         the exact integral of the native spectrum over the same range and Fraunhofer
         lines are averaged, not aliased.  ``linear``: point-wise linear interpolation
         (pvlib's own method).
-    solar : str
-        A key of :data:`SOLAR_SPECTRA` (``astm_g173``, ``calspec``, ``kurucz1993``).
+    solar : str, colour.SpectralDistribution or xarray.DataArray
+        A key of :data:`SOLAR_SPECTRA` (``astm_g173``, ``calspec``, ``kurucz1993``), or a
+        spectrum at 1 AU [W m-2 nm-1] (:func:`solar_name`).
 
     Returns
     -------

@@ -176,10 +176,15 @@ def test_canx1_plot(canx1):
         ax = fig.axes[0]
         assert ax.name == "3d"
         assert len(ax.collections[0].get_paths()) == canx1.n_facets
-        assert [t.get_text() for t in ax.get_legend().get_texts()] == canx1.materials
-        # facets coloured by material with the paper's colours: red, blue, white
-        colours = {tuple(np.round(c[:3], 3)) for c in ax.collections[0].get_facecolor()}
-        assert colours == {(1.0, 0.0, 0.0), (0.0, 0.0, 1.0), (1.0, 1.0, 1.0)}
+        assert [t.get_text() for t in fig.legends[0].get_texts()] == canx1.materials
+        # facets coloured by material with the paper's colours, red, blue and white,
+        # shaded by their orientation (each a darker or equal shade of its colour)
+        shades = np.asarray(ax.collections[0].get_facecolor())[:, :3]
+        kinds = {tuple(c > 1e-3) for c in shades}
+        assert kinds == {(True, False, False), (False, False, True), (True, True, True)}
+        white = shades[np.all(shades > 1e-3, axis=1)]
+        assert np.allclose(white, white[:, :1]) and 0.2 < white.min() < white.max() <= 1.0
+        assert ax.get_zlabel() == "z [m]" and not ax.zaxis.get_rotate_label(ax.get_zlabel())
     finally:
         plt.close(fig)
     fig, ax = plt.subplots(subplot_kw={"projection": "3d"})

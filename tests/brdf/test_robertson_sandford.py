@@ -279,7 +279,7 @@ def rs_params(draw):
     return {"rho_D": t * u * g, "epsilon": t * (1 - u) * g, "b": b, "e": e}
 
 
-@settings(max_examples=examples(300), deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(
     s=directions(),
     o=directions(),

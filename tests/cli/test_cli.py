@@ -43,6 +43,11 @@ def test_info(capsys, tmp_path):
     assert "sbrdf" in capsys.readouterr().out
 
 
+def test_bench_repeat_must_be_positive(capsys):
+    assert main(["bench", "--quick", "--repeat", "0"]) == 2
+    assert "--repeat: got 0; expected a whole number >= 1" in capsys.readouterr().err
+
+
 def test_bad_subcommand_exits_with_usage():
     with pytest.raises(SystemExit) as exc:
         main(["fly"])
@@ -54,7 +59,8 @@ def test_bench_quick_runs_and_reports_ratios(capsys, tmp_path):
     import xarray as xr
 
     csv, nc, png = tmp_path / "b.csv", tmp_path / "b.nc", tmp_path / "front.png"
-    assert main(["bench", "--quick", "--csv", str(csv), "-o", str(nc), "--plot", str(png)]) == 0
+    argv = ["bench", "--quick", "--repeat", "2", "--csv", str(csv), "-o", str(nc)]
+    assert main([*argv, "--plot", str(png)]) == 0
     out = capsys.readouterr().out
     assert "sbrdf_xr linear look-up kernel" in out and "xarray .interp (linear)" in out
     assert (
@@ -72,6 +78,14 @@ def test_bench_quick_runs_and_reports_ratios(capsys, tmp_path):
     assert np.all(
         ds.mmag_max.sel(case="materials: analytic generating models (ground truth)").values > 1
     )
+    # Every preset has its row: its errors against the reference and the generating models,
+    # its time as the best of repeated runs with their spread.
+    for preset in ("fast", "balanced", "reference"):
+        row = ds.sel(case=f"preset: {preset}")
+        assert np.all(np.isfinite(row.model_mmag_max)) and np.all(row.model_mmag_max > 1)
+        assert np.all(row.time_spread >= 0) and np.all(row.time_ratio > 0)
+    assert np.all(ds.mmag_max.sel(case="preset: reference").values == 0)
+    assert "preset: balanced" in out and "vs generating models" in out
     ds.close()
     assert csv.stat().st_size > 0 and png.stat().st_size > 0
 

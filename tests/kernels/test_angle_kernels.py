@@ -30,7 +30,7 @@ finite = st.floats(min_value=-1e300, max_value=1e300, width=64)
 positive = st.floats(min_value=2.3e-308, max_value=1e300, width=64)
 
 
-@settings(max_examples=examples(300), deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(
     arrays(np.float64, 64, elements=finite),
     arrays(np.float64, 64, elements=positive),

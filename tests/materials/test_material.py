@@ -15,6 +15,7 @@ from hypothesis_profiles import examples
 import sbrdf_xr  # noqa: F401  (registers the accessors)
 from sbrdf_xr import testing
 from sbrdf_xr.errors import NonPhysicalWarning, ValidationError
+from sbrdf_xr.materials import energy as E
 from sbrdf_xr.materials import tables as M
 
 
@@ -267,7 +268,7 @@ def test_hemispherical_reflectance_wrapper_and_warning():
     np.testing.assert_allclose(rho.values, 0.5, rtol=1e-11)
     bright = testing.make_material(value=1.5 / np.pi, **full)
     with pytest.warns(NonPhysicalWarning, match="reaches 1.500 > 1"):
-        M.hemispherical_reflectance(bright)
+        E.hemispherical_reflectance(bright)
 
 
 # --------------------------------------------------------------------- I/O
@@ -364,7 +365,7 @@ def test_below_noise_model_fill_keeps_the_floor_and_the_measurements():
     mod, _, kw = models.model_parameters(spec)
     ti_all = filled.theta_i.values
     np.testing.assert_allclose(
-        M.hemispherical_reflectance(filled),
+        E.hemispherical_reflectance(filled),
         mod.directional_hemispherical_reflectance(np.minimum(ti_all, 90.0), wl, **kw),
         rtol=1e-9,
     )
@@ -391,7 +392,7 @@ def test_below_noise_model_fill_keeps_the_floor_and_the_measurements():
     model, _, kw = models.model_parameters(spec)
     rho_m = model.directional_hemispherical_reflectance([20.0, 40.0, 60.0], wl, **kw)
     np.testing.assert_allclose(
-        M.hemispherical_reflectance(filled, [20.0, 40.0, 60.0]), rho_m, rtol=0.02
+        E.hemispherical_reflectance(filled, [20.0, 40.0, 60.0]), rho_m, rtol=0.02
     )
     with pytest.raises(ValidationError, match="below_noise"):
         M.build_lut(meas, below_noise="floor")
@@ -427,7 +428,7 @@ def test_lambertian_material_is_exact_everywhere(method):
         np.testing.assert_allclose(
             got, np.broadcast_to(np.asarray(albedo) / np.pi, got.shape), rtol=1e-12
         )
-        rho = M.hemispherical_reflectance(lam, [0.0, 45.0, 89.0])
+        rho = E.hemispherical_reflectance(lam, [0.0, 45.0, 89.0])
         # Gauss-Legendre on the constant integrand: ~1e-13
         np.testing.assert_allclose(rho, np.broadcast_to(albedo, rho.shape), rtol=1e-10)
     const = M.constant_material([0.1, 0.2, 0.3], wl, material="c")
@@ -674,7 +675,7 @@ def test_shipped_tables_keep_their_generating_models_energy(name):
 
     table = catalog.load(name)
     wl = table.wavelength.values
-    rho_t = M.hemispherical_reflectance(table, ENERGY_THETA_I).values
+    rho_t = E.hemispherical_reflectance(table, ENERGY_THETA_I).values
     if ENERGY_TABLES[name] is None:  # a Lambertian table: rho is its albedo, 0.5
         rho_m = np.full_like(rho_t, 0.5)
     else:
@@ -692,4 +693,4 @@ def test_shipped_tables_keep_their_generating_models_energy(name):
         f"{name}: reflectance off its model's by {rel[worst]:.3f} at theta_i = "
         f"{ENERGY_THETA_I[worst[0]]} deg, {wl[worst[1]]} nm"
     )
-    assert float(M.hemispherical_reflectance(table).max()) <= 1.0  # every row, 0-90 deg
+    assert float(E.hemispherical_reflectance(table).max()) <= 1.0  # every row, 0-90 deg

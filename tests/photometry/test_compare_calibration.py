@@ -38,7 +38,7 @@ def _unit(q):
 def held_out_pass():
     from sbrdf_xr.body.spacecraft import canx1
     from sbrdf_xr.engine import Scene, simulate
-    from sbrdf_xr.observing.attitude import Tumble
+    from sbrdf_xr.observing import Tumble
     from sbrdf_xr.observing.observe import Observation, Orbit, Site
     from sbrdf_xr.observing.timescales import times
 

@@ -1,0 +1,227 @@
+"""Material unmixing: recovery of a known mixture, honest uncertainties, warnings, bad input.
+
+The measured spectra are the forward model's per-material terms of CanX-1 mixed with known
+scale factors, plus Gaussian noise; tolerances are stated where they are used.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from sbrdf_xr import invert
+from sbrdf_xr.errors import FitQualityWarning, InversionError
+
+AL, CELL, PAINT = "aluminium-6061-t6", "tjpv-cell", "white-paint-a276"
+
+
+def _noisy(truth, rel, seed):
+    rng = np.random.default_rng(seed)
+    sigma = rel * np.abs(truth) + 1e-12
+    return truth + sigma * rng.normal(size=truth.shape), sigma
+
+
+def _mix(per_material, scales):
+    return (per_material * xr.DataArray(scales, dims="material")).sum("material")
+
+
+def test_unmix_recovers_areas(per_material, sc):
+    scale = np.array([0.0, 1.2, 1.0])  # no aluminium
+    y, sigma = _noisy(_mix(per_material, scale), 0.01, 3)
+    r = invert.unmix(y, per_material, sigma, areas=invert.material_areas(sc), select=None)
+    est, unc = r["scale"].values, r["scale_uncertainty"].values
+    # linear least squares with the true sigma: every estimate within 4 sigma of the truth
+    # (a 6e-5 chance per value for a calibrated estimator)
+    assert np.all(np.abs(est - scale) < 4 * unc)
+    assert r.attrs["fit_quality"] == "consistent"
+    assert r["area"].attrs["units"] == "m2" and "long_name" in r["scale"].attrs
+    # the fractions sum to one over the candidates, and say so
+    assert float(r["area_fraction"].sum()) == pytest.approx(1.0)
+    assert "candidate materials of this fit" in r["area_fraction"].attrs["normalisation"]
+
+
+def test_unmix_equals_independent_least_squares(per_material):
+    """The estimate and covariance of the full model are numpy's weighted least squares."""
+    y, sigma = _noisy(_mix(per_material, [0.6, 1.0, 0.25]), 0.03, 11)
+    r = invert.unmix(
+        y.isel(geometry=0), per_material.isel(geometry=0), sigma.isel(geometry=0), select=None
+    )
+    a = per_material.isel(geometry=0).transpose("wavelength", "material").values
+    s = sigma.isel(geometry=0).values
+    x, *_ = np.linalg.lstsq(a / s[:, None], y.isel(geometry=0).values / s, rcond=None)
+    cov = np.linalg.inv((a / s[:, None]).T @ (a / s[:, None]))
+    np.testing.assert_allclose(r["scale"].values, x, rtol=1e-6)
+    np.testing.assert_allclose(r["scale_uncertainty"].values, np.sqrt(np.diag(cov)), rtol=1e-6)
+
+
+def test_selection_keeps_a_material_it_cannot_drop(per_material):
+    """One geometry, paint poorly determined: dropping it would bias the aluminium by far
+    more than its sigma, so the full model (with paint's large sigma) is kept."""
+    y, sigma = _noisy(_mix(per_material, [0.6, 1.0, 0.25]), 0.03, 5)
+    r = invert.unmix(y.isel(geometry=0), per_material.isel(geometry=0), sigma.isel(geometry=0))
+    assert bool(r["selected"].all())
+    sub = r.sel(subset=f"{AL}+{CELL}")
+    assert float(sub["subset_bias_ratio"]) > invert.DROP_BIAS and not bool(sub["subset_admissible"])
+    # the paint's uncertainty says the data cannot tell 0.25 from 0 or from 1
+    assert float(r["scale_uncertainty"].sel(material=PAINT)) > 0.5
+
+
+def test_selection_drops_an_absent_material(per_material):
+    """Geometry 0, no cells: leaving them out costs the others less than DROP_BIAS sigma,
+    so the BIC drops them (in 390 of 400 draws of a study of this case; >= 15 of 20 here
+    fails with probability 2e-4); whenever the lowest-BIC subset is not the one chosen, it
+    is because its omission could bias the others by more than DROP_BIAS sigma."""
+    left_out = 0
+    for seed in range(20):
+        y, sigma = _noisy(_mix(per_material, [0.3, 0.0, 1.0]), 0.03, seed)
+        r = invert.unmix(y.isel(geometry=0), per_material.isel(geometry=0), sigma.isel(geometry=0))
+        assert r.sizes["subset"] == 7  # every non-empty subset of three
+        lowest = str(r.subset.values[int(np.argmin(r.subset_bic.values))])
+        chosen = r.attrs["selected_materials"].replace(", ", "+")
+        if chosen != lowest:
+            assert float(r["subset_bias_ratio"].sel(subset=lowest)) > invert.DROP_BIAS
+        left_out += chosen == f"{AL}+{PAINT}"
+    assert left_out >= 15
+    assert float(r["scale"].sel(material=CELL)) == 0.0
+    g = invert.unmix(
+        y.isel(geometry=0), per_material.isel(geometry=0), sigma.isel(geometry=0), select="greedy"
+    )
+    assert g.attrs["selected_materials"] == r.attrs["selected_materials"]
+    assert float(r["subset_weight"].sum()) == pytest.approx(1.0)
+
+
+def test_selection_keeps_an_absent_material_it_cannot_drop_safely(per_material):
+    """Six geometries, no aluminium: the cells' estimate is correlated with the aluminium's
+    (dropping it could shift the cells by 2 of their sigma), so the aluminium stays in the
+    model, its estimate consistent with zero."""
+    y, sigma = _noisy(_mix(per_material, [0.0, 1.0, 0.25]), 0.03, 0)
+    r = invert.unmix(y, per_material, sigma)
+    assert bool(r["selected"].all())
+    al = r.sel(material=AL)
+    assert abs(float(al["scale"])) < 3 * float(al["scale_uncertainty"])
+    assert float(r["subset_bias_ratio"].sel(subset=f"{CELL}+{PAINT}")) > invert.DROP_BIAS
+
+
+def test_unmix_degeneracy_reported(per_material):
+    a = per_material.isel(material=1)
+    lib = {"cell": a, "cell-copy": a * 1.0001, "paint": per_material.isel(material=2)}
+    y, sigma = _noisy(a + per_material.isel(material=2), 0.01, 5)
+    r = invert.unmix(y, lib, sigma, select=None)
+    assert "cell / cell-copy" in r.attrs["degenerate"]
+    assert "paint" not in r.attrs["degenerate"]
+
+
+def test_candidates_on_other_grids_are_interpolated(per_material):
+    """A candidate on a coarser grid is interpolated to the measured one, with a note;
+    the fit equals least squares on the candidate interpolated independently (np.interp)."""
+    g0 = per_material.isel(geometry=4)
+    coarse = g0.sel(material=CELL).isel(wavelength=slice(None, None, 4))  # 141 -> 36, ends kept
+    lib = {AL: g0.sel(material=AL), CELL: coarse, PAINT: g0.sel(material=PAINT)}
+    y, sigma = _noisy(_mix(g0, [0.6, 1.0, 0.25]), 0.01, 8)
+    r = invert.unmix(y, lib, sigma, select=None)
+    assert f"'{CELL}' interpolated linearly" in r.attrs["library_note"]
+    wl = g0.wavelength.values
+    cols = [
+        g0.sel(material=AL).values,
+        np.interp(wl, coarse.wavelength.values, coarse.values),
+        g0.sel(material=PAINT).values,
+    ]
+    a = np.stack(cols, axis=-1) / sigma.values[:, None]
+    x, *_ = np.linalg.lstsq(a, y.values / sigma.values, rcond=None)
+    np.testing.assert_allclose(r["scale"].values, x, rtol=1e-6)
+    # a candidate that does not cover the measured wavelengths is refused, named
+    short = g0.sel(material=CELL).isel(wavelength=slice(0, 40))
+    with pytest.raises(InversionError, match=f"'{CELL}' covers"):
+        invert.unmix(y, {**lib, CELL: short}, sigma)
+
+
+def test_missing_material_warns(per_material):
+    y, sigma = _noisy(_mix(per_material, [0.6, 1.0, 0.25]), 0.01, 6)
+    lib = {AL: per_material.sel(material=AL), CELL: per_material.sel(material=CELL)}
+    with pytest.warns(FitQualityWarning, match="missing from the candidate library") as rec:
+        r = invert.unmix(y, lib, sigma)
+    assert "99.9 % point" in str(rec[0].message) and r.attrs["fit_quality"] == "poor"
+    assert float(r["reduced_chi2"]) > 5
+
+
+def test_wrong_geometry_warns(per_material):
+    y, sigma = _noisy(per_material.isel(geometry=4).sum("material"), 0.01, 7)
+    with pytest.warns(FitQualityWarning, match="simulated geometry differs"):
+        invert.unmix(y, per_material.isel(geometry=5), sigma)
+
+
+def test_overstated_uncertainties_warn(per_material):
+    y, sigma = _noisy(per_material.sum("material"), 0.01, 9)
+    with pytest.warns(FitQualityWarning, match="overstated"):
+        r = invert.unmix(y, per_material, 10 * sigma)
+    assert r.attrs["fit_quality"] == "too good"
+
+
+@pytest.mark.parametrize("geoms", [[0], [0, 1, 2, 3, 4, 5]], ids=["one-geometry", "six"])
+def test_calibration_small(per_material, geoms):
+    """60 draws per case in the default run: pull widths 1 within 0.3 (the spread of a
+    standard deviation of 60 unit normals is 0.09, so 0.3 is 3.3 sigma)."""
+    terms = per_material.isel(geometry=geoms)
+    study = invert.unmix_calibration(
+        terms, {AL: 0.6, CELL: 1.0, PAINT: 0.25}, relative_noise=0.03, n_draws=60, seed=1
+    )
+    np.testing.assert_allclose(study["pull_width"].values, 1.0, atol=0.3)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "geoms",
+    [[0], [2], [4], [0, 1, 2, 3, 4, 5]],
+    ids=["geometry-0", "geometry-2", "geometry-4", "six"],
+)
+@pytest.mark.parametrize(
+    "truth",
+    [(0.6, 1.0, 0.25), (0.0, 1.0, 0.25), (0.3, 0.0, 1.0)],
+    ids=["all-present", "no-aluminium", "no-cells"],
+)
+def test_calibration_study(per_material, geoms, truth):
+    """400 draws per case: the pulls of the materials present have width 1 +- 0.15, and
+    the stated 2-sigma intervals of every material cover the truth in >= 91.5 % of draws
+    (95.4 % expected, binomial spread 1.05 %: 3.7 spreads below, for 36 such numbers)."""
+    terms = per_material.isel(geometry=geoms)
+    names = [AL, CELL, PAINT]
+    study = invert.unmix_calibration(
+        terms, dict(zip(names, truth, strict=True)), relative_noise=0.03, n_draws=400, seed=2
+    )
+    table = study.drop_vars(["n_draws", "quality_warnings", "seconds_per_fit"]).to_dataframe()
+    print(f"\ngeometries {geoms}, truth {truth}, {int(study.n_draws)} draws:\n{table.to_string()}")
+    present = np.array(truth) > 0
+    np.testing.assert_allclose(study["pull_width"].values[present], 1.0, atol=0.15)
+    assert np.all(study["coverage_2sigma"].values >= 0.915)
+
+
+def test_unmix_bad_input(per_material):
+    y = per_material.sum("material")
+    with pytest.raises(InversionError, match="uncertainty"):
+        invert.unmix(y, per_material, 0.0)
+    with pytest.raises(InversionError, match="uncertainty"):
+        invert.unmix(y, per_material, -1e-5)
+    with pytest.raises(InversionError, match="uncertainty"):
+        invert.unmix(y, per_material, np.nan)
+    with pytest.raises(InversionError, match="NaN or infinite"):
+        invert.unmix(y.where(y.wavelength != y.wavelength[3]), per_material, 1e-5)
+    far = y.assign_coords(wavelength=y.wavelength + 2000.0)
+    with pytest.raises(InversionError, match="outside the simulated range"):
+        invert.unmix(far, per_material, 1e-5)
+    with pytest.raises(InversionError, match="2 values for 3 material parameters"):
+        invert.unmix(y.isel(geometry=0, wavelength=[0, 1]), per_material.isel(geometry=0), 1e-5)
+    with pytest.raises(InversionError, match="select"):
+        invert.unmix(y, per_material, 1e-5, select="some")
+    with pytest.raises(InversionError, match="drop_bias"):
+        invert.unmix(y, per_material, 1e-5, drop_bias=-1)
+    with pytest.raises(InversionError, match="empty"):
+        invert.unmix(y, {}, 1e-5)
+    with pytest.raises(InversionError, match="geometry"):
+        invert.unmix(y.isel(geometry=0), per_material, 1e-5)
+    bands = xr.DataArray([1.0, 1.0], dims="band", coords={"band": ["V", "R"]})
+    lib_b = xr.DataArray(
+        np.ones((2, 1)), dims=("material", "band"), coords={"material": ["x", "y"], "band": ["V"]}
+    )
+    with pytest.raises(InversionError, match="bands"):
+        invert.unmix(bands, lib_b, 0.1)
