@@ -12,7 +12,6 @@ import os
 from pathlib import Path
 
 import numpy as np
-
 from bad_input_tour import SECRET
 
 GREY = "lambertian-grey-50"
@@ -169,12 +168,10 @@ BROKEN_OBJ = {
     "no-faces": "v 0 0 0\nv 1 0 0\nv 0 1 0\n",
     "inside-out": "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 4 2\nf 1 3 4\nf 2 4 3\n",
     "duplicate-facets": (
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
-        "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\nf 2 3 4\n"
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\nf 2 3 4\n"
     ),
     "degenerate": (
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 2 0 0\n"
-        "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\nf 1 2 5\n"
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 2 0 0\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\nf 1 2 5\n"
     ),
     "tetra": "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
 }
@@ -233,6 +230,7 @@ def spoilt_material(kind: str, scale: float):
         ds["sbrdf"] = sb.astype(str)
     elif kind == "bad-source":
         ds.attrs["source"] = "rumour"
+        ds["sbrdf"].attrs["source"] = "rumour"
     elif kind == "string-coord":
         ds = ds.assign_coords(phi=("phi", ["a", "b", "c"], {"units": "degree"}))
     else:

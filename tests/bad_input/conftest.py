@@ -48,4 +48,3 @@ def secret_files(tmp_path_factory):
         p.write_text(f"{tour.SECRET}\n{tour.SECRET}\n", encoding="utf-8")
         out[suffix] = p
     return out
-

@@ -95,6 +95,8 @@ def _wrong_material(kind: str, scale: float) -> bool:
         return True
     if kind == "string-coord":
         return True
+    if kind == "wavelength-shift":  # nm added: wrong when it leaves the optical range
+        return not np.isfinite(scale) or abs(scale) >= 1e5 or scale <= -450
     if not np.isfinite(scale) or scale <= 0:
         return scale != 1.0
     if kind == "scaled-values":
@@ -105,8 +107,6 @@ def _wrong_material(kind: str, scale: float) -> bool:
         return scale > 1.0  # beyond -180
     if kind == "wavelength":
         return scale > 1e3 or scale < 1e-1  # beyond 1 mm, or below 45 nm
-    if kind == "wavelength-shift":
-        return abs(scale) >= 1e6
     return False
 
 
@@ -133,10 +133,21 @@ def test_spoilt_material_tables(tmp_path, kind, scale, reader):
 @given(kind=st.sampled_from(MEASUREMENT_SPOILS), scale=st.sampled_from(SCALES))
 def test_spoilt_measurement_sets(tmp_path, kind, scale):
     path = tmp_path / "measurements.nc"
-    spoilt_measurements(kind, scale).to_netcdf(path)
-    wrong = kind in ("int-values", "nan-values", "negative-values", "drop-variable") or (
-        kind not in ("no-units",) and (not np.isfinite(scale) or scale <= 0 or scale >= 100)
-    )
+    # values of make_measurements are about 0.2 sr-1: a glossy sample may be 100 times
+    # that (a mirror through a 1 degree aperture reaches 4e3 sr-1), 1e5 times is not;
+    # every incidence at 0 degree (theta_i x 0) is a possible, if odd, set
+    ds = spoilt_measurements(kind, scale)
+    domain = {"theta_i": (0.0, 89.999), "phi": (0.0, 180.0), "delta_theta": (-180.0, 180.0)}
+    if kind in domain:  # an angle is wrong outside its domain only
+        lo, hi = domain[kind]
+        v = ds[kind].values
+        wrong = not (np.isfinite(v).all() and lo <= v.min() and v.max() <= hi)
+    else:
+        wrong = kind in ("int-values", "nan-values", "negative-values", "drop-variable") or (
+            kind == "scaled-values" and not (np.isfinite(scale) and 0 <= scale <= 1e5)
+        )
+        wrong = wrong or (kind == "wavelength" and not (np.isfinite(scale) and 0.1 <= scale <= 100))
+    ds.to_netcdf(path)
     run_case(
         CATEGORY,
         lambda: _open_measurements(path),
