@@ -85,7 +85,7 @@ TOP_KEYS = [
 ]
 #: Values wrong only for their key (inside the TOML type the key takes).
 KEY_VALUES = {
-    "table_theta_step": [1e-9, 1e-6, 1e-3, 0.05, 1.0, 45.0, 46.0],
+    "table_theta_step": [1e-9, 1e-6, 1e-4, 0.05, 1.0, 45.0, 46.0],
     "wavelength_stride": [0, 2, 1000, 10**9],
     "chunk": [0, 1, 10**9, 10**12],
     "block_bytes": [0, 1, 2**40],
@@ -478,4 +478,3 @@ def test_zero_area_facet_does_not_warn():
     t = sc.merged()  # RuntimeWarning is an error in the tests
     np.testing.assert_array_equal(t.area.values, [0.5, 0.0])
     np.testing.assert_array_equal(t.normal.values, [[0, 0, 1], [0, 0, 0]])
-
