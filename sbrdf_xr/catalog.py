@@ -46,7 +46,7 @@ from ._catalog_index import (
 )
 from ._names import SBRDF
 from .body import spacecraft
-from .errors import CatalogError, ValidationError, did_you_mean
+from .errors import CatalogError, ValidationError, did_you_mean, input_file, reading
 from .materials import models
 from .materials import tables as material
 from .observing import observe
@@ -101,7 +101,7 @@ def _load_material(e: CatalogEntry, dtype: str | None = None) -> xr.DataArray:
     its values in ``dtype`` (None: as stored)."""
     source = e.extra.get("build_from")
     if source is None:
-        da = material.open_material(e.file)
+        da = material.open_material(e.file, check_energy=False)  # checked when built
         return da if dtype is None else da.astype(dtype, copy=False)
     options = tuple(sorted(e.extra.get("build", {}).items()))
     # a new DataArray (its own attrs) over the one built table, whose values are read-only:
@@ -148,7 +148,7 @@ def _built_material(
         material.to_netcdf(da, path, overwrite=True, complevel=0)  # fast to write and read
 
     def read(path: Any) -> xr.DataArray:
-        da = material.open_material(path)
+        da = material.open_material(path, check_energy=False)  # checked when built
         for k in _FILE_ATTRS:  # what writing a file adds, not what the build made
             da.attrs.pop(k, None)
         return da
@@ -460,10 +460,7 @@ def _file_of(
             f"{what}: {os.fspath(spec)!r} is neither a catalog name nor a file with a known "
             f"suffix (got {suffix or 'no suffix'!r}); allowed suffixes: {', '.join(suffixes)}"
         )
-    if not path.is_file():
-        where = f" (relative paths are taken from {base_dir})" if base_dir is not None else ""
-        raise CatalogError(f"{what}: file {path} does not exist{where}")
-    return path
+    return input_file(spec, what, CatalogError, base_dir=base_dir)
 
 
 def load_spacecraft_spec(
@@ -584,11 +581,8 @@ def load_material_spec(
             )
         return load(e.name)
     path = _file_of(spec, base_dir, "material", MATERIAL_SUFFIXES)
-    try:
-        with xr.open_dataset(path, engine="netcdf4") as ds:
-            is_table, is_model = SBRDF in ds.data_vars, "model" in ds.attrs
-    except (OSError, ValueError) as exc:
-        raise ValidationError(f"material: {path} cannot be read as netCDF ({exc})") from None
+    with reading(path, "material", "netCDF"), xr.open_dataset(path, engine="netcdf4") as ds:
+        is_table, is_model = SBRDF in ds.data_vars, "model" in ds.attrs
     if is_table:
         return material.open_material(path)
     if is_model:

@@ -9,8 +9,12 @@ is allowed.  Warnings derive from :class:`SbrdfWarning` so users can filter them
 
 from __future__ import annotations
 
+import contextlib
 import difflib
-from collections.abc import Iterable
+import os
+import stat
+from collections.abc import Iterable, Iterator
+from pathlib import Path
 
 __all__ = [
     "AttitudeError",
@@ -37,6 +41,8 @@ __all__ = [
     "ValidationError",
     "WorkersLostError",
     "did_you_mean",
+    "input_file",
+    "reading",
 ]
 
 
@@ -81,6 +87,159 @@ def did_you_mean(name: str, known: Iterable[str], kind: str = "known names") -> 
     if not close:
         return listed
     return f"did you mean {' or '.join(repr(c) for c in close)}? {listed}"
+
+
+def input_file(
+    path: str | os.PathLike[str],
+    what: str,
+    error: type[Exception] | None = None,
+    *,
+    base_dir: str | os.PathLike[str] | None = None,
+    empty_ok: bool = False,
+) -> Path:
+    """A file given as input, resolved and checked before anything opens it.
+
+    ``~`` is expanded, a relative path is taken from ``base_dir`` (when given), and the
+    result is made absolute with ``..`` resolved, as every message shows it.  A path that
+    does not exist, a dangling symbolic link, a directory, a FIFO, a socket, a device or
+    (unless ``empty_ok``) an empty file is refused with a message that names the path and
+    what it is, never what it holds.
+
+    Parameters
+    ----------
+    path : path-like
+        The path as given.
+    what : str
+        Where it was given (a field or flag), heading the message.
+    error : type, default ValidationError
+        The error raised (a subclass of :class:`SbrdfError`).
+    base_dir : path-like, optional
+        Directory that relative paths are taken from (a scene file's).
+    empty_ok : bool, default False
+        Accept an empty file.
+
+    Returns
+    -------
+    pathlib.Path
+        The absolute path of a regular file (``..`` resolved as written, symbolic links
+        kept, so that messages show the name the user gave).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.errors import input_file
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     _ = (Path(tmp) / "a.csv").write_text("x\\n1\\n")
+    ...     ok = input_file("sub/../a.csv", "spectrum", base_dir=tmp) == Path(tmp, "a.csv")
+    ...     try:
+    ...         input_file(tmp, "spectrum")
+    ...     except ValidationError as exc:
+    ...         said = str(exc).endswith("is a directory, not a file")
+    >>> ok, said
+    (True, True)
+    """
+    err = error or ValidationError
+    p = Path(os.fspath(path)).expanduser()
+    if base_dir is not None and not p.is_absolute():
+        p = Path(base_dir).expanduser() / p
+    p = Path(os.path.normpath(os.path.abspath(p)))  # ".." taken as written
+    resolved = p.resolve()
+    if p.is_symlink() and not p.exists():
+        raise err(f"{what}: {p} is a dangling symbolic link (its target does not exist)")
+    if not p.exists():
+        where = f" (relative paths are taken from {base_dir})" if base_dir is not None else ""
+        raise err(f"{what}: file {p} does not exist{where}")
+    mode = p.stat().st_mode
+    kinds = (
+        (stat.S_ISDIR, "a directory"),
+        (stat.S_ISFIFO, "a FIFO (named pipe)"),
+        (stat.S_ISSOCK, "a socket"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+    )
+    for test, kind in kinds:
+        if test(mode):
+            via = f" (a link to {resolved})" if resolved != p else ""
+            raise err(f"{what}: {p}{via} is {kind}, not a file")
+    if not empty_ok and p.stat().st_size == 0:
+        raise err(f"{what}: {p} is empty")
+    if not os.access(p, os.R_OK):
+        raise err(f"{what}: {p} is not readable (permission denied)")
+    return resolved
+
+
+def _reason(exc: BaseException) -> str:
+    """What went wrong in reading, without anything the file holds."""
+    if isinstance(exc, UnicodeDecodeError):
+        return f"not UTF-8 text (byte {exc.object[exc.start]:#04x} at offset {exc.start})"
+    if isinstance(exc, OSError) and exc.strerror:
+        return str(exc.strerror)
+    text = str(exc)
+    if isinstance(exc, RuntimeError | OSError) and text.startswith("NetCDF:"):
+        return text.split(":", 2)[1].strip() if text.count(":") > 1 else text
+    return type(exc).__name__
+
+
+@contextlib.contextmanager
+def reading(
+    path: str | os.PathLike[str], what: str, as_: str, error: type[Exception] | None = None
+) -> Iterator[None]:
+    """Turn a library's failure to read ``path`` into a named error that shows none of it.
+
+    Errors of the package pass through; ``OSError``, ``RuntimeError``, ``ValueError``,
+    ``KeyError``, ``IndexError``, ``TypeError``, ``EOFError``, ``StopIteration``,
+    ``SyntaxError`` (XML parse errors) and ``UnicodeDecodeError``
+    raised inside become ``error`` (default :class:`ValidationError`) naming the file, what
+    it was read as and the kind of failure (never the library's message, which may quote
+    the file's lines).
+
+    Parameters
+    ----------
+    path : path-like
+        The file being read.
+    what : str
+        Where it was given (a field or flag), heading the message.
+    as_ : str
+        What it was read as (``"netCDF"``, ``"a mesh"``).
+    error : type, default ValidationError
+        The error raised.
+
+    Yields
+    ------
+    None
+
+    Examples
+    --------
+    >>> from sbrdf_xr.errors import reading
+    >>> try:
+    ...     with reading("/tmp/x.csv", "spectrum", "CSV"):
+    ...         float("SECRET")
+    ... except ValidationError as exc:
+    ...     print(exc)
+    spectrum: /tmp/x.csv cannot be read as CSV (ValueError)
+    """
+    try:
+        yield
+    except SbrdfError:
+        raise
+    except (
+        OSError,
+        RuntimeError,
+        ValueError,
+        KeyError,
+        IndexError,
+        TypeError,
+        EOFError,
+        StopIteration,
+        SyntaxError,  # xml.etree's ParseError
+        UnicodeDecodeError,
+        AttributeError,
+        AssertionError,
+    ) as exc:
+        raise (error or ValidationError)(
+            f"{what}: {path} cannot be read as {as_} ({_reason(exc)})"
+        ) from None
 
 
 class SbrdfError(Exception):

@@ -52,8 +52,8 @@ PLAUSIBLE: dict[str, tuple[str, float, float, tuple[str, float], tuple[str, floa
     "range_km": ("km", 1e-3, 1e7, ("", 1.0), ("metres", 1e-3)),
     # Sun-object distances: from inside Mercury's orbit to beyond the planets
     "sun_distance_au": ("au", 0.05, 100.0, ("", 1.0), ("km", 1.0 / 149597870.7)),
-    # the largest side of a spacecraft mesh: 1 mm to 1 km
-    "mesh_size_m": ("m", 1e-3, 1e3, ("km", 1e3), ("millimetres", 1e-3)),
+    # the largest side of a spacecraft mesh: 1 mm to 500 m (the ISS spans 109 m)
+    "mesh_size_m": ("m", 1e-3, 500.0, ("km", 1e3), ("millimetres", 1e-3)),
 }
 
 #: Length units of mesh files and their size in metres [m].  Symbols are matched exactly

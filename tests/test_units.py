@@ -135,7 +135,7 @@ def test_a_mesh_unit_contradicting_the_file_or_an_implausible_size_warns(tmp_pat
     big = trimesh.creation.box(extents=(2000.0, 2000.0, 2000.0))  # 2 m in mm, read as metres
     with pytest.warns(
         UnitWarning,
-        match=r"largest side: 2000 m is above the plausible 1000 m: "
+        match=r"largest side: 2000 m is above the plausible 500 m: "
         r"millimetres\? .*\(2 m if it were millimetres\); give the file's unit",
     ):
         load_spacecraft(big, material="paint")

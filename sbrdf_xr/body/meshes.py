@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 import trimesh
 
-from ..errors import MeshError, ValidationError
+from ..errors import MeshError, ValidationError, input_file, reading
 from ..units import LENGTH_UNITS, metres_per
 from .facets import NORMAL_TOLERANCE
 from .repair import MERGE_DISTANCE, ZERO_AREA_FACTOR, clean_mesh
@@ -108,26 +108,44 @@ def read_material_map(path: str | Path) -> dict[Any, str]:
     >>> read_material_map(path)
     {(255, 255, 255): 'paint', 'panel': 'paint'}
     """
-    path = Path(path)
+    path = input_file(path, "material_map", ValidationError)
+    where = f"material map {path}"
     try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, tomllib.TOMLDecodeError) as exc:
-        raise ValidationError(f"material map {path}: cannot be read as TOML: {exc}") from exc
+        with reading(path, where, "UTF-8 text"):
+            text = path.read_text(encoding="utf-8")
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:  # its message says where, not what
+        raise ValidationError(f"{where}: cannot be read as TOML: {exc}") from None
     out: dict[Any, str] = {}
     tables = raw.get("material")
     if not isinstance(tables, list) or not tables:
-        raise ValidationError(f"material map {path}: expected [[material]] tables, found none")
+        raise ValidationError(f"{where}: expected [[material]] tables, found none")
     for i, table in enumerate(tables):
+        if not isinstance(table, dict):
+            raise ValidationError(f"{where}: material[{i}] is not a [[material]] table")
         name = table.get("name")
         if not isinstance(name, str) or not name:
-            raise ValidationError(f"material map {path}: table {i} lacks a 'name' string")
+            raise ValidationError(f"{where}: material[{i}] lacks a 'name' string")
         rgb = table.get("rgb", [])
-        colours = [rgb] if rgb and not isinstance(rgb[0], list) else rgb
-        keys = [tuple(c) for c in colours] + list(table.get("labels", []))
-        if not keys:
+        if not isinstance(rgb, list):
             raise ValidationError(
-                f"material map {path}: material {name!r} has neither 'rgb' nor 'labels'"
+                f"{where}: material[{i}] ({name!r}) rgb: expected [r, g, b] or a list of "
+                f"them, got {type(rgb).__name__}"
             )
+        colours = [rgb] if rgb and not isinstance(rgb[0], list) else rgb
+        labels = table.get("labels", [])
+        if not isinstance(labels, list) or any(
+            isinstance(x, bool) or not isinstance(x, str | int) for x in labels
+        ):
+            raise ValidationError(
+                f"{where}: material[{i}] ({name!r}) labels: expected a list of names or integers"
+            )
+        for c in colours:
+            if _as_color(c if isinstance(c, list) else [c]) is None:
+                raise ValidationError(f"{where}: material[{i}] ({name!r}) rgb: got {c!r}")
+        keys = [tuple(c) for c in colours] + labels
+        if not keys:
+            raise ValidationError(f"{where}: material {name!r} has neither 'rgb' nor 'labels'")
         for k in keys:
             out[k] = name
     return out
@@ -145,7 +163,10 @@ def _as_color(key: Any) -> Color | None:
         return None
     if isinstance(key, bool | int | np.integer):
         return None
-    arr = np.asarray(key)
+    try:
+        arr = np.asarray(key)
+    except ValueError:  # ragged
+        arr = np.asarray(None)
     if arr.shape != (3,) or not np.issubdtype(arr.dtype, np.number):
         raise ValidationError(
             f"material_map: key {key!r} is neither a colour (3 integers 0-255) nor a name"
@@ -409,17 +430,15 @@ def read_mesh(
     default_name = None
     obj = path_or_mesh
     if isinstance(obj, str | Path):
-        path = Path(obj)
-        if not path.is_file():
-            raise FileNotFoundError(f"mesh file {path} does not exist")
+        path = input_file(obj, "mesh file", MeshError)
         default_name = path.stem
         try:
             obj = trimesh.load(path, file_type=file_type, process=False)
-        except Exception as exc:
+        except Exception as exc:  # the library's message may quote the file: not shown
             raise MeshError(
-                f"{path}: could not be read as a mesh ({type(exc).__name__}: {exc}); "
+                f"{path}: could not be read as a mesh ({type(exc).__name__}); "
                 "expected a format trimesh reads (STL, OBJ, PLY, glTF/GLB, OFF, ...)"
-            ) from exc
+            ) from None
     stated = getattr(obj, "units", None)
     out.units = str(stated) if stated else None
     if isinstance(obj, trimesh.Scene):

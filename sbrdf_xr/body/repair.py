@@ -127,11 +127,18 @@ def clean_mesh(
     mesh = trimesh.Trimesh(vertices, faces, process=False, validate=False)
     # 5. open surface
     if not mesh.is_watertight:
-        n_open = len(trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1))
+        e = np.sort(mesh.edges_sorted, axis=1)
+        _, counts = np.unique(e, axis=0, return_counts=True)
+        n_open, n_fin = int(np.sum(counts == 1)), int(np.sum(counts > 2))
+        if n_fin:  # no repair makes this a closed surface
+            raise MeshError(
+                f"the surface is not manifold: {n_fin} edges are shared by more than two "
+                f"facets (and {n_open} belong to a single facet); a closed surface shares "
+                "every edge between exactly two"
+            )
         _problem(
             repair,
-            f"the surface is not closed ({n_open} edges belong to a single facet, "
-            "or edges are shared by more than two)",
+            f"the surface is not closed ({n_open} edges belong to a single facet)",
             "fill the holes with trimesh.repair.fill_holes",
         )
         n_before = len(mesh.faces)

@@ -48,7 +48,14 @@ from numpy.typing import NDArray
 
 from .. import _catalog_index
 from ..anisotropy import DEFAULT_TANGENT_DIRECTION, project_tangents
-from ..errors import CatalogError, MeshError, MeshRepairWarning, UnitWarning, ValidationError
+from ..errors import (
+    CatalogError,
+    MeshError,
+    MeshRepairWarning,
+    UnitWarning,
+    ValidationError,
+    input_file,
+)
 from ..units import check_plausible
 from .facets import NORMAL_TOLERANCE, check_facet_material, facet_table, merge_facets
 from .meshes import (
@@ -168,8 +175,9 @@ def load_spacecraft(
         the problems of :mod:`sbrdf_xr.body.repair` while ``repair`` is False.
     ValidationError
         If the length unit or the map is invalid, or the map names an unknown material.
-    FileNotFoundError
-        If ``path_or_mesh`` is a path that does not exist.
+    MeshError
+        If ``path_or_mesh`` is a path that is not a readable file (missing, a directory, a
+        FIFO, a device, empty) or not a usable mesh; the message names the file.
 
     Examples
     --------
@@ -199,6 +207,54 @@ def load_spacecraft(
             )
     elif material_map is not None:
         colours, name_map = normalise_map(material_map, known_materials)
+    if not isinstance(path_or_mesh, str | Path):
+        return _load(
+            path_or_mesh,
+            face_property,
+            file_type,
+            material,
+            colours,
+            name_map,
+            name,
+            length_unit,
+            factor,
+            tangent,
+            repair,
+        )
+    path = input_file(path_or_mesh, "mesh file", MeshError)
+    try:
+        return _load(
+            path,
+            face_property,
+            file_type,
+            material,
+            colours,
+            name_map,
+            name,
+            length_unit,
+            factor,
+            tangent,
+            repair,
+        )
+    except MeshError as exc:  # say which file
+        if str(path) in str(exc):
+            raise
+        raise MeshError(f"mesh file {path}: {exc}") from None
+
+
+def _load(
+    path_or_mesh: Any,
+    face_property: str | None,
+    file_type: str | None,
+    material: str | None,
+    colours: dict[Color, str],
+    name_map: dict[str, str],
+    name: str | None,
+    length_unit: Any,
+    factor: float | None,
+    tangent: Any,
+    repair: bool,
+) -> Spacecraft:
     labelled, default_name = read_mesh(path_or_mesh, face_property, file_type)
     vertices, faces, rgb, names = labelled.arrays()
     if len(faces) == 0:

@@ -15,8 +15,9 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from .. import catalog, geometry
-from ..errors import CatalogError, SceneError, ValidationError
+from ..errors import CatalogError, SceneError, ValidationError, did_you_mean
 from ..materials.tables import validate_material
+from ..units import check_plausible
 from .effects import DEFAULT_EFFECTS, SCENE_EFFECTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS, scene_effects
 from .knobs import KNOBS, PRESETS, apply_preset, check_knob
 from .plan import Plan, compile_plan
@@ -58,6 +59,8 @@ _NEEDS = {"to_earth": _needs_to_earth, "observation": _needs_observation}
 
 
 _UNIT_TOL = 1e-6
+#: The hottest facet temperature a scene accepts [K].
+MAX_TEMPERATURE_K = 1e4
 
 
 def _unit_vectors(v: ArrayLike, name: str) -> np.ndarray:
@@ -303,8 +306,27 @@ class Scene:
             if isinstance(self.temperature, Mapping)
             else [self.temperature]
         )
-        if any(not (np.isfinite(x) and x > 0) for x in temps):
-            raise SceneError(f"temperature: must be positive kelvin, got {self.temperature}")
+        if any(not (np.isfinite(x) and 0 < x <= MAX_TEMPERATURE_K) for x in temps):
+            raise SceneError(
+                f"temperature: must be positive kelvin, at most {MAX_TEMPERATURE_K:g} K (every "
+                f"material has melted long before), got {self.temperature}"
+            )
+        if self.band_extrapolate not in (None, "zero", "constant"):
+            raise SceneError(
+                f"band_extrapolate: got {self.band_extrapolate!r}; allowed: 'zero', 'constant' "
+                "(or leave it out to refuse bands beyond the wavelengths)"
+            )
+        check_plausible(self.earth_range_km, "range_km", "earth_range_km")
+        for key in ("temperature", "surface_tilt"):
+            value = getattr(self, key)
+            have = getattr(self.spacecraft, "materials", None)
+            if isinstance(value, Mapping) and have is not None:
+                for m in value:
+                    if m not in have:
+                        raise SceneError(
+                            f"{key}: {m!r} is not a material of the spacecraft "
+                            f"{self.spacecraft.name!r}; {did_you_mean(m, have, 'its materials')}"
+                        )
         grid = self.attitudes is not None or self.phase_angles is not None
         explicit = self.to_sun is not None or self.to_observer is not None
         observed = self.observation is not None
@@ -327,6 +349,11 @@ class Scene:
             try:
                 q = geometry.check_quaternions(self.attitudes)
                 beta = np.atleast_1d(np.asarray(self.phase_angles, dtype=np.float64))
+                if beta.size and not np.all((beta >= 0) & (beta <= 180)):
+                    raise SceneError(
+                        "phase_angles: must lie in [0, 180] degree, got "
+                        f"{beta[~((beta >= 0) & (beta <= 180))][:5].tolist()}"
+                    )
                 # checked here, kept for the geometry (computed once per scene)
                 plane = geometry.observation_plane(beta, self.bisector, self.plane_normal)
                 self._cache["plane"] = (beta.copy(), plane)
@@ -430,10 +457,18 @@ class Scene:
             When a material of the spacecraft is neither given nor in the catalog.
         """
         from ..materials.models import render
+        from .spectral import TABLE_LIMIT_BYTES
 
         out: dict[str, xr.DataArray] = {}
+        limit = self.size_limit * TABLE_LIMIT_BYTES
         for m, v in self.material_data.items():
-            out[m] = render(v, dtype=np.dtype(self.dtype)) if isinstance(v, xr.Dataset) else v
+            if not isinstance(v, xr.Dataset):
+                out[m] = v
+                continue
+            try:
+                out[m] = render(v, dtype=np.dtype(self.dtype), max_bytes=limit)
+            except ValidationError as exc:
+                raise SceneError(f"material {m!r}: {exc}") from None
         return out
 
     # ----------------------------------------------------------- geometry

@@ -225,6 +225,7 @@ def _spacecraft(spec: Any, base_dir: str | Path | None) -> Any:
     from .. import catalog
 
     options: dict[str, Any] = {}
+    table = isinstance(spec, Mapping)
     if isinstance(spec, Mapping):
         _check_keys(spec, _SPACECRAFT_KEYS, "[spacecraft]")
         if "path" not in spec:
@@ -237,7 +238,9 @@ def _spacecraft(spec: Any, base_dir: str | Path | None) -> Any:
             spec = Path(spec)  # a table always names a file
     try:
         return catalog.load_spacecraft_spec(spec, base_dir=base_dir, **options)
-    except (CatalogError, SceneError):
+    except (CatalogError, SceneError) as exc:
+        if table and not str(exc).startswith("[spacecraft]"):
+            raise type(exc)(f"[spacecraft] path: {exc}") from None
         raise
     except (ValidationError, FileNotFoundError) as exc:
         hint = ""
@@ -246,7 +249,7 @@ def _spacecraft(spec: Any, base_dir: str | Path | None) -> Any:
                 f'; write a [spacecraft] table: path = "{spec}" and material = "..." or '
                 'material_map = "map.toml"'
             )
-        raise SceneError(f"{exc}{hint}") from None
+        raise SceneError(f"{'[spacecraft] ' if table else ''}{exc}{hint}") from None
 
 
 def material_tables(
@@ -395,7 +398,9 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
                 "[geometry] and phase_angles"
             )
         try:
-            kw["observation"] = observation_from_dict(d["observation"], base_dir)
+            kw["observation"] = observation_from_dict(
+                d["observation"], base_dir, size_limit=kw.get("size_limit", 1.0)
+            )
         except (ValidationError, CatalogError) as exc:
             raise SceneError(f"[observation]: {exc}") from exc
     if "attitude" in d:

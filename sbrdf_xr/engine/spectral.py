@@ -346,8 +346,21 @@ def _packed(
     slices of anisotropic tables by packed slot."""
     packed: list[tuple[Any, ...]] = []
     aniso: dict[int, Any] = {}
+    step = knobs["table_theta_step"]
+    sizes = {m: _table_bytes(scene.tables[m], wl.size, step) for m in used}
+    if sum(sizes.values()) > scene.size_limit * TABLE_LIMIT_BYTES:
+        big = max(sizes, key=lambda m: sizes[m])
+        raise SceneError(
+            f"scene {scene.name!r} is beyond reason: the tables on the plan's grid would hold "
+            f"{_gib(sum(sizes.values()))} in memory (limit "
+            f"{_gib(scene.size_limit * TABLE_LIMIT_BYTES)}; the largest, {big!r}, "
+            f"{_gib(sizes[big])} for {wl.size} wavelengths"
+            + ("" if step is None else f" and theta_i every {step:g} degree (table_theta_step)")
+            + "); coarsen table_theta_step or wavelength_stride, or raise the limits with "
+            "size_limit (a factor, default 1) if you mean it"
+        )
     for m in used:
-        da = table_on(scene.tables[m], wl, knobs["table_theta_step"])
+        da = table_on(scene.tables[m], wl, step)
         values = np.asarray(da.values)
         if bw is not None:
             values = np.asarray(values, dtype=np.float64) @ bw.T
@@ -369,6 +382,26 @@ def _packed(
         )
     n_spectral = len(scene.bands) if bw is not None else wl.size
     return pack_tables(packed, n_spectral, dtype), aniso
+
+
+#: Memory the tables of a plan may hold [byte], times the scene's ``size_limit``.
+TABLE_LIMIT_BYTES = 4 * 2**30
+
+
+def _gib(n: float) -> str:
+    return f"{n / 2**30:.3g} GiB"
+
+
+def _table_bytes(da: xr.DataArray, n_wavelength: int, theta_step: float | None) -> float:
+    """Bytes of a table resampled onto ``n_wavelength`` wavelengths and ``theta_step``."""
+    n = float(n_wavelength) * 8.0
+    for d in da.dims:
+        if d == "theta_i" and theta_step is not None:
+            ti = da["theta_i"].values
+            n *= (float(ti[-1]) - float(ti[0])) / float(theta_step) + 2.0
+        elif d != "wavelength":
+            n *= da.sizes[d]
+    return n
 
 
 def _bands_step(scene: Scene, pre: bool, spectral_asked: bool, n_wl: int) -> tuple[str, str]:

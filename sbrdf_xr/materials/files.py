@@ -2,17 +2,96 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
+import warnings
+from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import xarray as xr
 
 from .._names import SBRDF
 from .._output import write_netcdf
-from ..errors import ValidationError
+from ..errors import NonPhysicalWarning, ValidationError, input_file, reading
 from .schema import validate_material, validate_measurements
 
-__all__ = ["open_material", "open_measurements", "to_netcdf", "write_netcdf_atomic"]
+__all__ = [
+    "naming_file",
+    "open_material",
+    "open_measurements",
+    "read_netcdf",
+    "to_netcdf",
+    "write_netcdf_atomic",
+]
+
+
+def read_netcdf(path: str | os.PathLike[str], what: str) -> tuple[Path, xr.Dataset]:
+    """A netCDF file given as input, checked (:func:`~sbrdf_xr.errors.input_file`) and
+    loaded into memory; a file netCDF cannot read is a named error that shows none of it.
+
+    Parameters
+    ----------
+    path : path-like
+        The file.
+    what : str
+        What it is (``"material table"``), heading messages.
+
+    Returns
+    -------
+    (pathlib.Path, xarray.Dataset)
+        The absolute path and the loaded dataset.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.materials.files import read_netcdf
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     _ = (Path(tmp) / "x.nc").write_text("not netCDF")
+    ...     try:
+    ...         read_netcdf(Path(tmp) / "x.nc", "material table")
+    ...     except ValidationError as exc:
+    ...         print(str(exc).replace(tmp, "DIR"))
+    material table: DIR/x.nc cannot be read as netCDF (NetCDF: Unknown file format)
+    """
+    p = input_file(path, what)
+    with reading(p, what, "netCDF"), xr.open_dataset(p, engine="netcdf4") as ds:
+        return p, ds.load()
+
+
+@contextlib.contextmanager
+def naming_file(path: str | os.PathLike[str], what: str) -> Iterator[None]:
+    """Prefix a :class:`~sbrdf_xr.errors.ValidationError` raised inside with the file it
+    is about (unless its message names it already).
+
+    Parameters
+    ----------
+    path : path-like
+        The file.
+    what : str
+        What it is.
+
+    Yields
+    ------
+    None
+
+    Examples
+    --------
+    >>> from sbrdf_xr.materials.files import naming_file
+    >>> try:
+    ...     with naming_file("/data/t.nc", "material table"):
+    ...         raise ValidationError("sbrdf: contains 3 NaN values")
+    ... except ValidationError as exc:
+    ...     print(exc)
+    material table /data/t.nc: sbrdf: contains 3 NaN values
+    """
+    try:
+        yield
+    except ValidationError as exc:
+        if os.fspath(path) in str(exc):
+            raise
+        raise type(exc)(f"{what} {os.fspath(path)}: {exc}") from None
 
 
 # --------------------------------------------------------------------- I/O
@@ -119,13 +198,17 @@ def to_netcdf(
     return write_netcdf_atomic(obj, path, overwrite=overwrite, complevel=complevel)
 
 
-def open_material(path: str | os.PathLike[str]) -> xr.DataArray:
+def open_material(path: str | os.PathLike[str], *, check_energy: bool = True) -> xr.DataArray:
     """Read a material table written by :func:`to_netcdf` (loaded into memory).
 
     Parameters
     ----------
     path : path-like
         A netCDF file with an ``sbrdf`` variable.
+    check_energy : bool, default True
+        Warn (:class:`~sbrdf_xr.errors.NonPhysicalWarning`) when the table reflects more
+        than :data:`MAX_PLAUSIBLE_REFLECTANCE` times the light it receives (a quadrature:
+        up to a second for a large table).
 
     Returns
     -------
@@ -143,13 +226,37 @@ def open_material(path: str | os.PathLike[str]) -> xr.DataArray:
     >>> table.dims, table.attrs["material"]
     (('theta_i', 'delta_theta', 'phi', 'wavelength'), 'lambertian-0.2')
     """
-    with xr.open_dataset(path, engine="netcdf4") as ds:
-        ds = ds.load()
+    path, ds = read_netcdf(path, "material table")
     if SBRDF not in ds:
         raise ValidationError(f"{path}: no 'sbrdf' variable; not a material table")
     da = ds[SBRDF]
     da.attrs = {**{k: v for k, v in ds.attrs.items() if k != "Conventions"}, **da.attrs}
-    return validate_material(da)
+    with naming_file(path, "material table"):
+        da = validate_material(da)
+    if check_energy:
+        _check_energy(da, path)
+    return da
+
+
+#: Directional-hemispherical reflectance above which a table read from a file warns: no
+#: measurement error reaches it; values in other units (percent, counts) do.
+MAX_PLAUSIBLE_REFLECTANCE = 2.0
+
+
+def _check_energy(da: xr.DataArray, path: Path) -> None:
+    from .energy import hemispherical_reflectance
+
+    if float(da.max()) * np.pi <= MAX_PLAUSIBLE_REFLECTANCE:  # rho <= pi max(f_r)
+        return
+    rho = float(hemispherical_reflectance(da, warn=False).max())
+    if rho > MAX_PLAUSIBLE_REFLECTANCE:
+        warnings.warn(
+            f"material table {path}: sbrdf reflects up to {rho:.3g} times the light it "
+            f"receives (directional-hemispherical reflectance > {MAX_PLAUSIBLE_REFLECTANCE:g}):"
+            " values in other units (percent, counts)?",
+            NonPhysicalWarning,
+            stacklevel=3,
+        )
 
 
 def open_measurements(path: str | os.PathLike[str]) -> xr.Dataset:
@@ -177,11 +284,11 @@ def open_measurements(path: str | os.PathLike[str]) -> xr.Dataset:
     >>> back.reference.dtype, bool((back.measured_sbrdf == meas.measured_sbrdf).all())
     (dtype('bool'), True)
     """
-    with xr.open_dataset(path, engine="netcdf4") as ds:
-        ds = ds.load()
+    path, ds = read_netcdf(path, "measurement set")
     if "reference" in ds:
         ref = ds["reference"].astype(bool)
         for k in ("flag_values", "flag_meanings"):  # they describe the on-disk byte, not the bool
             ref.attrs.pop(k, None)
         ds["reference"] = ref
-    return validate_measurements(ds, duplicates="mean")
+    with naming_file(path, "measurement set"):
+        return validate_measurements(ds, duplicates="mean")

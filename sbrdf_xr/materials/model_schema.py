@@ -31,7 +31,7 @@ from .. import brdf as _brdf
 from .._names import WAVELENGTH, attrs
 from ..brdf import Model
 from ..errors import ValidationError
-from .files import write_netcdf_atomic
+from .files import naming_file, read_netcdf, write_netcdf_atomic
 
 __all__ = [
     "ModelParameters",
@@ -223,7 +223,7 @@ def open_model(path: str | os.PathLike[str]) -> xr.Dataset:
     >>> back.rho.attrs["long_name"], float(back.rho[0])
     ('Lambertian albedo', 0.5)
     """
-    with xr.open_dataset(path, engine="netcdf4") as ds:
-        ds = ds.load()
-    model_parameters(ds)
+    path, ds = read_netcdf(path, "model material")
+    with naming_file(path, "model material"):
+        model_parameters(ds)
     return ds

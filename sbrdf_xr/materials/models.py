@@ -124,6 +124,7 @@ def render(
     phi: ArrayLike | None = None,
     dtype: type | np.dtype = np.float64,
     progress: bool = True,
+    max_bytes: float | None = None,
 ) -> xr.DataArray:
     """Render a model material to a look-up table.
 
@@ -139,6 +140,9 @@ def render(
     progress : bool, default True
         Show a progress bar (tqdm.auto) while rendering a large table (2e7 values and
         more: seconds).
+    max_bytes : float, optional
+        Refuse (ValidationError, with the size) a table larger than this, before
+        allocating it.
 
     Returns
     -------
@@ -169,6 +173,13 @@ def render(
                 f"{name}: expected a non-empty 1-D grid [degree], got shape {g.shape}"
             )
     _require_isotropic(m)
+    size = float(ti.size) * dt.size * ph.size * wl.size * np.dtype(dtype).itemsize
+    if max_bytes is not None and size > max_bytes:
+        raise ValidationError(
+            f"model {spec.attrs.get('material', '')!r}: its table would hold {size:.3g} bytes "
+            f"({ti.size} x {dt.size} x {ph.size} angles x {wl.size} wavelengths), above the "
+            f"limit of {max_bytes:.3g}; give the model fewer wavelengths or raise size_limit"
+        )
     vals = np.empty((ti.size, dt.size, ph.size, wl.size), dtype=dtype)
     step = max(1, _RENDER_CHUNK // (dt.size * ph.size * wl.size))  # bounded temporaries
     from tqdm.auto import tqdm

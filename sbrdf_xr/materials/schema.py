@@ -9,6 +9,7 @@ paper 000 §3.2 that :mod:`sbrdf_xr.materials.tables` (look-up and construction)
 from __future__ import annotations
 
 import json
+import warnings
 from typing import Any
 
 import numpy as np
@@ -31,7 +32,7 @@ from .._names import (
     WAVELENGTH,
     attrs,
 )
-from ..errors import ValidationError
+from ..errors import NonPhysicalWarning, ValidationError
 from ..units import check_wavelengths, to_unit
 
 __all__ = [
@@ -172,8 +173,10 @@ def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.Data
     if da[WAVELENGTH].values[0] <= 0:
         raise ValidationError("wavelength: must be positive")
     check_wavelengths(da[WAVELENGTH].values, "wavelength")
+    _check_delta_theta(da[DELTA_THETA].values)
     if "source" in da.attrs:
         _check_source(da.attrs["source"])
+    _check_float(da, SBRDF)
     if check_values:
         v = np.asarray(da.values)
         if not np.all(np.isfinite(v)):
@@ -250,7 +253,9 @@ def new_material(
     }
     a = attrs(SBRDF, material=material, source=source, provenance=provenance)
     a.update({k: _attr_value(v) for k, v in parameters.items()})
-    da = xr.DataArray(np.asarray(values), dims=LUT_DIMS, coords=coords, name=SBRDF, attrs=a)
+    v = np.asarray(values)
+    v = v.astype(np.float64) if np.issubdtype(v.dtype, np.integer) else v
+    da = xr.DataArray(v, dims=LUT_DIMS, coords=coords, name=SBRDF, attrs=a)
     return validate_material(da)
 
 
@@ -533,8 +538,14 @@ def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Da
     ti = ds[THETA_I].values
     if np.any((ti < 0) | (ti >= 90)):
         raise ValidationError("theta_i: measured incidence angles must lie in [0, 90) degree")
-    if np.any(ds[PHI].values < 0):
-        raise ValidationError("phi: must be >= 0 (unsigned angle from the illumination plane)")
+    ph = ds[PHI].values
+    if np.any((ph < 0) | (ph > 180)):
+        raise ValidationError(
+            f"phi: must lie in [0, 180] degree (unsigned angle from the illumination plane), "
+            f"got [{ph.min():g}, {ph.max():g}]"
+        )
+    _check_delta_theta(ds[DELTA_THETA].values)
+    _check_float(da, MEASURED)
     if duplicates not in DUPLICATES:
         raise ValidationError(f"duplicates: got {duplicates!r}; allowed: {', '.join(DUPLICATES)}")
     groups, first, counts = _geometry_groups(ds)
@@ -561,7 +572,35 @@ def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Da
         )
     if np.any(v < 0):
         raise ValidationError(f"{MEASURED}: contains negative values; a BRDF is >= 0")
+    if v.size and v.max() > MAX_PLAUSIBLE_SBRDF:
+        warnings.warn(
+            f"{MEASURED}: values up to {v.max():.3g} sr-1, above the {MAX_PLAUSIBLE_SBRDF:g} "
+            "sr-1 of a mirror seen through a 1 degree aperture: values in other units?",
+            NonPhysicalWarning,
+            stacklevel=2,
+        )
     return ds
+
+
+#: The largest plausible measured SBRDF [sr-1]: a perfect mirror seen by a detector of
+#: 1 degree full aperture (1 / solid angle, about 4e3 sr-1), with margin.
+MAX_PLAUSIBLE_SBRDF = 1e4
+
+
+def _check_delta_theta(dt: np.ndarray) -> None:
+    if dt.size and (np.nanmin(dt) < -180 or np.nanmax(dt) > 180):
+        raise ValidationError(
+            f"delta_theta: must lie in [-180, 180] degree, got [{np.nanmin(dt):g}, "
+            f"{np.nanmax(dt):g}]"
+        )
+
+
+def _check_float(da: xr.DataArray, name: str) -> None:
+    if not np.issubdtype(da.dtype, np.floating):
+        raise ValidationError(
+            f"{name}: values of dtype {da.dtype}; expected floating-point reflectances [sr-1] "
+            "(integers are most likely scaled counts)"
+        )
 
 
 def reference_mask(ds: xr.Dataset) -> np.ndarray:

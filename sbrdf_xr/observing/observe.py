@@ -66,7 +66,7 @@ __all__ = [
 
 
 def observation_from_dict(
-    table: Mapping[str, Any], base_dir: str | Path | None = None
+    table: Mapping[str, Any], base_dir: str | Path | None = None, *, size_limit: float = 1.0
 ) -> Observation:
     """An :class:`Observation` from a TOML ``[observation]`` table.
 
@@ -77,6 +77,8 @@ def observation_from_dict(
     :func:`sbrdf_xr.observing.attitude.law_from_dict`; optional ``airmass_model``,
     ``min_elevation_deg``, ``name`` and ``earth`` (``"wgs84"``, the default, or
     ``"sphere"``: the Earth of the shadow).  Relative paths are taken from ``base_dir``.
+    A start/stop/step_s axis of more than ``size_limit`` times
+    :data:`~sbrdf_xr.observing.timescales.MAX_TIMES` times is refused before it is made.
     Example::
 
         [observation]
@@ -151,6 +153,10 @@ def observation_from_dict(
         orbit = Orbit.from_tle(table["tle_line1"], table["tle_line2"], table.get("name"))
     else:
         omm = table["omm"]
+        if not isinstance(omm, Mapping | str):
+            raise ObservationError(
+                f"[observation] omm: expected a file name or a table, got {omm!r}"
+            )
         orbit = Orbit.from_omm(omm if isinstance(omm, Mapping) else resolve(omm))
 
     site_v = table.get("site")
@@ -179,9 +185,11 @@ def observation_from_dict(
             raise ObservationError(
                 f"[observation]: needs times or start and stop (missing {missing})"
             )
-        t = times(table["start"], table["stop"], float(table.get("step_s", 1.0)))
+        t = times(table["start"], table["stop"], table.get("step_s", 1.0), size_limit=size_limit)
 
     att = table.get("attitude")
+    if att is not None and not isinstance(att, Mapping):
+        raise ObservationError(f"[observation] attitude: expected a table (law = ...), got {att!r}")
     if isinstance(att, Mapping) and att.get("law") == "quaternion_series" and "path" in att:
         att = {**att, "path": str(resolve(att["path"]))}
     kw = {

@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _catalog_index
 from .._names import AIRMASS_MODELS as AIRMASS_NAMES
-from ..errors import CatalogError, ObservationError
+from ..errors import CatalogError, ObservationError, input_file, reading
 from ..units import to_unit
 from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, disc_overlap_fraction, sunlit_fraction
 from .timescales import (
@@ -234,27 +234,31 @@ class Orbit:
         from sgp4 import omm as sgp4_omm
         from skyfield.api import EarthSatellite
 
+        where = "OMM"
         if not isinstance(omm, Mapping):
-            path = Path(omm)
-            try:
-                with open(path, encoding="utf-8") as f:
-                    if path.suffix.lower() == ".xml":
-                        fields = next(iter(sgp4_omm.parse_xml(f)))
-                    elif path.suffix.lower() == ".csv":
-                        fields = next(iter(sgp4_omm.parse_csv(f)))
-                    else:
-                        data = json.load(f)
-                        fields = data[0] if isinstance(data, list) else data
-            except (OSError, ValueError, StopIteration, KeyError) as exc:
-                raise ObservationError(f"OMM: cannot read {path}: {exc!r}") from None
+            path = input_file(omm, "omm", ObservationError)
+            where = f"OMM {path}"
+            kind = {".xml": "OMM XML", ".csv": "OMM CSV"}.get(path.suffix.lower(), "OMM JSON")
+            with reading(path, "omm", kind, ObservationError), open(path, encoding="utf-8") as f:
+                if kind == "OMM XML":
+                    fields = next(iter(sgp4_omm.parse_xml(f)), None)
+                elif kind == "OMM CSV":
+                    fields = next(iter(sgp4_omm.parse_csv(f)), None)
+                else:
+                    data = json.load(f)
+                    fields = data[0] if isinstance(data, list) and data else data
+            if not isinstance(fields, dict) or not all(isinstance(k, str) for k in fields):
+                raise ObservationError(f"omm: {path} holds no OMM record ({kind})")
         else:
             fields = dict(omm)
         ts, _ = skyfield_data()
         try:
             sat = EarthSatellite.from_omm(ts, fields)
-        except (KeyError, ValueError, TypeError) as exc:
+        except (KeyError, ValueError, TypeError) as exc:  # a file's fields are not shown
+            field = f" {exc.args[0]!r}" if isinstance(exc, KeyError) else ""
+            given = "" if where != "OMM" else f"; fields given: {sorted(map(str, fields))}"
             raise ObservationError(
-                f"OMM: missing or bad field: {exc!r}; fields given: {sorted(fields)}"
+                f"{where}: missing or bad field{field} ({type(exc).__name__}){given}"
             ) from None
         _check_model(sat, fields.get("OBJECT_NAME", "OMM"))
         l1, l2 = exporter.export_tle(sat.model)

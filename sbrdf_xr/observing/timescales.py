@@ -181,18 +181,38 @@ def to_datetime64(value: Any, name: str) -> np.datetime64:
         value = value.astimezone(_dt.UTC).replace(tzinfo=None)
     if isinstance(value, str) and value.endswith("Z"):
         value = value[:-1]
+    if isinstance(value, bool | int | float | np.number):  # a count of what, from when?
+        raise ObservationError(
+            f"{name}: got the number {value!r}; expected a UTC time (ISO 8601, datetime or "
+            "datetime64)"
+        )
     try:
         out = np.datetime64(value, "ns")
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ObservationError(
-            f"{name}: got {value!r}; expected a UTC time (ISO 8601, datetime or datetime64)"
+            f"{name}: got {value!r}; expected a UTC time (ISO 8601, datetime or datetime64) "
+            f"from {YEARS[0]} to {YEARS[1]}"
         ) from None
     if np.isnat(out):
         raise ObservationError(f"{name}: got NaT")
+    year = out.astype("datetime64[Y]").astype(int) + 1970
+    if not YEARS[0] <= year <= YEARS[1]:
+        raise ObservationError(
+            f"{name}: {out} is outside the years {YEARS[0]} to {YEARS[1]} that orbits, "
+            "time scales and ephemerides cover"
+        )
     return out
 
 
-def times(start: Any, stop: Any, step_s: float = 1.0) -> NDArray[np.datetime64]:
+#: The years a UTC time may lie in (the ephemerides and time scales of the package).
+YEARS = (1900, 2200)
+#: The most times a start/stop/step axis may hold, times ``size_limit``.
+MAX_TIMES = 10**7
+
+
+def times(
+    start: Any, stop: Any, step_s: float = 1.0, *, size_limit: float = 1.0
+) -> NDArray[np.datetime64]:
     """UTC times from ``start`` to ``stop`` (included when on the grid) every ``step_s``.
 
     Parameters
@@ -214,12 +234,23 @@ def times(start: Any, stop: Any, step_s: float = 1.0) -> NDArray[np.datetime64]:
     """
     t0, t1 = to_datetime64(start, "start"), to_datetime64(stop, "stop")
     step_s = to_unit(step_s, "s", "step_s")
-    if not (np.isfinite(step_s) and step_s > 0):
-        raise ObservationError(f"step_s: must be a positive number of seconds, got {step_s!r}")
+    if isinstance(step_s, bool) or not isinstance(step_s, int | float | np.number):
+        raise ObservationError(f"step_s: expected a number of seconds, got {step_s!r}")
+    if not (np.isfinite(step_s) and step_s >= 1e-6):
+        raise ObservationError(
+            f"step_s: must be a positive number of seconds, at least 1e-6 (a microsecond), "
+            f"got {step_s!r}"
+        )
     if t1 < t0:
         raise ObservationError(f"stop {t1} is before start {t0}")
     step = np.timedelta64(round(step_s * 1e9), "ns")
     n = int((t1 - t0) // step) + 1
+    if n > size_limit * MAX_TIMES:
+        raise ObservationError(
+            f"step_s: {t0} to {t1} every {step_s:g} s gives {n:.3g} times, beyond the "
+            f"{size_limit * MAX_TIMES:.3g} allowed ({MAX_TIMES:.0e} x size_limit); give a "
+            "larger step_s or a shorter window, or raise size_limit"
+        )
     return t0 + step * np.arange(n)
 
 

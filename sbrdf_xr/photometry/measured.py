@@ -21,7 +21,7 @@ import numpy as np
 import xarray as xr
 
 from .._names import BAND, attrs
-from ..errors import LightCurveError, ValidationError
+from ..errors import LightCurveError, ValidationError, input_file, reading
 from . import _curve_forms as forms
 from ._table_io import TABLE_FORMATS, in_unit, read_table
 from .filter_names import band_label
@@ -141,10 +141,9 @@ def read_light_curve(
     >>> str(lc.time.values[0])[:19], lc.attrs["table_form"], lc.attrs["magnitude_system"]
     ('2024-03-17T00:57:36', 'wide', 'Vega')
     """
-    path = Path(path)
-    if not path.is_file():
-        raise LightCurveError(f"light curve: file {path} does not exist")
-    df, units, meta, where, offset = read_table(path)
+    path = input_file(path, "light curve", LightCurveError)
+    with reading(path, "light curve", f"a table ({path.suffix or 'no suffix'})", LightCurveError):
+        df, units, meta, where, offset = read_table(path)
     return _build(path, df, units, meta, where, offset, bands, system, time_scale, band_map)
 
 
@@ -174,7 +173,8 @@ def _build(
     if len(absc) != 1:
         raise LightCurveError(
             f"{path}: need exactly one column of time (time, jd or mjd, with UTC) or "
-            f"rotation_angle, found {[roles[r] for r in absc] or 'none'} among {cols}"
+            f"rotation_angle, found {[roles[r] for r in absc] or 'none'} among its "
+            f"{len(cols)} columns"
         )
     xrole = absc[0]
 
@@ -190,10 +190,13 @@ def _build(
             bad = np.flatnonzero(~np.isfinite(v) & ~empty)
         if bad.size:
             val = raw.iloc[bad[0]]
-            raise LightCurveError(
-                f"{row_name(int(rows[bad[0]]))}, column {col!r}: value "
-                f"{val.item() if hasattr(val, 'item') else val!r} is not a finite number"
-            )
+            val = val.item() if hasattr(val, "item") else val
+            try:  # a number (NaN, inf) is shown; text is not (the file's contents)
+                float(val)
+                shown = f"value {val!r} is not a finite number"
+            except (TypeError, ValueError):
+                shown = f"holds text of {len(str(val))} characters, not a number"
+            raise LightCurveError(f"{row_name(int(rows[bad[0]]))}, column {col!r}: {shown}")
         return v
 
     all_rows = np.arange(len(df))

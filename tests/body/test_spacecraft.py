@@ -486,7 +486,7 @@ def test_not_a_mesh(tmp_path):
     (tmp_path / "junk.stl").write_bytes(b"\x01\x02garbage")
     with pytest.raises(MeshError):
         sc.load_spacecraft(tmp_path / "junk.stl", BOX_MAP)
-    with pytest.raises(FileNotFoundError):
+    with pytest.raises(MeshError, match="does not exist"):
         sc.load_spacecraft(tmp_path / "missing.ply", BOX_MAP)
     with pytest.raises(MeshError, match="expected a triangle mesh"):
         sc.load_spacecraft(trimesh.PointCloud(np.random.default_rng(0).random((5, 3))), BOX_MAP)
