@@ -44,11 +44,12 @@ from ._catalog_index import (
     names,
     user_catalog_dirs,
 )
-from ._names import SBRDF
+from ._names import SBRDF, WAVELENGTH
 from .body import spacecraft
 from .errors import CatalogError, ValidationError, did_you_mean
 from .materials import models
 from .materials import tables as material
+from .materials.shipped import read_reflectance
 from .observing import observe
 
 __all__ = [
@@ -131,8 +132,14 @@ def _built_material(
 
     def build() -> xr.DataArray:
         opts = dict(kw)
+        meas = load(measurements)
         if "fit" in opts:  # a model entry that fills the unmeasurable range
+            fit = entry(opts["fit"]).file
             opts["model"] = load(opts.pop("fit"))
+            # its reflectance at the table's rows, shipped beside it while current
+            ti = np.asarray(opts.get("theta_i", np.arange(0.0, 91.0)), dtype=np.float64)
+            wl = np.asarray(meas[WAVELENGTH].values, dtype=np.float64)
+            opts["model_reflectance"] = read_reflectance(fit, ti, wl)
         bar.append(_progress_bar(name))
 
         def report(fraction: float, step: str) -> None:
@@ -140,7 +147,7 @@ def _built_material(
             bar[0].set_postfix_str(step, refresh=False)
             bar[0].refresh()
 
-        return material.build_lut(load(measurements), material=name, progress=report, **opts)
+        return material.build_lut(meas, material=name, progress=report, **opts)
 
     def write(da: xr.DataArray, path: Any) -> None:
         if bar:
