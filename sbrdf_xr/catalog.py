@@ -311,7 +311,7 @@ def load_materials(
     proc = compile_ahead(_table_dtype(dtype) or "float64") if building and compile_kernels else None
     try:
         with _batch(building):
-            return {name: load(name, dtype) for name in wanted}
+            return {name: load(name, dtype=dtype) for name in wanted}
     finally:
         if proc is not None:
             _wait_compiling(proc)
