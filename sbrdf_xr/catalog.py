@@ -22,6 +22,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import os
+import subprocess
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
@@ -44,11 +45,13 @@ from ._catalog_index import (
     names,
     user_catalog_dirs,
 )
-from ._names import SBRDF
+from ._names import SBRDF, WAVELENGTH
 from .body import spacecraft
 from .errors import CatalogError, ValidationError, did_you_mean, input_file, reading
+from .kernels.warm import compile_ahead
 from .materials import models
 from .materials import tables as material
+from .materials.shipped import read_reflectance
 from .observing import observe
 
 __all__ = [
@@ -131,8 +134,14 @@ def _built_material(
 
     def build() -> xr.DataArray:
         opts = dict(kw)
+        meas = load(measurements)
         if "fit" in opts:  # a model entry that fills the unmeasurable range
+            fit = entry(opts["fit"]).file
             opts["model"] = load(opts.pop("fit"))
+            # its reflectance at the table's rows, shipped beside it while current
+            ti = np.asarray(opts.get("theta_i", np.arange(0.0, 91.0)), dtype=np.float64)
+            wl = np.asarray(meas[WAVELENGTH].values, dtype=np.float64)
+            opts["model_reflectance"] = read_reflectance(fit, ti, wl)
         bar.append(_progress_bar(name))
 
         def report(fraction: float, step: str) -> None:
@@ -140,7 +149,7 @@ def _built_material(
             bar[0].set_postfix_str(step, refresh=False)
             bar[0].refresh()
 
-        return material.build_lut(load(measurements), material=name, progress=report, **opts)
+        return material.build_lut(meas, material=name, progress=report, **opts)
 
     def write(da: xr.DataArray, path: Any) -> None:
         if bar:
@@ -266,11 +275,16 @@ def to_build(wanted: Iterable[str]) -> list[str]:
     return out
 
 
-def load_materials(wanted: Iterable[str], dtype: DTypeLike | None = None) -> dict[str, Any]:
+def load_materials(
+    wanted: Iterable[str], dtype: DTypeLike | None = None, compile_kernels: bool = True
+) -> dict[str, Any]:
     """Load several material entries, the tables to build labelled as one batch.
 
     Every table that has to be built shows a progress bar "building table NAME (k of
-    n)" (:func:`to_build`); loading from the cache shows nothing.
+    n)" (:func:`to_build`); loading from the cache shows nothing.  While tables build,
+    a second process compiles the engine's kernel for them
+    (:func:`sbrdf_xr.kernels.warm.compile_ahead`), so that the first simulation finds it
+    in numba's cache; the call returns when both are done.
 
     Parameters
     ----------
@@ -278,6 +292,8 @@ def load_materials(wanted: Iterable[str], dtype: DTypeLike | None = None) -> dic
         Names of ``material`` entries.
     dtype : {None, "float32", "float64"}, optional
         As :func:`load`.
+    compile_kernels : bool, default True
+        Compile the engine's kernel meanwhile when a table is built.
 
     Returns
     -------
@@ -290,8 +306,35 @@ def load_materials(wanted: Iterable[str], dtype: DTypeLike | None = None) -> dic
     {'lambertian-grey-50': 'float32'}
     """
     wanted = list(dict.fromkeys(wanted))
-    with _batch(to_build(wanted)):
-        return {name: load(name, dtype) for name in wanted}
+    building = to_build(wanted)
+    # the engine's kernel compiles in a second process while the tables build
+    proc = compile_ahead(_table_dtype(dtype) or "float64") if building and compile_kernels else None
+    try:
+        with _batch(building):
+            return {name: load(name, dtype=dtype) for name in wanted}
+    finally:
+        if proc is not None:
+            _wait_compiling(proc)
+
+
+def _wait_compiling(proc: Any) -> None:
+    """Wait for the process compiling the engine's kernel, with a progress bar while it
+    runs (none when it is already done)."""
+    if proc.poll() is not None:
+        return
+    from tqdm.auto import tqdm
+
+    with tqdm(
+        desc="compiling the engine's kernel",
+        bar_format="{desc}: {elapsed}",
+        disable=not _SHOW_PROGRESS[0],
+    ) as bar:
+        while True:
+            try:
+                proc.wait(timeout=0.25)
+                break
+            except subprocess.TimeoutExpired:
+                bar.refresh()
 
 
 @contextlib.contextmanager

@@ -437,8 +437,9 @@ def test_the_private_check_catches_imports_and_attributes(tmp_path):
 #: geometry -> rotations -> units -> errors (11): ``units`` (every argument with a unit
 #: converted at the door, the rotations' angles too) is its one link below the root
 #: modules.  The edges include one from every package that writes a file (materials,
-#: photometry, store, bench, cli, ``_cache``) to ``_output``, the one safe output.
-GRAPH_LIMITS = {"nodes": 30, "depth": 12, "edges": 113}
+#: photometry, store, bench, cli, ``_cache``) to ``_output``, the one safe output, and
+#: ``catalog -> kernels`` (the kernel compiled while tables build).
+GRAPH_LIMITS = {"nodes": 30, "depth": 12, "edges": 116}
 
 
 def node_of(mod: str, root: Path = PACKAGE) -> str:

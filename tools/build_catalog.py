@@ -2,19 +2,24 @@
 
 Run ``python tools/build_catalog.py`` from a source checkout.  Every file written
 here is synthetic; its index entry in ``catalogs/index.toml`` says how it was made.
+``python tools/build_catalog.py reflectances`` writes only the model reflectances that
+ship beside the fits of the built tables (:mod:`sbrdf_xr.materials.shipped`); run it
+after a change to the code that computes them (``tests/materials/test_shipped.py``
+says when).
 """
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from sbrdf_xr import testing
+from sbrdf_xr import catalog, testing
 from sbrdf_xr.brdf import get_model, optics
-from sbrdf_xr.materials import goniometer, models
+from sbrdf_xr.materials import goniometer, models, shipped
 from sbrdf_xr.materials import tables as material
 
 ROOT = Path(__file__).resolve().parent.parent / "catalogs"
@@ -418,7 +423,33 @@ def brushed_aluminium() -> None:
     )
 
 
+def shipped_reflectances() -> list[tuple[Path, np.ndarray, np.ndarray]]:
+    """The model file, rows and wavelengths of every built catalog table whose build
+    renormalises to its fit's reflectance (the default with ``below_noise="model"``)."""
+    out = {}
+    for e in catalog.entries():
+        build = e.extra.get("build", {})
+        if e.kind != "material" or "fit" not in build or build.get("below_noise") != "model":
+            continue
+        if build.get("renormalise", "auto") not in ("auto", "model"):
+            continue
+        ti = np.asarray(build.get("theta_i", np.arange(0.0, 91.0)), dtype=np.float64)
+        meas = catalog.load(e.extra["build_from"])
+        wl = np.asarray(meas.wavelength.values, dtype=np.float64)
+        out[catalog.entry(build["fit"]).file] = (ti, wl)
+    return [(f, ti, wl) for f, (ti, wl) in out.items()]
+
+
+def model_reflectances() -> None:
+    """Write the model reflectances shipped beside the fits (``<fit>-reflectance.nc``)."""
+    for fit, ti, wl in shipped_reflectances():
+        print("wrote", shipped.write_reflectance(fit, ti, wl))
+
+
 def main() -> None:
+    if sys.argv[1:] == ["reflectances"]:
+        model_reflectances()
+        return
     (ROOT / "materials").mkdir(parents=True, exist_ok=True)
     brushed_aluminium()
     lambertian_grey()
@@ -427,6 +458,7 @@ def main() -> None:
     canx1_microfacet_fits()
     canx1_coated_fits()
     table4_paints()
+    model_reflectances()
 
 
 if __name__ == "__main__":

@@ -430,9 +430,17 @@ class Scene:
             out.update({m: models[m] for m in self.spacecraft.materials if m not in out})
             return out
         out = {}
+        known = set(catalog.names("material"))
+        # the tables to build as one batch, the engine's kernel compiling meanwhile
+        try:
+            loaded = catalog.load_materials(
+                [m for m in self.spacecraft.materials if m in known], self.dtype
+            )
+        except CatalogError:  # named below, material by material
+            loaded = {}
         for m in self.spacecraft.materials:
             try:  # in the scene's precision: a float32 scene holds no float64 copy of its tables
-                out[m] = catalog.load(m, dtype=self.dtype)
+                out[m] = loaded[m] if m in loaded else catalog.load(m, dtype=self.dtype)
             except CatalogError as exc:
                 if m in (self.models or {}):
                     out[m] = (self.models or {})[m]

@@ -156,7 +156,7 @@ class Facets(NamedTuple):
         def floats(a: NDArray[np.floating] | None, empty: tuple[int, ...]) -> NDArray[np.float64]:
             return np.zeros(empty) if a is None else np.ascontiguousarray(a, dtype=np.float64)
 
-        return cls(
+        arrays = (
             n,
             np.ascontiguousarray(area, dtype=np.float64),
             ints(material, np.zeros(t, dtype=np.int64)),
@@ -164,6 +164,17 @@ class Facets(NamedTuple):
             floats(tangent, (0, 3)),
             floats(fraction, (0, 0)),
         )
+        return cls(*(_readonly(a) for a in arrays))
+
+
+def _readonly(a: NDArray[Any]) -> NDArray[Any]:
+    """A read-only view of ``a``: the kernels read their inputs, and numba compiles a
+    kernel once per signature, read-only arrays being another type.  Every input in
+    the same form (the catalog's tables and a plan's terms are read-only, a caller's
+    arrays usually not) makes one compilation serve every call."""
+    v = a.view()
+    v.flags.writeable = False
+    return v
 
 
 class KernelOptions(NamedTuple):
@@ -361,7 +372,7 @@ def typed_values(tables: PackedTables) -> Any:
         hit = _TYPED.get(key)
         if hit is not None and hit[0] is tables.values:
             return hit[1]
-    typed = numba.typed.List(tables.values)
+    typed = numba.typed.List([_readonly(v) for v in tables.values])
     with _TYPED_LOCK:
         while len(_TYPED) >= _TYPED_KEEP:
             del _TYPED[next(iter(_TYPED))]

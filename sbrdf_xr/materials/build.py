@@ -10,11 +10,9 @@ and every row can be renormalised to the model's directional-hemispherical refle
 
 from __future__ import annotations
 
-import itertools
 import threading
 import warnings
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
@@ -25,6 +23,7 @@ from .._names import DELTA_THETA, MEASURED, PHI, SAMPLE, THETA_I, WAVELENGTH
 from ..errors import NonPhysicalWarning, ValidationError
 from ..kernels import lut as _lut
 from . import models
+from ._jobs import _by_rows, _Done, _Job, _Parts
 from .construction import (
     azimuthal_average,
     blend_weights,
@@ -72,6 +71,7 @@ def build_lut(
     check_energy: bool = True,
     renormalise: str = "auto",
     progress: Callable[[float, str], None] | None = None,
+    model_reflectance: xr.DataArray | None = None,
 ) -> xr.DataArray:
     """Look-up table from sparse measurements, by the construction of paper 000 §3.2.
 
@@ -207,6 +207,12 @@ def build_lut(
         ``progress(fraction, step)``, called as the construction goes on with the
         fraction of its work done (0 to 1) and what it is doing (``"model on the
         grid"``, ``"model reflectance"``, ...): for a progress bar.
+    model_reflectance : xarray.DataArray, optional
+        The model's directional-hemispherical reflectance ``rho_model`` of
+        ``renormalise="model"`` at the table's rows, dims ``(theta_i, wavelength)`` with
+        the table's incidence angles and the measurements' wavelengths [1], when it is
+        known: its quadrature is most of a build's work (the catalog ships it for its
+        tables, :mod:`sbrdf_xr.materials.shipped`).  Computed when not given.
 
     Returns
     -------
@@ -292,7 +298,11 @@ def build_lut(
     if (extrapolation == "model" or below_noise == "model") and fit_model is None:
         fit_model = models.fit_robertson_sandford(ds)
 
-    parts = _Parts(report, _MODEL_STEPS)
+    rho_given = (
+        None if model_reflectance is None else _given_reflectance(model_reflectance, ti_out, wl)
+    )
+    steps = {k: v for k, v in _MODEL_STEPS.items() if rho_given is None or k != "model reflectance"}
+    parts = _Parts(report, steps)
     rho_job: _Job | None = None
     if below_noise == "zero":
         # Table edges: zero beyond them if the extreme samples are reference points.
@@ -350,7 +360,9 @@ def build_lut(
             w = blend_weights(ti_out, -np.inf, measured_ti[-1], blend)[:, None, None, None]
             r_lut *= 1.0 - w  # in place: (1 - w) r + w, one table in memory
             r_lut += w
-        if renormalise == "model":  # the model's reflectance, while the grid is filled
+        if renormalise == "model" and rho_given is not None:
+            rho_job = _Done(rho_given)
+        elif renormalise == "model":  # the model's reflectance, while the grid is filled
             rho_job = _Job(
                 _model_reflectance, fit_model, ti_out, wl, parts.part("model reflectance")
             )
@@ -449,46 +461,23 @@ _MODEL_STEPS = {
 }
 
 
-class _Parts:
-    """The progress of a build made of weighted steps, one of which may run in a
-    background thread: ``part(step)(fraction)`` records a step's fraction done and, from
-    the building thread, reports the weighted total."""
-
-    def __init__(self, report: Callable[[float, str], None], weights: dict[str, float]):
-        self.report, self.weights = report, weights
-        self.done = dict.fromkeys(weights, 0.0)
-        self.thread = threading.get_ident()
-
-    def part(self, step: str) -> Callable[[float], None]:
-        def done(fraction: float) -> None:
-            self.done[step] = fraction
-            if threading.get_ident() == self.thread:
-                total = sum(w * self.done[k] for k, w in self.weights.items())
-                self.report(total / sum(self.weights.values()), step)
-
-        return done
-
-
-class _Job:
-    """``func(*args, stop=event)`` in a background thread; :meth:`result` waits for it."""
-
-    def __init__(self, func: Callable[..., np.ndarray], *args: Any) -> None:
-        self.stop = threading.Event()
-        self.pool = ThreadPoolExecutor(1, thread_name_prefix="sbrdf-build")
-        self.future = self.pool.submit(func, *args, stop=self.stop)
-        self.pool.shutdown(wait=False)
-
-    def result(self, tick: Callable[[], None]) -> np.ndarray:
-        """The result, calling ``tick()`` every quarter second while waiting."""
-        while True:
-            try:
-                return self.future.result(timeout=0.25)
-            except TimeoutError:
-                tick()
-
-    def cancel(self) -> None:
-        """Stop the job at its next row group (the build failed)."""
-        self.stop.set()
+def _given_reflectance(rho: xr.DataArray, ti: np.ndarray, wl: np.ndarray) -> np.ndarray:
+    """``model_reflectance`` of :func:`build_lut` as an array, checked against the table's
+    rows ``ti`` and wavelengths ``wl``."""
+    if not isinstance(rho, xr.DataArray) or set(rho.dims) != {THETA_I, WAVELENGTH}:
+        raise ValidationError(
+            "model_reflectance: expected an xarray.DataArray with dims (theta_i, wavelength), "
+            f"got {type(rho).__name__} with dims {getattr(rho, 'dims', None)}"
+        )
+    rho = rho.transpose(THETA_I, WAVELENGTH)
+    for dim, want in ((THETA_I, ti), (WAVELENGTH, wl)):
+        got = np.asarray(rho[dim].values, dtype=np.float64)
+        if not np.array_equal(got, want):
+            raise ValidationError(
+                f"model_reflectance: its {dim} ({got.size} values, {got[:1]}..{got[-1:]}) "
+                f"is not the table's ({want.size} values, {want[:1]}..{want[-1:]})"
+            )
+    return np.array(rho.values, dtype=np.float64)
 
 
 def _model_reflectance(
@@ -506,26 +495,6 @@ def _model_reflectance(
         done,
         stop,
     )
-
-
-def _by_rows(
-    func: Callable[[np.ndarray], np.ndarray],
-    ti: np.ndarray,
-    done: Callable[[float], None],
-    stop: threading.Event | None = None,
-) -> np.ndarray:
-    """``func(ti)`` (one result row per incidence angle) a few rows at a time, reporting the
-    fraction done (and stopping when ``stop`` is set): the rows are computed
-    independently, so the result is the same."""
-    bounds = np.unique(np.linspace(0, ti.size, min(ti.size, 12) + 1).astype(int))
-    out = []
-    for a, b in itertools.pairwise(bounds):
-        if stop is not None and stop.is_set():
-            raise RuntimeError("build_lut: stopped (the build failed)")
-        done(a / ti.size)
-        out.append(func(ti[a:b]))
-    done(1.0)
-    return np.concatenate(out)
 
 
 def _bound_grazing_rows(
