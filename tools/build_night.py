@@ -50,8 +50,9 @@ SEED = 27847
 
 
 def truth_attitude():
-    """The spin: body +z along the inertial axis (the shortest arc from the GCRS z axis,
-    :func:`sbrdf_xr.invert.spin_model`), angle ``SPIN_PHASE_DEG`` at ``SPIN_EPOCH``."""
+    """The spin about body +z, from the attitude that takes body +z to the inertial axis by the
+    shortest arc (:func:`sbrdf_xr.invert.spin_model`), angle ``SPIN_PHASE_DEG`` at
+    ``SPIN_EPOCH``."""
     from sbrdf_xr import invert
 
     axis = invert.axis_vector(SPIN_AXIS_LONGITUDE_DEG, SPIN_AXIS_LATITUDE_DEG)
@@ -130,6 +131,10 @@ def measured_table(seed: int = SEED) -> Table:
                 "spin_axis_longitude_deg": SPIN_AXIS_LONGITUDE_DEG,
                 "spin_axis_latitude_deg": SPIN_AXIS_LATITUDE_DEG,
                 "spin_axis_frame": "GCRS",
+                "spin_convention": (
+                    "sbrdf_xr.invert.spin_model: from the attitude that takes the body axis to "
+                    "the inertial axis by the shortest arc, spin angle phase at the epoch"
+                ),
                 "spin_period_s": SPIN_PERIOD_S,
                 "spin_phase_deg": SPIN_PHASE_DEG,
                 "spin_epoch_utc": SPIN_EPOCH,
@@ -137,7 +142,7 @@ def measured_table(seed: int = SEED) -> Table:
                 "zero_point_mag": {b: ZERO_POINT_MAG for b in FILTERS},
                 "extinction_mag_per_airmass": EXTINCTION,
                 "noise_mag": NOISE_MAG,
-                "seed": SEED,
+                "seed": seed,
             },
         }
     )
