@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import tempfile
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
@@ -54,7 +55,8 @@ def measured_table(sim, path: Path, seed: int = 0) -> None:
     tab.write(path, overwrite=True)
 
 
-def main() -> None:
+def fitted() -> Any:
+    """The comparison of the measured table with the simulated pass (``compare``'s result)."""
     scene = builtin_scene("canx1-pass")
     o = scene.observation
     fine = Observation(o.orbit, o.site, times(o.times[0], o.times[-1], 0.1), o.attitude)
@@ -63,7 +65,18 @@ def main() -> None:
     path = Path(tempfile.mkdtemp()) / "canx1-pass-measured.ecsv"
     measured_table(sim, path)
     measured = read_light_curve(path)
-    fit = compare(measured, sim, extinction="fit", fit_time_shift=True, max_time_shift_s=5.0)
+    return compare(measured, sim, extinction="fit", fit_time_shift=True, max_time_shift_s=5.0)
+
+
+def figures(fit: Any = None) -> dict[str, Any]:
+    """The figure by file name."""
+    fit = fitted() if fit is None else fit
+    title = "canx1-pass: a measured V, R, I table against the simulation"
+    return {OUT.name: plot_comparison(fit, title=title)}
+
+
+def main() -> None:
+    fit = fitted()
     for p, e, s in zip(
         fit.parameter.values, fit.estimate.values, fit.standard_error.values, strict=True
     ):
@@ -74,8 +87,8 @@ def main() -> None:
         }[str(p)]
         print(f"{p:10s} {e:+.4f} +- {s:.4f} (injected {truth:+.3f})")
     print(f"reduced chi2 {float(fit.reduced_chi_square):.3f} ({int(fit.degrees_of_freedom)} dof)")
-    fig = plot_comparison(fit, title="canx1-pass: a measured V, R, I table against the simulation")
-    fig.savefig(OUT, dpi=110)
+    for name, fig in figures(fit).items():
+        fig.savefig(OUT.parent / name, dpi=110)
     print(f"wrote {OUT}")
 
 

@@ -18,7 +18,7 @@ The packages are the layers, lowest first; a package imports only from lower one
   magnitudes, light curves), :mod:`~sbrdf_xr.observing` (orbits, sites, times,
   attitude laws, the Earth's shadow);
 * :mod:`~sbrdf_xr.catalog` (the shipped data, loaded by kind);
-* :mod:`~sbrdf_xr.store` (the cube writer) and :mod:`~sbrdf_xr.engine` (scenes,
+* :mod:`~sbrdf_xr.store` (the output formats and cube writers) and :mod:`~sbrdf_xr.engine` (scenes,
   plans, simulation);
 * users of everything: :mod:`~sbrdf_xr.invert`, :mod:`~sbrdf_xr.bench`,
   :mod:`~sbrdf_xr.plot`, :mod:`~sbrdf_xr.accessors`, :mod:`~sbrdf_xr.testing` and
@@ -33,7 +33,7 @@ import importlib as _importlib
 from . import accessors, catalog, errors, geometry
 from ._version import __version__
 from .body import Spacecraft, canx1, load_spacecraft
-from .engine import Scene, builtin_scene, load_scene, simulate, write
+from .engine import Scene, builtin_scene, load_scene, simulate
 from .materials import (
     build_lut,
     constant_material,
@@ -42,6 +42,7 @@ from .materials import (
     lookup,
     open_material,
 )
+from .store import write
 
 #: The public modules and packages, reachable as attributes (imported on first use).
 _SUBMODULES = (

@@ -25,7 +25,8 @@ from pathlib import Path
 
 import xarray as xr
 
-from .errors import CacheWarning
+from ._output import file_kind
+from .errors import CacheWarning, OutputError
 
 __all__ = ["build_modules", "cache_dir", "cache_file", "cached_table", "source_digest"]
 
@@ -219,7 +220,7 @@ def cached_table(
     if path is None:
         return build()
     d = path.parent
-    if path.is_file():
+    if file_kind(path) == "file":  # a symbolic link or special file there is not followed
         try:
             return read(path)
         except (OSError, ValueError) as exc:  # a damaged cache file: build again
@@ -231,7 +232,7 @@ def cached_table(
             )
             path.unlink(missing_ok=True)
     with _building(d):  # one builder at a time: another process's build is read, not redone
-        if path.is_file():
+        if file_kind(path) == "file":
             try:
                 return read(path)
             except (OSError, ValueError):  # a damaged file (warned above): build it anew
@@ -241,12 +242,12 @@ def cached_table(
             d.mkdir(parents=True, exist_ok=True)
             write(table, path)  # atomic: a temporary file renamed, so two builders cannot clash
             return read(path)
-        except OSError as exc:  # read-only or full: the built table, uncached
-            _unusable(d, name, exc)
+        except (OSError, OutputError) as exc:  # read-only, full or a special file in the way:
+            _unusable(d, name, exc)  # the built table, uncached
             return table
 
 
-def _unusable(d: Path, name: str, exc: OSError) -> None:
+def _unusable(d: Path, name: str, exc: Exception) -> None:
     warnings.warn(
         f"table cache {d} is not usable ({type(exc).__name__}: {exc}); table {name} "
         "was built but not kept (set SBRDF_XR_CACHE_DIR to a writable directory, or "

@@ -16,6 +16,8 @@ __all__ = [
     "AttitudeError",
     "CacheWarning",
     "CatalogError",
+    "CubeLockedError",
+    "CubeWriteError",
     "EpochGapWarning",
     "FitQualityWarning",
     "InversionError",
@@ -25,12 +27,15 @@ __all__ = [
     "NonPhysicalWarning",
     "NotObservableError",
     "ObservationError",
+    "OutputError",
     "SbrdfError",
     "SbrdfWarning",
     "SceneError",
+    "SchedulerError",
     "UnitError",
     "UnitWarning",
     "ValidationError",
+    "WorkersLostError",
     "did_you_mean",
 ]
 
@@ -112,6 +117,29 @@ class AttitudeError(ValidationError):
 
 class InversionError(ValidationError):
     """Measured data, uncertainties or a model library that an inversion cannot use."""
+
+
+class OutputError(SbrdfError):
+    """An output that cannot be written where asked: a special file, a symbolic link or a
+    directory the package did not write at the output path (or at one of its siblings
+    ``.part``, ``.lock``, ...), which is never replaced, or a write that failed."""
+
+
+class CubeWriteError(OutputError):
+    """A cube could not be written, or an unfinished ``.part`` cannot be resumed."""
+
+
+class CubeLockedError(CubeWriteError):
+    """Another writer holds the lock of this cube (``<path>.lock``)."""
+
+
+class WorkersLostError(CubeWriteError):
+    """The Dask cluster computing a cube lost every worker (or its scheduler); the blocks
+    written so far are kept in the ``.part`` for a resume."""
+
+
+class SchedulerError(SbrdfError):
+    """A Dask scheduler address that is malformed or cannot be reached."""
 
 
 class LightCurveError(ValidationError):

@@ -150,7 +150,7 @@ def _edited(tmp_path, rel, old, new):
         ("brdf/_fresnel_kernels.py", "0.5 * kd[j, w] * qr", "0.5 * qr * kd[j, w]", True),
         ("materials/build.py", "blend: float = 10.0", "blend: float = 11.0", True),
         ("kernels/lut.py", "_MAX_STEP_DEG = 5.0", "_MAX_STEP_DEG = 4.0", True),
-        ("materials/files.py", '"_FillValue": None', '"_FillValue": 0.0', True),
+        ("_output.py", '"_FillValue": None', '"_FillValue": 0.0', True),
         ("catalog.py", "complevel=0)", "complevel=1)", True),
         ("catalog.py", "_FILE_ATTRS = (", "_FILE_ATTRS = ('x', ", True),
         ("_catalog_index.py", "def ", "def  ", True),

@@ -107,6 +107,7 @@ SCRIPTS = {
     "accuracy_front": [],
     "gallery": [],
     "observation": [],
+    "comparison": [],
     "imperfections": [pytest.mark.slow],
     "anisotropy": [pytest.mark.slow],
 }
@@ -133,6 +134,7 @@ IMAGES = {
     "canx1_model.png": "gallery",
     "canx1_off_specular.png": "gallery",
     "canx1_pass.png": "observation",
+    "canx1_pass_comparison.png": "comparison",
     "canx1_plusx_spectra.png": "gallery",
     "canx1_rotation.png": "gallery",
 }

@@ -9,13 +9,14 @@ alike; only those under ``if TYPE_CHECKING:`` are left out (they do not run).
 * L0, shared by every layer: ``_version``, ``_names``, ``errors``, ``units`` (Quantities
   converted at the door, bare numbers checked against their unit), ``rotations``,
   ``geometry``, ``anisotropy`` (facet tangents, ``psi``), ``sources``, ``_catalog_index``
-  (where the shipped files are; it loads nothing) and ``_cache`` (tables built on load,
-  cached on disk).
+  (where the shipped files are; it loads nothing), ``_cache`` (tables built on load,
+  cached on disk) and ``_output`` (the safe output every writer goes through).
 * L1, arithmetic: ``kernels`` (compiled and numpy kernels) and ``brdf`` (analytic models).
 * L2, the domain: ``materials``, ``body`` (the spacecraft), ``photometry`` and
   ``observing`` (orbits, sites, times, attitude laws, the Earth's shadow).
 * L3: ``catalog`` (knows every kind's loader in L2).
-* L4, the cube: ``store`` (the writer) and ``engine`` (scenes, plans, simulation).
+* L4, the cube: ``store`` (the output formats and cube writers) and ``engine`` (scenes,
+  plans, simulation).
 * L5, users of everything: ``invert``, ``bench``, ``plot``, ``accessors``, ``testing``,
   ``cli`` and the package's ``__init__``.
 
@@ -44,6 +45,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "sources",
         "_catalog_index",
         "_cache",
+        "_output",
         "units",
     ),
     ("kernels", "brdf"),
@@ -432,11 +434,12 @@ def test_the_private_check_catches_imports_and_attributes(tmp_path):
 # ------------------------------------------------------------------ the package graph
 
 #: Bounds of the import graph with each package counted as one node.  The depth is that
-#: of the chain cli -> invert -> engine -> catalog -> observing -> photometry -> materials
-#: -> kernels -> anisotropy -> geometry -> rotations -> units -> errors: ``units`` (every
-#: argument with a unit converted at the door, the rotations' angles too) is its one link
-#: below the root modules.
-GRAPH_LIMITS = {"nodes": 30, "depth": 13, "edges": 110}
+#: of the chain cli -> bench -> engine -> catalog -> body -> kernels -> anisotropy ->
+#: geometry -> rotations -> units -> errors (11): ``units`` (every argument with a unit
+#: converted at the door, the rotations' angles too) is its one link below the root
+#: modules.  The edges include one from every package that writes a file (materials,
+#: photometry, store, bench, cli, ``_cache``) to ``_output``, the one safe output.
+GRAPH_LIMITS = {"nodes": 30, "depth": 12, "edges": 116}
 
 
 def node_of(mod: str, root: Path = PACKAGE) -> str:

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from .._output import atomic_file
 from .rows import BenchRow
 
 __all__ = [
@@ -115,9 +116,8 @@ def write_presets(record: dict[str, Any], path: str | os.PathLike[str] = PRESETS
     True
     """
     path = Path(path)
-    tmp = path.with_name(path.name + ".part")
-    tmp.write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
-    os.replace(tmp, path)
+    with atomic_file(path, overwrite=True) as tmp:  # a special file at path is refused
+        tmp.write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
     return path
 
 

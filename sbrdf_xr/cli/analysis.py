@@ -6,10 +6,10 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 from typing import Any
 
 from ..errors import SbrdfError, ValidationError
+from ..store import formats
 from .commands import spacecraft_of
 from .output import open_dataset
 
@@ -101,9 +101,10 @@ def cmd_photometry(args: argparse.Namespace) -> int:
 
     from .. import photometry as phot
 
-    for out in (args.output, args.csv):
-        if out and Path(out).exists() and not args.overwrite:
-            raise FileExistsError(f"{out} exists; pass --overwrite to replace it")
+    outputs = [(args.output, None), (args.csv, "photometry-csv")]
+    for out, name in outputs:
+        if out:  # refused before anything is computed
+            formats.check(out, "photometry", overwrite=args.overwrite, name=name)
     with open_dataset(args.cube) as probe:
         if not any(
             v in probe and "wavelength" in probe[v].dims for v in ("signal", "spacecraft_sbrdf")
@@ -170,23 +171,10 @@ def cmd_photometry(args: argparse.Namespace) -> int:
             v = v[np.isfinite(v)]
             med = f"{np.median(v):.3f}" if v.size else "nan"
             print(f"colour {c!s:<10} median {med} mag")
-    if args.output:
-        phot.to_netcdf(ds, args.output, overwrite=args.overwrite)
-        print(f"wrote {args.output}")
-    if args.csv:
-        lead = set(ds.magnitude.dims) - {"band"}
-        parts = [
-            ds.magnitude.to_dataset(dim="band").rename({str(b): f"mag_{b}" for b in ds.band.values})
-        ]
-        if "colour_index" in ds:
-            parts.append(ds.colour_index.to_dataset(dim="colour"))
-        wide = xr.merge(parts, compat="override")
-        wide = wide.drop_vars(
-            [c for c in wide.coords if not set(wide[c].dims) <= lead or c in ("band", "colour")],
-            errors="ignore",
-        )
-        wide.to_dataframe().to_csv(args.csv)
-        print(f"wrote {args.csv}")
+    for out, name in outputs:
+        if out:
+            formats.format_for(out, "photometry", name).writer(ds, out, overwrite=args.overwrite)
+            print(f"wrote {out}")
     return 0
 
 
@@ -409,12 +397,10 @@ def cmd_invert(args: argparse.Namespace) -> int:
     >>> print(error)
     --isel 'geometry=3': index 3 is out of range; geometry of TMP/cube.nc has 1 entries (0..0)
     """
-    from ..materials.tables import write_netcdf_atomic
-
-    if args.output and Path(args.output).exists() and not args.overwrite:
-        raise FileExistsError(f"{args.output} exists; pass --overwrite to replace it")
+    if args.output:  # refused before anything is computed
+        formats.check(args.output, "inversion", overwrite=args.overwrite)
     ds = _unmix(args) if args.invert_command == "unmix" else _spin(args)
     if args.output:
-        write_netcdf_atomic(ds, args.output, overwrite=args.overwrite)
+        formats.write(ds, args.output, kind="inversion", overwrite=args.overwrite)
         print(f"wrote {args.output}")
     return 0

@@ -12,9 +12,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from .. import catalog
+from .._output import file_kind
 from .._version import __version__
 from ..errors import ValidationError, did_you_mean
-from ..store.writer import PART_SUFFIX
+from ..store import PART_SUFFIX, formats
 from .output import escape, escaped_attrs, open_cube, open_dataset
 
 if TYPE_CHECKING:
@@ -186,6 +187,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
     """
     from .. import bench
 
+    for out, kind in ((args.output, "table"), (args.csv, "table"), (args.plot, "figure")):
+        if out:  # refused before minutes of benchmarks, not after
+            formats.check(out, kind, overwrite=args.overwrite)
     if args.engine:
         from ..bench.engine import engine_rows
 
@@ -201,18 +205,16 @@ def cmd_bench(args: argparse.Namespace) -> int:
         print(f"wrote {path}")
     ds = bench.rows_to_dataset(rows)
     if args.output:
-        from ..materials.tables import write_netcdf_atomic
-
-        write_netcdf_atomic(ds, args.output, overwrite=True)
+        formats.write(ds, args.output, kind="table", overwrite=args.overwrite)
         print(f"wrote {args.output}")
     if args.csv:
-        ds.to_dataframe().to_csv(args.csv)
+        formats.write(ds, args.csv, kind="table", overwrite=args.overwrite)
         print(f"wrote {args.csv}")
     if args.plot:
         import matplotlib
 
         matplotlib.use("Agg")
-        bench.plot_front(rows).savefig(args.plot, dpi=120)
+        formats.write(bench.plot_front(rows), args.plot, kind="figure", overwrite=args.overwrite)
         print(f"wrote {args.plot}")
     return 0
 
@@ -265,8 +267,13 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 '=', '4', 'geometries'])
     """
     from ..engine import resolve_scene
-    from ..engine.run import simulate, write
+    from ..engine.run import simulate
 
+    out = Path(args.output)
+    if not args.plan:  # every output is refused (a special file, ...) before the sweep runs
+        fmt = formats.check(out, "cube", overwrite=args.overwrite, resume=args.resume)
+        if args.plot:
+            formats.check(args.plot, "figure", overwrite=args.overwrite)
     scene = resolve_scene(args.scene)
     scene = _with_body(scene, args)
     changes = _knob_values(args.set or [])
@@ -282,13 +289,15 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     print(plan)
     if args.plan:
         return 0
-    out = Path(args.output)
+    part = out.with_name(out.name + PART_SUFFIX)
     finished = (
         args.resume
         and not args.overwrite
-        and out.is_file()
-        and not out.with_name(out.name + PART_SUFFIX).exists()
+        and file_kind(out) is not None
+        and file_kind(part) is None
     )
+    # what a resume keeps, read before the write (which refuses a .part it cannot keep)
+    kept = fmt.unfinished(out) if args.resume and fmt.unfinished is not None else None
     client = None
     if args.scheduler is not None:
         from ..store.writer import connect
@@ -300,15 +309,14 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
     try:
         cube = simulate(plan, client=client)
-        extra = {} if str(out).endswith(".zarr") else {"complevel": args.complevel}
-        path = write(
+        path = fmt.writer(
             cube,
             out,
             overwrite=args.overwrite,
             resume=args.resume,
             client=client,
             progress=not args.quiet,
-            **extra,
+            complevel=args.complevel,
         )
     finally:
         if client is not None:
@@ -316,9 +324,11 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     if finished:
         print(f"{path} is already complete; nothing to resume")
     else:
+        if kept:
+            print(f"resumed {kept}; those were kept and only the missing blocks computed")
         print(f"wrote {path}")
     if args.plot:
-        _save_figure(path, args.plot)
+        _save_figure(path, args.plot, overwrite=args.overwrite)
     return 0
 
 
@@ -465,14 +475,19 @@ def cmd_knobs(args: argparse.Namespace) -> int:
 
 
 def _save_figure(
-    cube_path: str | Path, figure_path: str, bands: tuple[str, ...] = ("V", "R", "I")
+    cube_path: str | Path,
+    figure_path: str,
+    overwrite: bool = False,
+    bands: tuple[str, ...] = ("V", "R", "I"),
 ) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
 
     from ..plot import cube_figure
 
+    formats.check(figure_path, "figure", overwrite=overwrite)
     cube = open_cube(cube_path)
     try:
         fig = cube_figure(cube, bands=bands)
@@ -480,12 +495,8 @@ def _save_figure(
         raise ValidationError(
             f"{cube_path}: cannot be drawn ({type(exc).__name__}: {exc})"
         ) from None
-    import matplotlib.pyplot as plt
-
     try:
-        fig.savefig(figure_path, dpi=120)
-    except ValueError as exc:  # an unknown image format
-        raise ValidationError(f"{figure_path}: {exc}") from None
+        formats.write(fig, figure_path, kind="figure", overwrite=overwrite)
     finally:
         plt.close(fig)
     print(f"wrote {figure_path}")
@@ -520,5 +531,5 @@ def cmd_plot(args: argparse.Namespace) -> int:
     >>> status, png, out.getvalue().startswith("wrote ")
     (0, b'PNG', True)
     """
-    _save_figure(args.cube, args.output)
+    _save_figure(args.cube, args.output, overwrite=args.overwrite)
     return 0

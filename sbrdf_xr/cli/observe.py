@@ -3,7 +3,7 @@
 Elements (a TLE or OMM file, or a catalog orbit), a site (a catalog observatory or
 latitude, longitude and height), a UTC window and step, an attitude law with its
 parameters, a spacecraft and its materials, and bands: the observation cube is
-simulated, written by :func:`sbrdf_xr.engine.run.write` and drawn with ``--plot``::
+simulated, written by :func:`sbrdf_xr.store.write` and drawn with ``--plot``::
 
     sbrdf-xr observe --elements canx1-example --site mont-megantic \\
         --start 2024-03-17T01:20:00 --duration 300 --step 1 \\
@@ -355,9 +355,14 @@ def cmd_observe(args: argparse.Namespace) -> int:
     2
     """
     from ..engine import Scene
-    from ..engine.run import simulate, write
+    from ..engine.run import simulate
+    from ..store import formats
     from .commands import _save_figure, _with_body, spacecraft_of
 
+    if not args.plan:  # every output is refused (a special file, ...) before the pass runs
+        fmt = formats.check(args.output, "cube", overwrite=args.overwrite)
+        if args.plot:
+            formats.check(args.plot, "figure", overwrite=args.overwrite)
     body = spacecraft_of(args)
     obs = observation_of(args, body)
     bands = () if [b.lower() for b in args.bands] == ["none"] else tuple(args.bands)
@@ -377,10 +382,12 @@ def cmd_observe(args: argparse.Namespace) -> int:
     print(plan)
     if args.plan:
         return 0
-    path = write(
+    path = fmt.writer(
         simulate(plan), Path(args.output), overwrite=args.overwrite, progress=not args.quiet
     )
     print(f"wrote {path}")
     if args.plot:
-        _save_figure(path, args.plot, bands=tuple(bands) or ("V", "R", "I"))
+        _save_figure(
+            path, args.plot, overwrite=args.overwrite, bands=tuple(bands) or ("V", "R", "I")
+        )
     return 0

@@ -77,7 +77,7 @@ def escaped_attrs(obj: Any) -> Any:
 
 
 def open_dataset(path: str | Path) -> Any:
-    """Open a netCDF file, turning "not netCDF" into a :class:`ValidationError`.
+    """Open a netCDF file (or a Zarr store), turning "not netCDF" into a :class:`ValidationError`.
 
     Examples
     --------
@@ -107,6 +107,13 @@ def open_dataset(path: str | Path) -> Any:
     p = Path(path)
     if not p.exists():
         raise FileNotFoundError(f"{path}: no such file")
+    if p.is_dir() and any((p / m).is_file() for m in (".zgroup", "zarr.json")):
+        try:
+            return xr.open_zarr(p)  # a Zarr cube
+        except (OSError, ValueError, TypeError, KeyError, RuntimeError) as exc:
+            raise ValidationError(
+                f"{path}: not a readable Zarr store ({type(exc).__name__}: {exc})"
+            ) from None
     if not p.is_file():
         raise ValidationError(f"{path}: not a file")
     try:

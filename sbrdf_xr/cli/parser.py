@@ -38,11 +38,12 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from .. import catalog
+from .._output import command_line_messages
 from .._version import __version__
 from ..engine.builtin import builtin_scenes
 from ..engine.knobs import KNOBS, PRESETS
 from ..errors import SbrdfError
-from ..store.writer import DEFAULT_COMPLEVEL, LOG_SUFFIX, PART_SUFFIX, command_line_messages
+from ..store import DEFAULT_COMPLEVEL, PART_SUFFIX
 from .analysis import cmd_invert, cmd_photometry
 from .commands import (
     cmd_bench,
@@ -86,7 +87,7 @@ def build_parser() -> argparse.ArgumentParser:
     ...     ["simulate", "canx1-rotation", "-o", "cube.nc", "--preset", "fast"]
     ... )
     >>> args.command, args.scene, args.output, args.preset, args.complevel
-    ('simulate', 'canx1-rotation', 'cube.nc', 'fast', 0)
+    ('simulate', 'canx1-rotation', 'cube.nc', 'fast', None)
     """
     p = argparse.ArgumentParser(
         prog="sbrdf-xr", description="Spectral BRDF simulation of unresolved spacecraft."
@@ -124,6 +125,7 @@ def build_parser() -> argparse.ArgumentParser:
     pb.add_argument("-o", "--output", help="write the table to this netCDF file")
     pb.add_argument("--csv", help="write the table to this CSV file")
     pb.add_argument("--plot", help="draw the accuracy/time front to this PNG file")
+    pb.add_argument("--overwrite", action="store_true", help="replace existing output files")
     pb.add_argument(
         "--repeat",
         type=int,
@@ -141,7 +143,13 @@ def build_parser() -> argparse.ArgumentParser:
     psim.add_argument(
         "scene", help=f"built-in scene name ({', '.join(builtin_scenes())}) or a TOML file"
     )
-    psim.add_argument("-o", "--output", required=True, help="netCDF file to write")
+    psim.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        help="the cube to write: netCDF (CUBE.nc), or a Zarr store (CUBE.zarr) whose blocks "
+        "the Dask workers store themselves",
+    )
     psim.add_argument(
         "--scheduler", help="address of a dask.distributed scheduler (default: threads)"
     )
@@ -163,21 +171,22 @@ def build_parser() -> argparse.ArgumentParser:
     psim.add_argument(
         "--complevel",
         type=int,
-        default=DEFAULT_COMPLEVEL,
+        default=None,
         choices=range(10),
         metavar="0-9",
-        help=f"zlib compression level of the netCDF cube (default {DEFAULT_COMPLEVEL}; 0: "
-        "none, fastest, and resumable after a kill at any instant)",
+        help=f"compression of the cube: 0 none, 1-9 zlib with byte shuffle (default: netCDF "
+        f"{DEFAULT_COMPLEVEL}, uncompressed, the fastest and resumable after a kill at any "
+        "instant; Zarr its own LZ4); a resume keeps the level the cube was started with",
     )
     psim.add_argument(
         "--plot",
-        help="also write the cube's figure to this PNG file (chosen by the cube: a pass "
+        help="also write the cube's figure to this PNG (PDF, SVG) file (chosen by the cube: a pass "
         "against UTC, a rotation's BRDF and V, R, I magnitudes, or a few spectra)",
     )
     psim.add_argument(
         "--overwrite",
         action="store_true",
-        help="replace an existing output file (a regular file only)",
+        help="replace existing output files (regular files, and Zarr stores sbrdf-xr wrote, only)",
     )
     psim.add_argument(
         "--resume",
@@ -339,6 +348,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     pp.add_argument("cube", help="a cube file (netCDF or Zarr)")
     pp.add_argument("-o", "--output", required=True, help="the image file (PNG, PDF, SVG, ...)")
+    pp.add_argument("--overwrite", action="store_true", help="replace an existing image file")
     pp.set_defaults(func=cmd_plot)
     return p
 
@@ -399,7 +409,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         out = getattr(args, "output", None)
         hint = ""
-        if out and Path(str(out) + LOG_SUFFIX).exists():
+        if out and Path(str(out) + PART_SUFFIX).exists():
             hint = (
                 f"; the blocks written so far are kept in {out}{PART_SUFFIX}: "
                 "run again with --resume"

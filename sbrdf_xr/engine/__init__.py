@@ -18,9 +18,12 @@ Modules
     meaning, and the reference rendered from them) and the built-in scenes.
 ``plan``, ``stages`` and ``spectral``
     The plan and its stages.
+``reuse``
+    What a plan computes from the tables, the spacecraft and the knobs alone (packed
+    tables, merged facets), kept by content for the next plans.
 ``run``
     Executing a plan: blocks of geometries through the kernel into an xarray cube
-    (:func:`simulate`, :func:`write`).
+    (:func:`simulate`; :func:`sbrdf_xr.store.write` writes it).
 """
 
 from ..errors import SceneError
@@ -29,6 +32,7 @@ from . import (
     effects,
     knobs,
     plan,
+    reuse,
     run,
     scene,
     scene_file,
@@ -41,7 +45,7 @@ from .builtin import builtin_scene, builtin_scenes, resolve_scene
 from .effects import SPECTRAL_OUTPUTS, BlockInputs, Effect, Output, finish, reflected
 from .knobs import KNOBS, PRESETS, Knob, apply_preset, check_knob, knob_table
 from .plan import Estimate, Plan, PlannedOutput, Terms, compile_plan
-from .run import IN_PROCESS_BYTES, run_block, simulate, write
+from .run import IN_PROCESS_BYTES, run_block, simulate
 from .scene import EFFECTS, OUTPUTS, Scene
 from .scene_file import (
     MAX_SCENE_COUNT,
@@ -91,6 +95,7 @@ __all__ = [
     "plan",
     "reflected",
     "resolve_scene",
+    "reuse",
     "run",
     "run_block",
     "scene",
@@ -101,5 +106,4 @@ __all__ = [
     "spectral",
     "stages",
     "sweep",
-    "write",
 ]

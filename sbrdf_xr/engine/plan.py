@@ -35,8 +35,9 @@ from .._version import __version__
 from ..errors import SceneError
 from ..kernels import PackedTables, normal_rows
 from ..materials.models import model_parameters
-from ..store.fingerprint import scene_fingerprint
+from ..store.fingerprint import PREFIX, scene_fingerprint
 from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, BlockInputs, Effect, PlanInputs, readonly
+from .reuse import FACETS, digest
 from .spectral import spectral_stage
 from .stages import contributing_terms, describe_bytes, effect_stage, facet_terms, tilted_terms
 
@@ -341,6 +342,31 @@ def _anisotropic(material: xr.DataArray | xr.Dataset) -> bool:
     return PSI in material.dims
 
 
+def _facet_terms(
+    scene: Scene,
+    per_facet: tuple[str, ...],
+    steps: list[tuple[str, str]],
+    aniso: frozenset[str],
+    fingerprint: Mapping[str, str],
+) -> tuple[dict[str, np.ndarray], bool]:
+    """:func:`~sbrdf_xr.engine.stages.facet_terms`, kept by the content of the mesh, the
+    tangents and the merging asked for (:data:`sbrdf_xr.engine.reuse.FACETS`)."""
+    sc = scene.spacecraft
+    tangent = getattr(sc, "facet_tangent", None)
+    key = None
+    if getattr(sc, "mesh", None) is not None and tangent is not None:
+        key = (fingerprint[f"{PREFIX}_mesh"], digest(tangent), per_facet, scene.merge, aniso)
+
+    def make() -> tuple[dict[str, np.ndarray], bool, list[tuple[str, str]]]:
+        lines: list[tuple[str, str]] = []
+        raw, merged = facet_terms(scene, per_facet, lines, aniso)
+        return {k: readonly(np.array(v)) for k, v in raw.items()}, merged, lines  # own copies
+
+    raw, merged, lines = FACETS.get(key, make)
+    steps += lines
+    return dict(raw), merged
+
+
 def compile_plan(scene: Scene) -> Plan:
     """Compile a scene into its :class:`Plan` (see the module docstring).
 
@@ -379,13 +405,15 @@ def compile_plan(scene: Scene) -> Plan:
     knobs = {k: getattr(scene, k) for k in scene.knob_names()}
     geo = scene.geometry
     steps: list[tuple[str, str]] = [("geometry", geo.describe())]
+    # the content of every input, stored in the cube and keying what later plans reuse
+    fingerprint = scene_fingerprint(scene)
 
     # ---- effects that change what terms are needed (per facet)
     early, params = effect_stage(PlanInputs(scene, knobs), True, steps)
     per_facet = tuple(EFFECTS[e].title for e in early)
 
     aniso_names = frozenset(m for m, v in scene.material_data.items() if _anisotropic(v))
-    raw, merged = facet_terms(scene, per_facet, steps, aniso_names)
+    raw, merged = _facet_terms(scene, per_facet, steps, aniso_names, fingerprint)
     raw = tilted_terms(scene, raw, knobs["tilt_nodes"], steps)
     keep = contributing_terms(scene, raw["normal"])
     if not keep.all():
@@ -419,7 +447,7 @@ def compile_plan(scene: Scene) -> Plan:
     )
 
     # ---- spectral axis, bands and tables
-    sx = spectral_stage(scene, used, knobs, steps)
+    sx = spectral_stage(scene, used, knobs, steps, fingerprint)
     wl, bw, pre, dtype = sx.wavelength, sx.band_weights, sx.pre_integrated, sx.dtype
 
     # ---- the other effects
@@ -514,7 +542,7 @@ def compile_plan(scene: Scene) -> Plan:
             "spacecraft_sbrdf is 0 where area is 0 (no lit and visible facet; 0/0 of Eq. 4)"
         ),
         **geo.attrs,
-        **scene_fingerprint(scene),  # checked when an interrupted write is resumed
+        **fingerprint,  # checked when an interrupted write is resumed
     }
     plan = Plan(
         name=scene.name,

@@ -7,10 +7,10 @@ few threads (the compiled kernel releases the GIL), without building a Dask grap
 the cube comes back numpy-backed.  Larger ones, or any call with ``chunk``,
 ``lazy=True`` or a ``client``, return a *lazy* cube: one Dask task per block, built
 directly (the plan enters the graph once), chunked over the first geometry
-dimension with the spectral dimension whole.  :func:`write` streams a cube to
-netCDF block by block (atomic, resumable; see :mod:`sbrdf_xr.store.writer`), or to a
-Zarr store whose blocks the Dask workers write themselves.  This module and the
-writer are the only ones that know about Dask scheduling.
+dimension with the spectral dimension whole.  :func:`sbrdf_xr.store.write` writes a
+cube (netCDF block by block, or a Zarr store whose blocks the Dask workers store
+themselves; atomic, resumable).  This module and the writers are the only ones that
+know about Dask scheduling.
 
 The cube (DESIGN.md data model)
 -------------------------------
@@ -43,7 +43,7 @@ import os
 import threading
 import uuid
 from concurrent.futures import ThreadPoolExecutor
-from pathlib import Path
+from functools import partial
 from typing import Any
 
 import dask.array as dsa
@@ -51,16 +51,17 @@ import numpy as np
 import xarray as xr
 from dask.highlevelgraph import HighLevelGraph
 from dask.typing import Key
+from xarray.indexes import PandasIndex
 
 from .._names import WAVELENGTH, attrs
 from ..errors import SceneError
-from ..store.writer import write_cube
 from .builtin import resolve_scene
 from .effects import EFFECTS, finish
 from .plan import Plan
+from .reuse import INDEXES
 from .scene import Scene
 
-__all__ = ["IN_PROCESS_BYTES", "run_block", "simulate", "write"]
+__all__ = ["IN_PROCESS_BYTES", "run_block", "simulate"]
 
 #: Scenes whose outputs are smaller than this [byte] run in-process, without Dask
 #: (unless ``chunk``, ``lazy=True`` or a client is given).
@@ -211,8 +212,49 @@ def _template(plan: Plan) -> xr.Dataset:
         coords.update(plan.band_coords)
     if "material" in dims:
         coords["material"] = ("material", list(plan.materials), attrs("material"))
-    plan.cache["template"] = xr.Dataset(coords=coords, attrs=dict(plan.attrs))
+    plan.cache["template"] = _coordinates_only(coords, dict(plan.attrs))
     return plan.cache["template"]
+
+
+def _coordinates_only(coords: dict[str, Any], attributes: dict[str, Any]) -> xr.Dataset:
+    """``xr.Dataset(coords=coords, attrs=attributes)`` built directly: a default (pandas)
+    index for each dimension coordinate, no alignment or merging (the coordinates come
+    from one geometry and agree by construction), in the same order."""
+    arrays = [c.coords for c in coords.values() if isinstance(c, xr.DataArray)]
+    if any(k not in coords for a in arrays for k in a):  # coordinates that come with them
+        return xr.Dataset(coords=coords, attrs=attributes)
+    variables: dict[str, xr.Variable] = {}
+    indexes: dict[str, Any] = {}
+    # xarray puts the coordinates of DataArray-valued entries first
+    for name in dict.fromkeys([*(str(k) for a in arrays for k in a), *coords]):
+        spec = coords[name]
+        if isinstance(spec, xr.DataArray):
+            var = spec.variable
+        else:
+            var = xr.as_variable(spec, name=name, auto_convert=False)
+        if var.dims == (name,):
+            index = INDEXES.get(_index_key(name, var), partial(_pandas_index, name, var))
+            indexes[name] = index
+            var = index.create_variables({name: var})[name]
+        variables[name] = var
+    return xr.Dataset._construct_direct(variables, set(variables), None, attributes, indexes)
+
+
+def _pandas_index(name: str, var: xr.Variable) -> PandasIndex:
+    """A default index over a copy of ``var``'s values (kept: it must own its memory)."""
+    return PandasIndex.from_variables({name: var.copy(deep=True)}, options={})
+
+
+#: Largest dimension coordinate whose index is kept for later cubes (:data:`INDEXES`).
+_INDEX_KEEP_SIZE = 4096
+
+
+def _index_key(name: str, var: xr.Variable) -> tuple | None:
+    """The content of a small numeric or string dimension coordinate (None: not kept)."""
+    values = var.values
+    if values.size > _INDEX_KEEP_SIZE or values.dtype.kind not in "biufcmMUS":
+        return None
+    return (name, var.dims, values.dtype.str, values.shape, values.tobytes())
 
 
 def _dataset(plan: Plan, arrays: dict[str, Any]) -> xr.Dataset:
@@ -334,107 +376,3 @@ def simulate(
             )
         arrays = _in_process(the_plan)
     return _dataset(the_plan, arrays)
-
-
-def write(cube: xr.Dataset, path: str | os.PathLike[str], **kwargs: Any) -> Path:
-    """Write a cube: netCDF block by block, or a Zarr store for a path ending in ``.zarr``.
-
-    netCDF (the default): :func:`sbrdf_xr.store.writer.write_cube` (atomic, resumable, the
-    calling process writes; see it for the keyword arguments).  Zarr: every block is
-    computed *and written* by the Dask worker (or thread) that computes it, so adding
-    workers to a cluster speeds the whole sweep up; the store is written as
-    ``<path>.part`` and renamed when complete (keywords ``overwrite``, ``client``,
-    ``progress``).
-
-    Returns
-    -------
-    pathlib.Path
-        ``path``.
-
-    Examples
-    --------
-    >>> import trimesh
-    >>> from sbrdf_xr import Scene, geometry, load_spacecraft, simulate
-    >>> from sbrdf_xr.materials.schema import lambertian
-    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
-    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
-    >>> turns = geometry.axis_rotation([0, 0, 1], [0.0, 45.0])  # two attitudes about z
-    >>> scene = Scene(box, {"grey": grey}, attitudes=turns, phase_angles=[0.0, 60.0])
-    >>> import tempfile, xarray as xr
-    >>> from pathlib import Path
-    >>> from sbrdf_xr import write
-    >>> cube = simulate(scene)
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     path = write(cube, Path(tmp) / "cube.nc")
-    ...     with xr.open_dataset(path) as back:
-    ...         print(path.name, back.signal.shape, round(float(back.signal[1, 0, 0]), 6))
-    cube.nc (2, 2, 3) 0.159155
-    """
-    if str(path).rstrip("/").endswith(".zarr"):
-        return _write_zarr(cube, Path(path), **kwargs)
-    return write_cube(_encode_times(cube), path, **kwargs)
-
-
-def _encode_times(cube: xr.Dataset) -> xr.Dataset:
-    """datetime64 coordinates as CF numbers with ``units`` and ``calendar`` (xarray's own
-    encoder, the one ``open_dataset`` decodes), for the netCDF writer."""
-    times = [k for k, v in cube.coords.items() if v.dtype.kind in "mM"]
-    if not times:
-        return cube
-    encoded = {}
-    for k in times:
-        v = xr.conventions.encode_cf_variable(cube[k].variable, name=str(k))
-        v.attrs.pop("_FillValue", None)  # CF 2.5.1: no fill value on a coordinate variable
-        encoded[k] = v
-    return cube.assign_coords(encoded)
-
-
-def _write_zarr(
-    cube: xr.Dataset,
-    path: Path,
-    *,
-    overwrite: bool = False,
-    client: Any = None,
-    progress: bool = False,
-    resume: bool = False,
-    scheduler: str | None = None,
-) -> Path:
-    import shutil
-
-    from ..errors import ValidationError
-
-    if resume:
-        raise ValidationError("resume: supported for netCDF cubes; a Zarr store is rewritten whole")
-    if scheduler is not None and client is None:
-        raise ValidationError(
-            "scheduler: for a Zarr store pass client= (a dask.distributed.Client)"
-        )
-    if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass --overwrite (overwrite=True) to replace it")
-    if path.exists() and not path.is_dir():
-        raise ValidationError(f"{path} exists and is not a Zarr store (a directory); not replaced")
-    part = path.with_name(path.name + ".part")
-    if part.exists():
-        shutil.rmtree(part)
-    ds = cube.copy()
-    for v in ds.variables.values():
-        v.encoding = {}
-    job = ds.to_zarr(part, mode="w", compute=False, consolidated=True, zarr_format=2)
-    if client is not None:
-        fut = client.compute(job)
-        if progress:
-            from distributed import progress as dist_progress
-
-            dist_progress(fut)
-        fut.result()
-    elif progress:
-        from dask.diagnostics import ProgressBar
-
-        with ProgressBar():
-            job.compute()
-    else:
-        job.compute()
-    if path.exists():
-        shutil.rmtree(path)
-    os.replace(part, path)
-    return path

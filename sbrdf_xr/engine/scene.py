@@ -327,7 +327,9 @@ class Scene:
             try:
                 q = geometry.check_quaternions(self.attitudes)
                 beta = np.atleast_1d(np.asarray(self.phase_angles, dtype=np.float64))
-                geometry.observation_plane(beta, self.bisector, self.plane_normal)
+                # checked here, kept for the geometry (computed once per scene)
+                plane = geometry.observation_plane(beta, self.bisector, self.plane_normal)
+                self._cache["plane"] = (beta.copy(), plane)
             except ValidationError as exc:
                 raise SceneError(str(exc)) from None
             if q.ndim != 2:
@@ -465,7 +467,11 @@ class Scene:
             return PairGeometry.from_observation(observed, sources)
         if self.is_grid:
             phase = np.asarray(self.phase_angles)
-            s, o = geometry.observation_plane(phase, self.bisector, self.plane_normal)
+            kept = self._cache.get("plane")
+            if kept is not None and np.array_equal(kept[0], phase):
+                s, o = kept[1]
+            else:  # the phase angles were changed in place since the scene was made
+                s, o = geometry.observation_plane(phase, self.bisector, self.plane_normal)
             return GridGeometry(
                 np.asarray(self.attitudes),
                 phase,

@@ -24,7 +24,9 @@ from ..kernels.anisotropic import pack_anisotropic
 from ..kernels.lut import table_edges, table_normal_blend
 from ..materials import models
 from ..photometry import band_weights
-from .effects.base import SPECTRAL_OUTPUTS
+from ..store.fingerprint import PREFIX
+from .effects.base import SPECTRAL_OUTPUTS, readonly
+from .reuse import GRIDS, TABLES, WEIGHTS, digest, immutable, table_digests
 
 if TYPE_CHECKING:
     from .scene import Scene
@@ -224,9 +226,17 @@ class Spectral:
 
 
 def spectral_stage(
-    scene: Scene, used: list[str], knobs: Mapping[str, Any], steps: list[tuple[str, str]]
+    scene: Scene,
+    used: list[str],
+    knobs: Mapping[str, Any],
+    steps: list[tuple[str, str]],
+    fingerprint: Mapping[str, str] | None = None,
 ) -> Spectral:
     """The wavelength grid, the band weights, and the tables (or models) of ``used``.
+
+    Given the scene's ``fingerprint`` (:func:`sbrdf_xr.store.fingerprint.scene_fingerprint`),
+    the band weights and the packed tables are kept by the content of what they are
+    computed from (:mod:`sbrdf_xr.engine.reuse`) and reused by later plans.
 
     Examples
     --------
@@ -254,14 +264,24 @@ def spectral_stage(
     bands: skipped: no band output requested
     wavelength: 3 wavelengths 500-700 nm (every 2th)
     """
-    wl_full = common_wavelength(scene, used or list(scene.material_data))
+    digests = None if fingerprint is None else table_digests(fingerprint)
+    names = used or list(scene.material_data)
+    grid_key = None if digests is None else tuple((m, digests.get(m)) for m in names)
+    wl_full = GRIDS.get(grid_key, lambda: readonly(np.array(common_wavelength(scene, names))))
     wl = wl_full[:: knobs["wavelength_stride"]]
     bw = None
     band_coords: dict[str, Any] = {}
     if scene.bands:
-        w = band_weights_of(scene, wl)
-        bw = np.asarray(w.values)
-        band_coords = {str(c): w[c] for c in w.coords if BAND in w[c].dims}
+
+        def weigh() -> tuple[np.ndarray, dict[str, Any]]:
+            w = band_weights_of(scene, wl).copy(deep=True)  # owns its memory
+            return readonly(w.values), {str(c): w[c] for c in w.coords if BAND in w[c].dims}
+
+        key = None
+        if fingerprint is not None:
+            filters = fingerprint[f"{PREFIX}_filters"]
+            key = (tuple(scene.bands), scene.band_extrapolate, filters, digest(wl))
+        bw, band_coords = WEIGHTS.get(key, weigh)
     spectral_asked = any(o in SPECTRAL_OUTPUTS for o in scene.outputs)
     pre = bool(scene.bands) and not spectral_asked and knobs["band_integration"] == "auto"
     dtype = np.dtype(knobs["dtype"])
@@ -279,7 +299,15 @@ def spectral_stage(
         )
     else:
         mods = {}
-        tables = _packed(scene, used, wl, bw if pre else None, dtype, knobs, aniso)
+        # kept only for read-only tables: the packing views their memory
+        packing_key: tuple | None = None
+        if digests is not None and all(_immutable_table(scene, m) for m in used):
+            tables_key = tuple((m, digests[m]) for m in used)
+            grid = digest(wl, bw if pre else None)
+            packing_key = (tables_key, grid, dtype.str, knobs["table_theta_step"])
+        tables, aniso = TABLES.get(
+            packing_key, lambda: _packed(scene, used, wl, bw if pre else None, dtype, knobs)
+        )
         if aniso:
             steps.append(_aniso_kernels.plan_step(used, aniso))
         res = (
@@ -300,6 +328,12 @@ def spectral_stage(
     return Spectral(wl, bw, band_coords, pre, dtype, tables, mods, aniso)
 
 
+def _immutable_table(scene: Scene, m: str) -> bool:
+    """Whether material ``m`` is a table whose values no one can write (not a model)."""
+    da = scene.material_data[m]
+    return isinstance(da, xr.DataArray) and immutable(da.variable.data)
+
+
 def _packed(
     scene: Scene,
     used: list[str],
@@ -307,11 +341,11 @@ def _packed(
     bw: np.ndarray | None,
     dtype: np.dtype,
     knobs: Mapping[str, Any],
-    aniso: dict[int, Any],
-) -> PackedTables:
-    """The used tables on ``wl`` (pre-integrated over the bands ``bw``), packed; the psi
-    slices of anisotropic tables go into ``aniso`` by packed slot."""
+) -> tuple[PackedTables, dict[int, Any]]:
+    """The used tables on ``wl`` (pre-integrated over the bands ``bw``), packed, and the psi
+    slices of anisotropic tables by packed slot."""
     packed: list[tuple[Any, ...]] = []
+    aniso: dict[int, Any] = {}
     for m in used:
         da = table_on(scene.tables[m], wl, knobs["table_theta_step"])
         values = np.asarray(da.values)
@@ -333,7 +367,8 @@ def _packed(
                 table_normal_blend(scene.tables[m].attrs),
             )
         )
-    return pack_tables(packed, len(scene.bands) if bw is not None else wl.size, dtype)
+    n_spectral = len(scene.bands) if bw is not None else wl.size
+    return pack_tables(packed, n_spectral, dtype), aniso
 
 
 def _bands_step(scene: Scene, pre: bool, spectral_asked: bool, n_wl: int) -> tuple[str, str]:

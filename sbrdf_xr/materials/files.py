@@ -3,14 +3,12 @@
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
-from typing import Any
 
-import numpy as np
 import xarray as xr
 
 from .._names import SBRDF
+from .._output import write_netcdf
 from ..errors import ValidationError
 from .schema import validate_material, validate_measurements
 
@@ -20,22 +18,14 @@ __all__ = ["open_material", "open_measurements", "to_netcdf", "write_netcdf_atom
 # --------------------------------------------------------------------- I/O
 
 
-def _encoding(obj: xr.Dataset, complevel: int = 4) -> dict[str, dict[str, Any]]:
-    """No fill values anywhere; lossless zlib compression of the data variables (none for
-    ``complevel`` 0)."""
-    enc: dict[str, dict[str, Any]] = {
-        str(name): {"_FillValue": None} for name in list(obj.variables)
-    }
-    for name, var in obj.data_vars.items():
-        if var.ndim and np.issubdtype(var.dtype, np.floating) and complevel > 0:
-            enc[str(name)].update(zlib=True, complevel=complevel, shuffle=True)
-    return enc
-
-
 def write_netcdf_atomic(
     ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False, complevel: int = 4
 ) -> Path:
-    """Write ``ds`` to ``path`` atomically (temporary file, then rename).
+    """Write ``ds`` to ``path`` atomically (a temporary file beside it, then a rename).
+
+    The package's safe output (:func:`sbrdf_xr._output.write_netcdf`): only a regular file
+    is ever replaced; a FIFO, socket, device, symbolic link or directory at ``path`` is
+    refused.
 
     Parameters
     ----------
@@ -54,6 +44,14 @@ def write_netcdf_atomic(
     -------
     pathlib.Path
 
+    Raises
+    ------
+    FileExistsError
+        ``path`` exists and ``overwrite`` is false.
+    OutputError
+        Something other than a regular file at ``path``, or the write failed (nothing
+        was replaced).
+
     Examples
     --------
     >>> import tempfile
@@ -68,25 +66,7 @@ def write_netcdf_atomic(
     >>> names, again.x.values.tolist(), again.attrs["Conventions"]
     (['example.nc'], [1.0, 2.0], 'CF-1.10')
     """
-    path = Path(path)
-    if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True to replace it")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".part", dir=path.parent)
-    os.close(fd)
-    from .._names import cf_finish
-
-    ds = cf_finish(ds)  # Conventions, title, source, history, flags, ancillary links
-    try:
-        ds.to_netcdf(tmp, engine="netcdf4", encoding=_encoding(ds, complevel))
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    return write_netcdf(ds, path, overwrite=overwrite, complevel=complevel)
 
 
 def to_netcdf(

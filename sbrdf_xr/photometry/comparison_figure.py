@@ -174,7 +174,7 @@ def plot_comparison(comparison: xr.Dataset, *, title: str | None = None) -> Any:
     axr.set_ylabel("residual [mag]")
     if pass_:
         day = str(x.min())[:10] if x.size else ""
-        axr.set_xlabel(f"time on {day} [UTC]")
+        axr.set_xlabel(f"time [UTC] on {day}")
         import matplotlib.dates as mdates
 
         axr.xaxis.set_major_formatter(mdates.DateFormatter("%H:%M:%S"))

@@ -1,4 +1,5 @@
-"""Photometry files: CF-1.10 netCDF that compliance checkers accept, and reading them back.
+"""Photometry files: CF-1.10 netCDF that compliance checkers accept, and reading them back;
+a CSV table of the magnitudes and colours.
 
 CF coordinate variables (a variable named after its dimension) are numeric; the band
 and colour labels are strings.  In the file they are therefore auxiliary coordinates
@@ -14,7 +15,10 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from .._output import atomic_file, check_output, write_netcdf
 from ..errors import ValidationError
+
+__all__ = ["cf_decode", "cf_encode", "open_photometry", "to_csv", "to_netcdf"]
 
 _SUFFIX = "_label"
 
@@ -96,8 +100,6 @@ def to_netcdf(ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool =
     >>> path.name, open_photometry(path).attrs["Conventions"]
     ('phot.nc', 'CF-1.10')
     """
-    from ..materials.tables import write_netcdf_atomic
-
     if not isinstance(ds, xr.Dataset):
         raise ValidationError(f"ds: expected an xarray Dataset, got {type(ds).__name__}")
     enc = cf_encode(ds)
@@ -106,7 +108,51 @@ def to_netcdf(ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool =
             enc[name].attrs.setdefault(
                 "comment", "+inf where nothing reflects toward the observer; NaN where undefined"
             )
-    return write_netcdf_atomic(enc, path, overwrite=overwrite)
+    return write_netcdf(enc, path, overwrite=overwrite)
+
+
+def to_csv(ds: xr.Dataset, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
+    """Write the magnitudes (``mag_<band>``) and colour indices of a
+    :func:`~sbrdf_xr.photometry.photometry` Dataset as a CSV table, one row per geometry,
+    atomically (a temporary file beside it, then a rename; only a regular file is replaced).
+
+    Returns
+    -------
+    pathlib.Path
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.photometry import photometry
+    >>> wl = np.arange(300.0, 1101.0, 10.0)
+    >>> cube = xr.Dataset({"signal": (("geometry", "wavelength"), np.full((2, wl.size), 0.1),
+    ...                               {"units": "m2 sr-1"})},
+    ...                   coords={"wavelength": ("wavelength", wl, {"units": "nm"})})
+    >>> ph = photometry(cube, ["B", "V"], 1000.0, pairs=[("B", "V")])
+    >>> path = to_csv(ph, Path(tempfile.mkdtemp()) / "phot.csv")
+    >>> path.read_text().splitlines()[0]
+    'geometry,mag_B,mag_V,B-V'
+    """
+    if not isinstance(ds, xr.Dataset) or "magnitude" not in ds:
+        raise ValidationError(
+            f"ds: expected the Dataset of sbrdf_xr.photometry.photometry, got {type(ds).__name__}"
+        )
+    path = check_output(path, overwrite=overwrite)
+    lead = set(ds.magnitude.dims) - {"band"}
+    parts = [
+        ds.magnitude.to_dataset(dim="band").rename({str(b): f"mag_{b}" for b in ds.band.values})
+    ]
+    if "colour_index" in ds:
+        parts.append(ds.colour_index.to_dataset(dim="colour"))
+    wide = xr.merge(parts, compat="override")
+    wide = wide.drop_vars(
+        [c for c in wide.coords if not set(wide[c].dims) <= lead or c in ("band", "colour")],
+        errors="ignore",
+    )
+    with atomic_file(path, overwrite=overwrite) as tmp:
+        wide.to_dataframe().to_csv(tmp)
+    return path
 
 
 def open_photometry(path: str | os.PathLike[str]) -> xr.Dataset:

@@ -21,6 +21,7 @@ from .bands import (
     _resolve_bands,
     pre_integrate,
 )
+from .colour_science import as_spectrum
 from .spectra import (
     MAGNITUDE_SYSTEMS,
     SOLAR_SPECTRA,
@@ -119,6 +120,7 @@ def _system_attrs(system: str) -> dict[str, str]:
 
 
 def _signal_of(cube: xr.Dataset | xr.DataArray, variable: str = "signal") -> xr.DataArray:
+    cube = as_spectrum(cube)  # a colour-science spectrum, labelled along ``spectrum``
     if isinstance(cube, xr.Dataset):
         if variable not in cube:
             raise ValidationError(

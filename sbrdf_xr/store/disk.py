@@ -1,9 +1,11 @@
-"""Disk-durability primitives of the cube writer (see ``Durability`` in
-:mod:`sbrdf_xr.store.writer`).
+"""Disk-durability primitives of the cube writers (see ``Durability`` in
+:mod:`sbrdf_xr.store.writer`), and the words for their failures.
 
 Room checked and reserved before a block is written (free space, ``RLIMIT_FSIZE``,
 ``fallocate``), a failed HDF5 write fenced off and cut back to the last synced state,
-directories synced, and what kind of file is at a path.
+the page cache of written blocks dropped, and the cause of an I/O failure in words
+(:func:`reason`) with what to do about it (:func:`fix`).  Where a file may be written at
+all (special files, symbolic links, temporary names) is :mod:`sbrdf_xr._output`'s job.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
-from .common import _SPACE_MARGIN, _file_size_limit, _mib, _NoRoom, libc_function
+from .._output import error_words, libc_function
 
 __all__ = [
     "CHECK_SPACE",
@@ -33,8 +35,8 @@ __all__ = [
     "drop_behind",
     "fallocate_fn",
     "fence",
-    "file_kind",
-    "fsync_dir",
+    "fix",
+    "reason",
     "reserve",
 ]
 
@@ -42,32 +44,91 @@ __all__ = [
 CHECK_SPACE = True
 #: Bytes at the start of a ``.part`` (the HDF5 superblock) saved after each sync.
 HEAD_BYTES = 4096
+#: Free space [byte] kept beyond a block's raw size for HDF5 metadata (chunk index,
+#: object headers, superblock) written with it.
+_SPACE_MARGIN = 256 * 2**10
 
 
-def fsync_dir(directory: Path) -> None:
-    """``fsync`` ``directory``, so that a file created, renamed or removed in it stays so
-    after a crash; a directory that cannot be opened is skipped without error.
+class _NoRoom(OSError):
+    """Raised before a write that would not fit: nothing was written."""
+
+
+def _mib(n: float) -> str:
+    return f"{n / 2**20:.1f} MiB"
+
+
+def _file_size_limit() -> int | None:
+    try:
+        import resource
+    except ImportError:  # pragma: no cover - not on POSIX
+        return None
+    soft, _ = resource.getrlimit(resource.RLIMIT_FSIZE)
+    return None if soft == resource.RLIM_INFINITY else int(soft)
+
+
+def reason(exc: BaseException, part: Path | None = None, need: int = 0) -> str:
+    """The cause of an I/O failure in words ("no space left on device", ...).
+
+    HDF5 reports a failed write as "HDF error" without its cause; with ``part`` (the file
+    being written) and ``need`` (bytes it was still to grow by) the cause is then
+    diagnosed from the free space and the file size limit.
 
     Examples
     --------
-    >>> import os
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> from sbrdf_xr.store.disk import fsync_dir
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     _ = (Path(tmp) / "cube.nc.part").write_bytes(b"data")
-    ...     os.replace(Path(tmp) / "cube.nc.part", Path(tmp) / "cube.nc")
-    ...     fsync_dir(Path(tmp))  # the rename is now durable
-    ...     fsync_dir(Path(tmp) / "missing")  # nothing to sync: no error
-    ...     print(os.listdir(tmp))
-    ['cube.nc']
+    >>> import errno
+    >>> from sbrdf_xr.store.disk import reason
+    >>> reason(OSError(errno.EFBIG, "File too large"))
+    'file size limit exceeded'
+    >>> reason(RuntimeError("NetCDF: HDF error"))
+    'RuntimeError: NetCDF: HDF error'
     """
-    with contextlib.suppress(OSError):
-        fd = os.open(directory, os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
+    words = error_words(exc)
+    if words is None and part is not None:
+        words = _diagnose(part, need)
+    if words is None:
+        return f"{type(exc).__name__}: {exc}"
+    detail = getattr(exc, "strerror", None) if isinstance(exc, _NoRoom) else None
+    return f"{words} ({detail})" if detail else words
+
+
+_FIXES = {
+    "no space left on device": "free some space",
+    "file size limit exceeded": "raise the file size limit (ulimit -f)",
+    "disk quota exceeded": "free some space within your quota",
+}
+
+
+def fix(why: str) -> str:
+    """What to do about a failure worded by :func:`reason`.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.store.disk import fix
+    >>> fix("no space left on device (about 3.0 MiB needed, 1.0 MiB free on /tmp)")
+    'free some space'
+    >>> fix("RuntimeError: NetCDF: HDF error")
+    'fix the cause'
+    """
+    return next((v for k, v in _FIXES.items() if why.startswith(k)), "fix the cause")
+
+
+def _diagnose(part: Path, need: int = 0) -> str | None:
+    """Why a write into ``part`` may have failed when HDF5 does not say (it reports "HDF error")."""
+    try:
+        st = os.statvfs(part.parent)
+        free = (st.f_bfree if os.geteuid() == 0 else st.f_bavail) * st.f_frsize
+        if free < need + _SPACE_MARGIN:
+            return "no space left on device"
+    except (OSError, AttributeError):
+        pass
+    limit = _file_size_limit()
+    try:
+        size = part.stat().st_size
+    except OSError:
+        size = 0
+    if limit is not None and size + need + _SPACE_MARGIN > limit:
+        return "file size limit exceeded"
+    return None
 
 
 def check_room(part: Path, need: int) -> None:
@@ -312,45 +373,6 @@ class SyncBehind:
 
     def close(self) -> None:
         self.pool.shutdown(wait=True)
-
-
-def file_kind(p: Path) -> str | None:
-    """None if nothing is at ``p``, ``"file"`` for a regular file, else what it is.
-
-    Examples
-    --------
-    >>> import os
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> from sbrdf_xr.store.disk import file_kind
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     d = Path(tmp)
-    ...     _ = (d / "cube.nc").write_bytes(b"")
-    ...     (d / "link.nc").symlink_to(d / "cube.nc")
-    ...     os.mkfifo(d / "pipe.nc")
-    ...     for name in ("missing.nc", "cube.nc", "link.nc", "pipe.nc", "."):
-    ...         print(name, file_kind(d / name))
-    missing.nc None
-    cube.nc file
-    link.nc a symbolic link
-    pipe.nc a FIFO (named pipe)
-    . a directory
-    """
-    try:
-        mode = os.lstat(p).st_mode
-    except (FileNotFoundError, NotADirectoryError):
-        return None
-    if stat.S_ISREG(mode):
-        return "file"
-    kinds = (
-        (stat.S_ISDIR, "a directory"),
-        (stat.S_ISLNK, "a symbolic link"),
-        (stat.S_ISFIFO, "a FIFO (named pipe)"),
-        (stat.S_ISCHR, "a character device"),
-        (stat.S_ISBLK, "a block device"),
-        (stat.S_ISSOCK, "a socket"),
-    )
-    return next((name for test, name in kinds if test(mode)), "not a regular file")
 
 
 def fence(part: Path) -> None:

@@ -1,13 +1,15 @@
-"""The files of a cube being written: the ``.part`` netCDF file, its bookkeeping sidecar,
-and the rules for what may already be at the destination.
+"""The files of a netCDF cube being written: the ``.part`` file, its bookkeeping sidecar,
+the rules for what may already be at the destination, and how a message says to go on.
 
 See :mod:`sbrdf_xr.store.writer` for the format (the ``Bookkeeping`` and ``Encoding``
-sections) and the overwrite/resume rules.
+sections) and the overwrite/resume rules.  Every file here is created, opened and
+replaced through the package's safe output (:mod:`sbrdf_xr._output`).
 """
 
 from __future__ import annotations
 
 import json
+import logging
 import math
 import os
 from collections.abc import Mapping
@@ -19,22 +21,38 @@ import netCDF4
 import numpy as np
 import xarray as xr
 
+from .._output import (
+    atomic_file,
+    cli_style,
+    error_words,
+    file_kind,
+    open_regular,
+    option,
+    refuse_special,
+    rename_no_replace,
+)
+from ..errors import CubeWriteError
 from . import fingerprint as _fingerprint
-from .common import CubeWriteError, _discard, _log, _opt
-from .disk import file_kind
 from .layout import VOLATILE_ATTRS, BlockLayout, storage_kind
 
 __all__ = [
     "FORMAT",
     "FORMAT_VERSION",
     "HDF5_CHUNK_BYTES",
+    "LOG_SUFFIX",
+    "PART_SUFFIX",
+    "again_hint",
     "check_destination",
     "check_finished",
     "coordinates_attrs",
     "create_part",
+    "discard_hint",
     "hdf5_chunks",
+    "make_parent",
     "nc_attr",
     "open_part",
+    "part_complevel",
+    "publish",
     "read_log",
     "set_attrs",
     "set_global_attrs",
@@ -43,6 +61,10 @@ __all__ = [
     "write_header",
 ]
 
+#: Suffix of the unfinished cube (a file, or a Zarr store's directory) before its rename.
+PART_SUFFIX = ".part"
+#: Suffix of the bookkeeping sidecar (JSON lines) of an unfinished netCDF cube.
+LOG_SUFFIX = ".part.jsonl"
 #: Format name and version in the header of the bookkeeping sidecar.
 FORMAT = "sbrdf_xr.write_cube"
 FORMAT_VERSION = 1
@@ -50,6 +72,44 @@ FORMAT_VERSION = 1
 #: Chunks of 1-2 MiB write about twice as fast as 4-8 MiB ones through netCDF-4/HDF5
 #: (measured on this package's sweeps) and keep a one-chunk cache small.
 HDF5_CHUNK_BYTES = 2 * 2**20
+
+_log = logging.getLogger("sbrdf_xr.write_cube")
+
+
+def discard_hint() -> str:
+    """How to discard an unfinished cube and start again, for Python or the command line.
+
+    Examples
+    --------
+    >>> from sbrdf_xr._output import command_line_messages
+    >>> from sbrdf_xr.store.files import discard_hint
+    >>> discard_hint()
+    'pass overwrite=True, resume=False to discard it and start again'
+    >>> with command_line_messages():
+    ...     discard_hint()
+    'run again with --overwrite (without --resume) to discard it and start again'
+    """
+    if cli_style():
+        return "run again with --overwrite (without --resume) to discard it and start again"
+    return "pass overwrite=True, resume=False to discard it and start again"
+
+
+def again_hint(function: str = "write_cube") -> str:
+    """How to continue an unfinished cube, for Python (``function``) or the command line.
+
+    Examples
+    --------
+    >>> from sbrdf_xr._output import command_line_messages
+    >>> from sbrdf_xr.store.files import again_hint
+    >>> again_hint()
+    'call write_cube again with resume=True'
+    >>> with command_line_messages():
+    ...     again_hint()
+    'run the same command again with --resume'
+    """
+    if cli_style():
+        return "run the same command again with --resume"
+    return f"call {function} again with resume=True"
 
 
 def coordinates_attrs(ds: xr.Dataset) -> tuple[dict[str, str], str | None]:
@@ -250,6 +310,7 @@ def create_part(part: Path, ds: xr.Dataset, plan: BlockLayout, complevel: int) -
     ...         print({d: len(n) for d, n in nc.dimensions.items()}, list(nc.variables))
     ...         print(nc["x"][:].tolist(), nc["v"].chunking(), nc.getncattr("title"))
     ...         print(nc["ok"].dtype, nc["ok"].getncattr("dtype"))
+    ...     part.unlink()  # a .part is created anew, never over an existing file
     ...     with create_part(part, ds, layout_of(ds), complevel=4) as nc:
     ...         print(nc["v"].chunking(), nc["v"].filters()["complevel"])
     {'x': 4, 'y': 3} ['v', 'ok', 'x']
@@ -258,6 +319,9 @@ def create_part(part: Path, ds: xr.Dataset, plan: BlockLayout, complevel: int) -
     [2, 3] 4
     """
     coords_attr, global_coords = coordinates_attrs(ds)
+    # the name is claimed as a new regular file first (never a FIFO or a link followed);
+    # netCDF then rewrites that file
+    os.close(open_regular(part, os.O_WRONLY | os.O_CREAT | os.O_EXCL, error=CubeWriteError))
     nc = netCDF4.Dataset(part, mode="w", format="NETCDF4")
     try:
         for dim, size in ds.sizes.items():
@@ -331,7 +395,7 @@ def open_part(part: Path, ds: xr.Dataset, plan: BlockLayout) -> netCDF4.Dataset:
     >>> from pathlib import Path
     >>> import dask.array as da
     >>> import xarray as xr
-    >>> from sbrdf_xr.store.common import CubeWriteError
+    >>> from sbrdf_xr.errors import CubeWriteError
     >>> from sbrdf_xr.store.files import create_part, open_part
     >>> from sbrdf_xr.store.layout import layout_of
     >>> ds = xr.Dataset({"v": (("x", "y"), da.zeros((4, 3), chunks=(2, 3)))})
@@ -348,12 +412,13 @@ def open_part(part: Path, ds: xr.Dataset, plan: BlockLayout) -> netCDF4.Dataset:
     True True
     <tmp>/cube.nc.part: dimension 'y' is missing or has another size
     """
+    refuse_special([part], error=CubeWriteError)
     try:
         nc = netCDF4.Dataset(part, mode="a")
     except OSError as exc:
         raise CubeWriteError(
             f"{part} cannot be opened ({exc}); it was probably damaged while being "
-            f"written. {_discard()[0].upper()}{_discard()[1:]}"
+            f"written. {discard_hint()[0].upper()}{discard_hint()[1:]}"
         ) from exc
     try:
         for dim, size in ds.sizes.items():
@@ -410,7 +475,7 @@ def read_log(log: Path, part: Path) -> tuple[dict[str, Any], set[int]]:
     >>> from pathlib import Path
     >>> import dask.array as da
     >>> import xarray as xr
-    >>> from sbrdf_xr.store.common import CubeWriteError
+    >>> from sbrdf_xr.errors import CubeWriteError
     >>> from sbrdf_xr.store.files import read_log, write_header
     >>> from sbrdf_xr.store.layout import layout_of
     >>> plan = layout_of(xr.Dataset({"v": ("x", da.zeros(4, chunks=1))}))
@@ -430,23 +495,23 @@ def read_log(log: Path, part: Path) -> tuple[dict[str, Any], set[int]]:
     <tmp>/cube.nc.part has no bookkeeping file cube.nc.part.jsonl, so which blocks it holds
     is unknown; pass overwrite=True, resume=False to discard it and start again
     """
-    if not log.exists():
+    if file_kind(log) is None:
         raise CubeWriteError(
             f"{part} has no bookkeeping file {log.name}, so which blocks it holds is unknown; "
-            f"{_discard()}"
+            f"{discard_hint()}"
         )
     try:
-        with open(log, encoding="utf-8") as f:
-            lines = f.read().split("\n")
+        with os.fdopen(open_regular(log, os.O_RDONLY, error=CubeWriteError), "rb") as f:
+            lines = f.read().decode("utf-8").split("\n")
     except (OSError, UnicodeDecodeError) as exc:
-        raise CubeWriteError(f"{log}: cannot be read ({exc}); {_discard()}") from exc
+        raise CubeWriteError(f"{log}: cannot be read ({exc}); {discard_hint()}") from exc
     try:
         header = json.loads(lines[0])
         if header.get("format") != FORMAT:
             raise ValueError(f"format {header.get('format')!r}")
     except (ValueError, AttributeError) as exc:
         raise CubeWriteError(
-            f"{log}: not a write_cube bookkeeping file ({exc}); {_discard()}"
+            f"{log}: not a write_cube bookkeeping file ({exc}); {discard_hint()}"
         ) from exc
     done: set[int] = set()
     for line in lines[1:-1]:  # the last element follows the last newline: empty or torn
@@ -457,11 +522,12 @@ def read_log(log: Path, part: Path) -> tuple[dict[str, Any], set[int]]:
     return header, done
 
 
-def write_header(log: Path, plan: BlockLayout) -> None:
+def write_header(log: Path, plan: BlockLayout, complevel: int = 0) -> None:
     """Write the bookkeeping sidecar ``log`` afresh: one JSON header line, synced to disk.
 
-    The header is written to ``<log>.tmp`` and renamed over ``log``, so a reader sees
-    the old file or the whole new header, never part of it.
+    The header is written to a new temporary file and renamed over ``log``
+    (:func:`sbrdf_xr._output.atomic_file`), so a reader sees the old file or the whole new
+    header, never part of it.
 
     Examples
     --------
@@ -475,15 +541,15 @@ def write_header(log: Path, plan: BlockLayout) -> None:
     >>> plan = layout_of(xr.Dataset({"v": (("x", "y"), da.zeros((4, 3), chunks=(2, 3)))}))
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     log = Path(tmp) / "cube.nc.part.jsonl"
-    ...     write_header(log, plan)
+    ...     write_header(log, plan, complevel=4)
     ...     lines = log.read_text(encoding="utf-8").splitlines()
     ...     print(len(lines), sorted(p.name for p in Path(tmp).iterdir()))
     1 ['cube.nc.part.jsonl']
     >>> header = json.loads(lines[0])
     >>> sorted(header)
-    ['block_dims', 'fingerprint', 'format', 'n_blocks', 'structure', 'version']
-    >>> header["format"], header["version"], header["n_blocks"], header["block_dims"]
-    ('sbrdf_xr.write_cube', 1, 2, ['x', 'y'])
+    ['block_dims', 'complevel', 'fingerprint', 'format', 'n_blocks', 'structure', 'version']
+    >>> header["format"], header["version"], header["n_blocks"], header["complevel"]
+    ('sbrdf_xr.write_cube', 1, 2, 4)
     """
     header = {
         "format": FORMAT,
@@ -491,14 +557,39 @@ def write_header(log: Path, plan: BlockLayout) -> None:
         "fingerprint": plan.fingerprint,
         "n_blocks": plan.n_blocks,
         "block_dims": list(plan.block_dims),
+        "complevel": int(complevel),
         "structure": plan.structure,
     }
-    tmp = log.with_name(log.name + ".tmp")
-    with open(tmp, "w", encoding="utf-8") as f:
-        f.write(json.dumps(header, sort_keys=True) + "\n")
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, log)
+    with atomic_file(log, overwrite=True, error=CubeWriteError) as tmp:
+        tmp.write_text(json.dumps(header, sort_keys=True) + "\n", encoding="utf-8")
+
+
+def part_complevel(nc: netCDF4.Dataset, plan: BlockLayout) -> int:
+    """The zlib level the streamed variables of an open ``.part`` were created with.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import dask.array as da
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.files import create_part, part_complevel
+    >>> from sbrdf_xr.store.layout import layout_of
+    >>> ds = xr.Dataset({"v": (("x", "y"), da.zeros((4, 3), chunks=(2, 3)))})
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     for level in (0, 3):
+    ...         part = Path(tmp) / f"cube{level}.nc.part"
+    ...         with create_part(part, ds, layout_of(ds), complevel=level) as nc:
+    ...             print(part_complevel(nc, layout_of(ds)))
+    0
+    3
+    """
+    for v in plan.lazy:
+        var = nc.variables.get(v.name)
+        if var is not None and isinstance(var.dtype, np.dtype) and var.dtype.kind in "iuf":
+            filters = var.filters() or {}
+            return int(filters.get("complevel", 0)) if filters.get("zlib") else 0
+    return 0
 
 
 def check_destination(path: Path, part: Path, log: Path, overwrite: bool, resume: bool) -> str:
@@ -511,7 +602,7 @@ def check_destination(path: Path, part: Path, log: Path, overwrite: bool, resume
     --------
     >>> import tempfile
     >>> from pathlib import Path
-    >>> from sbrdf_xr.store.common import CubeWriteError
+    >>> from sbrdf_xr.errors import CubeWriteError
     >>> from sbrdf_xr.store.files import check_destination
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     path = Path(tmp) / "cube.nc"
@@ -537,33 +628,27 @@ def check_destination(path: Path, part: Path, log: Path, overwrite: bool, resume
     <tmp>/cube.nc exists; pass overwrite=True to replace it
     resume
     new
-    <tmp>/cube.nc is a directory, not a regular file; cubes replace only regular files, even
+    <tmp>/cube.nc is a directory, not a regular file; outputs replace only regular files, even
     with overwrite=True. Remove it or choose another output
     """
-    for p in (path, part, log):
-        kind = file_kind(p)
-        if kind not in (None, "file"):
-            raise CubeWriteError(
-                f"{p} is {kind}, not a regular file; cubes replace only regular files, even with "
-                f"{_opt('overwrite')}. Remove it or choose another output"
-            )
+    refuse_special([path, part, log], error=CubeWriteError)
     has_path, has_part = file_kind(path) == "file", file_kind(part) == "file"
     if has_part and resume:
         if has_path and not overwrite:
             raise FileExistsError(
-                f"{path} exists and {part} holds an unfinished write of it: pass {_opt('resume')} "
-                f"with {_opt('overwrite')} to finish it and replace {path.name}, "
-                "or remove one of them"
+                f"{path} exists and {part} holds an unfinished write of it: pass "
+                f"{option('resume')} with {option('overwrite')} to finish it and replace "
+                f"{path.name}, or remove one of them"
             )
         return "resume"
     if has_path and resume and not overwrite:
         return "finished"
     if has_path and not overwrite:
-        raise FileExistsError(f"{path} exists; pass {_opt('overwrite')} to replace it")
+        raise FileExistsError(f"{path} exists; pass {option('overwrite')} to replace it")
     if has_part and not overwrite:
         raise FileExistsError(
-            f"{part} exists: an unfinished write of {path.name}. Pass {_opt('resume')} to "
-            f"continue it, or {_opt('overwrite')} to discard it and start again"
+            f"{part} exists: an unfinished write of {path.name}. Pass {option('resume')} to "
+            f"continue it, or {option('overwrite')} to discard it and start again"
         )
     return "new"
 
@@ -577,7 +662,7 @@ def check_finished(path: Path, ds: xr.Dataset) -> None:
     >>> from pathlib import Path
     >>> import dask.array as da
     >>> import xarray as xr
-    >>> from sbrdf_xr.store.common import CubeWriteError
+    >>> from sbrdf_xr.errors import CubeWriteError
     >>> from sbrdf_xr.store.files import check_finished
     >>> from sbrdf_xr.store.writer import write_cube
     >>> ds = xr.Dataset(
@@ -606,7 +691,7 @@ def check_finished(path: Path, ds: xr.Dataset) -> None:
             attrs = {k: nc.getncattr(k) for k in nc.ncattrs()}
     except OSError as exc:
         raise CubeWriteError(
-            f"{path} exists and is not a readable netCDF cube ({exc}); pass {_opt('overwrite')} "
+            f"{path} exists and is not a readable netCDF cube ({exc}); pass {option('overwrite')} "
             "to replace it"
         ) from exc
     want = {str(d): int(n) for d, n in ds.sizes.items()}
@@ -626,6 +711,66 @@ def check_finished(path: Path, ds: xr.Dataset) -> None:
         raise CubeWriteError(
             f"{path} is a finished cube of other inputs ({'; '.join(problems)}); "
             "nothing was resumed. "
-            f"Pass {_opt('overwrite')} to replace it"
+            f"Pass {option('overwrite')} to replace it"
         )
     _log.info("%s is already complete; there is nothing to resume", path)
+
+
+def make_parent(path: Path) -> None:
+    """Create the directory of ``path`` if it is missing (an error names why it cannot be).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.store.files import make_parent
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     make_parent(Path(tmp) / "runs" / "2026" / "cube.nc")
+    ...     print((Path(tmp) / "runs" / "2026").is_dir())
+    True
+    """
+    if not path.parent.exists():
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            why = error_words(exc) or str(exc)
+            raise CubeWriteError(
+                f"cannot write {path}: creating {path.parent} failed: {why}"
+            ) from exc
+
+
+def publish(part: Path, path: Path, overwrite: bool) -> None:
+    """Rename the finished ``part`` to ``path``: replacing a regular file only with
+    ``overwrite``, and without it only if nothing appeared there meanwhile.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.errors import CubeWriteError
+    >>> from sbrdf_xr.store.files import publish
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     part, path = Path(tmp) / "cube.nc.part", Path(tmp) / "cube.nc"
+    ...     _ = part.write_text("new cube")
+    ...     _ = path.write_text("a cube written meanwhile")
+    ...     try:
+    ...         publish(part, path, overwrite=False)
+    ...     except CubeWriteError as exc:
+    ...         print(str(exc).split(";")[0].replace(tmp, "<tmp>"))
+    ...     publish(part, path, overwrite=True)
+    ...     print(path.read_text(), part.exists())
+    <tmp>/cube.nc appeared while the cube was written
+    new cube False
+    """
+    refuse_special([path], error=CubeWriteError)
+    if overwrite:
+        os.replace(part, path)
+    else:
+        try:
+            rename_no_replace(part, path)
+        except FileExistsError as exc:
+            raise CubeWriteError(
+                f"{path} appeared while the cube was written; it was not replaced and the "
+                f"finished cube is kept in {part}: {again_hint()} and {option('overwrite')} to "
+                "replace it"
+            ) from exc

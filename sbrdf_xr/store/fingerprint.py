@@ -22,10 +22,13 @@ and underscores, starting with a letter)::
 fingerprint differs, naming what changed (:func:`changes`).  Hashes are computed from
 values, never from object identity, so the same scene built twice has the same
 fingerprint.  The digest of a read-only array (a catalog table, whose values no one can
-write) is computed once and kept while the array lives, so a scene that differs from the
-last one only in geometry or knobs does not hash its tables again; writeable arrays are
-hashed every time.  (Making a read-only array writeable again and changing it in place
-defeats this; the catalog's tables are read-only so that they can be shared.)
+write) is computed once and kept while the array lives, and so is the digest of a whole
+table whose values are read-only: it is reused while the table still holds the same
+values array and coordinate variables (index coordinates cannot be written in place) and
+equal attributes, checked on every call, so a scene that differs from the last one only in
+geometry or knobs does not hash its tables again; writeable arrays are hashed every time.
+(Making a read-only array writeable again and changing it in place defeats this; the
+catalog's tables are read-only so that they can be shared.)
 """
 
 from __future__ import annotations
@@ -40,6 +43,7 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import xarray as xr
 
 from .._version import __version__
 
@@ -80,6 +84,11 @@ _PARTS = {
 
 def _canonical(value: Any) -> Any:
     """A JSON-able, order-independent image of ``value`` (arrays by dtype, shape and hash)."""
+    t = type(value)
+    if t is str or t is int or t is bool or value is None:  # the common cases, first
+        return value
+    if t is float:
+        return repr(value)
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
         return {
             f.name: _canonical(getattr(value, f.name))
@@ -125,7 +134,9 @@ def _read_only(a: np.ndarray) -> bool:
 
 #: id(array) -> (weak reference, layout when hashed, digest) for read-only arrays.
 _DIGESTS: dict[int, tuple[weakref.ref, tuple, str]] = {}
-_DIGESTS_LOCK = threading.Lock()
+#: Re-entrant: a kept array or table freed while the lock is held (an entry replaced, or
+#: the garbage collector running) calls its ``forget`` in the same thread.
+_DIGESTS_LOCK = threading.RLock()
 
 
 def _layout(a: np.ndarray) -> tuple:
@@ -164,9 +175,9 @@ def _array_sha_now(a: Any) -> str:
     h = hashlib.sha256(f"{arr.dtype.str}{arr.shape}".encode())
     if arr.dtype.kind in "mM":  # datetimes and durations: their integer counts
         arr = arr.view(np.int64)
-    if arr.dtype.kind in "OUS":
+    if arr.dtype.kind == "O":
         h.update(json.dumps([str(x) for x in arr.ravel().tolist()]).encode())
-    else:
+    else:  # numbers, and fixed-width strings by their code units (the dtype gives the width)
         h.update(arr.data.cast("B"))
     return h.hexdigest()
 
@@ -181,11 +192,98 @@ def _sha(*parts: str) -> str:
 
 def _table_sha(da: Any) -> str:
     """Values, dims, every coordinate and the attributes of one material table (or of each
-    variable of a model material)."""
+    variable of a model material).
+
+    The digest of a table whose values are read-only is kept while the table lives and
+    reused while :func:`_table_state` is unchanged; any other table is hashed every time.
+    """
     if hasattr(da, "data_vars"):  # a model (Dataset): every variable, and its attributes
-        parts = [f"{k}={_table_sha(da[k])}" for k in sorted(map(str, da.data_vars))]
+        parts = [f"{k}={_table_sha_now(da[k])}" for k in sorted(map(str, da.data_vars))]
         attrs = {k: v for k, v in da.attrs.items() if k not in _VOLATILE_TABLE_ATTRS}
         return _sha(*parts, _json(attrs))
+    found = _table_state(da)
+    if found is None:
+        return _table_sha_now(da)
+    state, held = found
+    key = id(da)
+    with _DIGESTS_LOCK:
+        hit = _TABLES.get(key)
+    if hit is not None and hit[0]() is da and hit[1] == state:
+        return hit[3]
+    sha = _table_sha_now(da)
+
+    def forget(ref: weakref.ref, key: int = key) -> None:
+        with _DIGESTS_LOCK:
+            if key in _TABLES and _TABLES[key][0] is ref:
+                del _TABLES[key]
+
+    with _DIGESTS_LOCK:  # ``held`` keeps the identities in ``state`` from being reused
+        _TABLES[key] = (weakref.ref(da, forget), state, held, sha)
+    return sha
+
+
+#: id(table) -> (weak reference, state when hashed, objects whose ids the state holds,
+#: digest) for tables whose values are read-only (:func:`_table_sha`).
+_TABLES: dict[int, tuple[weakref.ref, tuple, list, str]] = {}
+
+
+class _Opaque(Exception):
+    """A value :func:`_plain` cannot take an exact snapshot of."""
+
+
+_PLAIN_SCALARS = (str, bytes, int, float, bool, type(None))
+
+
+def _plain(v: Any) -> Any:
+    """An immutable snapshot of an attribute value that compares equal exactly when the
+    value is still the same (types included: ``1``, ``1.0`` and ``True`` differ)."""
+    t = type(v)
+    if t is str:  # the common case; a str equals only a str
+        return v
+    if t in _PLAIN_SCALARS:
+        return (t, v)
+    if isinstance(v, np.generic) and v.dtype.kind not in "OV":
+        return (t, v.dtype.str, v.tobytes())
+    if isinstance(v, np.ndarray) and v.dtype.kind not in "OV":
+        return (np.ndarray, v.dtype.str, v.shape, v.tobytes())
+    if isinstance(v, list | tuple):
+        return (t, tuple(_plain(x) for x in v))
+    if isinstance(v, Mapping):
+        return (t, tuple((_plain(k), _plain(x)) for k, x in v.items()))
+    raise _Opaque
+
+
+def _table_state(da: Any) -> tuple[tuple, list] | None:
+    """What :func:`_table_sha_now` reads from ``da``, cheaply, and the objects whose ids it
+    holds; None unless the values are a read-only array (:func:`_read_only`).
+
+    The values and any other coordinate count by identity and memory (read-only, so equal
+    identity means equal values), index coordinates by identity (their values cannot be
+    written in place), the dims and every attribute by an exact snapshot (:func:`_plain`).
+    """
+    values = getattr(getattr(da, "variable", None), "data", None)
+    if not isinstance(values, np.ndarray) or not _read_only(values):
+        return None
+    held: list[Any] = [values]
+    try:
+        parts: list[Any] = [id(values), _layout(values), tuple(map(str, da.dims)), _plain(da.attrs)]
+        for name, var in da.coords.variables.items():
+            if isinstance(var, xr.IndexVariable):
+                token: Any = id(var)
+                held.append(var)
+            else:
+                data = var.data
+                if not isinstance(data, np.ndarray) or not _read_only(data):
+                    return None
+                token = (id(data), _layout(data))
+                held.append(data)
+            parts.append((str(name), tuple(map(str, var.dims)), token, _plain(var.attrs)))
+    except _Opaque:
+        return None
+    return tuple(parts), held
+
+
+def _table_sha_now(da: Any) -> str:
     parts = [_array_sha(np.asarray(da.values)), _json(list(map(str, da.dims)))]
     for name in sorted(map(str, da.coords)):
         c = da.coords[name]

@@ -33,7 +33,9 @@ __all__ = [
     "attr_json",
     "block_bytes",
     "check_attrs",
+    "describe_chunks",
     "difference",
+    "encode_times",
     "layout_of",
     "storage_kind",
     "values_sha",
@@ -152,6 +154,37 @@ class BlockLayout:
         out = f"write_cube-block-{k}-{self.fingerprint[:16]}"
         sub[out] = (tuple, list(keys))
         return sub, out
+
+
+def encode_times(cube: xr.Dataset) -> xr.Dataset:
+    """``cube`` with its datetime64 coordinates as CF numbers with ``units`` and ``calendar``.
+
+    xarray's own encoder, the one :func:`xarray.open_dataset` decodes; the netCDF writer
+    stores numbers, and the block layout (and fingerprint) of either format is taken
+    from the encoded cube.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.layout import encode_times
+    >>> times = np.array(["2026-01-01T00:00", "2026-01-01T00:01"], dtype="datetime64[ns]")
+    >>> cube = xr.Dataset({"v": ("time", [1.0, 2.0])}, coords={"time": times})
+    >>> enc = encode_times(cube)
+    >>> enc.time.values.tolist(), enc.time.attrs["units"]
+    ([0, 1], 'minutes since 2026-01-01 00:00:00')
+    >>> xr.decode_cf(enc).time.values.tolist() == cube.time.values.tolist()
+    True
+    """
+    times = [k for k, v in cube.coords.items() if v.dtype.kind in "mM"]
+    if not times:
+        return cube
+    encoded = {}
+    for k in times:
+        v = xr.conventions.encode_cf_variable(cube[k].variable, name=str(k))
+        v.attrs.pop("_FillValue", None)  # CF 2.5.1: no fill value on a coordinate variable
+        encoded[k] = v
+    return cube.assign_coords(encoded)
 
 
 def storage_kind(name: Hashable, dtype: np.dtype) -> str:
@@ -425,6 +458,22 @@ def difference(old: Mapping[str, Any], new: Mapping[str, Any]) -> str:
         plural = "s" if len(keys) > 1 else ""
         return f"global attribute{plural} {', '.join(map(repr, keys[:5]))} differ"
     return "the file format version differs"
+
+
+def describe_chunks(chunks: list[list[Any]]) -> str:
+    """The ``chunks`` of a ``structure`` record in words: the block size along every
+    dimension cut into more than one chunk.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.store.layout import describe_chunks
+    >>> describe_chunks([["attitude", [2, 2, 1]], ["phase_angle", [4]], ["wavelength", [71]]])
+    'chunks of attitude 2'
+    >>> describe_chunks([["attitude", [5]]])
+    'one block'
+    """
+    cut = [f"{d} {c[0]}" for d, c in chunks if len(c) > 1]
+    return f"chunks of {', '.join(cut)}" if cut else "one block"
 
 
 def lazy_bytes(plan: BlockLayout) -> int:

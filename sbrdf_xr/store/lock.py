@@ -1,6 +1,8 @@
-"""The exclusive writer lock of a cube (``<path>.lock``).
+"""The exclusive writer lock of a cube (``<path>.lock``), for netCDF and Zarr alike.
 
-flock where the file system has it, a PID file otherwise, stale locks taken over.
+flock where the file system has it, a PID file otherwise, stale locks taken over; anything
+at ``<path>.lock`` that is not a regular file (a FIFO, symbolic link, device, directory)
+is refused, never opened.
 """
 
 from __future__ import annotations
@@ -8,14 +10,25 @@ from __future__ import annotations
 import contextlib
 import datetime
 import json
+import logging
 import os
 import socket
+import stat
 import time
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from .common import _LOCK_GRACE, CubeLockedError, CubeWriteError, _log, _reason
+from .._output import file_kind
+from ..errors import CubeLockedError, CubeWriteError
+from .disk import reason
+
+#: Suffix of the exclusive writer lock held while a cube is being written.
+LOCK_SUFFIX = ".lock"
+#: Seconds a lock file without readable content counts as being created, not stale.
+_LOCK_GRACE = 10.0
+
+_log = logging.getLogger("sbrdf_xr.write_cube")
 
 
 def _pid_alive(pid: Any) -> bool:
@@ -71,6 +84,13 @@ class _Lock:
 
     def acquire(self) -> None:
         for _ in range(8):
+            kind = file_kind(self.path)
+            if kind not in (None, "file"):
+                raise CubeWriteError(
+                    f"{self.path} is {kind}, not a regular file, where the lock of "
+                    f"{self.target} goes; it was left as it is. Remove it, or choose another "
+                    "output"
+                )
             try:
                 fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_EXCL | _NOFOLLOW, 0o644)
             except FileExistsError:
@@ -79,7 +99,7 @@ class _Lock:
             except OSError as exc:
                 raise CubeWriteError(
                     f"cannot write {self.target}: creating the lock {self.path} "
-                    f"failed: {_reason(exc)}"
+                    f"failed: {reason(exc)}"
                 ) from exc
             try:
                 for _ in range(50):  # a stale-lock check may hold it for an instant
@@ -102,7 +122,7 @@ class _Lock:
                 if isinstance(exc, OSError):
                     raise CubeWriteError(
                         f"cannot write {self.target}: writing the lock {self.path} "
-                        f"failed: {_reason(exc, self.path)}"
+                        f"failed: {reason(exc, self.path)}"
                     ) from exc
                 raise
             self.fd = fd
@@ -124,17 +144,23 @@ class _Lock:
 
     def _clear_stale(self) -> None:
         try:
-            fd = os.open(self.path, os.O_RDWR | _NOFOLLOW)
+            fd = os.open(self.path, os.O_RDWR | _NOFOLLOW | os.O_NONBLOCK)
         except FileNotFoundError:
             return
         except OSError as exc:
             raise CubeLockedError(
-                f"{self.path} exists and cannot be used as a lock ({_reason(exc)}); "
+                f"{self.path} exists and cannot be used as a lock ({reason(exc)}); "
                 f"remove it if no writer of {self.target} is running"
             ) from exc
         try:
-            held = _try_flock(fd)
             st = os.fstat(fd)
+            if not stat.S_ISREG(st.st_mode):
+                raise CubeWriteError(
+                    f"{self.path} is {file_kind(self.path)}, not a regular file, where the lock "
+                    f"of {self.target} goes; it was left as it is. Remove it, or choose another "
+                    "output"
+                )
+            held = _try_flock(fd)
             raw = os.pread(fd, 4096, 0) if hasattr(os, "pread") else b""
             try:
                 info = json.loads(raw.decode())

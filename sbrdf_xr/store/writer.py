@@ -17,8 +17,10 @@ Atomicity
     renamed (:func:`os.replace`) to ``path`` only after every block is written,
     flushed and ``fsync``-ed.  A cube is never half-written under its final name,
     and with ``overwrite=True`` the old file stays intact until the new one is
-    complete.  Only regular files are ever replaced: a FIFO, symbolic link, device
-    node or directory at ``path`` or at the ``.part`` is refused, overwrite or not.
+    complete (without it, the rename refuses a file that appeared meanwhile).  Only
+    regular files are ever replaced or reopened (:mod:`sbrdf_xr._output`): a FIFO,
+    socket, symbolic link, device node or directory at ``path`` or at its ``.part``,
+    ``.part.jsonl`` or ``.lock`` is refused, overwrite or not, and never opened.
 
 Lock (``<path>.lock``)
     One writer per path: the lock file is created atomically (``O_CREAT |
@@ -63,13 +65,13 @@ Memory
     host reclaims the next block reuses the same pages instead of faulting in new
     ones (on this project's 2-core machine a 2.4 GB cube was written 2.3x faster).
     Memory freed while preparing the cube is handed back before the blocks stream
-    (:func:`~sbrdf_xr.store.common.release_freed_memory`).
+    (:func:`~sbrdf_xr.store.runners.release_freed_memory`).
 
 Bookkeeping (``<path>.part.jsonl``)
     A sidecar JSON-lines file next to the ``.part``.  Line 1 is a header object::
 
         {"format": "sbrdf_xr.write_cube", "version": 1, "fingerprint": "<sha256>",
-         "n_blocks": 24, "block_dims": ["attitude", "phase_angle"],
+         "n_blocks": 24, "block_dims": ["attitude", "phase_angle"], "complevel": 0,
          "structure": {...}}
 
     where ``structure`` describes the cube (dims and sizes, chunks of the block
@@ -92,7 +94,9 @@ Resume
     carry the content fingerprint of their scene (:mod:`sbrdf_xr.store.fingerprint`:
     table values, mesh, materials map, filters, settings, geometry, version) in
     their global attributes, so a resume with other inputs is refused with a
-    message naming what changed.  ``resume=True`` with a finished ``path`` and no
+    message naming what changed.  The header also records ``complevel``: a resume
+    with another level is refused (the blocks written keep their layout), naming the
+    level to resume with.  ``resume=True`` with a finished ``path`` and no
     ``.part`` checks that it is the same cube and does nothing.  Global attributes in
     :data:`VOLATILE_ATTRS` (``history`` and the ACDD dates) may change between
     runs; they are rewritten from ``ds`` on resume.
@@ -105,7 +109,10 @@ Schedulers
     submitted to the cluster with :meth:`~distributed.Client.compute` and the
     results are gathered, as they complete, by the calling process, which is the
     only writer.  A lost worker's tasks are recomputed by Dask; a block is
-    written exactly once (the writer skips blocks already recorded).
+    written exactly once (the writer skips blocks already recorded).  A cluster left
+    without any worker for :data:`~sbrdf_xr.store.runners.NO_WORKERS_TIMEOUT` (or whose
+    scheduler is gone) stops the write with :class:`~sbrdf_xr.errors.WorkersLostError`;
+    the blocks written stay in the ``.part`` for a resume.
 
 Encoding
     Variables are stored in their in-memory dtype with no fill value and no
@@ -129,42 +136,45 @@ import netCDF4
 import numpy as np
 import xarray as xr
 
-from ..errors import SbrdfError, ValidationError
-from .common import (
-    _SYNC_NAMES,
-    _THREAD_NAMES,
-    LOCK_SUFFIX,
-    LOG_SUFFIX,
-    PART_SUFFIX,
-    BlockWritten,
+from .._output import (
+    cli_style,
+    fsync_dir,
+    open_regular,
+    refuse_special,
+)
+from ..errors import (
     CubeLockedError,
     CubeWriteError,
+    SbrdfError,
     SchedulerError,
-    _again,
-    _discard,
-    _fix,
-    _NoRoom,
-    _reason,
-    command_line_messages,
-    release_freed_memory,
+    ValidationError,
+    WorkersLostError,
 )
 from .disk import (
     HEAD_BYTES,
     SyncBehind,
+    _NoRoom,
     check_room,
     cut_back,
     drop_behind,
     fence,
-    file_kind,
-    fsync_dir,
+    fix,
+    reason,
     reserve,
     reserve_file,
 )
 from .files import (
+    LOG_SUFFIX,
+    PART_SUFFIX,
+    again_hint,
     check_destination,
     check_finished,
     create_part,
+    discard_hint,
+    make_parent,
     open_part,
+    part_complevel,
+    publish,
     read_back_error,
     read_log,
     to_storage,
@@ -179,9 +189,18 @@ from .layout import (
     lazy_bytes,
     storage_kind,
 )
-from .lock import _Lock
+from .lock import LOCK_SUFFIX, _Lock
 from .progress import NoProgress, progress_bar
-from .runners import Feed, _check_address, _runner, connect
+from .runners import (
+    BlockWritten,
+    ClusterLost,
+    Feed,
+    _runner,
+    check_arguments,
+    connect,
+    lost_workers,
+    release_freed_memory,
+)
 
 __all__ = [
     "DEFAULT_COMPLEVEL",
@@ -193,8 +212,9 @@ __all__ = [
     "CubeLockedError",
     "CubeWriteError",
     "SchedulerError",
-    "command_line_messages",
+    "WorkersLostError",
     "connect",
+    "lost_workers",
     "write_cube",
 ]
 
@@ -214,7 +234,7 @@ def write_cube(
     scheduler: str | None = None,
     max_in_flight: int | None = None,
     progress: bool = False,
-    complevel: int = DEFAULT_COMPLEVEL,
+    complevel: int | None = DEFAULT_COMPLEVEL,
     on_block: Callable[[BlockWritten], None] | None = None,
 ) -> Path:
     """Compute a lazy cube block by block and stream it to a netCDF-4 file.
@@ -255,9 +275,11 @@ def write_cube(
         the last one finished is written).
     progress : bool, default False
         Show a progress bar of blocks on stderr (tqdm if installed).
-    complevel : int, default :data:`DEFAULT_COMPLEVEL` (0)
+    complevel : int or None, default :data:`DEFAULT_COMPLEVEL` (0)
         zlib level (1-9, with byte shuffle) for the numeric variables; 0 stores
-        them uncompressed (contiguous, resumable after a kill at any instant).
+        them uncompressed (contiguous, resumable after a kill at any instant).  None:
+        the level of the ``.part`` when resuming, else the default.  A resume with
+        another level than the ``.part``'s is refused.
     on_block : callable, optional
         Called with a :class:`BlockWritten` in the writing thread after each
         block is committed (written, flushed, synced and recorded).
@@ -329,23 +351,8 @@ def write_cube(
     part = path.with_name(path.name + PART_SUFFIX)
     log = path.with_name(path.name + LOG_SUFFIX)
     plan = layout_of(ds)
-    if max_in_flight is not None and (
-        not isinstance(max_in_flight, int | np.integer) or max_in_flight < 1
-    ):
-        raise ValidationError(f"max_in_flight: must be an integer >= 1, got {max_in_flight!r}")
-    if not 0 <= int(complevel) <= 9:
-        raise ValidationError(f"complevel: must be 0 (no compression) to 9, got {complevel!r}")
-    if client is not None and scheduler is not None:
-        raise ValidationError("pass either client or scheduler, not both")
-    if scheduler is not None and scheduler not in _THREAD_NAMES + _SYNC_NAMES:
-        _check_address(scheduler)
-    if file_kind(path.parent) is None:
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise CubeWriteError(
-                f"cannot write {path}: creating {path.parent} failed: {_reason(exc)}"
-            ) from exc
+    check_arguments(max_in_flight, complevel, client, scheduler)
+    make_parent(path)
     lock = _Lock(path.with_name(path.name + LOCK_SUFFIX), path)
     lock.acquire()
     try:
@@ -381,7 +388,7 @@ def _write_locked(
     scheduler: str | None,
     max_in_flight: int | None,
     progress: bool,
-    complevel: int,
+    complevel: int | None,
     on_block: Callable[[BlockWritten], None] | None,
 ) -> Path:
     """:func:`write_cube` once the lock is held."""
@@ -397,9 +404,18 @@ def _write_locked(
             why = difference(header.get("structure", {}), plan.structure)
             raise CubeWriteError(
                 f"{part} belongs to a different cube ({why}); it was left untouched. "
-                f"Resume with the same inputs, or {_discard()}"
+                f"Resume with the same inputs, or {discard_hint()}"
             )
+        kept = header.get("complevel")
+        if kept is None:  # a sidecar written before it recorded the level: read the file
+            with contextlib.suppress(OSError), netCDF4.Dataset(part, mode="r") as nc_read:
+                kept = part_complevel(nc_read, plan)
+        if complevel is None:  # a resume keeps the level the cube was started with
+            complevel = DEFAULT_COMPLEVEL if kept is None else int(kept)
+        elif kept is not None and int(kept) != int(complevel):
+            _refuse_complevel(part, int(kept), complevel)
         done = {k for k in done if 0 <= k < plan.n_blocks}
+    level = DEFAULT_COMPLEVEL if complevel is None else int(complevel)
 
     runner = _runner(client, scheduler)
     feed = Feed(
@@ -421,30 +437,30 @@ def _write_locked(
                 if not isinstance(exc, _NoRoom):
                     with contextlib.suppress(OSError):
                         os.truncate(part, size0)  # undo a half-written attribute update
-                why = _reason(exc, part)
+                why = reason(exc, part)
                 raise CubeWriteError(
                     f"cannot resume {path}: {why}. The {len(done)} of {plan.n_blocks} blocks "
-                    f"written so far are kept in {part}; {_fix(why)} and {_again()}"
+                    f"written so far are kept in {part}; {fix(why)} and {again_hint()}"
                 ) from exc
             feed.fill()
         else:
             log.unlink(missing_ok=True)
             part.unlink(missing_ok=True)
             # an uncompressed cube is laid out whole at creation: its room is needed now
-            need = 0 if complevel else lazy_bytes(plan)
+            need = 0 if level else lazy_bytes(plan)
 
             def creation_failed(exc: BaseException) -> NoReturn:
                 if nc is not None:
                     with contextlib.suppress(Exception):
                         nc.close()
-                why = _reason(exc, part, need) if isinstance(exc, Exception) else ""
+                why = reason(exc, part, need) if isinstance(exc, Exception) else ""
                 part.unlink(missing_ok=True)  # nothing recorded yet: nothing lost
                 log.unlink(missing_ok=True)
                 if not isinstance(exc, Exception) or isinstance(exc, SbrdfError):
                     raise exc
                 raise CubeWriteError(
                     f"cannot write {path}: creating {part} failed: {why}. Nothing was "
-                    f"written; {_fix(why)} and write again"
+                    f"written; {fix(why)} and write again"
                 ) from exc
 
             try:
@@ -453,8 +469,8 @@ def _write_locked(
                 creation_failed(exc)
             feed.fill()  # the first blocks compute while the file is created and laid out
             try:
-                nc = create_part(part, ds, plan, complevel)
-                write_header(log, plan)
+                nc = create_part(part, ds, plan, level)
+                write_header(log, plan, level)
             except BaseException as exc:
                 creation_failed(exc)
     except BaseException:
@@ -470,10 +486,10 @@ def _write_locked(
     damaged: str | None = None
     try:
         writing = True
-        fd = os.open(part, os.O_RDWR)
+        fd = open_regular(part, os.O_RDWR, error=CubeWriteError)
         os.fsync(fd)
         good, head = os.fstat(fd).st_size, os.pread(fd, HEAD_BYTES, 0)
-        log_fd = os.open(log, os.O_WRONLY | os.O_APPEND)
+        log_fd = open_regular(log, os.O_WRONLY | os.O_APPEND, error=CubeWriteError)
         # blocks grow the file only where a variable is chunked (compressed)
         grows = any(nc.variables[v.name].chunking() != "contiguous" for v in plan.lazy)
         if not grows:
@@ -538,10 +554,7 @@ def _write_locked(
         os.ftruncate(fd, os.fstat(fd).st_size)  # release room reserved past the end
         os.fsync(fd)
         writing = False
-        for p in (path, part):
-            kind = file_kind(p)
-            if kind not in (None, "file"):
-                raise CubeWriteError(f"{p} became {kind} during the write; it was not replaced")
+        refuse_special([path, part], error=CubeWriteError)  # nothing else appeared meanwhile
         # a .part resumed, or one whose chunk index grew with its blocks, may carry HDF5
         # metadata torn by an earlier failure; a fresh uncompressed cube's were written
         # once, at creation, and closed without error
@@ -549,13 +562,17 @@ def _write_locked(
             damaged = read_back_error(part)
             drop_behind(fd)  # what reading it back brought into the page cache
         if damaged is None:  # never a cube that does not read under the final name
-            os.replace(part, path)
+            publish(part, path, overwrite)
+    except ClusterLost as exc:
+        if sync is not None:
+            done.update(sync.settle())
+        raise lost_workers(path, part, exc, len(done), plan.n_blocks) from exc
     except Exception as exc:
         if sync is not None:  # before anything is cut back: the blocks synced behind count
             done.update(sync.settle())
         where = f"at block {k} ({_describe(plan.slices(k))}) " if k >= 0 else ""
         why = (
-            _reason(exc, part)
+            reason(exc, part)
             if isinstance(exc, OSError) or writing
             else f"{type(exc).__name__}: {exc}"
         )
@@ -569,17 +586,19 @@ def _write_locked(
             lost = cut_back(part, good, head)
         intro = f"writing {path} failed {where}after {len(done)} of {plan.n_blocks} blocks: {why}. "
         if lost is not None:
-            raise CubeWriteError(f"{intro}{part} could not be kept ({lost}); {_discard()}") from exc
+            raise CubeWriteError(
+                f"{intro}{part} could not be kept ({lost}); {discard_hint()}"
+            ) from exc
         if writing and good >= 0:
             raise CubeWriteError(
                 f"{intro}HDF5 failed in the middle of a block; {part} was cut back to its last "
                 f"synced state, with the blocks written so far. "
-                f"{_fix(why)[0].upper()}{_fix(why)[1:]} "
-                f"and {_again()}; should HDF5 fail again at the same block, the file cannot be "
-                f"continued: {_discard()}"
+                f"{fix(why)[0].upper()}{fix(why)[1:]} "
+                f"and {again_hint()}; should HDF5 fail again at the same block, the file cannot be "
+                f"continued: {discard_hint()}"
             ) from exc
         raise CubeWriteError(
-            f"{intro}The blocks written so far are kept in {part}; {_fix(why)} and {_again()} "
+            f"{intro}The blocks written so far are kept in {part}; {fix(why)} and {again_hint()} "
             "to compute only the missing blocks"
         ) from exc
     except BaseException as exc:
@@ -587,7 +606,7 @@ def _write_locked(
             done.update(sync.settle())
         exc.add_note(
             f"write_cube: {len(done)} of {plan.n_blocks} blocks of {path} are kept in {part}; "
-            f"{_again()} to finish it"
+            f"{again_hint()} to finish it"
         )
         raise
     finally:
@@ -608,7 +627,7 @@ def _write_locked(
         raise CubeWriteError(
             f"{part} holds every block but does not read back ({damaged}): an earlier "
             f"failure damaged its HDF5 metadata, so it was not renamed to {path.name}; "
-            f"{_discard()}"
+            f"{discard_hint()}"
         )
     log.unlink(missing_ok=True)
     fsync_dir(path.parent)
@@ -617,3 +636,11 @@ def _write_locked(
 
 def _describe(slices: Mapping[str, slice]) -> str:
     return ", ".join(f"{d}[{s.start}:{s.stop}]" for d, s in slices.items())
+
+
+def _refuse_complevel(part: Path, kept: int, asked: int) -> NoReturn:
+    raise CubeWriteError(
+        f"{part} was started with complevel {kept} and this write asks for {asked}: its blocks "
+        f"keep their layout, so it is resumed only with the same level. Resume with "
+        f"{f'--complevel {kept}' if cli_style() else f'complevel={kept}'}, or {discard_hint()}"
+    )

@@ -13,8 +13,9 @@ from sbrdf_xr import testing as T
 from sbrdf_xr.engine import Scene, knobs
 from sbrdf_xr.engine.effects import EFFECTS, OUTPUTS
 from sbrdf_xr.engine.plan import Plan
-from sbrdf_xr.engine.run import simulate, write
+from sbrdf_xr.engine.run import simulate
 from sbrdf_xr.errors import SceneError
+from sbrdf_xr.store import write
 
 RTOL = 1e-12  # reordered float64 sums (see tests/test_kernels.py)
 

@@ -8,9 +8,10 @@ import xarray as xr
 
 from sbrdf_xr.body.spacecraft import canx1
 from sbrdf_xr.engine import Scene, builtin_scene, load_scene
-from sbrdf_xr.engine.run import simulate, write
+from sbrdf_xr.engine.run import simulate
 from sbrdf_xr.errors import SceneError
 from sbrdf_xr.observing import observe
+from sbrdf_xr.store import write
 
 PASS_TOML = """
 name = "toml-pass"

@@ -280,7 +280,7 @@ def test_thermal_emission_is_kirchhoff_times_planck_and_skipped_when_negligible(
 def test_simulation_on_a_local_cluster_equals_the_threaded_run(tmp_path):
     """The tables are scattered to the workers once; the cube is identical to the threaded one."""
     distributed = pytest.importorskip("distributed")
-    from sbrdf_xr.engine.run import write
+    from sbrdf_xr.store import write
 
     scene = cube_scene(
         table=catalog.load("example-lobe"),
@@ -320,3 +320,48 @@ def test_materials_without_common_wavelengths_are_rejected():
     )
     with pytest.raises(SceneError, match="no wavelengths in common"):
         simulate(scene)
+
+
+def _cube_coordinates_as_xarray_builds_them(plan):
+    """The cube's coordinates through ``xr.Dataset(coords=...)`` (alignment and merging)."""
+    from sbrdf_xr._names import attrs
+
+    coords = plan.geometry.coords()
+    coords["xyz"] = ("xyz", ["x", "y", "z"], attrs("xyz"))
+    coords["wavelength"] = ("wavelength", plan.wavelength, attrs("wavelength"))
+    coords.update(plan.band_coords)
+    coords["material"] = ("material", list(plan.materials), attrs("material"))
+    return coords, xr.Dataset(coords=coords, attrs=dict(plan.attrs))
+
+
+@pytest.mark.parametrize("kind", ["grid", "pairs with bands", "observation"])
+def test_cube_coordinates_are_those_xarray_would_build(kind):
+    from sbrdf_xr.engine.builtin import builtin_scene
+    from sbrdf_xr.engine.run import _coordinates_only
+
+    if kind == "grid":
+        scene = cube_scene(
+            attitudes=geometry.axis_rotation([0, 0, 1], [0.0, 45.0]),
+            phase_angles=[0.0, 60.0],
+            attitude_angle=[0.0, 45.0],
+        )
+    elif kind == "pairs with bands":
+        scene = cube_scene(
+            to_sun=[[1.0, 0, 0], [0, 1.0, 0]],
+            to_observer=[[1.0, 0, 0]] * 2,
+            bands=("V", "R"),
+            outputs=("signal", "band_signal"),
+        )
+    else:
+        scene = builtin_scene("canx1-pass").with_options(
+            materials={m: grey() for m in ("aluminium-6061-t6", "tjpv-cell", "white-paint-a276")}
+        )
+    coords, expected = _cube_coordinates_as_xarray_builds_them(scene.plan())
+    built = _coordinates_only(coords, dict(expected.attrs))
+    xr.testing.assert_identical(built, expected)
+    assert list(built.variables) == list(expected.variables)  # the same order
+    for k, v in expected.variables.items():
+        assert type(built.variables[k]) is type(v) and built[k].dtype == v.dtype
+        assert type(built.xindexes.get(k)) is type(expected.xindexes.get(k))
+    again = _coordinates_only(coords, dict(expected.attrs))  # with the kept indexes
+    xr.testing.assert_identical(again, expected)

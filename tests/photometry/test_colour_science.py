@@ -146,6 +146,15 @@ def test_spectra_as_spectral_distributions(cube):
     np.testing.assert_array_equal(P.srgb(s).values, P.srgb(cube).isel(geometry=0).values)
     banded = P.pre_integrate(s, ["V"])
     np.testing.assert_allclose(banded.values, P.band_signal(cube, ["V"]).values[0], rtol=1e-13)
+    # band signals and magnitudes take the SpectralDistribution as they take the cube
+    np.testing.assert_allclose(
+        P.band_signal(s, ["V", "R"]).values, P.band_signal(cube, ["V", "R"]).values[0], rtol=1e-13
+    )
+    np.testing.assert_allclose(
+        P.magnitudes(s, ["V", "R"], range_km=1e3).values,
+        P.magnitudes(cube, ["V", "R"], range_km=1e3).values[0],
+        rtol=1e-13,
+    )
 
 
 def test_cubes_export_and_come_back(cube):

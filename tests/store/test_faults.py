@@ -51,12 +51,15 @@ SEED = 14
 
 sys.path.insert(0, str(TESTS))
 sys.path.insert(1, str(TESTS.parent))
-from test_writer import make_cube  # noqa: E402
+from test_writer import dask_cluster, make_cube  # noqa: E402, F401
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals and rlimits")
 
 #: One row per trial: (kind, outcome) with outcome in the columns of the table.
 TRIALS: list[tuple[str, str]] = []
+#: Blocks marked as stored when each Zarr writer was killed (-1: before its ``.part``
+#: existed; 24: after the rename).
+KILL_POINTS: list[int] = []
 OUTCOMES = ("value-identical", "named error, resumed", "named error", "data lost", "wrong cube")
 
 
@@ -73,6 +76,8 @@ def fault_table(request):
         )
     reporter = request.config.pluginmanager.get_plugin("terminalreporter")
     capman = request.config.pluginmanager.getplugin("capturemanager")
+    if KILL_POINTS:
+        lines.append(f"Zarr writers killed with these blocks stored: {sorted(KILL_POINTS)}")
     with capman.global_and_fixture_disabled() if capman else contextlib.nullcontext():
         for line in ["", *lines]:
             if reporter is not None:
@@ -535,3 +540,220 @@ def test_resume_after_a_changed_table_is_refused(tmp_path, capsys):
     assert main(["simulate", str(remapped), "-o", str(path), "--resume", "-q"]) == 2
     assert "finished cube of other inputs" in capsys.readouterr().err
     np.testing.assert_array_equal(read(path)["signal"].values, want["signal"].values)
+
+
+# ------------------------------------------------------------------ Zarr
+
+ZARR_WRITER = textwrap.dedent(
+    """
+    import json, sys
+    sys.path[:0] = [{repo!r}, {tests!r}, {tests_root!r}]
+    from test_faults import cube_24
+    from sbrdf_xr.store.zarr_store import write_zarr
+    from sbrdf_xr.errors import SbrdfError
+    args = json.loads(sys.argv[1])
+    cube = cube_24(delay=args.get("delay", 0.0))
+    print("started", flush=True)
+    try:
+        write_zarr(cube, args["path"], overwrite=args.get("overwrite", False),
+                   resume=args.get("resume", False), max_in_flight=args.get("max_in_flight"))
+        print(json.dumps({{"ok": True}}))
+    except Exception as exc:
+        print(json.dumps({{"ok": False, "named": isinstance(exc, SbrdfError),
+                          "error": type(exc).__name__, "message": str(exc)}}))
+    """
+)
+
+
+def zarr_writer(tmp_path: Path, **args) -> subprocess.Popen:
+    script = tmp_path / "zarr_writer.py"
+    if not script.exists():
+        script.write_text(
+            ZARR_WRITER.format(repo=str(REPO), tests=str(TESTS), tests_root=str(TESTS.parent))
+        )
+    proc = subprocess.Popen(
+        [sys.executable, str(script), json.dumps(args)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    line = proc.stdout.readline()  # the cube is built: the write starts now
+    assert line.strip() == "started", proc.stderr.read()[-2000:]
+    return proc
+
+
+def zarr_result(proc: subprocess.Popen) -> dict:
+    """The last line a Zarr writer printed (its first, "started", was read already: the
+    rest may sit in the reader's buffer, so it is read through it, not around it)."""
+    out = proc.stdout.read()
+    err = proc.stderr.read()
+    proc.wait(timeout=TIMEOUT)
+    lines = out.strip().splitlines()
+    assert lines, f"the writer printed nothing (exit {proc.returncode}): {err[-2000:]}"
+    return json.loads(lines[-1])
+
+
+def read_zarr(path: Path) -> xr.Dataset:
+    with xr.open_zarr(path) as ds:
+        return ds.load()
+
+
+def zarr_marks(path: Path) -> int:
+    from sbrdf_xr.store.zarr_store import marked_blocks
+
+    return len(marked_blocks(path.with_name(path.name + PART_SUFFIX), 24))
+
+
+def zarr_kill_trials(tmp_path: Path, reference: xr.Dataset, n: int, seed: int) -> None:
+    """``n`` writers of a 24-block Zarr cube killed at random instants, each resumed."""
+    from sbrdf_xr.store.zarr_store import write_zarr
+
+    pytest.importorskip("zarr")
+    rng = random.Random(seed)
+    for trial in range(n):
+        path = tmp_path / f"kill{trial}" / "cube.zarr"
+        path.parent.mkdir()
+        # the instant: while the store is created (-1), or after a random number of blocks
+        # were stored and a random part of the next 0.1 s block (24: during the rename)
+        after = rng.randint(-1, 24) if trial else -1  # the first while the store is created
+        proc = zarr_writer(path.parent, path=str(path), delay=0.1)
+        deadline = time.monotonic() + TIMEOUT
+        while after > 0 and zarr_marks(path) < after and proc.poll() is None:
+            assert time.monotonic() < deadline, "the writer made no progress"
+            time.sleep(0.002)
+        time.sleep(rng.uniform(0.0, 0.05 if after < 0 else 0.1))  # the store's creation: ~0.1 s
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(proc.pid, signal.SIGKILL)
+        proc.wait(timeout=TIMEOUT)
+        proc.stdout.close()
+        proc.stderr.close()
+        part = path.with_name(path.name + PART_SUFFIX)
+        stored = 24 if path.exists() else zarr_marks(path) if part.exists() else -1
+        KILL_POINTS.append(stored)
+        # what a user does next: resume (a no-op for a finished store, which clears the lock)
+        write_zarr(cube_24(), path, resume=True)
+        try:
+            xr.testing.assert_identical(read_zarr(path), reference)
+            outcome = "value-identical"
+        except AssertionError:
+            outcome = "wrong cube"
+        left = sorted(p.name for p in path.parent.iterdir())
+        if left != ["cube.zarr", "zarr_writer.py"]:
+            outcome = "wrong cube"  # a lock or a .part left behind
+        TRIALS.append(("Zarr SIGKILL at random instants", outcome))
+        assert outcome == "value-identical", (trial, stored, left)
+
+
+def test_zarr_sigkill_at_random_instants(tmp_path, reference):
+    """Writers of a Zarr cube killed at seeded random instants (while the store is
+    created, with blocks in flight, while it is renamed) resume to value-identical
+    stores, leaving no lock or ``.part``."""
+    zarr_kill_trials(tmp_path, reference, n=3, seed=SEED)
+
+
+@pytest.mark.slow
+def test_zarr_sigkill_at_random_instants_many(tmp_path, reference):
+    zarr_kill_trials(tmp_path, reference, n=12, seed=SEED + 1)
+
+
+@pytest.mark.parametrize("start", ["mid-write", "together", "together-overwrite"])
+def test_two_zarr_writers_on_one_path(tmp_path, reference, start):
+    """Two simultaneous Zarr writers of one path: one writes, the other is refused by the
+    lock (naming the holder), and the store opens and equals the cube."""
+    from sbrdf_xr.store.zarr_store import write_zarr
+
+    pytest.importorskip("zarr")
+    path = tmp_path / "cube.zarr"
+    overwrite = start == "together-overwrite"
+    if overwrite:
+        write_zarr(cube_24().isel(attitude=slice(0, 6)), path)
+    first = zarr_writer(tmp_path, path=str(path), overwrite=overwrite, delay=0.25)
+    if start == "mid-write":
+        deadline = time.monotonic() + TIMEOUT
+        while zarr_marks(path) < 2:
+            assert first.poll() is None and time.monotonic() < deadline, "no progress"
+            time.sleep(0.01)
+    second = zarr_writer(tmp_path, path=str(path), overwrite=overwrite, delay=0.25)
+    results = [zarr_result(first), zarr_result(second)]
+    won = [r for r in results if r["ok"]]
+    refused = [r for r in results if not r["ok"]]
+    assert len(won) == 1 and len(refused) == 1, results
+    assert refused[0]["error"] == "CubeLockedError", refused
+    assert "being written by another writer" in refused[0]["message"]
+    outcome = "value-identical"
+    try:
+        xr.testing.assert_identical(read_zarr(path), reference)
+    except AssertionError:
+        outcome = "wrong cube"
+    TRIALS.append(("two Zarr writers on one path", outcome))
+    assert outcome == "value-identical"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cube.zarr", "zarr_writer.py"]
+
+
+@pytest.mark.parametrize("suffix", [".nc", ".zarr"])
+def test_every_worker_of_the_cluster_dies(tmp_path, dask_cluster, suffix):  # noqa: F811
+    """Both workers killed mid-sweep: a named WorkersLostError (not a Dask exception, not
+    a hang), the blocks written kept, and a resume without the cluster finishes the cube."""
+    import dask
+
+    from sbrdf_xr.errors import WorkersLostError
+    from sbrdf_xr.store import write
+
+    if suffix == ".zarr":
+        pytest.importorskip("zarr")
+    address, workers = dask_cluster
+    path = tmp_path / f"c{suffix}"
+    ds = make_cube(chunks=(3, 2), delay=0.2)  # 20 blocks
+    events: list[int] = []
+
+    def on_block(event) -> None:
+        events.append(event.index)
+        if len(events) == 3:
+            for w in workers:
+                os.kill(w.pid, signal.SIGKILL)
+
+    with (
+        dask.config.set({"sbrdf_xr.no-workers-timeout": "2s"}),
+        pytest.raises(WorkersLostError) as info,
+    ):
+        write(ds, path, scheduler=address, on_block=on_block)
+    message = str(info.value)
+    assert "no worker for 2 s" in message and "resume=True" in message, message
+    assert f"{path}{PART_SUFFIX}" in message and not path.exists()
+    write(make_cube(chunks=(3, 2)), path, resume=True)  # threads of this process
+    with xr.open_zarr(path) if suffix == ".zarr" else xr.open_dataset(path) as back:
+        xr.testing.assert_identical(back.load(), make_cube(chunks=(3, 2)).compute())
+    TRIALS.append((f"every worker killed ({suffix})", "named error, resumed"))
+
+
+@pytest.mark.parametrize("suffix", [".nc", ".zarr"])
+def test_the_scheduler_dies(tmp_path, dask_cluster, suffix):  # noqa: F811
+    """The scheduler killed mid-sweep: a named WorkersLostError, the blocks written kept,
+    and a resume without the cluster finishes the cube."""
+    import distributed
+
+    from sbrdf_xr.errors import WorkersLostError
+    from sbrdf_xr.store import write
+
+    if suffix == ".zarr":
+        pytest.importorskip("zarr")
+    address, _ = dask_cluster
+    with distributed.Client(address, set_as_default=False) as c:
+        scheduler_pid = c.run_on_scheduler(os.getpid)
+    path = tmp_path / f"c{suffix}"
+    events: list[int] = []
+
+    def on_block(event) -> None:
+        events.append(event.index)
+        if len(events) == 3:
+            os.kill(scheduler_pid, signal.SIGKILL)
+
+    with pytest.raises(WorkersLostError) as info:
+        write(make_cube(chunks=(3, 2), delay=0.2), path, scheduler=address, on_block=on_block)
+    message = str(info.value)
+    assert "scheduler" in message and "resume=True" in message and "\n" not in message, message
+    assert f"{path}{PART_SUFFIX}" in message and not path.exists()
+    write(make_cube(chunks=(3, 2)), path, resume=True)
+    with xr.open_zarr(path) if suffix == ".zarr" else xr.open_dataset(path) as back:
+        xr.testing.assert_identical(back.load(), make_cube(chunks=(3, 2)).compute())
+    TRIALS.append((f"scheduler killed ({suffix})", "named error, resumed"))

@@ -65,3 +65,38 @@ def test_kept_digest_is_forgotten_with_its_array():
     assert key in fp._DIGESTS
     del v
     assert key not in fp._DIGESTS
+
+
+def _read_only_table() -> xr.DataArray:
+    v = np.arange(12.0).reshape(3, 4).copy()  # owns its memory
+    v.flags.writeable = False
+    da = _table(v)
+    da.attrs.update(units="sr-1", measured=np.array([1.0, 2.0]), nested={"a": [1, 2]})
+    return da
+
+
+def test_kept_table_digest_equals_the_digest_computed_afresh():
+    da = _read_only_table()
+    digest = fp._table_sha(da)
+    assert id(da) in fp._TABLES and fp._table_sha(da) == digest  # kept, then reused
+    assert digest == fp._table_sha_now(da)
+    assert fp._table_state(_table(np.zeros((3, 4)))) is None  # writeable: never kept
+
+
+def test_every_change_to_a_kept_table_changes_its_digest():
+    changes = [
+        lambda da: da.attrs.update(units="m"),
+        lambda da: da.attrs["measured"].__setitem__(0, 5.0),  # an attribute array in place
+        lambda da: da.attrs["nested"]["a"].append(3),  # a nested list in place
+        lambda da: da.attrs.update(measured=np.array([1, 2])),  # equal values, other dtype
+        lambda da: da["a"].attrs.update(units="degree"),
+        lambda da: da.coords.update({"a": [0.0, 1.0, 3.0]}),
+        lambda da: setattr(da, "values", np.ones((3, 4))),
+    ]
+    for change in changes:
+        da = _read_only_table()
+        before = fp._table_sha(da)
+        change(da)
+        after = fp._table_sha(da)
+        assert after != before
+        assert after == fp._table_sha_now(da)

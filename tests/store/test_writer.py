@@ -31,8 +31,8 @@ from hypothesis import strategies as st
 from hypothesis_profiles import examples
 
 from sbrdf_xr.errors import ValidationError
-from sbrdf_xr.store.common import release_freed_memory
 from sbrdf_xr.store.disk import SyncBehind, drop_behind
+from sbrdf_xr.store.runners import release_freed_memory
 from sbrdf_xr.store.writer import (
     LOG_SUFFIX,
     PART_SUFFIX,
@@ -590,7 +590,7 @@ def test_no_block_is_computed_when_the_room_is_refused(tmp_path, monkeypatch):
     import errno
 
     import sbrdf_xr.store.writer as writer
-    from sbrdf_xr.store.common import _NoRoom
+    from sbrdf_xr.store.disk import _NoRoom
 
     def full(part, need):
         raise _NoRoom(errno.ENOSPC, f"about {need} B needed, 0 B free")
@@ -876,3 +876,26 @@ def test_worker_killed_mid_sweep(tmp_path, dask_cluster):
     assert set(irradiance) == {(i, j) for i in range(4) for j in range(5)}
     # Blocks lost with the worker were computed again (how many depends on timing).
     assert len(irradiance) >= 20
+
+
+@pytest.mark.parametrize("recorded", [True, False], ids=["sidecar", "sidecar-without-level"])
+def test_resume_with_another_complevel_is_refused_and_touches_nothing(tmp_path, recorded):
+    """The level is read from the sidecar (or, from a sidecar that predates it, from the
+    ``.part`` itself, read-only); another level is refused, naming the one to use."""
+    path = tmp_path / "c.nc"
+    switch = tmp_path / "fail"
+    switch.touch()
+    with pytest.raises(CubeWriteError):
+        write_cube(make_cube(fail_switch=str(switch), fail_at=(1, 1)), path, complevel=3)
+    part, log = path.with_name(path.name + PART_SUFFIX), path.with_name(path.name + LOG_SUFFIX)
+    if not recorded:
+        lines = log.read_text().splitlines()
+        header = json.loads(lines[0])
+        del header["complevel"]
+        log.write_text("\n".join([json.dumps(header), *lines[1:]]) + "\n")
+    before = {p.name: p.read_bytes() for p in (part, log)}
+    with pytest.raises(CubeWriteError, match=r"started with complevel 3 .*complevel=3"):
+        write_cube(make_cube(), path, resume=True)
+    assert {p.name: p.read_bytes() for p in (part, log)} == before
+    write_cube(make_cube(), path, resume=True, complevel=3)
+    xr.testing.assert_identical(read(path), make_cube().compute())
