@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import subprocess
 import sys
@@ -10,11 +11,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from astropy.table import Table
 
 from sbrdf_xr import catalog
+from sbrdf_xr.body.spacecraft import canx1
 from sbrdf_xr.errors import CatalogError, ValidationError
 from sbrdf_xr.materials import energy
 from sbrdf_xr.materials import tables as material
+from sbrdf_xr.observing import Observation, Orbit, Site
+from sbrdf_xr.photometry import read_light_curve
 
 
 def test_every_entry_has_provenance_and_loads():
@@ -299,3 +304,48 @@ def test_building_tables_shows_progress_and_a_warm_load_is_quiet(tmp_path, monke
     catalog.material_tables({"paint": "example-lobe", "rail": "lambertian-grey-50"})
     assert "building table example-lobe (1 of 1)" in capfd.readouterr().err
     catalog._built_material.cache_clear()
+
+
+# ----------------------------------------------------------------- the example night
+
+NIGHT = "observe/canx1-zimmerwald-night.ecsv"
+
+
+def _tool(name: str):
+    """A build script of ``tools/`` (not part of the package), imported by path."""
+    path = Path(__file__).resolve().parent.parent / "tools" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(f"tools_{name}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_example_night_reads_as_written_and_says_it_is_simulated():
+    lc = read_light_curve(catalog.data_path(NIGHT))
+    assert lc.sizes["obs"] == 280
+    assert (lc.attrs["table_form"], lc.attrs["magnitude_system"]) == ("long", "Vega")
+    assert "grouped by band" in lc.attrs["row_order"]  # the file lists V, then R, then I
+    written = dict(zip(lc.filter_as_written.values.tolist(), lc.band.values.tolist(), strict=True))
+    assert written == {"Johnson V": "V", "Cousins R": "R", "Cousins I": "I"}
+    meta = Table.read(catalog.data_path(NIGHT)).meta
+    assert meta["comment"].startswith("SIMULATED MEASUREMENT")
+    truth = meta["simulated_truth"]
+    assert set(truth["area_fraction"]) == set(np.unique(canx1().facet_material).tolist())
+    assert sum(truth["area_fraction"].values()) == pytest.approx(1.0, abs=1e-12)
+    # every exposure sees the object sunlit and well above the horizon from the site
+    orbit = Orbit.from_catalog("canx1-example")
+    g = Observation(orbit, Site.from_catalog("zimmerwald"), lc.time.values).geometry()
+    assert float(g.sunlit_fraction.min()) == 1.0
+    assert float(g.elevation.min()) > 20.0
+
+
+@pytest.mark.slow
+def test_the_example_night_is_what_its_script_writes():
+    new = _tool("build_night").measured_table()
+    old = Table.read(catalog.data_path(NIGHT))
+    assert list(new["utc"]) == list(old["utc"])
+    assert list(new["filter"]) == list(old["filter"])
+    # the same seed draws the same noise: only a change of the forward model moves the
+    # magnitudes; a tenth of the 0.02 mag noise is allowed before the file is stale
+    # (re-run python tools/build_night.py and the notebook that reads it)
+    np.testing.assert_allclose(new["mag"], old["mag"], rtol=0, atol=2e-3)

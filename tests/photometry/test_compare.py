@@ -300,6 +300,9 @@ def test_plot_comparison_of_a_pass(tmp_path):
     text = fig.axes[0].texts[0].get_text()
     assert "AB magnitudes" in text and "ZP V = " in text and "time shift = " in text
     assert fig.axes[1].get_xlabel() == "time [UTC] on 2024-03-17"
+    from sbrdf_xr.plot import figure_problems
+
+    assert figure_problems(fig) == []  # labels with units, no text over text
     fig.savefig(tmp_path / "pass.png", dpi=80)
     assert (tmp_path / "pass.png").stat().st_size > 10_000
 
