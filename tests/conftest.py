@@ -13,6 +13,12 @@ import pytest
 
 matplotlib.use("Agg")
 
+#: conftest files hold fixtures, not doctests: collecting them as doctest modules would
+#: import this one under the name ``conftest`` after a subdirectory's (tests/bad_input)
+#: took it, which pytest refuses as an import file mismatch.
+collect_ignore = ["conftest.py"]
+collect_ignore_glob = ["*/conftest.py"]
+
 
 @pytest.fixture(autouse=True)
 def _no_user_catalogs(monkeypatch):

@@ -21,6 +21,7 @@ import xarray as xr
 
 from .._cache import build_modules
 from .._names import THETA_I, WAVELENGTH
+from .._output import write_netcdf
 from . import models
 from .build import _model_reflectance
 
@@ -125,7 +126,7 @@ def write_reflectance(fit_file: Path, theta_i: np.ndarray, wavelength: np.ndarra
         },
     )
     out = reflectance_file(Path(fit_file))
-    da.to_netcdf(out, engine="netcdf4", encoding={"model_reflectance": {"zlib": True}})
+    write_netcdf(da.to_dataset(), out, overwrite=True)  # CF-clean: no fill values
     return out
 
 
