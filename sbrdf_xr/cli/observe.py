@@ -373,7 +373,9 @@ def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     else:
         stop = to_datetime64(args.stop, "--stop")
     window = float((stop - start) / np.timedelta64(1, "ns")) * 1e-9
-    if math.isfinite(args.step) and window > 0 and args.step > window:
+    if not (math.isfinite(args.step) and args.step > 0):
+        raise ValidationError(f"--step: got {args.step:g} s; allowed a finite step > 0 s")
+    if window > 0 and args.step > window:
         raise ValidationError(
             f"--step: got {args.step:g} s, longer than the {window:g} s window; allowed a "
             "step > 0 and at most the window (or give --duration / --stop a longer window)"
