@@ -6,6 +6,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 from typing import Any
 
 from ..errors import SbrdfError, ValidationError
@@ -14,6 +15,12 @@ from .commands import spacecraft_of
 from .output import open_dataset
 
 __all__ = ["cmd_invert", "cmd_photometry"]
+
+#: The shortest wavelength a measured spectrum of ``invert unmix`` may hold [nm] (a
+#: spectrum in micrometres or metres lies wholly below it).
+MIN_WAVELENGTH_NM = 50.0
+#: The shortest candidate period of ``invert spin --periods`` [s].
+MIN_PERIOD_S = 1e-3
 
 
 def _cube_range_km(cube) -> float | None:
@@ -55,6 +62,27 @@ def _parse_colours(text: str | None) -> list[tuple[str, str]] | None:
             )
         pairs.append((a, b))
     return pairs
+
+
+#: The options of ``photometry`` by the parameter that a message of
+#: :func:`~sbrdf_xr.photometry.photometry` starts with.
+_PHOTOMETRY_FLAGS = {
+    "band": "--bands",
+    "bands": "--bands",
+    "pairs": "--colours",
+    "extinction": "--extinction",
+    "sun_distance_au": "--sun-distance-au",
+    "range_km": "--range-km",
+    "system": "--system",
+    "extrapolate": "--extrapolate",
+}
+
+
+def _flag_of(message: str) -> str:
+    """``"--flag: "`` for a message that starts with a parameter of an option, else ``""``."""
+    head = message.split(":", 1)[0].split()[0] if message.strip() else ""
+    flag = _PHOTOMETRY_FLAGS.get(head)
+    return f"{flag}: " if flag and flag not in message else ""
 
 
 def cmd_photometry(args: argparse.Namespace) -> int:
@@ -102,8 +130,18 @@ def cmd_photometry(args: argparse.Namespace) -> int:
     from .. import photometry as phot
 
     outputs = [(args.output, None), (args.csv, "photometry-csv")]
-    for out, name in outputs:
-        if out:  # refused before anything is computed
+    if args.csv is not None:  # a CSV file under the suffix of another format is refused
+        suffix = Path(args.csv).suffix.lower()
+        owners = [f.label for f in formats.FORMATS.values() if suffix in f.suffixes]
+        if suffix and suffix != ".csv" and owners:
+            raise ValidationError(
+                f"--csv {args.csv}: writes CSV, not {suffix} (the suffix of "
+                f"{' or '.join(dict.fromkeys(owners))}); give a .csv name, or -o for netCDF"
+            )
+    for (out, name), flag in zip(outputs, ("-o", "--csv"), strict=True):
+        if out is not None and not str(out).strip():
+            raise ValidationError(f"{flag}: got {out!r}; give a file name for the output")
+        if out is not None:  # refused before anything is computed
             formats.check(out, "photometry", overwrite=args.overwrite, name=name)
     with open_dataset(args.cube) as probe:
         if not any(
@@ -129,19 +167,22 @@ def cmd_photometry(args: argparse.Namespace) -> int:
                 f"--extinction: {args.cube} records no airmass (only the cube of an "
                 "observation does)"
             )
-        lazy = phot.photometry(
-            cube,
-            args.bands,
-            range_km,
-            pairs=colours,
-            system=args.system,
-            sun_distance_au=args.sun_distance_au,
-            extinction=extinction,
-            weighting=args.weighting,
-            quadrature=args.quadrature,
-            extrapolate=args.extrapolate,
-            solar=args.solar,
-        )
+        try:
+            lazy = phot.photometry(
+                cube,
+                args.bands,
+                range_km,
+                pairs=colours,
+                system=args.system,
+                sun_distance_au=args.sun_distance_au,
+                extinction=extinction,
+                weighting=args.weighting,
+                quadrature=args.quadrature,
+                extrapolate=args.extrapolate,
+                solar=args.solar,
+            )
+        except SbrdfError as exc:  # the option named, with the function's own message
+            raise ValidationError(f"{_flag_of(str(exc))}{exc}") from None
         with TqdmCallback(desc="photometry", disable=args.quiet):
             ds = lazy.compute()
     print(
@@ -172,7 +213,7 @@ def cmd_photometry(args: argparse.Namespace) -> int:
             med = f"{np.median(v):.3f}" if v.size else "nan"
             print(f"colour {c!s:<10} median {med} mag")
     for out, name in outputs:
-        if out:
+        if out is not None:
             formats.format_for(out, "photometry", name).writer(ds, out, overwrite=args.overwrite)
             print(f"wrote {out}")
     return 0
@@ -224,19 +265,32 @@ def _unmix(args: argparse.Namespace):
     terms = _isel(terms, args.isel, args.cube)
     if invert.measured_kind(args.measured) == "spectrum":
         y, sigma = invert.read_spectrum(args.measured)
+        lo, hi = float(y.wavelength.min()), float(y.wavelength.max())
+        if hi < MIN_WAVELENGTH_NM:
+            raise InversionError(
+                f"{args.measured}: wavelengths {lo:g}..{hi:g}; expected nm (values below "
+                f"{MIN_WAVELENGTH_NM:g} look like micrometres or metres: give the wavelength "
+                "column in nm)"
+            )
     else:
         lc = read_light_curve(args.measured)
         if args.range_km is None:
             raise InversionError("--range-km: needed to turn measured magnitudes into signal")
         y, sigma = invert.magnitudes_to_signal(lc, args.range_km)
         terms = invert.band_terms(terms, [str(b) for b in y.band.values])
-    ds = invert.unmix(
-        y,
-        terms,
-        sigma,
-        select=None if args.select == "none" else args.select,
-        criterion=args.criterion,
-    )
+    try:
+        ds = invert.unmix(
+            y,
+            terms,
+            sigma,
+            select=None if args.select == "none" else args.select,
+            criterion=args.criterion,
+        )
+    except SbrdfError as exc:  # the files named, with the fit's own message
+        text = str(exc)
+        if str(args.measured) not in text:
+            text = f"{args.measured} against {args.cube}: {text}"
+        raise InversionError(text) from None
     print(
         f"unmix {args.measured}: chi2 {float(ds.chi2):.4g} for {int(ds.dof)} degrees of "
         f"freedom, reduced {float(ds.reduced_chi2):.4g} ({ds.attrs['fit_quality']}); "
@@ -265,6 +319,11 @@ def _periods(args: argparse.Namespace, lc) -> Any:
     if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo <= hi):
         raise InversionError(
             f"--periods {lo:g} {hi:g} {n:g}: MIN and MAX must be finite with 0 < MIN <= MAX [s]"
+        )
+    if lo < MIN_PERIOD_S:
+        raise InversionError(
+            f"--periods {lo:g} {hi:g} {n:g}: MIN must be at least {MIN_PERIOD_S:g} s "
+            "(a thousand turns a second)"
         )
     if not (np.isfinite(n) and n >= 1 and float(n) == int(n)):
         raise InversionError(f"--periods {lo:g} {hi:g} {n:g}: N must be an integer >= 1")

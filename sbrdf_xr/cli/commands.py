@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 from .. import catalog
 from .._names import __version__
 from .._output import file_kind
-from ..errors import ValidationError, did_you_mean
+from ..errors import SbrdfError, ValidationError, did_you_mean
 from ..store import PART_SUFFIX, formats
 from .output import escape, escaped_attrs, open_cube, open_dataset
 
@@ -267,6 +267,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 '=', '4', 'geometries'])
     """
     from ..engine import resolve_scene
+    from ..engine.builtin import builtin_scenes
     from ..engine.run import simulate
 
     out = Path(args.output)
@@ -274,13 +275,23 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         fmt = formats.check(out, "cube", overwrite=args.overwrite, resume=args.resume)
         if args.plot:
             formats.check(args.plot, "figure", overwrite=args.overwrite)
+    if not str(args.scene).strip():
+        raise ValidationError(
+            f"simulate SCENE: got {args.scene!r}; give a built-in scene name "
+            f"({', '.join(builtin_scenes())}) or a scene TOML file"
+        )
     scene = resolve_scene(args.scene)
     scene = _with_body(scene, args)
     changes = _knob_values(args.set or [])
-    if args.preset:
-        scene = scene.with_options(preset=args.preset, **changes)
-    elif changes:
-        scene = scene.with_options(**changes)
+    given = [f"--preset {args.preset!r}"] if args.preset is not None else []
+    given += [f"--set {s}" for s in args.set or []]
+    try:
+        if args.preset is not None:
+            scene = scene.with_options(preset=args.preset, **changes)
+        elif changes:
+            scene = scene.with_options(**changes)
+    except SbrdfError as exc:  # the option named, with the knob's own message
+        raise ValidationError(f"{', '.join(given)}: {exc}") from None
     if scene.materials is None:  # the catalog's tables, those to build labelled as one batch
         known = set(catalog.names("material"))
         wanted = [m for m in scene.spacecraft.materials if m in known]

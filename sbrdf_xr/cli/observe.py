@@ -20,10 +20,13 @@ The attitude laws are those of :mod:`sbrdf_xr.observing.attitude`: ``inertial``
 from __future__ import annotations
 
 import argparse
+import contextlib
+import math
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from ..errors import AttitudeError, ValidationError
+from ..errors import AttitudeError, SbrdfError, ValidationError
 
 __all__ = [
     "add_observe_parser",
@@ -33,6 +36,10 @@ __all__ = [
 ]
 
 LAW_NAMES = ("inertial", "nadir", "sun-pointing", "spin", "tumble", "series")
+#: The fastest spin ``--period`` / ``--rate`` give [degree s-1]: 100 turns a second.
+MAX_SPIN_RATE_DEG_S = 36000.0
+#: The longest ``--duration`` [s]: about 32 years, beyond any use of one element set.
+MAX_DURATION_S = 1e9
 
 
 def _axis(text: str) -> Any:
@@ -211,6 +218,15 @@ def add_observe_parser(sub: Any, mesh_options: Any) -> argparse.ArgumentParser:
     return po
 
 
+@contextlib.contextmanager
+def _flags(names: str) -> Iterator[None]:
+    """An error of the law built from the options ``names`` says which they are."""
+    try:
+        yield
+    except SbrdfError as exc:
+        raise AttitudeError(f"{names}: {exc}") from None
+
+
 def _quaternion(text: str, what: str) -> list[float]:
     parts = text.replace(",", " ").split()
     try:
@@ -248,14 +264,18 @@ def attitude_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
             raise AttitudeError("--attitude inertial: give --quaternion X Y Z W")
         return law.Inertial(tuple(args.quaternion))
     if kind == "nadir":
-        return law.Nadir(args.yaw, _axis(args.nadir_axis), _axis(args.velocity_axis))
+        with _flags("--yaw, --nadir-axis, --velocity-axis"):
+            return law.Nadir(args.yaw, _axis(args.nadir_axis), _axis(args.velocity_axis))
     if kind == "sun-pointing":
         target = args.secondary_target
-        return law.SunPointing(
-            _axis(args.sun_axis),
-            _axis(args.secondary_axis),
-            target if target in ("orbit_normal", "nadir", "velocity", "north") else _axis(target),
-        )
+        with _flags("--sun-axis, --secondary-axis, --secondary-target"):
+            return law.SunPointing(
+                _axis(args.sun_axis),
+                _axis(args.secondary_axis),
+                target
+                if target in ("orbit_normal", "nadir", "velocity", "north")
+                else _axis(target),
+            )
     if kind == "series":
         if not args.series:
             raise AttitudeError("--attitude series: give --series FILE (.csv or .nc)")
@@ -269,19 +289,28 @@ def attitude_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     if kind == "spin":
         if (args.period is None) == (args.rate is None):
             raise AttitudeError("--attitude spin: give --period S or --rate DEG_S")
-        if args.period is not None and not args.period > 0:
-            raise AttitudeError(f"--period: must be > 0 s, got {args.period}")
+        if args.period is not None and not (math.isfinite(args.period) and args.period > 0):
+            raise AttitudeError(f"--period: got {args.period}; allowed a finite period > 0 s")
         rate = args.rate if args.rate is not None else 360.0 / args.period
-        return law.Spin(_axis(args.spin_axis), rate, args.phase, initial, args.epoch)
+        given = f"--rate {args.rate}" if args.rate is not None else f"--period {args.period}"
+        if not (math.isfinite(rate) and 0 < abs(rate) <= MAX_SPIN_RATE_DEG_S):
+            raise AttitudeError(
+                f"{given}: a spin rate of {rate:g} degree s-1; allowed a finite rate with "
+                f"0 < |rate| <= {MAX_SPIN_RATE_DEG_S:g} degree s-1 (a period of at least "
+                f"{360.0 / MAX_SPIN_RATE_DEG_S:g} s)"
+            )
+        with _flags("--spin-axis, --phase, --initial, --epoch"):
+            return law.Spin(_axis(args.spin_axis), rate, args.phase, initial, args.epoch)
     if args.omega is None:
         raise AttitudeError("--attitude tumble: give --omega WX WY WZ [degree s-1]")
     if (args.inertia is None) == (args.density is None):
         raise AttitudeError("--attitude tumble: give --inertia IXX IYY IZZ or --density KG_M3")
-    if args.inertia is not None:
-        return law.Tumble(tuple(args.inertia), tuple(args.omega), initial, args.epoch)
-    return law.Tumble.from_spacecraft(
-        spacecraft, args.density, tuple(args.omega), initial, args.epoch
-    )
+    with _flags("--omega, --inertia, --density, --initial, --epoch"):
+        if args.inertia is not None:
+            return law.Tumble(tuple(args.inertia), tuple(args.omega), initial, args.epoch)
+        return law.Tumble.from_spacecraft(
+            spacecraft, args.density, tuple(args.omega), initial, args.epoch
+        )
 
 
 def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
@@ -308,25 +337,49 @@ def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     else:
         if args.satellite:
             raise ValidationError("--satellite picks from an element file; --elements is a name")
-        orbit = Orbit.from_catalog(spec)
+        if not spec.strip():
+            raise ValidationError(
+                f"--elements: got {spec!r}; give a TLE or OMM file or a catalog orbit "
+                "('sbrdf-xr catalog list --kind orbit')"
+            )
+        try:
+            orbit = Orbit.from_catalog(spec)
+        except SbrdfError as exc:
+            raise ValidationError(f"--elements {spec}: {exc}") from None
     latlon = [args.lat is not None, args.lon is not None]
     if args.site is not None and any(latlon):
         raise ValidationError("give --site NAME or --lat/--lon/--height, not both")
     if args.site is not None:
         site = Site.from_catalog(args.site)
     elif all(latlon):
-        site = Site(args.lat, args.lon, args.height, name=f"{args.lat:g}, {args.lon:g}")
+        try:
+            site = Site(args.lat, args.lon, args.height, name=f"{args.lat:g}, {args.lon:g}")
+        except SbrdfError as exc:
+            raise ValidationError(
+                f"--lat {args.lat:g} --lon {args.lon:g} --height {args.height:g}: {exc}"
+            ) from None
     else:
         raise ValidationError("give --site NAME (a catalog observatory) or both --lat and --lon")
     if (args.stop is None) == (args.duration is None):
         raise ValidationError("give --stop UTC or --duration S (the end of the window)")
     start = to_datetime64(args.start, "--start")
     if args.duration is not None:
-        if not args.duration > 0:
-            raise ValidationError(f"--duration: must be > 0 s, got {args.duration}")
+        if not (math.isfinite(args.duration) and 0 < args.duration <= MAX_DURATION_S):
+            raise ValidationError(
+                f"--duration: got {args.duration:g} s; allowed a finite duration > 0 and at "
+                f"most {MAX_DURATION_S:g} s ({MAX_DURATION_S / 86400 / 365.25:.3g} years)"
+            )
         stop = start + np.timedelta64(round(args.duration * 1e9), "ns")
     else:
         stop = to_datetime64(args.stop, "--stop")
+    window = float((stop - start) / np.timedelta64(1, "ns")) * 1e-9
+    if not (math.isfinite(args.step) and args.step > 0):
+        raise ValidationError(f"--step: got {args.step:g} s; allowed a finite step > 0 s")
+    if window > 0 and args.step > window:
+        raise ValidationError(
+            f"--step: got {args.step:g} s, longer than the {window:g} s window; allowed a "
+            "step > 0 and at most the window (or give --duration / --stop a longer window)"
+        )
     return Observation(
         orbit,
         site,

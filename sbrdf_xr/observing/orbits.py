@@ -327,7 +327,7 @@ class Orbit:
                 k += 3
             else:
                 raise ObservationError(
-                    f"orbit file {path}: line {k + 1} ({lines[k][:30]!r}) starts no element "
+                    f"orbit file {path}: line {k + 1} (not blank) starts no element "
                     "set; expected TLEs (an optional name line, then lines '1 ...' and "
                     "'2 ...') or an OMM file (.json, .xml, .csv)"
                 )

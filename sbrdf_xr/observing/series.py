@@ -144,7 +144,8 @@ class QuaternionSeries(AttitudeLaw):
         missing = [c for c in (time_column, *columns) if c not in df.columns]
         if missing:
             raise AttitudeError(
-                f"quaternion_series: {path} lacks the columns {missing}; has {list(df.columns)}"
+                f"quaternion_series: {path} lacks the columns {missing} (its header has "
+                f"{len(df.columns)} columns; expected {[time_column, *columns]})"
             )
         tcol = df[time_column]
         if pd.api.types.is_numeric_dtype(tcol):

@@ -21,6 +21,9 @@ from .frames import Context, check_epoch, check_quaternion, seconds_since
 
 __all__ = ["TUMBLE_RTOL", "Tumble"]
 
+#: The most turns a tumble is integrated over (the work grows with them: about 2 s a
+#: thousand turns at the default tolerance).
+MAX_TUMBLE_TURNS = 1e4
 #: Relative tolerance of the tumble integration (scipy ``solve_ivp``, DOP853).
 TUMBLE_RTOL = 1e-12
 
@@ -188,6 +191,15 @@ class Tumble(AttitudeLaw):
         t = seconds_since(times, self.epoch, context)
         rhs = self._rhs_function()
         y0 = np.concatenate([np.radians(self.omega_deg_s), self.initial])
+        span = float(np.max(np.abs(t))) if t.size else 0.0
+        turns = float(np.linalg.norm(self.omega_deg_s)) * span / 360.0
+        if not turns <= MAX_TUMBLE_TURNS:  # the integrator's work grows with the turns
+            raise AttitudeError(
+                f"tumble omega_deg_s: {turns:.3g} turns at |omega| "
+                f"{float(np.linalg.norm(self.omega_deg_s)):.3g} degree s-1 over {span:.3g} s "
+                f"from the epoch; allowed at most {MAX_TUMBLE_TURNS:g} turns (slower rates, "
+                "or a shorter window nearer the epoch)"
+            )
         out = np.empty((t.size, 7))
         scale = max(float(np.linalg.norm(y0[:3])), 1e-12)
         atol = np.concatenate([np.full(3, 1e-14 * scale), np.full(4, 1e-14)])

@@ -133,7 +133,10 @@ def test_every_attitude_law_and_its_options():
     assert type(law).__name__ == "Tumble"
     for extra, msg in (
         (["--attitude", "inertial"], "give --quaternion"),
-        (["--attitude", "spin", "--period", "-5"], "--period: must be > 0 s"),
+        (
+            ["--attitude", "spin", "--period", "-5"],
+            "--period: got -5.0; allowed a finite period > 0 s",
+        ),
         (["--attitude", "spin", "--period", "5", "--rate", "3"], "give --period S or --rate"),
         (["--attitude", "tumble", "--omega", "1", "2", "3"], "give --inertia"),
         (["--attitude", "series"], "give --series FILE"),
