@@ -87,8 +87,8 @@ def compile_ahead(dtype: str = "float64") -> subprocess.Popen[bytes] | None:
     env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH")) if p)
     code = f"from sbrdf_xr.kernels.warm import warm_up; warm_up({str(np.dtype(dtype))!r})"
     try:
-        return subprocess.Popen(
-            [sys.executable, "-c", code],
+        return subprocess.Popen(  # -P: not the working directory's sbrdf_xr, this one
+            [sys.executable, "-P", "-c", code],
             env=env,
             stdin=subprocess.DEVNULL,
             stdout=subprocess.DEVNULL,

@@ -49,3 +49,15 @@ def test_compile_ahead_fills_numba_s_cache(tmp_path, monkeypatch):
 def test_compile_ahead_is_off_without_the_jit(monkeypatch):
     monkeypatch.setenv("NUMBA_DISABLE_JIT", "1")
     assert compile_ahead("float64") is None
+
+
+def test_compile_ahead_imports_this_package_not_the_working_directorys(tmp_path, monkeypatch):
+    # a source checkout in the working directory (the README's main job runs from the
+    # clone) must not be what the compiling process imports: its kernels would be cached
+    # under another path and compiled a second time by the first simulation
+    other = tmp_path / "sbrdf_xr"
+    other.mkdir()
+    (other / "__init__.py").write_text("raise SystemExit(3)\n")
+    monkeypatch.chdir(tmp_path)
+    proc = compile_ahead("float64")
+    assert proc is not None and proc.wait(timeout=600) == 0
