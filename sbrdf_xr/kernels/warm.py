@@ -82,10 +82,20 @@ def compile_ahead(dtype: str = "float64") -> subprocess.Popen[bytes] | None:
     """
     if os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0"):
         return None
-    root = str(Path(__file__).resolve().parents[2])  # the directory holding this sbrdf_xr
+    package = str(Path(__file__).resolve().parents[1])  # this sbrdf_xr
     env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH")) if p)
-    code = f"from sbrdf_xr.kernels.warm import warm_up; warm_up({str(np.dtype(dtype))!r})"
+    env["PYTHONPATH"] = os.pathsep.join(
+        p for p in (str(Path(package).parent), env.get("PYTHONPATH")) if p
+    )
+    # The package stands in sys.modules without running its __init__ (which imports the
+    # engine, xarray and the rest: a second of the first run's critical path); the kernels
+    # import only what they use.  The modules, so numba's cache, are this package's.
+    code = (
+        "import sys, types\n"
+        f"package = types.ModuleType('sbrdf_xr'); package.__path__ = [{package!r}]\n"
+        "sys.modules['sbrdf_xr'] = package\n"
+        f"from sbrdf_xr.kernels.warm import warm_up; warm_up({str(np.dtype(dtype))!r})"
+    )
     try:
         return subprocess.Popen(  # -P: not the working directory's sbrdf_xr, this one
             [sys.executable, "-P", "-c", code],
