@@ -46,6 +46,7 @@ __all__ = [
     "check_finished",
     "coordinates_attrs",
     "create_part",
+    "destination_state",
     "discard_hint",
     "hdf5_chunks",
     "make_parent",
@@ -633,6 +634,26 @@ def check_destination(path: Path, part: Path, log: Path, overwrite: bool, resume
     """
     refuse_special([path, part, log], error=CubeWriteError)
     has_path, has_part = file_kind(path) == "file", file_kind(part) == "file"
+    return destination_state(path, part, has_path, has_part, overwrite=overwrite, resume=resume)
+
+
+def destination_state(
+    path: Path, part: Path, has_path: bool, has_part: bool, *, overwrite: bool, resume: bool
+) -> str:
+    """What a cube writer does at ``path`` given whether the finished cube (``has_path``)
+    and an unfinished write of it (``has_part``, at ``part``) are there: ``"new"``,
+    ``"resume"`` or ``"finished"`` (nothing to do); FileExistsError when the options do
+    not say what to do with what is there.  Shared by the netCDF and Zarr writers.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> p, part = Path("cube.nc"), Path("cube.nc.part")
+    >>> [destination_state(p, part, True, True, overwrite=True, resume=r) for r in (True, False)]
+    ['resume', 'new']
+    >>> destination_state(p, part, True, False, overwrite=False, resume=True)
+    'finished'
+    """
     if has_part and resume:
         if has_path and not overwrite:
             raise FileExistsError(

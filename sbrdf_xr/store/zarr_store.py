@@ -74,7 +74,7 @@ from .._output import (
 )
 from ..errors import CubeWriteError, ValidationError
 from .disk import check_room, drop_behind, fix, reason
-from .files import PART_SUFFIX, again_hint, discard_hint, make_parent
+from .files import PART_SUFFIX, again_hint, destination_state, discard_hint, make_parent
 from .layout import (
     BlockLayout,
     describe_chunks,
@@ -249,24 +249,7 @@ def check_destination(path: Path, overwrite: bool, resume: bool) -> str:
     has_part = part.is_dir() and (read_marker(part) is not None or not holds_nothing(part))
     if has_part and read_marker(part) is None:
         raise _foreign(part)
-    if has_part and resume:
-        if has_path and not overwrite:
-            raise FileExistsError(
-                f"{path} exists and {part} holds an unfinished write of it: pass "
-                f"{option('resume')} with {option('overwrite')} to finish it and replace "
-                f"{path.name}, or remove one of them"
-            )
-        return "resume"
-    if has_path and resume and not overwrite:
-        return "finished"
-    if has_path and not overwrite:
-        raise FileExistsError(f"{path} exists; pass {option('overwrite')} to replace it")
-    if has_part and not overwrite:
-        raise FileExistsError(
-            f"{part} exists: an unfinished write of {path.name}. Pass {option('resume')} to "
-            f"continue it, or {option('overwrite')} to discard it and start again"
-        )
-    return "new"
+    return destination_state(path, part, has_path, has_part, overwrite=overwrite, resume=resume)
 
 
 def _foreign(d: Path) -> CubeWriteError:
