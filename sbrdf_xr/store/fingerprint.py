@@ -143,6 +143,22 @@ def _layout(a: np.ndarray) -> tuple:
     return (a.__array_interface__["data"][0], a.shape, a.strides, a.dtype.str)
 
 
+def _forgetter(kept: dict[int, tuple], key: int) -> Any:
+    """The weak reference callback that drops ``kept[key]`` when its object dies.
+
+    The lock and the dict are bound now, not looked up when it runs: at interpreter exit
+    the module's globals may already be gone when the last kept objects are freed.
+    """
+    lock = _DIGESTS_LOCK
+
+    def forget(ref: weakref.ref) -> None:
+        with lock:
+            if key in kept and kept[key][0] is ref:
+                del kept[key]
+
+    return forget
+
+
 def _array_sha(a: Any) -> str:
     """SHA-256 of an array's dtype, shape and values.
 
@@ -160,13 +176,8 @@ def _array_sha(a: Any) -> str:
         return hit[2]
     sha = _array_sha_now(a)
 
-    def forget(ref: weakref.ref, key: int = key) -> None:
-        with _DIGESTS_LOCK:
-            if key in _DIGESTS and _DIGESTS[key][0] is ref:
-                del _DIGESTS[key]
-
     with _DIGESTS_LOCK:
-        _DIGESTS[key] = (weakref.ref(a, forget), layout, sha)
+        _DIGESTS[key] = (weakref.ref(a, _forgetter(_DIGESTS, key)), layout, sha)
     return sha
 
 
@@ -212,13 +223,8 @@ def _table_sha(da: Any) -> str:
         return hit[3]
     sha = _table_sha_now(da)
 
-    def forget(ref: weakref.ref, key: int = key) -> None:
-        with _DIGESTS_LOCK:
-            if key in _TABLES and _TABLES[key][0] is ref:
-                del _TABLES[key]
-
     with _DIGESTS_LOCK:  # ``held`` keeps the identities in ``state`` from being reused
-        _TABLES[key] = (weakref.ref(da, forget), state, held, sha)
+        _TABLES[key] = (weakref.ref(da, _forgetter(_TABLES, key)), state, held, sha)
     return sha
 
 
