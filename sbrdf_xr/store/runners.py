@@ -254,6 +254,19 @@ class _DistributedRunner:
                 f"the Dask scheduler no longer answers ({type(exc).__name__}: {exc})"
             ) from exc
 
+    def _alone(self, since: float | None, timeout: float) -> float | None:
+        """Since when the cluster has had no worker (None while it has some); ClusterLost
+        once that lasts ``timeout`` seconds."""
+        if self._workers():
+            return None
+        now = time.monotonic()
+        since = now if since is None else since
+        if now - since >= timeout:
+            raise ClusterLost(
+                f"the Dask cluster has had no worker for {timeout:g} s (every worker died or left)"
+            )
+        return since
+
     def next_done(self) -> tuple[int, Any]:
         timeout = no_workers_timeout()
         alone_since: float | None = None
@@ -264,22 +277,29 @@ class _DistributedRunner:
             if now - checked < _POLL:
                 continue
             checked = now
-            if self._workers():
-                alone_since = None
-                continue
-            alone_since = now if alone_since is None else alone_since
-            if now - alone_since >= timeout:
-                raise ClusterLost(
-                    f"the Dask cluster has had no worker for {timeout:g} s (every worker died "
-                    "or left)"
-                )
+            alone_since = self._alone(alone_since, timeout)
         fut = next(self.done)
         k, _ = self.futures.pop(fut.key)
         return k, fut
 
+    def _wait(self, fut: Any) -> tuple[np.ndarray, ...]:
+        # A block computed on a worker that died before its result was fetched goes back
+        # to waiting for a worker: with none left it would wait for ever.
+        timeout = no_workers_timeout()
+        alone_since: float | None = None
+        while True:
+            try:
+                return fut.result(timeout=_POLL)
+            except TimeoutError:
+                if fut.done():  # the block's own error, not the wait's
+                    raise
+                alone_since = self._alone(alone_since, timeout)
+
     def result(self, fut: Any) -> tuple[np.ndarray, ...]:
         try:
-            return fut.result()
+            return self._wait(fut)
+        except ClusterLost:
+            raise
         except Exception as exc:
             if type(exc).__name__ in ("FutureCancelledError", "CancelledError"):
                 first = (str(exc).splitlines() or [""])[0]
