@@ -10,6 +10,12 @@ model.  Models are registered in :data:`BRDF_MODELS` and selected by name with
 :func:`get_model` (case-insensitive; colour-science's ``CanonicalMapping`` and
 ``validate_method`` style).
 
+Units: wavelengths (and layer thicknesses) in nm, angles in degree.  Every such
+argument of the functions of this package also takes an astropy Quantity, converted
+as the function's first step (a wavelength also from a frequency or wavenumber);
+a Quantity of another kind raises :class:`~sbrdf_xr.errors.UnitError` naming the
+argument (:func:`sbrdf_xr.units.to_unit`).  The arithmetic stays pure numpy.
+
 Adding a model is one module defining a :class:`Model` and its line in
 :data:`_REGISTERED` below (or, from outside the package, :func:`register_model`).
 

@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import geometry
 from ..errors import ValidationError
+from ..units import to_unit
 
 
 def _out_dtype(*arrays: ArrayLike) -> np.dtype:
@@ -36,8 +37,9 @@ def _cast_out(values: np.ndarray, dtype: np.dtype) -> np.ndarray:
 
 
 def _check_wavelength(wavelength: ArrayLike) -> NDArray[np.float64]:
-    """Validate the wavelength grid [nm]: 1-D (or scalar), finite, positive."""
-    wl = np.asarray(wavelength)
+    """Validate the wavelength grid [nm] (a Quantity is converted): 1-D (or scalar), finite,
+    positive."""
+    wl = np.asarray(to_unit(wavelength, "nm", "wavelength", spectral=True))
     if not (np.issubdtype(wl.dtype, np.number) and not np.iscomplexobj(wl)):
         raise ValidationError(f"wavelength: expected real numbers [nm], got dtype {wl.dtype}")
     wl = np.atleast_1d(wl).astype(np.float64)
@@ -137,10 +139,10 @@ def _cos_half(s: np.ndarray, o: np.ndarray) -> np.ndarray:
 
 
 def _check_angles(*named: tuple[str, ArrayLike]) -> list[np.ndarray]:
-    """Angles [degree] checked to be finite real numbers."""
+    """Angles [degree] (Quantities converted) checked to be finite real numbers."""
     arrays = []
     for name, a in named:
-        arr = np.asarray(a)
+        arr = np.asarray(to_unit(a, "deg", name))
         if not np.issubdtype(arr.dtype, np.number) or np.iscomplexobj(arr):
             raise ValidationError(f"{name}: expected real angles [degree], got dtype {arr.dtype}")
         if not np.all(np.isfinite(arr)):
@@ -167,7 +169,8 @@ def tangent_from_azimuth(psi: ArrayLike) -> np.ndarray:
     Parameters
     ----------
     psi : array_like
-        Azimuth of the illumination plane from the tangent [degree].
+        Azimuth of the illumination plane from the tangent [degree]; a Quantity is
+        converted.
 
     Returns
     -------
@@ -180,20 +183,20 @@ def tangent_from_azimuth(psi: ArrayLike) -> np.ndarray:
     >>> (np.round(tangent_from_azimuth([0.0, 90.0]), 6) + 0.0).tolist()
     [[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
     """
-    a = np.radians(np.asarray(psi, dtype=np.float64))
+    a = np.radians(np.asarray(to_unit(psi, "deg", "psi"), dtype=np.float64))
     return np.stack([-np.cos(a), np.sin(a), np.zeros_like(a)], axis=-1)
 
 
-def _check_theta_i(theta_i: ArrayLike) -> np.ndarray:
-    """Validate incidence angles [degree] in ``[0, 90]`` for hemispherical reflectances."""
-    ti = np.asarray(theta_i)
+def _check_theta_i(theta_i: ArrayLike, name: str = "theta_i") -> np.ndarray:
+    """Validate incidence angles [degree] (a Quantity is converted) in ``[0, 90]`` for
+    hemispherical reflectances."""
+    ti = np.asarray(to_unit(theta_i, "deg", name))
     if not np.issubdtype(ti.dtype, np.number) or np.iscomplexobj(ti):
-        raise ValidationError(f"theta_i: expected real angles [degree], got dtype {ti.dtype}")
+        raise ValidationError(f"{name}: expected real angles [degree], got dtype {ti.dtype}")
     ti = ti.astype(np.float64)
     if not np.all(np.isfinite(ti)) or np.any((ti < 0) | (ti > 90)):
         bad = ti[~(np.isfinite(ti) & (ti >= 0) & (ti <= 90))]
         raise ValidationError(
-            f"theta_i: got {bad.ravel()[:5].tolist()}; "
-            "allowed domain is 0 <= theta_i <= 90 [degree]"
+            f"{name}: got {bad.ravel()[:5].tolist()}; allowed domain is 0 <= {name} <= 90 [degree]"
         )
     return ti

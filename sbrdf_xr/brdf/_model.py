@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ValidationError
+from ..units import to_unit
 from ._common import (
     _angles_to_vectors,
     _band_param,
@@ -362,9 +363,15 @@ class Model:
 
         Parameters
         ----------
-        theta_i, delta_theta, phi, wavelength, psi, **kwargs
-            As :meth:`brdf_angles`, the angles (and ``psi``) as 1-D grids; a ``psi``
-            grid adds an axis before ``wavelength``.
+        theta_i, delta_theta, phi : array_like, 1-D
+            Grids of the paper-000 angles [degree].
+        wavelength : array_like, shape (n_wl,)
+            Vacuum wavelength [nm].
+        psi : array_like, 1-D, optional
+            A grid of tangent azimuths [degree] (anisotropic models): adds an axis
+            before ``wavelength``.
+        **kwargs
+            As :meth:`brdf_angles`.
         horizon : {"zero", "limit"}, default "zero"
             Treatment of the nodes that are not lit and visible.
 
@@ -392,7 +399,7 @@ class Model:
             named["psi"] = psi
         grids = []
         for name, a in named.items():
-            arr = np.asarray(a)
+            arr = np.asarray(to_unit(a, "deg", name))
             if arr.ndim != 1:
                 raise ValidationError(
                     f"{name}: expected a 1-D grid [degree], got shape {arr.shape}"

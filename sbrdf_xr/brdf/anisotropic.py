@@ -47,6 +47,7 @@ from ..errors import ValidationError
 from . import optics
 from ._common import (
     _cast_out,
+    _check_angles,
     _check_theta_i,
     _check_wavelength,
     _cos_half,
@@ -271,7 +272,7 @@ def directional_hemispherical_reflectance(
     wl = _check_wavelength(wavelength)
     p = MODEL.check_params(wl, **params)
     ti = _check_theta_i(theta_i)
-    ti, ps = np.broadcast_arrays(ti, np.asarray(psi, dtype=np.float64))
+    ti, ps = np.broadcast_arrays(ti, _check_angles(("psi", psi))[0].astype(np.float64))
     tx, wx = np.polynomial.legendre.leggauss(_N_U)
     x = 0.25 * np.pi * (tx + 1.0)  # [0, pi/2]
     wx = 0.25 * np.pi * wx

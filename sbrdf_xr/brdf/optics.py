@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ValidationError
+from ..units import to_unit
 from . import _fresnel_kernels
 from ._model import Parameter
 
@@ -75,7 +76,7 @@ _AL_OSC = np.array(  # f_j, Gamma_j [eV], omega_j [eV]
 
 
 def _check_wl(wavelength_nm: ArrayLike) -> NDArray[np.float64]:
-    wl = np.asarray(wavelength_nm)
+    wl = np.asarray(to_unit(wavelength_nm, "nm", "wavelength_nm", spectral=True))
     if not np.issubdtype(wl.dtype, np.number) or np.iscomplexobj(wl):
         raise ValidationError(f"wavelength_nm: expected real numbers [nm], got dtype {wl.dtype}")
     wl = wl.astype(np.float64)
@@ -444,7 +445,9 @@ def _stack_inputs(
 ) -> tuple[np.ndarray, list[tuple[np.ndarray, float]], np.ndarray, float]:
     """The checked inputs of a stack: wavelengths, ``(index, thickness)`` per layer (ambient
     side first, indices broadcast to the wavelengths), the substrate's index and ``n0``."""
-    wl = np.atleast_1d(np.asarray(wavelength, dtype=np.float64))
+    wl = np.atleast_1d(
+        np.asarray(to_unit(wavelength, "nm", "wavelength", spectral=True), dtype=np.float64)
+    )
     if wl.ndim != 1 or not np.all(np.isfinite(wl)) or np.any(wl <= 0):
         raise ValidationError(
             f"wavelength: expected a 1-D array of positive values [nm], got {wl!r}"
@@ -470,7 +473,7 @@ def _stack_inputs(
             raise ValidationError(
                 f"layers[{j}]: expected (index, thickness [nm]), got {layer!r}"
             ) from exc
-        d = float(thickness)
+        d = float(to_unit(thickness, "nm", f"layers[{j}] thickness"))
         if not (np.isfinite(d) and d >= 0):
             raise ValidationError(
                 f"layers[{j}] thickness: got {thickness!r}; allowed domain is thickness >= 0 [nm]"

@@ -202,7 +202,7 @@ def directional_emissivity(
     [[0.8931], [0.8561], [0.0185]]
     """
     p = MODEL.check_params(wavelength, **params)
-    t = _check_theta_i(theta)[..., None]
+    t = _check_theta_i(theta, "theta")[..., None]
     return p["epsilon"] * angular_g(t, p["b"]) / normalisation_G(p["b"])
 
 
@@ -290,7 +290,7 @@ def total_reflectance(
     >>> np.round(total_reflectance([0.0, 60.0], [4000.0], **TABLE4["AFGL-01"]), 4).tolist()
     [[0.1069], [0.1439]]
     """
-    return 1.0 - directional_emissivity(theta_i, wavelength, **params)
+    return 1.0 - directional_emissivity(_check_theta_i(theta_i), wavelength, **params)
 
 
 # --------------------------------------------------------------------------

@@ -3,7 +3,7 @@ r"""Angular functions of the Robertson–Sandford model (paper 001 §4, Eqs. 9, 
 The emissivity and diffuse shape ``g`` (Eq. 9) and its normalisation ``G`` (Eq. 10),
 the Trowbridge–Reitz structure function ``h`` (Eq. 16) and its normalisation ``H``
 (Eq. 18), the grazing cut-off ``c`` (Eq. 21) and the fraction of the specular lobe
-that the cut-off removes.  How each equation is read is stated in
+that the cut-off removes.  Angles are in degree (a Quantity is converted).  How each equation is read is stated in
 :mod:`sbrdf_xr.brdf.robertson_sandford`; the BRDF built from these functions is there.
 
 References
@@ -17,6 +17,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import special
+
+from ..units import to_unit
 
 __all__ = [
     "CUTOFF_ANGLE",
@@ -77,7 +79,7 @@ def angular_g(theta: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
     >>> np.round(angular_g([0.0, 45.0, 90.0], 0.5), 6).tolist()
     [1.0, 0.8, 0.0]
     """
-    t = np.radians(np.asarray(theta, dtype=np.float64))
+    t = np.radians(np.asarray(to_unit(theta, "deg", "theta"), dtype=np.float64))
     return _g_cs(np.cos(t) ** 2, np.sin(t) ** 2, np.asarray(b, dtype=np.float64))
 
 
@@ -145,7 +147,7 @@ def structure_h(alpha: ArrayLike, e: ArrayLike) -> NDArray[np.float64]:
     >>> np.round(structure_h([0.0, 90.0], 0.5), 6).tolist()  # e^-4 at the glint, 1 at 90 deg
     [16.0, 1.0]
     """
-    a = np.radians(np.asarray(alpha, dtype=np.float64))
+    a = np.radians(np.asarray(to_unit(alpha, "deg", "alpha"), dtype=np.float64))
     return _h_cs(np.cos(a) ** 2, np.sin(a) ** 2, np.asarray(e, dtype=np.float64))
 
 
@@ -192,7 +194,7 @@ def normalisation_H(theta_i: ArrayLike, e: ArrayLike) -> NDArray[np.float64]:
     >>> round(float(normalisation_H(30.0, 1.0)), 6)
     0.5
     """
-    ti = np.radians(np.asarray(theta_i, dtype=np.float64))
+    ti = np.radians(np.asarray(to_unit(theta_i, "deg", "theta_i"), dtype=np.float64))
     e = np.asarray(e, dtype=np.float64)
     return _e2_h_norm(np.cos(ti), e) / (e * e)
 
@@ -238,7 +240,7 @@ def cutoff_factor(theta_r: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
     >>> np.round(cutoff_factor([45.0, 85.0, 90.0], 0.12), 6).tolist()
     [1.0, 0.50781, 0.0]
     """
-    t = np.radians(np.asarray(theta_r, dtype=np.float64))
+    t = np.radians(np.asarray(to_unit(theta_r, "deg", "theta_r"), dtype=np.float64))
     return _cutoff_cs(np.cos(t), np.sin(t) ** 2, np.asarray(b, dtype=np.float64))
 
 
