@@ -1,5 +1,9 @@
 """Facet tangents and the azimuth ``psi`` of anisotropic materials.  Pure numpy.
 
+Arguments with a unit (``psi`` and its grids [degree]) also take an astropy Quantity,
+converted first (:func:`sbrdf_xr.units.to_unit`; another kind raises
+:class:`~sbrdf_xr.errors.UnitError`).
+
 An anisotropic material (brushed metal) reflects differently depending on how the
 illumination plane is turned about the facet normal relative to a direction fixed in
 the surface, the facet tangent ``t`` (the brushing direction, the direction of the
@@ -56,6 +60,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .errors import ValidationError
 from .geometry import _forward_direction, normal_incidence_tolerance, normalize
+from .units import to_unit
 
 __all__ = [
     "DEFAULT_TANGENT_DIRECTION",
@@ -246,12 +251,12 @@ def psi_weights(grid: ArrayLike, psi: ArrayLike) -> tuple[NDArray[np.intp], NDAr
     >>> idx.tolist(), w.tolist()
     ([[0, 1], [2, 0], [0, 1]], [[0.5, 0.5], [0.5, 0.5], [1.0, 0.0]])
     """
-    g = np.asarray(grid, dtype=np.float64)
+    g = np.asarray(to_unit(grid, "deg", "grid"), dtype=np.float64)
     if g.ndim != 1 or g.size == 0 or np.any(np.diff(g) <= 0) or g[0] < 0 or g[-1] > PSI_PERIOD:
         raise ValidationError(
             f"psi: grid must be strictly increasing in [0, 180] degree, got {g.tolist()}"
         )
-    x = np.asarray(psi, dtype=np.float64)
+    x = np.asarray(to_unit(psi, "deg", "psi"), dtype=np.float64)
     shape = x.shape
     x = x.ravel()
     if g.size == 1:
@@ -297,7 +302,7 @@ def psi_average(values: ArrayLike, grid: ArrayLike, axis: int = -1) -> NDArray[n
     >>> float(psi_average([1.0, 3.0, 1.0], [0.0, 90.0, 180.0]))
     2.0
     """
-    g = np.asarray(grid, dtype=np.float64)
+    g = np.asarray(to_unit(grid, "deg", "grid"), dtype=np.float64)
     psi_weights(g, g[:1])  # validates the grid
     v = np.moveaxis(np.asarray(values, dtype=np.float64), axis, -1)
     if g.size == 1:

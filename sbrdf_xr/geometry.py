@@ -3,7 +3,9 @@
 Pure, vectorised numpy: every function takes arrays whose last axis holds the
 three Cartesian components of a vector and broadcasts over all leading axes.
 The attitude (quaternion) helpers live in :mod:`sbrdf_xr.rotations` and are
-importable from here too.
+importable from here too.  Angles [degree] also come as astropy Quantities, converted
+first (:func:`sbrdf_xr.units.to_unit`; another kind raises
+:class:`~sbrdf_xr.errors.UnitError`).
 
 Angle convention (paper 000 §3.1, Fig. 4; DESIGN.md "Angle convention")
 -----------------------------------------------------------------------
@@ -388,7 +390,8 @@ def facet_vectors(
     >>> [round(float(x), 6) for x in facet_angles(n, s, o)[:3]]
     [30.0, 10.0, 0.0]
     """
-    ti, dt, ph = np.broadcast_arrays(*(_as_float(a) for a in (theta_i, delta_theta, phi)))
+    named = {"theta_i": theta_i, "delta_theta": delta_theta, "phi": phi}
+    ti, dt, ph = np.broadcast_arrays(*(_as_float(to_unit(a, "deg", k)) for k, a in named.items()))
     ti_r, ph_r = np.radians(ti), np.radians(ph)
     trp = ti_r + np.radians(dt)
     zeros = np.zeros_like(ti_r)
@@ -529,7 +532,8 @@ def from_conventional(
     >>> [round(float(x), 6) for x in from_conventional(30.0, 0.0, 40.0, 180.0)]
     [30.0, 10.0, 0.0]
     """
-    ti, pi_, tr, pr = (np.radians(_as_float(a)) for a in (theta_i, phi_i, theta_r, phi_r))
+    named = {"theta_i": theta_i, "phi_i": phi_i, "theta_r": theta_r, "phi_r": phi_r}
+    ti, pi_, tr, pr = (np.radians(_as_float(to_unit(a, "deg", k))) for k, a in named.items())
     ti, pi_, tr, pr = np.broadcast_arrays(ti, pi_, tr, pr)
     s = np.stack([np.sin(ti) * np.cos(pi_), np.sin(ti) * np.sin(pi_), np.cos(ti)], axis=-1)
     o = np.stack([np.sin(tr) * np.cos(pr), np.sin(tr) * np.sin(pr), np.cos(tr)], axis=-1)

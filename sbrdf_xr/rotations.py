@@ -8,6 +8,9 @@ An attitude is the rotation ``R`` that takes body-frame vectors to the reference
 observer directions given in the reference frame reach the body frame as ``R^T v``
 (:func:`to_body_frame`).  The names here are also importable from
 :mod:`sbrdf_xr.geometry`.
+
+Arguments with a unit (angles [degree]) also take an astropy Quantity, converted first
+(:func:`sbrdf_xr.units.to_unit`; another kind raises :class:`~sbrdf_xr.errors.UnitError`).
 """
 
 from __future__ import annotations
@@ -255,7 +258,7 @@ def rotation_sweep(
     >>> np.round(to_body_frame(q[25:26], [1.0, 0.0, 0.0]), 6) + 0.0
     array([[1., 0., 0.]])
     """
-    q = axis_rotation(axis, np.atleast_1d(angles))
+    q = axis_rotation(axis, np.atleast_1d(to_unit(angles, "deg", "angles")))
     if initial is None:
         return q
     return compose(q, np.asarray(initial, dtype=np.float64))
@@ -284,6 +287,7 @@ def euler_attitudes(sequence: str, angles: ArrayLike) -> NDArray[np.float64]:
     >>> euler_attitudes("ZYX", [[10.0, 20.0, 30.0], [0.0, 0.0, 0.0]]).shape
     (2, 4)
     """
+    angles = to_unit(angles, "deg", "angles")
     try:
         r = Rotation.from_euler(sequence, np.atleast_2d(np.asarray(angles, float)), degrees=True)
     except ValueError as exc:

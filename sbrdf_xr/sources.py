@@ -14,6 +14,9 @@ simulation need:
 * :func:`kirchhoff_emissivity`: directional emissivity from directional-hemispherical
   reflectance, and :func:`emissivity_at`, its linear interpolation in the emission
   angle.
+
+Arguments with a unit (wavelengths [nm], temperatures [K], angles [degree], distances [km]) also take an astropy Quantity, converted first
+(:func:`sbrdf_xr.units.to_unit`; another kind raises :class:`~sbrdf_xr.errors.UnitError`).
 """
 
 from __future__ import annotations
@@ -151,7 +154,7 @@ def moon_v_magnitude(phase_angle_deg: ArrayLike) -> NDArray[np.float64]:
     >>> moon_v_magnitude([0.0, 90.0, -90.0]).round(2).tolist()  # full and quarter Moons
     [-12.73, -10.13, -10.13]
     """
-    a = np.abs(np.asarray(phase_angle_deg, dtype=np.float64))
+    a = np.abs(np.asarray(to_unit(phase_angle_deg, "deg", "phase_angle_deg"), dtype=np.float64))
     return -12.73 + 0.026 * a + 4e-9 * a**4
 
 
@@ -195,7 +198,7 @@ def moonlight_irradiance_ratio(
     >>> f"{full:.3e}", round(float(quarter / full), 3)
     ('2.489e-06', 0.091)
     """
-    d = np.asarray(distance_km, dtype=np.float64)
+    d = np.asarray(to_unit(distance_km, "km", "distance_km"), dtype=np.float64)
     m = moon_v_magnitude(phase_angle_deg)
     ratio = 10.0 ** (-0.4 * (m - SUN_V_MAGNITUDE))
     return ratio * (MOON_MEAN_DISTANCE_KM / d) ** 2 * np.asarray(sun_distance_ratio) ** 2
@@ -259,8 +262,8 @@ def emissivity_at(
     >>> emissivity_at(eps, np.array([0.0, 90.0]), [45.0, 120.0]).round(6).tolist()
     [[0.7, 0.4], [0.6, 0.3]]
     """
-    grid = np.asarray(theta_grid, dtype=np.float64)
-    t = np.clip(np.asarray(theta, dtype=np.float64), grid[0], grid[-1])
+    grid = np.asarray(to_unit(theta_grid, "deg", "theta_grid"), dtype=np.float64)
+    t = np.clip(np.asarray(to_unit(theta, "deg", "theta"), dtype=np.float64), grid[0], grid[-1])
     if grid.size == 1:
         return np.broadcast_to(emissivity[0], (*t.shape, emissivity.shape[-1])).copy()
     i = np.clip(np.searchsorted(grid, t, side="right") - 1, 0, grid.size - 2)

@@ -7,6 +7,8 @@ Every public argument of the package that carries a unit names it (``range_km`` 
 * an astropy :class:`~astropy.units.Quantity` is converted to that unit (``1e6 * u.m``
   given as ``range_km`` is 1000 km; ``0.5 * u.rad`` as ``phase_deg`` is 28.6479 degree;
   wavelengths also from frequencies and wavenumbers, by astropy's spectral equivalency);
+* temperatures also from degrees Celsius or Fahrenheit (astropy's ``temperature``
+  equivalency);
 * a Quantity of another kind (a time given for a length) is refused with
   :class:`~sbrdf_xr.errors.UnitError`, naming the argument, the unit received and the
   unit expected;
@@ -151,7 +153,7 @@ def to_unit(value: Any, unit: str, what: str, *, spectral: bool = False) -> Any:
     import astropy.units as u
 
     target = u.Unit(unit) if unit else u.dimensionless_unscaled
-    equiv = u.spectral() if spectral else []
+    equiv = [*(u.spectral() if spectral else []), *u.temperature()]
     try:
         out = value.to_value(target, equivalencies=equiv)
     except (u.UnitConversionError, u.UnitsError, TypeError, ValueError):

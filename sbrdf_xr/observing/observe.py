@@ -21,6 +21,7 @@ from typing import Any, TypedDict
 import numpy as np
 
 from ..errors import ObservationError, did_you_mean
+from ..units import to_unit
 from . import attitude as _att
 from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, disc_overlap_fraction, sunlit_fraction
 from .observation import ATTRS, TIME, Observation
@@ -275,6 +276,15 @@ def bench_geometry(n_times: int = 3600, step_s: float = 1.0, repeats: int = 3) -
     skyfield data; it is reported apart from the best of ``repeats`` further calls on
     fresh observations (nothing cached between them).
 
+    Parameters
+    ----------
+    n_times : int
+        Times of the pass.
+    step_s : float
+        Their spacing [s]; a Quantity is converted.
+    repeats : int
+        Warm calls, the best of which is reported.
+
     Returns
     -------
     dict
@@ -287,6 +297,7 @@ def bench_geometry(n_times: int = 3600, step_s: float = 1.0, repeats: int = 3) -
     >>> sorted(row), row["n_times"]
     (['first_call_seconds', 'n_times', 'seconds', 'seconds_per_time'], 60.0)
     """
+    step_s = float(to_unit(step_s, "s", "step_s"))
     p = CANX1_PASS
     t0 = to_datetime64(p["start"], "start") - np.timedelta64(int(n_times * step_s / 2), "s")
     t = t0 + np.timedelta64(round(step_s * 1e9), "ns") * np.arange(n_times)
