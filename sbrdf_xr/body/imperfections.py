@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ValidationError
+from ..units import to_unit
 
 __all__ = ["tilt_quadrature", "tilted_normals"]
 
@@ -31,7 +32,8 @@ def tilt_quadrature(sigma_deg: float, n: int) -> tuple[NDArray[np.float64], NDAr
     Parameters
     ----------
     sigma_deg : float
-        Standard deviation of each tangent component of the tilt [degree], >= 0.
+        Standard deviation of each tangent component of the tilt [degree], >= 0; a
+        Quantity is converted.
     n : int
         Nodes per tangent axis, >= 1.
 
@@ -50,6 +52,7 @@ def tilt_quadrature(sigma_deg: float, n: int) -> tuple[NDArray[np.float64], NDAr
     >>> round(float(np.degrees(np.sqrt((w * (t**2).sum(1)).sum()))), 9)  # rms tilt sqrt(2) sigma
     2.828427125
     """
+    sigma_deg = to_unit(sigma_deg, "deg", "sigma_deg")
     if not (np.isfinite(sigma_deg) and sigma_deg >= 0):
         raise ValidationError(f"sigma: expected a finite tilt >= 0 degree, got {sigma_deg!r}")
     if isinstance(n, bool) or int(n) != n or n < 1:
@@ -75,7 +78,7 @@ def tilted_normals(normals: ArrayLike, tilts: ArrayLike) -> NDArray[np.float64]:
         Unit normals [1].
     tilts : array_like, shape (K, 2) or (F, K, 2)
         Tilt vectors [radian] along a deterministic tangent basis ``(e_1, e_2)`` of
-        each normal.
+        each normal; a Quantity is converted.
 
     Returns
     -------
@@ -98,7 +101,7 @@ def tilted_normals(normals: ArrayLike, tilts: ArrayLike) -> NDArray[np.float64]:
     10.0
     """
     n = np.asarray(normals, dtype=np.float64)
-    t = np.asarray(tilts, dtype=np.float64)
+    t = np.asarray(to_unit(tilts, "rad", "tilts"), dtype=np.float64)
     if t.ndim == 2:
         t = np.broadcast_to(t, (n.shape[0], *t.shape))
     # tangent basis: cross with the axis least aligned with n

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 import trimesh
 
+from ..units import to_unit
 from .facets import check_facet_material
 
 __all__ = ["plot_facets"]
@@ -53,7 +54,7 @@ def plot_facets(
     legend : bool
         Add a legend of the materials.
     elev, azim : float
-        View angles [degree].
+        View angles [degree]; a Quantity is converted.
 
     Returns
     -------
@@ -87,6 +88,7 @@ def plot_facets(
     from matplotlib.ticker import MaxNLocator
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
+    elev, azim = float(to_unit(elev, "deg", "elev")), float(to_unit(azim, "deg", "azim"))
     labels = check_facet_material(facet_material, len(mesh.faces))
     materials = sorted(set(labels.tolist()))
     if ax is None:

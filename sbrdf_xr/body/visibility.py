@@ -81,6 +81,7 @@ from numpy.typing import ArrayLike, NDArray
 from .._names import FACET, GEOMETRY, VECTOR, attrs
 from ..errors import ValidationError
 from ..geometry import normalize
+from ..units import to_unit
 from ..kernels.shadow import exact_kernel, facet_shadows
 from .rays import (
     MAX_RAYS_PER_CALL,
@@ -352,6 +353,7 @@ def escape_masks(
     n = check_density(density)
     engine = engine_name(engine)
     scale = float(mesh.scale)
+    offset = to_unit(offset, "m", "offset")
     if offset is None:
         offset = OFFSET_FACTOR * scale
     if not (np.isfinite(offset) and offset > 0):
@@ -406,6 +408,7 @@ def _fractions(
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """Fractions unobstructed along all ``directions`` at once, (n_geom, n_facets), and the
     standard error of the sampled estimate (zeros for the exact method) if asked."""
+    offset = to_unit(offset, "m", "offset")
     mesh_of(spacecraft)
     if _method(method) == "exact":
         check_density(density)
@@ -452,8 +455,9 @@ def lit_fraction(
         Ray engine of the sampled method (see :data:`~sbrdf_xr.body.rays.ENGINES`); None
         is ``"auto"``.
     offset : float, optional
-        Sampled method: lift of the ray origins along the facet normal [m]; default
-        :data:`~sbrdf_xr.body.rays.OFFSET_FACTOR` times the bounding-box diagonal.
+        Sampled method: lift of the ray origins along the facet normal [m] (a Quantity
+        is converted); default :data:`~sbrdf_xr.body.rays.OFFSET_FACTOR` times the
+        bounding-box diagonal.
     convex_shortcut : bool
         Skip the computation for convex spacecraft (the result is the same; False forces it,
         for testing).

@@ -15,6 +15,10 @@ towards the Earth's centre, ``asin(R_sun |M e| / |s'|)`` (``M`` the stretch, ``e
 direction), which puts the edges of the umbra and the penumbra where the tangent rays are
 (to the order of the Sun's angular radius times ``k - 1``, ``1.6e-5`` of it) and leaves the
 sunlit fraction inside the penumbra within ``k - 1 = 0.34 %`` of the solar disc's area.
+
+Positions and radii are in km, the angles of the discs in radians; an astropy Quantity
+is converted first (:func:`sbrdf_xr.units.to_unit`; another kind raises
+:class:`~sbrdf_xr.errors.UnitError`).
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._names import SHADOW_EVENTS
 from ..errors import ObservationError
+from ..units import to_unit
 
 __all__ = [
     "EARTH_MODELS",
@@ -76,7 +81,9 @@ def disc_overlap_fraction(a: ArrayLike, b: ArrayLike, c: ArrayLike) -> NDArray[n
     >>> disc_overlap_fraction([1.0, 1.0, 1.0], [2.0, 0.5, 0.5], [5.0, 0.0, 1.0])
     array([1.        , 0.75      , 0.88834752])
     """
-    a, b, c = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (a, b, c)))
+    a, b, c = np.broadcast_arrays(
+        *(np.asarray(to_unit(x, "rad", k), dtype=np.float64) for k, x in zip("abc", (a, b, c)))
+    )
     # The lens of the two discs, written with atan2 (never arccos near +-1, which loses
     # half the digits at the tangencies): the chord lies x1 = (c^2 + a^2 - b^2) / 2c from
     # the centre of disc a and x2 = c - x1 from that of disc b, its half-length is
@@ -139,8 +146,10 @@ def shadow_angles(
     """
     if earth not in EARTH_MODELS:
         raise ObservationError(f"earth: got {earth!r}; allowed: {', '.join(EARTH_MODELS)}")
-    r = np.asarray(position_km, dtype=np.float64)
-    s = np.asarray(sun_km, dtype=np.float64)
+    r = np.asarray(to_unit(position_km, "km", "position_km"), dtype=np.float64)
+    s = np.asarray(to_unit(sun_km, "km", "sun_km"), dtype=np.float64)
+    earth_radius_km = to_unit(earth_radius_km, "km", "earth_radius_km")
+    sun_radius_km = to_unit(sun_radius_km, "km", "sun_radius_km")
     factor: NDArray[np.float64] | float = 1.0
     if earth == "wgs84":
         p = np.asarray(pole, dtype=np.float64)
@@ -278,8 +287,10 @@ def shadow_events(
     if t.size < 2:
         return out
     secs = (t - t[0]).astype(np.int64) / 1e9
-    r = np.asarray(position_km, dtype=np.float64)
-    s = np.broadcast_to(np.asarray(sun_km, dtype=np.float64), r.shape)
+    r = np.asarray(to_unit(position_km, "km", "position_km"), dtype=np.float64)
+    s = np.broadcast_to(np.asarray(to_unit(sun_km, "km", "sun_km"), dtype=np.float64), r.shape)
+    earth_radius_km = to_unit(earth_radius_km, "km", "earth_radius_km")
+    sun_radius_km = to_unit(sun_radius_km, "km", "sun_radius_km")
     p = np.broadcast_to(np.asarray(pole, dtype=np.float64), r.shape)
     spline = CubicSpline(secs, np.concatenate([r, s, p], axis=1), axis=0)
 

@@ -16,6 +16,7 @@ from scipy.spatial.transform import Rotation
 
 from ..errors import AttitudeError, ValidationError
 from ..geometry import check_quaternions
+from ..units import to_unit
 
 #: Body axes by name.
 _AXES = {
@@ -177,6 +178,8 @@ class Context:
     sun_km : array_like, shape (n, 3)
         Position of the Sun relative to the spacecraft [km].
 
+    A Quantity is converted to the unit of its field.
+
     Examples
     --------
     >>> ctx = Context(epoch=np.datetime64("2024-03-17T01:20:00", "ns"),
@@ -190,6 +193,10 @@ class Context:
     position_km: NDArray[np.float64] | None = None
     velocity_km_s: NDArray[np.float64] | None = None
     sun_km: NDArray[np.float64] | None = None
+
+    def __post_init__(self) -> None:
+        for name, unit in (("position_km", "km"), ("velocity_km_s", "km / s"), ("sun_km", "km")):
+            object.__setattr__(self, name, to_unit(getattr(self, name), unit, name))
 
 
 def seconds_since(
