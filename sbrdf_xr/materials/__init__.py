@@ -3,6 +3,11 @@
 A material is a labelled :class:`xarray.DataArray` over ``(theta_i, delta_theta, phi,
 wavelength)`` (paper 000 §3.1) or a model parameter set (paper 001 §4).
 
+Angles are in degree, wavelengths (and layer thicknesses) in nm.  Every such argument
+of the functions of this package also takes an astropy Quantity, converted first (a
+wavelength also from a frequency or wavenumber); one of another kind raises
+:class:`~sbrdf_xr.errors.UnitError` naming the argument (:func:`sbrdf_xr.units.to_unit`).
+
 Modules
 -------
 ``schema``

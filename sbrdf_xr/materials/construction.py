@@ -4,7 +4,8 @@ Grids, interpolation weights, steps 1 and 2 per measured incidence angle, the
 model blend and the azimuthal average at normal incidence.
 
 :func:`sbrdf_xr.materials.tables.build_lut` drives it on xarray objects; everything here takes and
-returns plain arrays.
+returns plain arrays.  Angles [degree] also come as astropy Quantities, converted first
+(:func:`sbrdf_xr.units.to_unit`; another kind raises :class:`~sbrdf_xr.errors.UnitError`).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ValidationError
+from ..units import to_unit
 from ..kernels import lut as _lut
 
 
@@ -36,6 +38,7 @@ def paper_phi_grid(phi_max: float, n: int = 21) -> np.ndarray:
     >>> paper_phi_grid(10.0, 5)
     array([ 0. ,  2.5,  5. ,  7.5, 10. ])
     """
+    phi_max = to_unit(phi_max, "deg", "phi_max")
     if not phi_max > 0:
         raise ValidationError(f"phi_max: must be > 0 degree, got {phi_max}")
     return np.linspace(0.0, float(phi_max), n)
@@ -68,6 +71,7 @@ def paper_delta_theta_grid(dt_min: float, dt_max: float, n: int = 21) -> np.ndar
     >>> paper_delta_theta_grid(-40.0, 30.0).size
     21
     """
+    dt_min, dt_max = to_unit(dt_min, "deg", "dt_min"), to_unit(dt_max, "deg", "dt_max")
     if not (dt_min < 0 < dt_max):
         raise ValidationError(
             "delta_theta: measured extent must straddle specular (min < 0 < max), "

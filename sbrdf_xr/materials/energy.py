@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike
 from .._names import ANGLE_DIMS, PSI, THETA_I, WAVELENGTH, attrs
 from ..anisotropy import psi_weights
 from ..errors import NonPhysicalWarning
+from ..units import to_unit
 from ..kernels import lut as _lut
 from .schema import validate_material
 
@@ -77,6 +78,7 @@ def hemispherical_reflectance(
     """
     material = validate_material(material, check_values=False)
     grids = [np.asarray(material[d].values) for d in ANGLE_DIMS]
+    theta_i = to_unit(theta_i, "deg", "theta_i")
     ti = grids[0] if theta_i is None else np.atleast_1d(np.asarray(theta_i, dtype=np.float64))
 
     def kernel(values: np.ndarray) -> np.ndarray:

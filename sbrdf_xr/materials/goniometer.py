@@ -17,6 +17,9 @@ specular until the signal falls below the noise floor, within what the apparatus
 can reach (the observer above ``max_theta_r`` is too close to the horizon; closer
 than ``min_phase_angle`` to the source it obscures the beam).
 
+Angles [degree] and wavelengths [nm] also come as astropy Quantities, converted first
+(:func:`sbrdf_xr.units.to_unit`; another kind raises :class:`~sbrdf_xr.errors.UnitError`).
+
 The sampled material is the ground truth, so the error of a look-up table built
 from the measurement set (:func:`sbrdf_xr.materials.tables.build_lut`) is measurable.
 """
@@ -31,6 +34,7 @@ from numpy.typing import ArrayLike
 
 from .._names import DELTA_THETA, MEASURED, PHI, SAMPLE, THETA_I, WAVELENGTH, attrs
 from ..errors import ValidationError
+from ..units import to_unit
 
 __all__ = ["PAPER_THETA_I", "measure", "paper_scheme", "scheme_extents"]
 
@@ -92,7 +96,9 @@ def paper_scheme(
     >>> ref[:4]
     array([False, False, False,  True])
     """
-    phi_max = np.asarray(phi_max, dtype=np.float64)
+    theta_i = to_unit(theta_i, "deg", "theta_i")
+    dt_min, dt_max = to_unit(dt_min, "deg", "dt_min"), to_unit(dt_max, "deg", "dt_max")
+    phi_max = np.asarray(to_unit(phi_max, "deg", "phi_max"), dtype=np.float64)
     if phi_max.shape != (7,):
         raise ValidationError(f"phi_max: need one extent per row (7), got shape {phi_max.shape}")
     if not (dt_min < 0 < dt_max):
@@ -186,6 +192,11 @@ def scheme_extents(
     >>> round(dt_min, 6), round(dt_max, 6), phi_max.shape, bool(in_noise.all())
     (-22.8, 22.8, (7,), True)
     """
+    theta_i = float(to_unit(theta_i, "deg", "theta_i"))
+    max_theta_r = float(to_unit(max_theta_r, "deg", "max_theta_r"))
+    min_phase_angle = float(to_unit(min_phase_angle, "deg", "min_phase_angle"))
+    max_phi = float(to_unit(max_phi, "deg", "max_phi"))
+    step = float(to_unit(step, "deg", "step"))
 
     def band(ti: float, dt: np.ndarray, ph: np.ndarray) -> np.ndarray:
         return np.mean(func(np.full(dt.shape, ti), dt, ph), axis=-1)
@@ -270,8 +281,8 @@ def measure(
     >>> sorted(meas.coords)
     ['delta_theta', 'phi', 'reference', 'theta_i', 'wavelength']
     """
-    wl = np.asarray(wavelength, dtype=np.float64)
-    tis = np.asarray(theta_i, dtype=np.float64)
+    wl = np.asarray(to_unit(wavelength, "nm", "wavelength", spectral=True), dtype=np.float64)
+    tis = np.asarray(to_unit(theta_i, "deg", "theta_i"), dtype=np.float64)
     if tis.size == 0:
         raise ValidationError("theta_i: need at least one incidence angle")
     if noise < 0:

@@ -31,6 +31,7 @@ from .. import brdf as _brdf
 from .._names import WAVELENGTH, attrs
 from ..brdf import Model
 from ..errors import ValidationError
+from ..units import check_wavelengths, to_unit
 from .files import naming_file, read_netcdf, write_netcdf_atomic
 
 __all__ = [
@@ -90,7 +91,8 @@ def model_material(
     (('wavelength',), '1', 'model:lambert')
     """
     m = _brdf.get_model(model)
-    wl = np.asarray(wavelength, dtype=np.float64)
+    wl = np.asarray(to_unit(wavelength, "nm", "wavelength", spectral=True), dtype=np.float64)
+    check_wavelengths(wl, "wavelength")
     checked = m.check_params(wl, **params)
     data: dict[str, Any] = {k: (WAVELENGTH, v, m.parameter(k).attrs) for k, v in checked.items()}
     if layers:
@@ -117,7 +119,9 @@ def _stack_variables(
             f"{' has' if len(with_stack) == 1 else 's have'} a thin-film stack, not {m.name!r}"
         )
     idx = np.stack([np.broadcast_to(np.asarray(n, np.complex128), wl.shape) for n, _ in layers])
-    thick = np.array([float(t) for _, t in layers])
+    thick = np.array(
+        [float(to_unit(t, "nm", f"layers[{j}] thickness")) for j, (_, t) in enumerate(layers)]
+    )
     rows = {"layer_n": idx.real, "layer_k": idx.imag, "layer_thickness": thick[None]}
     out = {}
     for name, v in rows.items():

@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike
 from .._names import ANISO_LUT_DIMS, DELTA_THETA, PHI, PSI, SBRDF, THETA_I, WAVELENGTH, attrs
 from ..brdf import Model
 from ..errors import ValidationError
+from ..units import to_unit
 from .model_schema import ModelParameters, model_material, model_parameters, open_model, to_netcdf
 from .schema import new_material
 
@@ -159,6 +160,8 @@ def render(
     >>> bool(np.allclose(lut * np.pi, 0.5, rtol=1e-12))
     True
     """
+    theta_i, phi = to_unit(theta_i, "deg", THETA_I), to_unit(phi, "deg", PHI)
+    delta_theta = to_unit(delta_theta, "deg", DELTA_THETA)
     m, wl, kw = model_parameters(spec)
     ti = np.arange(0.0, 91.0) if theta_i is None else np.asarray(theta_i, dtype=np.float64)
     dt = (
@@ -271,7 +274,8 @@ def render_anisotropic(
     m, wl, kw = model_parameters(spec)
     if not m.anisotropic:
         raise ValidationError(f"model {m.name!r} is isotropic: use render")
-    grids = [np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi, psi)]
+    named = {THETA_I: theta_i, DELTA_THETA: delta_theta, PHI: phi, PSI: psi}
+    grids = [np.asarray(to_unit(a, "deg", k), dtype=np.float64) for k, a in named.items()]
     for name, g in zip((THETA_I, DELTA_THETA, PHI, PSI), grids, strict=True):
         if g.ndim != 1 or g.size == 0 or np.any(np.diff(g) <= 0):
             raise ValidationError(
@@ -339,6 +343,8 @@ def render_values(
     >>> v.shape, np.round(v.ravel() * np.pi, 6).tolist()
     ((2, 1, 2, 1), [0.5, 0.5, 0.5, 0.5])
     """
+    ti, dt, ph = (to_unit(a, "deg", k) for k, a in (("ti", ti), ("dt", dt), ("ph", ph)))
+    wl = to_unit(wl, "nm", "wl", spectral=True)
     return model.render_grid(ti, dt, ph, wl, horizon="limit", **kw)
 
 

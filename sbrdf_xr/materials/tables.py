@@ -45,6 +45,7 @@ from .._names import (
 )
 from ..anisotropy import PSI_PERIOD, psi_weights
 from ..errors import ValidationError
+from ..units import to_unit
 from ..kernels import lut as _lut
 from .build import build_lut
 from .construction import paper_delta_theta_grid, paper_phi_grid
@@ -153,7 +154,7 @@ def lookup(
     angles = []
     for name, a in ((THETA_I, theta_i), (DELTA_THETA, delta_theta), (PHI, phi)):
         if not isinstance(a, xr.DataArray):
-            arr = np.asarray(a, dtype=np.float64)
+            arr = np.asarray(to_unit(a, "deg", name), dtype=np.float64)
             a = xr.DataArray(arr, dims=[f"dim_{k}" for k in range(arr.ndim)])
         if a.chunks is None and not np.all(np.isfinite(a.values)):
             raise ValidationError(f"{name}: query angles contain NaN or infinite values")
@@ -245,8 +246,9 @@ def lookup_anisotropic(
             f"got {getattr(material, 'dims', type(material).__name__)}"
         )
     material = material.transpose(*ANISO_LUT_DIMS)
+    named = {THETA_I: theta_i, DELTA_THETA: delta_theta, PHI: phi, PSI: psi}
     ti, dt, ph, ps = np.broadcast_arrays(
-        *(np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi, psi))
+        *(np.asarray(to_unit(a, "deg", k), dtype=np.float64) for k, a in named.items())
     )
     grid = np.asarray(material[PSI].values, dtype=np.float64)
     idx, w = psi_weights(grid, ps.ravel())
