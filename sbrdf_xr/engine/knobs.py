@@ -28,6 +28,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..errors import SceneError
+from ..units import to_unit
 
 __all__ = ["KNOBS", "PRESETS", "Knob", "apply_preset", "check_knob", "knob_table"]
 
@@ -58,7 +59,8 @@ class Knob:
     none : str or None
         What None means, when None is allowed.
     unit : str
-        Unit of a number (``"degree"``, ``"byte"``).
+        Unit of a number (``"degree"``, ``"byte"``): an astropy Quantity given for the
+        knob is converted to it (:meth:`convert`).
 
     Examples
     --------
@@ -99,6 +101,22 @@ class Knob:
         """Its allowed values, in words."""
         what = ", ".join(map(str, self.allowed)) if self.allowed is not None else self._range()
         return what if self.none is None else f"none ({self.none}) or {what}"
+
+    def convert(self, value: Any) -> Any:
+        """``value`` in :attr:`unit`: a Quantity converted (an integral value of an integer
+        knob made an int), anything else unchanged.
+
+        Raises
+        ------
+        UnitError
+            For a Quantity of another kind, naming the knob.
+        """
+        if not self.unit:
+            return value
+        out = to_unit(value, self.unit, self.name)
+        if self.kind is int and isinstance(out, float) and out.is_integer():
+            return int(out)
+        return out
 
     def check(self, value: Any) -> str | None:
         """An error text for ``value``, or None when the value is allowed."""
@@ -241,18 +259,24 @@ PRESETS: dict[str, dict[str, Any]] = {
 
 
 def check_knob(name: str, value: Any) -> Any:
-    """Validate one knob value.
+    """Validate one knob value; returns it in the knob's unit (a Quantity converted,
+    :meth:`Knob.convert`).
 
     Raises
     ------
     SceneError
         Unknown knob, or a value outside what it allows.
+    UnitError
+        A Quantity of another kind than the knob's unit.
 
     Examples
     --------
     >>> from sbrdf_xr.engine.knobs import check_knob
     >>> check_knob("dtype", "float32")
     'float32'
+    >>> import astropy.units as u
+    >>> check_knob("table_theta_step", 0.05 * u.rad)  # a Quantity: in the knob's unit
+    2.8647889756541165
     >>> check_knob("dtype", "float16")
     Traceback (most recent call last):
     ...
@@ -262,6 +286,7 @@ def check_knob(name: str, value: Any) -> Any:
         knob = KNOBS[name]
     except KeyError:
         raise SceneError(f"unknown knob {name!r}; knobs: {', '.join(KNOBS)}") from None
+    value = knob.convert(value)
     why = knob.check(value)
     if why:
         raise SceneError(f"{name}: got {value!r}; {why}")

@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike
 from .. import catalog, geometry
 from ..errors import CatalogError, SceneError, ValidationError, did_you_mean
 from ..materials.tables import validate_material
-from ..units import check_plausible
+from ..units import check_plausible, to_unit
 from .effects import DEFAULT_EFFECTS, SCENE_EFFECTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS, scene_effects
 from .knobs import KNOBS, PRESETS, apply_preset, check_knob
 from .plan import Plan, compile_plan
@@ -83,6 +83,27 @@ def _unit_vectors(v: ArrayLike, name: str) -> np.ndarray:
             f"directions must be unit vectors (|length - 1| <= {_UNIT_TOL})"
         )
     return arr / norm[:, None]
+
+
+#: Scene fields with a unit: a Quantity (or a mapping of them per material) is converted.
+_UNITS = {
+    "phase_angles": "deg",
+    "attitude_angle": "deg",
+    "surface_tilt": "deg",
+    "earth_range_km": "km",
+    "earth_phase_angle": "deg",
+    "temperature": "K",
+}
+
+
+def _in_units(scene: Scene) -> None:
+    for name, unit in _UNITS.items():
+        v = getattr(scene, name)
+        if isinstance(v, Mapping):
+            v = {m: to_unit(x, unit, f"{name}[{m!r}]") for m, x in v.items()}
+        object.__setattr__(scene, name, to_unit(v, unit, name))
+    for k in KNOBS:  # in the knob's unit (table_theta_step [degree], block_bytes [byte])
+        object.__setattr__(scene, k, check_knob(k, getattr(scene, k)))
 
 
 def _optional_array(v: ArrayLike | None) -> np.ndarray | None:
@@ -177,6 +198,11 @@ class Scene:
     name, description : str
         Labels stored in the output.
 
+    Every number with a unit (the angles [degree], ``earth_range_km`` [km],
+    ``temperature`` [K], the knobs with a unit) also takes an astropy Quantity, converted
+    when the scene is made; one of another kind raises :class:`~sbrdf_xr.errors.UnitError`
+    naming the field.
+
     Examples
     --------
     A unit cube of one Lambertian material at one attitude and two phase angles:
@@ -251,14 +277,13 @@ class Scene:
     _cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
+        _in_units(self)
         bad = [o for o in self.outputs if o not in OUTPUTS]
         if bad:
             raise SceneError(f"outputs: unknown {bad}; allowed: {', '.join(OUTPUTS)}")
         bad = [e for e in self.effects if e not in EFFECTS]
         if bad:
             raise SceneError(f"effects: unknown {bad}; allowed: {', '.join(EFFECTS)}")
-        for k in KNOBS:
-            check_knob(k, getattr(self, k))
         tilts = (
             self.surface_tilt.values()
             if isinstance(self.surface_tilt, Mapping)

@@ -11,6 +11,7 @@ import numpy as np
 import xarray as xr
 
 from ..errors import InversionError
+from ..units import check_plausible, to_unit
 from ._spin_data import LN10_2P5
 
 __all__ = ["band_terms", "magnitudes_to_signal", "measured_kind", "read_spectrum"]
@@ -71,6 +72,13 @@ def magnitudes_to_signal(
     Inverts :func:`sbrdf_xr.photometry.magnitudes` at 1 AU:
     ``S = d**2 10**(-0.4 (m - m_sun))``, ``sigma_S = S ln(10)/2.5 sigma_m``.
 
+    Parameters
+    ----------
+    light_curve : Dataset
+        ``magnitude`` and ``uncertainty`` over ``band``.
+    range_km : float
+        Observer range [km]; a Quantity is converted.
+
     Examples
     --------
     V = 8 at 1000 km with the Sun's V = -26.768: ``S = 1e12 * 10**(-0.4 * 34.768)``:
@@ -87,8 +95,10 @@ def magnitudes_to_signal(
     """
     from ..photometry import sun_magnitudes
 
+    range_km = to_unit(range_km, "km", "range_km")
     if not np.isfinite(range_km) or range_km <= 0:
         raise InversionError(f"range_km: must be finite and > 0, got {range_km}")
+    check_plausible(range_km, "range_km", "range_km")
     bands = [str(b) for b in light_curve["band"].values]
     if len(set(bands)) != len(bands):
         raise InversionError(

@@ -17,6 +17,7 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from ..errors import FitQualityWarning, InversionError
+from ..units import to_unit
 from ._quality import fit_quality
 from ._spin_data import light_curve_fluxes, spin_geometry
 from ._spin_refine import Minimum, axis_angle, exact_minimum, twins
@@ -259,7 +260,7 @@ def fit_spin(
         Inertial directions from the spacecraft to the Sun and to the observer, fixed or
         one per distinct time (sorted).
     periods : array_like
-        Candidate spin periods [s].
+        Candidate spin periods [s]; a Quantity is converted.
     axis_body : array_like, shape (3,)
         The body axis the spacecraft spins about (nonzero).
     n_axes, n_phases : int
@@ -348,6 +349,7 @@ def fit_spin(
     >>> [w.category.__name__ for w in caught], fit.attrs["ambiguity"][:48]
     (['FitQualityWarning'], 'the data do not tell the solution from its twins')
     """
+    periods = to_unit(periods, "s", "periods")
     t_start = time.perf_counter()
     if method not in ("auto", *METHODS):
         raise InversionError(f"method: {method!r}; allowed 'auto', {', '.join(map(repr, METHODS))}")
@@ -547,6 +549,17 @@ def period_grid(p_min: float, p_max: float, span_s: float, n_phases: int = 16) -
     ``n_phases`` grid between neighbours: ``dP = P**2 / (n_phases span_s)`` (the search
     defines the phase at the middle of the light curve), growing with ``P``.
 
+    Parameters
+    ----------
+    p_min, p_max : float
+        The range of periods [s].
+    span_s : float
+        Time span of the light curve [s].
+    n_phases : int
+        Phases of the search grid.
+
+    A Quantity is converted.
+
     Examples
     --------
     >>> from sbrdf_xr.invert import period_grid
@@ -554,6 +567,8 @@ def period_grid(p_min: float, p_max: float, span_s: float, n_phases: int = 16) -
     >>> grid.size, grid[:3].round(3).tolist()
     (11, [60.0, 60.938, 61.905])
     """
+    p_min, p_max = to_unit(p_min, "s", "p_min"), to_unit(p_max, "s", "p_max")
+    span_s = to_unit(span_s, "s", "span_s")
     if not (0 < p_min <= p_max and np.isfinite(p_max) and span_s > 0 and n_phases >= 1):
         raise InversionError(
             f"period_grid: need 0 < p_min <= p_max, span_s > 0 and n_phases >= 1, got "
@@ -570,6 +585,11 @@ def period_grid(p_min: float, p_max: float, span_s: float, n_phases: int = 16) -
 def axis_vector(longitude: ArrayLike, latitude: ArrayLike) -> np.ndarray:
     """Unit vector(s) of an axis at ``longitude``, ``latitude`` [degree], shape (..., 3).
 
+    Parameters
+    ----------
+    longitude, latitude : array_like
+        Direction of the axis [degree] (a Quantity is converted), broadcast together.
+
     Examples
     --------
     >>> from sbrdf_xr.invert import axis_vector
@@ -578,7 +598,8 @@ def axis_vector(longitude: ArrayLike, latitude: ArrayLike) -> np.ndarray:
     >>> axis_vector([0.0, 0.0], [0.0, 90.0]).round(6).tolist()
     [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
     """
-    return vec(np.asarray(longitude, dtype=np.float64), np.asarray(latitude, dtype=np.float64))
+    lon = np.asarray(to_unit(longitude, "deg", "longitude"), dtype=np.float64)
+    return vec(lon, np.asarray(to_unit(latitude, "deg", "latitude"), dtype=np.float64))
 
 
 def axis_separation(a: ArrayLike, b: ArrayLike) -> float:

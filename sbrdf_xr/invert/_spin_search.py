@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike
 
 from ..errors import InversionError
 from ..kernels import sums as _kernels
+from ..units import to_unit
 from ._spin_data import SpinGeometry
 
 __all__ = [
@@ -108,6 +109,19 @@ def spin_model(
     ``axis_body`` to the inertial ``axis`` by the shortest arc, angle ``phase_deg`` at
     ``epoch`` (UTC; default t = 0, or the start of an observation).
 
+    Parameters
+    ----------
+    axis_body : array_like, shape (3,)
+        The body's spin axis.
+    axis : array_like, shape (3,)
+        Its inertial direction.
+    period_s : float
+        Spin period [s]; a Quantity is converted.
+    phase_deg : float
+        Spin angle at ``epoch`` [degree]; a Quantity is converted.
+    epoch : optional
+        UTC time of ``phase_deg``.
+
     Examples
     --------
     A body spinning about its z axis once a minute, that axis pointing along inertial x:
@@ -129,8 +143,8 @@ def spin_model(
     q = Rotation.from_matrix(m).as_quat()
     return Spin(
         axis_body=np.asarray(axis_body, float),
-        rate_deg_s=360.0 / float(period_s),
-        phase_deg=float(phase_deg),
+        rate_deg_s=360.0 / float(to_unit(period_s, "s", "period_s")),
+        phase_deg=float(to_unit(phase_deg, "deg", "phase_deg")),
         initial=q,
         epoch=epoch,
     )

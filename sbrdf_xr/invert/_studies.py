@@ -15,6 +15,7 @@ import numpy as np
 import xarray as xr
 
 from ..errors import FitQualityWarning, InversionError
+from ..units import to_unit
 from ._unmix import MATERIAL, unmix
 
 __all__ = ["spin_recovery", "unmix_calibration"]
@@ -140,6 +141,31 @@ def spin_recovery(
     succeeds when the axis is within ``axis_tolerance_deg`` and the period within
     ``period_tolerance_sigma`` of its stated uncertainty.
 
+    Parameters
+    ----------
+    spacecraft : Spacecraft
+        The body.
+    observation : Observation
+        The pass, its attitude the truth.
+    periods : sequence of float
+        Candidate periods of the fits [s].
+    bands : sequence of str
+        Bands simulated and fitted.
+    relative_noise : float
+        Noise relative to the flux (see above).
+    n_draws, seed : int
+        Noise draws and the seed of the first.
+    times : array_like of datetime64, optional
+        The times measured.
+    axis_tolerance_deg : float
+        Largest axis error of a success [degree].
+    period_tolerance_sigma : float
+        Largest period error of a success, in its uncertainties.
+    **options
+        Passed on to :func:`fit_spin`.
+
+    A Quantity is converted to the unit of its argument.
+
     Returns
     -------
     xarray.Dataset
@@ -164,6 +190,8 @@ def spin_recovery(
     >>> study.sizes["draw"], study.attrs["truth_period"]
     (2, 90.0)
     """
+    periods = to_unit(periods, "s", "periods")
+    axis_tolerance_deg = to_unit(axis_tolerance_deg, "deg", "axis_tolerance_deg")
     import os
 
     from ..engine import Scene, simulate

@@ -49,6 +49,7 @@ from scipy import constants
 from ..._names import WAVELENGTH
 from ...geometry import rotation_matrices
 from ...sources import MOON_RADIUS_KM, moonlight_irradiance_ratio
+from ...units import to_unit
 from .base import BlockInputs, Decision, Effect, Output, PlanInputs, facet_fraction, reflected
 
 if TYPE_CHECKING:
@@ -110,6 +111,8 @@ def moon_from_spacecraft(
     earth : {"wgs84", "sphere"}
         The Earth that hides the Moon and casts its shadow.
 
+    A Quantity is converted to the unit of its argument.
+
     Returns
     -------
     dict of str to ndarray
@@ -151,9 +154,9 @@ def moon_from_spacecraft(
     from ...observing import skyfield_data, skyfield_utc, spline_knots, sunlit_fraction
 
     t64 = np.asarray(times, dtype="datetime64[ns]")
-    r = np.asarray(position_km, dtype=np.float64)
-    v = np.asarray(velocity_km_s, dtype=np.float64)
-    sun = np.asarray(sun_km, dtype=np.float64)
+    r = np.asarray(to_unit(position_km, "km", "position_km"), dtype=np.float64)
+    v = np.asarray(to_unit(velocity_km_s, "km / s", "velocity_km_s"), dtype=np.float64)
+    sun = np.asarray(to_unit(sun_km, "km", "sun_km"), dtype=np.float64)
     _, eph = skyfield_data()
     start = t64.min()
     secs, knots = spline_knots(np.array([start, t64.max()]))
