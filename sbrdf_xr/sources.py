@@ -15,8 +15,9 @@ simulation need:
   reflectance, and :func:`emissivity_at`, its linear interpolation in the emission
   angle.
 
-Arguments with a unit (wavelengths [nm], temperatures [K], angles [degree], distances [km]) also take an astropy Quantity, converted first
-(:func:`sbrdf_xr.units.to_unit`; another kind raises :class:`~sbrdf_xr.errors.UnitError`).
+Arguments with a unit (wavelengths [nm], temperatures [K], angles [degree], distances
+[km]) also take an astropy Quantity, converted first (:func:`sbrdf_xr.units.to_unit`;
+another kind raises :class:`~sbrdf_xr.errors.UnitError`).
 """
 
 from __future__ import annotations

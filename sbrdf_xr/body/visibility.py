@@ -81,8 +81,8 @@ from numpy.typing import ArrayLike, NDArray
 from .._names import FACET, GEOMETRY, VECTOR, attrs
 from ..errors import ValidationError
 from ..geometry import normalize
-from ..units import to_unit
 from ..kernels.shadow import exact_kernel, facet_shadows
+from ..units import to_unit
 from .rays import (
     MAX_RAYS_PER_CALL,
     OFFSET_FACTOR,

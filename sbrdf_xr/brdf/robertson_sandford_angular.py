@@ -3,8 +3,9 @@ r"""Angular functions of the Robertson–Sandford model (paper 001 §4, Eqs. 9, 
 The emissivity and diffuse shape ``g`` (Eq. 9) and its normalisation ``G`` (Eq. 10),
 the Trowbridge–Reitz structure function ``h`` (Eq. 16) and its normalisation ``H``
 (Eq. 18), the grazing cut-off ``c`` (Eq. 21) and the fraction of the specular lobe
-that the cut-off removes.  Angles are in degree (a Quantity is converted).  How each equation is read is stated in
-:mod:`sbrdf_xr.brdf.robertson_sandford`; the BRDF built from these functions is there.
+that the cut-off removes.  Angles are in degree (a Quantity is converted).  How each
+equation is read is stated in :mod:`sbrdf_xr.brdf.robertson_sandford`; the BRDF built
+from these functions is there.
 
 References
 ----------

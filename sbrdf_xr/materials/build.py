@@ -21,8 +21,8 @@ from numpy.typing import ArrayLike
 
 from .._names import DELTA_THETA, MEASURED, PHI, SAMPLE, THETA_I, WAVELENGTH
 from ..errors import NonPhysicalWarning, ValidationError
-from ..units import to_unit
 from ..kernels import lut as _lut
+from ..units import to_unit
 from . import models
 from ._jobs import _by_rows, _Done, _Job, _Parts
 from .construction import (
@@ -249,7 +249,10 @@ def build_lut(
     True
     """
     theta_i = to_unit(theta_i, "deg", "theta_i")
-    blend, blend_normal = to_unit(blend, "deg", "blend"), to_unit(blend_normal, "deg", "blend_normal")
+    blend, blend_normal = (
+        to_unit(blend, "deg", "blend"),
+        to_unit(blend_normal, "deg", "blend_normal"),
+    )
     ds = validate_measurements(measurements, duplicates=duplicates)
     if duplicates == "mean":
         ds = average_duplicates(ds)

@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ValidationError
-from ..units import to_unit
 from ..kernels import lut as _lut
+from ..units import to_unit
 
 
 def paper_phi_grid(phi_max: float, n: int = 21) -> np.ndarray:

@@ -17,8 +17,8 @@ from numpy.typing import ArrayLike
 from .._names import ANGLE_DIMS, PSI, THETA_I, WAVELENGTH, attrs
 from ..anisotropy import psi_weights
 from ..errors import NonPhysicalWarning
-from ..units import to_unit
 from ..kernels import lut as _lut
+from ..units import to_unit
 from .schema import validate_material
 
 __all__ = ["ENERGY_TOL", "hemispherical_reflectance"]

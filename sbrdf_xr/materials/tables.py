@@ -45,8 +45,8 @@ from .._names import (
 )
 from ..anisotropy import PSI_PERIOD, psi_weights
 from ..errors import ValidationError
-from ..units import to_unit
 from ..kernels import lut as _lut
+from ..units import to_unit
 from .build import build_lut
 from .construction import paper_delta_theta_grid, paper_phi_grid
 from .files import open_material, open_measurements, to_netcdf, write_netcdf_atomic

@@ -82,7 +82,10 @@ def disc_overlap_fraction(a: ArrayLike, b: ArrayLike, c: ArrayLike) -> NDArray[n
     array([1.        , 0.75      , 0.88834752])
     """
     a, b, c = np.broadcast_arrays(
-        *(np.asarray(to_unit(x, "rad", k), dtype=np.float64) for k, x in zip("abc", (a, b, c)))
+        *(
+            np.asarray(to_unit(x, "rad", k), dtype=np.float64)
+            for k, x in zip("abc", (a, b, c), strict=True)
+        )
     )
     # The lens of the two discs, written with atan2 (never arccos near +-1, which loses
     # half the digits at the tangencies): the chord lies x1 = (c^2 + a^2 - b^2) / 2c from

@@ -39,6 +39,12 @@ own exact quadrature (:func:`hat_integrals`, cross-checked against colour-scienc
 integration in the tests); colour-science does the colorimetry of :func:`srgb` and the
 conversions of ``colour_science``.
 
+Units: every argument with a unit (wavelengths [nm], ranges [km], distances [au], angles
+[degree], times [s], pressures [hPa]) also takes an astropy Quantity, converted first
+(:func:`sbrdf_xr.units.to_unit`; another kind raises :class:`~sbrdf_xr.errors.UnitError`
+naming the argument); bare wavelength axes and ranges far outside their unit's span warn
+with the likely mistake.
+
 Modules: ``spectra`` (reference spectra, quadrature), ``bands``, ``magnitude``,
 ``atmosphere``, ``standard``, ``colour``, ``colour_science``, ``filter_names``, ``measured``,
 ``lightcurves``, ``files``.

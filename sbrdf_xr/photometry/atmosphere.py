@@ -199,7 +199,8 @@ def rayleigh_optical_depth(
     >>> np.round(rayleigh_optical_depth([400.0, 550.0, 700.0]), 4)
     array([0.3601, 0.0973, 0.0365])
     """
-    lam = np.asarray(wavelength, dtype=np.float64) / 1000.0
+    lam = np.asarray(to_unit(wavelength, "nm", "wavelength", spectral=True), np.float64) / 1000.0
+    pressure_hpa = to_unit(pressure_hpa, "hPa", "pressure_hpa")
     return (
         0.008569
         * lam**-4
@@ -251,6 +252,7 @@ def transmission(
     ('1', array([0.5202, 0.8018, 0.8962]))
     """
     wl = _check_grid(wavelength, "wavelength")
+    pressure_hpa = to_unit(pressure_hpa, "hPa", "pressure_hpa")
     for name, v, lo in (
         ("airmass", airmass, 1.0),
         ("pressure_hpa", pressure_hpa, 0.0),

@@ -275,6 +275,8 @@ def compare(
     max_shift = float(to_unit(max_time_shift_s, "s", "max_time_shift_s"))
     if not (np.isfinite(max_shift) and max_shift > 0):
         raise LightCurveError(f"max_time_shift_s: must be > 0 s, got {max_time_shift_s!r}")
+    phase_angle = to_unit(phase_angle, "deg", "phase_angle")
+    period_s = to_unit(period_s, "s", "period_s")
     sim = _simulated(simulated, measured, phase_angle)
     system = _system(measured, sim)
     col = _band_columns(measured, sim)

@@ -110,9 +110,9 @@ def hat_integrals(x: ArrayLike, y: ArrayLike, t: ArrayLike) -> np.ndarray:
     >>> hat_integrals(t, np.ones(3), t)  # of y = 1: the trapezoid weights
     array([0.5, 1. , 0.5])
     """
-    x = np.asarray(x, dtype=np.float64)
+    x = np.asarray(to_unit(x, "nm", "x", spectral=True), dtype=np.float64)
     y = np.asarray(y, dtype=np.float64)
-    t = np.asarray(t, dtype=np.float64)
+    t = np.asarray(to_unit(t, "nm", "t", spectral=True), dtype=np.float64)
     lead = y.shape[:-1]
     y2 = y.reshape(-1, x.size)
     out = np.zeros((y2.shape[0], t.size))
@@ -528,5 +528,5 @@ def ab_reference_flux(wavelength: ArrayLike) -> np.ndarray:
     >>> np.round(ab_reference_flux([550.0]) * 1e11, 4)  # 3631 Jy at 550 nm [1e-11 W m-2 nm-1]
     array([3.5985])
     """
-    lam_m = np.asarray(wavelength, dtype=np.float64) * 1e-9
+    lam_m = np.asarray(to_unit(wavelength, "nm", "wavelength", spectral=True), np.float64) * 1e-9
     return AB_ZERO_POINT_JY * _JY * _C_M_S / lam_m**2 * 1e-9

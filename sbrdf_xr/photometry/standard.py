@@ -61,7 +61,7 @@ def specular_sphere_phase(alpha_deg: ArrayLike) -> np.ndarray:
     >>> specular_sphere_phase([0.0, 90.0])
     array([1., 1.])
     """
-    return np.ones_like(np.asarray(alpha_deg, dtype=np.float64))
+    return np.ones_like(np.asarray(to_unit(alpha_deg, "deg", "alpha_deg"), dtype=np.float64))
 
 
 #: Phase functions for standard magnitudes:
