@@ -1,0 +1,934 @@
+"""Every public argument with a unit takes an astropy Quantity.
+
+The public callables of every package (``__all__`` of each package and of the public
+modules it lists, classes through their constructor) are walked; an argument carries a
+unit when its numpydoc description states one in brackets (``[nm]``, ``[degree]``,
+``[s]``, ``[km]``, ``[au]``, ``[m]``, ``[K]``, ``[hPa]``, ``[degree s-1]``, ...) or its
+name ends in a unit (``_km``, ``_deg``, ``_s``, ``_nm``, ``_au``, ``_m``).  Each such
+argument has a row in :data:`CASES` (a call taking the argument's value) or in
+:data:`EXEMPT` (with the reason); a new argument with a unit and neither fails
+:func:`test_every_unit_argument_has_a_case`.  Every case checks that
+
+* a Quantity in another unit of the same kind gives the result of the bare number in
+  the documented unit (``0.5 * u.um`` for ``500`` nm, radians for degrees, minutes for
+  seconds, metres for kilometres), and
+* a Quantity of another kind (a mass) raises :class:`~sbrdf_xr.errors.UnitError` naming
+  the argument.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import inspect
+import re
+import types
+import warnings
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import astropy.units as u
+import numpy as np
+import pytest
+import xarray as xr
+from numpydoc.docscrape import NumpyDocString
+
+from sbrdf_xr.errors import UnitError
+
+PACKAGES = (
+    "bench",
+    "body",
+    "brdf",
+    "cli",
+    "engine",
+    "invert",
+    "kernels",
+    "materials",
+    "observing",
+    "photometry",
+    "plot",
+    "store",
+)
+MODULES = ("anisotropy", "catalog", "geometry", "rotations", "sources", "units")
+
+#: Physical kinds of the units converted at the door.
+KINDS = {
+    "length",
+    "angle",
+    "time",
+    "angular speed",
+    "angular frequency",
+    "temperature",
+    "pressure",
+    "speed",
+    "frequency",
+}
+#: Units named by an argument's ending.
+SUFFIXES = {
+    "_deg_s": "deg / s",
+    "_km_s": "km / s",
+    "_hpa": "hPa",
+    "_km": "km",
+    "_deg": "deg",
+    "_nm": "nm",
+    "_au": "au",
+    "_s": "s",
+    "_m": "m",
+}
+_BRACKET = re.compile(r"\[([^\]\[]+)\]")
+
+
+def _unit_in(text: str) -> str | None:
+    for s in _BRACKET.findall(text):
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                unit = u.Unit(s.strip(), parse_strict="raise")
+        except (ValueError, TypeError):
+            continue
+        if str(unit.physical_type) in KINDS:
+            return s.strip()
+    return None
+
+
+def public_callables() -> dict[str, Any]:
+    """Canonical name -> every public function and class of the package's ``__all__``s
+    (bound methods exported as functions, such as a model's ``brdf_angles``, by the name
+    they are exported under)."""
+    found: dict[str, Any] = {}
+    visited: set[str] = set()
+
+    def walk(mod: types.ModuleType) -> None:
+        for n in getattr(mod, "__all__", ()):
+            obj = getattr(mod, n, None)
+            if isinstance(obj, types.ModuleType):
+                if obj.__name__.startswith("sbrdf_xr.") and obj.__name__ not in visited:
+                    visited.add(obj.__name__)
+                    walk(obj)
+            elif (
+                inspect.isclass(obj) or inspect.isfunction(obj) or inspect.ismethod(obj)
+            ) and getattr(obj, "__module__", "").startswith("sbrdf_xr"):
+                name = (
+                    f"{mod.__name__}.{n}"
+                    if inspect.ismethod(obj)
+                    else f"{obj.__module__}.{obj.__qualname__}"
+                )
+                found.setdefault(name, obj)
+
+    for name in PACKAGES + MODULES:
+        mod = importlib.import_module(f"sbrdf_xr.{name}")
+        visited.add(mod.__name__)
+        walk(mod)
+    return found
+
+
+def unit_arguments() -> dict[tuple[str, str], str]:
+    """(callable, argument) -> its unit, for every public argument that has one."""
+    out = {}
+    for name, obj in public_callables().items():
+        try:
+            sig = inspect.signature(obj)
+        except (TypeError, ValueError):
+            continue
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            doc = NumpyDocString(inspect.getdoc(obj) or "")
+        described: dict[str, str] = {}
+        sections = ("Parameters", "Other Parameters") + (
+            ("Attributes",) if inspect.isclass(obj) else ()
+        )
+        for sec in sections:
+            for p in doc[sec]:
+                for arg in p.name.split(","):
+                    described.setdefault(arg.strip().lstrip("*"), f"{p.type} {' '.join(p.desc)}")
+        for arg, param in sig.parameters.items():
+            if param.annotation in (bool, "bool"):
+                continue  # a flag whose description names the unit of what it fits
+            # the unit a name ends in, else the first one its description states
+            unit = next((v for s, v in SUFFIXES.items() if arg.endswith(s)), None)
+            if unit is None:
+                unit = _unit_in(described.get(arg, ""))
+            if unit is not None:
+                out[(name, arg)] = unit
+    from sbrdf_xr.engine.knobs import KNOBS
+
+    for knob in KNOBS.values():  # the scene's numerical knobs, documented in their table
+        if knob.unit:
+            out[("sbrdf_xr.engine.scene.Scene", knob.name)] = knob.unit
+    return out
+
+
+# ------------------------------------------------------------------ the inputs of the cases
+WL = np.array([500.0, 600.0, 700.0])  # [nm]
+NORMAL, TO_SUN, TO_OBS = [0.0, 0.0, 1.0], [0.5, 0.0, 1.0], [-0.4, 0.1, 1.0]
+T0 = np.datetime64("2024-03-17T01:20:00", "ns")
+
+
+def _rs() -> dict[str, Any]:
+    from sbrdf_xr.brdf.robertson_sandford import TABLE4
+
+    return dict(TABLE4["AFGL-01"])
+
+
+_MICRO = {"roughness": 0.2, "n": 1.5, "k": 0.0, "rho_d": 0.1}
+_ANISO = {"alpha_x": 0.2, "alpha_y": 0.3, "n": 1.5, "k": 0.0, "rho_d": 0.1}
+_LAMBERT = {"rho": 0.4}
+
+
+def _model(name: str) -> Any:
+    return importlib.import_module(f"sbrdf_xr.brdf.{name}").MODEL
+
+
+def _box() -> Any:
+    import trimesh
+
+    from sbrdf_xr import load_spacecraft
+
+    return load_spacecraft(trimesh.creation.box(), material="grey")
+
+
+def _grey() -> xr.DataArray:
+    from sbrdf_xr.materials.schema import lambertian
+
+    return lambertian(0.5, WL, material="grey")
+
+
+def _table() -> xr.DataArray:
+    """A small table with structure in every angle (a lobe measured and built)."""
+    from sbrdf_xr.materials.tables import build_lut
+    from sbrdf_xr.testing import make_measurements
+
+    return build_lut(
+        make_measurements(n_wavelength=2, theta_i=(20.0, 50.0)),
+        n_phi=7,
+        n_delta_theta=7,
+        check_energy=False,
+    )
+
+
+def _spec(model: str = "lambert", **params: Any) -> xr.Dataset:
+    from sbrdf_xr.materials.models import model_material
+
+    return model_material(model, [550.0], material="m", provenance="test", **(params or _LAMBERT))
+
+
+def _aniso_spec() -> xr.Dataset:
+    return _spec("anisotropic_microfacet", **{**_ANISO, "n": 1.0, "k": 6.0, "rho_d": 0.0})
+
+
+def _lobe() -> Any:
+    from sbrdf_xr.testing import lobe_function
+
+    return lobe_function(np.array([500.0, 700.0]))
+
+
+def _cube() -> xr.Dataset:
+    wl = np.arange(400.0, 1101.0, 10.0)
+    return xr.Dataset(
+        {"signal": (("geometry", "wavelength"), np.full((2, wl.size), 0.1), {"units": "m2 sr-1"})},
+        coords={"wavelength": ("wavelength", wl, {"units": "nm"})},
+    )
+
+
+def _rotation_cube() -> xr.Dataset:
+    from sbrdf_xr import Scene, simulate
+
+    ang = np.arange(0.0, 360.0, 30.0)
+    from sbrdf_xr.geometry import rotation_sweep
+
+    scene = Scene(
+        _box(),
+        {"grey": _grey_wide()},
+        attitudes=rotation_sweep([0, 0, 1], ang),
+        phase_angles=[30.0],
+        attitude_angle=ang,
+    )
+    return simulate(scene).compute()
+
+
+def _grey_wide() -> xr.DataArray:
+    from sbrdf_xr.materials.schema import lambertian
+
+    return lambertian(0.5, np.arange(400.0, 1101.0, 50.0), material="grey")
+
+
+def _observation(**kw: Any) -> Any:
+    from sbrdf_xr.observing.observe import canx1_pass
+
+    obs = canx1_pass()
+    return dataclasses.replace(obs, times=obs.times[100:104], **kw)
+
+
+def _light_curve() -> xr.Dataset:
+    return xr.Dataset(
+        {"magnitude": ("band", [8.0, 7.6]), "uncertainty": ("band", [0.02, 0.02])},
+        coords={"band": ["V", "R"]},
+    )
+
+
+def _compare_inputs() -> dict[str, Any]:
+    ang = np.arange(0.0, 360.0, 10.0)
+    sim = xr.DataArray(
+        np.stack([10 + np.cos(np.radians(ang))], 1),
+        dims=("attitude", "band"),
+        coords={"attitude_angle": ("attitude", ang), "band": ["V"]},
+    )
+    t = 3.0 * np.arange(9)
+    lc = xr.Dataset(
+        {
+            "magnitude": ("obs", 10.5 + np.cos(np.radians(ang[:9] + 7.0))),
+            "uncertainty": ("obs", np.full(9, 0.01)),
+        },
+        coords={"time": ("obs", t), "band": ("obs", ["V"] * 9)},
+    )
+    return {"measured": lc, "simulated": sim, "period_s": 360.0 / 10.0 * 3.0}
+
+
+def _time_curve() -> dict[str, Any]:
+    t = T0 + np.arange(61) * np.timedelta64(1, "s")
+    curve = 12.0 + 0.3 * np.sin(np.arange(61) / 5.0)
+    sim = xr.DataArray(curve[:, None], dims=("time", "band"), coords={"time": t, "band": ["V"]})
+    k = np.arange(0, 60, 3)
+    lc = xr.Dataset(
+        {
+            "magnitude": ("obs", curve[k] + 0.1 + 0.01 * np.sin(k)),
+            "uncertainty": ("obs", np.full(k.size, 0.01)),
+        },
+        coords={"time": ("obs", t[k] + np.timedelta64(2, "s")), "band": ("obs", ["V"] * k.size)},
+    )
+    return {"measured": lc, "simulated": sim}
+
+
+def _spin_lc() -> dict[str, Any]:
+    from sbrdf_xr import Scene, geometry, simulate
+    from sbrdf_xr.invert import axis_vector, spin_model
+
+    spin = spin_model([0, 0, 1], axis_vector(60.0, 30.0), period_s=20.0, phase_deg=30.0)
+    t = np.arange(0.0, 24.0, 1.0)
+    box = _box()
+    scene = Scene(
+        box,
+        {"grey": _grey_wide()},
+        attitudes=spin.quaternions(t),
+        phase_angles=[30.0],
+        outputs=("band_signal",),
+        bands=("V",),
+    )
+    flux = simulate(scene).band_signal.isel(phase_angle=0).values.ravel()
+    lc = xr.Dataset(
+        {"flux": ("obs", flux), "flux_uncertainty": ("obs", 0.01 * flux)},
+        coords={"time": ("obs", t), "band": ("obs", ["V"] * t.size)},
+    )
+    s, o = geometry.observation_plane([30.0], (1, 0, 0), (0, 0, 1))
+    return dict(
+        light_curve=lc,
+        spacecraft=box,
+        to_sun=s[0],
+        to_observer=o[0],
+        materials={"grey": _grey_wide()},
+        periods=np.linspace(18.0, 22.0, 5),
+        n_axes=6,
+        n_phases=6,
+        n_starts=1,
+        refine=False,
+        method="direct",
+        n_threads=1,
+    )
+
+
+def _brdf_case(params: Any, wl: Any = WL, **extra: Any) -> Callable:
+    return lambda: dict(
+        normal=NORMAL,
+        to_sun=TO_SUN,
+        to_observer=TO_OBS,
+        wavelength=wl,
+        **(params() if callable(params) else params),
+        **extra,
+    )
+
+
+def _angles_case(module: str, params: Any) -> Callable:
+    def make() -> dict[str, Any]:
+        p = params() if callable(params) else params
+        wl = [4000.0] if module == "robertson_sandford" else WL
+        psi = {"psi": [30.0]} if module == "anisotropic" else {}
+        return dict(theta_i=[20.0, 40.0], delta_theta=[5.0], phi=[10.0], wavelength=wl, **psi, **p)
+
+    return make
+
+
+#: (callable, its keyword arguments): every argument with a unit is checked by replacing
+#: its value.  ``slow``: the comparison runs with ``--runslow`` only (the refusal always).
+CASES: dict[str, Callable[[], dict[str, Any]]] = {
+    # --- sbrdf_xr (modules)
+    "sbrdf_xr.anisotropy.psi_average": lambda: dict(
+        values=[1.0, 3.0, 2.0], grid=[0.0, 90.0, 180.0]
+    ),
+    "sbrdf_xr.anisotropy.psi_weights": lambda: dict(grid=[0.0, 60.0, 120.0], psi=[30.0, 150.0]),
+    "sbrdf_xr.geometry.facet_vectors": lambda: dict(theta_i=[20.0], delta_theta=[5.0], phi=[10.0]),
+    "sbrdf_xr.geometry.from_conventional": lambda: dict(
+        theta_i=[20.0], phi_i=[180.0], theta_r=[30.0], phi_r=[10.0]
+    ),
+    "sbrdf_xr.geometry.to_conventional": lambda: dict(
+        theta_i=[20.0], delta_theta=[5.0], phi=[10.0]
+    ),
+    "sbrdf_xr.geometry.observation_plane": lambda: dict(phase_angle_deg=[20.0, 75.0]),
+    "sbrdf_xr.rotations.axis_rotation": lambda: dict(axis=[0, 0, 1], angle=[30.0, 60.0]),
+    "sbrdf_xr.rotations.euler_attitudes": lambda: dict(sequence="zyx", angles=[[10.0, 20.0, 30.0]]),
+    "sbrdf_xr.rotations.rotation_sweep": lambda: dict(axis=[0, 0, 1], angles=[0.0, 45.0]),
+    "sbrdf_xr.sources.earthshine_irradiance_ratio": lambda: dict(
+        albedo=0.3, range_km=42164.0, phase_angle_deg=30.0
+    ),
+    "sbrdf_xr.sources.emissivity_at": lambda: dict(
+        emissivity=np.array([[0.8, 0.5], [0.6, 0.3]]),
+        theta_grid=np.array([0.0, 90.0]),
+        theta=[45.0, 70.0],
+    ),
+    "sbrdf_xr.sources.moon_v_magnitude": lambda: dict(phase_angle_deg=[10.0, 90.0]),
+    "sbrdf_xr.sources.moonlight_irradiance_ratio": lambda: dict(
+        phase_angle_deg=[10.0, 90.0], distance_km=384400.0
+    ),
+    "sbrdf_xr.sources.planck": lambda: dict(wavelength_nm=[800.0, 10_000.0], temperature=300.0),
+    # --- body
+    "sbrdf_xr.body.imperfections.tilt_quadrature": lambda: dict(sigma_deg=2.0, n=3),
+    "sbrdf_xr.body.imperfections.tilted_normals": lambda: dict(
+        normals=[[0.0, 0.0, 1.0]], tilts=[[0.0, 0.0], [0.1, 0.05]]
+    ),
+    "sbrdf_xr.body.picture.plot_facets": lambda: dict(
+        mesh=_box().mesh, facet_material=["grey"] * 12, elev=25.0, azim=35.0
+    ),
+    "sbrdf_xr.body.visibility.lit_fraction": lambda: dict(
+        spacecraft=_l_body(), directions=[[0.3, 0.4, 0.866]], offset=1e-6
+    ),
+    # --- brdf
+    "sbrdf_xr.brdf.lambert.brdf": _brdf_case(_LAMBERT),
+    "sbrdf_xr.brdf.lambert.directional_hemispherical_reflectance": lambda: dict(
+        theta_i=[20.0, 60.0], wavelength=WL, **_LAMBERT
+    ),
+    "sbrdf_xr.brdf.lambert.check_params": lambda: dict(wavelength=WL, **_LAMBERT),
+    "sbrdf_xr.brdf.lambert.brdf_angles": _angles_case("lambert", _LAMBERT),
+    "sbrdf_xr.brdf.lambert.render_grid": _angles_case("lambert", _LAMBERT),
+    "sbrdf_xr.brdf.microfacet.brdf": _brdf_case(_MICRO, layers=[(1.38, 100.0)]),
+    "sbrdf_xr.brdf.microfacet.directional_hemispherical_reflectance": lambda: dict(
+        theta_i=[20.0, 60.0], wavelength=WL, layers=[(1.38, 100.0)], **_MICRO
+    ),
+    "sbrdf_xr.brdf.microfacet.check_params": lambda: dict(wavelength=WL, **_MICRO),
+    "sbrdf_xr.brdf.microfacet.brdf_angles": _angles_case("microfacet", _MICRO),
+    "sbrdf_xr.brdf.microfacet.render_grid": _angles_case("microfacet", _MICRO),
+    "sbrdf_xr.brdf.anisotropic.brdf": _brdf_case(_ANISO, tangent=[1.0, 0.0, 0.0]),
+    "sbrdf_xr.brdf.anisotropic.directional_hemispherical_reflectance": lambda: dict(
+        theta_i=[20.0], wavelength=[550.0], psi=30.0, **_ANISO
+    ),
+    "sbrdf_xr.brdf.anisotropic.check_params": lambda: dict(wavelength=WL, **_ANISO),
+    "sbrdf_xr.brdf.anisotropic.brdf_angles": _angles_case("anisotropic", _ANISO),
+    "sbrdf_xr.brdf.anisotropic.render_grid": _angles_case("anisotropic", _ANISO),
+    "sbrdf_xr.brdf._common.tangent_from_azimuth": lambda: dict(psi=[0.0, 30.0]),
+    "sbrdf_xr.brdf.optics.aluminium_index": lambda: dict(wavelength_nm=WL),
+    "sbrdf_xr.brdf.optics.gaas_index": lambda: dict(wavelength_nm=[900.0, 1000.0]),
+    "sbrdf_xr.brdf.optics.silica_index": lambda: dict(wavelength_nm=WL),
+    "sbrdf_xr.brdf.optics.sapphire_index": lambda: dict(wavelength_nm=WL),
+    "sbrdf_xr.brdf.optics.titania_index": lambda: dict(wavelength_nm=WL),
+    "sbrdf_xr.brdf.optics.fresnel_thin_film_stack": lambda: dict(
+        cos_theta=[1.0, 0.5], wavelength=WL, layers=[(1.38, 100.0)], substrate=1.5
+    ),
+    "sbrdf_xr.brdf.robertson_sandford.brdf": _brdf_case(_rs, wl=[4000.0]),
+    "sbrdf_xr.brdf.robertson_sandford.diffuse_brdf": _brdf_case(_rs, wl=[4000.0]),
+    "sbrdf_xr.brdf.robertson_sandford.specular_brdf": _brdf_case(_rs, wl=[4000.0]),
+    "sbrdf_xr.brdf.robertson_sandford.diffuse_reflectance": lambda: dict(
+        theta_i=[20.0, 60.0], wavelength=[4000.0], **_rs()
+    ),
+    "sbrdf_xr.brdf.robertson_sandford.specular_reflectance": lambda: dict(
+        theta_i=[20.0, 60.0], wavelength=[4000.0], **_rs()
+    ),
+    "sbrdf_xr.brdf.robertson_sandford.total_reflectance": lambda: dict(
+        theta_i=[20.0, 60.0], wavelength=[4000.0], **_rs()
+    ),
+    "sbrdf_xr.brdf.robertson_sandford.directional_hemispherical_reflectance": lambda: dict(
+        theta_i=[20.0, 60.0], wavelength=[4000.0], **_rs()
+    ),
+    "sbrdf_xr.brdf.robertson_sandford.directional_emissivity": lambda: dict(
+        theta=[20.0, 60.0], wavelength=[4000.0], **_rs()
+    ),
+    "sbrdf_xr.brdf.robertson_sandford.check_params": lambda: dict(wavelength=[4000.0], **_rs()),
+    "sbrdf_xr.brdf.robertson_sandford.brdf_angles": _angles_case("robertson_sandford", _rs),
+    "sbrdf_xr.brdf.robertson_sandford.render_grid": _angles_case("robertson_sandford", _rs),
+    "sbrdf_xr.brdf.robertson_sandford_angular.angular_g": lambda: dict(theta=[20.0, 45.0], b=0.5),
+    "sbrdf_xr.brdf.robertson_sandford_angular.cutoff_factor": lambda: dict(
+        theta_r=[45.0, 85.0], b=0.12
+    ),
+    "sbrdf_xr.brdf.robertson_sandford_angular.normalisation_H": lambda: dict(theta_i=30.0, e=1.0),
+    "sbrdf_xr.brdf.robertson_sandford_angular.structure_h": lambda: dict(alpha=[10.0, 80.0], e=0.5),
+    # --- engine
+    "sbrdf_xr.engine.scene.Scene": lambda: dict(
+        spacecraft=_box(),
+        materials={"grey": _grey()},
+        attitudes=[[0, 0, 0, 1.0]],
+        phase_angles=[20.0, 60.0],
+        attitude_angle=[15.0],
+        surface_tilt=2.0,
+        earth_range_km=42164.0,
+        earth_phase_angle=60.0,
+        temperature=300.0,
+        table_theta_step=5.0,
+        block_bytes=2**20,
+    ),
+    "sbrdf_xr.engine.effects.moonlight.moon_from_spacecraft": lambda: _moon_inputs(),
+    # --- invert
+    "sbrdf_xr.invert._data.magnitudes_to_signal": lambda: dict(
+        light_curve=_light_curve(), range_km=1000.0
+    ),
+    "sbrdf_xr.invert._spin.fit_spin": _spin_lc,
+    "sbrdf_xr.invert._spin.period_grid": lambda: dict(p_min=60.0, p_max=70.0, span_s=240.0),
+    "sbrdf_xr.invert._spin.axis_vector": lambda: dict(
+        longitude=[30.0, 60.0], latitude=[20.0, -5.0]
+    ),
+    "sbrdf_xr.invert._studies.spin_recovery": lambda: _recovery_inputs(),
+    "sbrdf_xr.invert._spin_search.spin_model": lambda: dict(
+        axis_body=[0, 0, 1], axis=[1.0, 0.0, 0.0], period_s=60.0, phase_deg=30.0
+    ),
+    # --- materials
+    "sbrdf_xr.materials.schema.lambertian": lambda: dict(albedo=0.5, wavelength=WL),
+    "sbrdf_xr.materials.schema.constant_material": lambda: dict(
+        value=0.1, wavelength=WL, material="c"
+    ),
+    "sbrdf_xr.materials.schema.new_material": lambda: dict(
+        values=np.full((2, 2, 2, 3), 0.1),
+        theta_i=[0.0, 60.0],
+        delta_theta=[-10.0, 10.0],
+        phi=[0.0, 30.0],
+        wavelength=WL,
+        material="n",
+        source="synthetic",
+        provenance="test",
+    ),
+    "sbrdf_xr.materials.tables.lookup": lambda: dict(
+        material=_table(), theta_i=[25.0, 42.0], delta_theta=[3.0, -7.0], phi=[4.0, 11.0]
+    ),
+    "sbrdf_xr.materials.tables.lookup_anisotropic": lambda: dict(
+        material=_aniso_table(), theta_i=[30.0], delta_theta=[0.0], phi=[4.0], psi=[25.0]
+    ),
+    "sbrdf_xr.materials.build.build_lut": lambda: dict(
+        measurements=_measurements(),
+        n_phi=7,
+        n_delta_theta=7,
+        theta_i=[20.0, 35.0, 50.0],
+        blend=10.0,
+        blend_normal=5.0,
+        check_energy=False,
+    ),
+    "sbrdf_xr.materials.construction.paper_delta_theta_grid": lambda: dict(
+        dt_min=-4.0, dt_max=8.0, n=5
+    ),
+    "sbrdf_xr.materials.construction.paper_phi_grid": lambda: dict(phi_max=10.0, n=5),
+    "sbrdf_xr.materials.energy.hemispherical_reflectance": lambda: dict(
+        material=_table(), theta_i=[25.0, 45.0], warn=False
+    ),
+    "sbrdf_xr.materials.goniometer.measure": lambda: dict(
+        func=_lobe(),
+        wavelength=np.array([500.0, 700.0]),
+        theta_i=(20.0, 50.0),
+        noise_floor=0.05,
+    ),
+    "sbrdf_xr.materials.goniometer.paper_scheme": lambda: dict(
+        theta_i=30.0, dt_min=-20.0, dt_max=30.0, phi_max=[10, 12, 14, 16, 14, 12, 10]
+    ),
+    "sbrdf_xr.materials.goniometer.scheme_extents": lambda: dict(
+        func=_lobe(),
+        theta_i=30.0,
+        noise_floor=0.05,
+        max_theta_r=80.0,
+        min_phase_angle=5.0,
+        max_phi=80.0,
+        step=0.5,
+    ),
+    "sbrdf_xr.materials.model_schema.model_material": lambda: dict(
+        model="microfacet",
+        wavelength=WL,
+        material="m",
+        provenance="test",
+        layers=[(1.38, 100.0)],
+        **_MICRO,
+    ),
+    "sbrdf_xr.materials.models.measure": lambda: dict(
+        spec=_spec("robertson_sandford", rho_D=0.6, epsilon=0.2, b=0.1, e=0.3),
+        theta_i=[20.0, 40.0],
+    ),
+    "sbrdf_xr.materials.models.render": lambda: dict(
+        spec=_spec(),
+        theta_i=[0.0, 45.0],
+        delta_theta=[-10.0, 10.0],
+        phi=[0.0, 30.0],
+        progress=False,
+    ),
+    "sbrdf_xr.materials.models.render_anisotropic": lambda: dict(
+        spec=_aniso_spec(), theta_i=[30.0], delta_theta=[0.0], phi=[0.0, 10.0], psi=[0.0, 90.0]
+    ),
+    "sbrdf_xr.materials.models.render_values": lambda: dict(
+        model=_model("microfacet"),
+        ti=np.array([20.0, 40.0]),
+        dt=np.array([0.0, 5.0]),
+        ph=np.array([0.0, 10.0]),
+        wl=WL,
+        kw=dict(_MICRO),
+    ),
+    "sbrdf_xr.materials.models.spectra": lambda: dict(
+        spec=_aniso_spec(), theta_i=[30.0, 40.0], delta_theta=[5.0], phi=[10.0], psi=[20.0]
+    ),
+    # --- observing
+    "sbrdf_xr.observing.attitude.Nadir": lambda: dict(yaw_deg=30.0),
+    "sbrdf_xr.observing.attitude.Spin": lambda: dict(rate_deg_s=2.0, phase_deg=30.0),
+    "sbrdf_xr.observing.tumble.Tumble": lambda: dict(
+        inertia=(1.0, 2.0, 3.0), omega_deg_s=(1.0, 2.0, 3.0)
+    ),
+    "sbrdf_xr.observing.orbits.Site": lambda: dict(
+        latitude_deg=20.7, longitude_deg=-156.3, height_m=3058.0
+    ),
+    "sbrdf_xr.observing.orbits.airmass": lambda: dict(elevation_deg=[30.0, 60.0]),
+    "sbrdf_xr.observing.observation.Observation": lambda: dict(
+        **{f.name: getattr(_observation(), f.name) for f in _observation_fields()},
+        min_elevation_deg=5.0,
+    ),
+    "sbrdf_xr.observing.timescales.times": lambda: dict(
+        start="2024-03-17T01:20:00", stop="2024-03-17T01:21:00", step_s=20.0
+    ),
+    "sbrdf_xr.observing.earth_shadow.disc_overlap_fraction": lambda: dict(
+        a=[0.01, 0.01], b=[0.02, 0.005], c=[0.015, 0.001]
+    ),
+    "sbrdf_xr.observing.earth_shadow.shadow_angles": lambda: dict(
+        position_km=[-7000.0, 100.0, 0.0],
+        sun_km=[1.496e8, 0.0, 0.0],
+        earth_radius_km=6378.137,
+        sun_radius_km=695700.0,
+    ),
+    "sbrdf_xr.observing.earth_shadow.sunlit_fraction": lambda: dict(
+        position_km=[[-7000.0, 6378.137, 0.0]],
+        sun_km=[[1.5e8, 0.0, 0.0]],
+        earth_radius_km=6378.137,
+        sun_radius_km=695700.0,
+    ),
+    "sbrdf_xr.observing.earth_shadow.shadow_events": lambda: _shadow_inputs(),
+    "sbrdf_xr.observing.frames.Context": lambda: dict(
+        epoch=T0,
+        position_km=np.array([[7000.0, 0.0, 0.0]]),
+        velocity_km_s=np.array([[0.0, 7.5, 0.0]]),
+        sun_km=np.array([[1.496e8, 0.0, 0.0]]),
+    ),
+    "sbrdf_xr.observing.observe.bench_geometry": lambda: dict(n_times=3, step_s=2.0, repeats=1),
+    # --- photometry
+    "sbrdf_xr.photometry.atmosphere.airmass": lambda: dict(elevation=[30.0, 60.0]),
+    "sbrdf_xr.photometry.atmosphere.rayleigh_optical_depth": lambda: dict(
+        wavelength=WL, pressure_hpa=700.0
+    ),
+    "sbrdf_xr.photometry.atmosphere.transmission": lambda: dict(
+        wavelength=WL, airmass=1.5, pressure_hpa=700.0
+    ),
+    "sbrdf_xr.photometry.bands.band_weights": lambda: dict(
+        bands=["V"], wavelength=np.arange(400.0, 1101.0, 10.0)
+    ),
+    "sbrdf_xr.photometry.bands.filters": lambda: dict(
+        bands=["V"], wavelength=np.arange(400.0, 1101.0, 10.0)
+    ),
+    "sbrdf_xr.photometry.lightcurves.compare": lambda: dict(
+        **_compare_inputs(), max_time_shift_s=10.0, phase_angle=None, fit_phase=True
+    ),
+    "sbrdf_xr.photometry.magnitude.magnitudes": lambda: dict(
+        cube=_cube(), bands=["V"], range_km=1000.0, sun_distance_au=1.01
+    ),
+    "sbrdf_xr.photometry.magnitude.photometry": lambda: dict(
+        cube=_cube(), bands=["V", "R"], range_km=1000.0, sun_distance_au=1.01
+    ),
+    "sbrdf_xr.photometry.spectra.ab_reference_flux": lambda: dict(wavelength=WL),
+    "sbrdf_xr.photometry.spectra.hat_integrals": lambda: dict(
+        x=np.array([400.0, 500.0, 600.0]), y=np.array([1.0, 2.0, 1.5]), t=np.array([450.0, 550.0])
+    ),
+    "sbrdf_xr.photometry.spectra.solar_spectrum": lambda: dict(wavelength=WL),
+    "sbrdf_xr.photometry.spectra.vega_spectrum": lambda: dict(wavelength=WL),
+    "sbrdf_xr.photometry.standard.at_resolution": lambda: dict(
+        spectrum=_solar(), fwhm_nm=5.0, wavelength=WL
+    ),
+    "sbrdf_xr.photometry.standard.lambert_sphere_phase": lambda: dict(alpha_deg=[10.0, 90.0]),
+    "sbrdf_xr.photometry.standard.specular_sphere_phase": lambda: dict(alpha_deg=[10.0, 90.0]),
+    "sbrdf_xr.photometry.standard.standard_magnitude": lambda: dict(
+        mags=_mags(),
+        range_km=2000.0,
+        to_range_km=1000.0,
+        phase_angle=40.0,
+        to_phase_angle=90.0,
+        sun_distance_au=1.01,
+    ),
+    # --- plot
+    "sbrdf_xr.plot.cube.cube_magnitudes": lambda: dict(cube=_cube(), bands=["V"], range_km=1000.0),
+    "sbrdf_xr.plot.cube.cube_figure": lambda: dict(
+        cube=_rotation_cube(), bands=["V"], range_km=1000.0
+    ),
+    "sbrdf_xr.plot.cube.rotation_figure": lambda: dict(
+        cube=_rotation_cube(), bands=["V"], range_km=1000.0
+    ),
+    "sbrdf_xr.plot.cube.observation_figure": lambda: dict(
+        cube=_observation_cube(), bands=["V"], range_km=1000.0
+    ),
+}
+
+#: Arguments with a unit that no case replaces, and why.
+EXEMPT: dict[tuple[str, str], str] = {}
+_CONTAINER = "a container: the unit is its coordinate's CF attribute, a Quantity cannot be one"
+for _name, _arg in (
+    ("sbrdf_xr.body.visibility.lit_fraction", "spacecraft"),
+    ("sbrdf_xr.body.visibility.lit_visible_fraction", "spacecraft"),
+    ("sbrdf_xr.invert._unmix.unmix", "measured"),
+    ("sbrdf_xr.photometry.bands.pre_integrate", "table"),
+    ("sbrdf_xr.photometry.colour_science.to_colour", "obj"),
+    ("sbrdf_xr.photometry.standard.at_resolution", "spectrum"),
+    ("sbrdf_xr.photometry.bands.filters", "bands"),
+    ("sbrdf_xr.materials.goniometer.measure", "func"),
+):
+    EXEMPT[(_name, _arg)] = _CONTAINER
+EXEMPT[("sbrdf_xr.units.check_wavelengths", "values")] = (
+    "the check of bare numbers itself: a Quantity is converted before it"
+)
+for _row, _arg in (
+    ("sbrdf_xr.bench.rows.BenchRow", "seconds"),
+    ("sbrdf_xr.bench.shadowing.CostRow", "ms_per_geometry"),
+    ("sbrdf_xr.bench.shadowing.ShadowRow", "ms_per_geometry"),
+    ("sbrdf_xr.geometry.FacetAngles", "theta_i"),
+    ("sbrdf_xr.geometry.FacetAngles", "delta_theta"),
+    ("sbrdf_xr.geometry.FacetAngles", "phi"),
+):
+    EXEMPT[(_row, _arg)] = "a result record the package fills, not an input"
+
+for _model_name in ("lambert", "microfacet", "robertson_sandford"):
+    for _method in ("brdf_angles", "render_grid"):
+        EXEMPT[(f"sbrdf_xr.brdf.{_model_name}.{_method}", "psi")] = "an isotropic model refuses psi"
+
+#: The compiled layer: its functions take the grids and angles that the layers above
+#: (materials.tables, engine) have converted; a Quantity never reaches them.
+KERNELS = "sbrdf_xr.kernels."
+
+
+def _l_body() -> Any:
+    from sbrdf_xr.testing import l_shaped_spacecraft
+
+    return l_shaped_spacecraft()
+
+
+def _measurements() -> xr.Dataset:
+    from sbrdf_xr.testing import make_measurements
+
+    return make_measurements(n_wavelength=2, theta_i=(20.0, 50.0))
+
+
+def _aniso_table() -> xr.DataArray:
+    from sbrdf_xr.materials.models import render_anisotropic
+
+    return render_anisotropic(
+        _aniso_spec(), [20.0, 40.0], [-10.0, 10.0], [0.0, 20.0], [0.0, 90.0, 180.0]
+    )
+
+
+def _moon_inputs() -> dict[str, Any]:
+    t = np.array(["2022-11-08T07:59", "2022-11-08T08:59"], dtype="datetime64[ns]")
+    r = np.array([[7000.0, 0.0, 0.0], [6990.0, 300.0, 0.0]])
+    return dict(
+        times=t,
+        position_km=r,
+        velocity_km_s=np.array([[0.0, 7.5, 0.0]] * 2),
+        sun_km=np.array([[1.4e8, 5e7, 0.0]] * 2) - r,
+    )
+
+
+def _shadow_inputs() -> dict[str, Any]:
+    t = T0 + np.arange(0, 121, 10) * np.timedelta64(1, "s")
+    phase = 1.95 + 2 * np.pi / 5900.0 * np.arange(0, 121, 10)
+    pos = 7000.0 * np.stack([np.cos(phase), np.sin(phase), 0 * phase], axis=1)
+    return dict(
+        times=t,
+        position_km=pos,
+        sun_km=np.array([1.5e8, 0.0, 0.0]) - pos,
+        earth="sphere",
+        earth_radius_km=6378.137,
+        sun_radius_km=695700.0,
+    )
+
+
+def _observation_fields() -> list[Any]:
+    return [
+        f for f in dataclasses.fields(_observation()) if f.init and f.name != "min_elevation_deg"
+    ]
+
+
+def _observation_cube() -> xr.Dataset:
+    from sbrdf_xr import Scene, simulate
+
+    obs = _observation()
+    return simulate(Scene(_box(), {"grey": _grey_wide()}, observation=obs)).compute()
+
+
+def _recovery_inputs() -> dict[str, Any]:
+    from sbrdf_xr.body.spacecraft import canx1
+    from sbrdf_xr.observing.observe import canx1_pass
+
+    obs = canx1_pass()
+    return dict(
+        spacecraft=canx1(),
+        observation=obs,
+        periods=np.linspace(85.0, 95.0, 5),
+        times=obs.times[100:120],
+        n_draws=1,
+        n_axes=12,
+        n_phases=8,
+        n_starts=1,
+        axis_tolerance_deg=1.0,
+        n_threads=1,
+    )
+
+
+def _solar() -> xr.DataArray:
+    from sbrdf_xr.photometry.spectra import solar_spectrum
+
+    return solar_spectrum(np.arange(400.0, 800.0, 1.0))
+
+
+def _mags() -> xr.DataArray:
+    from sbrdf_xr.photometry import magnitudes
+
+    return magnitudes(_cube(), ["V"], range_km=2000.0)
+
+
+#: Cases whose comparison is long (a fit or a simulation): ``-m slow`` runs it; the
+#: refusal of a wrong unit, at the door, always runs.
+SLOW = {
+    "sbrdf_xr.invert._spin.fit_spin",
+    "sbrdf_xr.invert._studies.spin_recovery",
+    "sbrdf_xr.plot.cube.cube_figure",
+    "sbrdf_xr.plot.cube.rotation_figure",
+    "sbrdf_xr.plot.cube.observation_figure",
+}
+#: Cases whose result is a figure or a timing: the Quantity must be accepted, the
+#: results are not compared.
+NOT_COMPARED = {
+    "sbrdf_xr.body.picture.plot_facets",
+    "sbrdf_xr.plot.cube.cube_figure",
+    "sbrdf_xr.plot.cube.rotation_figure",
+    "sbrdf_xr.plot.cube.observation_figure",
+    "sbrdf_xr.observing.observe.bench_geometry",
+}
+
+#: What of a result is compared (a study's wall times are not).
+POST = {"sbrdf_xr.invert._studies.spin_recovery": lambda ds: ds.drop_vars("seconds")}
+
+#: The same quantity in another unit than the documented one (the case's conversion).
+OTHER = {
+    "nm": u.um,
+    "degree": u.rad,
+    "deg": u.rad,
+    "radian": u.deg,
+    "rad": u.deg,
+    "s": u.min,
+    "km": u.m,
+    "m": u.mm,
+    "au": u.km,
+    "AU": u.km,
+    "K": u.deg_C,
+    "hPa": u.Pa,
+    "byte": u.Unit("KiB"),
+    "degree s-1": u.rad / u.s,
+    "deg / s": u.rad / u.s,
+    "km / s": u.m / u.s,
+    "km s-1": u.m / u.s,
+}
+#: Arguments whose value is a structure holding the number with a unit: its Quantity form.
+FORMS: dict[str, Callable[[Any, Any], Any]] = {
+    "layers": lambda value, unit: [
+        (n, (d * u.nm).to(unit) if unit.physical_type == "length" else d * unit) for n, d in value
+    ],
+}
+
+
+def _quantity(arg: str, value: Any, doc_unit: str, unit: Any) -> Any:
+    if arg in FORMS:
+        return FORMS[arg](value, unit)
+    q = np.asarray(value, dtype=np.float64) * u.Unit(doc_unit)
+    if unit.physical_type != q.unit.physical_type:
+        return q.value * unit  # a Quantity of another kind
+    return q.to(unit, equivalencies=u.temperature())
+
+
+def _same(a: Any, b: Any, where: str = "result") -> None:
+    """Equal to within float rounding of a unit conversion (rtol 1e-9)."""
+    if isinstance(a, xr.Dataset | xr.DataArray):
+        xr.testing.assert_allclose(a, b, rtol=1e-9, atol=0.0)
+    elif isinstance(a, Mapping):
+        assert set(a) == set(b), where
+        for k in a:
+            _same(a[k], b[k], f"{where}[{k!r}]")
+    elif isinstance(a, tuple | list) and not all(isinstance(x, int | float | np.number) for x in a):
+        assert len(a) == len(b), where
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            _same(x, y, f"{where}[{i}]")
+    elif dataclasses.is_dataclass(a) and not isinstance(a, type):
+        for f in dataclasses.fields(a):
+            if f.compare:
+                _same(getattr(a, f.name), getattr(b, f.name), f"{where}.{f.name}")
+    elif isinstance(a, np.ndarray | float | int | np.number | list):
+        arr = np.asarray(a)
+        if arr.dtype.kind in "fciu":
+            np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-300, err_msg=where)
+        else:
+            np.testing.assert_array_equal(a, b, err_msg=where)
+    else:
+        assert a == b, where
+
+
+def _cases() -> list[Any]:
+    out = []
+    for (name, arg), unit in sorted(unit_arguments().items()):
+        if name.startswith(KERNELS) or (name, arg) in EXEMPT:
+            continue
+        marks = [pytest.mark.slow] if name in SLOW else []
+        out.append(pytest.param(name, arg, unit, marks=marks, id=f"{name[9:]}:{arg}"))
+    return out
+
+
+def test_every_unit_argument_has_a_case():
+    found = unit_arguments()
+    missing = sorted(
+        f"{name}({arg}) [{unit}]"
+        for (name, arg), unit in found.items()
+        if not name.startswith(KERNELS) and (name, arg) not in EXEMPT and name not in CASES
+    )
+    assert not missing, f"arguments with a unit without a case in CASES: {missing}"
+    stale = sorted(set(CASES) - {name for name, _ in found}) + sorted(set(EXEMPT) - set(found))
+    assert not stale, f"cases of no argument with a unit: {stale}"
+
+
+def _call(name: str, kwargs: dict[str, Any]) -> Any:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return public_callables()[name](**kwargs)
+
+
+@pytest.mark.parametrize(("name", "arg", "unit"), _cases())
+def test_a_quantity_is_converted(name, arg, unit):
+    kwargs = CASES[name]()
+    bare = _call(name, kwargs)
+    given = _call(name, {**kwargs, arg: _quantity(arg, kwargs[arg], unit, OTHER[unit])})
+    if name not in NOT_COMPARED:
+        keep = POST.get(name, lambda r: r)
+        _same(keep(given), keep(bare))
+    if name == "sbrdf_xr.plot.cube.cube_figure" or "figure" in name or "plot" in name:
+        import matplotlib.pyplot as plt
+
+        plt.close("all")
+
+
+@pytest.mark.parametrize(
+    ("name", "arg", "unit"), [pytest.param(*p.values, id=p.id) for p in _cases()]
+)
+def test_a_quantity_of_another_kind_is_refused_by_name(name, arg, unit):
+    kwargs = CASES[name]()
+    with pytest.raises(UnitError, match=rf"\b{re.escape(arg)}\b"):
+        wrong = _quantity(arg, kwargs[arg], unit, u.Unit(unit) * u.kg)
+        _call(name, {**kwargs, arg: wrong})
