@@ -9,6 +9,8 @@ Every public argument of the package that carries a unit names it (``range_km`` 
   wavelengths also from frequencies and wavenumbers, by astropy's spectral equivalency);
 * temperatures also from degrees Celsius or Fahrenheit (astropy's ``temperature``
   equivalency);
+* an xarray DataArray whose data is a Quantity (xarray keeps one as it is) is returned
+  with its data converted, its dims and coordinates kept;
 * a Quantity of another kind (a time given for a length) is refused with
   :class:`~sbrdf_xr.errors.UnitError`, naming the argument, the unit received and the
   unit expected;
@@ -125,7 +127,8 @@ def to_unit(value: Any, unit: str, what: str, *, spectral: bool = False) -> Any:
     Returns
     -------
     Any
-        A float (scalar Quantity) or a float64 array in ``unit``, or ``value`` itself.
+        A float (scalar Quantity) or a float64 array in ``unit``, a DataArray holding a
+        Quantity with its data so converted, or ``value`` itself.
 
     Raises
     ------
@@ -143,13 +146,19 @@ def to_unit(value: Any, unit: str, what: str, *, spectral: bool = False) -> Any:
     599.584916
     >>> round(to_unit(0.5 * u.rad, "deg", "phase_deg"), 4)
     28.6479
+    >>> import xarray as xr
+    >>> to_unit(xr.DataArray([0.5, 1.0] * u.rad, dims="x"), "deg", "theta_i").round(4).values
+    array([28.6479, 57.2958])
     >>> to_unit(3.0 * u.s, "km", "range_km")
     Traceback (most recent call last):
         ...
     sbrdf_xr.errors.UnitError: range_km: got 3.0 s (time), which is not in km (length); ...
     """
     if not is_quantity(value):
-        return value
+        data = getattr(value, "data", None) if hasattr(value, "dims") else None
+        if not is_quantity(data):
+            return value
+        return value.copy(data=np.asarray(to_unit(data, unit, what, spectral=spectral)))
     import astropy.units as u
 
     target = u.Unit(unit) if unit else u.dimensionless_unscaled

@@ -49,7 +49,7 @@ PACKAGES = (
     "plot",
     "store",
 )
-MODULES = ("anisotropy", "catalog", "geometry", "rotations", "sources", "units")
+MODULES = ("accessors", "anisotropy", "catalog", "geometry", "rotations", "sources", "units")
 
 #: Physical kinds of the units converted at the door.
 KINDS = {
@@ -114,6 +114,12 @@ def public_callables() -> dict[str, Any]:
                     else f"{obj.__module__}.{obj.__qualname__}"
                 )
                 found.setdefault(name, obj)
+                if inspect.isclass(obj):  # and its public methods, taking ``self=`` by name
+                    for m, attr in vars(obj).items():
+                        if not m.startswith("_") and isinstance(
+                            attr, types.FunctionType | classmethod | staticmethod
+                        ):
+                            found.setdefault(f"{name}.{m}", getattr(obj, m))
 
     for name in PACKAGES + MODULES:
         mod = importlib.import_module(f"sbrdf_xr.{name}")
@@ -458,6 +464,28 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     ),
     "sbrdf_xr.brdf.robertson_sandford_angular.normalisation_H": lambda: dict(theta_i=30.0, e=1.0),
     "sbrdf_xr.brdf.robertson_sandford_angular.structure_h": lambda: dict(alpha=[10.0, 80.0], e=0.5),
+    "sbrdf_xr.brdf._model.Model.brdf_angles": lambda: dict(
+        self=_model("anisotropic"), **_angles_case("anisotropic", _ANISO)()
+    ),
+    "sbrdf_xr.brdf._model.Model.render_grid": lambda: dict(
+        self=_model("anisotropic"), **_angles_case("anisotropic", _ANISO)()
+    ),
+    "sbrdf_xr.brdf._model.Model.check_params": lambda: dict(
+        self=_model("lambert"), wavelength=WL, **_LAMBERT
+    ),
+    "sbrdf_xr.body.spacecraft.Spacecraft.plot": lambda: dict(self=_box(), elev=25.0, azim=35.0),
+    "sbrdf_xr.accessors.SbrdfDatasetAccessor.magnitudes": lambda: dict(
+        self=_cube().sbrdf, bands=["V"], range_km=1000.0
+    ),
+    "sbrdf_xr.accessors.SbrdfDatasetAccessor.photometry": lambda: dict(
+        self=_cube().sbrdf, bands=["V", "R"], range_km=1000.0
+    ),
+    "sbrdf_xr.observing.observation.Observation.next_pass": lambda: dict(
+        self=_observation(), days=0.5
+    ),
+    "sbrdf_xr.observing.tumble.Tumble.from_spacecraft": lambda: dict(
+        spacecraft=_box(), density_kg_m3=100.0, omega_deg_s=(1.0, 2.0, 3.0)
+    ),
     # --- engine
     "sbrdf_xr.engine.scene.Scene": lambda: dict(
         spacecraft=_box(),
@@ -571,6 +599,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         wl=WL,
         kw=dict(_MICRO),
     ),
+    "sbrdf_xr.materials.models.spectrum_function": lambda: dict(spec=_aniso_spec(), psi=30.0),
     "sbrdf_xr.materials.models.spectra": lambda: dict(
         spec=_aniso_spec(), theta_i=[30.0, 40.0], delta_theta=[5.0], phi=[10.0], psi=[20.0]
     ),
@@ -638,6 +667,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         cube=_cube(), bands=["V", "R"], range_km=1000.0, sun_distance_au=1.01
     ),
     "sbrdf_xr.photometry.spectra.ab_reference_flux": lambda: dict(wavelength=WL),
+    "sbrdf_xr.photometry.spectra.reference_flux": lambda: dict(system="Vega", wavelength=WL),
     "sbrdf_xr.photometry.spectra.hat_integrals": lambda: dict(
         x=np.array([400.0, 500.0, 600.0]), y=np.array([1.0, 2.0, 1.5]), t=np.array([450.0, 550.0])
     ),
@@ -657,6 +687,9 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         sun_distance_au=1.01,
     ),
     # --- plot
+    "sbrdf_xr.plot.curves.lut_slice": lambda: dict(
+        material=_table(), theta_i=35.0, wavelength=600.0
+    ),
     "sbrdf_xr.plot.cube.cube_magnitudes": lambda: dict(cube=_cube(), bands=["V"], range_km=1000.0),
     "sbrdf_xr.plot.cube.cube_figure": lambda: dict(
         cube=_rotation_cube(), bands=["V"], range_km=1000.0
@@ -807,14 +840,19 @@ SLOW = {
 #: results are not compared.
 NOT_COMPARED = {
     "sbrdf_xr.body.picture.plot_facets",
+    "sbrdf_xr.plot.curves.lut_slice",
+    "sbrdf_xr.body.spacecraft.Spacecraft.plot",
     "sbrdf_xr.plot.cube.cube_figure",
     "sbrdf_xr.plot.cube.rotation_figure",
     "sbrdf_xr.plot.cube.observation_figure",
     "sbrdf_xr.observing.observe.bench_geometry",
 }
 
-#: What of a result is compared (a study's wall times are not).
-POST = {"sbrdf_xr.invert._studies.spin_recovery": lambda ds: ds.drop_vars("seconds")}
+#: What of a result is compared (a study's wall times are not; a function's values are).
+POST = {
+    "sbrdf_xr.invert._studies.spin_recovery": lambda ds: ds.drop_vars("seconds"),
+    "sbrdf_xr.materials.models.spectrum_function": lambda f: f(*np.array([[30.0], [0.0], [5.0]])),
+}
 
 #: The same quantity in another unit than the documented one (the case's conversion).
 OTHER = {
@@ -830,6 +868,7 @@ OTHER = {
     "AU": u.km,
     "K": u.deg_C,
     "hPa": u.Pa,
+    "day": u.h,
     "byte": u.Unit("KiB"),
     "degree s-1": u.rad / u.s,
     "deg / s": u.rad / u.s,
@@ -932,3 +971,20 @@ def test_a_quantity_of_another_kind_is_refused_by_name(name, arg, unit):
     with pytest.raises(UnitError, match=rf"\b{re.escape(arg)}\b"):
         wrong = _quantity(arg, kwargs[arg], unit, u.Unit(unit) * u.kg)
         _call(name, {**kwargs, arg: wrong})
+
+
+def test_a_dataarray_holding_a_quantity_is_converted():
+    """xarray keeps a Quantity as a DataArray's data: converted too, never read as bare."""
+    from sbrdf_xr.materials.tables import lookup
+    from sbrdf_xr.photometry import band_weights
+
+    table, ti = _table(), np.array([25.0, 42.0])
+    angles = xr.DataArray(np.radians(ti) * u.rad, dims="x")
+    _same(lookup(table, angles, 3.0, 4.0), lookup(table, xr.DataArray(ti, dims="x"), 3.0, 4.0))
+    wl = np.arange(400.0, 1101.0, 10.0)
+    in_um = xr.DataArray(wl / 1e3 * u.um, dims="wavelength")
+    a, b = band_weights(["V"], in_um).values, band_weights(["V"], wl).values
+    # 0.7 um is 700.0000000000001 nm, where the V curve ends: a weight 1e-16 of the largest
+    np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-12 * b.max())
+    with pytest.raises(UnitError, match="theta_i"):
+        lookup(table, xr.DataArray(ti * u.s, dims="x"), 3.0, 4.0)

@@ -98,9 +98,15 @@ def spectra(
 def spectrum_function(spec: xr.Dataset, psi: float | None = None) -> Any:
     """``func(theta_i, delta_theta, phi) -> spectra`` of a model material (for the goniometer).
 
-    ``psi`` [degree]: for an anisotropic model, the azimuth of the illumination plane
-    from the sample's tangent (a sample rotation,
-    :func:`sbrdf_xr.materials.tables.build_lut_anisotropic`).
+    Parameters
+    ----------
+    spec : Dataset
+        A model material.
+    psi : float, optional
+        For an anisotropic model, the azimuth of the illumination plane from the
+        sample's tangent [degree] (a sample rotation,
+        :func:`sbrdf_xr.materials.tables.build_lut_anisotropic`); a Quantity is converted.
+
     Examples
     --------
     >>> import numpy as np
@@ -109,6 +115,7 @@ def spectrum_function(spec: xr.Dataset, psi: float | None = None) -> Any:
     >>> np.round(f(np.array([30.0]), np.array([0.0]), np.array([0.0])) * np.pi, 6)
     array([[0.5]])
     """
+    psi = to_unit(psi, "deg", "psi")
 
     def func(ti: np.ndarray, dt: np.ndarray, ph: np.ndarray) -> np.ndarray:
         if psi is None:

@@ -153,8 +153,9 @@ def lookup(
         )
     angles = []
     for name, a in ((THETA_I, theta_i), (DELTA_THETA, delta_theta), (PHI, phi)):
+        a = to_unit(a, "deg", name)  # also a DataArray holding a Quantity
         if not isinstance(a, xr.DataArray):
-            arr = np.asarray(to_unit(a, "deg", name), dtype=np.float64)
+            arr = np.asarray(a, dtype=np.float64)
             a = xr.DataArray(arr, dims=[f"dim_{k}" for k in range(arr.ndim)])
         if a.chunks is None and not np.all(np.isfinite(a.values)):
             raise ValidationError(f"{name}: query angles contain NaN or infinite values")

@@ -468,7 +468,7 @@ class Observation:
         Parameters
         ----------
         days : float
-            How far ahead to look [day].
+            How far ahead to look [day]; a Quantity is converted.
 
         Returns
         -------
@@ -487,6 +487,7 @@ class Observation:
         """
         from .timescales import skyfield_utc
 
+        days = float(to_unit(days, "day", "days"))
         t64 = np.array([self.times[0], self.times[0] + np.timedelta64(round(days * 86400), "s")])
         t0, t1 = skyfield_utc(t64)
         when, kind = self.orbit.satellite.find_events(

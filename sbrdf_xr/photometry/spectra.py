@@ -411,6 +411,13 @@ def reference_flux(system: str, wavelength: ArrayLike) -> np.ndarray:
 
     AB: :func:`ab_reference_flux`; Vega: the CALSPEC spectrum, linearly interpolated.
 
+    Parameters
+    ----------
+    system : {"AB", "Vega"}
+        The magnitude system.
+    wavelength : array_like
+        Wavelengths [nm]; a Quantity is converted.
+
     Examples
     --------
     >>> np.round(reference_flux("ab", [550.0]) / ab_reference_flux([550.0]), 12)
@@ -419,7 +426,7 @@ def reference_flux(system: str, wavelength: ArrayLike) -> np.ndarray:
     (1,)
     """
     system = check_system(system)
-    wl = np.asarray(wavelength, dtype=np.float64)
+    wl = np.asarray(to_unit(wavelength, "nm", "wavelength", spectral=True), dtype=np.float64)
     if system == "AB":
         return ab_reference_flux(wl)
     wv, fv, _ = _vega_native()

@@ -14,6 +14,7 @@ import numpy as np
 import xarray as xr
 
 from ..errors import ValidationError
+from ..units import to_unit
 from ._labels import (
     SHORT_LABELS,
     STYLES,
@@ -239,6 +240,19 @@ def lut_slice(
     Without ``wavelength`` the table is integrated over wavelength (the broadband
     BRDF of paper 000 Eq. 2).
 
+    Parameters
+    ----------
+    material : DataArray
+        A material table.
+    theta_i : float
+        Incidence angle of the slice [degree] (the nearest node).
+    wavelength : float, optional
+        Wavelength of the slice [nm] (the nearest node).
+    ax : matplotlib Axes, optional
+        Where to draw.
+
+    A Quantity is converted to the unit of its argument.
+
     Examples
     --------
     >>> import matplotlib
@@ -250,6 +264,8 @@ def lut_slice(
     ('delta_theta [deg]', 'broadband BRDF [sr-1 nm]')
     >>> plt.close(fig)
     """
+    theta_i = to_unit(theta_i, "deg", "theta_i")
+    wavelength = to_unit(wavelength, "nm", "wavelength", spectral=True)
     fig, ax = new_axes(ax, figsize=(6, 4))
     da = material.sel(theta_i=theta_i, method="nearest")
     units = unit_text(str(material.attrs.get("units", "sr-1")))
