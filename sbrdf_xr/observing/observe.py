@@ -47,6 +47,7 @@ __all__ = [
     "AU_KM",
     "EARTH_RADIUS_KM",
     "EPOCH_GAP_DAYS",
+    "OBSERVATION_KEYS",
     "SUN_RADIUS_KM",
     "TIME",
     "Observation",
@@ -63,6 +64,39 @@ __all__ = [
     "times",
     "tle_checksum",
 ]
+
+
+_NUMBER = (int, float)
+
+#: The keys of an ``[observation]`` table that :func:`observation_from_dict` reads: name ->
+#: (its TOML types, what it means with its unit, its default in TOML syntax or ``"-"``
+#: for none, ``"required"`` when it must be given).  The scene-file reference of
+#: :mod:`sbrdf_xr.engine.schema` is made from this table.
+OBSERVATION_KEYS: dict[str, tuple[tuple[type, ...], str, str]] = {
+    "orbit": ((str,), "the orbit: a catalog name (or tle, tle_line1/2, omm)", "-"),
+    "tle": ((list,), "the orbit as [line1, line2]", "-"),
+    "tle_line1": ((str,), "the orbit's first TLE line (with tle_line2)", "-"),
+    "tle_line2": ((str,), "the orbit's second TLE line", "-"),
+    "omm": ((str, dict), "the orbit as an OMM file or table", "-"),
+    "name": ((str,), "the observation's name", "-"),
+    "site": (
+        (str, dict),
+        "a catalog name or {latitude_deg, longitude_deg, height_m, name}",
+        "required",
+    ),
+    "start": ((str,), "first time, UTC (ISO 8601)", "-"),
+    "stop": ((str,), "last time, UTC", "-"),
+    "step_s": (_NUMBER, "time step [s]", "1"),
+    "times": ((list,), "explicit UTC times instead of start/stop/step_s", "-"),
+    "attitude": ((dict,), "[observation.attitude]: a law (the laws table below)", "-"),
+    "airmass_model": (
+        (str,),
+        "the airmass formula (sbrdf_xr.observing.AIRMASS_MODELS)",
+        '"kastenyoung1989"',
+    ),
+    "min_elevation_deg": (_NUMBER, "lowest elevation that counts as observable [degree]", "0.0"),
+    "earth": ((str,), 'the Earth of the shadow: "wgs84" or "sphere"', '"wgs84"'),
+}
 
 
 def observation_from_dict(
@@ -104,23 +138,7 @@ def observation_from_dict(
         ...
     sbrdf_xr.errors.ObservationError: [observation]: unknown key(s) ['when']; allowed keys: ...
     """
-    allowed = {
-        "orbit",
-        "tle",
-        "tle_line1",
-        "tle_line2",
-        "omm",
-        "name",
-        "site",
-        "start",
-        "stop",
-        "step_s",
-        "times",
-        "attitude",
-        "airmass_model",
-        "min_elevation_deg",
-        "earth",
-    }
+    allowed = set(OBSERVATION_KEYS)
     if not isinstance(table, Mapping):
         raise ObservationError(f"[observation]: expected a table, got {type(table).__name__}")
     bad = sorted(set(table) - allowed)
