@@ -2,7 +2,8 @@
 
 :func:`observation_from_dict` builds an :class:`~sbrdf_xr.observing.observation.Observation` from
 an ``[observation]`` table (an orbit, a site, UTC times and an attitude law);
-:func:`canx1_pass` is the built-in example and :func:`bench_geometry` times its geometry.
+:func:`canx1_pass` is the built-in example (:func:`sbrdf_xr.bench.suite.bench_geometry` times its
+geometry).
 The frames and models of the geometry are described in :mod:`sbrdf_xr.observing.observation`.
 This module also gathers the observation API in one place: the :class:`Observation`,
 the :class:`~sbrdf_xr.observing.orbits.Orbit` and :class:`~sbrdf_xr.observing.orbits.Site`, the UTC
@@ -13,12 +14,9 @@ times of
 
 from __future__ import annotations
 
-import time as _time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, TypedDict
-
-import numpy as np
 
 from ..errors import ObservationError, did_you_mean
 from . import attitude as _att
@@ -38,7 +36,6 @@ from .orbits import (
 from .timescales import (
     check_times,
     times,
-    to_datetime64,
 )
 
 __all__ = [
@@ -54,7 +51,6 @@ __all__ = [
     "Orbit",
     "Site",
     "airmass",
-    "bench_geometry",
     "canx1_pass",
     "disc_overlap_fraction",
     "load_orbit_entry",
@@ -284,43 +280,3 @@ def canx1_pass(attitude: _att.AttitudeLaw | None = None) -> Observation:
         attitude if attitude is not None else canx1_attitude(),
         name="canx1-pass",
     )
-
-
-def bench_geometry(n_times: int = 3600, step_s: float = 1.0, repeats: int = 3) -> dict[str, float]:
-    """Time :meth:`Observation.geometry` of the built-in orbit and site over ``n_times`` steps.
-
-    The first call in a process also pays the one-off imports and the loading of the
-    skyfield data; it is reported apart from the best of ``repeats`` further calls on
-    fresh observations (nothing cached between them).
-
-    Returns
-    -------
-    dict
-        ``n_times``, ``first_call_seconds``, ``seconds`` (best warm call) and
-        ``seconds_per_time``.
-
-    Examples
-    --------
-    >>> row = bench_geometry(n_times=60, repeats=1)
-    >>> sorted(row), row["n_times"]
-    (['first_call_seconds', 'n_times', 'seconds', 'seconds_per_time'], 60.0)
-    """
-    p = CANX1_PASS
-    t0 = to_datetime64(p["start"], "start") - np.timedelta64(int(n_times * step_s / 2), "s")
-    t = t0 + np.timedelta64(round(step_s * 1e9), "ns") * np.arange(n_times)
-    start = _time.perf_counter()
-    orbit, site = Orbit.from_catalog(p["orbit"]), Site.from_catalog(p["site"])
-    Observation(orbit, site, t, canx1_attitude()).geometry(on_unobservable="keep")
-    first = _time.perf_counter() - start
-    best = np.inf
-    for _ in range(max(1, repeats)):
-        obs = Observation(orbit, site, t, canx1_attitude())
-        start = _time.perf_counter()
-        obs.geometry(on_unobservable="keep")
-        best = min(best, _time.perf_counter() - start)
-    return {
-        "n_times": float(n_times),
-        "first_call_seconds": first,
-        "seconds": best,
-        "seconds_per_time": best / n_times,
-    }
