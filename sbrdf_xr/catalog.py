@@ -32,7 +32,6 @@ import trimesh
 import xarray as xr
 from numpy.typing import DTypeLike
 
-from ._cache import cache_file, cached_table
 from ._catalog_index import (
     CATALOG_PATH_ENV,
     KINDS,
@@ -51,6 +50,7 @@ from .errors import CatalogError, ValidationError, did_you_mean, input_file, rea
 from .kernels.warm import compile_ahead
 from .materials import models
 from .materials import tables as material
+from .materials.cache import cache_file, cached_table
 from .materials.shipped import read_reflectance
 from .observing import observe
 
@@ -123,7 +123,8 @@ def _built_material(
     options: tuple[tuple[str, Any], ...],
     dtype: str | None = None,
 ) -> xr.DataArray:
-    """A table built from a measurement entry, through the disk cache (:mod:`sbrdf_xr._cache`),
+    """A table built from a measurement entry, through the disk cache
+    (:mod:`sbrdf_xr.materials.cache`),
     its values in ``dtype`` (None: as built, float64).
 
     A table in another dtype is cast from the file's values, not from the float64 table
@@ -239,7 +240,7 @@ def to_build(wanted: Iterable[str]) -> list[str]:
     """The built tables among catalog entries ``names`` that loading them would build.
 
     A material with ``build_from`` in its entry is built from its measurements on its
-    first load and then read from the table cache (:mod:`sbrdf_xr._cache`); these are
+    first load and then read from the table cache (:mod:`sbrdf_xr.materials.cache`); these are
     the ones neither in the cache nor loaded in this process (with the cache switched off,
     every one not loaded yet).
 
