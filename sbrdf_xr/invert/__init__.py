@@ -49,6 +49,7 @@ from ..errors import FitQualityWarning, InversionError
 from ._bench import benchmark_spin_search
 from ._data import band_terms, magnitudes_to_signal, measured_kind, read_spectrum
 from ._joint import JOINT_CAUSES, fit_observation
+from ._joint_study import observation_recovery, simulated_light_curve
 from ._spin import (
     AMBIGUITY_CHI2,
     SEARCH_BYTES_LIMIT,
@@ -86,9 +87,11 @@ __all__ = [
     "magnitudes_to_signal",
     "material_areas",
     "measured_kind",
+    "observation_recovery",
     "period_grid",
     "read_spectrum",
     "search_size",
+    "simulated_light_curve",
     "spin_model",
     "spin_recovery",
     "unmix",
