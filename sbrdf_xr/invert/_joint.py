@@ -295,7 +295,14 @@ def fit_observation(
     span = max(float(np.ptp(data.seconds)), 1e-9)
     x_scale = lay.x_scale(start["period"], span)
     res = least_squares(
-        residuals, p0, x_scale=x_scale, method="lm", diff_step=1e-7, max_nfev=MAX_NFEV
+        residuals,
+        p0,
+        x_scale=x_scale,
+        method="lm",
+        diff_step=1e-7,
+        max_nfev=MAX_NFEV,
+        ftol=1e-10,
+        xtol=1e-10,
     )
     p = res.x
     if not p[2] > 0:

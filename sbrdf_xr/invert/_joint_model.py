@@ -111,7 +111,7 @@ def pass_data(
             f"light curve: a joint fit needs calibrated magnitudes (magnitude, uncertainty), "
             f"got {got}; read the table with sbrdf_xr.photometry.read_light_curve"
         )
-    have = list(dict.fromkeys(np.asarray(light_curve["band"].values).astype(str)))
+    have = [str(b) for b in dict.fromkeys(np.asarray(light_curve["band"].values).astype(str))]
     if bands is not None:
         bands = [str(b) for b in bands]
         extra = [b for b in have if b not in bands]
