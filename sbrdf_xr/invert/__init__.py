@@ -14,7 +14,9 @@ Inverse problems built on the forward model:
     weighted; a material is left out only if its omission cannot bias the other
     estimates by more than :data:`DROP_BIAS` of their sigma, so that the uncertainties
     of the chosen model stay calibrated.  Pairs of materials whose estimates are
-    correlated beyond a threshold are reported as degenerate.
+    correlated beyond a threshold are reported as degenerate.  ``total_area`` makes the
+    fitted areas add up to a known total, the mesh's (equality-constrained least
+    squares, Seber & Lee 2003, *Linear Regression Analysis*, §3.8).
 :func:`fit_spin`
     Spin axis (two angles of the inertial axis of a known body axis), period and phase
     of a uniform spin (:class:`sbrdf_xr.observing.attitude.Spin`) fitted to a colour
@@ -42,10 +44,13 @@ measure, over noise draws of a known truth, how well the stated uncertainties ho
 
 Measured fluxes are in any unit proportional to the band signal (the scale is fitted);
 magnitudes are converted to relative fluxes ``10**(-0.4 m)`` with uncertainties
-``sigma_F = F ln(10)/2.5 sigma_m`` (first order).
+``sigma_F = F ln(10)/2.5 sigma_m`` (first order).  A spin fit with one scale for every
+band (``offset="common"``) compares band colours, so it puts the model's in the
+magnitude system the light curve states (AB or Vega).
 """
 
 from ..errors import FitQualityWarning, InversionError
+from ._areas import material_areas
 from ._bench import benchmark_spin_search
 from ._data import band_terms, magnitudes_to_signal, measured_kind, read_spectrum
 from ._joint import JOINT_CAUSES, fit_observation
@@ -64,7 +69,7 @@ from ._spin import (
 from ._spin_data import light_curve_fluxes
 from ._spin_search import fibonacci_sphere, spin_model
 from ._studies import spin_recovery, unmix_calibration
-from ._unmix import DEGENERACY_THRESHOLD, DROP_BIAS, material_areas, unmix
+from ._unmix import DEGENERACY_THRESHOLD, DROP_BIAS, unmix
 
 __all__ = [
     "AMBIGUITY_CHI2",

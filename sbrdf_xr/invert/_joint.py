@@ -18,12 +18,12 @@ from numpy.typing import ArrayLike
 from scipy.optimize import least_squares
 
 from ..errors import InversionError
+from ._areas import material_areas
 from ._joint_model import PassModel, pass_data
 from ._joint_result import Layout, model_check, result_dataset
 from ._quality import fit_quality
 from ._spin_refine import _tangent
 from ._spin_search import vec
-from ._unmix import material_areas
 
 __all__ = ["JOINT_CAUSES", "fit_observation"]
 

@@ -19,9 +19,9 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from ..errors import FitQualityWarning, InversionError
+from ._areas import material_areas
 from ._joint import fit_observation
 from ._spin_search import spin_model, vec
-from ._unmix import material_areas
 
 __all__ = ["observation_recovery", "simulated_light_curve"]
 

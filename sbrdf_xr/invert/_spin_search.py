@@ -147,7 +147,9 @@ def body_vectors(v: np.ndarray, align: np.ndarray, k: np.ndarray, angle: np.ndar
 
 
 class Kernel:
-    """Band signal of a spacecraft for body-frame geometries, on pre-integrated tables."""
+    """Band signal of a spacecraft for body-frame geometries, on pre-integrated tables,
+    times ``band_factors`` (one per band, default 1: see
+    :func:`sbrdf_xr.invert._spin_data.band_factors`)."""
 
     def __init__(
         self,
@@ -155,6 +157,7 @@ class Kernel:
         bands: Sequence[str],
         materials: Mapping[str, Any] | None = None,
         method: str = "linear",
+        band_factors: ArrayLike | None = None,
     ) -> None:
         from ..engine import Scene
 
@@ -173,6 +176,11 @@ class Kernel:
             raise InversionError("spin fit: the band tables could not be pre-integrated")
         self.bands = tuple(str(b) for b in plan.bands)
         self.method = method
+        self.band_factors = (
+            np.ones(len(self.bands))
+            if band_factors is None
+            else np.asarray(band_factors, dtype=np.float64).reshape(len(self.bands))
+        )
 
     @property
     def materials(self) -> tuple[str, ...]:
@@ -196,8 +204,9 @@ class Kernel:
         )
         if per_material:
             shape = (*s.shape[:-1], len(self.materials), len(self.bands))
-            return np.asarray(r.per_material, dtype=np.float64).reshape(shape)
-        return np.asarray(r.signal, dtype=np.float64).reshape(*s.shape[:-1], len(self.bands))
+            return np.asarray(r.per_material, dtype=np.float64).reshape(shape) * self.band_factors
+        sig = np.asarray(r.signal, dtype=np.float64).reshape(*s.shape[:-1], len(self.bands))
+        return sig * self.band_factors
 
 
 class Problem:
