@@ -182,7 +182,14 @@ class Kernel:
             else np.asarray(band_factors, dtype=np.float64).reshape(len(self.bands))
         )
 
-    def __call__(self, s: np.ndarray, o: np.ndarray) -> np.ndarray:
+    @property
+    def materials(self) -> tuple[str, ...]:
+        """The materials of the plan, in the order of ``per_material`` outputs."""
+        return tuple(str(m) for m in self.plan.materials)
+
+    def __call__(self, s: np.ndarray, o: np.ndarray, per_material: bool = False) -> np.ndarray:
+        """Band signal (..., B) [m2 sr-1] at body-frame directions (..., 3); with
+        ``per_material`` the signal of each material, (..., M, B) (:attr:`materials`)."""
         t = self.plan.terms
         r = _kernels.fused_sums(
             s.reshape(-1, 3),
@@ -193,8 +200,11 @@ class Kernel:
             self.plan.tables,
             self.method,
             None,
-            False,
+            per_material,
         )
+        if per_material:
+            shape = (*s.shape[:-1], len(self.materials), len(self.bands))
+            return np.asarray(r.per_material, dtype=np.float64).reshape(shape) * self.band_factors
         sig = np.asarray(r.signal, dtype=np.float64).reshape(*s.shape[:-1], len(self.bands))
         return sig * self.band_factors
 
