@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from .._names import attrs as cf
 from ._joint_model import PassData
 from ._spin_search import lonlat
 
@@ -167,8 +168,8 @@ def result_dataset(
             "parameter": ("parameter", lay.names, _cf("1", "fitted parameter")),
             "parameter_b": ("parameter_b", lay.names, _cf("1", "fitted parameter")),
             "parameter_units": ("parameter", lay.units, _cf("1", "unit of the parameter")),
-            "band": ("band", list(lay.bands), _cf("1", "photometric filter band")),
-            "material": ("material", list(lay.materials), _cf("1", "material name")),
+            "band": ("band", list(lay.bands), cf("band")),
+            "material": ("material", list(lay.materials), cf("material")),
             "xyz": ("xyz", ["x", "y", "z"], _cf("1", "vector component")),
         }
     )
@@ -204,35 +205,35 @@ def result_dataset(
     ds["extinction_coefficient"] = (
         "band",
         lay.extinction(p),
-        _cf("1", f"{k_how} first-order extinction coefficient (mag per airmass)"),
+        cf("magnitude", long_name=f"{k_how} first-order extinction coefficient (mag per airmass)"),
     )
     ds["extinction_coefficient_uncertainty"] = (
         "band",
         k_sd,
-        _cf("1", "1-sigma uncertainty of the extinction coefficient (0: given)"),
+        cf("magnitude", long_name="1-sigma uncertainty of the extinction coefficient (0: given)"),
     )
     if lay.offset == "common":
         ds["magnitude_offset"] = (
             (),
             float(p[lay.sl["z"]][0]),
-            _cf("1", "fitted common magnitude offset (measured - model)"),
+            cf("magnitude", long_name="fitted common magnitude offset (measured - model)"),
         )
         ds["magnitude_offset_uncertainty"] = (
             (),
             float(sd[lay.sl["z"]][0]),
-            _cf("1", "1-sigma uncertainty of the magnitude offset"),
+            cf("magnitude", long_name="1-sigma uncertainty of the magnitude offset"),
         )
     else:
         z_how = "fitted" if lay.offset == "band" else "held at 0 (a calibrated table)"
         ds["zero_point"] = (
             "band",
             lay.zero_points(p),
-            _cf("1", f"zero point, measured - model ({z_how})"),
+            cf("magnitude", long_name=f"zero point, measured - model ({z_how})"),
         )
         ds["zero_point_uncertainty"] = (
             "band",
             sd[lay.sl["z"]] if lay.offset == "band" else np.zeros(nb),
-            _cf("1", "1-sigma uncertainty of the zero point (0: not fitted)"),
+            cf("magnitude", long_name="1-sigma uncertainty of the zero point (0: not fitted)"),
         )
     _areas(ds, lay, p, c_out)
     scal = {
@@ -253,10 +254,8 @@ def result_dataset(
         "residual": (residual, "measured - model magnitude"),
     }
     for key, (val, ln) in per_obs.items():
-        ds[key] = xr.DataArray(val, dims=obs, attrs=_cf("1", ln))
-    ds["airmass"] = xr.DataArray(
-        data.airmass, dims=obs, attrs=_cf("1", "relative optical air mass")
-    )
+        ds[key] = xr.DataArray(val, dims=obs, attrs=cf("magnitude", long_name=ln))
+    ds["airmass"] = xr.DataArray(data.airmass, dims=obs, attrs=cf("airmass"))
     ds = ds.assign_coords({f"{k}_{obs}" if k == "band" else k: v.variable for k, v in keep.items()})
     ds.attrs = {
         **attrs,
