@@ -30,7 +30,7 @@ public package and module, each imported on first use.
 
 import importlib as _importlib
 
-from . import accessors, catalog, errors, geometry
+from . import accessors  # registers the .sbrdf accessors
 from ._names import __version__
 from .body import Spacecraft, canx1, load_spacecraft
 from .engine import Scene, builtin_scene, load_scene, simulate

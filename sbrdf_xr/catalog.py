@@ -22,8 +22,8 @@ from __future__ import annotations
 import contextlib
 import functools
 import os
-import subprocess
 from collections.abc import Callable, Iterable, Iterator, Mapping
+from contextlib import AbstractContextManager
 from pathlib import Path
 from typing import Any
 
@@ -32,7 +32,6 @@ import trimesh
 import xarray as xr
 from numpy.typing import DTypeLike
 
-from ._cache import cache_file, cached_table
 from ._catalog_index import (
     CATALOG_PATH_ENV,
     KINDS,
@@ -48,9 +47,9 @@ from ._catalog_index import (
 from ._names import SBRDF, WAVELENGTH
 from .body import spacecraft
 from .errors import CatalogError, ValidationError, did_you_mean, input_file, reading
-from .kernels.warm import compile_ahead
 from .materials import models
 from .materials import tables as material
+from .materials.cache import cache_file, cached_table
 from .materials.shipped import read_reflectance
 from .observing import observe
 
@@ -123,7 +122,8 @@ def _built_material(
     options: tuple[tuple[str, Any], ...],
     dtype: str | None = None,
 ) -> xr.DataArray:
-    """A table built from a measurement entry, through the disk cache (:mod:`sbrdf_xr._cache`),
+    """A table built from a measurement entry, through the disk cache
+    (:mod:`sbrdf_xr.materials.cache`),
     its values in ``dtype`` (None: as built, float64).
 
     A table in another dtype is cast from the file's values, not from the float64 table
@@ -239,7 +239,7 @@ def to_build(wanted: Iterable[str]) -> list[str]:
     """The built tables among catalog entries ``names`` that loading them would build.
 
     A material with ``build_from`` in its entry is built from its measurements on its
-    first load and then read from the table cache (:mod:`sbrdf_xr._cache`); these are
+    first load and then read from the table cache (:mod:`sbrdf_xr.materials.cache`); these are
     the ones neither in the cache nor loaded in this process (with the cache switched off,
     every one not loaded yet).
 
@@ -276,15 +276,18 @@ def to_build(wanted: Iterable[str]) -> list[str]:
 
 
 def load_materials(
-    wanted: Iterable[str], dtype: DTypeLike | None = None, compile_kernels: bool = True
+    wanted: Iterable[str],
+    dtype: DTypeLike | None = None,
+    while_building: Callable[[str, bool], AbstractContextManager[object]] | None = None,
 ) -> dict[str, Any]:
     """Load several material entries, the tables to build labelled as one batch.
 
     Every table that has to be built shows a progress bar "building table NAME (k of
     n)" (:func:`to_build`); loading from the cache shows nothing.  While tables build,
-    a second process compiles the engine's kernel for them
-    (:func:`sbrdf_xr.kernels.warm.compile_ahead`), so that the first simulation finds it
-    in numba's cache; the call returns when both are done.
+    the context ``while_building(dtype, progress)`` is held: the engine compiles its
+    kernel for them in a second process meanwhile
+    (:func:`sbrdf_xr.kernels.warm.compiling_ahead`), so that the first simulation finds
+    it in numba's cache; the call returns when both are done.
 
     Parameters
     ----------
@@ -292,8 +295,9 @@ def load_materials(
         Names of ``material`` entries.
     dtype : {None, "float32", "float64"}, optional
         As :func:`load`.
-    compile_kernels : bool, default True
-        Compile the engine's kernel meanwhile when a table is built.
+    while_building : callable, optional
+        Called with the tables' dtype name and whether progress bars show, when a table
+        is to be built; returns a context manager held while they build.
 
     Returns
     -------
@@ -307,34 +311,11 @@ def load_materials(
     """
     wanted = list(dict.fromkeys(wanted))
     building = to_build(wanted)
-    # the engine's kernel compiles in a second process while the tables build
-    proc = compile_ahead(_table_dtype(dtype) or "float64") if building and compile_kernels else None
-    try:
-        with _batch(building):
-            return {name: load(name, dtype=dtype) for name in wanted}
-    finally:
-        if proc is not None:
-            _wait_compiling(proc)
-
-
-def _wait_compiling(proc: Any) -> None:
-    """Wait for the process compiling the engine's kernel, with a progress bar while it
-    runs (none when it is already done)."""
-    if proc.poll() is not None:
-        return
-    from tqdm.auto import tqdm
-
-    with tqdm(
-        desc="compiling the engine's kernel",
-        bar_format="{desc}: {elapsed}",
-        disable=not _SHOW_PROGRESS[0],
-    ) as bar:
-        while True:
-            try:
-                proc.wait(timeout=0.25)
-                break
-            except subprocess.TimeoutExpired:
-                bar.refresh()
+    meanwhile: AbstractContextManager[object] = contextlib.nullcontext()
+    if building and while_building is not None:
+        meanwhile = while_building(_table_dtype(dtype) or "float64", _SHOW_PROGRESS[0])
+    with meanwhile, _batch(building):
+        return {name: load(name, dtype=dtype) for name in wanted}
 
 
 @contextlib.contextmanager

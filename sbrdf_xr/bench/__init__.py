@@ -8,7 +8,8 @@ Modules
 ``rows``
     The record of one measurement, how it is timed and how rows are shown.
 ``suite``
-    The benchmarks users run: table construction, look-up, kernel throughput.
+    The benchmarks users run: table construction, look-up, kernel throughput, the
+    geometry of a pass.
 ``accuracy``
     The accuracy/cost sweep of the knobs and presets.
 ``engine``
@@ -35,7 +36,7 @@ from .shadowing import (
     markdown,
     scaling_rows,
 )
-from .suite import bench_build_lut, bench_lookup, kernel_throughput, run
+from .suite import bench_build_lut, bench_geometry, bench_lookup, kernel_throughput, run
 
 __all__ = [
     "ACCURACY_BODIES",
@@ -48,6 +49,7 @@ __all__ = [
     "accuracy_cost",
     "accuracy_rows",
     "bench_build_lut",
+    "bench_geometry",
     "bench_lookup",
     "best_time",
     "canx1_sweep_rows",

@@ -9,8 +9,9 @@ self-shadowing comparison of :mod:`sbrdf_xr.bench.shadowing`.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import partial
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import xarray as xr
@@ -19,6 +20,9 @@ from .. import catalog
 from ..engine.knobs import PRESETS
 from ..materials import tables as material
 from .rows import BenchRow, timed_runs
+
+if TYPE_CHECKING:
+    from ..engine.scene import Scene
 
 __all__ = ["BANDS", "CANX1_MATERIALS", "accuracy_cost", "shadow_rows"]
 
@@ -227,8 +231,8 @@ _KEEP = ("materials", "outputs")
 
 
 def _run(
-    simulate: Any,
-    scene: Any,
+    simulate: Callable[[Scene], xr.Dataset],
+    scene: Scene,
     reference: dict[str, Any],
     opts: dict[str, Any],
     cubes: dict[str, xr.Dataset],

@@ -21,12 +21,16 @@ per-facet numpy evaluation and estimates the machine's limit for it.
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import xarray as xr
 
 from ..kernels import lut as _lut
 from ..materials import tables as material
 from ..materials.goniometer import measure
+from ..observing.observe import CANX1_PASS, Observation, Orbit, Site, canx1_attitude
+from ..observing.timescales import to_datetime64
 from ..testing import lobe_function
 from .accuracy import CANX1_MATERIALS, accuracy_cost
 from .rows import BenchRow, best_time, format_rows, rows_to_dataset, timed_runs
@@ -292,6 +296,47 @@ def kernel_throughput(repeat: int = 3, attitude_step: int = 1) -> list[BenchRow]
         ),
     ]
     return rows
+
+
+def bench_geometry(n_times: int = 3600, step_s: float = 1.0, repeats: int = 3) -> dict[str, float]:
+    """Time :meth:`~sbrdf_xr.observing.Observation.geometry` of the built-in CanX-1 orbit and
+    site (:data:`~sbrdf_xr.observing.observe.CANX1_PASS`) over ``n_times`` steps.
+
+    The first call in a process also pays the one-off imports and the loading of the
+    skyfield data; it is reported apart from the best of ``repeats`` further calls on
+    fresh observations (nothing cached between them).
+
+    Returns
+    -------
+    dict
+        ``n_times``, ``first_call_seconds``, ``seconds`` (best warm call) and
+        ``seconds_per_time``.
+
+    Examples
+    --------
+    >>> row = bench_geometry(n_times=60, repeats=1)
+    >>> sorted(row), row["n_times"]
+    (['first_call_seconds', 'n_times', 'seconds', 'seconds_per_time'], 60.0)
+    """
+    p = CANX1_PASS
+    t0 = to_datetime64(p["start"], "start") - np.timedelta64(int(n_times * step_s / 2), "s")
+    t = t0 + np.timedelta64(round(step_s * 1e9), "ns") * np.arange(n_times)
+    start = time.perf_counter()
+    orbit, site = Orbit.from_catalog(p["orbit"]), Site.from_catalog(p["site"])
+    Observation(orbit, site, t, canx1_attitude()).geometry(on_unobservable="keep")
+    first = time.perf_counter() - start
+    best = np.inf
+    for _ in range(max(1, repeats)):
+        obs = Observation(orbit, site, t, canx1_attitude())
+        start = time.perf_counter()
+        obs.geometry(on_unobservable="keep")
+        best = min(best, time.perf_counter() - start)
+    return {
+        "n_times": float(n_times),
+        "first_call_seconds": first,
+        "seconds": best,
+        "seconds_per_time": best / n_times,
+    }
 
 
 def run(quick: bool = False, repeat: int | None = None) -> list[BenchRow]:

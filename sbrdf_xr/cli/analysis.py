@@ -278,11 +278,16 @@ def _unmix(args: argparse.Namespace):
             raise InversionError("--range-km: needed to turn measured magnitudes into signal")
         y, sigma = invert.magnitudes_to_signal(lc, args.range_km)
         terms = invert.band_terms(terms, [str(b) for b in y.band.values])
+    if args.total_area and args.spacecraft is None:
+        raise InversionError("--total-area: needs --spacecraft (the areas to add up)")
+    areas = None if args.spacecraft is None else invert.material_areas(spacecraft_of(args))
     try:
         ds = invert.unmix(
             y,
             terms,
             sigma,
+            areas=areas,
+            total_area=True if args.total_area else None,
             select=None if args.select == "none" else args.select,
             criterion=args.criterion,
         )
@@ -298,9 +303,15 @@ def _unmix(args: argparse.Namespace):
     )
     for m in ds.material.values:
         kept = "" if bool(ds.selected.sel(material=m)) else "  (left out)"
+        area = (
+            f", area {float(ds.area.sel(material=m)):.4g} m2 "
+            f"({float(ds.area_fraction.sel(material=m)):.3f} of the total)"
+            if "area" in ds
+            else ""
+        )
         print(
             f"  {m!s:<24} scale {float(ds.scale.sel(material=m)):.4f} "
-            f"+- {float(ds.scale_uncertainty.sel(material=m)):.4f}{kept}"
+            f"+- {float(ds.scale_uncertainty.sel(material=m)):.4f}{area}{kept}"
         )
     print(f"  selection: {ds.attrs['selection_note']}")
     print(f"  degenerate: {ds.attrs['degenerate']}")

@@ -292,11 +292,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             scene = scene.with_options(**changes)
     except SbrdfError as exc:  # the option named, with the knob's own message
         raise ValidationError(f"{', '.join(given)}: {exc}") from None
-    if scene.materials is None:  # the catalog's tables, those to build labelled as one batch
-        known = set(catalog.names("material"))
-        wanted = [m for m in scene.spacecraft.materials if m in known]
-        catalog.load_materials(wanted, dtype=scene.dtype)
-    plan = scene.plan()
+    plan = scene.plan()  # the catalog's tables built as one batch, the kernel compiling meanwhile
     print(plan)
     if args.plan:
         return 0

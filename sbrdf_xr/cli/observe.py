@@ -329,7 +329,8 @@ def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     """
     import numpy as np
 
-    from ..observing.observe import Observation, Orbit, Site, times, to_datetime64
+    from ..observing.observe import Observation, Orbit, Site, times
+    from ..observing.timescales import to_datetime64
 
     spec = args.elements
     if Path(spec).is_file():

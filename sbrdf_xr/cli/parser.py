@@ -20,6 +20,7 @@ Sub-commands::
                         [--colours V-R,R-I]
              [--system ab|vega] [-o PHOT.nc] [--csv PHOT.csv]
     sbrdf-xr invert unmix MEASURED --cube CUBE.nc [--range-km R] [-o OUT.nc]   material areas
+             [--spacecraft NAME|MESH --total-area]
     sbrdf-xr invert spin CURVE (--cube CUBE.nc | --scene SCENE | --to-sun X Y Z --to-observer X Y Z)
              --periods MIN MAX N [-o OUT.nc]                                      spin state
 
@@ -281,6 +282,18 @@ def build_parser() -> argparse.ArgumentParser:
     pu.add_argument("--range-km", type=float, help="observer range [km] (band magnitudes)")
     pu.add_argument("--select", choices=("all", "greedy", "none"), default="all")
     pu.add_argument("--criterion", choices=("bic", "aic"), default="bic")
+    pu.add_argument(
+        "--spacecraft",
+        help="a catalog name or a mesh file: the nominal area of each material, to report "
+        "areas [m2] and for --total-area",
+    )
+    _mesh_options(pu)
+    pu.add_argument(
+        "--total-area",
+        action="store_true",
+        help="the fitted material areas add up to the spacecraft's (needs --spacecraft; "
+        "every material of the body must be in the cube)",
+    )
     pspin = isub.add_parser("spin", help="spin axis, period and phase from a colour light curve")
     pspin.add_argument(
         "measured", help="light curve CSV/ECSV/netCDF (read_light_curve format; UTC times or s)"

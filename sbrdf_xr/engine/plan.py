@@ -33,6 +33,7 @@ import xarray as xr
 from .._names import BAND, MATERIAL, PSI, WAVELENGTH, __version__
 from ..errors import SceneError
 from ..kernels import PackedTables, normal_rows
+from ..kernels.anisotropic import AnisotropicTable
 from ..materials.models import model_parameters
 from ..store.fingerprint import PREFIX, scene_fingerprint
 from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, BlockInputs, Effect, PlanInputs, readonly
@@ -250,7 +251,7 @@ class Plan:
     steps: tuple[tuple[str, str], ...]
     attrs: Mapping[str, Any] = field(default_factory=dict)
     #: Anisotropic tables by material index (:func:`sbrdf_xr.kernels.anisotropic.pack_anisotropic`).
-    anisotropic: Mapping[int, Any] = field(default_factory=dict)
+    anisotropic: Mapping[int, AnisotropicTable] = field(default_factory=dict)
     #: Products of the plan made on first use (the cube's coordinate template).
     cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 

@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike
 
 from .. import catalog, geometry
 from ..errors import CatalogError, SceneError, ValidationError, did_you_mean
+from ..kernels.warm import compiling_ahead
 from ..materials.tables import validate_material
 from ..units import check_plausible, to_unit
 from .effects import DEFAULT_EFFECTS, SCENE_EFFECTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS, scene_effects
@@ -459,7 +460,9 @@ class Scene:
         # the tables to build as one batch, the engine's kernel compiling meanwhile
         try:
             loaded = catalog.load_materials(
-                [m for m in self.spacecraft.materials if m in known], self.dtype
+                [m for m in self.spacecraft.materials if m in known],
+                self.dtype,
+                while_building=compiling_ahead,
             )
         except CatalogError:  # named below, material by material
             loaded = {}

@@ -18,6 +18,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from ..observing.observe import OBSERVATION_KEYS as _OBSERVATION
 from .effects import DEFAULT_EFFECTS, EFFECTS, SCENE_EFFECTS, SCENE_OUTPUTS
 from .knobs import KNOBS
 from .scene import Scene
@@ -260,41 +261,11 @@ GEOMETRY_KEYS: dict[str, Key] = _table(
     ]
 )
 
-#: Keys of an ``[observation]`` table (read by
-#: :func:`sbrdf_xr.observing.observe.observation_from_dict`).
+#: Keys of an ``[observation]`` table, as
+#: :data:`sbrdf_xr.observing.observe.OBSERVATION_KEYS` declares them for
+#: :func:`~sbrdf_xr.observing.observe.observation_from_dict`, the reader.
 OBSERVATION_KEYS: dict[str, Key] = _table(
-    [
-        Key("orbit", (str,), "the orbit: a catalog name (or tle, tle_line1/2, omm)", "-"),
-        Key("tle", (list,), "the orbit as [line1, line2]", "-"),
-        Key("tle_line1", (str,), "the orbit's first TLE line (with tle_line2)", "-"),
-        Key("tle_line2", (str,), "the orbit's second TLE line", "-"),
-        Key("omm", (str, dict), "the orbit as an OMM file or table", "-"),
-        Key("name", (str,), "the observation's name", "-"),
-        Key(
-            "site",
-            (str, dict),
-            "a catalog name or {latitude_deg, longitude_deg, height_m, name}",
-            "required",
-        ),
-        Key("start", (str,), "first time, UTC (ISO 8601)", "-"),
-        Key("stop", (str,), "last time, UTC", "-"),
-        Key("step_s", _NUMBER, "time step [s]", "1"),
-        Key("times", (list,), "explicit UTC times instead of start/stop/step_s", "-"),
-        Key("attitude", (dict,), "[observation.attitude]: a law (the laws table below)", "-"),
-        Key(
-            "airmass_model",
-            (str,),
-            "the airmass formula (sbrdf_xr.observing.AIRMASS_MODELS)",
-            '"kastenyoung1989"',
-        ),
-        Key(
-            "min_elevation_deg",
-            _NUMBER,
-            "lowest elevation that counts as observable [degree]",
-            "0.0",
-        ),
-        Key("earth", (str,), 'the Earth of the shadow: "wgs84" or "sphere"', '"wgs84"'),
-    ]
+    Key(name, types, text, default) for name, (types, text, default) in _OBSERVATION.items()
 )
 
 

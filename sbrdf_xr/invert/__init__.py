@@ -1,6 +1,6 @@
 """Inversion: what a measured spectrum or colour light curve says about the spacecraft.
 
-Two inverse problems built on the forward model:
+Inverse problems built on the forward model:
 
 :func:`unmix`
     The signal is linear in each material's effective area (paper 000 Eq. 3 is a sum
@@ -14,7 +14,9 @@ Two inverse problems built on the forward model:
     weighted; a material is left out only if its omission cannot bias the other
     estimates by more than :data:`DROP_BIAS` of their sigma, so that the uncertainties
     of the chosen model stay calibrated.  Pairs of materials whose estimates are
-    correlated beyond a threshold are reported as degenerate.
+    correlated beyond a threshold are reported as degenerate.  ``total_area`` makes the
+    fitted areas add up to a known total, the mesh's (equality-constrained least
+    squares, Seber & Lee 2003, *Linear Regression Analysis*, §3.8).
 :func:`fit_spin`
     Spin axis (two angles of the inertial axis of a known body axis), period and phase
     of a uniform spin (:class:`sbrdf_xr.observing.attitude.Spin`) fitted to a colour
@@ -26,19 +28,33 @@ Two inverse problems built on the forward model:
     by :func:`scipy.optimize.least_squares` from the best candidates, the lowest
     chi-square reported with its ambiguous twins; uncertainties from the Jacobian.
 
-Both check their chi-square against its distribution and warn
+:func:`fit_observation`
+    The two together, with the atmosphere, on calibrated magnitudes measured over a pass
+    (an :class:`sbrdf_xr.observing.Observation`): the spin state, the first-order
+    extinction coefficient of each band against the pass's air mass, optionally zero
+    points, and the area fraction of each material (adding up to the mesh's area, or
+    free scales), fitted at once by :func:`scipy.optimize.least_squares` from a start such
+    as :func:`fit_spin`'s, every material's band signal recomputed with the compiled
+    kernel for each spin state; uncertainties and correlations from the Jacobian.
+
+All three check their chi-square against its distribution and warn
 (:class:`~sbrdf_xr.errors.FitQualityWarning`) when the fit is not to be taken at face
-value.  :func:`unmix_calibration` and :func:`spin_recovery` measure, over noise draws of a
-known truth, how well the stated uncertainties hold.
+value.  :func:`unmix_calibration`, :func:`spin_recovery` and :func:`observation_recovery`
+measure, over noise draws of a known truth, how well the stated uncertainties hold.
 
 Measured fluxes are in any unit proportional to the band signal (the scale is fitted);
 magnitudes are converted to relative fluxes ``10**(-0.4 m)`` with uncertainties
-``sigma_F = F ln(10)/2.5 sigma_m`` (first order).
+``sigma_F = F ln(10)/2.5 sigma_m`` (first order).  A spin fit with one scale for every
+band (``offset="common"``) compares band colours, so it puts the model's in the
+magnitude system the light curve states (AB or Vega).
 """
 
 from ..errors import FitQualityWarning, InversionError
+from ._areas import material_areas
 from ._bench import benchmark_spin_search
 from ._data import band_terms, magnitudes_to_signal, measured_kind, read_spectrum
+from ._joint import JOINT_CAUSES, fit_observation
+from ._joint_study import observation_recovery, simulated_light_curve
 from ._spin import (
     AMBIGUITY_CHI2,
     SEARCH_BYTES_LIMIT,
@@ -53,12 +69,13 @@ from ._spin import (
 from ._spin_data import light_curve_fluxes
 from ._spin_search import fibonacci_sphere, spin_model
 from ._studies import spin_recovery, unmix_calibration
-from ._unmix import DEGENERACY_THRESHOLD, DROP_BIAS, material_areas, unmix
+from ._unmix import DEGENERACY_THRESHOLD, DROP_BIAS, unmix
 
 __all__ = [
     "AMBIGUITY_CHI2",
     "DEGENERACY_THRESHOLD",
     "DROP_BIAS",
+    "JOINT_CAUSES",
     "SEARCH_BYTES_LIMIT",
     "SEARCH_WORK_LIMIT",
     "FitQualityWarning",
@@ -69,14 +86,17 @@ __all__ = [
     "benchmark_spin_search",
     "check_search_size",
     "fibonacci_sphere",
+    "fit_observation",
     "fit_spin",
     "light_curve_fluxes",
     "magnitudes_to_signal",
     "material_areas",
     "measured_kind",
+    "observation_recovery",
     "period_grid",
     "read_spectrum",
     "search_size",
+    "simulated_light_curve",
     "spin_model",
     "spin_recovery",
     "unmix",

@@ -65,12 +65,16 @@ def band_terms(per_material: xr.DataArray, bands: Sequence[str]) -> xr.DataArray
 
 
 def magnitudes_to_signal(
-    light_curve: xr.Dataset, range_km: float
+    light_curve: xr.Dataset, range_km: float, *, system: str | None = None
 ) -> tuple[xr.DataArray, xr.DataArray]:
     """Band signal [m2 sr-1] and its uncertainty from measured magnitudes (one per band).
 
     Inverts :func:`sbrdf_xr.photometry.magnitudes` at 1 AU:
-    ``S = d**2 10**(-0.4 (m - m_sun))``, ``sigma_S = S ln(10)/2.5 sigma_m``.
+    ``S = d**2 10**(-0.4 (m - m_sun))``, ``sigma_S = S ln(10)/2.5 sigma_m``, with the
+    Sun's magnitudes ``m_sun`` in the system of the magnitudes: ``system`` (AB or Vega),
+    by default the light curve's attribute ``magnitude_system``, AB when it states none
+    (recorded in the attribute ``magnitude_system_note``).  The band colours of the signal
+    depend on it (the Sun's V - I is 0.73 in Vega, 0.29 in AB).
 
     Parameters
     ----------
@@ -92,8 +96,13 @@ def magnitudes_to_signal(
     ([0.012381, 0.014961], 'm2 sr-1')
     >>> round(float(sigma[0] / signal[0]), 6)  # ln(10) / 2.5 * 0.02
     0.018421
+    >>> signal.attrs["magnitude_system"], signal.attrs["magnitude_system_note"]
+    ('AB', 'the light curve states no magnitude system: AB assumed')
+    >>> vega, _ = magnitudes_to_signal(mags.assign_attrs(magnitude_system="Vega"), 1000.0)
+    >>> vega.round(6).values.tolist()  # the Sun's V is -26.774 in Vega
+    [0.012314, 0.01242]
     """
-    from ..photometry import sun_magnitudes
+    from ..photometry import MAGNITUDE_SYSTEMS, sun_magnitudes
 
     range_km = to_unit(range_km, "km", "range_km")
     if not np.isfinite(range_km) or range_km <= 0:
@@ -104,7 +113,21 @@ def magnitudes_to_signal(
         raise InversionError(
             f"magnitudes: one value per band expected (a spectrum in bands), got bands {bands}"
         )
-    msun = sun_magnitudes(bands).values
+    stated = str(light_curve.attrs.get("magnitude_system", "unstated"))
+    given = stated if system is None else str(system)
+    known = {k.lower(): k for k in MAGNITUDE_SYSTEMS}
+    if given.lower() in known:
+        source = "stated by the light curve" if system is None else "the system argument"
+        system = known[given.lower()]
+        note = f"the Sun's magnitudes in the {system} system ({source})"
+    elif system is None and given == "unstated":
+        system, note = "AB", "the light curve states no magnitude system: AB assumed"
+    else:
+        raise InversionError(
+            f"magnitudes: system {given!r} unknown; allowed {sorted(MAGNITUDE_SYSTEMS)} (the "
+            "system argument or the light curve's attribute magnitude_system)"
+        )
+    msun = sun_magnitudes(bands, system=system).values
     m = np.asarray(light_curve["magnitude"].values, dtype=np.float64)
     sm = np.asarray(light_curve["uncertainty"].values, dtype=np.float64)
     if not np.all(np.isfinite(m)):
@@ -121,7 +144,15 @@ def magnitudes_to_signal(
     coords = {"band": bands}
     return (
         xr.DataArray(
-            s, dims="band", coords=coords, attrs={"units": "m2 sr-1", "long_name": "band signal"}
+            s,
+            dims="band",
+            coords=coords,
+            attrs={
+                "units": "m2 sr-1",
+                "long_name": "band signal",
+                "magnitude_system": system,
+                "magnitude_system_note": note,
+            },
         ),
         xr.DataArray(
             sig,

@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike
 from ..errors import FitQualityWarning, InversionError
 from ..units import to_unit
 from ._quality import fit_quality
-from ._spin_data import light_curve_fluxes, spin_geometry
+from ._spin_data import band_factors, light_curve_fluxes, spin_geometry
 from ._spin_refine import Minimum, axis_angle, exact_minimum, twins
 from ._spin_refine import refine as refine_state
 from ._spin_result import result_dataset
@@ -270,7 +270,11 @@ def fit_spin(
         light curve (all the values at those times; the exact model): the chi-square of
         that subset of the data ranks the candidates, the refinements use every value.
     offset : {"band", "common"}
-        A free flux scale per band, or one for all bands.
+        A free flux scale per band, or one for all bands.  With one, the model's band
+        colours are put in the light curve's magnitude system (its ``magnitude_system``
+        attribute, AB or Vega; refused when unstated): the band signal times
+        ``10**(-0.4 m_sun,b)``, the Sun's magnitude in each band.  Fluxes (``flux``) are
+        taken as proportional to the band signal (the reflected band flux over the Sun's).
     refine : bool
         Refine the best candidates by least squares (else the grid's best, unrefined).
     n_starts : int
@@ -408,7 +412,8 @@ def fit_spin(
     )
     chain = _chain(method, fixed, sizes, n_search, n_search_values)
     _check_size(sizes[chain[0]], what, size_limit)  # before the kernel or any allocation
-    kern = Kernel(spacecraft, list(lc["labels"]), materials)
+    factors, offset_note = band_factors(light_curve, list(lc["labels"]), offset)
+    kern = Kernel(spacecraft, list(lc["labels"]), materials, band_factors=factors)
     prob = Problem(lc, geo, kern, ab, offset)
     grid_prob = prob.subset(n_search)
     axes = fibonacci_sphere(n_axes)
@@ -449,6 +454,7 @@ def fit_spin(
         attrs={
             "axis_body": str(ab.tolist()),
             "offset": offset,
+            "offset_note": offset_note,
             "n_candidates": int(grid.size),
             "search_times": (
                 f"the grid ranked candidates by the chi-square of the values at {n_search} of "

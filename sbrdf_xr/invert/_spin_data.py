@@ -14,7 +14,14 @@ import xarray as xr
 
 from ..errors import InversionError
 
-__all__ = ["LN10_2P5", "SpinGeometry", "directions", "light_curve_fluxes", "spin_geometry"]
+__all__ = [
+    "LN10_2P5",
+    "SpinGeometry",
+    "band_factors",
+    "directions",
+    "light_curve_fluxes",
+    "spin_geometry",
+]
 
 #: ln(10) / 2.5: d(flux) / flux per magnitude.
 LN10_2P5 = np.log(10.0) / 2.5
@@ -126,6 +133,66 @@ def light_curve_fluxes(
         "sigma": sf,
         "labels": np.array(labels),
     }
+
+
+def band_factors(
+    light_curve: xr.Dataset, labels: Sequence[str], offset: str
+) -> tuple[np.ndarray, str]:
+    """Factors that put the model's band signal in the units of the measured fluxes.
+
+    With a free scale per band (``offset="band"``) any factor is absorbed: all 1.  With
+    one scale for every band (``"common"``) the model's band colours must be those of the
+    data.  Magnitudes ``m_b = m_sun,b + 5 log10(r / AU) - 2.5 log10(S_b / d**2)``
+    (:func:`sbrdf_xr.photometry.magnitudes`) make fluxes ``10**(-0.4 m_b)`` proportional
+    to ``S_b 10**(-0.4 m_sun,b)``, with the Sun's magnitudes ``m_sun,b`` of the light
+    curve's system (AB or Vega: its ``magnitude_system`` attribute), so the factors are
+    ``10**(-0.4 (m_sun,b - m_sun,0))``.  Fluxes (``flux``) are taken as proportional to
+    the band signal itself (the reflected band flux over the Sun's): all 1.
+
+    Examples
+    --------
+    The Sun (ASTM G173) is redder than Vega: V - R = 0.39 and V - I = 0.73 in the Vega
+    system, so the fluxes of a body of the Sun's colour are 1.43 and 1.96 times those in V:
+
+    >>> import xarray as xr
+    >>> from sbrdf_xr.invert._spin_data import band_factors
+    >>> lc = xr.Dataset({"magnitude": ("obs", [9.0, 8.6, 8.3]),
+    ...                  "uncertainty": ("obs", [0.02] * 3)},
+    ...                 coords={"band": ("obs", ["V", "R", "I"])},
+    ...                 attrs={"magnitude_system": "Vega"})
+    >>> factors, note = band_factors(lc, ["V", "R", "I"], "common")
+    >>> factors.round(3).tolist()
+    [1.0, 1.433, 1.962]
+    >>> band_factors(lc, ["V", "R", "I"], "band")[0].tolist()
+    [1.0, 1.0, 1.0]
+    """
+    ones = np.ones(len(labels))
+    if offset == "band":
+        return ones, "a free flux scale per band"
+    if "magnitude" not in light_curve or "flux" in light_curve:
+        return ones, "one flux scale for every band; fluxes proportional to the band signal"
+    from ..photometry import MAGNITUDE_SYSTEMS, sun_magnitudes
+
+    system = str(
+        light_curve.attrs.get(
+            "magnitude_system", light_curve["magnitude"].attrs.get("magnitude_system", "unstated")
+        )
+    )
+    known = {k.lower(): k for k in MAGNITUDE_SYSTEMS}
+    if system.lower() not in known:  # "unstated", or anything else
+        raise InversionError(
+            f"light curve: offset='common' fits one scale to every band, so the model's band "
+            f"colours must be in the magnitude system of the data, but the light curve states "
+            f"{system!r} (attribute magnitude_system); allowed {sorted(MAGNITUDE_SYSTEMS)}: "
+            "state it (read_light_curve(..., system=...)) or use offset='band'"
+        )
+    system = known[system.lower()]
+    msun = sun_magnitudes(list(labels), system=system).values
+    return (
+        10 ** (-0.4 * (msun - msun[0])),
+        f"one flux scale for every band; the model's band colours in the {system} system "
+        "(the band signal times 10**(-0.4 m_sun,band), the Sun's magnitudes)",
+    )
 
 
 def _rows(bad: np.ndarray) -> str:

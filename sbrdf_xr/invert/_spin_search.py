@@ -161,7 +161,9 @@ def body_vectors(v: np.ndarray, align: np.ndarray, k: np.ndarray, angle: np.ndar
 
 
 class Kernel:
-    """Band signal of a spacecraft for body-frame geometries, on pre-integrated tables."""
+    """Band signal of a spacecraft for body-frame geometries, on pre-integrated tables,
+    times ``band_factors`` (one per band, default 1: see
+    :func:`sbrdf_xr.invert._spin_data.band_factors`)."""
 
     def __init__(
         self,
@@ -169,6 +171,7 @@ class Kernel:
         bands: Sequence[str],
         materials: Mapping[str, Any] | None = None,
         method: str = "linear",
+        band_factors: ArrayLike | None = None,
     ) -> None:
         from ..engine import Scene
 
@@ -187,8 +190,20 @@ class Kernel:
             raise InversionError("spin fit: the band tables could not be pre-integrated")
         self.bands = tuple(str(b) for b in plan.bands)
         self.method = method
+        self.band_factors = (
+            np.ones(len(self.bands))
+            if band_factors is None
+            else np.asarray(band_factors, dtype=np.float64).reshape(len(self.bands))
+        )
 
-    def __call__(self, s: np.ndarray, o: np.ndarray) -> np.ndarray:
+    @property
+    def materials(self) -> tuple[str, ...]:
+        """The materials of the plan, in the order of ``per_material`` outputs."""
+        return tuple(str(m) for m in self.plan.materials)
+
+    def __call__(self, s: np.ndarray, o: np.ndarray, per_material: bool = False) -> np.ndarray:
+        """Band signal (..., B) [m2 sr-1] at body-frame directions (..., 3); with
+        ``per_material`` the signal of each material, (..., M, B) (:attr:`materials`)."""
         t = self.plan.terms
         r = _kernels.fused_sums(
             s.reshape(-1, 3),
@@ -199,9 +214,13 @@ class Kernel:
             self.plan.tables,
             self.method,
             None,
-            False,
+            per_material,
         )
-        return np.asarray(r.signal, dtype=np.float64).reshape(*s.shape[:-1], len(self.bands))
+        if per_material:
+            shape = (*s.shape[:-1], len(self.materials), len(self.bands))
+            return np.asarray(r.per_material, dtype=np.float64).reshape(shape) * self.band_factors
+        sig = np.asarray(r.signal, dtype=np.float64).reshape(*s.shape[:-1], len(self.bands))
+        return sig * self.band_factors
 
 
 class Problem:

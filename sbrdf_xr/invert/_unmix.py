@@ -14,6 +14,7 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from ..errors import InversionError
+from ._areas import add_areas, area_constraint, material_areas
 from ._library import MATERIAL, design, library
 from ._quality import fit_quality
 
@@ -43,28 +44,30 @@ UNMIX_CAUSES = (
 )
 
 
-def material_areas(spacecraft: Any) -> dict[str, float]:
-    """Total facet area of each material of a spacecraft [m2].
+def _wls(
+    aw: np.ndarray,
+    yw: np.ndarray,
+    cols: list[int],
+    con: tuple[np.ndarray, float] | None = None,
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """Weighted least squares on the columns ``cols``: estimate, covariance, chi-square.
 
-    Examples
-    --------
-    >>> import trimesh
-    >>> from sbrdf_xr import load_spacecraft
-    >>> from sbrdf_xr.invert import material_areas
-    >>> box = load_spacecraft(trimesh.creation.box(extents=(1.0, 2.0, 3.0)), material="grey")
-    >>> material_areas(box)  # 2 (1 x 2 + 1 x 3 + 2 x 3)
-    {'grey': 22.0}
+    With ``con = (c, total)`` the estimate obeys ``c[cols] . x = total`` (Seber & Lee
+    2003, *Linear Regression Analysis*, §3.8): ``x_c = x - C c^T (c C c^T)^-1 (c x -
+    total)``, ``C_c = C - C c^T (c C c^T)^-1 c C``; a subset whose ``c`` is 0 cannot meet
+    it (chi-square infinite).
     """
-    areas = np.asarray(spacecraft.mesh.area_faces, dtype=np.float64)
-    names = np.asarray(spacecraft.facet_material)
-    return {str(m): float(areas[names == m].sum()) for m in np.unique(names)}
-
-
-def _wls(aw: np.ndarray, yw: np.ndarray, cols: list[int]) -> tuple[np.ndarray, np.ndarray, float]:
-    """Weighted least squares on the columns ``cols``: estimate, covariance, chi-square."""
     a = aw[:, cols]
     cov = np.linalg.pinv(a.T @ a)
     x = np.linalg.lstsq(a, yw, rcond=None)[0]
+    if con is not None:
+        c = con[0][cols]
+        cc = float(c @ cov @ c)
+        if not cc > 0:
+            return x, cov, np.inf
+        gain = cov @ c / cc
+        x = x - gain * (float(c @ x) - con[1])
+        cov = cov - np.outer(gain, c @ cov)
     r = yw - a @ x
     return x, cov, float(r @ r)
 
@@ -122,6 +125,7 @@ def unmix(
     criterion: str = "bic",
     degeneracy_threshold: float = DEGENERACY_THRESHOLD,
     drop_bias: float = DROP_BIAS,
+    total_area: float | bool | None = None,
 ) -> xr.Dataset:
     """Effective area scale factor of each material from a measured spectrum or band fluxes.
 
@@ -144,6 +148,19 @@ def unmix(
     admissible).  So a material the data cannot pin down is kept, with the large
     uncertainty it brings, rather than dropped with a confident and biased remainder.
 
+    With ``total_area`` the areas ``a_m A_m`` (``A_m`` from ``areas``) must add up to a
+    known total, e.g. the mesh's: equality-constrained weighted least squares (Seber &
+    Lee 2003, *Linear Regression Analysis*, §3.8), ``x_c = x - C c^T (c C c^T)^-1 (c x -
+    A)``, ``C_c = C - C c^T (c C c^T)^-1 c C`` with ``c = (A_m)``.  It holds for the
+    materials of every subset scored: a left-out material has area 0 and the kept ones
+    fill the total.  The selection accounts for it: each subset is fitted with the
+    constraint, the leave-out bias is that of the constrained full fit (adding ``x_D =
+    0`` to the constraint shifts the kept estimates by ``-C_c,SD C_c,DD^-1 x_c,D``, the
+    same formula on the constrained covariance), and the criteria, ``dof`` and
+    ``reduced_chi2`` count one free parameter less.  Use it when the library holds every
+    material of the body and the data are calibrated: the total then pins down a
+    material the spectrum hardly sees (dark, or never lit), by elimination.
+
     Parameters
     ----------
     measured : DataArray
@@ -159,7 +176,13 @@ def unmix(
         1-sigma measurement errors, broadcast against ``measured``; > 0.
     areas : mapping of str to float, optional
         Nominal area of each material [m2] (:func:`material_areas`): adds ``area`` [m2]
-        and ``area_fraction`` [1] with their uncertainties.
+        and ``area_fraction`` [1] with their uncertainties.  ``area_fraction`` is the
+        fraction of the summed fitted area of the candidates (without ``total_area``) or
+        of ``total_area`` (with it); its attribute ``normalisation`` says which.
+    total_area : float, True or None
+        Constrain the fitted areas to add up to this [m2] (True: the sum of every value
+        of ``areas``, the mesh's total area when they come from :func:`material_areas`);
+        needs ``areas``.  Default None: unconstrained.
     select : {"all", "greedy", None}
         Subsets scored: every subset up to ``max_materials``, a forward greedy path, or
         only the full set of candidates.
@@ -183,8 +206,9 @@ def unmix(
         material_b); scalars ``chi2``, ``reduced_chi2``, ``dof``, ``fit_probability``,
         ``aic``, ``bic``, ``condition_number``; over ``subset``: ``subset_chi2``,
         ``subset_aic``, ``subset_bic``, ``subset_weight``, ``subset_bias_ratio``,
-        ``subset_admissible``; attributes ``selected_materials``, ``selection_note``,
-        ``degenerate``, ``fit_quality`` (and ``fit_quality_note``), ``library_note``.
+        ``subset_admissible``; ``total_area`` [m2] (with the constraint); attributes
+        ``selected_materials``, ``selection_note``, ``degenerate``, ``fit_quality`` (and
+        ``fit_quality_note``), ``library_note``, ``area_constraint``.
 
     Warns
     -----
@@ -238,6 +262,16 @@ def unmix(
     ('grey, red', 'none', 'consistent')
     >>> fit.area_fraction.attrs["long_name"]
     'fraction of the summed effective area of the fitted candidate materials'
+
+    Grey covers 4 m2 and red 2 m2 of the cube, so the truth above has areas of 3.2 and
+    3.0 m2, 6.2 m2 in all.  Constrained to that total, the fit keeps one free parameter
+    and the fractions add up to 1 exactly:
+
+    >>> tied = unmix(measured, cube, sigma, areas=material_areas(box), total_area=6.2)
+    >>> tied.scale.round(3).values.tolist(), int(tied.dof), int(fit.dof)
+    ([0.805, 1.491], 25, 24)
+    >>> round(float(tied.area_fraction.sum()), 12), tied.area_fraction.attrs["long_name"]
+    (1.0, 'fraction of total_area, the constrained sum of the areas')
     """
     if not isinstance(measured, xr.DataArray):
         raise InversionError(
@@ -251,27 +285,30 @@ def unmix(
         raise InversionError(f"drop_bias: {drop_bias!r}; allowed a finite number >= 0")
     lib, notes = library(simulated, measured)
     names = [str(m) for m in lib[MATERIAL].values]
+    con = area_constraint(total_area, areas, names)
+    n_con = 0 if con is None else 1
     a, y, s = design(measured, uncertainty, lib)
     n, k = a.shape
-    if n < k:
+    if n < k - n_con:
         raise InversionError(
-            f"measured: {n} values for {k} material parameters ({', '.join(names)}); need at "
-            "least as many values as parameters (more wavelengths, bands or geometries, or "
-            "fewer candidates)"
+            f"measured: {n} values for {k - n_con} material parameters ({', '.join(names)}"
+            f"{', their areas summing to total_area' if con else ''}); need at least as many "
+            "values as parameters (more wavelengths, bands or geometries, or fewer candidates)"
         )
     if max_materials is not None and int(max_materials) < 1:
         raise InversionError(f"max_materials: {max_materials!r}; allowed an integer >= 1")
     aw, yw = a / s[:, None], y / s
     kmax = k if max_materials is None else min(int(max_materials), k)
-    x_full, cov_full, _ = _wls(aw, yw, list(range(k)))
+    x_full, cov_full, _ = _wls(aw, yw, list(range(k)), con)
     pen = 2.0 if criterion == "aic" else float(np.log(n))
     fits: dict[tuple[int, ...], tuple[np.ndarray, np.ndarray, float, float]] = {}
 
     def score(c: tuple[int, ...]) -> float:
         if c not in fits:
-            x, cov, chi2 = _wls(aw, yw, list(c))
-            fits[c] = (x, cov, chi2, _bias_ratio(x_full, cov_full, list(c), cov))
-        return fits[c][2] + pen * len(c)
+            x, cov, chi2 = _wls(aw, yw, list(c), con)
+            bias = _bias_ratio(x_full, cov_full, list(c), cov) if np.isfinite(chi2) else np.inf
+            fits[c] = (x, cov, chi2, bias)
+        return fits[c][2] + pen * (len(c) - n_con)
 
     subsets = _subsets(select, k, kmax, score)
     for c in subsets:
@@ -279,7 +316,7 @@ def unmix(
     admissible = [c for c in subsets if fits[c][3] <= drop_bias]
     best = min(admissible, key=score)
     crit = np.array([score(c) for c in subsets])
-    w = np.exp(-(crit - crit.min()) / 2)
+    w = np.exp(-(crit - crit.min()) / 2)  # 0 for a subset that cannot meet the constraint
     w /= w.sum()
     lowest = subsets[int(np.argmin(crit))]
     cols = list(best)
@@ -290,7 +327,7 @@ def unmix(
     cov[np.ix_(cols, cols)] = cov_s
     sig = np.sqrt(np.clip(np.diag(cov_full), 0, None))  # left out: sigma of the full fit
     sig[cols] = np.sqrt(np.clip(np.diag(cov_s), 0, None))
-    dof = n - len(cols)
+    dof = n - len(cols) + n_con
 
     def label(c: tuple[int, ...]) -> str:
         return "+".join(names[j] for j in c)
@@ -317,13 +354,14 @@ def unmix(
                 label(c),
                 fits[c][2],
                 fits[c][3],
-                fits[c][2] + 2 * len(c),
-                fits[c][2] + len(c) * np.log(n),
+                fits[c][2] + 2 * (len(c) - n_con),
+                fits[c][2] + (len(c) - n_con) * np.log(n),
                 wi,
             )
             for c, wi in zip(subsets, w, strict=True)
         ],
-        scalars={"chi2": chi2, "dof": dof, "n": n},
+        scalars={"chi2": chi2, "dof": dof, "n": n, "npar": len(cols) - n_con},
+        total=None if con is None else con[1],
         importance=np.array(
             [sum(wi for c, wi in zip(subsets, w, strict=True) if j in c) for j in range(k)]
         ),
@@ -333,6 +371,13 @@ def unmix(
             "selection": str(select),
             "selection_note": sel_note,
             "drop_bias": drop_bias,
+            "area_constraint": (
+                "none"
+                if con is None
+                else f"the areas of the fitted materials add up to total_area = {con[1]:.6g} m2 "
+                "(equality-constrained least squares; the information criteria count one "
+                "parameter less, the degrees of freedom one more)"
+            ),
             "library_note": "; ".join(notes) if notes else "every candidate on the measured grid",
             **{k_: v for k_, v in quality.items() if k_.startswith("fit_quality")},
         },
@@ -356,6 +401,7 @@ def _result(
     attrs: dict[str, Any],
     quality: dict[str, Any],
     degeneracy_threshold: float,
+    total: float | None,
 ) -> xr.Dataset:
     """The result Dataset of :func:`unmix`."""
     k = len(names)
@@ -415,18 +461,23 @@ def _result(
         {"units": "1", "long_name": "correlation of the scale factors with every candidate fitted"},
     )
     if areas is not None:
-        _areas(ds, names, x, sig, cov, areas)
-    chi2, dof, n = (scalars[k_] for k_ in ("chi2", "dof", "n"))
-    npar = len(cols)
+        add_areas(ds, names, x, sig, cov, areas, total)
+    chi2, dof, n, npar = (scalars[k_] for k_ in ("chi2", "dof", "n", "npar"))
     scal = {
         "chi2": (chi2, "chi-square of the chosen model"),
-        "dof": (dof, "degrees of freedom (values minus fitted scale factors)"),
+        "dof": (
+            dof,
+            "degrees of freedom (values minus fitted scale factors, plus one for the area "
+            "constraint)"
+            if total is not None
+            else "degrees of freedom (values minus fitted scale factors)",
+        ),
         "reduced_chi2": (chi2 / dof if dof > 0 else np.nan, "chi-square per degree of freedom"),
         "fit_probability": (
             quality["fit_probability"],
             "probability of a chi-square at least this large for a right model",
         ),
-        "aic": (chi2 + 2 * npar, "Akaike information criterion chi2 + 2k"),
+        "aic": (chi2 + 2 * npar, "Akaike information criterion chi2 + 2k (k free parameters)"),
         "bic": (chi2 + npar * np.log(n), "Bayesian information criterion chi2 + k ln n"),
         "condition_number": (cond, "condition number of the weighted design of all candidates"),
         "n_samples": (n, "number of measured values"),
@@ -467,57 +518,3 @@ def _result(
         ),
     }
     return ds
-
-
-def _areas(
-    ds: xr.Dataset,
-    names: list[str],
-    x: np.ndarray,
-    sig: np.ndarray,
-    cov: np.ndarray,
-    areas: Mapping[str, float],
-) -> None:
-    """``area``, ``area_fraction`` and their uncertainties (first-order propagation)."""
-    missing = [m for m in names if m not in areas]
-    if missing:
-        raise InversionError(f"areas: no area for {missing}; have {sorted(areas)}")
-    nominal = np.array([float(areas[m]) for m in names])
-    bad = ~(np.isfinite(nominal) & (nominal >= 0))
-    if bad.any():
-        given = {m: float(v) for m, v, b in zip(names, nominal, bad, strict=True) if b}
-        raise InversionError(f"areas: must be finite and >= 0 [m2], got {given}")
-    area = x * nominal
-    ds["area"] = (MATERIAL, area, {"units": "m2", "long_name": "effective area of the material"})
-    ds["area_uncertainty"] = (
-        MATERIAL,
-        sig * nominal,
-        {"units": "m2", "long_name": "1-sigma uncertainty of the effective area"},
-    )
-    tot = float(area.sum())
-    cov_a = cov * np.outer(nominal, nominal)
-    if tot > 0:
-        jac = (np.eye(len(names)) * tot - area[:, None]) / tot**2  # d f_i / d area_j
-        frac = area / tot
-        frac_sig = np.sqrt(np.clip(np.diag(jac @ cov_a @ jac.T), 0, None))
-    else:
-        frac = frac_sig = np.full(len(names), np.nan)
-    normalised = (
-        "the summed effective area of the candidate materials of this fit "
-        f"({', '.join(names)}): the spacecraft's total only if the library holds all of its "
-        "materials"
-    )
-    ds["area_fraction"] = (
-        MATERIAL,
-        frac,
-        {
-            "units": "1",
-            "long_name": "fraction of the summed effective area of the fitted candidate materials",
-            "normalisation": normalised,
-        },
-    )
-    ds["area_fraction_uncertainty"] = (
-        MATERIAL,
-        frac_sig,
-        {"units": "1", "long_name": "1-sigma uncertainty of the area fraction (first order)"},
-    )
-    ds.attrs["area_fraction_normalisation"] = normalised

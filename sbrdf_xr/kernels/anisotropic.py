@@ -31,13 +31,15 @@ isotropic materials go through the plan's kernel as before, anisotropic ones thr
 
 from __future__ import annotations
 
-from typing import Any, NamedTuple
+from collections.abc import Mapping, Sequence
+from typing import Any, NamedTuple, Protocol, runtime_checkable
 
 import numba
 import numpy as np
 from numpy.typing import DTypeLike, NDArray
 
 from ..anisotropy import PSI_PERIOD, illumination_azimuth, psi_weights
+from ..errors import SceneError
 from ..geometry import normal_incidence_tolerance
 from . import lut as _lut
 from .angles import facet_frame, tangent_azimuth
@@ -46,7 +48,15 @@ from .packing import Facets, KernelOptions, PackedTables, pack_tables, typed_val
 from .reference import MaterialSums, material_sums
 from .sums import METHOD_CODES, FusedSums, fused_sums
 
-__all__ = ["AnisotropicTable", "anisotropic_sums", "pack_anisotropic", "plan_step", "reflected"]
+__all__ = [
+    "AnisotropicTable",
+    "FacetTerms",
+    "TablePlan",
+    "anisotropic_sums",
+    "pack_anisotropic",
+    "plan_step",
+    "reflected",
+]
 
 
 class AnisotropicTable(NamedTuple):
@@ -121,7 +131,7 @@ def pack_anisotropic(
     return AnisotropicTable(slices, psi, edges)  # type: ignore[arg-type]
 
 
-def plan_step(materials: Any, tables: dict[int, AnisotropicTable]) -> tuple[str, str]:
+def plan_step(materials: Sequence[str], tables: Mapping[int, AnisotropicTable]) -> tuple[str, str]:
     """The plan's line for its anisotropic tables.
 
     Examples
@@ -361,8 +371,71 @@ def _compiled_sums(s, o, n, tangents, areas, table, method, fraction):
     return out
 
 
+@runtime_checkable
+class FacetTerms(Protocol):
+    """The facet terms :func:`reflected` evaluates (:class:`sbrdf_xr.engine.plan.Terms` is
+    one): unit normals (T, 3) [1], areas (T,) [m2], material indices (T,) and, with
+    anisotropic materials, unit tangents (T, 3) [1].
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0], material="grey")
+    >>> plan = Scene(box, {"grey": grey}, to_sun=[[1, 0, 0]], to_observer=[[1, 0, 0]]).plan()
+    >>> isinstance(plan.terms, FacetTerms)
+    True
+    """
+
+    @property
+    def normal(self) -> np.ndarray: ...
+    @property
+    def area(self) -> np.ndarray: ...
+    @property
+    def material(self) -> np.ndarray: ...
+    @property
+    def tangent(self) -> np.ndarray | None: ...
+
+
+@runtime_checkable
+class TablePlan(Protocol):
+    """What :func:`reflected` reads of a compiled plan (:class:`sbrdf_xr.engine.plan.Plan`
+    is one): its facet terms, material names, packed tables, knobs (``method``,
+    ``kernel``), anisotropic tables by material index, and each table unpacked.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0], material="grey")
+    >>> plan = Scene(box, {"grey": grey}, to_sun=[[1, 0, 0]], to_observer=[[1, 0, 0]]).plan()
+    >>> isinstance(plan, TablePlan)
+    True
+    """
+
+    @property
+    def terms(self) -> FacetTerms: ...
+    @property
+    def materials(self) -> tuple[str, ...]: ...
+    @property
+    def tables(self) -> PackedTables: ...
+    @property
+    def knobs(self) -> Mapping[str, Any]: ...
+    @property
+    def anisotropic(self) -> Mapping[int, AnisotropicTable]: ...
+    def table(
+        self, m: int
+    ) -> tuple[
+        np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray], tuple[bool, bool, bool], float
+    ]: ...
+
+
 def reflected(
-    plan: Any,
+    plan: TablePlan,
     to_source: NDArray[np.floating],
     to_observer: NDArray[np.floating],
     fraction: NDArray[np.floating] | None,
@@ -449,6 +522,11 @@ def reflected(
             continue
         frac = None if fraction is None else fraction[:, sel]
         if m in aniso:
+            if t.tangent is None:
+                raise SceneError(
+                    f"material {plan.materials[m]!r} is anisotropic but the plan's facet "
+                    "terms carry no tangents; give the spacecraft facet tangents"
+                )
             r = anisotropic_sums(
                 to_source,
                 to_observer,

@@ -11,14 +11,16 @@ a machine with two cores the compilation costs no wall time as long as the build
 
 from __future__ import annotations
 
+import contextlib
 import os
 import subprocess
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["compile_ahead", "warm_up"]
+__all__ = ["compile_ahead", "compiling_ahead", "warm_up"]
 
 
 def warm_up(dtype: str = "float64") -> None:
@@ -106,3 +108,51 @@ def compile_ahead(dtype: str = "float64") -> subprocess.Popen[bytes] | None:
         )
     except OSError:  # pragma: no cover - no second process here
         return None
+
+
+@contextlib.contextmanager
+def compiling_ahead(dtype: str = "float64", progress: bool = True) -> Iterator[None]:
+    """Compile the kernel for ``dtype`` in a second process while the block runs
+    (:func:`compile_ahead`), and wait for it when the block ends, with a progress bar
+    "compiling the engine's kernel" while it still runs (none when it is done already).
+
+    The engine holds it while the catalog builds a scene's tables
+    (:func:`sbrdf_xr.catalog.load_materials`).
+
+    Parameters
+    ----------
+    dtype : {"float64", "float32"}
+        The dtype of the material tables.
+    progress : bool, default True
+        Show the progress bar of the wait.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.kernels.warm import compiling_ahead, warm_up
+    >>> with compiling_ahead("float64", progress=False):
+    ...     pass  # the tables would build here
+    >>> warm_up("float64")  # loads the compiled kernel from numba's cache
+    """
+    proc = compile_ahead(dtype)
+    try:
+        yield
+    finally:
+        if proc is not None:
+            _wait(proc, progress)
+
+
+def _wait(proc: subprocess.Popen[bytes], progress: bool) -> None:
+    """Wait for the process compiling the kernel, with a progress bar while it runs."""
+    if proc.poll() is not None:
+        return
+    from tqdm.auto import tqdm
+
+    with tqdm(
+        desc="compiling the engine's kernel", bar_format="{desc}: {elapsed}", disable=not progress
+    ) as bar:
+        while True:
+            try:
+                proc.wait(timeout=0.25)
+                break
+            except subprocess.TimeoutExpired:
+                bar.refresh()

@@ -18,6 +18,9 @@ Modules
     Look-up (:func:`lookup`), anisotropic tables and the material front end.
 ``energy``
     The directional-hemispherical reflectance of a table.
+``cache``
+    The disk cache of tables built on load from their measurements, keyed by their inputs
+    and the sources of the code that builds them.
 ``files``
     Lossless, atomic netCDF files of tables and measurement sets.
 ``model_schema`` and ``models``
@@ -27,7 +30,18 @@ Modules
 """
 
 from ..errors import NonPhysicalWarning, ValidationError
-from . import build, construction, energy, files, goniometer, model_schema, models, schema, tables
+from . import (
+    build,
+    cache,
+    construction,
+    energy,
+    files,
+    goniometer,
+    model_schema,
+    models,
+    schema,
+    tables,
+)
 from .build import BELOW_NOISE, EXTRAPOLATIONS, RENORMALISE, build_lut
 from .construction import paper_delta_theta_grid, paper_phi_grid
 from .energy import ENERGY_TOL, hemispherical_reflectance
@@ -78,6 +92,7 @@ __all__ = [
     "build",
     "build_lut",
     "build_lut_anisotropic",
+    "cache",
     "check_coord",
     "constant_material",
     "construction",

@@ -52,7 +52,7 @@ from .earth_shadow import (
 )
 from .frames import Context, triad
 from .observation import ATTRS, COMPONENT, TIME, UNOBSERVABLE, Observation
-from .observe import bench_geometry, canx1_pass, observation_from_dict
+from .observe import canx1_pass, observation_from_dict
 from .orbits import (
     AIRMASS_MODELS,
     AU_KM,
@@ -109,7 +109,6 @@ __all__ = [
     "Tumble",
     "airmass",
     "attitude",
-    "bench_geometry",
     "canx1_pass",
     "check_times",
     "compose",

@@ -2,7 +2,8 @@
 
 :func:`observation_from_dict` builds an :class:`~sbrdf_xr.observing.observation.Observation` from
 an ``[observation]`` table (an orbit, a site, UTC times and an attitude law);
-:func:`canx1_pass` is the built-in example and :func:`bench_geometry` times its geometry.
+:func:`canx1_pass` is the built-in example (:func:`sbrdf_xr.bench.suite.bench_geometry` times its
+geometry).
 The frames and models of the geometry are described in :mod:`sbrdf_xr.observing.observation`.
 This module also gathers the observation API in one place: the :class:`Observation`,
 the :class:`~sbrdf_xr.observing.orbits.Orbit` and :class:`~sbrdf_xr.observing.orbits.Site`, the UTC
@@ -13,15 +14,11 @@ times of
 
 from __future__ import annotations
 
-import time as _time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, TypedDict
 
-import numpy as np
-
 from ..errors import ObservationError, did_you_mean
-from ..units import to_unit
 from . import attitude as _att
 from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, disc_overlap_fraction, sunlit_fraction
 from .observation import ATTRS, TIME, Observation
@@ -39,7 +36,6 @@ from .orbits import (
 from .timescales import (
     check_times,
     times,
-    to_datetime64,
 )
 
 __all__ = [
@@ -48,13 +44,13 @@ __all__ = [
     "AU_KM",
     "EARTH_RADIUS_KM",
     "EPOCH_GAP_DAYS",
+    "OBSERVATION_KEYS",
     "SUN_RADIUS_KM",
     "TIME",
     "Observation",
     "Orbit",
     "Site",
     "airmass",
-    "bench_geometry",
     "canx1_pass",
     "disc_overlap_fraction",
     "load_orbit_entry",
@@ -64,6 +60,39 @@ __all__ = [
     "times",
     "tle_checksum",
 ]
+
+
+_NUMBER = (int, float)
+
+#: The keys of an ``[observation]`` table that :func:`observation_from_dict` reads: name ->
+#: (its TOML types, what it means with its unit, its default in TOML syntax or ``"-"``
+#: for none, ``"required"`` when it must be given).  The scene-file reference of
+#: :mod:`sbrdf_xr.engine.schema` is made from this table.
+OBSERVATION_KEYS: dict[str, tuple[tuple[type, ...], str, str]] = {
+    "orbit": ((str,), "the orbit: a catalog name (or tle, tle_line1/2, omm)", "-"),
+    "tle": ((list,), "the orbit as [line1, line2]", "-"),
+    "tle_line1": ((str,), "the orbit's first TLE line (with tle_line2)", "-"),
+    "tle_line2": ((str,), "the orbit's second TLE line", "-"),
+    "omm": ((str, dict), "the orbit as an OMM file or table", "-"),
+    "name": ((str,), "the observation's name", "-"),
+    "site": (
+        (str, dict),
+        "a catalog name or {latitude_deg, longitude_deg, height_m, name}",
+        "required",
+    ),
+    "start": ((str,), "first time, UTC (ISO 8601)", "-"),
+    "stop": ((str,), "last time, UTC", "-"),
+    "step_s": (_NUMBER, "time step [s]", "1"),
+    "times": ((list,), "explicit UTC times instead of start/stop/step_s", "-"),
+    "attitude": ((dict,), "[observation.attitude]: a law (the laws table below)", "-"),
+    "airmass_model": (
+        (str,),
+        "the airmass formula (sbrdf_xr.observing.AIRMASS_MODELS)",
+        '"kastenyoung1989"',
+    ),
+    "min_elevation_deg": (_NUMBER, "lowest elevation that counts as observable [degree]", "0.0"),
+    "earth": ((str,), 'the Earth of the shadow: "wgs84" or "sphere"', '"wgs84"'),
+}
 
 
 def observation_from_dict(
@@ -105,23 +134,7 @@ def observation_from_dict(
         ...
     sbrdf_xr.errors.ObservationError: [observation]: unknown key(s) ['when']; allowed keys: ...
     """
-    allowed = {
-        "orbit",
-        "tle",
-        "tle_line1",
-        "tle_line2",
-        "omm",
-        "name",
-        "site",
-        "start",
-        "stop",
-        "step_s",
-        "times",
-        "attitude",
-        "airmass_model",
-        "min_elevation_deg",
-        "earth",
-    }
+    allowed = set(OBSERVATION_KEYS)
     if not isinstance(table, Mapping):
         raise ObservationError(f"[observation]: expected a table, got {type(table).__name__}")
     bad = sorted(set(table) - allowed)
@@ -267,53 +280,3 @@ def canx1_pass(attitude: _att.AttitudeLaw | None = None) -> Observation:
         attitude if attitude is not None else canx1_attitude(),
         name="canx1-pass",
     )
-
-
-def bench_geometry(n_times: int = 3600, step_s: float = 1.0, repeats: int = 3) -> dict[str, float]:
-    """Time :meth:`Observation.geometry` of the built-in orbit and site over ``n_times`` steps.
-
-    The first call in a process also pays the one-off imports and the loading of the
-    skyfield data; it is reported apart from the best of ``repeats`` further calls on
-    fresh observations (nothing cached between them).
-
-    Parameters
-    ----------
-    n_times : int
-        Times of the pass.
-    step_s : float
-        Their spacing [s]; a Quantity is converted.
-    repeats : int
-        Warm calls, the best of which is reported.
-
-    Returns
-    -------
-    dict
-        ``n_times``, ``first_call_seconds``, ``seconds`` (best warm call) and
-        ``seconds_per_time``.
-
-    Examples
-    --------
-    >>> row = bench_geometry(n_times=60, repeats=1)
-    >>> sorted(row), row["n_times"]
-    (['first_call_seconds', 'n_times', 'seconds', 'seconds_per_time'], 60.0)
-    """
-    step_s = float(to_unit(step_s, "s", "step_s"))
-    p = CANX1_PASS
-    t0 = to_datetime64(p["start"], "start") - np.timedelta64(int(n_times * step_s / 2), "s")
-    t = t0 + np.timedelta64(round(step_s * 1e9), "ns") * np.arange(n_times)
-    start = _time.perf_counter()
-    orbit, site = Orbit.from_catalog(p["orbit"]), Site.from_catalog(p["site"])
-    Observation(orbit, site, t, canx1_attitude()).geometry(on_unobservable="keep")
-    first = _time.perf_counter() - start
-    best = np.inf
-    for _ in range(max(1, repeats)):
-        obs = Observation(orbit, site, t, canx1_attitude())
-        start = _time.perf_counter()
-        obs.geometry(on_unobservable="keep")
-        best = min(best, _time.perf_counter() - start)
-    return {
-        "n_times": float(n_times),
-        "first_call_seconds": first,
-        "seconds": best,
-        "seconds_per_time": best / n_times,
-    }

@@ -46,6 +46,11 @@ def unmix_files(tmp_path_factory):
         Scene(box, tables, to_sun=sun, to_observer=obs, outputs=("signal", "per_material"))
     )
     write(cube, tmp / "cube.nc")
+    mesh.export(tmp / "box.ply")
+    (tmp / "map.toml").write_text(
+        '[[material]]\nname = "red"\nrgb = [255, 0, 0]\n'
+        '[[material]]\nname = "grey"\nrgb = [128, 128, 128]\n'
+    )
     truth = cube.signal_material.isel(geometry=0).sum("material")
     sigma = 0.01 * truth
     y = truth + sigma * np.random.default_rng(0).normal(size=truth.shape)
@@ -83,6 +88,32 @@ def test_unmix_spectrum_and_band_magnitudes(unmix_files, capsys, tmp_path):
     assert "chi2" in capsys.readouterr().out
     assert _unmix(unmix_files, tmp_path / "mags.csv", "--isel", "geometry=0") == 2
     assert "--range-km" in capsys.readouterr().err
+
+
+def test_unmix_with_the_spacecraft_s_areas_adding_up(unmix_files, capsys, tmp_path):
+    """--spacecraft gives each material's area; --total-area makes the fitted areas add up
+    to the body's (6 m2): the same fit as invert.unmix(total_area=True) on the same data."""
+    body = ["--spacecraft", str(unmix_files["dir"] / "box.ply")]
+    body += ["--material-map", str(unmix_files["dir"] / "map.toml")]
+    out = tmp_path / "unmix.nc"
+    argv = ["--isel", "geometry=0", "--total-area", "-o", str(out), *body]
+    assert _unmix(unmix_files, unmix_files["spec"], *argv) == 0
+    r = xr.open_dataset(out)
+    np.testing.assert_allclose(float(r["area"].sum()), 6.0, rtol=1e-12)
+    np.testing.assert_allclose(float(r["area_fraction"].sum()), 1.0, rtol=1e-12)
+    f = unmix_files["frame"]
+    wl = {"wavelength": f.wavelength.values}
+    direct = invert.unmix(
+        xr.DataArray(f.signal.values, dims="wavelength", coords=wl),
+        unmix_files["terms"].isel(geometry=0),
+        xr.DataArray(f.uncertainty.values, dims="wavelength", coords=wl),
+        areas={"grey": 4.0, "red": 2.0},
+        total_area=True,
+        select="all",
+    )
+    np.testing.assert_allclose(r["scale"].values, direct["scale"].values, rtol=1e-10)
+    assert _unmix(unmix_files, unmix_files["spec"], "--isel", "geometry=0", "--total-area") == 2
+    assert "--total-area: needs --spacecraft" in capsys.readouterr().err
 
 
 def _spectrum(tmp_path, text):

@@ -17,8 +17,8 @@ from sbrdf_xr import load_spacecraft
 from sbrdf_xr.cli.parser import build_parser
 from sbrdf_xr.engine import Scene, builtin_scenes, load_scene, scene_from_dict, simulate
 from sbrdf_xr.engine.knobs import KNOBS
-from sbrdf_xr.engine.schema import OBSERVATION_KEYS, SCENE_KEYS, reference
-from sbrdf_xr.errors import ObservationError, SceneError
+from sbrdf_xr.engine.schema import SCENE_KEYS, reference
+from sbrdf_xr.errors import SceneError
 from sbrdf_xr.materials import models
 
 README = Path(__file__).resolve().parents[2] / "README.md"
@@ -51,16 +51,6 @@ def test_every_knob_is_a_key_and_a_scene_field_declared_once():
         scene_from_dict({**base, "shadow_density": True})
     with pytest.raises(SceneError, match=r"chunk: got 0; expected None \(from block_bytes\)"):
         Scene(_box(), _grey_table(), to_sun=X, to_observer=X, chunk=0)
-
-
-def test_the_observation_keys_are_those_the_reader_takes():
-    """observation_from_dict lists the keys it allows when it meets an unknown one."""
-    from sbrdf_xr.observing.observe import observation_from_dict
-
-    with pytest.raises(ObservationError) as err:
-        observation_from_dict({"orbit": "canx1-example", "bogus": 1})
-    allowed = re.search(r"allowed keys: (.*)$", str(err.value)).group(1)
-    assert set(allowed.split(", ")) == set(OBSERVATION_KEYS)
 
 
 def test_simulate_help_lists_every_builtin_scene_knob_and_preset():

@@ -225,3 +225,210 @@ def test_unmix_bad_input(per_material):
     )
     with pytest.raises(InversionError, match="bands"):
         invert.unmix(bands, lib_b, 0.1)
+
+
+# ------------------------------------------------------------ areas adding up to a total
+
+
+def _constrained_truth(sc, scales, free):
+    """Scale factors with the one of index ``free`` set so that the areas add up to the
+    mesh's."""
+    names = [AL, CELL, PAINT]
+    nominal = np.array([invert.material_areas(sc)[m] for m in names])
+    x = np.array(scales, dtype=float)
+    x[free] = 0.0
+    x[free] = (nominal.sum() - nominal @ x) / nominal[free]
+    return x, nominal
+
+
+def _kkt(a, y, s, c, total):
+    """Equality-constrained weighted least squares by the Lagrange (KKT) system, solved
+    by numpy: estimate, covariance (the inverse's upper-left block), chi-square."""
+    aw, yw = a / s[:, None], y / s
+    k = a.shape[1]
+    kkt = np.block([[aw.T @ aw, c[:, None]], [c[None, :], np.zeros((1, 1))]])
+    inv = np.linalg.inv(kkt)
+    x = np.linalg.solve(kkt, np.r_[aw.T @ yw, total])[:k]
+    return x, inv[:k, :k], float(((yw - aw @ x) ** 2).sum())
+
+
+def test_total_area_equals_independent_constrained_least_squares(per_material, sc):
+    """With total_area the estimate, covariance and chi-square are those of the Lagrange
+    system solved by numpy (to 1e-8: two routes of double-precision linear algebra on a
+    design of condition ~1e3); dof one more than without; the area fractions add up to 1
+    and say they are of the total."""
+    truth, nominal = _constrained_truth(sc, [0.6, 1.0, 0.0], free=2)
+    g = per_material.isel(geometry=0)
+    y, sigma = _noisy(_mix(g, truth), 0.03, 21)
+    areas = invert.material_areas(sc)
+    r = invert.unmix(y, g, sigma, areas=areas, total_area=True, select=None)
+    a = g.transpose("wavelength", "material").values
+    x, cov, chi2 = _kkt(a, y.values, sigma.values, nominal, nominal.sum())
+    np.testing.assert_allclose(r["scale"].values, x, rtol=1e-8)
+    np.testing.assert_allclose(r["scale_uncertainty"].values, np.sqrt(np.diag(cov)), rtol=1e-8)
+    assert float(r["chi2"]) == pytest.approx(chi2, rel=1e-8)
+    assert int(r["dof"]) == y.size - 2 and "area constraint" in r["dof"].attrs["long_name"]
+    assert float(r["reduced_chi2"]) == pytest.approx(chi2 / (y.size - 2))
+    assert float(r["aic"]) == pytest.approx(chi2 + 2 * 2)  # two free parameters
+    assert float(r["area"].sum()) == pytest.approx(nominal.sum(), rel=1e-12)
+    assert float(r["area_fraction"].sum()) == pytest.approx(1.0, rel=1e-12)
+    assert "total_area" in r["area_fraction"].attrs["normalisation"]
+    assert float(r["total_area"]) == pytest.approx(nominal.sum())
+    # the fractions' uncertainties are the areas' over the (exact) total
+    np.testing.assert_allclose(
+        r["area_fraction_uncertainty"].values,
+        np.sqrt(np.diag(cov)) * nominal / nominal.sum(),
+        rtol=1e-8,
+    )
+    # True is the sum of areas: the same fit as the number
+    same = invert.unmix(y, g, sigma, areas=areas, total_area=float(nominal.sum()), select=None)
+    np.testing.assert_allclose(same["scale"].values, r["scale"].values, rtol=1e-12)
+
+
+def test_total_area_selection_fits_every_subset_with_the_constraint(per_material, sc):
+    """Every subset scored obeys the constraint (its chi-square is that of the Lagrange
+    system on its columns), counts one parameter less in its criteria, and the kept
+    model's areas add up to the total; a subset whose omission the constraint turns into
+    a bias (the others must fill the left-out area) is inadmissible."""
+    truth, nominal = _constrained_truth(sc, [0.6, 1.0, 0.0], free=2)
+    g = per_material.isel(geometry=[0, 4])
+    y, sigma = _noisy(_mix(g, truth), 0.03, 22)
+    r = invert.unmix(y, g, sigma, areas=invert.material_areas(sc), total_area=True)
+    names = [AL, CELL, PAINT]
+    a = g.transpose("geometry", "wavelength", "material").values.reshape(-1, 3)
+    for label in r.subset.values:
+        cols = [names.index(m) for m in str(label).split("+")]
+        _, _, chi2 = _kkt(
+            a[:, cols], y.values.ravel(), sigma.values.ravel(), nominal[cols], nominal.sum()
+        )
+        row = r.sel(subset=label)
+        assert float(row["subset_chi2"]) == pytest.approx(chi2, rel=1e-8)
+        assert float(row["subset_bic"]) == pytest.approx(chi2 + (len(cols) - 1) * np.log(y.size))
+    assert float((r["scale"] * xr.DataArray(nominal, dims="material")).sum()) == pytest.approx(
+        nominal.sum()
+    )
+    assert r.attrs["area_constraint"].startswith("the areas of the fitted materials add up")
+    assert not bool(r["subset_admissible"].sel(subset=f"{AL}+{PAINT}"))
+
+
+def test_total_area_bad_input(per_material, sc):
+    y = per_material.isel(geometry=0).sum("material")
+    g = per_material.isel(geometry=0)
+    areas = invert.material_areas(sc)
+    with pytest.raises(InversionError, match="total_area: True needs areas"):
+        invert.unmix(y, g, 1e-5, total_area=True)
+    for bad in (0.0, -1.0, np.nan, "big"):
+        with pytest.raises(InversionError, match="total_area"):
+            invert.unmix(y, g, 1e-5, areas=areas, total_area=bad)
+    with pytest.raises(InversionError, match="every candidate has area 0"):
+        invert.unmix(y, g, 1e-5, areas=dict.fromkeys(areas, 0.0), total_area=1.0)
+    # False is no constraint
+    y, sigma = _noisy(y, 0.01, 23)
+    free = invert.unmix(y, g, sigma, areas=areas, total_area=False, select=None)
+    assert free.attrs["area_constraint"] == "none" and "total_area" not in free
+
+
+#: Held-out mixtures whose areas add up to the mesh's (the paint takes the rest), all
+#: other than the model's own (scale 1 each).
+CONSTRAINED = {
+    "all-present": ([0.6, 1.0, 0.0], 2),
+    "no-aluminium": ([0.0, 1.2, 0.0], 2),
+    "no-cells": ([0.3, 0.0, 0.0], 2),
+}
+
+
+@pytest.mark.parametrize("geoms", [[0], [0, 1, 2, 3, 4, 5]], ids=["one-geometry", "six"])
+def test_calibration_total_area_small(per_material, sc, geoms):
+    """60 draws per case in the default run, areas constrained to the mesh's: pull widths
+    1 within 0.3 (3.3 spreads of a standard deviation of 60 unit normals)."""
+    truth, _ = _constrained_truth(sc, *CONSTRAINED["all-present"])
+    study = invert.unmix_calibration(
+        per_material.isel(geometry=geoms),
+        dict(zip([AL, CELL, PAINT], truth, strict=True)),
+        relative_noise=0.03,
+        n_draws=60,
+        seed=1,
+        areas=invert.material_areas(sc),
+        total_area=True,
+    )
+    np.testing.assert_allclose(study["pull_width"].values, 1.0, atol=0.3)
+    assert np.all(study["coverage_2sigma"].values >= 0.85)  # 95.4 % expected, spread 2.7 %
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "geoms",
+    [[0], [2], [4], [0, 1, 2, 3, 4, 5]],
+    ids=["geometry-0", "geometry-2", "geometry-4", "six"],
+)
+@pytest.mark.parametrize("mixture", list(CONSTRAINED))
+def test_calibration_total_area_study(per_material, sc, geoms, mixture):
+    """200 draws per case, areas constrained to the mesh's: the pulls of every material
+    (present or not: with the constraint none is left out) have width 1 +- 0.15 (3
+    spreads of 0.05), and the 2-sigma intervals cover the truth in >= 91 % of draws (95.4 %
+    expected, binomial spread 1.5 %: 3 spreads)."""
+    truth, _ = _constrained_truth(sc, *CONSTRAINED[mixture])
+    study = invert.unmix_calibration(
+        per_material.isel(geometry=geoms),
+        dict(zip([AL, CELL, PAINT], truth, strict=True)),
+        relative_noise=0.03,
+        n_draws=200,
+        seed=2,
+        areas=invert.material_areas(sc),
+        total_area=True,
+    )
+    table = study.drop_vars(["n_draws", "quality_warnings", "seconds_per_fit"]).to_dataframe()
+    print(f"\ngeometries {geoms}, {mixture} {np.round(truth, 4)}, 200 draws:\n{table.to_string()}")
+    np.testing.assert_allclose(study["pull_width"].values, 1.0, atol=0.15)
+    assert np.all(study["coverage_2sigma"].values >= 0.91)
+
+
+# ---------------------------------------------------------- a measured spectrum over time
+
+
+def test_unmix_takes_a_spectrum_over_time(per_material, sc):
+    """A measured spectrum over wavelength (no band dimension) on a spectrometer's grid
+    (5 nm steps offset by 2.5 nm from the simulated one), at three times: the fit equals
+    numpy's weighted least squares on the simulated terms interpolated by np.interp, every
+    time and wavelength a row (to 1e-6: linear interpolation by two routes), free and
+    with the areas constrained (the Lagrange system)."""
+    g = per_material.isel(geometry=[0, 2, 4]).rename(geometry="time")
+    g = g.assign_coords(
+        time=np.array(
+            ["2024-03-17T20:00:00", "2024-03-17T20:00:10", "2024-03-17T20:00:20"],
+            dtype="datetime64[ns]",
+        )
+    )
+    wl = np.arange(402.5, 1100.0, 5.0)
+    truth, nominal = _constrained_truth(sc, [0.6, 1.0, 0.0], free=2)
+    rng = np.random.default_rng(31)
+    a = np.stack(
+        [
+            np.stack(
+                [
+                    np.interp(wl, g.wavelength.values, g.isel(time=t, material=m).values)
+                    for m in range(3)
+                ],
+                axis=-1,
+            )
+            for t in range(3)
+        ]
+    )  # (time, wavelength, material)
+    clean = a @ truth
+    sigma = 0.02 * clean + 1e-12
+    y = xr.DataArray(
+        clean + sigma * rng.normal(size=clean.shape),
+        dims=("time", "wavelength"),
+        coords={"time": g.time.values, "wavelength": wl},
+    )
+    assert "band" not in y.dims
+    r = invert.unmix(y, g, sigma, select=None)
+    x, *_ = np.linalg.lstsq(
+        a.reshape(-1, 3) / sigma.reshape(-1, 1), (y.values / sigma).ravel(), rcond=None
+    )
+    np.testing.assert_allclose(r["scale"].values, x, rtol=1e-6)
+    assert int(r["n_samples"]) == 3 * wl.size
+    tied = invert.unmix(y, g, sigma, areas=invert.material_areas(sc), total_area=True, select=None)
+    xc, cov, _ = _kkt(a.reshape(-1, 3), y.values.ravel(), sigma.ravel(), nominal, nominal.sum())
+    np.testing.assert_allclose(tied["scale"].values, xc, rtol=1e-6)
+    np.testing.assert_allclose(tied["scale_uncertainty"].values, np.sqrt(np.diag(cov)), rtol=1e-6)

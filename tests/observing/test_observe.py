@@ -391,11 +391,6 @@ def test_times_helper():
         observe.times("2024-01-02", "2024-01-01", 1)
 
 
-def test_bench_geometry_runs():
-    out = observe.bench_geometry(n_times=120, repeats=1)
-    assert out["n_times"] == 120 and out["seconds"] > 0
-
-
 # ----------------------------------------------------------------- bad input
 
 

@@ -240,8 +240,8 @@ def test_a_foreign_part_directory_beside_every_output(tmp_path, name, overwrite)
 def test_the_table_cache_never_writes_through_a_special_file(tmp_path, monkeypatch, kind):
     """A special file at a table's cache file: the table is built and returned, with a
     CacheWarning naming the file, and the special file is left as it is."""
-    from sbrdf_xr import _cache
     from sbrdf_xr.errors import CacheWarning
+    from sbrdf_xr.materials import cache as _cache
     from sbrdf_xr.materials import tables
 
     monkeypatch.setenv("SBRDF_XR_CACHE_DIR", str(tmp_path))

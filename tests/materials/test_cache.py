@@ -1,4 +1,4 @@
-"""The disk cache of catalog tables built on load (sbrdf_xr._cache)."""
+"""The disk cache of catalog tables built on load (sbrdf_xr.materials.cache)."""
 
 from __future__ import annotations
 
@@ -11,10 +11,11 @@ from pathlib import Path
 import pytest
 import xarray as xr
 
-from sbrdf_xr import _cache, catalog
+from sbrdf_xr import catalog
 from sbrdf_xr.errors import CacheWarning
+from sbrdf_xr.materials import cache as _cache
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_built_tables_are_cached_and_identical(tmp_path, monkeypatch):
@@ -92,7 +93,7 @@ def test_the_cache_key_covers_every_module_a_build_runs(monkeypatch):
     assert root / "brdf" / "_fresnel_kernels.py" in ran
     # the cache's own code stores and reads the table; what it stores is the build's
     # (test_built_tables_are_cached_and_identical): it need not be in the key
-    outside = ran - key - {root / "_cache.py"}
+    outside = ran - key - {root / "materials" / "cache.py"}
     assert outside == {root / "catalog.py"}
     # ... of the catalog, only the definitions hashed in the key ran
     src = (root / "catalog.py").read_text()

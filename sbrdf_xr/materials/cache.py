@@ -25,14 +25,32 @@ from pathlib import Path
 
 import xarray as xr
 
-from ._output import file_kind
-from .errors import CacheWarning, OutputError
+from .._output import file_kind
+from ..errors import CacheWarning, OutputError
 
 __all__ = ["build_modules", "cache_dir", "cache_file", "cached_table", "source_digest"]
 
 
 def cache_dir() -> Path | None:
-    """The cache directory, or None when the cache is switched off."""
+    """The cache directory, or None when the cache is switched off.
+
+    Returns
+    -------
+    pathlib.Path or None
+        ``$SBRDF_XR_CACHE_DIR`` if set (None for ``off``, ``0``, ``none`` or empty),
+        else ``$XDG_CACHE_HOME/sbrdf_xr`` or ``~/.cache/sbrdf_xr``.
+
+    Examples
+    --------
+    >>> import os
+    >>> os.environ["SBRDF_XR_CACHE_DIR"] = "off"
+    >>> cache_dir() is None
+    True
+    >>> os.environ["SBRDF_XR_CACHE_DIR"] = "/tmp/tables"
+    >>> str(cache_dir())
+    '/tmp/tables'
+    >>> del os.environ["SBRDF_XR_CACHE_DIR"]
+    """
     env = os.environ.get("SBRDF_XR_CACHE_DIR")
     if env is not None:
         return None if env.strip().lower() in ("", "off", "0", "none") else Path(env)
@@ -122,8 +140,28 @@ def build_modules(roots: Iterable[str] = _BUILD_ROOTS, root: Path | None = None)
     :data:`_BUILD_DEFINITIONS`), the spacecraft, the observing and photometry
     packages, the engine, the writers, the benchmarks and the command line are outside
     it, so changing them keeps the built tables.
+
+    Parameters
+    ----------
+    roots : iterable of str
+        Dotted names of the modules whose closure is wanted.
+    root : pathlib.Path, optional
+        The package directory to read (default: this installed package).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The source files, sorted.
+
+    Examples
+    --------
+    >>> files = build_modules()
+    >>> sorted({f.parent.name for f in files})[:4]
+    ['brdf', 'kernels', 'materials', 'sbrdf_xr']
+    >>> any(f.parent.name == "engine" for f in files)
+    False
     """
-    root = Path(__file__).resolve().parent if root is None else root
+    root = Path(__file__).resolve().parent.parent if root is None else root
     seen: set[str] = set()
     todo = list(roots)
     while todo:
@@ -178,8 +216,19 @@ def _digest(root: Path) -> str:
 def source_digest() -> str:
     """SHA-256 of the sources that build a table (:func:`build_modules` and the
     definitions of :data:`_BUILD_DEFINITIONS`): a change to one of them invalidates
-    the cache."""
-    return _digest(Path(__file__).resolve().parent)
+    the cache.
+
+    Returns
+    -------
+    str
+        64 hexadecimal digits.
+
+    Examples
+    --------
+    >>> len(source_digest())
+    64
+    """
+    return _digest(Path(__file__).resolve().parent.parent)
 
 
 def _file_digest(path: Path) -> str:
@@ -192,7 +241,32 @@ def _file_digest(path: Path) -> str:
 
 def cache_file(name: str, inputs: Iterable[Path], options: str) -> Path | None:
     """The cache file of table ``name`` built from ``inputs`` with ``options`` (it may not
-    exist yet), or None when the cache is switched off."""
+    exist yet), or None when the cache is switched off.
+
+    Parameters
+    ----------
+    name : str
+        The table's catalog name (the start of the file name).
+    inputs : iterable of pathlib.Path
+        The files the table is built from; their bytes are part of the key.
+    options : str
+        The build options as text; part of the key.
+
+    Returns
+    -------
+    pathlib.Path or None
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> os.environ["SBRDF_XR_CACHE_DIR"] = tempfile.mkdtemp()
+    >>> a = cache_file("grey", [], "()")
+    >>> a.name.startswith("grey-"), a == cache_file("grey", [], "()")
+    (True, True)
+    >>> a == cache_file("grey", [], "(dtype='float32')")
+    False
+    >>> del os.environ["SBRDF_XR_CACHE_DIR"]
+    """
     d = cache_dir()
     if d is None:
         return None
@@ -214,7 +288,41 @@ def cached_table(
 
     The table returned is always the one read back from the cache file (when the cache
     works), so a first, building load and a later, cached load give identical tables
-    (values and attributes), and so identical content fingerprints.
+    (values and attributes), and so identical content fingerprints.  A damaged cache file
+    is built again; an unusable directory builds the table with a
+    :class:`~sbrdf_xr.errors.CacheWarning`.  One process builds at a time (an advisory
+    lock of the directory); another waits and reads the file.
+
+    Parameters
+    ----------
+    name, inputs, options
+        The key, as for :func:`cache_file`.
+    build : callable
+        Builds the table (called only when no cache file is there).
+    write, read : callable
+        Write a table to a path (atomically) and read it back.
+
+    Returns
+    -------
+    xarray.DataArray
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from sbrdf_xr.materials import constant_material, tables
+    >>> os.environ["SBRDF_XR_CACHE_DIR"] = tempfile.mkdtemp()
+    >>> calls = []
+    >>> def build():
+    ...     calls.append(1)
+    ...     return constant_material(0.1, [500.0, 600.0], material="grey")
+    >>> def write(table, path):
+    ...     tables.to_netcdf(table, path, overwrite=True)
+    >>> args = ("grey", [], "()", build, write, tables.open_material)
+    >>> a = cached_table(*args)
+    >>> b = cached_table(*args)
+    >>> len(calls), bool((a == b).all())
+    (1, True)
+    >>> del os.environ["SBRDF_XR_CACHE_DIR"]
     """
     path = cache_file(name, inputs, options)
     if path is None:
