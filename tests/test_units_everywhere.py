@@ -19,6 +19,7 @@ argument has a row in :data:`CASES` (a call taking the argument's value) or in
 from __future__ import annotations
 
 import dataclasses
+import functools
 import importlib
 import inspect
 import re
@@ -185,12 +186,12 @@ def _model(name: str) -> Any:
     return importlib.import_module(f"sbrdf_xr.brdf.{name}").MODEL
 
 
-def _box() -> Any:
+def _box(material: str = "grey") -> Any:
     import trimesh
 
     from sbrdf_xr import load_spacecraft
 
-    return load_spacecraft(trimesh.creation.box(), material="grey")
+    return load_spacecraft(trimesh.creation.box(), material=material)
 
 
 def _grey() -> xr.DataArray:
@@ -511,6 +512,17 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         longitude=[30.0, 60.0], latitude=[20.0, -5.0]
     ),
     "sbrdf_xr.invert._studies.spin_recovery": lambda: _recovery_inputs(),
+    "sbrdf_xr.invert._joint.fit_observation": lambda: _joint_inputs(),
+    "sbrdf_xr.invert._joint_study.observation_recovery": lambda: dict(
+        spacecraft=_box("lambertian-grey-50"),
+        observation=_joint_inputs()["observation"],
+        spin=dict(_SPIN),
+        area_fraction={"lambertian-grey-50": 1.0},
+        extinction={"V": 0.2},
+        bands=("V",),
+        n_draws=1,
+        phase_symmetry_deg=180.0,
+    ),
     "sbrdf_xr.invert._spin_search.spin_model": lambda: dict(
         axis_body=[0, 0, 1], axis=[1.0, 0.0, 0.0], period_s=60.0, phase_deg=30.0
     ),
@@ -817,6 +829,42 @@ def _recovery_inputs() -> dict[str, Any]:
     )
 
 
+_SPIN = {"axis_longitude": 60.0, "axis_latitude": 30.0, "period": 40.0, "phase": 20.0}
+
+
+@functools.cache
+def _joint_light_curve() -> tuple[Any, xr.Dataset]:
+    from sbrdf_xr import Scene, simulate
+    from sbrdf_xr.invert import axis_vector, spin_model
+    from sbrdf_xr.observing import Observation
+    from sbrdf_xr.observing.observe import canx1_pass
+    from sbrdf_xr.photometry import magnitudes
+
+    full = canx1_pass()
+    spin = spin_model([0, 0, 1], axis_vector(60.0, 30.0), 40.0, 20.0)
+    obs = Observation(full.orbit, full.site, full.times[60:120:4], spin)
+    m = magnitudes(
+        simulate(Scene(_box(), {"grey": _grey_wide()}, observation=obs)), ["V"], system="Vega"
+    )
+    lc = xr.Dataset(
+        {"magnitude": ("obs", m.values.ravel()), "uncertainty": ("obs", np.full(m.size, 0.01))},
+        coords={"time": ("obs", obs.times), "band": ("obs", ["V"] * m.size)},
+        attrs={"magnitude_system": "Vega"},
+    )
+    return obs, lc
+
+
+def _joint_inputs() -> dict[str, Any]:
+    obs, lc = _joint_light_curve()
+    return dict(
+        light_curve=lc,
+        spacecraft=_box(),
+        observation=obs,
+        spin=dict(_SPIN),
+        materials={"grey": _grey_wide()},
+    )
+
+
 def _solar() -> xr.DataArray:
     from sbrdf_xr.photometry.spectra import solar_spectrum
 
@@ -832,6 +880,8 @@ def _mags() -> xr.DataArray:
 #: Cases whose comparison is long (a fit or a simulation): ``-m slow`` runs it; the
 #: refusal of a wrong unit, at the door, always runs.
 SLOW = {
+    "sbrdf_xr.invert._joint.fit_observation",
+    "sbrdf_xr.invert._joint_study.observation_recovery",
     "sbrdf_xr.invert._spin.fit_spin",
     "sbrdf_xr.invert._studies.spin_recovery",
     "sbrdf_xr.plot.cube.cube_figure",
@@ -852,6 +902,9 @@ NOT_COMPARED = {
 #: What of a result is compared (a study's wall times are not; a function's values are).
 POST = {
     "sbrdf_xr.invert._studies.spin_recovery": lambda ds: ds.drop_vars("seconds"),
+    "sbrdf_xr.invert._joint_study.observation_recovery": lambda ds: ds.drop_vars(
+        ["seconds_per_fit", "simulate_seconds", "fit_to_simulate"]
+    ),
     "sbrdf_xr.materials.models.spectrum_function": lambda f: f(*np.array([[30.0], [0.0], [5.0]])),
 }
 
@@ -878,6 +931,14 @@ OTHER = {
 }
 #: Arguments whose value is a structure holding the number with a unit: its Quantity form.
 FORMS: dict[str, Callable[[Any, Any], Any]] = {
+    "spin": lambda value, unit: {
+        k: np.float64(v) * u.Unit(unit)
+        if unit.physical_type != "angle"
+        else (np.float64(v) * (u.s if k == "period" else u.deg)).to(
+            u.min if k == "period" else unit
+        )
+        for k, v in value.items()
+    },
     "layers": lambda value, unit: [
         (n, (d * u.nm).to(unit) if unit.physical_type == "length" else d * unit) for n, d in value
     ],

@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike
 from scipy.optimize import least_squares
 
 from ..errors import InversionError
+from ..units import to_unit
 from ._areas import material_areas
 from ._joint_model import PassModel, pass_data
 from ._joint_result import Layout, model_check, result_dataset
@@ -59,7 +60,8 @@ def _start_spin(spin: Any, axis_body: ArrayLike | None) -> tuple[dict[str, float
     missing = [k for k in keys if k not in have]
     if missing:
         raise InversionError(f"spin: missing {missing}; a start needs {list(keys)}")
-    out = {k: float(np.asarray(have[k])) for k in keys}
+    units = {"axis_longitude": "deg", "axis_latitude": "deg", "period": "s", "phase": "deg"}
+    out = {k: float(np.asarray(to_unit(have[k], units[k], f"spin {k}"))) for k in keys}
     if not all(np.isfinite(v) for v in out.values()) or out["period"] <= 0:
         raise InversionError(f"spin: start values must be finite with period > 0 [s], got {out}")
     epoch = attrs.get("epoch")
@@ -178,8 +180,8 @@ def fit_observation(
         Orbit, site and a window covering the measured times (its attitude is not used).
     spin : Dataset or mapping
         The start: :func:`fit_spin` output, or a mapping with ``axis_longitude``,
-        ``axis_latitude`` [degree], ``period`` [s], ``phase`` [degree] and ``epoch`` (UTC
-        of the phase; default the observation's first time).
+        ``axis_latitude`` [degree], ``period`` [s], ``phase`` [degree] (Quantities
+        converted) and ``epoch`` (UTC of the phase; default the observation's first time).
     axis_body : array_like, shape (3,), optional
         The body axis of the spin (default the ``fit_spin`` result's, else z).
     extinction, offset, areas

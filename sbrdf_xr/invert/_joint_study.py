@@ -19,6 +19,7 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from ..errors import FitQualityWarning, InversionError
+from ..units import to_unit
 from ._areas import material_areas
 from ._joint import fit_observation
 from ._spin_search import spin_model, vec
@@ -142,7 +143,7 @@ def observation_recovery(
     from the truth moved by ``start_offset``: ``axis`` [degree] towards the north,
     ``period`` [s], ``phase`` [degree] (default 2 deg, 0.05 s, 5 deg).  The phase is
     compared modulo ``phase_symmetry_deg`` (180 for a body that looks the same turned half
-    a turn about its spin axis).
+    a turn about its spin axis; a Quantity is converted).
 
     Returns
     -------
@@ -171,6 +172,7 @@ def observation_recovery(
     >>> int(study.n_draws), study.parameter.values[:4].tolist()
     (3, ['axis_longitude', 'axis_latitude', 'period', 'phase'])
     """
+    phase_symmetry_deg = to_unit(phase_symmetry_deg, "deg", "phase_symmetry_deg")
     from ._spin_refine import _tangent
 
     truth_spin = {k: float(spin[k]) for k in ("axis_longitude", "axis_latitude", "period", "phase")}
