@@ -9,8 +9,8 @@ points: :func:`build_lut` and :func:`lookup` (materials), :func:`load_spacecraft
 The packages are the layers, lowest first; a package imports only from lower ones:
 
 * shared by every layer: :mod:`~sbrdf_xr.errors`, :mod:`~sbrdf_xr.units`,
-  :mod:`~sbrdf_xr.rotations`, :mod:`~sbrdf_xr.geometry`, :mod:`~sbrdf_xr.anisotropy`,
-  :mod:`~sbrdf_xr.sources`;
+  :mod:`~sbrdf_xr.geometry` (the angle convention, ``psi`` of anisotropic materials, and
+  attitudes as quaternions), :mod:`~sbrdf_xr.sources`;
 * :mod:`~sbrdf_xr.kernels` (compiled and numpy kernels), :mod:`~sbrdf_xr.brdf`
   (analytic BRDF models);
 * :mod:`~sbrdf_xr.materials` (tables, models, measurements), :mod:`~sbrdf_xr.body`
@@ -47,7 +47,6 @@ from .store import write
 #: The public modules and packages, reachable as attributes (imported on first use).
 _SUBMODULES = (
     "accessors",
-    "anisotropy",
     "bench",
     "body",
     "brdf",
@@ -62,7 +61,6 @@ _SUBMODULES = (
     "observing",
     "photometry",
     "plot",
-    "rotations",
     "sources",
     "store",
     "testing",
@@ -74,7 +72,6 @@ __all__ = [
     "Spacecraft",
     "__version__",
     "accessors",
-    "anisotropy",
     "bench",
     "body",
     "brdf",
@@ -99,7 +96,6 @@ __all__ = [
     "open_material",
     "photometry",
     "plot",
-    "rotations",
     "simulate",
     "sources",
     "store",

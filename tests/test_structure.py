@@ -7,10 +7,10 @@ Imports are read from the source with :mod:`ast`, at module level and inside fun
 alike; only those under ``if TYPE_CHECKING:`` are left out (they do not run).
 
 * L0, shared by every layer: ``_names`` (the version too), ``errors``, ``units`` (Quantities
-  converted at the door, bare numbers checked against their unit), ``rotations``,
-  ``geometry``, ``anisotropy`` (facet tangents, ``psi``), ``sources``, ``_catalog_index``
-  (where the shipped files are; it loads nothing) and ``_output`` (the safe output every
-  writer goes through).
+  converted at the door, bare numbers checked against their unit), ``geometry`` (the
+  angle convention, facet tangents and ``psi``, attitudes as quaternions), ``sources``,
+  ``_catalog_index`` (where the shipped files are; it loads nothing) and ``_output`` (the
+  safe output every writer goes through).
 * L1, arithmetic: ``kernels`` (compiled and numpy kernels) and ``brdf`` (analytic models).
 * L2, the domain: ``materials``, ``body`` (the spacecraft), ``photometry`` and
   ``observing`` (orbits, sites, times, attitude laws, the Earth's shadow).
@@ -38,9 +38,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     (
         "_names",
         "errors",
-        "rotations",
         "geometry",
-        "anisotropy",
         "sources",
         "_catalog_index",
         "_output",
@@ -304,12 +302,7 @@ def test_domain_modules_do_not_import_the_catalog(mod):
 # Any other use is listed here, with the reason it stands, or fails the test.
 
 #: (importer, "module._name" or "module") -> why the use stands.
-PRIVATE_USES: dict[tuple[str, str], str] = {
-    ("anisotropy", "geometry._forward_direction"): (
-        "the facet azimuth psi measures from the in-plane forward direction of "
-        "facet_angles (paper 000 Fig. 4): one function, so both use one convention"
-    ),
-}
+PRIVATE_USES: dict[tuple[str, str], str] = {}
 
 
 def _is_private(name: str) -> bool:
@@ -432,16 +425,13 @@ def test_the_private_check_catches_imports_and_attributes(tmp_path):
 # ------------------------------------------------------------------ the package graph
 
 #: Bounds of the import graph with each package counted as one node.  The depth is that
-#: of the chain cli -> bench -> engine -> catalog -> body -> kernels -> anisotropy ->
-#: geometry -> rotations -> units -> errors (11): ``units`` (every argument with a unit
-#: converted at the door, the rotations' angles too) is its one link below the root
-#: modules.  The edges include one from every package that writes a file (materials,
-#: photometry, store, bench, cli) to ``_output``, the one safe output, and
-#: ``catalog -> kernels`` (the kernel compiled while tables build), and one to ``units``
-#: from every package whose public functions take an argument with a unit (brdf,
-#: anisotropy, invert and plot among them).  The package's ``__init__`` imports only what
-#: it publishes by name; its modules load on first use.
-GRAPH_LIMITS = {"nodes": 30, "depth": 12, "edges": 114}
+#: of the chain cli -> bench -> engine -> store -> materials -> brdf -> geometry -> units
+#: -> errors (9).  The edges include one from every package that writes a file
+#: (materials, photometry, store, bench, cli) to ``_output``, the one safe output, and
+#: one to ``units`` from every package whose public functions take an argument with a
+#: unit (converted at the door).  The package's ``__init__`` imports only what it
+#: publishes by name; its modules load on first use.
+GRAPH_LIMITS = {"nodes": 30, "depth": 12, "edges": 110}
 
 
 def node_of(mod: str, root: Path = PACKAGE) -> str:

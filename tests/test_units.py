@@ -14,11 +14,11 @@ from sbrdf_xr import photometry as P
 from sbrdf_xr import units
 from sbrdf_xr.body.spacecraft import load_spacecraft
 from sbrdf_xr.errors import UnitError, UnitWarning, ValidationError
+from sbrdf_xr.geometry.rotations import axis_rotation
 from sbrdf_xr.materials.schema import constant_material, lambertian
 from sbrdf_xr.observing.attitude import Nadir, Spin
 from sbrdf_xr.observing.orbits import Site, airmass
 from sbrdf_xr.observing.timescales import times
-from sbrdf_xr.rotations import axis_rotation
 from sbrdf_xr.sources import earthshine_irradiance_ratio, planck
 
 

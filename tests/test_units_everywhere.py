@@ -42,6 +42,7 @@ PACKAGES = (
     "brdf",
     "cli",
     "engine",
+    "geometry",
     "invert",
     "kernels",
     "materials",
@@ -50,7 +51,7 @@ PACKAGES = (
     "plot",
     "store",
 )
-MODULES = ("accessors", "anisotropy", "catalog", "geometry", "rotations", "sources", "units")
+MODULES = ("accessors", "catalog", "sources", "units")
 
 #: Physical kinds of the units converted at the door.
 KINDS = {
@@ -368,21 +369,27 @@ def _angles_case(module: str, params: Any) -> Callable:
 #: its value.  ``slow``: the comparison runs with ``--runslow`` only (the refusal always).
 CASES: dict[str, Callable[[], dict[str, Any]]] = {
     # --- sbrdf_xr (modules)
-    "sbrdf_xr.anisotropy.psi_average": lambda: dict(
+    "sbrdf_xr.geometry.anisotropy.psi_average": lambda: dict(
         values=[1.0, 3.0, 2.0], grid=[0.0, 90.0, 180.0]
     ),
-    "sbrdf_xr.anisotropy.psi_weights": lambda: dict(grid=[0.0, 60.0, 120.0], psi=[30.0, 150.0]),
-    "sbrdf_xr.geometry.facet_vectors": lambda: dict(theta_i=[20.0], delta_theta=[5.0], phi=[10.0]),
-    "sbrdf_xr.geometry.from_conventional": lambda: dict(
-        theta_i=[20.0], phi_i=[180.0], theta_r=[30.0], phi_r=[10.0]
+    "sbrdf_xr.geometry.anisotropy.psi_weights": lambda: dict(
+        grid=[0.0, 60.0, 120.0], psi=[30.0, 150.0]
     ),
-    "sbrdf_xr.geometry.to_conventional": lambda: dict(
+    "sbrdf_xr.geometry.angles.facet_vectors": lambda: dict(
         theta_i=[20.0], delta_theta=[5.0], phi=[10.0]
     ),
-    "sbrdf_xr.geometry.observation_plane": lambda: dict(phase_angle_deg=[20.0, 75.0]),
-    "sbrdf_xr.rotations.axis_rotation": lambda: dict(axis=[0, 0, 1], angle=[30.0, 60.0]),
-    "sbrdf_xr.rotations.euler_attitudes": lambda: dict(sequence="zyx", angles=[[10.0, 20.0, 30.0]]),
-    "sbrdf_xr.rotations.rotation_sweep": lambda: dict(axis=[0, 0, 1], angles=[0.0, 45.0]),
+    "sbrdf_xr.geometry.angles.from_conventional": lambda: dict(
+        theta_i=[20.0], phi_i=[180.0], theta_r=[30.0], phi_r=[10.0]
+    ),
+    "sbrdf_xr.geometry.angles.to_conventional": lambda: dict(
+        theta_i=[20.0], delta_theta=[5.0], phi=[10.0]
+    ),
+    "sbrdf_xr.geometry.angles.observation_plane": lambda: dict(phase_angle_deg=[20.0, 75.0]),
+    "sbrdf_xr.geometry.rotations.axis_rotation": lambda: dict(axis=[0, 0, 1], angle=[30.0, 60.0]),
+    "sbrdf_xr.geometry.rotations.euler_attitudes": lambda: dict(
+        sequence="zyx", angles=[[10.0, 20.0, 30.0]]
+    ),
+    "sbrdf_xr.geometry.rotations.rotation_sweep": lambda: dict(axis=[0, 0, 1], angles=[0.0, 45.0]),
     "sbrdf_xr.sources.earthshine_irradiance_ratio": lambda: dict(
         albedo=0.3, range_km=42164.0, phase_angle_deg=30.0
     ),
@@ -737,9 +744,9 @@ for _row, _arg in (
     ("sbrdf_xr.bench.rows.BenchRow", "seconds"),
     ("sbrdf_xr.bench.shadowing.CostRow", "ms_per_geometry"),
     ("sbrdf_xr.bench.shadowing.ShadowRow", "ms_per_geometry"),
-    ("sbrdf_xr.geometry.FacetAngles", "theta_i"),
-    ("sbrdf_xr.geometry.FacetAngles", "delta_theta"),
-    ("sbrdf_xr.geometry.FacetAngles", "phi"),
+    ("sbrdf_xr.geometry.angles.FacetAngles", "theta_i"),
+    ("sbrdf_xr.geometry.angles.FacetAngles", "delta_theta"),
+    ("sbrdf_xr.geometry.angles.FacetAngles", "phi"),
 ):
     EXEMPT[(_row, _arg)] = "a result record the package fills, not an input"
 

@@ -17,8 +17,8 @@ import xarray as xr
 from numpy.typing import ArrayLike, NDArray
 
 from .._names import FACET, MATERIAL, VECTOR, attrs
-from ..anisotropy import project_tangents
 from ..errors import ValidationError
+from ..geometry.anisotropy import project_tangents
 
 __all__ = ["NORMAL_TOLERANCE", "check_facet_material", "facet_table", "merge_facets"]
 
@@ -97,7 +97,7 @@ def facet_table(
         Material name of every facet.
     facet_tangent : array_like, shape (n_facets, 3)
         Unit tangent of every facet [1]
-        (:func:`sbrdf_xr.anisotropy.project_tangents`).
+        (:func:`sbrdf_xr.geometry.anisotropy.project_tangents`).
     name : str
         Name of the spacecraft (the ``spacecraft`` attribute).
 

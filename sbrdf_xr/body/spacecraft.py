@@ -47,7 +47,6 @@ import xarray as xr
 from numpy.typing import NDArray
 
 from .. import _catalog_index
-from ..anisotropy import DEFAULT_TANGENT_DIRECTION, project_tangents
 from ..errors import (
     CatalogError,
     MeshError,
@@ -56,6 +55,7 @@ from ..errors import (
     ValidationError,
     input_file,
 )
+from ..geometry.anisotropy import DEFAULT_TANGENT_DIRECTION, project_tangents
 from ..units import check_plausible
 from .facets import NORMAL_TOLERANCE, check_facet_material, facet_table, merge_facets
 from .meshes import (
@@ -153,14 +153,14 @@ def load_spacecraft(
     file_type : str, optional
         Format of a file without a telling extension (``"stl"``, ``"ply"``, ...).
     tangent : array_like, shape (3,) or (n_facets, 3), optional
-        Facet tangents for anisotropic materials (:mod:`sbrdf_xr.anisotropy`): a
+        Facet tangents for anisotropic materials (:mod:`sbrdf_xr.geometry.anisotropy`): a
         body-frame direction [1] projected onto every facet, or one direction per
         facet of the mesh as read.  Without it, the mesh's per-face ``tangent``
         attribute if it has one (:func:`sbrdf_xr.body.meshes.face_tangents`; faces
         without a valid one take the default), else the default direction
-        (:data:`sbrdf_xr.anisotropy.DEFAULT_TANGENT_DIRECTION`).  Directions parallel
+        (:data:`sbrdf_xr.geometry.anisotropy.DEFAULT_TANGENT_DIRECTION`).  Directions parallel
         to a facet's normal take the documented fallback of
-        :func:`sbrdf_xr.anisotropy.project_tangents`.  Isotropic materials ignore
+        :func:`sbrdf_xr.geometry.anisotropy.project_tangents`.  Isotropic materials ignore
         tangents.
 
     Returns
@@ -341,9 +341,9 @@ class Spacecraft:
         Display colour of each material (0-255), used by :meth:`plot`.
     tangent : array_like, shape (3,) or (n_facets, 3), optional
         Tangent direction(s) [1] for anisotropic materials, projected onto every facet
-        (:func:`sbrdf_xr.anisotropy.project_tangents`, with its fallback for
+        (:func:`sbrdf_xr.geometry.anisotropy.project_tangents`, with its fallback for
         directions along the normal); default
-        :data:`sbrdf_xr.anisotropy.DEFAULT_TANGENT_DIRECTION`.  Kept as
+        :data:`sbrdf_xr.geometry.anisotropy.DEFAULT_TANGENT_DIRECTION`.  Kept as
         :attr:`facet_tangent`, unit vectors orthogonal to the facet normals.
     tangent_source : str, optional
         Where the tangents come from (``"default"``, ``"direction"``, ``"per facet"``,

@@ -205,7 +205,7 @@ def illumination_azimuth(
 ) -> NDArray[np.float64]:
     """``psi`` [degree] of a geometry: azimuth of the illumination plane from the tangent.
 
-    :func:`sbrdf_xr.anisotropy.illumination_azimuth` (its convention), in float64.
+    :func:`sbrdf_xr.geometry.anisotropy.illumination_azimuth` (its convention), in float64.
 
     Parameters
     ----------
@@ -225,7 +225,7 @@ def illumination_azimuth(
     >>> float(np.round(illumination_azimuth(n, across, s, o), 6))
     90.0
     """
-    from .. import anisotropy
+    from ..geometry import anisotropy
 
     f64 = [np.asarray(a, dtype=np.float64) for a in (normal, to_sun, to_observer)]
     return anisotropy.illumination_azimuth(f64[0], tangent, f64[1], f64[2]).astype(np.float64)

@@ -78,7 +78,7 @@ class Terms:
     n_facets : ndarray of int, shape (T,)
         Facets merged into each term.
     tangent : ndarray, shape (T, 3), optional
-        Unit tangents [1] (anisotropic materials; :mod:`sbrdf_xr.anisotropy`).
+        Unit tangents [1] (anisotropic materials; :mod:`sbrdf_xr.geometry.anisotropy`).
 
     Examples
     --------

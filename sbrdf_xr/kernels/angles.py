@@ -14,7 +14,7 @@ compiled parts, shared by the isotropic and the anisotropic kernels:
 * :func:`chunk_angles`, the same for a chunk of geometries x terms in one vectorisable
   pass (the first stage of :func:`sbrdf_xr.kernels.sums.fused_sums`);
 * :func:`tangent_azimuth`, the azimuth ``psi`` of the illumination plane from a facet
-  tangent (:func:`sbrdf_xr.anisotropy.illumination_azimuth`).
+  tangent (:func:`sbrdf_xr.geometry.anisotropy.illumination_azimuth`).
 
 Vectors travel as 3-tuples of floats (numba keeps them in registers).
 
@@ -333,7 +333,7 @@ def tangent_azimuth(
 ) -> float:  # pragma: no cover - compiled
     """``psi`` [degree], the azimuth of the illumination plane (``e_f`` of
     :func:`facet_frame`) from the facet tangent, before its reduction to ``[0, 180)``:
-    :func:`sbrdf_xr.anisotropy.illumination_azimuth` (the tangent made orthogonal to the
+    :func:`sbrdf_xr.geometry.anisotropy.illumination_azimuth` (the tangent made orthogonal to the
     normal; mirrored when the observer is below the plane, ``o.p < -tol``).
 
     Examples

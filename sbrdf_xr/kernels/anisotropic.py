@@ -1,7 +1,7 @@
 """Facet sums for anisotropic materials: tables with a ``psi`` axis.
 
 An anisotropic table (dims ``(theta_i, delta_theta, phi, psi, wavelength)``) is a
-stack of isotropic tables, one per ``psi`` node (:mod:`sbrdf_xr.anisotropy`).  The
+stack of isotropic tables, one per ``psi`` node (:mod:`sbrdf_xr.geometry.anisotropy`).  The
 look-up interpolates each slice in ``(theta_i, delta_theta, phi)`` with the isotropic
 method and the slices linearly and periodically in ``psi``.  The facet sums of
 paper 000 Eqs. 3-4 are linear in ``f_r``, so
@@ -38,9 +38,9 @@ import numba
 import numpy as np
 from numpy.typing import DTypeLike, NDArray
 
-from ..anisotropy import PSI_PERIOD, illumination_azimuth, psi_weights
 from ..errors import SceneError
 from ..geometry import normal_incidence_tolerance
+from ..geometry.anisotropy import PSI_PERIOD, illumination_azimuth, psi_weights
 from . import lut as _lut
 from .angles import facet_frame, tangent_azimuth
 from .lookup import _gather, _lookup_rows, _material_axes, _outside, _psi_cell, _range_limits

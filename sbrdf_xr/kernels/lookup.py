@@ -26,7 +26,7 @@ from typing import NamedTuple
 
 import numba
 
-from ..anisotropy import PSI_PERIOD
+from ..geometry.anisotropy import PSI_PERIOD
 
 __all__: list[str] = []
 

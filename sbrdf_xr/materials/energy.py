@@ -15,8 +15,8 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from .._names import ANGLE_DIMS, PSI, THETA_I, WAVELENGTH, attrs
-from ..anisotropy import psi_weights
 from ..errors import NonPhysicalWarning
+from ..geometry.anisotropy import psi_weights
 from ..kernels import lut as _lut
 from ..units import to_unit
 from .schema import validate_material
@@ -60,7 +60,7 @@ def hemispherical_reflectance(
         Dims ``(theta_i, wavelength)``, ``units = 1``; for an anisotropic table
         ``(theta_i, psi, wavelength)`` at the table's ``psi`` nodes: an observer on
         the far side of the illumination plane sees the mirror geometry, whose tangent
-        is at ``-psi`` (:mod:`sbrdf_xr.anisotropy`), so the reflectance at ``psi`` is
+        is at ``-psi`` (:mod:`sbrdf_xr.geometry.anisotropy`), so the reflectance at ``psi`` is
         the mean of the slice integrals at ``psi`` and ``-psi`` (each integrates one
         side of the plane twice), the latter interpolated periodically.
 

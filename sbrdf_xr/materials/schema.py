@@ -119,7 +119,7 @@ def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.Data
     xarray.DataArray
         ``da`` with its dims in the canonical order ``(theta_i, delta_theta, phi,
         wavelength)`` (a transpose, never a change of values); an anisotropic table
-        (:mod:`sbrdf_xr.anisotropy`) has the dims ``(theta_i, delta_theta, phi, psi,
+        (:mod:`sbrdf_xr.geometry.anisotropy`) has the dims ``(theta_i, delta_theta, phi, psi,
         wavelength)``, ``psi`` strictly increasing in ``[0, 180]`` degree.
 
     Raises

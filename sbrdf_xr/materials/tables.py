@@ -43,8 +43,8 @@ from .._names import (
     WAVELENGTH,
     attrs,
 )
-from ..anisotropy import PSI_PERIOD, psi_weights
 from ..errors import ValidationError
+from ..geometry.anisotropy import PSI_PERIOD, psi_weights
 from ..kernels import lut as _lut
 from ..units import to_unit
 from .build import build_lut
@@ -199,7 +199,7 @@ def lookup_anisotropic(
     every ``psi`` slice is looked up as an isotropic table (:func:`lookup`, with the
     table's edges; ``method`` in the three table angles) and the slices are
     interpolated linearly and periodically in ``psi`` (period 180 deg,
-    :func:`sbrdf_xr.anisotropy.psi_weights`: a grid ``[0, ..., 180]`` is closed, any
+    :func:`sbrdf_xr.geometry.anisotropy.psi_weights`: a grid ``[0, ..., 180]`` is closed, any
     other wraps from its last node to its first).  No normal-incidence blend: an
     anisotropic material depends on the observer's azimuth at ``theta_i = 0``.
 
@@ -339,7 +339,7 @@ def build_lut_anisotropic(
     :func:`~sbrdf_xr.materials.build.build_lut` takes (one
     :func:`sbrdf_xr.materials.goniometer.measure` run) with the attribute or scalar coordinate
     ``sample_rotation`` [degree]: the azimuth ``psi`` of the illumination plane from
-    the sample's tangent (:mod:`sbrdf_xr.anisotropy`), the observer on the ``+p``
+    the sample's tangent (:mod:`sbrdf_xr.geometry.anisotropy`), the observer on the ``+p``
     side of the plane (the side of :func:`sbrdf_xr.geometry.facet_vectors`).
 
     Construction: every set becomes an isotropic table by

@@ -11,8 +11,8 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 from hypothesis_profiles import examples
 
-from sbrdf_xr.anisotropy import PSI_PERIOD, illumination_azimuth
 from sbrdf_xr.geometry import facet_angles, normal_incidence_tolerance
+from sbrdf_xr.geometry.anisotropy import PSI_PERIOD, illumination_azimuth
 from sbrdf_xr.kernels.angles import atan2_pos, chunk_angles, facet_frame, tangent_azimuth
 
 

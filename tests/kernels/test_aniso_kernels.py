@@ -9,13 +9,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis_profiles import examples
 
-from sbrdf_xr import anisotropy, catalog, geometry
+from sbrdf_xr import catalog, geometry
 from sbrdf_xr import testing as T
 from sbrdf_xr.body.spacecraft import Spacecraft
 from sbrdf_xr.brdf import anisotropic as A
 from sbrdf_xr.engine import Scene
 from sbrdf_xr.engine.plan import compile_plan
 from sbrdf_xr.engine.run import simulate
+from sbrdf_xr.geometry import anisotropy
 from sbrdf_xr.kernels import anisotropic as AK
 from sbrdf_xr.materials import energy, models
 from sbrdf_xr.materials import tables as material

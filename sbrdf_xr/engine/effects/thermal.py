@@ -40,7 +40,7 @@ import numpy as np
 
 from ... import sources
 from ..._names import PSI, WAVELENGTH
-from ...anisotropy import psi_average
+from ...geometry.anisotropy import psi_average
 from ...materials.energy import hemispherical_reflectance
 from ...photometry import solar_spectrum
 from .base import BlockInputs, Decision, Effect, Output, PlanInputs, readonly

@@ -2,10 +2,9 @@
 
 Pure, vectorised numpy: every function takes arrays whose last axis holds the
 three Cartesian components of a vector and broadcasts over all leading axes.
-The attitude (quaternion) helpers live in :mod:`sbrdf_xr.rotations` and are
-importable from here too.  Angles [degree] also come as astropy Quantities, converted
-first (:func:`sbrdf_xr.units.to_unit`; another kind raises
-:class:`~sbrdf_xr.errors.UnitError`).
+The attitude (quaternion) helpers are in :mod:`sbrdf_xr.geometry.rotations`.  Angles
+[degree] also come as astropy Quantities, converted first (:func:`sbrdf_xr.units.to_unit`;
+another kind raises :class:`~sbrdf_xr.errors.UnitError`).
 
 Angle convention (paper 000 §3.1, Fig. 4; DESIGN.md "Angle convention")
 -----------------------------------------------------------------------
@@ -49,27 +48,11 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .errors import ValidationError
-from .rotations import (
-    QUATERNION_NORM_TOL,
-    axis_rotation,
-    check_quaternions,
-    compose,
-    euler_attitudes,
-    rotation_matrices,
-    rotation_sweep,
-    to_body_frame,
-    uniform_attitudes,
-)
-from .units import to_unit
+from ..errors import ValidationError
+from ..units import to_unit
 
 __all__ = [
-    "QUATERNION_NORM_TOL",
     "FacetAngles",
-    "axis_rotation",
-    "check_quaternions",
-    "compose",
-    "euler_attitudes",
     "facet_angles",
     "facet_vectors",
     "from_conventional",
@@ -78,11 +61,7 @@ __all__ = [
     "normalize",
     "observation_plane",
     "phase_angle",
-    "rotation_matrices",
-    "rotation_sweep",
-    "to_body_frame",
     "to_conventional",
-    "uniform_attitudes",
 ]
 
 #: Multiple of the working precision's machine epsilon below which the tangential

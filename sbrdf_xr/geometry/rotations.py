@@ -19,8 +19,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from .errors import ValidationError
-from .units import to_unit
+from ..errors import ValidationError
+from ..units import to_unit
 
 __all__ = [
     "QUATERNION_NORM_TOL",
@@ -60,7 +60,7 @@ def check_quaternions(q: ArrayLike) -> NDArray[np.float64]:
 
     Examples
     --------
-    >>> from sbrdf_xr.rotations import check_quaternions
+    >>> from sbrdf_xr.geometry.rotations import check_quaternions
     >>> check_quaternions([0.0, 0.0, 0.0, 1.0])
     array([0., 0., 0., 1.])
     >>> check_quaternions([0.0, 0.0, 1.0, 1.0])
@@ -120,7 +120,7 @@ def rotation_matrices(q: ArrayLike) -> NDArray[np.float64]:
     A quarter turn about +z takes the body +x axis to the reference +y axis:
 
     >>> import numpy as np
-    >>> from sbrdf_xr.rotations import axis_rotation, rotation_matrices
+    >>> from sbrdf_xr.geometry.rotations import axis_rotation, rotation_matrices
     >>> r = rotation_matrices(axis_rotation([0, 0, 1], 90.0))
     >>> np.round(r, 6) + 0.0
     array([[ 0., -1.,  0.],
@@ -154,7 +154,7 @@ def to_body_frame(q: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
     For a body turned by 90 deg about +z, the reference +x direction is body -y:
 
     >>> import numpy as np
-    >>> from sbrdf_xr.rotations import axis_rotation, to_body_frame
+    >>> from sbrdf_xr.geometry.rotations import axis_rotation, to_body_frame
     >>> q = axis_rotation([0, 0, 1], [0.0, 90.0])
     >>> np.round(to_body_frame(q, [1.0, 0.0, 0.0]), 6) + 0.0
     array([[ 1.,  0.,  0.],
@@ -185,7 +185,7 @@ def axis_rotation(axis: ArrayLike, angle: ArrayLike) -> NDArray[np.float64]:
     Examples
     --------
     >>> import numpy as np
-    >>> from sbrdf_xr.rotations import axis_rotation
+    >>> from sbrdf_xr.geometry.rotations import axis_rotation
     >>> axis_rotation([0, 0, 2], 90.0).round(6)
     array([0.      , 0.      , 0.707107, 0.707107])
     >>> axis_rotation([1, 0, 0], np.zeros((2, 5))).shape
@@ -214,7 +214,7 @@ def compose(q_outer: ArrayLike, q_inner: ArrayLike) -> NDArray[np.float64]:
     Turning by 30 deg and then by 60 deg about the same axis is a 90 deg turn:
 
     >>> import numpy as np
-    >>> from sbrdf_xr.rotations import axis_rotation, compose
+    >>> from sbrdf_xr.geometry.rotations import axis_rotation, compose
     >>> q = compose(axis_rotation([0, 0, 1], 60.0), axis_rotation([0, 0, 1], 30.0))
     >>> np.allclose(q, axis_rotation([0, 0, 1], 90.0))
     True
@@ -251,7 +251,7 @@ def rotation_sweep(
     about -z; the body +x axis returns to the reference +x direction after 25 steps:
 
     >>> import numpy as np
-    >>> from sbrdf_xr.rotations import axis_rotation, rotation_sweep, to_body_frame
+    >>> from sbrdf_xr.geometry.rotations import axis_rotation, rotation_sweep, to_body_frame
     >>> q = rotation_sweep([0, 0, -1], np.arange(360), axis_rotation([0, 0, 1], 25))
     >>> q.shape
     (360, 4)
@@ -281,7 +281,7 @@ def euler_attitudes(sequence: str, angles: ArrayLike) -> NDArray[np.float64]:
     Examples
     --------
     >>> import numpy as np
-    >>> from sbrdf_xr.rotations import euler_attitudes
+    >>> from sbrdf_xr.geometry.rotations import euler_attitudes
     >>> euler_attitudes("z", [[90.0]]).round(6)
     array([[0.      , 0.      , 0.707107, 0.707107]])
     >>> euler_attitudes("ZYX", [[10.0, 20.0, 30.0], [0.0, 0.0, 0.0]]).shape
@@ -312,7 +312,7 @@ def uniform_attitudes(n: int, seed: int | None = 0) -> NDArray[np.float64]:
     Examples
     --------
     >>> import numpy as np
-    >>> from sbrdf_xr.rotations import uniform_attitudes
+    >>> from sbrdf_xr.geometry.rotations import uniform_attitudes
     >>> q = uniform_attitudes(1000, seed=1)
     >>> q.shape, bool(np.allclose(np.linalg.norm(q, axis=1), 1.0))
     ((1000, 4), True)

@@ -1,4 +1,4 @@
-"""Tests of sbrdf_xr.anisotropy: facet tangents, the azimuth psi and its interpolation."""
+"""Tests of sbrdf_xr.geometry.anisotropy: facet tangents, the azimuth psi and its interpolation."""
 
 from __future__ import annotations
 
@@ -8,10 +8,10 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from hypothesis_profiles import examples
 
-from sbrdf_xr import anisotropy as AN
 from sbrdf_xr import geometry
 from sbrdf_xr.brdf import anisotropic as A
 from sbrdf_xr.errors import ValidationError
+from sbrdf_xr.geometry import anisotropy as AN
 
 unit = (
     st.tuples(*[st.floats(-1, 1, allow_nan=False)] * 3)

@@ -58,9 +58,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .errors import ValidationError
-from .geometry import _forward_direction, normal_incidence_tolerance, normalize
-from .units import to_unit
+from ..errors import ValidationError
+from ..units import to_unit
+from .angles import _forward_direction, normal_incidence_tolerance, normalize
 
 __all__ = [
     "DEFAULT_TANGENT_DIRECTION",
@@ -211,7 +211,7 @@ def illumination_azimuth(
     if np.any(lt <= tol):
         raise ValidationError(
             "tangent: must not be parallel to the facet normal (or zero); see "
-            "sbrdf_xr.anisotropy.project_tangents"
+            "sbrdf_xr.geometry.anisotropy.project_tangents"
         )
     t = t / lt[..., None]
     b = np.cross(n, t)

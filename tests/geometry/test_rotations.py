@@ -1,4 +1,4 @@
-"""Tests of sbrdf_xr.rotations: attitudes as unit quaternions."""
+"""Tests of sbrdf_xr.geometry.rotations: attitudes as unit quaternions."""
 
 from __future__ import annotations
 
@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from sbrdf_xr import geometry
-from sbrdf_xr import rotations as r
 from sbrdf_xr.errors import ValidationError
+from sbrdf_xr.geometry import rotations as r
 
 
 def test_rotation_sweep_of_the_paper_rotation_scenario():

@@ -307,7 +307,7 @@ def test_observation_plane_geometry():
 
 
 def test_attitude_helpers_are_importable_from_geometry():
-    from sbrdf_xr import rotations
+    from sbrdf_xr.geometry import rotations
 
     for name in rotations.__all__:
         assert getattr(g, name) is getattr(rotations, name)
