@@ -8,23 +8,30 @@ See :func:`fit_observation`; the data and the forward model are in
 
 from __future__ import annotations
 
+import dataclasses
 import time
-from collections.abc import Mapping, Sequence
-from typing import Any
+import warnings
+from collections.abc import Callable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 from scipy.optimize import least_squares
 
-from ..errors import InversionError
+from ..errors import FitQualityWarning, InversionError
 from ..units import to_unit
 from ._areas import material_areas
 from ._joint_model import PassModel, pass_data
 from ._joint_result import Layout, model_check, result_dataset
+from ._joint_starts import Start, minima_dataset, start_states
 from ._quality import fit_quality
+from ._spin import AMBIGUITY_CHI2
 from ._spin_refine import _tangent
-from ._spin_search import vec
+
+if TYPE_CHECKING:
+    from ..body import Spacecraft
+    from ..observing import Observation
 
 __all__ = ["JOINT_CAUSES", "fit_observation"]
 
@@ -42,9 +49,9 @@ JOINT_CAUSES = (
 MAX_NFEV = 2000
 
 
-def _start_spin(spin: Any, axis_body: ArrayLike | None) -> tuple[dict[str, float], Any, Any]:
-    """Start values (axis_longitude, axis_latitude, period, phase), their epoch (UTC or
-    None) and the body axis, from a :func:`fit_spin` result or a mapping."""
+def _read_start(spin: Any) -> tuple[dict[str, float], Any]:
+    """Start values (axis_longitude, axis_latitude, period, phase) and their epoch (UTC or
+    None), from a :func:`fit_spin` result or a mapping."""
     keys = ("axis_longitude", "axis_latitude", "period", "phase")
     have: Mapping[Any, Any]
     attrs: Mapping[Any, Any]
@@ -73,6 +80,12 @@ def _start_spin(spin: Any, axis_body: ArrayLike | None) -> tuple[dict[str, float
                 f"spin: epoch {epoch!r} is not a UTC time; the spin must be fitted to the "
                 "observation (fit_spin(..., geometry=observation)) or give epoch as UTC"
             ) from None
+    return out, epoch
+
+
+def _axis_body(spin: Any, axis_body: ArrayLike | None) -> np.ndarray:
+    """The body axis of the spin: given, else the :func:`fit_spin` result's, else z."""
+    attrs = spin.attrs if isinstance(spin, xr.Dataset) else spin
     ab = axis_body
     if ab is None:
         ab = attrs.get("axis_body", (0.0, 0.0, 1.0))
@@ -81,7 +94,7 @@ def _start_spin(spin: Any, axis_body: ArrayLike | None) -> tuple[dict[str, float
     abv = np.asarray(ab, dtype=np.float64)
     if abv.shape != (3,) or not np.all(np.isfinite(abv)) or np.linalg.norm(abv) == 0:
         raise InversionError(f"axis_body: {ab!r}; allowed a finite nonzero 3-vector")
-    return out, epoch, abv
+    return abv
 
 
 def _options(extinction: Any, offset: str | None, areas: str, labels: Sequence[str]) -> Any:
@@ -121,8 +134,8 @@ def _options(extinction: Any, offset: str | None, areas: str, labels: Sequence[s
 
 def fit_observation(
     light_curve: xr.Dataset,
-    spacecraft: Any,
-    observation: Any,
+    spacecraft: Spacecraft,
+    observation: Observation,
     spin: Any,
     *,
     axis_body: ArrayLike | None = None,
@@ -133,6 +146,7 @@ def fit_observation(
     system: str | None = None,
     materials: Mapping[str, xr.DataArray] | None = None,
     scale_uncertainties: bool = False,
+    starts: str | Sequence[Mapping[str, Any]] = "given",
     check: bool = True,
 ) -> xr.Dataset:
     """Spin state, extinction, zero points and material areas fitted jointly to the
@@ -165,8 +179,11 @@ def fit_observation(
     The uncertainties are ``sqrt(diag(J^T J)^-1)`` from a central-difference Jacobian of
     the normalised residuals at the solution, unscaled (the measured uncertainties taken
     as right; ``scale_uncertainties=True`` multiplies the covariance by the reduced
-    chi-square).  They describe the neighbourhood of the minimum reached: the spin's
-    twins (:func:`fit_spin` reports them) are not explored.
+    chi-square).  They describe the neighbourhood of the minimum reached.  The fit is
+    local: from a start too far off (for a period ``P`` over a span ``T``, a phase slip of
+    a quarter turn or more over the pass, ``|dP| > P**2 / (4 T)``) it stops in another
+    minimum; ``starts="aliases"`` refines from the period aliases and the spin's twins too
+    and keeps the lowest chi-square, listing every minimum found.
 
     Parameters
     ----------
@@ -194,6 +211,13 @@ def fit_observation(
         Material tables by name, instead of the catalog's.
     scale_uncertainties : bool
         Scale the covariance by the reduced chi-square (Birge ratio squared).
+    starts : {"given", "aliases"} or sequence of mappings
+        Where the fit starts: ``"given"`` from ``spin`` only; ``"aliases"`` from ``spin``,
+        its period aliases (a half and a whole turn more and fewer over the measured
+        span ``T``: ``P' = T / (T / P + j / 2)``, ``j = -2, -1, 1, 2``, the phase at the
+        middle of the pass kept) and, for a :func:`fit_spin` result, its twins (antipode,
+        mirror, half and double period); a sequence: from ``spin`` and each mapping (as
+        ``spin``).  The lowest chi-square is the solution.
     check : bool
         Recompute the solution's magnitudes through :func:`sbrdf_xr.engine.simulate` and
         :func:`sbrdf_xr.photometry.magnitudes` (spectral signal, band-integrated): the
@@ -209,14 +233,20 @@ def fit_observation(
         ``scale``, ``area`` [m2] with uncertainties and ``model_area``; over
         ``parameter``: ``estimate``, ``uncertainty``, ``correlation``; ``chi2``, ``dof``,
         ``reduced_chi2``, ``fit_probability``; over ``obs``: ``model_magnitude``,
-        ``residual``, ``airmass``.  Attributes say what was fitted, how the uncertainties
-        are scaled, the ``fit_quality``, the model check and the timing.
+        ``residual``, ``airmass``; over ``start``: the minimum refined from each start
+        (``start_chi2``, ``start_chi2_gap`` above the solution's, ``start_period``,
+        ``start_phase``, ``start_axis_longitude``, ``start_axis_latitude``,
+        ``start_axis_separation``).  Attributes say what was fitted, how the uncertainties
+        are scaled, the ``fit_quality``, the ``ambiguity``, the model check and the timing.
 
     Warns
     -----
     FitQualityWarning
         When the chi-square lies beyond the 99.9 % point of its distribution (or below its
-        0.1 % point), naming the likely causes.
+        0.1 % point), naming the likely causes; or when a minimum from another start, at
+        another spin state (period more than 3 sigma or axis more than 3 times its
+        uncertainty away), fits within a chi-square of :data:`AMBIGUITY_CHI2` of the
+        solution.
 
     Raises
     ------
@@ -263,7 +293,8 @@ def fit_observation(
     ([0.82, 0.18], 'consistent')
     """
     t_start = time.perf_counter()
-    start, epoch, ab = _start_spin(spin, axis_body)
+    start, epoch = _read_start(spin)
+    ab = _axis_body(spin, axis_body)
     data = pass_data(light_curve, observation, bands, system)
     k_mode = _options(extinction, offset, areas, data.labels)
     model = PassModel(data, spacecraft, ab, materials)
@@ -279,33 +310,20 @@ def fit_observation(
             f"({', '.join(lay.names)}); need more values than parameters (fix some: "
             "extinction=None or a mapping, offset=None, areas='fixed')"
         )
-    e0 = vec(start["axis_longitude"], start["axis_latitude"])
-    east, north = _tangent(e0)
-    dt_epoch = float((epoch - data.epoch) / np.timedelta64(1, "ns")) * 1e-9
-    phase_ref0 = start["phase"] + 360.0 * (model.t_ref - dt_epoch) / start["period"]
 
-    def axis_of(p: np.ndarray) -> np.ndarray:
-        a = e0 + np.radians(p[0]) * east + np.radians(p[1]) * north
-        return a / np.linalg.norm(a)
+    def seconds_of(t: Any) -> float:
+        return float((t - data.epoch) / np.timedelta64(1, "ns")) * 1e-9
 
-    def residuals(p: np.ndarray) -> np.ndarray:
-        terms = model.terms(axis_of(p), p[2], p[3])
-        m = model.magnitudes(terms, lay.scales(p)) + lay.extra(p, data)
-        return (data.magnitude - m) / data.sigma
+    def read(s: Any) -> tuple[dict[str, float], float | None]:
+        values, t = _read_start(s)
+        return values, None if t is None else seconds_of(t)
 
-    p0 = lay.start(start["period"], phase_ref0)
+    dt_epoch = seconds_of(epoch)
     span = max(float(np.ptp(data.seconds)), 1e-9)
-    x_scale = lay.x_scale(start["period"], span)
-    res = least_squares(
-        residuals,
-        p0,
-        x_scale=x_scale,
-        method="lm",
-        diff_step=1e-7,
-        max_nfev=MAX_NFEV,
-        ftol=1e-10,
-        xtol=1e-10,
-    )
+    states = start_states(starts, spin, start, dt_epoch, model.t_ref, span, read)
+    local = [_refine(model, lay, st, span) for st in states]
+    best = min(range(len(local)), key=lambda i: local[i].chi2)
+    res, axis_of, residuals = local[best].res, local[best].axis_of, local[best].residuals
     p = res.x
     if not p[2] > 0:
         raise InversionError(
@@ -352,6 +370,10 @@ def fit_observation(
             "time_source": data.time_source,
         },
     )
+    ds = ds.merge(_minima(local, best, model.t_ref, dt_epoch))
+    ds.attrs["ambiguity"] = _ambiguity(ds)
+    if ds.attrs["ambiguity"] != "none":
+        warnings.warn(f"joint fit: {ds.attrs['ambiguity']}", FitQualityWarning, stacklevel=2)
     if check:
         t0 = time.perf_counter()
         ds.attrs["model_check"] = model_check(
@@ -359,6 +381,87 @@ def fit_observation(
         )
         ds.attrs["check_seconds"] = time.perf_counter() - t0
     return ds
+
+
+@dataclasses.dataclass(frozen=True)
+class _Local:
+    """The minimum refined from one start: the optimizer's result, the axis of its
+    parameters (tangent plane of the start's axis), its residual function, chi-square."""
+
+    res: Any
+    axis_of: Callable[[np.ndarray], np.ndarray]
+    residuals: Callable[[np.ndarray], np.ndarray]
+    chi2: float
+    label: str
+
+
+def _refine(model: PassModel, lay: Layout, st: Start, span: float) -> _Local:
+    """Levenberg-Marquardt from one start (the axis on the tangent plane of its axis)."""
+    data = model.data
+    e0 = st.axis
+    east, north = _tangent(e0)
+
+    def axis_of(p: np.ndarray) -> np.ndarray:
+        a = e0 + np.radians(p[0]) * east + np.radians(p[1]) * north
+        return a / np.linalg.norm(a)
+
+    def residuals(p: np.ndarray) -> np.ndarray:
+        terms = model.terms(axis_of(p), p[2], p[3])
+        m = model.magnitudes(terms, lay.scales(p)) + lay.extra(p, data)
+        return (data.magnitude - m) / data.sigma
+
+    res = least_squares(
+        residuals,
+        lay.start(st.period, st.phase_ref),
+        x_scale=lay.x_scale(st.period, span),
+        method="lm",
+        diff_step=1e-7,
+        max_nfev=MAX_NFEV,
+        ftol=1e-10,
+        xtol=1e-10,
+    )
+    chi2 = float(2.0 * res.cost) if res.x[2] > 0 else np.inf
+    return _Local(res, axis_of, residuals, chi2, st.label)
+
+
+def _minima(local: Sequence[_Local], best: int, t_ref: float, dt_epoch: float) -> xr.Dataset:
+    """The table of the minima refined from every start (phases at the epoch)."""
+    x = np.array([m.res.x[:4] for m in local])
+    phase = (x[:, 3] - 360.0 * (t_ref - dt_epoch) / np.where(x[:, 2] > 0, x[:, 2], np.nan)) % 360
+    return minima_dataset(
+        [m.label for m in local],
+        np.array([m.chi2 for m in local]),
+        np.array([m.axis_of(m.res.x) for m in local]),
+        x[:, 2],
+        phase,
+        best,
+    )
+
+
+def _ambiguity(ds: xr.Dataset) -> str:
+    """The minima from other starts that fit about as well as the solution (chi-square gap
+    below :data:`AMBIGUITY_CHI2`) at another spin state (period more than 3 sigma away,
+    or axis more than 3 times its uncertainty, and 0.1 deg, away)."""
+    sig_p = 3 * float(ds["period_uncertainty"])
+    sig_a = max(3 * float(ds["axis_uncertainty"]), 0.1)
+    rows = []
+    for name in ds["start"].values:
+        row = ds.sel(start=name)
+        gap = float(row["start_chi2_gap"])
+        dper = abs(float(row["start_period"]) - float(ds["period"]))
+        sep = float(row["start_axis_separation"])
+        if gap < AMBIGUITY_CHI2 and (dper > sig_p or sep > sig_a):
+            rows.append(
+                f"{name} (period {float(row['start_period']):.6g} s, axis {sep:.2g} deg away, "
+                f"chi2 gap {gap:.3g})"
+            )
+    if not rows:
+        return "none"
+    return (
+        f"minima at other spin states fit about as well: {'; '.join(rows)} (chi2 gap < "
+        f"{AMBIGUITY_CHI2:g}); the stated uncertainties describe the neighbourhood of the "
+        "solution only"
+    )
 
 
 def _jacobian(fun: Any, p: np.ndarray, steps: np.ndarray) -> np.ndarray:

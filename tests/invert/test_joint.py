@@ -136,7 +136,12 @@ def test_starts_from_fit_spin(sc, lc, night, fit):
             search_times=40,
             n_starts=2,
         )
-    again = invert.fit_observation(lc, sc, night, spin, check=False)
+    again = invert.fit_observation(lc, sc, night, spin, starts="aliases", check=False)
+    # refined from the start, its four period aliases and fit_spin's four twins; the
+    # solution is the lowest, and the table says how far above it the others stopped
+    assert again.sizes["start"] == 9 and "twin antipode" in again.start.values
+    assert float(again.start_chi2_gap.min()) == 0.0
+    assert float(again.start_chi2.min()) == pytest.approx(float(again.chi2), rel=1e-12)
     # the same minimum up to CanX-1's half-turn symmetry: fit_spin starts at a phase near
     # 210 deg, and the twin half a turn away fits as well within 0.01 in chi2 (the body is
     # nearly, not exactly, the same turned half a turn about z)
@@ -185,6 +190,9 @@ def test_a_wrong_model_warns(sc, lc, night):
         ({"extinction": {"V": 0.2}}, r"no coefficient for bands \['R', 'I'\]"),
         ({"extinction": "guess"}, "extinction: 'guess'; allowed 'fit'"),
         ({"system": "AB"}, "the light curve's magnitudes are 'Vega'"),
+        ({"starts": "all"}, "starts: 'all'; allowed 'given'"),
+        ({"starts": START}, "starts: got a dict; allowed 'given', 'aliases' or a sequence"),
+        ({"starts": [{**START, "period": -1.0}]}, r"start values must be finite with period > 0"),
     ],
 )
 def test_bad_options(sc, lc, night, change, match):
@@ -209,6 +217,40 @@ def test_bad_data(sc, lc, night):
         invert.fit_observation(early, sc, dark, START)
     with pytest.raises(InversionError, match=r"expected an sbrdf_xr\.observing\.Observation"):
         invert.fit_observation(lc, sc, "zimmerwald", START)
+
+
+def test_aliases_find_the_minimum_a_start_misses(sc):
+    # a 10 s spin over a 279 s pass: a start 0.2 s off slips the phase by 360 * 279 * 0.2
+    # / 10**2 = 200 deg over the pass (more than the quarter turn P**2 / (4 T) = 0.09 s
+    # allows) and the local fit stops in another minimum
+    truth = {**TRUTH_SPIN, "period": 10.0}
+    pass_ = _night("2024-03-17T19:55:40", "2024-03-17T20:00:19")
+    clean, _ = invert.simulated_light_curve(
+        sc, pass_, truth, area_fraction=FRACTIONS, extinction=EXTINCTION
+    )
+    lc = clean.copy()
+    lc["magnitude"] = clean.magnitude + np.random.default_rng(3).normal(0.0, 0.02, lc.sizes["obs"])
+    lc["uncertainty"] = clean.uncertainty + 0.02
+    start = {**truth, "axis_longitude": 216.0, "axis_latitude": 41.0, "period": 10.2, "phase": 33.0}
+    with pytest.warns(FitQualityWarning, match="beyond the 99.9 %"):
+        local = invert.fit_observation(lc, sc, pass_, start, check=False)
+    assert float(local.reduced_chi2) > 5 and abs(float(local.period) - 10.0) > 0.2
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FitQualityWarning)  # consistent, and not ambiguous
+        fit = invert.fit_observation(lc, sc, pass_, start, starts="aliases", check=False)
+    assert fit.start.values.tolist() == [
+        "given", "alias -2/2 turn", "alias -1/2 turn", "alias +1/2 turn", "alias +2/2 turn"
+    ]  # fmt: skip
+    assert float(fit.reduced_chi2) < 1.25 and fit.attrs["ambiguity"] == "none"
+    assert abs(float(fit.period) - 10.0) < 4 * float(fit.period_uncertainty)
+    assert float(fit.start_chi2_gap.sel(start="given")) == pytest.approx(
+        float(local.chi2) - float(fit.chi2), rel=1e-9
+    )
+    # the same from an explicit start near the truth
+    near = {**start, "period": 10.01}
+    again = invert.fit_observation(lc, sc, pass_, start, starts=[near], check=False)
+    assert again.start.values.tolist() == ["given", "start 0"]
+    assert float(again.chi2) == pytest.approx(float(fit.chi2), abs=0.5)  # micro-minima
 
 
 def _recovery(sc, n_draws: int, seed: int):
