@@ -179,11 +179,13 @@ def fit_observation(
     The uncertainties are ``sqrt(diag(J^T J)^-1)`` from a central-difference Jacobian of
     the normalised residuals at the solution, unscaled (the measured uncertainties taken
     as right; ``scale_uncertainties=True`` multiplies the covariance by the reduced
-    chi-square).  They describe the neighbourhood of the minimum reached.  The fit is
-    local: from a start too far off (for a period ``P`` over a span ``T``, a phase slip of
-    a quarter turn or more over the pass, ``|dP| > P**2 / (4 T)``) it stops in another
-    minimum; ``starts="aliases"`` refines from the period aliases and the spin's twins too
-    and keeps the lowest chi-square, listing every minimum found.
+    chi-square).  Over 1000 noise draws of a CanX-1 pass (0.02 mag, README) their pulls
+    had widths 0.98 to 1.04, and 1.10 for the axis longitude, which is not linear over a
+    sigma (1.05 at 0.005 mag).  They describe the neighbourhood of the minimum reached.
+    The fit is local: from a start too far off (for a period ``P`` over a span ``T``, a
+    phase slip of a quarter turn or more over the pass, ``|dP| > P**2 / (4 T)``) it stops
+    in another minimum; ``starts="aliases"`` refines from the period aliases and the spin's
+    twins too and keeps the lowest chi-square, listing every minimum found.
 
     Parameters
     ----------

@@ -281,10 +281,13 @@ def test_recovery_few_draws(sc):
 def test_recovery_calibrated():
     from sbrdf_xr.body.spacecraft import canx1
 
-    study = _recovery(canx1(), 100, seed=2)
-    # 100 draws: a pull width scatters by 1/sqrt(200) = 0.07; 200 draws measured 0.86 ..
-    # 1.16 (README), so 0.7 .. 1.35 allows the measured spread plus 3 of that scatter
-    assert np.all((study.pull_width > 0.7) & (study.pull_width < 1.35))
-    assert np.all(np.abs(study.pull_mean) < 0.4)
-    assert np.all(study.coverage_2sigma >= 0.85)
+    study = _recovery(canx1(), 200, seed=2)
+    # 200 draws: a pull width scatters by 1/sqrt(400) = 0.05 and a pull mean by 0.07;
+    # 1000 draws (README) measured widths 0.98 .. 1.04 and 1.10 for the axis longitude,
+    # so 0.83 .. 1.27 allows the measured spread plus 3 of that scatter
+    assert np.all((study.pull_width > 0.83) & (study.pull_width < 1.27))
+    assert np.all(np.abs(study.pull_mean) < 0.25)
+    # coverage of 2 sigma: 0.954 for a Gaussian, 0.924 measured for the axis longitude;
+    # 200 draws scatter it by 0.019
+    assert np.all(study.coverage_2sigma >= 0.87)
     assert int(study.quality_warnings) <= 3
