@@ -38,7 +38,7 @@ __all__ = ["JOINT_CAUSES", "fit_observation"]
 #: Likely causes of a poor joint fit, most likely first.
 JOINT_CAUSES = (
     "the fit stopped in a local minimum: start from a better spin state (fit_spin over the "
-    "light curve, its twins)",
+    "light curve) or from more (starts='aliases': the period aliases and fit_spin's twins)",
     "the attitude is not a uniform spin about axis_body",
     "a material of the object is missing from the model, or the shape is wrong",
     "the extinction is not first order in the air mass, or the table is not calibrated "
