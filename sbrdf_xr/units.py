@@ -10,7 +10,8 @@ Every public argument of the package that carries a unit names it (``range_km`` 
 * temperatures also from degrees Celsius or Fahrenheit (astropy's ``temperature``
   equivalency);
 * an xarray DataArray whose data is a Quantity (xarray keeps one as it is) is returned
-  with its data converted, its dims and coordinates kept;
+  with its data converted, its dims and coordinates kept and its ``units`` attribute
+  stating the unit (a material table in ``1 / deg2`` becomes one in ``sr-1``);
 * a Quantity of another kind (a time given for a length) is refused with
   :class:`~sbrdf_xr.errors.UnitError`, naming the argument, the unit received and the
   unit expected;
@@ -128,7 +129,8 @@ def to_unit(value: Any, unit: str, what: str, *, spectral: bool = False) -> Any:
     -------
     Any
         A float (scalar Quantity) or a float64 array in ``unit``, a DataArray holding a
-        Quantity with its data so converted, or ``value`` itself.
+        Quantity with its data so converted (its ``units`` attribute set to ``unit``), or
+        ``value`` itself.
 
     Raises
     ------
@@ -149,6 +151,10 @@ def to_unit(value: Any, unit: str, what: str, *, spectral: bool = False) -> Any:
     >>> import xarray as xr
     >>> to_unit(xr.DataArray([0.5, 1.0] * u.rad, dims="x"), "deg", "theta_i").round(4).values
     array([28.6479, 57.2958])
+    >>> to_unit(xr.DataArray([1.0] / u.deg**2, dims="x"), "sr-1", "sbrdf").attrs["units"]
+    'sr-1'
+    >>> to_unit(1.0 / u.deg**2, "sr-1", "sbrdf")
+    3282.806350011744
     >>> to_unit(3.0 * u.s, "km", "range_km")
     Traceback (most recent call last):
         ...
@@ -158,7 +164,8 @@ def to_unit(value: Any, unit: str, what: str, *, spectral: bool = False) -> Any:
         data = getattr(value, "data", None) if hasattr(value, "dims") else None
         if not is_quantity(data):
             return value
-        return value.copy(data=np.asarray(to_unit(data, unit, what, spectral=spectral)))
+        out = value.copy(data=np.asarray(to_unit(data, unit, what, spectral=spectral)))
+        return out.assign_attrs(units=unit or "1")
     import astropy.units as u
 
     target = u.Unit(unit) if unit else u.dimensionless_unscaled
@@ -166,11 +173,17 @@ def to_unit(value: Any, unit: str, what: str, *, spectral: bool = False) -> Any:
     try:
         out = value.to_value(target, equivalencies=equiv)
     except (u.UnitConversionError, u.UnitsError, TypeError, ValueError):
-        got = value.unit.physical_type
+        got, kind = value.unit.physical_type, target.physical_type
+        shown = (
+            value
+            if value.size <= 8
+            else f"{value.size} values of shape {value.shape} in {value.unit}"
+        )
         raise UnitError(
-            f"{what}: got {value}{f' ({got})' if got != 'unknown' else ''}, which is not in "
-            f"{unit or 'a dimensionless number'} ({target.physical_type}); give a Quantity "
-            f"convertible to {unit or 'a number'} or a bare number in {unit or 'no unit'}"
+            f"{what}: got {shown}{f' ({got})' if got != 'unknown' else ''}, which is not in "
+            f"{unit or 'a dimensionless number'}{f' ({kind})' if kind != 'unknown' else ''}; "
+            f"give a Quantity convertible to {unit or 'a number'} or a bare number in "
+            f"{unit or 'no unit'}"
         ) from None
     arr = np.asarray(out, dtype=np.float64)
     return float(arr) if arr.ndim == 0 else arr

@@ -53,7 +53,10 @@ PACKAGES = (
 )
 MODULES = ("accessors", "catalog", "sources", "units")
 
-#: Physical kinds of the units converted at the door.
+#: Physical kinds of the units converted at the door (astropy's names; a unit of several
+#: names, such as ``km s-1`` "speed/velocity", is of a kind when one of them is here).
+#: Dimensionless numbers (``[1]``: reflectances, fractions, emissivities) have no unit to
+#: convert and are left out.
 KINDS = {
     "length",
     "angle",
@@ -64,9 +67,36 @@ KINDS = {
     "pressure",
     "speed",
     "frequency",
+    "area",
+    "volume",
+    "mass",
+    "mass density",
+    "moment of inertia",
+    "data quantity",
+    "energy",
+    "power",
+    "energy flux",
+    "radiance",
+    "radiant intensity",
+    "spectral flux density",
+    "spectral flux density wav",
+    "surface brightness wav",
+    "particle flux",
+}
+#: Kinds astropy has no name for ("unknown"), each by a unit of it: a unit that converts
+#: to it is of the kind.
+UNNAMED_KINDS = {
+    "inverse solid angle": "sr-1",  # an sBRDF
+    "area per solid angle": "m2 sr-1",  # a signal
+    "spectral intensity wav": "W sr-1 nm-1",  # a signal under sunlight
+    "magnitude": "mag",
+    "cubed angle": "deg3",  # a smoothing spline's parameter over angles in degrees
 }
 #: Units named by an argument's ending.
 SUFFIXES = {
+    "_kg_m3": "kg m-3",
+    "_bytes": "byte",
+    "_mag": "mag",
     "_deg_s": "deg / s",
     "_km_s": "km / s",
     "_hpa": "hPa",
@@ -80,6 +110,14 @@ SUFFIXES = {
 _BRACKET = re.compile(r"\[([^\]\[]+)\]")
 
 
+def kind(unit: Any) -> str | None:
+    """The kind of ``unit`` among :data:`KINDS` and :data:`UNNAMED_KINDS`, or None."""
+    named = set(unit.physical_type) & KINDS
+    if named:
+        return min(named)
+    return next((k for k, ref in UNNAMED_KINDS.items() if unit.is_equivalent(ref)), None)
+
+
 def _unit_in(text: str) -> str | None:
     for s in _BRACKET.findall(text):
         try:
@@ -88,7 +126,7 @@ def _unit_in(text: str) -> str | None:
                 unit = u.Unit(s.strip(), parse_strict="raise")
         except (ValueError, TypeError):
             continue
-        if str(unit.physical_type) in KINDS:
+        if kind(unit) is not None:
             return s.strip()
     return None
 
@@ -482,6 +520,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         self=_model("lambert"), wavelength=WL, **_LAMBERT
     ),
     "sbrdf_xr.body.spacecraft.Spacecraft.plot": lambda: dict(self=_box(), elev=25.0, azim=35.0),
+    "sbrdf_xr.body.spacecraft.Spacecraft.inertia": lambda: dict(self=_box(), density=100.0),
     "sbrdf_xr.accessors.SbrdfDatasetAccessor.magnitudes": lambda: dict(
         self=_cube().sbrdf, bands=["V"], range_km=1000.0
     ),
@@ -514,6 +553,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         light_curve=_light_curve(), range_km=1000.0
     ),
     "sbrdf_xr.invert._spin.fit_spin": _spin_lc,
+    "sbrdf_xr.invert._unmix.unmix": lambda: _unmix_inputs(),
     "sbrdf_xr.invert._spin.period_grid": lambda: dict(p_min=60.0, p_max=70.0, span_s=240.0),
     "sbrdf_xr.invert._spin.axis_vector": lambda: dict(
         longitude=[30.0, 60.0], latitude=[20.0, -5.0]
@@ -528,6 +568,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         extinction={"V": 0.2},
         bands=("V",),
         n_draws=1,
+        noise_mag=0.02,
         phase_symmetry_deg=180.0,
     ),
     "sbrdf_xr.invert._spin_search.spin_model": lambda: dict(
@@ -555,10 +596,11 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         material=_aniso_table(), theta_i=[30.0], delta_theta=[0.0], phi=[4.0], psi=[25.0]
     ),
     "sbrdf_xr.materials.build.build_lut": lambda: dict(
-        measurements=_measurements(),
+        measurements=_measurements((20.0, 35.0, 55.0)),
         n_phi=7,
         n_delta_theta=7,
         theta_i=[20.0, 35.0, 50.0],
+        smoothing=300.0,
         blend=10.0,
         blend_normal=5.0,
         check_energy=False,
@@ -606,6 +648,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         delta_theta=[-10.0, 10.0],
         phi=[0.0, 30.0],
         progress=False,
+        max_bytes=1e6,
     ),
     "sbrdf_xr.materials.models.render_anisotropic": lambda: dict(
         spec=_aniso_spec(), theta_i=[30.0], delta_theta=[0.0], phi=[0.0, 10.0], psi=[0.0, 90.0]
@@ -670,7 +713,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         wavelength=WL, airmass=1.5, pressure_hpa=700.0
     ),
     "sbrdf_xr.photometry.bands.band_weights": lambda: dict(
-        bands=["V"], wavelength=np.arange(400.0, 1101.0, 10.0)
+        bands=["V"], wavelength=np.arange(400.0, 1101.0, 10.0), solar=_sun()
     ),
     "sbrdf_xr.photometry.bands.filters": lambda: dict(
         bands=["V"], wavelength=np.arange(400.0, 1101.0, 10.0)
@@ -689,7 +732,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.photometry.spectra.hat_integrals": lambda: dict(
         x=np.array([400.0, 500.0, 600.0]), y=np.array([1.0, 2.0, 1.5]), t=np.array([450.0, 550.0])
     ),
-    "sbrdf_xr.photometry.spectra.solar_spectrum": lambda: dict(wavelength=WL),
+    "sbrdf_xr.photometry.spectra.solar_spectrum": lambda: dict(wavelength=WL, solar=_sun()),
     "sbrdf_xr.photometry.spectra.vega_spectrum": lambda: dict(wavelength=WL),
     "sbrdf_xr.photometry.standard.at_resolution": lambda: dict(
         spectrum=_solar(), fwhm_nm=5.0, wavelength=WL
@@ -705,6 +748,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         sun_distance_au=1.01,
     ),
     # --- plot
+    "sbrdf_xr.plot.front.accuracy_front": lambda: dict(rows=_bench_rows(), zero_below=1e-3),
     "sbrdf_xr.plot.curves.lut_slice": lambda: dict(
         material=_table(), theta_i=35.0, wavelength=600.0
     ),
@@ -732,6 +776,8 @@ for _name, _arg in (
     ("sbrdf_xr.photometry.standard.at_resolution", "spectrum"),
     ("sbrdf_xr.photometry.bands.filters", "bands"),
     ("sbrdf_xr.materials.goniometer.measure", "func"),
+    ("sbrdf_xr.materials.goniometer.scheme_extents", "func"),
+    ("sbrdf_xr.invert._joint.fit_observation", "light_curve"),
 ):
     EXEMPT[(_name, _arg)] = _CONTAINER
 EXEMPT[("sbrdf_xr.bench.suite.bench_geometry", "step_s")] = (
@@ -747,8 +793,15 @@ for _row, _arg in (
     ("sbrdf_xr.geometry.angles.FacetAngles", "theta_i"),
     ("sbrdf_xr.geometry.angles.FacetAngles", "delta_theta"),
     ("sbrdf_xr.geometry.angles.FacetAngles", "phi"),
+    ("sbrdf_xr.engine.plan.Estimate", "output_bytes"),
+    ("sbrdf_xr.engine.plan.Estimate", "block_bytes"),
+    ("sbrdf_xr.engine.plan.Terms", "area"),
 ):
     EXEMPT[(_row, _arg)] = "a result record the package fills, not an input"
+
+EXEMPT[("sbrdf_xr.brdf._model.Model", "brdf")] = (
+    "a function (the model's sBRDF), not a value: its results are in sr-1 by contract"
+)
 
 for _model_name in ("lambert", "microfacet", "robertson_sandford"):
     for _method in ("brdf_angles", "render_grid"):
@@ -765,10 +818,10 @@ def _l_body() -> Any:
     return l_shaped_spacecraft()
 
 
-def _measurements() -> xr.Dataset:
+def _measurements(theta_i: tuple[float, ...] = (20.0, 50.0)) -> xr.Dataset:
     from sbrdf_xr.testing import make_measurements
 
-    return make_measurements(n_wavelength=2, theta_i=(20.0, 50.0))
+    return make_measurements(n_wavelength=2, theta_i=theta_i)
 
 
 def _aniso_table() -> xr.DataArray:
@@ -872,6 +925,40 @@ def _joint_inputs() -> dict[str, Any]:
     )
 
 
+def _unmix_inputs() -> dict[str, Any]:
+    wl = np.linspace(400.0, 1000.0, 7)
+    paint = xr.DataArray(np.linspace(0.5, 0.2, 7), dims="wavelength", coords={"wavelength": wl})
+    cell = xr.DataArray(np.linspace(0.1, 0.4, 7), dims="wavelength", coords={"wavelength": wl})
+    truth = 0.8 * paint + 1.2 * cell + 1e-3 * np.sin(wl)
+    return dict(
+        measured=truth,
+        simulated={"paint": paint, "cell": cell},
+        uncertainty=1e-3,
+        areas={"paint": 2.0, "cell": 3.0},
+        total_area=5.0,
+    )
+
+
+def _sun() -> xr.DataArray:
+    """A solar spectrum of the user's [W m-2 nm-1] over 300-1200 nm."""
+    wl = np.arange(300.0, 1201.0, 5.0)
+    e = 1.8 + 0.1 * np.sin(wl / 50.0)
+    return xr.DataArray(e, dims="wavelength", coords={"wavelength": wl}, name="test-sun")
+
+
+def _bench_rows() -> xr.Dataset:
+    return xr.Dataset(
+        {
+            "time_ratio": ("case", [1.0, 0.35, 0.6]),
+            "mmag_max": ("case", [0.0, 63.0, 0.002]),
+            "mmag_median": ("case", [0.0, 0.55, 0.0003]),
+            "sweep": ("case", ["demo"] * 3),
+            "baseline": ("case", ["reference"] * 3),
+        },
+        coords={"case": ["reference", "lookup: linear", "precision: float32"]},
+    )
+
+
 def _solar() -> xr.DataArray:
     from sbrdf_xr.photometry.spectra import solar_spectrum
 
@@ -904,6 +991,7 @@ NOT_COMPARED = {
     "sbrdf_xr.plot.cube.cube_figure",
     "sbrdf_xr.plot.cube.rotation_figure",
     "sbrdf_xr.plot.cube.observation_figure",
+    "sbrdf_xr.plot.front.accuracy_front",
 }
 
 #: What of a result is compared (a study's wall times are not; a function's values are).
@@ -935,6 +1023,14 @@ OTHER = {
     "deg / s": u.rad / u.s,
     "km / s": u.m / u.s,
     "km s-1": u.m / u.s,
+    "kg m-3": u.g / u.cm**3,
+    "kg m2": u.g * u.cm**2,
+    "m2": u.cm**2,
+    "sr-1": u.deg**-2,
+    "degree**3": u.rad**3,
+    "W m-2 nm-1": u.mW / u.cm**2 / u.um,
+    "mag": u.mmag,
+    "mmag": u.mag,
 }
 #: Arguments whose value is a structure holding the number with a unit: its Quantity form.
 FORMS: dict[str, Callable[[Any, Any], Any]] = {
@@ -955,8 +1051,12 @@ FORMS: dict[str, Callable[[Any, Any], Any]] = {
 def _quantity(arg: str, value: Any, doc_unit: str, unit: Any) -> Any:
     if arg in FORMS:
         return FORMS[arg](value, unit)
+    if isinstance(value, xr.DataArray):  # a DataArray holding the Quantity
+        return value.copy(data=_quantity(arg, value.values, doc_unit, unit))
+    if isinstance(value, Mapping):  # one Quantity per key
+        return {k: _quantity(arg, v, doc_unit, unit) for k, v in value.items()}
     q = np.asarray(value, dtype=np.float64) * u.Unit(doc_unit)
-    if unit.physical_type != q.unit.physical_type:
+    if not q.unit.is_equivalent(unit, equivalencies=u.temperature()):
         return q.value * unit  # a Quantity of another kind
     return q.to(unit, equivalencies=u.temperature())
 
@@ -1057,3 +1157,27 @@ def test_a_dataarray_holding_a_quantity_is_converted():
     np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-12 * b.max())
     with pytest.raises(UnitError, match="theta_i"):
         lookup(table, xr.DataArray(ti * u.s, dims="x"), 3.0, 4.0)
+
+
+def test_a_material_table_holding_a_quantity_is_converted():
+    """A table whose data is an sBRDF Quantity (in 1 / deg2) is that table in sr-1, in a
+    look-up and in a simulation; a table of another kind is refused by name."""
+    from sbrdf_xr import Scene, simulate
+    from sbrdf_xr.materials.tables import lookup
+
+    table = _grey()
+    in_deg2 = table.copy(data=(table.values / u.sr).to(u.deg**-2))
+    in_deg2.attrs.pop("units")  # the Quantity states it
+    angles = ([25.0, 60.0], [3.0, -20.0], [4.0, 30.0])
+    _same(lookup(in_deg2, *angles), lookup(table, *angles))
+
+    def run(t: xr.DataArray) -> xr.DataArray:
+        scene = Scene(_box(), {"grey": t}, attitudes=[[0, 0, 0, 1.0]], phase_angles=[30.0, 70.0])
+        return simulate(scene).signal
+
+    _same(run(in_deg2), run(table))
+    in_kg = table.copy(data=table.values * u.kg)
+    with pytest.raises(UnitError, match=r"materials\['grey'\]"):
+        run(in_kg)
+    with pytest.raises(UnitError, match=r"\bmaterial\b"):
+        lookup(in_kg, *angles)

@@ -56,7 +56,7 @@ from ..errors import (
     input_file,
 )
 from ..geometry.anisotropy import DEFAULT_TANGENT_DIRECTION, project_tangents
-from ..units import check_plausible
+from ..units import check_plausible, to_unit
 from .facets import NORMAL_TOLERANCE, check_facet_material, facet_table, merge_facets
 from .meshes import (
     LENGTH_UNITS,
@@ -488,6 +488,7 @@ class Spacecraft:
                [-0.,  1., -0.],
                [-0., -0.,  1.]])
         """
+        density = to_unit(density, "kg m-3", "density")
         if not (np.isfinite(density) and density > 0):
             raise ValidationError(f"density: must be a positive number [kg m-3], got {density!r}")
         props = trimesh.triangles.mass_properties(self.mesh.triangles, density=float(density))

@@ -94,6 +94,7 @@ _UNITS = {
     "earth_range_km": "km",
     "earth_phase_angle": "deg",
     "temperature": "K",
+    "materials": "sr-1",  # a table holding a Quantity; a model (Dataset) is kept
 }
 
 
@@ -200,9 +201,10 @@ class Scene:
         Labels stored in the output.
 
     Every number with a unit (the angles [degree], ``earth_range_km`` [km],
-    ``temperature`` [K], the knobs with a unit) also takes an astropy Quantity, converted
-    when the scene is made; one of another kind raises :class:`~sbrdf_xr.errors.UnitError`
-    naming the field.
+    ``temperature`` [K], the knobs with a unit, a material table's sBRDF [sr-1] given as a
+    DataArray holding a Quantity) also takes an astropy Quantity, converted when the
+    scene is made; one of another kind raises :class:`~sbrdf_xr.errors.UnitError` naming
+    the field.
 
     Examples
     --------

@@ -173,6 +173,7 @@ def observation_recovery(
     (3, ['axis_longitude', 'axis_latitude', 'period', 'phase'])
     """
     phase_symmetry_deg = to_unit(phase_symmetry_deg, "deg", "phase_symmetry_deg")
+    noise_mag = to_unit(noise_mag, "mag", "noise_mag")
     from ._spin_refine import _tangent
 
     truth_spin = {k: float(spin[k]) for k in ("axis_longitude", "axis_latitude", "period", "phase")}

@@ -14,6 +14,7 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from ..errors import InversionError
+from ..units import to_unit
 from ._areas import add_areas, area_constraint, material_areas
 from ._library import MATERIAL, design, library
 from ._quality import fit_quality
@@ -273,6 +274,9 @@ def unmix(
     >>> round(float(tied.area_fraction.sum()), 12), tied.area_fraction.attrs["long_name"]
     (1.0, 'fraction of total_area, the constrained sum of the areas')
     """
+    if isinstance(areas, Mapping):
+        areas = {k: to_unit(v, "m2", "areas") for k, v in areas.items()}
+    total_area = to_unit(total_area, "m2", "total_area")
     if not isinstance(measured, xr.DataArray):
         raise InversionError(
             f"measured: expected a DataArray over wavelength or band, got {type(measured).__name__}"

@@ -249,6 +249,7 @@ def build_lut(
     True
     """
     theta_i = to_unit(theta_i, "deg", "theta_i")
+    smoothing = to_unit(smoothing, "deg3", "smoothing")  # "csaps" is kept
     blend, blend_normal = (
         to_unit(blend, "deg", "blend"),
         to_unit(blend_normal, "deg", "blend_normal"),

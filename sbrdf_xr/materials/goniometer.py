@@ -192,6 +192,7 @@ def scheme_extents(
     >>> round(dt_min, 6), round(dt_max, 6), phi_max.shape, bool(in_noise.all())
     (-22.8, 22.8, (7,), True)
     """
+    noise_floor = float(to_unit(noise_floor, "sr-1", "noise_floor"))
     theta_i = float(to_unit(theta_i, "deg", "theta_i"))
     max_theta_r = float(to_unit(max_theta_r, "deg", "max_theta_r"))
     min_phase_angle = float(to_unit(min_phase_angle, "deg", "min_phase_angle"))
@@ -281,6 +282,7 @@ def measure(
     >>> sorted(meas.coords)
     ['delta_theta', 'phi', 'reference', 'theta_i', 'wavelength']
     """
+    noise_floor = to_unit(noise_floor, "sr-1", "noise_floor")
     wl = np.asarray(to_unit(wavelength, "nm", "wavelength", spectral=True), dtype=np.float64)
     tis = np.asarray(to_unit(theta_i, "deg", "theta_i"), dtype=np.float64)
     if tis.size == 0:

@@ -149,7 +149,7 @@ def render(
         Show a progress bar (tqdm.auto) while rendering a large table (2e7 values and
         more: seconds).
     max_bytes : float, optional
-        Refuse (ValidationError, with the size) a table larger than this, before
+        Refuse (ValidationError, with the size) a table larger than this [byte], before
         allocating it.
 
     Returns
@@ -169,6 +169,7 @@ def render(
     """
     theta_i, phi = to_unit(theta_i, "deg", THETA_I), to_unit(phi, "deg", PHI)
     delta_theta = to_unit(delta_theta, "deg", DELTA_THETA)
+    max_bytes = to_unit(max_bytes, "byte", "max_bytes")
     m, wl, kw = model_parameters(spec)
     ti = np.arange(0.0, 91.0) if theta_i is None else np.asarray(theta_i, dtype=np.float64)
     dt = (

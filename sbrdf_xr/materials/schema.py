@@ -118,7 +118,9 @@ def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.Data
     -------
     xarray.DataArray
         ``da`` with its dims in the canonical order ``(theta_i, delta_theta, phi,
-        wavelength)`` (a transpose, never a change of values); an anisotropic table
+        wavelength)`` (a transpose, never a change of values; a table whose data is an
+        astropy Quantity is converted to sr-1, another kind raises
+        :class:`~sbrdf_xr.errors.UnitError`); an anisotropic table
         (:mod:`sbrdf_xr.geometry.anisotropy`) has the dims ``(theta_i, delta_theta, phi, psi,
         wavelength)``, ``psi`` strictly increasing in ``[0, 180]`` degree.
 
@@ -144,6 +146,7 @@ def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.Data
     """
     if not isinstance(da, xr.DataArray):
         raise ValidationError(f"material: expected an xarray.DataArray, got {type(da).__name__}")
+    da = to_unit(da, PER_SR, "material")  # a table holding a Quantity: in sr-1
     dims = ANISO_LUT_DIMS if PSI in da.dims else LUT_DIMS
     if set(da.dims) != set(dims) or len(da.dims) != len(dims):
         raise ValidationError(
@@ -241,6 +244,7 @@ def new_material(
     >>> table.attrs["units"], table.attrs["material"]
     ('sr-1', 'grey')
     """
+    values = to_unit(values, PER_SR, "values")
     _check_source(source)
     coords = {
         name: (name, np.asarray(to_unit(v, unit, name, spectral=unit == NM), float), attrs(name))
@@ -305,6 +309,7 @@ def constant_material(
     >>> table.sel(wavelength=600.0).values.ravel().tolist()
     [0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2]
     """
+    value = to_unit(value, PER_SR, "value")
     wl = np.atleast_1d(np.asarray(to_unit(wavelength, NM, WAVELENGTH, spectral=True), float))
     v = np.asarray(value, dtype=np.float64)
     if v.ndim > 1 or (v.ndim == 1 and v.size not in (1, wl.size)):

@@ -29,6 +29,7 @@ TUMBLE_RTOL = 1e-12
 
 
 def _inertia(value: ArrayLike) -> NDArray[np.float64]:
+    value = to_unit(value, "kg m2", "inertia")
     try:
         arr = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
@@ -141,6 +142,7 @@ class Tumble(AttitudeLaw):
         >>> np.round(np.diag(law.inertia), 9)  # a 1 kg cube of side 0.1 m [kg m2]
         array([0.00166667, 0.00166667, 0.00166667])
         """
+        density_kg_m3 = to_unit(density_kg_m3, "kg m-3", "density_kg_m3")
         return cls(spacecraft.inertia(density_kg_m3), omega_deg_s, initial, epoch)
 
     def _rhs_function(self):

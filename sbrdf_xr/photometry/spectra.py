@@ -224,8 +224,9 @@ def solar_name(solar: Any) -> str:
     """The name of a solar spectrum: a key of :data:`SOLAR_SPECTRA`, or a spectrum's own.
 
     A spectrum - a colour-science ``SpectralDistribution`` or a DataArray over
-    ``wavelength`` [nm], in W m-2 nm-1 at 1 AU - is registered under
-    ``user:<its name>:<hash of its values>`` and can be named by that from then on;
+    ``wavelength`` [nm], in W m-2 nm-1 at 1 AU (a DataArray whose data is an astropy
+    Quantity, in any unit of spectral irradiance, is converted to it) - is registered
+    under ``user:<its name>:<hash of its values>`` and can be named by that from then on;
     every ``solar=`` of the package goes through here.
 
     Examples
@@ -241,6 +242,8 @@ def solar_name(solar: Any) -> str:
     if isinstance(solar, str):
         return str(_choose(solar, SOLAR_SPECTRA, "solar"))
     da = from_colour(solar, units="W m-2 nm-1") if is_colour_spectrum(solar) else solar
+    if isinstance(da, xr.DataArray):  # one holding a Quantity: converted
+        da = to_unit(da, "W m-2 nm-1", "solar")
     if not isinstance(da, xr.DataArray) or da.dims != (WAVELENGTH,) or WAVELENGTH not in da.coords:
         allowed = ", ".join(repr(k) for k in SOLAR_SPECTRA)
         raise ValidationError(

@@ -8,6 +8,7 @@ import numpy as np
 import xarray as xr
 
 from ..errors import ValidationError
+from ..units import to_unit
 
 __all__ = ["accuracy_front", "is_preset"]
 
@@ -86,6 +87,7 @@ def accuracy_front(rows: Any, *, zero_below: float = 1e-6) -> Any:
     ('band error against the baseline [mmag]', 'wall time / baseline wall time')
     >>> plt.close(fig)
     """
+    zero_below = to_unit(zero_below, "mmag", "zero_below")
     import matplotlib.pyplot as plt
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
