@@ -11,6 +11,7 @@ import xarray as xr
 
 from .._names import attrs as cf
 from ._joint_model import PassData
+from ._quality import quality_attrs
 from ._spin_search import lonlat
 
 __all__ = ["Layout", "model_check", "result_dataset"]
@@ -271,13 +272,7 @@ def result_dataset(
             "free": "a free area scale per material",
             "fixed": "the model's areas",
         }[lay.areas],
-        "fit_quality": quality["fit_quality"],
-        "birge_ratio": quality["birge_ratio"],
-        **(
-            {"fit_quality_note": quality["fit_quality_note"]}
-            if "fit_quality_note" in quality
-            else {}
-        ),
+        **quality_attrs(quality),
     }
     return ds
 

@@ -12,14 +12,14 @@ overstated.  Either way the fitted uncertainties are not to be taken at face val
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
 from ..errors import FitQualityWarning
 
-__all__ = ["QUALITY_LEVEL", "fit_quality"]
+__all__ = ["QUALITY_LEVEL", "fit_quality", "quality_attrs"]
 
 #: Two-sided level of the chi-square check: a warning beyond the ``1 - QUALITY_LEVEL`` point
 #: of the chi-square distribution (or below its ``QUALITY_LEVEL`` point).
@@ -121,3 +121,17 @@ def fit_quality(
     if warn:
         warnings.warn(note, FitQualityWarning, stacklevel=stacklevel)
     return out
+
+
+def quality_attrs(quality: Mapping[str, Any]) -> dict[str, Any]:
+    """The attributes a fit's result carries from :func:`fit_quality`: ``fit_quality``,
+    ``birge_ratio`` and, when the check failed, ``fit_quality_note``.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.invert._quality import fit_quality, quality_attrs
+    >>> sorted(quality_attrs(fit_quality(100.0, 90, "demo", ["a wrong model"])))
+    ['birge_ratio', 'fit_quality']
+    """
+    keys = ("fit_quality", "birge_ratio", "fit_quality_note")
+    return {k: quality[k] for k in keys if k in quality}

@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from ._quality import quality_attrs
 from ._spin_data import SpinGeometry
 from ._spin_refine import Minimum, axis_angle, lonlat_covariance
 from ._spin_search import Problem, lonlat
@@ -184,12 +185,6 @@ def result_dataset(
         ),
         "geometry_source": geo.source,
         "geometry_notes": "; ".join(geo.notes),
-        "fit_quality": quality["fit_quality"],
-        "birge_ratio": quality["birge_ratio"],
-        **(
-            {"fit_quality_note": quality["fit_quality_note"]}
-            if "fit_quality_note" in quality
-            else {}
-        ),
+        **quality_attrs(quality),
     }
     return ds
