@@ -200,6 +200,20 @@ def normalize(v: ArrayLike, name: str = "vector") -> NDArray[np.floating]:
     return arr / norm
 
 
+def _vectors(
+    normal: ArrayLike, to_sun: ArrayLike, to_observer: ArrayLike, check: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The facet normal and the directions to the Sun and the observer as arrays, normalised
+    and checked (finite, non-zero, last axis 3) when ``check``."""
+    if not check:
+        return np.asarray(normal), np.asarray(to_sun), np.asarray(to_observer)
+    return (
+        normalize(normal, "normal"),
+        normalize(to_sun, "to_sun"),
+        normalize(to_observer, "to_observer"),
+    )
+
+
 def _perpendicular(n: np.ndarray) -> np.ndarray:
     """A unit vector perpendicular to each unit vector ``n`` (deterministic)."""
     # Cross with the coordinate axis least aligned with n: well conditioned.
@@ -303,12 +317,7 @@ def facet_angles(
     >>> a.lit
     array([ True, False, False])
     """
-    if check:
-        n = normalize(normal, "normal")
-        s = normalize(to_sun, "to_sun")
-        o = normalize(to_observer, "to_observer")
-    else:
-        n, s, o = (np.asarray(a) for a in (normal, to_sun, to_observer))
+    n, s, o = _vectors(normal, to_sun, to_observer, check)
     dtype = _float_dtype(n, s, o)
     n, s, o = np.broadcast_arrays(
         n.astype(dtype, copy=False), s.astype(dtype, copy=False), o.astype(dtype, copy=False)

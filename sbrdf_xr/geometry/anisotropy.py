@@ -60,7 +60,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ValidationError
 from ..units import to_unit
-from .angles import _forward_direction, normal_incidence_tolerance, normalize
+from .angles import _forward_direction, _vectors, normal_incidence_tolerance
 
 __all__ = [
     "DEFAULT_TANGENT_DIRECTION",
@@ -189,12 +189,7 @@ def illumination_azimuth(
     >>> float(illumination_azimuth(z, x + y, s, np.array([1.0, 0.0, 1.0])))
     135.0
     """
-    if check:
-        n = normalize(normal, "normal")
-        s = normalize(to_sun, "to_sun")
-        o = normalize(to_observer, "to_observer")
-    else:
-        n, s, o = (np.asarray(a) for a in (normal, to_sun, to_observer))
+    n, s, o = _vectors(normal, to_sun, to_observer, check)
     dtypes = [a.dtype for a in (n, s, o)]
     dtype = (
         np.result_type(*dtypes)
