@@ -207,35 +207,12 @@ def load_spacecraft(
             )
     elif material_map is not None:
         colours, name_map = normalise_map(material_map, known_materials)
+    opts = (face_property, file_type, material, colours, name_map, name, length_unit, factor)
     if not isinstance(path_or_mesh, str | Path):
-        return _load(
-            path_or_mesh,
-            face_property,
-            file_type,
-            material,
-            colours,
-            name_map,
-            name,
-            length_unit,
-            factor,
-            tangent,
-            repair,
-        )
+        return _load(path_or_mesh, *opts, tangent, repair)
     path = input_file(path_or_mesh, "mesh file", MeshError)
     try:
-        return _load(
-            path,
-            face_property,
-            file_type,
-            material,
-            colours,
-            name_map,
-            name,
-            length_unit,
-            factor,
-            tangent,
-            repair,
-        )
+        return _load(path, *opts, tangent, repair)
     except MeshError as exc:  # say which file
         if str(path) in str(exc):
             raise
