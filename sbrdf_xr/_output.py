@@ -64,6 +64,7 @@ __all__ = [
     "remove_marked_dir",
     "rename_no_replace",
     "replace_dir",
+    "write_all",
     "write_marker",
     "write_netcdf",
 ]
@@ -72,6 +73,9 @@ __all__ = [
 MARKER = ".sbrdf_xr.json"
 #: The ``writer`` recorded in every :data:`MARKER`.
 WRITER = "sbrdf_xr"
+#: The ``state`` :func:`read_marker` gives a :data:`MARKER` of the package cut short (by a
+#: disk that filled while it was written, before writes were checked to be complete).
+TORN = "torn"
 
 _STYLE: contextvars.ContextVar[str] = contextvars.ContextVar(
     "sbrdf_xr_option_style", default="python"
@@ -666,14 +670,20 @@ def write_marker(directory: str | os.PathLike[str], info: Mapping[str, Any]) -> 
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     write_marker(tmp, {"state": "writing"})
     ...     print(json.loads((Path(tmp) / MARKER).read_text()))
-    {'state': 'writing', 'writer': 'sbrdf_xr'}
+    {'writer': 'sbrdf_xr', 'state': 'writing'}
     """
     d = Path(directory)
     fd, name = tempfile.mkstemp(prefix=f"{MARKER}.", suffix=".part", dir=d)
+    # the writer first: even a marker cut short names the package
+    record = {"writer": WRITER, **{k: info[k] for k in sorted(info) if k != "writer"}}
     try:
-        os.write(fd, (json.dumps({**info, "writer": WRITER}, sort_keys=True) + "\n").encode())
+        write_all(fd, (json.dumps(record) + "\n").encode())
         os.fsync(fd)
-    finally:
+    except BaseException:
+        os.close(fd)
+        Path(name).unlink(missing_ok=True)
+        raise
+    else:
         os.close(fd)
     try:
         os.replace(name, d / MARKER)
@@ -683,19 +693,52 @@ def write_marker(directory: str | os.PathLike[str], info: Mapping[str, Any]) -> 
     fsync_dir(d)
 
 
+def write_all(fd: int, data: bytes) -> None:
+    """``os.write`` ``data`` to ``fd`` whole: a short write (a disk filling up) is
+    continued, and a write that makes no progress raises ``OSError(ENOSPC)``.
+
+    Examples
+    --------
+    >>> import os
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr._output import write_all
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     fd = os.open(Path(tmp) / "log", os.O_WRONLY | os.O_CREAT)
+    ...     write_all(fd, b"x" * 100_000)
+    ...     os.close(fd)
+    ...     print((Path(tmp) / "log").stat().st_size)
+    100000
+    """
+    view = memoryview(data)
+    while view:
+        n = os.write(fd, view)
+        if n <= 0:
+            raise OSError(errno.ENOSPC, "No space left on device (a write made no progress)")
+        view = view[n:]
+
+
 def read_marker(directory: str | os.PathLike[str]) -> dict[str, Any] | None:
     """The :data:`MARKER` of ``directory`` if the package wrote it, else None.
+
+    A marker of the package cut short (no longer JSON) gives ``{"writer": "sbrdf_xr",
+    "state": "torn"}`` (:data:`TORN`): the directory is the package's, its content unknown.
 
     Examples
     --------
     >>> import tempfile
+    >>> from pathlib import Path
     >>> from sbrdf_xr._output import read_marker, write_marker
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     print(read_marker(tmp))
     ...     write_marker(tmp, {"state": "complete"})
     ...     print(read_marker(tmp)["state"])
+    ...     whole = (Path(tmp) / ".sbrdf_xr.json").read_bytes()
+    ...     _ = (Path(tmp) / ".sbrdf_xr.json").write_bytes(whole[:40])  # cut short
+    ...     print(read_marker(tmp))
     None
     complete
+    {'writer': 'sbrdf_xr', 'state': 'torn'}
     """
     try:
         fd = open_regular(Path(directory) / MARKER, os.O_RDONLY)
@@ -703,9 +746,18 @@ def read_marker(directory: str | os.PathLike[str]) -> dict[str, Any] | None:
         return None
     try:
         with os.fdopen(fd, "rb") as f:
-            info = json.loads(f.read(2**24).decode())
-    except (OSError, ValueError, UnicodeDecodeError):
+            raw = f.read(2**24)
+    except OSError:
         return None
+    try:
+        info = json.loads(raw.decode())
+    except (ValueError, UnicodeDecodeError):
+        # cut short: the package's own if it begins as the package writes markers (the
+        # writer first; before that, sorted keys with this package's format early on)
+        ours = raw.startswith(b'{"writer": "%s"' % WRITER.encode()) or (
+            raw.startswith(b'{"block_dims": ') and b'"format": "sbrdf_xr.' in raw[:4096]
+        )
+        return {"writer": WRITER, "state": TORN} if ours else None
     return info if isinstance(info, dict) and info.get("writer") == WRITER else None
 
 

@@ -21,7 +21,8 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
-from .._output import error_words, libc_function
+from .._output import error_words, libc_function, write_all
+from ..errors import CubeWriteError
 
 __all__ = [
     "CHECK_SPACE",
@@ -29,6 +30,8 @@ __all__ = [
     "FALLOC_FL_KEEP_SIZE",
     "HEAD_BYTES",
     "SyncBehind",
+    "abandon",
+    "check_held",
     "check_opens",
     "check_room",
     "cut_back",
@@ -47,6 +50,10 @@ HEAD_BYTES = 4096
 #: Free space [byte] kept beyond a block's raw size for HDF5 metadata (chunk index,
 #: object headers, superblock) written with it.
 _SPACE_MARGIN = 256 * 2**10
+
+
+#: HDF5 handles abandoned after a failed write (:func:`abandon`), by (device, inode).
+_ABANDONED: dict[tuple[int, int], Any] = {}
 
 
 class _NoRoom(OSError):
@@ -349,7 +356,7 @@ class SyncBehind:
         try:
             os.fsync(self.fd)
             drop_behind(self.fd)
-            os.write(self.log_fd, (json.dumps({"block": k}) + "\n").encode())
+            write_all(self.log_fd, (json.dumps({"block": k}) + "\n").encode())
             os.fsync(self.log_fd)
         except BaseException:
             self.failed = True
@@ -476,6 +483,65 @@ def cut_back(part: Path, size: int, head: bytes) -> str | None:
     except OSError as exc:
         return str(exc)
     return check_opens(part)
+
+
+def abandon(handle: Any, part: Path) -> None:
+    """Keep ``handle`` (a netCDF4 Dataset whose write failed) open and untouched for the
+    life of the process: no further HDF5 call, not even at exit.
+
+    Closing a file whose descriptor was fenced (:func:`fence`) can crash HDF5; an
+    abandoned handle is referenced for ever (so its finaliser, which would close it,
+    never runs) and its ``(device, inode)`` is remembered: HDF5 would share the open
+    handle with any new open of the same file, so this process must not reopen it
+    (:func:`check_held`).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.errors import CubeWriteError
+    >>> from sbrdf_xr.store.disk import abandon, check_held
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     part = Path(tmp) / "cube.nc.part"
+    ...     _ = part.write_bytes(b"synced")
+    ...     check_held(part)  # nothing abandoned: no error
+    ...     abandon(object(), part)
+    ...     try:
+    ...         check_held(part)
+    ...     except CubeWriteError as exc:
+    ...         print(str(exc).replace(tmp, "<tmp>"))
+    HDF5 in this process still holds <tmp>/cube.nc.part since a write of it failed; continue
+    it from a new process
+    """
+    import ctypes
+
+    with contextlib.suppress(OSError):
+        st = part.stat()
+        _ABANDONED[(st.st_dev, st.st_ino)] = handle
+    ctypes.pythonapi.Py_IncRef(ctypes.py_object(handle))  # never finalised, even at exit
+
+
+def check_held(part: Path) -> None:
+    """Raise :class:`~sbrdf_xr.errors.CubeWriteError` if ``part`` is a file whose HDF5
+    handle this process abandoned (:func:`abandon`); reopening it here would share that
+    handle's torn state.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.store.disk import check_held
+    >>> check_held(Path("no-such-cube.nc.part")) is None
+    True
+    """
+    try:
+        st = part.stat()
+    except OSError:
+        return
+    if (st.st_dev, st.st_ino) in _ABANDONED:
+        raise CubeWriteError(
+            f"HDF5 in this process still holds {part} since a write of it failed; "
+            "continue it from a new process"
+        )
 
 
 def check_opens(part: Path) -> str | None:

@@ -19,7 +19,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from .._output import file_kind
+from .._output import file_kind, write_all
 from ..errors import CubeLockedError, CubeWriteError
 from .disk import reason
 
@@ -112,7 +112,7 @@ class _Lock:
                     "cube": str(self.target),
                     "started": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
                 }
-                os.write(fd, (json.dumps(info) + "\n").encode())
+                write_all(fd, (json.dumps(info) + "\n").encode())
                 os.fsync(fd)
                 self.ino = os.fstat(fd).st_ino
             except BaseException as exc:

@@ -127,6 +127,7 @@ Encoding
 from __future__ import annotations
 
 import contextlib
+import logging
 import os
 from collections.abc import Callable, Mapping
 from pathlib import Path
@@ -138,6 +139,7 @@ import xarray as xr
 
 from .._output import (
     cli_style,
+    file_kind,
     fsync_dir,
     open_regular,
     refuse_special,
@@ -154,6 +156,8 @@ from .disk import (
     HEAD_BYTES,
     SyncBehind,
     _NoRoom,
+    abandon,
+    check_held,
     check_room,
     cut_back,
     drop_behind,
@@ -201,6 +205,8 @@ from .runners import (
     lost_workers,
     release_freed_memory,
 )
+
+_log = logging.getLogger("sbrdf_xr.write_cube")
 
 __all__ = [
     "DEFAULT_COMPLEVEL",
@@ -397,6 +403,16 @@ def _write_locked(
         check_finished(path, ds)
         return path
     resuming = state == "resume"
+    if resuming and file_kind(log) is None and _just_created(part):
+        # killed before its bookkeeping existed (older versions created it after the
+        # .part): no block was ever recorded, so the .part is started again in place
+        _log.warning(
+            "%s has no bookkeeping file %s: it was stopped before any block was recorded, "
+            "so it is written again from the start",
+            part,
+            log.name,
+        )
+        resuming = False
     done: set[int] = set()
     if resuming:
         header, done = read_log(log, part)
@@ -428,22 +444,35 @@ def _write_locked(
     try:
         if resuming:
             size0 = part.stat().st_size
+            check_held(part)
             try:
                 check_room(part, block_bytes(plan))
                 nc = open_part(part, ds, plan)
-            except CubeWriteError:
-                raise
             except Exception as exc:
-                if not isinstance(exc, _NoRoom):
-                    with contextlib.suppress(OSError):
-                        os.truncate(part, size0)  # undo a half-written attribute update
-                why = reason(exc, part)
-                raise CubeWriteError(
-                    f"cannot resume {path}: {why}. The {len(done)} of {plan.n_blocks} blocks "
-                    f"written so far are kept in {part}; {fix(why)} and {again_hint()}"
-                ) from exc
-            feed.fill()
-        else:
+                if not done and not isinstance(exc, _NoRoom):
+                    # stopped while it was created: nothing recorded, nothing to lose
+                    _log.warning(
+                        "%s holds no recorded block and does not open as this cube (%s); "
+                        "it is written again from the start",
+                        part,
+                        exc,
+                    )
+                    resuming = False
+                elif isinstance(exc, CubeWriteError):
+                    raise
+                else:
+                    if not isinstance(exc, _NoRoom):
+                        with contextlib.suppress(OSError):
+                            os.truncate(part, size0)  # undo a half-written attribute update
+                    why = reason(exc, part)
+                    raise CubeWriteError(
+                        f"cannot resume {path}: {why}. The {len(done)} of {plan.n_blocks} "
+                        f"blocks written so far are kept in {part}; {fix(why)} and "
+                        f"{again_hint()}"
+                    ) from exc
+            if resuming:
+                feed.fill()
+        if not resuming:
             log.unlink(missing_ok=True)
             part.unlink(missing_ok=True)
             # an uncompressed cube is laid out whole at creation: its room is needed now
@@ -469,8 +498,10 @@ def _write_locked(
                 creation_failed(exc)
             feed.fill()  # the first blocks compute while the file is created and laid out
             try:
-                nc = create_part(part, ds, plan, level)
+                # the bookkeeping first: a .part never exists without it, so a writer
+                # killed at any instant leaves a .part that a resume continues
                 write_header(log, plan, level)
+                nc = create_part(part, ds, plan, level)
             except BaseException as exc:
                 creation_failed(exc)
     except BaseException:
@@ -482,6 +513,7 @@ def _write_locked(
     fd = log_fd = -1
     k = -1
     writing = False
+    in_hdf5 = False  # inside an HDF5 write: its metadata in memory may be torn if it fails
     good, head = -1, b""
     damaged: str | None = None
     try:
@@ -524,7 +556,7 @@ def _write_locked(
             if grows:
                 check_room(part, nbytes)
                 reserve(fd, nbytes)
-            writing = True
+            writing = in_hdf5 = True
             for (name, region, _), values in zip(block, arrays, strict=True):
                 expected = tuple(s.stop - s.start for s in region)
                 if np.shape(values) != expected:
@@ -535,6 +567,7 @@ def _write_locked(
                 nc.variables[name][region] = to_storage(values, kinds[name])
             del arrays
             nc.sync()
+            in_hdf5 = False
             good, head = os.fstat(fd).st_size, os.pread(fd, HEAD_BYTES, 0)
             sync.submit(k)
             # the previous block, synced while this one was computed and written
@@ -548,9 +581,10 @@ def _write_locked(
         writing = False
         if ready is not None:
             report(ready)
-        writing = True
+        writing = in_hdf5 = True
         nc.close()
         nc = None
+        in_hdf5 = False
         os.ftruncate(fd, os.fstat(fd).st_size)  # release room reserved past the end
         os.fsync(fd)
         writing = False
@@ -578,18 +612,14 @@ def _write_locked(
         )
         lost = None
         if writing and good >= 0:  # an I/O failure: cut the file back to its last synced state
-            fence(part)
-            if nc is not None:
-                with contextlib.suppress(Exception):
-                    nc.close()
-                nc = None
+            nc = _let_go(nc, part, in_hdf5)
             lost = cut_back(part, good, head)
         intro = f"writing {path} failed {where}after {len(done)} of {plan.n_blocks} blocks: {why}. "
         if lost is not None:
             raise CubeWriteError(
                 f"{intro}{part} could not be kept ({lost}); {discard_hint()}"
             ) from exc
-        if writing and good >= 0:
+        if writing and good >= 0 and in_hdf5:
             raise CubeWriteError(
                 f"{intro}HDF5 failed in the middle of a block; {part} was cut back to its last "
                 f"synced state, with the blocks written so far. "
@@ -632,6 +662,39 @@ def _write_locked(
     log.unlink(missing_ok=True)
     fsync_dir(path.parent)
     return path
+
+
+def _just_created(part: Path) -> bool:
+    """Whether ``part`` is what a writer stopped at its first instant leaves: empty (its
+    name claimed) or an HDF5 file (being laid out); anything else is not touched."""
+    try:
+        with open(part, "rb") as f:
+            head = f.read(8)
+    except OSError:
+        return False
+    return head in (b"", b"\x89HDF\r\n\x1a\n")
+
+
+def _let_go(nc: netCDF4.Dataset | None, part: Path, torn: bool) -> None:
+    """Let go of the HDF5 handle of ``part`` after an I/O failure, never crashing.
+
+    Outside an HDF5 call (``torn`` false: a reservation, a sync or the bookkeeping
+    failed) HDF5's state is the synced file and it is closed as usual (its close rewrites
+    the superblock in place).  After a failed HDF5 write its metadata in memory may be
+    torn: its descriptor is made read-only (:func:`~sbrdf_xr.store.disk.fence`) and the
+    handle is abandoned without another HDF5 call (:func:`~sbrdf_xr.store.disk.abandon`),
+    because closing a fenced file can crash HDF5 (a segmentation fault in its error
+    path, found by fault injection at each step of the layout).
+    """
+    if nc is None:
+        return None
+    if torn:
+        fence(part)
+        abandon(nc, part)
+    else:
+        with contextlib.suppress(Exception):
+            nc.close()
+    return None
 
 
 def _describe(slices: Mapping[str, slice]) -> str:

@@ -58,6 +58,7 @@ import xarray as xr
 
 from .._output import (
     MARKER,
+    TORN,
     cli_style,
     fsync_dir,
     fsync_tree,
@@ -273,7 +274,14 @@ def _check_finished(path: Path, plan: BlockLayout) -> None:
 def _resumable(part: Path, plan: BlockLayout, complevel: int | None) -> set[int] | None:
     """Blocks already stored in ``part`` (None: it holds none and is created again)."""
     marker = read_marker(part)
-    if marker is None or marker.get("state") == "creating":
+    if marker is not None and marker.get("state") == TORN:
+        _log.warning(
+            "%s: its marker %s was cut short (a disk that filled); what it holds is "
+            "unknown, so it is created again in place",
+            part,
+            MARKER,
+        )
+    if marker is None or marker.get("state") in ("creating", TORN):
         return None
     if marker.get("format") != FORMAT:
         raise CubeWriteError(

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import logging
 import os
 import signal
 import subprocess
@@ -481,6 +482,25 @@ def test_resume_needs_bookkeeping(tmp_path):
     with pytest.raises(CubeWriteError, match="no bookkeeping"):
         write_cube(make_cube(), path, resume=True)
     assert part.read_bytes() == b"not a cube"
+
+
+@pytest.mark.parametrize("content", ["empty", "hdf5 header", "laid out"])
+def test_part_without_bookkeeping_is_started_again_in_place(tmp_path, caplog, content):
+    """A .part that a writer killed at its first instant leaves (its name claimed, its
+    HDF5 layout begun, before the bookkeeping existed in older versions): ``resume``
+    writes it again from the start, with a message, instead of refusing."""
+    path = tmp_path / "cube.nc"
+    part = path.with_name(path.name + PART_SUFFIX)
+    if content == "laid out":
+        write_cube(make_cube(), path)
+        os.replace(path, part)
+    else:
+        part.write_bytes(b"" if content == "empty" else b"\x89HDF\r\n\x1a\n" + bytes(40))
+    with caplog.at_level(logging.WARNING, logger="sbrdf_xr.write_cube"):
+        write_cube(make_cube(), path, resume=True)
+    assert any("written again from the start" in r.getMessage() for r in caplog.records)
+    xr.testing.assert_identical(read(path), make_cube().compute())
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cube.nc"]
 
 
 # ------------------------------------------------------------------ validation

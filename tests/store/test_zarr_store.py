@@ -333,3 +333,57 @@ def test_a_writer_stopped_while_creating_or_renaming_resumes(tmp_path, monkeypat
     write_zarr(make_cube(), path, resume=True)
     xr.testing.assert_identical(read(path), make_cube().compute())
     assert sorted(p.name for p in tmp_path.iterdir()) == ["c.zarr"]
+
+
+@pytest.mark.parametrize("layout", ["writer first", "sorted keys"])
+@pytest.mark.parametrize("how", ["resume", "overwrite"])
+def test_a_part_whose_marker_was_cut_short_is_recovered(tmp_path, caplog, how, layout):
+    """A ``.part`` whose marker a full disk cut short (a short write, before writes were
+    checked to be whole; the issue's was cut at 4096 bytes): still the package's own,
+    whether written with the writer first (now) or with sorted keys (earlier versions); a
+    plain rerun names what to do, ``resume`` and ``overwrite`` write the cube again in
+    place."""
+    path = tmp_path / "c.zarr"
+    part = path.with_name(path.name + PART_SUFFIX)
+    write_zarr(make_cube(), path)
+    os.rename(path, part)
+    whole = (part / MARKER).read_bytes()
+    if layout == "sorted keys":
+        whole = json.dumps(json.loads(whole), sort_keys=True).encode()
+    (part / MARKER).write_bytes(whole[: len(whole) // 2])
+    with pytest.raises(FileExistsError, match=r"an unfinished write of c\.zarr"):
+        write_zarr(make_cube(), path)
+    with caplog.at_level(logging.WARNING, logger="sbrdf_xr.write_cube"):
+        write_zarr(make_cube(), path, **{how: True})
+    if how == "resume":
+        assert any("was cut short" in r.getMessage() for r in caplog.records)
+    xr.testing.assert_identical(read(path), make_cube().compute())
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c.zarr"]
+
+
+def test_a_marker_written_by_short_writes_is_whole(tmp_path, monkeypatch):
+    """``os.write`` writing at most 100 bytes a call (as on a disk filling up): the marker
+    is written whole; a write that makes no progress (the disk full) leaves no marker."""
+    import errno as _errno
+
+    from sbrdf_xr._output import read_marker, write_marker
+
+    real = os.write
+    monkeypatch.setattr(os, "write", lambda fd, data: real(fd, bytes(data[:100])))
+    info = {"state": "writing", "structure": {"text": "x" * 5000}}
+    write_marker(tmp_path, info)
+    assert read_marker(tmp_path) == {"writer": "sbrdf_xr", **info}
+    calls = []
+
+    def full(fd, data):  # 100 bytes fit, then the disk is full
+        calls.append(len(data))
+        if len(calls) > 1:
+            raise OSError(_errno.ENOSPC, "No space left on device")
+        return real(fd, bytes(data[:100]))
+
+    monkeypatch.setattr(os, "write", full)
+    with pytest.raises(OSError) as info_exc:
+        write_marker(tmp_path, {**info, "state": "complete"})
+    assert info_exc.value.errno == _errno.ENOSPC
+    assert read_marker(tmp_path)["state"] == "writing"  # the old marker, untouched
+    assert sorted(os.listdir(tmp_path)) == [MARKER]  # no temporary file left
