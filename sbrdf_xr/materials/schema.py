@@ -34,6 +34,7 @@ from .._names import (
 )
 from ..errors import NonPhysicalWarning, ValidationError
 from ..units import check_wavelengths, to_unit
+from .coverage import snap_angles
 
 __all__ = [
     "DUPLICATES",
@@ -404,15 +405,10 @@ DUPLICATES = ("error", "mean")
 
 
 def _geometry_groups(ds: xr.Dataset) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Group samples by geometry (angles equal to 1e-9 degree): the group of every sample,
+    """Group samples by geometry (angles within
+    :data:`~sbrdf_xr.materials.coverage.ANGLE_TOL` are equal): the group of every sample,
     the first sample of every group and the group sizes."""
-    key = np.stack(
-        [
-            np.round(np.asarray(ds[d].values, dtype=np.float64), 9)
-            for d in (THETA_I, DELTA_THETA, PHI)
-        ],
-        axis=1,
-    )
+    key = np.stack([snap_angles(ds[d].values) for d in (THETA_I, DELTA_THETA, PHI)], axis=1)
     _, first, groups, counts = np.unique(
         key, axis=0, return_index=True, return_inverse=True, return_counts=True
     )
