@@ -576,7 +576,7 @@ def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Da
     if v.size and v.max() > MAX_PLAUSIBLE_SBRDF:
         warnings.warn(
             f"{MEASURED}: values up to {v.max():.3g} sr-1, above the {MAX_PLAUSIBLE_SBRDF:g} "
-            "sr-1 of a mirror seen through a 1 degree aperture: values in other units?",
+            "sr-1 of a mirror seen through a 0.1 degree aperture: values in other units?",
             NonPhysicalWarning,
             stacklevel=2,
         )
@@ -584,8 +584,9 @@ def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Da
 
 
 #: The largest plausible measured SBRDF [sr-1]: a perfect mirror seen by a detector of
-#: 1 degree full aperture (1 / solid angle, about 4e3 sr-1), with margin.
-MAX_PLAUSIBLE_SBRDF = 1e4
+#: 0.1 degree full aperture (1 / solid angle, about 4e5 sr-1), with margin.  A near-mirror
+#: (a solar array's cover glass: 5.3e4 sr-1 in a 1-degree scan) is below it.
+MAX_PLAUSIBLE_SBRDF = 1e6
 
 
 def _check_delta_theta(dt: np.ndarray) -> None:
