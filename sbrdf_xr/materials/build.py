@@ -467,7 +467,12 @@ def build_lut(
         material=name,
         source=ds.attrs.get("source", "measured"),
         provenance=(prov + "; " if prov else "") + "look-up table built by sbrdf_xr.build_lut "
-        "(paper 000 section 3.2)",
+        "(paper 000 section 3.2)"
+        + (
+            f"; measured: {extra['layout']}; modelled: {extra['modelled']}"
+            if "layout" in extra
+            else ""
+        ),
         construction="paper000-3.2",
         n_phi=n_phi,
         n_delta_theta=n_delta_theta,

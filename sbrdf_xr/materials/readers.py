@@ -485,7 +485,7 @@ def _check_zenith(z: np.ndarray, what: str, path: Path) -> None:
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
         raise ValidationError(
-            f"{what} zenith angles of {path.name}: row {k + 1} has {z[k]!r} degree; "
+            f"{what} zenith angles of {path.name}: row {k + 1} has {float(z[k])!r} degree; "
             "allowed: 0 to 90 (or state zenith='theta'/'phi' if the columns are swapped)"
         )
 
