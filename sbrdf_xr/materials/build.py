@@ -43,7 +43,7 @@ from .schema import (
     reference_mask,
     validate_measurements,
 )
-from .selfcheck import CHECK_BOUND, CHECK_FLOOR, self_check
+from .selfcheck import CHECK_BOUND, CHECK_FLOOR, check_attrs, sample_errors, self_check
 
 __all__ = ["BELOW_NOISE", "EXTRAPOLATIONS", "RENORMALISE", "build_lut"]
 
@@ -77,6 +77,7 @@ def build_lut(
     model_reflectance: xr.DataArray | None = None,
     check_floor: float = CHECK_FLOOR,
     check_bound: float = CHECK_BOUND,
+    holdout: int = 4,
 ) -> xr.DataArray:
     """Look-up table from sparse measurements, by the construction of paper 000 §3.2.
 
@@ -247,6 +248,13 @@ def build_lut(
         their incidence angle's samples are left out.
     check_bound : float, default 0.1
         Own-sample median relative error above which the build warns [1].
+    holdout : int, default 4
+        Leave-out check of a table filled by a fitted model (in-plane or scattered
+        data): every ``holdout``-th sample of each incidence angle's scan (in
+        ``delta_theta`` order, the ends kept) is left out, the table built again from
+        the rest (its own fit) and looked up at them; attributes
+        ``holdout_check_median``, ``_p95``, ``_worst`` and ``_n``.  0 skips it (it
+        doubles the build's work).
 
     Returns
     -------
@@ -282,6 +290,7 @@ def build_lut(
     >>> bool(np.allclose(lut.sel(theta_i=20.0, delta_theta=0.0, phi=0.0), measured))
     True
     """
+    call = {k: v for k, v in locals().items() if k != "measurements"}  # for the holdout
     theta_i = to_unit(theta_i, "deg", "theta_i")
     smoothing = to_unit(smoothing, "deg3", "smoothing")  # "csaps" is kept
     blend, blend_normal = (
@@ -513,8 +522,39 @@ def build_lut(
                 NonPhysicalWarning,
                 stacklevel=2,
             )
+    if holdout and not rows_only:  # a fitted fill: predict samples it has not seen
+        report(0.97, "leave-out check")
+        out.attrs.update(_holdout(ds, call, (ti_s, dt_s, ph_s), spectra, ref, int(holdout)))
     report(1.0, "built")
     return out
+
+
+def _holdout(
+    ds: xr.Dataset,
+    call: dict[str, Any],
+    angles: tuple[np.ndarray, np.ndarray, np.ndarray],
+    spectra: np.ndarray,
+    ref: np.ndarray,
+    k: int,
+) -> dict[str, Any]:
+    """The leave-out check: every ``k``-th sample of each scan predicted by a table built
+    without them (and with its own fit)."""
+    ti, dt, _ = angles
+    hold = np.zeros(ti.size, dtype=bool)
+    for t in np.unique(ti):
+        at = np.flatnonzero(ti == t)
+        at = at[np.argsort(dt[at], kind="stable")]
+        hold[at[1:-1][np.arange(at.size - 2) % k == k // 2]] = True
+    opts = {**call, "holdout": 0, "check_energy": False, "progress": None}
+    if call.get("model") is None:
+        opts["model"] = None  # its own fit
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NonPhysicalWarning)
+        table = build_lut(ds.isel({SAMPLE: np.flatnonzero(~hold)}), **opts)
+    # the floor from every sample of the scan, the errors at the held-out ones
+    rel, _, _ = sample_errors(table, *angles, spectra, ref, opts["check_floor"])
+    rel[~hold] = np.nan
+    return {**check_attrs("holdout_check", rel), "holdout_every": k}
 
 
 def _at_horizon(ti: np.ndarray, dt: np.ndarray, ph: np.ndarray) -> np.ndarray:

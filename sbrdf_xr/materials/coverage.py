@@ -18,8 +18,9 @@ A measured incidence angle's samples come in one of three layouts
     signed scattering angle.  Out of the plane the table is the fitted model times the
     measured ratio to the model at the same angular distance from the specular
     direction (:func:`specular_distance`): a lobe keeps its measured width in every
-    direction about the mirror direction.  Between samples the ratio is interpolated
-    geometrically (linearly in its logarithm): a lobe falls by factors.
+    direction about the mirror direction.  Between samples the logarithm of the ratio
+    is interpolated by a shape-preserving cubic (PCHIP, F. N. Fritsch & R. E. Carlson,
+    SIAM J. Numer. Anal. 17, 238, 1980): a lobe falls by factors, and no overshoot.
 ``scattered``
     Samples spread over the ``(delta_theta, phi)`` plane without rows (a regular grid
     in conventional angles).  The ratio of the samples to the fitted model is
@@ -33,11 +34,11 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.interpolate import LinearNDInterpolator, NearestNDInterpolator
+from scipy.interpolate import LinearNDInterpolator, NearestNDInterpolator, PchipInterpolator
 
 from ..errors import ValidationError
 from ..units import to_unit
-from .construction import interp_weights, per_theta_tables
+from .construction import per_theta_tables
 
 __all__ = [
     "ANGLE_TOL",
@@ -206,11 +207,16 @@ def in_plane_phi_grid(step: float) -> np.ndarray:
 def _in_plane(dt: np.ndarray, ratio: np.ndarray, dt_grid: np.ndarray, phi_grid: np.ndarray):
     """The ratio of one in-plane scan on the grid, taken at the same distance from specular."""
     order = np.argsort(dt)
-    at = specular_distance(dt_grid[:, None], phi_grid[None, :]).ravel()
-    w = interp_weights(dt[order], at, hold_lo=True, hold_hi=True)
-    # Geometric between samples: a lobe decays by factors, not by steps.
+    x = dt[order]
+    at = np.clip(specular_distance(dt_grid[:, None], phi_grid[None, :]).ravel(), x[0], x[-1])
+    # In the logarithm (a lobe falls by factors, not by steps), shape-preserving cubic
+    # (PCHIP: no overshoot, each sample's value at its node), held beyond the scan's ends.
     log_r = np.log(np.maximum(ratio[order], np.finfo(np.float64).tiny))
-    out = np.exp(w @ log_r)
+    if x.size == 1:
+        return np.broadcast_to(
+            np.exp(log_r[0]), (dt_grid.size, phi_grid.size, ratio.shape[1])
+        ).copy()
+    out = np.exp(PchipInterpolator(x, log_r, axis=0)(at))
     return out.reshape(dt_grid.size, phi_grid.size, ratio.shape[1])
 
 
