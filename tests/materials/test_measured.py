@@ -127,6 +127,7 @@ def test_an_in_plane_scan_gives_an_isotropic_table_filled_by_the_fit():
     assert "phi > 0" in table.attrs["modelled"]
     assert "phi > 0" in table.attrs["provenance"]  # shown by print(table)
     assert table.attrs["self_check_worst"] < 1e-9  # the scan's own nodes
+    assert table.attrs["holdout_check_median"] < SYNTHETIC_MEDIAN  # its own leave-out check
     held = _errors(table, t[hold], d[hold], np.zeros(hold.sum()), vals[hold])
     assert np.median(held) < SYNTHETIC_MEDIAN
     # out of the plane: the fitted model (the generating one, recovered)
@@ -283,3 +284,81 @@ def test_material_build_command(tmp_path, capsys):
     assert "self-check over" in text
     table = open_material(out)
     assert table.attrs["self_check_worst"] < 1e-9
+
+
+# ------------------------------------------------------------------ MERL
+
+
+def _rgb_lobe(s, o):
+    """The test lobe at the three channels (red, green, blue) of a MERL file."""
+    from sbrdf_xr.geometry import facet_angles
+
+    n = np.zeros_like(s)
+    n[:, 2] = 1.0
+    a = facet_angles(n, s, o, check=False)
+    return models.spectra(_rgb_spec(), a.theta_i, a.delta_theta, a.phi)[:, ::-1]
+
+
+def _rgb_spec():
+    from sbrdf_xr.materials.merl import CHANNEL_WAVELENGTHS
+
+    return models.model_material(
+        "robertson_sandford", list(CHANNEL_WAVELENGTHS), material="rgb", provenance="test",
+        rho_D=[0.2, 0.3, 0.4], epsilon=0.1, b=0.1, e=0.3,
+    )  # fmt: skip
+
+
+def test_a_merl_file_of_constant_channels_reads_them_exactly(tmp_path):
+    from sbrdf_xr.materials.merl import write_merl
+
+    p = write_merl(tmp_path / "c.binary", lambda s, o: np.tile([0.3, 0.2, 0.1], (len(s), 1)))
+    with pytest.warns(NonPhysicalWarning, match="unmeasured cells"):  # grazing cells
+        ds = read_measurements(p, theta_i=(10.0, 50.0), step=5.0)
+    assert "MERL RGB colour channels" in ds.attrs["channels"]
+    np.testing.assert_allclose(ds.measured_sbrdf.values, [[0.1, 0.2, 0.3]] * ds.sizes["sample"],
+                               rtol=1e-12)  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("cut", "match"), [(100, "truncated"), (-8, "trailing bytes"), (None, "declares dimensions")]
+)
+def test_a_merl_file_of_the_wrong_size_is_a_named_error(tmp_path, cut, match):
+    good = 12 + 3 * 90 * 90 * 180 * 8
+    if cut is None:
+        raw = np.asarray([90, 90, 360], "<i4").tobytes() + bytes(good - 12)
+    else:
+        raw = np.asarray([90, 90, 180], "<i4").tobytes() + bytes(good - 12 - cut)
+    p = tmp_path / "bad.binary"
+    p.write_bytes(raw)
+    with pytest.raises(ValidationError, match=match):
+        read_measurements(p)
+
+
+@pytest.mark.slow
+def test_a_merl_file_of_a_known_model_round_trips_and_builds(tmp_path):
+    from sbrdf_xr.materials.merl import write_merl
+
+    p = write_merl(tmp_path / "lobe.binary", _rgb_lobe)
+    with pytest.warns(NonPhysicalWarning, match="unmeasured cells"):
+        ds = read_measurements(p)
+    truth = models.spectra(_rgb_spec(), ds.theta_i.values, ds.delta_theta.values, ds.phi.values)
+    err = np.abs(ds.measured_sbrdf.values - truth) / truth
+    assert np.median(err) < 1e-3  # bins interpolated linearly between their centres
+    hold = np.arange(ds.sizes["sample"]) % 4 == 0
+    table = build_lut(ds.isel(sample=np.flatnonzero(~hold)))
+    held = _errors(table, ds.theta_i.values[hold], ds.delta_theta.values[hold],
+                   ds.phi.values[hold], ds.measured_sbrdf.values[hold])  # fmt: skip
+    assert np.median(held) < SYNTHETIC_MEDIAN
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("name", "bound"), [("solar-array", 0.10), ("chassis", 0.25)])
+def test_the_starlink_tables_predict_held_out_samples(name, bound):
+    """Every 4th sample of each scan left out (the build's own leave-out check), over
+    the samples above 1e-3 of their scan's peak: the solar array meets the 10 % of the
+    issue (1.4 %); the chassis's 1-degree scan does not resolve its sub-degree mirror
+    core (16 %, its wings within a few %), held here against regressions."""
+    with pytest.warns(NonPhysicalWarning):  # horizon samples left out; energy of the spikes
+        table = build_lut(catalog.load(f"starlink-v1.5-{name}-measurements"))
+    assert table.attrs["self_check_worst"] < 1e-9
+    assert table.attrs["holdout_check_median"] < bound
