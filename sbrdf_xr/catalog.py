@@ -50,6 +50,7 @@ from .errors import CatalogError, ValidationError, did_you_mean, input_file, rea
 from .materials import models
 from .materials import tables as material
 from .materials.cache import cache_file, cached_table
+from .materials.readers import read_measurements
 from .materials.shipped import read_reflectance
 from .observing import observe
 
@@ -336,7 +337,7 @@ def _load_paint_parameters(e: CatalogEntry) -> xr.Dataset:
 #: Loader per kind: takes the entry, returns the loaded object.
 LOADERS: dict[str, Callable[[CatalogEntry], Any]] = {
     "material": _load_material,
-    "measurements": lambda e: material.open_measurements(e.file),
+    "measurements": lambda e: read_measurements(e.file, **e.extra.get("read", {})),
     "model": lambda e: models.open_model(e.file),
     "paint_parameters": _load_paint_parameters,
     "spacecraft": spacecraft.load_catalog_entry,

@@ -21,6 +21,8 @@ Sub-commands::
              [--system ab|vega] [-o PHOT.nc] [--csv PHOT.csv]
     sbrdf-xr invert unmix MEASURED --cube CUBE.nc [--range-km R] [-o OUT.nc]   material areas
              [--spacecraft NAME|MESH --total-area]
+    sbrdf-xr material build MEASUREMENTS -o TABLE.nc [--model robertson-sandford|MODEL.nc]
+             [--format table|scan] [--wavelength NM] [--zenith theta|phi]   a measured table
     sbrdf-xr invert spin CURVE (--cube CUBE.nc | --scene SCENE | --to-sun X Y Z --to-observer X Y Z)
              --periods MIN MAX N [-o OUT.nc]                                      spin state
 
@@ -55,6 +57,7 @@ from .commands import (
     cmd_plot,
     cmd_simulate,
 )
+from .material import add_material_parser
 from .observe import add_observe_parser
 from .output import escape
 
@@ -351,6 +354,7 @@ def build_parser() -> argparse.ArgumentParser:
         q.set_defaults(func=cmd_invert)
 
     add_observe_parser(sub, _mesh_options)
+    add_material_parser(sub)
 
     pp = sub.add_parser(
         "plot",

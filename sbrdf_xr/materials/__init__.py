@@ -27,6 +27,12 @@ Modules
     Analytic materials as labelled parameter sets: evaluate, render to a table, measure.
 ``goniometer``
     A virtual goniospectrometer sampling any material with the scheme of paper 000.
+``readers`` and ``merl``
+    Measurement files as laboratories deliver them (:func:`read_measurements`): long
+    tables, in-plane scans, MERL ``.binary``.
+``coverage`` and ``selfcheck``
+    Angles grouped with a tolerance, scan layouts and model fills; every build checked
+    against its own samples.
 """
 
 from ..errors import NonPhysicalWarning, ValidationError
@@ -34,12 +40,15 @@ from . import (
     build,
     cache,
     construction,
+    coverage,
     energy,
     files,
     goniometer,
     model_schema,
     models,
+    readers,
     schema,
+    selfcheck,
     tables,
 )
 from .build import BELOW_NOISE, EXTRAPOLATIONS, RENORMALISE, build_lut
@@ -56,6 +65,7 @@ from .models import (
     spectra,
     spectrum_function,
 )
+from .readers import READERS, Reader, read_measurements, register_reader
 from .schema import (
     DUPLICATES,
     SOURCES,
@@ -83,10 +93,12 @@ __all__ = [
     "EXTRAPOLATIONS",
     "LOOKUP_METHODS",
     "PAPER_THETA_I",
+    "READERS",
     "RENORMALISE",
     "SOURCES",
     "ModelParameters",
     "NonPhysicalWarning",
+    "Reader",
     "ValidationError",
     "average_duplicates",
     "build",
@@ -96,6 +108,7 @@ __all__ = [
     "check_coord",
     "constant_material",
     "construction",
+    "coverage",
     "energy",
     "files",
     "fit_robertson_sandford",
@@ -104,6 +117,7 @@ __all__ = [
     "lambertian",
     "lookup",
     "lookup_anisotropic",
+    "merl",
     "model_material",
     "model_parameters",
     "model_schema",
@@ -115,13 +129,17 @@ __all__ = [
     "paper_delta_theta_grid",
     "paper_phi_grid",
     "paper_scheme",
+    "read_measurements",
+    "readers",
     "reference_mask",
+    "register_reader",
     "render",
     "render_anisotropic",
     "render_values",
     "sample_rotation",
     "schema",
     "scheme_extents",
+    "selfcheck",
     "spectra",
     "spectrum_function",
     "tables",

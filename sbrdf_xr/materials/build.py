@@ -34,6 +34,7 @@ from .construction import (
     paper_phi_grid,
     per_theta_tables,
 )
+from .coverage import in_plane_phi_grid, ratio_tables, scan_layout, snap_angles
 from .energy import ENERGY_TOL, hemispherical_reflectance
 from .schema import (
     average_duplicates,
@@ -42,13 +43,14 @@ from .schema import (
     reference_mask,
     validate_measurements,
 )
+from .selfcheck import CHECK_BOUND, CHECK_FLOOR, check_attrs, sample_errors, self_check
 
 __all__ = ["BELOW_NOISE", "EXTRAPOLATIONS", "RENORMALISE", "build_lut"]
 
 #: Extrapolation policies of :func:`build_lut` beyond the measured incidence angles.
-EXTRAPOLATIONS = ("cubic", "linear", "constant", "model")
+EXTRAPOLATIONS = ("auto", "cubic", "linear", "constant", "model")
 #: Below-noise policies of :func:`build_lut`.
-BELOW_NOISE = ("zero", "model")
+BELOW_NOISE = ("auto", "zero", "model")
 #: Row renormalisations of :func:`build_lut`.
 RENORMALISE = ("auto", "none", "model")
 
@@ -60,19 +62,22 @@ def build_lut(
     n_delta_theta: int = 21,
     theta_i: ArrayLike | None = None,
     smoothing: float | str = 0.0,
-    extrapolation: str = "cubic",
+    extrapolation: str = "auto",
     material: str | None = None,
     dtype: type | np.dtype = np.float64,
     blend: float = 10.0,
     model: xr.Dataset | None = None,
     normal_incidence: str = "symmetric",
     blend_normal: float = 5.0,
-    below_noise: str = "zero",
+    below_noise: str = "auto",
     duplicates: str = "error",
     check_energy: bool = True,
     renormalise: str = "auto",
     progress: Callable[[float, str], None] | None = None,
     model_reflectance: xr.DataArray | None = None,
+    check_floor: float = CHECK_FLOOR,
+    check_bound: float = CHECK_BOUND,
+    holdout: int = 4,
 ) -> xr.DataArray:
     """Look-up table from sparse measurements, by the construction of paper 000 §3.2.
 
@@ -118,6 +123,25 @@ def build_lut(
     carry over), and a row whose directional-hemispherical reflectance exceeds the
     model's is scaled down to it (grazing extrapolation bounded by the model).
 
+    Angles are grouped with a tolerance, never by float equality: sample angles closer
+    than :data:`~sbrdf_xr.materials.coverage.ANGLE_TOL` (1e-6 degree) are one angle
+    (:func:`~sbrdf_xr.materials.coverage.snap_angles`), so angles converted from
+    conventional ones (:func:`sbrdf_xr.geometry.from_conventional`) group as measured.
+    Data that do not come in the paper's rows (:func:`~sbrdf_xr.materials.coverage.scan_layout`)
+    are built with ``below_noise="model"``: an in-plane scan (every ``phi = 0``) gives
+    an isotropic table on the scan's own ``delta_theta`` nodes whose out-of-plane
+    values are the fitted model times the measured ratio at the same angular distance
+    from specular; samples scattered over ``(delta_theta, phi)`` have their ratio to
+    the model interpolated on their triangulation.  The measured incidence angles are
+    then rows of the table.  The attributes ``layout`` and ``modelled`` say what was
+    measured and what comes from the model.
+
+    Every build checks itself against its own samples
+    (:mod:`sbrdf_xr.materials.selfcheck`): attributes ``self_check_median``,
+    ``self_check_p95`` and ``self_check_worst`` (relative errors over the samples above
+    ``check_floor`` of their incidence angle's peak); a median above ``check_bound``
+    warns naming the worst geometries, a table zero where the samples are not raises.
+
     Parameters
     ----------
     measurements : xarray.Dataset
@@ -137,9 +161,11 @@ def build_lut(
         (:func:`sbrdf_xr.kernels.lut.csaps_default_lambda`), which with five incidence
         angles 10-15 deg apart smooths spectral features that move with angle
         (a solar cell's interference minima) by tens of nanometres.
-    extrapolation : {"cubic", "linear", "constant", "model"}, default "cubic"
+    extrapolation : {"auto", "cubic", "linear", "constant", "model"}, default "auto"
         How the table continues below the smallest and above the largest measured
-        ``theta_i``.  ``cubic`` (default) continues the spline's end polynomial
+        ``theta_i``.  ``auto`` is ``cubic`` for data in the paper's rows and ``model``
+        otherwise (an in-plane scan's ratio to the model is not extrapolated by a
+        polynomial).  ``cubic`` continues the spline's end polynomial
         pieces, as the paper's spline evaluation did (the source of the
         discontinuities its §4.2 reports); ``linear`` and ``constant`` are milder.
         ``model`` (beyond the paper) fits the Robertson-Sandford model (paper 001)
@@ -167,9 +193,11 @@ def build_lut(
         Sun's azimuth as ``theta_i -> 0``.  ``paper`` leaves the row as extrapolated.
     blend_normal : float, default 5
         Width of that blend [degree].
-    below_noise : {"zero", "model"}, default "zero"
+    below_noise : {"auto", "zero", "model"}, default "auto"
         ``zero`` is the paper's: reference points and everything beyond an
-        incidence angle's extents are zero.  ``model``: see above.
+        incidence angle's extents are zero.  ``model``: see above.  ``auto`` is
+        ``zero`` for data in the paper's rows and ``model`` otherwise (in-plane or
+        scattered samples); ``zero`` with such data is an error.
     duplicates : {"error", "mean"}, default "error"
         A geometry measured more than once is an error
         (:func:`~sbrdf_xr.materials.schema.validate_measurements`) or its repeats are
@@ -215,6 +243,19 @@ def build_lut(
         known: its quadrature is most of a build's work (the catalog ships it for its
         tables, :mod:`sbrdf_xr.materials.shipped`).  Computed when not given.
 
+    check_floor : float, default 1e-3
+        Noise floor of the self-check [1]: samples below this fraction of the peak of
+        their incidence angle's samples are left out.
+    check_bound : float, default 0.1
+        Own-sample median relative error above which the build warns [1].
+    holdout : int, default 4
+        Leave-out check of a table filled by a fitted model (in-plane or scattered
+        data): every ``holdout``-th sample of each incidence angle's scan (in
+        ``delta_theta`` order, the ends kept) is left out, the table built again from
+        the rest (its own fit) and looked up at them; attributes
+        ``holdout_check_median``, ``_p95``, ``_worst`` and ``_n``.  0 skips it (it
+        doubles the build's work).
+
     Returns
     -------
     xarray.DataArray
@@ -226,7 +267,8 @@ def build_lut(
     ValidationError
         For an invalid measurement set, fewer than two measured incidence angles,
         no measured extent in ``phi`` or ``delta_theta``, repeated geometries with
-        ``duplicates="error"``.
+        ``duplicates="error"``, in-plane or scattered data with ``below_noise="zero"``,
+        a table zero where its samples are not.
 
     Examples
     --------
@@ -248,6 +290,7 @@ def build_lut(
     >>> bool(np.allclose(lut.sel(theta_i=20.0, delta_theta=0.0, phi=0.0), measured))
     True
     """
+    call = {k: v for k, v in locals().items() if k != "measurements"}  # for the holdout
     theta_i = to_unit(theta_i, "deg", "theta_i")
     smoothing = to_unit(smoothing, "deg3", "smoothing")  # "csaps" is kept
     blend, blend_normal = (
@@ -269,12 +312,30 @@ def build_lut(
         raise ValidationError(
             f"below_noise: got {below_noise!r}; allowed: {', '.join(BELOW_NOISE)}"
         )
+    ref = reference_mask(ds)
+    ti_s, dt_s, ph_s = (snap_angles(ds[d].values) for d in (THETA_I, DELTA_THETA, PHI))
+    measured_ti = np.unique(ti_s)
+    horizon = _at_horizon(ti_s, dt_s, ph_s)
+    if horizon.any():  # cos(theta_r) = 0: no reflectance can be measured there
+        warnings.warn(
+            f"build_lut: {int(horizon.sum())} of {horizon.size} samples have the observer at "
+            "or below the horizon (theta_i + delta_theta = +-90 deg in the plane); they are "
+            "left out (attribute n_dropped_horizon)",
+            NonPhysicalWarning,
+            stacklevel=2,
+        )
+        ref = ref | horizon
+    layouts = [scan_layout(dt_s[ti_s == t], ph_s[ti_s == t]) for t in measured_ti]
+    below_noise = _below_noise(below_noise, layouts, measured_ti)
+    rows_only = all(lay == "rows" for lay in layouts)
+    if extrapolation == "auto":
+        extrapolation = "cubic" if rows_only else "model"
     if renormalise not in RENORMALISE:
         raise ValidationError(
             f"renormalise: got {renormalise!r}; allowed: {', '.join(RENORMALISE)}"
         )
-    if renormalise == "auto":
-        renormalise = "model" if below_noise == "model" else "none"
+    if renormalise == "auto":  # keep measured values where the data are not in rows
+        renormalise = "model" if below_noise == "model" and rows_only else "none"
     elif renormalise == "model" and below_noise != "model":
         raise ValidationError(
             "renormalise: 'model' corrects a table made of a model times a ratio and needs "
@@ -282,22 +343,23 @@ def build_lut(
         )
     report = progress or _no_progress
     report(0.0, "measurements")
-    ref = reference_mask(ds)
-    ti_s = np.asarray(ds[THETA_I].values, dtype=np.float64)
-    dt_s = np.asarray(ds[DELTA_THETA].values, dtype=np.float64)
-    ph_s = np.asarray(ds[PHI].values, dtype=np.float64)
     wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
     spectra = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64).copy()
     spectra[ref] = 0.0
-    measured_ti = np.unique(ti_s)
     if measured_ti.size < 2:
         raise ValidationError(
             "theta_i: need measurements at >= 2 incidence angles to build a table, "
             f"got {measured_ti.tolist()}"
         )
-    phi_grid = paper_phi_grid(ph_s.max(), n_phi)
-    dt_grid = paper_delta_theta_grid(dt_s.min(), dt_s.max(), n_delta_theta)
+    if all(lay == "in-plane" for lay in layouts):  # the scans' own nodes
+        dt_grid = np.unique(dt_s)
+        phi_grid = in_plane_phi_grid(float(np.median(np.diff(dt_grid))))
+    else:
+        phi_grid = paper_phi_grid(ph_s.max(), n_phi)
+        dt_grid = paper_delta_theta_grid(dt_s.min(), dt_s.max(), n_delta_theta)
     ti_out = np.arange(0.0, 91.0) if theta_i is None else np.asarray(theta_i, dtype=np.float64)
+    if theta_i is None and not rows_only:  # the measured incidence angles are rows
+        ti_out = np.union1d(ti_out, measured_ti)
     check_coord("theta_i", ti_out)
     lam = _lut.csaps_default_lambda(measured_ti) if smoothing == "csaps" else float(smoothing)
     extra: dict[str, Any] = {}
@@ -336,6 +398,8 @@ def build_lut(
         assert fit_model is not None  # fitted above whenever a model is used
         dt_grid = extend_grid(dt_grid, -180.0, 90.0)
         phi_grid = extend_grid(phi_grid, phi_grid[0], 90.0)
+        if not rows_only:
+            extra.update(_coverage_attrs(layouts, measured_ti, fit_model))
         # Beyond -180/90 and phi = 90 lies the far side of the horizon: nothing to hold.
         edges = {
             "edge_delta_theta_min": "zero",
@@ -346,16 +410,8 @@ def build_lut(
         truth_s = _model_at(fit_model, ti_s, dt_s, ph_s, wl)
         ok = ~ref
         ratio = np.divide(spectra, truth_s, out=np.ones_like(spectra), where=truth_s > 0)
-        per_theta = per_theta_tables(
-            measured_ti,
-            ti_s[ok],
-            dt_s[ok],
-            ph_s[ok],
-            ratio[ok],
-            np.zeros(int(ok.sum()), dtype=bool),
-            dt_grid,
-            phi_grid,
-            hold_all=True,
+        per_theta, _ = ratio_tables(
+            measured_ti, ti_s[ok], dt_s[ok], ph_s[ok], ratio[ok], dt_grid, phi_grid
         )
         spline_mode = "constant" if extrapolation == "model" else extrapolation
         e = _lut.smoothing_spline_matrix(measured_ti, ti_out, lam, spline_mode)
@@ -384,10 +440,10 @@ def build_lut(
         if extrapolation == "model" and renormalise == "none":
             _bound_grazing_rows(lut, ti_out, dt_grid, phi_grid, wl, fit_model, measured_ti[-1])
     if fit_model is not None and (extrapolation == "model" or below_noise == "model"):
-        extra = {
-            "extrapolation_model": fit_model.attrs.get("model", ""),
-            "extrapolation_model_provenance": fit_model.attrs.get("provenance", ""),
-        }
+        extra.update(
+            extrapolation_model=fit_model.attrs.get("model", ""),
+            extrapolation_model_provenance=fit_model.attrs.get("provenance", ""),
+        )
         if extrapolation == "model" and below_noise == "zero":
             extra["blend_width"] = blend
     if normal_incidence == "symmetric" and ti_out[0] == 0.0:
@@ -420,7 +476,12 @@ def build_lut(
         material=name,
         source=ds.attrs.get("source", "measured"),
         provenance=(prov + "; " if prov else "") + "look-up table built by sbrdf_xr.build_lut "
-        "(paper 000 section 3.2)",
+        "(paper 000 section 3.2)"
+        + (
+            f"; measured: {extra['layout']}; modelled: {extra['modelled']}"
+            if "layout" in extra
+            else ""
+        ),
         construction="paper000-3.2",
         n_phi=n_phi,
         n_delta_theta=n_delta_theta,
@@ -430,8 +491,20 @@ def build_lut(
         below_noise=below_noise,
         measured_theta_i=measured_ti,
         n_measurements=int(ds.sizes[SAMPLE]),
+        n_dropped_horizon=int(horizon.sum()),
         **edges,
         **extra,
+    )
+    out.attrs.update(
+        self_check(
+            out,
+            ds,
+            (ti_s, dt_s, ph_s),
+            spectra,
+            ref,
+            floor=to_unit(check_floor, "1", "check_floor"),
+            bound=to_unit(check_bound, "1", "check_bound"),
+        )
     )
     if check_energy:
         report(0.95, "energy check")
@@ -449,8 +522,89 @@ def build_lut(
                 NonPhysicalWarning,
                 stacklevel=2,
             )
+    if holdout and not rows_only:  # a fitted fill: predict samples it has not seen
+        report(0.97, "leave-out check")
+        out.attrs.update(_holdout(ds, call, (ti_s, dt_s, ph_s), spectra, ref, int(holdout)))
     report(1.0, "built")
     return out
+
+
+def _holdout(
+    ds: xr.Dataset,
+    call: dict[str, Any],
+    angles: tuple[np.ndarray, np.ndarray, np.ndarray],
+    spectra: np.ndarray,
+    ref: np.ndarray,
+    k: int,
+) -> dict[str, Any]:
+    """The leave-out check: every ``k``-th sample of each scan predicted by a table built
+    without them (and with its own fit)."""
+    ti, dt, _ = angles
+    hold = np.zeros(ti.size, dtype=bool)
+    for t in np.unique(ti):
+        at = np.flatnonzero(ti == t)
+        at = at[np.argsort(dt[at], kind="stable")]
+        hold[at[1:-1][np.arange(at.size - 2) % k == k // 2]] = True
+    opts = {**call, "holdout": 0, "check_energy": False, "progress": None}
+    if call.get("model") is None:
+        opts["model"] = None  # its own fit
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NonPhysicalWarning)
+        table = build_lut(ds.isel({SAMPLE: np.flatnonzero(~hold)}), **opts)
+    # the floor from every sample of the scan, the errors at the held-out ones
+    rel, _, _ = sample_errors(table, *angles, spectra, ref, opts["check_floor"])
+    rel[~hold] = np.nan
+    return {**check_attrs("holdout_check", rel), "holdout_every": k}
+
+
+def _at_horizon(ti: np.ndarray, dt: np.ndarray, ph: np.ndarray) -> np.ndarray:
+    """Which samples have the observer at or below the horizon (``cos theta_r <= 1e-8``)."""
+    return np.cos(np.radians(ph)) * np.cos(np.radians(ti + dt)) <= 1e-8
+
+
+def _below_noise(below_noise: str, layouts: list[str], measured_ti: np.ndarray) -> str:
+    """The below-noise policy of a build: ``auto`` resolved by the data's layouts."""
+    rows_only = all(lay == "rows" for lay in layouts)
+    if below_noise == "auto":
+        return "zero" if rows_only else "model"
+    if below_noise == "zero" and not rows_only:
+        what = sorted({lay for lay in layouts if lay != "rows"})
+        at = [float(t) for t, lay in zip(measured_ti, layouts, strict=True) if lay != "rows"]
+        why = (
+            "no sample out of the plane of incidence: phi = 0 everywhere"
+            if what == ["in-plane"]
+            else "not in rows of constant delta_theta"
+        )
+        raise ValidationError(
+            f"below_noise: got 'zero', but the samples at theta_i = {at} deg are "
+            f"{' and '.join(what)} ({why}): "
+            "the paper's construction needs rows of constant delta_theta sampled in phi. "
+            "Allowed: below_noise='model' or 'auto' (a model fitted to the samples fills "
+            "what was not measured)"
+        )
+    return below_noise
+
+
+def _coverage_attrs(layouts: list[str], measured_ti: np.ndarray, model: xr.Dataset) -> dict:
+    """The attributes that say what of a table was measured and what was modelled."""
+    name = model.attrs.get("model", "model")
+    parts = []
+    for lay in ("rows", "in-plane", "scattered"):
+        at = [f"{t:g}" for t, la in zip(measured_ti, layouts, strict=True) if la == lay]
+        if at:
+            parts.append(f"{lay} at theta_i = {', '.join(at)} deg")
+    modelled = {
+        "in-plane": "phi > 0 (out of the plane of incidence) is the fitted "
+        f"{name} model times the measured ratio at the same angular distance from specular",
+        "scattered": f"between the samples the fitted {name} model times their ratio "
+        "interpolated on their triangulation",
+        "rows": "beyond the measured extents the fitted model",
+    }
+    return {
+        "layout": "; ".join(parts),
+        "modelled": "; ".join(modelled[lay] for lay in dict.fromkeys(layouts))
+        + "; other incidence angles: the model times the ratio splined in theta_i",
+    }
 
 
 def _no_progress(fraction: float, step: str) -> None:

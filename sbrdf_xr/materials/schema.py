@@ -34,6 +34,7 @@ from .._names import (
 )
 from ..errors import NonPhysicalWarning, ValidationError
 from ..units import check_wavelengths, to_unit
+from .coverage import snap_angles
 
 __all__ = [
     "DUPLICATES",
@@ -404,15 +405,10 @@ DUPLICATES = ("error", "mean")
 
 
 def _geometry_groups(ds: xr.Dataset) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Group samples by geometry (angles equal to 1e-9 degree): the group of every sample,
+    """Group samples by geometry (angles within
+    :data:`~sbrdf_xr.materials.coverage.ANGLE_TOL` are equal): the group of every sample,
     the first sample of every group and the group sizes."""
-    key = np.stack(
-        [
-            np.round(np.asarray(ds[d].values, dtype=np.float64), 9)
-            for d in (THETA_I, DELTA_THETA, PHI)
-        ],
-        axis=1,
-    )
+    key = np.stack([snap_angles(ds[d].values) for d in (THETA_I, DELTA_THETA, PHI)], axis=1)
     _, first, groups, counts = np.unique(
         key, axis=0, return_index=True, return_inverse=True, return_counts=True
     )
@@ -580,7 +576,7 @@ def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Da
     if v.size and v.max() > MAX_PLAUSIBLE_SBRDF:
         warnings.warn(
             f"{MEASURED}: values up to {v.max():.3g} sr-1, above the {MAX_PLAUSIBLE_SBRDF:g} "
-            "sr-1 of a mirror seen through a 1 degree aperture: values in other units?",
+            "sr-1 of a mirror seen through a 0.1 degree aperture: values in other units?",
             NonPhysicalWarning,
             stacklevel=2,
         )
@@ -588,8 +584,9 @@ def validate_measurements(ds: xr.Dataset, *, duplicates: str = "error") -> xr.Da
 
 
 #: The largest plausible measured SBRDF [sr-1]: a perfect mirror seen by a detector of
-#: 1 degree full aperture (1 / solid angle, about 4e3 sr-1), with margin.
-MAX_PLAUSIBLE_SBRDF = 1e4
+#: 0.1 degree full aperture (1 / solid angle, about 4e5 sr-1), with margin.  A near-mirror
+#: (a solar array's cover glass: 5.3e4 sr-1 in a 1-degree scan) is below it.
+MAX_PLAUSIBLE_SBRDF = 1e6
 
 
 def _check_delta_theta(dt: np.ndarray) -> None:

@@ -1,0 +1,308 @@
+"""How measurements cover the angles: grouping with a tolerance, scan layouts, model fills.
+
+Angles that come from a conversion (:func:`sbrdf_xr.geometry.from_conventional`, a
+goniometer's encoder) carry float noise of ~1e-12 degree: equal angles are never equal
+floats.  Every grouping and matching of angles in the construction of a table
+(:func:`sbrdf_xr.materials.build.build_lut`,
+:func:`sbrdf_xr.materials.schema.validate_measurements`) therefore goes through
+:func:`snap_angles`, which merges angles closer than :data:`ANGLE_TOL` (1e-6 degree).
+
+A measured incidence angle's samples come in one of three layouts
+(:func:`scan_layout`):
+
+``rows``
+    The scheme of paper 000 §3.2: rows of constant ``delta_theta`` sampled at several
+    ``phi``.  The paper's construction applies.
+``in-plane``
+    Every sample in the plane of incidence (``phi = 0``): a goniometer scan of the
+    signed scattering angle.  Out of the plane the table is the fitted model times the
+    measured ratio to the model at the same angular distance from the specular
+    direction (:func:`specular_distance`): a lobe keeps its measured width in every
+    direction about the mirror direction.  Between samples the logarithm of the ratio
+    is interpolated by a shape-preserving cubic (PCHIP, F. N. Fritsch & R. E. Carlson,
+    SIAM J. Numer. Anal. 17, 238, 1980): a lobe falls by factors, and no overshoot.
+``scattered``
+    Samples spread over the ``(delta_theta, phi)`` plane without rows (a regular grid
+    in conventional angles).  The ratio of the samples to the fitted model is
+    interpolated linearly on their Delaunay triangulation (mirrored about ``phi = 0``)
+    and held at its nearest sample outside it.
+
+Angles are in degree (astropy Quantities are converted, :func:`sbrdf_xr.units.to_unit`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy.interpolate import LinearNDInterpolator, NearestNDInterpolator, PchipInterpolator
+
+from ..errors import ValidationError
+from ..units import to_unit
+from .construction import per_theta_tables
+
+__all__ = [
+    "ANGLE_TOL",
+    "LAYOUTS",
+    "in_plane_phi_grid",
+    "ratio_tables",
+    "scan_layout",
+    "snap_angles",
+    "specular_distance",
+]
+
+#: Angles closer than this are the same angle [degree]: far above the float noise of an
+#: angle conversion (~1e-12 degree), far below any goniometer's step (~0.01 degree).
+ANGLE_TOL = 1e-6
+
+#: The layouts of a measured incidence angle's samples (:func:`scan_layout`).
+LAYOUTS = ("rows", "in-plane", "scattered")
+
+#: Fraction of an incidence angle's samples that must lie in rows of constant
+#: ``delta_theta`` with >= 2 ``phi`` samples for the layout to be ``rows``.
+ROW_FRACTION = 0.75
+
+
+def snap_angles(values: ArrayLike, tol: float = ANGLE_TOL) -> np.ndarray:
+    """Angles closer than ``tol`` replaced by the mean of their group.
+
+    Sorted angles are grouped where consecutive ones differ by at most ``tol``; every
+    angle becomes its group's mean, so equal angles compare equal afterwards.
+
+    Parameters
+    ----------
+    values : array_like
+        Angles [degree].
+    tol : float, default :data:`ANGLE_TOL`
+        Grouping tolerance [degree], ``>= 0``.
+
+    Returns
+    -------
+    ndarray
+        The snapped angles [degree], shaped like ``values``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.materials.coverage import snap_angles
+    >>> x = np.array([10.0, 10.0 + 1e-12, 20.0, 10.0 - 1e-12])
+    >>> np.unique(x).size, np.unique(snap_angles(x)).size
+    (4, 2)
+    """
+    tol = to_unit(tol, "deg", "tol")
+    if not tol >= 0:
+        raise ValidationError(f"tol: must be >= 0 degree, got {tol}")
+    v = np.asarray(to_unit(values, "deg", "values"), dtype=np.float64)
+    flat = v.ravel()
+    if flat.size == 0:
+        return v.copy()
+    order = np.argsort(flat, kind="stable")
+    s = flat[order]
+    ids = np.cumsum(np.concatenate([[True], np.diff(s) > tol])) - 1
+    means = np.bincount(ids, weights=s) / np.bincount(ids)
+    out = np.empty_like(flat)
+    out[order] = means[ids]
+    return out.reshape(v.shape)
+
+
+def scan_layout(delta_theta: ArrayLike, phi: ArrayLike, tol: float = ANGLE_TOL) -> str:
+    """The layout of one incidence angle's samples: ``rows``, ``in-plane`` or ``scattered``.
+
+    Parameters
+    ----------
+    delta_theta, phi : array_like, shape (s,)
+        The samples' angles [degree], already snapped (:func:`snap_angles`).
+    tol : float, default :data:`ANGLE_TOL`
+        A ``phi`` at most ``tol`` is in the plane of incidence [degree].
+
+    Returns
+    -------
+    str
+        One of :data:`LAYOUTS`: ``in-plane`` if every ``phi <= tol``; ``rows`` if at
+        least :data:`ROW_FRACTION` of the samples lie in rows of one ``delta_theta``
+        with >= 2 ``phi`` values; ``scattered`` otherwise.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.materials.coverage import scan_layout
+    >>> scan_layout([-2.0, 0.0, 2.0], [0.0, 0.0, 0.0])
+    'in-plane'
+    >>> scan_layout([-2.0, -2.0, 0.0, 0.0], [0.0, 5.0, 0.0, 5.0])
+    'rows'
+    >>> scan_layout([-2.0, -1.0, 0.0, 1.0], [0.0, 5.0, 3.0, 7.0])
+    'scattered'
+    """
+    dt = np.asarray(to_unit(delta_theta, "deg", "delta_theta"), dtype=np.float64)
+    ph = np.asarray(to_unit(phi, "deg", "phi"), dtype=np.float64)
+    if np.all(ph <= tol):
+        return "in-plane"
+    _, inverse, counts = np.unique(dt, return_inverse=True, return_counts=True)
+    in_rows = np.sum(counts[inverse.ravel()] >= 2)
+    return "rows" if in_rows >= ROW_FRACTION * dt.size else "scattered"
+
+
+def specular_distance(delta_theta: ArrayLike, phi: ArrayLike) -> np.ndarray:
+    """The in-plane ``delta_theta`` at the same angular distance from specular.
+
+    In paper-000 angles the observer is ``o = (cos phi sin(theta_i + delta_theta),
+    sin phi, cos phi cos(theta_i + delta_theta))`` in the frame (forward, plane
+    normal, facet normal) and the specular direction is ``(sin theta_i, 0, cos
+    theta_i)``, so the angle ``gamma`` between them has ``cos gamma = cos phi cos
+    delta_theta``, whatever ``theta_i``.  Computed with ``arctan2`` (exact near 0).
+
+    Parameters
+    ----------
+    delta_theta, phi : array_like
+        Angles [degree], broadcast together.
+
+    Returns
+    -------
+    ndarray
+        ``sign(delta_theta) * gamma`` [degree] (``+gamma`` at ``delta_theta = 0``);
+        equal to ``delta_theta`` at ``phi = 0``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.materials.coverage import specular_distance
+    >>> specular_distance([-3.0, 0.0, 3.0], 0.0).tolist()
+    [-3.0, 0.0, 3.0]
+    >>> round(float(specular_distance(0.0, 4.0)), 12), round(float(specular_distance(-3.0, 4.0)), 3)
+    (4.0, -4.998)
+    """
+    dt = np.radians(np.asarray(to_unit(delta_theta, "deg", "delta_theta"), dtype=np.float64))
+    ph = np.radians(np.asarray(to_unit(phi, "deg", "phi"), dtype=np.float64))
+    dt, ph = np.broadcast_arrays(dt, ph)
+    sin_g = np.hypot(np.sin(ph), np.cos(ph) * np.sin(dt))
+    gamma = np.degrees(np.arctan2(sin_g, np.cos(ph) * np.cos(dt)))
+    return np.where(dt < 0, -gamma, gamma)
+
+
+def in_plane_phi_grid(step: float) -> np.ndarray:
+    """The ``phi`` grid of a table built from in-plane scans: 0, then steps from the
+    scan's own step doubling up to 10 degree, then every 10 degree to 90.
+
+    Parameters
+    ----------
+    step : float
+        The scans' ``delta_theta`` step [degree], ``> 0``.
+
+    Returns
+    -------
+    ndarray
+        Strictly increasing ``phi`` nodes [degree] from 0 to 90.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.materials.coverage import in_plane_phi_grid
+    >>> in_plane_phi_grid(1.0).tolist()
+    [0.0, 1.0, 2.0, 4.0, 8.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0]
+    """
+    step = to_unit(step, "deg", "step")
+    if not step > 0:
+        raise ValidationError(f"step: must be > 0 degree, got {step}")
+    near = step * 2.0 ** np.arange(0, 20)
+    return np.unique(np.concatenate([[0.0], near[near < 10.0], np.arange(10.0, 90.1, 10.0)]))
+
+
+def _in_plane(dt: np.ndarray, ratio: np.ndarray, dt_grid: np.ndarray, phi_grid: np.ndarray):
+    """The ratio of one in-plane scan on the grid, taken at the same distance from specular."""
+    order = np.argsort(dt)
+    x = dt[order]
+    at = np.clip(specular_distance(dt_grid[:, None], phi_grid[None, :]).ravel(), x[0], x[-1])
+    # In the logarithm (a lobe falls by factors, not by steps), shape-preserving cubic
+    # (PCHIP: no overshoot, each sample's value at its node), held beyond the scan's ends.
+    log_r = np.log(np.maximum(ratio[order], np.finfo(np.float64).tiny))
+    if x.size == 1:
+        return np.broadcast_to(
+            np.exp(log_r[0]), (dt_grid.size, phi_grid.size, ratio.shape[1])
+        ).copy()
+    out = np.exp(PchipInterpolator(x, log_r, axis=0)(at))
+    return out.reshape(dt_grid.size, phi_grid.size, ratio.shape[1])
+
+
+def _scattered(
+    dt: np.ndarray, ph: np.ndarray, ratio: np.ndarray, dt_grid: np.ndarray, phi_grid: np.ndarray
+) -> np.ndarray:
+    """The ratio of one scattered set on the grid: linear on its (mirrored) triangulation,
+    the nearest sample's outside it."""
+    pts = np.concatenate([np.stack([dt, ph], 1), np.stack([dt, -ph], 1)[ph > 0]])
+    vals = np.concatenate([ratio, ratio[ph > 0]])
+    gd, gp = np.meshgrid(dt_grid, phi_grid, indexing="ij")
+    q = np.stack([gd.ravel(), gp.ravel()], 1)
+    out = LinearNDInterpolator(pts, vals)(q)
+    miss = ~np.all(np.isfinite(out), axis=1)
+    if miss.any():
+        out[miss] = NearestNDInterpolator(pts, vals)(q[miss])
+    return out.reshape(dt_grid.size, phi_grid.size, ratio.shape[1])
+
+
+def ratio_tables(
+    measured_ti: np.ndarray,
+    ti_s: np.ndarray,
+    dt_s: np.ndarray,
+    ph_s: np.ndarray,
+    ratio: np.ndarray,
+    dt_grid: np.ndarray,
+    phi_grid: np.ndarray,
+) -> tuple[np.ndarray, list[str]]:
+    """The ratio of the samples to a model on the grid at every measured incidence angle.
+
+    Each incidence angle by its own layout (:func:`scan_layout`): ``rows`` by steps 1
+    and 2 of paper 000 §3.2 with every edge held
+    (:func:`~sbrdf_xr.materials.construction.per_theta_tables`), ``in-plane`` at the
+    same distance from specular, ``scattered`` on the triangulation.
+
+    Parameters
+    ----------
+    measured_ti : ndarray, shape (t,)
+        The measured incidence angles [degree] (snapped).
+    ti_s, dt_s, ph_s : ndarray, shape (s,)
+        Angles of the samples [degree] (snapped).
+    ratio : ndarray, shape (s, n_wavelength)
+        Sample over model [1].
+    dt_grid, phi_grid : ndarray
+        The table's grids [degree].
+
+    Returns
+    -------
+    ratios : ndarray, shape (t, len(dt_grid), len(phi_grid), n_wavelength)
+        The ratio on the grid [1].
+    layouts : list of str
+        The layout of every measured incidence angle.
+
+    Examples
+    --------
+    An in-plane scan whose ratio is 2 everywhere gives 2 everywhere:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.materials.coverage import ratio_tables
+    >>> dt = np.array([-10.0, 0.0, 10.0])
+    >>> r, layouts = ratio_tables(np.array([30.0]), np.full(3, 30.0), dt, np.zeros(3),
+    ...                           np.full((3, 1), 2.0), np.linspace(-20, 20, 5),
+    ...                           np.array([0.0, 5.0]))
+    >>> r.shape, layouts, float(r.min()), float(r.max())
+    ((1, 5, 2, 1), ['in-plane'], 2.0, 2.0)
+    """
+    out = np.empty((measured_ti.size, dt_grid.size, phi_grid.size, ratio.shape[1]))
+    layouts = []
+    for a, t in enumerate(measured_ti):
+        sel = np.flatnonzero(ti_s == t)
+        layout = scan_layout(dt_s[sel], ph_s[sel])
+        layouts.append(layout)
+        if layout == "rows":
+            out[a] = per_theta_tables(
+                np.array([t]),
+                ti_s[sel],
+                dt_s[sel],
+                ph_s[sel],
+                ratio[sel],
+                np.zeros(sel.size, dtype=bool),
+                dt_grid,
+                phi_grid,
+                hold_all=True,
+            )[0]
+        elif layout == "in-plane":
+            out[a] = _in_plane(dt_s[sel], ratio[sel], dt_grid, phi_grid)
+        else:
+            out[a] = _scattered(dt_s[sel], ph_s[sel], ratio[sel], dt_grid, phi_grid)
+    return out, layouts
