@@ -40,12 +40,14 @@ from ..units import to_unit
 
 __all__ = [
     "LAWS",
+    "PART_KEYS",
     "AngleSeries",
     "Fixed",
     "Part",
     "SunTracking",
     "check_parts",
     "hinge_rotation",
+    "part_from_spec",
     "tracking_angle",
 ]
 
@@ -362,3 +364,78 @@ def check_parts(
         q = Part(p.name, p.facets, p.axis, p.point, p.law, unit)
         out.append(q)
     return tuple(out)
+
+
+#: Keys of a part in a scene file's ``[[spacecraft.parts]]`` table, and their meaning.
+PART_KEYS: dict[str, str] = {
+    "name": "the part's name (required)",
+    "facets": "its facets: indices into the mesh as loaded",
+    "materials": "or its facets by front material: every facet of these materials",
+    "axis": "hinge axis in the bus frame [1], default [0, 0, 1]",
+    "point": "a point of the hinge line in the bus frame [m], default [0, 0, 0]",
+    "law": '"fixed", "sun-tracking" or "series", default "fixed"',
+    "angle": "fixed: the hinge angle [degree], default 0",
+    "limits": "sun-tracking: allowed angles [lo, hi] [degree]",
+    "normal": "sun-tracking: the part's normal at angle 0, default its facets' mean",
+    "angles": "series: one angle per geometry of the sweep [degree]",
+}
+
+
+def part_from_spec(spec: Mapping[str, Any], facet_material: np.ndarray) -> Part:
+    """A :class:`Part` from a scene file's table (keys: :data:`PART_KEYS`).
+
+    Examples
+    --------
+    >>> spec = {"name": "array", "materials": ["cell"], "axis": [0, 1, 0], "law": "sun-tracking"}
+    >>> p = part_from_spec(spec, np.array(["bus", "cell", "cell"]))
+    >>> p.facets.tolist(), type(p.law).__name__
+    ([1, 2], 'SunTracking')
+    >>> part_from_spec({"name": "x", "facets": [0], "law": "spin"}, np.array(["a"]))
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.ValidationError: part 'x': law 'spin'; allowed: fixed, series, sun-tracking
+    """
+    unknown = sorted(set(spec) - set(PART_KEYS))
+    name = spec.get("name")
+    if unknown:
+        raise ValidationError(
+            f"part {name!r}: unknown keys {unknown}; allowed: {sorted(PART_KEYS)}"
+        )
+    if ("facets" in spec) == ("materials" in spec):
+        raise ValidationError(f"part {name!r}: give exactly one of 'facets' and 'materials'")
+    if "materials" in spec:
+        wanted = [spec["materials"]] if isinstance(spec["materials"], str) else spec["materials"]
+        facets = np.flatnonzero(np.isin(facet_material, list(wanted)))
+        if facets.size == 0:
+            raise ValidationError(
+                f"part {name!r}: no facet has the materials {list(wanted)}; the facets have "
+                f"{sorted(set(facet_material.tolist()))}"
+            )
+    else:
+        facets = np.asarray(spec["facets"])
+    law_name = spec.get("law", "fixed")
+    if law_name not in LAWS:
+        raise ValidationError(
+            f"part {name!r}: law {law_name!r}; allowed: {', '.join(sorted(LAWS))}"
+        )
+    own = {"fixed": ("angle",), "sun-tracking": ("limits", "normal"), "series": ("angles",)}
+    for law, keys in own.items():
+        stray = [k for k in keys if k in spec and law != law_name]
+        if stray:
+            raise ValidationError(f"part {name!r}: {stray} apply to law {law!r}, not {law_name!r}")
+    if law_name == "fixed":
+        pointing: Any = Fixed(float(spec.get("angle", 0.0)))
+    elif law_name == "sun-tracking":
+        lim = spec.get("limits")
+        pointing = SunTracking(spec.get("normal"), None if lim is None else tuple(lim))
+    else:
+        if "angles" not in spec:
+            raise ValidationError(f"part {name!r}: law 'series' needs 'angles'")
+        pointing = AngleSeries(spec["angles"])
+    return Part(
+        name,  # type: ignore[arg-type]
+        facets,
+        axis=spec.get("axis", (0.0, 0.0, 1.0)),
+        point=spec.get("point", (0.0, 0.0, 0.0)),
+        law=pointing,
+    )

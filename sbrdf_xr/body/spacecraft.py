@@ -439,6 +439,10 @@ class Spacecraft:
         self.sides: Sides = build_sides(
             mesh, labels, self.facet_back, self.facet_tangent, self.parts
         )
+        if self.facet_back is not None:  # the backs kept (those on closed surfaces are not)
+            kept = np.full(len(mesh.faces), "", dtype=object)
+            kept[self.sides.facet[self.sides.back]] = self.sides.material[self.sides.back]
+            self.facet_back = kept.astype(str) if self.sides.back.any() else None
 
     @property
     def moving_parts(self) -> tuple[Part, ...]:
@@ -494,6 +498,37 @@ class Spacecraft:
             tangent=tangent,
             back_material=self.facet_back,
             parts=self.parts,
+        )
+
+    def with_parts(self, parts: Iterable[Part]) -> Spacecraft:
+        """The same spacecraft with these articulated parts (:mod:`sbrdf_xr.body.parts`).
+
+        Parameters
+        ----------
+        parts : iterable of Part
+            Facets of the mesh turning about hinges; the other facets are the bus.
+
+        Returns
+        -------
+        Spacecraft
+
+        Examples
+        --------
+        >>> from sbrdf_xr.body.parts import Part, SunTracking
+        >>> box = Spacecraft(trimesh.creation.box(), ["paint"] * 12)
+        >>> lid = Part("lid", [4, 6], law=SunTracking(normal=(1, 0, 0)))
+        >>> box.with_parts([lid]).moving_parts[0].name
+        'lid'
+        """
+        return Spacecraft(
+            self.mesh,
+            self.facet_material,
+            name=self.name,
+            colors=self.colors,
+            tangent=self.facet_tangent,
+            tangent_source=self.tangent_source,
+            back_material=self.facet_back,
+            parts=parts,
         )
 
     def __repr__(self) -> str:

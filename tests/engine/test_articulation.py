@@ -9,7 +9,7 @@ import trimesh
 from sbrdf_xr import Scene, simulate
 from sbrdf_xr.body.parts import AngleSeries, Fixed, Part, SunTracking, tracking_angle
 from sbrdf_xr.body.spacecraft import Spacecraft
-from sbrdf_xr.errors import MeshError, ValidationError
+from sbrdf_xr.errors import MeshError, SceneError, ValidationError
 from sbrdf_xr.materials.schema import lambertian
 from sbrdf_xr.testing import box_with_plate_spacecraft
 
@@ -168,3 +168,47 @@ def test_bad_parts_are_named_errors():
         s, o = random_pairs(3, 1)
         body = box_with_plate_spacecraft(parts=True, law=AngleSeries([0.0, 1.0]))
         simulate(Scene(body, MATS, to_sun=s, to_observer=o))
+
+
+def test_a_scene_file_describes_backs_and_parts(tmp_path):
+    from sbrdf_xr.engine import load_scene
+    from sbrdf_xr.materials.files import to_netcdf
+
+    for m, table in MATS.items():
+        to_netcdf(table, tmp_path / f"{m}.nc")
+    body = box_with_plate_spacecraft()
+    mesh = body.mesh.copy()
+    mesh.visual.face_colors = [[200, 200, 200, 255]] * 12 + [[0, 0, 255, 255]] * 2
+    mesh.export(tmp_path / "body.ply")
+    (tmp_path / "scene.toml").write_text(
+        """
+name = "bus-and-array"
+[materials]
+bus = "bus.nc"
+cell = "cell.nc"
+backsheet = "backsheet.nc"
+[spacecraft]
+path = "body.ply"
+material_map = {"#c8c8c8" = "bus", "#0000ff" = "cell"}
+back_material = {cell = "backsheet"}
+[[spacecraft.parts]]
+name = "array"
+materials = ["cell"]
+axis = [1, 0, 0]
+point = [0, 0, 1.5]
+law = "sun-tracking"
+[geometry]
+to_sun = [[0, 0.6, 0.8], [0.6, 0, -0.8]]
+to_observer = [[0, 0.8, 0.6], [0.0, 0.6, -0.8]]
+"""
+    )
+    scene = load_scene(tmp_path / "scene.toml")
+    assert "array (2 facets): sun-tracking" in dict(scene.plan().steps)["parts"]
+    s, o = np.asarray(scene.to_sun), np.asarray(scene.to_observer)
+    np.testing.assert_allclose(
+        simulate(scene).signal.values[:, 0], bus_plus_tracking_plate(s, o), rtol=0, atol=TOL
+    )
+    bad = (tmp_path / "scene.toml").read_text().replace('law = "sun-tracking"', 'law = "spin"')
+    (tmp_path / "bad.toml").write_text(bad)
+    with pytest.raises(SceneError, match="law 'spin'; allowed: fixed, series, sun-tracking"):
+        load_scene(tmp_path / "bad.toml")
