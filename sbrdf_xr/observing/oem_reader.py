@@ -104,7 +104,7 @@ def read_oem(cls: Any, path: str | Path, max_step_factor: float = 10.0) -> Any:
     >>> read_oem(Ephemeris, "no-such-file.oem")
     Traceback (most recent call last):
         ...
-    sbrdf_xr.errors.EphemerisError: oem: no-such-file.oem does not exist
+    sbrdf_xr.errors.EphemerisError: oem: file ...no-such-file.oem does not exist
     """
     from astropy.time import Time
     from oem import OrbitEphemerisMessage

@@ -135,10 +135,11 @@ def read_tracking_table(
         ...
     sbrdf_xr.errors.TrackingTableError: tracking table ...: line 4: column 'range' is 'abc', ...
     >>> import warnings
-    >>> with warnings.catch_warnings(record=True):
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
     ...     table = read_tracking_table(path, site, range_km="range", on_bad="drop")
-    >>> table.times.size, table.dropped
-    (1, ((4, "column 'range' is 'abc', not a number"),))
+    >>> table.times.size, table.dropped, len(caught)  # counted, listed and warned
+    (1, ((4, "column 'range' is 'abc', not a number"),), 1)
     """
     if on_bad not in ("raise", "drop"):
         raise TrackingTableError(f"on_bad: got {on_bad!r}; allowed: raise, drop")
@@ -229,7 +230,7 @@ def read_pomenis(path: str | Path, *, on_bad: str = "raise") -> TrackingTable:
     ...     "ab_magnitude\\n2022-01-25T13:28:39,448.4444346,32.87386184,316.0661315,4.86\\n")
     >>> table = read_pomenis(path)
     >>> table.site.name, table.columns["ab_magnitude"].tolist(), round(float(table.ranges()[0]))
-    ('pomenis-mount-lemmon', [4.86], 774)
+    ('pomenis-mount-lemmon', [4.86], 765)
     """
     p = input_file(path, "pomenis", TrackingTableError)
     head = [ln for ln in p.read_text(encoding="utf-8").splitlines()[:40] if ln.startswith("#")]
