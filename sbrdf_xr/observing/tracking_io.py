@@ -30,7 +30,13 @@ from .orbits import Site
 from .timescales import to_datetime64
 from .tracking import TrackingTable
 
-__all__ = ["POMENIS_SITE", "read_pomenis", "read_tracking_table"]
+__all__ = [
+    "POMENIS_SITE",
+    "TRACKING_KEYS",
+    "read_pomenis",
+    "read_tracking_table",
+    "tracking_from_dict",
+]
 
 #: The Pomenis telescope on Mount Lemmon: the latitude and longitude the data's header gives
 #: (32.4434 N, 110.7881 W); the height (not given there) that of the Minor Planet Center's
@@ -256,3 +262,70 @@ def read_pomenis(path: str | Path, *, on_bad: str = "raise") -> TrackingTable:
         ),
         track=None,
     )
+
+
+#: Keys of a scene file's ``[observation.tracking]`` table besides ``path`` and ``format``:
+#: the arguments of :func:`read_tracking_table`.
+TRACKING_KEYS = (
+    "time",
+    "elevation",
+    "azimuth",
+    "ra",
+    "dec",
+    "range_km",
+    "height_km",
+    "track",
+    "time_zone",
+    "on_bad",
+    "name",
+)
+
+
+def tracking_from_dict(
+    spec: Any, site: Site | None, base_dir: str | Path | None = None
+) -> TrackingTable:
+    """A tracking table from a scene file's ``tracking`` table.
+
+    ``path`` (relative to ``base_dir``), ``format`` (``"csv"``, the default, read by
+    :func:`read_tracking_table` with the column names and options of
+    :data:`TRACKING_KEYS`, at ``site``; or ``"pomenis"``, :func:`read_pomenis`, at its own
+    site).
+
+    Examples
+    --------
+    >>> tracking_from_dict({"format": "pomenis"}, None)
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.TrackingTableError: [observation.tracking]: needs a path
+    >>> tracking_from_dict({"path": "t.csv", "colour": "red"}, None)
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.TrackingTableError: [observation.tracking]: unknown key(s) ['colour']; ...
+    """
+    if not isinstance(spec, dict) or "path" not in spec:
+        raise TrackingTableError("[observation.tracking]: needs a path")
+    bad = sorted(set(spec) - {"path", "format", *TRACKING_KEYS})
+    if bad:
+        raise TrackingTableError(
+            f"[observation.tracking]: unknown key(s) {bad}; allowed: path, format, "
+            + ", ".join(TRACKING_KEYS)
+        )
+    path = Path(spec["path"])
+    if not path.is_absolute() and base_dir is not None:
+        path = Path(base_dir) / path
+    fmt = spec.get("format", "csv")
+    opts = {k: v for k, v in spec.items() if k not in ("path", "format")}
+    if fmt == "pomenis":
+        if site is not None or set(opts) - {"on_bad"}:
+            raise TrackingTableError(
+                "[observation.tracking]: format pomenis fixes its site and columns; give "
+                f"only path and on_bad (got site {site!r}, {sorted(opts)})"
+            )
+        return read_pomenis(path, **opts)
+    if fmt != "csv":
+        raise TrackingTableError(
+            f"[observation.tracking] format: got {fmt!r}; allowed: csv, pomenis"
+        )
+    if site is None:
+        raise TrackingTableError("[observation]: a csv tracking table needs the site")
+    return read_tracking_table(path, site, **opts)
