@@ -342,8 +342,8 @@ def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     """
     import numpy as np
 
-    from ..observing.ephemeris import Ephemeris
     from ..observing.observe import Observation, Orbit, Site, times
+    from ..observing.oem_reader import read_oem
     from ..observing.timescales import to_datetime64
 
     spec = args.elements
@@ -351,7 +351,7 @@ def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     if Path(spec).is_file() and _is_oem(Path(spec)):
         if args.satellite:
             raise ValidationError("--satellite picks from an element file, not from an OEM")
-        orbit = Ephemeris.from_oem(spec)
+        orbit = read_oem(spec)
     elif Path(spec).is_file():
         orbit = Orbit.from_file(spec, args.satellite)
     else:
