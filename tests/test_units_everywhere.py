@@ -208,6 +208,7 @@ def unit_arguments() -> dict[tuple[str, str], str]:
 WL = np.array([500.0, 600.0, 700.0])  # [nm]
 NORMAL, TO_SUN, TO_OBS = [0.0, 0.0, 1.0], [0.5, 0.0, 1.0], [-0.4, 0.1, 1.0]
 T0 = np.datetime64("2024-03-17T01:20:00", "ns")
+_T2 = np.array(["2024-03-17T01:20:00", "2024-03-17T01:20:10"], dtype="datetime64[ns]")
 
 
 def _rs() -> dict[str, Any]:
@@ -704,6 +705,45 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         velocity_km_s=np.array([[0.0, 7.5, 0.0]]),
         sun_km=np.array([[1.496e8, 0.0, 0.0]]),
     ),
+    "sbrdf_xr.observing.ephemeris.Ephemeris.from_states": lambda: dict(
+        times=_T2,
+        position_km=[[7000.0, 0.0, 0.0], [7000.0, 75.0, 0.0]],
+        velocity_km_s=[[0.0, 7.5, 0.0], [0.0, 7.5, 0.0]],
+    ),
+    "sbrdf_xr.observing.ephemeris.to_gcrs": lambda: dict(
+        frame="ITRF",
+        times=_T2[:1],
+        position_km=[[7000.0, 0.0, 0.0]],
+        velocity_km_s=[[0.0, 0.0, 7.5]],
+    ),
+    "sbrdf_xr.observing.passes.visible_passes": lambda: dict(
+        source=_observation().orbit,
+        site=_observation().site,
+        start="2024-03-17T01:18:00",
+        stop="2024-03-17T01:24:00",
+        min_elevation_deg=15.0,
+        step_s=30.0,
+        cross_section_m2=2.0,
+    ),
+    "sbrdf_xr.observing.tracking.TrackingTable": lambda: dict(
+        site=_observation().site,
+        times=_T2,
+        elevation_deg=[90.0, 90.0],
+        azimuth_deg=[0.0, 30.0],
+        range_km=[500.0, 570.0],
+        height_km=[501.111, 571.111],  # at the zenith of a site 1111 m up
+        max_gap_s=30.0,
+    ),
+    "sbrdf_xr.observing.tracking.range_for_height": lambda: dict(
+        site=_observation().site, direction_itrs=[[1.0, 0.0, 0.0]], height_km=[550.0]
+    ),
+    "sbrdf_xr.observing.tracking.topocentric_to_gcrs": lambda: dict(
+        site=_observation().site,
+        times=_T2,
+        elevation_deg=[30.0, 40.0],
+        azimuth_deg=[10.0, 20.0],
+        range_km=[900.0, 800.0],
+    ),
     # --- photometry
     "sbrdf_xr.photometry.atmosphere.airmass": lambda: dict(elevation=[30.0, 60.0]),
     "sbrdf_xr.photometry.atmosphere.rayleigh_optical_depth": lambda: dict(
@@ -780,6 +820,11 @@ for _name, _arg in (
     ("sbrdf_xr.invert._joint.fit_observation", "light_curve"),
 ):
     EXEMPT[(_name, _arg)] = _CONTAINER
+for _arg in ("ra_deg", "dec_deg"):
+    EXEMPT[("sbrdf_xr.observing.tracking.TrackingTable", _arg)] = (
+        "exclusive with elevation_deg/azimuth_deg, whose case runs the same conversion; "
+        "tests/observing/test_tracking.py converts RA/Dec Quantities"
+    )
 EXEMPT[("sbrdf_xr.bench.suite.bench_geometry", "step_s")] = (
     "a benchmark's problem size: the timing tools take bare numbers"
 )
@@ -980,6 +1025,7 @@ SLOW = {
     "sbrdf_xr.invert._studies.spin_recovery",
     "sbrdf_xr.plot.cube.cube_figure",
     "sbrdf_xr.plot.cube.rotation_figure",
+    "sbrdf_xr.observing.passes.visible_passes",
     "sbrdf_xr.plot.cube.observation_figure",
 }
 #: Cases whose result is a figure or a timing: the Quantity must be accepted, the
@@ -996,6 +1042,7 @@ NOT_COMPARED = {
 
 #: What of a result is compared (a study's wall times are not; a function's values are).
 POST = {
+    "sbrdf_xr.observing.ephemeris.Ephemeris.from_states": lambda e: e.state(_T2),
     "sbrdf_xr.invert._studies.spin_recovery": lambda ds: ds.drop_vars("seconds"),
     "sbrdf_xr.invert._joint_study.observation_recovery": lambda ds: ds.drop_vars(
         ["seconds_per_fit", "simulate_seconds", "fit_to_simulate"]

@@ -77,8 +77,8 @@ def add_observe_parser(sub: Any, mesh_options: Any) -> argparse.ArgumentParser:
         "--elements",
         required=True,
         metavar="FILE|NAME",
-        help="a TLE file (2- or 3-line sets), an OMM file (.json, .xml, .csv) or "
-        "a catalog orbit ('sbrdf-xr catalog list --kind orbit')",
+        help="a TLE file (2- or 3-line sets), an OMM file (.json, .xml, .csv), a CCSDS "
+        "OEM file (states) or a catalog orbit ('sbrdf-xr catalog list --kind orbit')",
     )
     g.add_argument(
         "--satellite",
@@ -187,7 +187,9 @@ def add_observe_parser(sub: Any, mesh_options: Any) -> argparse.ArgumentParser:
         metavar="KG_M3",
         help="tumble: inertia of the mesh filled at this uniform density",
     )
-    a.add_argument("--series", metavar="FILE", help="series: quaternions over time (.csv, .nc)")
+    a.add_argument(
+        "--series", metavar="FILE", help="series: quaternions over time (.csv, .nc, CCSDS .aem)"
+    )
     s = po.add_argument_group("spacecraft and output")
     s.add_argument(
         "--spacecraft",
@@ -279,7 +281,8 @@ def attitude_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     if kind == "series":
         if not args.series:
             raise AttitudeError("--attitude series: give --series FILE (.csv or .nc)")
-        return law.law_from_dict({"law": "quaternion_series", "path": args.series})
+        kind_of = "aem" if Path(args.series).suffix.lower() == ".aem" else "quaternion_series"
+        return law.law_from_dict({"law": kind_of, "path": args.series})
     initial: Any = (0.0, 0.0, 0.0, 1.0)
     if args.initial:
         if kind == "spin" and args.initial in ("nadir", "sun-pointing"):
@@ -313,6 +316,16 @@ def attitude_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
         )
 
 
+def _is_oem(path: Path) -> bool:
+    """A CCSDS OEM file (by its suffix or its first keyword), not elements."""
+    if path.suffix.lower() == ".oem":
+        return True
+    with contextlib.suppress(OSError, UnicodeDecodeError):
+        head = path.read_text(encoding="utf-8")[:400]
+        return "CCSDS_OEM_VERS" in head or "<oem" in head
+    return False
+
+
 def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     """The :class:`~sbrdf_xr.observing.observation.Observation` of the ``observe`` options.
 
@@ -330,10 +343,16 @@ def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     import numpy as np
 
     from ..observing.observe import Observation, Orbit, Site, times
+    from ..observing.oem_reader import read_oem
     from ..observing.timescales import to_datetime64
 
     spec = args.elements
-    if Path(spec).is_file():
+    orbit: Any
+    if Path(spec).is_file() and _is_oem(Path(spec)):
+        if args.satellite:
+            raise ValidationError("--satellite picks from an element file, not from an OEM")
+        orbit = read_oem(spec)
+    elif Path(spec).is_file():
         orbit = Orbit.from_file(spec, args.satellite)
     else:
         if args.satellite:
