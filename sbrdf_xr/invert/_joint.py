@@ -22,6 +22,7 @@ from scipy.optimize import least_squares
 from ..errors import FitQualityWarning, InversionError
 from ..units import to_unit
 from ._areas import material_areas
+from ._bounds import covariance, stick_breaking, stick_breaking_inverse
 from ._joint_model import PassModel, pass_data
 from ._joint_result import Layout, model_check, result_dataset
 from ._joint_starts import Start, minima_dataset, start_states
@@ -324,9 +325,14 @@ def fit_observation(
     span = max(float(np.ptp(data.seconds)), 1e-9)
     states = start_states(starts, spin, start, dt_epoch, model.t_ref, span, read)
     local = [_refine(model, lay, st, span) for st in states]
+    lowest = min(local, key=lambda m: m.chi2)
+    unbounded = outside_physics(lay, lowest.x)
+    for i, st in enumerate(states):  # a minimum outside physics: refined inside the bounds
+        if outside_physics(lay, local[i].x):
+            local[i] = _refine(model, lay, st, span, bounded=True)
     best = min(range(len(local)), key=lambda i: local[i].chi2)
     res, axis_of, residuals = local[best].res, local[best].axis_of, local[best].residuals
-    p = res.x
+    p = local[best].x
     if not p[2] > 0:
         raise InversionError(
             f"the fit ran to a period of {p[2]:.4g} s from {start['period']:.4g} s: start "
@@ -336,13 +342,11 @@ def fit_observation(
     chi2 = float(r @ r)
     dof = data.magnitude.size - lay.n
     jac = _jacobian(residuals, p, lay.steps(p[2]))
-    try:
-        cov = np.linalg.inv(jac.T @ jac)
-    except np.linalg.LinAlgError:
-        cov = np.full((lay.n, lay.n), np.inf)
+    cov, free = covariance(jac)
     if scale_uncertainties:
         cov = cov * chi2 / dof
     quality = fit_quality(chi2, dof, "joint fit", JOINT_CAUSES)
+    status = _status(lay, local[best], unbounded, free, quality, chi2 / dof)
     fit_s = time.perf_counter() - t_start
     ds = result_dataset(
         lay=lay,
@@ -350,6 +354,7 @@ def fit_observation(
         light_curve=light_curve,
         p=p,
         cov=cov,
+        free=free,
         axis_of=axis_of,
         t_ref=model.t_ref,
         dt_epoch=dt_epoch,
@@ -366,12 +371,21 @@ def fit_observation(
             )
             + ": covariance (J^T J)^-1 of the normalised residuals, J by central differences "
             "at the solution",
-            "optimizer": f"scipy least_squares (lm): {res.message} ({res.nfev} evaluations)",
+            "optimizer": f"scipy least_squares ({'trf, bounded' if local[best].bounded else 'lm'})"
+            f": {res.message} ({res.nfev} evaluations)",
+            **status,
             "n_model_evaluations": int(model.n_calls),
             "fit_seconds": fit_s,  # the fit, without the check
             "time_source": data.time_source,
         },
     )
+    if ds.attrs["status"] == "ok" and bool(np.isnan(ds["uncertainty"].values).any()):
+        ds.attrs["status"] = "failed"
+        ds.attrs["status_note"] = f"the fit failed: its covariance is not finite. {RECOVER}"
+        status["status_note"] = ds.attrs["status_note"]
+    for key in ("status_note", "unconstrained_note"):
+        if key in status:
+            warnings.warn(f"joint fit: {status[key]}", FitQualityWarning, stacklevel=2)
     ds = ds.merge(_minima(local, best, model.t_ref, dt_epoch))
     ds.attrs["ambiguity"] = _ambiguity(ds)
     if ds.attrs["ambiguity"] != "none":
@@ -395,10 +409,14 @@ class _Local:
     residuals: Callable[[np.ndarray], np.ndarray]
     chi2: float
     label: str
+    x: np.ndarray
+    bounded: bool = False
 
 
-def _refine(model: PassModel, lay: Layout, st: Start, span: float) -> _Local:
-    """Levenberg-Marquardt from one start (the axis on the tangent plane of its axis)."""
+def _refine(model: PassModel, lay: Layout, st: Start, span: float, bounded: bool = False) -> _Local:
+    """Levenberg-Marquardt from one start (the axis on the tangent plane of its axis); with
+    ``bounded``, the trust-region reflective method on the area fractions' stick-breaking
+    transform in ``[0, 1]`` (or scales ``>= 0``), keeping them inside physics."""
     data = model.data
     e0 = st.axis
     east, north = _tangent(e0)
@@ -412,28 +430,126 @@ def _refine(model: PassModel, lay: Layout, st: Start, span: float) -> _Local:
         m = model.magnitudes(terms, lay.scales(p)) + lay.extra(p, data)
         return (data.magnitude - m) / data.sigma
 
-    res = least_squares(
-        residuals,
-        lay.start(st.period, st.phase_ref),
-        x_scale=lay.x_scale(st.period, span),
-        method="lm",
-        diff_step=1e-7,
-        max_nfev=MAX_NFEV,
-        ftol=1e-10,
-        xtol=1e-10,
+    p0 = lay.start(st.period, st.phase_ref)
+    opts = {"diff_step": 1e-7, "max_nfev": MAX_NFEV, "ftol": 1e-10, "xtol": 1e-10}
+    scale = lay.x_scale(st.period, span)
+    if not bounded:
+        res = least_squares(residuals, p0, x_scale=scale, method="lm", **opts)
+        x = res.x
+    else:
+        to_p, q0, lo, hi = _bounded_map(lay, p0, st.period)
+        res = least_squares(
+            lambda q: residuals(to_p(q)), q0, x_scale=scale, method="trf", bounds=(lo, hi), **opts
+        )
+        x = to_p(res.x)
+    chi2 = float(2.0 * res.cost) if x[2] > 0 else np.inf
+    return _Local(res, axis_of, residuals, chi2, st.label, x, bounded)
+
+
+#: How to recover from a failed fit.
+RECOVER = (
+    "recover: fit the spin first (fit_spin(light_curve, spacecraft, geometry=observation)) "
+    "and start from its result with starts='aliases'; check the materials and the shape if "
+    "that fails too. The values returned are the last iterate, not estimates"
+)
+
+
+def _status(
+    lay: Layout,
+    loc: _Local,
+    unbounded: list[str],
+    free: np.ndarray,
+    quality: Mapping[str, Any],
+    reduced: float,
+) -> dict[str, str]:
+    """``status`` ("ok" or "failed") with ``status_note`` (why it failed, or what bound
+    holds), ``bounded`` and ``unconstrained_note``: what the result can be trusted for."""
+    out: dict[str, str] = {"status": "ok"}
+    why = []
+    if loc.res.status <= 0:
+        why.append(f"the optimizer stopped without converging ({loc.res.message})")
+    if not np.all(np.isfinite(loc.x)):
+        why.append("the parameters are not finite")
+    if unbounded and quality.get("fit_quality") == "poor":
+        why.append(
+            f"the lowest minimum needs area fractions outside [0, 1] ({', '.join(unbounded)}) "
+            f"and the fit inside the bounds does not describe the data (reduced chi-square "
+            f"{reduced:.4g}): the spin state is likely wrong, not the areas"
+        )
+    if why:
+        out["status"] = "failed"
+        out["status_note"] = "the fit failed: " + "; ".join(why) + ". " + RECOVER
+    out["bounded"] = (
+        f"the unconstrained minimum lies outside physics ({', '.join(unbounded)}): refined "
+        "with the area fractions held inside [0, 1] (stick-breaking transform); a fraction "
+        "at 0 or 1 is at its bound, its uncertainty is the curvature's"
+        if unbounded
+        else "none: the minimum lies inside the physical bounds"
     )
-    chi2 = float(2.0 * res.cost) if res.x[2] > 0 else np.inf
-    return _Local(res, axis_of, residuals, chi2, st.label)
+    names = [n for n, f in zip(lay.names, free, strict=True) if f]
+    if names:
+        out["unconstrained_note"] = (
+            f"the data do not constrain {', '.join(names)} (a null direction of the Jacobian: "
+            "a material never lit and seen, extinction and zero point over a constant air "
+            "mass): each is reported at its start value with an infinite uncertainty"
+        )
+    out["unconstrained"] = ", ".join(names) if names else "none"
+    return out
+
+
+def _bounded_map(
+    lay: Layout, p0: np.ndarray, period: float
+) -> tuple[Callable[[np.ndarray], np.ndarray], np.ndarray, np.ndarray, np.ndarray]:
+    """The bounded parameters ``q`` of a fit (area fractions by their stick-breaking
+    transform ``u`` in ``[0, 1]``, scales ``>= 0``, period ``> 0``): the map ``q -> p``, the
+    start ``q0`` and the bounds."""
+    sl = lay.sl["f"]
+    lo = np.full(lay.n, -np.inf)
+    hi = np.full(lay.n, np.inf)
+    lo[2] = 1e-6 * period
+    q0 = p0.copy()
+    if lay.areas == "total":
+        lo[sl], hi[sl] = 0.0, 1.0
+        q0[sl] = stick_breaking_inverse(p0[sl])
+    elif lay.areas == "free":
+        lo[sl] = 0.0
+
+    def to_p(q: np.ndarray) -> np.ndarray:
+        p = np.array(q, dtype=np.float64)
+        if lay.areas == "total":
+            p[sl] = stick_breaking(q[sl])[:-1]
+        return p
+
+    return to_p, np.clip(q0, lo, hi), lo, hi
+
+
+def outside_physics(lay: Layout, p: np.ndarray, tol: float = 1e-9) -> list[str]:
+    """The area fractions (or scales) of ``p`` outside their physical bounds, as text.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.invert._joint import outside_physics
+    >>> from sbrdf_xr.invert._joint_result import Layout
+    >>> lay = Layout(("V",), ("a", "b"), np.array([1.0, 1.0]), "fit", None, "total")
+    >>> outside_physics(lay, np.array([0, 0, 10, 0, 0.1, 1.3]))
+    ['a 1.3', 'b -0.3']
+    """
+    if lay.areas == "fixed":
+        return []
+    f = lay.fractions(p) if lay.areas == "total" else lay.scales(p)
+    top = 1.0 if lay.areas == "total" else np.inf
+    bad = (f < -tol) | (f > top + tol)
+    return [f"{m} {v:.4g}" for m, v, b in zip(lay.materials, f, bad, strict=True) if b]
 
 
 def _minima(local: Sequence[_Local], best: int, t_ref: float, dt_epoch: float) -> xr.Dataset:
     """The table of the minima refined from every start (phases at the epoch)."""
-    x = np.array([m.res.x[:4] for m in local])
+    x = np.array([m.x[:4] for m in local])
     phase = (x[:, 3] - 360.0 * (t_ref - dt_epoch) / np.where(x[:, 2] > 0, x[:, 2], np.nan)) % 360
     return minima_dataset(
         [m.label for m in local],
         np.array([m.chi2 for m in local]),
-        np.array([m.axis_of(m.res.x) for m in local]),
+        np.array([m.axis_of(m.x) for m in local]),
         x[:, 2],
         phase,
         best,

@@ -13,6 +13,7 @@ from .._names import attrs as cf
 from ._joint_model import PassData
 from ._quality import quality_attrs
 from ._spin_search import lonlat
+from ._unmix import correlation
 
 __all__ = ["Layout", "model_check", "result_dataset"]
 
@@ -144,6 +145,7 @@ def result_dataset(
     light_curve: xr.Dataset,
     p: np.ndarray,
     cov: np.ndarray,
+    free: np.ndarray,
     axis_of: Any,
     t_ref: float,
     dt_epoch: float,
@@ -158,12 +160,19 @@ def result_dataset(
     lon, lat = (float(v) for v in lonlat(axis))
     phase = (p[3] - 360.0 * (t_ref - dt_epoch) / p[2]) % 360.0
     t = _transform(lay, p, axis_of, t_ref, dt_epoch)
-    finite = np.all(np.isfinite(cov))
-    c_out = t @ cov @ t.T if finite else np.full_like(cov, np.nan)
+    # a parameter the data do not constrain (free) carries an infinite variance into every
+    # output that depends on it; the others' covariance is carried through t
+    finite = bool(np.all(np.isfinite(cov[np.ix_(~free, ~free)])))
+    c_out = t @ np.where(np.outer(free, free) | ~np.isfinite(cov), 0.0, cov) @ t.T
+    if not finite:
+        c_out = np.full_like(cov, np.nan)
+    free_out = (np.abs(t) @ free.astype(float)) > 0
+    c_out[free_out, :] = 0.0
+    c_out[:, free_out] = 0.0
+    c_out[free_out, free_out] = np.inf
     sd = np.sqrt(np.clip(np.diag(c_out), 0, None))
     est = np.array([lon, lat, p[2], phase, *p[4:]])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        corr = c_out / np.outer(sd, sd)
+    corr = correlation(c_out)
     ds = xr.Dataset(
         coords={
             "parameter": ("parameter", lay.names, _cf("1", "fitted parameter")),
@@ -193,10 +202,12 @@ def result_dataset(
     # the 1-sigma ellipse of the axis on the sphere: the east/north covariance, in degrees
     # of arc (the longitude step times cos latitude)
     c_ax = c_out[:2, :2] * np.outer([np.cos(np.radians(lat)), 1.0], [np.cos(np.radians(lat)), 1.0])
-    ev = np.linalg.eigvalsh(c_ax) if finite else np.array([np.nan])
+    if free_out[:2].any():
+        c_ax = np.full((2, 2), np.inf)
+    ev = np.linalg.eigvalsh(c_ax) if finite and np.isfinite(c_ax).all() else np.array([np.inf])
     ds["axis_uncertainty"] = (
         (),
-        float(np.sqrt(max(ev.max(), 0.0))) if finite else float("nan"),
+        float(np.sqrt(max(ev.max(), 0.0))) if finite else float("nan"),  # nan: failed
         _cf("degree", "major semi-axis of the 1-sigma ellipse of the spin axis"),
     )
     ds["axis_vector"] = ("xyz", axis, _cf("1", "unit vector of the inertial spin axis"))
@@ -289,7 +300,12 @@ def _areas(ds: xr.Dataset, lay: Layout, p: np.ndarray, c_out: np.ndarray) -> Non
     else:
         g = np.zeros((nm, 0))
     f = lay.fractions(p)
-    f_sd = np.sqrt(np.clip(np.diag(g @ c_out[sl, sl] @ g.T), 0, None)) if g.size else np.zeros(nm)
+    c_f = c_out[sl, sl]
+    inf = np.isinf(np.diag(c_f))  # not constrained: inf in every fraction that holds it
+    c_f = np.where(np.isinf(c_f), 0.0, c_f)
+    f_sd = np.sqrt(np.clip(np.diag(g @ c_f @ g.T), 0, None)) if g.size else np.zeros(nm)
+    if g.size:
+        f_sd[(np.abs(g) @ inf.astype(float)) > 0] = np.inf
     per_area = lay.total / np.where(lay.model_area > 0, lay.model_area, 1)
     how = {
         "total": "of the mesh's total area (they add up to 1)",

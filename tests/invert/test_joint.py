@@ -122,6 +122,8 @@ def test_result_is_self_describing(fit):
     assert float(fit.area_fraction_uncertainty[-1]) == pytest.approx(np.sqrt(cov.sum()))
     assert fit.attrs["uncertainty_scaling"].startswith("unscaled")
     assert fit.attrs["epoch"] == "2024-03-17T19:55:00.000"
+    assert fit.attrs["status"] == "ok" and fit.attrs["unconstrained"] == "none"
+    assert fit.attrs["bounded"].startswith("none")
 
 
 def test_starts_from_fit_spin(sc, lc, night, fit):
@@ -232,9 +234,17 @@ def test_aliases_find_the_minimum_a_start_misses(sc):
     lc["magnitude"] = clean.magnitude + np.random.default_rng(3).normal(0.0, 0.02, lc.sizes["obs"])
     lc["uncertainty"] = clean.uncertainty + 0.02
     start = {**truth, "axis_longitude": 216.0, "axis_latitude": 41.0, "period": 10.2, "phase": 33.0}
-    with pytest.warns(FitQualityWarning, match="beyond the 99.9 %"):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", FitQualityWarning)
         local = invert.fit_observation(lc, sc, pass_, start, check=False)
+    said = " ".join(str(w.message) for w in caught)
+    assert "beyond the 99.9 %" in said and "the fit failed" in said and "fit_spin" in said
     assert float(local.reduced_chi2) > 5 and abs(float(local.period) - 10.0) > 0.2
+    # its minimum needs impossible areas: refined inside the bounds, and marked failed
+    assert local.attrs["status"] == "failed" and "outside physics" in local.attrs["bounded"]
+    f = local.area_fraction.values
+    assert np.all((f >= 0) & (f <= 1)) and float(f.sum()) == pytest.approx(1.0)
+    assert np.all(np.isfinite(local.uncertainty.values))
     with warnings.catch_warnings():
         warnings.simplefilter("error", FitQualityWarning)  # consistent, and not ambiguous
         fit = invert.fit_observation(lc, sc, pass_, start, starts="aliases", check=False)
