@@ -23,6 +23,8 @@ from ..errors import FitQualityWarning, InversionError
 from ..units import to_unit
 from ._areas import material_areas
 from ._bounds import covariance, stick_breaking, stick_breaking_inverse
+from ._extinction import extinction_prior as _k_prior
+from ._extinction import separable_sd
 from ._joint_model import PassModel, pass_data
 from ._joint_result import Layout, model_check, result_dataset
 from ._joint_starts import Start, minima_dataset, start_states
@@ -149,6 +151,7 @@ def fit_observation(
     scale_uncertainties: bool = False,
     starts: str | Sequence[Mapping[str, Any]] = "given",
     check: bool = True,
+    extinction_prior: Mapping[str, Any] | None = None,
 ) -> xr.Dataset:
     """Spin state, extinction, zero points and material areas fitted jointly to the
     calibrated magnitudes measured over a pass.
@@ -300,13 +303,22 @@ def fit_observation(
     ab = _axis_body(spin, axis_body)
     data = pass_data(light_curve, observation, bands, system)
     k_mode = _options(extinction, offset, areas, data.labels)
+    k_prior = _k_prior(extinction_prior, data.labels)
+    k_sep = separable_sd(data.airmass, data.sigma, data.band, len(data.labels))
+    held = None
+    if isinstance(k_mode, str) and bool(np.any(k_sep > k_prior[1])):
+        k_mode, held = k_prior[0], _held_note(data, k_sep, k_prior, offset, areas)
+        if offset is None and areas != "free":
+            offset = "band"  # k Xbar over the pass is a zero point: fitted as one
     model = PassModel(data, spacecraft, ab, materials)
     names = model.materials
     area_of = material_areas(spacecraft)
     a_model = np.array([area_of.get(m, 0.0) for m in names])
     if epoch is None:
         epoch = data.epoch
-    lay = Layout(data.labels, names, a_model, k_mode, offset, areas)
+    lay = Layout(
+        data.labels, names, a_model, k_mode, offset, areas, None if held is None else k_prior[1]
+    )
     if data.magnitude.size <= lay.n:
         raise InversionError(
             f"light curve: {data.magnitude.size} values for {lay.n} parameters "
@@ -347,6 +359,12 @@ def fit_observation(
         cov = cov * chi2 / dof
     quality = fit_quality(chi2, dof, "joint fit", JOINT_CAUSES)
     status = _status(lay, local[best], unbounded, free, quality, chi2 / dof)
+    if held is not None:
+        status["unconstrained"] = ", ".join(
+            [f"extinction_{b}" for b in lay.bands]
+            + [n for n in [status["unconstrained"]] if n != "none"]
+        )
+        status["extinction_note"] = held
     fit_s = time.perf_counter() - t_start
     ds = result_dataset(
         lay=lay,
@@ -383,7 +401,7 @@ def fit_observation(
         ds.attrs["status"] = "failed"
         ds.attrs["status_note"] = f"the fit failed: its covariance is not finite. {RECOVER}"
         status["status_note"] = ds.attrs["status_note"]
-    for key in ("status_note", "unconstrained_note"):
+    for key in ("status_note", "unconstrained_note", "extinction_note"):
         if key in status:
             warnings.warn(f"joint fit: {status[key]}", FitQualityWarning, stacklevel=2)
     ds = ds.merge(_minima(local, best, model.t_ref, dt_epoch))
@@ -495,6 +513,28 @@ def _status(
         )
     out["unconstrained"] = ", ".join(names) if names else "none"
     return out
+
+
+def _held_note(
+    data: Any, k_sep: np.ndarray, prior: tuple[np.ndarray, np.ndarray, str], offset: Any, areas: str
+) -> str:
+    """Why the extinction is held at its prior, and what takes its place."""
+    worst = int(np.argmax(k_sep / prior[1]))
+    x = data.airmass
+    took = (
+        "its share k Xbar over the pass is fitted as a zero point per band"
+        if offset is None and areas != "free"
+        else "the fitted zero points take its share k Xbar"
+        if offset is not None
+        else "with free area scales no zero point can take its share k Xbar: the scales carry it"
+    )
+    return (
+        f"extinction not constrained: the air mass spans only {x.min():.6g}-{x.max():.6g}, "
+        f"so with a free zero point band {data.labels[worst]}'s coefficient would be known "
+        f"to +- {k_sep[worst]:.3g} mag per air mass, no better than its prior +- "
+        f"{prior[1][worst]:.3g} ({prior[2]}); every coefficient is held at its prior value "
+        f"and reported with the prior's width, and {took}"
+    )
 
 
 def _bounded_map(

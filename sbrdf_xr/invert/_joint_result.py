@@ -36,6 +36,7 @@ class Layout:
     k_mode: Any  # "fit" or the given coefficients (B,)
     offset: str | None
     areas: str
+    k_prior_sd: np.ndarray | None = None  # extinction held at its prior: the prior's width
 
     def __post_init__(self) -> None:
         nb, nm = len(self.bands), len(self.materials)
@@ -214,6 +215,9 @@ def result_dataset(
     nb = len(lay.bands)
     k_sd = sd[lay.sl["k"]] if isinstance(lay.k_mode, str) else np.zeros(nb)
     k_how = "fitted" if isinstance(lay.k_mode, str) else "given (not fitted)"
+    if lay.k_prior_sd is not None:
+        k_sd = np.asarray(lay.k_prior_sd, dtype=np.float64)
+        k_how = "held at its prior (the pass's air mass cannot tell it from a zero point)"
     ds["extinction_coefficient"] = (
         "band",
         lay.extinction(p),
@@ -222,7 +226,11 @@ def result_dataset(
     ds["extinction_coefficient_uncertainty"] = (
         "band",
         k_sd,
-        cf("magnitude", long_name="1-sigma uncertainty of the extinction coefficient (0: given)"),
+        cf(
+            "magnitude",
+            long_name="1-sigma uncertainty of the extinction coefficient (0: given; the "
+            "prior's width: held at its prior)",
+        ),
     )
     if lay.offset == "common":
         ds["magnitude_offset"] = (

@@ -195,6 +195,12 @@ def test_a_wrong_model_warns(sc, lc, night):
         ({"starts": "all"}, "starts: 'all'; allowed 'given'"),
         ({"starts": START}, "starts: got a dict; allowed 'given', 'aliases' or a sequence"),
         ({"starts": [{**START, "period": -1.0}]}, r"start values must be finite with period > 0"),
+        (
+            {"extinction_prior": {"V": (0.2, 0.0), "R": (0.1, 0.1), "I": (0.05, 0.1)}},
+            r"extinction_prior\['V'\]: k 0.2, width 0.0; allowed finite values with a width > 0",
+        ),
+        ({"extinction_prior": {"V": (0.2, 0.1)}}, r"no \(k, width\) for bands \['R', 'I'\]"),
+        ({"extinction_prior": {"V": 0.2, "R": 1, "I": 2}}, r"allowed a pair \(k, width\)"),
     ],
 )
 def test_bad_options(sc, lc, night, change, match):
