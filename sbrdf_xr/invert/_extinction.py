@@ -103,8 +103,8 @@ def extinction_prior(
         sd[i] = float(np.asarray(to_unit(sv, "mag", "extinction_prior width")))
         if not (np.isfinite(k[i]) and np.isfinite(sd[i]) and sd[i] > 0):
             raise InversionError(
-                f"extinction_prior[{b!r}]: k {float(k[i])!r}, width {float(sd[i])!r}; allowed finite values "
-                "with a width > 0 [mag per air mass] (a prior of zero width is a given "
-                "coefficient: pass extinction={band: k})"
+                f"extinction_prior[{b!r}]: k {float(k[i])!r}, width {float(sd[i])!r}; allowed "
+                "finite values with a width > 0 [mag per air mass] (a prior of zero width is "
+                "a given coefficient: pass extinction={band: k})"
             )
     return k, sd, "given"

@@ -28,9 +28,11 @@ from ._extinction import separable_sd
 from ._joint_model import PassModel, pass_data
 from ._joint_result import Layout, model_check, result_dataset
 from ._joint_starts import Start, minima_dataset, start_states
+from ._joint_twins import twin_dataset
 from ._quality import fit_quality
 from ._spin import AMBIGUITY_CHI2
 from ._spin_refine import _tangent
+from ._symmetry import SYMMETRY_TOL, body_symmetries
 
 if TYPE_CHECKING:
     from ..body import Spacecraft
@@ -152,6 +154,7 @@ def fit_observation(
     starts: str | Sequence[Mapping[str, Any]] = "given",
     check: bool = True,
     extinction_prior: Mapping[str, Any] | None = None,
+    symmetry_tolerance: float = SYMMETRY_TOL,
 ) -> xr.Dataset:
     """Spin state, extinction, zero points and material areas fitted jointly to the
     calibrated magnitudes measured over a pass.
@@ -228,6 +231,21 @@ def fit_observation(
         Recompute the solution's magnitudes through :func:`sbrdf_xr.engine.simulate` and
         :func:`sbrdf_xr.photometry.magnitudes` (spectral signal, band-integrated): the
         largest difference is ``attrs["model_check"]``.
+    extinction_prior : mapping of str to (float, float), optional
+        ``{band: (k, width)}`` [mag per air mass], the prior of each extinction coefficient
+        (default: :func:`sbrdf_xr.photometry.extinction_coefficients` +- 0.1).  Used when
+        the pass's air mass cannot tell the extinction from a zero point: with a free zero
+        point a band's ``k`` would be known to ``1 / sqrt(sum (X - Xbar)^2 / sigma^2)``;
+        when that is wider than the prior (a geostationary object: a near-constant air
+        mass), every ``k`` is held at its prior value, reported with the prior's width,
+        and its share ``k Xbar`` is fitted as a zero point per band (``offset="band"``
+        unless set), with a warning.
+    symmetry_tolerance : float
+        Tolerance of the body's symmetries, in ``(0, 0.1]`` (normals within this chord,
+        areas within this fraction of the total): every rotation of the body frame that
+        maps the body's facets (normals, areas, materials: the model's terms) onto
+        themselves gives a twin state of the solution, evaluated on the data and listed
+        over ``twin`` and in ``ambiguity`` (:mod:`sbrdf_xr.invert._symmetry`).
 
     Returns
     -------
@@ -237,13 +255,32 @@ def fit_observation(
         over ``band``: ``extinction_coefficient``, ``zero_point`` (or the scalar
         ``magnitude_offset``) with uncertainties; over ``material``: ``area_fraction``,
         ``scale``, ``area`` [m2] with uncertainties and ``model_area``; over
-        ``parameter``: ``estimate``, ``uncertainty``, ``correlation``; ``chi2``, ``dof``,
+        ``parameter``: ``estimate``, ``uncertainty``, ``correlation``; over ``twin`` the
+        body's symmetry twins of the solution (``twin_chi2_gap``, ``twin_phase``,
+        ``twin_axis_longitude``, ``twin_axis_latitude``, ``twin_sense``); ``chi2``, ``dof``,
         ``reduced_chi2``, ``fit_probability``; over ``obs``: ``model_magnitude``,
         ``residual``, ``airmass``; over ``start``: the minimum refined from each start
         (``start_chi2``, ``start_chi2_gap`` above the solution's, ``start_period``,
         ``start_phase``, ``start_axis_longitude``, ``start_axis_latitude``,
         ``start_axis_separation``).  Attributes say what was fitted, how the uncertainties
-        are scaled, the ``fit_quality``, the ``ambiguity``, the model check and the timing.
+        are scaled, the ``fit_quality``, the ``ambiguity``, the model check and the timing,
+        and what the result can be trusted for: ``status`` (``"ok"`` or ``"failed"``, then
+        ``status_note`` says why and how to recover), ``bounded`` (whether the area
+        fractions were held inside ``[0, 1]``) and ``unconstrained`` (the parameters the
+        data do not constrain, reported at their start or prior value with an infinite
+        or the prior's uncertainty; ``unconstrained_note``, ``extinction_note``).
+
+    Notes
+    -----
+    Results stay inside physics: when the lowest minimum needs area fractions outside
+    ``[0, 1]`` (or negative scales), every start whose minimum does is refined again on
+    the stick-breaking transform of the fractions with box bounds
+    (:mod:`sbrdf_xr.invert._bounds`); if that fit is poor the result is marked
+    ``"failed"``: impossible areas mean the spin state is wrong.  A parameter whose
+    Jacobian column vanishes or lies in its null space (a material never lit and seen,
+    extinction and zero point over a constant air mass) is reported as not constrained
+    (infinite uncertainty, NaN correlations), never with the value of an inverse of a
+    singular matrix; no uncertainty is NaN in a result not marked ``"failed"``.
 
     Warns
     -----
@@ -252,7 +289,8 @@ def fit_observation(
         0.1 % point), naming the likely causes; or when a minimum from another start, at
         another spin state (period more than 3 sigma or axis more than 3 times its
         uncertainty away), fits within a chi-square of :data:`AMBIGUITY_CHI2` of the
-        solution.
+        solution; when the fit failed, a parameter is not constrained or the extinction
+        is held at its prior.
 
     Raises
     ------
@@ -311,6 +349,8 @@ def fit_observation(
         if offset is None and areas != "free":
             offset = "band"  # k Xbar over the pass is a zero point: fitted as one
     model = PassModel(data, spacecraft, ab, materials)
+    terms = model.kernel.plan.terms
+    syms = body_symmetries(terms.normal, terms.area, terms.material, ab, symmetry_tolerance)
     names = model.materials
     area_of = material_areas(spacecraft)
     a_model = np.array([area_of.get(m, 0.0) for m in names])
@@ -408,6 +448,12 @@ def fit_observation(
     ds.attrs["ambiguity"] = _ambiguity(ds)
     if ds.attrs["ambiguity"] != "none":
         warnings.warn(f"joint fit: {ds.attrs['ambiguity']}", FitQualityWarning, stacklevel=2)
+    twins, twin_text = twin_dataset(model, lay, local[best], p, chi2, syms, float(ds["phase"]))
+    ds = ds.merge(twins)
+    ds.attrs["symmetry_twins"] = twin_text
+    if twin_text != "none":
+        have = ds.attrs["ambiguity"]
+        ds.attrs["ambiguity"] = twin_text if have == "none" else f"{have}; {twin_text}"
     if check:
         t0 = time.perf_counter()
         ds.attrs["model_check"] = model_check(

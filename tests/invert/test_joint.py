@@ -257,7 +257,15 @@ def test_aliases_find_the_minimum_a_start_misses(sc):
     assert fit.start.values.tolist() == [
         "given", "alias -2/2 turn", "alias -1/2 turn", "alias +1/2 turn", "alias +2/2 turn"
     ]  # fmt: skip
-    assert float(fit.reduced_chi2) < 1.25 and fit.attrs["ambiguity"] == "none"
+    # no other minimum is ambiguous; CanX-1's symmetries give exact twins (a half turn
+    # about its spin axis and two flips), named in ambiguity, their chi2 gaps of rounding
+    assert float(fit.reduced_chi2) < 1.25 and fit.attrs["ambiguity"] == fit.attrs["symmetry_twins"]
+    assert fit.twin.values.tolist() == [
+        "turn 180 deg",
+        "flip about [0, 1, 0]",
+        "flip about [1, 0, 0]",
+    ]
+    assert np.all(np.abs(fit.twin_chi2_gap.values) < 1e-6)
     assert abs(float(fit.period) - 10.0) < 4 * float(fit.period_uncertainty)
     assert float(fit.start_chi2_gap.sel(start="given")) == pytest.approx(
         float(local.chi2) - float(fit.chi2), rel=1e-9
