@@ -23,12 +23,14 @@ from ..errors import FitQualityWarning, InversionError
 from ..units import to_unit
 from ._areas import material_areas
 from ._bounds import covariance, stick_breaking, stick_breaking_inverse
+from ._diagnose import CAUSES, likely_causes
 from ._extinction import extinction_prior as _k_prior
 from ._extinction import separable_sd
 from ._joint_model import PassModel, pass_data
 from ._joint_result import Layout, model_check, result_dataset
 from ._joint_starts import Start, minima_dataset, start_states
 from ._joint_twins import twin_dataset
+from ._model_error import table_widths
 from ._quality import fit_quality
 from ._spin import AMBIGUITY_CHI2
 from ._spin_refine import _tangent
@@ -40,7 +42,8 @@ if TYPE_CHECKING:
 
 __all__ = ["JOINT_CAUSES", "fit_observation"]
 
-#: Likely causes of a poor joint fit, most likely first.
+#: Likely causes of a poor joint fit (the warning ranks them from the residuals: see
+#: :mod:`sbrdf_xr.invert._diagnose`).
 JOINT_CAUSES = (
     "the fit stopped in a local minimum: start from a better spin state (fit_spin over the "
     "light curve) or from more (starts='aliases': the period aliases and fit_spin's twins)",
@@ -155,6 +158,7 @@ def fit_observation(
     check: bool = True,
     extinction_prior: Mapping[str, Any] | None = None,
     symmetry_tolerance: float = SYMMETRY_TOL,
+    material_scale: str | Mapping[str, float] | None = None,
 ) -> xr.Dataset:
     """Spin state, extinction, zero points and material areas fitted jointly to the
     calibrated magnitudes measured over a pass.
@@ -357,9 +361,16 @@ def fit_observation(
     if epoch is None:
         epoch = data.epoch
     lay = Layout(
-        data.labels, names, a_model, k_mode, offset, areas, None if held is None else k_prior[1]
+        data.labels,
+        names,
+        a_model,
+        k_mode,
+        offset,
+        areas,
+        None if held is None else k_prior[1],
+        table_widths(material_scale, names, model.kernel.sources),
     )
-    if data.magnitude.size <= lay.n:
+    if data.magnitude.size <= lay.n - lay.n_prior:
         raise InversionError(
             f"light curve: {data.magnitude.size} values for {lay.n} parameters "
             f"({', '.join(lay.names)}); need more values than parameters (fix some: "
@@ -390,14 +401,22 @@ def fit_observation(
             f"the fit ran to a period of {p[2]:.4g} s from {start['period']:.4g} s: start "
             "from a better spin state (fit_spin)"
         )
-    r = residuals(p)
-    chi2 = float(r @ r)
-    dof = data.magnitude.size - lay.n
+    r_all = residuals(p)
+    r = r_all[: data.magnitude.size]
+    chi2 = float(r_all @ r_all)  # with the priors' terms, each a datum: dof counts them
+    dof = data.magnitude.size + lay.n_prior - lay.n
     jac = _jacobian(residuals, p, lay.steps(p[2]))
     cov, free = covariance(jac)
     if scale_uncertainties:
         cov = cov * chi2 / dof
-    quality = fit_quality(chi2, dof, "joint fit", JOINT_CAUSES)
+    ranked = likely_causes(
+        r,
+        data.band,
+        p[3] + 360.0 * (data.seconds[data.t_index] - model.t_ref) / p[2],
+        data.airmass,
+        data.seconds[data.t_index],
+    )
+    quality = fit_quality(chi2, dof, "joint fit", _causes(ranked))
     status = _status(lay, local[best], unbounded, free, quality, chi2 / dof)
     if held is not None:
         status["unconstrained"] = ", ".join(
@@ -432,6 +451,8 @@ def fit_observation(
             "optimizer": f"scipy least_squares ({'trf, bounded' if local[best].bounded else 'lm'})"
             f": {res.message} ({res.nfev} evaluations)",
             **status,
+            "likely_causes": "residual patterns, (delta chi2 - k) / sqrt(2 k), about 0 +- 1 "
+            "for noise: " + ", ".join(f"{k} {v:.3g}" for k, v in ranked),
             "n_model_evaluations": int(model.n_calls),
             "fit_seconds": fit_s,  # the fit, without the check
             "time_source": data.time_source,
@@ -492,7 +513,7 @@ def _refine(model: PassModel, lay: Layout, st: Start, span: float, bounded: bool
     def residuals(p: np.ndarray) -> np.ndarray:
         terms = model.terms(axis_of(p), p[2], p[3])
         m = model.magnitudes(terms, lay.scales(p)) + lay.extra(p, data)
-        return (data.magnitude - m) / data.sigma
+        return np.append((data.magnitude - m) / data.sigma, lay.prior_residuals(p))
 
     p0 = lay.start(st.period, st.phase_ref)
     opts = {"diff_step": 1e-7, "max_nfev": MAX_NFEV, "ftol": 1e-10, "xtol": 1e-10}
@@ -516,6 +537,20 @@ RECOVER = (
     "and start from its result with starts='aliases'; check the materials and the shape if "
     "that fails too. The values returned are the last iterate, not estimates"
 )
+
+
+#: Score of a residual pattern above which its cause is named first.
+CAUSE_SCORE = 3.0
+
+
+def _causes(ranked: Sequence[tuple[str, float]]) -> list[str]:
+    """The likely causes of a poor fit, from the residual patterns (:func:`likely_causes`):
+    those scoring above :data:`CAUSE_SCORE`, highest first; else the understated
+    uncertainties (no pattern stands out)."""
+    out = [f"{CAUSES[k]} [score {v:.3g}]" for k, v in ranked if v > CAUSE_SCORE]
+    if not out:
+        out = ["no residual pattern stands out: the uncertainties are understated"]
+    return out
 
 
 def _status(

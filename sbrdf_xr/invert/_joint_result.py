@@ -37,6 +37,7 @@ class Layout:
     offset: str | None
     areas: str
     k_prior_sd: np.ndarray | None = None  # extinction held at its prior: the prior's width
+    m_sd: np.ndarray | None = None  # prior widths of the tables' scales (nuisance), or None
 
     def __post_init__(self) -> None:
         nb, nm = len(self.bands), len(self.materials)
@@ -44,6 +45,7 @@ class Layout:
             "k": nb if isinstance(self.k_mode, str) else 0,
             "z": {None: 0, "band": nb, "common": 1}[self.offset],
             "f": {"total": nm - 1, "free": nm, "fixed": 0}[self.areas],
+            "s": 0 if self.m_sd is None else nm,
         }
         i = 4
         self.sl: dict[str, slice] = {}
@@ -66,7 +68,9 @@ class Layout:
             *([f"extinction_{b}" for b in self.bands] if sizes["k"] else []),
             *(zn if self.offset != "common" else ["magnitude_offset"]),
             *fn,
+            *([f"table_scale_{m}" for m in self.materials] if sizes["s"] else []),
         ]
+        self.n_prior = sizes["s"]
         self.units = ["degree", "degree", "s", "degree"] + ["1"] * (i - 4)
 
     def fractions(self, p: np.ndarray) -> np.ndarray:
@@ -79,10 +83,29 @@ class Layout:
         return self.model_area / self.total
 
     def scales(self, p: np.ndarray) -> np.ndarray:
-        """Area scale ``a_m`` of each material."""
+        """Scale of each material's signal: its area scale ``a_m`` times its table's scale
+        (the nuisance parameter, 1 when not fitted)."""
+        t = self.table_scales(p)
         if self.areas == "free":
-            return np.asarray(p[self.sl["f"]], dtype=np.float64)
-        return self.fractions(p) * self.total / np.where(self.model_area > 0, self.model_area, 1)
+            return np.asarray(p[self.sl["f"]], dtype=np.float64) * t
+        a = self.fractions(p) * self.total / np.where(self.model_area > 0, self.model_area, 1)
+        return np.asarray(a * t)
+
+    def table_scales(self, p: np.ndarray) -> np.ndarray:
+        """The fitted scale of each material's table (1 when not fitted)."""
+        if self.m_sd is None:
+            return np.ones(len(self.materials))
+        return np.asarray(p[self.sl["s"]], dtype=np.float64)
+
+    def prior_residuals(self, p: np.ndarray) -> np.ndarray:
+        """``(s_m - 1) / w_m`` of the tables' scales (none when not fitted)."""
+        if self.m_sd is None:
+            return np.zeros(0)
+        return np.asarray((p[self.sl["s"]] - 1.0) / self.m_sd)
+
+    def area_scales(self, p: np.ndarray) -> np.ndarray:
+        """Area scale ``a_m`` of each material (without its table's scale)."""
+        return np.asarray(self.scales(p) / self.table_scales(p))
 
     def extinction(self, p: np.ndarray) -> np.ndarray:
         return p[self.sl["k"]] if isinstance(self.k_mode, str) else np.asarray(self.k_mode)
@@ -106,6 +129,7 @@ class Layout:
             p[self.sl["f"]] = (self.model_area / self.total)[:-1]
         elif self.areas == "free":
             p[self.sl["f"]] = 1.0
+        p[self.sl["s"]] = 1.0
         return p
 
     def x_scale(self, period: float, span: float) -> np.ndarray:
@@ -117,6 +141,7 @@ class Layout:
         h = np.full(self.n, 1e-4)
         h[:4] = [1e-3, 1e-3, 1e-6 * period, 1e-3]
         h[self.sl["f"]] = 1e-5
+        h[self.sl["s"]] = 1e-5
         return h
 
 
@@ -256,6 +281,23 @@ def result_dataset(
             cf("magnitude", long_name="1-sigma uncertainty of the zero point (0: not fitted)"),
         )
     _areas(ds, lay, p, c_out)
+    if lay.m_sd is not None:
+        sl = lay.sl["s"]
+        ds["table_scale"] = (
+            "material",
+            p[sl],
+            _cf("1", "fitted scale of the material's table (nuisance parameter: model error)"),
+        )
+        ds["table_scale_uncertainty"] = (
+            "material",
+            sd[sl],
+            _cf("1", "1-sigma uncertainty of the table's scale"),
+        )
+        ds["table_scale_prior_width"] = (
+            "material",
+            lay.m_sd,
+            _cf("1", "prior width of the table's scale (prior 1 +- width)"),
+        )
     scal = {
         "chi2": (chi2, "chi-square of the fit"),
         "dof": (dof, "degrees of freedom (values minus fitted parameters)"),

@@ -50,7 +50,7 @@ def twin_dataset(
         else:
             terms = model.terms(axis, p[2], p[3], body_rotation=sym.matrix)
             m = model.magnitudes(terms, lay.scales(p)) + lay.extra(p, data)
-            r = (data.magnitude - m) / data.sigma
+            r = np.append((data.magnitude - m) / data.sigma, lay.prior_residuals(p))
             align = align_matrices(model.k, axis[None, :])[0]
             tw_axis, sense = -axis, -1
             phase = flip_phase(sym, align, model.k, phase_epoch)
