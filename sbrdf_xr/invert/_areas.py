@@ -97,8 +97,11 @@ def add_areas(
         sig * nominal,
         {"units": "m2", "long_name": "1-sigma uncertainty of the effective area"},
     )
-    tot = float(area.sum())
-    cov_a = cov * np.outer(nominal, nominal)
+    free = ~np.isfinite(sig)  # not constrained: left out of the sum, fraction unknown
+    tot = float(np.nansum(np.where(free, 0.0, area)))
+    cov_a = np.where(np.outer(free, free) | ~np.isfinite(cov), 0.0, cov) * np.outer(
+        nominal, nominal
+    )
     if total is not None:  # a constant: the fractions are the areas over it
         frac, frac_sig = area / total, sig * nominal / total
         long_name = "fraction of total_area, the constrained sum of the areas"
@@ -108,9 +111,11 @@ def add_areas(
         )
     else:
         if tot > 0:
-            jac = (np.eye(len(names)) * tot - area[:, None]) / tot**2  # d f_i / d area_j
-            frac = area / tot
+            a_in = np.where(free, 0.0, area)
+            jac = (np.eye(len(names)) * tot - a_in[:, None]) / tot**2  # d f_i / d area_j
+            frac = np.where(free, np.nan, a_in / tot)
             frac_sig = np.sqrt(np.clip(np.diag(jac @ cov_a @ jac.T), 0, None))
+            frac_sig[free] = np.inf
         else:
             frac = frac_sig = np.full(len(names), np.nan)
         long_name = "fraction of the summed effective area of the fitted candidate materials"

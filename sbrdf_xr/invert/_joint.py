@@ -22,12 +22,19 @@ from scipy.optimize import least_squares
 from ..errors import FitQualityWarning, InversionError
 from ..units import to_unit
 from ._areas import material_areas
+from ._bounds import covariance, stick_breaking, stick_breaking_inverse
+from ._diagnose import CAUSES, likely_causes
+from ._extinction import extinction_prior as _k_prior
+from ._extinction import separable_sd
 from ._joint_model import PassModel, pass_data
 from ._joint_result import Layout, model_check, result_dataset
 from ._joint_starts import Start, minima_dataset, start_states
+from ._joint_twins import twin_dataset
+from ._model_error import table_widths
 from ._quality import fit_quality
 from ._spin import AMBIGUITY_CHI2
 from ._spin_refine import _tangent
+from ._symmetry import SYMMETRY_TOL, body_symmetries
 
 if TYPE_CHECKING:
     from ..body import Spacecraft
@@ -35,7 +42,8 @@ if TYPE_CHECKING:
 
 __all__ = ["JOINT_CAUSES", "fit_observation"]
 
-#: Likely causes of a poor joint fit, most likely first.
+#: Likely causes of a poor joint fit (the warning ranks them from the residuals: see
+#: :mod:`sbrdf_xr.invert._diagnose`).
 JOINT_CAUSES = (
     "the fit stopped in a local minimum: start from a better spin state (fit_spin over the "
     "light curve) or from more (starts='aliases': the period aliases and fit_spin's twins)",
@@ -148,6 +156,9 @@ def fit_observation(
     scale_uncertainties: bool = False,
     starts: str | Sequence[Mapping[str, Any]] = "given",
     check: bool = True,
+    extinction_prior: Mapping[str, Any] | None = None,
+    symmetry_tolerance: float = SYMMETRY_TOL,
+    material_scale: str | Mapping[str, float] | None = None,
 ) -> xr.Dataset:
     """Spin state, extinction, zero points and material areas fitted jointly to the
     calibrated magnitudes measured over a pass.
@@ -224,6 +235,21 @@ def fit_observation(
         Recompute the solution's magnitudes through :func:`sbrdf_xr.engine.simulate` and
         :func:`sbrdf_xr.photometry.magnitudes` (spectral signal, band-integrated): the
         largest difference is ``attrs["model_check"]``.
+    extinction_prior : mapping of str to (float, float), optional
+        ``{band: (k, width)}`` [mag per air mass], the prior of each extinction coefficient
+        (default: :func:`sbrdf_xr.photometry.extinction_coefficients` +- 0.1).  Used when
+        the pass's air mass cannot tell the extinction from a zero point: with a free zero
+        point a band's ``k`` would be known to ``1 / sqrt(sum (X - Xbar)^2 / sigma^2)``;
+        when that is wider than the prior (a geostationary object: a near-constant air
+        mass), every ``k`` is held at its prior value, reported with the prior's width,
+        and its share ``k Xbar`` is fitted as a zero point per band (``offset="band"``
+        unless set), with a warning.
+    symmetry_tolerance : float
+        Tolerance of the body's symmetries, in ``(0, 0.1]`` (normals within this chord,
+        areas within this fraction of the total): every rotation of the body frame that
+        maps the body's facets (normals, areas, materials: the model's terms) onto
+        themselves gives a twin state of the solution, evaluated on the data and listed
+        over ``twin`` and in ``ambiguity`` (:mod:`sbrdf_xr.invert._symmetry`).
 
     Returns
     -------
@@ -233,13 +259,32 @@ def fit_observation(
         over ``band``: ``extinction_coefficient``, ``zero_point`` (or the scalar
         ``magnitude_offset``) with uncertainties; over ``material``: ``area_fraction``,
         ``scale``, ``area`` [m2] with uncertainties and ``model_area``; over
-        ``parameter``: ``estimate``, ``uncertainty``, ``correlation``; ``chi2``, ``dof``,
+        ``parameter``: ``estimate``, ``uncertainty``, ``correlation``; over ``twin`` the
+        body's symmetry twins of the solution (``twin_chi2_gap``, ``twin_phase``,
+        ``twin_axis_longitude``, ``twin_axis_latitude``, ``twin_sense``); ``chi2``, ``dof``,
         ``reduced_chi2``, ``fit_probability``; over ``obs``: ``model_magnitude``,
         ``residual``, ``airmass``; over ``start``: the minimum refined from each start
         (``start_chi2``, ``start_chi2_gap`` above the solution's, ``start_period``,
         ``start_phase``, ``start_axis_longitude``, ``start_axis_latitude``,
         ``start_axis_separation``).  Attributes say what was fitted, how the uncertainties
-        are scaled, the ``fit_quality``, the ``ambiguity``, the model check and the timing.
+        are scaled, the ``fit_quality``, the ``ambiguity``, the model check and the timing,
+        and what the result can be trusted for: ``status`` (``"ok"`` or ``"failed"``, then
+        ``status_note`` says why and how to recover), ``bounded`` (whether the area
+        fractions were held inside ``[0, 1]``) and ``unconstrained`` (the parameters the
+        data do not constrain, reported at their start or prior value with an infinite
+        or the prior's uncertainty; ``unconstrained_note``, ``extinction_note``).
+
+    Notes
+    -----
+    Results stay inside physics: when the lowest minimum needs area fractions outside
+    ``[0, 1]`` (or negative scales), every start whose minimum does is refined again on
+    the stick-breaking transform of the fractions with box bounds
+    (:mod:`sbrdf_xr.invert._bounds`); if that fit is poor the result is marked
+    ``"failed"``: impossible areas mean the spin state is wrong.  A parameter whose
+    Jacobian column vanishes or lies in its null space (a material never lit and seen,
+    extinction and zero point over a constant air mass) is reported as not constrained
+    (infinite uncertainty, NaN correlations), never with the value of an inverse of a
+    singular matrix; no uncertainty is NaN in a result not marked ``"failed"``.
 
     Warns
     -----
@@ -248,7 +293,8 @@ def fit_observation(
         0.1 % point), naming the likely causes; or when a minimum from another start, at
         another spin state (period more than 3 sigma or axis more than 3 times its
         uncertainty away), fits within a chi-square of :data:`AMBIGUITY_CHI2` of the
-        solution.
+        solution; when the fit failed, a parameter is not constrained or the extinction
+        is held at its prior.
 
     Raises
     ------
@@ -299,14 +345,32 @@ def fit_observation(
     ab = _axis_body(spin, axis_body)
     data = pass_data(light_curve, observation, bands, system)
     k_mode = _options(extinction, offset, areas, data.labels)
+    k_prior = _k_prior(extinction_prior, data.labels)
+    k_sep = separable_sd(data.airmass, data.sigma, data.band, len(data.labels))
+    held = None
+    if isinstance(k_mode, str) and bool(np.any(k_sep > k_prior[1])):
+        k_mode, held = k_prior[0], _held_note(data, k_sep, k_prior, offset, areas)
+        if offset is None and areas != "free":
+            offset = "band"  # k Xbar over the pass is a zero point: fitted as one
     model = PassModel(data, spacecraft, ab, materials)
+    terms = model.kernel.plan.terms
+    syms = body_symmetries(terms.normal, terms.area, terms.material, ab, symmetry_tolerance)
     names = model.materials
     area_of = material_areas(spacecraft)
     a_model = np.array([area_of.get(m, 0.0) for m in names])
     if epoch is None:
         epoch = data.epoch
-    lay = Layout(data.labels, names, a_model, k_mode, offset, areas)
-    if data.magnitude.size <= lay.n:
+    lay = Layout(
+        data.labels,
+        names,
+        a_model,
+        k_mode,
+        offset,
+        areas,
+        None if held is None else k_prior[1],
+        table_widths(material_scale, names, model.kernel.sources),
+    )
+    if data.magnitude.size <= lay.n - lay.n_prior:
         raise InversionError(
             f"light curve: {data.magnitude.size} values for {lay.n} parameters "
             f"({', '.join(lay.names)}); need more values than parameters (fix some: "
@@ -324,25 +388,42 @@ def fit_observation(
     span = max(float(np.ptp(data.seconds)), 1e-9)
     states = start_states(starts, spin, start, dt_epoch, model.t_ref, span, read)
     local = [_refine(model, lay, st, span) for st in states]
+    lowest = min(local, key=lambda m: m.chi2)
+    unbounded = outside_physics(lay, lowest.x)
+    for i, st in enumerate(states):  # a minimum outside physics: refined inside the bounds
+        if outside_physics(lay, local[i].x):
+            local[i] = _refine(model, lay, st, span, bounded=True)
     best = min(range(len(local)), key=lambda i: local[i].chi2)
     res, axis_of, residuals = local[best].res, local[best].axis_of, local[best].residuals
-    p = res.x
+    p = local[best].x
     if not p[2] > 0:
         raise InversionError(
             f"the fit ran to a period of {p[2]:.4g} s from {start['period']:.4g} s: start "
             "from a better spin state (fit_spin)"
         )
-    r = residuals(p)
-    chi2 = float(r @ r)
-    dof = data.magnitude.size - lay.n
+    r_all = residuals(p)
+    r = r_all[: data.magnitude.size]
+    chi2 = float(r_all @ r_all)  # with the priors' terms, each a datum: dof counts them
+    dof = data.magnitude.size + lay.n_prior - lay.n
     jac = _jacobian(residuals, p, lay.steps(p[2]))
-    try:
-        cov = np.linalg.inv(jac.T @ jac)
-    except np.linalg.LinAlgError:
-        cov = np.full((lay.n, lay.n), np.inf)
+    cov, free = covariance(jac)
     if scale_uncertainties:
         cov = cov * chi2 / dof
-    quality = fit_quality(chi2, dof, "joint fit", JOINT_CAUSES)
+    ranked = likely_causes(
+        r,
+        data.band,
+        p[3] + 360.0 * (data.seconds[data.t_index] - model.t_ref) / p[2],
+        data.airmass,
+        data.seconds[data.t_index],
+    )
+    quality = fit_quality(chi2, dof, "joint fit", _causes(ranked))
+    status = _status(lay, local[best], unbounded, free, quality, chi2 / dof)
+    if held is not None:
+        status["unconstrained"] = ", ".join(
+            [f"extinction_{b}" for b in lay.bands]
+            + [n for n in [status["unconstrained"]] if n != "none"]
+        )
+        status["extinction_note"] = held
     fit_s = time.perf_counter() - t_start
     ds = result_dataset(
         lay=lay,
@@ -350,6 +431,7 @@ def fit_observation(
         light_curve=light_curve,
         p=p,
         cov=cov,
+        free=free,
         axis_of=axis_of,
         t_ref=model.t_ref,
         dt_epoch=dt_epoch,
@@ -366,16 +448,33 @@ def fit_observation(
             )
             + ": covariance (J^T J)^-1 of the normalised residuals, J by central differences "
             "at the solution",
-            "optimizer": f"scipy least_squares (lm): {res.message} ({res.nfev} evaluations)",
+            "optimizer": f"scipy least_squares ({'trf, bounded' if local[best].bounded else 'lm'})"
+            f": {res.message} ({res.nfev} evaluations)",
+            **status,
+            "likely_causes": "residual patterns, (delta chi2 - k) / sqrt(2 k), about 0 +- 1 "
+            "for noise: " + ", ".join(f"{k} {v:.3g}" for k, v in ranked),
             "n_model_evaluations": int(model.n_calls),
             "fit_seconds": fit_s,  # the fit, without the check
             "time_source": data.time_source,
         },
     )
+    if ds.attrs["status"] == "ok" and bool(np.isnan(ds["uncertainty"].values).any()):
+        ds.attrs["status"] = "failed"
+        ds.attrs["status_note"] = f"the fit failed: its covariance is not finite. {RECOVER}"
+        status["status_note"] = ds.attrs["status_note"]
+    for key in ("status_note", "unconstrained_note", "extinction_note"):
+        if key in status:
+            warnings.warn(f"joint fit: {status[key]}", FitQualityWarning, stacklevel=2)
     ds = ds.merge(_minima(local, best, model.t_ref, dt_epoch))
     ds.attrs["ambiguity"] = _ambiguity(ds)
     if ds.attrs["ambiguity"] != "none":
         warnings.warn(f"joint fit: {ds.attrs['ambiguity']}", FitQualityWarning, stacklevel=2)
+    twins, twin_text = twin_dataset(model, lay, local[best], p, chi2, syms, float(ds["phase"]))
+    ds = ds.merge(twins)
+    ds.attrs["symmetry_twins"] = twin_text
+    if twin_text != "none":
+        have = ds.attrs["ambiguity"]
+        ds.attrs["ambiguity"] = twin_text if have == "none" else f"{have}; {twin_text}"
     if check:
         t0 = time.perf_counter()
         ds.attrs["model_check"] = model_check(
@@ -395,10 +494,14 @@ class _Local:
     residuals: Callable[[np.ndarray], np.ndarray]
     chi2: float
     label: str
+    x: np.ndarray
+    bounded: bool = False
 
 
-def _refine(model: PassModel, lay: Layout, st: Start, span: float) -> _Local:
-    """Levenberg-Marquardt from one start (the axis on the tangent plane of its axis)."""
+def _refine(model: PassModel, lay: Layout, st: Start, span: float, bounded: bool = False) -> _Local:
+    """Levenberg-Marquardt from one start (the axis on the tangent plane of its axis); with
+    ``bounded``, the trust-region reflective method on the area fractions' stick-breaking
+    transform in ``[0, 1]`` (or scales ``>= 0``), keeping them inside physics."""
     data = model.data
     e0 = st.axis
     east, north = _tangent(e0)
@@ -410,30 +513,164 @@ def _refine(model: PassModel, lay: Layout, st: Start, span: float) -> _Local:
     def residuals(p: np.ndarray) -> np.ndarray:
         terms = model.terms(axis_of(p), p[2], p[3])
         m = model.magnitudes(terms, lay.scales(p)) + lay.extra(p, data)
-        return (data.magnitude - m) / data.sigma
+        return np.append((data.magnitude - m) / data.sigma, lay.prior_residuals(p))
 
-    res = least_squares(
-        residuals,
-        lay.start(st.period, st.phase_ref),
-        x_scale=lay.x_scale(st.period, span),
-        method="lm",
-        diff_step=1e-7,
-        max_nfev=MAX_NFEV,
-        ftol=1e-10,
-        xtol=1e-10,
+    p0 = lay.start(st.period, st.phase_ref)
+    opts = {"diff_step": 1e-7, "max_nfev": MAX_NFEV, "ftol": 1e-10, "xtol": 1e-10}
+    scale = lay.x_scale(st.period, span)
+    if not bounded:
+        res = least_squares(residuals, p0, x_scale=scale, method="lm", **opts)
+        x = res.x
+    else:
+        to_p, q0, lo, hi = _bounded_map(lay, p0, st.period)
+        res = least_squares(
+            lambda q: residuals(to_p(q)), q0, x_scale=scale, method="trf", bounds=(lo, hi), **opts
+        )
+        x = to_p(res.x)
+    chi2 = float(2.0 * res.cost) if x[2] > 0 else np.inf
+    return _Local(res, axis_of, residuals, chi2, st.label, x, bounded)
+
+
+#: How to recover from a failed fit.
+RECOVER = (
+    "recover: fit the spin first (fit_spin(light_curve, spacecraft, geometry=observation)) "
+    "and start from its result with starts='aliases'; check the materials and the shape if "
+    "that fails too. The values returned are the last iterate, not estimates"
+)
+
+
+#: Score of a residual pattern above which its cause is named first.
+CAUSE_SCORE = 3.0
+
+
+def _causes(ranked: Sequence[tuple[str, float]]) -> list[str]:
+    """The likely causes of a poor fit, from the residual patterns (:func:`likely_causes`):
+    those scoring above :data:`CAUSE_SCORE`, highest first; else the understated
+    uncertainties (no pattern stands out)."""
+    out = [f"{CAUSES[k]} [score {v:.3g}]" for k, v in ranked if v > CAUSE_SCORE]
+    if not out:
+        out = ["no residual pattern stands out: the uncertainties are understated"]
+    return out
+
+
+def _status(
+    lay: Layout,
+    loc: _Local,
+    unbounded: list[str],
+    free: np.ndarray,
+    quality: Mapping[str, Any],
+    reduced: float,
+) -> dict[str, str]:
+    """``status`` ("ok" or "failed") with ``status_note`` (why it failed, or what bound
+    holds), ``bounded`` and ``unconstrained_note``: what the result can be trusted for."""
+    out: dict[str, str] = {"status": "ok"}
+    why = []
+    if loc.res.status <= 0:
+        why.append(f"the optimizer stopped without converging ({loc.res.message})")
+    if not np.all(np.isfinite(loc.x)):
+        why.append("the parameters are not finite")
+    if unbounded and quality.get("fit_quality") == "poor":
+        why.append(
+            f"the lowest minimum needs area fractions outside [0, 1] ({', '.join(unbounded)}) "
+            f"and the fit inside the bounds does not describe the data (reduced chi-square "
+            f"{reduced:.4g}): the spin state is likely wrong, not the areas"
+        )
+    if why:
+        out["status"] = "failed"
+        out["status_note"] = "the fit failed: " + "; ".join(why) + ". " + RECOVER
+    out["bounded"] = (
+        f"the unconstrained minimum lies outside physics ({', '.join(unbounded)}): refined "
+        "with the area fractions held inside [0, 1] (stick-breaking transform); a fraction "
+        "at 0 or 1 is at its bound, its uncertainty is the curvature's"
+        if unbounded
+        else "none: the minimum lies inside the physical bounds"
     )
-    chi2 = float(2.0 * res.cost) if res.x[2] > 0 else np.inf
-    return _Local(res, axis_of, residuals, chi2, st.label)
+    names = [n for n, f in zip(lay.names, free, strict=True) if f]
+    if names:
+        out["unconstrained_note"] = (
+            f"the data do not constrain {', '.join(names)} (a null direction of the Jacobian: "
+            "a material never lit and seen, extinction and zero point over a constant air "
+            "mass): each is reported at its start value with an infinite uncertainty"
+        )
+    out["unconstrained"] = ", ".join(names) if names else "none"
+    return out
+
+
+def _held_note(
+    data: Any, k_sep: np.ndarray, prior: tuple[np.ndarray, np.ndarray, str], offset: Any, areas: str
+) -> str:
+    """Why the extinction is held at its prior, and what takes its place."""
+    worst = int(np.argmax(k_sep / prior[1]))
+    x = data.airmass
+    took = (
+        "its share k Xbar over the pass is fitted as a zero point per band"
+        if offset is None and areas != "free"
+        else "the fitted zero points take its share k Xbar"
+        if offset is not None
+        else "with free area scales no zero point can take its share k Xbar: the scales carry it"
+    )
+    return (
+        f"extinction not constrained: the air mass spans only {x.min():.6g}-{x.max():.6g}, "
+        f"so with a free zero point band {data.labels[worst]}'s coefficient would be known "
+        f"to +- {k_sep[worst]:.3g} mag per air mass, no better than its prior +- "
+        f"{prior[1][worst]:.3g} ({prior[2]}); every coefficient is held at its prior value "
+        f"and reported with the prior's width, and {took}"
+    )
+
+
+def _bounded_map(
+    lay: Layout, p0: np.ndarray, period: float
+) -> tuple[Callable[[np.ndarray], np.ndarray], np.ndarray, np.ndarray, np.ndarray]:
+    """The bounded parameters ``q`` of a fit (area fractions by their stick-breaking
+    transform ``u`` in ``[0, 1]``, scales ``>= 0``, period ``> 0``): the map ``q -> p``, the
+    start ``q0`` and the bounds."""
+    sl = lay.sl["f"]
+    lo = np.full(lay.n, -np.inf)
+    hi = np.full(lay.n, np.inf)
+    lo[2] = 1e-6 * period
+    q0 = p0.copy()
+    if lay.areas == "total":
+        lo[sl], hi[sl] = 0.0, 1.0
+        q0[sl] = stick_breaking_inverse(p0[sl])
+    elif lay.areas == "free":
+        lo[sl] = 0.0
+
+    def to_p(q: np.ndarray) -> np.ndarray:
+        p = np.array(q, dtype=np.float64)
+        if lay.areas == "total":
+            p[sl] = stick_breaking(q[sl])[:-1]
+        return p
+
+    return to_p, np.clip(q0, lo, hi), lo, hi
+
+
+def outside_physics(lay: Layout, p: np.ndarray, tol: float = 1e-9) -> list[str]:
+    """The area fractions (or scales) of ``p`` outside their physical bounds, as text.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.invert._joint import outside_physics
+    >>> from sbrdf_xr.invert._joint_result import Layout
+    >>> lay = Layout(("V",), ("a", "b"), np.array([1.0, 1.0]), "fit", None, "total")
+    >>> outside_physics(lay, np.array([0, 0, 10, 0, 0.1, 1.3]))
+    ['a 1.3', 'b -0.3']
+    """
+    if lay.areas == "fixed":
+        return []
+    f = lay.fractions(p) if lay.areas == "total" else lay.scales(p)
+    top = 1.0 if lay.areas == "total" else np.inf
+    bad = (f < -tol) | (f > top + tol)
+    return [f"{m} {v:.4g}" for m, v, b in zip(lay.materials, f, bad, strict=True) if b]
 
 
 def _minima(local: Sequence[_Local], best: int, t_ref: float, dt_epoch: float) -> xr.Dataset:
     """The table of the minima refined from every start (phases at the epoch)."""
-    x = np.array([m.res.x[:4] for m in local])
+    x = np.array([m.x[:4] for m in local])
     phase = (x[:, 3] - 360.0 * (t_ref - dt_epoch) / np.where(x[:, 2] > 0, x[:, 2], np.nan)) % 360
     return minima_dataset(
         [m.label for m in local],
         np.array([m.chi2 for m in local]),
-        np.array([m.axis_of(m.res.x) for m in local]),
+        np.array([m.axis_of(m.x) for m in local]),
         x[:, 2],
         phase,
         best,

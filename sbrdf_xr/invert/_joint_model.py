@@ -202,15 +202,23 @@ class PassModel:
         self.n_calls = 0
         self._cache: tuple[tuple[float, ...], np.ndarray] | None = None
 
-    def terms(self, axis: np.ndarray, period: float, phase: float) -> np.ndarray:
+    def terms(
+        self, axis: np.ndarray, period: float, phase: float, body_rotation: Any = None
+    ) -> np.ndarray:
+        """``f_t S_m,b(t)`` (N, M); with ``body_rotation`` ``F`` (3, 3), those of the
+        attitude ``R(t) F`` (the body turned by ``F`` in its own frame)."""
         key = (*np.asarray(axis, dtype=np.float64).tolist(), float(period), float(phase))
-        if self._cache is not None and self._cache[0] == key:
+        if body_rotation is None and self._cache is not None and self._cache[0] == key:
             return self._cache[1]
         d = self.data
         align = align_matrices(self.k, np.asarray(axis, dtype=np.float64)[None, :])
         ang = np.radians(phase + 360.0 * (d.seconds - self.t_ref) / period)[None, :]
         s = body_vectors(d.to_sun, align, self.k, ang)[0]
         o = body_vectors(d.to_observer, align, self.k, ang)[0]
+        if body_rotation is not None:  # F^T v in the body frame, as rows: v F
+            f = np.asarray(body_rotation, dtype=np.float64)
+            sig = self.kernel(s @ f, o @ f, per_material=True) * d.sunlit_fraction[:, None, None]
+            return np.asarray(sig[d.t_index, :, d.band])
         sig = self.kernel(s, o, per_material=True) * d.sunlit_fraction[:, None, None]  # (T, M, B)
         out = sig[d.t_index, :, d.band]  # (N, M)
         self.n_calls += 1

@@ -13,6 +13,7 @@ from .._names import attrs as cf
 from ._joint_model import PassData
 from ._quality import quality_attrs
 from ._spin_search import lonlat
+from ._unmix import correlation
 
 __all__ = ["Layout", "model_check", "result_dataset"]
 
@@ -35,6 +36,8 @@ class Layout:
     k_mode: Any  # "fit" or the given coefficients (B,)
     offset: str | None
     areas: str
+    k_prior_sd: np.ndarray | None = None  # extinction held at its prior: the prior's width
+    m_sd: np.ndarray | None = None  # prior widths of the tables' scales (nuisance), or None
 
     def __post_init__(self) -> None:
         nb, nm = len(self.bands), len(self.materials)
@@ -42,6 +45,7 @@ class Layout:
             "k": nb if isinstance(self.k_mode, str) else 0,
             "z": {None: 0, "band": nb, "common": 1}[self.offset],
             "f": {"total": nm - 1, "free": nm, "fixed": 0}[self.areas],
+            "s": 0 if self.m_sd is None else nm,
         }
         i = 4
         self.sl: dict[str, slice] = {}
@@ -64,7 +68,9 @@ class Layout:
             *([f"extinction_{b}" for b in self.bands] if sizes["k"] else []),
             *(zn if self.offset != "common" else ["magnitude_offset"]),
             *fn,
+            *([f"table_scale_{m}" for m in self.materials] if sizes["s"] else []),
         ]
+        self.n_prior = sizes["s"]
         self.units = ["degree", "degree", "s", "degree"] + ["1"] * (i - 4)
 
     def fractions(self, p: np.ndarray) -> np.ndarray:
@@ -77,10 +83,29 @@ class Layout:
         return self.model_area / self.total
 
     def scales(self, p: np.ndarray) -> np.ndarray:
-        """Area scale ``a_m`` of each material."""
+        """Scale of each material's signal: its area scale ``a_m`` times its table's scale
+        (the nuisance parameter, 1 when not fitted)."""
+        t = self.table_scales(p)
         if self.areas == "free":
-            return np.asarray(p[self.sl["f"]], dtype=np.float64)
-        return self.fractions(p) * self.total / np.where(self.model_area > 0, self.model_area, 1)
+            return np.asarray(p[self.sl["f"]], dtype=np.float64) * t
+        a = self.fractions(p) * self.total / np.where(self.model_area > 0, self.model_area, 1)
+        return np.asarray(a * t)
+
+    def table_scales(self, p: np.ndarray) -> np.ndarray:
+        """The fitted scale of each material's table (1 when not fitted)."""
+        if self.m_sd is None:
+            return np.ones(len(self.materials))
+        return np.asarray(p[self.sl["s"]], dtype=np.float64)
+
+    def prior_residuals(self, p: np.ndarray) -> np.ndarray:
+        """``(s_m - 1) / w_m`` of the tables' scales (none when not fitted)."""
+        if self.m_sd is None:
+            return np.zeros(0)
+        return np.asarray((p[self.sl["s"]] - 1.0) / self.m_sd)
+
+    def area_scales(self, p: np.ndarray) -> np.ndarray:
+        """Area scale ``a_m`` of each material (without its table's scale)."""
+        return np.asarray(self.scales(p) / self.table_scales(p))
 
     def extinction(self, p: np.ndarray) -> np.ndarray:
         return p[self.sl["k"]] if isinstance(self.k_mode, str) else np.asarray(self.k_mode)
@@ -104,6 +129,7 @@ class Layout:
             p[self.sl["f"]] = (self.model_area / self.total)[:-1]
         elif self.areas == "free":
             p[self.sl["f"]] = 1.0
+        p[self.sl["s"]] = 1.0
         return p
 
     def x_scale(self, period: float, span: float) -> np.ndarray:
@@ -115,6 +141,7 @@ class Layout:
         h = np.full(self.n, 1e-4)
         h[:4] = [1e-3, 1e-3, 1e-6 * period, 1e-3]
         h[self.sl["f"]] = 1e-5
+        h[self.sl["s"]] = 1e-5
         return h
 
 
@@ -144,6 +171,7 @@ def result_dataset(
     light_curve: xr.Dataset,
     p: np.ndarray,
     cov: np.ndarray,
+    free: np.ndarray,
     axis_of: Any,
     t_ref: float,
     dt_epoch: float,
@@ -158,12 +186,19 @@ def result_dataset(
     lon, lat = (float(v) for v in lonlat(axis))
     phase = (p[3] - 360.0 * (t_ref - dt_epoch) / p[2]) % 360.0
     t = _transform(lay, p, axis_of, t_ref, dt_epoch)
-    finite = np.all(np.isfinite(cov))
-    c_out = t @ cov @ t.T if finite else np.full_like(cov, np.nan)
+    # a parameter the data do not constrain (free) carries an infinite variance into every
+    # output that depends on it; the others' covariance is carried through t
+    finite = bool(np.all(np.isfinite(cov[np.ix_(~free, ~free)])))
+    c_out = t @ np.where(np.outer(free, free) | ~np.isfinite(cov), 0.0, cov) @ t.T
+    if not finite:
+        c_out = np.full_like(cov, np.nan)
+    free_out = (np.abs(t) @ free.astype(float)) > 0
+    c_out[free_out, :] = 0.0
+    c_out[:, free_out] = 0.0
+    c_out[free_out, free_out] = np.inf
     sd = np.sqrt(np.clip(np.diag(c_out), 0, None))
     est = np.array([lon, lat, p[2], phase, *p[4:]])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        corr = c_out / np.outer(sd, sd)
+    corr = correlation(c_out)
     ds = xr.Dataset(
         coords={
             "parameter": ("parameter", lay.names, _cf("1", "fitted parameter")),
@@ -193,16 +228,21 @@ def result_dataset(
     # the 1-sigma ellipse of the axis on the sphere: the east/north covariance, in degrees
     # of arc (the longitude step times cos latitude)
     c_ax = c_out[:2, :2] * np.outer([np.cos(np.radians(lat)), 1.0], [np.cos(np.radians(lat)), 1.0])
-    ev = np.linalg.eigvalsh(c_ax) if finite else np.array([np.nan])
+    if free_out[:2].any():
+        c_ax = np.full((2, 2), np.inf)
+    ev = np.linalg.eigvalsh(c_ax) if finite and np.isfinite(c_ax).all() else np.array([np.inf])
     ds["axis_uncertainty"] = (
         (),
-        float(np.sqrt(max(ev.max(), 0.0))) if finite else float("nan"),
+        float(np.sqrt(max(ev.max(), 0.0))) if finite else float("nan"),  # nan: failed
         _cf("degree", "major semi-axis of the 1-sigma ellipse of the spin axis"),
     )
     ds["axis_vector"] = ("xyz", axis, _cf("1", "unit vector of the inertial spin axis"))
     nb = len(lay.bands)
     k_sd = sd[lay.sl["k"]] if isinstance(lay.k_mode, str) else np.zeros(nb)
     k_how = "fitted" if isinstance(lay.k_mode, str) else "given (not fitted)"
+    if lay.k_prior_sd is not None:
+        k_sd = np.asarray(lay.k_prior_sd, dtype=np.float64)
+        k_how = "held at its prior (the pass's air mass cannot tell it from a zero point)"
     ds["extinction_coefficient"] = (
         "band",
         lay.extinction(p),
@@ -211,7 +251,11 @@ def result_dataset(
     ds["extinction_coefficient_uncertainty"] = (
         "band",
         k_sd,
-        cf("magnitude", long_name="1-sigma uncertainty of the extinction coefficient (0: given)"),
+        cf(
+            "magnitude",
+            long_name="1-sigma uncertainty of the extinction coefficient (0: given; the "
+            "prior's width: held at its prior)",
+        ),
     )
     if lay.offset == "common":
         ds["magnitude_offset"] = (
@@ -237,6 +281,23 @@ def result_dataset(
             cf("magnitude", long_name="1-sigma uncertainty of the zero point (0: not fitted)"),
         )
     _areas(ds, lay, p, c_out)
+    if lay.m_sd is not None:
+        sl = lay.sl["s"]
+        ds["table_scale"] = (
+            "material",
+            p[sl],
+            _cf("1", "fitted scale of the material's table (nuisance parameter: model error)"),
+        )
+        ds["table_scale_uncertainty"] = (
+            "material",
+            sd[sl],
+            _cf("1", "1-sigma uncertainty of the table's scale"),
+        )
+        ds["table_scale_prior_width"] = (
+            "material",
+            lay.m_sd,
+            _cf("1", "prior width of the table's scale (prior 1 +- width)"),
+        )
     scal = {
         "chi2": (chi2, "chi-square of the fit"),
         "dof": (dof, "degrees of freedom (values minus fitted parameters)"),
@@ -289,7 +350,12 @@ def _areas(ds: xr.Dataset, lay: Layout, p: np.ndarray, c_out: np.ndarray) -> Non
     else:
         g = np.zeros((nm, 0))
     f = lay.fractions(p)
-    f_sd = np.sqrt(np.clip(np.diag(g @ c_out[sl, sl] @ g.T), 0, None)) if g.size else np.zeros(nm)
+    c_f = c_out[sl, sl]
+    inf = np.isinf(np.diag(c_f))  # not constrained: inf in every fraction that holds it
+    c_f = np.where(np.isinf(c_f), 0.0, c_f)
+    f_sd = np.sqrt(np.clip(np.diag(g @ c_f @ g.T), 0, None)) if g.size else np.zeros(nm)
+    if g.size:
+        f_sd[(np.abs(g) @ inf.astype(float)) > 0] = np.inf
     per_area = lay.total / np.where(lay.model_area > 0, lay.model_area, 1)
     how = {
         "total": "of the mesh's total area (they add up to 1)",

@@ -38,6 +38,8 @@ def simulated_light_curve(
     axis_body: ArrayLike = (0.0, 0.0, 1.0),
     system: str = "Vega",
     zero_point: Mapping[str, float] | None = None,
+    brightness: Mapping[str, float] | None = None,
+    effects: Sequence[str] = (),
 ) -> tuple[xr.Dataset, float]:
     """Noise-free magnitudes of a pass, one band per time in turn, and the wall time [s] of
     the :func:`sbrdf_xr.engine.simulate` call.
@@ -47,7 +49,9 @@ def simulated_light_curve(
     its area scaled to ``area_fraction`` of the mesh's total, is band-integrated by
     :func:`sbrdf_xr.photometry.magnitudes` (the cube's range and Sun distance), and
     ``k_b X + z_b`` is added with the cube's air mass.  Times in the Earth's umbra or
-    below the horizon are left out.
+    below the horizon are left out.  A truth other than the fit's model: ``brightness``
+    scales a material's signal (``{"white-paint-a276": 1.1}``: its table 10 % too dark),
+    ``effects`` adds effects of :func:`sbrdf_xr.engine.simulate` (``("shadowing",)``).
 
     Examples
     --------
@@ -75,7 +79,14 @@ def simulated_light_curve(
     )
     obs = dataclasses.replace(observation, attitude=law)
     t0 = time.perf_counter()
-    cube = simulate(Scene(spacecraft, observation=obs, outputs=("signal", "per_material")))
+    cube = simulate(
+        Scene(
+            spacecraft,
+            observation=obs,
+            outputs=("signal", "per_material"),
+            effects=("sunlight", *effects),
+        )
+    )
     seconds = time.perf_counter() - t0
     areas = material_areas(spacecraft)
     missing = sorted(set(areas) - set(area_fraction))
@@ -83,8 +94,9 @@ def simulated_light_curve(
         raise InversionError(f"area_fraction: no value for {missing}; have {sorted(area_fraction)}")
     total = sum(areas.values())
     names = [str(m) for m in cube["material"].values]
+    gain = brightness or {}
     scale = xr.DataArray(
-        [area_fraction[m] * total / areas[m] for m in names],
+        [area_fraction[m] * total / areas[m] * float(gain.get(m, 1.0)) for m in names],
         dims="material",
         coords={"material": names},
     )
@@ -133,6 +145,8 @@ def observation_recovery(
     seed: int = 0,
     start_offset: Mapping[str, float] | None = None,
     phase_symmetry_deg: float = 360.0,
+    brightness: Mapping[str, float] | None = None,
+    effects: Sequence[str] = (),
     **options: Any,
 ) -> xr.Dataset:
     """Pulls and coverage of :func:`fit_observation` over noise draws of a simulated pass.
@@ -143,7 +157,10 @@ def observation_recovery(
     from the truth moved by ``start_offset``: ``axis`` [degree] towards the north,
     ``period`` [s], ``phase`` [degree] (default 2 deg, 0.05 s, 5 deg).  The phase is
     compared modulo ``phase_symmetry_deg`` (180 for a body that looks the same turned half
-    a turn about its spin axis; a Quantity is converted).
+    a turn about its spin axis; a Quantity is converted).  ``brightness`` and ``effects``
+    make the truth other than the fit's model (see :func:`simulated_light_curve`): the
+    pulls then measure what a model error does to the stated uncertainties, and
+    ``quality_warnings`` how often the fit says so.
 
     Returns
     -------
@@ -186,6 +203,8 @@ def observation_recovery(
         extinction=extinction,
         bands=bands,
         axis_body=axis_body,
+        brightness=brightness,
+        effects=effects,
     )
     obs_at = dataclasses.replace(observation, times=np.unique(lc0["time"].values))
     sim_s = min(  # the baseline: simulate of the measured times, warm, best of 3 in this run

@@ -186,6 +186,12 @@ class Kernel:
             method=method,
         )
         self.plan = plan = scene.plan()
+        #: Where each material's table comes from (its ``source`` attribute).
+        self.sources = {
+            str(m): str(scene.material_data[m].attrs.get("source", ""))
+            for m in plan.materials
+            if m in scene.material_data
+        }
         if not plan.pre_integrated:
             raise InversionError("spin fit: the band tables could not be pre-integrated")
         self.bands = tuple(str(b) for b in plan.bands)

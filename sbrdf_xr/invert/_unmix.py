@@ -6,6 +6,7 @@ See the package docstring.
 from __future__ import annotations
 
 import itertools
+import warnings
 from collections.abc import Mapping
 from typing import Any
 
@@ -13,7 +14,7 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from ..errors import InversionError
+from ..errors import FitQualityWarning, InversionError
 from ..units import to_unit
 from ._areas import add_areas, area_constraint, material_areas
 from ._library import MATERIAL, design, library
@@ -45,6 +46,25 @@ UNMIX_CAUSES = (
 )
 
 
+#: A material whose weighted column norm is below this fraction of the largest is never lit
+#: and seen at the measured geometries: the data say nothing about it.
+UNSEEN_TOL = 1e-9
+
+
+def unseen_columns(aw: np.ndarray) -> np.ndarray:
+    """Columns of the weighted design that the data do not see (a material never lit and
+    seen): norm at most :data:`UNSEEN_TOL` of the largest.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.invert._unmix import unseen_columns
+    >>> unseen_columns(np.array([[1.0, 0.0], [2.0, 0.0]])).tolist()
+    [False, True]
+    """
+    norm = np.sqrt((aw**2).sum(axis=0))
+    return np.asarray(norm <= UNSEEN_TOL * max(float(norm.max(initial=0.0)), 1e-300))
+
+
 def _wls(
     aw: np.ndarray,
     yw: np.ndarray,
@@ -54,21 +74,52 @@ def _wls(
     """Weighted least squares on the columns ``cols``: estimate, covariance, chi-square.
 
     With ``con = (c, total)`` the estimate obeys ``c[cols] . x = total`` (Seber & Lee
-    2003, *Linear Regression Analysis*, §3.8): ``x_c = x - C c^T (c C c^T)^-1 (c x -
-    total)``, ``C_c = C - C c^T (c C c^T)^-1 c C``; a subset whose ``c`` is 0 cannot meet
-    it (chi-square infinite).
+    2003, *Linear Regression Analysis*, §3.8), solved through the Lagrange (KKT) system
+    ``[[A^T A, c], [c^T, 0]] [x, l] = [A^T y, total]`` whose inverse's upper-left block is
+    the covariance: it holds when ``A^T A`` is singular, so a material the data never see
+    is pinned by the constraint (by elimination), with the others' uncertainties.  Columns
+    never seen (:func:`unseen_columns`) are tied to one common scale (the data cannot split
+    them); without the constraint they keep scale 0 and variance 0 here and are reported
+    as unconstrained by :func:`unmix`.  A subset whose ``c`` is 0 cannot meet the
+    constraint (chi-square infinite).
     """
     a = aw[:, cols]
-    cov = np.linalg.pinv(a.T @ a)
-    x = np.linalg.lstsq(a, yw, rcond=None)[0]
-    if con is not None:
+    k = len(cols)
+    x = np.zeros(k)
+    cov = np.zeros((k, k))
+    unseen = unseen_columns(aw)[cols]
+    seen = np.flatnonzero(~unseen)
+    if con is None:
+        if seen.size:
+            g = a[:, seen]
+            cov[np.ix_(seen, seen)] = np.linalg.pinv(g.T @ g)
+            x[seen] = np.linalg.lstsq(g, yw, rcond=None)[0]
+    else:
         c = con[0][cols]
-        cc = float(c @ cov @ c)
-        if not cc > 0:
+        if not np.any(c != 0):
             return x, cov, np.inf
-        gain = cov @ c / cc
-        x = x - gain * (float(c @ x) - con[1])
-        cov = cov - np.outer(gain, c @ cov)
+        # the unseen columns as one (tied) scale: a column of zeros with their summed area
+        tie = np.flatnonzero(unseen & (c != 0))
+        g = a[:, seen]
+        cs = c[seen]
+        if tie.size:
+            g = np.hstack([g, np.zeros((a.shape[0], 1))])
+            cs = np.append(cs, c[tie].sum())
+        m = g.shape[1]
+        kkt = np.block([[g.T @ g, cs[:, None]], [cs[None, :], np.zeros((1, 1))]])
+        try:
+            inv = np.linalg.inv(kkt)
+        except np.linalg.LinAlgError:
+            inv = np.linalg.pinv(kkt)
+        sol = inv @ np.append(g.T @ yw, con[1])
+        idx = np.append(seen, tie[:1]) if tie.size else seen
+        x[idx] = sol[:m]
+        cov[np.ix_(idx, idx)] = inv[:m, :m]
+        if tie.size > 1:  # every tied column the same scale, fully correlated
+            x[tie] = sol[m - 1]
+            cov[np.ix_(tie, tie)] = inv[m - 1, m - 1]
+            cov[np.ix_(tie, seen)] = inv[m - 1, : m - 1]
+            cov[np.ix_(seen, tie)] = inv[: m - 1, m - 1][:, None]
     r = yw - a @ x
     return x, cov, float(r @ r)
 
@@ -305,6 +356,14 @@ def unmix(
     kmax = k if max_materials is None else min(int(max_materials), k)
     x_full, cov_full, _ = _wls(aw, yw, list(range(k)), con)
     pen = 2.0 if criterion == "aic" else float(np.log(n))
+    unseen = unseen_columns(aw)
+
+    def npar(c: tuple[int, ...]) -> int:
+        """Free parameters of a subset: its seen materials (and one for its unseen ones,
+        tied, with the constraint), less the constraint."""
+        u = unseen[list(c)]
+        return int((~u).sum()) + int(con is not None and bool(u.any())) - n_con
+
     fits: dict[tuple[int, ...], tuple[np.ndarray, np.ndarray, float, float]] = {}
 
     def score(c: tuple[int, ...]) -> float:
@@ -312,7 +371,7 @@ def unmix(
             x, cov, chi2 = _wls(aw, yw, list(c), con)
             bias = _bias_ratio(x_full, cov_full, list(c), cov) if np.isfinite(chi2) else np.inf
             fits[c] = (x, cov, chi2, bias)
-        return fits[c][2] + pen * (len(c) - n_con)
+        return fits[c][2] + pen * npar(c)
 
     subsets = _subsets(select, k, kmax, score)
     for c in subsets:
@@ -331,7 +390,12 @@ def unmix(
     cov[np.ix_(cols, cols)] = cov_s
     sig = np.sqrt(np.clip(np.diag(cov_full), 0, None))  # left out: sigma of the full fit
     sig[cols] = np.sqrt(np.clip(np.diag(cov_s), 0, None))
-    dof = n - len(cols) + n_con
+    dof = n - npar(best)
+    constrained_by = _constrained_by(unseen, cols, con is not None)
+    free = constrained_by == "none"
+    if con is None:
+        x[free] = np.nan
+    sig[free] = np.inf
 
     def label(c: tuple[int, ...]) -> str:
         return "+".join(names[j] for j in c)
@@ -358,13 +422,14 @@ def unmix(
                 label(c),
                 fits[c][2],
                 fits[c][3],
-                fits[c][2] + 2 * (len(c) - n_con),
-                fits[c][2] + (len(c) - n_con) * np.log(n),
+                fits[c][2] + 2 * npar(c),
+                fits[c][2] + npar(c) * np.log(n),
                 wi,
             )
             for c, wi in zip(subsets, w, strict=True)
         ],
-        scalars={"chi2": chi2, "dof": dof, "n": n, "npar": len(cols) - n_con},
+        scalars={"chi2": chi2, "dof": dof, "n": n, "npar": npar(best)},
+        constrained_by=constrained_by,
         total=None if con is None else con[1],
         importance=np.array(
             [sum(wi for c, wi in zip(subsets, w, strict=True) if j in c) for j in range(k)]
@@ -390,8 +455,61 @@ def unmix(
     )
 
 
+def correlation(cov: np.ndarray) -> np.ndarray:
+    """Correlation matrix of a covariance, in [-1, 1]; NaN in the rows and columns of a
+    parameter of zero or infinite variance (not estimated, or not constrained).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.invert._unmix import correlation
+    >>> correlation(np.array([[4.0, 2.0, 0.0], [2.0, 4.0, 0.0], [0.0, 0.0, 0.0]])).tolist()
+    [[1.0, 0.5, nan], [0.5, 1.0, nan], [nan, nan, nan]]
+    """
+    v = np.diag(cov)
+    ok = np.isfinite(v) & (v > 0)
+    d = np.sqrt(np.where(ok, v, 1.0))
+    with np.errstate(invalid="ignore"):
+        c = np.clip(cov / np.outer(d, d), -1.0, 1.0)
+    c[~ok, :] = np.nan
+    c[:, ~ok] = np.nan
+    return np.asarray(c)
+
+
+def _constrained_by(unseen: np.ndarray, cols: list[int], constrained: bool) -> np.ndarray:
+    """What pins each material: ``"data"`` (seen), ``"total_area"`` (never lit and seen,
+    the only such material of the chosen model, pinned by the area constraint by
+    elimination) or ``"none"`` (not constrained)."""
+    out = np.where(unseen, "none", "data").astype(object)
+    in_model = unseen & np.isin(np.arange(unseen.size), cols)
+    if constrained and int(in_model.sum()) == 1:
+        out[in_model] = "total_area"
+    return out.astype(str)
+
+
+def _unconstrained_note(names: list[str], constrained_by: np.ndarray) -> str:
+    """The note on materials the data do not see (and a warning when one is free)."""
+    free = [m for m, c in zip(names, constrained_by, strict=True) if c == "none"]
+    tied = [m for m, c in zip(names, constrained_by, strict=True) if c == "total_area"]
+    parts = []
+    if free:
+        parts.append(
+            f"{', '.join(free)}: never lit and seen at the measured geometries (zero column), "
+            "not constrained by the data: scale reported NaN (or a share of total_area) with "
+            "an infinite uncertainty; with every material of the body in the library, "
+            "total_area pins one such material by elimination"
+        )
+        warnings.warn(f"unmix: {parts[-1]}", FitQualityWarning, stacklevel=3)
+    if tied:
+        parts.append(
+            f"{', '.join(tied)}: never lit and seen; its area is total_area less the others' "
+            "(by elimination), with their uncertainties"
+        )
+    return "; ".join(parts) if parts else "none: every material is lit and seen"
+
+
 def _result(
     *,
+    constrained_by: np.ndarray,
     names: list[str],
     x: np.ndarray,
     sig: np.ndarray,
@@ -409,19 +527,19 @@ def _result(
 ) -> xr.Dataset:
     """The result Dataset of :func:`unmix`."""
     k = len(names)
-    d = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
     corr = np.full((k, k), np.nan)
-    corr[np.ix_(cols, cols)] = (cov / np.outer(d, d))[np.ix_(cols, cols)]
-    cand_full = np.linalg.pinv(aw.T @ aw)
-    dc = np.sqrt(np.clip(np.diag(cand_full), 1e-300, None))
-    cand_corr = cand_full / np.outer(dc, dc)
+    corr[np.ix_(cols, cols)] = correlation(cov)[np.ix_(cols, cols)]
+    seen = constrained_by == "data"
+    cand_full = np.zeros((k, k))
+    cand_full[np.ix_(seen, seen)] = np.linalg.pinv(aw[:, seen].T @ aw[:, seen])
+    cand_corr = correlation(cand_full)
     sv = np.linalg.svd(aw, compute_uv=False)
     cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else np.inf
     degenerate = [
         f"{names[i]} / {names[j]} (correlation {cand_corr[i, j]:+.3f})"
         for i in range(k)
         for j in range(i + 1, k)
-        if abs(cand_corr[i, j]) > degeneracy_threshold
+        if np.isfinite(cand_corr[i, j]) and abs(cand_corr[i, j]) > degeneracy_threshold
     ]
     selected = np.isin(np.arange(k), cols)
     ds = xr.Dataset(
@@ -443,8 +561,16 @@ def _result(
             "left out of it: with every candidate fitted)",
         ),
         "significance": (
-            np.where(selected, x / np.where(sig > 0, sig, np.inf), 0.0),
-            "scale factor over its uncertainty (0 when left out)",
+            np.where(
+                selected & np.isfinite(x), np.nan_to_num(x) / np.where(sig > 0, sig, np.inf), 0.0
+            ),
+            "scale factor over its uncertainty (0 when left out or not constrained)",
+        ),
+        "constrained_by": (
+            constrained_by,
+            "what pins the scale factor: data (the material is lit and seen), total_area (never "
+            "lit and seen: by elimination through the area constraint) or none (not "
+            "constrained: NaN, or a tied share of the constraint, with an infinite uncertainty)",
         ),
         "selected": (selected, "material in the chosen model"),
         "importance": (
@@ -514,6 +640,7 @@ def _result(
     )
     ds.attrs = {
         **attrs,
+        "unconstrained": _unconstrained_note(names, constrained_by),
         "degenerate": "; ".join(degenerate) if degenerate else "none",
         "degeneracy_note": (
             f"the data cannot tell apart: {'; '.join(degenerate)}"

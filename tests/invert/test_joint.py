@@ -122,6 +122,8 @@ def test_result_is_self_describing(fit):
     assert float(fit.area_fraction_uncertainty[-1]) == pytest.approx(np.sqrt(cov.sum()))
     assert fit.attrs["uncertainty_scaling"].startswith("unscaled")
     assert fit.attrs["epoch"] == "2024-03-17T19:55:00.000"
+    assert fit.attrs["status"] == "ok" and fit.attrs["unconstrained"] == "none"
+    assert fit.attrs["bounded"].startswith("none")
 
 
 def test_starts_from_fit_spin(sc, lc, night, fit):
@@ -193,6 +195,12 @@ def test_a_wrong_model_warns(sc, lc, night):
         ({"starts": "all"}, "starts: 'all'; allowed 'given'"),
         ({"starts": START}, "starts: got a dict; allowed 'given', 'aliases' or a sequence"),
         ({"starts": [{**START, "period": -1.0}]}, r"start values must be finite with period > 0"),
+        (
+            {"extinction_prior": {"V": (0.2, 0.0), "R": (0.1, 0.1), "I": (0.05, 0.1)}},
+            r"extinction_prior\['V'\]: k 0.2, width 0.0; allowed finite values with a width > 0",
+        ),
+        ({"extinction_prior": {"V": (0.2, 0.1)}}, r"no \(k, width\) for bands \['R', 'I'\]"),
+        ({"extinction_prior": {"V": 0.2, "R": 1, "I": 2}}, r"allowed a pair \(k, width\)"),
     ],
 )
 def test_bad_options(sc, lc, night, change, match):
@@ -232,16 +240,32 @@ def test_aliases_find_the_minimum_a_start_misses(sc):
     lc["magnitude"] = clean.magnitude + np.random.default_rng(3).normal(0.0, 0.02, lc.sizes["obs"])
     lc["uncertainty"] = clean.uncertainty + 0.02
     start = {**truth, "axis_longitude": 216.0, "axis_latitude": 41.0, "period": 10.2, "phase": 33.0}
-    with pytest.warns(FitQualityWarning, match="beyond the 99.9 %"):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", FitQualityWarning)
         local = invert.fit_observation(lc, sc, pass_, start, check=False)
+    said = " ".join(str(w.message) for w in caught)
+    assert "beyond the 99.9 %" in said and "the fit failed" in said and "fit_spin" in said
     assert float(local.reduced_chi2) > 5 and abs(float(local.period) - 10.0) > 0.2
+    # its minimum needs impossible areas: refined inside the bounds, and marked failed
+    assert local.attrs["status"] == "failed" and "outside physics" in local.attrs["bounded"]
+    f = local.area_fraction.values
+    assert np.all((f >= 0) & (f <= 1)) and float(f.sum()) == pytest.approx(1.0)
+    assert np.all(np.isfinite(local.uncertainty.values))
     with warnings.catch_warnings():
         warnings.simplefilter("error", FitQualityWarning)  # consistent, and not ambiguous
         fit = invert.fit_observation(lc, sc, pass_, start, starts="aliases", check=False)
     assert fit.start.values.tolist() == [
         "given", "alias -2/2 turn", "alias -1/2 turn", "alias +1/2 turn", "alias +2/2 turn"
     ]  # fmt: skip
-    assert float(fit.reduced_chi2) < 1.25 and fit.attrs["ambiguity"] == "none"
+    # no other minimum is ambiguous; CanX-1's symmetries give exact twins (a half turn
+    # about its spin axis and two flips), named in ambiguity, their chi2 gaps of rounding
+    assert float(fit.reduced_chi2) < 1.25 and fit.attrs["ambiguity"] == fit.attrs["symmetry_twins"]
+    assert fit.twin.values.tolist() == [
+        "turn 180 deg",
+        "flip about [0, 1, 0]",
+        "flip about [1, 0, 0]",
+    ]
+    assert np.all(np.abs(fit.twin_chi2_gap.values) < 1e-6)
     assert abs(float(fit.period) - 10.0) < 4 * float(fit.period_uncertainty)
     assert float(fit.start_chi2_gap.sel(start="given")) == pytest.approx(
         float(local.chi2) - float(fit.chi2), rel=1e-9
