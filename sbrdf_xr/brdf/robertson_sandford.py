@@ -493,9 +493,11 @@ def directional_hemispherical_reflectance(
     ndarray, shape theta_i.shape + (n_wl,)
         Without the cut-off, the closed form of Eq. 11, ``1 - epsilon(lambda,
         theta_i)``.  With it, ``rho_d + rho_s (1 - L(theta_i))`` where the lost
-        fraction ``L`` is computed by Gauss–Legendre quadrature in glint-centred
-        coordinates (relative accuracy ~1e-9 below 80 deg incidence, ~1e-5 above,
-        where the band boundary has a square-root singularity in azimuth).
+        fraction ``L`` is computed by Gauss–Legendre quadrature on panels graded
+        geometrically toward the lobe's peak and the horizon, over the band
+        ``80 < theta_r < 90 deg`` in ``(theta_r, phi_r)``; it agrees with an
+        adaptive cubature to ~1e-13 for the Table 4 paints and for needle lobes
+        (``e = 1e-4``) at every ``theta_i`` up to 89.99 deg.
 
     Examples
     --------
@@ -516,12 +518,8 @@ def directional_hemispherical_reflectance(
         return rho_d + rho_s
     # The loss depends on (theta_i, b, e) only: evaluate on the distinct (b, e) pairs.
     pairs, inverse = np.unique(np.stack([p["b"], p["e"]], axis=-1), axis=0, return_inverse=True)
-    cos_flat = np.cos(np.radians(ti.ravel()))
-    loss_pairs = np.empty((cos_flat.size, pairs.shape[0]))
-    chunk = max(1, 256 // max(1, pairs.shape[0]))
-    for start in range(0, cos_flat.size, chunk):  # memory bound, not a per-sample loop
-        c = cos_flat[start : start + chunk, None]
-        loss_pairs[start : start + chunk] = _cutoff_loss(c, pairs[:, 0], pairs[:, 1])
+    ti_rad = np.radians(ti.ravel())
+    loss_pairs = np.stack([_cutoff_loss(ti_rad, bj, ej) for bj, ej in pairs], axis=-1)
     loss = loss_pairs[:, inverse.ravel()].reshape((*ti.shape, p["b"].size))
     # b = 0: no cut-off at all (d == 1).
     loss = np.where(p["b"] > 0, loss, 0.0)
