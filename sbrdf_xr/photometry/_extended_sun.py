@@ -65,8 +65,8 @@ def extend(
     >>> sun = SUN_SOLID_ANGLE * _blackbody(wl, 5772.0)
     >>> w, e = extend((wl[(wl >= 280) & (wl <= 4000)], sun[(wl >= 280) & (wl <= 4000)]),
     ...               (wl, sun), (wl, sun))
-    >>> bool(w[0] == 200.0 and w[-1] == 1e6)
-    True
+    >>> float(w[0]), round(float(w[-1]))
+    (200.0, 1000000)
     >>> i = np.searchsorted(w, 15_000.0)
     >>> round(float(e[i] / (SUN_SOLID_ANGLE * _blackbody(w[i], 5772.0))), 6)
     1.0
