@@ -40,9 +40,13 @@ _COS_FLOOR = 1.0e-150
 #: |1 - b^2| below which G(b) uses its power series.
 _G_SERIES_RADIUS = 0.5
 _G_SERIES_TERMS = 64
-#: Gauss–Legendre orders of the cut-off-loss quadrature (azimuth, each polar piece).
-_N_PHI = 96
-_N_X = 48
+#: Cut-off-loss quadrature: Gauss–Legendre points per panel, the geometric ratio of
+#: the panels graded toward the lobe and the horizon, the smallest panel as a
+#: fraction of the narrowest width, and the number of integrand values per chunk.
+_N_NODES = 16
+_GRADE = 0.2
+_SCALE = 0.05
+_CHUNK = 4_000_000
 
 
 # --------------------------------------------------------------------------
@@ -250,55 +254,97 @@ def cutoff_factor(theta_r: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
 # --------------------------------------------------------------------------
 
 
-def _cutoff_loss(cos_i: np.ndarray, b: np.ndarray, e: np.ndarray) -> np.ndarray:
+def _graded_rule(breaks: np.ndarray, n_nodes: int = _N_NODES) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss–Legendre nodes and weights on the panels between sorted ``breaks`` (last axis)."""
+    t, w = np.polynomial.legendre.leggauss(n_nodes)
+    lo, hi = breaks[..., :-1, None], breaks[..., 1:, None]
+    half = 0.5 * (hi - lo)
+    nodes = (lo + half * (t + 1.0)).reshape(*breaks.shape[:-1], -1)
+    return nodes, (half * w).reshape(nodes.shape)
+
+
+def _n_grades(length: float, smallest: float) -> int:
+    """Number of geometric panels (ratio :data:`_GRADE`) from ``length`` down to ``smallest``."""
+    ratio = max(smallest, 1e-300) / max(length, 1e-300)
+    return max(1, int(np.ceil(np.log(ratio) / np.log(_GRADE))) + 1)
+
+
+def _loss_rows(theta_i: np.ndarray, b: float, e: float, psi: np.ndarray, w_psi: np.ndarray):
+    """``e^2 H L`` for incidence angles ``theta_i`` [rad] (1-D), one (b, e) pair."""
+    lo, hi = np.radians(CUTOFF_ANGLE), 0.5 * np.pi
+    peak = np.clip(theta_i, lo, hi)[:, None]
+    width = hi - lo
+    frac = _GRADE ** np.arange(1, _n_grades(width, _SCALE * e) + 1)
+    horizon = hi - width * _GRADE ** np.arange(1, _n_grades(width, _SCALE * max(b, 1e-8)) + 1)
+    breaks = np.concatenate(
+        [
+            np.broadcast_to([lo, hi], (theta_i.size, 2)),
+            peak,
+            peak - (peak - lo) * frac,
+            peak + (hi - peak) * frac,
+            np.broadcast_to(horizon, (theta_i.size, horizon.size)),
+        ],
+        axis=1,
+    )
+    th, w_th = _graded_rule(np.sort(breaks, axis=1))
+    th, w_th = th[..., None], w_th[..., None]
+    ti = theta_i[:, None, None]
+    s_r, c_r = np.sin(th), np.cos(th)
+    # the glint vector (s + o) in the facet frame, psi = pi - phi_r (psi = 0: the
+    # plane of incidence, forward); written without cancellation near the mirror
+    # direction (theta_r = theta_i, psi = 0) where needle lobes live.
+    tx = (
+        2.0 * np.cos(0.5 * (ti + th)) * np.sin(0.5 * (ti - th)) + 2.0 * s_r * np.sin(0.5 * psi) ** 2
+    )
+    ty = s_r * np.sin(psi)
+    nz = np.cos(ti) + c_r
+    t2 = tx * tx + ty * ty
+    den = (e * e) * nz * nz + t2
+    ok = den > 0
+    e2h = np.where(ok, (e * e) * ((nz * nz + t2) / np.where(ok, den, 1.0)) ** 2, 1.0 / (e * e))
+    # 1 - c(theta_r) of Eq. 21 above 80 deg, without the cancellation at 80 deg
+    lost = (
+        (b * b)
+        * np.sin(th - lo)
+        * np.sin(th + lo)
+        / (np.cos(lo) ** 2 * (c_r**2 + (b * b) * s_r**2))
+    )
+    f = 2.0 * e2h * lost * s_r  # both halves of the azimuth range
+    return np.einsum("imk,im,k->i", f, w_th[..., 0], w_psi) / (4.0 * np.pi)
+
+
+def _cutoff_loss(theta_i: np.ndarray, b: float, e: float) -> np.ndarray:
     """Fraction ``L`` of the specular lobe removed by the Eq. 21 cut-off.
 
     ``L = (1/4 pi H) int h(alpha) (1 - c(theta_r)) dOmega_r`` over the band
-    ``80 deg < theta_r < 90 deg``.  Written in half-vector coordinates
-    ``(phi_h, x)`` with ``tan(alpha) = e tan(x)`` (centred on the glint direction,
-    so needle lobes are resolved), ``e^2 H L = (2/pi) int_0^pi dphi int dx
-    [sin x cos x cos(theta_i) + e sin^2 x cos(phi) sin(theta_i)] (1 - c)``.  The
-    x-range where ``theta_r > 80 deg`` is found in closed form
-    (``cos(theta_r) = R cos(2 alpha - beta)``), so each Gauss–Legendre piece has a
-    smooth integrand.  Inputs broadcast; returns their broadcast shape.
+    ``80 deg < theta_r < 90 deg``, for incidence angles ``theta_i`` [rad] (any shape)
+    and one ``(b, e)`` pair.  The band is a rectangle in ``(theta_r, psi)``
+    (``psi = pi - phi_r``), so the only difficulty is the lobe: it peaks at the
+    mirror direction ``(theta_i, 0)`` (clipped into the band when ``theta_i < 80``
+    deg) with widths ``~e`` in ``theta_r`` and down to ``~e cos(theta_i)`` and
+    ``~e^2`` in ``psi`` (near grazing the glint vector of nearly opposite ``s`` and
+    ``o`` turns fast).  Both coordinates are cut into panels graded geometrically
+    (ratio :data:`_GRADE`) toward the peak, and toward the horizon where ``1 - c``
+    varies on the scale ``b``, down to a fraction :data:`_SCALE` of those widths;
+    a Gauss–Legendre rule of :data:`_N_NODES` points on each panel then converges
+    exponentially (the hp-quadrature of a point singularity).  The integrand is
+    written without cancellation, so needle lobes (``e = 1e-4``) at ``theta_i =
+    89.99 deg`` are integrated to ~1e-12 (tests compare with an adaptive cubature).
     """
-    cos_i, b, e = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in (cos_i, b, e)))
-    sin_i = np.sqrt(np.maximum(1.0 - cos_i**2, 0.0))
-    tp, wp = np.polynomial.legendre.leggauss(_N_PHI)
-    phi = 0.5 * np.pi * (tp + 1.0)
-    w_phi = 0.5 * np.pi * wp
-    tx, wx = np.polynomial.legendre.leggauss(_N_X)
-    tx, wx = 0.5 * (tx + 1.0), 0.5 * wx  # on [0, 1]
-
-    ci = cos_i[..., None]
-    si = sin_i[..., None]
-    bb = b[..., None, None]
-    ee = e[..., None]
-    cphi = np.cos(phi)
-    bprime = cphi * si  # cos(theta_r) = A' cos 2a + B' sin 2a
-    r = np.hypot(ci, bprime)
-    beta = np.arctan2(bprime, ci)
-    gamma = np.arccos(np.clip(_COS_CUT / np.maximum(r, 1e-300), -1.0, 1.0))
-    a_max = 0.5 * (beta + 0.5 * np.pi)
-    a1 = np.clip(0.5 * (beta - gamma), 0.0, a_max)
-    a2 = np.clip(0.5 * (beta + gamma), 0.0, a_max)
-
-    def x_of(alpha: np.ndarray) -> np.ndarray:
-        return np.arctan2(np.tan(alpha), ee)
-
-    total = np.zeros(cos_i.shape)
-    for lo, hi in ((np.zeros_like(a1), a1), (a2, a_max)):  # the two pieces of the band
-        x_lo, x_hi = x_of(lo), x_of(hi)
-        x = x_lo[..., None] + (x_hi - x_lo)[..., None] * tx
-        alpha = np.arctan(ee[..., None] * np.tan(x))
-        cos_r = ci[..., None] * np.cos(2 * alpha) + bprime[..., None] * np.sin(2 * alpha)
-        cos_r = np.clip(cos_r, 0.0, 1.0)
-        cut = _cutoff_cs(cos_r, 1.0 - cos_r**2, bb)
-        f = (
-            np.sin(x) * np.cos(x) * ci[..., None]
-            + ee[..., None] * np.sin(x) ** 2 * (cphi * si)[..., None]
-        ) * (1.0 - cut)
-        inner = np.einsum("...px,x->...p", f, wx) * (x_hi - x_lo)
-        total = total + np.einsum("...p,p->...", inner, w_phi)
-    loss = (2.0 / np.pi) * total / _e2_h_norm(cos_i, e)
-    return np.clip(loss, 0.0, 1.0)
+    theta_i = np.asarray(theta_i, dtype=np.float64)
+    flat = theta_i.ravel()
+    if b <= 0 or flat.size == 0:
+        return np.zeros(theta_i.shape)
+    c_min = max(float(np.cos(np.max(flat))), 1e-7)
+    w_smallest = max(_SCALE * min(e * e, e * c_min), 1e-16)
+    psi_breaks = np.concatenate(
+        [[0.0], np.pi * _GRADE ** np.arange(_n_grades(np.pi, w_smallest))[::-1]]
+    )
+    psi, w_psi = _graded_rule(psi_breaks)
+    out = np.empty(flat.size)
+    step = max(1, _CHUNK // (psi.size * 400))
+    for start in range(0, flat.size, step):  # memory bound, not a per-sample loop
+        rows = flat[start : start + step]
+        out[start : start + step] = _loss_rows(rows, b, e, psi, w_psi)
+    e2h_norm = _e2_h_norm(np.cos(flat), e)
+    return np.clip(out / e2h_norm, 0.0, 1.0).reshape(theta_i.shape)

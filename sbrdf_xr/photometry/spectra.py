@@ -54,6 +54,10 @@ SOLAR_SPECTRA: dict[str, str] = _SolarSpectra(
         "(STScI CALSPEC, shipped by pyphot)",
         "kurucz1993": "Kurucz (1993) model atmosphere of the Sun (Teff 5777 K, log g 4.44, "
         "[M/H] 0) at 1 AU, CALSPEC grid file sun_kurucz93 (shipped by pyphot)",
+        "astm_g173_extended": "ASTM G173-03 AM0 over 280-4000 nm (as astm_g173), CALSPEC "
+        "sun_reference_stis_001 below (scaled at 280-300 nm), the Kurucz (1993) model to 10 um "
+        "(scaled at 3.5-4 um) and Planck's law at the model's brightness temperature to 1 mm; "
+        "119.5 nm - 1 mm",
     }
 )
 _USER_SOLAR: dict[str, tuple[np.ndarray, np.ndarray, str]] = {}
@@ -278,7 +282,15 @@ def _solar_native(solar: Any = "astm_g173") -> tuple[np.ndarray, np.ndarray, str
 def _solar_table(solar: str) -> tuple[np.ndarray, np.ndarray, str]:
     if solar in _USER_SOLAR:
         return _USER_SOLAR[solar]
-    if solar == "astm_g173":
+    if solar == "astm_g173_extended":
+        from ._extended_sun import extend
+
+        gw, ge, g_src = _solar_table("astm_g173")
+        uw, ue, u_src = _solar_table("calspec")
+        mw, me, m_src = _read_calspec("sun_kurucz93.fits")
+        wl, e = extend((gw, ge), (uw, ue), (mw, me))
+        src = f"{g_src}; {u_src}; {m_src}; Planck continuation (sbrdf_xr.photometry._extended_sun)"
+    elif solar == "astm_g173":
         import pvlib
 
         path = Path(pvlib.__file__).resolve().parent / "data" / _SOLAR_FILE
@@ -498,7 +510,8 @@ def solar_spectrum(
         if wl[0] < wl0[0] or wl[-1] > wl0[-1]:
             raise ValidationError(
                 f"wavelength: {wl[0]:g}-{wl[-1]:g} nm is outside the solar spectrum "
-                f"({wl0[0]:g}-{wl0[-1]:g} nm)"
+                f"({wl0[0]:g}-{wl0[-1]:g} nm); solar='astm_g173_extended' covers "
+                "119.5 nm - 1 mm"
             )
         if method == "linear" or wl.size == 1:
             e = np.interp(wl, wl0, e0)

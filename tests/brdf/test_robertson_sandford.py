@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -164,6 +166,134 @@ def test_cutoff_loss_by_independent_quadrature():
     assert (no_cut - cut) / rho_s == pytest.approx(lost, rel=1e-6)
 
 
+#: The cut-off reflectance against an adaptive cubature (scipy ``cubature``, GK21)
+#: of the public specular BRDF over the 80-90 deg band, in coordinates logarithmic in
+#: the distance from the mirror direction (so the needle lobe is a smooth feature of
+#: unit width); the cubature is asked for 1e-12 relative, 1e-14 absolute, and the
+#: two agree to ~1e-13 (measured): the issue's requirement is 1e-10.
+TOL_CUTOFF_EXACT = 1e-10
+
+
+def _cutoff_reference(theta_i: float, p: dict) -> float:
+    """``1 - eps(theta_i)`` minus the band integral of ``(f_s uncut - f_s cut) cos dOmega``."""
+    s = _s(theta_i)
+    lo, hi = np.radians(80.0), np.pi / 2
+    peak = min(max(np.radians(theta_i), lo), hi)
+
+    def band(x, side):
+        d, psi = np.exp(x[:, 0]), np.exp(x[:, 1])  # distance from the peak, pi - phi_r
+        th = peak + side * d
+        o = np.stack([-np.sin(th) * np.cos(psi), np.sin(th) * np.sin(psi), np.cos(th)], -1)
+        f_uncut = rs.specular_brdf(Z, s, o, WL[2:], cutoff=False, **p)[:, 0]
+        f_cut = rs.specular_brdf(Z, s, o, WL[2:], **p)[:, 0]
+        return 2.0 * (f_uncut - f_cut) * np.cos(th) * np.sin(th) * d * psi
+
+    lost = 0.0
+    for side, length in ((-1.0, peak - lo), (1.0, hi - peak)):
+        if length > 0:
+            lower, upper = [np.log(1e-22)] * 2, [np.log(length), np.log(np.pi)]
+            res = integrate.cubature(
+                lambda x, side=side: band(x, side), lower, upper, rtol=1e-12, atol=1e-14
+            )
+            lost += res.estimate
+    return float(rs.total_reflectance(theta_i, WL[2:], **p)[0] - lost)
+
+
+NEEDLE = {"rho_D": 0.05, "epsilon": 0.3, "b": 0.6, "e": 1e-4}
+
+
+@pytest.mark.parametrize(
+    ("params", "theta_i"),
+    [
+        (AFGL01, 40.0),
+        (AFGL01, 80.0),
+        (AFGL01, 89.9),
+        (AFGL10, 85.0),
+        (AFGL10, 89.99),
+        (NEEDLE, 79.9),
+        pytest.param(AFGL01, 89.99, marks=pytest.mark.slow),
+        pytest.param(AFGL10, 89.9, marks=pytest.mark.slow),
+        pytest.param(NEEDLE, 85.0, marks=pytest.mark.slow),
+    ],
+)
+def test_cutoff_reflectance_to_1e_10(params, theta_i):
+    """The cut-off reflectance to 1e-10 up to 89.99 deg and for needle lobes (issue 46)."""
+    got = rs.directional_hemispherical_reflectance(theta_i, WL[2:], **params)[0]
+    assert got == pytest.approx(_cutoff_reference(theta_i, params), abs=TOL_CUTOFF_EXACT)
+
+
+def _loss_glint_centred(theta_i: float, b: float, e: float) -> float:
+    """The lost fraction L by nested adaptive quad in glint-centred coordinates.
+
+    Azimuth ``phi_h`` of the glint vector and ``x`` with ``tan(alpha) = e tan(x)``
+    (the lobe is smooth in x); the band ``theta_r > 80 deg`` is cut out in closed
+    form (``cos(theta_r) = R cos(2 alpha - beta)``) and the azimuth range is split
+    where the band boundary turns (square-root points) and around 90 deg, where
+    the glint vector swings over ``~cot(theta_i)`` near grazing.
+    """
+    ti = np.radians(theta_i)
+    ci, si, c80 = np.cos(ti), np.sin(ti), np.cos(np.radians(80.0))
+
+    def x_of(a):
+        return np.arctan2(np.tan(a), e)
+
+    def inner(phi):
+        bp = np.cos(phi) * si
+        r, beta = np.hypot(ci, bp), np.arctan2(bp, ci)
+        a_max = 0.5 * (beta + 0.5 * np.pi)
+        gam = np.arccos(min(c80 / r, 1.0))
+        a1 = min(max(0.5 * (beta - gam), 0.0), a_max)
+        a2 = min(max(0.5 * (beta + gam), 0.0), a_max)
+
+        def f(x):
+            alpha = np.arctan(e * np.tan(x))
+            cos_r = np.clip(ci * np.cos(2 * alpha) + bp * np.sin(2 * alpha), 0.0, 1.0)
+            cut = rs.cutoff_factor(np.degrees(np.arccos(cos_r)), b)
+            return (np.sin(x) * np.cos(x) * ci + e * np.sin(x) ** 2 * bp) * (1.0 - cut)
+
+        pieces = [(lo, hi) for lo, hi in ((0.0, a1), (a2, a_max)) if hi > lo]
+        return sum(
+            integrate.quad(f, x_of(lo), x_of(hi), epsabs=1e-16, epsrel=1e-13, limit=400)[0]
+            for lo, hi in pieces
+        )
+
+    pts = {0.5 * np.pi + k * ci / si for k in (-30, -10, -3, -1, 0, 1, 3, 10, 30)}
+    if ci < c80:
+        c_star = np.sqrt(c80**2 - ci**2) / si
+        pts |= {np.arccos(c_star), np.arccos(-c_star)}
+    edges = [0.0, *sorted(q for q in pts if 0 < q < np.pi), np.pi]
+    total = sum(
+        integrate.quad(inner, a, z, epsabs=1e-16, epsrel=1e-13, limit=400)[0]
+        for a, z in itertools.pairwise(edges)
+    )
+    return (2.0 / np.pi) * total / (rs.normalisation_H(theta_i, e) * e * e)
+
+
+@pytest.mark.parametrize(
+    ("params", "theta_i"),
+    [
+        (NEEDLE, 89.9),
+        (AFGL01, 89.99),
+        pytest.param(NEEDLE, 89.99, marks=pytest.mark.slow),
+        pytest.param({**NEEDLE, "e": 1e-3}, 89.99, marks=pytest.mark.slow),
+        pytest.param(AFGL10, 89.9, marks=pytest.mark.slow),
+    ],
+)
+def test_cutoff_reflectance_needle_at_grazing(params, theta_i):
+    """A second, independent reference (glint-centred nested quad) near grazing."""
+    rho_s = rs.specular_reflectance(theta_i, WL[2:], **params)[0]
+    loss = _loss_glint_centred(theta_i, params["b"], params["e"])
+    ref = rs.total_reflectance(theta_i, WL[2:], **params)[0] - rho_s * loss
+    got = rs.directional_hemispherical_reflectance(theta_i, WL[2:], **params)[0]
+    assert got == pytest.approx(ref, abs=TOL_CUTOFF_EXACT)
+
+
+def test_cutoff_reflectance_issue_value_at_grazing():
+    """AFGL-01 at 89.9 deg: 0.9148925146 by two independent quadratures (issue 46)."""
+    got = rs.directional_hemispherical_reflectance(89.9, WL[2:], **AFGL01)[0]
+    assert got == pytest.approx(0.9148925146, abs=1e-10)
+
+
 def test_cutoff_loss_documented_values():
     """The cut-off removes little below 60 deg and more toward grazing (module notes)."""
     ti = np.array([0.0, 60.0, 80.0, 89.0])
@@ -223,13 +353,39 @@ def test_fig10_lobe_narrows_and_peak_rises_as_e_shrinks():
     assert widths[0] > widths[1] > widths[2]
 
 
-@pytest.mark.parametrize(("params", "lo", "hi"), [(AFGL10, 1.0, 6.0), (AFGL01, 10.0, 40.0)])
-def test_table3_lobe_widths_at_40_deg(params, lo, hi):
-    """FWHM of the in-plane BRDF at 40 deg: gloss ~3 deg, flat paint tens (Table 3)."""
-    dt = np.linspace(-45, 45, 90001)
-    f = rs.brdf_angles(40.0, dt, 0.0, WL[:1], **params)[:, 0]
+def _fwhm_40(params: dict, blur: float = 0.0) -> float:
+    """In-plane FWHM [degree] of the BRDF at 40 deg incidence, optionally blurred."""
+    from scipy.ndimage import gaussian_filter1d
+
+    dt = np.linspace(-60, 60, 240001)
+    f = rs.brdf_angles(40.0, dt, 0.0, WL[2:], **params)[:, 0]
+    if blur:
+        f = gaussian_filter1d(f, blur / np.sqrt(8 * np.log(2)) / (dt[1] - dt[0]), mode="nearest")
     above = dt[f >= f.max() / 2]
-    assert lo < above.max() - above.min() < hi
+    return above.max() - above.min()
+
+
+def test_table3_lobe_widths_at_40_deg():
+    """Table 3 (24 and 3 deg) against Table 4's parameters: the documented numbers.
+
+    The 0.01-deg sampling of the scan bounds each width to 0.01 deg (tolerance 0.02).
+    """
+    assert _fwhm_40(AFGL01) == pytest.approx(19.25, abs=0.02)
+    assert _fwhm_40(AFGL10) == pytest.approx(1.77, abs=0.02)
+    # the e that would give Table 3's widths
+    assert _fwhm_40({**AFGL01, "e": 0.144}) == pytest.approx(24.0, abs=0.05)
+    assert _fwhm_40({**AFGL10, "e": 0.0203}) == pytest.approx(3.0, abs=0.02)
+    # a 2.14-deg instrument response explains AFGL-10's 3 deg, not AFGL-01's 24 deg
+    assert _fwhm_40(AFGL10, blur=2.14) == pytest.approx(3.0, abs=0.02)
+    assert _fwhm_40(AFGL01, blur=2.14) == pytest.approx(19.46, abs=0.02)
+
+
+def test_table3_solar_absorptance_is_not_a_4um_quantity():
+    """Grey 4-um parameters absorb ~0.89-0.90, Table 3's solar values are 0.77 and 0.26."""
+    a01 = 1 - rs.directional_hemispherical_reflectance(0.0, WL[2:], **AFGL01)[0]
+    a10 = 1 - rs.directional_hemispherical_reflectance(0.0, WL[2:], **AFGL10)[0]
+    assert a01 == pytest.approx(0.893, abs=5e-4) and a10 == pytest.approx(0.904, abs=5e-4)
+    assert a01 - 0.77 > 0.1 and a10 - 0.26 > 0.6
 
 
 def test_diffuse_reciprocity():
