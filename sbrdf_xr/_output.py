@@ -860,5 +860,18 @@ def remove_marked_dir(
             f"{p} is a directory that sbrdf_xr did not write (it holds no {MARKER}); it was "
             "left as it is. Move or remove it yourself, or choose another output"
         )
-    shutil.rmtree(p)
+    # the marker last: a removal that fails half-way leaves a directory still marked
+    for _ in range(5):  # what a writer's last in-flight stores add meanwhile, again
+        for entry in os.scandir(p):
+            if entry.name == MARKER:
+                continue
+            if entry.is_dir(follow_symlinks=False):
+                shutil.rmtree(entry.path, ignore_errors=True)
+            else:
+                with contextlib.suppress(FileNotFoundError):
+                    os.unlink(entry.path)
+        if os.listdir(p) == [MARKER]:
+            break
+    os.unlink(p / MARKER)
+    os.rmdir(p)
     fsync_dir(p.parent)

@@ -127,6 +127,7 @@ Encoding
 from __future__ import annotations
 
 import contextlib
+import glob
 import logging
 import os
 from collections.abc import Callable, Mapping
@@ -399,8 +400,14 @@ def _write_locked(
 ) -> Path:
     """:func:`write_cube` once the lock is held."""
     state = check_destination(path, part, log, overwrite, resume)
+    # what a writer killed at an instant of its bookkeeping leaves (the lock is held: no
+    # writer of this path is running): a temporary header, or the log of a published cube
+    for tmp in path.parent.glob(glob.escape(log.name) + ".*" + PART_SUFFIX):
+        if file_kind(tmp) == "file":
+            tmp.unlink(missing_ok=True)
     if state == "finished":
         check_finished(path, ds)
+        log.unlink(missing_ok=True)
         return path
     resuming = state == "resume"
     if resuming and file_kind(log) is None and _just_created(part):
