@@ -718,11 +718,14 @@ def write_all(fd: int, data: bytes) -> None:
         view = view[n:]
 
 
-def read_marker(directory: str | os.PathLike[str]) -> dict[str, Any] | None:
+def read_marker(
+    directory: str | os.PathLike[str], *, strict: bool = False
+) -> dict[str, Any] | None:
     """The :data:`MARKER` of ``directory`` if the package wrote it, else None.
 
     A marker of the package cut short (no longer JSON) gives ``{"writer": "sbrdf_xr",
     "state": "torn"}`` (:data:`TORN`): the directory is the package's, its content unknown.
+    With ``strict`` a marker that cannot be opened or read raises instead of giving None.
 
     Examples
     --------
@@ -742,12 +745,11 @@ def read_marker(directory: str | os.PathLike[str]) -> dict[str, Any] | None:
     """
     try:
         fd = open_regular(Path(directory) / MARKER, os.O_RDONLY)
-    except (OSError, OutputError):
-        return None
-    try:
         with os.fdopen(fd, "rb") as f:
             raw = f.read(2**24)
-    except OSError:
+    except (OSError, OutputError):
+        if strict:  # an I/O failure raised, for its cause to be named
+            raise
         return None
     try:
         info = json.loads(raw.decode())

@@ -146,12 +146,22 @@ def faulty_write(path: Path, args: dict, steps: Steps | None, limit: int | None)
 
 
 def resumed(path: Path, args: dict, reference: dict[str, np.ndarray]) -> dict:
-    write_any(cube(), path, scheduler="synchronous", complevel=args.get("complevel"), resume=True)
+    """Resume; should the resume say the ``.part`` cannot be continued and to discard it
+    (a compressed ``.part`` whose HDF5 write failed mid-block), do so, and say it."""
+    level = args.get("complevel")
+    discarded = False
+    try:
+        write_any(cube(), path, scheduler="synchronous", complevel=level, resume=True)
+    except SbrdfError as exc:
+        if "overwrite=True, resume=False to discard it" not in str(exc):
+            raise
+        write_any(cube(), path, scheduler="synchronous", complevel=level, overwrite=True)
+        discarded = True
     opener = xr.open_zarr if path.suffix == ".zarr" else xr.open_dataset
     with opener(path) as back:
         same = all(np.array_equal(back[k].values, v) for k, v in reference.items())
         same = same and set(map(str, back.variables)) == set(reference)
-    return {"ok": True, "identical": bool(same)}
+    return {"ok": True, "identical": bool(same), "discarded": discarded}
 
 
 def main() -> None:
