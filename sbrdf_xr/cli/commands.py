@@ -443,7 +443,7 @@ def _knob_values(items: list[str]) -> dict[str, object]:
             )
         try:
             value = tomllib.loads(f"v = {text.strip()}")["v"]
-        except tomllib.TOMLDecodeError:
+        except ValueError:  # not TOML (or an integer of over 4300 digits): the text
             value = text.strip()
         out[name] = None if value == "none" else value
     return out
