@@ -30,7 +30,10 @@ public package and module, each imported on first use.
 
 import importlib as _importlib
 
-from . import accessors  # registers the .sbrdf accessors
+from . import (
+    _startup,  # noqa: F401  first: Ctrl-C while the command line starts
+    accessors,  # registers the .sbrdf accessors
+)
 from ._names import __version__
 from .body import Spacecraft, canx1, load_spacecraft
 from .engine import Scene, builtin_scene, load_scene, simulate

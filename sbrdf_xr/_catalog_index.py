@@ -246,8 +246,8 @@ def _read_index(path: Path, stamp: tuple[int, int], root: Path | None) -> tuple[
         raw = tomllib.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError) as exc:
         raise CatalogError(f"{path}: cannot be read ({exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise CatalogError(f"{path}: invalid TOML: {exc}") from exc
+    except ValueError as exc:  # TOMLDecodeError, or an integer of over 4300 digits
+        raise CatalogError(f"{path}: invalid TOML: {exc}") from None
     out = []
     required = ("name", "kind", "path", "source", "description", "provenance")
     for i, item in enumerate(raw.get("entry", [])):

@@ -718,11 +718,14 @@ def write_all(fd: int, data: bytes) -> None:
         view = view[n:]
 
 
-def read_marker(directory: str | os.PathLike[str]) -> dict[str, Any] | None:
+def read_marker(
+    directory: str | os.PathLike[str], *, strict: bool = False
+) -> dict[str, Any] | None:
     """The :data:`MARKER` of ``directory`` if the package wrote it, else None.
 
     A marker of the package cut short (no longer JSON) gives ``{"writer": "sbrdf_xr",
     "state": "torn"}`` (:data:`TORN`): the directory is the package's, its content unknown.
+    With ``strict`` a marker that cannot be opened or read raises instead of giving None.
 
     Examples
     --------
@@ -742,12 +745,11 @@ def read_marker(directory: str | os.PathLike[str]) -> dict[str, Any] | None:
     """
     try:
         fd = open_regular(Path(directory) / MARKER, os.O_RDONLY)
-    except (OSError, OutputError):
-        return None
-    try:
         with os.fdopen(fd, "rb") as f:
             raw = f.read(2**24)
-    except OSError:
+    except (OSError, OutputError):
+        if strict:  # an I/O failure raised, for its cause to be named
+            raise
         return None
     try:
         info = json.loads(raw.decode())
@@ -860,5 +862,18 @@ def remove_marked_dir(
             f"{p} is a directory that sbrdf_xr did not write (it holds no {MARKER}); it was "
             "left as it is. Move or remove it yourself, or choose another output"
         )
-    shutil.rmtree(p)
+    # the marker last: a removal that fails half-way leaves a directory still marked
+    for _ in range(5):  # what a writer's last in-flight stores add meanwhile, again
+        for entry in os.scandir(p):
+            if entry.name == MARKER:
+                continue
+            if entry.is_dir(follow_symlinks=False):
+                shutil.rmtree(entry.path, ignore_errors=True)
+            else:
+                with contextlib.suppress(FileNotFoundError):
+                    os.unlink(entry.path)
+        if os.listdir(p) == [MARKER]:
+            break
+    os.unlink(p / MARKER)
+    os.rmdir(p)
     fsync_dir(p.parent)

@@ -37,6 +37,7 @@ PACKAGE = Path(__file__).resolve().parent.parent / "sbrdf_xr"
 LAYERS: tuple[tuple[str, ...], ...] = (
     (
         "_names",
+        "_startup",
         "errors",
         "geometry",
         "sources",

@@ -21,6 +21,7 @@ import trimesh
 
 from ..errors import MeshError, ValidationError, input_file, reading
 from ..units import LENGTH_UNITS, metres_per
+from ._mesh_files import check_mesh_file
 from .facets import NORMAL_TOLERANCE
 from .repair import MERGE_DISTANCE, ZERO_AREA_FACTOR, clean_mesh
 
@@ -114,7 +115,7 @@ def read_material_map(path: str | Path) -> dict[Any, str]:
         with reading(path, where, "UTF-8 text"):
             text = path.read_text(encoding="utf-8")
         raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:  # its message says where, not what
+    except ValueError as exc:  # TOML's message says where, not what; or over 4300 digits
         raise ValidationError(f"{where}: cannot be read as TOML: {exc}") from None
     out: dict[Any, str] = {}
     tables = raw.get("material")
@@ -431,6 +432,7 @@ def read_mesh(
     obj = path_or_mesh
     if isinstance(obj, str | Path):
         path = input_file(obj, "mesh file", MeshError)
+        check_mesh_file(path, file_type)  # declared counts, vertex rows: before reading
         default_name = path.stem
         try:
             obj = trimesh.load(path, file_type=file_type, process=False)

@@ -148,7 +148,7 @@ def cmd_info(args: argparse.Namespace) -> int:
     (0, True, False)
     """
     if args.file:
-        with open_dataset(args.file) as ds:
+        with open_dataset(args.file, describe=True) as ds:  # nothing read to describe it
             print(escape(escaped_attrs(ds)))
         return 0
     import dask
@@ -443,7 +443,7 @@ def _knob_values(items: list[str]) -> dict[str, object]:
             )
         try:
             value = tomllib.loads(f"v = {text.strip()}")["v"]
-        except tomllib.TOMLDecodeError:
+        except ValueError:  # not TOML (or an integer of over 4300 digits): the text
             value = text.strip()
         out[name] = None if value == "none" else value
     return out

@@ -8,6 +8,7 @@ stored in a file prints as text instead of acting on the terminal.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -76,7 +77,7 @@ def escaped_attrs(obj: Any) -> Any:
     return obj
 
 
-def open_dataset(path: str | Path) -> Any:
+def open_dataset(path: str | Path, *, describe: bool = False) -> Any:
     """Open a netCDF file (or a Zarr store), turning "not netCDF" into a :class:`ValidationError`.
 
     Examples
@@ -102,14 +103,20 @@ def open_dataset(path: str | Path) -> Any:
     ...
     FileNotFoundError: no-such-file.nc: no such file
     """
-    import xarray as xr
-
     p = Path(path)
     if not p.exists():
         raise FileNotFoundError(f"{path}: no such file")
+    if not describe:  # the indexes read at opening: their declared size first
+        with open_dataset(p, describe=True) as ds:
+            axes = {d: ds.variables[d] for d in ds.dims if d in ds.variables}
+            _check_declared(p, axes, "its axes")
+    import xarray as xr
+
+    # describe: the header only, no index read (a file's size says nothing of its axes')
+    kw = {"create_default_indexes": False} if describe else {}
     if p.is_dir() and any((p / m).is_file() for m in (".zgroup", "zarr.json")):
         try:
-            return xr.open_zarr(p)  # a Zarr cube
+            return xr.open_zarr(p, **kw)  # a Zarr cube
         except (OSError, ValueError, TypeError, KeyError, RuntimeError) as exc:
             raise ValidationError(
                 f"{path}: not a readable Zarr store ({type(exc).__name__}: {exc})"
@@ -117,7 +124,7 @@ def open_dataset(path: str | Path) -> Any:
     if not p.is_file():
         raise ValidationError(f"{path}: not a file")
     try:
-        return xr.open_dataset(p)
+        return xr.open_dataset(p, **kw)
     except (OSError, ValueError, TypeError, KeyError, RuntimeError) as exc:
         why = (
             "unrecognised format"
@@ -125,6 +132,21 @@ def open_dataset(path: str | Path) -> Any:
             else f"{type(exc).__name__}: {exc}"
         )
         raise ValidationError(f"{path}: not a readable netCDF file ({why})") from None
+
+
+def _check_declared(path: Path, variables: Mapping[Any, Any], what: str) -> None:
+    """A ValidationError if ``variables`` (of a file opened lazily) declare more than
+    :data:`~sbrdf_xr.materials.files.MAX_FILE_BYTES` once read; nothing is read."""
+    from ..materials.files import MAX_FILE_BYTES
+
+    total = sum(int(v.size) * v.dtype.itemsize for v in variables.values())
+    if total > MAX_FILE_BYTES:
+        big = max(variables, key=lambda k: variables[k].size)
+        raise ValidationError(
+            f"{path}: {what} declare {total / 2**30:.3g} GiB once read (the largest, "
+            f"{escape(str(big), True)!r}, of sizes {dict(variables[big].sizes)}); files of at "
+            f"most {MAX_FILE_BYTES / 2**30:.3g} GiB are read"
+        )
 
 
 def open_cube(path: str | Path) -> Any:
@@ -163,6 +185,7 @@ def open_cube(path: str | Path) -> Any:
                 "(it needs 'spacecraft_sbrdf' or 'signal' over wavelength, or 'brdf' over "
                 f"attitude; its variables: {escape(names, True)})"
             )
+        _check_declared(Path(path), dict(ds.variables), "its variables")
         try:
             return ds.load()
         except (OSError, ValueError, RuntimeError) as exc:

@@ -36,11 +36,12 @@ from __future__ import annotations
 
 import argparse
 import logging
+import signal
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from .. import catalog
+from .. import _startup, catalog
 from .._names import __version__
 from .._output import command_line_messages
 from ..engine.builtin import builtin_scenes
@@ -417,6 +418,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     level = logger.level
     logger.setLevel(logging.WARNING)
     try:
+        if signal.getsignal(signal.SIGINT) is _startup._interrupted:  # main takes over
+            signal.signal(signal.SIGINT, signal.default_int_handler)
         # --quiet: no progress bars, of the writer nor of the tables the command builds
         with command_line_messages(), catalog.showing_progress(not getattr(args, "quiet", False)):
             return int(args.func(args))

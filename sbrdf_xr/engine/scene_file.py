@@ -560,8 +560,9 @@ def load_scene(path: str | Path) -> Scene:
         ) from None
     try:
         d = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{path}: invalid TOML: {exc}") from None
+    except ValueError as exc:  # TOMLDecodeError, or an integer of over 4300 digits
+        why = "an integer of more than 4300 digits" if "digits" in str(exc) else exc
+        raise SceneError(f"{path}: invalid TOML: {why}") from None
     except RecursionError:
         raise SceneError(f"{path}: invalid TOML: nested too deeply") from None
     return scene_from_dict(d, path.parent)

@@ -254,7 +254,7 @@ class Orbit:
         ts, _ = skyfield_data()
         try:
             sat = EarthSatellite.from_omm(ts, fields)
-        except (KeyError, ValueError, TypeError) as exc:  # a file's fields are not shown
+        except (KeyError, ValueError, TypeError, OverflowError) as exc:  # fields not shown
             field = f" {exc.args[0]!r}" if isinstance(exc, KeyError) else ""
             given = "" if where != "OMM" else f"; fields given: {sorted(map(str, fields))}"
             raise ObservationError(

@@ -39,6 +39,7 @@ __all__ = [
     "fallocate_fn",
     "fence",
     "fix",
+    "let_go",
     "reason",
     "reserve",
 ]
@@ -519,6 +520,42 @@ def abandon(handle: Any, part: Path) -> None:
         st = part.stat()
         _ABANDONED[(st.st_dev, st.st_ino)] = handle
     ctypes.pythonapi.Py_IncRef(ctypes.py_object(handle))  # never finalised, even at exit
+
+
+def let_go(nc: Any, part: Path, torn: bool) -> None:
+    """Let go of the HDF5 handle ``nc`` of ``part`` after an I/O failure, never crashing;
+    returns None (for ``nc = let_go(nc, ...)``).
+
+    Outside an HDF5 call (``torn`` false: a reservation, a sync or the bookkeeping
+    failed) HDF5's state is the synced file and it is closed as usual (its close rewrites
+    the superblock in place).  After a failed HDF5 write its metadata in memory may be
+    torn: its descriptor is made read-only (:func:`fence`) and the handle is abandoned
+    without another HDF5 call (:func:`abandon`), because closing a fenced file can crash
+    HDF5 (a segmentation fault in its error path, found by fault injection at each step
+    of the layout).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import netCDF4
+    >>> from sbrdf_xr.store.disk import let_go
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     nc = netCDF4.Dataset(Path(tmp) / "c.nc.part", "w")
+    ...     nc.sync()
+    ...     nc = let_go(nc, Path(tmp) / "c.nc.part", torn=False)  # synced: closed as usual
+    ...     print(nc)
+    None
+    """
+    if nc is None:
+        return None
+    if torn:
+        fence(part)
+        abandon(nc, part)
+    else:
+        with contextlib.suppress(Exception):
+            nc.close()
+    return None
 
 
 def check_held(part: Path) -> None:

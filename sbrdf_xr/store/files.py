@@ -8,6 +8,7 @@ replaced through the package's safe output (:mod:`sbrdf_xr._output`).
 
 from __future__ import annotations
 
+import glob
 import json
 import logging
 import math
@@ -44,6 +45,7 @@ __all__ = [
     "again_hint",
     "check_destination",
     "check_finished",
+    "clear_leftovers",
     "coordinates_attrs",
     "create_part",
     "destination_state",
@@ -57,6 +59,7 @@ __all__ = [
     "read_log",
     "set_attrs",
     "set_global_attrs",
+    "started_again",
     "to_storage",
     "tune",
     "write_header",
@@ -463,6 +466,62 @@ def read_back_error(part: Path) -> str | None:
 
 
 # --------------------------------------------------------------- bookkeeping
+
+
+def clear_leftovers(log: Path) -> None:
+    """Remove the temporary headers of ``log`` (:func:`write_header`'s) that a writer
+    killed while writing one left; called with the lock held, so no writer is running.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.store.files import clear_leftovers
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     log = Path(tmp) / "cube.nc.part.jsonl"
+    ...     _ = (Path(tmp) / "cube.nc.part.jsonl.k3j9x0.part").write_text('{"form')
+    ...     clear_leftovers(log)
+    ...     print(list(Path(tmp).iterdir()))
+    []
+    """
+    for tmp in log.parent.glob(glob.escape(log.name) + ".*" + PART_SUFFIX):
+        if file_kind(tmp) == "file":
+            tmp.unlink(missing_ok=True)
+
+
+def started_again(part: Path, log: Path, why: BaseException | None = None) -> bool:
+    """Whether an unfinished ``part`` is written again from the start, with a logged
+    message: one that does not open as the cube (``why``), or has no bookkeeping ``log``,
+    while no block of it was recorded and it is what a writer stopped at its first
+    instants leaves (empty, or an HDF5 file being laid out).  Anything else is kept.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.store.files import started_again
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     part, log = Path(tmp) / "cube.nc.part", Path(tmp) / "cube.nc.part.jsonl"
+    ...     _ = part.write_bytes(b"")  # its name claimed, then the writer killed
+    ...     first = started_again(part, log)
+    ...     _ = part.write_bytes(b"someone's notes")
+    ...     print(first, started_again(part, log))
+    True False
+    """
+    if why is None and file_kind(log) is not None:
+        return False
+    try:
+        with open(part, "rb") as f:
+            head = f.read(8)
+    except OSError:
+        return False
+    if head not in (b"", b"\x89HDF\r\n\x1a\n"):
+        return False
+    what = f"does not open as this cube ({why})" if why else f"has no bookkeeping file {log.name}"
+    _log.warning(
+        "%s %s and holds no recorded block: it is written again from the start", part, what
+    )
+    return True
 
 
 def read_log(log: Path, part: Path) -> tuple[dict[str, Any], set[int]]:

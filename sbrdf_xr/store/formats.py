@@ -37,7 +37,14 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from .._output import atomic_file, check_output, file_kind, option, refuse_special
+from .._output import (
+    atomic_file,
+    check_output,
+    error_words,
+    file_kind,
+    option,
+    refuse_special,
+)
 from ..errors import CubeWriteError, OutputError, ValidationError
 from .files import LOG_SUFFIX, PART_SUFFIX, read_log
 from .files import check_destination as cube_destination
@@ -428,6 +435,11 @@ def check(
     <tmp>/pipe.csv is a FIFO (named pipe), not a regular file; outputs replace only regular
     files, even with overwrite=True. Remove it or choose another output
     """
+    if str(path) == "-":
+        raise ValidationError(
+            "'-' names no file: outputs are written to files, not to standard output; give "
+            "a file name"
+        )
     fmt = format_for(path, kind, name)
     p = Path(path)
     if p.name in ("", ".", ".."):
@@ -438,7 +450,28 @@ def check(
         check_output(p, overwrite=overwrite)
     if resume and not overwrite:
         _resume_keeps_the_format(p, fmt)
+    _check_writable(p)
     return fmt
+
+
+def _check_writable(path: Path) -> None:
+    """Refuse an output whose directory cannot be written (read-only, permissions, a
+    file where a directory goes): a file created and removed in the nearest existing
+    directory on its way proves it can."""
+    import tempfile
+
+    d = path.parent.absolute()
+    while not d.exists() and d != d.parent:
+        d = d.parent
+    if not d.is_dir():
+        raise ValidationError(f"cannot write {path}: {d} is not a directory")
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".sbrdf_xr-probe-", dir=d)
+    except OSError as exc:
+        why = error_words(exc) or str(exc)
+        raise ValidationError(f"cannot write {path}: {why} in {d}") from None
+    os.close(fd)
+    os.unlink(probe)
 
 
 def _resume_keeps_the_format(path: Path, fmt: Format) -> None:

@@ -169,10 +169,12 @@ class _Lock:
                 info = None
             if held is False:
                 raise self._locked(info)
+            if info is None and held and not self._still_empty(fd):
+                return  # a writer took it meanwhile: looked at again
             if info is None:
-                if time.time() - st.st_mtime < _LOCK_GRACE:
+                if not held and time.time() - st.st_mtime < _LOCK_GRACE:
                     raise self._locked(None)
-                why = "it names no owner"
+                why = "it names no owner" + (" and no writer holds it" if held else "")
             else:
                 pid, host = info.get("pid"), info.get("host")
                 if host != socket.gethostname():
@@ -198,6 +200,18 @@ class _Lock:
                 _log.warning("removed the stale lock %s: %s (an interrupted write)", self.path, why)
         finally:
             os.close(fd)
+
+    @staticmethod
+    def _still_empty(fd: int) -> bool:
+        """An empty lock whose ``flock`` was free: free and empty still after its creator's
+        time to take the ``flock`` (``acquire`` retries for 0.5 s), so none is starting."""
+        import fcntl
+
+        fcntl.flock(fd, fcntl.LOCK_UN)
+        time.sleep(0.6)
+        if _try_flock(fd) is False:
+            return False
+        return not os.pread(fd, 4096, 0).strip()
 
     def release(self) -> None:
         if self.fd < 0:

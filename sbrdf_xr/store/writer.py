@@ -127,7 +127,6 @@ Encoding
 from __future__ import annotations
 
 import contextlib
-import logging
 import os
 from collections.abc import Callable, Mapping
 from pathlib import Path
@@ -139,7 +138,6 @@ import xarray as xr
 
 from .._output import (
     cli_style,
-    file_kind,
     fsync_dir,
     open_regular,
     refuse_special,
@@ -156,13 +154,12 @@ from .disk import (
     HEAD_BYTES,
     SyncBehind,
     _NoRoom,
-    abandon,
     check_held,
     check_room,
     cut_back,
     drop_behind,
-    fence,
     fix,
+    let_go,
     reason,
     reserve,
     reserve_file,
@@ -173,6 +170,7 @@ from .files import (
     again_hint,
     check_destination,
     check_finished,
+    clear_leftovers,
     create_part,
     discard_hint,
     make_parent,
@@ -181,6 +179,7 @@ from .files import (
     publish,
     read_back_error,
     read_log,
+    started_again,
     to_storage,
     write_header,
 )
@@ -205,8 +204,6 @@ from .runners import (
     lost_workers,
     release_freed_memory,
 )
-
-_log = logging.getLogger("sbrdf_xr.write_cube")
 
 __all__ = [
     "DEFAULT_COMPLEVEL",
@@ -399,20 +396,12 @@ def _write_locked(
 ) -> Path:
     """:func:`write_cube` once the lock is held."""
     state = check_destination(path, part, log, overwrite, resume)
+    clear_leftovers(log)
     if state == "finished":
         check_finished(path, ds)
+        log.unlink(missing_ok=True)
         return path
-    resuming = state == "resume"
-    if resuming and file_kind(log) is None and _just_created(part):
-        # killed before its bookkeeping existed (older versions created it after the
-        # .part): no block was ever recorded, so the .part is started again in place
-        _log.warning(
-            "%s has no bookkeeping file %s: it was stopped before any block was recorded, "
-            "so it is written again from the start",
-            part,
-            log.name,
-        )
-        resuming = False
+    resuming = state == "resume" and not started_again(part, log)
     done: set[int] = set()
     if resuming:
         header, done = read_log(log, part)
@@ -450,14 +439,7 @@ def _write_locked(
                 nc = open_part(part, ds, plan)
             except Exception as exc:
                 if not done and not isinstance(exc, _NoRoom):
-                    # stopped while it was created: nothing recorded, nothing to lose
-                    _log.warning(
-                        "%s holds no recorded block and does not open as this cube (%s); "
-                        "it is written again from the start",
-                        part,
-                        exc,
-                    )
-                    resuming = False
+                    resuming = not started_again(part, log, exc)  # nothing recorded
                 elif isinstance(exc, CubeWriteError):
                     raise
                 else:
@@ -612,7 +594,7 @@ def _write_locked(
         )
         lost = None
         if writing and good >= 0:  # an I/O failure: cut the file back to its last synced state
-            nc = _let_go(nc, part, in_hdf5)
+            nc = let_go(nc, part, in_hdf5)
             lost = cut_back(part, good, head)
         intro = f"writing {path} failed {where}after {len(done)} of {plan.n_blocks} blocks: {why}. "
         if lost is not None:
@@ -662,39 +644,6 @@ def _write_locked(
     log.unlink(missing_ok=True)
     fsync_dir(path.parent)
     return path
-
-
-def _just_created(part: Path) -> bool:
-    """Whether ``part`` is what a writer stopped at its first instant leaves: empty (its
-    name claimed) or an HDF5 file (being laid out); anything else is not touched."""
-    try:
-        with open(part, "rb") as f:
-            head = f.read(8)
-    except OSError:
-        return False
-    return head in (b"", b"\x89HDF\r\n\x1a\n")
-
-
-def _let_go(nc: netCDF4.Dataset | None, part: Path, torn: bool) -> None:
-    """Let go of the HDF5 handle of ``part`` after an I/O failure, never crashing.
-
-    Outside an HDF5 call (``torn`` false: a reservation, a sync or the bookkeeping
-    failed) HDF5's state is the synced file and it is closed as usual (its close rewrites
-    the superblock in place).  After a failed HDF5 write its metadata in memory may be
-    torn: its descriptor is made read-only (:func:`~sbrdf_xr.store.disk.fence`) and the
-    handle is abandoned without another HDF5 call (:func:`~sbrdf_xr.store.disk.abandon`),
-    because closing a fenced file can crash HDF5 (a segmentation fault in its error
-    path, found by fault injection at each step of the layout).
-    """
-    if nc is None:
-        return None
-    if torn:
-        fence(part)
-        abandon(nc, part)
-    else:
-        with contextlib.suppress(Exception):
-            nc.close()
-    return None
 
 
 def _describe(slices: Mapping[str, slice]) -> str:

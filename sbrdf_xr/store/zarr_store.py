@@ -529,7 +529,12 @@ def _stream(
 def _finish(path: Path, part: Path, plan: BlockLayout, overwrite: bool) -> None:
     """Check every block is marked, mark the store complete, tidy it and rename it to
     ``path`` (a store already marked complete was stopped while this was done)."""
-    marker = read_marker(part) or {}
+    marker = read_marker(part, strict=True) or {}
+    if marker.get("fingerprint") != plan.fingerprint:  # never renamed without its record
+        raise CubeWriteError(
+            f"{part}: its marker {MARKER} cannot be read back; the blocks stored are kept, "
+            f"{again_hint(_FUNCTION)} to finish it"
+        )
     if marker.get("state") != "complete":
         missing = sorted(set(range(plan.n_blocks)) - marked_blocks(part, plan.n_blocks))
         if missing:

@@ -80,6 +80,7 @@ def test_toml_explicit_geometry(tmp_path):
             "not a spacecraft",
         ),
         ("this is = not toml", "invalid TOML"),
+        ("[attitude]\nn = " + "9" * 5000 + "\n", "an integer of more than 4300 digits"),
         (
             'spacecraft = "canx1"\n[geometry]\nto_sun = [[2.0, 0.0, 0.0]]\n'
             "to_observer = [[0.0, 1.0, 0.0]]\n" + GREY,

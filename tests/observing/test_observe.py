@@ -381,6 +381,19 @@ def test_omm_gives_the_same_orbit(tmp_path):
         observe.Orbit.from_omm({"OBJECT_NAME": "X"})
 
 
+@pytest.mark.parametrize("norad", ["1e30", "9" * 5000])
+def test_omm_with_an_out_of_range_catalogue_number_is_refused_by_name(tmp_path, norad):
+    from sgp4 import exporter
+
+    fields = exporter.export_omm(observe.Orbit.from_catalog("canx1-example").satellite.model, "X")
+    text = json.dumps({**fields, "NORAD_CAT_ID": 0})
+    path = tmp_path / "omm.json"
+    path.write_text(text.replace('"NORAD_CAT_ID": 0', f'"NORAD_CAT_ID": {norad}'))
+    with pytest.raises(ObservationError, match="omm") as info:
+        observe.Orbit.from_omm(path)
+    assert str(path) in str(info.value)
+
+
 def test_times_helper():
     t = observe.times("2024-01-01T00:00:00Z", dt.datetime(2024, 1, 1, 0, 0, 3, tzinfo=dt.UTC), 0.5)
     assert t.dtype == np.dtype("datetime64[ns]") and t.size == 7

@@ -552,7 +552,8 @@ ZARR_WRITER = textwrap.dedent(
     from sbrdf_xr.store.zarr_store import write_zarr
     from sbrdf_xr.errors import SbrdfError
     args = json.loads(sys.argv[1])
-    cube = cube_24(delay=args.get("delay", 0.0))
+    gate = {{k: args[k] for k in ("gate", "gate_from") if k in args}}
+    cube = cube_24(delay=args.get("delay", 0.0), **gate)
     print("started", flush=True)
     try:
         write_zarr(cube, args["path"], overwrite=args.get("overwrite", False),
@@ -659,21 +660,33 @@ def test_zarr_sigkill_at_random_instants_many(tmp_path, reference):
 @pytest.mark.parametrize("start", ["mid-write", "together", "together-overwrite"])
 def test_two_zarr_writers_on_one_path(tmp_path, reference, start):
     """Two simultaneous Zarr writers of one path: one writes, the other is refused by the
-    lock (naming the holder), and the store opens and equals the cube."""
+    lock (naming the holder), and the store opens and equals the cube.
+
+    The overlap is forced, not assumed from timing: the blocks of both writers wait for a
+    gate file (mid-write: from the third block on), opened only once one writer has ended,
+    so the winner still holds the lock when the loser tries it, however slowly either
+    starts.
+    """
     from sbrdf_xr.store.zarr_store import write_zarr
 
     pytest.importorskip("zarr")
     path = tmp_path / "cube.zarr"
+    gate = tmp_path / "gate"
     overwrite = start == "together-overwrite"
     if overwrite:
         write_zarr(cube_24().isel(attitude=slice(0, 6)), path)
-    first = zarr_writer(tmp_path, path=str(path), overwrite=overwrite, delay=0.25)
+    held = {"gate": str(gate), "gate_from": 2 if start == "mid-write" else 0}
+    first = zarr_writer(tmp_path, path=str(path), overwrite=overwrite, **held)
+    deadline = time.monotonic() + TIMEOUT
     if start == "mid-write":
-        deadline = time.monotonic() + TIMEOUT
         while zarr_marks(path) < 2:
             assert first.poll() is None and time.monotonic() < deadline, "no progress"
             time.sleep(0.01)
-    second = zarr_writer(tmp_path, path=str(path), overwrite=overwrite, delay=0.25)
+    second = zarr_writer(tmp_path, path=str(path), overwrite=overwrite, **held)
+    while first.poll() is None and second.poll() is None:  # the loser ends; the winner waits
+        assert time.monotonic() < deadline, "neither writer ended"
+        time.sleep(0.01)
+    gate.touch()
     results = [zarr_result(first), zarr_result(second)]
     won = [r for r in results if r["ok"]]
     refused = [r for r in results if not r["ok"]]
@@ -687,7 +700,7 @@ def test_two_zarr_writers_on_one_path(tmp_path, reference, start):
         outcome = "wrong cube"
     TRIALS.append(("two Zarr writers on one path", outcome))
     assert outcome == "value-identical"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["cube.zarr", "zarr_writer.py"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cube.zarr", "gate", "zarr_writer.py"]
 
 
 @pytest.mark.parametrize("suffix", [".nc", ".zarr"])

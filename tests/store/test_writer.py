@@ -59,10 +59,19 @@ def block_values(
     fail_switch: str | None = None,
     fail_at: tuple[int, ...] | None = None,
     delay: float = 0.0,
+    gate: str | None = None,
+    gate_from: int = 0,
 ) -> np.ndarray:
-    """Deterministic values of one block; optionally logged, slowed down or failing."""
+    """Deterministic values of one block; optionally logged, slowed down or failing, or
+    held (the blocks from attitude chunk ``gate_from`` on) until the file ``gate`` exists."""
     info = block_info[None]
     loc = tuple(int(i) for i in info["chunk-location"])
+    if gate is not None and loc[0] >= gate_from:
+        deadline = time.monotonic() + 120.0  # a test that never opens the gate fails
+        while not os.path.exists(gate):
+            if time.monotonic() > deadline:
+                raise RuntimeError(f"the gate {gate} was never opened")
+            time.sleep(0.01)
     if calls is not None:
         fd = os.open(calls, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
         try:

@@ -1,0 +1,55 @@
+"""Sizes declared inside files (a few kB of header declaring tens of GiB) are refused by
+name before anything is allocated, and ``info`` describes any file without reading data."""
+
+from __future__ import annotations
+
+import netCDF4
+import pytest
+
+from sbrdf_xr.cli import main
+from sbrdf_xr.errors import ValidationError
+from sbrdf_xr.materials.files import open_material
+
+
+def sparse(path, dims, name, dtype="f8", coords=()):
+    """A netCDF file whose header declares ``dims``; no value written (HDF5 allocates none)."""
+    with netCDF4.Dataset(path, "w") as nc:
+        for d, n in dims.items():
+            nc.createDimension(d, n)
+        for c in coords:
+            nc.createVariable(c, "f8", (c,))
+        nc.createVariable(name, dtype, tuple(dims))
+    assert path.stat().st_size < 100_000
+    return path
+
+
+def test_a_material_table_declaring_71_gib_is_refused_with_the_estimate(tmp_path):
+    path = sparse(tmp_path / "m.nc", {"a": 4, "b": 4, "c": 3, "wavelength": 2 * 10**8}, "sbrdf")
+    with pytest.raises(ValidationError, match=r"declares 71\.5 GiB of arrays .*'sbrdf'"):
+        open_material(path)
+
+
+@pytest.mark.parametrize("axis", [True, False], ids=["attitude axis", "no attitude axis"])
+@pytest.mark.parametrize("command", ["plot", "photometry"])
+def test_a_cube_declaring_1e9_attitudes_is_refused(tmp_path, capsys, axis, command):
+    dims = {"attitude": 10**9, "phase_angle": 2, "wavelength": 3}
+    coords = ("attitude", "phase_angle", "wavelength") if axis else ("phase_angle", "wavelength")
+    cube = sparse(tmp_path / "c.nc", dims, "spacecraft_sbrdf", "f4", coords)
+    out = tmp_path / ("c.png" if command == "plot" else "p.nc")
+    extra = ["--range-km", "36000"] if command == "photometry" else []
+    status = main([command, str(cube), "-o", str(out), *extra])
+    err = capsys.readouterr().err
+    assert status == 2 and len(err.strip().splitlines()) == 1, err
+    if axis or command == "plot":
+        assert "GiB once read" in err, err
+    assert not out.exists()
+
+
+def test_info_describes_a_file_without_reading_its_data(tmp_path, capsys):
+    path = sparse(
+        tmp_path / "m.nc", {"a": 4, "wavelength": 2 * 10**8}, "sbrdf", coords=("wavelength",)
+    )
+    assert main(["info", str(path)]) == 0
+    text = capsys.readouterr().out
+    # the 1.6 GB axis is not read to be shown: its values are not in the summary
+    assert "wavelength  (wavelength) float64 2GB ..." in text, text
