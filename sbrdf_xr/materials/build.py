@@ -35,16 +35,16 @@ from .construction import (
     per_theta_tables,
 )
 from .coverage import (
-    at_horizon,
-    coverage_attrs,
-    in_plane_phi_grid,
-    ratio_across_theta,
-    ratio_tables,
-    resolve_below_noise,
+    _at_horizon,
+    _coverage_attrs,
+    _in_plane_phi_grid,
+    _ratio_across_theta,
+    _ratio_tables,
+    _resolve_below_noise,
     scan_layout,
     snap_angles,
 )
-from .energy import check_energy_conservation
+from .energy import _check_energy_conservation
 from .schema import (
     average_duplicates,
     check_coord,
@@ -52,7 +52,7 @@ from .schema import (
     reference_mask,
     validate_measurements,
 )
-from .selfcheck import CHECK_BOUND, CHECK_FLOOR, holdout_check, self_check
+from .selfcheck import CHECK_BOUND, CHECK_FLOOR, _holdout_check, _self_check
 
 __all__ = ["BELOW_NOISE", "EXTRAPOLATIONS", "RENORMALISE", "build_lut"]
 
@@ -324,10 +324,10 @@ def build_lut(
     ref = reference_mask(ds)
     ti_s, dt_s, ph_s = (snap_angles(ds[d].values) for d in (THETA_I, DELTA_THETA, PHI))
     measured_ti = np.unique(ti_s)
-    horizon = at_horizon(ti_s, dt_s, ph_s, warn=True)  # cos(theta_r) = 0: left out
+    horizon = _at_horizon(ti_s, dt_s, ph_s, warn=True, known=ref)  # cos(theta_r) = 0: out
     ref = ref | horizon
     layouts = [scan_layout(dt_s[ti_s == t], ph_s[ti_s == t]) for t in measured_ti]
-    below_noise = resolve_below_noise(below_noise, layouts, measured_ti)
+    below_noise = _resolve_below_noise(below_noise, layouts, measured_ti)
     rows_only = all(lay == "rows" for lay in layouts)
     if extrapolation == "auto":
         extrapolation = "cubic" if rows_only else "model"
@@ -354,7 +354,7 @@ def build_lut(
         )
     if all(lay == "in-plane" for lay in layouts):  # the scans' own nodes
         dt_grid = np.unique(dt_s)
-        phi_grid = in_plane_phi_grid(float(np.median(np.diff(dt_grid))))
+        phi_grid = _in_plane_phi_grid(float(np.median(np.diff(dt_grid))))
     else:
         phi_grid = paper_phi_grid(ph_s.max(), n_phi)
         dt_grid = paper_delta_theta_grid(dt_s.min(), dt_s.max(), n_delta_theta)
@@ -400,7 +400,7 @@ def build_lut(
         dt_grid = extend_grid(dt_grid, -180.0, 90.0)
         phi_grid = extend_grid(phi_grid, phi_grid[0], 90.0)
         if not rows_only:
-            extra.update(coverage_attrs(layouts, measured_ti, fit_model))
+            extra.update(_coverage_attrs(layouts, measured_ti, fit_model))
         # Beyond -180/90 and phi = 90 lies the far side of the horizon: nothing to hold.
         edges = {
             "edge_delta_theta_min": "zero",
@@ -411,7 +411,7 @@ def build_lut(
         truth_s = _model_at(fit_model, ti_s, dt_s, ph_s, wl)
         ok = ~ref
         ratio = np.divide(spectra, truth_s, out=np.ones_like(spectra), where=truth_s > 0)
-        per_theta, _ = ratio_tables(
+        per_theta, _ = _ratio_tables(
             measured_ti, ti_s[ok], dt_s[ok], ph_s[ok], ratio[ok], dt_grid, phi_grid
         )
         if rows_only:
@@ -420,7 +420,7 @@ def build_lut(
             r_lut = np.tensordot(e, per_theta, axes=(1, 0))
             np.maximum(r_lut, 0.0, out=r_lut)
         else:  # orders of magnitude between incidence angles: no overshoot below zero
-            r_lut = ratio_across_theta(measured_ti, per_theta, ti_out)
+            r_lut = _ratio_across_theta(measured_ti, per_theta, ti_out)
         if extrapolation == "model":
             # Towards grazing incidence the measured ratio does not carry over (the
             # lobe meets the horizon): the model alone, reached over ``blend`` degrees.
@@ -500,15 +500,15 @@ def build_lut(
         **extra,
     )
     samples = (ds, (ti_s, dt_s, ph_s), spectra, ref)
-    out.attrs.update(self_check(out, *samples, floor=check_floor, bound=check_bound))
+    out.attrs.update(_self_check(out, *samples, floor=check_floor, bound=check_bound))
     if check_energy:
         report(0.95, "energy check")
-        check_energy_conservation(out, np.unique(np.concatenate([ti_out[::5], ti_out[-1:]])))
+        _check_energy_conservation(out, np.unique(np.concatenate([ti_out[::5], ti_out[-1:]])))
     if holdout and not rows_only:  # a fitted fill: predict samples it has not seen
         report(0.97, "leave-out check")
         opts = {**call, "holdout": 0, "check_energy": False, "progress": None}
         rebuild = functools.partial(build_lut, **opts)  # model None: the held-in's own fit
-        out.attrs.update(holdout_check(rebuild, *samples, every=int(holdout), floor=check_floor))
+        out.attrs.update(_holdout_check(rebuild, *samples, every=int(holdout), floor=check_floor))
     report(1.0, "built")
     return out
 

@@ -46,12 +46,6 @@ from .construction import per_theta_tables
 __all__ = [
     "ANGLE_TOL",
     "LAYOUTS",
-    "at_horizon",
-    "coverage_attrs",
-    "in_plane_phi_grid",
-    "ratio_across_theta",
-    "ratio_tables",
-    "resolve_below_noise",
     "scan_layout",
     "snap_angles",
     "specular_distance",
@@ -142,6 +136,7 @@ def scan_layout(delta_theta: ArrayLike, phi: ArrayLike, tol: float = ANGLE_TOL) 
     """
     dt = np.asarray(to_unit(delta_theta, "deg", "delta_theta"), dtype=np.float64)
     ph = np.asarray(to_unit(phi, "deg", "phi"), dtype=np.float64)
+    tol = to_unit(tol, "deg", "tol")
     if np.all(ph <= tol):
         return "in-plane"
     _, inverse, counts = np.unique(dt, return_inverse=True, return_counts=True)
@@ -186,7 +181,7 @@ def specular_distance(delta_theta: ArrayLike, phi: ArrayLike) -> np.ndarray:
     return np.where(dt < 0, -gamma, gamma)
 
 
-def in_plane_phi_grid(step: float) -> np.ndarray:
+def _in_plane_phi_grid(step: float) -> np.ndarray:
     """The ``phi`` grid of a table built from in-plane scans: 0, then steps from the
     scan's own step doubling up to 10 degree, then every 10 degree to 90.
 
@@ -202,8 +197,8 @@ def in_plane_phi_grid(step: float) -> np.ndarray:
 
     Examples
     --------
-    >>> from sbrdf_xr.materials.coverage import in_plane_phi_grid
-    >>> in_plane_phi_grid(1.0).tolist()
+    >>> from sbrdf_xr.materials.coverage import _in_plane_phi_grid
+    >>> _in_plane_phi_grid(1.0).tolist()
     [0.0, 1.0, 2.0, 4.0, 8.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0]
     """
     step = to_unit(step, "deg", "step")
@@ -254,7 +249,7 @@ def _scattered(
     return out.reshape(dt_grid.size, phi_grid.size, ratio.shape[1])
 
 
-def ratio_tables(
+def _ratio_tables(
     measured_ti: np.ndarray,
     ti_s: np.ndarray,
     dt_s: np.ndarray,
@@ -293,9 +288,9 @@ def ratio_tables(
     An in-plane scan whose ratio is 2 everywhere gives 2 everywhere:
 
     >>> import numpy as np
-    >>> from sbrdf_xr.materials.coverage import ratio_tables
+    >>> from sbrdf_xr.materials.coverage import _ratio_tables
     >>> dt = np.array([-10.0, 0.0, 10.0])
-    >>> r, layouts = ratio_tables(np.array([30.0]), np.full(3, 30.0), dt, np.zeros(3),
+    >>> r, layouts = _ratio_tables(np.array([30.0]), np.full(3, 30.0), dt, np.zeros(3),
     ...                           np.full((3, 1), 2.0), np.linspace(-20, 20, 5),
     ...                           np.array([0.0, 5.0]))
     >>> r.shape, layouts, float(r.min()), float(r.max())
@@ -326,8 +321,13 @@ def ratio_tables(
     return out, layouts
 
 
-def at_horizon(
-    theta_i: ArrayLike, delta_theta: ArrayLike, phi: ArrayLike, *, warn: bool = False
+def _at_horizon(
+    theta_i: ArrayLike,
+    delta_theta: ArrayLike,
+    phi: ArrayLike,
+    *,
+    warn: bool = False,
+    known: np.ndarray | None = None,
 ) -> np.ndarray:
     """Which samples have the observer at or below the horizon (``cos theta_r <= 1e-8``).
 
@@ -340,6 +340,8 @@ def at_horizon(
         Sample angles [degree].
     warn : bool, default False
         Warn when there are any.
+    known : ndarray of bool, optional
+        Samples already left out (reference points): neither returned nor counted.
 
     Returns
     -------
@@ -347,8 +349,8 @@ def at_horizon(
 
     Examples
     --------
-    >>> from sbrdf_xr.materials.coverage import at_horizon
-    >>> at_horizon([30.0, 30.0], [60.0, 10.0], [0.0, 0.0]).tolist()
+    >>> from sbrdf_xr.materials.coverage import _at_horizon
+    >>> _at_horizon([30.0, 30.0], [60.0, 10.0], [0.0, 0.0]).tolist()
     [True, False]
     """
     ti, dt, ph = (
@@ -356,6 +358,8 @@ def at_horizon(
         for a, n in ((theta_i, "theta_i"), (delta_theta, "delta_theta"), (phi, "phi"))
     )
     out = np.cos(np.radians(ph)) * np.cos(np.radians(ti + dt)) <= 1e-8
+    if known is not None:
+        out &= ~np.asarray(known, dtype=bool)
     if warn and out.any():
         warnings.warn(
             f"build_lut: {int(out.sum())} of {out.size} samples have the observer at or "
@@ -367,7 +371,7 @@ def at_horizon(
     return out
 
 
-def resolve_below_noise(below_noise: str, layouts: list[str], measured_ti: ArrayLike) -> str:
+def _resolve_below_noise(below_noise: str, layouts: list[str], measured_ti: ArrayLike) -> str:
     """The below-noise policy of a build, ``auto`` resolved by the data's layouts.
 
     Parameters
@@ -391,10 +395,10 @@ def resolve_below_noise(below_noise: str, layouts: list[str], measured_ti: Array
 
     Examples
     --------
-    >>> from sbrdf_xr.materials.coverage import resolve_below_noise
-    >>> resolve_below_noise("auto", ["rows", "rows"], [10.0, 40.0])
+    >>> from sbrdf_xr.materials.coverage import _resolve_below_noise
+    >>> _resolve_below_noise("auto", ["rows", "rows"], [10.0, 40.0])
     'zero'
-    >>> resolve_below_noise("auto", ["in-plane"], [10.0])
+    >>> _resolve_below_noise("auto", ["in-plane"], [10.0])
     'model'
     """
     rows_only = all(lay == "rows" for lay in layouts)
@@ -421,7 +425,7 @@ def resolve_below_noise(below_noise: str, layouts: list[str], measured_ti: Array
     return below_noise
 
 
-def coverage_attrs(layouts: list[str], measured_ti: ArrayLike, model: Any) -> dict[str, str]:
+def _coverage_attrs(layouts: list[str], measured_ti: ArrayLike, model: Any) -> dict[str, str]:
     """The attributes ``layout`` and ``modelled`` of a table: what was measured and what
     comes from the fitted model.
 
@@ -440,9 +444,9 @@ def coverage_attrs(layouts: list[str], measured_ti: ArrayLike, model: Any) -> di
 
     Examples
     --------
-    >>> from sbrdf_xr.materials.coverage import coverage_attrs
+    >>> from sbrdf_xr.materials.coverage import _coverage_attrs
     >>> import xarray as xr
-    >>> a = coverage_attrs(["in-plane"], [30.0], xr.Dataset(attrs={"model": "robertson_sandford"}))
+    >>> a = _coverage_attrs(["in-plane"], [30.0], xr.Dataset(attrs={"model": "robertson_sandford"}))
     >>> a["layout"]
     'in-plane at theta_i = 30 deg'
     """
@@ -468,7 +472,7 @@ def coverage_attrs(layouts: list[str], measured_ti: ArrayLike, model: Any) -> di
     }
 
 
-def ratio_across_theta(
+def _ratio_across_theta(
     measured_ti: np.ndarray, ratios: np.ndarray, theta_i: np.ndarray
 ) -> np.ndarray:
     """The ratio tables of the measured incidence angles at the table's rows.
@@ -482,7 +486,7 @@ def ratio_across_theta(
     measured_ti : ndarray, shape (t,)
         Measured incidence angles [degree], increasing.
     ratios : ndarray, shape (t, ...)
-        Their ratio tables [1] (:func:`ratio_tables`).
+        Their ratio tables [1] (:func:`_ratio_tables`).
     theta_i : ndarray, shape (n,)
         The table's rows [degree].
 
@@ -494,8 +498,8 @@ def ratio_across_theta(
     Examples
     --------
     >>> import numpy as np
-    >>> from sbrdf_xr.materials.coverage import ratio_across_theta
-    >>> r = ratio_across_theta(np.array([10.0, 50.0]), np.array([[1.0], [100.0]]),
+    >>> from sbrdf_xr.materials.coverage import _ratio_across_theta
+    >>> r = _ratio_across_theta(np.array([10.0, 50.0]), np.array([[1.0], [100.0]]),
     ...                        np.array([0.0, 30.0, 50.0, 80.0]))
     >>> np.round(r.ravel(), 6).tolist()
     [1.0, 10.0, 100.0, 100.0]

@@ -21,7 +21,7 @@ from ..kernels import lut as _lut
 from ..units import to_unit
 from .schema import validate_material
 
-__all__ = ["ENERGY_TOL", "check_energy_conservation", "hemispherical_reflectance"]
+__all__ = ["ENERGY_TOL", "hemispherical_reflectance"]
 
 #: Reflectance above ``1 + ENERGY_TOL`` is reported by
 #: :func:`sbrdf_xr.materials.build.build_lut` (the quadrature of a float32 table is good
@@ -126,7 +126,7 @@ def hemispherical_reflectance(
     return out
 
 
-def check_energy_conservation(table: xr.DataArray, theta_i: ArrayLike) -> np.ndarray:
+def _check_energy_conservation(table: xr.DataArray, theta_i: ArrayLike) -> np.ndarray:
     """Warn when a table's directional-hemispherical reflectance exceeds 1.
 
     Parameters
@@ -145,9 +145,9 @@ def check_energy_conservation(table: xr.DataArray, theta_i: ArrayLike) -> np.nda
 
     Examples
     --------
-    >>> from sbrdf_xr.materials.energy import check_energy_conservation
+    >>> from sbrdf_xr.materials.energy import _check_energy_conservation
     >>> from sbrdf_xr.materials.schema import lambertian
-    >>> check_energy_conservation(lambertian(0.5, [550.0]), [0.0, 45.0]).round(3).tolist()
+    >>> _check_energy_conservation(lambertian(0.5, [550.0]), [0.0, 45.0]).round(3).tolist()
     [[0.5], [0.5]]
     """
     ti = np.atleast_1d(np.asarray(to_unit(theta_i, "deg", "theta_i"), dtype=np.float64))

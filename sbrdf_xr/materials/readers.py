@@ -123,8 +123,8 @@ def read_measurements(
         A reader's name (:data:`READERS`); default: the reader of the file's suffix.
     **options
         The reader's options (for ``table``: ``angles``, ``zenith``, ``columns``,
-        ``wavelength`` [nm], ``units``, ``angle_units``, ``noise_floor`` [sr-1],
-        ``material``, ``provenance``, ``duplicates``).
+        ``wavelength`` in nm, ``units``, ``angle_units``, ``noise_floor`` in sr-1,
+        ``material``, ``provenance``, ``duplicates``; each reader converts Quantities).
 
     Returns
     -------
@@ -210,8 +210,10 @@ def measurement_set(
     >>> ds.reference.values.tolist()
     [False, True]
     """
-    ang = [snap_angles(a) for a in (theta_i, delta_theta, phi)]
-    v = np.asarray(values, dtype=np.float64)
+    named = ((theta_i, THETA_I), (delta_theta, DELTA_THETA), (phi, PHI))
+    ang = [snap_angles(np.asarray(to_unit(a, "deg", n), dtype=np.float64)) for a, n in named]
+    v = np.asarray(to_unit(values, "sr-1", "values"), dtype=np.float64)
+    wavelength = to_unit(wavelength, "nm", WAVELENGTH, spectral=True)
     if v.shape[0] == 0:
         raise ValidationError(f"measurements: {material!r} is empty (no samples)")
     ref = np.zeros(v.shape[0], dtype=bool)

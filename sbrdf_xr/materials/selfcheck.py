@@ -30,9 +30,7 @@ __all__ = [
     "CHECK_BOUND",
     "CHECK_FLOOR",
     "check_attrs",
-    "holdout_check",
     "sample_errors",
-    "self_check",
 ]
 
 #: Samples below this fraction of the peak of their incidence angle's samples (per
@@ -89,6 +87,11 @@ def sample_errors(
     >>> float(rel[0, 0]), bool(used[0, 0])
     (0.0, True)
     """
+    theta_i, delta_theta, phi = (
+        np.asarray(to_unit(a, "deg", n), dtype=np.float64)
+        for a, n in ((theta_i, THETA_I), (delta_theta, DELTA_THETA), (phi, PHI))
+    )
+    spectra = np.asarray(to_unit(spectra, "sr-1", "spectra"), dtype=np.float64)
     table = table.transpose(THETA_I, DELTA_THETA, PHI, WAVELENGTH)
     got = _lut.lookup_kernel(
         np.asarray(table.values, dtype=np.float64),
@@ -163,7 +166,7 @@ def _worst(rel: np.ndarray, ti, dt, ph, wl, k: int = 3) -> str:
     return "; ".join(parts)
 
 
-def self_check(
+def _self_check(
     table: xr.DataArray,
     ds: xr.Dataset,
     angles: tuple[np.ndarray, np.ndarray, np.ndarray],
@@ -241,7 +244,7 @@ def self_check(
     return out
 
 
-def holdout_check(
+def _holdout_check(
     build: Callable[[xr.Dataset], xr.DataArray],
     ds: xr.Dataset,
     angles: tuple[np.ndarray, np.ndarray, np.ndarray],
@@ -286,9 +289,9 @@ def holdout_check(
     >>> import numpy as np
     >>> import xarray as xr
     >>> from sbrdf_xr.materials import constant_material
-    >>> from sbrdf_xr.materials.selfcheck import holdout_check
+    >>> from sbrdf_xr.materials.selfcheck import _holdout_check
     >>> ti, dt, ph = np.full(9, 30.0), np.linspace(-20.0, 20.0, 9), np.zeros(9)
-    >>> out = holdout_check(lambda m: constant_material(0.1, [550.0], material="c"),
+    >>> out = _holdout_check(lambda m: constant_material(0.1, [550.0], material="c"),
     ...                     xr.Dataset(), (ti, dt, ph), np.full((9, 1), 0.1), np.zeros(9, bool))
     >>> out["holdout_check_n"], out["holdout_check_worst"]
     (2, 0.0)
