@@ -475,7 +475,7 @@ def read_table(
     wl = np.atleast_1d(np.asarray(to_unit(wavelength, "nm", "wavelength", spectral=True), float))
     values = _brdf_values(brdf, file_units.get(bname), units, path).reshape(n, 1)
     return measurement_set(
-        *ang, wl, values, material=material or path.stem,
+        ang[0], ang[1], ang[2], wl, values, material=material or path.stem,
         provenance=provenance or f"{path.name}, read by sbrdf_xr.materials.read_measurements "
         f"(table reader, {how}, {n} rows)",
         noise_floor=noise_floor, duplicates=duplicates,
