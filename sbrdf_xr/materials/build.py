@@ -41,6 +41,7 @@ from .coverage import (
     _ratio_across_theta,
     _ratio_tables,
     _resolve_below_noise,
+    _specular_nodes,
     scan_layout,
     snap_angles,
 )
@@ -353,8 +354,8 @@ def build_lut(
             f"got {measured_ti.tolist()}"
         )
     if all(lay == "in-plane" for lay in layouts):  # the scans' own nodes
-        dt_grid = np.unique(dt_s)
-        phi_grid = _in_plane_phi_grid(float(np.median(np.diff(dt_grid))))
+        dt_grid = _specular_nodes(dt_s)
+        phi_grid = _in_plane_phi_grid(float(np.median(np.diff(np.unique(dt_s)))))
     else:
         phi_grid = paper_phi_grid(ph_s.max(), n_phi)
         dt_grid = paper_delta_theta_grid(dt_s.min(), dt_s.max(), n_delta_theta)

@@ -183,7 +183,8 @@ def specular_distance(delta_theta: ArrayLike, phi: ArrayLike) -> np.ndarray:
 
 def _in_plane_phi_grid(step: float) -> np.ndarray:
     """The ``phi`` grid of a table built from in-plane scans: 0, then steps from the
-    scan's own step doubling up to 10 degree, then every 10 degree to 90.
+    scan's own step halved :data:`SPECULAR_REFINE` times, doubling up to 10 degree, then
+    every 10 degree to 90.
 
     Parameters
     ----------
@@ -198,14 +199,39 @@ def _in_plane_phi_grid(step: float) -> np.ndarray:
     Examples
     --------
     >>> from sbrdf_xr.materials.coverage import _in_plane_phi_grid
-    >>> _in_plane_phi_grid(1.0).tolist()
-    [0.0, 1.0, 2.0, 4.0, 8.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0]
+    >>> _in_plane_phi_grid(1.0).tolist()[:8]
+    [0.0, 0.03125, 0.0625, 0.125, 0.25, 0.5, 1.0, 2.0]
     """
     step = to_unit(step, "deg", "step")
     if not step > 0:
         raise ValidationError(f"step: must be > 0 degree, got {step}")
-    near = step * 2.0 ** np.arange(0, 20)
+    near = step * 2.0 ** np.arange(-SPECULAR_REFINE, 20)
     return np.unique(np.concatenate([[0.0], near[near < 10.0], np.arange(10.0, 90.1, 10.0)]))
+
+
+#: Halvings of the scan's step by which the grids of an in-plane table are refined about
+#: the specular direction (:func:`_specular_nodes`).
+SPECULAR_REFINE = 5
+
+
+def _specular_nodes(dt: np.ndarray) -> np.ndarray:
+    """The ``delta_theta`` nodes of an in-plane table: the scans' own, and nodes at
+    ``+-step / 2**k`` (``k = 1..SPECULAR_REFINE``) about specular, so that the look-up's
+    linear interpolation follows a mirror peak that falls by orders of magnitude within
+    one step of the scan (not a pyramid one step wide, which holds tens of times its
+    energy).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.materials.coverage import _specular_nodes
+    >>> _specular_nodes(np.array([-2.0, -1.0, 0.0, 1.0, 2.0])).size
+    15
+    """
+    nodes = np.unique(dt)
+    step = float(np.median(np.diff(nodes))) if nodes.size > 1 else 1.0
+    fine = step * 2.0 ** -np.arange(1, SPECULAR_REFINE + 1)
+    return np.unique(np.concatenate([nodes, fine, -fine]))
 
 
 def _in_plane(dt: np.ndarray, ratio: np.ndarray, dt_grid: np.ndarray, phi_grid: np.ndarray):

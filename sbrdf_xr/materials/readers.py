@@ -45,7 +45,7 @@ from .._names import DELTA_THETA, MEASURED, PHI, SAMPLE, THETA_I, WAVELENGTH, at
 from ..errors import UnitError, ValidationError
 from ..geometry import from_conventional
 from ..units import to_unit
-from .coverage import snap_angles
+from .coverage import _at_horizon, snap_angles
 from .schema import validate_measurements
 
 __all__ = ["READERS", "Reader", "measurement_set", "read_measurements", "register_reader"]
@@ -192,7 +192,9 @@ def measurement_set(
     material, provenance : str
         Attributes.
     noise_floor : float, optional
-        Samples at or below it [sr-1] (at every wavelength) are reference points.
+        Samples at or below it [sr-1] (at every wavelength) are reference points, as are
+        samples with the observer on the horizon (``theta_i + delta_theta = +-90`` deg in
+        the plane), counted in the attribute ``n_horizon`` and said in the provenance.
     duplicates : {"error", "mean"}, default "error"
         As :func:`~sbrdf_xr.materials.schema.validate_measurements`.
 
@@ -219,6 +221,13 @@ def measurement_set(
     ref = np.zeros(v.shape[0], dtype=bool)
     if noise_floor is not None:
         ref = np.all(v <= to_unit(noise_floor, "sr-1", "noise_floor"), axis=1)
+    horizon = _at_horizon(*ang, known=ref)  # cos(theta_r) = 0: nothing measurable
+    ref |= horizon
+    if horizon.any():
+        provenance += (
+            f"; {int(horizon.sum())} samples with the observer on the horizon marked as "
+            "reference points"
+        )
     ds = xr.Dataset(
         {
             MEASURED: ((SAMPLE, WAVELENGTH), v, attrs(MEASURED)),
@@ -235,6 +244,7 @@ def measurement_set(
             "source": "measured",
             "provenance": provenance,
             "n_reference": int(ref.sum()),
+            "n_horizon": int(horizon.sum()),
         },
     )
     return validate_measurements(ds, duplicates=duplicates)

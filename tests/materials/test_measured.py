@@ -358,7 +358,11 @@ def test_the_starlink_tables_predict_held_out_samples(name, bound):
     the samples above 1e-3 of their scan's peak: the solar array meets the 10 % of the
     issue (1.4 %); the chassis's 1-degree scan does not resolve its sub-degree mirror
     core (16 %, its wings within a few %), held here against regressions."""
-    with pytest.warns(NonPhysicalWarning):  # horizon samples left out; energy of the spikes
-        table = build_lut(catalog.load(f"starlink-v1.5-{name}-measurements"))
+    meas = catalog.load(f"starlink-v1.5-{name}-measurements")
+    if name == "chassis":  # its 1-degree mirror core, isotropic about specular: rho 1.1-1.4
+        with pytest.warns(NonPhysicalWarning, match="does not conserve energy"):
+            table = build_lut(meas)
+    else:
+        table = build_lut(meas)
     assert table.attrs["self_check_worst"] < 1e-9
     assert table.attrs["holdout_check_median"] < bound
