@@ -44,6 +44,7 @@ from . import (
     energy,
     files,
     goniometer,
+    merl,
     model_schema,
     models,
     readers,

@@ -30,7 +30,7 @@ from sbrdf_xr.materials.coverage import (
     specular_distance,
 )
 from sbrdf_xr.materials.readers import measurement_set
-from sbrdf_xr.materials.selfcheck import sample_errors, self_check
+from sbrdf_xr.materials.selfcheck import _self_check, sample_errors
 
 WL = np.array([450.0, 550.0, 650.0])
 #: Lambert 0.3 plus a lobe: the Robertson-Sandford model (paper 001) with rho_D = 0.3.
@@ -151,10 +151,10 @@ def test_the_self_check_raises_on_a_table_of_zeros_and_warns_on_a_wrong_one():
     ds = xr.Dataset(attrs={"material": "m"})
     zero = constant_material(0.0, [550.0], material="zero")
     with pytest.raises(ValidationError, match="is zero at 2 of the 2 sample values"):
-        self_check(zero, ds, (ti, dt, ph), spectra, np.zeros(2, bool))
+        _self_check(zero, ds, (ti, dt, ph), spectra, np.zeros(2, bool))
     big = constant_material(1.0, [550.0], material="big")
     with pytest.warns(NonPhysicalWarning, match=r"misses its own samples.*worst at"):
-        out = self_check(big, ds, (ti, dt, ph), spectra, np.zeros(2, bool))
+        out = _self_check(big, ds, (ti, dt, ph), spectra, np.zeros(2, bool))
     assert out["self_check_median"] == pytest.approx(6.5)  # (0.8/0.2 + 0.9/0.1) / 2
     _, _, used = sample_errors(big, ti, dt, ph, spectra, floor=0.6)
     assert used[:, 0].tolist() == [True, False]  # 0.1 < 0.6 of the peak 0.2
@@ -358,7 +358,11 @@ def test_the_starlink_tables_predict_held_out_samples(name, bound):
     the samples above 1e-3 of their scan's peak: the solar array meets the 10 % of the
     issue (1.4 %); the chassis's 1-degree scan does not resolve its sub-degree mirror
     core (16 %, its wings within a few %), held here against regressions."""
-    with pytest.warns(NonPhysicalWarning):  # horizon samples left out; energy of the spikes
-        table = build_lut(catalog.load(f"starlink-v1.5-{name}-measurements"))
+    meas = catalog.load(f"starlink-v1.5-{name}-measurements")
+    if name == "chassis":  # its 1-degree mirror core, isotropic about specular: rho 1.1-1.4
+        with pytest.warns(NonPhysicalWarning, match="does not conserve energy"):
+            table = build_lut(meas)
+    else:
+        table = build_lut(meas)
     assert table.attrs["self_check_worst"] < 1e-9
     assert table.attrs["holdout_check_median"] < bound
