@@ -171,6 +171,18 @@ def posed_fraction(
     -------
     ndarray, shape (G, n_sides)
         Fractions in ``[0, 1]`` [1].
+
+    Examples
+    --------
+    The plate above the box, turned edge-on, shades nothing; flat, it shades the whole top:
+
+    >>> from sbrdf_xr.body.parts import hinge_rotation
+    >>> from sbrdf_xr.testing import box_with_plate_spacecraft
+    >>> body = box_with_plate_spacecraft(parts=True)
+    >>> up = np.array([[0.0, 0.0, 1.0]] * 2)
+    >>> rot = hinge_rotation([1, 0, 0], [0.0, np.pi / 2])[:, None]
+    >>> posed_fraction(body, rot, [up, up])[:, [4, 6]].round(12).tolist()
+    [[0.0, 0.0], [1.0, 1.0]]
     """
     dirs = np.ascontiguousarray(np.stack(directions, axis=1), dtype=np.float64)
     rot = np.asarray(rotations, dtype=np.float64)

@@ -51,6 +51,13 @@ class Sides:
 
     ``group`` is 0 for the bus and ``k + 1`` for part ``k``; ``vertex_group`` the group
     of every vertex of :attr:`mesh`.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import plate_spacecraft
+    >>> s = plate_spacecraft().sides
+    >>> s.n_sides, s.facet.tolist(), s.group.tolist()
+    (4, [0, 1, 0, 1], [0, 0, 0, 0])
     """
 
     mesh: trimesh.Trimesh
