@@ -16,6 +16,7 @@ per geometry and the ratio to ``slab``.
 from __future__ import annotations
 
 import itertools
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -115,7 +116,7 @@ def parts_rows(n_attitudes: int = 2000, n_shadowed: int = 200, repeat: int = 5) 
         best = {k: np.inf for k in KINDS}
         for _, k in itertools.product(range(repeat), KINDS):  # in turns: load falls alike
             p = plans[k]
-            best[k] = min(best[k], best_time(lambda p=p: simulate(p, lazy=False), 1))
+            best[k] = min(best[k], best_time(partial(simulate, p, lazy=False), 1))
         what = "exact shadowing" if shadow else "unshadowed"
         for k in KINDS:
             rows.append(

@@ -197,7 +197,7 @@ class SunTracking:
         """Angle [radian] at every geometry."""
         assert part is not None
         lim = None if self.limits is None else tuple(np.radians(self.limits))
-        return tracking_angle(part.axis, part.normal, to_sun, lim)  # type: ignore[arg-type]
+        return tracking_angle(part.axis, part.normal, to_sun, lim)
 
 
 @dataclass(frozen=True)

@@ -128,7 +128,8 @@ def build_sides(
     facet = np.concatenate([np.arange(n), np.flatnonzero(back)])
     is_back = np.concatenate([np.zeros(n, bool), np.ones(int(back.sum()), bool)])
     mats = np.asarray(material, dtype=str)
-    side_mat = mats if not back.any() else np.concatenate([mats, back_material[back]])
+    backs = np.asarray(back_material if back_material is not None else mats, dtype=str)
+    side_mat = mats if not back.any() else np.concatenate([mats, backs[back]])
     if not back.any() and not parts:
         return Sides(
             mesh, facet, is_back, side_mat, tangent, group_of, np.zeros(len(mesh.vertices), int)

@@ -93,7 +93,7 @@ def group_terms(terms: Terms) -> tuple[tuple[int, Terms], ...]:
             f: None if getattr(terms, f) is None else np.ascontiguousarray(getattr(terms, f)[sel])
             for f in fields
         }
-        out.append((int(g), replace(terms, **picked)))
+        out.append((int(g), replace(terms, **picked)))  # type: ignore[arg-type]
     return tuple(out)
 
 
