@@ -114,6 +114,31 @@ class Articulation:
     parts: tuple[Part, ...]
     groups: tuple[tuple[int, Terms], ...]
 
+    def angles(self, to_sun: np.ndarray, index: np.ndarray) -> np.ndarray:
+        """Hinge angle of every part at every geometry [degree], (G, P)."""
+        out = np.empty((len(index), len(self.parts)))
+        for k, p in enumerate(self.parts):
+            out[:, k] = np.degrees(p.law.angles(to_sun, index, p))
+        return out
+
+    def coords(self, to_sun: np.ndarray, dims: tuple[str, ...]) -> dict[str, Any]:
+        """The cube's coordinates ``part`` (names) and ``part_angle`` (every geometry's
+        hinge angles [degree]) from ``to_sun`` (lead dims + (3,))."""
+        s = np.asarray(to_sun).reshape(-1, 3)
+        a = self.angles(s, np.arange(s.shape[0])).reshape(*np.shape(to_sun)[:-1], -1)
+        return {
+            "part": (
+                "part",
+                [p.name for p in self.parts],
+                {"units": "1", "long_name": "part name"},
+            ),
+            "part_angle": (
+                (*dims, "part"),
+                a,
+                {"units": "degree", "long_name": "hinge angle of the part (its pointing law)"},
+            ),
+        }
+
     def rotations(self, to_sun: np.ndarray, index: np.ndarray) -> np.ndarray:
         """Rotation of every part at every geometry, part -> bus frame, (G, P, 3, 3)."""
         from ..body.parts import hinge_rotation

@@ -73,6 +73,10 @@ def test_a_grid_sweep_turns_the_plate_per_geometry():
     np.testing.assert_allclose(
         cube.signal.values[..., 0].reshape(-1), bus_plus_tracking_plate(s, o), rtol=0, atol=TOL
     )
+    # the cube says where the plate turned: the angle that faces it to the Sun
+    theta = np.degrees(tracking_angle([1.0, 0, 0], [0, 0, 1.0], s)).reshape(20, 3)
+    np.testing.assert_allclose(cube.part_angle.sel(part="array").values, theta, atol=1e-9)
+    assert cube.part_angle.attrs["units"] == "degree"
 
 
 def rigid_pose(angle):
