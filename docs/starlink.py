@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from sbrdf_xr import Scene, simulate
-from sbrdf_xr.body.parts import Fixed, Part, tracking_angle
+from sbrdf_xr.body.parts import Fixed, Part
 from sbrdf_xr.body.starlink import starlink_v15
 from sbrdf_xr.engine.builtin import starlink_materials
 from sbrdf_xr.observing.attitude import Nadir
@@ -54,9 +54,7 @@ def figures() -> dict[str, Any]:
     ax.set_yscale("symlog", linthresh=1e-3)
     ax.legend(loc="lower right", fontsize=8)
     ax.set_title("Starlink v1.5-class body, chassis to nadir (Lambertian stand-ins)", fontsize=9)
-    p = starlink_v15().parts[0]
-    angle = np.degrees(tracking_angle(p.axis, p.normal, t.to_sun.values))
-    bx.plot(minutes, angle, color="C2")
+    bx.plot(minutes, t.part_angle.sel(part="solar-array"), color="C2")
     bx.set_ylabel("array hinge angle [degree]")
     bx.set_xlabel("time since 01:20 UTC [min]")
     return {"starlink_pass.png": fig}
