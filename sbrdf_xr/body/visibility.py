@@ -201,8 +201,9 @@ def supporting(mesh: trimesh.Trimesh, cache: dict[str, Any], tol: float) -> np.n
     """
     key = f"supporting:{tol!r}"
     if key not in cache:
-        try:
-            pts = np.asarray(mesh.convex_hull.vertices)
+        try:  # a flat (open) surface has a hull of no volume: trimesh divides by it
+            with np.errstate(invalid="ignore", divide="ignore"):
+                pts = np.asarray(mesh.convex_hull.vertices)
         except Exception:  # pragma: no cover - degenerate (flat) meshes
             pts = np.asarray(mesh.vertices)
         normals = np.asarray(mesh.face_normals)
