@@ -218,7 +218,7 @@ class Observation:
     array([75.85, 75.93, 75.55])
     """
 
-    orbit: Orbit
+    orbit: Orbit | Ephemeris
     site: Site
     times: Any
     attitude: Any = None
@@ -583,19 +583,20 @@ class Observation:
         return "", "in the Earth's shadow"
 
     def _altitude_at(self, t: Any) -> float:
-        topo = (self.orbit.satellite - self.site.position).at(t)
+        sat = getattr(self.orbit, "satellite", None)  # an Orbit: only it has find_events
+        topo = (sat - self.site.position).at(t)
         return float(topo.altaz()[0].degrees)
 
     def _attrs(self) -> dict[str, Any]:
         import skyfield
         import skyfield_data
 
-        eph = isinstance(self.orbit, Ephemeris)
+        orbit = self.orbit
         out = {
             "observation": self.name,
             "orbit_name": self.orbit.name,
-            "tle_line1": "" if eph else self.orbit.line1,
-            "tle_line2": "" if eph else self.orbit.line2,
+            "tle_line1": orbit.line1 if isinstance(orbit, Orbit) else "",
+            "tle_line2": orbit.line2 if isinstance(orbit, Orbit) else "",
             "orbit_provenance": self.orbit.provenance,
             "site_name": self.site.name,
             "site_latitude": self.site.latitude_deg,
@@ -627,7 +628,7 @@ class Observation:
             ),
             "airmass_model": self.airmass_model,
         }
-        if eph:
+        if isinstance(orbit, Ephemeris):
             del out["tle_line1"], out["tle_line2"]
-            out.update(self.orbit.attrs())
+            out.update(orbit.attrs())
         return out

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -179,7 +179,7 @@ def read_oem(path: str | Path, *, max_step_factor: float = 10.0) -> Ephemeris:
     name = str(meta["OBJECT_NAME"])
     return Ephemeris(
         name,
-        spans,
+        cast(Any, spans),
         evaluate,
         f"CCSDS OEM {p} (OBJECT_ID {meta['OBJECT_ID']}, REF_FRAME {frames[0][0]}, "
         f"TIME_SYSTEM {frames[0][1]}, {len(segs)} segment(s))",
