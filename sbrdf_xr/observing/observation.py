@@ -252,6 +252,7 @@ class Observation:
                 f"min_elevation_deg: must lie in [-90, 90], got {self.min_elevation_deg}"
             )
         if isinstance(self.orbit, Ephemeris):
+            self.orbit.check_covers(t)
             return
         epoch = self.orbit.epoch
         gap = np.abs(t[[0, -1]] - epoch).max().astype(np.int64) / 86400e9
