@@ -118,19 +118,23 @@ def _sun_from_spacecraft(t64: np.ndarray, r: np.ndarray, v: np.ndarray) -> np.nd
 
     skyfield's geocentric apparent Sun (light time, aberration by the Earth's velocity,
     deflection) on knots every :data:`~sbrdf_xr.observing.timescales.KNOT_S`, cubic-spline
-    interpolated, moved to the spacecraft (``- r``) and aberrated by its geocentric
-    velocity ``v`` to first order (``u' = u + b - u (u.b)``, ``b = v/c``).  Against
-    skyfield's own ``(earth + satellite).at(t).observe(sun).apparent()`` the direction
-    differs by the cross term of the two aberrations, ``|v_earth| |v| / c^2 ~ 3e-9 rad``
+    interpolated (or at every time when the times are fewer than the knots), moved to
+    the spacecraft (``- r``) and aberrated by its geocentric velocity ``v`` to first
+    order (``u' = u + b - u (u.b)``, ``b = v/c``).  Against skyfield's own
+    ``(earth + satellite).at(t).observe(sun).apparent()`` the direction differs by the
+    cross term of the two aberrations, ``|v_earth| |v| / c^2 ~ 3e-9 rad``
     (0.6 mas).
     """
     from scipy.interpolate import CubicSpline
 
     _, eph = skyfield_data()
     secs, knots = spline_knots(t64)
-    tk = skyfield_utc(t64[0] + (knots * 1e9).astype("timedelta64[ns]"))
-    sun_k = eph["earth"].at(tk).observe(eph["sun"]).apparent().position.km.T
-    sun_geo = CubicSpline(knots, sun_k, axis=0)(secs)
+    if knots.size >= t64.size:  # sparse times (a tracking table over months): direct
+        sun_geo = eph["earth"].at(skyfield_utc(t64)).observe(eph["sun"]).apparent().position.km.T
+    else:
+        tk = skyfield_utc(t64[0] + (knots * 1e9).astype("timedelta64[ns]"))
+        sun_k = eph["earth"].at(tk).observe(eph["sun"]).apparent().position.km.T
+        sun_geo = CubicSpline(knots, sun_k, axis=0)(secs)
     rel = sun_geo - r
     d = np.linalg.norm(rel, axis=1, keepdims=True)
     u = rel / d
