@@ -540,7 +540,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         self=_cube().sbrdf, bands=["V", "R"], range_km=1000.0
     ),
     "sbrdf_xr.observing.observation.Observation.next_pass": lambda: dict(
-        self=_observation(), days=0.5
+        self=_observation(), days=0.5, twilight_deg=-12.0
     ),
     "sbrdf_xr.observing.tumble.Tumble.from_spacecraft": lambda: dict(
         spacecraft=_box(), density_kg_m3=100.0, omega_deg_s=(1.0, 2.0, 3.0)

@@ -9,6 +9,12 @@ simulated, written by :func:`sbrdf_xr.store.write` and drawn with ``--plot``::
         --start 2024-03-17T01:20:00 --duration 300 --step 1 \\
         --attitude spin --spin-axis 0.3,0.4,0.866 --period 90 -o pass.nc --plot pass.png
 
+Instead of elements and a window, ``--tracking FILE`` takes an observer's tracking table
+(:mod:`sbrdf_xr.observing.tracking_io`: a CSV of ``time``, ``elevation``, ``azimuth`` and
+``range_km`` or ``height_km`` at ``--site``, or with ``--tracking-format pomenis`` the
+Pomenis Starlink table at its own site); ``--elements`` also takes a CCSDS OEM file and
+``--series`` a CCSDS AEM.
+
 The attitude laws are those of :mod:`sbrdf_xr.observing.attitude`: ``inertial``
 (``--quaternion``), ``nadir`` (``--yaw``, ``--nadir-axis``, ``--velocity-axis``),
 ``sun-pointing`` (``--sun-axis``, ``--secondary-axis``, ``--secondary-target``),
@@ -75,11 +81,24 @@ def add_observe_parser(sub: Any, mesh_options: Any) -> argparse.ArgumentParser:
     g = po.add_argument_group("orbit and site")
     g.add_argument(
         "--elements",
-        required=True,
         metavar="FILE|NAME",
         help="a TLE file (2- or 3-line sets), an OMM file (.json, .xml, .csv), a CCSDS "
         "OEM file (states) or a catalog orbit ('sbrdf-xr catalog list --kind orbit')",
     )
+    g.add_argument(
+        "--tracking",
+        metavar="FILE",
+        help="instead of --elements and the window: an observer's tracking table (CSV: "
+        "columns time, elevation, azimuth [degree] and range_km or height_km; "
+        "--tracking-format pomenis: the Pomenis Starlink table at its own site)",
+    )
+    g.add_argument(
+        "--tracking-format",
+        choices=("csv", "pomenis"),
+        default="csv",
+        help="the tracking table's layout (default csv)",
+    )
+    g.add_argument("--utc", action="store_true", help="tracking csv: zoneless times are UTC")
     g.add_argument(
         "--satellite",
         metavar="NAME|NUMBER",
@@ -111,7 +130,7 @@ def add_observe_parser(sub: Any, mesh_options: Any) -> argparse.ArgumentParser:
         help="the Earth that casts the shadow (default wgs84)",
     )
     w = po.add_argument_group("UTC window")
-    w.add_argument("--start", required=True, metavar="UTC", help="first time, ISO 8601 UTC")
+    w.add_argument("--start", metavar="UTC", help="first time, ISO 8601 UTC (not with --tracking)")
     w.add_argument("--stop", metavar="UTC", help="last time (or --duration)")
     w.add_argument("--duration", type=float, metavar="S", help="length of the window [s]")
     w.add_argument("--step", type=float, default=1.0, metavar="S", help="time step [s]")
@@ -316,14 +335,49 @@ def attitude_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
         )
 
 
-def _is_oem(path: Path) -> bool:
-    """A CCSDS OEM file (by its suffix or its first keyword), not elements."""
-    if path.suffix.lower() == ".oem":
-        return True
-    with contextlib.suppress(OSError, UnicodeDecodeError):
-        head = path.read_text(encoding="utf-8")[:400]
-        return "CCSDS_OEM_VERS" in head or "<oem" in head
-    return False
+def _site_of(args: argparse.Namespace) -> Any:
+    """The site of ``--site`` or ``--lat``/``--lon``/``--height``."""
+    from ..observing.observe import Site
+
+    latlon = [args.lat is not None, args.lon is not None]
+    if args.site is not None and any(latlon):
+        raise ValidationError("give --site NAME or --lat/--lon/--height, not both")
+    if args.site is not None:
+        return Site.from_catalog(args.site)
+    elif all(latlon):
+        try:
+            return Site(args.lat, args.lon, args.height, name=f"{args.lat:g}, {args.lon:g}")
+        except SbrdfError as exc:
+            raise ValidationError(
+                f"--lat {args.lat:g} --lon {args.lon:g} --height {args.height:g}: {exc}"
+            ) from None
+    else:
+        raise ValidationError("give --site NAME (a catalog observatory) or both --lat and --lon")
+
+
+def _tracking_observation(args: argparse.Namespace, spacecraft: Any) -> Any:
+    """The observation of ``--tracking``: the table's times, orbit and (pomenis) site."""
+    from ..observing.tracking_io import tracking_from_dict
+
+    given = [f for f in ("elements", "start", "stop", "duration") if getattr(args, f)]
+    if given:
+        raise ValidationError(
+            f"--tracking gives the orbit and the times; remove --{', --'.join(given)}"
+        )
+    spec: dict[str, Any] = {"path": args.tracking, "format": args.tracking_format}
+    site = None
+    if args.tracking_format == "csv":
+        site = _site_of(args)
+        spec["time_zone"] = "UTC" if args.utc else None
+    elif args.site is not None or args.lat is not None:
+        raise ValidationError("--tracking-format pomenis has its own site; remove the site")
+    table = tracking_from_dict(spec, site)
+    return table.observation(
+        attitude_of(args, spacecraft),
+        min_elevation_deg=args.min_elevation,
+        earth=args.earth,
+        name=args.name or f"{table.name} from {table.site.name}",
+    )
 
 
 def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
@@ -342,13 +396,17 @@ def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     """
     import numpy as np
 
-    from ..observing.observe import Observation, Orbit, Site, times
-    from ..observing.oem_reader import read_oem
+    from ..observing.observe import Observation, Orbit, times
+    from ..observing.oem_reader import is_oem_file, read_oem
     from ..observing.timescales import to_datetime64
 
+    if args.tracking:
+        return _tracking_observation(args, spacecraft)
+    if not args.elements or not args.start:
+        raise ValidationError("give --elements and --start (or a --tracking table)")
     spec = args.elements
     orbit: Any
-    if Path(spec).is_file() and _is_oem(Path(spec)):
+    if Path(spec).is_file() and is_oem_file(spec):
         if args.satellite:
             raise ValidationError("--satellite picks from an element file, not from an OEM")
         orbit = read_oem(spec)
@@ -366,20 +424,7 @@ def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
             orbit = Orbit.from_catalog(spec)
         except SbrdfError as exc:
             raise ValidationError(f"--elements {spec}: {exc}") from None
-    latlon = [args.lat is not None, args.lon is not None]
-    if args.site is not None and any(latlon):
-        raise ValidationError("give --site NAME or --lat/--lon/--height, not both")
-    if args.site is not None:
-        site = Site.from_catalog(args.site)
-    elif all(latlon):
-        try:
-            site = Site(args.lat, args.lon, args.height, name=f"{args.lat:g}, {args.lon:g}")
-        except SbrdfError as exc:
-            raise ValidationError(
-                f"--lat {args.lat:g} --lon {args.lon:g} --height {args.height:g}: {exc}"
-            ) from None
-    else:
-        raise ValidationError("give --site NAME (a catalog observatory) or both --lat and --lon")
+    site = _site_of(args)
     if (args.stop is None) == (args.duration is None):
         raise ValidationError("give --stop UTC or --duration S (the end of the window)")
     start = to_datetime64(args.start, "--start")

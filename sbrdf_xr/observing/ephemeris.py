@@ -277,6 +277,36 @@ class Ephemeris:
             )
         return cls(name, spans, _tabulated(t64, r, v, segs), provenance, method)
 
+    def check_covers(self, times: ArrayLike) -> NDArray[np.datetime64]:
+        """The UTC ``times`` as datetime64[ns], checked to lie in a segment.
+
+        Raises
+        ------
+        EphemerisError
+            When a time lies outside every segment (the spans are listed).
+
+        Examples
+        --------
+        >>> t = np.array(["2024-03-17T01:20:00", "2024-03-17T01:20:10"], dtype="datetime64[ns]")
+        >>> eph = Ephemeris.from_states(t, [[7000.0, 0.0, 0.0], [7000.0, 75.0, 0.0]],
+        ...                             [[0.0, 7.5, 0.0], [0.0, 7.5, 0.0]], name="demo")
+        >>> eph.check_covers(t[:1])
+        array(['2024-03-17T01:20:00.000000000'], dtype='datetime64[ns]')
+        """
+        t = check_times(times)
+        covered = np.zeros(t.size, dtype=bool)
+        for a, b in self.spans:
+            covered |= (t >= a) & (t <= b)
+        if not covered.all():
+            bad = t[~covered][0]
+            shown = ", ".join(f"{a} .. {b}" for a, b in self.spans[:5])
+            more = f" (and {len(self.spans) - 5} more)" if len(self.spans) > 5 else ""
+            raise EphemerisError(
+                f"{self.name}: time {bad} is outside the ephemeris ({(~covered).sum()} of "
+                f"{t.size} times are); it covers {shown}{more}"
+            )
+        return t
+
     def state(self, times: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """GCRS position [km] and velocity [km s-1] at UTC ``times``, (n, 3) each.
 
@@ -295,18 +325,7 @@ class Ephemeris:
             ...
         sbrdf_xr.errors.EphemerisError: demo: time 2024-03-17T01:20:11.000000000 is outside ...
         """
-        t = check_times(times)
-        covered = np.zeros(t.size, dtype=bool)
-        for a, b in self.spans:
-            covered |= (t >= a) & (t <= b)
-        if not covered.all():
-            bad = t[~covered][0]
-            shown = ", ".join(f"{a} .. {b}" for a, b in self.spans[:5])
-            more = f" (and {len(self.spans) - 5} more)" if len(self.spans) > 5 else ""
-            raise EphemerisError(
-                f"{self.name}: time {bad} is outside the ephemeris ({(~covered).sum()} of "
-                f"{t.size} times are); it covers {shown}{more}"
-            )
+        t = self.check_covers(times)
         return self.evaluate(t)
 
     def attrs(self) -> dict[str, Any]:
