@@ -202,3 +202,96 @@ def test_symmetry_tolerance_out_of_range(box_wing, geo_curve, bad):
         InversionError, match=r"symmetry_tolerance: .*; allowed a number in \(0, 0.1\]"
     ):
         invert.fit_observation(lc, box_wing, obs, SPIN, bands=("V", "R"), symmetry_tolerance=bad)
+
+
+def dao_pass() -> Observation:
+    """A held-out pass: the CanX-1 orbit over the Dominion Astrophysical Observatory."""
+    return Observation(
+        Orbit.from_catalog("canx1-example"),
+        Site.from_catalog("dominion-astrophysical"),
+        times("2024-03-15T03:46:00", "2024-03-15T03:49:59", 2.0),
+        name="dao-pass",
+    )
+
+
+DAO_SPIN = {
+    "axis_longitude": 100.0,
+    "axis_latitude": 20.0,
+    "period": 47.0,
+    "phase": 50.0,
+    "epoch": "2024-03-15T03:46:00",
+}
+DAO_FRACTIONS = {"aluminium-6061-t6": 0.2, "tjpv-cell": 0.247, "white-paint-a276": 0.553}
+DAO_EXTINCTION = {"V": 0.2, "R": 0.12, "I": 0.07}
+
+
+def _dao_curve(box_wing, noise, seed, **truth):
+    lc, _ = invert.simulated_light_curve(
+        box_wing,
+        dao_pass(),
+        DAO_SPIN,
+        area_fraction=DAO_FRACTIONS,
+        extinction=DAO_EXTINCTION,
+        **truth,
+    )
+    lc["magnitude"] = lc.magnitude + np.random.default_rng(seed).normal(0, noise, lc.sizes["obs"])
+    lc["uncertainty"] = lc.uncertainty + noise
+    return lc
+
+
+def test_material_scale_is_a_nuisance_parameter(box_wing):
+    """The paint 10 % brighter than its table: with the tables' scales fitted (prior 1 +- 0.2,
+    the catalog's tables being synthetic) the areas' uncertainties carry the tables'; the
+    priors count as data in the degrees of freedom."""
+    lc = _dao_curve(box_wing, 0.05, 7, brightness={"white-paint-a276": 1.1})
+    start = {**DAO_SPIN, "axis_longitude": 101.0, "period": 47.03}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FitQualityWarning)
+        exact = invert.fit_observation(lc, box_wing, dao_pass(), start, check=False)
+        fit = invert.fit_observation(
+            lc, box_wing, dao_pass(), start, check=False, material_scale="provenance"
+        )
+    assert fit.table_scale_prior_width.values.tolist() == [0.2, 0.2, 0.2]
+    assert int(fit.dof) == int(exact.dof)  # three scales, three priors
+    assert "table_scale_white-paint-a276" in fit.parameter.values
+    assert np.all(fit.area_fraction_uncertainty.values > 2 * exact.area_fraction_uncertainty)
+    truth = np.array(list(DAO_FRACTIONS.values()))
+    assert np.all(np.abs(fit.area_fraction.values - truth) < 2 * fit.area_fraction_uncertainty)
+    mine = invert.fit_observation(
+        lc, box_wing, dao_pass(), start, check=False, material_scale={"tjpv-cell": 0.05}
+    )
+    assert mine.table_scale_prior_width.values.tolist() == [0.2, 0.05, 0.2]
+
+
+@pytest.mark.parametrize(
+    ("bad", "match"),
+    [
+        ({"tjpv-cell": 0.0}, r"material_scale\['tjpv-cell'\]: 0.0; allowed a prior width > 0"),
+        ({"tjpv-cell": -0.1}, "allowed a prior width > 0"),
+        ({"unobtainium": 0.1}, r"\['unobtainium'\] are not materials of the body"),
+        ("measured", "material_scale: 'measured'; allowed None"),
+    ],
+)
+def test_material_scale_bad_input(box_wing, bad, match):
+    from sbrdf_xr.errors import InversionError
+
+    lc = _dao_curve(box_wing, 0.02, 1)
+    with pytest.raises(InversionError, match=match):
+        invert.fit_observation(lc, box_wing, dao_pass(), DAO_SPIN, material_scale=bad)
+
+
+def test_the_warning_names_the_causes_the_residuals_show(box_wing):
+    """A truth with self-shadowing fitted without it: the warning names a cause that holds
+    self-shadowing first (ranked by the residual patterns, not a fixed order), and
+    likely_causes gives every score."""
+    lc = _dao_curve(box_wing, 0.02, 2, effects=("shadowing",))
+    with pytest.warns(FitQualityWarning, match="beyond the 99.9") as caught:
+        fit = invert.fit_observation(lc, box_wing, dao_pass(), DAO_SPIN, check=False)
+    said = next(str(w.message) for w in caught if "beyond the 99.9" in str(w.message))
+    first = said.split("Likely causes: ")[1].split(";")[0]
+    assert "self-shadowing" in first
+    scores = dict(
+        (k, float(v))
+        for k, v in (t.split() for t in fit.attrs["likely_causes"].split(": ")[1].split(", "))
+    )
+    assert set(scores) == {"material", "extinction", "shape", "spin"} and max(scores.values()) > 3
