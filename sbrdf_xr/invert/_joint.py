@@ -31,9 +31,11 @@ from ._joint_result import Layout, model_check, result_dataset
 from ._joint_starts import Start, minima_dataset, start_states
 from ._joint_twins import twin_dataset
 from ._model_error import table_widths
+from ._posterior import check_budget, sample_posterior
 from ._quality import fit_quality
 from ._spin import AMBIGUITY_CHI2
 from ._spin_refine import _tangent
+from ._spin_search import vec
 from ._symmetry import SYMMETRY_TOL, body_symmetries
 
 if TYPE_CHECKING:
@@ -159,6 +161,10 @@ def fit_observation(
     extinction_prior: Mapping[str, Any] | None = None,
     symmetry_tolerance: float = SYMMETRY_TOL,
     material_scale: str | Mapping[str, float] | None = None,
+    method: str = "point",
+    posterior_walkers: int = 32,
+    posterior_steps: int = 300,
+    seed: int = 0,
 ) -> xr.Dataset:
     """Spin state, extinction, zero points and material areas fitted jointly to the
     calibrated magnitudes measured over a pass.
@@ -341,6 +347,11 @@ def fit_observation(
     ([0.82, 0.18], 'consistent')
     """
     t_start = time.perf_counter()
+    if method not in ("point", "posterior"):
+        raise InversionError(
+            f"method: {method!r}; allowed 'point' (least squares, uncertainties from the "
+            "Jacobian) or 'posterior' (emcee from every minimum)"
+        )
     start, epoch = _read_start(spin)
     ab = _axis_body(spin, axis_body)
     data = pass_data(light_curve, observation, bands, system)
@@ -356,6 +367,10 @@ def fit_observation(
     terms = model.kernel.plan.terms
     syms = body_symmetries(terms.normal, terms.area, terms.material, ab, symmetry_tolerance)
     names = model.materials
+    if method == "posterior":  # refuse a budget beyond the bound before fitting
+        t0 = time.perf_counter()
+        model.terms(vec(start["axis_longitude"], start["axis_latitude"]), start["period"], 0.0)
+        check_budget(posterior_walkers, posterior_steps, 1, time.perf_counter() - t0)
     area_of = material_areas(spacecraft)
     a_model = np.array([area_of.get(m, 0.0) for m in names])
     if epoch is None:
@@ -475,6 +490,10 @@ def fit_observation(
     if twin_text != "none":
         have = ds.attrs["ambiguity"]
         ds.attrs["ambiguity"] = twin_text if have == "none" else f"{have}; {twin_text}"
+    if method == "posterior":
+        ds = _with_posterior(
+            ds, lay, local, best, model, dt_epoch, fit_s, posterior_walkers, posterior_steps, seed
+        )
     if check:
         t0 = time.perf_counter()
         ds.attrs["model_check"] = model_check(
@@ -550,6 +569,49 @@ def _causes(ranked: Sequence[tuple[str, float]]) -> list[str]:
     out = [f"{CAUSES[k]} [score {v:.3g}]" for k, v in ranked if v > CAUSE_SCORE]
     if not out:
         out = ["no residual pattern stands out: the uncertainties are understated"]
+    return out
+
+
+def _with_posterior(
+    ds: xr.Dataset,
+    lay: Layout,
+    local: Sequence[_Local],
+    best: int,
+    model: PassModel,
+    dt_epoch: float,
+    fit_s: float,
+    walkers: int,
+    steps: int,
+    seed: int,
+) -> xr.Dataset:
+    """The result with the posterior sampled from every minimum (:mod:`._posterior`)."""
+
+    def chi2_of(m: _Local, p: np.ndarray) -> float:
+        if not p[2] > 0 or outside_physics(lay, p):
+            return np.inf
+        r = m.residuals(p)
+        return float(r @ r)
+
+    def jac(m: _Local, p: np.ndarray) -> np.ndarray:
+        return _jacobian(m.residuals, p, lay.steps(p[2]))
+
+    post, attrs = sample_posterior(
+        lay,
+        local,
+        best,
+        chi2_of,
+        jac,
+        360.0 * (model.t_ref - dt_epoch),
+        walkers=walkers,
+        steps=steps,
+        seed=seed,
+        seconds_per_call=fit_s / max(model.n_calls, 1),
+    )
+    out = ds.merge(post)
+    out.attrs.update(attrs)
+    out.attrs["posterior_cost"] = (
+        f"{attrs['posterior_seconds'] / fit_s:.3g} times the point fit's wall time"
+    )
     return out
 
 
