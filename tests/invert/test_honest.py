@@ -295,3 +295,56 @@ def test_the_warning_names_the_causes_the_residuals_show(box_wing):
         for k, v in (t.split() for t in fit.attrs["likely_causes"].split(": ")[1].split(", "))
     )
     assert set(scores) == {"material", "extinction", "shape", "spin"} and max(scores.values()) > 3
+
+
+def test_posterior_from_every_minimum(box_wing):
+    """method="posterior": emcee from the minimum (one mode here, probability 1), its
+    median within 3 of its sd of the truth for the spin and the areas (one draw; the
+    coverage over 100 draws is the slow study), the fractions inside [0, 1], the cost
+    stated."""
+    lc = _dao_curve(box_wing, 0.02, 3)
+    start = {**DAO_SPIN, "axis_longitude": 101.0, "period": 47.03}
+    fit = invert.fit_observation(
+        lc,
+        box_wing,
+        dao_pass(),
+        start,
+        check=False,
+        method="posterior",
+        posterior_walkers=20,
+        posterior_steps=60,
+    )
+    assert fit.mode_probability.values.tolist() == [1.0]
+    post = fit.set_index(posterior_parameter="posterior_parameter")
+    truth = {
+        "period": 47.0,
+        "axis_latitude": 20.0,
+        **{f"fraction_{m}": v for m, v in DAO_FRACTIONS.items()},
+    }
+    for k, v in truth.items():
+        med = float(post.posterior_median.sel(posterior_parameter=k))
+        sd = float(post.posterior_sd.sel(posterior_parameter=k))
+        assert abs(med - v) < 3 * sd, k
+    low = post.posterior_low.sel(posterior_parameter=[f"fraction_{m}" for m in DAO_FRACTIONS])
+    assert float(low.min()) >= 0.0
+    assert "times the point fit's wall time" in fit.attrs["posterior_cost"]
+
+
+@pytest.mark.parametrize(
+    ("options", "match"),
+    [
+        ({"method": "mcmc"}, "method: 'mcmc'; allowed 'point'"),
+        ({"method": "posterior", "posterior_walkers": 4}, r"4 walkers for 9 parameters; allowed at least 2 x 9 = 18"),
+        (
+            {"method": "posterior", "posterior_walkers": 1000, "posterior_steps": 1000},
+            r"1000 walkers x 1000 steps x 1 modes = 1000000 model evaluations \(about \d+ s",
+        ),
+        ({"method": "posterior", "posterior_steps": 0}, "allowed positive integers"),
+    ],
+)
+def test_posterior_bad_input(box_wing, options, match):
+    from sbrdf_xr.errors import InversionError
+
+    lc = _dao_curve(box_wing, 0.02, 1)
+    with pytest.raises(InversionError, match=match):
+        invert.fit_observation(lc, box_wing, dao_pass(), DAO_SPIN, check=False, **options)
