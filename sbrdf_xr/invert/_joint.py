@@ -382,6 +382,12 @@ def fit_observation(
         None if held is None else k_prior[1],
         table_widths(material_scale, names, model.kernel.sources),
     )
+    if method == "posterior" and isinstance(posterior_walkers, int):
+        if posterior_walkers < 2 * lay.n:
+            raise InversionError(
+                f"posterior: {posterior_walkers} walkers for {lay.n} parameters; allowed at "
+                f"least 2 x {lay.n} = {2 * lay.n} (emcee's affine-invariant moves need them)"
+            )
     if data.magnitude.size <= lay.n - lay.n_prior:
         raise InversionError(
             f"light curve: {data.magnitude.size} values for {lay.n} parameters "
