@@ -7,8 +7,11 @@ ranked by the chi-square each pattern explains over its expectation for pure noi
 pattern of ``k`` columns takes out ``k`` of a right model's chi-square on average, with a
 spread ``sqrt(2 k)``):
 
-* a material's table too bright or dark, or its colour wrong: a constant per band;
-* the extinction or the calibration: a straight line in the air mass per band;
+* a material's table too bright or dark, its colour or the calibration wrong: a constant
+  per band;
+* the extinction not first order, or a slow change over the pass that the model lacks
+  (the phase angle changes slowly: self-shadowing, a material's phase function): a
+  straight line in the air mass per band;
 * the shape or self-shadowing (the body's appearance over a turn differs from the
   model's): a Fourier series of the spin angle, orders 1-4 (and per band constants);
 * a local minimum or an attitude that is not a uniform spin: the same series with
@@ -31,8 +34,10 @@ CAUSES = {
     "material": "a material's table is too bright or too dark, or its colour is off (the "
     "residuals keep a mean per band): give the tables' scales room (material_scale) or "
     "check the materials",
-    "extinction": "the extinction is not first order in the air mass, or the table is not "
-    "calibrated (the residuals follow the air mass): try offset='band'",
+    "extinction": "a slow trend over the pass (the residuals follow the air mass): the "
+    "extinction is not first order, or the brightness changes with the phase angle unlike "
+    "the model's (self-shadowing, a material's phase function): simulate with shadowing, "
+    "try offset='band'",
     "shape": "the shape or self-shadowing differs from the model's (the residuals repeat "
     "with the spin): check the mesh and simulate with shadowing",
     "spin": "the fit stopped in a local minimum or the attitude is not a uniform spin "

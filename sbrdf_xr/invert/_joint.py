@@ -8,32 +8,33 @@ See :func:`fit_observation`; the data and the forward model are in
 
 from __future__ import annotations
 
-import dataclasses
 import time
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
-from scipy.optimize import least_squares
 
 from ..errors import FitQualityWarning, InversionError
 from ..units import to_unit
 from ._areas import material_areas
-from ._bounds import covariance, stick_breaking, stick_breaking_inverse
-from ._diagnose import CAUSES, likely_causes
+from ._bounds import covariance
+from ._diagnose import likely_causes
 from ._extinction import extinction_prior as _k_prior
 from ._extinction import separable_sd
 from ._joint_model import PassModel, pass_data
+from ._joint_refine import Local, jacobian, outside_physics, refine
 from ._joint_result import Layout, model_check, result_dataset
-from ._joint_starts import Start, minima_dataset, start_states
+from ._joint_starts import minima_dataset, start_states
+from ._joint_status import RECOVER, causes, held_note, status_attrs, with_posterior
 from ._joint_twins import twin_dataset
 from ._model_error import table_widths
+from ._posterior import check_budget
 from ._quality import fit_quality
 from ._spin import AMBIGUITY_CHI2
-from ._spin_refine import _tangent
+from ._spin_search import vec
 from ._symmetry import SYMMETRY_TOL, body_symmetries
 
 if TYPE_CHECKING:
@@ -53,8 +54,6 @@ JOINT_CAUSES = (
     "(try offset='band')",
     "the uncertainties are understated",
 )
-#: Function evaluations allowed to the least-squares fit.
-MAX_NFEV = 2000
 
 
 def _read_start(spin: Any) -> tuple[dict[str, float], Any]:
@@ -159,6 +158,10 @@ def fit_observation(
     extinction_prior: Mapping[str, Any] | None = None,
     symmetry_tolerance: float = SYMMETRY_TOL,
     material_scale: str | Mapping[str, float] | None = None,
+    method: str = "point",
+    posterior_walkers: int = 32,
+    posterior_steps: int = 300,
+    seed: int = 0,
 ) -> xr.Dataset:
     """Spin state, extinction, zero points and material areas fitted jointly to the
     calibrated magnitudes measured over a pass.
@@ -341,6 +344,11 @@ def fit_observation(
     ([0.82, 0.18], 'consistent')
     """
     t_start = time.perf_counter()
+    if method not in ("point", "posterior"):
+        raise InversionError(
+            f"method: {method!r}; allowed 'point' (least squares, uncertainties from the "
+            "Jacobian) or 'posterior' (emcee from every minimum)"
+        )
     start, epoch = _read_start(spin)
     ab = _axis_body(spin, axis_body)
     data = pass_data(light_curve, observation, bands, system)
@@ -349,13 +357,17 @@ def fit_observation(
     k_sep = separable_sd(data.airmass, data.sigma, data.band, len(data.labels))
     held = None
     if isinstance(k_mode, str) and bool(np.any(k_sep > k_prior[1])):
-        k_mode, held = k_prior[0], _held_note(data, k_sep, k_prior, offset, areas)
+        k_mode, held = k_prior[0], held_note(data, k_sep, k_prior, offset, areas)
         if offset is None and areas != "free":
             offset = "band"  # k Xbar over the pass is a zero point: fitted as one
     model = PassModel(data, spacecraft, ab, materials)
     terms = model.kernel.plan.terms
     syms = body_symmetries(terms.normal, terms.area, terms.material, ab, symmetry_tolerance)
     names = model.materials
+    if method == "posterior":  # refuse a budget beyond the bound before fitting
+        t0 = time.perf_counter()
+        model.terms(vec(start["axis_longitude"], start["axis_latitude"]), start["period"], 0.0)
+        check_budget(posterior_walkers, posterior_steps, 1, time.perf_counter() - t0)
     area_of = material_areas(spacecraft)
     a_model = np.array([area_of.get(m, 0.0) for m in names])
     if epoch is None:
@@ -370,6 +382,12 @@ def fit_observation(
         None if held is None else k_prior[1],
         table_widths(material_scale, names, model.kernel.sources),
     )
+    if method == "posterior" and isinstance(posterior_walkers, int):
+        if posterior_walkers < 2 * lay.n:
+            raise InversionError(
+                f"posterior: {posterior_walkers} walkers for {lay.n} parameters; allowed at "
+                f"least 2 x {lay.n} = {2 * lay.n} (emcee's affine-invariant moves need them)"
+            )
     if data.magnitude.size <= lay.n - lay.n_prior:
         raise InversionError(
             f"light curve: {data.magnitude.size} values for {lay.n} parameters "
@@ -387,12 +405,12 @@ def fit_observation(
     dt_epoch = seconds_of(epoch)
     span = max(float(np.ptp(data.seconds)), 1e-9)
     states = start_states(starts, spin, start, dt_epoch, model.t_ref, span, read)
-    local = [_refine(model, lay, st, span) for st in states]
+    local = [refine(model, lay, st, span) for st in states]
     lowest = min(local, key=lambda m: m.chi2)
     unbounded = outside_physics(lay, lowest.x)
     for i, st in enumerate(states):  # a minimum outside physics: refined inside the bounds
         if outside_physics(lay, local[i].x):
-            local[i] = _refine(model, lay, st, span, bounded=True)
+            local[i] = refine(model, lay, st, span, bounded=True)
     best = min(range(len(local)), key=lambda i: local[i].chi2)
     res, axis_of, residuals = local[best].res, local[best].axis_of, local[best].residuals
     p = local[best].x
@@ -405,7 +423,7 @@ def fit_observation(
     r = r_all[: data.magnitude.size]
     chi2 = float(r_all @ r_all)  # with the priors' terms, each a datum: dof counts them
     dof = data.magnitude.size + lay.n_prior - lay.n
-    jac = _jacobian(residuals, p, lay.steps(p[2]))
+    jac = jacobian(residuals, p, lay.steps(p[2]))
     cov, free = covariance(jac)
     if scale_uncertainties:
         cov = cov * chi2 / dof
@@ -416,8 +434,8 @@ def fit_observation(
         data.airmass,
         data.seconds[data.t_index],
     )
-    quality = fit_quality(chi2, dof, "joint fit", _causes(ranked))
-    status = _status(lay, local[best], unbounded, free, quality, chi2 / dof)
+    quality = fit_quality(chi2, dof, "joint fit", causes(ranked))
+    status = status_attrs(lay, local[best], unbounded, free, quality, chi2 / dof)
     if held is not None:
         status["unconstrained"] = ", ".join(
             [f"extinction_{b}" for b in lay.bands]
@@ -475,6 +493,10 @@ def fit_observation(
     if twin_text != "none":
         have = ds.attrs["ambiguity"]
         ds.attrs["ambiguity"] = twin_text if have == "none" else f"{have}; {twin_text}"
+    if method == "posterior":
+        ds = with_posterior(
+            ds, lay, local, best, model, dt_epoch, fit_s, posterior_walkers, posterior_steps, seed
+        )
     if check:
         t0 = time.perf_counter()
         ds.attrs["model_check"] = model_check(
@@ -484,186 +506,7 @@ def fit_observation(
     return ds
 
 
-@dataclasses.dataclass(frozen=True)
-class _Local:
-    """The minimum refined from one start: the optimizer's result, the axis of its
-    parameters (tangent plane of the start's axis), its residual function, chi-square."""
-
-    res: Any
-    axis_of: Callable[[np.ndarray], np.ndarray]
-    residuals: Callable[[np.ndarray], np.ndarray]
-    chi2: float
-    label: str
-    x: np.ndarray
-    bounded: bool = False
-
-
-def _refine(model: PassModel, lay: Layout, st: Start, span: float, bounded: bool = False) -> _Local:
-    """Levenberg-Marquardt from one start (the axis on the tangent plane of its axis); with
-    ``bounded``, the trust-region reflective method on the area fractions' stick-breaking
-    transform in ``[0, 1]`` (or scales ``>= 0``), keeping them inside physics."""
-    data = model.data
-    e0 = st.axis
-    east, north = _tangent(e0)
-
-    def axis_of(p: np.ndarray) -> np.ndarray:
-        a = e0 + np.radians(p[0]) * east + np.radians(p[1]) * north
-        return a / np.linalg.norm(a)
-
-    def residuals(p: np.ndarray) -> np.ndarray:
-        terms = model.terms(axis_of(p), p[2], p[3])
-        m = model.magnitudes(terms, lay.scales(p)) + lay.extra(p, data)
-        return np.append((data.magnitude - m) / data.sigma, lay.prior_residuals(p))
-
-    p0 = lay.start(st.period, st.phase_ref)
-    opts = {"diff_step": 1e-7, "max_nfev": MAX_NFEV, "ftol": 1e-10, "xtol": 1e-10}
-    scale = lay.x_scale(st.period, span)
-    if not bounded:
-        res = least_squares(residuals, p0, x_scale=scale, method="lm", **opts)
-        x = res.x
-    else:
-        to_p, q0, lo, hi = _bounded_map(lay, p0, st.period)
-        res = least_squares(
-            lambda q: residuals(to_p(q)), q0, x_scale=scale, method="trf", bounds=(lo, hi), **opts
-        )
-        x = to_p(res.x)
-    chi2 = float(2.0 * res.cost) if x[2] > 0 else np.inf
-    return _Local(res, axis_of, residuals, chi2, st.label, x, bounded)
-
-
-#: How to recover from a failed fit.
-RECOVER = (
-    "recover: fit the spin first (fit_spin(light_curve, spacecraft, geometry=observation)) "
-    "and start from its result with starts='aliases'; check the materials and the shape if "
-    "that fails too. The values returned are the last iterate, not estimates"
-)
-
-
-#: Score of a residual pattern above which its cause is named first.
-CAUSE_SCORE = 3.0
-
-
-def _causes(ranked: Sequence[tuple[str, float]]) -> list[str]:
-    """The likely causes of a poor fit, from the residual patterns (:func:`likely_causes`):
-    those scoring above :data:`CAUSE_SCORE`, highest first; else the understated
-    uncertainties (no pattern stands out)."""
-    out = [f"{CAUSES[k]} [score {v:.3g}]" for k, v in ranked if v > CAUSE_SCORE]
-    if not out:
-        out = ["no residual pattern stands out: the uncertainties are understated"]
-    return out
-
-
-def _status(
-    lay: Layout,
-    loc: _Local,
-    unbounded: list[str],
-    free: np.ndarray,
-    quality: Mapping[str, Any],
-    reduced: float,
-) -> dict[str, str]:
-    """``status`` ("ok" or "failed") with ``status_note`` (why it failed, or what bound
-    holds), ``bounded`` and ``unconstrained_note``: what the result can be trusted for."""
-    out: dict[str, str] = {"status": "ok"}
-    why = []
-    if loc.res.status <= 0:
-        why.append(f"the optimizer stopped without converging ({loc.res.message})")
-    if not np.all(np.isfinite(loc.x)):
-        why.append("the parameters are not finite")
-    if unbounded and quality.get("fit_quality") == "poor":
-        why.append(
-            f"the lowest minimum needs area fractions outside [0, 1] ({', '.join(unbounded)}) "
-            f"and the fit inside the bounds does not describe the data (reduced chi-square "
-            f"{reduced:.4g}): the spin state is likely wrong, not the areas"
-        )
-    if why:
-        out["status"] = "failed"
-        out["status_note"] = "the fit failed: " + "; ".join(why) + ". " + RECOVER
-    out["bounded"] = (
-        f"the unconstrained minimum lies outside physics ({', '.join(unbounded)}): refined "
-        "with the area fractions held inside [0, 1] (stick-breaking transform); a fraction "
-        "at 0 or 1 is at its bound, its uncertainty is the curvature's"
-        if unbounded
-        else "none: the minimum lies inside the physical bounds"
-    )
-    names = [n for n, f in zip(lay.names, free, strict=True) if f]
-    if names:
-        out["unconstrained_note"] = (
-            f"the data do not constrain {', '.join(names)} (a null direction of the Jacobian: "
-            "a material never lit and seen, extinction and zero point over a constant air "
-            "mass): each is reported at its start value with an infinite uncertainty"
-        )
-    out["unconstrained"] = ", ".join(names) if names else "none"
-    return out
-
-
-def _held_note(
-    data: Any, k_sep: np.ndarray, prior: tuple[np.ndarray, np.ndarray, str], offset: Any, areas: str
-) -> str:
-    """Why the extinction is held at its prior, and what takes its place."""
-    worst = int(np.argmax(k_sep / prior[1]))
-    x = data.airmass
-    took = (
-        "its share k Xbar over the pass is fitted as a zero point per band"
-        if offset is None and areas != "free"
-        else "the fitted zero points take its share k Xbar"
-        if offset is not None
-        else "with free area scales no zero point can take its share k Xbar: the scales carry it"
-    )
-    return (
-        f"extinction not constrained: the air mass spans only {x.min():.6g}-{x.max():.6g}, "
-        f"so with a free zero point band {data.labels[worst]}'s coefficient would be known "
-        f"to +- {k_sep[worst]:.3g} mag per air mass, no better than its prior +- "
-        f"{prior[1][worst]:.3g} ({prior[2]}); every coefficient is held at its prior value "
-        f"and reported with the prior's width, and {took}"
-    )
-
-
-def _bounded_map(
-    lay: Layout, p0: np.ndarray, period: float
-) -> tuple[Callable[[np.ndarray], np.ndarray], np.ndarray, np.ndarray, np.ndarray]:
-    """The bounded parameters ``q`` of a fit (area fractions by their stick-breaking
-    transform ``u`` in ``[0, 1]``, scales ``>= 0``, period ``> 0``): the map ``q -> p``, the
-    start ``q0`` and the bounds."""
-    sl = lay.sl["f"]
-    lo = np.full(lay.n, -np.inf)
-    hi = np.full(lay.n, np.inf)
-    lo[2] = 1e-6 * period
-    q0 = p0.copy()
-    if lay.areas == "total":
-        lo[sl], hi[sl] = 0.0, 1.0
-        q0[sl] = stick_breaking_inverse(p0[sl])
-    elif lay.areas == "free":
-        lo[sl] = 0.0
-
-    def to_p(q: np.ndarray) -> np.ndarray:
-        p = np.array(q, dtype=np.float64)
-        if lay.areas == "total":
-            p[sl] = stick_breaking(q[sl])[:-1]
-        return p
-
-    return to_p, np.clip(q0, lo, hi), lo, hi
-
-
-def outside_physics(lay: Layout, p: np.ndarray, tol: float = 1e-9) -> list[str]:
-    """The area fractions (or scales) of ``p`` outside their physical bounds, as text.
-
-    Examples
-    --------
-    >>> from sbrdf_xr.invert._joint import outside_physics
-    >>> from sbrdf_xr.invert._joint_result import Layout
-    >>> lay = Layout(("V",), ("a", "b"), np.array([1.0, 1.0]), "fit", None, "total")
-    >>> outside_physics(lay, np.array([0, 0, 10, 0, 0.1, 1.3]))
-    ['a 1.3', 'b -0.3']
-    """
-    if lay.areas == "fixed":
-        return []
-    f = lay.fractions(p) if lay.areas == "total" else lay.scales(p)
-    top = 1.0 if lay.areas == "total" else np.inf
-    bad = (f < -tol) | (f > top + tol)
-    return [f"{m} {v:.4g}" for m, v, b in zip(lay.materials, f, bad, strict=True) if b]
-
-
-def _minima(local: Sequence[_Local], best: int, t_ref: float, dt_epoch: float) -> xr.Dataset:
+def _minima(local: Sequence[Local], best: int, t_ref: float, dt_epoch: float) -> xr.Dataset:
     """The table of the minima refined from every start (phases at the epoch)."""
     x = np.array([m.x[:4] for m in local])
     phase = (x[:, 3] - 360.0 * (t_ref - dt_epoch) / np.where(x[:, 2] > 0, x[:, 2], np.nan)) % 360
@@ -701,13 +544,3 @@ def _ambiguity(ds: xr.Dataset) -> str:
         f"{AMBIGUITY_CHI2:g}); the stated uncertainties describe the neighbourhood of the "
         "solution only"
     )
-
-
-def _jacobian(fun: Any, p: np.ndarray, steps: np.ndarray) -> np.ndarray:
-    """Central-difference Jacobian of ``fun`` at ``p``."""
-    cols = []
-    for j, h in enumerate(steps):
-        d = np.zeros_like(p)
-        d[j] = h
-        cols.append((fun(p + d) - fun(p - d)) / (2 * h))
-    return np.stack(cols, axis=-1)

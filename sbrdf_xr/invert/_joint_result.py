@@ -13,7 +13,7 @@ from .._names import attrs as cf
 from ._joint_model import PassData
 from ._quality import quality_attrs
 from ._spin_search import lonlat
-from ._unmix import correlation
+from ._unseen import correlation
 
 __all__ = ["Layout", "model_check", "result_dataset"]
 

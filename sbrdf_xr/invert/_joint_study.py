@@ -260,6 +260,14 @@ def observation_recovery(
                 float(fit.area_fraction.sel(material=m)),
                 float(fit.area_fraction_uncertainty.sel(material=m)),
             )
+        if "posterior_median" in fit:  # method="posterior": its median and sd
+            post = fit.set_index(posterior_parameter="posterior_parameter")
+            for k in list(row):
+                key = k.replace("area_fraction_", "fraction_")
+                row[k] = (
+                    float(post.posterior_median.sel(posterior_parameter=key)),
+                    float(post.posterior_sd.sel(posterior_parameter=key)),
+                )
         for k, per in (("phase", phase_symmetry_deg), ("axis_longitude", 360.0)):
             row[k] = (truth[k] + _wrap(row[k][0] - truth[k], per), row[k][1])
         rows.append(row)

@@ -6,7 +6,6 @@ See the package docstring.
 from __future__ import annotations
 
 import itertools
-import warnings
 from collections.abc import Mapping
 from typing import Any
 
@@ -14,11 +13,13 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from ..errors import FitQualityWarning, InversionError
+from ..errors import InversionError
 from ..units import to_unit
 from ._areas import add_areas, area_constraint, material_areas
 from ._library import MATERIAL, design, library
 from ._quality import fit_quality
+from ._unseen import constrained_by as _pinned_by
+from ._unseen import correlation, unconstrained_note, unseen_columns
 
 __all__ = [
     "DEGENERACY_THRESHOLD",
@@ -44,25 +45,6 @@ UNMIX_CAUSES = (
     "the material tables or the mesh do not describe the spacecraft",
     "the uncertainties are understated (calibration, atmosphere, systematic errors)",
 )
-
-
-#: A material whose weighted column norm is below this fraction of the largest is never lit
-#: and seen at the measured geometries: the data say nothing about it.
-UNSEEN_TOL = 1e-9
-
-
-def unseen_columns(aw: np.ndarray) -> np.ndarray:
-    """Columns of the weighted design that the data do not see (a material never lit and
-    seen): norm at most :data:`UNSEEN_TOL` of the largest.
-
-    Examples
-    --------
-    >>> from sbrdf_xr.invert._unmix import unseen_columns
-    >>> unseen_columns(np.array([[1.0, 0.0], [2.0, 0.0]])).tolist()
-    [False, True]
-    """
-    norm = np.sqrt((aw**2).sum(axis=0))
-    return np.asarray(norm <= UNSEEN_TOL * max(float(norm.max(initial=0.0)), 1e-300))
 
 
 def _wls(
@@ -391,7 +373,7 @@ def unmix(
     sig = np.sqrt(np.clip(np.diag(cov_full), 0, None))  # left out: sigma of the full fit
     sig[cols] = np.sqrt(np.clip(np.diag(cov_s), 0, None))
     dof = n - npar(best)
-    constrained_by = _constrained_by(unseen, cols, con is not None)
+    constrained_by = _pinned_by(unseen, cols, con is not None)
     free = constrained_by == "none"
     if con is None:
         x[free] = np.nan
@@ -453,58 +435,6 @@ def unmix(
         quality=quality,
         degeneracy_threshold=degeneracy_threshold,
     )
-
-
-def correlation(cov: np.ndarray) -> np.ndarray:
-    """Correlation matrix of a covariance, in [-1, 1]; NaN in the rows and columns of a
-    parameter of zero or infinite variance (not estimated, or not constrained).
-
-    Examples
-    --------
-    >>> from sbrdf_xr.invert._unmix import correlation
-    >>> correlation(np.array([[4.0, 2.0, 0.0], [2.0, 4.0, 0.0], [0.0, 0.0, 0.0]])).tolist()
-    [[1.0, 0.5, nan], [0.5, 1.0, nan], [nan, nan, nan]]
-    """
-    v = np.diag(cov)
-    ok = np.isfinite(v) & (v > 0)
-    d = np.sqrt(np.where(ok, v, 1.0))
-    with np.errstate(invalid="ignore"):
-        c = np.clip(cov / np.outer(d, d), -1.0, 1.0)
-    c[~ok, :] = np.nan
-    c[:, ~ok] = np.nan
-    return np.asarray(c)
-
-
-def _constrained_by(unseen: np.ndarray, cols: list[int], constrained: bool) -> np.ndarray:
-    """What pins each material: ``"data"`` (seen), ``"total_area"`` (never lit and seen,
-    the only such material of the chosen model, pinned by the area constraint by
-    elimination) or ``"none"`` (not constrained)."""
-    out = np.where(unseen, "none", "data").astype(object)
-    in_model = unseen & np.isin(np.arange(unseen.size), cols)
-    if constrained and int(in_model.sum()) == 1:
-        out[in_model] = "total_area"
-    return out.astype(str)
-
-
-def _unconstrained_note(names: list[str], constrained_by: np.ndarray) -> str:
-    """The note on materials the data do not see (and a warning when one is free)."""
-    free = [m for m, c in zip(names, constrained_by, strict=True) if c == "none"]
-    tied = [m for m, c in zip(names, constrained_by, strict=True) if c == "total_area"]
-    parts = []
-    if free:
-        parts.append(
-            f"{', '.join(free)}: never lit and seen at the measured geometries (zero column), "
-            "not constrained by the data: scale reported NaN (or a share of total_area) with "
-            "an infinite uncertainty; with every material of the body in the library, "
-            "total_area pins one such material by elimination"
-        )
-        warnings.warn(f"unmix: {parts[-1]}", FitQualityWarning, stacklevel=3)
-    if tied:
-        parts.append(
-            f"{', '.join(tied)}: never lit and seen; its area is total_area less the others' "
-            "(by elimination), with their uncertainties"
-        )
-    return "; ".join(parts) if parts else "none: every material is lit and seen"
 
 
 def _result(
@@ -640,7 +570,7 @@ def _result(
     )
     ds.attrs = {
         **attrs,
-        "unconstrained": _unconstrained_note(names, constrained_by),
+        "unconstrained": unconstrained_note(names, constrained_by),
         "degenerate": "; ".join(degenerate) if degenerate else "none",
         "degeneracy_note": (
             f"the data cannot tell apart: {'; '.join(degenerate)}"
