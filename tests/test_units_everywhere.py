@@ -431,6 +431,21 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.sources.earthshine_irradiance_ratio": lambda: dict(
         albedo=0.3, range_km=42164.0, phase_angle_deg=30.0
     ),
+    "sbrdf_xr.sources.earthshine_finite": lambda: dict(
+        plate_normal=[0, 0, -1],
+        to_earth=[0, 0, -1],
+        to_sun=[0, 0, 1],
+        range_km=42164.0,
+        nodes=(16, 32),
+    ),
+    "sbrdf_xr.sources.earth_thermal_irradiance": lambda: dict(
+        wavelength=[8000.0, 10_000.0],
+        plate_normal=[0, 0, -1],
+        to_earth=[0, 0, -1],
+        range_km=42164.0,
+        temperature=255.0,
+        nodes=(16, 32),
+    ),
     "sbrdf_xr.sources.emissivity_at": lambda: dict(
         emissivity=np.array([[0.8, 0.5], [0.6, 0.3]]),
         theta_grid=np.array([0.0, 90.0]),
