@@ -13,7 +13,10 @@ simulation need:
   light at the spacecraft, relative to the Sun's;
 * :func:`kirchhoff_emissivity`: directional emissivity from directional-hemispherical
   reflectance, and :func:`emissivity_at`, its linear interpolation in the emission
-  angle.
+  angle;
+* :func:`earthshine_finite` and :func:`earth_thermal_irradiance`: the Earth at its true
+  size, reflected sunlight and thermal emission on a plate (quadrature over the disc);
+* :func:`equilibrium_temperature`: a facet's radiative-equilibrium temperature.
 
 Arguments with a unit (wavelengths [nm], temperatures [K], angles [degree], distances
 [km]) also take an astropy Quantity, converted first (:func:`sbrdf_xr.units.to_unit`;
@@ -40,6 +43,7 @@ __all__ = [
     "earthshine_finite",
     "earthshine_irradiance_ratio",
     "emissivity_at",
+    "equilibrium_temperature",
     "kirchhoff_emissivity",
     "moon_v_magnitude",
     "moonlight_irradiance_ratio",
@@ -420,3 +424,48 @@ def earth_thermal_irradiance(
     wl = to_unit(wavelength, "nm", "wavelength", spectral=True)
     _, _, cos_plate, w = _earth_cap(plate_normal, to_earth, range_km, nodes)
     return np.sum(w * cos_plate) * planck(wl, t)
+
+
+def equilibrium_temperature(
+    absorbed: ArrayLike, emissivity: ArrayLike, *, radiating_sides: float = 1.0
+) -> NDArray[np.float64]:
+    """Radiative-equilibrium temperature of a facet with no conduction.
+
+    The conductance model is stated: none.  Each facet is a thin plate insulated from the
+    rest of the body that emits from ``radiating_sides`` faces (1: an insulated panel
+    such as a blanket; 2: a thin conductive plate, both faces at one temperature), so
+    ``absorbed = radiating_sides * epsilon * sigma * T^4`` (paper 001 Eqs. 2-4: absorbed
+    sunlight, earthshine and Earth emission equal the emission).
+
+    Parameters
+    ----------
+    absorbed : array_like
+        Absorbed power per unit area [W m-2] (e.g. ``alpha_solar E_sun cos(theta_i)`` plus
+        the absorbed Earth light), >= 0.
+    emissivity : array_like
+        Hemispherical infrared emissivity [1], ``0 < epsilon <= 1``.
+    radiating_sides : float
+        Number of faces that radiate, 1 or 2 [1].
+
+    Returns
+    -------
+    ndarray
+        Temperature [K]; 0 where nothing is absorbed (no internal heat).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.sources import equilibrium_temperature
+    >>> round(float(equilibrium_temperature(1361.0, 1.0)), 1)  # a black plate facing the Sun
+    393.6
+    >>> round(float(equilibrium_temperature(0.26 * 1361.0, 0.88)), 1)  # white paint (Table 3)
+    290.2
+    """
+    q = np.asarray(absorbed, dtype=np.float64)
+    eps = np.asarray(emissivity, dtype=np.float64)
+    if np.any(~np.isfinite(q)) or np.any(q < 0):
+        raise ValidationError(f"absorbed: got {np.ravel(q)[:5].tolist()}; allowed: >= 0 W m-2")
+    if np.any(~(eps > 0)) or np.any(eps > 1):
+        raise ValidationError(f"emissivity: got {np.ravel(eps)[:5].tolist()}; allowed: 0 < e <= 1")
+    if radiating_sides not in (1, 2, 1.0, 2.0):
+        raise ValidationError(f"radiating_sides: got {radiating_sides!r}; allowed: 1 or 2")
+    return (q / (radiating_sides * eps * constants.sigma)) ** 0.25

@@ -104,3 +104,21 @@ def test_bad_input_is_named():
         earth_thermal_irradiance([1e4], DOWN, DOWN, 7000.0, temperature=-5.0)
     with pytest.raises(ValidationError, match="temperature"):
         earth_thermal_irradiance([1e4], DOWN, DOWN, 7000.0, temperature=5000.0)
+
+
+def test_equilibrium_temperature_balances_absorbed_and_emitted():
+    """sigma T^4 eps sides = absorbed, to float64 rounding; bad input is named."""
+    from scipy import constants
+
+    from sbrdf_xr.sources import equilibrium_temperature
+
+    q = np.array([0.0, 100.0, 1361.0])
+    for eps, sides in ((1.0, 1), (0.85, 2)):
+        t = equilibrium_temperature(q, eps, radiating_sides=sides)
+        assert sides * eps * constants.sigma * t**4 == pytest.approx(q, rel=1e-14)
+    with pytest.raises(ValidationError, match="absorbed"):
+        equilibrium_temperature(-1.0, 0.5)
+    with pytest.raises(ValidationError, match="emissivity"):
+        equilibrium_temperature(1.0, 0.0)
+    with pytest.raises(ValidationError, match="radiating_sides"):
+        equilibrium_temperature(1.0, 0.5, radiating_sides=3)
