@@ -460,7 +460,7 @@ def equilibrium_temperature(
     >>> round(float(equilibrium_temperature(0.26 * 1361.0, 0.88)), 1)  # white paint (Table 3)
     290.2
     """
-    q = np.asarray(absorbed, dtype=np.float64)
+    q = np.asarray(to_unit(absorbed, "W m-2", "absorbed"), dtype=np.float64)
     eps = np.asarray(emissivity, dtype=np.float64)
     if np.any(~np.isfinite(q)) or np.any(q < 0):
         raise ValidationError(f"absorbed: got {np.ravel(q)[:5].tolist()}; allowed: >= 0 W m-2")

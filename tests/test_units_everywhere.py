@@ -446,6 +446,9 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         temperature=255.0,
         nodes=(16, 32),
     ),
+    "sbrdf_xr.sources.equilibrium_temperature": lambda: dict(
+        absorbed=[100.0, 1361.0], emissivity=0.8
+    ),
     "sbrdf_xr.sources.emissivity_at": lambda: dict(
         emissivity=np.array([[0.8, 0.5], [0.6, 0.3]]),
         theta_grid=np.array([0.0, 90.0]),
@@ -1044,6 +1047,7 @@ OTHER = {
     "sr-1": u.deg**-2,
     "degree**3": u.rad**3,
     "W m-2 nm-1": u.mW / u.cm**2 / u.um,
+    "W m-2": u.mW / u.cm**2,
     "mag": u.mmag,
     "mmag": u.mag,
 }
