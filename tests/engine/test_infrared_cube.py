@@ -80,3 +80,24 @@ def test_in_band_refuses_a_band_past_the_spectrum():
     with pytest.raises(ValidationError, match="LWIR"):
         in_band(s, ["LWIR"])
     assert float(in_band(s, ["N"][:0] or [("box", ([8000.0, 10000.0], [1.0, 1.0]))])[0]) == 2000.0
+
+
+def test_kirchhoff_emissivity_of_a_rendered_paint_is_the_models():
+    """The thermal effect's emissivity (1 - the table's hemispherical reflectance) against
+    the model's own 1 - rho(theta_i) for paper 001's AFGL-01: a 1-degree table integrates
+    the glint lobe (FWHM 19 deg) to ~4e-5 (measured), hence 1e-4."""
+    from sbrdf_xr.brdf import robertson_sandford as rs
+    from sbrdf_xr.materials.energy import hemispherical_reflectance
+    from sbrdf_xr.materials.model_schema import model_material
+    from sbrdf_xr.materials.models import render
+    from sbrdf_xr.sources import kirchhoff_emissivity
+
+    p = dict(rs.TABLE4["AFGL-01"])
+    wl = [4000.0, 10000.0]
+    spec = model_material("robertson_sandford", wl, material="afgl01", provenance="Table 4", **p)
+    ti = np.array([0.0, 20.0, 40.0, 60.0, 80.0])
+    grid = (np.arange(-180.0, 90.1, 1.0), np.arange(0.0, 90.1, 1.0))
+    lut = render(spec, ti, *grid, progress=False)
+    eps_table = kirchhoff_emissivity(hemispherical_reflectance(lut, ti, warn=False).values)
+    eps_model = 1.0 - rs.directional_hemispherical_reflectance(ti, wl, **p)
+    assert eps_table == pytest.approx(eps_model, abs=1e-4)
