@@ -16,7 +16,8 @@ simulation need:
   angle;
 * :func:`earthshine_finite` and :func:`earth_thermal_irradiance`: the Earth at its true
   size, reflected sunlight and thermal emission on a plate (quadrature over the disc);
-* :func:`equilibrium_temperature`: a facet's radiative-equilibrium temperature.
+* :func:`equilibrium_temperature`: a facet's radiative-equilibrium temperature, and
+  :func:`radiative_cooling`: its cooling in the shadow.
 
 Arguments with a unit (wavelengths [nm], temperatures [K], angles [degree], distances
 [km]) also take an astropy Quantity, converted first (:func:`sbrdf_xr.units.to_unit`;
@@ -48,6 +49,7 @@ __all__ = [
     "moon_v_magnitude",
     "moonlight_irradiance_ratio",
     "planck",
+    "radiative_cooling",
 ]
 
 #: Earth's mean radius [km].
@@ -469,3 +471,58 @@ def equilibrium_temperature(
     if radiating_sides not in (1, 2, 1.0, 2.0):
         raise ValidationError(f"radiating_sides: got {radiating_sides!r}; allowed: 1 or 2")
     return (q / (radiating_sides * eps * constants.sigma)) ** 0.25
+
+
+def radiative_cooling(
+    time_s: ArrayLike,
+    initial_temperature: float,
+    heat_capacity: float,
+    emissivity: float,
+    *,
+    radiating_sides: float = 1.0,
+) -> NDArray[np.float64]:
+    """Temperature of a facet cooling by radiation alone (in the Earth's shadow).
+
+    ``C dT/dt = -sides epsilon sigma T^4`` (no absorbed power, no conduction: the model of
+    :func:`equilibrium_temperature` with the Sun gone) has the closed form
+    ``T(t) = (T0^-3 + 3 sides epsilon sigma t / C)^(-1/3)``.
+
+    Parameters
+    ----------
+    time_s : array_like
+        Time since entering the shadow [s], >= 0.
+    initial_temperature : float
+        Temperature at ``t = 0`` [K], > 0.
+    heat_capacity : float
+        Heat capacity per unit area [J m-2 K-1] (e.g. 1 mm of aluminium: 2430), > 0.
+    emissivity : float
+        Hemispherical infrared emissivity [1], ``0 < epsilon <= 1``.
+    radiating_sides : float
+        Number of faces that radiate, 1 or 2 [1].
+
+    Returns
+    -------
+    ndarray
+        Temperature [K].
+
+    Examples
+    --------
+    >>> from sbrdf_xr.sources import radiative_cooling
+    >>> np.round(radiative_cooling([0.0, 600.0, 3600.0], 300.0, 2430.0, 0.85), 1).tolist()
+    [300.0, 239.6, 158.5]
+    """
+    t = np.asarray(to_unit(time_s, "s", "time_s"), dtype=np.float64)
+    t0 = float(to_unit(initial_temperature, "K", "initial_temperature"))
+    c = float(to_unit(heat_capacity, "J m-2 K-1", "heat_capacity"))
+    if np.any(~np.isfinite(t)) or np.any(t < 0):
+        raise ValidationError(f"time_s: got {np.ravel(t)[:5].tolist()}; allowed: >= 0 s")
+    if not (0.0 < t0 <= 10_000.0):
+        raise ValidationError(f"initial_temperature: got {t0:g} K; allowed: 0 < T <= 10000 K")
+    if not (c > 0 and np.isfinite(c)):
+        raise ValidationError(f"heat_capacity: got {c:g} J m-2 K-1; allowed: > 0")
+    if not (0.0 < emissivity <= 1.0):
+        raise ValidationError(f"emissivity: got {emissivity!r}; allowed: 0 < e <= 1")
+    if radiating_sides not in (1, 2, 1.0, 2.0):
+        raise ValidationError(f"radiating_sides: got {radiating_sides!r}; allowed: 1 or 2")
+    rate = 3.0 * radiating_sides * emissivity * constants.sigma / c
+    return (t0**-3 + rate * t) ** (-1.0 / 3.0)

@@ -122,3 +122,30 @@ def test_equilibrium_temperature_balances_absorbed_and_emitted():
         equilibrium_temperature(1.0, 0.0)
     with pytest.raises(ValidationError, match="radiating_sides"):
         equilibrium_temperature(1.0, 0.5, radiating_sides=3)
+
+
+def test_radiative_cooling_solves_the_energy_balance():
+    """The closed form against scipy's ODE solver (rtol 1e-10) for C dT/dt = -eps sigma T^4."""
+    from scipy import constants
+
+    from sbrdf_xr.sources import radiative_cooling
+
+    c, eps, t0 = 2430.0, 0.85, 300.0
+    t = np.linspace(0.0, 7200.0, 13)
+    sol = integrate.solve_ivp(
+        lambda _, y: -2 * eps * constants.sigma * y**4 / c,
+        (0.0, t[-1]),
+        [t0],
+        t_eval=t,
+        rtol=1e-11,
+        atol=1e-9,
+    )
+    got = radiative_cooling(t, t0, c, eps, radiating_sides=2)
+    assert got == pytest.approx(sol.y[0], rel=1e-8)
+    assert np.all(np.diff(got) < 0)
+    for bad in (dict(time_s=-1.0), dict(initial_temperature=0.0), dict(heat_capacity=0.0)):
+        args = dict(time_s=1.0, initial_temperature=300.0, heat_capacity=c) | bad
+        with pytest.raises(ValidationError, match=next(iter(bad))):
+            radiative_cooling(
+                args["time_s"], args["initial_temperature"], args["heat_capacity"], eps
+            )

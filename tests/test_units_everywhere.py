@@ -449,6 +449,9 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.sources.equilibrium_temperature": lambda: dict(
         absorbed=[100.0, 1361.0], emissivity=0.8
     ),
+    "sbrdf_xr.sources.radiative_cooling": lambda: dict(
+        time_s=[0.0, 600.0], initial_temperature=300.0, heat_capacity=2430.0, emissivity=0.85
+    ),
     "sbrdf_xr.sources.emissivity_at": lambda: dict(
         emissivity=np.array([[0.8, 0.5], [0.6, 0.3]]),
         theta_grid=np.array([0.0, 90.0]),
