@@ -443,6 +443,27 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.sources.earthshine_irradiance_ratio": lambda: dict(
         albedo=0.3, range_km=42164.0, phase_angle_deg=30.0
     ),
+    "sbrdf_xr.sources.earthshine_finite": lambda: dict(
+        plate_normal=[0, 0, -1],
+        to_earth=[0, 0, -1],
+        to_sun=[0, 0, 1],
+        range_km=42164.0,
+        nodes=(16, 32),
+    ),
+    "sbrdf_xr.sources.earth_thermal_irradiance": lambda: dict(
+        wavelength=[8000.0, 10_000.0],
+        plate_normal=[0, 0, -1],
+        to_earth=[0, 0, -1],
+        range_km=42164.0,
+        temperature=255.0,
+        nodes=(16, 32),
+    ),
+    "sbrdf_xr.sources.equilibrium_temperature": lambda: dict(
+        absorbed=[100.0, 1361.0], emissivity=0.8
+    ),
+    "sbrdf_xr.sources.radiative_cooling": lambda: dict(
+        time_s=[0.0, 600.0], initial_temperature=300.0, heat_capacity=2430.0, emissivity=0.85
+    ),
     "sbrdf_xr.sources.emissivity_at": lambda: dict(
         emissivity=np.array([[0.8, 0.5], [0.6, 0.3]]),
         theta_grid=np.array([0.0, 90.0]),
@@ -1117,6 +1138,7 @@ OTHER = {
     "sr-1": u.deg**-2,
     "degree**3": u.rad**3,
     "W m-2 nm-1": u.mW / u.cm**2 / u.um,
+    "W m-2": u.mW / u.cm**2,
     "mag": u.mmag,
     "mmag": u.mag,
 }

@@ -42,11 +42,10 @@ _G_SERIES_RADIUS = 0.5
 _G_SERIES_TERMS = 64
 #: Cut-off-loss quadrature: Gauss–Legendre points per panel, the geometric ratio of
 #: the panels graded toward the lobe and the horizon, the smallest panel as a
-#: fraction of the narrowest width, and the number of integrand values per chunk.
+#: fraction of the narrowest width.
 _N_NODES = 16
 _GRADE = 0.2
 _SCALE = 0.05
-_CHUNK = 4_000_000
 
 
 # --------------------------------------------------------------------------
@@ -335,16 +334,19 @@ def _cutoff_loss(theta_i: np.ndarray, b: float, e: float) -> np.ndarray:
     flat = theta_i.ravel()
     if b <= 0 or flat.size == 0:
         return np.zeros(theta_i.shape)
-    c_min = max(float(np.cos(np.max(flat))), 1e-7)
-    w_smallest = max(_SCALE * min(e * e, e * c_min), 1e-16)
-    psi_breaks = np.concatenate(
-        [[0.0], np.pi * _GRADE ** np.arange(_n_grades(np.pi, w_smallest))[::-1]]
-    )
-    psi, w_psi = _graded_rule(psi_breaks)
+    order = np.argsort(flat)
     out = np.empty(flat.size)
-    step = max(1, _CHUNK // (psi.size * 400))
+    step = 16
     for start in range(0, flat.size, step):  # memory bound, not a per-sample loop
-        rows = flat[start : start + step]
-        out[start : start + step] = _loss_rows(rows, b, e, psi, w_psi)
+        idx = order[start : start + step]
+        rows = flat[idx]
+        # the lobe's width in psi: ~e cos(theta_i), and ~e^2 (the ridge) near grazing
+        c_min = max(float(np.cos(np.max(rows))), 1e-7)
+        w_smallest = max(_SCALE * e * max(c_min, e), 1e-16)
+        psi_breaks = np.concatenate(
+            [[0.0], np.pi * _GRADE ** np.arange(_n_grades(np.pi, w_smallest))[::-1]]
+        )
+        psi, w_psi = _graded_rule(psi_breaks)
+        out[idx] = _loss_rows(rows, b, e, psi, w_psi)
     e2h_norm = _e2_h_norm(np.cos(flat), e)
     return np.clip(out / e2h_norm, 0.0, 1.0).reshape(theta_i.shape)

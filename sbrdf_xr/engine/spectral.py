@@ -23,7 +23,7 @@ from ..kernels import anisotropic as _aniso_kernels
 from ..kernels.anisotropic import pack_anisotropic
 from ..kernels.lut import table_edges, table_normal_blend
 from ..materials import models
-from ..photometry import band_weights
+from ..photometry import band_weights, filters
 from ..store.fingerprint import PREFIX
 from .effects.base import SPECTRAL_OUTPUTS, readonly
 from .reuse import GRIDS, TABLES, WEIGHTS, digest, immutable, table_digests
@@ -68,6 +68,33 @@ def common_wavelength(scene: Scene, used: list[str]) -> np.ndarray:
     return wl
 
 
+#: The solar spectrum of the engine: ASTM G173 (280-4000 nm), and its extension
+#: (:data:`sbrdf_xr.photometry.SOLAR_SPECTRA`, 119.5 nm - 1 mm) for grids or bands past it.
+SOLAR, SOLAR_EXTENDED = "astm_g173", "astm_g173_extended"
+_SOLAR_RANGE = (280.0, 4000.0)
+
+
+def solar_for(wl: np.ndarray, bands: list[Any] | tuple[Any, ...] = ()) -> str:
+    """The solar spectrum for wavelengths ``wl`` [nm] and ``bands``: ASTM G173 inside
+    280-4000 nm (node for node the same as the extension there), the extension beyond.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> solar_for(np.array([400.0, 900.0])), solar_for(np.array([3000.0, 15000.0]))
+    ('astm_g173', 'astm_g173_extended')
+    >>> solar_for(np.array([3000.0, 3900.0]), ["twomass-Ks"]), solar_for(np.array([3.0e3]), ["N"])
+    ('astm_g173', 'astm_g173_extended')
+    """
+    lo, hi = float(np.min(wl)), float(np.max(wl))
+    if bands:
+        response = filters(list(bands))
+        support = response[WAVELENGTH].values[(response.values > 0).any(axis=0)]
+        lo, hi = min(lo, float(support[0])), max(hi, float(support[-1]))
+    inside = _SOLAR_RANGE[0] <= lo and hi <= _SOLAR_RANGE[1]
+    return SOLAR if inside else SOLAR_EXTENDED
+
+
 def band_weights_of(scene: Scene, wl: np.ndarray) -> xr.DataArray:
     """The scene's band weights (filter x Sun, normalised) on the wavelengths ``wl``.
 
@@ -98,8 +125,13 @@ def band_weights_of(scene: Scene, wl: np.ndarray) -> xr.DataArray:
 continue the spectrum past its grid (scene field band_extrapolate)
     """
     try:
+        bands = list(scene.bands)
         return band_weights(
-            list(scene.bands), wl, normalize=True, extrapolate=scene.band_extrapolate
+            bands,
+            wl,
+            normalize=True,
+            extrapolate=scene.band_extrapolate,
+            solar=solar_for(wl, bands),
         )
     except ValidationError as exc:
         raise SceneError(f"bands: {exc} (scene field band_extrapolate)") from None

@@ -132,6 +132,8 @@ from . import (
     colour,
     colour_science,
     files,
+    inband,
+    infrared,
     lightcurves,
     magnitude,
     measured,
@@ -160,6 +162,7 @@ from .colour import srgb
 from .colour_science import from_colour, to_colour
 from .files import cf_decode, cf_encode, open_photometry, to_netcdf
 from .filter_names import band_label
+from .inband import in_band
 from .lightcurves import compare, compare_light_curves, plot_comparison
 from .magnitude import band_signal, colour_indices, magnitudes, photometry, sun_magnitudes
 from .measured import (
@@ -227,6 +230,9 @@ __all__ = [
     "filters",
     "from_colour",
     "hat_integrals",
+    "in_band",
+    "inband",
+    "infrared",
     "lambert_sphere_phase",
     "lightcurves",
     "magnitude",

@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike
 from .._names import BAND, WAVELENGTH, attrs
 from ..errors import ValidationError
 from .colour_science import as_bands, as_spectrum
+from .infrared import INFRARED_BANDS, band_curve
 from .spectra import (
     _check_grid,
     _choose,
@@ -43,6 +44,9 @@ BAND_ALIASES: dict[str, str] = {
     "r": "sdss2010-r",
     "i": "sdss2010-i",
     "z": "sdss2010-z",
+    "J": "twomass-J",
+    "H": "twomass-H",
+    "Ks": "twomass-Ks",
 }
 
 #: Spectral weightings of the band integral: name -> description.
@@ -110,6 +114,8 @@ def speclite_names() -> list[str]:
 def _speclite_band(name: str) -> tuple[np.ndarray, np.ndarray, str]:
     import speclite.filters
 
+    if name in INFRARED_BANDS:  # boxes and WISE (sbrdf_xr.photometry.infrared)
+        return band_curve(name)
     if name not in speclite_names():
         raise ValidationError(
             f"band: unknown {name!r}; use an alias ({', '.join(BAND_ALIASES)}) or a speclite "

@@ -115,7 +115,7 @@ def thermal_to_reflected(scene: Scene, wl: np.ndarray) -> float:
     >>> round(thermal_to_reflected(hot, infrared), 1)
     42.7
     """
-    e_sun = solar_spectrum(wl).values
+    e_sun = solar_spectrum(wl, solar="astm_g173_extended").values  # 119.5 nm - 1 mm
     b = np.max([sources.planck(wl, temperature(scene, m)) for m in scene.material_data], axis=0)
     return float(np.max(b / np.maximum(e_sun / np.pi, 1e-300)))
 
