@@ -20,7 +20,7 @@ from ..errors import FitQualityWarning, InversionError
 from ..units import to_unit
 from ._quality import fit_quality
 from ._spin_data import band_factors, light_curve_fluxes, spin_geometry
-from ._spin_refine import Minimum, axis_angle, exact_minimum, twins
+from ._spin_refine import Minimum, axis_angle, exact_minimum, symmetry_twins, twins
 from ._spin_refine import refine as refine_state
 from ._spin_result import result_dataset
 from ._spin_search import (
@@ -473,6 +473,7 @@ def fit_spin(
     ds.attrs["ambiguity"] = _ambiguity(ds)
     if ds.attrs["ambiguity"] != "none":
         warnings.warn(f"spin fit: {ds.attrs['ambiguity']}", FitQualityWarning, stacklevel=2)
+    ds.attrs["symmetry_twins"] = symmetry_twins(prob, best, ab)
     return ds
 
 

@@ -148,3 +148,26 @@ def lonlat_covariance(m: Minimum) -> tuple[float, float, np.ndarray]:
     jac[1, :2] = [np.dot(e, north0), np.dot(n, north0)]
     with np.errstate(invalid="ignore"):  # an unconstrained parameter: inf stays inf or NaN
         return lon, lat, jac @ m.cov @ jac.T
+
+
+def symmetry_twins(prob: Problem, best: Minimum, axis_body: np.ndarray) -> str:
+    """The body's symmetry twins of a spin fit's solution (:mod:`._symmetry`): a turn by
+    ``theta`` about the spin axis is the phase ``+ theta``, its chi-square evaluated on the
+    data; a flip is the antipode with the other sense of rotation (outside the fit's
+    parameters, identical for the unshadowed model).  ``"none"`` without symmetries."""
+    from ._symmetry import body_symmetries
+
+    t = prob.kernel.plan.terms
+    rows = []
+    for sym in body_symmetries(t.normal, t.area, t.material, axis_body):
+        if sym.kind == "turn":
+            r = _residuals(prob, best.axis, best.period, best.phase + sym.angle)
+            rows.append(f"{sym.name}: phase + {sym.angle:g} deg (chi2 gap {r @ r - best.chi2:.2g})")
+        else:
+            rows.append(f"{sym.name}: the axis antipode, the other sense of rotation")
+    if not rows:
+        return "none"
+    return (
+        "symmetry twins of the body (found from the mesh), which the light curve cannot tell "
+        "from the solution: " + "; ".join(rows)
+    )

@@ -408,3 +408,22 @@ def test_model_error_study(box_wing, truth, noise, goal):
         assert float(study.coverage_2sigma.sel(parameter=fractions).min()) >= 0.80
     else:
         assert int(study.quality_warnings) >= 0.95 * 30
+
+
+def test_fit_spin_names_the_symmetry_twins(box_wing):
+    """fit_spin on the box-wing spun about x: the half turn is found from the mesh and its
+    chi-square evaluated at phase + 180 deg (a gap of rounding size)."""
+    lc = _dao_curve(box_wing, 0.02, 3, axis_body=(1.0, 0.0, 0.0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FitQualityWarning)
+        spin = invert.fit_spin(
+            lc,
+            box_wing,
+            dao_pass(),
+            periods=invert.period_grid(40.0, 55.0, 240.0),
+            axis_body=(1.0, 0.0, 0.0),
+        )
+    text = spin.attrs["symmetry_twins"]
+    assert "turn 180 deg: phase + 180 deg (chi2 gap" in text
+    gap = float(text.split("chi2 gap ")[1].split(")")[0])
+    assert abs(gap) < 1e-6
