@@ -113,7 +113,7 @@ def open_dataset(path: str | Path, *, describe: bool = False) -> Any:
     import xarray as xr
 
     # describe: the header only, no index read (a file's size says nothing of its axes')
-    kw = {"create_default_indexes": False} if describe else {}
+    kw: dict[str, Any] = {"create_default_indexes": False} if describe else {}
     if p.is_dir() and any((p / m).is_file() for m in (".zgroup", "zarr.json")):
         try:
             return xr.open_zarr(p, **kw)  # a Zarr cube

@@ -523,8 +523,7 @@ def abandon(handle: Any, part: Path) -> None:
 
 
 def let_go(nc: Any, part: Path, torn: bool) -> None:
-    """Let go of the HDF5 handle ``nc`` of ``part`` after an I/O failure, never crashing;
-    returns None (for ``nc = let_go(nc, ...)``).
+    """Let go of the HDF5 handle ``nc`` of ``part`` after an I/O failure, never crashing.
 
     Outside an HDF5 call (``torn`` false: a reservation, a sync or the bookkeeping
     failed) HDF5's state is the synced file and it is closed as usual (its close rewrites
@@ -543,19 +542,18 @@ def let_go(nc: Any, part: Path, torn: bool) -> None:
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     nc = netCDF4.Dataset(Path(tmp) / "c.nc.part", "w")
     ...     nc.sync()
-    ...     nc = let_go(nc, Path(tmp) / "c.nc.part", torn=False)  # synced: closed as usual
-    ...     print(nc)
-    None
+    ...     let_go(nc, Path(tmp) / "c.nc.part", torn=False)  # synced: closed as usual
+    ...     print(nc.isopen())
+    False
     """
     if nc is None:
-        return None
+        return
     if torn:
         fence(part)
         abandon(nc, part)
     else:
         with contextlib.suppress(Exception):
             nc.close()
-    return None
 
 
 def check_held(part: Path) -> None:

@@ -447,7 +447,8 @@ def read_back_error(part: Path) -> str | None:
 
     Opens it read-only and reads every attribute and the first and last value of every
     variable (which walks a chunked variable's index from end to end): what a torn
-    HDF5 metadata write leaves unreadable.
+    HDF5 metadata write leaves unreadable.  An error of the system (``OSError`` with an
+    errno: a full disk, too many open files) is raised, not taken for damage.
     """
     try:
         with netCDF4.Dataset(part, mode="r") as nc:
@@ -460,6 +461,10 @@ def read_back_error(part: Path) -> str | None:
                 if v.size:
                     v[(0,) * v.ndim]
                     v[tuple(n - 1 for n in v.shape)]
+    except OSError as exc:
+        if exc.errno is not None and exc.errno > 0:  # the system's (a full disk), not damage
+            raise
+        return f"{type(exc).__name__}: {exc}"
     except Exception as exc:  # HDF5 reports damage as several exception types
         return f"{type(exc).__name__}: {exc}"
     return None

@@ -490,6 +490,7 @@ def _write_locked(
         runner.close()
         raise
 
+    assert nc is not None  # opened (resumed) or created above, or an error was raised
     bar: Any = NoProgress()
     sync: SyncBehind | None = None
     fd = log_fd = -1
@@ -594,7 +595,8 @@ def _write_locked(
         )
         lost = None
         if writing and good >= 0:  # an I/O failure: cut the file back to its last synced state
-            nc = let_go(nc, part, in_hdf5)
+            let_go(nc, part, in_hdf5)
+            nc = None
             lost = cut_back(part, good, head)
         intro = f"writing {path} failed {where}after {len(done)} of {plan.n_blocks} blocks: {why}. "
         if lost is not None:
