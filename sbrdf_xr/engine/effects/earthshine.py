@@ -130,8 +130,8 @@ def _plan(inputs: PlanInputs) -> Decision:
     if finite:  # an Earth-facing plate, the Sun in the x-z plane as seen from the Earth
         a = np.radians(scene.earth_phase_angle)
         down, sun = [0.0, 0.0, -1.0], [np.sin(a), 0.0, np.cos(a)]
-        ratio = earthshine_facets([down], [down], [sun], scene.earth_range_km, scene.earth_albedo)
-        ratio = float(ratio[0, 0])
+        facing = earthshine_facets([down], [down], [sun], scene.earth_range_km, scene.earth_albedo)
+        ratio = float(facing[0, 0])
     return Decision(
         True,
         f"{what} (albedo {scene.earth_albedo:g}, range "
