@@ -26,6 +26,8 @@ another kind raises :class:`~sbrdf_xr.errors.UnitError`).
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import constants
@@ -41,6 +43,7 @@ __all__ = [
     "MOON_RADIUS_KM",
     "SUN_V_MAGNITUDE",
     "earth_thermal_irradiance",
+    "earthshine_facets",
     "earthshine_finite",
     "earthshine_irradiance_ratio",
     "emissivity_at",
@@ -291,6 +294,12 @@ EARTH_NODES = (256, 512)
 EARTH_TEMPERATURE_MAX = 400.0
 
 
+@functools.lru_cache(maxsize=8)
+def _leggauss(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights on [-1, 1], made once per order."""
+    return np.polynomial.legendre.leggauss(n)
+
+
 def _earth_cap(
     plate_normal: ArrayLike, to_earth: ArrayLike, range_km: float, nodes: tuple[int, int]
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -310,9 +319,9 @@ def _earth_cap(
     y = np.cross(z, x)
     sin_rho = EARTH_RADIUS_KM / r
     # sin(psi) = sin(rho) sin(chi): smooth up to the limb (chi = pi/2)
-    tc, wc = np.polynomial.legendre.leggauss(nodes[0])
+    tc, wc = _leggauss(nodes[0])
     chi, w_chi = 0.25 * np.pi * (tc + 1.0), 0.25 * np.pi * wc
-    tw, ww = np.polynomial.legendre.leggauss(nodes[1])
+    tw, ww = _leggauss(nodes[1])
     om, w_om = np.pi * (tw + 1.0), np.pi * ww
     sin_psi = sin_rho * np.sin(chi)
     cos_psi = np.sqrt(1.0 - sin_psi**2)
@@ -526,3 +535,99 @@ def radiative_cooling(
         raise ValidationError(f"radiating_sides: got {radiating_sides!r}; allowed: 1 or 2")
     rate = 3.0 * radiating_sides * emissivity * constants.sigma / c
     return (t0**-3 + rate * t) ** (-1.0 / 3.0)
+
+
+def _canonical_cap(
+    range_km: float, cos_sun: float, nodes: tuple[int, int]
+) -> tuple[np.ndarray, np.ndarray]:
+    """Directions (K, 3) toward the visible Earth and their weights ``w max(u.s, 0)`` [sr] in
+    the frame with the Earth's centre on +z and the Sun in the x-z half-plane ``x >= 0``."""
+    s = np.array([np.sqrt(max(0.0, 1.0 - cos_sun**2)), 0.0, cos_sun])
+    d, u, _, w = _earth_cap([0.0, 0.0, 1.0], [0.0, 0.0, 1.0], range_km, nodes)
+    lw = (w * np.maximum(u @ s, 0.0)).ravel()
+    keep = lw > 0.0  # the night side adds nothing
+    return d.reshape(-1, 3)[keep], lw[keep]
+
+
+def earthshine_facets(
+    normals: ArrayLike,
+    to_earth: ArrayLike,
+    to_sun: ArrayLike,
+    range_km: ArrayLike,
+    albedo: float = 0.3,
+    *,
+    nodes: tuple[int, int] = (64, 128),
+) -> NDArray[np.float64]:
+    """:func:`earthshine_finite` for many plates and geometries at once, ``E/E_sun`` (G, T).
+
+    The same integral, evaluated in the frame of the Earth's centre and the Sun: a plate
+    that sees the whole visible cap (its normal within ``90 deg - rho`` of the Earth's
+    centre, ``sin(rho) = R / r``) receives ``n . V`` with ``V = (a/pi) int max(u.s, 0) d
+    dOmega`` one vector per geometry; a plate that sees none of it (normal beyond ``90 deg
+    + rho``) receives 0; only the plates whose horizon cuts the Earth are integrated node
+    by node.  Geometries sharing a range and a solar angle share their nodes.
+
+    Parameters
+    ----------
+    normals : array_like, shape (T, 3)
+        Unit plate normals [1].
+    to_earth, to_sun : array_like, shape (G, 3)
+        Unit directions to the Earth's centre and to the Sun [1], in the normals' frame.
+    range_km : array_like, shape (G,) or scalar
+        Distance from the Earth's centre [km], above the Earth's radius.
+    albedo : float
+        The Earth's Lambertian albedo [1].
+    nodes : tuple of int
+        Gauss-Legendre nodes (radial, azimuthal) over the Earth's disc; the default is
+        measured at 2e-5 of the largest irradiance against :func:`earthshine_finite` on
+        (512, 1024) nodes, at GEO, 7000 and 6471 km.
+
+    Returns
+    -------
+    ndarray, shape (G, T)
+        ``E_earth / E_sun`` [1] of every plate in every geometry.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.sources import earthshine_facets, earthshine_finite
+    >>> n = [[0.0, 0.0, -1.0], [0.995037, 0.0, -0.0995037]]  # Earth-facing; nearly edge-on
+    >>> e, s = [[0.0, 0.0, -1.0]], [[0.6, 0.0, 0.8]]
+    >>> earthshine_facets(n, e, s, 7000.0).round(5).tolist()
+    [[0.1972, 0.07328]]
+    >>> round(earthshine_finite(n[1], e[0], s[0], 7000.0), 5)  # the single-plate integral
+    0.07328
+    """
+    nrm = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+    e = np.asarray(to_earth, dtype=np.float64).reshape(-1, 3)
+    s = np.asarray(to_sun, dtype=np.float64).reshape(-1, 3)
+    rng = np.broadcast_to(np.asarray(to_unit(range_km, "km", "range_km"), float), e.shape[:1])
+    e = e / np.linalg.norm(e, axis=1, keepdims=True)
+    s = s / np.linalg.norm(s, axis=1, keepdims=True)
+    cz = np.clip(np.einsum("gi,gi->g", s, e), -1.0, 1.0)
+    x = s - cz[:, None] * e
+    nx = np.linalg.norm(x, axis=1)
+    other = np.where(np.abs(e[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    alt = np.cross(e, other)
+    x = np.where((nx > 1e-12)[:, None], x, alt)
+    x /= np.linalg.norm(x, axis=1, keepdims=True)
+    y = np.cross(e, x)
+    # the normals in every geometry's frame (x toward the Sun, z toward the Earth)
+    nc = np.stack([x @ nrm.T, y @ nrm.T, e @ nrm.T], axis=-1)  # (G, T, 3)
+    out = np.zeros(nc.shape[:2])
+    cache: dict[tuple[float, float], tuple[np.ndarray, np.ndarray]] = {}
+    for g in range(e.shape[0]):
+        key = (float(rng[g]), round(float(cz[g]), 12))
+        if key not in cache:
+            cache[key] = _canonical_cap(key[0], key[1], nodes)
+        d, lw = cache[key]
+        if lw.size == 0:
+            continue
+        sin_rho = EARTH_RADIUS_KM / key[0]
+        nz = nc[g, :, 2]
+        whole, cut = nz >= sin_rho, np.abs(nz) < sin_rho
+        out[g, whole] = nc[g, whole] @ (lw @ d)
+        idx = np.flatnonzero(cut)
+        for k in range(0, idx.size, 64):  # (64, K) at a time
+            j = idx[k : k + 64]
+            out[g, j] = np.maximum(nc[g, j] @ d.T, 0.0) @ lw
+    return albedo / np.pi * out

@@ -450,6 +450,13 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         range_km=42164.0,
         nodes=(16, 32),
     ),
+    "sbrdf_xr.sources.earthshine_facets": lambda: dict(
+        normals=[[0, 0, -1], [1, 0, 0]],
+        to_earth=[[0, 0, -1]],
+        to_sun=[[0, 0, 1]],
+        range_km=[7000.0],
+        nodes=(16, 32),
+    ),
     "sbrdf_xr.sources.earth_thermal_irradiance": lambda: dict(
         wavelength=[8000.0, 10_000.0],
         plate_normal=[0, 0, -1],

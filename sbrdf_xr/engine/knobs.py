@@ -230,6 +230,14 @@ KNOBS: dict[str, Knob] = {
             allowed=("fused", "numpy"),
         ),
         Knob(
+            "earth_model",
+            "finite",
+            str,
+            "finite: a Lambertian Earth at its true size cut by each facet's horizon (a "
+            "quadrature per geometry); point: a distant source at the Earth's centre",
+            allowed=("finite", "point"),
+        ),
+        Knob(
             "chunk",
             None,
             int,

@@ -272,6 +272,7 @@ class Scene:
     earth_albedo: float = 0.3
     earth_range_km: float = 42164.0
     earth_phase_angle: float = 90.0
+    earth_model: str = KNOBS["earth_model"].default
     temperature: float | Mapping[str, float] = 300.0
     models: Mapping[str, xr.Dataset] | None = None
     size_limit: float = 1.0

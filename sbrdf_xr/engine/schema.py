@@ -168,6 +168,7 @@ SCENE_KEYS: dict[str, Key] = _table(
         *(_knob_key(k) for k in ("shadow_method", "shadow_density", "chunk")),
         *(_knob_key(k) for k in ("wavelength_stride", "band_integration", "table_theta_step")),
         *(_knob_key(k) for k in ("evaluation", "kernel", "block_bytes", "tilt_nodes")),
+        _knob_key("earth_model"),
         Key(
             "size_limit",
             _NUMBER,

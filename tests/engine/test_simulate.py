@@ -240,6 +240,7 @@ def test_earthshine_is_a_second_lambertian_source():
             earth_albedo=0.3,
             earth_range_km=42164.0,
             earth_phase_angle=60.0,
+            earth_model="point",  # the finite Earth: tests/engine/test_earthshine_finite.py
         )
     ).compute()
     ratio = earthshine_irradiance_ratio(0.3, 42164.0, 60.0)
