@@ -24,6 +24,7 @@ __all__ = [
     "CubeWriteError",
     "EpochGapWarning",
     "FitQualityWarning",
+    "HiddenSideWarning",
     "InversionError",
     "LightCurveError",
     "MeshError",
@@ -322,6 +323,11 @@ class NonPhysicalWarning(SbrdfWarning):
 
 class MeshRepairWarning(SbrdfWarning):
     """A spacecraft mesh was repaired as documented in :mod:`sbrdf_xr.body.spacecraft`."""
+
+
+class HiddenSideWarning(SbrdfWarning):
+    """Back materials on facets of a closed surface: those sides face the inside of a solid,
+    can never be lit or seen, and are dropped."""
 
 
 class CacheWarning(SbrdfWarning):

@@ -655,3 +655,69 @@ def pass_cube(n_times: int = 121) -> xr.Dataset:
             "penumbra_exit": "2024-03-17T01:20:30.000",
         },
     )
+
+
+def plate_spacecraft(
+    size: tuple[float, float] = (1.0, 2.0), front: str = "cell", back: str | None = "backsheet"
+):
+    """An open flat plate in the plane z = 0 [m], front towards +z, two triangles.
+
+    Parameters
+    ----------
+    size : (float, float)
+        Extent along x and y [m].
+    front, back : str
+        Materials of the front and of the back (None: one-sided).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import plate_spacecraft
+    >>> plate = plate_spacecraft()
+    >>> plate.n_facets, plate.n_sides, plate.materials
+    (2, 4, ['backsheet', 'cell'])
+    """
+    import trimesh
+
+    from .body.spacecraft import Spacecraft
+
+    a, b = size
+    mesh = trimesh.Trimesh(
+        [[0, 0, 0], [a, 0, 0], [a, b, 0], [0, b, 0]], [[0, 1, 2], [0, 2, 3]], process=False
+    )
+    return Spacecraft(mesh, [front] * 2, name="plate", back_material=back)
+
+
+def box_with_plate_spacecraft(height: float = 1.0, parts: bool = False, law=None):
+    """A closed unit cube (``bus``, centred at the origin) and a two-sided 1 x 1 m plate
+    ``height`` [m] above its top face (``cell`` in front, towards +z, ``backsheet``
+    behind): a mixed open and closed body.
+
+    With ``parts=True`` the plate is the part ``"array"`` hinged about the x axis through
+    its centre (``law``: its pointing law, default sun-tracking).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import box_with_plate_spacecraft
+    >>> body = box_with_plate_spacecraft()
+    >>> body.n_facets, body.n_sides, body.is_convex
+    (14, 16, False)
+    >>> box_with_plate_spacecraft(parts=True).moving_parts[0].name
+    'array'
+    """
+    import trimesh
+
+    from .body.parts import Part, SunTracking
+    from .body.spacecraft import Spacecraft
+
+    box = trimesh.creation.box()
+    z = 0.5 + height
+    v = np.vstack([box.vertices, [[-0.5, -0.5, z], [0.5, -0.5, z], [0.5, 0.5, z], [-0.5, 0.5, z]]])
+    f = np.vstack([box.faces, [[8, 9, 10], [8, 10, 11]]])
+    mesh = trimesh.Trimesh(v, f, process=False)
+    mats = ["bus"] * 12 + ["cell"] * 2
+    backs = [""] * 12 + ["backsheet"] * 2
+    plist = ()
+    if parts:
+        law = SunTracking() if law is None else law
+        plist = (Part("array", [12, 13], axis=[1.0, 0, 0], point=[0, 0, z], law=law),)
+    return Spacecraft(mesh, mats, name="box-with-plate", back_material=backs, parts=plist)

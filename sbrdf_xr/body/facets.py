@@ -151,6 +151,7 @@ def merge_facets(
     name: str = "spacecraft",
     tolerance: float = NORMAL_TOLERANCE,
     tangent_materials: Iterable[str] = (),
+    groups: ArrayLike | None = None,
 ) -> xr.Dataset:
     """Collapse facets that share (normal, material) into terms with summed area.
 
@@ -169,6 +170,9 @@ def merge_facets(
         :meth:`sbrdf_xr.body.spacecraft.Spacecraft.merged`.
     tangent_materials : iterable of str
         Anisotropic materials, whose facets also need equal tangents to share a term.
+    groups : array_like of int, shape (n_facets,), optional
+        Facets of different groups (the bus and the parts that move against it) never
+        share a term.
 
     Returns
     -------
@@ -203,6 +207,7 @@ def merge_facets(
             mat_code.reshape(-1),
             np.round(normals / tolerance).astype(np.int64),
             t_key.astype(np.int64),
+            np.zeros(len(labels), np.int64) if groups is None else np.asarray(groups, np.int64),
         ]
     )
     _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)

@@ -16,16 +16,17 @@ documented repair below is applied and reported with a
 3. zero-area facets (area <= :data:`ZERO_AREA_FACTOR` x the squared bounding-box diagonal,
    or repeated vertices): removed;
 4. duplicate facets (same three vertices, any order or winding): the first is kept;
-5. open surface (edges used by one facet): holes are filled with :func:`trimesh.repair.fill_holes`;
-   each new facet takes the material of the nearest original facet; an error remains if the
-   surface is still open;
+5. edges shared by more than two facets (not manifold): an error, no repair; open
+   surfaces are allowed (not a problem): a sheet, a panel, a solar array exported
+   as a surface; every facet faces the side its winding gives (its front), and closed
+   components are checked as solids below.  Only quantities that need a volume
+   (:meth:`~sbrdf_xr.body.spacecraft.Spacecraft.inertia`) refuse an open surface;
 6. inconsistent winding: :func:`trimesh.repair.fix_winding`;
-7. inside-out bodies (negative volume): their facets are flipped
-   (:func:`trimesh.repair.fix_inversion`).
+7. inside-out closed components (negative volume): their facets are flipped.
 
-Self-intersections and internal faces are not detected.  Zero-thickness panels, common in
-CAD exports, make a surface open: model them as thin boxes (ray-cast shadowing needs a closed
-surface to tell the inside from the outside).
+Repairs are reported only once every check has passed: a mesh that cannot be used
+raises :class:`~sbrdf_xr.errors.MeshError` without having warned "repaired" first.
+Self-intersections and internal faces are not detected.
 """
 
 from __future__ import annotations
@@ -49,10 +50,11 @@ ZERO_AREA_FACTOR = 1.0e-14
 MERGE_DISTANCE = 1.0e-8
 
 
-def _problem(repair: bool, message: str, fix: str) -> None:
+def _problem(repair: bool, message: str, fix: str, done: list[str]) -> None:
+    """Raise, or note the repair in ``done`` (warned once the mesh is usable)."""
     if not repair:
         raise MeshError(f"{message}; pass repair=True to {fix}")
-    warnings.warn(f"{message}: repaired ({fix})", MeshRepairWarning, stacklevel=4)
+    done.append(f"{message}: repaired ({fix})")
 
 
 def clean_mesh(
@@ -71,6 +73,7 @@ def clean_mesh(
     """
     if len(faces) == 0:
         raise MeshError("the mesh is empty: it has no facets")
+    done: list[str] = []
     if faces.min() < 0 or faces.max() >= len(vertices):
         raise MeshError(f"facets index vertices outside 0..{len(vertices) - 1}")
     # 1. non-finite vertices
@@ -82,6 +85,7 @@ def clean_mesh(
             f"{int(bad_v.sum())} vertices are not finite (NaN or inf), "
             f"used by {int(bad_f.sum())} facets",
             "remove them and their facets",
+            done,
         )
         vertices = np.where(bad_v[:, None], 0.0, vertices)
         faces, material = faces[~bad_f], material[~bad_f]
@@ -108,6 +112,7 @@ def clean_mesh(
             f"{int(zero.sum())} of {len(faces)} facets have zero area "
             f"(first: {np.flatnonzero(zero)[:5].tolist()})",
             "remove them",
+            done,
         )
         faces, material = faces[~zero], material[~zero]
         if len(faces) == 0:
@@ -122,57 +127,59 @@ def clean_mesh(
             f"{len(faces) - len(first)} facets duplicate another facet "
             f"(first: {np.flatnonzero(~keep)[:5].tolist()})",
             "keep the first of each set of duplicates",
+            done,
         )
         faces, material = faces[keep], material[keep]
     mesh = trimesh.Trimesh(vertices, faces, process=False, validate=False)
-    # 5. open surface
-    if not mesh.is_watertight:
-        e = np.sort(mesh.edges_sorted, axis=1)
-        _, counts = np.unique(e, axis=0, return_counts=True)
-        n_open, n_fin = int(np.sum(counts == 1)), int(np.sum(counts > 2))
-        if n_fin:  # no repair makes this a closed surface
-            raise MeshError(
-                f"the surface is not manifold: {n_fin} edges are shared by more than two "
-                f"facets (and {n_open} belong to a single facet); a closed surface shares "
-                "every edge between exactly two"
-            )
-        _problem(
-            repair,
-            f"the surface is not closed ({n_open} edges belong to a single facet)",
-            "fill the holes with trimesh.repair.fill_holes",
+    # 5. open surfaces are allowed, edges shared by more than two facets are not
+    e = np.sort(mesh.edges_sorted, axis=1)
+    _, counts = np.unique(e, axis=0, return_counts=True)
+    n_fin = int(np.sum(counts > 2))
+    if n_fin:
+        raise MeshError(
+            f"the surface is not manifold: {n_fin} edges are shared by more than two facets; "
+            "a surface (closed or open) shares every edge between at most two (give a "
+            "panel joined to the bus along an edge its own copy of the edge's vertices)"
         )
-        n_before = len(mesh.faces)
-        old_centres = mesh.triangles_center.copy()
-        trimesh.repair.fill_holes(mesh)
-        if not mesh.is_watertight:
-            raise MeshError(
-                "the surface is not closed and trimesh.repair.fill_holes could not close it"
-            )
-        if len(mesh.faces) > n_before:
-            from scipy.spatial import cKDTree
-
-            _, nearest = cKDTree(old_centres).query(mesh.triangles_center[n_before:])
-            material = np.concatenate([material, material[nearest]])
     # 6. winding
     if not mesh.is_winding_consistent:
         _problem(
             repair,
             "the facets are not consistently wound",
             "reorient them with trimesh.repair.fix_winding",
+            done,
         )
         trimesh.repair.fix_winding(mesh)
-    # 7. inside-out bodies
-    probe = mesh.copy()
-    trimesh.repair.fix_inversion(probe, multibody=True)
-    flipped = (np.asarray(probe.faces) != np.asarray(mesh.faces)).any(axis=1)
+    # 7. inside-out closed components
+    flipped = _inside_out(mesh)
     if flipped.any():
         _problem(
             repair,
             f"{int(flipped.sum())} facets belong to inside-out bodies "
             "(negative volume, normals pointing inwards)",
             "flip them",
+            done,
         )
-        mesh = probe
+        faces = np.asarray(mesh.faces).copy()
+        faces[flipped] = faces[flipped][:, ::-1]
+        mesh = trimesh.Trimesh(np.asarray(mesh.vertices), faces, process=False, validate=False)
+    for message in done:
+        warnings.warn(message, MeshRepairWarning, stacklevel=4)
     return trimesh.Trimesh(
         np.asarray(mesh.vertices), np.asarray(mesh.faces), process=False
     ), material
+
+
+def _inside_out(mesh: trimesh.Trimesh) -> np.ndarray:
+    """Facets of closed components whose signed volume is negative."""
+    from .sides import closed_facets
+
+    out = np.zeros(len(mesh.faces), dtype=bool)
+    closed = closed_facets(mesh)
+    if not closed.any():
+        return out
+    labels = trimesh.graph.connected_component_labels(mesh.face_adjacency, len(mesh.faces))
+    tri = np.asarray(mesh.triangles)
+    vol = np.einsum("fi,fi->f", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])) / 6.0
+    comp_vol = np.bincount(labels, weights=vol)
+    return closed & (comp_vol[labels] < 0)

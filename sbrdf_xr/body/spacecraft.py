@@ -27,8 +27,9 @@ surface, inconsistent winding, inside-out bodies) raises :class:`~sbrdf_xr.error
 unless ``repair=True``; then the documented repair is applied and reported with a
 :class:`MeshRepairWarning` (never silently).  The checks, their order, repairs and
 tolerances are listed in :mod:`sbrdf_xr.body.repair`.  Self-intersections and internal
-faces are not detected; zero-thickness panels make a surface open (model them as thin
-boxes).
+faces are not detected.  A surface may be open (a panel, a sheet): every facet has a front
+and, where ``back_material`` says so, a back (:mod:`sbrdf_xr.body.sides`); parts that turn
+about a hinge are :mod:`sbrdf_xr.body.parts`.
 
 The facet tables are built by :mod:`sbrdf_xr.body.facets` and the picture by
 :mod:`sbrdf_xr.body.picture`.
@@ -67,8 +68,10 @@ from .meshes import (
     read_material_map,
     read_mesh,
 )
+from .parts import Part, check_parts
 from .picture import plot_facets
 from .repair import clean_mesh
+from .sides import Sides, build_sides
 
 __all__ = [
     "CANX1_MATERIALS",
@@ -117,6 +120,7 @@ def load_spacecraft(
     face_property: str | None = None,
     file_type: str | None = None,
     tangent: Any = None,
+    back_material: str | Mapping[str, str] | None = None,
 ) -> Spacecraft:
     """Load a triangulated spacecraft model and label every facet with a material.
 
@@ -162,6 +166,10 @@ def load_spacecraft(
         to a facet's normal take the documented fallback of
         :func:`sbrdf_xr.geometry.anisotropy.project_tangents`.  Isotropic materials ignore
         tangents.
+    back_material : str or mapping of str to str, optional
+        Backs of the facets (an open surface: a panel, a sheet): one material for the
+        back of every facet, or front material -> back material (facets of other
+        materials stay one-sided).  See :mod:`sbrdf_xr.body.sides`.
 
     Returns
     -------
@@ -209,10 +217,10 @@ def load_spacecraft(
         colours, name_map = normalise_map(material_map, known_materials)
     opts = (face_property, file_type, material, colours, name_map, name, length_unit, factor)
     if not isinstance(path_or_mesh, str | Path):
-        return _load(path_or_mesh, *opts, tangent, repair)
+        return _with_backs(_load(path_or_mesh, *opts, tangent, repair), back_material)
     path = input_file(path_or_mesh, "mesh file", MeshError)
     try:
-        return _load(path, *opts, tangent, repair)
+        return _with_backs(_load(path, *opts, tangent, repair), back_material)
     except MeshError as exc:  # say which file
         if str(path) in str(exc):
             raise
@@ -278,6 +286,36 @@ def _load(
     )
 
 
+def _with_backs(sc: Spacecraft, back_material: str | Mapping[str, str] | None) -> Spacecraft:
+    """``sc`` with the backs ``back_material`` asks for (see :func:`load_spacecraft`)."""
+    if back_material is None:
+        return sc
+    if isinstance(back_material, Mapping):
+        unknown = sorted(set(back_material) - set(sc.materials))
+        if unknown:
+            raise ValidationError(
+                f"back_material: front materials {unknown} are on no facet; the facets "
+                f"have {sc.materials}"
+            )
+        back = [back_material.get(m, "") for m in sc.facet_material.tolist()]
+    elif isinstance(back_material, str) and back_material.strip():
+        back = [back_material] * sc.n_facets
+    else:
+        raise ValidationError(
+            "back_material: expected a material name or a mapping front material -> back "
+            f"material, got {back_material!r}"
+        )
+    return Spacecraft(
+        sc.mesh,
+        sc.facet_material,
+        name=sc.name,
+        colors=sc.colors,
+        tangent=sc.facet_tangent,
+        tangent_source=sc.tangent_source,
+        back_material=back,
+    )
+
+
 def _unit_factor(factor: float | None, length_unit: Any, stated: str | None) -> float:
     """Metres per file unit: the one given, else the one the file states, else 1; a given
     unit that contradicts the file's statement warns."""
@@ -300,11 +338,13 @@ def _unit_factor(factor: float | None, length_unit: Any, stated: str | None) -> 
 
 
 class Spacecraft:
-    """A closed triangulated surface in metres with a material name on every facet.
+    """A triangulated surface in metres with a material name on every facet: a bus and
+    optionally named parts that turn about hinges.
 
     Composition, not a trimesh subclass: :attr:`mesh` is the geometry and
     :attr:`facet_material` the labels.  Build it with :func:`load_spacecraft` (which checks
-    the mesh) or :func:`canx1`.
+    the mesh) or :func:`canx1`.  The surface may be open; facets are one-sided unless
+    ``back_material`` gives a back (:mod:`sbrdf_xr.body.sides`).
 
     Parameters
     ----------
@@ -325,6 +365,13 @@ class Spacecraft:
     tangent_source : str, optional
         Where the tangents come from (``"default"``, ``"direction"``, ``"per facet"``,
         ``"mesh attribute"``), for display; inferred when omitted.
+    back_material : str or array_like of str, shape (n_facets,), optional
+        Material of the back of every facet (``""``: no back, one-sided), or one name for
+        every facet.  Backs on a closed surface are dropped with a
+        :class:`~sbrdf_xr.errors.HiddenSideWarning`.
+    parts : sequence of Part, optional
+        Articulated parts (:class:`sbrdf_xr.body.parts.Part`): facets turning about a hinge
+        with a pointing law; the other facets are the bus.
 
     Examples
     --------
@@ -349,6 +396,8 @@ class Spacecraft:
         colors: Mapping[str, Color] | None = None,
         tangent: Any = None,
         tangent_source: str | None = None,
+        back_material: Any = None,
+        parts: Iterable[Part] | None = None,
     ) -> None:
         if not isinstance(mesh, trimesh.Trimesh):
             raise ValidationError(f"mesh: expected a trimesh.Trimesh, got {type(mesh).__name__}")
@@ -367,6 +416,55 @@ class Spacecraft:
         self.tangent_source = tangent_source or (
             "default" if d is None else "direction" if d.ndim == 1 else "per facet"
         )
+        back = None
+        if back_material is not None:
+            if isinstance(back_material, str):
+                back_material = [back_material] * len(mesh.faces)
+            back = np.array(
+                ["" if b is None else str(b) for b in back_material], dtype=object
+            ).astype(str)
+            if back.shape != (len(mesh.faces),):
+                raise ValidationError(
+                    f"back_material: expected one name per facet ({len(mesh.faces)}) or one "
+                    f"name, got {back.shape[0]}"
+                )
+        #: Back material of every facet, ``""`` where it has none (one-sided), or None.
+        self.facet_back: NDArray[np.str_] | None = back if back is not None and back.any() else None
+        normals = np.asarray(mesh.face_normals, dtype=np.float64)
+        #: The articulated parts (:mod:`sbrdf_xr.body.parts`), with their normals at angle 0.
+        self.parts: tuple[Part, ...] = check_parts(
+            parts, len(mesh.faces), normals, np.asarray(mesh.area_faces)
+        )
+        #: The sides light can reach (:mod:`sbrdf_xr.body.sides`).
+        self.sides: Sides = build_sides(
+            mesh, labels, self.facet_back, self.facet_tangent, self.parts
+        )
+        if self.facet_back is not None:  # the backs kept (those on closed surfaces are not)
+            kept = np.full(len(mesh.faces), "", dtype=object)
+            kept[self.sides.facet[self.sides.back]] = self.sides.material[self.sides.back]
+            self.facet_back = kept.astype(str) if self.sides.back.any() else None
+
+    @property
+    def moving_parts(self) -> tuple[Part, ...]:
+        """The parts whose angle changes with the geometry (not :class:`Fixed`).
+
+        Examples
+        --------
+        >>> Spacecraft(trimesh.creation.box(), ["paint"] * 12).moving_parts
+        ()
+        """
+        return tuple(p for p in self.parts if p.moving)
+
+    @property
+    def n_sides(self) -> int:
+        """Number of one-sided facets light can reach: every front plus every back.
+
+        Examples
+        --------
+        >>> Spacecraft(trimesh.creation.box(), ["paint"] * 12).n_sides
+        12
+        """
+        return self.sides.n_sides
 
     def with_tangent(self, tangent: Any) -> Spacecraft:
         """The same spacecraft with other facet tangents (see the class parameters).
@@ -393,7 +491,44 @@ class Spacecraft:
         [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0]]
         """
         return Spacecraft(
-            self.mesh, self.facet_material, name=self.name, colors=self.colors, tangent=tangent
+            self.mesh,
+            self.facet_material,
+            name=self.name,
+            colors=self.colors,
+            tangent=tangent,
+            back_material=self.facet_back,
+            parts=self.parts,
+        )
+
+    def with_parts(self, parts: Iterable[Part]) -> Spacecraft:
+        """The same spacecraft with these articulated parts (:mod:`sbrdf_xr.body.parts`).
+
+        Parameters
+        ----------
+        parts : iterable of Part
+            Facets of the mesh turning about hinges; the other facets are the bus.
+
+        Returns
+        -------
+        Spacecraft
+
+        Examples
+        --------
+        >>> from sbrdf_xr.body.parts import Part, SunTracking
+        >>> box = Spacecraft(trimesh.creation.box(), ["paint"] * 12)
+        >>> lid = Part("lid", [4, 6], law=SunTracking(normal=(1, 0, 0)))
+        >>> box.with_parts([lid]).moving_parts[0].name
+        'lid'
+        """
+        return Spacecraft(
+            self.mesh,
+            self.facet_material,
+            name=self.name,
+            colors=self.colors,
+            tangent=self.facet_tangent,
+            tangent_source=self.tangent_source,
+            back_material=self.facet_back,
+            parts=parts,
         )
 
     def __repr__(self) -> str:
@@ -422,7 +557,7 @@ class Spacecraft:
         >>> Spacecraft(trimesh.creation.box(), ["paint"] * 6 + ["cell"] * 6).materials
         ['cell', 'paint']
         """
-        return sorted(set(self.facet_material.tolist()))
+        return sorted(set(self.sides.material.tolist()))
 
     @property
     def is_convex(self) -> bool:
@@ -438,7 +573,9 @@ class Spacecraft:
         True
         """
         if "is_convex" not in self._cache:
-            self._cache["is_convex"] = bool(self.mesh.is_convex)
+            self._cache["is_convex"] = (
+                not self.moving_parts and self.sides.mesh is self.mesh and bool(self.mesh.is_convex)
+            )
         return self._cache["is_convex"]
 
     def inertia(self, density: float = 1.0) -> NDArray[np.float64]:
@@ -468,6 +605,12 @@ class Spacecraft:
         density = to_unit(density, "kg m-3", "density")
         if not (np.isfinite(density) and density > 0):
             raise ValidationError(f"density: must be a positive number [kg m-3], got {density!r}")
+        if not self.mesh.is_watertight:
+            raise MeshError(
+                f"inertia: needs a volume, and the surface of {self.name!r} is open (some "
+                "edges belong to a single facet); give the inertia tensor of the real "
+                "spacecraft instead"
+            )
         props = trimesh.triangles.mass_properties(self.mesh.triangles, density=float(density))
         return np.asarray(props["inertia"], dtype=np.float64)
 
@@ -489,7 +632,17 @@ class Spacecraft:
         >>> ds.normal.isel(facet=0).values.tolist()
         [-1.0, 0.0, 0.0]
         """
-        return facet_table(self.mesh, self.facet_material, self.facet_tangent, self.name)
+        s = self.sides
+        table = facet_table(s.mesh, s.material, s.tangent, self.name)
+        if s.mesh is not self.mesh:  # backs or parts: say which facet and group each side is
+            table["mesh_facet"] = (
+                "facet",
+                s.facet,
+                {"long_name": "facet of the mesh", "units": "1"},
+            )
+            table["back"] = ("facet", s.back, {"long_name": "the back of the facet", "units": "1"})
+            table["part"] = ("facet", s.group, {"long_name": "0: bus, k: part k - 1", "units": "1"})
+        return table
 
     def merged(
         self, tolerance: float = NORMAL_TOLERANCE, tangent_materials: Iterable[str] = ()
@@ -529,13 +682,15 @@ class Spacecraft:
         >>> terms.sizes["term"], terms.area.values.tolist()  # 6 faces of 2 facets each
         (6, [1.0, 1.0, 1.0, 1.0, 1.0, 1.0])
         """
+        s = self.sides
         return merge_facets(
-            self.mesh,
-            self.facet_material,
-            self.facet_tangent,
+            s.mesh,
+            s.material,
+            s.tangent,
             self.name,
             tolerance=tolerance,
             tangent_materials=tangent_materials,
+            groups=None if s.mesh is self.mesh else s.group,
         )
 
     def plot(

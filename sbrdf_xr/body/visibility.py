@@ -154,8 +154,8 @@ def mesh_of(spacecraft: Spacecraft | trimesh.Trimesh) -> tuple[trimesh.Trimesh, 
     ...
     sbrdf_xr.errors.ValidationError: spacecraft: expected a Spacecraft or trimesh.Trimesh, got str
     """
-    if isinstance(spacecraft, Spacecraft):
-        return spacecraft.mesh, spacecraft._cache
+    if isinstance(spacecraft, Spacecraft):  # every side light can reach (fronts, backs)
+        return spacecraft.sides.mesh, spacecraft._cache
     if isinstance(spacecraft, trimesh.Trimesh):
         return spacecraft, {}
     raise ValidationError(
@@ -713,7 +713,7 @@ def facet_visibility(
         coords={
             "to_sun": ((GEOMETRY, VECTOR), ds, attrs("to_sun")),
             "to_observer": ((GEOMETRY, VECTOR), do, attrs("to_observer")),
-            FACET: (FACET, np.arange(spacecraft.n_facets), attrs(FACET)),
+            FACET: (FACET, np.arange(spacecraft.n_sides), attrs(FACET)),
             VECTOR: (VECTOR, ["x", "y", "z"], attrs(VECTOR)),
         },
         attrs={"spacecraft": spacecraft.name, "method": method, **extra},

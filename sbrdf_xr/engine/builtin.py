@@ -10,12 +10,14 @@ and re-exported here.  All are re-exported from :mod:`sbrdf_xr.engine`.
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from .. import geometry
-from ..errors import SceneError
+from ..errors import SceneError, ValidationError
 from .scene import Scene
 from .scene_file import (
     MAX_SCENE_COUNT,
@@ -29,6 +31,7 @@ from .scene_file import (
 __all__ = [
     "MAX_SCENE_COUNT",
     "MAX_SHADOW_DENSITY",
+    "STARLINK_STAND_INS",
     "builtin_scene",
     "builtin_scenes",
     "load_material_specs",
@@ -36,7 +39,71 @@ __all__ = [
     "material_tables",
     "resolve_scene",
     "scene_from_dict",
+    "starlink_materials",
 ]
+
+#: Albedos of the Lambertian stand-ins of :func:`starlink_materials` [1]: placeholders
+#: chosen here (a grey chassis, dark cells, a light backsheet), not measurements.
+STARLINK_STAND_INS = {
+    "starlink-chassis": 0.3,
+    "starlink-solar-array": 0.1,
+    "starlink-array-back": 0.5,
+}
+
+
+def starlink_materials(
+    tables: Mapping[str, Any] | None = None, wavelength: Any = (400.0, 550.0, 700.0, 900.0)
+) -> dict[str, Any]:
+    """Materials of :func:`sbrdf_xr.body.starlink.starlink_v15`: the tables given, and a
+    labelled Lambertian stand-in (:data:`STARLINK_STAND_INS`) for each one not given.
+
+    Parameters
+    ----------
+    tables : mapping of str to DataArray or Dataset, optional
+        Tables (or BRDF models) for any of ``starlink-chassis``, ``starlink-solar-array``,
+        ``starlink-array-back`` (e.g. built from the laboratory scans of the data set).
+    wavelength : array_like
+        Wavelengths of the stand-ins [nm].
+
+    Returns
+    -------
+    dict of str to DataArray or Dataset
+        For ``Scene(materials=...)``; a stand-in's ``provenance`` says it is one.
+
+    Examples
+    --------
+    >>> mats = starlink_materials()
+    >>> sorted(mats)
+    ['starlink-array-back', 'starlink-chassis', 'starlink-solar-array']
+    >>> mats["starlink-chassis"].attrs["provenance"].split(":")[0]
+    'STAND-IN, not a measurement'
+    >>> starlink_materials({"chassis": mats["starlink-chassis"]})
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.ValidationError: starlink_materials: 'chassis' is not a material of \
+the Starlink v1.5 body; its materials: starlink-chassis, starlink-solar-array, starlink-array-back
+    """
+    from ..materials.schema import lambertian
+
+    given = dict(tables or {})
+    for name in given:
+        if name not in STARLINK_STAND_INS:
+            raise ValidationError(
+                f"starlink_materials: {name!r} is not a material of the Starlink v1.5 body; "
+                f"its materials: {', '.join(STARLINK_STAND_INS)}"
+            )
+    out = {}
+    for name, albedo in STARLINK_STAND_INS.items():
+        if name in given:
+            out[name] = given[name]
+            continue
+        table = lambertian(albedo, wavelength, material=name)
+        table.attrs["provenance"] = (
+            f"STAND-IN, not a measurement: Lambertian of albedo {albedo:g} chosen by "
+            "sbrdf_xr.engine.builtin.starlink_materials; give the measured table instead"
+        )
+        out[name] = table
+    return out
 
 
 def _canx1_plusx_specular() -> Scene:

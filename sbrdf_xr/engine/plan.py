@@ -36,6 +36,7 @@ from ..kernels import PackedTables, normal_rows
 from ..kernels.anisotropic import AnisotropicTable
 from ..materials.models import model_parameters
 from ..store.fingerprint import PREFIX, scene_fingerprint
+from .articulation import Articulation, describe_parts, group_terms
 from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, BlockInputs, Effect, PlanInputs, readonly
 from .reuse import FACETS, digest
 from .spectral import spectral_stage
@@ -79,6 +80,9 @@ class Terms:
         Facets merged into each term.
     tangent : ndarray, shape (T, 3), optional
         Unit tangents [1] (anisotropic materials; :mod:`sbrdf_xr.geometry.anisotropy`).
+    part : ndarray of int, shape (T,), optional
+        The group of each term on a body with parts: 0 for the bus, ``k + 1`` for part
+        ``k`` (:mod:`sbrdf_xr.engine.articulation`).
 
     Examples
     --------
@@ -105,6 +109,7 @@ class Terms:
     facet: np.ndarray
     n_facets: np.ndarray
     tangent: np.ndarray | None = None
+    part: np.ndarray | None = None
 
     @property
     def size(self) -> int:
@@ -252,6 +257,10 @@ class Plan:
     attrs: Mapping[str, Any] = field(default_factory=dict)
     #: Anisotropic tables by material index (:func:`sbrdf_xr.kernels.anisotropic.pack_anisotropic`).
     anisotropic: Mapping[int, AnisotropicTable] = field(default_factory=dict)
+    #: The parts and the terms of each group of a body with parts
+    #: (:class:`~sbrdf_xr.engine.articulation.Articulation`), or one group bound to a
+    #: block (:class:`~sbrdf_xr.engine.articulation.BoundGroup`); None for a rigid body.
+    articulation: Any = None
     #: Products of the plan made on first use (the cube's coordinate template).
     cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -416,6 +425,9 @@ def compile_plan(scene: Scene) -> Plan:
     raw, merged = _facet_terms(scene, per_facet, steps, aniso_names, fingerprint)
     raw = tilted_terms(scene, raw, knobs["tilt_nodes"], steps)
     keep = contributing_terms(scene, raw["normal"])
+    parts = tuple(getattr(scene.spacecraft, "parts", ()))
+    if parts:  # a part's terms turn: where they face at rest says nothing
+        keep |= raw["part"] > 0
     if not keep.all():
         raw = {k: v[keep] for k, v in raw.items()}
         steps.append(
@@ -443,8 +455,11 @@ def compile_plan(scene: Scene) -> Plan:
                 raw["n_facets"],
                 raw["tangent"],
             )
-        )
+        ),
+        part=readonly(raw["part"][order]) if parts else None,
     )
+    if parts:
+        steps.append(("parts", describe_parts(parts)))
 
     # ---- spectral axis, bands and tables
     sx = spectral_stage(scene, used, knobs, steps, fingerprint)
@@ -568,6 +583,7 @@ def compile_plan(scene: Scene) -> Plan:
         steps=tuple(steps),
         attrs=MappingProxyType(attrs),
         anisotropic=MappingProxyType(sx.anisotropic),
+        articulation=Articulation(parts, group_terms(terms)) if parts else None,
     )
     attrs["plan"] = str(plan)
     return plan

@@ -55,6 +55,7 @@ from xarray.indexes import PandasIndex
 
 from .._names import WAVELENGTH, attrs
 from ..errors import SceneError
+from .articulation import articulated_sums
 from .builtin import resolve_scene
 from .effects import EFFECTS, finish
 from .plan import Plan
@@ -101,6 +102,8 @@ def run_block(plan: Plan, sl: slice) -> dict[str, np.ndarray]:
     0.159155
     """
     block = plan.geometry.block(sl)
+    if plan.articulation is not None:  # parts that turn: every group in its own frame
+        return finish(plan, articulated_sums(plan, block, sl), block.lead_shape)
     sums: dict[str, np.ndarray] = {}
     for name in plan.effects:
         contribute = EFFECTS[name].contribute

@@ -225,6 +225,7 @@ def _spacecraft(spec: Any, base_dir: str | Path | None) -> Any:
     from .. import catalog
 
     options: dict[str, Any] = {}
+    parts = None
     table = isinstance(spec, Mapping)
     if isinstance(spec, Mapping):
         _check_keys(spec, _SPACECRAFT_KEYS, "[spacecraft]")
@@ -232,12 +233,14 @@ def _spacecraft(spec: Any, base_dir: str | Path | None) -> Any:
             raise SceneError(
                 "[spacecraft]: key 'path' is required (a mesh file, relative to the scene file)"
             )
-        options = {k: v for k, v in spec.items() if k != "path"}
+        options = {k: v for k, v in spec.items() if k not in ("path", "parts")}
+        parts = spec.get("parts")
         spec = spec["path"]
         if not catalog.is_file_spec(spec):
             spec = Path(spec)  # a table always names a file
     try:
-        return catalog.load_spacecraft_spec(spec, base_dir=base_dir, **options)
+        sc = catalog.load_spacecraft_spec(spec, base_dir=base_dir, **options)
+        return sc if parts is None else _with_parts(sc, parts)
     except (CatalogError, SceneError) as exc:
         if table and not str(exc).startswith("[spacecraft]"):
             raise type(exc)(f"[spacecraft] path: {exc}") from None
@@ -250,6 +253,18 @@ def _spacecraft(spec: Any, base_dir: str | Path | None) -> Any:
                 'material_map = "map.toml"'
             )
         raise SceneError(f"{'[spacecraft] ' if table else ''}{exc}{hint}") from None
+
+
+def _with_parts(sc: Any, parts: Any) -> Any:
+    """``sc`` with the parts of a ``[[spacecraft.parts]]`` array of tables."""
+    from ..body.parts import part_from_spec
+
+    if not isinstance(parts, list) or not all(isinstance(p, Mapping) for p in parts):
+        raise SceneError("[spacecraft] parts: expected [[spacecraft.parts]] tables")
+    try:
+        return sc.with_parts([part_from_spec(p, sc.facet_material) for p in parts])
+    except ValidationError as exc:
+        raise SceneError(f"[spacecraft] parts: {exc}") from None
 
 
 def material_tables(

@@ -231,6 +231,20 @@ SPACECRAFT_KEYS: dict[str, Key] = _table(
             "false",
         ),
         Key("name", (str,), "the spacecraft's name", "the file's stem"),
+        Key(
+            "back_material",
+            (str, dict),
+            "backs of the facets: one material, or front material -> back material",
+            "none (one-sided)",
+        ),
+        Key(
+            "parts",
+            (list,),
+            "[[spacecraft.parts]] tables: facets turning about a hinge "
+            "(sbrdf_xr.body.parts.PART_KEYS: name, facets or materials, axis, point, law, "
+            "angle, limits, normal, angles)",
+            "none (rigid)",
+        ),
     ]
 )
 

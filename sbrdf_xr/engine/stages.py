@@ -179,6 +179,8 @@ effect is on'
             "tangent": np.asarray(f["tangent"].values),
         }
         steps.append(("facets", f"{n_fac} facets evaluated one by one ({why})"))
+    if getattr(sc, "parts", ()):  # the group of every term: the bus or a part
+        t["part"] = np.asarray(sc.sides.group)[t["facet"]]
     return t, merge
 
 

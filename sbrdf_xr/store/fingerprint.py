@@ -346,6 +346,12 @@ def _mesh_sha(spacecraft: Any) -> str:
     if getattr(spacecraft, "tangent_source", "default") != "default":
         # tangents other than the default (a function of the mesh) change anisotropic terms
         parts.append(_array_sha(np.asarray(spacecraft.facet_tangent, dtype=np.float64)))
+    back = getattr(spacecraft, "facet_back", None)
+    if back is not None:  # two-sided facets: their backs are terms of their own
+        parts.append(_array_sha(np.asarray(back, dtype=str)))
+    for p in getattr(spacecraft, "parts", ()):  # articulated parts: hinge and law
+        parts.append(_sha(p.name, repr(p.law), _array_sha(np.asarray(p.facets, np.int64))))
+        parts.append(_array_sha(np.concatenate([p.axis, p.point])))
     return _sha(*parts)
 
 

@@ -1,5 +1,5 @@
 """Bad mesh files: every one ends in a named error that names the file (and says what is
-wrong with it: not a file, not a mesh, not closed, not manifold), or loads with a warning
+wrong with it: not a file, not a mesh, not manifold), or loads with a warning
 when it is only implausible; no message shows the file.
 
 Files: a box in every format spoilt in its bytes (truncated, flipped, spliced, junk),
@@ -46,11 +46,13 @@ LOADERS = {"load_spacecraft": _load, "load_spacecraft_spec": _load_spec}
 
 
 def _usable(sc) -> None:
-    """A spacecraft that loaded is a closed body of finite facets, 1 mm to 1 km across."""
+    """A spacecraft that loaded is a surface (closed or open) of finite facets, 1 mm to 1 km
+    across, whose every edge joins at most two facets."""
     v = np.asarray(sc.mesh.vertices)
-    assert sc.n_facets >= 4, f"{sc.n_facets} facets"
+    assert sc.n_facets >= 1, f"{sc.n_facets} facets"
     assert np.isfinite(v).all(), "non-finite vertices"
-    assert sc.mesh.is_watertight, "an open surface"
+    _, counts = np.unique(np.sort(sc.mesh.edges_sorted, axis=1), axis=0, return_counts=True)
+    assert counts.max() <= 2, "a non-manifold surface"
     side = float(np.ptp(v, axis=0).max())
     assert 1e-3 <= side <= 1e3, f"largest side {side:g} m"
 
@@ -85,7 +87,7 @@ def test_broken_surfaces(tmp_path, broken, repair):
     run_case(
         CATEGORY,
         lambda: _load_spec(path, repair=repair),
-        wrong=broken not in ("tetra",),
+        wrong=broken not in ("tetra", "open-box", "one-triangle"),  # open surfaces are fine
         where=[str(path)],
         check=_usable,
         label=f"{broken} (repair={repair})",

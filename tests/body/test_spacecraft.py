@@ -532,7 +532,6 @@ def broken(kind: str) -> trimesh.Trimesh:
         ("nan", "not finite"),
         ("zero_area", "zero area"),
         ("duplicate", "duplicate"),
-        ("open", "not closed"),
         ("winding", "not consistently wound"),
         ("inside_out", "inside-out"),
     ],
@@ -546,8 +545,26 @@ def test_mesh_defects_raise_or_are_repaired_with_a_warning(kind, match):
     assert mesh.is_watertight and mesh.is_winding_consistent
     np.testing.assert_allclose(mesh.volume, 1.0, rtol=1e-12)
     assert craft.n_facets == 12 and len(craft.facet_material) == 12
-    if kind != "open":  # the refilled facet takes the nearest facet's material
-        np.testing.assert_array_equal(np.sort(craft.facet_material), [ALU] * 6 + [CELL] * 6)
+    np.testing.assert_array_equal(np.sort(craft.facet_material), [ALU] * 6 + [CELL] * 6)
+
+
+def test_an_open_surface_loads_without_repair_and_refuses_a_volume():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        craft = sc.load_spacecraft(broken("open"), BOX_MAP)
+        repaired = sc.load_spacecraft(broken("open"), BOX_MAP, repair=True)
+    assert craft.n_facets == repaired.n_facets == 11
+    assert not craft.is_convex
+    with pytest.raises(MeshError, match=r"inertia: needs a volume.*open"):
+        craft.inertia()
+
+
+def test_repair_never_warns_repaired_before_failing():
+    mesh = trimesh.Trimesh([[0, 0, 0], [1, 0, 0], [np.nan, 0, 0]], [[0, 1, 2]], process=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a warning here would fail the test
+        with pytest.raises(MeshError, match="empty after removing"):
+            sc.load_spacecraft(mesh, material="paint", repair=True)
 
 
 def test_repair_on_clean_mesh_is_silent():

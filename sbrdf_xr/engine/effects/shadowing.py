@@ -37,7 +37,7 @@ __all__ = ["EFFECT"]
 
 
 def _plan(inputs: PlanInputs) -> Decision:
-    if inputs.scene.spacecraft.is_convex:
+    if inputs.scene.spacecraft.is_convex:  # (a body with moving parts never is)
         return Decision(False, "skipped: the body is convex, no facet can shadow another")
     knobs = inputs.knobs
     options: dict[str, Any] = {"method": knobs["shadow_method"]}
@@ -56,6 +56,8 @@ def _fraction(plan: Plan, to_source: np.ndarray, to_observer: np.ndarray) -> np.
     from ...body.visibility import lit_visible_fraction
 
     options = plan.effect_params["shadowing"]
+    if plan.articulation is not None:  # a group of a body with parts: the posed union
+        return plan.articulation.fraction(plan, to_source, to_observer, options)
     frac = lit_visible_fraction(plan.spacecraft, to_source, to_observer, **options)
     return np.ascontiguousarray(np.asarray(frac)[:, plan.terms.facet])
 

@@ -13,6 +13,7 @@ fraction of the solar disc (the Earth's shadow is the ``eclipse`` effect's plan 
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -32,6 +33,8 @@ def _contribute(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
     if scale is not None and not np.all(scale > 0):
         lit = np.flatnonzero(scale > 0)
         sub = BlockInputs(block.to_sun[lit], block.to_observer[lit], scale[lit], (lit.size,))
+        if plan.articulation is not None:  # one group of a body with parts: its poses too
+            plan = replace(plan, articulation=plan.articulation.take(lit))
         part = _contribute(plan, sub) if lit.size else None
         g, n = (
             block.to_sun.shape[0],
