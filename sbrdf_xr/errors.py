@@ -22,6 +22,7 @@ __all__ = [
     "CatalogError",
     "CubeLockedError",
     "CubeWriteError",
+    "EphemerisError",
     "EpochGapWarning",
     "FitQualityWarning",
     "HiddenSideWarning",
@@ -37,6 +38,7 @@ __all__ = [
     "SbrdfWarning",
     "SceneError",
     "SchedulerError",
+    "TrackingTableError",
     "UnitError",
     "UnitWarning",
     "ValidationError",
@@ -269,6 +271,16 @@ class ObservationError(ValidationError):
 
 class NotObservableError(ObservationError):
     """An observation whose object is below the horizon, or in shadow, at every time."""
+
+
+class EphemerisError(ObservationError):
+    """A CCSDS orbit or attitude ephemeris message (OEM, AEM) that cannot be used: unreadable,
+    truncated, with gaps or epochs out of order, or not covering the times asked for."""
+
+
+class TrackingTableError(ObservationError):
+    """An observer's tracking table (times, altitude/azimuth or RA/Dec, range or height)
+    with a row that cannot be used; the message names the row."""
 
 
 class AttitudeError(ValidationError):

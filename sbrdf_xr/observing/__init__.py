@@ -17,20 +17,35 @@ Modules
 ``observation`` and ``observe``
     :class:`Observation`: an orbit, a site, UTC times and an attitude law, as the
     body-frame geometry of a pass; observations from TOML tables.
+``ephemeris``, ``oem_reader`` and ``aem``
+    :class:`Ephemeris`: states from data (tabulated, or a CCSDS OEM read by the ``oem``
+    package) in place of elements; attitude from a CCSDS AEM (``ccsds-ndm``).
+``tracking`` and ``tracking_io``
+    :class:`TrackingTable`: an observer's measured directions with range or height
+    as an ephemeris and an observation; CSV and Pomenis readers.
+``passes``
+    :func:`visible_passes`: the passes a site can measure (up, sunlit, sky dark).
 """
 
 from ..errors import AttitudeError, EpochGapWarning, NotObservableError, ObservationError
 from . import (
+    aem,
     attitude,
     earth_shadow,
+    ephemeris,
     frames,
     observation,
     observe,
+    oem_reader,
     orbits,
+    passes,
     series,
     timescales,
+    tracking,
+    tracking_io,
     tumble,
 )
+from .aem import AemSeries, read_aem
 from .attitude import (
     LAWS,
     AttitudeLaw,
@@ -50,6 +65,7 @@ from .earth_shadow import (
     shadow_events,
     sunlit_fraction,
 )
+from .ephemeris import Ephemeris
 from .frames import Context, triad
 from .observation import ATTRS, COMPONENT, TIME, UNOBSERVABLE, Observation
 from .observe import canx1_pass, observation_from_dict
@@ -64,6 +80,7 @@ from .orbits import (
     load_site_entry,
     tle_checksum,
 )
+from .passes import TWILIGHTS, visible_passes
 from .series import QuaternionSeries
 from .timescales import (
     KNOT_S,
@@ -75,6 +92,8 @@ from .timescales import (
     times,
     to_datetime64,
 )
+from .tracking import TrackingTable
+from .tracking_io import POMENIS_SITE, read_pomenis, read_tracking_table
 from .tumble import TUMBLE_RTOL, Tumble
 
 __all__ = [
@@ -87,14 +106,18 @@ __all__ = [
     "EPOCH_GAP_DAYS",
     "KNOT_S",
     "LAWS",
+    "POMENIS_SITE",
     "SUN_RADIUS_KM",
     "TIME",
     "TUMBLE_RTOL",
+    "TWILIGHTS",
     "UNOBSERVABLE",
+    "AemSeries",
     "AttitudeError",
     "AttitudeLaw",
     "Composed",
     "Context",
+    "Ephemeris",
     "EpochGapWarning",
     "Inertial",
     "Nadir",
@@ -106,7 +129,9 @@ __all__ = [
     "Site",
     "Spin",
     "SunPointing",
+    "TrackingTable",
     "Tumble",
+    "aem",
     "airmass",
     "attitude",
     "canx1_pass",
@@ -114,6 +139,7 @@ __all__ = [
     "compose",
     "disc_overlap_fraction",
     "earth_shadow",
+    "ephemeris",
     "frames",
     "law_from_dict",
     "load_orbit_entry",
@@ -121,7 +147,12 @@ __all__ = [
     "observation",
     "observation_from_dict",
     "observe",
+    "oem_reader",
     "orbits",
+    "passes",
+    "read_aem",
+    "read_pomenis",
+    "read_tracking_table",
     "series",
     "shadow_events",
     "skyfield_data",
@@ -133,6 +164,9 @@ __all__ = [
     "timescales",
     "tle_checksum",
     "to_datetime64",
+    "tracking",
+    "tracking_io",
     "triad",
     "tumble",
+    "visible_passes",
 ]

@@ -63,6 +63,7 @@ from .earth_shadow import (
     shadow_events,
     sunlit_fraction,
 )
+from .ephemeris import Ephemeris
 from .orbits import AIRMASS_MODELS, AU_KM, EPOCH_GAP_DAYS, Orbit, Site, airmass
 from .timescales import check_times, skyfield_data, skyfield_time, skyfield_utc, spline_knots
 
@@ -176,7 +177,10 @@ class Observation:
 
     Parameters
     ----------
-    orbit : Orbit
+    orbit : Orbit or Ephemeris
+        Elements propagated by SGP4, or states from data
+        (:class:`~sbrdf_xr.observing.ephemeris.Ephemeris`: tabulated states, a CCSDS OEM,
+        an observer's tracking table).
     site : Site
     times : array_like of datetime64
         Strictly increasing UTC times (see :func:`~sbrdf_xr.observing.timescales.times`).
@@ -225,8 +229,10 @@ class Observation:
     _cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        if not isinstance(self.orbit, Orbit):
-            raise ObservationError(f"orbit: expected an Orbit, got {type(self.orbit).__name__}")
+        if not isinstance(self.orbit, Orbit | Ephemeris):
+            raise ObservationError(
+                f"orbit: expected an Orbit or an Ephemeris, got {type(self.orbit).__name__}"
+            )
         if not isinstance(self.site, Site):
             raise ObservationError(f"site: expected a Site, got {type(self.site).__name__}")
         t = check_times(self.times)
@@ -245,6 +251,8 @@ class Observation:
             raise ObservationError(
                 f"min_elevation_deg: must lie in [-90, 90], got {self.min_elevation_deg}"
             )
+        if isinstance(self.orbit, Ephemeris):
+            return
         epoch = self.orbit.epoch
         gap = np.abs(t[[0, -1]] - epoch).max().astype(np.int64) / 86400e9
         if gap > EPOCH_GAP_DAYS:
@@ -274,10 +282,13 @@ class Observation:
         from skyfield.framelib import itrs
 
         t = skyfield_time(self.times)
-        sat = self.orbit.satellite
-        geo = sat.at(t)
-        r = geo.position.km.T
-        v = geo.velocity.km_per_s.T
+        if isinstance(self.orbit, Ephemeris):
+            r, v = self.orbit.state(self.times)
+            geo = None
+        else:
+            geo = self.orbit.satellite.at(t)
+            r = geo.position.km.T
+            v = geo.velocity.km_per_s.T
         if not np.all(np.isfinite(r)):
             bad = int(np.flatnonzero(~np.isfinite(r).all(axis=1))[0])
             msg = getattr(geo, "message", None)
@@ -285,7 +296,8 @@ class Observation:
             raise ObservationError(
                 f"orbit {self.orbit.name!r}: SGP4 fails at {self.times[bad]}: {msg}"
             )
-        sun_rel = _sun_from_spacecraft(self.times, r, v)
+        # A velocity an ephemeris cannot give (NaN) leaves out the Sun's aberration by it.
+        sun_rel = _sun_from_spacecraft(self.times, r, np.nan_to_num(v))
         site_r = self.site.position.at(t).position.km.T
         rot = itrs.rotation_at(t)  # GCRS -> ITRS, (3, 3, n)
         state = {"r": r, "v": v, "sun": sun_rel, "site": site_r, "itrs": rot}
@@ -326,10 +338,27 @@ class Observation:
                [0.      , 0.      , 0.422618, 0.906308],
                [0.      , 0.      , 0.766044, 0.642788]])
         """
-        q = np.asarray(self.attitude.quaternions(self.times, self.context()), dtype=np.float64)
+        ctx = self.context()
+        unknown = ~np.isfinite(np.asarray(ctx.velocity_km_s)).all(axis=1)
+        try:
+            with np.errstate(invalid="ignore"):
+                q = np.asarray(self.attitude.quaternions(self.times, ctx), dtype=np.float64)
+        except (np.linalg.LinAlgError, ValueError):
+            if not unknown.any():
+                raise
+            q = np.full((self.times.size, 4), np.nan)
         if q.shape != (self.times.size, 4):
             raise AttitudeError(
                 f"attitude law returned shape {q.shape}, expected ({self.times.size}, 4)"
+            )
+        if not np.all(np.isfinite(q)) and unknown.any():
+            bad = np.flatnonzero(~np.isfinite(q).all(axis=1) | unknown)
+            raise AttitudeError(
+                f"attitude law {self.attitude!r} gives no attitude at {bad.size} time(s), "
+                f"first {self.times[bad[0]]}: the spacecraft's velocity is unknown there "
+                f"({getattr(self.orbit, 'method', '')}); use a law that needs no velocity "
+                "(inertial, spin, sun_pointing with target nadir or north) or give the times "
+                "as tracks of several rows"
             )
         # Flip signs so consecutive quaternions are in the same hemisphere (same rotations).
         if q.shape[0] > 1:
@@ -519,11 +548,12 @@ class Observation:
         import skyfield
         import skyfield_data
 
-        return {
+        eph = isinstance(self.orbit, Ephemeris)
+        out = {
             "observation": self.name,
             "orbit_name": self.orbit.name,
-            "tle_line1": self.orbit.line1,
-            "tle_line2": self.orbit.line2,
+            "tle_line1": "" if eph else self.orbit.line1,
+            "tle_line2": "" if eph else self.orbit.line2,
             "orbit_provenance": self.orbit.provenance,
             "site_name": self.site.name,
             "site_latitude": self.site.latitude_deg,
@@ -555,3 +585,7 @@ class Observation:
             ),
             "airmass_model": self.airmass_model,
         }
+        if eph:
+            del out["tle_line1"], out["tle_line2"]
+            out.update(self.orbit.attrs())
+        return out

@@ -21,6 +21,7 @@ from typing import Any, TypedDict
 from ..errors import ObservationError, did_you_mean
 from . import attitude as _att
 from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, disc_overlap_fraction, sunlit_fraction
+from .ephemeris import Ephemeris
 from .observation import ATTRS, TIME, Observation
 from .orbits import (
     AIRMASS_MODELS,
@@ -37,6 +38,7 @@ from .timescales import (
     check_times,
     times,
 )
+from .tracking_io import tracking_from_dict
 
 __all__ = [
     "AIRMASS_MODELS",
@@ -74,11 +76,18 @@ OBSERVATION_KEYS: dict[str, tuple[tuple[type, ...], str, str]] = {
     "tle_line1": ((str,), "the orbit's first TLE line (with tle_line2)", "-"),
     "tle_line2": ((str,), "the orbit's second TLE line", "-"),
     "omm": ((str, dict), "the orbit as an OMM file or table", "-"),
+    "oem": ((str,), "the orbit as a CCSDS OEM file (interpolated as it states)", "-"),
+    "tracking": (
+        (dict,),
+        "an observer's tracking table {path, format = csv|pomenis, column names, "
+        "time_zone, on_bad}: the orbit, times (and site for pomenis)",
+        "-",
+    ),
     "name": ((str,), "the observation's name", "-"),
     "site": (
         (str, dict),
         "a catalog name or {latitude_deg, longitude_deg, height_m, name}",
-        "required",
+        "required (but with tracking format pomenis)",
     ),
     "start": ((str,), "first time, UTC (ISO 8601)", "-"),
     "stop": ((str,), "last time, UTC", "-"),
@@ -95,13 +104,32 @@ OBSERVATION_KEYS: dict[str, tuple[tuple[type, ...], str, str]] = {
 }
 
 
+def _site(site_v: Any) -> Site:
+    if isinstance(site_v, str):
+        return Site.from_catalog(site_v)
+    if isinstance(site_v, Mapping):
+        extra = sorted(set(site_v) - {"latitude_deg", "longitude_deg", "height_m", "name"})
+        if extra or not {"latitude_deg", "longitude_deg"} <= set(site_v):
+            raise ObservationError(
+                "[observation] site: needs latitude_deg, longitude_deg "
+                f"(and optional height_m, name); got {sorted(site_v)}"
+            )
+        return Site(**site_v)
+    raise ObservationError(
+        f"[observation] site: expected a catalog name or a table, got {site_v!r}"
+    )
+
+
 def observation_from_dict(
     table: Mapping[str, Any], base_dir: str | Path | None = None, *, size_limit: float = 1.0
 ) -> Observation:
     """An :class:`Observation` from a TOML ``[observation]`` table.
 
     Keys: the orbit as ``orbit`` (a catalog name), ``tle = [line1, line2]`` (or
-    ``tle_line1``/``tle_line2``) or ``omm`` (a path or a table); ``site`` as a catalog name
+    ``tle_line1``/``tle_line2``), ``omm`` (a path or a table), ``oem`` (a CCSDS OEM file,
+    :meth:`~sbrdf_xr.observing.ephemeris.Ephemeris.from_oem`) or ``tracking`` (an
+    observer's table, :func:`~sbrdf_xr.observing.tracking_io.tracking_from_dict`, which
+    also gives the times); ``site`` as a catalog name
     or a table ``{latitude_deg, longitude_deg, height_m, name}``; times as ``start``,
     ``stop``, ``step_s`` or a list ``times``; ``attitude`` a table for
     :func:`sbrdf_xr.observing.attitude.law_from_dict`; optional ``airmass_model``,
@@ -148,13 +176,21 @@ def observation_from_dict(
         path = Path(p)
         return path if path.is_absolute() else base / path
 
-    orbit_keys = [k for k in ("orbit", "tle", "tle_line1", "omm") if k in table]
+    orbit_keys = [k for k in ("orbit", "tle", "tle_line1", "omm", "oem", "tracking") if k in table]
     if len(orbit_keys) != 1:
         raise ObservationError(
-            "[observation]: give exactly one of orbit, tle, tle_line1/tle_line2, omm; "
-            f"got {orbit_keys}"
+            "[observation]: give exactly one of orbit, tle, tle_line1/tle_line2, omm, oem, "
+            f"tracking; got {orbit_keys}"
         )
-    if "orbit" in table:
+    site_v = table.get("site")
+    tracking = None
+    if "tracking" in table:
+        site_given = _site(site_v) if site_v is not None else None
+        tracking = tracking_from_dict(table["tracking"], site_given, base)
+        orbit: Orbit | Ephemeris = tracking.ephemeris()
+    elif "oem" in table:
+        orbit = Ephemeris.from_oem(resolve(table["oem"]))
+    elif "orbit" in table:
         orbit = Orbit.from_catalog(table["orbit"])
     elif "tle" in table:
         tle = table["tle"]
@@ -173,23 +209,15 @@ def observation_from_dict(
             )
         orbit = Orbit.from_omm(omm if isinstance(omm, Mapping) else resolve(omm))
 
-    site_v = table.get("site")
-    if isinstance(site_v, str):
-        site = Site.from_catalog(site_v)
-    elif isinstance(site_v, Mapping):
-        extra = sorted(set(site_v) - {"latitude_deg", "longitude_deg", "height_m", "name"})
-        if extra or not {"latitude_deg", "longitude_deg"} <= set(site_v):
+    site = tracking.site if tracking is not None else _site(site_v)
+    if tracking is not None:
+        given = [k for k in ("times", "start", "stop", "step_s") if k in table]
+        if given:
             raise ObservationError(
-                "[observation] site: needs latitude_deg, longitude_deg "
-                f"(and optional height_m, name); got {sorted(site_v)}"
+                f"[observation]: the tracking table gives the times; remove {given}"
             )
-        site = Site(**site_v)
-    else:
-        raise ObservationError(
-            f"[observation] site: expected a catalog name or a table, got {site_v!r}"
-        )
-
-    if "times" in table:
+        t = tracking.times
+    elif "times" in table:
         if any(k in table for k in ("start", "stop", "step_s")):
             raise ObservationError("[observation]: give times or start/stop/step_s, not both")
         t = check_times(table["times"])
@@ -204,7 +232,11 @@ def observation_from_dict(
     att = table.get("attitude")
     if att is not None and not isinstance(att, Mapping):
         raise ObservationError(f"[observation] attitude: expected a table (law = ...), got {att!r}")
-    if isinstance(att, Mapping) and att.get("law") == "quaternion_series" and "path" in att:
+    if (
+        isinstance(att, Mapping)
+        and att.get("law") in ("quaternion_series", "aem")
+        and "path" in att
+    ):
         att = {**att, "path": str(resolve(att["path"]))}
     kw = {
         k: table[k] for k in ("airmass_model", "min_elevation_deg", "name", "earth") if k in table

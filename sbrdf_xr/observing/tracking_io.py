@@ -1,0 +1,331 @@
+"""Reading tracking tables from CSV files, and the Pomenis Starlink table.
+
+:func:`read_tracking_table` reads a CSV of measurements (a time column, elevation and
+azimuth or right ascension and declination, range or height, optional track label and
+other numeric columns) into a :class:`~sbrdf_xr.observing.tracking.TrackingTable`,
+checking every row: a missing or non-numeric field, a time without a time zone (unless the
+table is declared UTC), an elevation below
+:data:`~sbrdf_xr.observing.tracking.MIN_ELEVATION_DEG` or a range that disagrees with the
+height raise :class:`~sbrdf_xr.errors.TrackingTableError` naming the file's line; with
+``on_bad="drop"`` such rows are left out, counted in a
+:class:`~sbrdf_xr.errors.SbrdfWarning` and listed in ``table.dropped``.
+
+:func:`read_pomenis` reads the Pomenis observations of Starlink v1.5 satellites from
+Mount Lemmon (Fankhauser, Askari & Tyson 2023, arXiv:2305.11123; MIT licence, data
+repository ``Forrest-Fankhauser/satellite-optical-brightness``).
+"""
+
+from __future__ import annotations
+
+import csv
+import re
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import SbrdfWarning, TrackingTableError, input_file
+from .orbits import Site
+from .timescales import to_datetime64
+from .tracking import TrackingTable
+
+__all__ = [
+    "POMENIS_SITE",
+    "TRACKING_KEYS",
+    "read_pomenis",
+    "read_tracking_table",
+    "tracking_from_dict",
+]
+
+#: The Pomenis telescope on Mount Lemmon: the latitude and longitude the data's header gives
+#: (32.4434 N, 110.7881 W); the height (not given there) that of the Minor Planet Center's
+#: Mt. Lemmon site G96 on the same summit, 2789 m above the WGS84 ellipsoid (the
+#: package's catalog site ``mount-lemmon``).
+POMENIS_SITE = Site(
+    32.4434,
+    -110.7881,
+    2789.0,
+    name="pomenis-mount-lemmon",
+    source=(
+        "Fankhauser et al. 2023 data header (32.4434 N, 110.7881 W); height 2789 m of "
+        "MPC site G96 (Mt. Lemmon Survey) on the same summit"
+    ),
+)
+
+_ZONE = re.compile(r"(Z|[+-]\d{2}:?\d{2})$")
+
+
+def _parse_time(text: str, line: int, time_zone: str | None, what: str) -> np.datetime64:
+    s = text.strip()
+    if not s:
+        raise TrackingTableError(f"{what}: line {line}: the time is missing")
+    has_zone = bool(_ZONE.search(s)) and ("T" in s or " " in s)
+    if not has_zone:
+        if time_zone != "UTC":
+            raise TrackingTableError(
+                f"{what}: line {line}: time {s!r} has no time zone; give times with Z or an "
+                "offset, or state time_zone='UTC' if the table's times are UTC"
+            )
+    else:
+        import pandas as pd
+
+        try:
+            s = str(pd.Timestamp(s).tz_convert("UTC").tz_localize(None).isoformat())
+        except ValueError:
+            raise TrackingTableError(f"{what}: line {line}: time {s!r} cannot be read") from None
+    try:
+        return to_datetime64(s, f"{what}: line {line}: time")
+    except Exception as exc:  # ObservationError with the reason
+        raise TrackingTableError(str(exc)) from None
+
+
+def _number(row: dict[str, str], col: str, line: int, what: str) -> float:
+    text = (row.get(col) or "").strip()
+    if not text:
+        raise TrackingTableError(f"{what}: line {line}: column {col!r} is empty")
+    try:
+        x = float(text)
+    except ValueError:
+        raise TrackingTableError(
+            f"{what}: line {line}: column {col!r} is {text!r}, not a number"
+        ) from None
+    if not np.isfinite(x):
+        raise TrackingTableError(f"{what}: line {line}: column {col!r} is {text!r}")
+    return x
+
+
+def read_tracking_table(
+    path: str | Path,
+    site: Site,
+    *,
+    time: str = "time",
+    elevation: str | None = "elevation",
+    azimuth: str | None = "azimuth",
+    ra: str | None = None,
+    dec: str | None = None,
+    range_km: str | None = None,
+    height_km: str | None = None,
+    track: str | None = None,
+    keep: tuple[str, ...] = (),
+    time_zone: str | None = None,
+    on_bad: str = "raise",
+    name: str | None = None,
+    source: str = "",
+) -> TrackingTable:
+    """Read a CSV tracking table (``#`` comment lines allowed before the header).
+
+    Parameters
+    ----------
+    path : str or Path
+    site : Site
+    time, elevation, azimuth, ra, dec, range_km, height_km, track : str
+        Column names (``ra``/``dec`` replace ``elevation``/``azimuth``); elevations,
+        azimuths, RA and Dec in [degree], range and height in [km].
+    keep : tuple of str
+        Other numeric columns to keep (``table.columns``).
+    time_zone : {None, "UTC"}
+        ``"UTC"`` when times without a zone are UTC; else such a time is an error.
+    on_bad : {"raise", "drop"}
+        A bad row raises, or is left out, counted and listed in ``table.dropped``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> path = Path(tempfile.mkdtemp()) / "track.csv"
+    >>> _ = path.write_text("# demo\\ntime,elevation,azimuth,range\\n"
+    ...     "2024-03-17T01:22:00Z,75.8,10.0,841.0\\n2024-03-17T01:22:05Z,75.9,12.0,abc\\n")
+    >>> site = Site(45.455, -71.1525, 1111.0)
+    >>> read_tracking_table(path, site, range_km="range")
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.TrackingTableError: tracking table ...: line 4: column 'range' is 'abc', ...
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     table = read_tracking_table(path, site, range_km="range", on_bad="drop")
+    >>> table.times.size, table.dropped, len(caught)  # counted, listed and warned
+    (1, ((4, "column 'range' is 'abc', not a number"),), 1)
+    """
+    if on_bad not in ("raise", "drop"):
+        raise TrackingTableError(f"on_bad: got {on_bad!r}; allowed: raise, drop")
+    p = input_file(path, "tracking table", TrackingTableError)
+    what = f"tracking table {p}"
+    with open(p, encoding="utf-8", newline="") as f:
+        lines = [(k, ln) for k, ln in enumerate(f, start=1) if not ln.lstrip().startswith("#")]
+    lines = [(k, ln) for k, ln in lines if ln.strip()]
+    if not lines:
+        raise TrackingTableError(f"{what}: holds no header line")
+    reader = csv.DictReader([ln for _, ln in lines])
+    header = reader.fieldnames or []
+    angles = (ra, dec) if ra is not None else (elevation, azimuth)
+    wanted = [time, *angles, range_km, height_km, track, *keep]
+    missing = [c for c in wanted if c is not None and c not in header]
+    if missing:
+        raise TrackingTableError(f"{what}: lacks the column(s) {missing}; its header: {header}")
+    numeric = [c for c in (*angles, range_km, height_km, *keep) if c is not None]
+    good: list[tuple[int, np.datetime64, list[float], str]] = []
+    dropped: list[tuple[int, str]] = []
+    for (line, _), row in zip(lines[1:], reader, strict=True):
+        try:
+            t = _parse_time(row.get(time) or "", line, time_zone, what)
+            vals = [_number(row, c, line, what) for c in numeric]
+        except TrackingTableError as exc:
+            if on_bad == "raise":
+                raise
+            dropped.append((line, str(exc).split(f"line {line}: ", 1)[-1]))
+            continue
+        good.append((line, t, vals, row.get(track, "") if track else ""))
+    if not good:
+        raise TrackingTableError(f"{what}: no usable row ({len(dropped)} dropped)")
+    order = np.argsort(np.array([g[1] for g in good]), kind="stable")
+    good = [good[i] for i in order]
+    tt = np.array([g[1] for g in good])
+    dup = np.flatnonzero(np.diff(tt) == np.timedelta64(0, "ns"))
+    if dup.size:
+        k = dup[0]
+        raise TrackingTableError(
+            f"{what}: lines {good[k][0]} and {good[k + 1][0]} have the same time {tt[k]}; "
+            "an observation needs distinct times (one object at a time)"
+        )
+    cols = {c: np.array([g[2][i] for g in good]) for i, c in enumerate(numeric)}
+    if dropped:
+        warnings.warn(
+            f"{what}: {len(dropped)} row(s) dropped (first: line {dropped[0][0]}: "
+            f"{dropped[0][1]}); table.dropped lists them",
+            SbrdfWarning,
+            stacklevel=2,
+        )
+    kw: dict[str, Any] = {
+        "range_km": cols.get(range_km) if range_km else None,
+        "height_km": cols.get(height_km) if height_km else None,
+        "track": np.array([g[3] for g in good]) if track else None,
+    }
+    if ra is not None:
+        kw.update(ra_deg=cols[ra], dec_deg=cols[dec] if dec else None)
+    else:
+        kw.update(elevation_deg=cols[elevation] if elevation else None)
+        kw.update(azimuth_deg=cols[azimuth] if azimuth else None)
+    return TrackingTable(
+        site,
+        tt,
+        rows=np.array([g[0] for g in good]),
+        columns={c: cols[c] for c in keep},
+        dropped=tuple(dropped),
+        name=name or what,
+        source=source or f"CSV {p}",
+        **kw,
+    )
+
+
+def read_pomenis(path: str | Path, *, on_bad: str = "raise") -> TrackingTable:
+    """The Pomenis Starlink v1.5 table (``pomenis_observations.csv``) at Mount Lemmon.
+
+    Times are UTC (the file's header says so, and is checked); ``satellite_height`` is the
+    height above the WGS84 ellipsoid [km] (lumos-sat, the authors' code, calls it the
+    geodetic height); ``satellite_altitude`` and ``satellite_azimuth`` are the elevation
+    and azimuth [degree]; ``ab_magnitude`` is kept in ``table.columns``.  Every row is
+    its own track (one measurement per satellite and time): the velocity is unknown.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> path = Path(tempfile.mkdtemp()) / "pomenis.csv"
+    >>> _ = path.write_text("# Observation Time : UTC\\n"
+    ...     "observation_time,satellite_height,satellite_altitude,satellite_azimuth,"
+    ...     "ab_magnitude\\n2022-01-25T13:28:39,448.4444346,32.87386184,316.0661315,4.86\\n")
+    >>> table = read_pomenis(path)
+    >>> table.site.name, table.columns["ab_magnitude"].tolist(), round(float(table.ranges()[0]))
+    ('pomenis-mount-lemmon', [4.86], 765)
+    """
+    p = input_file(path, "pomenis", TrackingTableError)
+    head = [ln for ln in p.read_text(encoding="utf-8").splitlines()[:40] if ln.startswith("#")]
+    if not any(re.search(r"Observation Time\s*:\s*UTC", ln) for ln in head):
+        raise TrackingTableError(
+            f"pomenis: {p}: its header does not state 'Observation Time : UTC'; read it with "
+            "read_tracking_table and the time zone it uses"
+        )
+    return read_tracking_table(
+        p,
+        POMENIS_SITE,
+        time="observation_time",
+        elevation="satellite_altitude",
+        azimuth="satellite_azimuth",
+        height_km="satellite_height",
+        keep=("ab_magnitude",),
+        time_zone="UTC",
+        on_bad=on_bad,
+        name="pomenis",
+        source=(
+            f"Pomenis observations of Starlink v1.5 from Mount Lemmon, {p} (Fankhauser, "
+            "Askari & Tyson 2023, arXiv:2305.11123; MIT licence)"
+        ),
+        track=None,
+    )
+
+
+#: Keys of a scene file's ``[observation.tracking]`` table besides ``path`` and ``format``:
+#: the arguments of :func:`read_tracking_table`.
+TRACKING_KEYS = (
+    "time",
+    "elevation",
+    "azimuth",
+    "ra",
+    "dec",
+    "range_km",
+    "height_km",
+    "track",
+    "time_zone",
+    "on_bad",
+    "name",
+)
+
+
+def tracking_from_dict(
+    spec: Any, site: Site | None, base_dir: str | Path | None = None
+) -> TrackingTable:
+    """A tracking table from a scene file's ``tracking`` table.
+
+    ``path`` (relative to ``base_dir``), ``format`` (``"csv"``, the default, read by
+    :func:`read_tracking_table` with the column names and options of
+    :data:`TRACKING_KEYS`, at ``site``; or ``"pomenis"``, :func:`read_pomenis`, at its own
+    site).
+
+    Examples
+    --------
+    >>> tracking_from_dict({"format": "pomenis"}, None)
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.TrackingTableError: [observation.tracking]: needs a path
+    >>> tracking_from_dict({"path": "t.csv", "colour": "red"}, None)
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.TrackingTableError: [observation.tracking]: unknown key(s) ['colour']; ...
+    """
+    if not isinstance(spec, dict) or "path" not in spec:
+        raise TrackingTableError("[observation.tracking]: needs a path")
+    bad = sorted(set(spec) - {"path", "format", *TRACKING_KEYS})
+    if bad:
+        raise TrackingTableError(
+            f"[observation.tracking]: unknown key(s) {bad}; allowed: path, format, "
+            + ", ".join(TRACKING_KEYS)
+        )
+    path = Path(spec["path"])
+    if not path.is_absolute() and base_dir is not None:
+        path = Path(base_dir) / path
+    fmt = spec.get("format", "csv")
+    opts = {k: v for k, v in spec.items() if k not in ("path", "format")}
+    if fmt == "pomenis":
+        if site is not None or set(opts) - {"on_bad"}:
+            raise TrackingTableError(
+                "[observation.tracking]: format pomenis fixes its site and columns; give "
+                f"only path and on_bad (got site {site!r}, {sorted(opts)})"
+            )
+        return read_pomenis(path, **opts)
+    if fmt != "csv":
+        raise TrackingTableError(
+            f"[observation.tracking] format: got {fmt!r}; allowed: csv, pomenis"
+        )
+    if site is None:
+        raise TrackingTableError("[observation]: a csv tracking table needs the site")
+    return read_tracking_table(path, site, **opts)
