@@ -54,6 +54,7 @@ from .attitude import (
     Nadir,
     Spin,
     SunPointing,
+    YawSteering,
     compose,
     law_from_dict,
 )
@@ -131,6 +132,7 @@ __all__ = [
     "SunPointing",
     "TrackingTable",
     "Tumble",
+    "YawSteering",
     "aem",
     "airmass",
     "attitude",
