@@ -667,6 +667,20 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     ),
     # --- observing
     "sbrdf_xr.observing.attitude.Nadir": lambda: dict(yaw_deg=30.0),
+    "sbrdf_xr.observing.attitude.geodetic_up": lambda: dict(
+        position_itrs_km=[[5000.0, 100.0, 5000.0]]
+    ),
+    "sbrdf_xr.observing.tracking_io.read_tracking_table": lambda: dict(
+        path=_POMENIS40,
+        site=_pomenis_site(),
+        time="observation_time",
+        elevation="satellite_altitude",
+        azimuth="satellite_azimuth",
+        height_km="satellite_height",
+        time_zone="UTC",
+        min_elevation=25.0,
+        on_bad="drop",
+    ),
     "sbrdf_xr.observing.attitude.Spin": lambda: dict(rate_deg_s=2.0, phase_deg=30.0),
     "sbrdf_xr.observing.tumble.Tumble": lambda: dict(
         inertia=(1.0, 2.0, 3.0), omega_deg_s=(1.0, 2.0, 3.0)
@@ -806,10 +820,26 @@ EXEMPT[("sbrdf_xr.brdf._model.Model", "brdf")] = (
 for _model_name in ("lambert", "microfacet", "robertson_sandford"):
     for _method in ("brdf_angles", "render_grid"):
         EXEMPT[(f"sbrdf_xr.brdf.{_model_name}.{_method}", "psi")] = "an isotropic model refuses psi"
+for _arg in ("time", "elevation", "azimuth", "ra", "dec", "range_km", "height_km", "track"):
+    EXEMPT[("sbrdf_xr.observing.tracking_io.read_tracking_table", _arg)] = (
+        "a column name of the CSV, not a value: the column's numbers are in the unit named"
+    )
 
 #: The compiled layer: its functions take the grids and angles that the layers above
 #: (materials.tables, engine) have converted; a Quantity never reaches them.
 KERNELS = "sbrdf_xr.kernels."
+
+
+_POMENIS40 = (
+    __import__("pathlib").Path(__file__).parent
+    / "observing/data/pomenis/pomenis_observations_first40.csv"
+)
+
+
+def _pomenis_site() -> Any:
+    from sbrdf_xr.observing.tracking_io import POMENIS_SITE
+
+    return POMENIS_SITE
 
 
 def _l_body() -> Any:

@@ -59,7 +59,7 @@ def compare_magnitudes(
     Parameters
     ----------
     predicted, observed : array_like or DataArray, shape (n,)
-        Magnitudes [mag]; a DataArray's coordinates along ``dim`` are kept.
+        Magnitudes, in one system; a DataArray's coordinates along ``dim`` are kept.
     dim : str
         Name of the rows' dimension in the result.
 
@@ -146,7 +146,7 @@ def binned_residuals(
     Parameters
     ----------
     residual : array_like or DataArray, shape (n,)
-        Residuals [mag] (NaN rows are left out).
+        Residuals, in magnitudes (NaN rows are left out).
     x : array_like or DataArray, shape (n,)
         The coordinate to bin by, in its own unit (a DataArray's ``units`` and
         ``long_name`` are kept on the bin centres).
@@ -156,7 +156,7 @@ def binned_residuals(
     Returns
     -------
     xarray.Dataset
-        ``median``, ``p16``, ``p84`` [mag] and ``count`` over the dimension ``bin``
+        ``median``, ``p16``, ``p84`` (magnitudes) and ``count`` over the dimension ``bin``
         (coordinate: the bin centres).
 
     Examples
