@@ -249,6 +249,7 @@ def _table() -> xr.DataArray:
         n_phi=7,
         n_delta_theta=7,
         check_energy=False,
+        check_bound=1.0,  # a deliberately coarse table: its self-check is not the point
     )
 
 
@@ -594,6 +595,32 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     ),
     "sbrdf_xr.materials.tables.lookup_anisotropic": lambda: dict(
         material=_aniso_table(), theta_i=[30.0], delta_theta=[0.0], phi=[4.0], psi=[25.0]
+    ),
+    "sbrdf_xr.materials.coverage.snap_angles": lambda: dict(
+        values=[10.0, 10.0 + 1e-12, 20.0], tol=1e-6
+    ),
+    "sbrdf_xr.materials.coverage.scan_layout": lambda: dict(
+        delta_theta=[-2.0, -2.0, 0.0, 0.0], phi=[0.0, 5.0, 0.0, 5.0], tol=1e-6
+    ),
+    "sbrdf_xr.materials.coverage.specular_distance": lambda: dict(
+        delta_theta=[3.0, -3.0], phi=[4.0, 4.0]
+    ),
+    "sbrdf_xr.materials.readers.measurement_set": lambda: dict(
+        theta_i=np.array([30.0, 30.0]),
+        delta_theta=np.array([0.0, 10.0]),
+        phi=np.array([0.0, 5.0]),
+        wavelength=np.array([550.0]),
+        values=np.array([[2.0], [1e-4]]),
+        material="m",
+        provenance="test",
+        noise_floor=2e-4,  # not at a sample: a conversion's rounding does not move it
+    ),
+    "sbrdf_xr.materials.selfcheck.sample_errors": lambda: dict(
+        table=_grey(),
+        theta_i=np.array([30.0, 60.0]),
+        delta_theta=np.array([0.0, -10.0]),
+        phi=np.array([0.0, 5.0]),
+        spectra=np.full((2, 3), 0.2),
     ),
     "sbrdf_xr.materials.build.build_lut": lambda: dict(
         measurements=_measurements((20.0, 35.0, 55.0)),

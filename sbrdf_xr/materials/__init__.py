@@ -27,8 +27,9 @@ Modules
     Analytic materials as labelled parameter sets: evaluate, render to a table, measure.
 ``goniometer``
     A virtual goniospectrometer sampling any material with the scheme of paper 000.
-``readers``
-    Measurement files as laboratories deliver them (:func:`read_measurements`).
+``readers`` and ``merl``
+    Measurement files as laboratories deliver them (:func:`read_measurements`): long
+    tables, in-plane scans, MERL ``.binary``.
 ``coverage`` and ``selfcheck``
     Angles grouped with a tolerance, scan layouts and model fills; every build checked
     against its own samples.
@@ -43,6 +44,7 @@ from . import (
     energy,
     files,
     goniometer,
+    merl,
     model_schema,
     models,
     readers,
@@ -116,6 +118,7 @@ __all__ = [
     "lambertian",
     "lookup",
     "lookup_anisotropic",
+    "merl",
     "model_material",
     "model_parameters",
     "model_schema",

@@ -10,8 +10,8 @@ and every row can be renormalised to the model's directional-hemispherical refle
 
 from __future__ import annotations
 
+import functools
 import threading
-import warnings
 from collections.abc import Callable
 from typing import Any
 
@@ -20,7 +20,7 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from .._names import DELTA_THETA, MEASURED, PHI, SAMPLE, THETA_I, WAVELENGTH
-from ..errors import NonPhysicalWarning, ValidationError
+from ..errors import ValidationError
 from ..kernels import lut as _lut
 from ..units import to_unit
 from . import models
@@ -34,8 +34,18 @@ from .construction import (
     paper_phi_grid,
     per_theta_tables,
 )
-from .coverage import in_plane_phi_grid, ratio_tables, scan_layout, snap_angles
-from .energy import ENERGY_TOL, hemispherical_reflectance
+from .coverage import (
+    _at_horizon,
+    _coverage_attrs,
+    _in_plane_phi_grid,
+    _ratio_across_theta,
+    _ratio_tables,
+    _resolve_below_noise,
+    _specular_nodes,
+    scan_layout,
+    snap_angles,
+)
+from .energy import _check_energy_conservation
 from .schema import (
     average_duplicates,
     check_coord,
@@ -43,7 +53,7 @@ from .schema import (
     reference_mask,
     validate_measurements,
 )
-from .selfcheck import CHECK_BOUND, CHECK_FLOOR, check_attrs, sample_errors, self_check
+from .selfcheck import CHECK_BOUND, CHECK_FLOOR, _holdout_check, _self_check
 
 __all__ = ["BELOW_NOISE", "EXTRAPOLATIONS", "RENORMALISE", "build_lut"]
 
@@ -315,18 +325,10 @@ def build_lut(
     ref = reference_mask(ds)
     ti_s, dt_s, ph_s = (snap_angles(ds[d].values) for d in (THETA_I, DELTA_THETA, PHI))
     measured_ti = np.unique(ti_s)
-    horizon = _at_horizon(ti_s, dt_s, ph_s)
-    if horizon.any():  # cos(theta_r) = 0: no reflectance can be measured there
-        warnings.warn(
-            f"build_lut: {int(horizon.sum())} of {horizon.size} samples have the observer at "
-            "or below the horizon (theta_i + delta_theta = +-90 deg in the plane); they are "
-            "left out (attribute n_dropped_horizon)",
-            NonPhysicalWarning,
-            stacklevel=2,
-        )
-        ref = ref | horizon
+    horizon = _at_horizon(ti_s, dt_s, ph_s, warn=True, known=ref)  # cos(theta_r) = 0: out
+    ref = ref | horizon
     layouts = [scan_layout(dt_s[ti_s == t], ph_s[ti_s == t]) for t in measured_ti]
-    below_noise = _below_noise(below_noise, layouts, measured_ti)
+    below_noise = _resolve_below_noise(below_noise, layouts, measured_ti)
     rows_only = all(lay == "rows" for lay in layouts)
     if extrapolation == "auto":
         extrapolation = "cubic" if rows_only else "model"
@@ -352,8 +354,8 @@ def build_lut(
             f"got {measured_ti.tolist()}"
         )
     if all(lay == "in-plane" for lay in layouts):  # the scans' own nodes
-        dt_grid = np.unique(dt_s)
-        phi_grid = in_plane_phi_grid(float(np.median(np.diff(dt_grid))))
+        dt_grid = _specular_nodes(dt_s)
+        phi_grid = _in_plane_phi_grid(float(np.median(np.diff(np.unique(dt_s)))))
     else:
         phi_grid = paper_phi_grid(ph_s.max(), n_phi)
         dt_grid = paper_delta_theta_grid(dt_s.min(), dt_s.max(), n_delta_theta)
@@ -410,13 +412,16 @@ def build_lut(
         truth_s = _model_at(fit_model, ti_s, dt_s, ph_s, wl)
         ok = ~ref
         ratio = np.divide(spectra, truth_s, out=np.ones_like(spectra), where=truth_s > 0)
-        per_theta, _ = ratio_tables(
+        per_theta, _ = _ratio_tables(
             measured_ti, ti_s[ok], dt_s[ok], ph_s[ok], ratio[ok], dt_grid, phi_grid
         )
-        spline_mode = "constant" if extrapolation == "model" else extrapolation
-        e = _lut.smoothing_spline_matrix(measured_ti, ti_out, lam, spline_mode)
-        r_lut = np.tensordot(e, per_theta, axes=(1, 0))
-        np.maximum(r_lut, 0.0, out=r_lut)
+        if rows_only:
+            spline_mode = "constant" if extrapolation == "model" else extrapolation
+            e = _lut.smoothing_spline_matrix(measured_ti, ti_out, lam, spline_mode)
+            r_lut = np.tensordot(e, per_theta, axes=(1, 0))
+            np.maximum(r_lut, 0.0, out=r_lut)
+        else:  # orders of magnitude between incidence angles: no overshoot below zero
+            r_lut = _ratio_across_theta(measured_ti, per_theta, ti_out)
         if extrapolation == "model":
             # Towards grazing incidence the measured ratio does not carry over (the
             # lobe meets the horizon): the model alone, reached over ``blend`` degrees.
@@ -498,116 +503,18 @@ def build_lut(
         **edges,
         **extra,
     )
-    out.attrs.update(
-        self_check(
-            out,
-            ds,
-            (ti_s, dt_s, ph_s),
-            spectra,
-            ref,
-            floor=to_unit(check_floor, "1", "check_floor"),
-            bound=to_unit(check_bound, "1", "check_bound"),
-        )
-    )
+    samples = (ds, (ti_s, dt_s, ph_s), spectra, ref)
+    out.attrs.update(_self_check(out, *samples, floor=check_floor, bound=check_bound))
     if check_energy:
         report(0.95, "energy check")
-        check_ti = np.unique(np.concatenate([ti_out[::5], ti_out[-1:]]))
-        rho = hemispherical_reflectance(out, check_ti, warn=False).values
-        if np.any(rho > 1.0 + ENERGY_TOL):
-            bad = np.argwhere(rho > 1.0 + ENERGY_TOL)
-            worst = np.unravel_index(np.argmax(rho), rho.shape)
-            tis = sorted({float(check_ti[b[0]]) for b in bad})
-            warnings.warn(
-                f"build_lut: the table of {name!r} does not conserve energy: its directional-"
-                f"hemispherical reflectance exceeds 1 at theta_i = {tis} deg (worst "
-                f"{rho[worst]:.3f} at theta_i = {check_ti[worst[0]]} deg, wavelength = "
-                f"{wl[worst[1]]} nm); consider below_noise='model' or extrapolation='model'",
-                NonPhysicalWarning,
-                stacklevel=2,
-            )
+        _check_energy_conservation(out, np.unique(np.concatenate([ti_out[::5], ti_out[-1:]])))
     if holdout and not rows_only:  # a fitted fill: predict samples it has not seen
         report(0.97, "leave-out check")
-        out.attrs.update(_holdout(ds, call, (ti_s, dt_s, ph_s), spectra, ref, int(holdout)))
+        opts = {**call, "holdout": 0, "check_energy": False, "progress": None}
+        rebuild = functools.partial(build_lut, **opts)  # model None: the held-in's own fit
+        out.attrs.update(_holdout_check(rebuild, *samples, every=int(holdout), floor=check_floor))
     report(1.0, "built")
     return out
-
-
-def _holdout(
-    ds: xr.Dataset,
-    call: dict[str, Any],
-    angles: tuple[np.ndarray, np.ndarray, np.ndarray],
-    spectra: np.ndarray,
-    ref: np.ndarray,
-    k: int,
-) -> dict[str, Any]:
-    """The leave-out check: every ``k``-th sample of each scan predicted by a table built
-    without them (and with its own fit)."""
-    ti, dt, _ = angles
-    hold = np.zeros(ti.size, dtype=bool)
-    for t in np.unique(ti):
-        at = np.flatnonzero(ti == t)
-        at = at[np.argsort(dt[at], kind="stable")]
-        hold[at[1:-1][np.arange(at.size - 2) % k == k // 2]] = True
-    opts = {**call, "holdout": 0, "check_energy": False, "progress": None}
-    if call.get("model") is None:
-        opts["model"] = None  # its own fit
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", NonPhysicalWarning)
-        table = build_lut(ds.isel({SAMPLE: np.flatnonzero(~hold)}), **opts)
-    # the floor from every sample of the scan, the errors at the held-out ones
-    rel, _, _ = sample_errors(table, *angles, spectra, ref, opts["check_floor"])
-    rel[~hold] = np.nan
-    return {**check_attrs("holdout_check", rel), "holdout_every": k}
-
-
-def _at_horizon(ti: np.ndarray, dt: np.ndarray, ph: np.ndarray) -> np.ndarray:
-    """Which samples have the observer at or below the horizon (``cos theta_r <= 1e-8``)."""
-    return np.cos(np.radians(ph)) * np.cos(np.radians(ti + dt)) <= 1e-8
-
-
-def _below_noise(below_noise: str, layouts: list[str], measured_ti: np.ndarray) -> str:
-    """The below-noise policy of a build: ``auto`` resolved by the data's layouts."""
-    rows_only = all(lay == "rows" for lay in layouts)
-    if below_noise == "auto":
-        return "zero" if rows_only else "model"
-    if below_noise == "zero" and not rows_only:
-        what = sorted({lay for lay in layouts if lay != "rows"})
-        at = [float(t) for t, lay in zip(measured_ti, layouts, strict=True) if lay != "rows"]
-        why = (
-            "no sample out of the plane of incidence: phi = 0 everywhere"
-            if what == ["in-plane"]
-            else "not in rows of constant delta_theta"
-        )
-        raise ValidationError(
-            f"below_noise: got 'zero', but the samples at theta_i = {at} deg are "
-            f"{' and '.join(what)} ({why}): "
-            "the paper's construction needs rows of constant delta_theta sampled in phi. "
-            "Allowed: below_noise='model' or 'auto' (a model fitted to the samples fills "
-            "what was not measured)"
-        )
-    return below_noise
-
-
-def _coverage_attrs(layouts: list[str], measured_ti: np.ndarray, model: xr.Dataset) -> dict:
-    """The attributes that say what of a table was measured and what was modelled."""
-    name = model.attrs.get("model", "model")
-    parts = []
-    for lay in ("rows", "in-plane", "scattered"):
-        at = [f"{t:g}" for t, la in zip(measured_ti, layouts, strict=True) if la == lay]
-        if at:
-            parts.append(f"{lay} at theta_i = {', '.join(at)} deg")
-    modelled = {
-        "in-plane": "phi > 0 (out of the plane of incidence) is the fitted "
-        f"{name} model times the measured ratio at the same angular distance from specular",
-        "scattered": f"between the samples the fitted {name} model times their ratio "
-        "interpolated on their triangulation",
-        "rows": "beyond the measured extents the fitted model",
-    }
-    return {
-        "layout": "; ".join(parts),
-        "modelled": "; ".join(modelled[lay] for lay in dict.fromkeys(layouts))
-        + "; other incidence angles: the model times the ratio splined in theta_i",
-    }
 
 
 def _no_progress(fraction: float, step: str) -> None:

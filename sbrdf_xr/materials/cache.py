@@ -63,6 +63,7 @@ def cache_dir() -> Path | None:
 _BUILD_ROOTS = (
     "sbrdf_xr.materials.tables",
     "sbrdf_xr.materials.models",
+    "sbrdf_xr.materials.readers",  # a measurement entry in a laboratory's file format
     "sbrdf_xr._catalog_index",
 )
 #: Definitions of modules outside the closure that take part in a build: only their own

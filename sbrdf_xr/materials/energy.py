@@ -124,3 +124,45 @@ def hemispherical_reflectance(
             stacklevel=2,
         )
     return out
+
+
+def _check_energy_conservation(table: xr.DataArray, theta_i: ArrayLike) -> np.ndarray:
+    """Warn when a table's directional-hemispherical reflectance exceeds 1.
+
+    Parameters
+    ----------
+    table : xarray.DataArray
+        A material table.
+    theta_i : array_like
+        Incidence angles to check [degree].
+
+    Returns
+    -------
+    ndarray, shape (n_theta_i, n_wavelength)
+        The reflectance [1] (:func:`hemispherical_reflectance`); a
+        :class:`~sbrdf_xr.errors.NonPhysicalWarning` names the incidence angles and the
+        worst wavelength where it exceeds ``1 + ENERGY_TOL``.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.materials.energy import _check_energy_conservation
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> _check_energy_conservation(lambertian(0.5, [550.0]), [0.0, 45.0]).round(3).tolist()
+    [[0.5], [0.5]]
+    """
+    ti = np.atleast_1d(np.asarray(to_unit(theta_i, "deg", "theta_i"), dtype=np.float64))
+    rho = hemispherical_reflectance(table, ti, warn=False).values
+    if np.any(rho > 1.0 + ENERGY_TOL):
+        bad = np.argwhere(rho > 1.0 + ENERGY_TOL)
+        worst = np.unravel_index(np.argmax(rho), rho.shape)
+        tis = sorted({float(ti[b[0]]) for b in bad})
+        wl = table[WAVELENGTH].values
+        warnings.warn(
+            f"build_lut: the table of {table.attrs.get('material', '')!r} does not conserve "
+            f"energy: its directional-hemispherical reflectance exceeds 1 at theta_i = {tis} "
+            f"deg (worst {rho[worst]:.3f} at theta_i = {ti[worst[0]]} deg, wavelength = "
+            f"{wl[worst[1]]} nm); consider below_noise='model' or extrapolation='model'",
+            NonPhysicalWarning,
+            stacklevel=3,
+        )
+    return rho

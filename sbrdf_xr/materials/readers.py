@@ -45,7 +45,7 @@ from .._names import DELTA_THETA, MEASURED, PHI, SAMPLE, THETA_I, WAVELENGTH, at
 from ..errors import UnitError, ValidationError
 from ..geometry import from_conventional
 from ..units import to_unit
-from .coverage import snap_angles
+from .coverage import _at_horizon, snap_angles
 from .schema import validate_measurements
 
 __all__ = ["READERS", "Reader", "measurement_set", "read_measurements", "register_reader"]
@@ -123,8 +123,8 @@ def read_measurements(
         A reader's name (:data:`READERS`); default: the reader of the file's suffix.
     **options
         The reader's options (for ``table``: ``angles``, ``zenith``, ``columns``,
-        ``wavelength`` [nm], ``units``, ``angle_units``, ``noise_floor`` [sr-1],
-        ``material``, ``provenance``, ``duplicates``).
+        ``wavelength`` in nm, ``units``, ``angle_units``, ``noise_floor`` in sr-1,
+        ``material``, ``provenance``, ``duplicates``; each reader converts Quantities).
 
     Returns
     -------
@@ -192,7 +192,9 @@ def measurement_set(
     material, provenance : str
         Attributes.
     noise_floor : float, optional
-        Samples at or below it [sr-1] (at every wavelength) are reference points.
+        Samples at or below it [sr-1] (at every wavelength) are reference points, as are
+        samples with the observer on the horizon (``theta_i + delta_theta = +-90`` deg in
+        the plane), counted in the attribute ``n_horizon`` and said in the provenance.
     duplicates : {"error", "mean"}, default "error"
         As :func:`~sbrdf_xr.materials.schema.validate_measurements`.
 
@@ -210,13 +212,22 @@ def measurement_set(
     >>> ds.reference.values.tolist()
     [False, True]
     """
-    ang = [snap_angles(a) for a in (theta_i, delta_theta, phi)]
-    v = np.asarray(values, dtype=np.float64)
+    named = ((theta_i, THETA_I), (delta_theta, DELTA_THETA), (phi, PHI))
+    ang = [snap_angles(np.asarray(to_unit(a, "deg", n), dtype=np.float64)) for a, n in named]
+    v = np.asarray(to_unit(values, "sr-1", "values"), dtype=np.float64)
+    wavelength = to_unit(wavelength, "nm", WAVELENGTH, spectral=True)
     if v.shape[0] == 0:
         raise ValidationError(f"measurements: {material!r} is empty (no samples)")
     ref = np.zeros(v.shape[0], dtype=bool)
     if noise_floor is not None:
         ref = np.all(v <= to_unit(noise_floor, "sr-1", "noise_floor"), axis=1)
+    horizon = _at_horizon(*ang, known=ref)  # cos(theta_r) = 0: nothing measurable
+    ref |= horizon
+    if horizon.any():
+        provenance += (
+            f"; {int(horizon.sum())} samples with the observer on the horizon marked as "
+            "reference points"
+        )
     ds = xr.Dataset(
         {
             MEASURED: ((SAMPLE, WAVELENGTH), v, attrs(MEASURED)),
@@ -233,6 +244,7 @@ def measurement_set(
             "source": "measured",
             "provenance": provenance,
             "n_reference": int(ref.sum()),
+            "n_horizon": int(horizon.sum()),
         },
     )
     return validate_measurements(ds, duplicates=duplicates)
@@ -473,7 +485,7 @@ def read_table(
     wl = np.atleast_1d(np.asarray(to_unit(wavelength, "nm", "wavelength", spectral=True), float))
     values = _brdf_values(brdf, file_units.get(bname), units, path).reshape(n, 1)
     return measurement_set(
-        *ang, wl, values, material=material or path.stem,
+        ang[0], ang[1], ang[2], wl, values, material=material or path.stem,
         provenance=provenance or f"{path.name}, read by sbrdf_xr.materials.read_measurements "
         f"(table reader, {how}, {n} rows)",
         noise_floor=noise_floor, duplicates=duplicates,

@@ -15,16 +15,23 @@ that is zero where samples above the floor are not is an error
 from __future__ import annotations
 
 import warnings
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from .._names import DELTA_THETA, PHI, THETA_I, WAVELENGTH
+from .._names import DELTA_THETA, PHI, SAMPLE, THETA_I, WAVELENGTH
 from ..errors import NonPhysicalWarning, ValidationError
 from ..kernels import lut as _lut
+from ..units import to_unit
 
-__all__ = ["CHECK_BOUND", "CHECK_FLOOR", "check_attrs", "sample_errors", "self_check"]
+__all__ = [
+    "CHECK_BOUND",
+    "CHECK_FLOOR",
+    "check_attrs",
+    "sample_errors",
+]
 
 #: Samples below this fraction of the peak of their incidence angle's samples (per
 #: wavelength) are in the noise and left out of the check [1].
@@ -80,6 +87,11 @@ def sample_errors(
     >>> float(rel[0, 0]), bool(used[0, 0])
     (0.0, True)
     """
+    theta_i, delta_theta, phi = (
+        np.asarray(to_unit(a, "deg", n), dtype=np.float64)
+        for a, n in ((theta_i, THETA_I), (delta_theta, DELTA_THETA), (phi, PHI))
+    )
+    spectra = np.asarray(to_unit(spectra, "sr-1", "spectra"), dtype=np.float64)
     table = table.transpose(THETA_I, DELTA_THETA, PHI, WAVELENGTH)
     got = _lut.lookup_kernel(
         np.asarray(table.values, dtype=np.float64),
@@ -154,7 +166,7 @@ def _worst(rel: np.ndarray, ti, dt, ph, wl, k: int = 3) -> str:
     return "; ".join(parts)
 
 
-def self_check(
+def _self_check(
     table: xr.DataArray,
     ds: xr.Dataset,
     angles: tuple[np.ndarray, np.ndarray, np.ndarray],
@@ -203,6 +215,7 @@ def self_check(
     >>> table.attrs["self_check_median"] < 1e-9
     True
     """
+    floor, bound = to_unit(floor, "1", "check_floor"), to_unit(bound, "1", "check_bound")
     ti, dt, ph = angles
     rel, got, used = sample_errors(table, ti, dt, ph, spectra, reference, floor)
     name = ds.attrs.get("material", "unnamed")
@@ -229,3 +242,71 @@ def self_check(
             stacklevel=3,
         )
     return out
+
+
+def _holdout_check(
+    build: Callable[[xr.Dataset], xr.DataArray],
+    ds: xr.Dataset,
+    angles: tuple[np.ndarray, np.ndarray, np.ndarray],
+    spectra: np.ndarray,
+    reference: np.ndarray,
+    *,
+    every: int = 4,
+    floor: float = CHECK_FLOOR,
+) -> dict[str, Any]:
+    """The leave-out check: held-out samples predicted by a table built without them.
+
+    Every ``every``-th sample of each incidence angle's scan (in ``delta_theta`` order,
+    its two ends kept in) is left out; ``build`` makes a table from the rest (with its
+    own fit), which is looked up at them.  The floor is that of the whole scan.
+
+    Parameters
+    ----------
+    build : callable
+        ``build(measurements) -> table``.
+    ds : xarray.Dataset
+        The measurement set.
+    angles : tuple of ndarray
+        ``(theta_i, delta_theta, phi)`` of its samples [degree] (snapped).
+    spectra : ndarray, shape (s, n_wavelength)
+        Its samples [sr-1].
+    reference : ndarray of bool
+        Reference points (left out of the statistics).
+    every : int, default 4
+        Hold out every ``every``-th sample, ``>= 2``.
+    floor : float, default :data:`CHECK_FLOOR`
+        Relative noise floor [1].
+
+    Returns
+    -------
+    dict
+        ``holdout_check_median``, ``_p95``, ``_worst``, ``_n`` and ``holdout_every``.
+
+    Examples
+    --------
+    A constant table predicts constant samples exactly:
+
+    >>> import numpy as np
+    >>> import xarray as xr
+    >>> from sbrdf_xr.materials import constant_material
+    >>> from sbrdf_xr.materials.selfcheck import _holdout_check
+    >>> ti, dt, ph = np.full(9, 30.0), np.linspace(-20.0, 20.0, 9), np.zeros(9)
+    >>> out = _holdout_check(lambda m: constant_material(0.1, [550.0], material="c"),
+    ...                     xr.Dataset(), (ti, dt, ph), np.full((9, 1), 0.1), np.zeros(9, bool))
+    >>> out["holdout_check_n"], out["holdout_check_worst"]
+    (2, 0.0)
+    """
+    if int(every) < 2:
+        raise ValidationError(f"holdout: must be >= 2 (or 0 for none), got {every}")
+    ti, dt, _ = angles
+    hold = np.zeros(ti.size, dtype=bool)
+    for t in np.unique(ti):
+        at = np.flatnonzero(ti == t)
+        at = at[np.argsort(dt[at], kind="stable")]
+        hold[at[1:-1][np.arange(at.size - 2) % every == every // 2]] = True
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NonPhysicalWarning)
+        table = build(ds.isel({SAMPLE: np.flatnonzero(~hold)}) if SAMPLE in ds.dims else ds)
+    rel, _, _ = sample_errors(table, *angles, spectra, reference, floor)
+    rel[~hold] = np.nan
+    return {**check_attrs("holdout_check", rel), "holdout_every": int(every)}

@@ -30,7 +30,7 @@ from sbrdf_xr.materials.coverage import (
     specular_distance,
 )
 from sbrdf_xr.materials.readers import measurement_set
-from sbrdf_xr.materials.selfcheck import sample_errors, self_check
+from sbrdf_xr.materials.selfcheck import _self_check, sample_errors
 
 WL = np.array([450.0, 550.0, 650.0])
 #: Lambert 0.3 plus a lobe: the Robertson-Sandford model (paper 001) with rho_D = 0.3.
@@ -127,6 +127,7 @@ def test_an_in_plane_scan_gives_an_isotropic_table_filled_by_the_fit():
     assert "phi > 0" in table.attrs["modelled"]
     assert "phi > 0" in table.attrs["provenance"]  # shown by print(table)
     assert table.attrs["self_check_worst"] < 1e-9  # the scan's own nodes
+    assert table.attrs["holdout_check_median"] < SYNTHETIC_MEDIAN  # its own leave-out check
     held = _errors(table, t[hold], d[hold], np.zeros(hold.sum()), vals[hold])
     assert np.median(held) < SYNTHETIC_MEDIAN
     # out of the plane: the fitted model (the generating one, recovered)
@@ -150,10 +151,10 @@ def test_the_self_check_raises_on_a_table_of_zeros_and_warns_on_a_wrong_one():
     ds = xr.Dataset(attrs={"material": "m"})
     zero = constant_material(0.0, [550.0], material="zero")
     with pytest.raises(ValidationError, match="is zero at 2 of the 2 sample values"):
-        self_check(zero, ds, (ti, dt, ph), spectra, np.zeros(2, bool))
+        _self_check(zero, ds, (ti, dt, ph), spectra, np.zeros(2, bool))
     big = constant_material(1.0, [550.0], material="big")
     with pytest.warns(NonPhysicalWarning, match=r"misses its own samples.*worst at"):
-        out = self_check(big, ds, (ti, dt, ph), spectra, np.zeros(2, bool))
+        out = _self_check(big, ds, (ti, dt, ph), spectra, np.zeros(2, bool))
     assert out["self_check_median"] == pytest.approx(6.5)  # (0.8/0.2 + 0.9/0.1) / 2
     _, _, used = sample_errors(big, ti, dt, ph, spectra, floor=0.6)
     assert used[:, 0].tolist() == [True, False]  # 0.1 < 0.6 of the peak 0.2
@@ -283,3 +284,85 @@ def test_material_build_command(tmp_path, capsys):
     assert "self-check over" in text
     table = open_material(out)
     assert table.attrs["self_check_worst"] < 1e-9
+
+
+# ------------------------------------------------------------------ MERL
+
+
+def _rgb_lobe(s, o):
+    """The test lobe at the three channels (red, green, blue) of a MERL file."""
+    from sbrdf_xr.geometry import facet_angles
+
+    n = np.zeros_like(s)
+    n[:, 2] = 1.0
+    a = facet_angles(n, s, o, check=False)
+    return models.spectra(_rgb_spec(), a.theta_i, a.delta_theta, a.phi)[:, ::-1]
+
+
+def _rgb_spec():
+    from sbrdf_xr.materials.merl import CHANNEL_WAVELENGTHS
+
+    return models.model_material(
+        "robertson_sandford", list(CHANNEL_WAVELENGTHS), material="rgb", provenance="test",
+        rho_D=[0.2, 0.3, 0.4], epsilon=0.1, b=0.1, e=0.3,
+    )  # fmt: skip
+
+
+def test_a_merl_file_of_constant_channels_reads_them_exactly(tmp_path):
+    from sbrdf_xr.materials.merl import write_merl
+
+    p = write_merl(tmp_path / "c.binary", lambda s, o: np.tile([0.3, 0.2, 0.1], (len(s), 1)))
+    with pytest.warns(NonPhysicalWarning, match="unmeasured cells"):  # grazing cells
+        ds = read_measurements(p, theta_i=(10.0, 50.0), step=5.0)
+    assert "MERL RGB colour channels" in ds.attrs["channels"]
+    np.testing.assert_allclose(ds.measured_sbrdf.values, [[0.1, 0.2, 0.3]] * ds.sizes["sample"],
+                               rtol=1e-12)  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("cut", "match"), [(100, "truncated"), (-8, "trailing bytes"), (None, "declares dimensions")]
+)
+def test_a_merl_file_of_the_wrong_size_is_a_named_error(tmp_path, cut, match):
+    good = 12 + 3 * 90 * 90 * 180 * 8
+    if cut is None:
+        raw = np.asarray([90, 90, 360], "<i4").tobytes() + bytes(good - 12)
+    else:
+        raw = np.asarray([90, 90, 180], "<i4").tobytes() + bytes(good - 12 - cut)
+    p = tmp_path / "bad.binary"
+    p.write_bytes(raw)
+    with pytest.raises(ValidationError, match=match):
+        read_measurements(p)
+
+
+@pytest.mark.slow
+def test_a_merl_file_of_a_known_model_round_trips_and_builds(tmp_path):
+    from sbrdf_xr.materials.merl import write_merl
+
+    p = write_merl(tmp_path / "lobe.binary", _rgb_lobe)
+    with pytest.warns(NonPhysicalWarning, match="unmeasured cells"):
+        ds = read_measurements(p)
+    truth = models.spectra(_rgb_spec(), ds.theta_i.values, ds.delta_theta.values, ds.phi.values)
+    err = np.abs(ds.measured_sbrdf.values - truth) / truth
+    assert np.median(err) < 1e-3  # bins interpolated linearly between their centres
+    hold = np.arange(ds.sizes["sample"]) % 4 == 0
+    table = build_lut(ds.isel(sample=np.flatnonzero(~hold)))
+    held = _errors(table, ds.theta_i.values[hold], ds.delta_theta.values[hold],
+                   ds.phi.values[hold], ds.measured_sbrdf.values[hold])  # fmt: skip
+    assert np.median(held) < SYNTHETIC_MEDIAN
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("name", "bound"), [("solar-array", 0.10), ("chassis", 0.25)])
+def test_the_starlink_tables_predict_held_out_samples(name, bound):
+    """Every 4th sample of each scan left out (the build's own leave-out check), over
+    the samples above 1e-3 of their scan's peak: the solar array meets the 10 % of the
+    issue (1.4 %); the chassis's 1-degree scan does not resolve its sub-degree mirror
+    core (16 %, its wings within a few %), held here against regressions."""
+    meas = catalog.load(f"starlink-v1.5-{name}-measurements")
+    if name == "chassis":  # its 1-degree mirror core, isotropic about specular: rho 1.1-1.4
+        with pytest.warns(NonPhysicalWarning, match="does not conserve energy"):
+            table = build_lut(meas)
+    else:
+        table = build_lut(meas)
+    assert table.attrs["self_check_worst"] < 1e-9
+    assert table.attrs["holdout_check_median"] < bound
