@@ -682,7 +682,9 @@ def plate_spacecraft(
 
     a, b = size
     mesh = trimesh.Trimesh(
-        [[0, 0, 0], [a, 0, 0], [a, b, 0], [0, b, 0]], [[0, 1, 2], [0, 2, 3]], process=False
+        np.array([[0, 0, 0], [a, 0, 0], [a, b, 0], [0, b, 0]], dtype=float),
+        [[0, 1, 2], [0, 2, 3]],
+        process=False,
     )
     return Spacecraft(mesh, [front] * 2, name="plate", back_material=back)
 
@@ -716,7 +718,7 @@ def box_with_plate_spacecraft(height: float = 1.0, parts: bool = False, law=None
     mesh = trimesh.Trimesh(v, f, process=False)
     mats = ["bus"] * 12 + ["cell"] * 2
     backs = [""] * 12 + ["backsheet"] * 2
-    plist = ()
+    plist: tuple[Part, ...] = ()
     if parts:
         law = SunTracking() if law is None else law
         plist = (Part("array", [12, 13], axis=[1.0, 0, 0], point=[0, 0, z], law=law),)

@@ -110,6 +110,7 @@ SCRIPTS = {
     "comparison": [],
     "imperfections": [pytest.mark.slow],
     "anisotropy": [pytest.mark.slow],
+    "starlink": [],
 }
 
 
@@ -137,6 +138,7 @@ IMAGES = {
     "canx1_pass_comparison.png": "comparison",
     "canx1_plusx_spectra.png": "gallery",
     "canx1_rotation.png": "gallery",
+    "starlink_pass.png": "starlink",
 }
 
 

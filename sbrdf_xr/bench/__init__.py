@@ -18,11 +18,14 @@ Modules
     Accuracy and cost of the shadowing methods against the exact method.
 ``presets``
     The presets' measured error and cost, recorded from a run and shipped.
+``parts``
+    What open surfaces and sun-tracking parts cost against the rigid closed path.
 """
 
-from . import accuracy, engine, presets, rows, shadowing, suite
+from . import accuracy, engine, parts, presets, rows, shadowing, suite
 from .accuracy import BANDS, CANX1_MATERIALS, accuracy_cost, shadow_rows
 from .engine import disk_rate, engine_rows, sweep_job, thread_scaling
+from .parts import KINDS, canx1_with_wing, parts_rows
 from .presets import load_presets, presets_record, presets_table, write_presets
 from .rows import BenchRow, best_time, format_rows, plot_front, rows_to_dataset, timed_runs
 from .shadowing import (
@@ -42,6 +45,7 @@ __all__ = [
     "ACCURACY_BODIES",
     "BANDS",
     "CANX1_MATERIALS",
+    "KINDS",
     "BenchRow",
     "CostRow",
     "ShadowRow",
@@ -53,6 +57,7 @@ __all__ = [
     "bench_lookup",
     "best_time",
     "canx1_sweep_rows",
+    "canx1_with_wing",
     "disk_rate",
     "engine",
     "engine_rows",
@@ -62,6 +67,8 @@ __all__ = [
     "lambertian_signal",
     "load_presets",
     "markdown",
+    "parts",
+    "parts_rows",
     "plot_front",
     "presets",
     "presets_record",

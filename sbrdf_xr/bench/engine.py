@@ -20,6 +20,8 @@ absolute claim:
   output, nothing written) and the bare kernel alone, and
   two process workers against one on a ``LocalCluster`` writing a Zarr store by
   blocks; beside them the machine's own two-thread ceiling (:func:`thread_scaling`);
+* open surfaces and sun-tracking parts against the rigid closed path
+  (:mod:`sbrdf_xr.bench.parts`);
 * kernel throughput (facet-spectra per second, linear, 141 wavelengths, unmerged)
   against the dense-matmul arithmetic rate of this machine and against the numpy
   reference kernel, measured first, before the sweeps load the machine.
@@ -560,4 +562,8 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
                 sweep=sw,
             )
         )
+    # open surfaces and articulated parts against the rigid closed path
+    from .parts import parts_rows
+
+    rows += parts_rows(repeat=max(repeat, 5))
     return rows + kernel

@@ -18,10 +18,29 @@ Modules
     The sampled method's tools: sampling densities, point sets on facets, ray engines.
 ``picture``
     A 3-D picture of a spacecraft, each facet coloured by its material.
+``sides``
+    The sides light can reach: every facet's front, and a back where one is given.
+``parts`` and ``posed``
+    Articulated parts (a hinge and a pointing law), and shadowing on the posed body.
+``starlink``
+    A built-in Starlink v1.5-class body: a nadir chassis and a sun-tracking array.
 """
 
 from ..errors import MeshError, MeshRepairWarning
-from . import facets, imperfections, meshes, picture, rays, repair, spacecraft, visibility
+from . import (
+    facets,
+    imperfections,
+    meshes,
+    parts,
+    picture,
+    posed,
+    rays,
+    repair,
+    sides,
+    spacecraft,
+    starlink,
+    visibility,
+)
 from .facets import NORMAL_TOLERANCE, check_facet_material, facet_table, merge_facets
 from .imperfections import tilt_quadrature, tilted_normals
 from .meshes import (
@@ -35,7 +54,20 @@ from .meshes import (
     read_material_map,
     read_mesh,
 )
+from .parts import (
+    LAWS,
+    PART_KEYS,
+    AngleSeries,
+    Fixed,
+    Part,
+    SunTracking,
+    check_parts,
+    hinge_rotation,
+    part_from_spec,
+    tracking_angle,
+)
 from .picture import plot_facets
+from .posed import posed_fraction
 from .rays import (
     DENSITY_PRESETS,
     ENGINES,
@@ -52,7 +84,9 @@ from .rays import (
     to_triangle,
 )
 from .repair import MERGE_DISTANCE, ZERO_AREA_FACTOR, clean_mesh
+from .sides import Sides, build_sides, closed_facets, posed_vertices
 from .spacecraft import CANX1_MATERIALS, Spacecraft, canx1, load_spacecraft
+from .starlink import STARLINK_AREAS, STARLINK_MATERIALS, starlink_v15
 from .visibility import (
     METHODS,
     PLANE_TOLERANCE,
@@ -70,31 +104,44 @@ __all__ = [
     "CANX1_MATERIALS",
     "DENSITY_PRESETS",
     "ENGINES",
+    "LAWS",
     "LENGTH_UNITS",
     "MAX_RAYS_PER_CALL",
     "MERGE_DISTANCE",
     "METHODS",
     "NORMAL_TOLERANCE",
     "OFFSET_FACTOR",
+    "PART_KEYS",
     "PLANE_TOLERANCE",
     "SEED",
+    "STARLINK_AREAS",
+    "STARLINK_MATERIALS",
     "TANGENT_ATTRIBUTE",
     "ZERO_AREA_FACTOR",
+    "AngleSeries",
     "Color",
+    "Fixed",
     "MeshError",
     "MeshRepairWarning",
+    "Part",
+    "Sides",
     "Spacecraft",
+    "SunTracking",
     "available_engines",
+    "build_sides",
     "canx1",
     "check_density",
     "check_facet_material",
+    "check_parts",
     "clean_mesh",
+    "closed_facets",
     "engine_name",
     "escape_masks",
     "face_tangents",
     "facet_table",
     "facet_visibility",
     "facets",
+    "hinge_rotation",
     "imperfections",
     "intersector",
     "is_convex",
@@ -107,8 +154,13 @@ __all__ = [
     "mesh_of",
     "meshes",
     "normalise_map",
+    "part_from_spec",
+    "parts",
     "picture",
     "plot_facets",
+    "posed",
+    "posed_fraction",
+    "posed_vertices",
     "rays",
     "read_material_map",
     "read_mesh",
@@ -116,11 +168,15 @@ __all__ = [
     "sample_triangle",
     "sample_uv",
     "samples_per_facet",
+    "sides",
     "spacecraft",
+    "starlink",
+    "starlink_v15",
     "supporting",
     "tilt_quadrature",
     "tilted_normals",
     "to_triangle",
+    "tracking_angle",
     "visibility",
     "visible_fraction",
 ]

@@ -76,7 +76,7 @@ def hinge_rotation(axis: ArrayLike, angle: ArrayLike) -> NDArray[np.float64]:
     array([0., 1., 0.])
     """
     a = np.asarray(axis, dtype=np.float64)
-    t = np.atleast_1d(np.asarray(angle, dtype=np.float64))
+    t = np.atleast_1d(np.asarray(to_unit(angle, "rad", "angle"), dtype=np.float64))
     K = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
     s, c = np.sin(t)[:, None, None], np.cos(t)[:, None, None]
     return np.eye(3) + s * K + (1.0 - c) * (K @ K)
@@ -124,7 +124,7 @@ def tracking_angle(
     theta = np.where((x == 0.0) & (y == 0.0), 0.0, np.arctan2(y, x))
     if limits is None:
         return theta
-    lo, hi = limits
+    lo, hi = (float(to_unit(v, "rad", "limits")) for v in limits)
     inside = (theta >= lo) & (theta <= hi)
     # angular distance to either limit, the shorter way round the circle
     d_lo = np.abs(np.angle(np.exp(1j * (theta - lo))))
@@ -179,7 +179,8 @@ class SunTracking:
 
     def __post_init__(self) -> None:
         if self.limits is not None:
-            lo, hi = (float(to_unit(v, "degree", "limits")) for v in self.limits)
+            # rounded: a Quantity in radians gives the same limits as the degrees it means
+            lo, hi = (round(float(to_unit(v, "degree", "limits")), 9) for v in self.limits)
             if not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi):
                 raise ValidationError(
                     f"limits: got {self.limits!r}; they exclude every angle (expected "
@@ -196,7 +197,7 @@ class SunTracking:
         """Angle [radian] at every geometry."""
         assert part is not None
         lim = None if self.limits is None else tuple(np.radians(self.limits))
-        return tracking_angle(part.axis, part.normal, to_sun, lim)  # type: ignore[arg-type]
+        return tracking_angle(part.axis, part.normal, to_sun, lim)
 
 
 @dataclass(frozen=True)

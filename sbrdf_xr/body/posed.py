@@ -36,8 +36,6 @@ from straight above:
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 import trimesh
 
@@ -48,6 +46,9 @@ from .spacecraft import Spacecraft
 from .visibility import _fractions, _plane_frames
 
 __all__ = ["posed_fraction"]
+
+#: Geometries posed at once by the exact method (bounds its temporary arrays).
+_CHUNK = 64
 
 
 def _group_hulls(spacecraft: Spacecraft) -> list[np.ndarray]:
@@ -69,55 +70,76 @@ def _group_hulls(spacecraft: Spacecraft) -> list[np.ndarray]:
     return cache["posed:hulls"]
 
 
-def _turn(a: np.ndarray, group: np.ndarray, rot: np.ndarray, point: Any = None) -> np.ndarray:
-    """Rows of ``a`` of group k + 1 turned by ``rot[k]`` (about ``point[k]`` if given)."""
-    out = a.copy()
-    for k in range(rot.shape[0]):
-        sel = group == k + 1
-        if point is None:
-            out[sel] = a[sel] @ rot[k].T
-        else:
-            out[sel] = point[k] + (a[sel] - point[k]) @ rot[k].T
-    return out
-
-
 def _exact_posed(spacecraft: Spacecraft, rot: np.ndarray, dirs: np.ndarray) -> np.ndarray:
-    """Exact fractions (G, n_sides) for poses ``rot`` (G, P, 3, 3) and directions (G, K, 3)."""
+    """Exact fractions (G, n_sides) for poses ``rot`` (G, P, 3, 3) and directions (G, K, 3).
+
+    The bus rows of the frames stay as they are; only the rows of the parts are turned at
+    each geometry, in place in buffers the kernel reads (their cost grows with the parts,
+    not the bus).  A bus facet cannot be shadowed if the bus's hull and every part's
+    (turned) hull lie on or behind its plane.
+    """
     s = spacecraft.sides
     rest = _plane_frames(s.mesh, spacecraft._cache)
     parts = spacecraft.parts
-    points = [p.point for p in parts]
-    group = s.group
     hulls = _group_hulls(spacecraft)
     tol = rest["eps"]
-    out = np.zeros((rot.shape[0], s.n_sides))
-    for g in range(rot.shape[0]):
-        r = rot[g]
-        V = np.ascontiguousarray(posed_vertices(s, parts, r))
-        N = np.ascontiguousarray(_turn(rest["N"], group, r))
-        E1 = np.ascontiguousarray(_turn(rest["E1"], group, r))
-        E2 = np.ascontiguousarray(_turn(rest["E2"], group, r))
-        P0 = np.ascontiguousarray(_turn(rest["P0"], group, r, points))
-        hull = np.concatenate(
-            [hulls[0]]
-            + [points[k] + (hulls[k + 1] - points[k]) @ r[k].T for k in range(len(parts))]
-        )
-        height = (hull @ N.T - np.einsum("ij,ij->i", N, P0)).max(axis=0)
-        receiver = (np.linalg.norm(N, axis=1) > 0) & (height > tol)
-        d = np.ascontiguousarray(dirs[g : g + 1])
-        front = np.all(d[0] @ N.T > 0, axis=0)
-        if not (receiver & front).any():
-            out[g] = front
+    G = rot.shape[0]
+    V, N, E1, E2, P0 = (rest[k].copy() for k in ("V", "N", "E1", "E2", "P0"))
+    part = s.group > 0
+    rows = np.flatnonzero(part)
+    vrows = np.flatnonzero(s.vertex_group > 0)
+    k_row = s.group[rows] - 1
+    k_vert = s.vertex_group[vrows] - 1
+    point = np.array([p.point for p in parts])
+
+    # every geometry's part rows at once: x -> p + R (x - p), n -> R n
+    def turned(a: np.ndarray, k: np.ndarray, about: bool) -> np.ndarray:
+        r = rot[:, k]  # (G, n, 3, 3)
+        if not about:
+            return np.einsum("gnij,nj->gni", r, a)
+        return point[k] + np.einsum("gnij,nj->gni", r, a - point[k])
+
+    pV = turned(rest["V"][vrows], k_vert, True)
+    pN = turned(rest["N"][rows], k_row, False)
+    pE1 = turned(rest["E1"][rows], k_row, False)
+    pE2 = turned(rest["E2"][rows], k_row, False)
+    pP0 = turned(rest["P0"][rows], k_row, True)
+    # receivers: a facet none of whose hull points (bus and turned parts) is in front
+    moved = np.concatenate(
+        [
+            p.point + np.einsum("gij,nj->gni", rot[:, k], hulls[k + 1] - p.point)
+            for k, p in enumerate(parts)
+        ],
+        axis=1,
+    )  # (G, m, 3)
+    off_bus = np.einsum("ij,ij->i", N, P0)
+    height = np.broadcast_to((hulls[0] @ N.T - off_bus).max(axis=0), (G, len(N))).copy()
+    height[:, rows] = (
+        np.einsum("mj,gnj->gnm", hulls[0], pN) - np.einsum("gnj,gnj->gn", pN, pP0)[:, :, None]
+    ).max(axis=2)
+    off = np.broadcast_to(off_bus, (G, len(N))).copy()
+    off[:, rows] = np.einsum("gnj,gnj->gn", pN, pP0)
+    allN = np.broadcast_to(N, (G, len(N), 3)).copy()
+    allN[:, rows] = pN
+    height = np.maximum(height, np.einsum("gmj,gnj->gnm", moved, allN).max(axis=2) - off)
+    receiver = (np.linalg.norm(N, axis=1) > 0) & (height > tol)  # (G, n)
+    front = np.all(np.einsum("gkj,gnj->gkn", dirs, allN) > 0, axis=1)  # (G, n)
+    out = np.zeros((G, s.n_sides))
+    for g in range(G):
+        if not (receiver[g] & front[g]).any():
+            out[g] = front[g]
             continue
+        V[vrows], N[rows], E1[rows], E2[rows], P0[rows] = pV[g], pN[g], pE1[g], pE2[g], pP0[g]
+        d = np.ascontiguousarray(dirs[g : g + 1])
         frac = exact_kernel(
-            V, rest["F"], N, P0, E1, E2, rest["T2"], receiver, d, rest["watertight"], tol
+            V, rest["F"], N, P0, E1, E2, rest["T2"], receiver[g], d, rest["open_facet"], tol
         )[0]
         if np.isnan(frac).any():  # past the kernel's budget: the posed mesh through GEOS
-            mesh = trimesh.Trimesh(V, rest["F"], process=False)
+            mesh = trimesh.Trimesh(V.copy(), rest["F"], process=False)
             frac = _fractions(
                 mesh, list(d[0][:, None, :]), "exact", 4, None, None, False, 0, False
             )[0][0]
-        out[g] = np.where(front, frac, 0.0)
+        out[g] = np.where(front[g], frac, 0.0)
     return out
 
 
@@ -149,11 +171,27 @@ def posed_fraction(
     -------
     ndarray, shape (G, n_sides)
         Fractions in ``[0, 1]`` [1].
+
+    Examples
+    --------
+    The plate above the box, turned edge-on, shades nothing; flat, it shades the whole top:
+
+    >>> from sbrdf_xr.body.parts import hinge_rotation
+    >>> from sbrdf_xr.testing import box_with_plate_spacecraft
+    >>> body = box_with_plate_spacecraft(parts=True)
+    >>> up = np.array([[0.0, 0.0, 1.0]] * 2)
+    >>> rot = hinge_rotation([1, 0, 0], [0.0, np.pi / 2])[:, None]
+    >>> posed_fraction(body, rot, [up, up])[:, [4, 6]].round(12).tolist()
+    [[0.0, 0.0], [1.0, 1.0]]
     """
     dirs = np.ascontiguousarray(np.stack(directions, axis=1), dtype=np.float64)
     rot = np.asarray(rotations, dtype=np.float64)
-    if method == "exact":
-        return _exact_posed(spacecraft, rot, dirs)
+    if method == "exact":  # in chunks of geometries: the receivers' arrays grow with them
+        parts = [
+            _exact_posed(spacecraft, rot[g : g + _CHUNK], dirs[g : g + _CHUNK])
+            for g in range(0, rot.shape[0], _CHUNK)
+        ]
+        return np.concatenate(parts) if parts else np.zeros((0, spacecraft.n_sides))
     s = spacecraft.sides
     out = np.zeros((rot.shape[0], s.n_sides))
     for g in range(rot.shape[0]):

@@ -51,6 +51,13 @@ class Sides:
 
     ``group`` is 0 for the bus and ``k + 1`` for part ``k``; ``vertex_group`` the group
     of every vertex of :attr:`mesh`.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.testing import plate_spacecraft
+    >>> s = plate_spacecraft().sides
+    >>> s.n_sides, s.facet.tolist(), s.group.tolist()
+    (4, [0, 1, 0, 1], [0, 0, 0, 0])
     """
 
     mesh: trimesh.Trimesh
@@ -121,7 +128,8 @@ def build_sides(
     facet = np.concatenate([np.arange(n), np.flatnonzero(back)])
     is_back = np.concatenate([np.zeros(n, bool), np.ones(int(back.sum()), bool)])
     mats = np.asarray(material, dtype=str)
-    side_mat = mats if not back.any() else np.concatenate([mats, back_material[back]])
+    backs = np.asarray(back_material if back_material is not None else mats, dtype=str)
+    side_mat = mats if not back.any() else np.concatenate([mats, backs[back]])
     if not back.any() and not parts:
         return Sides(
             mesh, facet, is_back, side_mat, tangent, group_of, np.zeros(len(mesh.vertices), int)

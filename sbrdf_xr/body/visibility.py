@@ -12,7 +12,8 @@ Methods (:data:`METHODS`)
     Area-exact, to float rounding.  A point ``p`` of facet ``i`` (``N_i.d > 0``) is shadowed
     along the direction ``d`` iff the ray ``p + t d``, ``t > 0``, meets the surface.  On a
     closed surface the first hit enters the solid, so the occluders are the facets with
-    ``N_j.d < 0`` (on an open surface: every facet not edge-on); each is cut to its part in
+    ``N_j.d < 0``, and those with ``N_j.d > 0`` that are one-sided facets of an open
+    component (light meets their backs, which block it too); each is cut to its part in
     front of the plane of ``i`` (``N_i.(x - p_i) >= 0``) and projected along ``d`` onto that
     plane, ``x - d N_i.(x - p_i) / N_i.d`` (a parallel projection: the shadow volume of a
     triangle).  The shadows of every occluder along the Sun *and* the observer directions,
@@ -200,8 +201,9 @@ def supporting(mesh: trimesh.Trimesh, cache: dict[str, Any], tol: float) -> np.n
     """
     key = f"supporting:{tol!r}"
     if key not in cache:
-        try:
-            pts = np.asarray(mesh.convex_hull.vertices)
+        try:  # a flat (open) surface has a hull of no volume: trimesh divides by it
+            with np.errstate(invalid="ignore", divide="ignore"):
+                pts = np.asarray(mesh.convex_hull.vertices)
         except Exception:  # pragma: no cover - degenerate (flat) meshes
             pts = np.asarray(mesh.vertices)
         normals = np.asarray(mesh.face_normals)
@@ -251,10 +253,21 @@ def _plane_frames(mesh: trimesh.Trimesh, cache: dict[str, Any]) -> dict[str, Any
         "T2": np.ascontiguousarray(T2),
         "receiver": receiver,
         "eps": tol,
-        "watertight": bool(mesh.is_watertight) and bool(mesh.is_winding_consistent),
+        "open_facet": _open_facets(mesh),
     }
     cache["exact:frames"] = frames
     return frames
+
+
+def _open_facets(mesh: trimesh.Trimesh) -> np.ndarray:
+    """Facets that block light from behind too: one-sided facets of an open component (a
+    closed component is entered through a facet facing the light first, and a two-sided
+    facet's back is its own facet)."""
+    if mesh.is_watertight and mesh.is_winding_consistent:
+        return np.zeros(len(mesh.faces), dtype=bool)
+    from .sides import closed_facets
+
+    return np.ascontiguousarray(~closed_facets(mesh))
 
 
 def _geos_fraction(frames: dict[str, Any], i: int, dirs: np.ndarray) -> float:
@@ -271,7 +284,7 @@ def _geos_fraction(frames: dict[str, Any], i: int, dirs: np.ndarray) -> float:
         frames["E1"],
         frames["E2"],
         frames["T2"],
-        frames["watertight"],
+        frames["open_facet"],
         frames["eps"],
     )
     tri = shapely.Polygon(frames["T2"][i])
@@ -303,7 +316,7 @@ def _exact(
         frames["T2"],
         frames["receiver"],
         dirs,
-        frames["watertight"],
+        frames["open_facet"],
         frames["eps"],
     )
     for g, i in np.argwhere(np.isnan(frac)):

@@ -18,6 +18,8 @@ Modules
     meaning, and the reference rendered from them) and the built-in scenes.
 ``plan``, ``stages`` and ``spectral``
     The plan and its stages.
+``articulation``
+    Bodies with parts that turn: each rigid group evaluated in its own frame.
 ``reuse``
     What a plan computes from the tables, the spacecraft and the knobs alone (packed
     tables, merged facets), kept by content for the next plans.
@@ -31,6 +33,7 @@ Modules
 
 from ..errors import SceneError
 from . import (
+    articulation,
     builtin,
     effects,
     knobs,
@@ -45,7 +48,14 @@ from . import (
     starlink,
     sweep,
 )
-from .builtin import builtin_scene, builtin_scenes, resolve_scene
+from .articulation import Articulation, BoundGroup
+from .builtin import (
+    STARLINK_STAND_INS,
+    builtin_scene,
+    builtin_scenes,
+    resolve_scene,
+    starlink_materials,
+)
 from .effects import SPECTRAL_OUTPUTS, BlockInputs, Effect, Output, finish, reflected
 from .knobs import KNOBS, PRESETS, Knob, apply_preset, check_knob, knob_table
 from .plan import Estimate, Plan, PlannedOutput, Terms, compile_plan
@@ -72,7 +82,10 @@ __all__ = [
     "PRESETS",
     "QUATERNION_COMPONENTS",
     "SPECTRAL_OUTPUTS",
+    "STARLINK_STAND_INS",
+    "Articulation",
     "BlockInputs",
+    "BoundGroup",
     "Effect",
     "Estimate",
     "GridGeometry",
@@ -85,6 +98,7 @@ __all__ = [
     "SceneError",
     "Terms",
     "apply_preset",
+    "articulation",
     "builtin",
     "builtin_scene",
     "builtin_scenes",
@@ -113,6 +127,7 @@ __all__ = [
     "spectral",
     "stages",
     "starlink",
+    "starlink_materials",
     "starlink_scene",
     "sweep",
 ]

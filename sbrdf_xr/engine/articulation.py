@@ -84,40 +84,60 @@ def group_terms(terms: Terms) -> tuple[tuple[int, Terms], ...]:
     >>> [(g, sub.facet.tolist()) for g, sub in group_terms(t)]
     [(0, [0, 2]), (1, [1])]
     """
-    from .plan import Terms
-
     out = []
     assert terms.part is not None
+    fields = ("normal", "area", "material", "facet", "n_facets", "tangent", "part")
     for g in np.unique(terms.part):
         sel = terms.part == g
-        out.append(
-            (
-                int(g),
-                Terms(
-                    *(
-                        None if a is None else np.ascontiguousarray(a[sel])
-                        for a in (
-                            terms.normal,
-                            terms.area,
-                            terms.material,
-                            terms.facet,
-                            terms.n_facets,
-                            terms.tangent,
-                            terms.part,
-                        )
-                    )
-                ),
-            )
-        )
+        picked = {
+            f: None if getattr(terms, f) is None else np.ascontiguousarray(getattr(terms, f)[sel])
+            for f in fields
+        }
+        out.append((int(g), replace(terms, **picked)))  # type: ignore[arg-type]
     return tuple(out)
 
 
 @dataclass(frozen=True, eq=False)
 class Articulation:
-    """A plan's parts and the terms of each group (see the module docstring)."""
+    """A plan's parts and the terms of each group (see the module docstring).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.body.parts import Part, SunTracking
+    >>> art = Articulation((Part("p", [0], axis=[0, 0, 1.0], normal=[1.0, 0, 0],
+    ...                         law=SunTracking()),), ())
+    >>> R = art.rotations(np.array([[0.0, 1.0, 0.0]]), np.arange(1))
+    >>> (R[0, 0] @ [1.0, 0, 0]).round(12) + 0.0  # the normal turned onto the Sun
+    array([0., 1., 0.])
+    """
 
     parts: tuple[Part, ...]
     groups: tuple[tuple[int, Terms], ...]
+
+    def angles(self, to_sun: np.ndarray, index: np.ndarray) -> np.ndarray:
+        """Hinge angle of every part at every geometry [degree], (G, P)."""
+        out = np.empty((len(index), len(self.parts)))
+        for k, p in enumerate(self.parts):
+            out[:, k] = np.degrees(p.law.angles(to_sun, index, p))
+        return out
+
+    def coords(self, to_sun: np.ndarray, dims: tuple[str, ...]) -> dict[str, Any]:
+        """The cube's coordinates ``part`` (names) and ``part_angle`` (every geometry's
+        hinge angles [degree]) from ``to_sun`` (lead dims + (3,))."""
+        s = np.asarray(to_sun).reshape(-1, 3)
+        a = self.angles(s, np.arange(s.shape[0])).reshape(*np.shape(to_sun)[:-1], -1)
+        return {
+            "part": (
+                "part",
+                [p.name for p in self.parts],
+                {"units": "1", "long_name": "part name"},
+            ),
+            "part_angle": (
+                (*dims, "part"),
+                a,
+                {"units": "degree", "long_name": "hinge angle of the part (its pointing law)"},
+            ),
+        }
 
     def rotations(self, to_sun: np.ndarray, index: np.ndarray) -> np.ndarray:
         """Rotation of every part at every geometry, part -> bus frame, (G, P, 3, 3)."""
@@ -132,7 +152,16 @@ class Articulation:
 @dataclass(frozen=True, eq=False)
 class BoundGroup:
     """One group of an articulated plan on one block: its poses and the block's
-    shadowing fractions, shared by the groups (``memo``)."""
+    shadowing fractions, shared by the groups (``memo``).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.body.parts import hinge_rotation
+    >>> rot = hinge_rotation([0, 0, 1.0], [np.pi / 2])[:, None]  # (G=1, P=1, 3, 3)
+    >>> b = BoundGroup(None, 1, rot)
+    >>> b.to_bus(np.array([[1.0, 0.0, 0.0]])).round(12) + 0.0  # part x is bus y
+    array([[0., 1., 0.]])
+    """
 
     articulation: Articulation
     group: int
@@ -196,6 +225,18 @@ def articulated_sums(plan: Plan, block: BlockInputs, sl: slice) -> dict[str, np.
     """Every effect's sums on one block of an articulated plan, summed over the groups.
 
     ``sl`` is the block's slice of the plan's first dimension (for angle series).
+
+    Examples
+    --------
+    >>> from sbrdf_xr import Scene
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> from sbrdf_xr.testing import box_with_plate_spacecraft
+    >>> mats = {m: lambertian(0.5, [500.0], material=m) for m in ("bus", "cell", "backsheet")}
+    >>> x = [[0.0, 0.0, 1.0]]  # Sun and observer overhead: the top and the plate, head on
+    >>> plan = Scene(box_with_plate_spacecraft(parts=True), mats, to_sun=x, to_observer=x).plan()
+    >>> sums = articulated_sums(plan, plan.geometry.block(slice(0, 1)), slice(0, 1))
+    >>> round(float(sums["signal"][0, 0] * np.pi), 12)  # 1 m2 top + 1 m2 plate, albedo 0.5
+    1.0
     """
     art = plan.articulation
     per = plan.geometry.n_geometries // max(1, plan.n_lead)

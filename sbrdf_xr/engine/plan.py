@@ -444,18 +444,24 @@ def compile_plan(scene: Scene) -> Plan:
     index = {m: i for i, m in enumerate(used)}
     code = np.array([index[m] for m in raw["material"].tolist()], dtype=np.int64)
     order = np.argsort(code, kind="stable")
+    normal, area, material, facet, n_facets, tangent = (
+        readonly(a[order])
+        for a in (
+            raw["normal"],
+            raw["area"],
+            code,
+            raw["facet"],
+            raw["n_facets"],
+            raw["tangent"],
+        )
+    )
     terms = Terms(
-        *(
-            readonly(a[order])
-            for a in (
-                raw["normal"],
-                raw["area"],
-                code,
-                raw["facet"],
-                raw["n_facets"],
-                raw["tangent"],
-            )
-        ),
+        normal,
+        area,
+        material,
+        facet,
+        n_facets,
+        tangent,
         part=readonly(raw["part"][order]) if parts else None,
     )
     if parts:

@@ -208,6 +208,10 @@ def _template(plan: Plan) -> xr.Dataset:
         return plan.cache["template"]
     coords = plan.geometry.coords()
     coords["xyz"] = ("xyz", ["x", "y", "z"], attrs("xyz"))
+    if plan.articulation is not None:  # the hinge angle of every part at every geometry
+        sun = coords["to_sun"]
+        values = sun.values if isinstance(sun, xr.DataArray) else sun[1]
+        coords.update(plan.articulation.coords(values, plan.geometry.dims))
     dims = {d for o in plan.outputs for d in o.dims}
     if WAVELENGTH in dims:
         coords[WAVELENGTH] = (WAVELENGTH, plan.wavelength, attrs(WAVELENGTH))

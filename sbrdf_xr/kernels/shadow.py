@@ -160,13 +160,14 @@ def _shadow_polygon(
 
 
 @nb.njit(cache=True, nogil=True)
-def exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
+def exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, open_facet, eps_h):
     """Lit (and visible) fraction of every facet for every geometry, exactly.
 
     ``dirs`` (G, K, 3): K directions per geometry that must all be unobstructed.  For facet i
     and direction d (N_i.d > 0) a point p of the facet is shadowed iff the ray p + t d
     (t > 0) meets the surface; on a closed surface the first hit enters the solid, so the
-    occluders are the facets with N_j.d < 0 (every facet with N_j.d != 0 on an open surface),
+    occluders are the facets with N_j.d < 0, and also those with N_j.d > 0 where
+    ``open_facet[j]`` (a one-sided facet of an open surface blocks light from behind too),
     cut to their part in front of the plane of i and projected along d onto it.  The union of
     these convex polygons over the K directions, clipped to the facet, is its shadowed area,
     computed by inclusion-exclusion over convex intersections; facets past the work budget
@@ -195,7 +196,7 @@ def exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
     ...     [np.einsum("fvx,fx->fv", rel, E1), np.einsum("fvx,fx->fv", rel, E2)], axis=-1))
     >>> P0 = np.ascontiguousarray(tri[:, 0])
     >>> dirs = np.array([[[0.0, 0.0, 1.0]]])  # (G=1, K=1, 3)
-    >>> frac = exact_kernel(V, F, N, P0, E1, E2, T2, np.ones(4, bool), dirs, False, 1e-9)
+    >>> frac = exact_kernel(V, F, N, P0, E1, E2, T2, np.ones(4, bool), dirs, np.ones(4, bool), 1e-9)
     >>> print(np.round(frac, 6))
     [[0.75 0.25 1.   1.  ]]
     """
@@ -234,7 +235,7 @@ def exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
         starts = []
         itemss = []
         for k in range(K):
-            occ = (nd[k] < 0.0) if watertight else (nd[k] != 0.0)
+            occ = (nd[k] < 0.0) | ((nd[k] > 0.0) & open_facet)
             box, grid, start, items = _view_grid(dirs[g, k], V, F, occ)
             boxes.append(box)
             grids.append(grid)
@@ -341,7 +342,7 @@ def exact_kernel(V, F, N, P0, E1, E2, T2, receiver, dirs, watertight, eps_h):
 
 
 @nb.njit(cache=True, nogil=True)
-def facet_shadows(i, dirs, V, F, N, P0, E1, E2, T2, watertight, eps_h):
+def facet_shadows(i, dirs, V, F, N, P0, E1, E2, T2, open_facet, eps_h):
     """Every shadow polygon on facet i for the K directions ``dirs`` (K, 3), by testing every
     facet (no grid): vertices (n, 2) and CSR offsets.  For the GEOS fallback.
 
@@ -367,7 +368,7 @@ def facet_shadows(i, dirs, V, F, N, P0, E1, E2, T2, watertight, eps_h):
     ...     [np.einsum("fvx,fx->fv", rel, E1), np.einsum("fvx,fx->fv", rel, E2)], axis=-1))
     >>> P0 = np.ascontiguousarray(tri[:, 0])
     >>> dirs = np.array([[0.0, 0.0, 1.0]])  # (K=1, 3)
-    >>> xy, start = facet_shadows(0, dirs, V, F, N, P0, E1, E2, T2, False, 1e-9)
+    >>> xy, start = facet_shadows(0, dirs, V, F, N, P0, E1, E2, T2, np.ones(4, bool), 1e-9)
     >>> start.tolist()
     [0, 3]
     >>> print(np.round(xy, 6))
@@ -397,7 +398,7 @@ def facet_shadows(i, dirs, V, F, N, P0, E1, E2, T2, watertight, eps_h):
             if j == i:
                 continue
             ndj = N[j, 0] * d[0] + N[j, 1] * d[1] + N[j, 2] * d[2]
-            if (watertight and ndj >= 0.0) or ndj == 0.0:
+            if ndj == 0.0 or (ndj > 0.0 and not open_facet[j]):
                 continue
             nq = _shadow_polygon(
                 i,

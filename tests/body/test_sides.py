@@ -46,6 +46,7 @@ def plate_closed_form(s, o, area=2.0):
     return area * np.abs(ci * cr) * f * (front | back)
 
 
+@pytest.mark.filterwarnings("error::RuntimeWarning")
 @pytest.mark.parametrize("effects", [("sunlight",), ("sunlight", "shadowing")])
 @pytest.mark.parametrize("method", ["exact", "sampled"])
 def test_flat_plate_meets_its_closed_form_front_and_back(effects, method):

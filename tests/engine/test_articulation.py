@@ -73,6 +73,10 @@ def test_a_grid_sweep_turns_the_plate_per_geometry():
     np.testing.assert_allclose(
         cube.signal.values[..., 0].reshape(-1), bus_plus_tracking_plate(s, o), rtol=0, atol=TOL
     )
+    # the cube says where the plate turned: the angle that faces it to the Sun
+    theta = np.degrees(tracking_angle([1.0, 0, 0], [0, 0, 1.0], s)).reshape(20, 3)
+    np.testing.assert_allclose(cube.part_angle.sel(part="array").values, theta, atol=1e-9)
+    assert cube.part_angle.attrs["units"] == "degree"
 
 
 def rigid_pose(angle):
@@ -212,3 +216,34 @@ to_observer = [[0, 0.8, 0.6], [0.0, 0.6, -0.8]]
     (tmp_path / "bad.toml").write_text(bad)
     with pytest.raises(SceneError, match="law 'spin'; allowed: fixed, series, sun-tracking"):
         load_scene(tmp_path / "bad.toml")
+
+
+def test_other_sources_see_the_plate_where_the_sun_turned_it():
+    """Earthshine: the plate tracks the Sun, the Earth lights it; the signal is the closed
+    form with the Earth in the Sun's place and the plate still facing the Sun, times the
+    constant irradiance ratio."""
+    s, o = random_pairs(60, 5)
+    e, _ = random_pairs(60, 6)
+    scene = Scene(
+        box_with_plate_spacecraft(parts=True),
+        MATS,
+        to_sun=s,
+        to_observer=o,
+        to_earth=e,
+        effects=("sunlight", "earthshine"),
+    )
+    plan = scene.plan()
+    cube = simulate(plan)
+    bus = (np.clip(e @ BOX_NORMALS.T, 0, None) * np.clip(o @ BOX_NORMALS.T, 0, None)).sum(1)
+    n = unit(np.column_stack([np.zeros(len(s)), s[:, 1], s[:, 2]]))
+    ci, cr = (e * n).sum(1), (o * n).sum(1)
+    plate = np.where(
+        (ci > 0) & (cr > 0),
+        ci * cr * ALBEDO["cell"],
+        np.where((ci < 0) & (cr < 0), ci * cr * ALBEDO["backsheet"], 0.0),
+    )
+    ratio = plan.effect_params["earthshine"]["ratio"]
+    expected = ratio * (bus * ALBEDO["bus"] + plate) / np.pi
+    np.testing.assert_allclose(
+        cube.signal_earthshine.values[:, 0], expected, rtol=0, atol=TOL * ratio
+    )
