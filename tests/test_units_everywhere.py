@@ -208,6 +208,7 @@ def unit_arguments() -> dict[tuple[str, str], str]:
 WL = np.array([500.0, 600.0, 700.0])  # [nm]
 NORMAL, TO_SUN, TO_OBS = [0.0, 0.0, 1.0], [0.5, 0.0, 1.0], [-0.4, 0.1, 1.0]
 T0 = np.datetime64("2024-03-17T01:20:00", "ns")
+_T2 = np.array(["2024-03-17T01:20:00", "2024-03-17T01:20:10"], dtype="datetime64[ns]")
 
 
 def _rs() -> dict[str, Any]:
@@ -539,7 +540,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         self=_cube().sbrdf, bands=["V", "R"], range_km=1000.0
     ),
     "sbrdf_xr.observing.observation.Observation.next_pass": lambda: dict(
-        self=_observation(), days=0.5
+        self=_observation(), days=0.5, twilight_deg=-12.0
     ),
     "sbrdf_xr.observing.tumble.Tumble.from_spacecraft": lambda: dict(
         spacecraft=_box(), density_kg_m3=100.0, omega_deg_s=(1.0, 2.0, 3.0)
@@ -713,7 +714,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         time="observation_time",
         elevation="satellite_altitude",
         azimuth="satellite_azimuth",
-        height_km="satellite_height",
+        height_column="satellite_height",
         time_zone="UTC",
         min_elevation=25.0,
         on_bad="drop",
@@ -754,6 +755,45 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         position_km=np.array([[7000.0, 0.0, 0.0]]),
         velocity_km_s=np.array([[0.0, 7.5, 0.0]]),
         sun_km=np.array([[1.496e8, 0.0, 0.0]]),
+    ),
+    "sbrdf_xr.observing.ephemeris.Ephemeris.from_states": lambda: dict(
+        times=_T2,
+        position_km=[[7000.0, 0.0, 0.0], [7000.0, 75.0, 0.0]],
+        velocity_km_s=[[0.0, 7.5, 0.0], [0.0, 7.5, 0.0]],
+    ),
+    "sbrdf_xr.observing.ephemeris.to_gcrs": lambda: dict(
+        frame="ITRF",
+        times=_T2[:1],
+        position_km=[[7000.0, 0.0, 0.0]],
+        velocity_km_s=[[0.0, 0.0, 7.5]],
+    ),
+    "sbrdf_xr.observing.passes.visible_passes": lambda: dict(
+        source=_observation().orbit,
+        site=_observation().site,
+        start="2024-03-17T01:18:00",
+        stop="2024-03-17T01:24:00",
+        min_elevation_deg=15.0,
+        step_s=30.0,
+        cross_section_m2=2.0,
+    ),
+    "sbrdf_xr.observing.tracking.TrackingTable": lambda: dict(
+        site=_observation().site,
+        times=_T2,
+        elevation_deg=[90.0, 90.0],
+        azimuth_deg=[0.0, 30.0],
+        range_km=[500.0, 570.0],
+        height_km=[501.111, 571.111],  # at the zenith of a site 1111 m up
+        max_gap_s=30.0,
+    ),
+    "sbrdf_xr.observing.tracking.range_for_height": lambda: dict(
+        site=_observation().site, direction_itrs=[[1.0, 0.0, 0.0]], height_km=[550.0]
+    ),
+    "sbrdf_xr.observing.tracking.topocentric_to_gcrs": lambda: dict(
+        site=_observation().site,
+        times=_T2,
+        elevation_deg=[30.0, 40.0],
+        azimuth_deg=[10.0, 20.0],
+        range_km=[900.0, 800.0],
     ),
     # --- photometry
     "sbrdf_xr.photometry.atmosphere.airmass": lambda: dict(elevation=[30.0, 60.0]),
@@ -835,6 +875,11 @@ EXEMPT[("sbrdf_xr.body.starlink.starlink_v15", "limits")] = (
     "handed to SunTracking(limits=...), whose case checks the conversion (a Spacecraft has "
     "no equality to compare the results by)"
 )
+for _arg in ("ra_deg", "dec_deg"):
+    EXEMPT[("sbrdf_xr.observing.tracking.TrackingTable", _arg)] = (
+        "exclusive with elevation_deg/azimuth_deg, whose case runs the same conversion; "
+        "tests/observing/test_tracking.py converts RA/Dec Quantities"
+    )
 EXEMPT[("sbrdf_xr.bench.suite.bench_geometry", "step_s")] = (
     "a benchmark's problem size: the timing tools take bare numbers"
 )
@@ -1051,6 +1096,7 @@ SLOW = {
     "sbrdf_xr.invert._studies.spin_recovery",
     "sbrdf_xr.plot.cube.cube_figure",
     "sbrdf_xr.plot.cube.rotation_figure",
+    "sbrdf_xr.observing.passes.visible_passes",
     "sbrdf_xr.plot.cube.observation_figure",
 }
 #: Cases whose result is a figure or a timing: the Quantity must be accepted, the
@@ -1067,6 +1113,7 @@ NOT_COMPARED = {
 
 #: What of a result is compared (a study's wall times are not; a function's values are).
 POST = {
+    "sbrdf_xr.observing.ephemeris.Ephemeris.from_states": lambda e: e.state(_T2),
     "sbrdf_xr.invert._studies.spin_recovery": lambda ds: ds.drop_vars("seconds"),
     "sbrdf_xr.invert._joint_study.observation_recovery": lambda ds: ds.drop_vars(
         ["seconds_per_fit", "simulate_seconds", "fit_to_simulate"]

@@ -9,6 +9,12 @@ simulated, written by :func:`sbrdf_xr.store.write` and drawn with ``--plot``::
         --start 2024-03-17T01:20:00 --duration 300 --step 1 \\
         --attitude spin --spin-axis 0.3,0.4,0.866 --period 90 -o pass.nc --plot pass.png
 
+Instead of elements and a window, ``--tracking FILE`` takes an observer's tracking table
+(:mod:`sbrdf_xr.observing.tracking_io`: a CSV of ``time``, ``elevation``, ``azimuth`` and
+``range_km`` or ``height_km`` at ``--site``, or with ``--tracking-format pomenis`` the
+Pomenis Starlink table at its own site); ``--elements`` also takes a CCSDS OEM file and
+``--series`` a CCSDS AEM.
+
 The attitude laws are those of :mod:`sbrdf_xr.observing.attitude`: ``inertial``
 (``--quaternion``), ``nadir`` (``--yaw``, ``--nadir-axis``, ``--velocity-axis``),
 ``sun-pointing`` (``--sun-axis``, ``--secondary-axis``, ``--secondary-target``),
@@ -75,10 +81,27 @@ def add_observe_parser(sub: Any, mesh_options: Any) -> argparse.ArgumentParser:
     g = po.add_argument_group("orbit and site")
     g.add_argument(
         "--elements",
-        required=True,
         metavar="FILE|NAME",
-        help="a TLE file (2- or 3-line sets), an OMM file (.json, .xml, .csv) or "
-        "a catalog orbit ('sbrdf-xr catalog list --kind orbit')",
+        help="a TLE file (2- or 3-line sets), an OMM file (.json, .xml, .csv), a CCSDS "
+        "OEM file (states) or a catalog orbit ('sbrdf-xr catalog list --kind orbit')",
+    )
+    g.add_argument(
+        "--tracking",
+        metavar="FILE",
+        help="instead of --elements and the window: an observer's tracking table (CSV: "
+        "columns time, elevation, azimuth [degree] and range_km or height_km; "
+        "--tracking-format pomenis: the Pomenis Starlink table at its own site)",
+    )
+    g.add_argument(
+        "--tracking-format",
+        choices=("csv", "pomenis"),
+        default="csv",
+        help="the tracking table's layout (default csv)",
+    )
+    g.add_argument(
+        "--utc",
+        action="store_true",
+        help="tracking csv: times without a time zone are UTC",
     )
     g.add_argument(
         "--satellite",
@@ -111,7 +134,7 @@ def add_observe_parser(sub: Any, mesh_options: Any) -> argparse.ArgumentParser:
         help="the Earth that casts the shadow (default wgs84)",
     )
     w = po.add_argument_group("UTC window")
-    w.add_argument("--start", required=True, metavar="UTC", help="first time, ISO 8601 UTC")
+    w.add_argument("--start", metavar="UTC", help="first time, ISO 8601 UTC (not with --tracking)")
     w.add_argument("--stop", metavar="UTC", help="last time (or --duration)")
     w.add_argument("--duration", type=float, metavar="S", help="length of the window [s]")
     w.add_argument("--step", type=float, default=1.0, metavar="S", help="time step [s]")
@@ -187,7 +210,9 @@ def add_observe_parser(sub: Any, mesh_options: Any) -> argparse.ArgumentParser:
         metavar="KG_M3",
         help="tumble: inertia of the mesh filled at this uniform density",
     )
-    a.add_argument("--series", metavar="FILE", help="series: quaternions over time (.csv, .nc)")
+    a.add_argument(
+        "--series", metavar="FILE", help="series: quaternions over time (.csv, .nc, CCSDS .aem)"
+    )
     s = po.add_argument_group("spacecraft and output")
     s.add_argument(
         "--spacecraft",
@@ -279,7 +304,8 @@ def attitude_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     if kind == "series":
         if not args.series:
             raise AttitudeError("--attitude series: give --series FILE (.csv or .nc)")
-        return law.law_from_dict({"law": "quaternion_series", "path": args.series})
+        kind_of = "aem" if Path(args.series).suffix.lower() == ".aem" else "quaternion_series"
+        return law.law_from_dict({"law": kind_of, "path": args.series})
     initial: Any = (0.0, 0.0, 0.0, 1.0)
     if args.initial:
         if kind == "spin" and args.initial in ("nadir", "sun-pointing"):
@@ -313,6 +339,59 @@ def attitude_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
         )
 
 
+def _is_oem(path: Path) -> bool:
+    """A CCSDS OEM file (by its suffix or its first keyword), not elements."""
+    if path.suffix.lower() == ".oem":
+        return True
+    with contextlib.suppress(OSError, UnicodeDecodeError):
+        head = path.read_text(encoding="utf-8")[:400]
+        return "CCSDS_OEM_VERS" in head or "<oem" in head
+    return False
+
+
+def _tracking_observation(args: argparse.Namespace, spacecraft: Any) -> Any:
+    """The observation of ``--tracking``: the table's times, orbit and (pomenis) site."""
+    from ..observing.observe import Site
+    from ..observing.tracking_io import tracking_from_dict
+
+    given = [f for f in ("elements", "start", "stop", "duration") if getattr(args, f)]
+    if given:
+        raise ValidationError(
+            f"--tracking gives the orbit and the times; remove --{', --'.join(given)}"
+        )
+    spec: dict[str, Any] = {"path": args.tracking, "format": args.tracking_format}
+    site = None
+    if args.tracking_format == "csv":
+        if args.site is not None:
+            site = Site.from_catalog(args.site)
+        elif args.lat is not None and args.lon is not None:
+            site = Site(args.lat, args.lon, args.height, name=f"{args.lat:g}, {args.lon:g}")
+        else:
+            raise ValidationError("--tracking csv: give the site (--site or --lat/--lon)")
+        header = _csv_header(Path(args.tracking))
+        kind = "range_km" if "range_km" in header else "height_km"
+        spec.update(
+            {kind.replace("_km", "_column"): kind, "time_zone": "UTC" if args.utc else None}
+        )
+    elif args.site is not None or args.lat is not None:
+        raise ValidationError("--tracking-format pomenis has its own site; remove the site")
+    table = tracking_from_dict(spec, site)
+    return table.observation(
+        attitude_of(args, spacecraft),
+        min_elevation_deg=args.min_elevation,
+        earth=args.earth,
+        name=args.name or f"{table.name} from {table.site.name}",
+    )
+
+
+def _csv_header(path: Path) -> list[str]:
+    with contextlib.suppress(OSError, UnicodeDecodeError), open(path, encoding="utf-8") as f:
+        for line in f:
+            if line.strip() and not line.lstrip().startswith("#"):
+                return [c.strip() for c in line.split(",")]
+    return []
+
+
 def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     """The :class:`~sbrdf_xr.observing.observation.Observation` of the ``observe`` options.
 
@@ -330,10 +409,20 @@ def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     import numpy as np
 
     from ..observing.observe import Observation, Orbit, Site, times
+    from ..observing.oem_reader import read_oem
     from ..observing.timescales import to_datetime64
 
+    if args.tracking:
+        return _tracking_observation(args, spacecraft)
+    if not args.elements or not args.start:
+        raise ValidationError("give --elements and --start (or a --tracking table)")
     spec = args.elements
-    if Path(spec).is_file():
+    orbit: Any
+    if Path(spec).is_file() and _is_oem(Path(spec)):
+        if args.satellite:
+            raise ValidationError("--satellite picks from an element file, not from an OEM")
+        orbit = read_oem(spec)
+    elif Path(spec).is_file():
         orbit = Orbit.from_file(spec, args.satellite)
     else:
         if args.satellite:

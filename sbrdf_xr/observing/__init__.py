@@ -70,6 +70,7 @@ from .ephemeris import Ephemeris
 from .frames import Context, triad
 from .observation import ATTRS, COMPONENT, TIME, UNOBSERVABLE, Observation
 from .observe import canx1_pass, observation_from_dict
+from .oem_reader import read_oem
 from .orbits import (
     AIRMASS_MODELS,
     AU_KM,
@@ -153,6 +154,7 @@ __all__ = [
     "orbits",
     "passes",
     "read_aem",
+    "read_oem",
     "read_pomenis",
     "read_tracking_table",
     "series",

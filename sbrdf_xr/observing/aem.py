@@ -45,7 +45,8 @@ def _quaternions(seg: Any, where: str) -> tuple[np.ndarray, np.ndarray]:
     if kind != "QUATERNION":
         raise EphemerisError(f"{where}: ATTITUDE_TYPE {kind}; only QUATERNION is read")
     states = list(getattr(seg.data, "attitude_state", []) or [])
-    rows, epochs = [], []
+    rows: list[list[float]] = []
+    epochs: list[Any] = []
     for s in states:
         qs = s.quaternion_state
         if qs is None or qs.quaternion is None:

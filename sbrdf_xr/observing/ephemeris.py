@@ -12,13 +12,14 @@ times an :class:`~sbrdf_xr.observing.observation.Observation` asks for, like an
   derivative gives the velocity.  A segment of one sample has no velocity (NaN): the
   laws that need it (nadir with its along-track axis) refuse it by name.  The error of
   that derivative is measured against SGP4's velocity in the tests (see
-  ``tests/observing/test_ephemeris.py``).
-* :meth:`Ephemeris.from_oem`: a CCSDS Orbit Ephemeris Message (CCSDS 502.0-B-3), KVN or
-  XML, read by the ``oem`` package, which also interpolates it as the message states
-  (``INTERPOLATION`` Lagrange or Hermite of ``INTERPOLATION_DEGREE``; Lagrange of degree 5
-  when the message says nothing).  Segments are kept apart: a time between two segments
-  is refused (:class:`~sbrdf_xr.errors.EphemerisError`), as are epochs out of order and a
-  step inside a segment more than ``max_step_factor`` times the segment's median step
+  ``tests/observing/test_tracking.py``).
+* :func:`~sbrdf_xr.observing.oem_reader.read_oem`: a CCSDS Orbit Ephemeris Message
+  (CCSDS 502.0-B-3), KVN or XML, read by the ``oem`` package, which also interpolates it
+  as the message states (``INTERPOLATION`` Lagrange or Hermite of
+  ``INTERPOLATION_DEGREE``; Lagrange of degree 5 when the message says nothing).
+  Segments are kept apart: a time between two segments is refused
+  (:class:`~sbrdf_xr.errors.EphemerisError`), as are epochs out of order and a step
+  inside a segment more than ``max_step_factor`` times the segment's median step
   (a gap).
 
 Frames (``REF_FRAME``): ``GCRF`` and ``ICRF`` (the GCRS axes), ``EME2000`` (rotated by
@@ -33,7 +34,6 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from itertools import pairwise
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -43,7 +43,7 @@ from ..errors import EphemerisError
 from ..units import to_unit
 from .timescales import check_times, skyfield_time
 
-__all__ = ["FRAMES", "TIME_SYSTEMS", "Ephemeris", "to_gcrs"]
+__all__ = ["FRAMES", "TIME_SYSTEMS", "Ephemeris", "skyfield_frame", "to_gcrs"]
 
 
 class _Bias:
@@ -56,7 +56,18 @@ class _Bias:
         return ICRS_to_J2000
 
 
-def _frame(name: str) -> Any:
+def skyfield_frame(name: str) -> Any:
+    """The skyfield frame of a CCSDS ``REF_FRAME`` name (None for the GCRS axes).
+
+    Examples
+    --------
+    >>> skyfield_frame("GCRF") is None, type(skyfield_frame("ITRF2014")).__name__
+    (True, 'itrs')
+    >>> skyfield_frame("MOD")
+    Traceback (most recent call last):
+        ...
+    sbrdf_xr.errors.EphemerisError: reference frame 'MOD': allowed: GCRF, ICRF, EME2000, ITRF, TEME
+    """
     from skyfield.framelib import itrs
     from skyfield.sgp4lib import TEME
 
@@ -109,7 +120,7 @@ def to_gcrs(
     r = np.asarray(to_unit(position_km, "km", "position_km"), dtype=np.float64).reshape(-1, 3)
     v = np.asarray(to_unit(velocity_km_s, "km / s", "velocity_km_s"), dtype=np.float64)
     v = v.reshape(-1, 3)
-    fr = _frame(frame)
+    fr = skyfield_frame(frame)
     if fr is None:
         return r.copy(), v.copy()
     t = skyfield_time(t64)
@@ -164,7 +175,7 @@ def _tabulated(
 class Ephemeris:
     """A spacecraft's GCRS states from data (tabulated states, a tracking table or an OEM).
 
-    Build with :meth:`from_states` or :meth:`from_oem` (or
+    Build with :meth:`from_states`, :func:`~sbrdf_xr.observing.oem_reader.read_oem` (or
     :meth:`sbrdf_xr.observing.tracking.TrackingTable.ephemeris`); an
     :class:`~sbrdf_xr.observing.observation.Observation` takes it in place of an
     :class:`~sbrdf_xr.observing.orbits.Orbit`.
@@ -248,7 +259,7 @@ class Ephemeris:
                 raise EphemerisError(
                     f"{name}: velocities must be finite, shape {r.shape}; got {v.shape}"
                 )
-        fr = _frame(frame)
+        fr = skyfield_frame(frame)
         if fr is not None:
             if v is None:
                 raise EphemerisError(
@@ -266,43 +277,35 @@ class Ephemeris:
             )
         return cls(name, spans, _tabulated(t64, r, v, segs), provenance, method)
 
-    @classmethod
-    def from_oem(cls, path: str | Path, *, max_step_factor: float = 10.0) -> Ephemeris:
-        """An ephemeris from a CCSDS OEM file (KVN or XML), read and interpolated by ``oem``.
-
-        Parameters
-        ----------
-        path : str or Path
-        max_step_factor : float
-            A step between two states of a segment longer than this many times the
-            segment's median step is a gap [1].
+    def check_covers(self, times: ArrayLike) -> NDArray[np.datetime64]:
+        """The UTC ``times`` as datetime64[ns], checked to lie in a segment.
 
         Raises
         ------
         EphemerisError
-            For an unreadable file, states out of order, a gap, an unknown frame or time
-            system, or a centre other than the Earth.
+            When a time lies outside every segment (the spans are listed).
 
         Examples
         --------
-        >>> import tempfile
-        >>> from sbrdf_xr.observing.ephemeris import Ephemeris
-        >>> path = Path(tempfile.mkdtemp()) / "demo.oem"
-        >>> rows = [f"2024-03-17T01:20:{s:02d} {7000.0:.3f} {7.5 * s:.3f} 0 0 7.5 0"
-        ...         for s in range(0, 60, 10)]
-        >>> _ = path.write_text("\\n".join([
-        ...     "CCSDS_OEM_VERS = 2.0", "CREATION_DATE = 2024-03-17T00:00:00",
-        ...     "ORIGINATOR = DEMO", "META_START", "OBJECT_NAME = DEMO", "OBJECT_ID = 1",
-        ...     "CENTER_NAME = EARTH", "REF_FRAME = GCRF", "TIME_SYSTEM = UTC",
-        ...     "START_TIME = 2024-03-17T01:20:00", "STOP_TIME = 2024-03-17T01:20:50",
-        ...     "META_STOP", *rows, ""]))
-        >>> eph = Ephemeris.from_oem(path)
-        >>> eph.state(np.array(["2024-03-17T01:20:05"], dtype="datetime64[ns]"))[0].round(6)
-        array([[7000. ,   37.5,    0. ]])
+        >>> t = np.array(["2024-03-17T01:20:00", "2024-03-17T01:20:10"], dtype="datetime64[ns]")
+        >>> eph = Ephemeris.from_states(t, [[7000.0, 0.0, 0.0], [7000.0, 75.0, 0.0]],
+        ...                             [[0.0, 7.5, 0.0], [0.0, 7.5, 0.0]], name="demo")
+        >>> eph.check_covers(t[:1])
+        array(['2024-03-17T01:20:00.000000000'], dtype='datetime64[ns]')
         """
-        from .oem_reader import read_oem
-
-        return read_oem(cls, path, max_step_factor)
+        t = check_times(times)
+        covered = np.zeros(t.size, dtype=bool)
+        for a, b in self.spans:
+            covered |= (t >= a) & (t <= b)
+        if not covered.all():
+            bad = t[~covered][0]
+            shown = ", ".join(f"{a} .. {b}" for a, b in self.spans[:5])
+            more = f" (and {len(self.spans) - 5} more)" if len(self.spans) > 5 else ""
+            raise EphemerisError(
+                f"{self.name}: time {bad} is outside the ephemeris ({(~covered).sum()} of "
+                f"{t.size} times are); it covers {shown}{more}"
+            )
+        return t
 
     def state(self, times: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """GCRS position [km] and velocity [km s-1] at UTC ``times``, (n, 3) each.
@@ -322,18 +325,7 @@ class Ephemeris:
             ...
         sbrdf_xr.errors.EphemerisError: demo: time 2024-03-17T01:20:11.000000000 is outside ...
         """
-        t = check_times(times)
-        covered = np.zeros(t.size, dtype=bool)
-        for a, b in self.spans:
-            covered |= (t >= a) & (t <= b)
-        if not covered.all():
-            bad = t[~covered][0]
-            shown = ", ".join(f"{a} .. {b}" for a, b in self.spans[:5])
-            more = f" (and {len(self.spans) - 5} more)" if len(self.spans) > 5 else ""
-            raise EphemerisError(
-                f"{self.name}: time {bad} is outside the ephemeris ({(~covered).sum()} of "
-                f"{t.size} times are); it covers {shown}{more}"
-            )
+        t = self.check_covers(times)
         return self.evaluate(t)
 
     def attrs(self) -> dict[str, Any]:

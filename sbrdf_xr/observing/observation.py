@@ -118,19 +118,23 @@ def _sun_from_spacecraft(t64: np.ndarray, r: np.ndarray, v: np.ndarray) -> np.nd
 
     skyfield's geocentric apparent Sun (light time, aberration by the Earth's velocity,
     deflection) on knots every :data:`~sbrdf_xr.observing.timescales.KNOT_S`, cubic-spline
-    interpolated, moved to the spacecraft (``- r``) and aberrated by its geocentric
-    velocity ``v`` to first order (``u' = u + b - u (u.b)``, ``b = v/c``).  Against
-    skyfield's own ``(earth + satellite).at(t).observe(sun).apparent()`` the direction
-    differs by the cross term of the two aberrations, ``|v_earth| |v| / c^2 ~ 3e-9 rad``
+    interpolated (or at every time when the times are fewer than the knots), moved to
+    the spacecraft (``- r``) and aberrated by its geocentric velocity ``v`` to first
+    order (``u' = u + b - u (u.b)``, ``b = v/c``).  Against skyfield's own
+    ``(earth + satellite).at(t).observe(sun).apparent()`` the direction differs by the
+    cross term of the two aberrations, ``|v_earth| |v| / c^2 ~ 3e-9 rad``
     (0.6 mas).
     """
     from scipy.interpolate import CubicSpline
 
     _, eph = skyfield_data()
     secs, knots = spline_knots(t64)
-    tk = skyfield_utc(t64[0] + (knots * 1e9).astype("timedelta64[ns]"))
-    sun_k = eph["earth"].at(tk).observe(eph["sun"]).apparent().position.km.T
-    sun_geo = CubicSpline(knots, sun_k, axis=0)(secs)
+    if knots.size >= t64.size:  # sparse times (a tracking table over months): direct
+        sun_geo = eph["earth"].at(skyfield_utc(t64)).observe(eph["sun"]).apparent().position.km.T
+    else:
+        tk = skyfield_utc(t64[0] + (knots * 1e9).astype("timedelta64[ns]"))
+        sun_k = eph["earth"].at(tk).observe(eph["sun"]).apparent().position.km.T
+        sun_geo = CubicSpline(knots, sun_k, axis=0)(secs)
     rel = sun_geo - r
     d = np.linalg.norm(rel, axis=1, keepdims=True)
     u = rel / d
@@ -218,7 +222,7 @@ class Observation:
     array([75.85, 75.93, 75.55])
     """
 
-    orbit: Orbit
+    orbit: Orbit | Ephemeris
     site: Site
     times: Any
     attitude: Any = None
@@ -252,6 +256,7 @@ class Observation:
                 f"min_elevation_deg: must lie in [-90, 90], got {self.min_elevation_deg}"
             )
         if isinstance(self.orbit, Ephemeris):
+            self.orbit.check_covers(t)
             return
         epoch = self.orbit.epoch
         gap = np.abs(t[[0, -1]] - epoch).max().astype(np.int64) / 86400e9
@@ -488,22 +493,29 @@ class Observation:
             ds.attrs["unobservable"] = "; ".join(reasons)
         return ds
 
-    def next_pass(self, days: float = 3.0) -> str:
-        """When the object next rises above ``min_elevation_deg`` after the first time.
+    def next_pass(self, days: float = 3.0, twilight_deg: float = -12.0) -> str:
+        """When the object next rises above ``min_elevation_deg``, and whether it can be seen.
 
         From skyfield's :meth:`~skyfield.sgp4lib.EarthSatellite.find_events` over
-        ``days`` from the first time of the observation.
+        ``days`` from the first time of the observation; each pass is then sampled every
+        10 s for the Sun: visible where the object is sunlit (half the solar disc or
+        more) and the site's Sun is below ``twilight_deg``.  When the next pass is not
+        visible, the next visible one is named.  The table of passes, with refined
+        edges, is :func:`sbrdf_xr.observing.passes.visible_passes`.
 
         Parameters
         ----------
         days : float
             How far ahead to look [day]; a Quantity is converted.
+        twilight_deg : float
+            Site Sun elevation below which the sky is dark enough [degree] (nautical
+            twilight by default).
 
         Returns
         -------
         str
             ``"it rises above 0 deg at ... UTC (highest ... deg at ... UTC, sets at ...
-            UTC)"``, or that it does not within ``days``.
+            UTC); visible ..."``, or that it does not within ``days``.
 
         Examples
         --------
@@ -512,11 +524,15 @@ class Observation:
         ...                   times("2024-03-17T01:20:00", "2024-03-17T01:25:00", 60.0))
         >>> print(obs.next_pass())  # doctest: +NORMALIZE_WHITESPACE
         it next rises above 0 deg at 2024-03-17T06:13:16 UTC (highest 22.0 deg at
-        2024-03-17T06:20:04 UTC, sets at 2024-03-17T06:26:51 UTC)
+        2024-03-17T06:20:04 UTC, sets at 2024-03-17T06:26:51 UTC); visible from
+        2024-03-17T06:24:46 to 2024-03-17T06:26:46 UTC
         """
         from .timescales import skyfield_utc
 
+        if isinstance(self.orbit, Ephemeris):
+            return "sbrdf_xr.observing.passes.visible_passes finds the passes of an ephemeris"
         days = float(to_unit(days, "day", "days"))
+        twilight_deg = float(to_unit(twilight_deg, "deg", "twilight_deg"))
         t64 = np.array([self.times[0], self.times[0] + np.timedelta64(round(days * 86400), "s")])
         t0, t1 = skyfield_utc(t64)
         when, kind = self.orbit.satellite.find_events(
@@ -538,22 +554,54 @@ class Observation:
             alt = self._altitude_at(when[kinds.index(1, start)])
             text += f" (highest {alt:.1f} deg at {culm} UTC"
             text += f", sets at {sets} UTC)" if sets is not None else ")"
-        return text
+        rises = [i for i in range(start, len(kinds)) if kinds[i] == 0]
+        for n, i in enumerate(rises):
+            end = next((stamps[j] for j in range(i + 1, len(kinds)) if kinds[j] == 2), None)
+            seen, why = self._visible(stamps[i], end or str(t64[1]), twilight_deg)
+            if seen and n == 0:
+                return text + f"; visible {seen}"
+            if n == 0:
+                text += f"; not visible ({why})"
+            elif seen:
+                return text + f"; the next visible pass rises at {stamps[i]} UTC (visible {seen})"
+        return text + f"; no visible pass within {days:g} days"
+
+    def _visible(self, start: str, stop: str, twilight_deg: float) -> tuple[str, str]:
+        """When a pass is visible (sunlit, site dark) on a 10-s grid, else why not."""
+        from .timescales import times
+
+        grid = times(start, stop, 10.0)
+        law = _att.Inertial((0.0, 0.0, 0.0, 1.0))
+        obs = Observation(
+            self.orbit, self.site, grid, law, min_elevation_deg=-90.0, earth=self.earth
+        )
+        g = obs.geometry(on_unobservable="keep")
+        lit = g.sunlit_fraction.values >= 0.5
+        dark = g.site_sun_elevation.values < twilight_deg
+        ok = np.flatnonzero(lit & dark)
+        if ok.size:
+            a, b = (str(grid[k].astype("datetime64[s]")) for k in (ok[0], ok[-1]))
+            return f"from {a} to {b} UTC", ""
+        if not dark.any():
+            sun = float(g.site_sun_elevation.values.min())
+            return "", f"the site's Sun is at {sun:.1f} deg, above {twilight_deg:g} deg"
+        return "", "in the Earth's shadow"
 
     def _altitude_at(self, t: Any) -> float:
-        topo = (self.orbit.satellite - self.site.position).at(t)
+        sat = getattr(self.orbit, "satellite", None)  # an Orbit: only it has find_events
+        topo = (sat - self.site.position).at(t)
         return float(topo.altaz()[0].degrees)
 
     def _attrs(self) -> dict[str, Any]:
         import skyfield
         import skyfield_data
 
-        eph = isinstance(self.orbit, Ephemeris)
+        orbit = self.orbit
         out = {
             "observation": self.name,
             "orbit_name": self.orbit.name,
-            "tle_line1": "" if eph else self.orbit.line1,
-            "tle_line2": "" if eph else self.orbit.line2,
+            "tle_line1": orbit.line1 if isinstance(orbit, Orbit) else "",
+            "tle_line2": orbit.line2 if isinstance(orbit, Orbit) else "",
             "orbit_provenance": self.orbit.provenance,
             "site_name": self.site.name,
             "site_latitude": self.site.latitude_deg,
@@ -585,7 +633,7 @@ class Observation:
             ),
             "airmass_model": self.airmass_model,
         }
-        if eph:
+        if isinstance(orbit, Ephemeris):
             del out["tle_line1"], out["tle_line2"]
-            out.update(self.orbit.attrs())
+            out.update(orbit.attrs())
         return out

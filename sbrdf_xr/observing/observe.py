@@ -23,6 +23,7 @@ from . import attitude as _att
 from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, disc_overlap_fraction, sunlit_fraction
 from .ephemeris import Ephemeris
 from .observation import ATTRS, TIME, Observation
+from .oem_reader import read_oem
 from .orbits import (
     AIRMASS_MODELS,
     AU_KM,
@@ -127,7 +128,7 @@ def observation_from_dict(
 
     Keys: the orbit as ``orbit`` (a catalog name), ``tle = [line1, line2]`` (or
     ``tle_line1``/``tle_line2``), ``omm`` (a path or a table), ``oem`` (a CCSDS OEM file,
-    :meth:`~sbrdf_xr.observing.ephemeris.Ephemeris.from_oem`) or ``tracking`` (an
+    :func:`~sbrdf_xr.observing.oem_reader.read_oem`) or ``tracking`` (an
     observer's table, :func:`~sbrdf_xr.observing.tracking_io.tracking_from_dict`, which
     also gives the times); ``site`` as a catalog name
     or a table ``{latitude_deg, longitude_deg, height_m, name}``; times as ``start``,
@@ -189,7 +190,7 @@ def observation_from_dict(
         tracking = tracking_from_dict(table["tracking"], site_given, base)
         orbit: Orbit | Ephemeris = tracking.ephemeris()
     elif "oem" in table:
-        orbit = Ephemeris.from_oem(resolve(table["oem"]))
+        orbit = read_oem(resolve(table["oem"]))
     elif "orbit" in table:
         orbit = Orbit.from_catalog(table["orbit"])
     elif "tle" in table:

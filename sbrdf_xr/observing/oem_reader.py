@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
 from ..errors import EphemerisError, input_file
-from .ephemeris import FRAMES, TIME_SYSTEMS, _frame, to_gcrs
+from .ephemeris import FRAMES, TIME_SYSTEMS, Ephemeris, skyfield_frame, to_gcrs
 
 __all__ = ["check_kvn_order", "read_oem"]
 
@@ -58,7 +58,7 @@ def _check_segment(seg: Any, where: str, factor: float) -> tuple[str, str]:
     meta = seg.metadata
     frame = str(meta["REF_FRAME"]).upper()
     try:
-        _frame(frame)
+        skyfield_frame(frame)
     except EphemerisError:
         raise EphemerisError(
             f"{where}: REF_FRAME {frame!r} is not supported; allowed: {', '.join(FRAMES)}"
@@ -95,13 +95,41 @@ def _check_segment(seg: Any, where: str, factor: float) -> tuple[str, str]:
     return frame, system
 
 
-def read_oem(cls: Any, path: str | Path, max_step_factor: float = 10.0) -> Any:
-    """The :class:`~sbrdf_xr.observing.ephemeris.Ephemeris` of an OEM file (``cls`` builds it).
+def read_oem(path: str | Path, *, max_step_factor: float = 10.0) -> Ephemeris:
+    """An :class:`~sbrdf_xr.observing.ephemeris.Ephemeris` from a CCSDS OEM file (KVN or XML).
+
+    Read and interpolated by the ``oem`` package as the message states (see the module
+    docstring of :mod:`sbrdf_xr.observing.ephemeris`).
+
+    Parameters
+    ----------
+    path : str or Path
+    max_step_factor : float
+        A step between two states of a segment longer than this many times the
+        segment's median step is a gap [1].
+
+    Raises
+    ------
+    EphemerisError
+        For an unreadable file, states out of order, a gap, an unknown frame or time
+        system, or a centre other than the Earth.
 
     Examples
     --------
-    >>> from sbrdf_xr.observing.ephemeris import Ephemeris
-    >>> read_oem(Ephemeris, "no-such-file.oem")
+    >>> import tempfile
+    >>> path = Path(tempfile.mkdtemp()) / "demo.oem"
+    >>> rows = [f"2024-03-17T01:20:{s:02d} {7000.0:.3f} {7.5 * s:.3f} 0 0 7.5 0"
+    ...         for s in range(0, 60, 10)]
+    >>> _ = path.write_text("\\n".join([
+    ...     "CCSDS_OEM_VERS = 2.0", "CREATION_DATE = 2024-03-17T00:00:00",
+    ...     "ORIGINATOR = DEMO", "META_START", "OBJECT_NAME = DEMO", "OBJECT_ID = 1",
+    ...     "CENTER_NAME = EARTH", "REF_FRAME = GCRF", "TIME_SYSTEM = UTC",
+    ...     "START_TIME = 2024-03-17T01:20:00", "STOP_TIME = 2024-03-17T01:20:50",
+    ...     "META_STOP", *rows, ""]))
+    >>> eph = read_oem(path)
+    >>> eph.state(np.array(["2024-03-17T01:20:05"], dtype="datetime64[ns]"))[0].round(6)
+    array([[7000. ,   37.5,    0. ]])
+    >>> read_oem("no-such-file.oem")
     Traceback (most recent call last):
         ...
     sbrdf_xr.errors.EphemerisError: oem: file ...no-such-file.oem does not exist
@@ -149,9 +177,9 @@ def read_oem(cls: Any, path: str | Path, max_step_factor: float = 10.0) -> Any:
     method = segs[0].metadata.get("INTERPOLATION", "LAGRANGE") if hasattr(meta, "get") else ""
     degree = meta["INTERPOLATION_DEGREE"] if "INTERPOLATION_DEGREE" in meta else 5
     name = str(meta["OBJECT_NAME"])
-    return cls(
+    return Ephemeris(
         name,
-        spans,
+        cast(Any, spans),
         evaluate,
         f"CCSDS OEM {p} (OBJECT_ID {meta['OBJECT_ID']}, REF_FRAME {frames[0][0]}, "
         f"TIME_SYSTEM {frames[0][1]}, {len(segs)} segment(s))",

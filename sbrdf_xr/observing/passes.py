@@ -180,7 +180,7 @@ def visible_passes(
     min_elevation_deg : float
         Lowest elevation that counts [degree].
     twilight : {"civil", "nautical", "astronomical", "night"}
-        The site's Sun must be below :data:`TWILIGHTS` of this [degree].
+        The site's Sun must be below this twilight's elevation (:data:`TWILIGHTS`).
     step_s : float
         Search grid [s]; events shorter than it may be missed (10 s suits LEO passes).
     cross_section_m2 : float

@@ -127,7 +127,8 @@ def skyfield_time(t64: np.ndarray) -> Any:
 
     The IAU 2000A nutation angles and the complementary terms of the equation of the
     equinoxes, which vary over days, are evaluated on knots every :data:`KNOT_S` and
-    splined; skyfield's own formula then gives the apparent sidereal time at every
+    splined (unless the times are fewer than the knots, when skyfield evaluates them
+    at every time); skyfield's own formula then gives the apparent sidereal time at every
     time (the pattern skyfield documents for supplying nutation angles).
 
     Examples
@@ -143,6 +144,8 @@ def skyfield_time(t64: np.ndarray) -> Any:
     if t64.size <= 8:
         return t
     secs, knots = spline_knots(t64)
+    if knots.size >= t64.size:  # sparse times (a tracking table over months): direct
+        return t
     tk = skyfield_utc(t64[0] + (knots * 1e9).astype("timedelta64[ns]"))
     d_psi_k, d_eps_k = tk._nutation_angles_radians
     c_terms_k = equation_of_the_equinoxes_complimentary_terms(tk.tt)

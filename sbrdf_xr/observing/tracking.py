@@ -239,6 +239,10 @@ class TrackingTable:
 
         t = check_times(self.times)
         object.__setattr__(self, "times", t)
+        gap = float(to_unit(self.max_gap_s, "s", "max_gap_s"))
+        if not gap > 0:
+            raise TrackingTableError(f"{self.name}: max_gap_s must be > 0 s, got {gap}")
+        object.__setattr__(self, "max_gap_s", gap)
         n = t.size
         rows = np.arange(n) if self.rows is None else np.asarray(self.rows)
         object.__setattr__(self, "rows", rows)

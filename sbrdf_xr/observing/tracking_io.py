@@ -105,8 +105,8 @@ def read_tracking_table(
     azimuth: str | None = "azimuth",
     ra: str | None = None,
     dec: str | None = None,
-    range_km: str | None = None,
-    height_km: str | None = None,
+    range_column: str | None = None,
+    height_column: str | None = None,
     track: str | None = None,
     keep: tuple[str, ...] = (),
     time_zone: str | None = None,
@@ -121,9 +121,9 @@ def read_tracking_table(
     ----------
     path : str or Path
     site : Site
-    time, elevation, azimuth, ra, dec, range_km, height_km, track : str
-        Column names (``ra``/``dec`` replace ``elevation``/``azimuth``); elevations,
-        azimuths, RA and Dec in [degree], range and height in [km].
+    time, elevation, azimuth, ra, dec, range_column, height_column, track : str
+        Column names (``ra``/``dec`` replace ``elevation``/``azimuth``); the columns hold
+        degrees (angles) and kilometres (range, height above the WGS84 ellipsoid).
     keep : tuple of str
         Other numeric columns to keep (``table.columns``).
     time_zone : {None, "UTC"}
@@ -142,14 +142,14 @@ def read_tracking_table(
     >>> _ = path.write_text("# demo\\ntime,elevation,azimuth,range\\n"
     ...     "2024-03-17T01:22:00Z,75.8,10.0,841.0\\n2024-03-17T01:22:05Z,75.9,12.0,abc\\n")
     >>> site = Site(45.455, -71.1525, 1111.0)
-    >>> read_tracking_table(path, site, range_km="range")
+    >>> read_tracking_table(path, site, range_column="range")
     Traceback (most recent call last):
         ...
     sbrdf_xr.errors.TrackingTableError: tracking table ...: line 4: column 'range' is 'abc', ...
     >>> import warnings
     >>> with warnings.catch_warnings(record=True) as caught:
     ...     warnings.simplefilter("always")
-    ...     table = read_tracking_table(path, site, range_km="range", on_bad="drop")
+    ...     table = read_tracking_table(path, site, range_column="range", on_bad="drop")
     >>> table.times.size, table.dropped, len(caught)  # counted, listed and warned
     (1, ((4, "column 'range' is 'abc', not a number"),), 1)
     """
@@ -165,11 +165,11 @@ def read_tracking_table(
     reader = csv.DictReader([ln for _, ln in lines])
     header = reader.fieldnames or []
     angles = (ra, dec) if ra is not None else (elevation, azimuth)
-    wanted = [time, *angles, range_km, height_km, track, *keep]
+    wanted = [time, *angles, range_column, height_column, track, *keep]
     missing = [c for c in wanted if c is not None and c not in header]
     if missing:
         raise TrackingTableError(f"{what}: lacks the column(s) {missing}; its header: {header}")
-    numeric = [c for c in (*angles, range_km, height_km, *keep) if c is not None]
+    numeric = [c for c in (*angles, range_column, height_column, *keep) if c is not None]
     lo = float(to_unit(min_elevation, "deg", "min_elevation"))
     good: list[tuple[int, np.datetime64, list[float], str]] = []
     dropped: list[tuple[int, str]] = []
@@ -211,8 +211,8 @@ def read_tracking_table(
             stacklevel=2,
         )
     kw: dict[str, Any] = {
-        "range_km": cols.get(range_km) if range_km else None,
-        "height_km": cols.get(height_km) if height_km else None,
+        "range_km": cols.get(range_column) if range_column else None,
+        "height_km": cols.get(height_column) if height_column else None,
         "track": np.array([g[3] for g in good]) if track else None,
     }
     if ra is not None:
@@ -266,7 +266,7 @@ def read_pomenis(path: str | Path, *, on_bad: str = "raise") -> TrackingTable:
         time="observation_time",
         elevation="satellite_altitude",
         azimuth="satellite_azimuth",
-        height_km="satellite_height",
+        height_column="satellite_height",
         keep=("ab_magnitude",),
         time_zone="UTC",
         on_bad=on_bad,
@@ -288,8 +288,8 @@ TRACKING_KEYS = (
     "azimuth",
     "ra",
     "dec",
-    "range_km",
-    "height_km",
+    "range_column",
+    "height_column",
     "track",
     "time_zone",
     "on_bad",

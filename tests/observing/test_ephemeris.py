@@ -13,6 +13,7 @@ from skyfield.sgp4lib import TEME
 from sbrdf_xr.errors import EphemerisError, ObservationError
 from sbrdf_xr.observing import Observation, canx1_pass
 from sbrdf_xr.observing.ephemeris import Ephemeris, to_gcrs
+from sbrdf_xr.observing.oem_reader import read_oem
 from sbrdf_xr.observing.timescales import skyfield_time, times
 
 # An OEM of SGP4 states every 60 s, Hermite of degree 7 (4 states), reproduces SGP4
@@ -71,7 +72,7 @@ def test_oem_written_from_a_tle_pass_gives_the_tle_cube(tmp_path, tle, frame, in
     t = times("2024-03-17T01:15:00", "2024-03-17T01:30:00", 60.0 if interp else 20.0)
     r, v = _states(obs, t, frame)
     path = _write(tmp_path / f"pass-{frame}.oem", t, r, v, frame, interp)
-    eph = Ephemeris.from_oem(path)
+    eph = read_oem(path)
     rr, vv = eph.state(obs.times)
     st = obs._state()
     assert np.abs(rr - st["r"]).max() < POS_ATOL_KM
@@ -104,21 +105,21 @@ def test_oem_out_of_order_gap_truncated_and_outside(tmp_path, tle):
     swapped[data[3]], swapped[data[4]] = text[data[4]], text[data[3]]
     (tmp_path / "order.oem").write_text("\n".join(swapped))
     with pytest.raises(EphemerisError, match=r"line \d+: epoch 2024-03-17T01:18:00.* not after"):
-        Ephemeris.from_oem(tmp_path / "order.oem")
+        read_oem(tmp_path / "order.oem")
     gap = [ln for k, ln in enumerate(text) if k not in data[5:15]]
     (tmp_path / "gap.oem").write_text("\n".join(gap))
     with pytest.raises(EphemerisError, match=r"a gap of 660 s between states 5 and 6"):
-        Ephemeris.from_oem(tmp_path / "gap.oem")
+        read_oem(tmp_path / "gap.oem")
     (tmp_path / "cut.oem").write_text("\n".join(text[: data[0] - 3]))
     with pytest.raises(EphemerisError, match="cannot be read by the oem package"):
-        Ephemeris.from_oem(tmp_path / "cut.oem")
-    eph = Ephemeris.from_oem(tmp_path / "ok.oem")
+        read_oem(tmp_path / "cut.oem")
+    eph = read_oem(tmp_path / "ok.oem")
     late = times("2024-03-17T01:29:00", "2024-03-17T01:31:00", 30.0)
     with pytest.raises(EphemerisError, match=r"outside the ephemeris \(2 of 5 times"):
         eph.state(late)
     with pytest.raises(EphemerisError, match="REF_FRAME 'MOD' is not supported"):
         (tmp_path / "mod.oem").write_text("\n".join(text).replace("= GCRF", "= MOD"))
-        Ephemeris.from_oem(tmp_path / "mod.oem")
+        read_oem(tmp_path / "mod.oem")
     with pytest.raises(ObservationError, match="outside the ephemeris"):
         Observation(eph, obs.site, late).geometry()
 

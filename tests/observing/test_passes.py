@@ -85,8 +85,10 @@ def test_visible_part_dark_sunlit_and_up(canx1, all_passes):
         assert g.site_sun_elevation.max() < -12.0 + 1e-3
     mags = p.peak_magnitude.values
     assert np.all((mags > 3) & (mags < 9))  # 1 m2, albedo 0.2, at 800-1700 km
-    darker = visible_passes(orbit, site, *WINDOW, twilight="astronomical")
-    assert darker.visible_duration.sum() <= p.visible_duration.sum()
+    short = (WINDOW[0], "2024-03-16T02:00:00")  # the first two visible passes
+    darker = visible_passes(orbit, site, *short, twilight="astronomical", earth="sphere")
+    assert darker.sizes["pass"] <= 2
+    assert darker.visible_duration.sum() <= p.visible_duration[:2].sum() + 1e-3
 
 
 def test_passes_from_an_ephemeris_match_the_elements(canx1, all_passes):

@@ -160,7 +160,7 @@ def test_reader_checks_every_row(tmp_path, tle_pass):
     obs, _ = tle_pass
     site = obs.site
     ok = "2024-03-17T01:22:00Z,75.8,10.0,841.0\n"
-    read = dict(elevation="el", azimuth="az", range_km="rng")
+    read = dict(elevation="el", azimuth="az", range_column="rng")
     t = read_tracking_table(_csv(tmp_path, ok), site, **read)
     assert t.rows.tolist() == [3] and t.times.size == 1
     cases = {
@@ -227,3 +227,24 @@ def test_full_pomenis_table():
     g = table.observation({"law": "inertial", "q": [0.0, 0.0, 0.0, 1.0]}).geometry()
     assert float(g.site_sun_elevation.max()) < -10.0
     assert float(g.sunlit_fraction.min()) > 0.4
+
+
+def test_radec_quantities_are_converted(tle_pass):
+    from sbrdf_xr.errors import UnitError
+
+    obs, g = tle_pass
+    st = obs._state()
+    los = st["r"] - st["site"]
+    ra = np.degrees(np.arctan2(los[:, 1], los[:, 0])) % 360.0
+    dec = np.degrees(np.arctan2(los[:, 2], np.hypot(los[:, 0], los[:, 1])))
+    bare = TrackingTable(obs.site, obs.times, ra_deg=ra, dec_deg=dec, range_km=g.range.values)
+    qty = TrackingTable(
+        obs.site,
+        obs.times,
+        ra_deg=np.radians(ra) * u.rad,
+        dec_deg=np.radians(dec) * u.rad,
+        range_km=g.range.values * u.km,
+    )
+    np.testing.assert_allclose(qty.positions(), bare.positions(), rtol=1e-12)
+    with pytest.raises(UnitError, match="dec_deg"):
+        TrackingTable(obs.site, obs.times, ra_deg=ra, dec_deg=dec * u.kg, range_km=[1.0])
