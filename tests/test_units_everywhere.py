@@ -906,10 +906,6 @@ EXEMPT[("sbrdf_xr.brdf._model.Model", "brdf")] = (
 for _model_name in ("lambert", "microfacet", "robertson_sandford"):
     for _method in ("brdf_angles", "render_grid"):
         EXEMPT[(f"sbrdf_xr.brdf.{_model_name}.{_method}", "psi")] = "an isotropic model refuses psi"
-for _arg in ("time", "elevation", "azimuth", "ra", "dec", "range_km", "height_km", "track"):
-    EXEMPT[("sbrdf_xr.observing.tracking_io.read_tracking_table", _arg)] = (
-        "a column name of the CSV, not a value: the column's numbers are in the unit named"
-    )
 
 #: The compiled layer: its functions take the grids and angles that the layers above
 #: (materials.tables, engine) have converted; a Quantity never reaches them.
