@@ -26,6 +26,7 @@ from ..units import to_unit
 from . import models
 from ._jobs import _by_rows, _Done, _Job, _Parts
 from .construction import (
+    _held_product,
     azimuthal_average,
     blend_weights,
     extend_grid,
@@ -440,11 +441,7 @@ def build_lut(
             if rho_job is not None:
                 rho_job.cancel()
             raise
-        lut = np.multiply(base, r_lut, out=r_lut)
-        del r_lut
-        _hold_horizon(lut, ti_out, dt_grid)
-        if renormalise == "model":
-            _hold_horizon(base, ti_out, dt_grid)
+        lut = _held_product(base, r_lut, ti_out, dt_grid, renormalise == "model")
         if extrapolation == "model" and renormalise == "none":
             _bound_grazing_rows(lut, ti_out, dt_grid, phi_grid, wl, fit_model, measured_ti[-1])
     if fit_model is not None and (extrapolation == "model" or below_noise == "model"):
@@ -645,28 +642,6 @@ def _model_for(model: xr.Dataset, wl: np.ndarray) -> xr.Dataset:
     if not np.array_equal(np.asarray(model[WAVELENGTH].values), wl):
         model = model.interp({WAVELENGTH: wl})
     return model
-
-
-def _hold_horizon(lut: np.ndarray, ti: np.ndarray, dt: np.ndarray) -> None:
-    """Nodes at or beyond the horizon (``|theta_i + delta_theta| >= 90`` deg, for every
-    ``phi``: ``cos(theta_r) = cos(phi) cos(theta_i + delta_theta) <= 0``) take, in place,
-    the value of the nearest node inside it in their row.
-
-    No observer sees them; they enter only through the interpolation between them and the
-    last visible nodes.  The model rendered there carries its limit at grazing exit, which
-    for a specular lobe (``1 / cos(theta_r)``) is orders of magnitude above the measured
-    grazing values (the Starlink array scan: 1e-3 sr-1 at 88 deg, the model's limit at 90
-    deg 6e2 sr-1), and a look-up a fraction of a node from the horizon would return it.
-    Holding the last visible value keeps the look-up continuous up to the horizon.
-    """
-    theta_r = ti[:, None] + dt[None, :]
-    for a in range(ti.size):
-        inside = np.flatnonzero(np.abs(theta_r[a]) < 90.0 - 1e-9)
-        if inside.size == 0:
-            continue
-        lo, hi = inside[0], inside[-1]
-        lut[a, :lo] = lut[a, lo]
-        lut[a, hi + 1 :] = lut[a, hi]
 
 
 def _model_rows(
