@@ -338,7 +338,9 @@ class YawSteering(AttitudeLaw):
                     "yaw_steering: a geodetic vertical needs UTC times (datetime64) or a "
                     "context epoch; got float times without one"
                 )
-            t = np.datetime64(epoch, "ns") + (t.astype(np.float64) * 1e9).astype("m8[ns]")
+            t = np.asarray(epoch, dtype="datetime64[ns]") + (t.astype(np.float64) * 1e9).astype(
+                "m8[ns]"
+            )
         rot = itrs.rotation_at(skyfield_time(t.astype("datetime64[ns]")))  # GCRS -> ITRS
         up_itrs = geodetic_up(np.einsum("ijn,nj->ni", rot, r))
         return np.einsum("jin,nj->ni", rot, up_itrs)
