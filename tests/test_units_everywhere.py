@@ -607,6 +607,9 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.materials.tables.lookup_anisotropic": lambda: dict(
         material=_aniso_table(), theta_i=[30.0], delta_theta=[0.0], phi=[4.0], psi=[25.0]
     ),
+    "sbrdf_xr.materials.merl.read_merl": lambda: dict(
+        path=_merl_file(), theta_i=[20.0, 50.0], step=10.0
+    ),
     "sbrdf_xr.materials.coverage.snap_angles": lambda: dict(
         values=[10.0, 10.0 + 1e-12, 20.0], tol=1e-6
     ),
@@ -899,6 +902,10 @@ for _row, _arg in (
 ):
     EXEMPT[(_row, _arg)] = "a result record the package fills, not an input"
 
+EXEMPT[("sbrdf_xr.materials.merl.write_merl", "brdf")] = (
+    "a function (a BRDF of directions), not a value: its results are in sr-1 by contract"
+)
+
 EXEMPT[("sbrdf_xr.brdf._model.Model", "brdf")] = (
     "a function (the model's sBRDF), not a value: its results are in sr-1 by contract"
 )
@@ -928,6 +935,18 @@ def _l_body() -> Any:
     from sbrdf_xr.testing import l_shaped_spacecraft
 
     return l_shaped_spacecraft()
+
+
+@functools.cache
+def _merl_file() -> Any:
+    """A MERL file of a constant BRDF (0.1, 0.2, 0.3 sr-1), written once per session."""
+    import tempfile
+    from pathlib import Path
+
+    from sbrdf_xr.materials.merl import write_merl
+
+    path = Path(tempfile.mkdtemp(prefix="sbrdf-merl-")) / "grey.binary"
+    return write_merl(path, lambda s, o: np.tile([0.3, 0.2, 0.1], (len(s), 1)))
 
 
 def _measurements(theta_i: tuple[float, ...] = (20.0, 50.0)) -> xr.Dataset:

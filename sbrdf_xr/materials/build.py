@@ -510,6 +510,8 @@ def build_lut(
         opts = {**call, "holdout": 0, "check_energy": False, "progress": None}
         rebuild = functools.partial(build_lut, **opts)  # model None: the held-in's own fit
         out.attrs.update(_holdout_check(rebuild, *samples, every=int(holdout), floor=check_floor))
+    # last: shown by print(table) beside the checks
+    out.attrs.update({k: out.attrs.pop(k) for k in ("layout", "modelled") if k in out.attrs})
     report(1.0, "built")
     return out
 

@@ -161,7 +161,13 @@ def _check_energy_conservation(table: xr.DataArray, theta_i: ArrayLike) -> np.nd
             f"build_lut: the table of {table.attrs.get('material', '')!r} does not conserve "
             f"energy: its directional-hemispherical reflectance exceeds 1 at theta_i = {tis} "
             f"deg (worst {rho[worst]:.3f} at theta_i = {ti[worst[0]]} deg, wavelength = "
-            f"{wl[worst[1]]} nm); consider below_noise='model' or extrapolation='model'",
+            f"{wl[worst[1]]} nm); "
+            + (
+                "the measured values hold it (a lobe narrower than the scan's step, or one "
+                "taken as isotropic about specular)"
+                if table.attrs.get("below_noise") == "model"
+                else "consider below_noise='model' or extrapolation='model'"
+            ),
             NonPhysicalWarning,
             stacklevel=3,
         )
