@@ -98,11 +98,7 @@ def add_observe_parser(sub: Any, mesh_options: Any) -> argparse.ArgumentParser:
         default="csv",
         help="the tracking table's layout (default csv)",
     )
-    g.add_argument(
-        "--utc",
-        action="store_true",
-        help="tracking csv: times without a time zone are UTC",
-    )
+    g.add_argument("--utc", action="store_true", help="tracking csv: zoneless times are UTC")
     g.add_argument(
         "--satellite",
         metavar="NAME|NUMBER",
@@ -339,19 +335,28 @@ def attitude_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
         )
 
 
-def _is_oem(path: Path) -> bool:
-    """A CCSDS OEM file (by its suffix or its first keyword), not elements."""
-    if path.suffix.lower() == ".oem":
-        return True
-    with contextlib.suppress(OSError, UnicodeDecodeError):
-        head = path.read_text(encoding="utf-8")[:400]
-        return "CCSDS_OEM_VERS" in head or "<oem" in head
-    return False
+def _site_of(args: argparse.Namespace) -> Any:
+    """The site of ``--site`` or ``--lat``/``--lon``/``--height``."""
+    from ..observing.observe import Site
+
+    latlon = [args.lat is not None, args.lon is not None]
+    if args.site is not None and any(latlon):
+        raise ValidationError("give --site NAME or --lat/--lon/--height, not both")
+    if args.site is not None:
+        return Site.from_catalog(args.site)
+    elif all(latlon):
+        try:
+            return Site(args.lat, args.lon, args.height, name=f"{args.lat:g}, {args.lon:g}")
+        except SbrdfError as exc:
+            raise ValidationError(
+                f"--lat {args.lat:g} --lon {args.lon:g} --height {args.height:g}: {exc}"
+            ) from None
+    else:
+        raise ValidationError("give --site NAME (a catalog observatory) or both --lat and --lon")
 
 
 def _tracking_observation(args: argparse.Namespace, spacecraft: Any) -> Any:
     """The observation of ``--tracking``: the table's times, orbit and (pomenis) site."""
-    from ..observing.observe import Site
     from ..observing.tracking_io import tracking_from_dict
 
     given = [f for f in ("elements", "start", "stop", "duration") if getattr(args, f)]
@@ -362,17 +367,8 @@ def _tracking_observation(args: argparse.Namespace, spacecraft: Any) -> Any:
     spec: dict[str, Any] = {"path": args.tracking, "format": args.tracking_format}
     site = None
     if args.tracking_format == "csv":
-        if args.site is not None:
-            site = Site.from_catalog(args.site)
-        elif args.lat is not None and args.lon is not None:
-            site = Site(args.lat, args.lon, args.height, name=f"{args.lat:g}, {args.lon:g}")
-        else:
-            raise ValidationError("--tracking csv: give the site (--site or --lat/--lon)")
-        header = _csv_header(Path(args.tracking))
-        kind = "range_km" if "range_km" in header else "height_km"
-        spec.update(
-            {kind.replace("_km", "_column"): kind, "time_zone": "UTC" if args.utc else None}
-        )
+        site = _site_of(args)
+        spec["time_zone"] = "UTC" if args.utc else None
     elif args.site is not None or args.lat is not None:
         raise ValidationError("--tracking-format pomenis has its own site; remove the site")
     table = tracking_from_dict(spec, site)
@@ -382,14 +378,6 @@ def _tracking_observation(args: argparse.Namespace, spacecraft: Any) -> Any:
         earth=args.earth,
         name=args.name or f"{table.name} from {table.site.name}",
     )
-
-
-def _csv_header(path: Path) -> list[str]:
-    with contextlib.suppress(OSError, UnicodeDecodeError), open(path, encoding="utf-8") as f:
-        for line in f:
-            if line.strip() and not line.lstrip().startswith("#"):
-                return [c.strip() for c in line.split(",")]
-    return []
 
 
 def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
@@ -408,8 +396,8 @@ def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     """
     import numpy as np
 
-    from ..observing.observe import Observation, Orbit, Site, times
-    from ..observing.oem_reader import read_oem
+    from ..observing.observe import Observation, Orbit, times
+    from ..observing.oem_reader import is_oem_file, read_oem
     from ..observing.timescales import to_datetime64
 
     if args.tracking:
@@ -418,7 +406,7 @@ def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
         raise ValidationError("give --elements and --start (or a --tracking table)")
     spec = args.elements
     orbit: Any
-    if Path(spec).is_file() and _is_oem(Path(spec)):
+    if Path(spec).is_file() and is_oem_file(spec):
         if args.satellite:
             raise ValidationError("--satellite picks from an element file, not from an OEM")
         orbit = read_oem(spec)
@@ -436,20 +424,7 @@ def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
             orbit = Orbit.from_catalog(spec)
         except SbrdfError as exc:
             raise ValidationError(f"--elements {spec}: {exc}") from None
-    latlon = [args.lat is not None, args.lon is not None]
-    if args.site is not None and any(latlon):
-        raise ValidationError("give --site NAME or --lat/--lon/--height, not both")
-    if args.site is not None:
-        site = Site.from_catalog(args.site)
-    elif all(latlon):
-        try:
-            site = Site(args.lat, args.lon, args.height, name=f"{args.lat:g}, {args.lon:g}")
-        except SbrdfError as exc:
-            raise ValidationError(
-                f"--lat {args.lat:g} --lon {args.lon:g} --height {args.height:g}: {exc}"
-            ) from None
-    else:
-        raise ValidationError("give --site NAME (a catalog observatory) or both --lat and --lon")
+    site = _site_of(args)
     if (args.stop is None) == (args.duration is None):
         raise ValidationError("give --stop UTC or --duration S (the end of the window)")
     start = to_datetime64(args.start, "--start")

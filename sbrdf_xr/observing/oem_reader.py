@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import EphemerisError, input_file
 from .ephemeris import FRAMES, TIME_SYSTEMS, Ephemeris, skyfield_frame, to_gcrs
 
-__all__ = ["check_kvn_order", "read_oem"]
+__all__ = ["check_kvn_order", "is_oem_file", "read_oem"]
 
 _EPOCH = re.compile(r"^\s*(\d{4}-\d{2}-\d{2}T[\d:.]+|\d{4}-\d{3}T[\d:.]+)\s")
 
@@ -48,6 +48,27 @@ def check_kvn_order(text: str, what: str) -> None:
                 f"(line {last[1]}); epochs of a segment must strictly increase"
             )
         last = (ep, k)
+
+
+def is_oem_file(path: str | Path) -> bool:
+    """Whether a file is a CCSDS OEM (by its suffix ``.oem`` or its first keyword).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> path = Path(tempfile.mkdtemp()) / "states.txt"
+    >>> _ = path.write_text("CCSDS_OEM_VERS = 2.0\\n")
+    >>> is_oem_file(path), is_oem_file(Path(tempfile.mkdtemp()) / "a.tle")
+    (True, False)
+    """
+    p = Path(path)
+    if p.suffix.lower() == ".oem":
+        return True
+    try:
+        head = p.read_text(encoding="utf-8")[:400]
+    except (OSError, UnicodeDecodeError):
+        return False
+    return "CCSDS_OEM_VERS" in head or "<oem" in head
 
 
 def _utc64(times: Any) -> np.ndarray:

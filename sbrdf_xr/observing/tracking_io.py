@@ -304,8 +304,8 @@ def tracking_from_dict(
 
     ``path`` (relative to ``base_dir``), ``format`` (``"csv"``, the default, read by
     :func:`read_tracking_table` with the column names and options of
-    :data:`TRACKING_KEYS`, at ``site``; or ``"pomenis"``, :func:`read_pomenis`, at its own
-    site).
+    :data:`TRACKING_KEYS`, at ``site``, the range or height from a column ``range_km`` or
+    ``height_km`` unless named; or ``"pomenis"``, :func:`read_pomenis`, at its own site).
 
     Examples
     --------
@@ -344,4 +344,23 @@ def tracking_from_dict(
         )
     if site is None:
         raise TrackingTableError("[observation]: a csv tracking table needs the site")
+    if "range_column" not in opts and "height_column" not in opts:
+        header = _header(path)
+        found = [c for c in ("range_km", "height_km") if c in header]
+        if not found:
+            raise TrackingTableError(
+                f"[observation.tracking]: {path} has no column range_km or height_km; name "
+                f"the one it has with range_column or height_column (its header: {header})"
+            )
+        opts[found[0].replace("_km", "_column")] = found[0]
     return read_tracking_table(path, site, **opts)
+
+
+def _header(path: Path) -> list[str]:
+    """The column names of a CSV file (its first line that is not a ``#`` comment)."""
+    p = input_file(path, "tracking table", TrackingTableError)
+    with open(p, encoding="utf-8", errors="replace") as f:
+        for line in f:
+            if line.strip() and not line.lstrip().startswith("#"):
+                return [c.strip() for c in line.split(",")]
+    return []
