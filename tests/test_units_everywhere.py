@@ -736,6 +736,20 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     ),
     # --- observing
     "sbrdf_xr.observing.attitude.Nadir": lambda: dict(yaw_deg=30.0),
+    "sbrdf_xr.observing.attitude.geodetic_up": lambda: dict(
+        position_itrs_km=[[5000.0, 100.0, 5000.0]]
+    ),
+    "sbrdf_xr.observing.tracking_io.read_tracking_table": lambda: dict(
+        path=_POMENIS40,
+        site=_pomenis_site(),
+        time="observation_time",
+        elevation="satellite_altitude",
+        azimuth="satellite_azimuth",
+        height_column="satellite_height",
+        time_zone="UTC",
+        min_elevation=25.0,
+        on_bad="drop",
+    ),
     "sbrdf_xr.observing.attitude.Spin": lambda: dict(rate_deg_s=2.0, phase_deg=30.0),
     "sbrdf_xr.observing.tumble.Tumble": lambda: dict(
         inertia=(1.0, 2.0, 3.0), omega_deg_s=(1.0, 2.0, 3.0)
@@ -931,6 +945,18 @@ for _model_name in ("lambert", "microfacet", "robertson_sandford"):
 #: The compiled layer: its functions take the grids and angles that the layers above
 #: (materials.tables, engine) have converted; a Quantity never reaches them.
 KERNELS = "sbrdf_xr.kernels."
+
+
+_POMENIS40 = (
+    __import__("pathlib").Path(__file__).parent
+    / "observing/data/pomenis/pomenis_observations_first40.csv"
+)
+
+
+def _pomenis_site() -> Any:
+    from sbrdf_xr.observing.tracking_io import POMENIS_SITE
+
+    return POMENIS_SITE
 
 
 def _l_body() -> Any:

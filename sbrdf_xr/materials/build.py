@@ -26,6 +26,7 @@ from ..units import to_unit
 from . import models
 from ._jobs import _by_rows, _Done, _Job, _Parts
 from .construction import (
+    _held_product,
     azimuthal_average,
     blend_weights,
     extend_grid,
@@ -440,8 +441,7 @@ def build_lut(
             if rho_job is not None:
                 rho_job.cancel()
             raise
-        lut = np.multiply(base, r_lut, out=r_lut)
-        del r_lut
+        lut = _held_product(base, r_lut, ti_out, dt_grid, renormalise == "model")
         if extrapolation == "model" and renormalise == "none":
             _bound_grazing_rows(lut, ti_out, dt_grid, phi_grid, wl, fit_model, measured_ti[-1])
     if fit_model is not None and (extrapolation == "model" or below_noise == "model"):

@@ -393,3 +393,38 @@ def azimuthal_average(
         table, np.array([0.0, 1.0]), dt, ph, 0.0, c_dt, c_ph, "linear", zero_edges=zero_edges
     )  # (n_dt, n_phi, n_psi, n_wl)
     return np.einsum("dpql,q->dpl", vals, w)
+
+
+def _hold_horizon(lut: np.ndarray, ti: np.ndarray, dt: np.ndarray) -> None:
+    """Nodes at or beyond the horizon (``|theta_i + delta_theta| >= 90`` deg, for every
+    ``phi``: ``cos(theta_r) = cos(phi) cos(theta_i + delta_theta) <= 0``) take, in place,
+    the value of the nearest node inside it in their row.
+
+    No observer sees them; they enter only through the interpolation between them and the
+    last visible nodes.  The model rendered there carries its limit at grazing exit, which
+    for a specular lobe (``1 / cos(theta_r)``) is orders of magnitude above the measured
+    grazing values (the Starlink array scan: 1e-3 sr-1 at 88 deg, the model's limit at 90
+    deg 6e2 sr-1), and a look-up a fraction of a node from the horizon would return it.
+    Holding the last visible value keeps the look-up continuous up to the horizon.
+    """
+    theta_r = ti[:, None] + dt[None, :]
+    for a in range(ti.size):
+        inside = np.flatnonzero(np.abs(theta_r[a]) < 90.0 - 1e-9)
+        if inside.size == 0:
+            continue
+        lo, hi = inside[0], inside[-1]
+        lut[a, :lo] = lut[a, lo]
+        lut[a, hi + 1 :] = lut[a, hi]
+
+
+def _held_product(
+    base: np.ndarray, ratio: np.ndarray, ti: np.ndarray, dt: np.ndarray, hold_base: bool
+) -> np.ndarray:
+    """``base * ratio`` (written into ``ratio``) with its horizon nodes held, and those of
+    ``base`` too when ``hold_base`` (it is integrated by the renormalisation):
+    :func:`_hold_horizon`."""
+    lut = np.multiply(base, ratio, out=ratio)
+    _hold_horizon(lut, ti, dt)
+    if hold_base:
+        _hold_horizon(base, ti, dt)
+    return lut

@@ -54,6 +54,7 @@ from .attitude import (
     Nadir,
     Spin,
     SunPointing,
+    YawSteering,
     compose,
     law_from_dict,
 )
@@ -132,6 +133,7 @@ __all__ = [
     "SunPointing",
     "TrackingTable",
     "Tumble",
+    "YawSteering",
     "aem",
     "airmass",
     "attitude",

@@ -18,6 +18,8 @@ Laws
 ==================  ========================================================================
 Inertial(q)         fixed orientation
 Nadir               LVLH: a body axis on the nadir, another toward the velocity, then a yaw
+YawSteering         a body axis on the (geodetic or geocentric) nadir, a second one turned
+                    toward the Sun about it: needs no velocity
 SunPointing         a body axis on the Sun, a second body axis as close as possible to a
                     target direction (orbit normal, nadir, velocity, north or a vector)
 Spin                rotation about a body axis at a constant rate from an initial attitude
@@ -63,13 +65,16 @@ from .frames import (
 
 __all__ = [
     "LAWS",
+    "VERTICALS",
     "AttitudeLaw",
     "Composed",
     "Inertial",
     "Nadir",
     "Spin",
     "SunPointing",
+    "YawSteering",
     "compose",
+    "geodetic_up",
     "law_from_dict",
 ]
 
@@ -218,6 +223,137 @@ class Nadir(AttitudeLaw):
             yaw = Rotation.from_rotvec(np.radians(self.yaw_deg) * a)
             q = (Rotation.from_quat(q) * yaw).as_quat().reshape(-1, 4)
         return q
+
+
+#: Verticals of :class:`YawSteering`: the WGS84 ellipsoid's normal, or the geocentre.
+VERTICALS = ("geodetic", "geocentric")
+
+
+def geodetic_up(position_itrs_km: ArrayLike, iterations: int = 6) -> NDArray[np.float64]:
+    """Unit normals of the WGS84 ellipsoid through ITRS points (geodetic zenith), (n, 3).
+
+    The geodetic latitude by fixed-point iteration of
+    ``tan(phi) = (z + e**2 N sin(phi)) / p`` with ``N = a / sqrt(1 - e**2 sin(phi)**2)``
+    (e.g. Montenbruck & Gill 2000, *Satellite Orbits*, sect. 5.5.2), from the geocentric
+    latitude; six steps reach 1e-12 rad above 100 km height.
+
+    Parameters
+    ----------
+    position_itrs_km : array_like, shape (n, 3)
+        Positions in the ITRS [km].
+    iterations : int
+        Fixed-point steps.
+
+    Examples
+    --------
+    >>> geodetic_up([[7000.0, 0.0, 0.0], [0.0, 0.0, 7000.0]]).round(12) + 0.0
+    array([[1., 0., 0.],
+           [0., 0., 1.]])
+    >>> r = [[5000.0, 0.0, 5000.0]]  # 45 deg geocentric: the geodetic latitude is larger
+    >>> bool(np.degrees(np.arcsin(geodetic_up(r)[0, 2])) > 45.1)
+    True
+    """
+    from .earth_shadow import EARTH_RADIUS_KM, WGS84_FLATTENING
+
+    x = np.asarray(to_unit(position_itrs_km, "km", "position_itrs_km"), dtype=np.float64)
+    x = x.reshape(-1, 3)
+    e2 = WGS84_FLATTENING * (2.0 - WGS84_FLATTENING)
+    p = np.hypot(x[:, 0], x[:, 1])
+    lat = np.arctan2(x[:, 2], p)
+    for _ in range(iterations):
+        s = np.sin(lat)
+        n = EARTH_RADIUS_KM / np.sqrt(1.0 - e2 * s**2)
+        lat = np.arctan2(x[:, 2] + e2 * n * s, p)
+    lon = np.arctan2(x[:, 1], x[:, 0])
+    c = np.cos(lat)
+    return np.stack([c * np.cos(lon), c * np.sin(lon), np.sin(lat)], axis=1)
+
+
+@dataclass(frozen=True)
+class YawSteering(AttitudeLaw):
+    """A body axis on the nadir, a second one turned about it toward the Sun.
+
+    ``nadir_axis`` points down the local vertical (``vertical="geodetic"``: the normal of
+    the WGS84 ellipsoid through the spacecraft, computed in the ITRS and rotated to the
+    GCRS by skyfield; ``"geocentric"``: to the Earth's centre), and ``sun_axis`` to the
+    Sun's direction projected on the plane perpendicular to it (TRIAD, Black 1964).  The
+    frame of Fankhauser et al. (2023, arXiv:2305.11123, sect. 2: ``z`` to geodetic zenith,
+    ``y`` perpendicular to it toward the Sun) is ``YawSteering("-z", "+y")``.  Unlike
+    :class:`Nadir` it needs no velocity, so it serves single-row tracks of a tracking
+    table.  With the Sun on the vertical the yaw is undefined and an
+    :class:`~sbrdf_xr.errors.AttitudeError` is raised.
+
+    Parameters
+    ----------
+    nadir_axis, sun_axis : str or array_like
+        Perpendicular body axes (``"+z"``, ``"-x"``, ... or 3 components).
+    vertical : {"geodetic", "geocentric"}
+        Which nadir.
+
+    Examples
+    --------
+    >>> from scipy.spatial.transform import Rotation
+    >>> from sbrdf_xr.observing import Context
+    >>> ctx = Context(position_km=np.array([[7000.0, 0.0, 0.0]]),
+    ...               sun_km=np.array([[-1e7, 1.5e8, 0.0]]))
+    >>> law = YawSteering(nadir_axis="-z", sun_axis="+y", vertical="geocentric")
+    >>> R = Rotation.from_quat(law.quaternions([0.0], ctx))
+    >>> np.round(R.apply([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]), 6) + 0.0  # z up, y to the Sun
+    array([[1., 0., 0.],
+           [0., 1., 0.]])
+    """
+
+    law_name: ClassVar[str] = "yaw_steering"
+    law_parameters: ClassVar[tuple[str, ...]] = ("nadir_axis", "sun_axis", "vertical")
+
+    nadir_axis: Any = "-z"
+    sun_axis: Any = "+y"
+    vertical: str = "geodetic"
+    _axes: tuple[np.ndarray, np.ndarray] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        if self.vertical not in VERTICALS:
+            raise AttitudeError(
+                f"yaw_steering vertical: got {self.vertical!r}; allowed: {', '.join(VERTICALS)}"
+            )
+        a, b = perpendicular_pair(
+            axis_vector(self.nadir_axis, "nadir_axis"),
+            axis_vector(self.sun_axis, "sun_axis"),
+            "yaw_steering",
+        )
+        object.__setattr__(self, "_axes", (a, b))
+
+    def _up(self, times: ArrayLike, r: np.ndarray, context: Context | None) -> np.ndarray:
+        if self.vertical == "geocentric":
+            return r / np.linalg.norm(r, axis=1)[:, None]
+        from skyfield.framelib import itrs
+
+        from .timescales import skyfield_time
+
+        t = np.atleast_1d(np.asarray(times))
+        if not np.issubdtype(t.dtype, np.datetime64):
+            epoch = None if context is None else context.epoch
+            if epoch is None:
+                raise AttitudeError(
+                    "yaw_steering: a geodetic vertical needs UTC times (datetime64) or a "
+                    "context epoch; got float times without one"
+                )
+            t = np.asarray(epoch, dtype="datetime64[ns]") + (t.astype(np.float64) * 1e9).astype(
+                "m8[ns]"
+            )
+        rot = itrs.rotation_at(skyfield_time(t.astype("datetime64[ns]")))  # GCRS -> ITRS
+        up_itrs = geodetic_up(np.einsum("ijn,nj->ni", rot, r))
+        return np.einsum("jin,nj->ni", rot, up_itrs)
+
+    def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
+        n = np.atleast_1d(np.asarray(times)).shape[0]
+        r, sun = context_fields(context, n, "yaw_steering", "position_km", "sun_km")
+        up = self._up(times, r, context)
+        s = sun / np.linalg.norm(sun, axis=1)[:, None]
+        if np.any(np.linalg.norm(np.cross(up, s), axis=1) < 1e-12):
+            raise AttitudeError("yaw_steering: the Sun is on the vertical; the yaw is undefined")
+        a, b = self._axes
+        return triad(a, b, -up, s)
 
 
 _SECONDARY_TARGETS = ("orbit_normal", "nadir", "velocity", "north")

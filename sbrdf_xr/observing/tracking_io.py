@@ -26,9 +26,10 @@ from typing import Any
 import numpy as np
 
 from ..errors import SbrdfWarning, TrackingTableError, input_file
+from ..units import to_unit
 from .orbits import Site
 from .timescales import to_datetime64
-from .tracking import TrackingTable
+from .tracking import MIN_ELEVATION_DEG, TrackingTable
 
 __all__ = [
     "POMENIS_SITE",
@@ -112,6 +113,7 @@ def read_tracking_table(
     on_bad: str = "raise",
     name: str | None = None,
     source: str = "",
+    min_elevation: float = MIN_ELEVATION_DEG,
 ) -> TrackingTable:
     """Read a CSV tracking table (``#`` comment lines allowed before the header).
 
@@ -128,6 +130,10 @@ def read_tracking_table(
         ``"UTC"`` when times without a zone are UTC; else such a time is an error.
     on_bad : {"raise", "drop"}
         A bad row raises, or is left out, counted and listed in ``table.dropped``.
+    min_elevation : float
+        A row whose elevation is below this is bad [degree] (default
+        :data:`~sbrdf_xr.observing.tracking.MIN_ELEVATION_DEG`, which leaves room for
+        refraction; 0 for elevations that are apparent, as measured on an image).
 
     Examples
     --------
@@ -164,12 +170,20 @@ def read_tracking_table(
     if missing:
         raise TrackingTableError(f"{what}: lacks the column(s) {missing}; its header: {header}")
     numeric = [c for c in (*angles, range_column, height_column, *keep) if c is not None]
+    lo = float(to_unit(min_elevation, "deg", "min_elevation"))
     good: list[tuple[int, np.datetime64, list[float], str]] = []
     dropped: list[tuple[int, str]] = []
     for (line, _), row in zip(lines[1:], reader, strict=True):
         try:
             t = _parse_time(row.get(time) or "", line, time_zone, what)
             vals = [_number(row, c, line, what) for c in numeric]
+            if elevation is not None and ra is None:
+                el = vals[numeric.index(elevation)]
+                if el < lo:
+                    raise TrackingTableError(
+                        f"{what}: line {line}: elevation {el:g} deg is below the horizon "
+                        f"limit {lo:g} deg"
+                    )
         except TrackingTableError as exc:
             if on_bad == "raise":
                 raise
@@ -224,7 +238,8 @@ def read_pomenis(path: str | Path, *, on_bad: str = "raise") -> TrackingTable:
     Times are UTC (the file's header says so, and is checked); ``satellite_height`` is the
     height above the WGS84 ellipsoid [km] (lumos-sat, the authors' code, calls it the
     geodetic height); ``satellite_altitude`` and ``satellite_azimuth`` are the elevation
-    and azimuth [degree]; ``ab_magnitude`` is kept in ``table.columns``.  Every row is
+    and azimuth [degree] (a row below the horizon, elevation < 0, is bad: a satellite
+    imaged there cannot be); ``ab_magnitude`` is kept in ``table.columns``.  Every row is
     its own track (one measurement per satellite and time): the velocity is unknown.
 
     Examples
@@ -255,6 +270,7 @@ def read_pomenis(path: str | Path, *, on_bad: str = "raise") -> TrackingTable:
         keep=("ab_magnitude",),
         time_zone="UTC",
         on_bad=on_bad,
+        min_elevation=0.0,
         name="pomenis",
         source=(
             f"Pomenis observations of Starlink v1.5 from Mount Lemmon, {p} (Fankhauser, "

@@ -47,7 +47,8 @@ with the likely mistake.
 
 Modules: ``spectra`` (reference spectra, quadrature), ``bands``, ``magnitude``,
 ``atmosphere``, ``standard``, ``colour``, ``colour_science``, ``filter_names``, ``measured``,
-``lightcurves``, ``files``.
+``lightcurves``, ``files``, ``agreement`` (predicted against observed magnitudes after one
+zero point: :func:`compare_magnitudes`, :func:`binned_residuals`).
 
 Conventions
 -----------
@@ -127,6 +128,7 @@ with noisy tables) gives a NaN magnitude.
 """
 
 from . import (
+    agreement,
     atmosphere,
     bands,
     colour,
@@ -140,6 +142,7 @@ from . import (
     spectra,
     standard,
 )
+from .agreement import binned_residuals, compare_magnitudes
 from .atmosphere import (
     AIRMASS_MODELS,
     airmass,
@@ -209,6 +212,7 @@ __all__ = [
     "TABLE_FORMATS",
     "WEIGHTINGS",
     "ab_reference_flux",
+    "agreement",
     "airmass",
     "apply_extinction",
     "at_resolution",
@@ -217,6 +221,7 @@ __all__ = [
     "band_signal",
     "band_weights",
     "bands",
+    "binned_residuals",
     "cf_decode",
     "cf_encode",
     "check_system",
@@ -225,6 +230,7 @@ __all__ = [
     "colour_science",
     "compare",
     "compare_light_curves",
+    "compare_magnitudes",
     "extinction_coefficients",
     "files",
     "filters",

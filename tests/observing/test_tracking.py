@@ -167,7 +167,7 @@ def test_reader_checks_every_row(tmp_path, tle_pass):
         "2024-03-17T01:22:05,75.9,12.0,840\n": "line 4: time .* has no time zone",
         "2024-03-17T01:22:05Z,,12.0,840\n": "line 4: column 'el' is empty",
         "2024-03-17T01:22:05Z,x,12.0,840\n": "line 4: column 'el' is 'x', not a number",
-        "2024-03-17T01:22:05Z,-3,12.0,840\n": "row 4: elevation -3 deg is below",
+        "2024-03-17T01:22:05Z,-3,12.0,840\n": "line 4: elevation -3 deg is below",
         "2024-03-17T01:22:00Z,70,12.0,840\n": "lines 3 and 4 have the same time",
         ",70,12.0,840\n": "line 4: the time is missing",
     }

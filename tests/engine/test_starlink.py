@@ -1,0 +1,132 @@
+"""The built-in Starlink v1.5-class body at the Pomenis observations (engine.starlink).
+
+The shipped table, the scene, a 12-row prediction checked against closed forms, bad
+input, and the 1,173 rows with the correlation bound of the run (~10 s).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from sbrdf_xr.engine import pomenis_table, predict_starlink, starlink_scene
+from sbrdf_xr.errors import TrackingTableError, ValidationError
+from sbrdf_xr.observing import read_pomenis
+from sbrdf_xr.photometry import (
+    compare_magnitudes,
+    lambert_sphere_phase,
+    sun_distance_au,
+    sun_magnitudes,
+)
+
+HEADER = (
+    "# Observation Time : UTC\n"
+    "observation_time,satellite_height,satellite_altitude,satellite_azimuth,ab_magnitude\n"
+)
+GOOD = "2022-01-25T13:28:39,448.4444346,32.87386184,316.0661315,4.864597228\n"
+
+
+@pytest.fixture(scope="module")
+def twelve():
+    return predict_starlink(pomenis_table(rows=slice(0, 12)))
+
+
+def test_the_shipped_table_is_whole():
+    table = pomenis_table()
+    assert table.times.size == 1173 and table.dropped == ()
+    assert table.columns["ab_magnitude"].size == 1173
+    assert table.site.latitude_deg == 32.4434 and table.site.longitude_deg == -110.7881
+
+
+def test_the_scene_has_the_effects_and_the_tracking_array():
+    plan = starlink_scene(pomenis_table(rows=slice(0, 3))).plan()
+    assert plan.effects == ("sunlight", "shadowing", "eclipse", "earthshine")
+    plan = starlink_scene(pomenis_table(rows=slice(0, 3)), earthshine=False, shadowing=False).plan()
+    assert plan.effects == ("sunlight", "eclipse")
+
+
+def test_the_sphere_control_is_russells_phase_law(twelve):
+    """m_sphere + 2.5 log10(0.65/pi Phi(alpha) / d**2) - 5 log10(r_sun) is the Sun's AB V
+    magnitude at 1 AU: the same at every row to the Almanac formula's 1e-5 au (5e-5 mag)
+    and the spacecraft's offset from the Earth (<1e-4 mag)."""
+    phi = lambert_sphere_phase(twelve.phase_angle.values)
+    d_m = twelve.range.values * 1e3
+    r_au = np.asarray(sun_distance_au(twelve.time.values))
+    c = twelve.magnitude_sphere.values + 2.5 * np.log10(0.65 / np.pi * phi / d_m**2)
+    c -= 5.0 * np.log10(r_au)
+    assert np.ptp(c) < 2e-4
+    assert c.mean() == pytest.approx(sun_magnitudes("V", system="AB").item(), abs=1e-3)
+
+
+def test_the_prediction_is_complete_and_labelled(twelve):
+    for v in twelve.data_vars:
+        assert twelve[v].attrs["units"] and twelve[v].attrs["long_name"]
+        assert np.isfinite(twelve[v]).all(), v
+    # earthshine only adds light
+    assert np.all(twelve.magnitude_model <= twelve.magnitude_sunlight + 1e-12)
+    # the sunlight magnitude is -2.5 log10 of the two surfaces' signal / (d r_sun)**2
+    total = (twelve.signal_chassis + twelve.signal_array).values
+    d, r = twelve.range.values, np.asarray(sun_distance_au(twelve.time.values))
+    m = -2.5 * np.log10(total / (d * r) ** 2)
+    dm = twelve.magnitude_sunlight.values - m
+    assert np.ptp(dm) < 2e-4  # the Almanac's r_sun to 1e-5 au against the cube's
+    np.testing.assert_allclose(
+        twelve.magnitude_observed, pomenis_table(rows=slice(0, 12)).columns["ab_magnitude"]
+    )
+
+
+def test_a_table_without_magnitudes_is_refused():
+    table = pomenis_table(rows=slice(0, 3))
+    bare = type(table)(
+        table.site, table.times, elevation_deg=table.elevation_deg,
+        azimuth_deg=table.azimuth_deg, height_km=table.height_km,
+    )  # fmt: skip
+    with pytest.raises(ValidationError, match="no column 'ab_magnitude'"):
+        predict_starlink(bare)
+    with pytest.raises(ValidationError, match=r"no table for \['starlink-solar-array'\]"):
+        starlink_scene(table, materials={"starlink-chassis": None})
+
+
+@pytest.mark.parametrize(
+    "line, why",
+    [
+        ("2022-01-26T13:04:48,448.06,,128.22,5.67\n", "column 'satellite_altitude' is empty"),
+        ("2022-01-26T13:04:48,448.06,45.8,north,5.67\n", "'north', not a number"),
+        ("2022-01-26T13:04:48,448.06,-0.5,128.22,5.67\n", "elevation -0.5 deg is below"),
+        ("2022-01-26T13:04:48,448.06,45.8,128.22,\n", "column 'ab_magnitude' is empty"),
+    ],
+)
+def test_bad_rows_are_named_or_counted(tmp_path, line, why):
+    p = tmp_path / "p.csv"
+    p.write_text(HEADER + GOOD + line)
+    with pytest.raises(TrackingTableError, match=f"line 4: .*{why}"):
+        read_pomenis(p)
+    with pytest.warns(UserWarning, match="1 row"):
+        table = read_pomenis(p, on_bad="drop")
+    assert table.times.size == 1 and table.dropped[0][0] == 4
+
+
+def test_a_file_that_does_not_state_utc_is_refused(tmp_path):
+    p = tmp_path / "p.csv"
+    p.write_text(HEADER.replace("UTC", "local") + GOOD)
+    with pytest.raises(TrackingTableError, match="does not state 'Observation Time : UTC'"):
+        read_pomenis(p)
+
+
+#: The package's model over the 1,173 rows (this branch's run, tables with the horizon
+#: nodes held): r = 0.662 with earthshine (RMS 0.93 mag), 0.671 sunlight only; the diffuse
+#: sphere 0.470 (published 0.47).  The r bound sits 0.02 below the run (a table rebuilt
+#: with other options moved r by 0.005-0.03 here; the grazing-node defect fixed on this
+#: branch cost 0.05); the RMS bound is under the two-slab baseline's 1.19 mag.
+R_MODEL_MIN, RMS_MODEL_MAX = 0.64, 1.0
+
+
+def test_the_correlation_over_all_rows():
+    out = predict_starlink()
+    model = compare_magnitudes(out.magnitude_model, out.magnitude_observed)
+    sphere = compare_magnitudes(out.magnitude_sphere, out.magnitude_observed)
+    assert model.attrs["n_unpredicted"] == 0
+    assert float(model.pearson_r) >= R_MODEL_MIN
+    assert float(model.rms_residual) < RMS_MODEL_MAX
+    assert float(sphere.pearson_r) == pytest.approx(0.47, abs=0.005)
+    assert float(model.pearson_r) > float(sphere.pearson_r) + 0.15
