@@ -20,8 +20,10 @@ and azimuth of a Starlink v1.5 satellite seen from Mount Lemmon, and its AB magn
   (``starlink-v1.5-chassis``, ``starlink-v1.5-solar-array``);
 * effects: sunlight scaled by the Earth's shadow (WGS84, finite Sun), exact self-shadowing
   and self-occlusion between chassis and array, and earthshine from a Lambertian Earth of
-  Bond albedo 0.3 seen as a point source at its centre (the package's ``earthshine``
-  effect: no finite disc, no measured Earth BRDF, no terminator).
+  Bond albedo 0.3 of finite size (the package's ``earthshine`` effect with its default
+  ``earth_model="finite"``: each facet's irradiance integrated over the sunlit Earth its
+  horizon sees, the BRDF taken at the direction of the Earth's centre; no measured Earth
+  BRDF).
 
 Band: the scans are at 532 nm and the surfaces are taken as grey, so the tables are
 continued as constants (``band_extrapolate="constant"``) and the magnitudes are AB in the
@@ -248,7 +250,7 @@ def predict_starlink(table: Any = None, **scene_options: Any) -> xr.Dataset:
     out.attrs.update(
         band=f"AB, Bessell {_BAND}; grey tables from the 532 nm scans",
         effects=", ".join(scene.plan().effects),
-        earthshine="Lambertian Earth, Bond albedo 0.3, a point source at the Earth's centre",
+        earthshine="Lambertian Earth, Bond albedo 0.3, finite disc (earth_model finite)",
         attitude="YawSteering: -z on the geodetic nadir, +y toward the Sun; array sun-tracking",
         sphere_area_albedo_m2=SPHERE_AREA_ALBEDO,
         source=table.source,
