@@ -211,7 +211,12 @@ def read_merl(
     >>> from sbrdf_xr.materials.merl import read_merl, write_merl
     >>> p = write_merl(pathlib.Path(tempfile.mkdtemp()) / "grey.binary",
     ...                lambda s, o: np.tile([0.3, 0.2, 0.1], (len(s), 1)))
-    >>> ds = read_merl(p, theta_i=(30.0,), step=10.0)
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:  # a cell MERL leaves unmeasured
+    ...     warnings.simplefilter("always")
+    ...     ds = read_merl(p, theta_i=(30.0,), step=10.0)
+    >>> [str(w.message)[:44] for w in caught]
+    ['MERL: 1 of 153 sampled geometries of grey.bi']
     >>> ds.attrs["channels"], np.round(ds.measured_sbrdf.values[0], 12).tolist()
     ('blue, green, red (MERL RGB colour channels at nominal wavelengths)', [0.1, 0.2, 0.3])
     """
