@@ -431,8 +431,10 @@ def test_the_private_check_catches_imports_and_attributes(tmp_path):
 #: (materials, photometry, store, bench, cli) to ``_output``, the one safe output, and
 #: one to ``units`` from every package whose public functions take an argument with a
 #: unit (converted at the door).  The package's ``__init__`` imports only what it
-#: publishes by name; its modules load on first use.
-GRAPH_LIMITS = {"nodes": 30, "depth": 12, "edges": 110}
+#: publishes by name; its modules load on first use.  ``bench -> catalog`` (111th edge):
+#: the accuracy study against the sky (``bench.starlink``) loads the shipped observations
+#: and scan tables by name.
+GRAPH_LIMITS = {"nodes": 30, "depth": 12, "edges": 111}
 
 
 def node_of(mod: str, root: Path = PACKAGE) -> str:

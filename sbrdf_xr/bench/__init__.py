@@ -20,9 +20,12 @@ Modules
     The presets' measured error and cost, recorded from a run and shipped.
 ``parts``
     What open surfaces and sun-tracking parts cost against the rigid closed path.
+``starlink``
+    Accuracy against the sky: the built-in Starlink v1.5-class body at 1,173 measured
+    magnitudes, beside the diffuse-sphere control (:func:`predict_starlink`).
 """
 
-from . import accuracy, engine, parts, presets, rows, shadowing, suite
+from . import accuracy, engine, parts, presets, rows, shadowing, starlink, suite
 from .accuracy import BANDS, CANX1_MATERIALS, accuracy_cost, shadow_rows
 from .engine import disk_rate, engine_rows, sweep_job, thread_scaling
 from .parts import KINDS, canx1_with_wing, parts_rows
@@ -39,6 +42,7 @@ from .shadowing import (
     markdown,
     scaling_rows,
 )
+from .starlink import pomenis_table, predict_starlink, starlink_scene
 from .suite import bench_build_lut, bench_geometry, bench_lookup, kernel_throughput, run
 
 __all__ = [
@@ -70,6 +74,8 @@ __all__ = [
     "parts",
     "parts_rows",
     "plot_front",
+    "pomenis_table",
+    "predict_starlink",
     "presets",
     "presets_record",
     "presets_table",
@@ -79,6 +85,8 @@ __all__ = [
     "scaling_rows",
     "shadow_rows",
     "shadowing",
+    "starlink",
+    "starlink_scene",
     "suite",
     "sweep_job",
     "thread_scaling",

@@ -23,9 +23,6 @@ Modules
 ``reuse``
     What a plan computes from the tables, the spacecraft and the knobs alone (packed
     tables, merged facets), kept by content for the next plans.
-``starlink``
-    The built-in Starlink v1.5-class body at the 1,173 shipped Pomenis observations
-    (:func:`predict_starlink`): real magnitudes against the model.
 ``run``
     Executing a plan: blocks of geometries through the kernel into an xarray cube
     (:func:`simulate`; :func:`sbrdf_xr.store.write` writes it).
@@ -45,7 +42,6 @@ from . import (
     schema,
     spectral,
     stages,
-    starlink,
     sweep,
 )
 from .articulation import Articulation, BoundGroup
@@ -69,7 +65,6 @@ from .scene_file import (
     material_tables,
     scene_from_dict,
 )
-from .starlink import pomenis_table, predict_starlink, starlink_scene
 from .sweep import QUATERNION_COMPONENTS, GridGeometry, PairGeometry
 
 __all__ = [
@@ -112,8 +107,6 @@ __all__ = [
     "load_scene",
     "material_tables",
     "plan",
-    "pomenis_table",
-    "predict_starlink",
     "reflected",
     "resolve_scene",
     "reuse",
@@ -126,8 +119,6 @@ __all__ = [
     "simulate",
     "spectral",
     "stages",
-    "starlink",
     "starlink_materials",
-    "starlink_scene",
     "sweep",
 ]

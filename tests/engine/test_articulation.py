@@ -231,6 +231,7 @@ def test_other_sources_see_the_plate_where_the_sun_turned_it():
         to_observer=o,
         to_earth=e,
         effects=("sunlight", "earthshine"),
+        earth_model="point",  # the closed form is that of a distant Earth
     )
     plan = scene.plan()
     cube = simulate(plan)

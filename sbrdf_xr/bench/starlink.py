@@ -46,8 +46,8 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from ..engine.scene import Scene
 from ..errors import ValidationError
-from .scene import Scene
 
 __all__ = [
     "POMENIS_DATA",
@@ -201,7 +201,7 @@ def predict_starlink(table: Any = None, **scene_options: Any) -> xr.Dataset:
     >>> bool(np.isfinite(out.magnitude_model).all()), out.attrs["band"][:14]
     (True, 'AB, Bessell V;')
     """
-    from .run import simulate
+    from ..engine.run import simulate
 
     table = pomenis_table() if table is None else table
     if "ab_magnitude" not in table.columns:

@@ -1,4 +1,4 @@
-"""The built-in Starlink v1.5-class body at the Pomenis observations (engine.starlink).
+"""The built-in Starlink v1.5-class body at the Pomenis observations (bench.starlink).
 
 The shipped table, the scene, a 12-row prediction checked against closed forms, bad
 input, and the 1,173 rows with the correlation bound of the run (~10 s).
@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sbrdf_xr.engine import pomenis_table, predict_starlink, starlink_scene
+from sbrdf_xr.bench import pomenis_table, predict_starlink, starlink_scene
 from sbrdf_xr.errors import TrackingTableError, ValidationError
 from sbrdf_xr.observing import read_pomenis
 from sbrdf_xr.photometry import (
