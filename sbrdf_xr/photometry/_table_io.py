@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ..errors import LightCurveError
+from ..errors import LightCurveError, check_declared_size
 
 #: Suffix -> astropy Table format.
 TABLE_FORMATS = {
@@ -119,6 +119,7 @@ def read_table(path: Path) -> tuple[Any, dict[str, Any], dict[str, Any], str, in
     units: dict[str, Any] = {}
     meta: dict[str, Any] = {}
     if suffix in (".nc", ".nc4", ".netcdf"):
+        check_declared_size(path, "light curve", error=LightCurveError)
         try:
             with xr.open_dataset(path, decode_times=True) as ds:
                 ds = ds.load()

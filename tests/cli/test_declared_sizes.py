@@ -53,3 +53,32 @@ def test_info_describes_a_file_without_reading_its_data(tmp_path, capsys):
     text = capsys.readouterr().out
     # the 1.6 GB axis is not read to be shown: its values are not in the summary
     assert "wavelength  (wavelength) float64 2GB ..." in text, text
+
+
+@pytest.mark.parametrize(
+    ("reader", "error"),
+    [
+        ("light curve", "LightCurveError"),
+        ("quaternion_series", "AttitudeError"),
+        ("spectrum", "InversionError"),
+    ],
+)
+def test_a_measured_file_declaring_a_huge_dimension_is_refused(tmp_path, reader, error):
+    """A light curve, a quaternion series and a measured spectrum: a sparse netCDF of a few
+    kB declaring 2e9 rows (16 GiB of float64) is refused from its header, naming the
+    estimate, with each reader's own error (before: xarray allocated until MemoryError)."""
+    from sbrdf_xr import errors
+    from sbrdf_xr.invert import read_spectrum
+    from sbrdf_xr.observing.series import QuaternionSeries
+    from sbrdf_xr.photometry import read_light_curve
+
+    read = {
+        "light curve": read_light_curve,
+        "quaternion_series": QuaternionSeries.from_netcdf,
+        "spectrum": read_spectrum,
+    }[reader]
+    name = {"light curve": "magnitude", "quaternion_series": "quaternion"}.get(reader, "signal")
+    path = sparse(tmp_path / "big.nc", {"obs": 2 * 10**9}, name)
+    with pytest.raises(getattr(errors, error), match=r"declares 14\.9 GiB of arrays") as info:
+        read(path)
+    assert str(path) in str(info.value) and reader in str(info.value)
