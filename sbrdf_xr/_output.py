@@ -171,18 +171,17 @@ def io_failure(exc: BaseException, path: str | os.PathLike[str]) -> str:
     text = error_words(exc) or f"{type(exc).__name__}: {exc}"
     if "HDF error" not in str(exc):
         return text
-    directory = Path(path).parent
     try:
-        free = f"{shutil.disk_usage(directory).free / 2**20:.1f} MiB free on {directory}"
-    except OSError as err:
-        free = f"the free space of {directory} unknown ({error_words(err) or err})"
+        free = f"{shutil.disk_usage(Path(path).parent).free / 2**20:.1f} MiB free"
+    except OSError:
+        free = "free space unknown"
     import resource
 
     soft = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
     limit = "none" if soft == resource.RLIM_INFINITY else f"{soft / 2**20:.3g} MiB"
     return (
         f"{text}: HDF5 gives no cause; most likely the disk filled or the file size limit "
-        f"was reached ({free}, file size limit {limit}, writing {path})"
+        f"was reached ({free} on {Path(path).parent}, file size limit {limit}, writing {path})"
     )
 
 
@@ -460,8 +459,7 @@ def write_netcdf(
         try:
             ds.to_netcdf(tmp, engine="netcdf4", encoding=netcdf_encoding(ds, complevel))
         except (OSError, RuntimeError) as exc:  # netCDF4 raises RuntimeError for HDF5's
-            why = io_failure(exc, tmp)
-            raise error(f"cannot write {path}: {why}; nothing was replaced") from exc
+            raise error(f"cannot write {path}: {io_failure(exc, tmp)}; nothing replaced") from exc
     return path
 
 

@@ -287,4 +287,4 @@ def test_a_compressed_netcdf_that_hits_the_file_size_limit_names_the_likely_caus
     assert run.returncode == 0 and text.startswith(f"cannot write {out}: "), (text, run.stderr)
     assert "HDF error: HDF5 gives no cause; most likely the disk filled or the file size" in text
     assert f"MiB free on {tmp_path}, file size limit 0.191 MiB, writing {out}." in text, text
-    assert text.endswith("nothing was replaced") and os.listdir(tmp_path) == []
+    assert text.endswith("; nothing replaced") and os.listdir(tmp_path) == []
