@@ -8,13 +8,14 @@ named in messages; :func:`in_unit` converts a column to the package's unit.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from ..errors import LightCurveError, check_declared_size
+from ..errors import MAX_FILE_BYTES, LightCurveError, check_declared_size
 
 #: Suffix -> astropy Table format.
 TABLE_FORMATS = {
@@ -33,6 +34,26 @@ def _suffix(path: Path) -> str:
     return ".fits.gz" if name.endswith(".fits.gz") else path.suffix.lower()
 
 
+def _check_fits_size(path: Path) -> None:
+    """Refuse a FITS file whose headers declare more than MAX_FILE_BYTES of data (read from
+    the headers alone; astropy would allocate it before finding the file shorter)."""
+    from astropy.io import fits
+
+    total = 0
+    with fits.open(path, lazy_load_hdus=True) as hdus:
+        for hdu in hdus:
+            h = hdu.header
+            axes = [int(h.get(f"NAXIS{i}", 0)) for i in range(1, int(h.get("NAXIS", 0)) + 1)]
+            if axes:
+                total += abs(int(h.get("BITPIX", 8))) // 8 * math.prod(axes)
+                total += int(h.get("PCOUNT", 0))
+    if total > MAX_FILE_BYTES:
+        raise LightCurveError(
+            f"light curve: {path} declares {total / 2**30:.3g} GiB of data in its FITS headers; "
+            f"files of at most {MAX_FILE_BYTES / 2**30:.3g} GiB are read"
+        )
+
+
 def _from_astropy(path: Path, fmt: str) -> tuple[Any, dict[str, Any], dict[str, Any]]:
     """Columns as a DataFrame of plain values, their astropy units, the table metadata."""
     import warnings
@@ -45,10 +66,14 @@ def _from_astropy(path: Path, fmt: str) -> tuple[Any, dict[str, Any], dict[str, 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # VOTable/FITS readers warn about vendor keywords
+            if fmt == "fits":
+                _check_fits_size(path)
             # astropy_native: FITS time columns come back as Time (with their scale)
             tab = Table.read(
                 path, format=fmt, **({"astropy_native": True} if fmt == "fits" else {})
             )
+    except LightCurveError:
+        raise
     except Exception as exc:  # astropy raises many types for malformed files
         raise LightCurveError(f"{path}: cannot be read as {fmt}: {exc}") from exc
     cols: dict[str, Any] = {}

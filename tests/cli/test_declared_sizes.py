@@ -82,3 +82,22 @@ def test_a_measured_file_declaring_a_huge_dimension_is_refused(tmp_path, reader,
     with pytest.raises(getattr(errors, error), match=r"declares 14\.9 GiB of arrays") as info:
         read(path)
     assert str(path) in str(info.value) and reader in str(info.value)
+
+
+def test_a_fits_light_curve_declaring_1e9_rows_is_refused(tmp_path):
+    """A 4-row FITS table whose header is edited to declare 1e9 rows (22.4 GiB): refused
+    from its headers (before: astropy allocated 22.4 GiB before finding the file short)."""
+    import numpy as np
+    from astropy.io import fits
+
+    from sbrdf_xr.errors import LightCurveError
+    from sbrdf_xr.photometry import read_light_curve
+
+    path = tmp_path / "lc.fits"
+    cols = [fits.Column(name=n, format="D", array=np.zeros(4)) for n in ("mjd_utc", "V", "V_err")]
+    fits.BinTableHDU.from_columns(cols).writeto(path)
+    raw = path.read_bytes()
+    at = raw.index(b"NAXIS2  =")
+    path.write_bytes(raw[:at] + b"NAXIS2  = %20d" % 10**9 + raw[at + 30 :])
+    with pytest.raises(LightCurveError, match=r"declares 22\.4 GiB of data in its FITS headers"):
+        read_light_curve(path, system="Vega")
