@@ -54,6 +54,25 @@ def _check_fits_size(path: Path) -> None:
         )
 
 
+def _check_votable_rows(path: Path) -> None:
+    """Refuse a VOTable whose ``TABLE nrows`` declare more than MAX_FILE_BYTES (8 bytes a
+    FIELD a row; astropy allocates the rows declared before reading them)."""
+    import mmap
+    import re
+
+    if path.stat().st_size == 0:
+        return
+    with open(path, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as m:
+        rows = sum(int(n) for n in re.findall(rb"<TABLE\b[^>]*?\bnrows\s*=\s*[\"'](\d{1,30})", m))
+        fields = max(len(re.findall(rb"<FIELD\b", m)), 1)
+    if rows * fields * 8 > MAX_FILE_BYTES:
+        raise LightCurveError(
+            f"light curve: {path} declares {rows} rows of {fields} fields in its VOTable "
+            f"(about {rows * fields * 8 / 2**30:.3g} GiB); files of at most "
+            f"{MAX_FILE_BYTES / 2**30:.3g} GiB are read"
+        )
+
+
 def _from_astropy(path: Path, fmt: str) -> tuple[Any, dict[str, Any], dict[str, Any]]:
     """Columns as a DataFrame of plain values, their astropy units, the table metadata."""
     import warnings
@@ -68,6 +87,8 @@ def _from_astropy(path: Path, fmt: str) -> tuple[Any, dict[str, Any], dict[str, 
             warnings.simplefilter("ignore")  # VOTable/FITS readers warn about vendor keywords
             if fmt == "fits":
                 _check_fits_size(path)
+            elif fmt == "votable":
+                _check_votable_rows(path)
             # astropy_native: FITS time columns come back as Time (with their scale)
             tab = Table.read(
                 path, format=fmt, **({"astropy_native": True} if fmt == "fits" else {})

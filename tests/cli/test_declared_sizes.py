@@ -101,3 +101,21 @@ def test_a_fits_light_curve_declaring_1e9_rows_is_refused(tmp_path):
     path.write_bytes(raw[:at] + b"NAXIS2  = %20d" % 10**9 + raw[at + 30 :])
     with pytest.raises(LightCurveError, match=r"declares 22\.4 GiB of data in its FITS headers"):
         read_light_curve(path, system="Vega")
+
+
+def test_a_votable_light_curve_declaring_1e9_rows_is_refused(tmp_path):
+    """A 2-row VOTable whose TABLE says nrows="1000000000": refused from that attribute
+    (before: astropy allocated 22.4 GiB for the rows declared)."""
+    from astropy.table import Table
+
+    from sbrdf_xr.errors import LightCurveError
+    from sbrdf_xr.photometry import read_light_curve
+
+    path = tmp_path / "lc.vot"
+    table = {"mjd_utc": [60000.0, 60000.1], "V": [10.0, 10.1], "V_err": [0.01, 0.01]}
+    Table(table).write(path, format="votable")
+    path.write_text(path.read_text().replace("<TABLE", '<TABLE nrows="1000000000"', 1))
+    with pytest.raises(LightCurveError, match=r"declares 1000000000 rows of 3 fields .*22\.4 GiB"):
+        read_light_curve(path, system="Vega")
+    path.write_text(path.read_text().replace('nrows="1000000000"', 'nrows="2"'))
+    assert read_light_curve(path, system="Vega").sizes["obs"] == 2  # a true count passes
