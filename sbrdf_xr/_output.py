@@ -54,6 +54,7 @@ __all__ = [
     "fsync_dir",
     "fsync_tree",
     "holds_nothing",
+    "io_failure",
     "libc_function",
     "make_marked_dir",
     "netcdf_encoding",
@@ -149,6 +150,39 @@ def error_words(exc: BaseException) -> str | None:
     """
     code = getattr(exc, "errno", None)
     return _ERRNO_WORDS.get(code) if isinstance(code, int) else None
+
+
+def io_failure(exc: BaseException, path: str | os.PathLike[str]) -> str:
+    """The cause of a failed write into ``path`` in words: :func:`error_words`, else the
+    error itself; HDF5's "HDF error", which gives no cause, with its usual ones measured
+    (the free space of ``path``'s directory by ``shutil.disk_usage``, the file size limit).
+
+    Examples
+    --------
+    >>> from sbrdf_xr._output import io_failure
+    >>> text = io_failure(RuntimeError("NetCDF: HDF error"), "/tmp/cube.nc")
+    >>> print(text.split("; ")[0])
+    RuntimeError: NetCDF: HDF error: HDF5 gives no cause
+    >>> print(text.split("; ")[1].split(" (")[0])
+    most likely the disk filled or the file size limit was reached
+    >>> io_failure(OSError(errno.ENOSPC, "No space left on device"), "/tmp/cube.nc")
+    'no space left on device'
+    """
+    text = error_words(exc) or f"{type(exc).__name__}: {exc}"
+    if "HDF error" not in str(exc):
+        return text
+    try:
+        free = f"{shutil.disk_usage(Path(path).parent).free / 2**20:.1f} MiB free"
+    except OSError:
+        free = "free space unknown"
+    import resource
+
+    soft = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
+    limit = "none" if soft == resource.RLIM_INFINITY else f"{soft / 2**20:.3g} MiB"
+    return (
+        f"{text}: HDF5 gives no cause; most likely the disk filled or the file size limit "
+        f"was reached ({free} on {Path(path).parent}, file size limit {limit}, writing {path})"
+    )
 
 
 def file_kind(p: str | os.PathLike[str]) -> str | None:
@@ -422,7 +456,10 @@ def write_netcdf(
     path = check_output(path, overwrite=overwrite, error=error)
     ds = cf_finish(ds)  # Conventions, title, source, history, flags, ancillary links
     with atomic_file(path, overwrite=overwrite, error=error) as tmp:
-        ds.to_netcdf(tmp, engine="netcdf4", encoding=netcdf_encoding(ds, complevel))
+        try:
+            ds.to_netcdf(tmp, engine="netcdf4", encoding=netcdf_encoding(ds, complevel))
+        except (OSError, RuntimeError) as exc:  # netCDF4 raises RuntimeError for HDF5's
+            raise error(f"cannot write {path}: {io_failure(exc, tmp)}; nothing replaced") from exc
     return path
 
 

@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import contextlib
 import difflib
+import math
 import os
 import stat
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 __all__ = [
+    "MAX_FILE_BYTES",
     "AttitudeError",
     "CacheWarning",
     "CatalogError",
@@ -43,6 +45,7 @@ __all__ = [
     "UnitWarning",
     "ValidationError",
     "WorkersLostError",
+    "check_declared_size",
     "did_you_mean",
     "input_file",
     "reading",
@@ -243,6 +246,77 @@ def reading(
         raise (error or ValidationError)(
             f"{what}: {path} cannot be read as {as_} ({_reason(exc)})"
         ) from None
+
+
+#: Memory the arrays of a netCDF input (material table, measurement set, light curve,
+#: quaternion series) may take once read [byte], times ``size_limit``.
+MAX_FILE_BYTES = 4 * 2**30
+
+
+def check_declared_size(
+    path: Path, what: str, size_limit: float = 1.0, error: type[Exception] | None = None
+) -> int:
+    """The bytes the variables of the netCDF file ``path`` declare (read from its header,
+    no data read); over ``size_limit`` x :data:`MAX_FILE_BYTES` a ValidationError with
+    the estimate and the largest variable (``error``, default :class:`ValidationError`).
+    Every reader of a netCDF input calls it first (material tables, measurement sets,
+    light curves, quaternion series, measured spectra).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The netCDF file.
+    what : str
+        What it is (``"light curve"``), heading the message.
+    size_limit : float, default 1
+        Factor on :data:`MAX_FILE_BYTES` [1].
+    error : type, default ValidationError
+        The error raised.
+
+    Returns
+    -------
+    int
+        The declared bytes.
+
+    Examples
+    --------
+    A 2e8-long wavelength axis in a file of a few kB (the header only; HDF5 allocates
+    nothing for values never written):
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import netCDF4
+    >>> from sbrdf_xr.errors import check_declared_size
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = Path(tmp) / "sparse.nc"
+    ...     with netCDF4.Dataset(path, "w") as nc:
+    ...         for d, n in zip("abcw", (4, 4, 3, 200_000_000)):
+    ...             _ = nc.createDimension(d, n)
+    ...         _ = nc.createVariable("sbrdf", "f8", tuple("abcw"))
+    ...     try:
+    ...         check_declared_size(path, "material table")
+    ...     except ValidationError as exc:
+    ...         print(str(exc).replace(tmp, "<tmp>"))
+    material table: <tmp>/sparse.nc declares 71.5 GiB of arrays (the largest, 'sbrdf', of
+    shape (4, 4, 3, 200000000) float64); files of at most 4 GiB are read (size_limit 1)
+    """
+    import netCDF4
+
+    with reading(path, what, "netCDF", error), netCDF4.Dataset(path, mode="r") as nc:
+        sizes = {
+            str(name): (tuple(v.shape), v.dtype, math.prod(float(n) for n in v.shape))
+            for name, v in nc.variables.items()
+        }
+    nbytes = {k: n * getattr(dt, "itemsize", 16) for k, (_, dt, n) in sizes.items()}
+    total = sum(nbytes.values())
+    if total > size_limit * MAX_FILE_BYTES:
+        big = max(nbytes, key=nbytes.__getitem__)
+        raise (error or ValidationError)(
+            f"{what}: {path} declares {total / 2**30:.3g} GiB of arrays (the largest, {big!r}, "
+            f"of shape {sizes[big][0]} {sizes[big][1]}); files of at most "
+            f"{size_limit * MAX_FILE_BYTES / 2**30:.3g} GiB are read (size_limit {size_limit:g})"
+        )
+    return int(total)
 
 
 class SbrdfError(Exception):

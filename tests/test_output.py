@@ -253,3 +253,38 @@ def test_replace_dir_keeps_the_old_store_until_the_new_one_is_in_place(tmp_path)
     with pytest.raises(OutputError, match="did not write"):
         replace_dir(new, foreign)  # a directory the package did not write is never replaced
     assert foreign.is_dir() and read_marker(new)["n"] == 3
+
+
+_FULL_WRITE = """
+import resource, signal, sys
+from pathlib import Path
+import numpy as np, xarray as xr
+from sbrdf_xr._output import write_netcdf
+from sbrdf_xr.errors import OutputError
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails with EFBIG
+resource.setrlimit(resource.RLIMIT_FSIZE, (200_000, resource.RLIM_INFINITY))
+ds = xr.Dataset({"v": (("x", "y"), np.random.default_rng(0).random((400, 400)))})
+try:
+    write_netcdf(ds, Path(sys.argv[1]), complevel=4)
+except OutputError as exc:
+    print(exc)
+"""
+
+
+def test_a_compressed_netcdf_that_hits_the_file_size_limit_names_the_likely_cause(tmp_path):
+    """A real failure, not an injected one: 1.2 MB of incompressible float64 under a file
+    size limit of 200 kB (in a child process).  HDF5 says only "NetCDF: HDF error" (all the
+    message was before); now the error names the likely causes with the free space of the
+    directory (``shutil.disk_usage``), the limit and the file, and nothing is left behind."""
+    import subprocess
+    import sys
+
+    out = tmp_path / "v.nc"
+    run = subprocess.run(
+        [sys.executable, "-c", _FULL_WRITE, str(out)], capture_output=True, text=True, timeout=300
+    )
+    text = run.stdout.strip()
+    assert run.returncode == 0 and text.startswith(f"cannot write {out}: "), (text, run.stderr)
+    assert "HDF error: HDF5 gives no cause; most likely the disk filled or the file size" in text
+    assert f"MiB free on {tmp_path}, file size limit 0.191 MiB, writing {out}." in text, text
+    assert text.endswith("; nothing replaced") and os.listdir(tmp_path) == []

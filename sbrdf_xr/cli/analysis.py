@@ -6,6 +6,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 from typing import Any
 
@@ -256,6 +257,10 @@ def _unmix(args: argparse.Namespace):
     from ..errors import InversionError
     from ..photometry import read_light_curve
 
+    if args.range_km is not None and not (math.isfinite(args.range_km) and args.range_km > 0):
+        raise InversionError(  # refused for a spectrum too, which does not use it
+            f"--range-km: must be finite and > 0 km, got {args.range_km:g} (the observer range)"
+        )
     with open_dataset(args.cube) as cube:
         terms = cube.load()["signal_material"] if "signal_material" in cube else None
     if terms is None:

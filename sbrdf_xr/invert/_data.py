@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ..errors import InversionError
+from ..errors import InversionError, check_declared_size
 from ..units import check_plausible, to_unit
 from ._spin_data import LN10_2P5
 
@@ -273,6 +273,7 @@ def read_spectrum(path: str | os.PathLike[str]) -> tuple[xr.DataArray, xr.DataAr
 
     path = _regular_file(path, "spectrum")
     if path.suffix.lower() in (".nc", ".nc4"):
+        check_declared_size(path, "spectrum", error=InversionError)
         try:
             with xr.open_dataset(path) as ds:
                 df = ds.load().reset_coords().to_dataframe().reset_index()

@@ -6,6 +6,7 @@ See the package docstring.
 from __future__ import annotations
 
 import itertools
+import warnings
 from collections.abc import Mapping
 from typing import Any
 
@@ -13,7 +14,7 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from ..errors import InversionError
+from ..errors import FitQualityWarning, InversionError
 from ..units import to_unit
 from ._areas import add_areas, area_constraint, material_areas
 from ._library import MATERIAL, design, library
@@ -249,7 +250,8 @@ def unmix(
     FitQualityWarning
         When the chi-square lies beyond the 99.9 % point of its distribution (the model
         does not describe the data: wrong geometry, a material missing from the library)
-        or below its 0.1 % point (uncertainties overstated).
+        or below its 0.1 % point (uncertainties overstated); and when the fit has 0 degrees
+        of freedom (as many free parameters as measured values: nothing is tested).
 
     Raises
     ------
@@ -391,6 +393,14 @@ def unmix(
             f"(more than drop_bias = {drop_bias:g}); the lowest admissible subset is used"
         )
     quality = fit_quality(chi2, dof, "unmix", UNMIX_CAUSES)
+    if dof <= 0:  # as many free parameters as values: an exact fit that tests nothing
+        quality["fit_quality_note"] = (
+            f"unmix: {n} measured values for {npar(best)} free parameters ({label(best)}): "
+            "0 degrees of freedom, so the fit passes through the data whatever their errors "
+            "and its chi-square tests nothing; add wavelengths, bands or geometries, or "
+            "fewer candidate materials, to test the model"
+        )
+        warnings.warn(quality["fit_quality_note"], FitQualityWarning, stacklevel=2)
     return _result(
         names=names,
         x=x,

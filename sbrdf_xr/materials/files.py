@@ -13,7 +13,14 @@ import xarray as xr
 
 from .._names import SBRDF
 from .._output import write_netcdf
-from ..errors import NonPhysicalWarning, ValidationError, input_file, reading
+from ..errors import (
+    MAX_FILE_BYTES,
+    NonPhysicalWarning,
+    ValidationError,
+    check_declared_size,
+    input_file,
+    reading,
+)
 from .schema import validate_material, validate_measurements
 
 __all__ = [
@@ -26,11 +33,6 @@ __all__ = [
     "to_netcdf",
     "write_netcdf_atomic",
 ]
-
-
-#: Memory the arrays of a material or measurement file may take once read [byte], times
-#: ``size_limit``.
-MAX_FILE_BYTES = 4 * 2**30
 
 
 def read_netcdf(
@@ -73,54 +75,6 @@ def read_netcdf(
     check_declared_size(p, what, size_limit)
     with reading(p, what, "netCDF"), xr.open_dataset(p, engine="netcdf4") as ds:
         return p, ds.load()
-
-
-def check_declared_size(path: Path, what: str, size_limit: float = 1.0) -> int:
-    """The bytes the variables of the netCDF file ``path`` declare (read from its header,
-    no data read); over ``size_limit`` x :data:`MAX_FILE_BYTES` a ValidationError with
-    the estimate and the largest variable.
-
-    Examples
-    --------
-    A 2e8-long wavelength axis in a file of a few kB (the header only; HDF5 allocates
-    nothing for values never written):
-
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> import netCDF4
-    >>> from sbrdf_xr.materials.files import check_declared_size
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     path = Path(tmp) / "sparse.nc"
-    ...     with netCDF4.Dataset(path, "w") as nc:
-    ...         for d, n in zip("abcw", (4, 4, 3, 200_000_000)):
-    ...             _ = nc.createDimension(d, n)
-    ...         _ = nc.createVariable("sbrdf", "f8", tuple("abcw"))
-    ...     try:
-    ...         check_declared_size(path, "material table")
-    ...     except ValidationError as exc:
-    ...         print(str(exc).replace(tmp, "<tmp>"))
-    material table: <tmp>/sparse.nc declares 71.5 GiB of arrays (the largest, 'sbrdf', of
-    shape (4, 4, 3, 200000000) float64); files of at most 4 GiB are read (size_limit 1)
-    """
-    import netCDF4
-
-    with reading(path, what, "netCDF"), netCDF4.Dataset(path, mode="r") as nc:
-        sizes = {
-            str(name): (tuple(v.shape), v.dtype, int(np.prod(v.shape, dtype=float)))
-            for name, v in nc.variables.items()
-        }
-    nbytes = {
-        k: n * (dt.itemsize if isinstance(dt, np.dtype) else 16) for k, (_, dt, n) in sizes.items()
-    }
-    total = sum(nbytes.values())
-    if total > size_limit * MAX_FILE_BYTES:
-        big = max(nbytes, key=nbytes.__getitem__)
-        raise ValidationError(
-            f"{what}: {path} declares {total / 2**30:.3g} GiB of arrays (the largest, {big!r}, "
-            f"of shape {sizes[big][0]} {sizes[big][1]}); files of at most "
-            f"{size_limit * MAX_FILE_BYTES / 2**30:.3g} GiB are read (size_limit {size_limit:g})"
-        )
-    return int(total)
 
 
 @contextlib.contextmanager

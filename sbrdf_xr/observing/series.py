@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation, Slerp
 
-from ..errors import AttitudeError
+from ..errors import AttitudeError, check_declared_size
 from ..geometry import check_quaternions
 from .attitude import AttitudeLaw
 from .frames import NS_PER_S, Context, check_epoch, seconds_since
@@ -175,6 +175,7 @@ class QuaternionSeries(AttitudeLaw):
         """
         import xarray as xr
 
+        check_declared_size(Path(path), "quaternion_series", error=AttitudeError)
         try:
             with xr.open_dataset(path) as ds:
                 da = ds[variable].load()

@@ -8,13 +8,14 @@ named in messages; :func:`in_unit` converts a column to the package's unit.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from ..errors import LightCurveError
+from ..errors import MAX_FILE_BYTES, LightCurveError, check_declared_size
 
 #: Suffix -> astropy Table format.
 TABLE_FORMATS = {
@@ -33,6 +34,45 @@ def _suffix(path: Path) -> str:
     return ".fits.gz" if name.endswith(".fits.gz") else path.suffix.lower()
 
 
+def _check_fits_size(path: Path) -> None:
+    """Refuse a FITS file whose headers declare more than MAX_FILE_BYTES of data (read from
+    the headers alone; astropy would allocate it before finding the file shorter)."""
+    from astropy.io import fits
+
+    total = 0
+    with fits.open(path, lazy_load_hdus=True) as hdus:
+        for hdu in hdus:
+            h = hdu.header
+            axes = [int(h.get(f"NAXIS{i}", 0)) for i in range(1, int(h.get("NAXIS", 0)) + 1)]
+            if axes:
+                total += abs(int(h.get("BITPIX", 8))) // 8 * math.prod(axes)
+                total += int(h.get("PCOUNT", 0))
+    if total > MAX_FILE_BYTES:
+        raise LightCurveError(
+            f"light curve: {path} declares {total / 2**30:.3g} GiB of data in its FITS headers; "
+            f"files of at most {MAX_FILE_BYTES / 2**30:.3g} GiB are read"
+        )
+
+
+def _check_votable_rows(path: Path) -> None:
+    """Refuse a VOTable whose ``TABLE nrows`` declare more than MAX_FILE_BYTES (8 bytes a
+    FIELD a row; astropy allocates the rows declared before reading them)."""
+    import mmap
+    import re
+
+    if path.stat().st_size == 0:
+        return
+    with open(path, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as m:
+        rows = sum(int(n) for n in re.findall(rb"<TABLE\b[^>]*?\bnrows\s*=\s*[\"'](\d{1,30})", m))
+        fields = max(len(re.findall(rb"<FIELD\b", m)), 1)
+    if rows * fields * 8 > MAX_FILE_BYTES:
+        raise LightCurveError(
+            f"light curve: {path} declares {rows} rows of {fields} fields in its VOTable "
+            f"(about {rows * fields * 8 / 2**30:.3g} GiB); files of at most "
+            f"{MAX_FILE_BYTES / 2**30:.3g} GiB are read"
+        )
+
+
 def _from_astropy(path: Path, fmt: str) -> tuple[Any, dict[str, Any], dict[str, Any]]:
     """Columns as a DataFrame of plain values, their astropy units, the table metadata."""
     import warnings
@@ -45,10 +85,16 @@ def _from_astropy(path: Path, fmt: str) -> tuple[Any, dict[str, Any], dict[str, 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # VOTable/FITS readers warn about vendor keywords
+            if fmt == "fits":
+                _check_fits_size(path)
+            elif fmt == "votable":
+                _check_votable_rows(path)
             # astropy_native: FITS time columns come back as Time (with their scale)
             tab = Table.read(
                 path, format=fmt, **({"astropy_native": True} if fmt == "fits" else {})
             )
+    except LightCurveError:
+        raise
     except Exception as exc:  # astropy raises many types for malformed files
         raise LightCurveError(f"{path}: cannot be read as {fmt}: {exc}") from exc
     cols: dict[str, Any] = {}
@@ -119,6 +165,7 @@ def read_table(path: Path) -> tuple[Any, dict[str, Any], dict[str, Any], str, in
     units: dict[str, Any] = {}
     meta: dict[str, Any] = {}
     if suffix in (".nc", ".nc4", ".netcdf"):
+        check_declared_size(path, "light curve", error=LightCurveError)
         try:
             with xr.open_dataset(path, decode_times=True) as ds:
                 ds = ds.load()

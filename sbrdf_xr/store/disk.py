@@ -21,7 +21,7 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
-from .._output import error_words, libc_function, write_all
+from .._output import error_words, io_failure, libc_function, write_all
 from ..errors import CubeWriteError
 
 __all__ = [
@@ -93,8 +93,8 @@ def reason(exc: BaseException, part: Path | None = None, need: int = 0) -> str:
     words = error_words(exc)
     if words is None and part is not None:
         words = _diagnose(part, need)
-    if words is None:
-        return f"{type(exc).__name__}: {exc}"
+    if words is None:  # HDF5's "HDF error" with the free space and the size limit
+        return io_failure(exc, part) if part is not None else f"{type(exc).__name__}: {exc}"
     detail = getattr(exc, "strerror", None) if isinstance(exc, _NoRoom) else None
     return f"{words} ({detail})" if detail else words
 
@@ -117,6 +117,8 @@ def fix(why: str) -> str:
     >>> fix("RuntimeError: NetCDF: HDF error")
     'fix the cause'
     """
+    if "HDF5 gives no cause" in why:
+        return "free some space or raise the file size limit (ulimit -f), whichever is short,"
     return next((v for k, v in _FIXES.items() if why.startswith(k)), "fix the cause")
 
 

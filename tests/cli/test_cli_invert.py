@@ -3,6 +3,7 @@ named error (exit status 2, one line naming the flag or file) for every bad inpu
 
 from __future__ import annotations
 
+import itertools
 import re
 import time
 import warnings
@@ -383,7 +384,7 @@ def test_unmix_bad_cube_and_range(unmix_files, tmp_path, capsys):
     pd.DataFrame({"time": [0.0] * 3, "band": BANDS, "magnitude": mags, "uncertainty": 0.01}).to_csv(
         tmp_path / "mags.csv", index=False
     )
-    for bad in ("-5", "nan", "0"):
+    for bad, measured in itertools.product(("-5", "nan", "0"), (tmp_path / "mags.csv", spec)):
         argv = ["--isel", "geometry=0", "--range-km", bad]
-        assert _unmix(unmix_files, tmp_path / "mags.csv", *argv) == 2
-        assert "range_km: must be finite and > 0" in capsys.readouterr().err
+        assert _unmix(unmix_files, measured, *argv) == 2  # a spectrum ignored it before
+        assert "--range-km: must be finite and > 0 km" in capsys.readouterr().err

@@ -160,6 +160,28 @@ def test_overstated_uncertainties_warn(per_material):
     assert r.attrs["fit_quality"] == "too good"
 
 
+def test_zero_degrees_of_freedom_warn(per_material):
+    """Three values for three materials: the fit is exact whatever the data's errors, so its
+    chi-square tests nothing; said in a FitQualityWarning and the result's note (before:
+    fit_quality 'undetermined' without a word)."""
+    pm = per_material.isel(geometry=0)
+    pm = pm.isel(wavelength=np.linspace(0, pm.sizes["wavelength"] - 1, 3).astype(int))
+    y, sigma = _noisy(_mix(pm, [0.6, 1.0, 0.25]), 0.01, 4)
+    with pytest.warns(FitQualityWarning, match="0 degrees of freedom") as rec:
+        r = invert.unmix(y, pm, sigma, select=None)
+    assert int(r["dof"]) == 0 and r.attrs["fit_quality"] == "undetermined"
+    assert "3 measured values for 3 free parameters" in str(rec[0].message)
+    assert r.attrs["fit_quality_note"] == str(rec[0].message)
+    # one value more: a fit with a degree of freedom to test, no such warning
+    pm4 = per_material.isel(geometry=0)
+    pm4 = pm4.isel(wavelength=np.linspace(0, pm4.sizes["wavelength"] - 1, 4).astype(int))
+    y4, sigma4 = _noisy(_mix(pm4, [0.6, 1.0, 0.25]), 0.01, 4)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        invert.unmix(y4, pm4, sigma4, select=None)
+    assert not [w for w in caught if "degrees of freedom, so" in str(w.message)]
+
+
 @pytest.mark.parametrize("geoms", [[0], [0, 1, 2, 3, 4, 5]], ids=["one-geometry", "six"])
 def test_calibration_small(per_material, geoms):
     """60 draws per case in the default run: pull widths 1 within 0.3 (the spread of a
