@@ -11,11 +11,14 @@ from __future__ import annotations
 
 import contextlib
 import difflib
+import functools
 import math
 import os
 import stat
-from collections.abc import Iterable, Iterator
+import warnings
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
+from typing import Any, TypeVar
 
 __all__ = [
     "MAX_FILE_BYTES",
@@ -36,6 +39,7 @@ __all__ = [
     "NotObservableError",
     "ObservationError",
     "OutputError",
+    "RenamedWarning",
     "SbrdfError",
     "SbrdfWarning",
     "SceneError",
@@ -49,6 +53,8 @@ __all__ = [
     "did_you_mean",
     "input_file",
     "reading",
+    "renamed_attributes",
+    "renamed_keywords",
 ]
 
 
@@ -403,6 +409,11 @@ class SbrdfWarning(UserWarning):
     """Base class of the warnings issued by sbrdf_xr."""
 
 
+class RenamedWarning(SbrdfWarning, FutureWarning):
+    """A name (keyword argument or module attribute) used under its old spelling: it still
+    works for one release; the message gives the new name."""
+
+
 class NonPhysicalWarning(SbrdfWarning):
     """A quantity that violates a physical bound (for example reflectance > 1)."""
 
@@ -436,3 +447,109 @@ class FitQualityWarning(SbrdfWarning):
     its chi-square distribution (the model does not describe the data within their
     uncertainties) or below its 0.1 % point (the uncertainties are overstated), or another
     solution (a mirror or period-alias twin) fits about as well as the one reported."""
+
+
+# --- renamed names, kept for one release ---------------------------------------
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def renamed_keywords(**old_to_new: str) -> Callable[[_F], _F]:
+    """Accept the old keyword names of a function for one release, with a warning.
+
+    Parameters
+    ----------
+    **old_to_new
+        Old keyword name -> new keyword name.
+
+    Returns
+    -------
+    callable
+        A decorator; the wrapped function takes the new names, and the old ones with a
+        :class:`~sbrdf_xr.errors.RenamedWarning`.
+
+    Raises
+    ------
+    ValidationError
+        An old and its new name passed together.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> @renamed_keywords(period_s="period")
+    ... def spin(period=1.0):
+    ...     return period
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     spin(period_s=3.0), caught[0].category.__name__
+    (3.0, 'RenamedWarning')
+    """
+
+    def decorate(func: _F) -> _F:
+        @functools.wraps(func)
+        def wrapper(*args: Any, **kwargs: Any) -> Any:
+            for old, new in old_to_new.items():
+                if old in kwargs:
+                    if new in kwargs:
+                        raise ValidationError(
+                            f"{func.__name__}() received both {old!r} and {new!r}; "
+                            f"{old!r} is the old name of {new!r}: pass only {new!r}"
+                        )
+                    warnings.warn(
+                        f"{func.__name__}(): the keyword {old!r} is renamed {new!r}; "
+                        f"the old name will be removed in the next release",
+                        RenamedWarning,
+                        stacklevel=2,
+                    )
+                    kwargs[new] = kwargs.pop(old)
+            return func(*args, **kwargs)
+
+        return wrapper  # type: ignore[return-value]
+
+    return decorate
+
+
+def renamed_attributes(
+    module: str, namespace: Mapping[str, Any], old_to_new: Mapping[str, str]
+) -> Callable[[str], Any]:
+    """A module ``__getattr__`` that serves renamed attributes under their old names.
+
+    Parameters
+    ----------
+    module : str
+        The module's name (``__name__``), for the messages.
+    namespace : mapping
+        The module's globals (``globals()``), where the new names live.
+    old_to_new : mapping
+        Old attribute name -> new attribute name.
+
+    Returns
+    -------
+    callable
+        ``__getattr__(name)``: the object under its new name, with a
+        :class:`~sbrdf_xr.errors.RenamedWarning`, or :class:`AttributeError`.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> getter = renamed_attributes("demo", {"EARTH_RADIUS_MEAN": 6371.0},
+    ...                             {"EARTH_RADIUS_KM": "EARTH_RADIUS_MEAN"})
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     getter("EARTH_RADIUS_KM"), "EARTH_RADIUS_MEAN" in str(caught[0].message)
+    (6371.0, True)
+    """
+
+    def __getattr__(name: str) -> Any:
+        if name in old_to_new:
+            new = old_to_new[name]
+            warnings.warn(
+                f"{module}.{name} is renamed {module}.{new}; "
+                f"the old name will be removed in the next release",
+                RenamedWarning,
+                stacklevel=2,
+            )
+            return namespace[new]
+        raise AttributeError(f"module {module!r} has no attribute {name!r}")
+
+    return __getattr__
