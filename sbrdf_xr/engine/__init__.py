@@ -23,6 +23,8 @@ Modules
 ``reuse``
     What a plan computes from the tables, the spacecraft and the knobs alone (packed
     tables, merged facets), kept by content for the next plans.
+``fingerprint``
+    The content fingerprint of a scene (:func:`scene_fingerprint`), stored in its cubes.
 ``run``
     Executing a plan: blocks of geometries through the kernel into an xarray cube
     (:func:`simulate`; :func:`sbrdf_xr.store.write` writes it).
@@ -33,6 +35,7 @@ from . import (
     articulation,
     builtin,
     effects,
+    fingerprint,
     knobs,
     plan,
     reuse,
@@ -53,6 +56,7 @@ from .builtin import (
     starlink_materials,
 )
 from .effects import SPECTRAL_OUTPUTS, BlockInputs, Effect, Output, finish, reflected
+from .fingerprint import scene_fingerprint
 from .knobs import KNOBS, PRESETS, Knob, apply_preset, check_knob, knob_table
 from .plan import Estimate, Plan, PlannedOutput, Terms, compile_plan
 from .run import IN_PROCESS_BYTES, run_block, simulate
@@ -100,6 +104,7 @@ __all__ = [
     "check_knob",
     "compile_plan",
     "effects",
+    "fingerprint",
     "finish",
     "knob_table",
     "knobs",
@@ -114,6 +119,7 @@ __all__ = [
     "run_block",
     "scene",
     "scene_file",
+    "scene_fingerprint",
     "scene_from_dict",
     "schema",
     "simulate",

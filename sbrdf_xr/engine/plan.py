@@ -35,9 +35,10 @@ from ..errors import SceneError
 from ..kernels import PackedTables, normal_rows
 from ..kernels.anisotropic import AnisotropicTable
 from ..materials.models import model_parameters
-from ..store.fingerprint import PREFIX, scene_fingerprint
+from ..store.fingerprint import PREFIX
 from .articulation import Articulation, describe_parts, group_terms
 from .effects import EFFECTS, OUTPUTS, SCENE_OUTPUTS, BlockInputs, Effect, PlanInputs, readonly
+from .fingerprint import scene_fingerprint
 from .reuse import FACETS, digest
 from .spectral import spectral_stage
 from .stages import contributing_terms, describe_bytes, effect_stage, facet_terms, tilted_terms

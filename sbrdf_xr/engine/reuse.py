@@ -5,7 +5,7 @@ A scene that differs from the last one in its geometry (or in knobs such a resul
 read) compiles without merging its facets or packing its tables again
 (:func:`sbrdf_xr.engine.plan.compile_plan`).  Each result is kept under a key made of
 *content* digests of everything it is computed from: the digests of the tables and of the
-mesh in the scene's fingerprint (:func:`sbrdf_xr.store.fingerprint.scene_fingerprint`,
+mesh in the scene's fingerprint (:func:`sbrdf_xr.engine.fingerprint.scene_fingerprint`,
 which hashes a writeable table every time and a read-only one once), :func:`digest` of the
 other arrays, and the values of the knobs it reads.  A changed table, mesh or knob is
 therefore another key: a kept result is never served for inputs that differ from those it
@@ -183,7 +183,7 @@ def table_digests(fingerprint: Mapping[str, str]) -> dict[str, str]:
     >>> from sbrdf_xr import Scene, load_spacecraft
     >>> from sbrdf_xr.materials.schema import lambertian
     >>> from sbrdf_xr.engine.reuse import table_digests
-    >>> from sbrdf_xr.store.fingerprint import scene_fingerprint
+    >>> from sbrdf_xr.engine.fingerprint import scene_fingerprint
     >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
     >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
     >>> scene = Scene(box, {"grey": grey}, attitudes=[[0, 0, 0, 1.0]], phase_angles=[0.0])

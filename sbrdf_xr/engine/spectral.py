@@ -266,7 +266,7 @@ def spectral_stage(
 ) -> Spectral:
     """The wavelength grid, the band weights, and the tables (or models) of ``used``.
 
-    Given the scene's ``fingerprint`` (:func:`sbrdf_xr.store.fingerprint.scene_fingerprint`),
+    Given the scene's ``fingerprint`` (:func:`sbrdf_xr.engine.fingerprint.scene_fingerprint`),
     the band weights and the packed tables are kept by the content of what they are
     computed from (:mod:`sbrdf_xr.engine.reuse`) and reused by later plans.
 

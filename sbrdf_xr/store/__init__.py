@@ -20,7 +20,8 @@ Modules
     The block layout, the files of a netCDF cube being written, disk durability and the
     words for its failures, the block computation, progress bars, the writer lock.
 ``fingerprint``
-    The content fingerprint of a scene, stored as global attributes.
+    The content fingerprint a cube stores as global attributes (computed by the engine,
+    :mod:`sbrdf_xr.engine.fingerprint`), and what changed between two.
 """
 
 from ..errors import (
@@ -43,7 +44,6 @@ from . import (
     zarr_store,
 )
 from .files import LOG_SUFFIX, PART_SUFFIX
-from .fingerprint import scene_fingerprint
 from .formats import FORMATS, Format, check, format_for, save_figure, write
 from .layout import BlockLayout, layout_of
 from .lock import LOCK_SUFFIX
@@ -78,10 +78,15 @@ __all__ = [
     "progress",
     "runners",
     "save_figure",
-    "scene_fingerprint",
     "write",
     "write_cube",
     "write_zarr",
     "writer",
     "zarr_store",
 ]
+
+
+def __getattr__(name: str) -> object:
+    """Names that moved to the engine, served one more release (see
+    :func:`sbrdf_xr.store.fingerprint.moved_name`)."""
+    return fingerprint.moved_name(__name__, name)

@@ -691,7 +691,7 @@ def test_merging_keeps_facets_of_different_tangents_apart_for_anisotropic_materi
 
 
 def test_fingerprint_sees_tangents_only_when_they_are_given():
-    from sbrdf_xr.store.fingerprint import _mesh_sha
+    from sbrdf_xr.engine.fingerprint import _mesh_sha
 
     craft = cube_spacecraft(1.0)
     assert _mesh_sha(craft.with_tangent((0.0, 0.0, 1.0))) != _mesh_sha(craft)

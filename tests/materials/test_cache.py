@@ -33,7 +33,7 @@ def test_built_tables_are_cached_and_identical(tmp_path, monkeypatch):
         rebuilt = catalog.load("example-lobe")
     xr.testing.assert_equal(rebuilt, first)
     # ... with the same content fingerprint (the write time in 'history' does not count)
-    from sbrdf_xr.store.fingerprint import _table_sha
+    from sbrdf_xr.engine.fingerprint import _table_sha
 
     assert _table_sha(rebuilt) == _table_sha(first)
     catalog._built_material.cache_clear()
@@ -188,7 +188,7 @@ def test_an_unusable_cache_directory_builds_the_table_with_a_warning(tmp_path, m
 _BUILD = """
 import sys
 from sbrdf_xr import catalog
-from sbrdf_xr.store.fingerprint import _table_sha
+from sbrdf_xr.engine.fingerprint import _table_sha
 sys.stdin.readline()  # start together
 print(_table_sha(catalog.load("example-lobe")))
 """
@@ -219,7 +219,7 @@ def test_two_processes_building_one_table_at_once_agree(tmp_path, monkeypatch):
     assert len(shas) == 1
     assert sorted(p.name for p in tmp_path.iterdir() if p.suffix != ".nc") == []
     assert len(list(tmp_path.glob("example-lobe-*.nc"))) == 1
-    from sbrdf_xr.store.fingerprint import _table_sha
+    from sbrdf_xr.engine.fingerprint import _table_sha
 
     monkeypatch.setenv("SBRDF_XR_CACHE_DIR", str(tmp_path))
     catalog._built_material.cache_clear()

@@ -495,7 +495,7 @@ def test_resume_after_a_changed_table_is_refused(tmp_path, capsys):
     the original scene then resumes to the uninterrupted cube."""
     from sbrdf_xr import simulate
     from sbrdf_xr.engine import load_scene
-    from sbrdf_xr.store.fingerprint import scene_fingerprint
+    from sbrdf_xr.engine.fingerprint import scene_fingerprint
 
     scene, remapped = tmp_path / "scene.toml", tmp_path / "remapped.toml"
     scene.write_text(SCENE)

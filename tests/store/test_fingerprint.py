@@ -1,102 +1,43 @@
-"""Digests of read-only arrays are kept; writeable arrays are hashed every time."""
+"""The store compares fingerprints it is given; the old place of ``scene_fingerprint`` warns."""
 
-import numpy as np
-import xarray as xr
+import pytest
 
+from sbrdf_xr.errors import RenamedWarning
 from sbrdf_xr.store import fingerprint as fp
 
 
-def _table(values: np.ndarray) -> xr.DataArray:
-    return xr.DataArray(values, dims=("a", "b"), coords={"a": [0.0, 1.0, 2.0]})
-
-
-def test_kept_digest_equals_the_digest_computed_afresh():
-    v = np.arange(12.0).reshape(3, 4).copy()  # owns its memory
-    fresh = fp._table_sha(_table(v.copy()))
-    v.flags.writeable = False
-    da = _table(v)
-    assert fp._table_sha(da) == fresh  # computed, then kept
-    assert id(da.values) in fp._DIGESTS
-    assert fp._table_sha(da) == fresh  # from the kept digest
-    assert fp._array_sha(v) == fp._array_sha_now(v)
-
-
-def test_changed_values_change_the_fingerprint():
-    v = np.arange(12.0).reshape(3, 4).copy()  # owns its memory
-    w = v.copy()
-    w[1, 2] += 1e-12
-    v.flags.writeable = False
-    w.flags.writeable = False
-    assert fp._table_sha(_table(v)) != fp._table_sha(_table(w))
-
-
-def test_in_place_change_of_a_writeable_array_is_seen():
-    v = np.arange(12.0).reshape(3, 4).copy()  # owns its memory
-    da = _table(v)
-    before = fp._table_sha(da)
-    assert id(v) not in fp._DIGESTS  # writeable: never kept
-    da.values[0, 0] = -1.0
-    assert fp._table_sha(da) != before
-
-
-def test_read_only_view_of_a_writeable_array_is_not_kept():
-    base = np.arange(12.0).reshape(3, 4).copy()  # owns its memory
-    view = base.view()
-    view.flags.writeable = False
-    before = fp._array_sha(view)
-    assert id(view) not in fp._DIGESTS
-    base[2, 3] = 99.0  # writes through the base change the view's values
-    assert fp._array_sha(view) != before
-
-
-def test_different_tables_of_the_same_shape_differ():
-    a = np.zeros((3, 4))
-    b = np.ones((3, 4))
-    a.flags.writeable = False
-    b.flags.writeable = False
-    assert fp._table_sha(_table(a)) != fp._table_sha(_table(b))
-
-
-def test_kept_digest_is_forgotten_with_its_array():
-    v = np.arange(6.0).reshape(3, 2).copy()
-    v.flags.writeable = False
-    fp._array_sha(v)
-    key = id(v)
-    assert key in fp._DIGESTS
-    del v
-    assert key not in fp._DIGESTS
-
-
-def _read_only_table() -> xr.DataArray:
-    v = np.arange(12.0).reshape(3, 4).copy()  # owns its memory
-    v.flags.writeable = False
-    da = _table(v)
-    da.attrs.update(units="sr-1", measured=np.array([1.0, 2.0]), nested={"a": [1, 2]})
-    return da
-
-
-def test_kept_table_digest_equals_the_digest_computed_afresh():
-    da = _read_only_table()
-    digest = fp._table_sha(da)
-    assert id(da) in fp._TABLES and fp._table_sha(da) == digest  # kept, then reused
-    assert digest == fp._table_sha_now(da)
-    assert fp._table_state(_table(np.zeros((3, 4)))) is None  # writeable: never kept
-
-
-def test_every_change_to_a_kept_table_changes_its_digest():
-    changes = [
-        lambda da: da.attrs.update(units="m"),
-        lambda da: da.attrs["measured"].__setitem__(0, 5.0),  # an attribute array in place
-        lambda da: da.attrs["nested"]["a"].append(3),  # a nested list in place
-        lambda da: da.attrs.update(measured=np.array([1, 2])),  # equal values, other dtype
-        lambda da: da["a"].attrs.update(units="degree"),
-        lambda da: da.coords.update({"a": [0.0, 1.0, 3.0]}),
-        lambda da: setattr(da, "values", np.ones((3, 4))),
+def test_changes_name_the_material_and_the_setting():
+    old = {
+        "fingerprint": "a",
+        "fingerprint_material_names": '{"w": "white paint"}',
+        "fingerprint_material_w": "1",
+        "fingerprint_knobs": "k1",
+        "fingerprint_knobs_json": '{"method": "linear"}',
+        "title": "not a fingerprint",
+    }
+    new = {
+        **old,
+        "fingerprint": "b",
+        "fingerprint_material_w": "2",
+        "fingerprint_knobs": "k2",
+        "fingerprint_knobs_json": '{"method": "cubic"}',
+    }
+    assert fp.changes(old, new) == [
+        "material 'white paint': table changed",
+        "setting 'method': 'linear' -> 'cubic'",
     ]
-    for change in changes:
-        da = _read_only_table()
-        before = fp._table_sha(da)
-        change(da)
-        after = fp._table_sha(da)
-        assert after != before
-        assert after == fp._table_sha_now(da)
+    assert fp.changes(old, {**old, "title": "other"}) == []
+    assert fp.changes({}, new) == ["only the new cube has a content fingerprint"]
+
+
+@pytest.mark.parametrize("where", ["sbrdf_xr.store", "sbrdf_xr.store.fingerprint"])
+def test_scene_fingerprint_is_served_from_its_old_place_with_a_warning(where):
+    import importlib
+
+    from sbrdf_xr.engine.fingerprint import scene_fingerprint
+
+    module = importlib.import_module(where)
+    with pytest.warns(RenamedWarning, match=f"{where}.scene_fingerprint moved to sbrdf_xr.engine"):
+        assert module.scene_fingerprint is scene_fingerprint
+    with pytest.raises(AttributeError, match="no_such_name"):
+        module.no_such_name
