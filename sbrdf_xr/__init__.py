@@ -25,27 +25,50 @@ The packages are the layers, lowest first; a package imports only from lower one
   :mod:`~sbrdf_xr.cli`.
 
 ``dir(sbrdf_xr)`` lists :data:`__all__`: the functions and classes above and every
-public package and module, each imported on first use.
+public package and module, each imported on first use, so that ``import sbrdf_xr`` loads
+xarray and the accessors but not Dask, numba, trimesh, netCDF4 or SciPy.
 """
 
 import importlib as _importlib
+from typing import TYPE_CHECKING
 
 from . import (
     _startup,  # noqa: F401  first: Ctrl-C while the command line starts
-    accessors,  # registers the .sbrdf accessors
+    accessors,  # registers the .sbrdf accessors (light: their methods import on first call)
 )
 from ._names import __version__
-from .body import Spacecraft, canx1, load_spacecraft
-from .engine import Scene, builtin_scene, load_scene, simulate
-from .materials import (
-    build_lut,
-    constant_material,
-    hemispherical_reflectance,
-    lambertian,
-    lookup,
-    open_material,
-)
-from .store import write
+
+if TYPE_CHECKING:  # what __getattr__ serves, for type checkers
+    from .body import Spacecraft, canx1, load_spacecraft
+    from .engine import Scene, builtin_scene, load_scene, simulate
+    from .materials import (
+        build_lut,
+        constant_material,
+        hemispherical_reflectance,
+        lambertian,
+        lookup,
+        open_material,
+    )
+    from .store import write
+
+#: The functions and classes published here -> the package that defines them (imported on
+#: first use).
+_EXPORTS = {
+    "Spacecraft": "body",
+    "canx1": "body",
+    "load_spacecraft": "body",
+    "Scene": "engine",
+    "builtin_scene": "engine",
+    "load_scene": "engine",
+    "simulate": "engine",
+    "build_lut": "materials",
+    "constant_material": "materials",
+    "hemispherical_reflectance": "materials",
+    "lambertian": "materials",
+    "lookup": "materials",
+    "open_material": "materials",
+    "write": "store",
+}
 
 #: The public modules and packages, reachable as attributes (imported on first use).
 _SUBMODULES = (
@@ -108,12 +131,16 @@ __all__ = [
 ]
 
 
-assert set(_SUBMODULES) <= set(__all__)
+assert set(_SUBMODULES) | set(_EXPORTS) <= set(__all__)
 
 
 def __getattr__(name: str) -> object:
     if name in _SUBMODULES:
         return _importlib.import_module(f"{__name__}.{name}")
+    if name in _EXPORTS:
+        value = getattr(_importlib.import_module(f"{__name__}.{_EXPORTS[name]}"), name)
+        globals()[name] = value  # found directly from now on
+        return value
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 

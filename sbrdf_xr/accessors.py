@@ -1,7 +1,9 @@
 """xarray accessors: ``da.sbrdf.<method>`` forwards to the module functions.
 
 Compose, never subclass: every accessor method is a one-line call of the function
-documented in :mod:`sbrdf_xr.materials.tables`.
+documented in :mod:`sbrdf_xr.materials.tables` or :mod:`sbrdf_xr.photometry`.  Importing
+:mod:`sbrdf_xr` registers the accessors; each method imports the module it calls on its
+first call, so that registering them loads nothing but xarray.
 """
 
 from __future__ import annotations
@@ -10,9 +12,6 @@ from typing import Any
 
 import xarray as xr
 from numpy.typing import ArrayLike
-
-from .materials import energy as _energy
-from .materials import tables as _material
 
 __all__ = ["SbrdfDataArrayAccessor", "SbrdfDatasetAccessor"]
 
@@ -43,6 +42,8 @@ class SbrdfDataArrayAccessor:
 
     def validate(self, **kwargs: Any) -> xr.DataArray:
         """:func:`sbrdf_xr.materials.tables.validate_material`."""
+        from .materials import tables as _material
+
         return _material.validate_material(self._da, **kwargs)
 
     def lookup(
@@ -53,16 +54,22 @@ class SbrdfDataArrayAccessor:
         method: str = "linear",
     ) -> xr.DataArray:
         """:func:`sbrdf_xr.materials.tables.lookup` on this table."""
+        from .materials import tables as _material
+
         return _material.lookup(self._da, theta_i, delta_theta, phi, method=method)
 
     def hemispherical_reflectance(
         self, theta_i: ArrayLike | None = None, **kwargs: Any
     ) -> xr.DataArray:
         """:func:`sbrdf_xr.materials.energy.hemispherical_reflectance` of this table."""
+        from .materials import energy as _energy
+
         return _energy.hemispherical_reflectance(self._da, theta_i, **kwargs)
 
     def to_netcdf(self, path: Any, **kwargs: Any) -> Any:
         """:func:`sbrdf_xr.materials.tables.to_netcdf` of this table."""
+        from .materials import tables as _material
+
         return _material.to_netcdf(self._da, path, **kwargs)
 
     @property

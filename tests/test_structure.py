@@ -523,3 +523,37 @@ def test_the_public_names_are_what_dir_shows():
         assert getattr(sbrdf_xr, name) is not None
     for pkg in _packages():
         assert importlib.import_module(f"sbrdf_xr.{pkg}") is getattr(sbrdf_xr, pkg)
+
+
+# ------------------------------------------------------------------ a light import
+
+#: Heavy libraries that ``import sbrdf_xr`` leaves for first use.
+LOADED_ON_FIRST_USE = ("dask", "numba", "trimesh", "netCDF4", "scipy")
+
+
+def test_importing_the_package_loads_no_heavy_library_and_registers_the_accessors():
+    """``import sbrdf_xr`` in a fresh interpreter: the ``.sbrdf`` accessors are there, the
+    libraries of :data:`LOADED_ON_FIRST_USE` are not, until a name that needs them is used."""
+    import json
+    import subprocess
+    import sys
+
+    code = (
+        "import json, sys\n"
+        "import xarray as xr\n"
+        "import sbrdf_xr\n"
+        f"heavy = {LOADED_ON_FIRST_USE!r}\n"
+        "before = sorted(m for m in heavy if m in sys.modules)\n"
+        "ok = hasattr(xr.Dataset().sbrdf, 'photometry')\n"
+        "ok = ok and hasattr(xr.DataArray().sbrdf, 'lookup')\n"
+        "sbrdf_xr.Scene\n"
+        "after = sorted(m for m in heavy if m in sys.modules)\n"
+        "print(json.dumps([before, ok, after, sbrdf_xr.Scene.__module__]))\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=600
+    )
+    before, accessors, after, where = json.loads(out.stdout.splitlines()[-1])
+    assert before == []
+    assert accessors
+    assert "numba" in after and where == "sbrdf_xr.engine.scene"  # served on first use
