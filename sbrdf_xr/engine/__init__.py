@@ -25,6 +25,9 @@ Modules
     tables, merged facets), kept by content for the next plans.
 ``fingerprint``
     The content fingerprint of a scene (:func:`scene_fingerprint`), stored in its cubes.
+``views``
+    What the plan's stages and the effects read of a scene and a plan (protocols), and
+    the facet terms.
 ``run``
     Executing a plan: blocks of geometries through the kernel into an xarray cube
     (:func:`simulate`; :func:`sbrdf_xr.store.write` writes it).
@@ -46,6 +49,7 @@ from . import (
     spectral,
     stages,
     sweep,
+    views,
 )
 from .articulation import Articulation, BoundGroup
 from .builtin import (
@@ -127,4 +131,5 @@ __all__ = [
     "stages",
     "starlink_materials",
     "sweep",
+    "views",
 ]

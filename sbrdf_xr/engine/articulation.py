@@ -40,7 +40,7 @@ from .effects import EFFECTS, BlockInputs
 
 if TYPE_CHECKING:
     from ..body.parts import Part
-    from .plan import Plan, Terms
+    from .views import PlanView, Terms
 
 __all__ = ["Articulation", "BoundGroup", "articulated_sums", "describe_parts", "group_terms"]
 
@@ -185,7 +185,7 @@ class BoundGroup:
         return np.einsum("gij,gj->gi", self.rotations[:, self.group - 1], d)
 
     def fraction(
-        self, plan: Plan, to_source: np.ndarray, to_observer: np.ndarray, options: Mapping
+        self, plan: PlanView, to_source: np.ndarray, to_observer: np.ndarray, options: Mapping
     ) -> np.ndarray:
         """Lit-and-visible fraction (G, T) of this group's terms on the posed body."""
         from ..body.posed import posed_fraction
@@ -221,7 +221,7 @@ def _turned(
     )
 
 
-def articulated_sums(plan: Plan, block: BlockInputs, sl: slice) -> dict[str, np.ndarray]:
+def articulated_sums(plan: PlanView, block: BlockInputs, sl: slice) -> dict[str, np.ndarray]:
     """Every effect's sums on one block of an articulated plan, summed over the groups.
 
     ``sl`` is the block's slice of the plan's first dimension (for angle series).

@@ -37,7 +37,7 @@ from .._names import __version__
 from ..store.fingerprint import KNOBS_JSON, MATERIAL_NAMES, MATERIAL_PREFIX, PREFIX
 
 if TYPE_CHECKING:
-    from .scene import Scene
+    from .views import SceneView
 
 __all__ = ["scene_fingerprint"]
 
@@ -330,7 +330,7 @@ def _mesh_sha(spacecraft: Any) -> str:
     return _sha(*parts)
 
 
-def scene_fingerprint(scene: Scene) -> dict[str, str]:
+def scene_fingerprint(scene: SceneView) -> dict[str, str]:
     """Content fingerprint of a scene, as flat netCDF global attributes.
 
     Parameters

@@ -32,7 +32,7 @@ import xarray as xr
 
 from .._names import BAND, MATERIAL, PSI, WAVELENGTH, __version__
 from ..errors import SceneError
-from ..kernels import PackedTables, normal_rows
+from ..kernels import PackedTables
 from ..kernels.anisotropic import AnisotropicTable
 from ..materials.models import model_parameters
 from ..store.fingerprint import PREFIX
@@ -42,11 +42,12 @@ from .fingerprint import scene_fingerprint
 from .reuse import FACETS, digest
 from .spectral import spectral_stage
 from .stages import contributing_terms, describe_bytes, effect_stage, facet_terms, tilted_terms
+from .views import Terms
 
 if TYPE_CHECKING:
     from ..body.spacecraft import Spacecraft
-    from .scene import Scene
     from .sweep import GridGeometry, PairGeometry
+    from .views import SceneView
 
 __all__ = ["BlockInputs", "Estimate", "Plan", "PlannedOutput", "Terms", "compile_plan"]
 
@@ -60,68 +61,6 @@ SIZE_LIMIT_BYTES = 2 * 2**40
 #: Plans estimated to need more than this many (geometry x term x node x wavelength)
 #: multiply-adds are refused (about a week on one core at 1e9 per second).
 WORK_LIMIT = 6e14
-
-
-@dataclass(frozen=True)
-class Terms:
-    """The facet terms a plan evaluates, sorted by material.
-
-    Attributes
-    ----------
-    normal : ndarray, shape (T, 3)
-        Unit normals [1].
-    area : ndarray, shape (T,)
-        Areas [m2] (summed over merged facets).
-    material : ndarray of int, shape (T,)
-        Index into :attr:`Plan.materials`.
-    facet : ndarray of int, shape (T,)
-        The facet of each term when facets are not merged (per-facet effects), else
-        the first facet of the term.
-    n_facets : ndarray of int, shape (T,)
-        Facets merged into each term.
-    tangent : ndarray, shape (T, 3), optional
-        Unit tangents [1] (anisotropic materials; :mod:`sbrdf_xr.geometry.anisotropy`).
-    part : ndarray of int, shape (T,), optional
-        The group of each term on a body with parts: 0 for the bus, ``k + 1`` for part
-        ``k`` (:mod:`sbrdf_xr.engine.articulation`).
-
-    Examples
-    --------
-    A unit cube turned by 0 and 45 deg about z, Sun and observer in the xy plane: its
-    12 triangles merge into 6 faces, of which only +x and -y are ever lit and seen.
-
-    >>> import trimesh
-    >>> from sbrdf_xr import Scene, geometry, load_spacecraft
-    >>> from sbrdf_xr.materials.schema import lambertian
-    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
-    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
-    >>> turns = geometry.axis_rotation([0, 0, 1], [0.0, 45.0])  # two attitudes about z
-    >>> scene = Scene(box, {"grey": grey}, attitudes=turns, phase_angles=[0.0, 60.0])
-    >>> terms = scene.plan().terms
-    >>> terms.size
-    2
-    >>> terms.normal.tolist(), terms.area.tolist(), terms.n_facets.tolist()
-    ([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0]], [1.0, 1.0], [2, 2])
-    """
-
-    normal: np.ndarray
-    area: np.ndarray
-    material: np.ndarray
-    facet: np.ndarray
-    n_facets: np.ndarray
-    tangent: np.ndarray | None = None
-    part: np.ndarray | None = None
-
-    @property
-    def size(self) -> int:
-        """Number of terms."""
-        return int(self.area.size)
-
-    @cached_property
-    def normal_rows(self) -> np.ndarray:
-        """Each term's row among the distinct normals (:func:`~sbrdf_xr.kernels.sums.normal_rows`),
-        found once per plan rather than once per block."""
-        return normal_rows(self.normal)
 
 
 @dataclass(frozen=True)
@@ -337,7 +276,7 @@ class Plan:
         return f"<table><caption>plan for {html.escape(self.name)}</caption>{rows}</table>"
 
     @classmethod
-    def from_scene(cls, scene: Scene) -> Plan:
+    def from_scene(cls, scene: SceneView) -> Plan:
         """Compile ``scene`` (see the module docstring)."""
         return compile_plan(scene)
 
@@ -353,7 +292,7 @@ def _anisotropic(material: xr.DataArray | xr.Dataset) -> bool:
 
 
 def _facet_terms(
-    scene: Scene,
+    scene: SceneView,
     per_facet: tuple[str, ...],
     steps: list[tuple[str, str]],
     aniso: frozenset[str],
@@ -377,12 +316,12 @@ def _facet_terms(
     return dict(raw), merged
 
 
-def compile_plan(scene: Scene) -> Plan:
+def compile_plan(scene: SceneView) -> Plan:
     """Compile a scene into its :class:`Plan` (see the module docstring).
 
     Parameters
     ----------
-    scene : Scene
+    scene : SceneView
 
     Returns
     -------

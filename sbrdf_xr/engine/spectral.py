@@ -25,14 +25,14 @@ from ..kernels.lut import table_edges, table_normal_blend
 from ..materials import models
 from ..photometry import band_weights, filters
 from ..store.fingerprint import PREFIX
-from .effects.base import SPECTRAL_OUTPUTS, readonly
+from .effects.base import SPECTRAL_OUTPUTS, readonly, table_on
 from .reuse import GRIDS, TABLES, WEIGHTS, digest, immutable, table_digests
 
 if TYPE_CHECKING:
-    from .scene import Scene
+    from .views import SceneView
 
 
-def common_wavelength(scene: Scene, used: list[str]) -> np.ndarray:
+def common_wavelength(scene: SceneView, used: list[str]) -> np.ndarray:
     """The wavelengths every used material's table covers (those of the first table).
 
     Examples
@@ -95,7 +95,7 @@ def solar_for(wl: np.ndarray, bands: list[Any] | tuple[Any, ...] = ()) -> str:
     return SOLAR if inside else SOLAR_EXTENDED
 
 
-def band_weights_of(scene: Scene, wl: np.ndarray) -> xr.DataArray:
+def band_weights_of(scene: SceneView, wl: np.ndarray) -> xr.DataArray:
     """The scene's band weights (filter x Sun, normalised) on the wavelengths ``wl``.
 
     Examples
@@ -137,39 +137,7 @@ continue the spectrum past its grid (scene field band_extrapolate)
         raise SceneError(f"bands: {exc} (scene field band_extrapolate)") from None
 
 
-def table_on(da: xr.DataArray, wl: np.ndarray, theta_step: float | None) -> xr.DataArray:
-    """A table on the wavelengths ``wl``, its theta_i resampled every ``theta_step`` degree.
-
-    Examples
-    --------
-    The last node of theta_i is kept when the step does not reach it:
-
-    >>> import numpy as np
-    >>> from sbrdf_xr.engine.spectral import table_on
-    >>> from sbrdf_xr.materials.schema import lambertian
-    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
-    >>> grey.theta_i.values.tolist()
-    [0.0, 90.0]
-    >>> t = table_on(grey, np.array([550.0]), 40.0)
-    >>> t.theta_i.values.tolist(), t.wavelength.values.tolist()
-    ([0.0, 40.0, 80.0, 90.0], [550.0])
-    >>> bool(np.allclose(t, 0.5 / np.pi))  # a Lambertian table stays albedo / pi
-    True
-    >>> table_on(grey, np.array([500.0, 600.0, 700.0]), None) is grey  # already on the grid
-    True
-    """
-    if not np.array_equal(da[WAVELENGTH].values, wl):
-        da = da.interp({WAVELENGTH: wl})
-    if theta_step is not None:
-        ti = da["theta_i"].values
-        new = np.arange(ti[0], ti[-1] + 1e-9, float(theta_step))
-        if new[-1] < ti[-1]:
-            new = np.append(new, ti[-1])
-        da = da.interp(theta_i=new)
-    return da
-
-
-def material_models(scene: Scene, used: list[str]) -> dict[int, tuple[Any, Mapping[str, Any]]]:
+def material_models(scene: SceneView, used: list[str]) -> dict[int, tuple[Any, Mapping[str, Any]]]:
     """BRDF model and parameters of every material, for analytic evaluation.
 
     Examples
@@ -258,7 +226,7 @@ class Spectral:
 
 
 def spectral_stage(
-    scene: Scene,
+    scene: SceneView,
     used: list[str],
     knobs: Mapping[str, Any],
     steps: list[tuple[str, str]],
@@ -360,14 +328,14 @@ def spectral_stage(
     return Spectral(wl, bw, band_coords, pre, dtype, tables, mods, aniso)
 
 
-def _immutable_table(scene: Scene, m: str) -> bool:
+def _immutable_table(scene: SceneView, m: str) -> bool:
     """Whether material ``m`` is a table whose values no one can write (not a model)."""
     da = scene.material_data[m]
     return isinstance(da, xr.DataArray) and immutable(da.variable.data)
 
 
 def _packed(
-    scene: Scene,
+    scene: SceneView,
     used: list[str],
     wl: np.ndarray,
     bw: np.ndarray | None,
@@ -436,7 +404,7 @@ def _table_bytes(da: xr.DataArray, n_wavelength: int, theta_step: float | None) 
     return n
 
 
-def _bands_step(scene: Scene, pre: bool, spectral_asked: bool, n_wl: int) -> tuple[str, str]:
+def _bands_step(scene: SceneView, pre: bool, spectral_asked: bool, n_wl: int) -> tuple[str, str]:
     if not scene.bands:
         return ("bands", "skipped: no band output requested")
     if pre:

@@ -20,7 +20,7 @@ from ..errors import SceneError
 from .effects import EFFECTS, PlanInputs, scene_effects
 
 if TYPE_CHECKING:
-    from .scene import Scene
+    from .views import SceneView
 
 __all__ = [
     "DROP_BLOCK",
@@ -96,7 +96,7 @@ def effect_stage(
 
 
 def facet_terms(
-    scene: Scene,
+    scene: SceneView,
     per_facet: Sequence[str],
     steps: list[tuple[str, str]],
     aniso: frozenset[str] = frozenset(),
@@ -185,7 +185,7 @@ effect is on'
 
 
 def tilted_terms(
-    scene: Scene, raw: dict[str, np.ndarray], nodes: int, steps: list[tuple[str, str]]
+    scene: SceneView, raw: dict[str, np.ndarray], nodes: int, steps: list[tuple[str, str]]
 ) -> dict[str, np.ndarray]:
     """Terms replaced by their tilted copies where the scene asks for surface imperfections.
 
@@ -250,7 +250,7 @@ def tilted_terms(
     return out
 
 
-def contributing_terms(scene: Scene, normals: np.ndarray) -> np.ndarray:
+def contributing_terms(scene: SceneView, normals: np.ndarray) -> np.ndarray:
     """Boolean per term: lit by a source of the scene's effects and visible for at least
     one geometry of the sweep; an emitting source (``source="facets"``) needs only
     visible.

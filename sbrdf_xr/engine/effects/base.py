@@ -23,8 +23,7 @@ from ...kernels import anisotropic as _aniso_kernels
 if TYPE_CHECKING:
     import xarray as xr
 
-    from ..plan import Plan
-    from ..scene import Scene
+    from ..views import PlanView, SceneView
 
 __all__ = [
     "CORE_OUTPUTS",
@@ -40,6 +39,7 @@ __all__ = [
     "finish",
     "readonly",
     "reflected",
+    "table_on",
 ]
 
 
@@ -237,7 +237,7 @@ class PlanInputs:
 params={})
     """
 
-    scene: Scene
+    scene: SceneView
     knobs: Mapping[str, Any]
     wavelength: np.ndarray | None = None  #: [nm], None before the spectral stage
     materials: tuple[str, ...] = ()  #: the materials of the contributing terms
@@ -346,9 +346,9 @@ class Effect:
     band: tuple[str, ...] = ()
     reads: tuple[str, ...] = ()
     plan: Callable[[PlanInputs], Decision] = runs
-    contribute: Callable[[Plan, BlockInputs], Mapping[str, np.ndarray]] | None = None
-    fraction: Callable[[Plan, np.ndarray, np.ndarray], np.ndarray] | None = None
-    geometry: Callable[[Scene, xr.Dataset | None], Mapping[str, np.ndarray]] | None = None
+    contribute: Callable[[PlanView, BlockInputs], Mapping[str, np.ndarray]] | None = None
+    fraction: Callable[[PlanView, np.ndarray, np.ndarray], np.ndarray] | None = None
+    geometry: Callable[[SceneView, xr.Dataset | None], Mapping[str, np.ndarray]] | None = None
 
     def __post_init__(self) -> None:
         if self.when not in WHEN:
@@ -368,7 +368,9 @@ class Effect:
 # ------------------------------------------------------------- contributions
 
 
-def facet_fraction(plan: Plan, to_source: np.ndarray, to_observer: np.ndarray) -> np.ndarray | None:
+def facet_fraction(
+    plan: PlanView, to_source: np.ndarray, to_observer: np.ndarray
+) -> np.ndarray | None:
     """The lit-and-visible fraction (G, T) of every term for a source in ``to_source``:
     the product of the plan's per-facet effects (:attr:`Effect.fraction`), or None (1).
 
@@ -394,7 +396,7 @@ def facet_fraction(plan: Plan, to_source: np.ndarray, to_observer: np.ndarray) -
 
 
 def reflected(
-    plan: Plan,
+    plan: PlanView,
     block: BlockInputs,
     to_source: np.ndarray,
     fraction: np.ndarray | None,
@@ -477,7 +479,7 @@ def reflected(
 
 
 def _analytic_sums(
-    plan: Plan, s: np.ndarray, o: np.ndarray, fraction: np.ndarray | None, per_material: bool
+    plan: PlanView, s: np.ndarray, o: np.ndarray, fraction: np.ndarray | None, per_material: bool
 ) -> _kernels.FusedSums:
     """The facet sums with every material evaluated by its BRDF model (no table)."""
     t = plan.terms
@@ -516,7 +518,7 @@ def _analytic_sums(
     )
 
 
-def _trapezoid_weights(plan: Plan) -> np.ndarray:
+def _trapezoid_weights(plan: PlanView) -> np.ndarray:
     """Weights ``w`` with ``y @ w`` the trapezoid integral of ``y`` over the wavelength grid
     (paper 000 Eq. 2); a single wavelength has weight 1.  Made once per plan."""
     w = plan.cache.get("trapezoid_weights")
@@ -532,7 +534,7 @@ def _trapezoid_weights(plan: Plan) -> np.ndarray:
 
 
 def finish(
-    plan: Plan, sums: Mapping[str, np.ndarray], lead_shape: tuple[int, ...]
+    plan: PlanView, sums: Mapping[str, np.ndarray], lead_shape: tuple[int, ...]
 ) -> dict[str, np.ndarray]:
     """The plan's outputs of one block from the effects' sums, shaped ``lead_shape + tail``.
 
@@ -598,3 +600,35 @@ def finish(
             total = np.einsum("gl,bl->gb", total, plan.band_weights)
         out["band_signal"] = total.astype(dt)
     return {k: v.reshape(*lead_shape, *v.shape[1:]) for k, v in out.items()}
+
+
+def table_on(da: xr.DataArray, wl: np.ndarray, theta_step: float | None) -> xr.DataArray:
+    """A table on the wavelengths ``wl``, its theta_i resampled every ``theta_step`` degree.
+
+    Examples
+    --------
+    The last node of theta_i is kept when the step does not reach it:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.engine.effects.base import table_on
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> grey.theta_i.values.tolist()
+    [0.0, 90.0]
+    >>> t = table_on(grey, np.array([550.0]), 40.0)
+    >>> t.theta_i.values.tolist(), t.wavelength.values.tolist()
+    ([0.0, 40.0, 80.0, 90.0], [550.0])
+    >>> bool(np.allclose(t, 0.5 / np.pi))  # a Lambertian table stays albedo / pi
+    True
+    >>> table_on(grey, np.array([500.0, 600.0, 700.0]), None) is grey  # already on the grid
+    True
+    """
+    if not np.array_equal(da[WAVELENGTH].values, wl):
+        da = da.interp({WAVELENGTH: wl})
+    if theta_step is not None:
+        ti = da["theta_i"].values
+        new = np.arange(ti[0], ti[-1] + 1e-9, float(theta_step))
+        if new[-1] < ti[-1]:
+            new = np.append(new, ti[-1])
+        da = da.interp(theta_i=new)
+    return da

@@ -58,8 +58,7 @@ from .base import BlockInputs, Decision, Effect, Output, PlanInputs, facet_fract
 if TYPE_CHECKING:
     import xarray as xr
 
-    from ..plan import Plan
-    from ..scene import Scene
+    from ..views import PlanView, SceneView
 
 __all__ = ["EFFECT", "SIGNAL"]
 
@@ -73,7 +72,7 @@ SIGNAL = Output(
 )
 
 
-def _geometry(scene: Scene, observed: xr.Dataset | None) -> dict[str, np.ndarray]:
+def _geometry(scene: SceneView, observed: xr.Dataset | None) -> dict[str, np.ndarray]:
     finite = scene.earth_model == "finite"
     if observed is not None:  # the Earth's distance and phase at every time
         dist = np.asarray(observed["earth_distance"].values, dtype=np.float64)
@@ -154,7 +153,7 @@ def _earth_sun(to_earth: np.ndarray, to_sun: np.ndarray, phase_deg: np.ndarray) 
     return -np.cos(a) * e + np.sin(a) * p
 
 
-def _contribute(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
+def _contribute(plan: PlanView, block: BlockInputs) -> dict[str, np.ndarray]:
     to_earth = block.sources["to_earth"]
     frac = facet_fraction(plan, to_earth, block.to_observer)
     if plan.knobs["earth_model"] == "finite":

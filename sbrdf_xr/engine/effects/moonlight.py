@@ -55,8 +55,7 @@ from .base import BlockInputs, Decision, Effect, Output, PlanInputs, facet_fract
 if TYPE_CHECKING:
     import xarray as xr
 
-    from ..plan import Plan
-    from ..scene import Scene
+    from ..views import PlanView, SceneView
 
 __all__ = ["EFFECT", "SIGNAL", "moon_from_spacecraft"]
 
@@ -191,7 +190,7 @@ def moon_from_spacecraft(
     }
 
 
-def _geometry(scene: Scene, observed: xr.Dataset | None) -> dict[str, np.ndarray]:
+def _geometry(scene: SceneView, observed: xr.Dataset | None) -> dict[str, np.ndarray]:
     obs = scene.observation
     assert obs is not None and observed is not None  # the effect needs an observation
     ctx = obs.context()
@@ -225,7 +224,7 @@ def _plan(inputs: PlanInputs) -> Decision:
     )
 
 
-def _contribute(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
+def _contribute(plan: PlanView, block: BlockInputs) -> dict[str, np.ndarray]:
     to_moon = block.sources["to_moon"]
     frac = facet_fraction(plan, to_moon, block.to_observer)
     r = reflected(plan, block, to_moon, frac, False)

@@ -31,7 +31,7 @@ import numpy as np
 from .base import Decision, Effect, PlanInputs
 
 if TYPE_CHECKING:
-    from ..plan import Plan
+    from ..views import PlanView
 
 __all__ = ["EFFECT"]
 
@@ -52,7 +52,7 @@ def _plan(inputs: PlanInputs) -> Decision:
     return Decision(True, line, options)
 
 
-def _fraction(plan: Plan, to_source: np.ndarray, to_observer: np.ndarray) -> np.ndarray:
+def _fraction(plan: PlanView, to_source: np.ndarray, to_observer: np.ndarray) -> np.ndarray:
     from ...body.visibility import lit_visible_fraction
 
     options = plan.effect_params["shadowing"]

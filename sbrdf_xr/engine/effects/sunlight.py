@@ -21,12 +21,12 @@ import numpy as np
 from .base import BlockInputs, Effect, facet_fraction, reflected
 
 if TYPE_CHECKING:
-    from ..plan import Plan
+    from ..views import PlanView
 
 __all__ = ["EFFECT"]
 
 
-def _contribute(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
+def _contribute(plan: PlanView, block: BlockInputs) -> dict[str, np.ndarray]:
     """Reflected sunlight; in the Earth's umbra nothing is evaluated (the sums are 0), in
     the penumbra the signal is scaled by the sunlit fraction of the solar disc."""
     scale = block.sun_scale

@@ -43,11 +43,10 @@ from ..._names import PSI, WAVELENGTH
 from ...geometry.anisotropy import psi_average
 from ...materials.energy import hemispherical_reflectance
 from ...photometry import solar_spectrum
-from .base import BlockInputs, Decision, Effect, Output, PlanInputs, readonly
+from .base import BlockInputs, Decision, Effect, Output, PlanInputs, readonly, table_on
 
 if TYPE_CHECKING:
-    from ..plan import Plan
-    from ..scene import Scene
+    from ..views import PlanView, SceneView
 
 __all__ = ["EFFECT", "INTENSITY", "THERMAL_NEGLIGIBLE", "temperature", "thermal_to_reflected"]
 
@@ -64,7 +63,7 @@ INTENSITY = Output(
 )
 
 
-def temperature(scene: Scene, material: str) -> float:
+def temperature(scene: SceneView, material: str) -> float:
     """The temperature [K] of a material: the scene's one value, or its entry in the
     scene's mapping (300 K if it has none).
 
@@ -87,7 +86,7 @@ def temperature(scene: Scene, material: str) -> float:
     return float(t.get(material, 300.0)) if isinstance(t, Mapping) else float(t)
 
 
-def thermal_to_reflected(scene: Scene, wl: np.ndarray) -> float:
+def thermal_to_reflected(scene: SceneView, wl: np.ndarray) -> float:
     """Largest ratio of blackbody radiance (emissivity 1) to the radiance of a white
     Lambertian surface in sunlight, E_sun / pi, over the scene's wavelengths.
 
@@ -121,8 +120,6 @@ def thermal_to_reflected(scene: Scene, wl: np.ndarray) -> float:
 
 
 def _plan(inputs: PlanInputs) -> Decision:
-    from ..spectral import table_on
-
     scene, wl = inputs.scene, inputs.wavelength
     assert wl is not None  # planned after the spectral stage
     worst = thermal_to_reflected(scene, wl)
@@ -156,7 +153,7 @@ def _plan(inputs: PlanInputs) -> Decision:
     )
 
 
-def _contribute(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
+def _contribute(plan: PlanView, block: BlockInputs) -> dict[str, np.ndarray]:
     """``sum_j A_j cos(theta_r) epsilon_j(lambda, theta_r) B(lambda, T_j)`` over the visible
     terms [W sr-1 nm-1] (the emission term of paper 001's signature model)."""
     t = plan.terms
