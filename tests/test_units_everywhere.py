@@ -926,7 +926,7 @@ for _row, _arg in (
     ("sbrdf_xr.geometry.angles.FacetAngles", "phi"),
     ("sbrdf_xr.engine.plan.Estimate", "output_bytes"),
     ("sbrdf_xr.engine.plan.Estimate", "block_bytes"),
-    ("sbrdf_xr.engine.plan.Terms", "area"),
+    ("sbrdf_xr.engine.views.Terms", "area"),
 ):
     EXEMPT[(_row, _arg)] = "a result record the package fills, not an input"
 
