@@ -1,11 +1,11 @@
 """Ctrl-C while the ``sbrdf-xr`` command is starting: one line and exit status 130.
 
-The package takes a second or more to import (xarray, Dask, numba, trimesh...); an
-interrupt then would end in a ``KeyboardInterrupt`` traceback, before the command line's
-own handler (:func:`sbrdf_xr.cli.parser.main`) is there.  Imported first by the package:
-when the running program is the ``sbrdf-xr`` command, an interrupt until ``main`` takes
-over prints one line and exits with status 130, as one during the command does.  Nothing
-has been written by then, so nothing needs cleaning up.
+The command line takes a second or more to start (it imports xarray, Dask, numba,
+trimesh...); an interrupt then would end in a ``KeyboardInterrupt`` traceback, before
+the command line's own handler (:func:`sbrdf_xr.cli.parser.main`) is there. Imported
+first by the package: when the running program is the ``sbrdf-xr`` command, an interrupt
+until ``main`` takes over prints one line and exits with status 130, as one during the
+command does. Nothing has been written by then, so nothing needs cleaning up.
 """
 
 from __future__ import annotations
