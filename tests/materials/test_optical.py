@@ -235,3 +235,34 @@ def test_the_catalog_ships_every_material_as_built():
         # run python tools/build_catalog.py after a change to the tables or the recipes
         for var in built.data_vars:
             np.testing.assert_array_equal(shipped[var].values, built[var].values, err_msg=name)
+
+
+def _colours_tool():
+    """``tools/optical_colours.py`` (not part of the package), imported by path."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "tools" / "optical_colours.py"
+    spec = importlib.util.spec_from_file_location("tools_optical_colours", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_solar_absorptance_and_colours_of_the_docs_table():
+    """Loose checks of the guide's table against what the physics and the literature say."""
+    tool = _colours_tool()
+    sun = tool.sun_colours()
+    # the Sun: B-V 0.65, V-R 0.39 (Vega) and g-r 0.48 (AB) within 0.05 (Willmer 2018)
+    assert sun["B-V"] == pytest.approx(0.65, abs=0.05)
+    assert sun["g-r"] == pytest.approx(0.46, abs=0.05)
+    gold, silver = tool.colours("gold"), tool.colours("silver")
+    assert gold["B-V"] > sun["B-V"] + 0.5  # gold reflects little blue
+    assert abs(silver["B-V"] - sun["B-V"]) < 0.1  # silver is nearly grey
+    # polished-metal solar absorptances (Gilmore, Spacecraft Thermal Control Handbook,
+    # App. A: gold 0.19-0.3, silver 0.04-0.1 as measured on real, not ideal, surfaces)
+    assert 0.12 < tool.solar_absorptance("gold")[0] < 0.3
+    assert 0.03 < tool.solar_absorptance("silver")[0] < 0.1
+    # and the page holds the table the tool writes
+    page = tool.GUIDE.read_text(encoding="utf-8")
+    assert tool.table() in page, "run python tools/optical_colours.py"
