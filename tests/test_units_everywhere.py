@@ -720,6 +720,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.materials.optical.optical_material": lambda: dict(
         name="gold", wavelength=[500.0, 600.0]
     ),
+    "sbrdf_xr.engine.builtin.geo_comsat_materials": lambda: dict(wavelength=[500.0, 600.0]),
     "sbrdf_xr.materials.models.render": lambda: dict(
         spec=_spec(),
         theta_i=[0.0, 45.0],
