@@ -38,6 +38,7 @@ __all__ = [
     "NonPhysicalWarning",
     "NotObservableError",
     "ObservationError",
+    "OpticalConstantsError",
     "OutputError",
     "RenamedWarning",
     "SbrdfError",
@@ -335,6 +336,10 @@ class ValidationError(SbrdfError, ValueError):
 
 class CatalogError(SbrdfError, LookupError):
     """A catalog entry that does not exist or cannot be loaded."""
+
+
+class OpticalConstantsError(ValidationError):
+    """A wavelength outside the range of measured optical constants (no extrapolation)."""
 
 
 class MeshError(ValidationError):

@@ -711,6 +711,16 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         spec=_spec("robertson_sandford", rho_D=0.6, epsilon=0.2, b=0.1, e=0.3),
         theta_i=[20.0, 40.0],
     ),
+    "sbrdf_xr.materials.optical.optical_constants": lambda: dict(
+        source="au-olmon-ev", wavelength=[500.0, 600.0]
+    ),
+    "sbrdf_xr.materials.optical.specular_reflectance": lambda: dict(
+        name="gold", wavelength=[500.0, 600.0], theta=[0.0, 30.0]
+    ),
+    "sbrdf_xr.materials.optical.optical_material": lambda: dict(
+        name="gold", wavelength=[500.0, 600.0]
+    ),
+    "sbrdf_xr.engine.builtin.geo_comsat_materials": lambda: dict(wavelength=[500.0, 600.0]),
     "sbrdf_xr.materials.models.render": lambda: dict(
         spec=_spec(),
         theta_i=[0.0, 45.0],
@@ -914,6 +924,9 @@ EXEMPT[("sbrdf_xr.body.starlink.starlink_v15", "limits")] = (
 EXEMPT[("sbrdf_xr.bench.suite.bench_geometry", "step_s")] = (
     "a benchmark's problem size: the timing tools take bare numbers"
 )
+EXEMPT[("sbrdf_xr.materials.optical.optical_material", "thickness")] = EXEMPT[
+    ("sbrdf_xr.materials.optical.specular_reflectance", "thickness")
+] = "a mapping of layer name to thickness: each value is converted (tests/materials/test_optical)"
 EXEMPT[("sbrdf_xr.units.check_wavelengths", "values")] = (
     "the check of bare numbers itself: a Quantity is converted before it"
 )

@@ -19,7 +19,7 @@ import xarray as xr
 
 from sbrdf_xr import catalog, testing
 from sbrdf_xr.brdf import get_model, optics
-from sbrdf_xr.materials import goniometer, models, shipped
+from sbrdf_xr.materials import goniometer, models, optical, shipped
 from sbrdf_xr.materials import tables as material
 
 ROOT = Path(__file__).resolve().parent.parent / "catalogs"
@@ -423,6 +423,15 @@ def brushed_aluminium() -> None:
     )
 
 
+def optical_materials() -> None:
+    """Write the materials from measured optical constants (``optical-<name>.nc``), each at
+    every tabulated wavelength of its sources (:func:`sbrdf_xr.materials.optical_material`
+    with its defaults)."""
+    for name in optical.OPTICAL_MATERIALS:
+        spec = optical.optical_material(name)
+        models.to_netcdf(spec, ROOT / "materials" / f"optical-{name}.nc", overwrite=True)
+
+
 def shipped_reflectances() -> list[tuple[Path, np.ndarray, np.ndarray]]:
     """The model file, rows and wavelengths of every built catalog table whose build
     renormalises to its fit's reflectance (the default with ``below_noise="model"``)."""
@@ -458,6 +467,7 @@ def main() -> None:
     canx1_microfacet_fits()
     canx1_coated_fits()
     table4_paints()
+    optical_materials()
     model_reflectances()
 
 

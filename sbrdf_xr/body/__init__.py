@@ -22,6 +22,9 @@ Modules
     The sides light can reach: every facet's front, and a back where one is given.
 ``parts`` and ``posed``
     Articulated parts (a hinge and a pointing law), and shadowing on the posed body.
+``geo_comsat``
+    A built-in GEO communications satellite-like body: gold MLI bus, OSR radiators, two
+    sun-tracking cell arrays.
 ``starlink``
     A built-in Starlink v1.5-class body: a nadir chassis and a sun-tracking array.
 """
@@ -29,6 +32,7 @@ Modules
 from ..errors import MeshError, MeshRepairWarning
 from . import (
     facets,
+    geo_comsat,
     imperfections,
     meshes,
     parts,
@@ -42,6 +46,7 @@ from . import (
     visibility,
 )
 from .facets import NORMAL_TOLERANCE, check_facet_material, facet_table, merge_facets
+from .geo_comsat import GEO_COMSAT_MATERIALS
 from .imperfections import tilt_quadrature, tilted_normals
 from .meshes import (
     LENGTH_UNITS,
@@ -104,6 +109,7 @@ __all__ = [
     "CANX1_MATERIALS",
     "DENSITY_PRESETS",
     "ENGINES",
+    "GEO_COMSAT_MATERIALS",
     "LAWS",
     "LENGTH_UNITS",
     "MAX_RAYS_PER_CALL",
@@ -141,6 +147,7 @@ __all__ = [
     "facet_table",
     "facet_visibility",
     "facets",
+    "geo_comsat",
     "hinge_rotation",
     "imperfections",
     "intersector",

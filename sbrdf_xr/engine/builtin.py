@@ -34,6 +34,7 @@ __all__ = [
     "STARLINK_STAND_INS",
     "builtin_scene",
     "builtin_scenes",
+    "geo_comsat_materials",
     "load_material_specs",
     "load_scene",
     "material_tables",
@@ -104,6 +105,40 @@ the Starlink v1.5 body; its materials: starlink-chassis, starlink-solar-array, s
         )
         out[name] = table
     return out
+
+
+def geo_comsat_materials(
+    wavelength: Any = None, *, roughness: Mapping[str, float] | None = None
+) -> dict[str, Any]:
+    """Materials of :func:`sbrdf_xr.body.geo_comsat.geo_comsat`: the optical-constant
+    materials of :mod:`sbrdf_xr.materials.optical` (model materials, measured optical
+    constants with an assumed roughness).
+
+    Parameters
+    ----------
+    wavelength : array_like, optional
+        Wavelengths [nm] (default: 360-900 nm every 0.2 nm, which resolves the fringes of
+        the 25 um Kapton film and, above ~450 nm, those of the 100 um silica layers).
+    roughness : mapping of str to float, optional
+        GGX roughness per material [1] (default: each material's).
+
+    Returns
+    -------
+    dict of str to Dataset
+        For ``Scene(materials=...)`` (evaluated with ``evaluation="analytic"``).
+
+    Examples
+    --------
+    >>> mats = geo_comsat_materials([500.0, 600.0])
+    >>> sorted(mats), mats["osr"].attrs["model"]
+    (['gaas-cell', 'kapton-mli', 'osr'], 'microfacet')
+    """
+    from ..body.geo_comsat import GEO_COMSAT_MATERIALS
+    from ..materials.optical import optical_material
+
+    wl = np.linspace(360.0, 900.0, 2701) if wavelength is None else wavelength
+    alpha = dict(roughness or {})
+    return {m: optical_material(m, wl, roughness=alpha.get(m)) for m in GEO_COMSAT_MATERIALS}
 
 
 def _canx1_plusx_specular() -> Scene:

@@ -25,6 +25,9 @@ Modules
     Lossless, atomic netCDF files of tables and measurement sets.
 ``model_schema`` and ``models``
     Analytic materials as labelled parameter sets: evaluate, render to a table, measure.
+``optical``
+    Real materials from measured optical constants (refractiveindex.info): bare metals,
+    Kapton MLI, optical solar reflectors, a covered GaAs cell (:func:`optical_material`).
 ``goniometer``
     A virtual goniospectrometer sampling any material with the scheme of paper 000.
 ``readers`` and ``merl``
@@ -47,6 +50,7 @@ from . import (
     merl,
     model_schema,
     models,
+    optical,
     readers,
     schema,
     selfcheck,
@@ -66,6 +70,7 @@ from .models import (
     spectra,
     spectrum_function,
 )
+from .optical import OPTICAL_MATERIALS, optical_material
 from .readers import READERS, Reader, read_measurements, register_reader
 from .schema import (
     DUPLICATES,
@@ -93,6 +98,7 @@ __all__ = [
     "ENERGY_TOL",
     "EXTRAPOLATIONS",
     "LOOKUP_METHODS",
+    "OPTICAL_MATERIALS",
     "PAPER_THETA_I",
     "READERS",
     "RENORMALISE",
@@ -127,6 +133,8 @@ __all__ = [
     "open_material",
     "open_measurements",
     "open_model",
+    "optical",
+    "optical_material",
     "paper_delta_theta_grid",
     "paper_phi_grid",
     "paper_scheme",
