@@ -23,6 +23,9 @@ Modules
 ``reuse``
     What a plan computes from the tables, the spacecraft and the knobs alone (packed
     tables, merged facets), kept by content for the next plans.
+``evaluator``
+    A compiled plan as a function of the directions: numpy in, numpy out, for small
+    calls (one geometry, a fit's inner loop).
 ``run``
     Executing a plan: blocks of geometries through the kernel into an xarray cube
     (:func:`simulate`; :func:`sbrdf_xr.store.write` writes it).
@@ -33,6 +36,7 @@ from . import (
     articulation,
     builtin,
     effects,
+    evaluator,
     knobs,
     plan,
     reuse,
@@ -53,6 +57,7 @@ from .builtin import (
     starlink_materials,
 )
 from .effects import SPECTRAL_OUTPUTS, BlockInputs, Effect, Output, finish, reflected
+from .evaluator import Evaluator, compile_evaluator
 from .knobs import KNOBS, PRESETS, Knob, apply_preset, check_knob, knob_table
 from .plan import Estimate, Plan, PlannedOutput, Terms, compile_plan
 from .run import IN_PROCESS_BYTES, run_block, simulate
@@ -83,6 +88,7 @@ __all__ = [
     "BoundGroup",
     "Effect",
     "Estimate",
+    "Evaluator",
     "GridGeometry",
     "Knob",
     "Output",
@@ -98,8 +104,10 @@ __all__ = [
     "builtin_scene",
     "builtin_scenes",
     "check_knob",
+    "compile_evaluator",
     "compile_plan",
     "effects",
+    "evaluator",
     "finish",
     "knob_table",
     "knobs",
