@@ -33,7 +33,15 @@ from .accuracy import BANDS, CANX1_MATERIALS, accuracy_cost, shadow_rows
 from .engine import disk_rate, engine_rows, sweep_job, thread_scaling
 from .parts import KINDS, canx1_with_wing, parts_rows
 from .presets import load_presets, presets_record, presets_table, write_presets
-from .rows import BenchRow, best_time, format_rows, plot_front, rows_to_dataset, timed_runs
+from .rows import (
+    BenchRow,
+    best_time,
+    format_rows,
+    load_warning,
+    plot_front,
+    rows_to_dataset,
+    timed_runs,
+)
 from .shadowing import (
     ACCURACY_BODIES,
     CostRow,
@@ -74,6 +82,7 @@ __all__ = [
     "kernel_throughput",
     "lambertian_signal",
     "load_presets",
+    "load_warning",
     "markdown",
     "parts",
     "parts_rows",
