@@ -11,7 +11,7 @@ stays float32).
 
 from __future__ import annotations
 
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, cast
 
 import numba
 import numpy as np
@@ -455,5 +455,5 @@ def _kernel_vectors(v: NDArray[np.floating]) -> NDArray[np.float64]:
     """``v`` as the kernel's entry point takes it: float64, C order, writeable (no copy
     when it already is)."""
     if v.dtype == np.float64 and v.flags.c_contiguous and v.flags.writeable:
-        return v.view(np.float64)
+        return cast("NDArray[np.float64]", v)
     return np.array(v, dtype=np.float64, order="C")
