@@ -27,6 +27,7 @@ __all__ = [
     "CatalogError",
     "CubeLockedError",
     "CubeWriteError",
+    "DirectionError",
     "EphemerisError",
     "EpochGapWarning",
     "FitQualityWarning",
@@ -45,6 +46,7 @@ __all__ = [
     "SbrdfWarning",
     "SceneError",
     "SchedulerError",
+    "StalePlanError",
     "TrackingTableError",
     "UnitError",
     "UnitWarning",
@@ -348,6 +350,17 @@ class MeshError(ValidationError):
 
 class SceneError(ValidationError):
     """A scene definition that cannot be compiled into a plan."""
+
+
+class DirectionError(ValidationError):
+    """Directions handed to a compiled evaluator (:class:`sbrdf_xr.engine.Evaluator`) that
+    it cannot use: not of shape (3,) or (n, 3), NaN or infinite, or not of unit length."""
+
+
+class StalePlanError(SbrdfError):
+    """A compiled evaluator whose plan no longer holds the tables or terms it was compiled
+    with (a field replaced, a table array made writeable, or its sampled content changed):
+    compile it again from the plan."""
 
 
 class ObservationError(ValidationError):

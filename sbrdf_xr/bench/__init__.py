@@ -14,6 +14,9 @@ Modules
     The accuracy/cost sweep of the knobs and presets.
 ``engine``
     What a sweep costs end to end.
+``calls``
+    What a small call costs: one geometry through the compiled evaluator, ``simulate``
+    and the bare kernel.
 ``shadowing``
     Accuracy and cost of the shadowing methods against the exact method.
 ``presets``
@@ -25,12 +28,20 @@ Modules
     magnitudes, beside the diffuse-sphere control (:func:`predict_starlink`).
 """
 
-from . import accuracy, engine, parts, presets, rows, shadowing, starlink, suite
+from . import accuracy, calls, engine, parts, presets, rows, shadowing, starlink, suite
 from .accuracy import BANDS, CANX1_MATERIALS, accuracy_cost, shadow_rows
 from .engine import disk_rate, engine_rows, sweep_job, thread_scaling
 from .parts import KINDS, canx1_with_wing, parts_rows
 from .presets import load_presets, presets_record, presets_table, write_presets
-from .rows import BenchRow, best_time, format_rows, plot_front, rows_to_dataset, timed_runs
+from .rows import (
+    BenchRow,
+    best_time,
+    format_rows,
+    load_warning,
+    plot_front,
+    rows_to_dataset,
+    timed_runs,
+)
 from .shadowing import (
     ACCURACY_BODIES,
     CostRow,
@@ -60,6 +71,7 @@ __all__ = [
     "bench_geometry",
     "bench_lookup",
     "best_time",
+    "calls",
     "canx1_sweep_rows",
     "canx1_with_wing",
     "disk_rate",
@@ -70,6 +82,7 @@ __all__ = [
     "kernel_throughput",
     "lambertian_signal",
     "load_presets",
+    "load_warning",
     "markdown",
     "parts",
     "parts_rows",

@@ -24,7 +24,7 @@ from .rows import BenchRow, timed_runs
 if TYPE_CHECKING:
     from ..engine.scene import Scene
 
-__all__ = ["BANDS", "CANX1_MATERIALS", "accuracy_cost", "shadow_rows"]
+__all__ = ["BANDS", "CANX1_MATERIALS", "accuracy_cost", "fixed_cost_rows", "shadow_rows"]
 
 BANDS = ("V", "R", "I")
 CANX1_MATERIALS = ("aluminium-6061-t6", "tjpv-cell", "white-paint-a276")
@@ -182,11 +182,11 @@ def accuracy_cost(quick: bool = False, repeat: int | None = None) -> list[BenchR
     for sweep in (rot, big):
         cubes: dict[str, xr.Dataset] = {}
         cases = [*knobs, analytic]
+        # each case planned once, outside the timing: the rows time the simulation, and
+        # the fixed cost of a scene (planning, one call's overhead) is a row of its own
+        plans = {f"{k}: {s}": _configured(sweep, reference, o).plan() for k, s, o in cases}
         timing = timed_runs(
-            {
-                f"{k}: {s}": partial(_run, simulate, sweep, reference, o, cubes, f"{k}: {s}")
-                for k, s, o in cases
-            },
+            {name: partial(_run, simulate, plan, cubes, name) for name, plan in plans.items()},
             repeat,
         )
         ref_name = f"{knobs[0][0]}: {knobs[0][1]}"
@@ -222,26 +222,87 @@ def accuracy_cost(quick: bool = False, repeat: int | None = None) -> list[BenchR
                     model_mmag_median=model[1],
                 )
             )
+        rows += fixed_cost_rows(sweep, reference, t_ref, repeat)
     rows += shadow_rows(quick=quick, repeat=repeat)
     return rows
 
+
+#: One-geometry ``simulate`` calls per timed repeat of :func:`fixed_cost_rows`.
+_CALLS = 20
 
 #: What a preset's row keeps of the reference configuration: the tables and the outputs.
 _KEEP = ("materials", "outputs")
 
 
-def _run(
-    simulate: Callable[[Scene], xr.Dataset],
-    scene: Scene,
-    reference: dict[str, Any],
-    opts: dict[str, Any],
-    cubes: dict[str, xr.Dataset],
-    name: str,
-) -> None:
-    """Simulate ``scene`` with the reference configuration changed by ``opts`` (a preset
-    keeps only :data:`_KEEP` of it) into ``cubes[name]``."""
+def _configured(scene: Scene, reference: dict[str, Any], opts: dict[str, Any]) -> Scene:
+    """``scene`` with the reference configuration changed by ``opts`` (a preset keeps only
+    :data:`_KEEP` of it)."""
     cfg = {k: v for k, v in reference.items() if "preset" not in opts or k in _KEEP}
-    cubes[name] = simulate(scene.with_options(**{**cfg, **opts})).compute(scheduler="sync")
+    return scene.with_options(**{**cfg, **opts})
+
+
+def _run(
+    simulate: Callable[[Any], xr.Dataset], plan: Any, cubes: dict[str, xr.Dataset], name: str
+) -> None:
+    """Simulate a compiled ``plan`` into ``cubes[name]``."""
+    cubes[name] = simulate(plan).compute(scheduler="sync")
+
+
+def fixed_cost_rows(
+    scene: Scene, reference: dict[str, Any], t_ref: float, repeat: int = 3
+) -> list[BenchRow]:
+    """The fixed cost of a scene in the reference configuration, beside the reference
+    sweep's own time: planning a fresh scene (``with_options`` and ``plan``, its tables
+    already loaded) and one ``simulate`` call of a single geometry (its overhead).
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.bench.accuracy import fixed_cost_rows
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> scene = Scene(box, {"grey": grey}, attitudes=[[0, 0, 0, 1.0]] * 4, phase_angles=[10.0])
+    >>> rows = fixed_cost_rows(scene, {"method": "linear"}, t_ref=1.0, repeat=1)
+    >>> [r.name for r in rows]
+    ['fixed cost: a fresh scene planned', 'fixed cost: one simulate call, one geometry']
+    """
+    from ..engine.run import simulate
+
+    base = _configured(scene, reference, {})
+    base.plan()
+    one = base.with_options(
+        attitudes=np.asarray(base.attitudes)[:1], attitude_angle=None, chunk=None
+    ).plan()
+    count = iter(range(1 << 30))
+
+    def fresh() -> None:  # another phase angle: a new scene and plan, tables reused
+        base.with_options(phase_angles=[10.0 + 1e-9 * next(count)]).plan()
+
+    def calls() -> None:  # a call is sub-millisecond: many per timed repeat
+        for _ in range(_CALLS):
+            simulate(one)
+
+    timing = timed_runs({"plan": fresh, "call": calls}, repeat)
+    timing["call"] = (timing["call"][0] / _CALLS, timing["call"][1])
+    label = {
+        "plan": "fixed cost: a fresh scene planned",
+        "call": "fixed cost: one simulate call, one geometry",
+    }
+    return [
+        BenchRow(
+            label[k],
+            t,
+            "reference",
+            t / t_ref,
+            f"{t * 1e3:.2f} ms, not in the rows above (each case planned before timing)",
+            sweep=scene.name,
+            knob="fixed cost",
+            spread=sp,
+        )
+        for k, (t, sp) in timing.items()
+    ]
 
 
 def shadow_rows(quick: bool = False, repeat: int = 2) -> list[BenchRow]:

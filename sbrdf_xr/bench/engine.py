@@ -7,7 +7,9 @@ absolute claim:
   ``simulate(scene).compute()`` (the scene's plan already compiled);
 * the same for a fresh scene on every call (``scene.with_options(phase_angles=...)``,
   planned anew; its tables loaded), as a ratio to the warm time;
-* a single-geometry call, warm;
+* a single-geometry call, warm; and one geometry through the compiled evaluator, the
+  effects' path, ``run_block``, ``simulate`` and the bare kernel
+  (:mod:`sbrdf_xr.bench.calls`);
 * sweeps of 1e4, 1e5 (and, without ``quick``, 1e6) random attitudes x 141
   wavelengths written to netCDF at default settings, each in a fresh process: the
   wall time, its growth exponent between sizes, the ratio to the bare kernel time
@@ -562,6 +564,10 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
                 sweep=sw,
             )
         )
+    # one geometry: the compiled evaluator against simulate and the bare kernel
+    from .calls import single_call_rows
+
+    rows += single_call_rows(repeat=max(repeat, 5))
     # open surfaces and articulated parts against the rigid closed path
     from .parts import parts_rows
 

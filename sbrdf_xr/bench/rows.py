@@ -17,7 +17,21 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-__all__ = ["BenchRow", "best_time", "format_rows", "plot_front", "rows_to_dataset", "timed_runs"]
+__all__ = [
+    "LOADED_SPREAD",
+    "BenchRow",
+    "best_time",
+    "format_rows",
+    "load_warning",
+    "plot_front",
+    "rows_to_dataset",
+    "timed_runs",
+]
+
+#: Median spread of the repeated timings (``max / min - 1``) above which a run is
+#: reported as taken on a loaded machine: on a quiet one the repeats of a row agree to
+#: a few per cent.
+LOADED_SPREAD = 0.15
 
 
 @dataclass
@@ -127,6 +141,42 @@ def timed_runs(
         k: (min(v), max(v) / min(v) - 1.0 if len(v) > 1 and min(v) > 0 else float("nan"))
         for k, v in times.items()
     }
+
+
+def load_warning(rows: list[BenchRow], limit: float = LOADED_SPREAD) -> str | None:
+    """A warning when the spread of the repeated timings says the machine was loaded, or
+    None: the median spread of the rows that have one is above ``limit``, or a third of
+    them are above twice ``limit``.  The message gives the spreads and the load average.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench.rows import BenchRow, load_warning
+    >>> quiet = [BenchRow("a", 1.0, "a", 1.0, spread=s) for s in (0.03, 0.1)]
+    >>> load_warning(quiet) is None
+    True
+    >>> busy = quiet + [BenchRow("c", 1.0, "a", 1.0, spread=0.9)] * 3
+    >>> load_warning(busy).startswith("the machine was loaded")
+    True
+    """
+    import os
+
+    spreads = np.array([r.spread for r in rows if np.isfinite(r.spread)])
+    if not spreads.size:
+        return None
+    median = float(np.median(spreads))
+    wide = float(np.mean(spreads > 2 * limit))
+    if median <= limit and wide < 1 / 3:
+        return None
+    try:
+        load = "load average {:.1f}, {:.1f}, {:.1f}".format(*os.getloadavg())
+    except OSError:  # pragma: no cover - not on every platform
+        load = "load average unknown"
+    return (
+        f"the machine was loaded: the repeats of a row differ by {median:.0%} (median) and "
+        f"{float(spreads.max()):.0%} (largest) over {spreads.size} rows ({wide:.0%} of them "
+        f"above {2 * limit:.0%}; {load} on {os.cpu_count()} CPUs); the ratios are uncertain "
+        "by about as much: run again on a quiet machine"
+    )
 
 
 def format_rows(rows: list[BenchRow]) -> str:

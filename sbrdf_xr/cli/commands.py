@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import signal
+import sys
 import textwrap
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -199,6 +200,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
             raise ValidationError(f"--repeat: got {args.repeat}; expected a whole number >= 1")
         rows = bench.run(quick=args.quick, repeat=args.repeat)
     print(bench.format_rows(rows))
+    loaded = bench.rows.load_warning(rows)
+    if loaded:
+        print(f"warning: {loaded}", file=sys.stderr)
     if args.record_presets:
         command = "sbrdf-xr bench" + (" --quick" if args.quick else "")
         path = bench.write_presets(bench.presets_record(rows, command))

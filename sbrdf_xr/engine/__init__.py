@@ -28,6 +28,9 @@ Modules
 ``views``
     What the plan's stages and the effects read of a scene and a plan (protocols), and
     the facet terms.
+``evaluator``
+    A compiled plan as a function of the directions: numpy in, numpy out, for small
+    calls (one geometry, a fit's inner loop).
 ``run``
     Executing a plan: blocks of geometries through the kernel into an xarray cube
     (:func:`simulate`; :func:`sbrdf_xr.store.write` writes it).
@@ -38,6 +41,7 @@ from . import (
     articulation,
     builtin,
     effects,
+    evaluator,
     fingerprint,
     knobs,
     plan,
@@ -60,6 +64,7 @@ from .builtin import (
     starlink_materials,
 )
 from .effects import SPECTRAL_OUTPUTS, BlockInputs, Effect, Output, finish, reflected
+from .evaluator import Evaluator, compile_evaluator
 from .fingerprint import scene_fingerprint
 from .knobs import KNOBS, PRESETS, Knob, apply_preset, check_knob, knob_table
 from .plan import Estimate, Plan, PlannedOutput, Terms, compile_plan
@@ -91,6 +96,7 @@ __all__ = [
     "BoundGroup",
     "Effect",
     "Estimate",
+    "Evaluator",
     "GridGeometry",
     "Knob",
     "Output",
@@ -106,8 +112,10 @@ __all__ = [
     "builtin_scene",
     "builtin_scenes",
     "check_knob",
+    "compile_evaluator",
     "compile_plan",
     "effects",
+    "evaluator",
     "fingerprint",
     "finish",
     "knob_table",

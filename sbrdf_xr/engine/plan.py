@@ -216,9 +216,9 @@ class Plan:
         """The entries of the effects that run (:data:`sbrdf_xr.engine.effects.EFFECTS`)."""
         return tuple(EFFECTS[e] for e in self.effects)
 
-    @property
+    @cached_property
     def output_names(self) -> tuple[str, ...]:
-        """Names of the output variables."""
+        """Names of the output variables (found once: every block reads them)."""
         return tuple(o.name for o in self.outputs)
 
     @property

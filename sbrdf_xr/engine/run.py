@@ -57,7 +57,8 @@ from .._names import WAVELENGTH, attrs
 from ..errors import SceneError
 from .articulation import articulated_sums
 from .builtin import resolve_scene
-from .effects import EFFECTS, finish
+from .effects import finish
+from .evaluator import block_outputs
 from .plan import Plan
 from .reuse import INDEXES
 from .scene import Scene
@@ -75,7 +76,9 @@ def run_block(plan: Plan, sl: slice) -> dict[str, np.ndarray]:
     """Every output of the plan for the geometries ``sl`` of its first dimension.
 
     Runs each effect of the plan (:data:`sbrdf_xr.engine.effects.EFFECTS`) on the block and
-    combines their sums into the outputs (:func:`sbrdf_xr.engine.effects.finish`).
+    combines their sums into the outputs (:func:`sbrdf_xr.engine.effects.finish`); a rigid
+    body's sunlight-only plan runs through its compiled evaluator
+    (:func:`sbrdf_xr.engine.evaluator.block_outputs`), bit for bit the same.
 
     Returns
     -------
@@ -104,14 +107,7 @@ def run_block(plan: Plan, sl: slice) -> dict[str, np.ndarray]:
     block = plan.geometry.block(sl)
     if plan.articulation is not None:  # parts that turn: every group in its own frame
         return finish(plan, articulated_sums(plan, block, sl), block.lead_shape)
-    sums: dict[str, np.ndarray] = {}
-    for name in plan.effects:
-        contribute = EFFECTS[name].contribute
-        if contribute is None:
-            continue
-        for k, v in contribute(plan, block).items():
-            sums[k] = sums[k] + v if k in sums else v
-    return finish(plan, sums, block.lead_shape)
+    return block_outputs(plan, block)  # the plan's evaluator where it allows
 
 
 def _block_task(plan: Plan, k: int) -> dict[str, np.ndarray]:

@@ -76,7 +76,7 @@ from .polygon import (
     union_area_slabs,
 )
 from .reference import MaterialSums, material_sums
-from .sums import METHOD_CODES, FusedSums, fused_sums, normal_rows
+from .sums import METHOD_CODES, BoundSums, FusedSums, fused_sums, normal_rows
 
 __all__ = [
     "BUDGET",
@@ -86,6 +86,7 @@ __all__ = [
     "MAX_BUCKETS",
     "METHOD_CODES",
     "AnisotropicTable",
+    "BoundSums",
     "Facets",
     "FusedSums",
     "KernelOptions",
