@@ -84,6 +84,8 @@ CASES = [
     (45.0, 7000.0),
     (87.0, 7000.0),  # grazing: the horizon cuts the disc
     (80.0, 6771.0),  # grazing, 400 km
+    (110.0, 7000.0),  # the Earth's centre below the horizon: only the limb is seen
+    (140.0, 6771.0),
 ]
 
 
@@ -99,6 +101,38 @@ def test_lambertian_facet_against_the_exact_integral(tilt, r):
     np.testing.assert_allclose(got, want, rtol=TOL)
     assert cube.earth_thermal_intensity.attrs["units"] == "W sr-1 nm-1"
     assert cube.earth_thermal_intensity.attrs["long_name"]
+
+
+def test_random_geometries_sum_every_facet_that_sees_the_earth():
+    """A box turned every way at 7200 km: each face that sees any of the Earth (its
+    centre above the horizon or only the limb) adds ``A cos(theta_r) (rho/pi) B V``,
+    ``V`` from sources.earth_view_facets (checked against the surface integral in
+    tests/test_sources_finite_earth.py): the engine's sums to rounding."""
+    import trimesh
+
+    from sbrdf_xr import load_spacecraft
+    from sbrdf_xr.sources import earth_view_facets
+
+    mesh = trimesh.creation.box((0.1, 0.1, 0.3))
+    body = load_spacecraft(mesh, material="p")
+    rng = np.random.default_rng(1)
+    e, o, s = (v / np.linalg.norm(v, axis=1)[:, None] for v in rng.normal(size=(3, 40, 3)))
+    scene = Scene(
+        body,
+        {"p": lambertian(0.1, WL, material="p")},
+        to_sun=s,
+        to_observer=o,
+        to_earth=e,
+        effects=("earth_thermal",),
+        earth_range_km=7200.0,
+        outputs=("signal",),
+    )
+    got = simulate(scene).compute().earth_thermal_intensity.values
+    fn, fa = mesh.face_normals, mesh.area_faces
+    view = earth_view_facets(fn, e, 7200.0)
+    assert ((e @ fn.T <= 0) & (view > 0) & (o @ fn.T > 0)).any()  # limb-only faces seen
+    want = (fa * np.maximum(o @ fn.T, 0.0) * view).sum(1)[:, None] * 0.1 / np.pi
+    np.testing.assert_allclose(got, want * planck(WL, 255.0), rtol=1e-9, atol=0)
 
 
 def test_tabulated_material_gives_the_same_light():

@@ -13,7 +13,11 @@ or ``pi sin^2(rho) cos(theta_i)`` of a distant source at the Earth's centre
 (``earth_model="point"``), and reflects it with its BRDF at the direction of the
 Earth's centre, as the reflected earthshine does: the output ``earth_thermal_intensity``
 ``sum_j A_j cos(theta_r) f_r(e, o) E_j(lambda)`` [W sr-1 nm-1].  It is exact for a
-Lambertian facet; a facet whose horizon hides the Earth's centre gets none.
+Lambertian facet.  A facet that sees only the Earth's limb, its centre below the facet's
+horizon (common below a few Earth radii: at 7200 km a facet sees part of the Earth up to
+152 deg from its centre), reflects ``E_j`` with its directional-hemispherical reflectance
+at the emission angle, ``rho(theta_r) / pi`` (reciprocity: exact for a Lambertian facet,
+the diffuse-sky approximation for a glossy one).
 
 Like ``thermal_intensity`` it is an intensity, not a signal per unit solar irradiance,
 so it does not add to ``band_signal`` (``photometry.inband.in_band`` integrates it over a
@@ -48,7 +52,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ... import geometry, sources
-from ..._names import WAVELENGTH
+from ..._names import PSI, WAVELENGTH
+from ...geometry.anisotropy import psi_average
+from ...materials.energy import hemispherical_reflectance
 from ...photometry import solar_spectrum
 from .base import BlockInputs, Decision, Effect, Output, PlanInputs, facet_fraction, readonly
 from .base import reflected as _reflected
@@ -75,20 +81,25 @@ INTENSITY = Output(
 
 def _geometry(scene: Scene, observed: xr.Dataset | None) -> dict[str, np.ndarray]:
     if observed is not None:  # the Earth's distance at every time
-        return {
-            "to_earth": np.ascontiguousarray(observed["to_earth"].values),
-            "earth_range": np.asarray(observed["earth_distance"].values, dtype=np.float64),
-        }
-    if scene.is_grid:
-        e = geometry.normalize(scene.earth_direction, "earth_direction")
-        n = len(np.asarray(scene.phase_angles))
-        to_earth = np.broadcast_to(e, (n, 3)).copy()
+        to_earth = np.ascontiguousarray(observed["to_earth"].values)
+        rng = np.asarray(observed["earth_distance"].values, dtype=np.float64)
     else:
-        to_earth = np.asarray(scene.to_earth)
-    return {"to_earth": to_earth, "earth_range": np.full(len(to_earth), scene.earth_range_km)}
+        if scene.is_grid:
+            e = geometry.normalize(scene.earth_direction, "earth_direction")
+            n = len(np.asarray(scene.phase_angles))
+            to_earth = np.broadcast_to(e, (n, 3)).copy()
+        else:
+            to_earth = np.asarray(scene.to_earth)
+        rng = np.full(len(to_earth), float(scene.earth_range_km))
+    out = {"to_earth": to_earth, "earth_range": rng}
+    if scene.earth_model == "finite":  # facets up to 90 deg + rho from the centre see it
+        out["earth_reach"] = sources.EARTH_RADIUS_KM / rng
+    return out
 
 
 def _plan(inputs: PlanInputs) -> Decision:
+    from ..spectral import table_on
+
     scene, wl = inputs.scene, inputs.wavelength
     assert wl is not None  # planned after the spectral stage
     ranges = np.asarray(scene.geometry.sources["earth_range"], dtype=np.float64)
@@ -117,12 +128,19 @@ def _plan(inputs: PlanInputs) -> Decision:
         if finite
         else "a distant source at the Earth's centre"
     )
+    reflectance = []
+    for m in inputs.materials:  # for the facets that see only the limb
+        da = table_on(scene.tables[m], wl, None)
+        th = np.asarray(da["theta_i"].values, dtype=np.float64)
+        rho_da = hemispherical_reflectance(da, th, warn=False)
+        rho = psi_average(rho_da.values, da[PSI].values, 1) if PSI in rho_da.dims else rho_da.values
+        reflectance.append((readonly(th), readonly(rho)))
     return Decision(
         True,
         f"the {'finite ' if finite else ''}Earth's emission at {scene.earth_temperature:g} K "
         f"({where}{dist}): irradiance up to {worst:.3g} of the Sun's on an Earth-facing facet "
         f"at {wl[0]:g}-{wl[-1]:g} nm, {how}",
-        {"radiance": readonly(radiance)},
+        {"radiance": readonly(radiance), "reflectance": tuple(reflectance)},
     )
 
 
@@ -131,18 +149,51 @@ def _contribute(plan: Plan, block: BlockInputs) -> dict[str, np.ndarray]:
     rng = block.sources["earth_range"]
     frac = facet_fraction(plan, to_earth, block.to_observer)
     normals = plan.terms.normal
+    cos_i = to_earth @ normals.T / np.linalg.norm(to_earth, axis=1)[:, None]
+    view = np.zeros_like(cos_i)
     if plan.knobs["earth_model"] == "finite":
         view = sources.earth_view_facets(normals, to_earth, rng)
-        cos_i = to_earth @ normals.T / np.linalg.norm(to_earth, axis=1)[:, None]
         # the kernel multiplies by cos(theta_i) at the Earth's centre: divide it out
         share = np.divide(view, cos_i, out=np.zeros_like(view), where=cos_i > 0)
     else:  # a distant source: pi sin^2(rho) times the kernel's cos(theta_i)
         solid = np.pi * (sources.EARTH_RADIUS_KM / np.asarray(rng, dtype=np.float64)) ** 2
         share = np.broadcast_to(solid[:, None], (len(to_earth), len(normals)))
     frac = share if frac is None else frac * share
-    r = _reflected(plan, block, to_earth, frac, False)
-    out = r.signal * plan.effect_params["earth_thermal"]["radiance"]
+    p = plan.effect_params["earth_thermal"]
+    out = _reflected(plan, block, to_earth, frac, False).signal.astype(np.float64)
+    if plan.knobs["earth_model"] == "finite":
+        out = out + _limb(plan, block, view, cos_i, p["reflectance"])
+    out = out * p["radiance"]
     return {"earth_thermal_intensity": out.astype(np.dtype(plan.knobs["dtype"]))}
+
+
+def _limb(
+    plan: Plan,
+    block: BlockInputs,
+    view: np.ndarray,
+    cos_i: np.ndarray,
+    reflectance: tuple[tuple[np.ndarray, np.ndarray], ...],
+) -> np.ndarray:
+    """``sum_j A_j cos(theta_r) rho(theta_r) / pi V_j`` (G, L) over the facets that see the
+    Earth's limb with its centre below their horizon (``V > 0``, ``cos(theta_i) <= 0``),
+    where the Earth's centre cannot be the direction of their BRDF: the light is reflected
+    with the facet's directional-hemispherical reflectance at the emission angle
+    (reciprocity; exact for a Lambertian facet, a diffuse-sky approximation otherwise)."""
+    t = plan.terms
+    o = block.to_observer
+    out = np.zeros((o.shape[0], plan.wavelength.size))
+    limb = (cos_i <= 0) & (view > 0)
+    if not limb.any():
+        return out
+    for m, (theta, rho) in enumerate(reflectance):
+        sel = t.material == m
+        cos_r = o @ t.normal[sel].T  # (G, T_m)
+        w = np.where(limb[:, sel] & (cos_r > 0), cos_r * view[:, sel], 0.0) * t.area[sel]
+        if not w.any():
+            continue
+        theta_r = np.degrees(np.arctan2(np.sqrt(np.clip(1 - cos_r**2, 0, None)), cos_r))
+        out += np.einsum("gf,gfl->gl", w, sources.emissivity_at(rho, theta, theta_r)) / np.pi
+    return out
 
 
 #: The Earth's thermal emission reflected by the facets.
