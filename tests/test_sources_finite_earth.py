@@ -89,7 +89,7 @@ VIEW_NORMALS = [DOWN, [1.0, 0.0, -0.05], [1.0, 0.0, 0.0], [1.0, 0.0, 0.1], [0.6,
 def test_view_facets_against_surface_integral(r):
     """Many plates at once (whole cap, horizon-cut, edge-on, beyond the centre's horizon):
     the default 64 x 128 nodes are within 1e-3 of the largest value (the horizon kink
-    converges as N^-2; measured below 2e-5)."""
+    converges as N^-2; measured 4e-6 at GEO, 4e-5 at 7000 and 6771 km)."""
     n = np.asarray(VIEW_NORMALS) / np.linalg.norm(VIEW_NORMALS, axis=1)[:, None]
     got = earth_view_facets(n, [DOWN], r)[0]
     want = np.array([_reference(m, DOWN, [0, 0, 1], r, emitted=True) for m in n])
