@@ -108,3 +108,30 @@ def test_bad_input_is_named():
         _scene(0.3, conductance="isothermal")
     with pytest.raises(ValidationError, match="emissivity"):
         simulate(_scene(1.0))
+
+
+def test_the_earths_shadow_scales_the_absorbed_sunlight():
+    """An observation's sunlit fraction f (the block's sun_scale) multiplies the absorbed
+    sunlight only: ``T(f)^4 - T(0)^4 = f (T(1)^4 - T(0)^4)``, and in the umbra the face
+    keeps the Earth's emission alone (steady state)."""
+    import dataclasses
+
+    from sbrdf_xr.engine.effects import EFFECTS
+
+    plan = _scene(
+        0.3, to_earth=[[0.0, 0.0, -1.0]], effects=("sunlight", "thermal", "earth_thermal")
+    ).plan()
+    block = plan.geometry.block(slice(None))
+    t = {
+        f: EFFECTS["thermal"].contribute(plan, dataclasses.replace(block, sun_scale=np.array([f])))[
+            "facet_temperature"
+        ][0]
+        for f in (0.0, 0.5, 1.0)
+    }
+    np.testing.assert_allclose(t[0.5] ** 4 - t[0.0] ** 4, 0.5 * (t[1.0] ** 4 - t[0.0] ** 4))
+    assert np.all(t[0.0] < t[0.5]) and np.all(t[0.5] < t[1.0])
+    # the +x face sees the Earth below edge-on: the edge-on view of a GEO Earth
+    h = 42164.0 / EARTH_RADIUS_KM
+    edge = np.arctan(1 / np.sqrt(h**2 - 1)) - np.sqrt(h**2 - 1) / h**2  # Howell, [sr]
+    j = int(np.flatnonzero(np.all(np.isclose(plan.terms.normal, [1.0, 0.0, 0.0]), axis=1))[0])
+    assert t[0.0][j] == pytest.approx(255.0 * (edge / np.pi) ** 0.25, rel=1e-3)
