@@ -43,6 +43,7 @@ __all__ = [
     "MOON_RADIUS_KM",
     "SUN_V_MAGNITUDE",
     "earth_thermal_irradiance",
+    "earth_view_facets",
     "earthshine_facets",
     "earthshine_finite",
     "earthshine_irradiance_ratio",
@@ -67,7 +68,7 @@ MOON_RADIUS_KM = 1737.4
 SUN_V_MAGNITUDE = -26.74
 
 
-def planck(wavelength_nm: ArrayLike, temperature: float) -> NDArray[np.float64]:
+def planck(wavelength_nm: ArrayLike, temperature: ArrayLike) -> NDArray[np.float64]:
     """Blackbody spectral radiance ``B(lambda, T)`` [W m-2 sr-1 nm-1] (Planck's law).
 
     ``B = 2 h c^2 / lambda^5 / (exp(h c / (lambda k T)) - 1)``, evaluated as
@@ -79,8 +80,9 @@ def planck(wavelength_nm: ArrayLike, temperature: float) -> NDArray[np.float64]:
     ----------
     wavelength_nm : array_like
         Vacuum wavelength [nm], > 0.
-    temperature : float
-        Temperature [K], > 0.
+    temperature : float or array_like
+        Temperature [K], >= 0 (0 K radiates nothing).  An array of temperatures gives
+        one spectrum each: the result has shape ``temperature.shape + wavelength.shape``.
 
     Returns
     -------
@@ -92,12 +94,18 @@ def planck(wavelength_nm: ArrayLike, temperature: float) -> NDArray[np.float64]:
     >>> from sbrdf_xr.sources import planck
     >>> float(planck(10_000.0, 300.0))  # 10 um, 300 K: ~9.9 W m-2 sr-1 um-1
     0.009924...
+    >>> planck([4000.0, 10_000.0], [[0.0], [300.0]]).shape  # (2, 1) temperatures
+    (2, 1, 2)
+    >>> float(planck(10_000.0, [0.0, 300.0])[0, 0])
+    0.0
     """
     h, c, k = constants.h, constants.c, constants.k
     wl = to_unit(wavelength_nm, "nm", "wavelength_nm", spectral=True)
     lam = np.asarray(wl, dtype=np.float64) * 1e-9
-    x = h * c / (lam * k * float(to_unit(temperature, "K", "temperature")))
-    with np.errstate(under="ignore", over="ignore"):
+    t = np.asarray(to_unit(temperature, "K", "temperature"), dtype=np.float64)
+    with np.errstate(divide="ignore"):
+        x = h * c / (lam * k * (t if t.ndim == 0 else t[..., None]))
+    with np.errstate(under="ignore", over="ignore", invalid="ignore"):
         return 2.0 * h * c**2 / lam**5 * np.exp(-x) / -np.expm1(-x) * 1e-9
 
 
@@ -631,3 +639,75 @@ def earthshine_facets(
             j = idx[k : k + 64]
             out[g, j] = np.maximum(nc[g, j] @ d.T, 0.0) @ lw
     return albedo / np.pi * out
+
+
+def earth_view_facets(
+    normals: ArrayLike,
+    to_earth: ArrayLike,
+    range_km: ArrayLike,
+    *,
+    nodes: tuple[int, int] = (64, 128),
+) -> NDArray[np.float64]:
+    """The solid angle of the visible Earth weighted by each plate's cosine (G, T) [sr].
+
+    ``V = int max(n.d, 0) dOmega`` over the directions ``d`` from the plate to the visible
+    Earth: a Lambertian Earth of radiance ``L`` gives the plate the irradiance ``L V`` (so
+    ``V / pi`` is the view factor of the finite sphere, cut by the plate's horizon; the
+    Earth's thermal emission of :func:`earth_thermal_irradiance` for many plates).  A plate
+    that sees the whole cap (normal within ``90 deg - rho`` of the Earth's centre,
+    ``sin(rho) = R / r``) has ``V = pi sin^2(rho) n.e`` exactly; one that sees none of it
+    (beyond ``90 deg + rho``) 0; those whose horizon cuts the Earth are integrated on the
+    Gauss-Legendre nodes of :func:`earthshine_finite`.
+
+    Parameters
+    ----------
+    normals : array_like, shape (T, 3)
+        Unit plate normals [1].
+    to_earth : array_like, shape (G, 3)
+        Unit directions to the Earth's centre [1], in the normals' frame.
+    range_km : array_like, shape (G,) or scalar
+        Distance from the Earth's centre [km], above the Earth's radius.
+    nodes : tuple of int
+        Gauss-Legendre nodes (radial, azimuthal) over the Earth's disc.
+
+    Returns
+    -------
+    ndarray, shape (G, T)
+        ``V`` [sr] of every plate in every geometry.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.sources import earth_view_facets
+    >>> n = [[0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]  # facing, edge-on, away
+    >>> v = earth_view_facets(n, [[0.0, 0.0, -1.0]], 42164.0)
+    >>> round(float(v[0, 0] / (np.pi * (6371 / 42164) ** 2)), 12)  # pi sin^2(rho)
+    1.0
+    >>> float(v[0, 2])  # facing away
+    0.0
+    >>> h = 42164.0 / 6371.0  # edge-on: V = atan(1/sqrt(H^2-1)) - sqrt(H^2-1)/H^2 (Howell)
+    >>> round(float(v[0, 1] / (np.arctan(1 / np.sqrt(h**2 - 1)) - np.sqrt(h**2 - 1) / h**2)), 3)
+    1.0
+    """
+    nrm = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+    e = np.asarray(to_earth, dtype=np.float64).reshape(-1, 3)
+    rng = np.broadcast_to(np.asarray(to_unit(range_km, "km", "range_km"), float), e.shape[:1])
+    e = e / np.linalg.norm(e, axis=1, keepdims=True)
+    nz = e @ nrm.T  # (G, T) the cosine of the Earth's centre from each normal
+    out = np.zeros(nz.shape)
+    for r in np.unique(rng):
+        rows = np.flatnonzero(rng == r)
+        sin_rho = EARTH_RADIUS_KM / float(r)
+        whole = nz[rows] >= sin_rho
+        out[rows] = np.where(whole, np.pi * sin_rho**2 * nz[rows], 0.0)
+        g_cut, t_cut = np.nonzero(np.abs(nz[rows]) < sin_rho)
+        if g_cut.size == 0:
+            continue
+        d, _, _, w = _earth_cap([0.0, 0.0, 1.0], [0.0, 0.0, 1.0], float(r), nodes)
+        d, w = d.reshape(-1, 3), w.ravel()
+        for k in range(0, g_cut.size, 64):  # (64, K) at a time
+            g, t = rows[g_cut[k : k + 64]], t_cut[k : k + 64]
+            # each normal in the cap's frame: only its angle from the centre matters
+            c = nz[g, t]
+            local = np.stack([np.sqrt(np.clip(1.0 - c**2, 0.0, None)), 0 * c, c], axis=1)
+            out[g, t] = np.maximum(local @ d.T, 0.0) @ w
+    return out

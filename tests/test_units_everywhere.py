@@ -465,6 +465,9 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         temperature=255.0,
         nodes=(16, 32),
     ),
+    "sbrdf_xr.sources.earth_view_facets": lambda: dict(
+        normals=[[0, 0, -1], [1, 0, 0]], to_earth=[[0, 0, -1]], range_km=[7000.0], nodes=(16, 32)
+    ),
     "sbrdf_xr.sources.equilibrium_temperature": lambda: dict(
         absorbed=[100.0, 1361.0], emissivity=0.8
     ),
@@ -584,6 +587,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         earth_range_km=42164.0,
         earth_phase_angle=60.0,
         temperature=300.0,
+        earth_temperature=255.0,
         table_theta_step=5.0,
         block_bytes=2**20,
     ),

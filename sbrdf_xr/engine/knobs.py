@@ -238,6 +238,14 @@ KNOBS: dict[str, Knob] = {
             allowed=("finite", "point"),
         ),
         Knob(
+            "conductance",
+            "none",
+            str,
+            "conductance model of temperature='equilibrium': none: each facet an insulated "
+            "panel radiating from its front; two_sided: a thin plate radiating from both faces",
+            allowed=("none", "two_sided"),
+        ),
+        Knob(
             "chunk",
             None,
             int,

@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import xarray as xr
 
-from .._names import BAND, MATERIAL, PSI, WAVELENGTH, __version__
+from .._names import BAND, FACET, MATERIAL, PSI, WAVELENGTH, __version__
 from ..errors import SceneError
 from ..kernels import PackedTables
 from ..kernels.anisotropic import AnisotropicTable
@@ -419,13 +419,15 @@ def compile_plan(scene: SceneView) -> Plan:
     # ---- outputs: the scene's, then those of the effects that run
     names = []
     wanted = [SCENE_OUTPUTS[o] for o in scene.outputs]
-    wanted += [o.name for e in active for o in EFFECTS[e].declares]
+    for e in active:  # an effect's own, or those its planner names in params["outputs"]
+        filled = params.get(e, {}).get("outputs")
+        wanted += [o.name for o in EFFECTS[e].declares if filled is None or o.name in filled]
     for v in wanted:
         if pre and OUTPUTS[v].tail and OUTPUTS[v].tail[-1] == WAVELENGTH:
             continue
         if v not in names:
             names.append(v)
-    sizes = {WAVELENGTH: wl.size, BAND: len(scene.bands), MATERIAL: len(used)}
+    sizes = {WAVELENGTH: wl.size, BAND: len(scene.bands), MATERIAL: len(used), FACET: terms.size}
     lead_dims, lead_shape = geo.dims, geo.shape
     outputs = []
     for v in names:

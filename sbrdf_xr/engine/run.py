@@ -53,7 +53,7 @@ from dask.highlevelgraph import HighLevelGraph
 from dask.typing import Key
 from xarray.indexes import PandasIndex
 
-from .._names import WAVELENGTH, attrs
+from .._names import FACET, WAVELENGTH, attrs
 from ..errors import SceneError
 from .articulation import articulated_sums
 from .builtin import resolve_scene
@@ -215,6 +215,9 @@ def _template(plan: Plan) -> xr.Dataset:
         coords.update(plan.band_coords)
     if "material" in dims:
         coords["material"] = ("material", list(plan.materials), attrs("material"))
+    if FACET in dims:  # the plan's terms: a facet, or the first of those merged into it
+        coords[FACET] = (FACET, np.asarray(plan.terms.facet), attrs(FACET))
+        coords["facet_normal"] = ((FACET, "xyz"), np.asarray(plan.terms.normal), attrs("normal"))
     plan.cache["template"] = _coordinates_only(coords, dict(plan.attrs))
     return plan.cache["template"]
 

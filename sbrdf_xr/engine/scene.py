@@ -94,6 +94,7 @@ _UNITS = {
     "earth_range_km": "km",
     "earth_phase_angle": "deg",
     "temperature": "K",
+    "earth_temperature": "K",
     "materials": "sr-1",  # a table holding a Quantity; a model (Dataset) is kept
 }
 
@@ -188,8 +189,13 @@ class Scene:
     earth_phase_angle : float
         Sun-Earth-spacecraft angle seen from the Earth's centre [degree] (0: the
         spacecraft sees a full Earth).
-    temperature : float or mapping of str to float
-        Facet temperature [K] of the ``thermal`` effect, one for all or per material.
+    temperature : float or mapping of str to float or "equilibrium"
+        Facet temperature [K] of the ``thermal`` effect, one for all or per material, or
+        ``"equilibrium"``: each facet's from radiative equilibrium at every geometry (the
+        knob ``conductance``; :mod:`sbrdf_xr.engine.effects.thermal`).
+    earth_temperature : float
+        The Earth's brightness temperature [K] of the ``earth_thermal`` effect, 0-400
+        (default 255 K, its effective temperature).
     models : mapping of str to Dataset, optional
         BRDF model parameters per material for ``evaluation="analytic"`` (default:
         the catalog entry ``<material>-model``); a material with a model needs no table
@@ -273,7 +279,9 @@ class Scene:
     earth_range_km: float = 42164.0
     earth_phase_angle: float = 90.0
     earth_model: str = KNOBS["earth_model"].default
-    temperature: float | Mapping[str, float] = 300.0
+    conductance: str = KNOBS["conductance"].default
+    temperature: float | Mapping[str, float] | str = 300.0
+    earth_temperature: float = 255.0
     models: Mapping[str, xr.Dataset] | None = None
     size_limit: float = 1.0
     name: str = "scene"
@@ -330,15 +338,19 @@ class Scene:
             raise SceneError(
                 f"earth_phase_angle: must lie in [0, 180] degree, got {self.earth_phase_angle}"
             )
-        temps = (
-            self.temperature.values()
-            if isinstance(self.temperature, Mapping)
-            else [self.temperature]
-        )
-        if any(not (np.isfinite(x) and 0 < x <= MAX_TEMPERATURE_K) for x in temps):
+        t = self.temperature
+        temps = t.values() if isinstance(t, Mapping) else [] if t == "equilibrium" else [t]
+        if any(
+            not (isinstance(x, int | float | np.number) and 0 < x <= MAX_TEMPERATURE_K)
+            for x in temps
+        ):
             raise SceneError(
                 f"temperature: must be positive kelvin, at most {MAX_TEMPERATURE_K:g} K (every "
-                f"material has melted long before), got {self.temperature}"
+                f"material has melted long before), or 'equilibrium'; got {t!r}"
+            )
+        if not 0.0 < self.earth_temperature <= 400.0:  # sources.EARTH_TEMPERATURE_MAX
+            raise SceneError(
+                f"earth_temperature: must lie in (0, 400] K, got {self.earth_temperature}"
             )
         if self.band_extrapolate not in (None, "zero", "constant"):
             raise SceneError(

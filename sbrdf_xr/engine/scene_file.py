@@ -378,7 +378,7 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
             if isinstance(st, Mapping)
             else _number(st, "surface_tilt")
         )
-    for k in ("earth_albedo", "earth_range_km", "earth_phase_angle"):
+    for k in ("earth_albedo", "earth_range_km", "earth_phase_angle", "earth_temperature"):
         if k in d:
             kw[k] = _number(d[k], k)
     if "temperature" in d:
@@ -386,7 +386,7 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
         if isinstance(t, Mapping):
             kw["temperature"] = {str(m): _number(x, f"temperature.{m}") for m, x in t.items()}
         else:
-            kw["temperature"] = _number(t, "temperature")
+            kw["temperature"] = t if t == "equilibrium" else _number(t, "temperature")
     if "outputs" in d:
         kw["outputs"] = _strings(d["outputs"], "outputs", allow_empty=False)
     for k in ("effects", "bands"):

@@ -205,8 +205,14 @@ SCENE_KEYS: dict[str, Key] = _table(
         ),
         Key(
             "temperature",
-            (int, float, dict),
-            "facet temperature [K], one value or a table by material",
+            (int, float, dict, str),
+            'facet temperature [K], one value or a table by material, or "equilibrium" (each '
+            "facet's from radiative equilibrium, the knob conductance)",
+        ),
+        Key(
+            "earth_temperature",
+            _NUMBER,
+            "the Earth's brightness temperature [K] (its infrared emission), 0-400",
         ),
     ]
 )

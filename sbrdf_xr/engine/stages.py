@@ -301,7 +301,10 @@ def contributing_terms(scene: SceneView, normals: np.ndarray) -> np.ndarray:
                 d = b.direction(source)
                 if d is None:
                     continue
-                on = d @ normals.T > 0
+                # a source of angular radius rho lights facets up to 90 deg + rho from its
+                # centre: its geometry may give sin(rho) per geometry as <source>_reach
+                reach = b.sources.get(f"{source}_reach")
+                on = d @ normals.T > (0.0 if reach is None else -reach[:, None])
                 scale = b.scale(source)
                 if scale is not None:
                     on = on & (scale > 0)[:, None]

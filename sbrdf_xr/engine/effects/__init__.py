@@ -12,6 +12,9 @@ Every effect is one :class:`Effect` entry of :data:`EFFECTS`, written in its own
     Sunlight reflected by a Lambertian Earth, a second distant source.
 ``thermal``
     Thermal emission of the facets, Kirchhoff emissivity times Planck.
+``earth_thermal``
+    The Earth's thermal emission (a disc at one brightness temperature) reflected by
+    the facets.
 ``moonlight``
     Sunlight reflected by the Moon during an observation, a second distant source.
 
@@ -31,16 +34,16 @@ Examples
 --------
 >>> from sbrdf_xr.engine.effects import EFFECTS, SCENE_EFFECTS, scene_effects
 >>> list(EFFECTS)
-['sunlight', 'shadowing', 'eclipse', 'earthshine', 'thermal', 'moonlight']
+['sunlight', 'shadowing', 'eclipse', 'earthshine', 'thermal', 'earth_thermal', 'moonlight']
 >>> SCENE_EFFECTS  # what Scene(effects=...) accepts
-('sunlight', 'shadowing', 'earthshine', 'thermal', 'moonlight')
+('sunlight', 'shadowing', 'earthshine', 'thermal', 'earth_thermal', 'moonlight')
 >>> [e.name for e in scene_effects(["thermal"])]  # planned for a scene asking for thermal
 ['sunlight', 'eclipse', 'thermal']
 """
 
 from collections.abc import Iterable
 
-from . import base, earthshine, eclipse, moonlight, shadowing, sunlight, thermal
+from . import base, earth_thermal, earthshine, eclipse, moonlight, shadowing, sunlight, thermal
 from .base import (
     SCENE_OUTPUTS,
     SPECTRAL_OUTPUTS,
@@ -68,6 +71,7 @@ __all__ = [
     "Output",
     "PlanInputs",
     "base",
+    "earth_thermal",
     "earthshine",
     "eclipse",
     "facet_fraction",
@@ -90,6 +94,7 @@ EFFECTS: dict[str, Effect] = {
         eclipse.EFFECT,
         earthshine.EFFECT,
         thermal.EFFECT,
+        earth_thermal.EFFECT,
         moonlight.EFFECT,
     )
 }
