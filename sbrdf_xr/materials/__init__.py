@@ -27,9 +27,9 @@ Modules
     Analytic materials as labelled parameter sets: evaluate, render to a table, measure.
 ``goniometer``
     A virtual goniospectrometer sampling any material with the scheme of paper 000.
-``readers`` and ``merl``
+``readers``, ``merl`` and ``rgl``
     Measurement files as laboratories deliver them (:func:`read_measurements`): long
-    tables, in-plane scans, MERL ``.binary``.
+    tables, in-plane scans, MERL ``.binary``, RGL ``.bsdf`` spectral tensor files.
 ``coverage`` and ``selfcheck``
     Angles grouped with a tolerance, scan layouts and model fills; every build checked
     against its own samples.
@@ -48,6 +48,7 @@ from . import (
     model_schema,
     models,
     readers,
+    rgl,
     schema,
     selfcheck,
     tables,
@@ -134,6 +135,7 @@ __all__ = [
     "readers",
     "reference_mask",
     "register_reader",
+    "rgl",
     "render",
     "render_anisotropic",
     "render_values",
