@@ -77,7 +77,7 @@ def build_lut(
     material: str | None = None,
     dtype: type | np.dtype = np.float64,
     blend: float = 10.0,
-    model: xr.Dataset | None = None,
+    model: xr.Dataset | str | None = None,
     normal_incidence: str = "symmetric",
     blend_normal: float = 5.0,
     below_noise: str = "auto",
@@ -188,10 +188,13 @@ def build_lut(
         the spline says.
     blend : float, default 10
         Width of the blend zone of ``extrapolation="model"`` [degree].
-    model : xarray.Dataset, optional
+    model : xarray.Dataset or str, optional
         The model material of ``extrapolation="model"`` and ``below_noise="model"``
-        (:mod:`sbrdf_xr.materials.models`); default: a Robertson-Sandford fit to the
-        measurements (:func:`sbrdf_xr.materials.models.fit_robertson_sandford`, a few seconds).
+        (:mod:`sbrdf_xr.materials.models`), or the name of the fit that makes it from
+        the measurements (:data:`sbrdf_xr.materials.models.FITS`: ``"microfacet"``,
+        ``"robertson-sandford"``; the leave-out check refits it to the held-in
+        samples); default: a Robertson-Sandford fit
+        (:func:`sbrdf_xr.materials.models.fit_robertson_sandford`, a few seconds).
     normal_incidence : {"symmetric", "paper"}, default "symmetric"
         ``symmetric`` enforces what physics requires at ``theta_i = 0``: no
         dependence on the undefined illumination plane.  The ``theta_i = 0`` row
@@ -366,9 +369,9 @@ def build_lut(
     check_coord("theta_i", ti_out)
     lam = _lut.csaps_default_lambda(measured_ti) if smoothing == "csaps" else float(smoothing)
     extra: dict[str, Any] = {}
-    fit_model = model
-    if (extrapolation == "model" or below_noise == "model") and fit_model is None:
-        fit_model = models.fit_robertson_sandford(ds)
+    fit_model = model if isinstance(model, xr.Dataset) else None
+    if (extrapolation == "model" or below_noise == "model") and not isinstance(model, xr.Dataset):
+        fit_model = models.fit_model(ds, model or "robertson-sandford")
 
     rho_given = (
         None if model_reflectance is None else _given_reflectance(model_reflectance, ti_out, wl)
@@ -508,7 +511,7 @@ def build_lut(
     if holdout and not rows_only:  # a fitted fill: predict samples it has not seen
         report(0.97, "leave-out check")
         opts = {**call, "holdout": 0, "check_energy": False, "progress": None}
-        rebuild = functools.partial(build_lut, **opts)  # model None: the held-in's own fit
+        rebuild = functools.partial(build_lut, **opts)  # a fit's name: the held-in's own fit
         out.attrs.update(_holdout_check(rebuild, *samples, every=int(holdout), floor=check_floor))
     # last: shown by print(table) beside the checks
     out.attrs.update({k: out.attrs.pop(k) for k in ("layout", "modelled") if k in out.attrs})
