@@ -46,16 +46,16 @@ def test_a_table_within_the_bound_is_not_touched():
 
 
 def _bright_scan():
-    """An in-plane scan of a lobe that reflects more than it receives (its specular
-    amplitude epsilon far above G(b), paper 001 Eq. 17's bound)."""
+    """An in-plane scan that reflects more than it receives: a lobe reflecting about
+    0.7, its values three times too large (a calibration error of the scan)."""
     spec = models.model_material(
         "robertson_sandford", [550.0], material="bright", provenance="test",
-        rho_D=0.5, epsilon=2.0, b=0.1, e=0.3,
+        rho_D=0.4, epsilon=0.4, b=0.1, e=0.3,
     )  # fmt: skip
     t, s = (a.ravel() for a in np.meshgrid([10.0, 35.0, 60.0], np.arange(-85.0, 86.0, 1.0),
                                             indexing="ij"))  # fmt: skip
     d = s - t
-    vals = models.spectra(spec, t, d, 0.0)
+    vals = 3.0 * models.spectra(spec, t, d, 0.0)
     return measurement_set(t, d, np.zeros_like(t), [550.0], vals, material="bright",
                            provenance="test")  # fmt: skip
 
