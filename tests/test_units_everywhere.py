@@ -642,6 +642,17 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.materials.merl.read_merl": lambda: dict(
         path=_merl_file(), theta_i=[20.0, 50.0], step=10.0
     ),
+    "sbrdf_xr.materials.rgl.read_rgl": lambda: dict(
+        path=_rgl_file(), theta_i=[20.0, 50.0], step=10.0, max_zenith=70.0
+    ),
+    "sbrdf_xr.materials.rgl.write_rgl": lambda: dict(
+        path=_rgl_file().with_name("again.bsdf"),
+        brdf=_grey_rgl,
+        wavelengths=[500.0],
+        theta_i=[0.0, 40.0, 80.0],
+        resolution=8,
+        ndf_resolution=8,
+    ),
     "sbrdf_xr.materials.coverage.snap_angles": lambda: dict(
         values=[10.0, 10.0 + 1e-12, 20.0], tol=1e-6
     ),
@@ -951,6 +962,10 @@ EXEMPT[("sbrdf_xr.materials.merl.write_merl", "brdf")] = (
     "a function (a BRDF of directions), not a value: its results are in sr-1 by contract"
 )
 
+EXEMPT[("sbrdf_xr.materials.rgl.write_rgl", "brdf")] = EXEMPT[
+    ("sbrdf_xr.materials.merl.write_merl", "brdf")
+]
+
 EXEMPT[("sbrdf_xr.brdf._model.Model", "brdf")] = (
     "a function (the model's sBRDF), not a value: its results are in sr-1 by contract"
 )
@@ -992,6 +1007,23 @@ def _merl_file() -> Any:
 
     path = Path(tempfile.mkdtemp(prefix="sbrdf-merl-")) / "grey.binary"
     return write_merl(path, lambda s, o: np.tile([0.3, 0.2, 0.1], (len(s), 1)))
+
+
+def _grey_rgl(s: np.ndarray, o: np.ndarray) -> np.ndarray:
+    return np.full((len(s), 1), 0.1)
+
+
+@functools.cache
+def _rgl_file() -> Any:
+    """An RGL file of a constant BRDF (0.1 sr-1 at 500 nm), written once per session."""
+    import tempfile
+    from pathlib import Path
+
+    from sbrdf_xr.materials.rgl import write_rgl
+
+    path = Path(tempfile.mkdtemp(prefix="sbrdf-rgl-")) / "grey.bsdf"
+    return write_rgl(path, _grey_rgl, wavelengths=[500.0], theta_i=[0.0, 40.0, 80.0],
+                     resolution=8, ndf_resolution=8)  # fmt: skip
 
 
 def _measurements(theta_i: tuple[float, ...] = (20.0, 50.0)) -> xr.Dataset:

@@ -16,7 +16,7 @@ from typing import Any
 __all__ = ["MODELS", "add_material_parser", "cmd_material_build"]
 
 #: The fitted models ``--model`` names (or a model netCDF file).
-MODELS = ("robertson-sandford",)
+MODELS = ("robertson-sandford", "microfacet")
 
 
 def add_material_parser(sub: Any) -> argparse.ArgumentParser:
@@ -93,7 +93,7 @@ def cmd_material_build(args: argparse.Namespace) -> int:
     if args.format == "scan":
         options.pop("zenith", None)
     ds = read_measurements(args.measurements, format=args.format, **options)
-    model = None
+    model: Any = args.model  # a fit's name (refitted by the leave-out check) or a model file
     if args.model not in MODELS:
         if not Path(args.model).is_file():
             raise ValidationError(

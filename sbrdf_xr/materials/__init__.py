@@ -30,9 +30,9 @@ Modules
     Kapton MLI, optical solar reflectors, a covered GaAs cell (:func:`optical_material`).
 ``goniometer``
     A virtual goniospectrometer sampling any material with the scheme of paper 000.
-``readers`` and ``merl``
+``readers``, ``merl`` and ``rgl``
     Measurement files as laboratories deliver them (:func:`read_measurements`): long
-    tables, in-plane scans, MERL ``.binary``.
+    tables, in-plane scans, MERL ``.binary``, RGL ``.bsdf`` spectral tensor files.
 ``coverage`` and ``selfcheck``
     Angles grouped with a tolerance, scan layouts and model fills; every build checked
     against its own samples.
@@ -52,6 +52,7 @@ from . import (
     models,
     optical,
     readers,
+    rgl,
     schema,
     selfcheck,
     tables,
@@ -145,6 +146,7 @@ __all__ = [
     "render",
     "render_anisotropic",
     "render_values",
+    "rgl",
     "sample_rotation",
     "schema",
     "scheme_extents",

@@ -46,7 +46,7 @@ from .coverage import (
     scan_layout,
     snap_angles,
 )
-from .energy import _check_energy_conservation
+from .energy import _check_energy_conservation, _clamp_energy, _given_reflectance
 from .schema import (
     average_duplicates,
     check_coord,
@@ -77,12 +77,12 @@ def build_lut(
     material: str | None = None,
     dtype: type | np.dtype = np.float64,
     blend: float = 10.0,
-    model: xr.Dataset | None = None,
+    model: xr.Dataset | str | None = None,
     normal_incidence: str = "symmetric",
     blend_normal: float = 5.0,
     below_noise: str = "auto",
     duplicates: str = "error",
-    check_energy: bool = True,
+    check_energy: bool | str = True,
     renormalise: str = "auto",
     progress: Callable[[float, str], None] | None = None,
     model_reflectance: xr.DataArray | None = None,
@@ -188,10 +188,13 @@ def build_lut(
         the spline says.
     blend : float, default 10
         Width of the blend zone of ``extrapolation="model"`` [degree].
-    model : xarray.Dataset, optional
+    model : xarray.Dataset or str, optional
         The model material of ``extrapolation="model"`` and ``below_noise="model"``
-        (:mod:`sbrdf_xr.materials.models`); default: a Robertson-Sandford fit to the
-        measurements (:func:`sbrdf_xr.materials.models.fit_robertson_sandford`, a few seconds).
+        (:mod:`sbrdf_xr.materials.models`), or the name of the fit that makes it from
+        the measurements (:data:`sbrdf_xr.materials.models.FITS`: ``"microfacet"``,
+        ``"robertson-sandford"``; the leave-out check refits it to the held-in
+        samples); default: a Robertson-Sandford fit
+        (:func:`sbrdf_xr.materials.models.fit_robertson_sandford`, a few seconds).
     normal_incidence : {"symmetric", "paper"}, default "symmetric"
         ``symmetric`` enforces what physics requires at ``theta_i = 0``: no
         dependence on the undefined illumination plane.  The ``theta_i = 0`` row
@@ -234,11 +237,15 @@ def build_lut(
         with ``extrapolation="model"``, only scales rows above the measured angles
         down to the model's reflectance); ``auto`` is ``none`` with
         ``below_noise="zero"`` (the paper's construction).
-    check_energy : bool, default True
+    check_energy : bool or "clamp", default True
         Compute the table's directional-hemispherical reflectance every 5 deg of
         ``theta_i`` (and at the last row) and issue a
         :class:`~sbrdf_xr.errors.NonPhysicalWarning` naming the incidence angle and
-        wavelength where it exceeds 1.
+        wavelength where it exceeds 1.  ``"clamp"`` first bounds it by 1 at every row
+        (:func:`~sbrdf_xr.materials.energy._clamp_energy`): where a row reflects more
+        than it receives, its values out of the plane of incidence (``phi > 0``; for
+        in-plane scans the modelled extension) are scaled down until it reflects 1,
+        and the plane keeps its samples (attributes ``energy_clamp_*``).
     material : str, optional
         Name; default the ``material`` attribute of ``measurements``.
     dtype : numpy dtype, default float64
@@ -366,9 +373,9 @@ def build_lut(
     check_coord("theta_i", ti_out)
     lam = _lut.csaps_default_lambda(measured_ti) if smoothing == "csaps" else float(smoothing)
     extra: dict[str, Any] = {}
-    fit_model = model
-    if (extrapolation == "model" or below_noise == "model") and fit_model is None:
-        fit_model = models.fit_robertson_sandford(ds)
+    fit_model = model if isinstance(model, xr.Dataset) else None
+    if (extrapolation == "model" or below_noise == "model") and not isinstance(model, xr.Dataset):
+        fit_model = models.fit_model(ds, model or "robertson-sandford")
 
     rho_given = (
         None if model_reflectance is None else _given_reflectance(model_reflectance, ti_out, wl)
@@ -470,6 +477,9 @@ def build_lut(
         )
         extra["renormalise"] = "model"
 
+    if check_energy == "clamp":  # the checks see the table as shipped
+        extra.update(_clamp_energy(lut, (ti_out, dt_grid, phi_grid), lut_edges(edges),
+                                   extra.get("normal_incidence_blend", 0.0)))  # fmt: skip
     name = material or ds.attrs.get("material", "unnamed")
     prov = ds.attrs.get("provenance", "")
     out = new_material(
@@ -507,8 +517,9 @@ def build_lut(
         _check_energy_conservation(out, np.unique(np.concatenate([ti_out[::5], ti_out[-1:]])))
     if holdout and not rows_only:  # a fitted fill: predict samples it has not seen
         report(0.97, "leave-out check")
-        opts = {**call, "holdout": 0, "check_energy": False, "progress": None}
-        rebuild = functools.partial(build_lut, **opts)  # model None: the held-in's own fit
+        opts = {**call, "holdout": 0, "check_energy": check_energy == "clamp" and "clamp"}
+        opts["progress"] = None
+        rebuild = functools.partial(build_lut, **opts)  # a fit's name: the held-in's own fit
         out.attrs.update(_holdout_check(rebuild, *samples, every=int(holdout), floor=check_floor))
     # last: shown by print(table) beside the checks
     out.attrs.update({k: out.attrs.pop(k) for k in ("layout", "modelled") if k in out.attrs})
@@ -529,25 +540,6 @@ _MODEL_STEPS = {
     "table reflectance": 0.2,
     "energy check": 0.05,
 }
-
-
-def _given_reflectance(rho: xr.DataArray, ti: np.ndarray, wl: np.ndarray) -> np.ndarray:
-    """``model_reflectance`` of :func:`build_lut` as an array, checked against the table's
-    rows ``ti`` and wavelengths ``wl``."""
-    if not isinstance(rho, xr.DataArray) or set(rho.dims) != {THETA_I, WAVELENGTH}:
-        raise ValidationError(
-            "model_reflectance: expected an xarray.DataArray with dims (theta_i, wavelength), "
-            f"got {type(rho).__name__} with dims {getattr(rho, 'dims', None)}"
-        )
-    rho = rho.transpose(THETA_I, WAVELENGTH)
-    for dim, want in ((THETA_I, ti), (WAVELENGTH, wl)):
-        got = np.asarray(rho[dim].values, dtype=np.float64)
-        if not np.array_equal(got, want):
-            raise ValidationError(
-                f"model_reflectance: its {dim} ({got.size} values, {got[:1]}..{got[-1:]}) "
-                f"is not the table's ({want.size} values, {want[:1]}..{want[-1:]})"
-            )
-    return np.array(rho.values, dtype=np.float64)
 
 
 def _model_reflectance(

@@ -32,7 +32,10 @@ from .model_schema import ModelParameters, model_material, model_parameters, ope
 from .schema import new_material
 
 __all__ = [
+    "FITS",
     "ModelParameters",
+    "fit_microfacet",
+    "fit_model",
     "fit_robertson_sandford",
     "measure",
     "model_material",
@@ -470,3 +473,85 @@ def fit_robertson_sandford(measurements: xr.Dataset, **kwargs: Any) -> xr.Datase
     out.attrs["chi2_reduced"] = float(fit["chi2_reduced"])
     out.attrs["source"] = "model:robertson_sandford"
     return out
+
+
+def fit_microfacet(measurements: xr.Dataset) -> xr.Dataset:
+    """Fit the microfacet model (Walter et al. 2007, GGX plus Lambert) to a measurement set.
+
+    Wraps :func:`sbrdf_xr.brdf.microfacet_fit.fit_microfacet` (log-residual least
+    squares: ``roughness`` shared, ``n`` and ``rho_d`` per wavelength, ``k = 0``).
+
+    Parameters
+    ----------
+    measurements : xarray.Dataset
+        A measurement set (:func:`sbrdf_xr.materials.tables.validate_measurements`).
+
+    Returns
+    -------
+    xarray.Dataset
+        The fitted model material (attribute ``rms_log``, the fit's root-mean-square
+        log residual [1]).
+
+    Examples
+    --------
+    >>> spec = model_material("microfacet", [550.0], material="paint", provenance="doc",
+    ...                       roughness=0.05, n=3.0, k=0.0, rho_d=0.1)
+    >>> fit = fit_microfacet(measure(spec, [20.0, 40.0, 60.0]))
+    >>> round(float(fit.roughness[0]), 6), round(float(fit.n[0]), 6), round(float(fit.rho_d[0]), 6)
+    (0.05, 3.0, 0.1)
+    """
+    from .._names import MEASURED, SAMPLE
+    from ..brdf import microfacet_fit
+    from .schema import reference_mask, validate_measurements
+
+    ds = validate_measurements(measurements, duplicates="mean")
+    wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
+    spectra = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64)
+    angles = (ds[THETA_I].values, ds[DELTA_THETA].values, ds[PHI].values)
+    fit = microfacet_fit.fit_microfacet(*angles, wl, spectra, reference=reference_mask(ds))
+    name = ds.attrs.get("material", "unnamed")
+    out = model_material(
+        "microfacet", wl, material=name,
+        provenance=f"microfacet (GGX) fit to the measurements of {name} (rms log residual "
+        f"{fit['rms_log']:.3g}, {fit['n_used']} residuals)",
+        roughness=fit["roughness"], n=fit["n"], k=fit["k"], rho_d=fit["rho_d"],
+    )  # fmt: skip
+    out.attrs["rms_log"] = fit["rms_log"]
+    out.attrs["source"] = "model:microfacet"
+    return out
+
+
+#: The model fits :func:`~sbrdf_xr.materials.build.build_lut` can fill a table with, by name.
+FITS = {"robertson-sandford": fit_robertson_sandford, "microfacet": fit_microfacet}
+
+
+def fit_model(measurements: xr.Dataset, name: str = "robertson-sandford") -> xr.Dataset:
+    """The fit :data:`FITS` names, of a measurement set.
+
+    Parameters
+    ----------
+    measurements : xarray.Dataset
+        A measurement set.
+    name : {"robertson-sandford", "microfacet"}
+        The fit.
+
+    Returns
+    -------
+    xarray.Dataset
+        The fitted model material.
+
+    Raises
+    ------
+    ValidationError
+        An unknown name.
+
+    Examples
+    --------
+    >>> spec = model_material("microfacet", [550.0], material="paint", provenance="doc",
+    ...                       roughness=0.05, n=3.0, k=0.0, rho_d=0.1)
+    >>> fit_model(measure(spec, [20.0, 40.0]), "microfacet").attrs["source"]
+    'model:microfacet'
+    """
+    if name not in FITS:
+        raise ValidationError(f"model: got {name!r}; allowed: {', '.join(FITS)} or a model")
+    return FITS[name](measurements)
