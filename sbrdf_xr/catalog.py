@@ -34,7 +34,7 @@ from numpy.typing import DTypeLike
 
 from ._catalog_index import (
     CATALOG_PATH_ENV,
-    KINDS,
+    ENTRY_KINDS,
     SOURCES,
     CatalogEntry,
     catalog_dir,
@@ -46,7 +46,14 @@ from ._catalog_index import (
 )
 from ._names import SBRDF, WAVELENGTH
 from .body import spacecraft
-from .errors import CatalogError, ValidationError, did_you_mean, input_file, reading
+from .errors import (
+    CatalogError,
+    ValidationError,
+    did_you_mean,
+    input_file,
+    reading,
+    renamed_attributes,
+)
 from .materials import models
 from .materials import tables as material
 from .materials.cache import cache_file, cached_table
@@ -56,7 +63,7 @@ from .observing import observe
 
 __all__ = [
     "CATALOG_PATH_ENV",
-    "KINDS",
+    "ENTRY_KINDS",
     "LOADERS",
     "MATERIAL_SUFFIXES",
     "MESH_SUFFIXES",
@@ -344,7 +351,7 @@ LOADERS: dict[str, Callable[[CatalogEntry], Any]] = {
     "orbit": observe.load_orbit_entry,
     "site": observe.load_site_entry,
 }
-assert set(LOADERS) == set(KINDS)
+assert set(LOADERS) == set(ENTRY_KINDS)
 
 
 def load(name: str, dtype: DTypeLike | None = None) -> Any:
@@ -685,3 +692,7 @@ def material_tables(
                 ) from None
             tables[mat] = obj
     return tables, given
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"KINDS": "ENTRY_KINDS"})

@@ -32,12 +32,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import constants
 
-from .errors import ValidationError
+from .errors import ValidationError, renamed_attributes
 from .units import check_plausible, to_unit
 
 __all__ = [
+    "EARTH_MEAN_RADIUS_KM",
     "EARTH_NODES",
-    "EARTH_RADIUS_KM",
     "EARTH_TEMPERATURE_MAX",
     "MOON_MEAN_DISTANCE_KM",
     "MOON_RADIUS_KM",
@@ -56,7 +56,7 @@ __all__ = [
 ]
 
 #: Earth's mean radius [km].
-EARTH_RADIUS_KM = 6371.0
+EARTH_MEAN_RADIUS_KM = 6371.0
 #: The Moon's mean distance from the Earth's centre [km], the distance its magnitude law
 #: refers to (Allen 1973; Krisciunas & Schaefer 1991).
 MOON_MEAN_DISTANCE_KM = 384400.0
@@ -138,7 +138,7 @@ def earthshine_irradiance_ratio(albedo: float, range_km: float, phase_angle_deg:
         2.0
         / 3.0
         * albedo
-        * (EARTH_RADIUS_KM / range_km) ** 2
+        * (EARTH_MEAN_RADIUS_KM / range_km) ** 2
         * ((np.pi - a) * np.cos(a) + np.sin(a))
         / np.pi
     )
@@ -306,10 +306,10 @@ def _earth_cap(
     """Directions ``d`` toward the visible Earth, the surface normals ``u`` they hit, the
     plate's ``max(n.d, 0)`` and the solid-angle weights [sr] (``sum w f = int f dOmega``)."""
     r = float(to_unit(range_km, "km", "range_km"))
-    if not np.isfinite(r) or r <= EARTH_RADIUS_KM:
+    if not np.isfinite(r) or r <= EARTH_MEAN_RADIUS_KM:
         raise ValidationError(
             f"range_km: got {r:g}; allowed: a distance from the Earth's centre above its "
-            f"radius, {EARTH_RADIUS_KM:g} km"
+            f"radius, {EARTH_MEAN_RADIUS_KM:g} km"
         )
     n = np.asarray(plate_normal, dtype=np.float64)
     z = np.asarray(to_earth, dtype=np.float64)
@@ -317,7 +317,7 @@ def _earth_cap(
     x = np.cross(z, [1.0, 0.0, 0.0] if abs(z[0]) < 0.9 else [0.0, 1.0, 0.0])
     x /= np.linalg.norm(x)
     y = np.cross(z, x)
-    sin_rho = EARTH_RADIUS_KM / r
+    sin_rho = EARTH_MEAN_RADIUS_KM / r
     # sin(psi) = sin(rho) sin(chi): smooth up to the limb (chi = pi/2)
     tc, wc = _leggauss(nodes[0])
     chi, w_chi = 0.25 * np.pi * (tc + 1.0), 0.25 * np.pi * wc
@@ -331,7 +331,7 @@ def _earth_cap(
     )
     # the nearer intersection with the sphere, t = r cos(psi) - sqrt(R^2 - r^2 sin^2 psi)
     t = r * cos_psi - r * sin_rho * np.cos(chi)
-    u = (-r * z + t[:, None, None] * d) / EARTH_RADIUS_KM
+    u = (-r * z + t[:, None, None] * d) / EARTH_MEAN_RADIUS_KM
     w = (w_chi * sin_psi * dpsi)[:, None] * w_om[None, :]
     return d, u, np.maximum(d @ n, 0.0), w
 
@@ -622,7 +622,7 @@ def earthshine_facets(
         d, lw = cache[key]
         if lw.size == 0:
             continue
-        sin_rho = EARTH_RADIUS_KM / key[0]
+        sin_rho = EARTH_MEAN_RADIUS_KM / key[0]
         nz = nc[g, :, 2]
         whole, cut = nz >= sin_rho, np.abs(nz) < sin_rho
         out[g, whole] = nc[g, whole] @ (lw @ d)
@@ -631,3 +631,7 @@ def earthshine_facets(
             j = idx[k : k + 64]
             out[g, j] = np.maximum(nc[g, j] @ d.T, 0.0) @ lw
     return albedo / np.pi * out
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"EARTH_RADIUS_KM": "EARTH_MEAN_RADIUS_KM"})

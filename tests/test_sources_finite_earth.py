@@ -9,7 +9,7 @@ from scipy import integrate
 
 from sbrdf_xr.errors import ValidationError
 from sbrdf_xr.sources import (
-    EARTH_RADIUS_KM,
+    EARTH_MEAN_RADIUS_KM,
     earth_thermal_irradiance,
     earthshine_finite,
     earthshine_irradiance_ratio,
@@ -19,7 +19,7 @@ from sbrdf_xr.sources import (
 #: The issue's requirement; the Gauss-Legendre rule of EARTH_NODES converges as N^-2
 #: across the terminator and horizon kinks and is measured at ~1e-5 relative here.
 TOL = 1e-3
-R = EARTH_RADIUS_KM
+R = EARTH_MEAN_RADIUS_KM
 
 
 def _reference(normal, to_earth, to_sun, r, albedo=0.3, emitted=False):

@@ -194,7 +194,7 @@ def kernel_throughput(repeat: int = 3, attitude_step: int = 1) -> list[BenchRow]
     s2, o2 = s.reshape(-1, 3), o.reshape(-1, 3)
     tables = {m: scene.tables[m] for m in scene.spacecraft.materials}
     n_geom, n_fac = s2.shape[0], facets.sizes["facet"]
-    n_wl = tables[CANX1_MATERIALS[0]].sizes["wavelength"]
+    n_wl = tables[next(iter(CANX1_MATERIALS))].sizes["wavelength"]
 
     def per_facet_loop() -> np.ndarray:
         out = np.zeros((n_geom, n_wl))

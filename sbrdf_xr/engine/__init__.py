@@ -28,7 +28,7 @@ Modules
     (:func:`simulate`; :func:`sbrdf_xr.store.write` writes it).
 """
 
-from ..errors import SceneError
+from ..errors import SceneError, renamed_attributes
 from . import (
     articulation,
     builtin,
@@ -62,8 +62,8 @@ from .scene_file import (
     MAX_SHADOW_DENSITY,
     load_material_specs,
     load_scene,
-    material_tables,
     scene_from_dict,
+    scene_material_tables,
 )
 from .sweep import QUATERNION_COMPONENTS, GridGeometry, PairGeometry
 
@@ -105,7 +105,6 @@ __all__ = [
     "knobs",
     "load_material_specs",
     "load_scene",
-    "material_tables",
     "plan",
     "reflected",
     "resolve_scene",
@@ -115,6 +114,7 @@ __all__ = [
     "scene",
     "scene_file",
     "scene_from_dict",
+    "scene_material_tables",
     "schema",
     "simulate",
     "spectral",
@@ -122,3 +122,6 @@ __all__ = [
     "starlink_materials",
     "sweep",
 ]
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"material_tables": "scene_material_tables"})

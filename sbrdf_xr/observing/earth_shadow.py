@@ -27,12 +27,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._names import SHADOW_EVENTS
-from ..errors import ObservationError
+from ..errors import ObservationError, renamed_attributes
 from ..units import to_unit
 
 __all__ = [
+    "EARTH_EQUATORIAL_RADIUS_KM",
     "EARTH_MODELS",
-    "EARTH_RADIUS_KM",
     "SHADOW_EVENTS",
     "SUN_RADIUS_KM",
     "WGS84_FLATTENING",
@@ -43,7 +43,7 @@ __all__ = [
 ]
 
 #: Equatorial radius of the Earth (WGS84) used by the shadow model [km].
-EARTH_RADIUS_KM = 6378.137
+EARTH_EQUATORIAL_RADIUS_KM = 6378.137
 
 #: Flattening of the WGS84 ellipsoid, ``f = 1/298.257223563`` (polar radius ``a (1 - f)``).
 WGS84_FLATTENING = 1.0 / 298.257223563
@@ -118,7 +118,7 @@ def shadow_angles(
     sun_km: ArrayLike,
     earth: str = "wgs84",
     pole: ArrayLike = (0.0, 0.0, 1.0),
-    earth_radius_km: float = EARTH_RADIUS_KM,
+    earth_radius_km: float = EARTH_EQUATORIAL_RADIUS_KM,
     sun_radius_km: float = SUN_RADIUS_KM,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Apparent radii of the Sun and the Earth and their separation [rad] (see the module).
@@ -181,7 +181,7 @@ def shadow_angles(
 def sunlit_fraction(
     position_km: ArrayLike,
     sun_km: ArrayLike,
-    earth_radius_km: float = EARTH_RADIUS_KM,
+    earth_radius_km: float = EARTH_EQUATORIAL_RADIUS_KM,
     sun_radius_km: float = SUN_RADIUS_KM,
     *,
     earth: str = "wgs84",
@@ -243,7 +243,7 @@ def shadow_events(
     *,
     earth: str = "wgs84",
     pole: ArrayLike = (0.0, 0.0, 1.0),
-    earth_radius_km: float = EARTH_RADIUS_KM,
+    earth_radius_km: float = EARTH_EQUATORIAL_RADIUS_KM,
     sun_radius_km: float = SUN_RADIUS_KM,
 ) -> dict[str, NDArray[np.datetime64]]:
     """UTC times the spacecraft crosses the edges of the penumbra and the umbra.
@@ -316,3 +316,9 @@ def shadow_events(
         for k, v in found.items():
             out[k] = t[0] + np.round(np.asarray(v) * 1e9).astype("timedelta64[ns]")
     return out
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(
+    __name__, globals(), {"EARTH_RADIUS_KM": "EARTH_EQUATORIAL_RADIUS_KM"}
+)

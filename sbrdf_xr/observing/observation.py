@@ -27,7 +27,8 @@ Frames and models
   (WGS84) horizon.
 * Earth shadow (:mod:`sbrdf_xr.observing.earth_shadow`): the WGS84 ellipsoid (pole the ITRS
   ``z`` axis, polar motion included), or with ``earth="sphere"`` a sphere of radius
-  :data:`~sbrdf_xr.observing.earth_shadow.EARTH_RADIUS_KM`, and the Sun's finite disc (radius
+  :data:`~sbrdf_xr.observing.earth_shadow.EARTH_EQUATORIAL_RADIUS_KM`, and the Sun's finite disc
+  (radius
   :data:`~sbrdf_xr.observing.earth_shadow.SUN_RADIUS_KM`); the sunlit fraction is the fraction of
   the apparent solar disc not covered by the apparent Earth disc, from the exact area of
   overlap of the two circles (Montenbruck & Gill, *Satellite Orbits*, 2000, §3.4.2,
@@ -56,8 +57,8 @@ from ..geometry import rotation_matrices
 from ..units import to_unit
 from . import attitude as _att
 from .earth_shadow import (
+    EARTH_EQUATORIAL_RADIUS_KM,
     EARTH_MODELS,
-    EARTH_RADIUS_KM,
     SUN_RADIUS_KM,
     WGS84_FLATTENING,
     shadow_events,
@@ -623,9 +624,10 @@ class Observation:
             ).strip(),
             "shadow_model": (
                 (
-                    f"WGS84 ellipsoid a = {EARTH_RADIUS_KM} km, 1/f = {1 / WGS84_FLATTENING:.9f}"
+                    f"WGS84 ellipsoid a = {EARTH_EQUATORIAL_RADIUS_KM} km, "
+                    f"1/f = {1 / WGS84_FLATTENING:.9f}"
                     if self.earth == "wgs84"
-                    else f"spherical Earth R = {EARTH_RADIUS_KM} km"
+                    else f"spherical Earth R = {EARTH_EQUATORIAL_RADIUS_KM} km"
                 )
                 + f", solar disc R = {SUN_RADIUS_KM} km, "
                 "exact disc-overlap area (Montenbruck & Gill 2000, 3.4.2); "

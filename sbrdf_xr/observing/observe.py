@@ -18,9 +18,14 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, TypedDict
 
-from ..errors import ObservationError, did_you_mean
+from ..errors import ObservationError, did_you_mean, renamed_attributes
 from . import attitude as _att
-from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, disc_overlap_fraction, sunlit_fraction
+from .earth_shadow import (
+    EARTH_EQUATORIAL_RADIUS_KM,
+    SUN_RADIUS_KM,
+    disc_overlap_fraction,
+    sunlit_fraction,
+)
 from .ephemeris import Ephemeris
 from .observation import ATTRS, TIME, Observation
 from .oem_reader import read_oem
@@ -45,7 +50,7 @@ __all__ = [
     "AIRMASS_MODELS",
     "ATTRS",
     "AU_KM",
-    "EARTH_RADIUS_KM",
+    "EARTH_EQUATORIAL_RADIUS_KM",
     "EPOCH_GAP_DAYS",
     "OBSERVATION_KEYS",
     "SUN_RADIUS_KM",
@@ -313,3 +318,9 @@ def canx1_pass(attitude: _att.AttitudeLaw | None = None) -> Observation:
         attitude if attitude is not None else canx1_attitude(),
         name="canx1-pass",
     )
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(
+    __name__, globals(), {"EARTH_RADIUS_KM": "EARTH_EQUATORIAL_RADIUS_KM"}
+)

@@ -18,13 +18,18 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
 
 from .. import _catalog_index
-from .._names import AIRMASS_MODELS as AIRMASS_NAMES
-from ..errors import CatalogError, ObservationError, input_file, reading
+from .._names import AIRMASS_MODELS
+from ..errors import CatalogError, ObservationError, input_file, reading, renamed_attributes
+from ..photometry.atmosphere import airmass
 from ..units import to_unit
-from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, disc_overlap_fraction, sunlit_fraction
+from .earth_shadow import (
+    EARTH_EQUATORIAL_RADIUS_KM,
+    SUN_RADIUS_KM,
+    disc_overlap_fraction,
+    sunlit_fraction,
+)
 from .timescales import (
     KNOT_S,
     check_times,
@@ -39,7 +44,7 @@ from .timescales import (
 __all__ = [
     "AIRMASS_MODELS",
     "AU_KM",
-    "EARTH_RADIUS_KM",
+    "EARTH_EQUATORIAL_RADIUS_KM",
     "EPOCH_GAP_DAYS",
     "KNOT_S",
     "SUN_RADIUS_KM",
@@ -67,11 +72,6 @@ AU_KM = 149597870.700
 #: Times farther than this from the element epoch raise an :class:`EpochGapWarning` [day]:
 #: SGP4 errors of LEO elements grow by about 1-3 km per day from the epoch.
 EPOCH_GAP_DAYS = 7.0
-
-
-#: Relative air-mass models of :func:`pvlib.atmosphere.get_relative_airmass`, those of
-#: :data:`sbrdf_xr._names.AIRMASS_MODELS` (declared there, once).
-AIRMASS_MODELS = tuple(AIRMASS_NAMES)
 
 
 def tle_checksum(line: str) -> int:
@@ -456,39 +456,6 @@ class Site:
         return wgs84.latlon(self.latitude_deg, self.longitude_deg, elevation_m=self.height_m)
 
 
-def airmass(elevation_deg: ArrayLike, model: str = "kastenyoung1989") -> NDArray[np.float64]:
-    """Relative airmass at an elevation (pvlib ``get_relative_airmass``); NaN below the horizon.
-
-    Parameters
-    ----------
-    elevation_deg : array_like
-        Elevation [degree].
-    model : str
-        One of :data:`AIRMASS_MODELS`; ``kastenyoung1989`` is Kasten & Young, Appl. Opt. 28,
-        4735 (1989), ``1 / (cos z + 0.50572 (96.07995 - z)^-1.6364)``.
-
-    Returns
-    -------
-    ndarray
-        Relative airmass [1].
-
-    Examples
-    --------
-    >>> np.round(airmass([90.0, 30.0, 10.0, -5.0]), 4)  # NaN below the horizon
-    array([0.9997, 1.9943, 5.586 ,    nan])
-    """
-    if model not in AIRMASS_MODELS:
-        raise ObservationError(
-            f"airmass_model: got {model!r}; allowed: {', '.join(AIRMASS_MODELS)}"
-        )
-    from pvlib.atmosphere import get_relative_airmass
-
-    el = np.asarray(to_unit(elevation_deg, "deg", "elevation_deg"), dtype=np.float64)
-    zen = np.where(el >= 0, 90.0 - el, 90.0)
-    am = np.asarray(get_relative_airmass(zen, model=model), dtype=np.float64)
-    return np.where(el >= 0, am, np.nan)
-
-
 def load_orbit_entry(entry: _catalog_index.CatalogEntry) -> Orbit:
     """A ``kind = "orbit"`` entry: a 2- or 3-line TLE file.
 
@@ -537,3 +504,9 @@ def load_site_entry(entry: _catalog_index.CatalogEntry) -> Site:
         )
     table.setdefault("source", entry.provenance)
     return Site(name=entry.name, **table)
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(
+    __name__, globals(), {"EARTH_RADIUS_KM": "EARTH_EQUATORIAL_RADIUS_KM"}
+)

@@ -39,45 +39,55 @@ def _values(x: Any) -> np.ndarray:
 def airmass(elevation: ArrayLike | xr.DataArray, model: str = "kastenyoung1989") -> Any:
     """Relative optical air mass from the object's elevation above the horizon.
 
+    The one air-mass function of the package (also :func:`sbrdf_xr.observing.airmass`).
     Dispatches to :func:`pvlib.atmosphere.get_relative_airmass` with zenith
     ``90 - elevation``; the models and their papers are listed in
-    :data:`AIRMASS_MODELS`.  Most models expect the apparent (refracted) elevation.
+    :data:`AIRMASS_MODELS` (default Kasten & Young 1989, Appl. Opt. 28, 4735, eq. 3:
+    ``1 / (cos z + 0.50572 (96.07995 - z)^-1.6364)``).  Most models expect the apparent
+    (refracted) elevation.
+
+    Below the horizon (elevation < 0) the air mass is not defined and is NaN, so that a
+    pass sampled through rise and set keeps its shape; NaN elevations give NaN.  At the
+    horizon itself most models are finite (Kasten & Young: 37.92).
 
     Parameters
     ----------
-    elevation : float, array_like or DataArray
-        Elevation above the horizon [degree], in (0, 90].
+    elevation : float, array_like, DataArray or Quantity
+        Elevation above the horizon [degree], in [-90, 90].
     model : str
         A key of :data:`AIRMASS_MODELS`.
 
     Returns
     -------
     float, ndarray or DataArray
-        Air mass [1] (1 at the zenith), the same shape (a DataArray keeps its
-        coordinates and gets the ``airmass`` attributes).
+        Air mass [1] (1 at the zenith, NaN below the horizon), the same shape (a
+        DataArray keeps its coordinates and gets the ``airmass`` attributes).
 
     Raises
     ------
     ValidationError
-        Unknown model; an elevation that is not finite or not in (0, 90] degree.
+        Unknown model; an elevation outside [-90, 90] degree or infinite.
 
     Examples
     --------
-    >>> np.round(airmass([90.0, 30.0, 10.0]), 4)  # Kasten and Young (1989)
-    array([0.9997, 1.9943, 5.586 ])
+    >>> np.round(airmass([90.0, 30.0, 10.0, -5.0]), 4)  # Kasten and Young (1989)
+    array([0.9997, 1.9943, 5.586 ,    nan])
     """
     from pvlib.atmosphere import get_relative_airmass
 
     _choose(model, AIRMASS_MODELS, "airmass model")
     el = _values(to_unit(elevation, "deg", "elevation"))
-    bad = ~np.isfinite(el) | (el <= 0.0) | (el > 90.0)
+    bad = np.isinf(el) | (np.abs(el) > 90.0)
     if np.any(bad):
         first = el.ravel()[np.flatnonzero(bad.ravel())[0]]
         raise ValidationError(
-            f"elevation: must be finite and in (0, 90] degree (above the horizon); "
+            f"elevation: must be in [-90, 90] degree (NaN below the horizon); "
             f"{int(bad.sum())} value(s) are not, the first is {first}"
         )
-    x = np.asarray(get_relative_airmass(90.0 - el, model=model), dtype=np.float64)
+    up = el >= 0.0  # NaN compares False: stays NaN
+    zenith = np.where(up, 90.0 - np.where(up, el, 0.0), 0.0)
+    x = np.asarray(get_relative_airmass(zenith, model=model), dtype=np.float64)
+    x = np.where(up, x, np.nan)
     if isinstance(elevation, xr.DataArray):
         return (
             elevation.copy(data=x)

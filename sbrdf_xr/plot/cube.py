@@ -21,7 +21,7 @@ import xarray as xr
 from .._names import SHADOW_EVENTS
 from ..errors import ValidationError
 from ._labels import STYLES, band_colour, finite, label, outside_legend, spread_indices
-from .curves import light_curve, magnitude_label, spectra
+from .curves import light_curve, magnitude_label, spectrum_curves
 
 __all__ = [
     "CUBE_KINDS",
@@ -360,6 +360,6 @@ def cube_figure(
     if kind == "bands":
         return _bands_figure(cube, bands, system)
     var = "spacecraft_sbrdf" if "spacecraft_sbrdf" in cube else "signal"
-    fig = spectra(cube, var, max_lines=max_lines)
+    fig = spectrum_curves(cube, var, max_lines=max_lines)
     fig.axes[0].set_title(str(cube.attrs.get("scene", "")), fontsize="medium")
     return fig

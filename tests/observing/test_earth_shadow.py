@@ -14,7 +14,7 @@ from sbrdf_xr.observing import earth_shadow as es
 from sbrdf_xr.observing import observe
 from sbrdf_xr.observing.timescales import skyfield_time, times
 
-A = es.EARTH_RADIUS_KM
+A = es.EARTH_EQUATORIAL_RADIUS_KM
 B = A * (1 - es.WGS84_FLATTENING)
 AXES = {"wgs84": np.array([A, A, B]), "sphere": np.array([A, A, A])}
 

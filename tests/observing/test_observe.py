@@ -135,7 +135,7 @@ def test_shadow_boundary_brackets_skyfield_is_sunlit(canx1):
 
 # ----------------------------------------------------------------- Earth shadow, closed forms
 
-R_E = observe.EARTH_RADIUS_KM
+R_E = observe.EARTH_EQUATORIAL_RADIUS_KM
 R_S = observe.SUN_RADIUS_KM
 MU = 398600.4418
 
@@ -285,7 +285,7 @@ def test_airmass_model():
     am = observe.airmass([90.0, 30.0, 0.0, -5.0])
     assert am[0] == pytest.approx(1.0, abs=1e-3) and am[1] == pytest.approx(1.995, abs=2e-3)
     assert am[2] == pytest.approx(37.92, abs=0.01) and np.isnan(am[3])
-    with pytest.raises(ObservationError, match="allowed: simple"):
+    with pytest.raises(ValidationError, match="allowed: 'simple'"):
         observe.airmass(10.0, "magic")
 
 
