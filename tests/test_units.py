@@ -82,7 +82,7 @@ def test_wavelength_axes_in_micrometres_are_converted_or_warned_about():
 def test_ranges_and_distances_outside_their_plausible_span_warn():
     with pytest.warns(
         UnitWarning,
-        match=r"range_km: 1\.2e\+09 km is above the plausible 1e\+07 km: "
+        match=r"range: 1\.2e\+09 km is above the plausible 1e\+07 km: "
         r"metres\? the value is read in km \(1\.2e\+06 km if it were metres\)",
     ):
         earthshine_irradiance_ratio(0.3, 1.2e9, 0.0)

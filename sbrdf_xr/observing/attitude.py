@@ -50,7 +50,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from ..errors import AttitudeError, did_you_mean, renamed_attributes
+from ..errors import AttitudeError, did_you_mean, renamed_attributes, renamed_keywords
 from ..units import to_unit
 from .frames import (
     Context,
@@ -229,7 +229,8 @@ class Nadir(AttitudeLaw):
 VERTICALS = ("geodetic", "geocentric")
 
 
-def geodetic_up(position_itrs_km: ArrayLike, iterations: int = 6) -> NDArray[np.float64]:
+@renamed_keywords(position_itrs_km="position_itrs")
+def geodetic_up(position_itrs: ArrayLike, iterations: int = 6) -> NDArray[np.float64]:
     """Unit normals of the WGS84 ellipsoid through ITRS points (geodetic zenith), (n, 3).
 
     The geodetic latitude by fixed-point iteration of
@@ -239,7 +240,7 @@ def geodetic_up(position_itrs_km: ArrayLike, iterations: int = 6) -> NDArray[np.
 
     Parameters
     ----------
-    position_itrs_km : array_like, shape (n, 3)
+    position_itrs : array_like, shape (n, 3)
         Positions in the ITRS [km].
     iterations : int
         Fixed-point steps.
@@ -255,7 +256,7 @@ def geodetic_up(position_itrs_km: ArrayLike, iterations: int = 6) -> NDArray[np.
     """
     from .earth_shadow import EARTH_EQUATORIAL_RADIUS_KM, WGS84_FLATTENING
 
-    x = np.asarray(to_unit(position_itrs_km, "km", "position_itrs_km"), dtype=np.float64)
+    x = np.asarray(to_unit(position_itrs, "km", "position_itrs"), dtype=np.float64)
     x = x.reshape(-1, 3)
     e2 = WGS84_FLATTENING * (2.0 - WGS84_FLATTENING)
     p = np.hypot(x[:, 0], x[:, 1])

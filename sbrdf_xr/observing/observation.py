@@ -52,7 +52,13 @@ import xarray as xr
 from numpy.typing import NDArray
 
 from .._names import VECTOR, attrs
-from ..errors import AttitudeError, EpochGapWarning, NotObservableError, ObservationError
+from ..errors import (
+    AttitudeError,
+    EpochGapWarning,
+    NotObservableError,
+    ObservationError,
+    renamed_keywords,
+)
 from ..geometry import rotation_matrices
 from ..units import to_unit
 from . import attitude as _att
@@ -494,13 +500,14 @@ class Observation:
             ds.attrs["unobservable"] = "; ".join(reasons)
         return ds
 
-    def next_pass(self, days: float = 3.0, twilight_deg: float = -12.0) -> str:
+    @renamed_keywords(twilight_deg="twilight")
+    def next_pass(self, days: float = 3.0, twilight: float = -12.0) -> str:
         """When the object next rises above ``min_elevation_deg``, and whether it can be seen.
 
         From skyfield's :meth:`~skyfield.sgp4lib.EarthSatellite.find_events` over
         ``days`` from the first time of the observation; each pass is then sampled every
         10 s for the Sun: visible where the object is sunlit (half the solar disc or
-        more) and the site's Sun is below ``twilight_deg``.  When the next pass is not
+        more) and the site's Sun is below ``twilight``.  When the next pass is not
         visible, the next visible one is named.  The table of passes, with refined
         edges, is :func:`sbrdf_xr.observing.passes.visible_passes`.
 
@@ -508,7 +515,7 @@ class Observation:
         ----------
         days : float
             How far ahead to look [day]; a Quantity is converted.
-        twilight_deg : float
+        twilight : float
             Site Sun elevation below which the sky is dark enough [degree] (nautical
             twilight by default).
 
@@ -533,7 +540,7 @@ class Observation:
         if isinstance(self.orbit, Ephemeris):
             return "sbrdf_xr.observing.passes.visible_passes finds the passes of an ephemeris"
         days = float(to_unit(days, "day", "days"))
-        twilight_deg = float(to_unit(twilight_deg, "deg", "twilight_deg"))
+        twilight = float(to_unit(twilight, "deg", "twilight"))
         t64 = np.array([self.times[0], self.times[0] + np.timedelta64(round(days * 86400), "s")])
         t0, t1 = skyfield_utc(t64)
         when, kind = self.orbit.satellite.find_events(
@@ -558,7 +565,7 @@ class Observation:
         rises = [i for i in range(start, len(kinds)) if kinds[i] == 0]
         for n, i in enumerate(rises):
             end = next((stamps[j] for j in range(i + 1, len(kinds)) if kinds[j] == 2), None)
-            seen, why = self._visible(stamps[i], end or str(t64[1]), twilight_deg)
+            seen, why = self._visible(stamps[i], end or str(t64[1]), twilight)
             if seen and n == 0:
                 return text + f"; visible {seen}"
             if n == 0:

@@ -24,7 +24,7 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from .._names import AIRMASS_MODELS, BAND, WAVELENGTH, attrs
-from ..errors import ValidationError
+from ..errors import ValidationError, renamed_keywords
 from ..units import to_unit
 from .spectra import _check_grid, _choose
 
@@ -184,9 +184,8 @@ def apply_extinction(mags: xr.DataArray, airmass: Any, coefficients: Any) -> xr.
     return out
 
 
-def rayleigh_optical_depth(
-    wavelength: ArrayLike, pressure_hpa: float = SEA_LEVEL_HPA
-) -> np.ndarray:
+@renamed_keywords(pressure_hpa="pressure")
+def rayleigh_optical_depth(wavelength: ArrayLike, pressure: float = SEA_LEVEL_HPA) -> np.ndarray:
     """Rayleigh-scattering optical depth of the atmosphere at the zenith.
 
     ``tau_R = 0.008569 l**-4 (1 + 0.0113 l**-2 + 0.00013 l**-4) P / 1013.25 hPa`` with
@@ -196,7 +195,7 @@ def rayleigh_optical_depth(
     ----------
     wavelength : array_like
         [nm]
-    pressure_hpa : float
+    pressure : float
         Surface pressure [hPa] (1013.25 at sea level; about 780 at 2 km).
 
     Returns
@@ -210,21 +209,18 @@ def rayleigh_optical_depth(
     array([0.3601, 0.0973, 0.0365])
     """
     lam = np.asarray(to_unit(wavelength, "nm", "wavelength", spectral=True), np.float64) / 1000.0
-    pressure_hpa = to_unit(pressure_hpa, "hPa", "pressure_hpa")
+    pressure = to_unit(pressure, "hPa", "pressure")
     return (
-        0.008569
-        * lam**-4
-        * (1.0 + 0.0113 * lam**-2 + 0.00013 * lam**-4)
-        * pressure_hpa
-        / SEA_LEVEL_HPA
+        0.008569 * lam**-4 * (1.0 + 0.0113 * lam**-2 + 0.00013 * lam**-4) * pressure / SEA_LEVEL_HPA
     )
 
 
+@renamed_keywords(pressure_hpa="pressure")
 def transmission(
     wavelength: ArrayLike,
     airmass: float,
     *,
-    pressure_hpa: float = SEA_LEVEL_HPA,
+    pressure: float = SEA_LEVEL_HPA,
     aerosol_optical_depth: float = 0.05,
     angstrom_exponent: float = 1.3,
 ) -> xr.DataArray:
@@ -242,7 +238,7 @@ def transmission(
         Strictly increasing [nm].
     airmass : float
         [1], >= 1.
-    pressure_hpa : float
+    pressure : float
         Surface pressure [hPa].
     aerosol_optical_depth : float
         Aerosol optical depth at 550 nm at the zenith [1] (0.05: a clear site).
@@ -262,10 +258,10 @@ def transmission(
     ('1', array([0.5202, 0.8018, 0.8962]))
     """
     wl = _check_grid(wavelength, "wavelength")
-    pressure_hpa = to_unit(pressure_hpa, "hPa", "pressure_hpa")
+    pressure = to_unit(pressure, "hPa", "pressure")
     for name, v, lo in (
         ("airmass", airmass, 1.0),
-        ("pressure_hpa", pressure_hpa, 0.0),
+        ("pressure", pressure, 0.0),
         ("aerosol_optical_depth", aerosol_optical_depth, 0.0),
     ):
         if not np.isfinite(v) or v < lo:
@@ -273,11 +269,11 @@ def transmission(
     if not np.isfinite(angstrom_exponent):
         raise ValidationError(f"angstrom_exponent: must be finite, got {angstrom_exponent}")
     tau = (
-        rayleigh_optical_depth(wl, pressure_hpa)
+        rayleigh_optical_depth(wl, pressure)
         + aerosol_optical_depth * (wl / 550.0) ** -angstrom_exponent
     )
     desc = (
-        f"Rayleigh (Hansen & Travis 1974, P = {pressure_hpa:g} hPa) + Angstrom aerosols "
+        f"Rayleigh (Hansen & Travis 1974, P = {pressure:g} hPa) + Angstrom aerosols "
         f"(tau_550 = {aerosol_optical_depth:g}, alpha = {angstrom_exponent:g}) "
         f"at air mass {airmass:g}"
     )

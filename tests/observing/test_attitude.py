@@ -123,7 +123,7 @@ def test_tumble_inertia_from_a_mesh():
     m = density * 0.1 * 0.2 * 0.3
     expected = m / 12 * np.diag([0.2**2 + 0.3**2, 0.1**2 + 0.3**2, 0.1**2 + 0.2**2])
     np.testing.assert_allclose(sc.inertia(density), expected, rtol=1e-12, atol=1e-15)
-    tumble = att.Tumble.from_spacecraft(sc, density, omega_deg_s=(1.0, 2.0, 3.0))
+    tumble = att.Tumble.from_spacecraft(sc, density, omega=(1.0, 2.0, 3.0))
     np.testing.assert_allclose(tumble.inertia, expected, rtol=1e-12, atol=1e-15)
 
 

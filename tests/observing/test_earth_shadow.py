@@ -53,7 +53,7 @@ def test_point_sun_umbra_is_the_ray_ellipsoid_intersection():
     r *= (rng.uniform(6400.0, 12000.0, n) / np.linalg.norm(r, axis=1))[:, None]
     sun = rng.normal(size=(n, 3))
     sun *= 1.5e8 / np.linalg.norm(sun, axis=1, keepdims=True)
-    f = es.sunlit_fraction(r, sun, sun_radius_km=0.0, pole=pole)
+    f = es.sunlit_fraction(r, sun, sun_radius=0.0, pole=pole)
     # The same in a frame whose z is the pole (any x, y: the ellipsoid is axisymmetric).
     ex = np.cross(pole, rng.normal(size=(n, 3)))
     ex /= np.linalg.norm(ex, axis=1, keepdims=True)

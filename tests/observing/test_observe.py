@@ -149,7 +149,7 @@ def circular_shadow_times(radius, beta_deg, sun_distance, sun_radius):
     def frac(t):
         r = radius * np.array([np.cos(n * t), np.sin(n * t), 0.0])
         s = sun_distance * s_hat - r
-        return float(observe.sunlit_fraction(r, s, sun_radius_km=sun_radius, earth="sphere"))
+        return float(observe.sunlit_fraction(r, s, sun_radius=sun_radius, earth="sphere"))
 
     x_cyl = np.sqrt(radius**2 - R_E**2)
     t_cyl = np.arccos(-x_cyl / (radius * np.cos(beta))) / n
