@@ -146,6 +146,4 @@ def test_radiative_cooling_solves_the_energy_balance():
     for bad in (dict(time=-1.0), dict(initial_temperature=0.0), dict(heat_capacity=0.0)):
         args = dict(time=1.0, initial_temperature=300.0, heat_capacity=c) | bad
         with pytest.raises(ValidationError, match=next(iter(bad))):
-            radiative_cooling(
-                args["time"], args["initial_temperature"], args["heat_capacity"], eps
-            )
+            radiative_cooling(args["time"], args["initial_temperature"], args["heat_capacity"], eps)
