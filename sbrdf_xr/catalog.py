@@ -394,7 +394,7 @@ def load(name: str, dtype: DTypeLike | None = None) -> Any:
 
     >>> catalog.load("canx1")  # doctest: +ELLIPSIS
     <Spacecraft 'canx1': 684 facets, materials ['aluminium-6061-t6', 'tjpv-cell', ...] m>
-    >>> catalog.load("mont-megantic").latitude_deg
+    >>> catalog.load("mont-megantic").latitude
     45.4555
 
     The grey table in float32, as a scene with ``dtype="float32"`` loads it:

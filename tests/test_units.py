@@ -40,8 +40,8 @@ def test_quantities_convert_and_other_kinds_are_refused_by_name():
 
 def test_observing_arguments_take_quantities():
     a = Site(Angle("20d42m30s"), -156.2575 * u.deg, 3.058 * u.km)
-    assert a.latitude_deg == pytest.approx(20.708333, abs=1e-6) and a.height_m == 3058.0
-    with pytest.raises(UnitError, match=r"site height_m: got 3\.0 s"):
+    assert a.latitude == pytest.approx(20.708333, abs=1e-6) and a.height == 3058.0
+    with pytest.raises(UnitError, match=r"site height: got 3\.0 s"):
         Site(0.0, 0.0, 3.0 * u.s)
     spin = Spin(rate_deg_s=np.pi / 90 * u.rad / u.s, phase_deg=0.5 * u.rad)
     assert spin.rate_deg_s == pytest.approx(2.0) and spin.phase_deg == pytest.approx(28.64789, 1e-6)

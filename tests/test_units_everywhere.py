@@ -754,9 +754,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.observing.tumble.Tumble": lambda: dict(
         inertia=(1.0, 2.0, 3.0), omega_deg_s=(1.0, 2.0, 3.0)
     ),
-    "sbrdf_xr.observing.orbits.Site": lambda: dict(
-        latitude_deg=20.7, longitude_deg=-156.3, height_m=3058.0
-    ),
+    "sbrdf_xr.observing.orbits.Site": lambda: dict(latitude=20.7, longitude=-156.3, height=3058.0),
     "sbrdf_xr.observing.observation.Observation": lambda: dict(
         **{f.name: getattr(_observation(), f.name) for f in _observation_fields()},
         min_elevation_deg=5.0,
@@ -1406,9 +1404,6 @@ UNIT_ENDING_PENDING: dict[tuple[str, str], str] = {
             ("sbrdf_xr.observing.frames.Context", "velocity_km_s"),
             ("sbrdf_xr.observing.frames.Context", "sun_km"),
             ("sbrdf_xr.observing.observation.Observation", "min_elevation_deg"),
-            ("sbrdf_xr.observing.orbits.Site", "latitude_deg"),
-            ("sbrdf_xr.observing.orbits.Site", "longitude_deg"),
-            ("sbrdf_xr.observing.orbits.Site", "height_m"),
             ("sbrdf_xr.observing.tracking.TrackingTable", "elevation_deg"),
             ("sbrdf_xr.observing.tracking.TrackingTable", "azimuth_deg"),
             ("sbrdf_xr.observing.tracking.TrackingTable", "ra_deg"),

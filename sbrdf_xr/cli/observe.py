@@ -391,7 +391,7 @@ def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     ...      "--height", "3050", "--start", "2024-03-17T06:14:00", "--duration", "60",
     ...      "--step", "30", "-o", "p.nc"])
     >>> obs = observation_of(args)
-    >>> obs.times.size, obs.site.height_m, type(obs.attitude).__name__
+    >>> obs.times.size, obs.site.height, type(obs.attitude).__name__
     (3, 3050.0, 'Nadir')
     """
     import numpy as np

@@ -282,8 +282,8 @@ class Observation:
         step = f", step {(t[1] - t[0]) / np.timedelta64(1, 's'):g} s" if t.size > 1 else ""
         return (
             f"<Observation {self.name!r}: {self.orbit.name!r} from {self.site.name or 'site'} "
-            f"({self.site.latitude_deg:.4f}, {self.site.longitude_deg:.4f}, "
-            f"{self.site.height_m:g} m), "
+            f"({self.site.latitude:.4f}, {self.site.longitude:.4f}, "
+            f"{self.site.height:g} m), "
             f"{t.size} times {t[0]} .. {t[-1]}{step}, attitude {self.attitude!r}>"
         )
 
@@ -425,7 +425,7 @@ class Observation:
         rng = np.linalg.norm(los, axis=1)
         # Topocentric position in the ITRS, then the geodetic east-north-up frame.
         rel = np.einsum("ijn,nj->ni", rot, -los)
-        lat, lon = np.radians(self.site.latitude_deg), np.radians(self.site.longitude_deg)
+        lat, lon = np.radians(self.site.latitude), np.radians(self.site.longitude)
         east = np.array([-np.sin(lon), np.cos(lon), 0.0])
         north = np.array([-np.sin(lat) * np.cos(lon), -np.sin(lat) * np.sin(lon), np.cos(lat)])
         up = np.array([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)])
@@ -612,9 +612,9 @@ class Observation:
             "tle_line2": orbit.line2 if isinstance(orbit, Orbit) else "",
             "orbit_provenance": self.orbit.provenance,
             "site_name": self.site.name,
-            "site_latitude": self.site.latitude_deg,
-            "site_longitude": self.site.longitude_deg,
-            "site_height": self.site.height_m,
+            "site_latitude": self.site.latitude,
+            "site_longitude": self.site.longitude,
+            "site_height": self.site.height,
             "site_source": self.site.source,
             "site_coordinates": (
                 "WGS84 geodetic latitude and east longitude [degree], "

@@ -38,6 +38,7 @@ from .orbits import (
     airmass,
     load_orbit_entry,
     load_site_entry,
+    site_fields,
     tle_checksum,
 )
 from .timescales import (
@@ -120,7 +121,7 @@ def _site(site_v: Any) -> Site:
                 "[observation] site: needs latitude_deg, longitude_deg "
                 f"(and optional height_m, name); got {sorted(site_v)}"
             )
-        return Site(**site_v)
+        return Site(**site_fields(site_v))
     raise ObservationError(
         f"[observation] site: expected a catalog name or a table, got {site_v!r}"
     )

@@ -59,7 +59,7 @@ MAX_SPEED_KM_S = 12.0
 
 
 def _enu(site: Site) -> np.ndarray:
-    lat, lon = np.radians(site.latitude_deg), np.radians(site.longitude_deg)
+    lat, lon = np.radians(site.latitude), np.radians(site.longitude)
     east = [-np.sin(lon), np.cos(lon), 0.0]
     north = [-np.sin(lat) * np.cos(lon), -np.sin(lat) * np.sin(lon), np.cos(lat)]
     up = [np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)]
@@ -107,7 +107,7 @@ def range_for_height(
     d = np.asarray(direction_itrs, dtype=np.float64).reshape(-1, 3)
     h = np.asarray(to_unit(height, "km", "height"), dtype=np.float64).reshape(-1)
     p = np.asarray(site.position.itrs_xyz.km, dtype=np.float64)
-    r_loc = np.linalg.norm(p) - site.height_m / 1000.0
+    r_loc = np.linalg.norm(p) - site.height / 1000.0
     pu = d @ p
 
     def height_of(rho: np.ndarray) -> np.ndarray:

@@ -437,13 +437,13 @@ def test_malformed_tles_raise_named_errors():
 
 
 def test_site_range_checks():
-    with pytest.raises(ObservationError, match="latitude_deg: got 91"):
+    with pytest.raises(ObservationError, match="latitude: got 91"):
         observe.Site(91.0, 0.0)
-    with pytest.raises(ObservationError, match="height_m"):
+    with pytest.raises(ObservationError, match="site height: got 20000"):
         observe.Site(10.0, 0.0, 20000.0)
     with pytest.raises(ObservationError, match="expected a number"):
         observe.Site("north", 0.0)
-    assert observe.Site(0.0, 350.0).longitude_deg == pytest.approx(-10.0)
+    assert observe.Site(0.0, 350.0).longitude == pytest.approx(-10.0)
     with pytest.raises(ObservationError, match="not a site"):
         observe.Site.from_catalog("canx1-example")
 
