@@ -757,7 +757,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.observing.orbits.Site": lambda: dict(latitude=20.7, longitude=-156.3, height=3058.0),
     "sbrdf_xr.observing.observation.Observation": lambda: dict(
         **{f.name: getattr(_observation(), f.name) for f in _observation_fields()},
-        min_elevation_deg=5.0,
+        min_elevation=5.0,
     ),
     "sbrdf_xr.observing.timescales.times": lambda: dict(
         start="2024-03-17T01:20:00", stop="2024-03-17T01:21:00", step=20.0
@@ -1014,9 +1014,7 @@ def _shadow_inputs() -> dict[str, Any]:
 
 
 def _observation_fields() -> list[Any]:
-    return [
-        f for f in dataclasses.fields(_observation()) if f.init and f.name != "min_elevation_deg"
-    ]
+    return [f for f in dataclasses.fields(_observation()) if f.init and f.name != "min_elevation"]
 
 
 def _observation_cube() -> xr.Dataset:
@@ -1403,7 +1401,6 @@ UNIT_ENDING_PENDING: dict[tuple[str, str], str] = {
             ("sbrdf_xr.observing.frames.Context", "position_km"),
             ("sbrdf_xr.observing.frames.Context", "velocity_km_s"),
             ("sbrdf_xr.observing.frames.Context", "sun_km"),
-            ("sbrdf_xr.observing.observation.Observation", "min_elevation_deg"),
             ("sbrdf_xr.observing.tracking.TrackingTable", "elevation_deg"),
             ("sbrdf_xr.observing.tracking.TrackingTable", "azimuth_deg"),
             ("sbrdf_xr.observing.tracking.TrackingTable", "ra_deg"),

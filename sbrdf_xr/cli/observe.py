@@ -374,7 +374,7 @@ def _tracking_observation(args: argparse.Namespace, spacecraft: Any) -> Any:
     table = tracking_from_dict(spec, site)
     return table.observation(
         attitude_of(args, spacecraft),
-        min_elevation_deg=args.min_elevation,
+        min_elevation=args.min_elevation,
         earth=args.earth,
         name=args.name or f"{table.name} from {table.site.name}",
     )
@@ -450,7 +450,7 @@ def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
         site,
         times(start, stop, args.step),
         attitude_of(args, spacecraft),
-        min_elevation_deg=args.min_elevation,
+        min_elevation=args.min_elevation,
         name=args.name or f"{orbit.name} from {site.name}",
         earth=args.earth,
     )

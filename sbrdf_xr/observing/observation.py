@@ -57,6 +57,7 @@ from ..errors import (
     EpochGapWarning,
     NotObservableError,
     ObservationError,
+    renamed_fields,
     renamed_keywords,
 )
 from ..geometry import rotation_matrices
@@ -182,6 +183,7 @@ def _as_law(value: Any) -> _att.AttitudeLaw:
 UNOBSERVABLE = ("raise", "empty", "keep")
 
 
+@renamed_fields(min_elevation_deg="min_elevation")
 @dataclass(frozen=True)
 class Observation:
     """A spacecraft on an orbit, seen from a site at UTC times, in an attitude law.
@@ -200,7 +202,7 @@ class Observation:
         :class:`~sbrdf_xr.observing.attitude.Nadir`.
     airmass_model : str
         One of :data:`~sbrdf_xr.observing.orbits.AIRMASS_MODELS`.
-    min_elevation_deg : float
+    min_elevation : float
         Elevation [degree] below which the object counts as not observable (for the
         whole-window check of :meth:`geometry`).
     name : str
@@ -234,7 +236,7 @@ class Observation:
     times: Any
     attitude: Any = None
     airmass_model: str = "kastenyoung1989"
-    min_elevation_deg: float = 0.0
+    min_elevation: float = 0.0
     name: str = "observation"
     earth: str = "wgs84"
     _cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
@@ -256,11 +258,11 @@ class Observation:
             )
         if self.earth not in EARTH_MODELS:
             raise ObservationError(f"earth: got {self.earth!r}; allowed: {', '.join(EARTH_MODELS)}")
-        min_el = to_unit(self.min_elevation_deg, "deg", "min_elevation_deg")
-        object.__setattr__(self, "min_elevation_deg", min_el)
-        if not -90.0 <= float(self.min_elevation_deg) <= 90.0:
+        min_el = to_unit(self.min_elevation, "deg", "min_elevation")
+        object.__setattr__(self, "min_elevation", min_el)
+        if not -90.0 <= float(self.min_elevation) <= 90.0:
             raise ObservationError(
-                f"min_elevation_deg: must lie in [-90, 90], got {self.min_elevation_deg}"
+                f"min_elevation: must lie in [-90, 90], got {self.min_elevation}"
             )
         if isinstance(self.orbit, Ephemeris):
             self.orbit.check_covers(t)
@@ -384,7 +386,7 @@ class Observation:
         Parameters
         ----------
         on_unobservable : {"raise", "empty", "keep"}
-            What to do when the object is below ``min_elevation_deg`` at every time, or
+            What to do when the object is below ``min_elevation`` at every time, or
             in the umbra at every time: raise :class:`NotObservableError`, return a
             Dataset with ``time`` of length 0 and the reason in ``attrs["unobservable"]``,
             or return the full Dataset anyway.
@@ -444,10 +446,10 @@ class Observation:
         earth_phase = _angle(sun + r, r)
 
         reasons = []
-        if np.all(elevation < self.min_elevation_deg):
+        if np.all(elevation < self.min_elevation):
             i = int(np.argmax(elevation))
             reasons.append(
-                f"below {self.min_elevation_deg:g} deg elevation at every time "
+                f"below {self.min_elevation:g} deg elevation at every time "
                 f"(highest {elevation[i]:.2f} deg at {self.times[i]}); " + self.next_pass()
             )
         if np.all(sunlit == 0):
@@ -502,7 +504,7 @@ class Observation:
 
     @renamed_keywords(twilight_deg="twilight")
     def next_pass(self, days: float = 3.0, twilight: float = -12.0) -> str:
-        """When the object next rises above ``min_elevation_deg``, and whether it can be seen.
+        """When the object next rises above ``min_elevation``, and whether it can be seen.
 
         From skyfield's :meth:`~skyfield.sgp4lib.EarthSatellite.find_events` over
         ``days`` from the first time of the observation; each pass is then sampled every
@@ -544,17 +546,17 @@ class Observation:
         t64 = np.array([self.times[0], self.times[0] + np.timedelta64(round(days * 86400), "s")])
         t0, t1 = skyfield_utc(t64)
         when, kind = self.orbit.satellite.find_events(
-            self.site.position, t0, t1, altitude_degrees=float(self.min_elevation_deg)
+            self.site.position, t0, t1, altitude_degrees=float(self.min_elevation)
         )
         if not len(when):
             return (
-                f"it does not rise above {self.min_elevation_deg:g} deg within {days:g} days "
+                f"it does not rise above {self.min_elevation:g} deg within {days:g} days "
                 f"after {self.times[0]}"
             )
         stamps = [str(np.datetime64(t.replace(tzinfo=None), "s")) for t in when.utc_datetime()]
         kinds = [int(k) for k in kind]
         start = kinds.index(0) if 0 in kinds else 0
-        text = f"it next rises above {self.min_elevation_deg:g} deg at {stamps[start]} UTC"
+        text = f"it next rises above {self.min_elevation:g} deg at {stamps[start]} UTC"
         rest = list(zip(kinds[start + 1 :], stamps[start + 1 :], strict=True))
         culm = next((s for k, s in rest if k == 1), None)
         sets = next((s for k, s in rest if k == 2), None)
@@ -580,9 +582,7 @@ class Observation:
 
         grid = times(start, stop, 10.0)
         law = _att.Inertial((0.0, 0.0, 0.0, 1.0))
-        obs = Observation(
-            self.orbit, self.site, grid, law, min_elevation_deg=-90.0, earth=self.earth
-        )
+        obs = Observation(self.orbit, self.site, grid, law, min_elevation=-90.0, earth=self.earth)
         g = obs.geometry(on_unobservable="keep")
         lit = g.sunlit_fraction.values >= 0.5
         dark = g.site_sun_elevation.values < twilight_deg

@@ -111,6 +111,11 @@ OBSERVATION_KEYS: dict[str, tuple[tuple[type, ...], str, str]] = {
 }
 
 
+#: Keys of an ``[observation]`` table that name a field differently (files keep the unit
+#: in the key; :class:`Observation` takes the bare name).
+_FIELD_OF_KEY = {"min_elevation_deg": "min_elevation"}
+
+
 def _site(site_v: Any) -> Site:
     if isinstance(site_v, str):
         return Site.from_catalog(site_v)
@@ -246,7 +251,9 @@ def observation_from_dict(
     ):
         att = {**att, "path": str(resolve(att["path"]))}
     kw = {
-        k: table[k] for k in ("airmass_model", "min_elevation_deg", "name", "earth") if k in table
+        _FIELD_OF_KEY.get(k, k): table[k]
+        for k in ("airmass_model", "min_elevation_deg", "name", "earth")
+        if k in table
     }
     return Observation(orbit, site, t, att, **kw)
 

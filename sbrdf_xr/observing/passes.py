@@ -51,7 +51,7 @@ _IDENTITY = {"law": "inertial", "q": [0.0, 0.0, 0.0, 1.0]}
 
 def _geometry(source: Any, site: Any, t: np.ndarray) -> xr.Dataset:
     site, earth = site if isinstance(site, tuple) else (site, "wgs84")
-    obs = Observation(source, site, t, _IDENTITY, min_elevation_deg=-90.0, earth=earth)
+    obs = Observation(source, site, t, _IDENTITY, min_elevation=-90.0, earth=earth)
     return obs.geometry(on_unobservable="keep")
 
 

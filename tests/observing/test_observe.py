@@ -368,12 +368,12 @@ def test_omm_gives_the_same_orbit(tmp_path):
     path.write_text(json.dumps([fields]))
     for source in (fields, path):
         omm = observe.Orbit.from_omm(source)
-        a = observe.Observation(
-            tle, observe.Site(45, -71), t, None, min_elevation_deg=-90
-        ).geometry(on_unobservable="keep")
-        b = observe.Observation(
-            omm, observe.Site(45, -71), t, None, min_elevation_deg=-90
-        ).geometry(on_unobservable="keep")
+        a = observe.Observation(tle, observe.Site(45, -71), t, None, min_elevation=-90).geometry(
+            on_unobservable="keep"
+        )
+        b = observe.Observation(omm, observe.Site(45, -71), t, None, min_elevation=-90).geometry(
+            on_unobservable="keep"
+        )
         np.testing.assert_allclose(
             a.range.values, b.range.values, atol=1e-6
         )  # same elements: < 1 mm
