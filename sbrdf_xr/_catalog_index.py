@@ -36,7 +36,6 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
-from ._names import SOURCES
 from .errors import CatalogError, did_you_mean
 
 __all__ = [
@@ -64,6 +63,7 @@ ENTRY_KINDS = (
     "orbit",
     "site",
 )
+SOURCES = ("measured", "synthetic")
 
 
 @dataclass(frozen=True)

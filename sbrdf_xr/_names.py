@@ -305,7 +305,5 @@ AIRMASS_MODELS: dict[str, str] = {
     "pickering2002": "Pickering 2002, DIO 12, 3",
     "gueymard2003": "Gueymard 2003, Sol. Energy 74, 355",
 }
-#: Origins of a material table (attribute ``source``; also ``"model:<name>"``).
-SOURCES = ("measured", "synthetic")
 #: Names of the Earth-shadow events of an observation, in the order of an eclipse.
 SHADOW_EVENTS = ("penumbra_entry", "umbra_entry", "umbra_exit", "penumbra_exit")

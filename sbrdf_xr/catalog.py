@@ -35,7 +35,6 @@ from numpy.typing import DTypeLike
 from ._catalog_index import (
     CATALOG_PATH_ENV,
     ENTRY_KINDS,
-    SOURCES,
     CatalogEntry,
     catalog_dir,
     data_path,
@@ -58,6 +57,7 @@ from .materials import models
 from .materials import tables as material
 from .materials.cache import cache_file, cached_table
 from .materials.readers import read_measurements
+from .materials.schema import SOURCES
 from .materials.shipped import read_reflectance
 from .observing import observe
 

@@ -35,7 +35,7 @@ Modules
     against its own samples.
 """
 
-from ..errors import NonPhysicalWarning, ValidationError, renamed_attributes
+from ..errors import NonPhysicalWarning, ValidationError
 from . import (
     build,
     cache,
@@ -52,7 +52,7 @@ from . import (
     selfcheck,
     tables,
 )
-from .build import BELOW_NOISE, INCIDENCE_EXTRAPOLATIONS, RENORMALISE, build_lut
+from .build import BELOW_NOISE, EXTRAPOLATIONS, RENORMALISE, build_lut
 from .construction import paper_delta_theta_grid, paper_phi_grid
 from .energy import ENERGY_TOL, hemispherical_reflectance
 from .files import open_material, open_measurements, write_netcdf_atomic
@@ -91,7 +91,7 @@ __all__ = [
     "BELOW_NOISE",
     "DUPLICATES",
     "ENERGY_TOL",
-    "INCIDENCE_EXTRAPOLATIONS",
+    "EXTRAPOLATIONS",
     "LOOKUP_METHODS",
     "PAPER_THETA_I",
     "READERS",
@@ -148,8 +148,3 @@ __all__ = [
     "validate_measurements",
     "write_netcdf_atomic",
 ]
-
-#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
-__getattr__ = renamed_attributes(
-    __name__, globals(), {"EXTRAPOLATIONS": "INCIDENCE_EXTRAPOLATIONS"}
-)

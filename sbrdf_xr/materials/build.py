@@ -20,7 +20,7 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from .._names import DELTA_THETA, MEASURED, PHI, SAMPLE, THETA_I, WAVELENGTH
-from ..errors import ValidationError, renamed_attributes
+from ..errors import ValidationError
 from ..kernels import lut as _lut
 from ..units import to_unit
 from . import models
@@ -56,10 +56,10 @@ from .schema import (
 )
 from .selfcheck import CHECK_BOUND, CHECK_FLOOR, _holdout_check, _self_check
 
-__all__ = ["BELOW_NOISE", "INCIDENCE_EXTRAPOLATIONS", "RENORMALISE", "build_lut"]
+__all__ = ["BELOW_NOISE", "EXTRAPOLATIONS", "RENORMALISE", "build_lut"]
 
 #: Extrapolation policies of :func:`build_lut` beyond the measured incidence angles.
-INCIDENCE_EXTRAPOLATIONS = ("auto", "cubic", "linear", "constant", "model")
+EXTRAPOLATIONS = ("auto", "cubic", "linear", "constant", "model")
 #: Below-noise policies of :func:`build_lut`.
 BELOW_NOISE = ("auto", "zero", "model")
 #: Row renormalisations of :func:`build_lut`.
@@ -311,9 +311,9 @@ def build_lut(
     ds = validate_measurements(measurements, duplicates=duplicates)
     if duplicates == "mean":
         ds = average_duplicates(ds)
-    if extrapolation not in INCIDENCE_EXTRAPOLATIONS:
+    if extrapolation not in EXTRAPOLATIONS:
         raise ValidationError(
-            f"extrapolation: got {extrapolation!r}; allowed: {', '.join(INCIDENCE_EXTRAPOLATIONS)}"
+            f"extrapolation: got {extrapolation!r}; allowed: {', '.join(EXTRAPOLATIONS)}"
         )
     if normal_incidence not in ("paper", "symmetric"):
         raise ValidationError(
@@ -678,9 +678,3 @@ def _model_at(
 ) -> np.ndarray:
     """A model material's spectra at sample geometries (1-D angle arrays)."""
     return models.spectra(_model_for(model, wl), ti, dt, ph)
-
-
-#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
-__getattr__ = renamed_attributes(
-    __name__, globals(), {"EXTRAPOLATIONS": "INCIDENCE_EXTRAPOLATIONS"}
-)

@@ -28,7 +28,6 @@ from .._names import (
     PSI,
     SAMPLE,
     SBRDF,
-    SOURCES,
     THETA_I,
     WAVELENGTH,
     attrs,
@@ -50,6 +49,7 @@ __all__ = [
     "validate_measurements",
 ]
 
+SOURCES = ("measured", "synthetic")
 _UNITS = {THETA_I: DEGREE, DELTA_THETA: DEGREE, PHI: DEGREE, PSI: DEGREE, WAVELENGTH: NM}
 
 

@@ -83,10 +83,12 @@ from .orbits import (
     EPOCH_GAP_DAYS,
     Orbit,
     Site,
-    airmass,
     load_orbit_entry,
     load_site_entry,
     tle_checksum,
+)
+from .orbits import (
+    airmass as airmass,  # photometry.airmass, the one air mass (published there)
 )
 from .passes import TWILIGHTS, visible_passes
 from .series import QuaternionSeries
@@ -141,7 +143,6 @@ __all__ = [
     "Tumble",
     "YawSteering",
     "aem",
-    "airmass",
     "attitude",
     "canx1_pass",
     "check_times",

@@ -51,15 +51,9 @@ import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
 
+from .. import errors as _errors
 from .._names import VECTOR, attrs
-from ..errors import (
-    AttitudeError,
-    EpochGapWarning,
-    NotObservableError,
-    ObservationError,
-    renamed_fields,
-    renamed_keywords,
-)
+from ..errors import AttitudeError, EpochGapWarning, NotObservableError, ObservationError
 from ..geometry import rotation_matrices
 from ..units import to_unit
 from . import attitude as _att
@@ -183,7 +177,7 @@ def _as_law(value: Any) -> _att.AttitudeLaw:
 UNOBSERVABLE = ("raise", "empty", "keep")
 
 
-@renamed_fields(min_elevation_deg="min_elevation")
+@_errors.renamed_fields(min_elevation_deg="min_elevation")
 @dataclass(frozen=True)
 class Observation:
     """A spacecraft on an orbit, seen from a site at UTC times, in an attitude law.
@@ -502,7 +496,7 @@ class Observation:
             ds.attrs["unobservable"] = "; ".join(reasons)
         return ds
 
-    @renamed_keywords(twilight_deg="twilight")
+    @_errors.renamed_keywords(twilight_deg="twilight")
     def next_pass(self, days: float = 3.0, twilight: float = -12.0) -> str:
         """When the object next rises above ``min_elevation``, and whether it can be seen.
 
