@@ -780,9 +780,9 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.observing.earth_shadow.shadow_events": lambda: _shadow_inputs(),
     "sbrdf_xr.observing.frames.Context": lambda: dict(
         epoch=T0,
-        position_km=np.array([[7000.0, 0.0, 0.0]]),
-        velocity_km_s=np.array([[0.0, 7.5, 0.0]]),
-        sun_km=np.array([[1.496e8, 0.0, 0.0]]),
+        position=np.array([[7000.0, 0.0, 0.0]]),
+        velocity=np.array([[0.0, 7.5, 0.0]]),
+        sun=np.array([[1.496e8, 0.0, 0.0]]),
     ),
     "sbrdf_xr.observing.ephemeris.Ephemeris.from_states": lambda: dict(
         times=_T2,
@@ -1398,9 +1398,6 @@ UNIT_ENDING_PENDING: dict[tuple[str, str], str] = {
         for name, arg in (
             ("sbrdf_xr.engine.scene.Scene", "earth_range_km"),
             ("sbrdf_xr.observing.attitude.Nadir", "yaw_deg"),
-            ("sbrdf_xr.observing.frames.Context", "position_km"),
-            ("sbrdf_xr.observing.frames.Context", "velocity_km_s"),
-            ("sbrdf_xr.observing.frames.Context", "sun_km"),
             ("sbrdf_xr.observing.tracking.TrackingTable", "elevation_deg"),
             ("sbrdf_xr.observing.tracking.TrackingTable", "azimuth_deg"),
             ("sbrdf_xr.observing.tracking.TrackingTable", "ra_deg"),

@@ -188,8 +188,8 @@ class Nadir(AttitudeLaw):
     --------
     >>> from scipy.spatial.transform import Rotation
     >>> from sbrdf_xr.observing import Context
-    >>> ctx = Context(position_km=np.array([[7000.0, 0.0, 0.0]]),
-    ...               velocity_km_s=np.array([[0.0, 7.5, 0.0]]))
+    >>> ctx = Context(position=np.array([[7000.0, 0.0, 0.0]]),
+    ...               velocity=np.array([[0.0, 7.5, 0.0]]))
     >>> q = Nadir(nadir_axis="+z", velocity_axis="+x").quaternions([0.0], ctx)
     >>> np.round(Rotation.from_quat(q).apply([0.0, 0.0, 1.0]), 6) + 0.0  # +z on the geocentre
     array([[-1.,  0.,  0.]])
@@ -216,7 +216,7 @@ class Nadir(AttitudeLaw):
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         n = np.atleast_1d(np.asarray(times)).shape[0]
-        r, v = context_fields(context, n, "nadir", "position_km", "velocity_km_s")
+        r, v = context_fields(context, n, "nadir", "position", "velocity")
         a, b = self._axes
         q = triad(a, b, -r, v)
         if self.yaw_deg:
@@ -295,8 +295,8 @@ class YawSteering(AttitudeLaw):
     --------
     >>> from scipy.spatial.transform import Rotation
     >>> from sbrdf_xr.observing import Context
-    >>> ctx = Context(position_km=np.array([[7000.0, 0.0, 0.0]]),
-    ...               sun_km=np.array([[-1e7, 1.5e8, 0.0]]))
+    >>> ctx = Context(position=np.array([[7000.0, 0.0, 0.0]]),
+    ...               sun=np.array([[-1e7, 1.5e8, 0.0]]))
     >>> law = YawSteering(nadir_axis="-z", sun_axis="+y", vertical="geocentric")
     >>> R = Rotation.from_quat(law.quaternions([0.0], ctx))
     >>> np.round(R.apply([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]), 6) + 0.0  # z up, y to the Sun
@@ -348,7 +348,7 @@ class YawSteering(AttitudeLaw):
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         n = np.atleast_1d(np.asarray(times)).shape[0]
-        r, sun = context_fields(context, n, "yaw_steering", "position_km", "sun_km")
+        r, sun = context_fields(context, n, "yaw_steering", "position", "sun")
         up = self._up(times, r, context)
         s = sun / np.linalg.norm(sun, axis=1)[:, None]
         if np.any(np.linalg.norm(np.cross(up, s), axis=1) < 1e-12):
@@ -379,9 +379,9 @@ class SunPointing(AttitudeLaw):
     --------
     >>> from scipy.spatial.transform import Rotation
     >>> from sbrdf_xr.observing import Context
-    >>> ctx = Context(position_km=np.array([[7000.0, 0.0, 0.0]]),
-    ...               velocity_km_s=np.array([[0.0, 7.5, 0.0]]),
-    ...               sun_km=np.array([[0.0, 1.5e8, 0.0]]))
+    >>> ctx = Context(position=np.array([[7000.0, 0.0, 0.0]]),
+    ...               velocity=np.array([[0.0, 7.5, 0.0]]),
+    ...               sun=np.array([[0.0, 1.5e8, 0.0]]))
     >>> q = SunPointing(axis="+z", secondary_axis="+x").quaternions([0.0], ctx)
     >>> R = Rotation.from_quat(q)
     >>> np.round(R.apply([0.0, 0.0, 1.0]), 6) + 0.0, np.round(R.apply([1.0, 0.0, 0.0]), 6) + 0.0
@@ -419,9 +419,9 @@ class SunPointing(AttitudeLaw):
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         n = np.atleast_1d(np.asarray(times)).shape[0]
         a, b, tgt = self._axes
-        (sun,) = context_fields(context, n, "sun_pointing", "sun_km")
+        (sun,) = context_fields(context, n, "sun_pointing", "sun")
         if isinstance(tgt, str) and tgt != "north":
-            r, v = context_fields(context, n, "sun_pointing", "position_km", "velocity_km_s")
+            r, v = context_fields(context, n, "sun_pointing", "position", "velocity")
             target = {"orbit_normal": np.cross(r, v), "nadir": -r, "velocity": v}[tgt]
         else:
             target = np.tile([0.0, 0.0, 1.0] if isinstance(tgt, str) else tgt, (n, 1))

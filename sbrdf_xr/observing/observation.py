@@ -323,13 +323,11 @@ class Observation:
         >>> obs = Observation(orbit, site, times("2024-03-17T01:22:00", "2024-03-17T01:22:10", 5.0),
         ...                   Spin(rate_deg_s=10.0))
         >>> ctx = obs.context()
-        >>> ctx.position_km.shape, round(float(np.linalg.norm(ctx.position_km[0])), 0)  # [km]
+        >>> ctx.position.shape, round(float(np.linalg.norm(ctx.position[0])), 0)  # [km]
         ((3, 3), 7187.0)
         """
         st = self._state()
-        return _att.Context(
-            epoch=self.times[0], position_km=st["r"], velocity_km_s=st["v"], sun_km=st["sun"]
-        )
+        return _att.Context(epoch=self.times[0], position=st["r"], velocity=st["v"], sun=st["sun"])
 
     def quaternions(self) -> NDArray[np.float64]:
         """Attitudes (body -> GCRS) at the observation times, sign-continuous; (n, 4).
@@ -347,7 +345,7 @@ class Observation:
                [0.      , 0.      , 0.766044, 0.642788]])
         """
         ctx = self.context()
-        unknown = ~np.isfinite(np.asarray(ctx.velocity_km_s)).all(axis=1)
+        unknown = ~np.isfinite(np.asarray(ctx.velocity)).all(axis=1)
         try:
             with np.errstate(invalid="ignore"):
                 q = np.asarray(self.attitude.quaternions(self.times, ctx), dtype=np.float64)

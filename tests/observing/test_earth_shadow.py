@@ -76,7 +76,7 @@ def exit_window():
     obs = dataclasses.replace(base, times=t)
     ctx = obs.context()
     rot = np.moveaxis(itrs.rotation_at(skyfield_time(t)), -1, 0)  # (n, 3, 3)
-    return obs, t, ctx.position_km, ctx.sun_km, rot
+    return obs, t, ctx.position, ctx.sun, rot
 
 
 def independent_edges(t, r, sun, rot, earth):

@@ -199,7 +199,7 @@ def _geometry(scene: Scene, observed: xr.Dataset | None) -> dict[str, np.ndarray
     obs = scene.observation
     assert obs is not None and observed is not None  # the effect needs an observation
     ctx = obs.context()
-    r, v, sun = ctx.position_km, ctx.velocity_km_s, ctx.sun_km
+    r, v, sun = ctx.position, ctx.velocity, ctx.sun
     assert r is not None and v is not None and sun is not None  # an observation's context has all
     m = moon_from_spacecraft(obs.times, r, v, sun, obs.earth)
     rot = rotation_matrices(observed["quaternion"].values)  # body -> GCRS
