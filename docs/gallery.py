@@ -95,7 +95,7 @@ def figures() -> dict[str, Any]:
     out["canx1_rotation.png"] = plot.cube_figure(rot)  # what `simulate --plot` draws
     out["canx1_colour_colour.png"] = colour_colour_figure(rot)
     spec = simulate("canx1-plusx-specular").compute()
-    fig = plot.spectra(spec, attitude=0)
+    fig = plot.spectrum_curves(spec, attitude=0)
     fig.axes[0].set_title("CanX-1 +X side at specular (paper 000 Fig. 14)", fontsize="medium")
     out["canx1_plusx_spectra.png"] = fig
     out["canx1_off_specular.png"] = off_specular_figure()

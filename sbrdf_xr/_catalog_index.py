@@ -40,7 +40,7 @@ from .errors import CatalogError, did_you_mean
 
 __all__ = [
     "CATALOG_PATH_ENV",
-    "KINDS",
+    "ENTRY_KINDS",
     "SOURCES",
     "CatalogEntry",
     "catalog_dir",
@@ -54,7 +54,15 @@ __all__ = [
 #: Environment variable listing user catalog directories (separated by :data:`os.pathsep`).
 CATALOG_PATH_ENV = "SBRDF_XR_CATALOG_PATH"
 
-KINDS = ("material", "measurements", "model", "paint_parameters", "spacecraft", "orbit", "site")
+ENTRY_KINDS = (
+    "material",
+    "measurements",
+    "model",
+    "paint_parameters",
+    "spacecraft",
+    "orbit",
+    "site",
+)
 SOURCES = ("measured", "synthetic")
 
 
@@ -254,9 +262,9 @@ def _read_index(path: Path, stamp: tuple[int, int], root: Path | None) -> tuple[
         missing = [k for k in required if k not in item]
         if missing:
             raise CatalogError(f"{path}: entry {i} lacks the field(s) {missing}")
-        if item["kind"] not in KINDS:
+        if item["kind"] not in ENTRY_KINDS:
             raise CatalogError(
-                f"{path}: entry {item['name']!r} has kind {item['kind']!r}; allowed: {KINDS}"
+                f"{path}: entry {item['name']!r} has kind {item['kind']!r}; allowed: {ENTRY_KINDS}"
             )
         src = item["source"]
         if src not in SOURCES and not src.startswith("model:"):
@@ -292,7 +300,7 @@ def entries(kind: str | None = None) -> list[CatalogEntry]:
     Parameters
     ----------
     kind : str, optional
-        One of :data:`KINDS`.
+        One of :data:`ENTRY_KINDS`.
 
     Returns
     -------
@@ -306,8 +314,8 @@ def entries(kind: str | None = None) -> list[CatalogEntry]:
     >>> catalog.entries("material")[0].kind
     'material'
     """
-    if kind is not None and kind not in KINDS:
-        raise CatalogError(f"unknown catalog kind {kind!r}; allowed: {', '.join(KINDS)}")
+    if kind is not None and kind not in ENTRY_KINDS:
+        raise CatalogError(f"unknown catalog kind {kind!r}; allowed: {', '.join(ENTRY_KINDS)}")
     return [e for e in _index() if kind is None or e.kind == kind]
 
 

@@ -78,7 +78,7 @@ class SbrdfDataArrayAccessor:
 
         ``da.sbrdf.plot.magnitudes()``, ``da.sbrdf.plot.lut_slice(30)``.
         """
-        return _Plotter(self._da, {"magnitudes": "magnitudes", "lut_slice": "lut_slice"})
+        return _Plotter(self._da, {"magnitudes": "magnitude_curves", "lut_slice": "lut_slice"})
 
 
 class _Plotter:
@@ -94,7 +94,7 @@ class _Plotter:
         if isinstance(self._obj, xr.Dataset):
             return _plot.cube_figure(self._obj, **kwargs)
         if "band" in self._obj.dims:
-            return _plot.magnitudes(self._obj, **kwargs)
+            return _plot.magnitude_curves(self._obj, **kwargs)
         raise AttributeError(
             "no natural figure for this array; use .lut_slice(theta_i) for a material table"
         )
@@ -181,5 +181,9 @@ class SbrdfDatasetAccessor:
         ``.spectra()``, ``.colour_colour("B-V", "V-R")`` (a photometry Dataset)."""
         return _Plotter(
             self._ds,
-            {"light_curve": "light_curve", "spectra": "spectra", "colour_colour": "colour_colour"},
+            {
+                "light_curve": "light_curve",
+                "spectra": "spectrum_curves",
+                "colour_colour": "colour_colour",
+            },
         )

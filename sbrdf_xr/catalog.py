@@ -34,8 +34,7 @@ from numpy.typing import DTypeLike
 
 from ._catalog_index import (
     CATALOG_PATH_ENV,
-    KINDS,
-    SOURCES,
+    ENTRY_KINDS,
     CatalogEntry,
     catalog_dir,
     data_path,
@@ -46,17 +45,25 @@ from ._catalog_index import (
 )
 from ._names import SBRDF, WAVELENGTH
 from .body import spacecraft
-from .errors import CatalogError, ValidationError, did_you_mean, input_file, reading
+from .errors import (
+    CatalogError,
+    ValidationError,
+    did_you_mean,
+    input_file,
+    reading,
+    renamed_attributes,
+)
 from .materials import models
 from .materials import tables as material
 from .materials.cache import cache_file, cached_table
 from .materials.readers import read_measurements
+from .materials.schema import SOURCES
 from .materials.shipped import read_reflectance
 from .observing import observe
 
 __all__ = [
     "CATALOG_PATH_ENV",
-    "KINDS",
+    "ENTRY_KINDS",
     "LOADERS",
     "MATERIAL_SUFFIXES",
     "MESH_SUFFIXES",
@@ -344,7 +351,7 @@ LOADERS: dict[str, Callable[[CatalogEntry], Any]] = {
     "orbit": observe.load_orbit_entry,
     "site": observe.load_site_entry,
 }
-assert set(LOADERS) == set(KINDS)
+assert set(LOADERS) == set(ENTRY_KINDS)
 
 
 def load(name: str, dtype: DTypeLike | None = None) -> Any:
@@ -387,7 +394,7 @@ def load(name: str, dtype: DTypeLike | None = None) -> Any:
 
     >>> catalog.load("canx1")  # doctest: +ELLIPSIS
     <Spacecraft 'canx1': 684 facets, materials ['aluminium-6061-t6', 'tjpv-cell', ...] m>
-    >>> catalog.load("mont-megantic").latitude_deg
+    >>> catalog.load("mont-megantic").latitude
     45.4555
 
     The grey table in float32, as a scene with ``dtype="float32"`` loads it:
@@ -685,3 +692,7 @@ def material_tables(
                 ) from None
             tables[mat] = obj
     return tables, given
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"KINDS": "ENTRY_KINDS"})

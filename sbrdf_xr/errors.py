@@ -57,6 +57,7 @@ __all__ = [
     "input_file",
     "reading",
     "renamed_attributes",
+    "renamed_fields",
     "renamed_keywords",
 ]
 
@@ -510,11 +511,11 @@ def renamed_keywords(**old_to_new: str) -> Callable[[_F], _F]:
                 if old in kwargs:
                     if new in kwargs:
                         raise ValidationError(
-                            f"{func.__name__}() received both {old!r} and {new!r}; "
+                            f"{func.__qualname__}() received both {old!r} and {new!r}; "
                             f"{old!r} is the old name of {new!r}: pass only {new!r}"
                         )
                     warnings.warn(
-                        f"{func.__name__}(): the keyword {old!r} is renamed {new!r}; "
+                        f"{func.__qualname__}(): the keyword {old!r} is renamed {new!r}; "
                         f"the old name will be removed in the next release",
                         RenamedWarning,
                         stacklevel=2,
@@ -571,3 +572,60 @@ def renamed_attributes(
         raise AttributeError(f"module {module!r} has no attribute {name!r}")
 
     return __getattr__
+
+
+_C = TypeVar("_C", bound=type)
+
+
+def renamed_fields(**old_to_new: str) -> Callable[[_C], _C]:
+    """Accept the old field names of a (data)class for one release, with a warning.
+
+    The constructor takes the old names as keywords (:func:`renamed_keywords`), and each
+    old name stays a read-only property that returns the new field, both with a
+    :class:`~sbrdf_xr.errors.RenamedWarning`.
+
+    Parameters
+    ----------
+    **old_to_new
+        Old field name -> new field name.
+
+    Returns
+    -------
+    callable
+        A class decorator.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> from dataclasses import dataclass
+    >>> @renamed_fields(height_m="height")
+    ... @dataclass(frozen=True)
+    ... class Post:
+    ...     height: float
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     p = Post(height_m=2.0)
+    ...     p.height, p.height_m, [w.category.__name__ for w in caught]
+    (2.0, 2.0, ['RenamedWarning', 'RenamedWarning'])
+    """
+
+    def decorate(cls: _C) -> _C:
+        cls.__init__ = renamed_keywords(**old_to_new)(cls.__init__)  # type: ignore[misc]
+
+        def alias(old: str, new: str) -> property:
+            def get(self: Any) -> Any:
+                warnings.warn(
+                    f"{type(self).__name__}.{old} is renamed {type(self).__name__}.{new}; "
+                    f"the old name will be removed in the next release",
+                    RenamedWarning,
+                    stacklevel=2,
+                )
+                return getattr(self, new)
+
+            return property(get, doc=f"Old name of :attr:`{new}` (deprecated).")
+
+        for old, new in old_to_new.items():
+            setattr(cls, old, alias(old, new))
+        return cls
+
+    return decorate

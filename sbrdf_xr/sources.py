@@ -32,12 +32,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import constants
 
-from .errors import ValidationError
+from .errors import ValidationError, renamed_attributes, renamed_keywords
 from .units import check_plausible, to_unit
 
 __all__ = [
+    "EARTH_MEAN_RADIUS_KM",
     "EARTH_NODES",
-    "EARTH_RADIUS_KM",
     "EARTH_TEMPERATURE_MAX",
     "MOON_MEAN_DISTANCE_KM",
     "MOON_RADIUS_KM",
@@ -57,7 +57,7 @@ __all__ = [
 ]
 
 #: Earth's mean radius [km].
-EARTH_RADIUS_KM = 6371.0
+EARTH_MEAN_RADIUS_KM = 6371.0
 #: The Moon's mean distance from the Earth's centre [km], the distance its magnitude law
 #: refers to (Allen 1973; Krisciunas & Schaefer 1991).
 MOON_MEAN_DISTANCE_KM = 384400.0
@@ -68,7 +68,8 @@ MOON_RADIUS_KM = 1737.4
 SUN_V_MAGNITUDE = -26.74
 
 
-def planck(wavelength_nm: ArrayLike, temperature: ArrayLike) -> NDArray[np.float64]:
+@renamed_keywords(wavelength_nm="wavelength")
+def planck(wavelength: ArrayLike, temperature: ArrayLike) -> NDArray[np.float64]:
     """Blackbody spectral radiance ``B(lambda, T)`` [W m-2 sr-1 nm-1] (Planck's law).
 
     ``B = 2 h c^2 / lambda^5 / (exp(h c / (lambda k T)) - 1)``, evaluated as
@@ -78,7 +79,7 @@ def planck(wavelength_nm: ArrayLike, temperature: ArrayLike) -> NDArray[np.float
 
     Parameters
     ----------
-    wavelength_nm : array_like
+    wavelength : array_like
         Vacuum wavelength [nm], > 0.
     temperature : float or array_like
         Temperature [K], >= 0 (0 K radiates nothing).  An array of temperatures gives
@@ -100,7 +101,7 @@ def planck(wavelength_nm: ArrayLike, temperature: ArrayLike) -> NDArray[np.float
     0.0
     """
     h, c, k = constants.h, constants.c, constants.k
-    wl = to_unit(wavelength_nm, "nm", "wavelength_nm", spectral=True)
+    wl = to_unit(wavelength, "nm", "wavelength", spectral=True)
     lam = np.asarray(wl, dtype=np.float64) * 1e-9
     t = np.asarray(to_unit(temperature, "K", "temperature"), dtype=np.float64)
     with np.errstate(divide="ignore"):
@@ -109,7 +110,8 @@ def planck(wavelength_nm: ArrayLike, temperature: ArrayLike) -> NDArray[np.float
         return 2.0 * h * c**2 / lam**5 * np.exp(-x) / -np.expm1(-x) * 1e-9
 
 
-def earthshine_irradiance_ratio(albedo: float, range_km: float, phase_angle_deg: float) -> float:
+@renamed_keywords(range_km="range", phase_angle_deg="phase_angle")
+def earthshine_irradiance_ratio(albedo: float, range: float, phase_angle: float) -> float:
     """Irradiance from a Lambertian Earth relative to the Sun's (same heliocentric distance).
 
     A Lambertian sphere of radius ``R`` and Bond albedo ``a`` seen at phase angle
@@ -123,9 +125,9 @@ def earthshine_irradiance_ratio(albedo: float, range_km: float, phase_angle_deg:
     ----------
     albedo : float
         Bond albedo [1].
-    range_km : float
+    range : float
         Distance to the Earth's centre [km].
-    phase_angle_deg : float
+    phase_angle : float
         Sun-Earth-spacecraft angle [degree].
 
     Returns
@@ -139,20 +141,21 @@ def earthshine_irradiance_ratio(albedo: float, range_km: float, phase_angle_deg:
     >>> round(earthshine_irradiance_ratio(0.3, 42164.0, 0.0), 5)  # full Earth from GEO
     0.00457
     """
-    a = np.radians(to_unit(phase_angle_deg, "deg", "phase_angle_deg"))
-    range_km = to_unit(range_km, "km", "range_km")
-    check_plausible(range_km, "range_km", "range_km")
+    a = np.radians(to_unit(phase_angle, "deg", "phase_angle"))
+    range = to_unit(range, "km", "range")
+    check_plausible(range, "range_km", "range")
     return float(
         2.0
         / 3.0
         * albedo
-        * (EARTH_RADIUS_KM / range_km) ** 2
+        * (EARTH_MEAN_RADIUS_KM / range) ** 2
         * ((np.pi - a) * np.cos(a) + np.sin(a))
         / np.pi
     )
 
 
-def moon_v_magnitude(phase_angle_deg: ArrayLike) -> NDArray[np.float64]:
+@renamed_keywords(phase_angle_deg="phase_angle")
+def moon_v_magnitude(phase_angle: ArrayLike) -> NDArray[np.float64]:
     """The Moon's V magnitude at its mean distance and 1 au from the Sun, by phase angle.
 
     ``m(alpha) = -12.73 + 0.026 |alpha| + 4e-9 alpha^4`` (``alpha`` in degree), the fit of
@@ -163,7 +166,7 @@ def moon_v_magnitude(phase_angle_deg: ArrayLike) -> NDArray[np.float64]:
 
     Parameters
     ----------
-    phase_angle_deg : array_like
+    phase_angle : array_like
         Sun-Moon-observer angle [degree], 0 at full Moon.
 
     Returns
@@ -177,13 +180,14 @@ def moon_v_magnitude(phase_angle_deg: ArrayLike) -> NDArray[np.float64]:
     >>> moon_v_magnitude([0.0, 90.0, -90.0]).round(2).tolist()  # full and quarter Moons
     [-12.73, -10.13, -10.13]
     """
-    a = np.abs(np.asarray(to_unit(phase_angle_deg, "deg", "phase_angle_deg"), dtype=np.float64))
+    a = np.abs(np.asarray(to_unit(phase_angle, "deg", "phase_angle"), dtype=np.float64))
     return -12.73 + 0.026 * a + 4e-9 * a**4
 
 
+@renamed_keywords(distance_km="distance", phase_angle_deg="phase_angle")
 def moonlight_irradiance_ratio(
-    phase_angle_deg: ArrayLike,
-    distance_km: ArrayLike,
+    phase_angle: ArrayLike,
+    distance: ArrayLike,
     sun_distance_ratio: ArrayLike = 1.0,
 ) -> NDArray[np.float64]:
     """Irradiance from the Moon relative to the Sun's at the observer.
@@ -199,9 +203,9 @@ def moonlight_irradiance_ratio(
 
     Parameters
     ----------
-    phase_angle_deg : array_like
+    phase_angle : array_like
         Sun-Moon-observer angle [degree].
-    distance_km : array_like
+    distance : array_like
         Moon-observer distance (centre to centre) [km].
     sun_distance_ratio : array_like
         Sun-observer distance over Sun-Moon distance [1].
@@ -221,8 +225,8 @@ def moonlight_irradiance_ratio(
     >>> f"{full:.3e}", round(float(quarter / full), 3)
     ('2.489e-06', 0.091)
     """
-    d = np.asarray(to_unit(distance_km, "km", "distance_km"), dtype=np.float64)
-    m = moon_v_magnitude(phase_angle_deg)
+    d = np.asarray(to_unit(distance, "km", "distance"), dtype=np.float64)
+    m = moon_v_magnitude(phase_angle)
     ratio = 10.0 ** (-0.4 * (m - SUN_V_MAGNITUDE))
     return ratio * (MOON_MEAN_DISTANCE_KM / d) ** 2 * np.asarray(sun_distance_ratio) ** 2
 
@@ -309,15 +313,15 @@ def _leggauss(n: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _earth_cap(
-    plate_normal: ArrayLike, to_earth: ArrayLike, range_km: float, nodes: tuple[int, int]
+    plate_normal: ArrayLike, to_earth: ArrayLike, range: float, nodes: tuple[int, int]
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Directions ``d`` toward the visible Earth, the surface normals ``u`` they hit, the
     plate's ``max(n.d, 0)`` and the solid-angle weights [sr] (``sum w f = int f dOmega``)."""
-    r = float(to_unit(range_km, "km", "range_km"))
-    if not np.isfinite(r) or r <= EARTH_RADIUS_KM:
+    r = float(to_unit(range, "km", "range"))
+    if not np.isfinite(r) or r <= EARTH_MEAN_RADIUS_KM:
         raise ValidationError(
-            f"range_km: got {r:g}; allowed: a distance from the Earth's centre above its "
-            f"radius, {EARTH_RADIUS_KM:g} km"
+            f"range: got {r:g}; allowed: a distance from the Earth's centre above its "
+            f"radius, {EARTH_MEAN_RADIUS_KM:g} km"
         )
     n = np.asarray(plate_normal, dtype=np.float64)
     z = np.asarray(to_earth, dtype=np.float64)
@@ -325,7 +329,7 @@ def _earth_cap(
     x = np.cross(z, [1.0, 0.0, 0.0] if abs(z[0]) < 0.9 else [0.0, 1.0, 0.0])
     x /= np.linalg.norm(x)
     y = np.cross(z, x)
-    sin_rho = EARTH_RADIUS_KM / r
+    sin_rho = EARTH_MEAN_RADIUS_KM / r
     # sin(psi) = sin(rho) sin(chi): smooth up to the limb (chi = pi/2)
     tc, wc = _leggauss(nodes[0])
     chi, w_chi = 0.25 * np.pi * (tc + 1.0), 0.25 * np.pi * wc
@@ -339,16 +343,17 @@ def _earth_cap(
     )
     # the nearer intersection with the sphere, t = r cos(psi) - sqrt(R^2 - r^2 sin^2 psi)
     t = r * cos_psi - r * sin_rho * np.cos(chi)
-    u = (-r * z + t[:, None, None] * d) / EARTH_RADIUS_KM
+    u = (-r * z + t[:, None, None] * d) / EARTH_MEAN_RADIUS_KM
     w = (w_chi * sin_psi * dpsi)[:, None] * w_om[None, :]
     return d, u, np.maximum(d @ n, 0.0), w
 
 
+@renamed_keywords(range_km="range")
 def earthshine_finite(
     plate_normal: ArrayLike,
     to_earth: ArrayLike,
     to_sun: ArrayLike,
-    range_km: float,
+    range: float,
     albedo: float = 0.3,
     *,
     nodes: tuple[int, int] = EARTH_NODES,
@@ -366,7 +371,7 @@ def earthshine_finite(
     plate_normal, to_earth, to_sun : array_like, shape (3,)
         The plate's normal, the direction to the Earth's centre and to the Sun [1], in
         one frame.
-    range_km : float
+    range : float
         Distance from the Earth's centre [km], above the Earth's radius.
     albedo : float
         The Earth's Lambertian albedo [1].
@@ -389,15 +394,16 @@ def earthshine_finite(
     """
     s = np.asarray(to_sun, dtype=np.float64)
     s = s / np.linalg.norm(s)
-    _, u, cos_plate, w = _earth_cap(plate_normal, to_earth, range_km, nodes)
+    _, u, cos_plate, w = _earth_cap(plate_normal, to_earth, range, nodes)
     return float(albedo / np.pi * np.sum(w * np.maximum(u @ s, 0.0) * cos_plate))
 
 
+@renamed_keywords(range_km="range")
 def earth_thermal_irradiance(
     wavelength: ArrayLike,
     plate_normal: ArrayLike,
     to_earth: ArrayLike,
-    range_km: float,
+    range: float,
     temperature: float = 255.0,
     *,
     nodes: tuple[int, int] = EARTH_NODES,
@@ -414,7 +420,7 @@ def earth_thermal_irradiance(
         Vacuum wavelength [nm].
     plate_normal, to_earth : array_like, shape (3,)
         The plate's normal and the direction to the Earth's centre [1].
-    range_km : float
+    range : float
         Distance from the Earth's centre [km].
     temperature : float
         The Earth's brightness temperature [K], 0 < T <= :data:`EARTH_TEMPERATURE_MAX`.
@@ -441,7 +447,7 @@ def earth_thermal_irradiance(
             "(the Earth's brightness temperature)"
         )
     wl = to_unit(wavelength, "nm", "wavelength", spectral=True)
-    _, _, cos_plate, w = _earth_cap(plate_normal, to_earth, range_km, nodes)
+    _, _, cos_plate, w = _earth_cap(plate_normal, to_earth, range, nodes)
     return np.sum(w * cos_plate) * planck(wl, t)
 
 
@@ -490,8 +496,9 @@ def equilibrium_temperature(
     return (q / (radiating_sides * eps * constants.sigma)) ** 0.25
 
 
+@renamed_keywords(time_s="time")
 def radiative_cooling(
-    time_s: ArrayLike,
+    time: ArrayLike,
     initial_temperature: float,
     heat_capacity: float,
     emissivity: float,
@@ -506,7 +513,7 @@ def radiative_cooling(
 
     Parameters
     ----------
-    time_s : array_like
+    time : array_like
         Time since entering the shadow [s], >= 0.
     initial_temperature : float
         Temperature at ``t = 0`` [K], > 0.
@@ -528,11 +535,11 @@ def radiative_cooling(
     >>> np.round(radiative_cooling([0.0, 600.0, 3600.0], 300.0, 2430.0, 0.85), 1).tolist()
     [300.0, 239.6, 158.5]
     """
-    t = np.asarray(to_unit(time_s, "s", "time_s"), dtype=np.float64)
+    t = np.asarray(to_unit(time, "s", "time"), dtype=np.float64)
     t0 = float(to_unit(initial_temperature, "K", "initial_temperature"))
     c = float(to_unit(heat_capacity, "J m-2 K-1", "heat_capacity"))
     if np.any(~np.isfinite(t)) or np.any(t < 0):
-        raise ValidationError(f"time_s: got {np.ravel(t)[:5].tolist()}; allowed: >= 0 s")
+        raise ValidationError(f"time: got {np.ravel(t)[:5].tolist()}; allowed: >= 0 s")
     if not (0.0 < t0 <= 10_000.0):
         raise ValidationError(f"initial_temperature: got {t0:g} K; allowed: 0 < T <= 10000 K")
     if not (c > 0 and np.isfinite(c)):
@@ -546,22 +553,23 @@ def radiative_cooling(
 
 
 def _canonical_cap(
-    range_km: float, cos_sun: float, nodes: tuple[int, int]
+    range: float, cos_sun: float, nodes: tuple[int, int]
 ) -> tuple[np.ndarray, np.ndarray]:
     """Directions (K, 3) toward the visible Earth and their weights ``w max(u.s, 0)`` [sr] in
     the frame with the Earth's centre on +z and the Sun in the x-z half-plane ``x >= 0``."""
     s = np.array([np.sqrt(max(0.0, 1.0 - cos_sun**2)), 0.0, cos_sun])
-    d, u, _, w = _earth_cap([0.0, 0.0, 1.0], [0.0, 0.0, 1.0], range_km, nodes)
+    d, u, _, w = _earth_cap([0.0, 0.0, 1.0], [0.0, 0.0, 1.0], range, nodes)
     lw = (w * np.maximum(u @ s, 0.0)).ravel()
     keep = lw > 0.0  # the night side adds nothing
     return d.reshape(-1, 3)[keep], lw[keep]
 
 
+@renamed_keywords(range_km="range")
 def earthshine_facets(
     normals: ArrayLike,
     to_earth: ArrayLike,
     to_sun: ArrayLike,
-    range_km: ArrayLike,
+    range: ArrayLike,
     albedo: float = 0.3,
     *,
     nodes: tuple[int, int] = (64, 128),
@@ -581,7 +589,7 @@ def earthshine_facets(
         Unit plate normals [1].
     to_earth, to_sun : array_like, shape (G, 3)
         Unit directions to the Earth's centre and to the Sun [1], in the normals' frame.
-    range_km : array_like, shape (G,) or scalar
+    range : array_like, shape (G,) or scalar
         Distance from the Earth's centre [km], above the Earth's radius.
     albedo : float
         The Earth's Lambertian albedo [1].
@@ -608,7 +616,7 @@ def earthshine_facets(
     nrm = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
     e = np.asarray(to_earth, dtype=np.float64).reshape(-1, 3)
     s = np.asarray(to_sun, dtype=np.float64).reshape(-1, 3)
-    rng = np.broadcast_to(np.asarray(to_unit(range_km, "km", "range_km"), float), e.shape[:1])
+    rng = np.broadcast_to(np.asarray(to_unit(range, "km", "range"), float), e.shape[:1])
     e = e / np.linalg.norm(e, axis=1, keepdims=True)
     s = s / np.linalg.norm(s, axis=1, keepdims=True)
     cz = np.clip(np.einsum("gi,gi->g", s, e), -1.0, 1.0)
@@ -623,19 +631,19 @@ def earthshine_facets(
     nc = np.stack([x @ nrm.T, y @ nrm.T, e @ nrm.T], axis=-1)  # (G, T, 3)
     out = np.zeros(nc.shape[:2])
     cache: dict[tuple[float, float], tuple[np.ndarray, np.ndarray]] = {}
-    for g in range(e.shape[0]):
+    for g in np.arange(e.shape[0]):
         key = (float(rng[g]), round(float(cz[g]), 12))
         if key not in cache:
             cache[key] = _canonical_cap(key[0], key[1], nodes)
         d, lw = cache[key]
         if lw.size == 0:
             continue
-        sin_rho = EARTH_RADIUS_KM / key[0]
+        sin_rho = EARTH_MEAN_RADIUS_KM / key[0]
         nz = nc[g, :, 2]
         whole, cut = nz >= sin_rho, np.abs(nz) < sin_rho
         out[g, whole] = nc[g, whole] @ (lw @ d)
         idx = np.flatnonzero(cut)
-        for k in range(0, idx.size, 64):  # (64, K) at a time
+        for k in np.arange(0, idx.size, 64):  # (64, K) at a time
             j = idx[k : k + 64]
             out[g, j] = np.maximum(nc[g, j] @ d.T, 0.0) @ lw
     return albedo / np.pi * out
@@ -644,7 +652,7 @@ def earthshine_facets(
 def earth_view_facets(
     normals: ArrayLike,
     to_earth: ArrayLike,
-    range_km: ArrayLike,
+    range: ArrayLike,
     *,
     nodes: tuple[int, int] = (64, 128),
 ) -> NDArray[np.float64]:
@@ -665,7 +673,7 @@ def earth_view_facets(
         Unit plate normals [1].
     to_earth : array_like, shape (G, 3)
         Unit directions to the Earth's centre [1], in the normals' frame.
-    range_km : array_like, shape (G,) or scalar
+    range : array_like, shape (G,) or scalar
         Distance from the Earth's centre [km], above the Earth's radius.
     nodes : tuple of int
         Gauss-Legendre nodes (radial, azimuthal) over the Earth's disc.
@@ -690,13 +698,13 @@ def earth_view_facets(
     """
     nrm = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
     e = np.asarray(to_earth, dtype=np.float64).reshape(-1, 3)
-    rng = np.broadcast_to(np.asarray(to_unit(range_km, "km", "range_km"), float), e.shape[:1])
+    rng = np.broadcast_to(np.asarray(to_unit(range, "km", "range"), float), e.shape[:1])
     e = e / np.linalg.norm(e, axis=1, keepdims=True)
     nz = e @ nrm.T  # (G, T) the cosine of the Earth's centre from each normal
     out = np.zeros(nz.shape)
     for r in np.unique(rng):
         rows = np.flatnonzero(rng == r)
-        sin_rho = EARTH_RADIUS_KM / float(r)
+        sin_rho = EARTH_MEAN_RADIUS_KM / float(r)
         whole = nz[rows] >= sin_rho
         out[rows] = np.where(whole, np.pi * sin_rho**2 * nz[rows], 0.0)
         g_cut, t_cut = np.nonzero(np.abs(nz[rows]) < sin_rho)
@@ -711,3 +719,7 @@ def earth_view_facets(
             local = np.stack([np.sqrt(np.clip(1.0 - c**2, 0.0, None)), 0 * c, c], axis=1)
             out[g, t] = np.maximum(local @ d.T, 0.0) @ w
     return out
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"EARTH_RADIUS_KM": "EARTH_MEAN_RADIUS_KM"})

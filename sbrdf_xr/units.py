@@ -1,11 +1,12 @@
 """Units at the door: astropy Quantities converted, bare numbers in the documented unit.
 
-Every public argument of the package that carries a unit names it (``range_km`` [km],
-``wavelength`` [nm], ``step_s`` [s], ``latitude_deg`` [degree]) and passes through
-:func:`to_unit` before anything else:
+Every public argument of the package that carries a unit is named bare and states the
+unit in brackets in its docstring (``range`` [km], ``wavelength`` [nm], ``step`` [s],
+``latitude`` [degree]; docs/guide/conventions.md) and passes through :func:`to_unit`
+before anything else:
 
 * an astropy :class:`~astropy.units.Quantity` is converted to that unit (``1e6 * u.m``
-  given as ``range_km`` is 1000 km; ``0.5 * u.rad`` as ``phase_deg`` is 28.6479 degree;
+  given as ``range`` is 1000 km; ``0.5 * u.rad`` as ``phase_angle`` is 28.6479 degree;
   wavelengths also from frequencies and wavenumbers, by astropy's spectral equivalency);
 * temperatures also from degrees Celsius or Fahrenheit (astropy's ``temperature``
   equivalency);

@@ -47,3 +47,15 @@ def test_old_attribute_returns_the_same_object():
         assert getter("OLD") is marker
     with pytest.raises(AttributeError, match="no attribute 'MISSING'"):
         getter("MISSING")
+
+
+def test_old_site_fields_still_work_with_a_warning():
+    from sbrdf_xr.observing import Site
+
+    with pytest.warns(RenamedWarning, match=r"Site.__init__\(\): the keyword 'height_m'"):
+        site = Site(45.0, -71.0, height_m=1000.0)
+    assert (site.latitude, site.longitude, site.height) == (45.0, -71.0, 1000.0)
+    with pytest.warns(RenamedWarning, match="Site.height_m is renamed Site.height"):
+        assert site.height_m == 1000.0
+    with pytest.raises(AttributeError):
+        site.latitude_deg = 3.0  # type: ignore[misc]  # read-only, as the field is

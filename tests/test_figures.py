@@ -74,11 +74,11 @@ FIGURES = {
     "light_curve": lambda: plot.light_curve(
         testing.rotation_cube(phase_angles=(5.0, 10.0, 30.0, 60.0, 90.0, 120.0))
     ),
-    "spectra of a rotation": lambda: plot.spectra(testing.rotation_cube(), attitude=0),
-    "spectra of a pass": lambda: plot.spectra(testing.pass_cube(), "signal"),
+    "spectra of a rotation": lambda: plot.spectrum_curves(testing.rotation_cube(), attitude=0),
+    "spectra of a pass": lambda: plot.spectrum_curves(testing.pass_cube(), "signal"),
     "lut_slice broadband": lambda: plot.lut_slice(lambertian(0.5, [500.0, 600.0]), 30.0),
     "lut_slice at 550 nm": lambda: plot.lut_slice(lambertian(0.5, [500.0, 600.0]), 30.0, 550.0),
-    "magnitudes": lambda: plot.magnitudes(
+    "magnitudes": lambda: plot.magnitude_curves(
         plot.cube_magnitudes(testing.rotation_cube()), phase_angle=10.0
     ),
     "colour_colour": lambda: plot.colour_colour(_photometry_of_rotation(), "V-R", "R-I"),
@@ -220,7 +220,7 @@ def test_the_observation_figure_marks_the_shadow():
 
 def test_spectra_are_few_and_named():
     cube = _geometry_cube()
-    fig = plot.spectra(cube, max_lines=5)
+    fig = plot.spectrum_curves(cube, max_lines=5)
     legend = fig.axes[0].get_legend()
     assert len(fig.axes[0].lines) == 5
     assert legend.get_title().get_text().startswith("5 of 30 spectra, ranked by mean")

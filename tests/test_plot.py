@@ -56,7 +56,7 @@ def _labels(fig):
 def test_cube_figures_have_short_labels_with_units(sweep):
     for fig in (
         plot.light_curve(sweep),
-        plot.spectra(sweep, "signal", attitude=0),
+        plot.spectrum_curves(sweep, "signal", attitude=0),
     ):
         for text in _labels(fig):
             assert 0 < len(text) <= MAX_LABEL and "[" in text, text
@@ -94,7 +94,7 @@ def test_log_axis_where_the_range_is_large():
 
 def test_magnitudes_per_band_brighter_up_and_the_accessor(sweep):
     mags = P.magnitudes(sweep, ["V", "R", "I"], 1000.0, system="vega")
-    fig = plot.magnitudes(mags, phase_angle=10.0)
+    fig = plot.magnitude_curves(mags, phase_angle=10.0)
     ax = fig.axes[0]
     assert ax.yaxis_inverted() and [t.get_text() for t in ax.get_legend().get_texts()] == [
         "V",
@@ -103,7 +103,7 @@ def test_magnitudes_per_band_brighter_up_and_the_accessor(sweep):
     ]
     assert ax.get_ylabel() == "magnitude at 1000 km [Vega mag]"
     with pytest.raises(ValueError, match="select the others"):
-        plot.magnitudes(mags)
+        plot.magnitude_curves(mags)
     f2 = mags.sbrdf.plot(phase_angle=10.0)
     assert f2.axes[0].yaxis_inverted()
     assert sweep.sbrdf.plot().axes[0].get_yscale() in ("log", "linear")

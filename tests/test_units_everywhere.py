@@ -434,34 +434,34 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.geometry.angles.to_conventional": lambda: dict(
         theta_i=[20.0], delta_theta=[5.0], phi=[10.0]
     ),
-    "sbrdf_xr.geometry.angles.observation_plane": lambda: dict(phase_angle_deg=[20.0, 75.0]),
+    "sbrdf_xr.geometry.angles.observation_plane": lambda: dict(phase_angle=[20.0, 75.0]),
     "sbrdf_xr.geometry.rotations.axis_rotation": lambda: dict(axis=[0, 0, 1], angle=[30.0, 60.0]),
     "sbrdf_xr.geometry.rotations.euler_attitudes": lambda: dict(
         sequence="zyx", angles=[[10.0, 20.0, 30.0]]
     ),
     "sbrdf_xr.geometry.rotations.rotation_sweep": lambda: dict(axis=[0, 0, 1], angles=[0.0, 45.0]),
     "sbrdf_xr.sources.earthshine_irradiance_ratio": lambda: dict(
-        albedo=0.3, range_km=42164.0, phase_angle_deg=30.0
+        albedo=0.3, range=42164.0, phase_angle=30.0
     ),
     "sbrdf_xr.sources.earthshine_finite": lambda: dict(
         plate_normal=[0, 0, -1],
         to_earth=[0, 0, -1],
         to_sun=[0, 0, 1],
-        range_km=42164.0,
+        range=42164.0,
         nodes=(16, 32),
     ),
     "sbrdf_xr.sources.earthshine_facets": lambda: dict(
         normals=[[0, 0, -1], [1, 0, 0]],
         to_earth=[[0, 0, -1]],
         to_sun=[[0, 0, 1]],
-        range_km=[7000.0],
+        range=[7000.0],
         nodes=(16, 32),
     ),
     "sbrdf_xr.sources.earth_thermal_irradiance": lambda: dict(
         wavelength=[8000.0, 10_000.0],
         plate_normal=[0, 0, -1],
         to_earth=[0, 0, -1],
-        range_km=42164.0,
+        range=42164.0,
         temperature=255.0,
         nodes=(16, 32),
     ),
@@ -472,20 +472,20 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         absorbed=[100.0, 1361.0], emissivity=0.8
     ),
     "sbrdf_xr.sources.radiative_cooling": lambda: dict(
-        time_s=[0.0, 600.0], initial_temperature=300.0, heat_capacity=2430.0, emissivity=0.85
+        time=[0.0, 600.0], initial_temperature=300.0, heat_capacity=2430.0, emissivity=0.85
     ),
     "sbrdf_xr.sources.emissivity_at": lambda: dict(
         emissivity=np.array([[0.8, 0.5], [0.6, 0.3]]),
         theta_grid=np.array([0.0, 90.0]),
         theta=[45.0, 70.0],
     ),
-    "sbrdf_xr.sources.moon_v_magnitude": lambda: dict(phase_angle_deg=[10.0, 90.0]),
+    "sbrdf_xr.sources.moon_v_magnitude": lambda: dict(phase_angle=[10.0, 90.0]),
     "sbrdf_xr.sources.moonlight_irradiance_ratio": lambda: dict(
-        phase_angle_deg=[10.0, 90.0], distance_km=384400.0
+        phase_angle=[10.0, 90.0], distance=384400.0
     ),
-    "sbrdf_xr.sources.planck": lambda: dict(wavelength_nm=[800.0, 10_000.0], temperature=300.0),
+    "sbrdf_xr.sources.planck": lambda: dict(wavelength=[800.0, 10_000.0], temperature=300.0),
     # --- body
-    "sbrdf_xr.body.imperfections.tilt_quadrature": lambda: dict(sigma_deg=2.0, n=3),
+    "sbrdf_xr.body.imperfections.tilt_quadrature": lambda: dict(sigma=2.0, n=3),
     "sbrdf_xr.body.imperfections.tilted_normals": lambda: dict(
         normals=[[0.0, 0.0, 1.0]], tilts=[[0.0, 0.0], [0.1, 0.05]]
     ),
@@ -518,11 +518,11 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.brdf.anisotropic.brdf_angles": _angles_case("anisotropic", _ANISO),
     "sbrdf_xr.brdf.anisotropic.render_grid": _angles_case("anisotropic", _ANISO),
     "sbrdf_xr.brdf._common.tangent_from_azimuth": lambda: dict(psi=[0.0, 30.0]),
-    "sbrdf_xr.brdf.optics.aluminium_index": lambda: dict(wavelength_nm=WL),
-    "sbrdf_xr.brdf.optics.gaas_index": lambda: dict(wavelength_nm=[900.0, 1000.0]),
-    "sbrdf_xr.brdf.optics.silica_index": lambda: dict(wavelength_nm=WL),
-    "sbrdf_xr.brdf.optics.sapphire_index": lambda: dict(wavelength_nm=WL),
-    "sbrdf_xr.brdf.optics.titania_index": lambda: dict(wavelength_nm=WL),
+    "sbrdf_xr.brdf.optics.aluminium_index": lambda: dict(wavelength=WL),
+    "sbrdf_xr.brdf.optics.gaas_index": lambda: dict(wavelength=[900.0, 1000.0]),
+    "sbrdf_xr.brdf.optics.silica_index": lambda: dict(wavelength=WL),
+    "sbrdf_xr.brdf.optics.sapphire_index": lambda: dict(wavelength=WL),
+    "sbrdf_xr.brdf.optics.titania_index": lambda: dict(wavelength=WL),
     "sbrdf_xr.brdf.optics.fresnel_thin_film_stack": lambda: dict(
         cos_theta=[1.0, 0.5], wavelength=WL, layers=[(1.38, 100.0)], substrate=1.5
     ),
@@ -571,10 +571,10 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         self=_cube().sbrdf, bands=["V", "R"], range_km=1000.0
     ),
     "sbrdf_xr.observing.observation.Observation.next_pass": lambda: dict(
-        self=_observation(), days=0.5, twilight_deg=-12.0
+        self=_observation(), days=0.5, twilight=-12.0
     ),
     "sbrdf_xr.observing.tumble.Tumble.from_spacecraft": lambda: dict(
-        spacecraft=_box(), density_kg_m3=100.0, omega_deg_s=(1.0, 2.0, 3.0)
+        spacecraft=_box(), density=100.0, omega=(1.0, 2.0, 3.0)
     ),
     # --- engine
     "sbrdf_xr.engine.scene.Scene": lambda: dict(
@@ -762,7 +762,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     # --- observing
     "sbrdf_xr.observing.attitude.Nadir": lambda: dict(yaw_deg=30.0),
     "sbrdf_xr.observing.attitude.geodetic_up": lambda: dict(
-        position_itrs_km=[[5000.0, 100.0, 5000.0]]
+        position_itrs=[[5000.0, 100.0, 5000.0]]
     ),
     "sbrdf_xr.observing.tracking_io.read_tracking_table": lambda: dict(
         path=_POMENIS40,
@@ -779,58 +779,55 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.observing.tumble.Tumble": lambda: dict(
         inertia=(1.0, 2.0, 3.0), omega_deg_s=(1.0, 2.0, 3.0)
     ),
-    "sbrdf_xr.observing.orbits.Site": lambda: dict(
-        latitude_deg=20.7, longitude_deg=-156.3, height_m=3058.0
-    ),
-    "sbrdf_xr.observing.orbits.airmass": lambda: dict(elevation_deg=[30.0, 60.0]),
+    "sbrdf_xr.observing.orbits.Site": lambda: dict(latitude=20.7, longitude=-156.3, height=3058.0),
     "sbrdf_xr.observing.observation.Observation": lambda: dict(
         **{f.name: getattr(_observation(), f.name) for f in _observation_fields()},
-        min_elevation_deg=5.0,
+        min_elevation=5.0,
     ),
     "sbrdf_xr.observing.timescales.times": lambda: dict(
-        start="2024-03-17T01:20:00", stop="2024-03-17T01:21:00", step_s=20.0
+        start="2024-03-17T01:20:00", stop="2024-03-17T01:21:00", step=20.0
     ),
     "sbrdf_xr.observing.earth_shadow.disc_overlap_fraction": lambda: dict(
         a=[0.01, 0.01], b=[0.02, 0.005], c=[0.015, 0.001]
     ),
     "sbrdf_xr.observing.earth_shadow.shadow_angles": lambda: dict(
-        position_km=[-7000.0, 100.0, 0.0],
-        sun_km=[1.496e8, 0.0, 0.0],
-        earth_radius_km=6378.137,
-        sun_radius_km=695700.0,
+        position=[-7000.0, 100.0, 0.0],
+        sun=[1.496e8, 0.0, 0.0],
+        earth_radius=6378.137,
+        sun_radius=695700.0,
     ),
     "sbrdf_xr.observing.earth_shadow.sunlit_fraction": lambda: dict(
-        position_km=[[-7000.0, 6378.137, 0.0]],
-        sun_km=[[1.5e8, 0.0, 0.0]],
-        earth_radius_km=6378.137,
-        sun_radius_km=695700.0,
+        position=[[-7000.0, 6378.137, 0.0]],
+        sun=[[1.5e8, 0.0, 0.0]],
+        earth_radius=6378.137,
+        sun_radius=695700.0,
     ),
     "sbrdf_xr.observing.earth_shadow.shadow_events": lambda: _shadow_inputs(),
     "sbrdf_xr.observing.frames.Context": lambda: dict(
         epoch=T0,
-        position_km=np.array([[7000.0, 0.0, 0.0]]),
-        velocity_km_s=np.array([[0.0, 7.5, 0.0]]),
-        sun_km=np.array([[1.496e8, 0.0, 0.0]]),
+        position=np.array([[7000.0, 0.0, 0.0]]),
+        velocity=np.array([[0.0, 7.5, 0.0]]),
+        sun=np.array([[1.496e8, 0.0, 0.0]]),
     ),
     "sbrdf_xr.observing.ephemeris.Ephemeris.from_states": lambda: dict(
         times=_T2,
-        position_km=[[7000.0, 0.0, 0.0], [7000.0, 75.0, 0.0]],
-        velocity_km_s=[[0.0, 7.5, 0.0], [0.0, 7.5, 0.0]],
+        position=[[7000.0, 0.0, 0.0], [7000.0, 75.0, 0.0]],
+        velocity=[[0.0, 7.5, 0.0], [0.0, 7.5, 0.0]],
     ),
     "sbrdf_xr.observing.ephemeris.to_gcrs": lambda: dict(
         frame="ITRF",
         times=_T2[:1],
-        position_km=[[7000.0, 0.0, 0.0]],
-        velocity_km_s=[[0.0, 0.0, 7.5]],
+        position=[[7000.0, 0.0, 0.0]],
+        velocity=[[0.0, 0.0, 7.5]],
     ),
     "sbrdf_xr.observing.passes.visible_passes": lambda: dict(
         source=_observation().orbit,
         site=_observation().site,
         start="2024-03-17T01:18:00",
         stop="2024-03-17T01:24:00",
-        min_elevation_deg=15.0,
-        step_s=30.0,
-        cross_section_m2=2.0,
+        min_elevation=15.0,
+        step=30.0,
+        cross_section=2.0,
     ),
     "sbrdf_xr.observing.tracking.TrackingTable": lambda: dict(
         site=_observation().site,
@@ -842,22 +839,22 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         max_gap_s=30.0,
     ),
     "sbrdf_xr.observing.tracking.range_for_height": lambda: dict(
-        site=_observation().site, direction_itrs=[[1.0, 0.0, 0.0]], height_km=[550.0]
+        site=_observation().site, direction_itrs=[[1.0, 0.0, 0.0]], height=[550.0]
     ),
     "sbrdf_xr.observing.tracking.topocentric_to_gcrs": lambda: dict(
         site=_observation().site,
         times=_T2,
-        elevation_deg=[30.0, 40.0],
-        azimuth_deg=[10.0, 20.0],
-        range_km=[900.0, 800.0],
+        elevation=[30.0, 40.0],
+        azimuth=[10.0, 20.0],
+        range=[900.0, 800.0],
     ),
     # --- photometry
     "sbrdf_xr.photometry.atmosphere.airmass": lambda: dict(elevation=[30.0, 60.0]),
     "sbrdf_xr.photometry.atmosphere.rayleigh_optical_depth": lambda: dict(
-        wavelength=WL, pressure_hpa=700.0
+        wavelength=WL, pressure=700.0
     ),
     "sbrdf_xr.photometry.atmosphere.transmission": lambda: dict(
-        wavelength=WL, airmass=1.5, pressure_hpa=700.0
+        wavelength=WL, airmass=1.5, pressure=700.0
     ),
     "sbrdf_xr.photometry.bands.band_weights": lambda: dict(
         bands=["V"], wavelength=np.arange(400.0, 1101.0, 10.0), solar=_sun()
@@ -882,32 +879,32 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.photometry.spectra.solar_spectrum": lambda: dict(wavelength=WL, solar=_sun()),
     "sbrdf_xr.photometry.spectra.vega_spectrum": lambda: dict(wavelength=WL),
     "sbrdf_xr.photometry.standard.at_resolution": lambda: dict(
-        spectrum=_solar(), fwhm_nm=5.0, wavelength=WL
+        spectrum=_solar(), fwhm=5.0, wavelength=WL
     ),
-    "sbrdf_xr.photometry.standard.lambert_sphere_phase": lambda: dict(alpha_deg=[10.0, 90.0]),
-    "sbrdf_xr.photometry.standard.specular_sphere_phase": lambda: dict(alpha_deg=[10.0, 90.0]),
+    "sbrdf_xr.photometry.standard.lambert_sphere_phase": lambda: dict(alpha=[10.0, 90.0]),
+    "sbrdf_xr.photometry.standard.specular_sphere_phase": lambda: dict(alpha=[10.0, 90.0]),
     "sbrdf_xr.photometry.standard.standard_magnitude": lambda: dict(
         mags=_mags(),
-        range_km=2000.0,
-        to_range_km=1000.0,
+        range=2000.0,
+        to_range=1000.0,
         phase_angle=40.0,
         to_phase_angle=90.0,
-        sun_distance_au=1.01,
+        sun_distance=1.01,
     ),
     # --- plot
     "sbrdf_xr.plot.front.accuracy_front": lambda: dict(rows=_bench_rows(), zero_below=1e-3),
     "sbrdf_xr.plot.curves.lut_slice": lambda: dict(
         material=_table(), theta_i=35.0, wavelength=600.0
     ),
-    "sbrdf_xr.plot.cube.cube_magnitudes": lambda: dict(cube=_cube(), bands=["V"], range_km=1000.0),
+    "sbrdf_xr.plot.cube.cube_magnitudes": lambda: dict(cube=_cube(), bands=["V"], range=1000.0),
     "sbrdf_xr.plot.cube.cube_figure": lambda: dict(
-        cube=_rotation_cube(), bands=["V"], range_km=1000.0
+        cube=_rotation_cube(), bands=["V"], range=1000.0
     ),
     "sbrdf_xr.plot.cube.rotation_figure": lambda: dict(
-        cube=_rotation_cube(), bands=["V"], range_km=1000.0
+        cube=_rotation_cube(), bands=["V"], range=1000.0
     ),
     "sbrdf_xr.plot.cube.observation_figure": lambda: dict(
-        cube=_observation_cube(), bands=["V"], range_km=1000.0
+        cube=_observation_cube(), bands=["V"], range=1000.0
     ),
 }
 
@@ -936,7 +933,7 @@ EXEMPT[("sbrdf_xr.body.starlink.starlink_v15", "limits")] = (
     "handed to SunTracking(limits=...), whose case checks the conversion (a Spacecraft has "
     "no equality to compare the results by)"
 )
-EXEMPT[("sbrdf_xr.bench.suite.bench_geometry", "step_s")] = (
+EXEMPT[("sbrdf_xr.bench.suite.bench_geometry", "step")] = (
     "a benchmark's problem size: the timing tools take bare numbers"
 )
 EXEMPT[("sbrdf_xr.materials.optical.optical_material", "thickness")] = EXEMPT[
@@ -1045,9 +1042,9 @@ def _moon_inputs() -> dict[str, Any]:
     r = np.array([[7000.0, 0.0, 0.0], [6990.0, 300.0, 0.0]])
     return dict(
         times=t,
-        position_km=r,
-        velocity_km_s=np.array([[0.0, 7.5, 0.0]] * 2),
-        sun_km=np.array([[1.4e8, 5e7, 0.0]] * 2) - r,
+        position=r,
+        velocity=np.array([[0.0, 7.5, 0.0]] * 2),
+        sun=np.array([[1.4e8, 5e7, 0.0]] * 2) - r,
     )
 
 
@@ -1057,18 +1054,16 @@ def _shadow_inputs() -> dict[str, Any]:
     pos = 7000.0 * np.stack([np.cos(phase), np.sin(phase), 0 * phase], axis=1)
     return dict(
         times=t,
-        position_km=pos,
-        sun_km=np.array([1.5e8, 0.0, 0.0]) - pos,
+        position=pos,
+        sun=np.array([1.5e8, 0.0, 0.0]) - pos,
         earth="sphere",
-        earth_radius_km=6378.137,
-        sun_radius_km=695700.0,
+        earth_radius=6378.137,
+        sun_radius=695700.0,
     )
 
 
 def _observation_fields() -> list[Any]:
-    return [
-        f for f in dataclasses.fields(_observation()) if f.init and f.name != "min_elevation_deg"
-    ]
+    return [f for f in dataclasses.fields(_observation()) if f.init and f.name != "min_elevation"]
 
 
 def _observation_cube() -> xr.Dataset:
@@ -1392,3 +1387,103 @@ def test_a_material_table_holding_a_quantity_is_converted():
         run(in_kg)
     with pytest.raises(UnitError, match=r"\bmaterial\b"):
         lookup(in_kg, *angles)
+
+
+# ------------------------------------------------------------------ one unit convention in names
+#: Endings that name a unit.  The convention (docs/guide/conventions.md): an argument is
+#: named for what it is (``range``, ``elevation``, ``step``), its unit stands in brackets
+#: in its docstring and a Quantity in any unit of the kind is accepted at the door.
+UNIT_ENDING = re.compile(
+    r"_(deg|rad|arcsec|s|ms|min|h|days?|km|m|mm|cm|nm|um|au|hpa|pa|k|kg|kg_m3|m2|m3|sr|hz|"
+    r"deg_s|rad_s|km_s|m_s|mag|bytes)$"
+)
+#: Arguments whose ending is not a unit, or whose unit cannot be a Quantity: the reason.
+UNIT_ENDING_ALLOWED: dict[tuple[str, str], str] = {
+    ("sbrdf_xr.brdf.microfacet.distribution_ggx", "cos2_h"): "h is the half vector, not hours",
+    ("sbrdf_xr.brdf.microfacet.distribution_ggx", "sin2_h"): "h is the half vector, not hours",
+    ("sbrdf_xr.materials.construction.paper_delta_theta_grid", "dt_min"): "the smallest step",
+    ("sbrdf_xr.materials.goniometer.paper_scheme", "dt_min"): "the smallest step, not minutes",
+    ("sbrdf_xr.invert._spin.period_grid", "p_min"): "the shortest period, not minutes",
+    ("sbrdf_xr.engine.plan.Estimate", "output_bytes"): "a count of bytes, a plain integer",
+    ("sbrdf_xr.engine.plan.Estimate", "block_bytes"): "a count of bytes, a plain integer",
+    ("sbrdf_xr.engine.scene.Scene", "block_bytes"): "a count of bytes, a plain integer",
+    ("sbrdf_xr.materials.models.render", "max_bytes"): "a count of bytes, a plain integer",
+}
+#: Not renamed yet, each with why: called under this name from modules that another
+#: change is moving (``invert/``, the measured light-curve workflow in ``photometry``),
+#: or a dataclass field (a file's key) whose rename needs its readers changed with it.
+UNIT_ENDING_PENDING: dict[tuple[str, str], str] = {
+    **{
+        (f"sbrdf_xr.{where}", "range_km"): "photometry.magnitudes: called so from invert/"
+        for where in (
+            "photometry.magnitude.magnitudes",
+            "photometry.magnitude.photometry",
+            "accessors.SbrdfDatasetAccessor.magnitudes",
+            "accessors.SbrdfDatasetAccessor.photometry",
+        )
+    },
+    **{
+        (f"sbrdf_xr.photometry.magnitude.{f}", "sun_distance_au"): "with range_km, from invert/"
+        for f in ("magnitudes", "photometry")
+    },
+    **{
+        (name, arg): "invert/ and the light-curve modules are being reorganised apart"
+        for name, arg in (
+            ("sbrdf_xr.invert._data.magnitudes_to_signal", "range_km"),
+            ("sbrdf_xr.invert._joint_study.observation_recovery", "noise_mag"),
+            ("sbrdf_xr.invert._joint_study.observation_recovery", "phase_symmetry_deg"),
+            ("sbrdf_xr.invert._spin.period_grid", "span_s"),
+            ("sbrdf_xr.invert._spin_search.spin_model", "period_s"),
+            ("sbrdf_xr.invert._spin_search.spin_model", "phase_deg"),
+            ("sbrdf_xr.invert._studies.spin_recovery", "axis_tolerance_deg"),
+            ("sbrdf_xr.photometry.lightcurves.compare", "max_time_shift_s"),
+            ("sbrdf_xr.photometry.lightcurves.compare", "period_s"),
+            ("sbrdf_xr.observing.attitude.Spin", "rate_deg_s"),
+            ("sbrdf_xr.observing.attitude.Spin", "phase_deg"),
+        )
+    },
+    **{
+        (name, arg): "a dataclass field named as the scene or tracking file's key"
+        for name, arg in (
+            ("sbrdf_xr.engine.scene.Scene", "earth_range_km"),
+            ("sbrdf_xr.observing.attitude.Nadir", "yaw_deg"),
+            ("sbrdf_xr.observing.tracking.TrackingTable", "elevation_deg"),
+            ("sbrdf_xr.observing.tracking.TrackingTable", "azimuth_deg"),
+            ("sbrdf_xr.observing.tracking.TrackingTable", "ra_deg"),
+            ("sbrdf_xr.observing.tracking.TrackingTable", "dec_deg"),
+            ("sbrdf_xr.observing.tracking.TrackingTable", "range_km"),
+            ("sbrdf_xr.observing.tracking.TrackingTable", "height_km"),
+            ("sbrdf_xr.observing.tracking.TrackingTable", "max_gap_s"),
+            ("sbrdf_xr.observing.tumble.Tumble", "omega_deg_s"),
+        )
+    },
+}
+
+
+def unit_endings() -> set[tuple[str, str]]:
+    """(callable, argument) for every public argument whose name ends in a unit."""
+    out = set()
+    for name, obj in public_callables().items():
+        try:
+            sig = inspect.signature(obj)
+        except (TypeError, ValueError):
+            continue
+        out |= {(name, arg) for arg in sig.parameters if UNIT_ENDING.search(arg)}
+    return out
+
+
+def test_the_unit_ending_rule_sees_units_and_spares_words():
+    assert all(UNIT_ENDING.search(a) for a in ("range_km", "step_s", "rate_deg_s", "size_bytes"))
+    assert not any(UNIT_ENDING.search(a) for a in ("range", "phase_angle", "n_axes", "is_sim"))
+
+
+def test_no_public_argument_name_ends_in_a_unit():
+    found = unit_endings()
+    listed = set(UNIT_ENDING_ALLOWED) | set(UNIT_ENDING_PENDING)
+    new = sorted(found - listed)
+    assert not new, (
+        "arguments named with a unit (name them bare, give the unit in brackets in the "
+        f"docstring and take a Quantity; see docs/guide/conventions.md): {new}"
+    )
+    stale = sorted(listed - found)
+    assert not stale, f"allowed or pending unit endings that no longer exist: {stale}"

@@ -28,10 +28,11 @@ Modules
     magnitudes, beside the diffuse-sphere control (:func:`predict_starlink`).
 """
 
+from ..errors import renamed_attributes
 from . import accuracy, calls, engine, parts, presets, rows, shadowing, starlink, suite
 from .accuracy import BANDS, CANX1_MATERIALS, accuracy_cost, shadow_rows
 from .engine import disk_rate, engine_rows, sweep_job, thread_scaling
-from .parts import KINDS, canx1_with_wing, parts_rows
+from .parts import WING_KINDS, canx1_with_wing, parts_rows
 from .presets import load_presets, presets_record, presets_table, write_presets
 from .rows import (
     BenchRow,
@@ -60,7 +61,7 @@ __all__ = [
     "ACCURACY_BODIES",
     "BANDS",
     "CANX1_MATERIALS",
-    "KINDS",
+    "WING_KINDS",
     "BenchRow",
     "CostRow",
     "ShadowRow",
@@ -106,3 +107,6 @@ __all__ = [
     "timed_runs",
     "write_presets",
 ]
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"KINDS": "WING_KINDS"})

@@ -17,6 +17,7 @@ import numpy as np
 import xarray as xr
 
 from .. import catalog
+from ..body.spacecraft import CANX1_MATERIALS
 from ..engine.knobs import PRESETS
 from ..materials import tables as material
 from .rows import BenchRow, timed_runs
@@ -27,7 +28,6 @@ if TYPE_CHECKING:
 __all__ = ["BANDS", "CANX1_MATERIALS", "accuracy_cost", "fixed_cost_rows", "shadow_rows"]
 
 BANDS = ("V", "R", "I")
-CANX1_MATERIALS = ("aluminium-6061-t6", "tjpv-cell", "white-paint-a276")
 
 # ---------------------------------------------------- accuracy and cost
 

@@ -21,20 +21,21 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import renamed_attributes
 from .rows import BenchRow, best_time
 
-__all__ = ["KINDS", "canx1_with_wing", "parts_rows"]
+__all__ = ["WING_KINDS", "canx1_with_wing", "parts_rows"]
 
 #: The bodies compared (see the module docstring).
-KINDS = ("slab", "open", "tracking")
+WING_KINDS = ("slab", "open", "tracking")
 
 
 def canx1_with_wing(kind: str) -> Any:
-    """CanX-1 with a 0.1 m x 0.2 m wing beside its +Y face, as ``kind`` (:data:`KINDS`).
+    """CanX-1 with a 0.1 m x 0.2 m wing beside its +Y face, as ``kind`` (:data:`WING_KINDS`).
 
     Examples
     --------
-    >>> [canx1_with_wing(k).n_sides for k in KINDS]
+    >>> [canx1_with_wing(k).n_sides for k in WING_KINDS]
     [696, 688, 688]
     """
     import trimesh
@@ -111,14 +112,14 @@ def parts_rows(n_attitudes: int = 2000, n_shadowed: int = 200, repeat: int = 5) 
                 outputs=("signal", "area"),
                 name=f"wing-{k}",
             ).plan()
-            for k in KINDS
+            for k in WING_KINDS
         }
-        best = {k: np.inf for k in KINDS}
-        for _, k in itertools.product(range(repeat), KINDS):  # in turns: load falls alike
+        best = {k: np.inf for k in WING_KINDS}
+        for _, k in itertools.product(range(repeat), WING_KINDS):  # in turns: load falls alike
             p = plans[k]
             best[k] = min(best[k], best_time(partial(simulate, p, lazy=False), 1))
         what = "exact shadowing" if shadow else "unshadowed"
-        for k in KINDS:
+        for k in WING_KINDS:
             rows.append(
                 BenchRow(
                     f"{names[k]}, {what}",
@@ -130,3 +131,7 @@ def parts_rows(n_attitudes: int = 2000, n_shadowed: int = 200, repeat: int = 5) 
                 )
             )
     return rows
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"KINDS": "WING_KINDS"})

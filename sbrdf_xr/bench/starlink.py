@@ -88,7 +88,7 @@ def pomenis_table(
     Examples
     --------
     >>> table = pomenis_table()
-    >>> table.times.size, table.dropped, table.site.height_m
+    >>> table.times.size, table.dropped, table.site.height
     (1173, (), 2789.0)
     >>> pomenis_table(rows=slice(0, 3)).rows.tolist()  # the file's lines, in time order
     [20, 19, 25]

@@ -26,6 +26,7 @@ import time
 import numpy as np
 import xarray as xr
 
+from ..errors import renamed_keywords
 from ..kernels import lut as _lut
 from ..materials import tables as material
 from ..materials.goniometer import measure
@@ -194,7 +195,7 @@ def kernel_throughput(repeat: int = 3, attitude_step: int = 1) -> list[BenchRow]
     s2, o2 = s.reshape(-1, 3), o.reshape(-1, 3)
     tables = {m: scene.tables[m] for m in scene.spacecraft.materials}
     n_geom, n_fac = s2.shape[0], facets.sizes["facet"]
-    n_wl = tables[CANX1_MATERIALS[0]].sizes["wavelength"]
+    n_wl = tables[next(iter(CANX1_MATERIALS))].sizes["wavelength"]
 
     def per_facet_loop() -> np.ndarray:
         out = np.zeros((n_geom, n_wl))
@@ -298,13 +299,23 @@ def kernel_throughput(repeat: int = 3, attitude_step: int = 1) -> list[BenchRow]
     return rows
 
 
-def bench_geometry(n_times: int = 3600, step_s: float = 1.0, repeats: int = 3) -> dict[str, float]:
+@renamed_keywords(step_s="step")
+def bench_geometry(n_times: int = 3600, step: float = 1.0, repeats: int = 3) -> dict[str, float]:
     """Time :meth:`~sbrdf_xr.observing.Observation.geometry` of the built-in CanX-1 orbit and
     site (:data:`~sbrdf_xr.observing.observe.CANX1_PASS`) over ``n_times`` steps.
 
     The first call in a process also pays the one-off imports and the loading of the
     skyfield data; it is reported apart from the best of ``repeats`` further calls on
     fresh observations (nothing cached between them).
+
+    Parameters
+    ----------
+    n_times : int
+        Number of times.
+    step : float
+        Time step [s].
+    repeats : int
+        Warm calls timed.
 
     Returns
     -------
@@ -319,8 +330,8 @@ def bench_geometry(n_times: int = 3600, step_s: float = 1.0, repeats: int = 3) -
     (['first_call_seconds', 'n_times', 'seconds', 'seconds_per_time'], 60.0)
     """
     p = CANX1_PASS
-    t0 = to_datetime64(p["start"], "start") - np.timedelta64(int(n_times * step_s / 2), "s")
-    t = t0 + np.timedelta64(round(step_s * 1e9), "ns") * np.arange(n_times)
+    t0 = to_datetime64(p["start"], "start") - np.timedelta64(int(n_times * step / 2), "s")
+    t = t0 + np.timedelta64(round(step * 1e9), "ns") * np.arange(n_times)
     start = time.perf_counter()
     orbit, site = Orbit.from_catalog(p["orbit"]), Site.from_catalog(p["site"])
     Observation(orbit, site, t, canx1_attitude()).geometry(on_unobservable="keep")

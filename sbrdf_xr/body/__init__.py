@@ -29,7 +29,7 @@ Modules
     A built-in Starlink v1.5-class body: a nadir chassis and a sun-tracking array.
 """
 
-from ..errors import MeshError, MeshRepairWarning
+from ..errors import MeshError, MeshRepairWarning, renamed_attributes
 from . import (
     facets,
     geo_comsat,
@@ -60,7 +60,7 @@ from .meshes import (
     read_mesh,
 )
 from .parts import (
-    LAWS,
+    ARTICULATION_LAWS,
     PART_KEYS,
     AngleSeries,
     Fixed,
@@ -106,11 +106,11 @@ from .visibility import (
 )
 
 __all__ = [
+    "ARTICULATION_LAWS",
     "CANX1_MATERIALS",
     "DENSITY_PRESETS",
     "ENGINES",
     "GEO_COMSAT_MATERIALS",
-    "LAWS",
     "LENGTH_UNITS",
     "MAX_RAYS_PER_CALL",
     "MERGE_DISTANCE",
@@ -187,3 +187,6 @@ __all__ = [
     "visibility",
     "visible_fraction",
 ]
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"LAWS": "ARTICULATION_LAWS"})

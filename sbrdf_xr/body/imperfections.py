@@ -20,18 +20,19 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import ValidationError
+from ..errors import ValidationError, renamed_keywords
 from ..units import to_unit
 
 __all__ = ["tilt_quadrature", "tilted_normals"]
 
 
-def tilt_quadrature(sigma_deg: float, n: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+@renamed_keywords(sigma_deg="sigma")
+def tilt_quadrature(sigma: float, n: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Nodes and weights of the Gaussian tilt distribution (product Gauss-Hermite rule).
 
     Parameters
     ----------
-    sigma_deg : float
+    sigma : float
         Standard deviation of each tangent component of the tilt [degree], >= 0; a
         Quantity is converted.
     n : int
@@ -52,17 +53,17 @@ def tilt_quadrature(sigma_deg: float, n: int) -> tuple[NDArray[np.float64], NDAr
     >>> round(float(np.degrees(np.sqrt((w * (t**2).sum(1)).sum()))), 9)  # rms tilt sqrt(2) sigma
     2.828427125
     """
-    sigma_deg = to_unit(sigma_deg, "deg", "sigma_deg")
-    if not (np.isfinite(sigma_deg) and sigma_deg >= 0):
-        raise ValidationError(f"sigma: expected a finite tilt >= 0 degree, got {sigma_deg!r}")
+    sigma = to_unit(sigma, "deg", "sigma")
+    if not (np.isfinite(sigma) and sigma >= 0):
+        raise ValidationError(f"sigma: expected a finite tilt >= 0 degree, got {sigma!r}")
     if isinstance(n, bool) or int(n) != n or n < 1:
         raise ValidationError(
             f"n: expected an integer >= 1 of quadrature nodes per axis, got {n!r}"
         )
-    if sigma_deg == 0 or n == 1:
+    if sigma == 0 or n == 1:
         return np.zeros((1, 2)), np.ones(1)
     x, w = np.polynomial.hermite.hermgauss(int(n))
-    t = np.sqrt(2.0) * np.radians(sigma_deg) * x
+    t = np.sqrt(2.0) * np.radians(sigma) * x
     w = w / np.sqrt(np.pi)
     tx, ty = np.meshgrid(t, t, indexing="ij")
     ww = np.outer(w, w)

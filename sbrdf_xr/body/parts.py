@@ -35,11 +35,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import MeshError, ValidationError
+from ..errors import MeshError, ValidationError, renamed_attributes
 from ..units import to_unit
 
 __all__ = [
-    "LAWS",
+    "ARTICULATION_LAWS",
     "PART_KEYS",
     "AngleSeries",
     "Fixed",
@@ -234,7 +234,11 @@ class AngleSeries:
 
 
 #: Pointing laws by the name scene files use.
-LAWS: dict[str, type] = {"fixed": Fixed, "sun-tracking": SunTracking, "series": AngleSeries}
+ARTICULATION_LAWS: dict[str, type] = {
+    "fixed": Fixed,
+    "sun-tracking": SunTracking,
+    "series": AngleSeries,
+}
 
 
 @dataclass(frozen=True, eq=False)
@@ -287,7 +291,8 @@ class Part:
             )
         if not isinstance(self.law, Fixed | SunTracking | AngleSeries):
             raise ValidationError(
-                f"part {self.name!r}: law {self.law!r}; expected one of {sorted(LAWS)} "
+                f"part {self.name!r}: law {self.law!r}; "
+                f"expected one of {sorted(ARTICULATION_LAWS)} "
                 "(Fixed, SunTracking, AngleSeries)"
             )
         object.__setattr__(self, "facets", f)
@@ -415,9 +420,9 @@ def part_from_spec(spec: Mapping[str, Any], facet_material: np.ndarray) -> Part:
     else:
         facets = np.asarray(spec["facets"])
     law_name = spec.get("law", "fixed")
-    if law_name not in LAWS:
+    if law_name not in ARTICULATION_LAWS:
         raise ValidationError(
-            f"part {name!r}: law {law_name!r}; allowed: {', '.join(sorted(LAWS))}"
+            f"part {name!r}: law {law_name!r}; allowed: {', '.join(sorted(ARTICULATION_LAWS))}"
         )
     own = {"fixed": ("angle",), "sun-tracking": ("limits", "normal"), "series": ("angles",)}
     for law, keys in own.items():
@@ -440,3 +445,7 @@ def part_from_spec(spec: Mapping[str, Any], facet_material: np.ndarray) -> Part:
         point=spec.get("point", (0.0, 0.0, 0.0)),
         law=pointing,
     )
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"LAWS": "ARTICULATION_LAWS"})

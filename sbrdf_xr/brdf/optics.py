@@ -27,7 +27,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import ValidationError
+from ..errors import ValidationError, renamed_keywords
 from ..units import to_unit
 from . import _fresnel_kernels
 from ._model import Parameter
@@ -75,15 +75,15 @@ _AL_OSC = np.array(  # f_j, Gamma_j [eV], omega_j [eV]
 )
 
 
-def _check_wl(wavelength_nm: ArrayLike) -> NDArray[np.float64]:
-    wl = np.asarray(to_unit(wavelength_nm, "nm", "wavelength_nm", spectral=True))
+def _check_wl(wavelength: ArrayLike) -> NDArray[np.float64]:
+    wl = np.asarray(to_unit(wavelength, "nm", "wavelength", spectral=True))
     if not np.issubdtype(wl.dtype, np.number) or np.iscomplexobj(wl):
-        raise ValidationError(f"wavelength_nm: expected real numbers [nm], got dtype {wl.dtype}")
+        raise ValidationError(f"wavelength: expected real numbers [nm], got dtype {wl.dtype}")
     wl = wl.astype(np.float64)
     if not np.all(np.isfinite(wl)) or np.any(wl <= 0):
         raise ValidationError(
-            f"wavelength_nm: got {wl[~(np.isfinite(wl) & (wl > 0))].ravel()[:5].tolist()}; "
-            "allowed domain is finite wavelength_nm > 0 [nm]"
+            f"wavelength: got {wl[~(np.isfinite(wl) & (wl > 0))].ravel()[:5].tolist()}; "
+            "allowed domain is finite wavelength > 0 [nm]"
         )
     return wl
 
@@ -94,7 +94,8 @@ def _sqrt_k_positive(eps: np.ndarray) -> np.ndarray:
     return np.where(root.imag < 0, -root, root)
 
 
-def aluminium_index(wavelength_nm: ArrayLike) -> NDArray[np.complex128]:
+@renamed_keywords(wavelength_nm="wavelength")
+def aluminium_index(wavelength: ArrayLike) -> NDArray[np.complex128]:
     """Complex refractive index of aluminium, Lorentz–Drude model of Rakić et al. (1998).
 
     ``eps(w) = 1 - f0 wp^2 / (w (w + i G0)) + sum_j f_j wp^2 / (w_j^2 - w^2 - i w G_j)``
@@ -106,7 +107,7 @@ def aluminium_index(wavelength_nm: ArrayLike) -> NDArray[np.complex128]:
 
     Parameters
     ----------
-    wavelength_nm : array_like
+    wavelength : array_like
         Vacuum wavelength [nm].
 
     Returns
@@ -121,7 +122,7 @@ def aluminium_index(wavelength_nm: ArrayLike) -> NDArray[np.complex128]:
     >>> np.round(aluminium_index([500.0, 800.0]), 3)  # the interband absorption near 800 nm
     array([0.761+5.9j  , 2.674+8.335j])
     """
-    w = HC_EV_NM / _check_wl(wavelength_nm)
+    w = HC_EV_NM / _check_wl(wavelength)
     wp2 = _AL_OMEGA_P**2
     eps = 1.0 - _AL_F0 * wp2 / (w * (w + 1j * _AL_GAMMA0))
     f, gam, w0 = (_AL_OSC[:, k] for k in range(3))
@@ -143,7 +144,8 @@ _GAAS_A = 5.6e4
 _GAAS_E_CLIP = 2.7
 
 
-def gaas_index(wavelength_nm: ArrayLike) -> NDArray[np.complex128]:
+@renamed_keywords(wavelength_nm="wavelength")
+def gaas_index(wavelength: ArrayLike) -> NDArray[np.complex128]:
     """Complex refractive index of GaAs from a simple documented dispersion model.
 
     * Real part: Wemple–DiDomenico single-oscillator model,
@@ -165,7 +167,7 @@ def gaas_index(wavelength_nm: ArrayLike) -> NDArray[np.complex128]:
 
     Parameters
     ----------
-    wavelength_nm : array_like
+    wavelength : array_like
         Vacuum wavelength [nm].
 
     Returns
@@ -179,7 +181,7 @@ def gaas_index(wavelength_nm: ArrayLike) -> NDArray[np.complex128]:
     >>> np.round(gaas_index([800.0]), 3)
     array([3.558+0.126j])
     """
-    wl = _check_wl(wavelength_nm)
+    wl = _check_wl(wavelength)
     energy = np.minimum(HC_EV_NM / wl, _GAAS_E_CLIP)
     n = np.sqrt(1.0 + _GAAS_ED * _GAAS_E0 / (_GAAS_E0**2 - energy**2))
     alpha_cm = _GAAS_A * np.sqrt(np.maximum(HC_EV_NM / wl - _GAAS_EG, 0.0))
@@ -192,12 +194,13 @@ def _sellmeier(wl_um: np.ndarray, b: Sequence[float], c: Sequence[float]) -> np.
     return np.sqrt(n2)
 
 
-def silica_index(wavelength_nm: ArrayLike) -> NDArray[np.float64]:
+@renamed_keywords(wavelength_nm="wavelength")
+def silica_index(wavelength: ArrayLike) -> NDArray[np.float64]:
     """Refractive index of fused silica, Sellmeier fit of Malitson, JOSA 55, 1205 (1965).
 
     Parameters
     ----------
-    wavelength_nm : array_like
+    wavelength : array_like
         Vacuum wavelength [nm] (fit range 210–3710 nm).
 
     Returns
@@ -211,16 +214,17 @@ def silica_index(wavelength_nm: ArrayLike) -> NDArray[np.float64]:
     >>> np.round(silica_index([589.3]), 4)  # the sodium D line
     array([1.4584])
     """
-    wl = _check_wl(wavelength_nm) * 1e-3
+    wl = _check_wl(wavelength) * 1e-3
     return _sellmeier(wl, (0.6961663, 0.4079426, 0.8974794), (0.0684043, 0.1162414, 9.896161))
 
 
-def sapphire_index(wavelength_nm: ArrayLike) -> NDArray[np.float64]:
+@renamed_keywords(wavelength_nm="wavelength")
+def sapphire_index(wavelength: ArrayLike) -> NDArray[np.float64]:
     """Ordinary index of sapphire (Al2O3), Malitson & Dodge, JOSA 62, 1405 (1972).
 
     Parameters
     ----------
-    wavelength_nm : array_like
+    wavelength : array_like
         Vacuum wavelength [nm] (fit range 200–5500 nm).
 
     Returns
@@ -235,18 +239,19 @@ def sapphire_index(wavelength_nm: ArrayLike) -> NDArray[np.float64]:
     >>> np.round(sapphire_index([589.3]), 4)
     array([1.7681])
     """
-    wl = _check_wl(wavelength_nm) * 1e-3
+    wl = _check_wl(wavelength) * 1e-3
     return _sellmeier(wl, (1.4313493, 0.65054713, 5.3414021), (0.0726631, 0.1193242, 18.028251))
 
 
-def titania_index(wavelength_nm: ArrayLike) -> NDArray[np.float64]:
+@renamed_keywords(wavelength_nm="wavelength")
+def titania_index(wavelength: ArrayLike) -> NDArray[np.float64]:
     """Ordinary index of rutile TiO2, DeVore, JOSA 41, 416 (1951).
 
     ``n_o^2 = 5.913 + 0.2441 / (lambda^2 - 0.0803)`` with ``lambda`` in µm.
 
     Parameters
     ----------
-    wavelength_nm : array_like
+    wavelength : array_like
         Vacuum wavelength [nm] (fit range 430–1530 nm).
 
     Returns
@@ -260,7 +265,7 @@ def titania_index(wavelength_nm: ArrayLike) -> NDArray[np.float64]:
     >>> np.round(titania_index([589.3]), 4)
     array([2.6129])
     """
-    wl = _check_wl(wavelength_nm) * 1e-3
+    wl = _check_wl(wavelength) * 1e-3
     return np.sqrt(5.913 + 0.2441 / (wl**2 - 0.0803))
 
 

@@ -374,7 +374,7 @@ def _tracking_observation(args: argparse.Namespace, spacecraft: Any) -> Any:
     table = tracking_from_dict(spec, site)
     return table.observation(
         attitude_of(args, spacecraft),
-        min_elevation_deg=args.min_elevation,
+        min_elevation=args.min_elevation,
         earth=args.earth,
         name=args.name or f"{table.name} from {table.site.name}",
     )
@@ -391,7 +391,7 @@ def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     ...      "--height", "3050", "--start", "2024-03-17T06:14:00", "--duration", "60",
     ...      "--step", "30", "-o", "p.nc"])
     >>> obs = observation_of(args)
-    >>> obs.times.size, obs.site.height_m, type(obs.attitude).__name__
+    >>> obs.times.size, obs.site.height, type(obs.attitude).__name__
     (3, 3050.0, 'Nadir')
     """
     import numpy as np
@@ -450,7 +450,7 @@ def observation_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
         site,
         times(start, stop, args.step),
         attitude_of(args, spacecraft),
-        min_elevation_deg=args.min_elevation,
+        min_elevation=args.min_elevation,
         name=args.name or f"{orbit.name} from {site.name}",
         earth=args.earth,
     )

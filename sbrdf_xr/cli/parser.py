@@ -105,7 +105,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     csub = pc.add_subparsers(dest="catalog_command", required=True)
     pl = csub.add_parser("list", help="list the catalog entries and the catalog of each")
-    pl.add_argument("--kind", choices=catalog.KINDS, help="only entries of this kind")
+    pl.add_argument("--kind", choices=catalog.ENTRY_KINDS, help="only entries of this kind")
     pl.set_defaults(func=cmd_catalog_list)
     ps = csub.add_parser("show", help="show one entry")
     ps.add_argument("name")

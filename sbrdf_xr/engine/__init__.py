@@ -36,7 +36,7 @@ Modules
     (:func:`simulate`; :func:`sbrdf_xr.store.write` writes it).
 """
 
-from ..errors import SceneError
+from ..errors import SceneError, renamed_attributes
 from . import (
     articulation,
     builtin,
@@ -75,8 +75,8 @@ from .scene_file import (
     MAX_SHADOW_DENSITY,
     load_material_specs,
     load_scene,
-    material_tables,
     scene_from_dict,
+    scene_material_tables,
 )
 from .sweep import QUATERNION_COMPONENTS, GridGeometry, PairGeometry
 
@@ -122,7 +122,6 @@ __all__ = [
     "knobs",
     "load_material_specs",
     "load_scene",
-    "material_tables",
     "plan",
     "reflected",
     "resolve_scene",
@@ -133,6 +132,7 @@ __all__ = [
     "scene_file",
     "scene_fingerprint",
     "scene_from_dict",
+    "scene_material_tables",
     "schema",
     "simulate",
     "spectral",
@@ -141,3 +141,6 @@ __all__ = [
     "sweep",
     "views",
 ]
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"material_tables": "scene_material_tables"})

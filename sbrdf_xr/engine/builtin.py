@@ -17,15 +17,15 @@ from typing import Any
 import numpy as np
 
 from .. import geometry
-from ..errors import SceneError, ValidationError
+from ..errors import SceneError, ValidationError, renamed_attributes
 from .scene import Scene
 from .scene_file import (
     MAX_SCENE_COUNT,
     MAX_SHADOW_DENSITY,
     load_material_specs,
     load_scene,
-    material_tables,
     scene_from_dict,
+    scene_material_tables,
 )
 
 __all__ = [
@@ -37,9 +37,9 @@ __all__ = [
     "geo_comsat_materials",
     "load_material_specs",
     "load_scene",
-    "material_tables",
     "resolve_scene",
     "scene_from_dict",
+    "scene_material_tables",
     "starlink_materials",
 ]
 
@@ -269,3 +269,7 @@ def resolve_scene(spec: str | os.PathLike[str] | Scene) -> Scene:
     raise SceneError(
         f"unknown scene {text!r}; built-in scenes: {', '.join(_BUILTIN)}, or a .toml file"
     )
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"material_tables": "scene_material_tables"})

@@ -18,7 +18,7 @@ import numpy as np
 import xarray as xr
 
 from .. import geometry
-from ..errors import CatalogError, SceneError, ValidationError, did_you_mean
+from ..errors import CatalogError, SceneError, ValidationError, did_you_mean, renamed_attributes
 from .knobs import KNOBS
 from .scene import Scene
 from .schema import ATTITUDE_KEYS, GEOMETRY_KEYS, SCENE_KEYS, SPACECRAFT_KEYS, toml_types
@@ -28,8 +28,8 @@ __all__ = [
     "MAX_SHADOW_DENSITY",
     "load_material_specs",
     "load_scene",
-    "material_tables",
     "scene_from_dict",
+    "scene_material_tables",
 ]
 
 
@@ -267,7 +267,7 @@ def _with_parts(sc: Any, parts: Any) -> Any:
         raise SceneError(f"[spacecraft] parts: {exc}") from None
 
 
-def material_tables(
+def scene_material_tables(
     specs: Mapping[str, str | Path],
     base_dir: str | Path | None = None,
     where: Mapping[str, str] | None = None,
@@ -276,7 +276,7 @@ def material_tables(
 
     Examples
     --------
-    >>> tables, models = material_tables({"paint": "lambertian-grey-50"})
+    >>> tables, models = scene_material_tables({"paint": "lambertian-grey-50"})
     >>> sorted(tables), models
     (['paint'], {})
     """
@@ -566,3 +566,7 @@ def load_scene(path: str | Path) -> Scene:
     except RecursionError:
         raise SceneError(f"{path}: invalid TOML: nested too deeply") from None
     return scene_from_dict(d, path.parent)
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"material_tables": "scene_material_tables"})

@@ -7,7 +7,7 @@ default, domain and meaning from the knob table (:data:`sbrdf_xr.engine.knobs.KN
 that is a field of :class:`~sbrdf_xr.engine.Scene` takes its default from the field; the
 values of ``effects`` and ``outputs`` come from the effect registry
 (:data:`sbrdf_xr.engine.effects.EFFECTS`), and the attitude laws of ``[observation.attitude]``
-from :data:`sbrdf_xr.observing.attitude.LAWS`.
+from :data:`sbrdf_xr.observing.attitude.ATTITUDE_LAWS`.
 """
 
 from __future__ import annotations
@@ -337,7 +337,7 @@ def reference() -> str:
     >>> "| `moonlight` |" in text  # the effects, from the registry
     True
     """
-    from ..observing.attitude import LAWS
+    from ..observing.attitude import ATTITUDE_LAWS
 
     out = ["Top-level keys (the numerical knobs among them are `sbrdf-xr knobs`'s):", ""]
     out += _rows(SCENE_KEYS)
@@ -354,7 +354,7 @@ def reference() -> str:
         out += ["", f"{title}:", "", *_rows(keys)]
     out += ["", "`[observation.attitude]`: `law` and its parameters:", ""]
     out += ["| law | parameters | what |", "|---|---|---|"]
-    for law, (cls, params) in LAWS.items():
+    for law, (cls, params) in ATTITUDE_LAWS.items():
         what = (cls.__doc__ or "").strip().splitlines()[0]
         out.append(f"| `{law}` | {', '.join(f'`{p}`' for p in params)} | {_md(what)} |")
     return "\n".join(out) + "\n"

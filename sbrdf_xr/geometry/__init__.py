@@ -17,6 +17,7 @@ leading axes of arrays whose last axis holds a vector's three components):
 Every name of the three modules is importable from here.
 """
 
+from ..errors import renamed_attributes
 from . import angles, anisotropy, rotations
 from .angles import (
     FacetAngles,
@@ -43,7 +44,7 @@ from .rotations import (
     QUATERNION_NORM_TOL,
     axis_rotation,
     check_quaternions,
-    compose,
+    compose_quaternions,
     euler_attitudes,
     rotation_matrices,
     rotation_sweep,
@@ -61,7 +62,7 @@ __all__ = [
     "anisotropy",
     "axis_rotation",
     "check_quaternions",
-    "compose",
+    "compose_quaternions",
     "euler_attitudes",
     "facet_angles",
     "facet_vectors",
@@ -82,3 +83,6 @@ __all__ = [
     "to_conventional",
     "uniform_attitudes",
 ]
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"compose": "compose_quaternions"})

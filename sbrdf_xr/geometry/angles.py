@@ -48,7 +48,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import ValidationError
+from ..errors import ValidationError, renamed_keywords
 from ..units import to_unit
 
 __all__ = [
@@ -531,8 +531,9 @@ def from_conventional(
     return ang.theta_i, ang.delta_theta, ang.phi
 
 
+@renamed_keywords(phase_angle_deg="phase_angle")
 def observation_plane(
-    phase_angle_deg: ArrayLike,
+    phase_angle: ArrayLike,
     bisector: ArrayLike = (1.0, 0.0, 0.0),
     plane_normal: ArrayLike = (0.0, 0.0, 1.0),
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -544,7 +545,7 @@ def observation_plane(
 
     Parameters
     ----------
-    phase_angle_deg : array_like
+    phase_angle : array_like
         Phase angles beta [degree], in [0, 180].
     bisector, plane_normal : array_like, shape (3,)
         Perpendicular directions [1].
@@ -563,7 +564,7 @@ def observation_plane(
     >>> np.round(to_sun[1], 6), np.round(to_observer[1], 6)
     (array([0.707107, 0.707107, 0.      ]), array([ 0.707107, -0.707107,  0.      ]))
     """
-    beta = np.asarray(to_unit(phase_angle_deg, "deg", "phase_angle_deg"), dtype=np.float64)
+    beta = np.asarray(to_unit(phase_angle, "deg", "phase_angle"), dtype=np.float64)
     if np.any((beta < 0) | (beta > 180)) or not np.all(np.isfinite(beta)):
         raise ValidationError(f"phase_angle: must lie in [0, 180] degree, got {beta.ravel()[:5]}")
     b = normalize(bisector, "bisector")

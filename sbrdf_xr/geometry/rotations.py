@@ -19,14 +19,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from ..errors import ValidationError
+from ..errors import ValidationError, renamed_attributes
 from ..units import to_unit
 
 __all__ = [
     "QUATERNION_NORM_TOL",
     "axis_rotation",
     "check_quaternions",
-    "compose",
+    "compose_quaternions",
     "euler_attitudes",
     "rotation_matrices",
     "rotation_sweep",
@@ -196,7 +196,7 @@ def axis_rotation(axis: ArrayLike, angle: ArrayLike) -> NDArray[np.float64]:
     return np.concatenate([np.sin(half)[..., None] * a, np.cos(half)[..., None]], axis=-1)
 
 
-def compose(q_outer: ArrayLike, q_inner: ArrayLike) -> NDArray[np.float64]:
+def compose_quaternions(q_outer: ArrayLike, q_inner: ArrayLike) -> NDArray[np.float64]:
     """Quaternion of the rotation ``q_inner`` followed by ``q_outer`` (``R_outer R_inner``).
 
     Parameters
@@ -214,8 +214,8 @@ def compose(q_outer: ArrayLike, q_inner: ArrayLike) -> NDArray[np.float64]:
     Turning by 30 deg and then by 60 deg about the same axis is a 90 deg turn:
 
     >>> import numpy as np
-    >>> from sbrdf_xr.geometry.rotations import axis_rotation, compose
-    >>> q = compose(axis_rotation([0, 0, 1], 60.0), axis_rotation([0, 0, 1], 30.0))
+    >>> from sbrdf_xr.geometry.rotations import axis_rotation, compose_quaternions
+    >>> q = compose_quaternions(axis_rotation([0, 0, 1], 60.0), axis_rotation([0, 0, 1], 30.0))
     >>> np.allclose(q, axis_rotation([0, 0, 1], 90.0))
     True
     """
@@ -261,7 +261,7 @@ def rotation_sweep(
     q = axis_rotation(axis, np.atleast_1d(to_unit(angles, "deg", "angles")))
     if initial is None:
         return q
-    return compose(q, np.asarray(initial, dtype=np.float64))
+    return compose_quaternions(q, np.asarray(initial, dtype=np.float64))
 
 
 def euler_attitudes(sequence: str, angles: ArrayLike) -> NDArray[np.float64]:
@@ -320,3 +320,7 @@ def uniform_attitudes(n: int, seed: int | None = 0) -> NDArray[np.float64]:
     if n < 1:
         raise ValidationError(f"n: need at least one attitude, got {n}")
     return Rotation.random(n, random_state=seed).as_quat().reshape(-1, 4)
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"compose": "compose_quaternions"})

@@ -30,7 +30,7 @@ Modules
     Plane-polygon clipping and the exact shadow kernel of :mod:`sbrdf_xr.body.visibility`.
 """
 
-from ..errors import ValidationError
+from ..errors import ValidationError, renamed_attributes
 from . import angles, anisotropic, lookup, lut, packing, polygon, reference, shadow, sums
 from .angles import (
     atan2_pos,
@@ -42,7 +42,13 @@ from .angles import (
     observer_components,
     tangent_azimuth,
 )
-from .anisotropic import AnisotropicTable, anisotropic_sums, pack_anisotropic, plan_step, reflected
+from .anisotropic import (
+    AnisotropicTable,
+    anisotropic_reflected,
+    anisotropic_sums,
+    pack_anisotropic,
+    plan_step,
+)
 from .lut import (
     LOOKUP_METHODS,
     axis_weights,
@@ -96,6 +102,7 @@ __all__ = [
     "ValidationError",
     "angles",
     "anisotropic",
+    "anisotropic_reflected",
     "anisotropic_sums",
     "atan2_pos",
     "axis_weights",
@@ -124,7 +131,6 @@ __all__ = [
     "plan_step",
     "polygon",
     "reference",
-    "reflected",
     "shadow",
     "signed_area",
     "smoothing_spline_matrix",
@@ -136,3 +142,6 @@ __all__ = [
     "union_area",
     "union_area_slabs",
 ]
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"reflected": "anisotropic_reflected"})

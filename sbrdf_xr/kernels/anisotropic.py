@@ -24,7 +24,7 @@ once over the slices packed as materials.  Consequences, stated once:
   number of ``psi`` nodes), so a table with ``n_psi`` nodes costs up to ``n_psi``
   times an isotropic one.
 
-:func:`reflected` is the hook the engine calls for a plan with anisotropic tables:
+:func:`anisotropic_reflected` is the hook the engine calls for a plan with anisotropic tables:
 isotropic materials go through the plan's kernel as before, anisotropic ones through
 :func:`anisotropic_sums`.
 """
@@ -38,7 +38,7 @@ import numba
 import numpy as np
 from numpy.typing import DTypeLike, NDArray
 
-from ..errors import SceneError
+from ..errors import SceneError, renamed_attributes
 from ..geometry import normal_incidence_tolerance
 from ..geometry.anisotropy import PSI_PERIOD, illumination_azimuth, psi_weights
 from . import lut as _lut
@@ -52,10 +52,10 @@ __all__ = [
     "AnisotropicTable",
     "FacetTerms",
     "TablePlan",
+    "anisotropic_reflected",
     "anisotropic_sums",
     "pack_anisotropic",
     "plan_step",
-    "reflected",
 ]
 
 
@@ -373,8 +373,9 @@ def _compiled_sums(s, o, n, tangents, areas, table, method, fraction):
 
 @runtime_checkable
 class FacetTerms(Protocol):
-    """The facet terms :func:`reflected` evaluates (:class:`sbrdf_xr.engine.plan.Terms` is
-    one): unit normals (T, 3) [1], areas (T,) [m2], material indices (T,) and, with
+    """The facet terms :func:`anisotropic_reflected` evaluates
+    (:class:`sbrdf_xr.engine.plan.Terms` is one): unit normals (T, 3) [1], areas (T,) [m2],
+    material indices (T,) and, with
     anisotropic materials, unit tangents (T, 3) [1].
 
     Examples
@@ -401,8 +402,9 @@ class FacetTerms(Protocol):
 
 @runtime_checkable
 class TablePlan(Protocol):
-    """What :func:`reflected` reads of a compiled plan (:class:`sbrdf_xr.engine.plan.Plan`
-    is one): its facet terms, material names, packed tables, knobs (``method``,
+    """What :func:`anisotropic_reflected` reads of a compiled plan
+    (:class:`sbrdf_xr.engine.plan.Plan` is one): its facet terms, material names, packed
+    tables, knobs (``method``,
     ``kernel``), anisotropic tables by material index, and each table unpacked.
 
     Examples
@@ -434,7 +436,7 @@ class TablePlan(Protocol):
     ]: ...
 
 
-def reflected(
+def anisotropic_reflected(
     plan: TablePlan,
     to_source: NDArray[np.floating],
     to_observer: NDArray[np.floating],
@@ -471,7 +473,7 @@ def reflected(
 
     >>> import trimesh
     >>> from sbrdf_xr import Scene, load_spacecraft
-    >>> from sbrdf_xr.kernels.anisotropic import reflected
+    >>> from sbrdf_xr.kernels.anisotropic import anisotropic_reflected
     >>> from sbrdf_xr.materials.schema import lambertian
     >>> grey = lambertian(0.5, [500.0, 600.0], material="grey")
     >>> brushed = grey.expand_dims(psi=[0.0, 90.0], axis=3)
@@ -484,7 +486,7 @@ def reflected(
     >>> sorted(plan.anisotropic), plan.anisotropic[0].psi.tolist()
     ([0], [0.0, 90.0])
     >>> block = plan.geometry.block(slice(None))
-    >>> r = reflected(plan, block.to_sun, block.to_observer, None, True)
+    >>> r = anisotropic_reflected(plan, block.to_sun, block.to_observer, None, True)
     >>> r.signal.shape, r.per_material.shape  # (G, L), (G, M, L)
     ((2, 2), (2, 1, 2))
     >>> r.signal[:, 0].round(6).tolist(), r.area.round(6).tolist()
@@ -561,3 +563,7 @@ def reflected(
         if pm is not None:
             pm[:, m] += r.signal
     return FusedSums(sig, pap, area, lit, pm)
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"reflected": "anisotropic_reflected"})

@@ -78,7 +78,7 @@ __all__ = [
     "write_netcdf_atomic",
 ]
 
-LOOKUP_METHODS = tuple(_lut.LOOKUP_METHODS)
+LOOKUP_METHODS = _lut.LOOKUP_METHODS
 
 
 def lookup(

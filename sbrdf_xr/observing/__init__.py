@@ -10,7 +10,7 @@ Modules
     The sunlit fraction of the solar disc seen from the spacecraft.
 ``attitude``
     Attitude laws: the orientation of a spacecraft as a function of time
-    (:class:`AttitudeLaw`, the table :data:`LAWS`, the pointing laws, spin and
+    (:class:`AttitudeLaw`, the table :data:`ATTITUDE_LAWS`, the pointing laws, spin and
     composition); ``tumble`` and ``series`` hold the torque-free tumble and the
     user time series, and ``frames`` the body axes, triads, times and the
     :class:`Context` the laws read.
@@ -27,7 +27,13 @@ Modules
     :func:`visible_passes`: the passes a site can measure (up, sunlit, sky dark).
 """
 
-from ..errors import AttitudeError, EpochGapWarning, NotObservableError, ObservationError
+from ..errors import (
+    AttitudeError,
+    EpochGapWarning,
+    NotObservableError,
+    ObservationError,
+    renamed_attributes,
+)
 from . import (
     aem,
     attitude,
@@ -47,7 +53,7 @@ from . import (
 )
 from .aem import AemSeries, read_aem
 from .attitude import (
-    LAWS,
+    ATTITUDE_LAWS,
     AttitudeLaw,
     Composed,
     Inertial,
@@ -59,8 +65,8 @@ from .attitude import (
     law_from_dict,
 )
 from .earth_shadow import (
+    EARTH_EQUATORIAL_RADIUS_KM,
     EARTH_MODELS,
-    EARTH_RADIUS_KM,
     SUN_RADIUS_KM,
     disc_overlap_fraction,
     shadow_events,
@@ -77,10 +83,12 @@ from .orbits import (
     EPOCH_GAP_DAYS,
     Orbit,
     Site,
-    airmass,
     load_orbit_entry,
     load_site_entry,
     tle_checksum,
+)
+from .orbits import (
+    airmass as airmass,  # photometry.airmass, the one air mass (published there)
 )
 from .passes import TWILIGHTS, visible_passes
 from .series import QuaternionSeries
@@ -100,14 +108,14 @@ from .tumble import TUMBLE_RTOL, Tumble
 
 __all__ = [
     "AIRMASS_MODELS",
+    "ATTITUDE_LAWS",
     "ATTRS",
     "AU_KM",
     "COMPONENT",
+    "EARTH_EQUATORIAL_RADIUS_KM",
     "EARTH_MODELS",
-    "EARTH_RADIUS_KM",
     "EPOCH_GAP_DAYS",
     "KNOT_S",
-    "LAWS",
     "POMENIS_SITE",
     "SUN_RADIUS_KM",
     "TIME",
@@ -135,7 +143,6 @@ __all__ = [
     "Tumble",
     "YawSteering",
     "aem",
-    "airmass",
     "attitude",
     "canx1_pass",
     "check_times",
@@ -174,3 +181,8 @@ __all__ = [
     "tumble",
     "visible_passes",
 ]
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(
+    __name__, globals(), {"EARTH_RADIUS_KM": "EARTH_EQUATORIAL_RADIUS_KM", "LAWS": "ATTITUDE_LAWS"}
+)

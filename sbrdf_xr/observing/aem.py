@@ -175,8 +175,8 @@ class AemSeries(QuaternionSeries):
 
     Examples
     --------
-    >>> from sbrdf_xr.observing.attitude import LAWS
-    >>> LAWS["aem"][1]
+    >>> from sbrdf_xr.observing.attitude import ATTITUDE_LAWS
+    >>> ATTITUDE_LAWS["aem"][1]
     ('path',)
     """
 

@@ -33,7 +33,7 @@ QuaternionSeries    a user time series (arrays, CSV or netCDF), slerp-interpolat
 
 This module holds the interface, the table of laws and every law but the last two,
 which have their own modules (:mod:`sbrdf_xr.observing.tumble`,
-:mod:`sbrdf_xr.observing.series`).  A law enters the table :data:`LAWS` by its class
+:mod:`sbrdf_xr.observing.series`).  A law enters the table :data:`ATTITUDE_LAWS` by its class
 definition (its ``law_name`` and ``law_parameters``), and :func:`law_from_dict` builds any
 law of the table from a TOML table (``[observation.attitude]``) through the class's
 ``from_table``.  The frames, :class:`~sbrdf_xr.observing.frames.Context` and
@@ -50,7 +50,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from ..errors import AttitudeError, did_you_mean
+from ..errors import AttitudeError, did_you_mean, renamed_attributes, renamed_keywords
 from ..units import to_unit
 from .frames import (
     Context,
@@ -64,7 +64,7 @@ from .frames import (
 )
 
 __all__ = [
-    "LAWS",
+    "ATTITUDE_LAWS",
     "VERTICALS",
     "AttitudeLaw",
     "Composed",
@@ -80,7 +80,7 @@ __all__ = [
 
 #: Law name -> (class, allowed parameters); each law's class definition enters it
 #: (:class:`AttitudeLaw`).
-LAWS: dict[str, tuple[type[AttitudeLaw], tuple[str, ...]]] = {}
+ATTITUDE_LAWS: dict[str, tuple[type[AttitudeLaw], tuple[str, ...]]] = {}
 
 
 class AttitudeLaw:
@@ -88,7 +88,7 @@ class AttitudeLaw:
 
     ``outer * inner`` composes two laws (:class:`Composed`).  A subclass that sets
     ``law_name`` (the ``law`` of a TOML table) and ``law_parameters`` (its other keys)
-    enters :data:`LAWS`; :meth:`from_table` builds it from such a table.
+    enters :data:`ATTITUDE_LAWS`; :meth:`from_table` builds it from such a table.
 
     Examples
     --------
@@ -103,7 +103,7 @@ class AttitudeLaw:
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
         if cls.__dict__.get("law_name"):
-            LAWS[cls.law_name] = (cls, cls.law_parameters)
+            ATTITUDE_LAWS[cls.law_name] = (cls, cls.law_parameters)
 
     @classmethod
     def from_table(cls, params: dict[str, Any]) -> AttitudeLaw:
@@ -188,8 +188,8 @@ class Nadir(AttitudeLaw):
     --------
     >>> from scipy.spatial.transform import Rotation
     >>> from sbrdf_xr.observing import Context
-    >>> ctx = Context(position_km=np.array([[7000.0, 0.0, 0.0]]),
-    ...               velocity_km_s=np.array([[0.0, 7.5, 0.0]]))
+    >>> ctx = Context(position=np.array([[7000.0, 0.0, 0.0]]),
+    ...               velocity=np.array([[0.0, 7.5, 0.0]]))
     >>> q = Nadir(nadir_axis="+z", velocity_axis="+x").quaternions([0.0], ctx)
     >>> np.round(Rotation.from_quat(q).apply([0.0, 0.0, 1.0]), 6) + 0.0  # +z on the geocentre
     array([[-1.,  0.,  0.]])
@@ -216,7 +216,7 @@ class Nadir(AttitudeLaw):
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         n = np.atleast_1d(np.asarray(times)).shape[0]
-        r, v = context_fields(context, n, "nadir", "position_km", "velocity_km_s")
+        r, v = context_fields(context, n, "nadir", "position", "velocity")
         a, b = self._axes
         q = triad(a, b, -r, v)
         if self.yaw_deg:
@@ -229,7 +229,8 @@ class Nadir(AttitudeLaw):
 VERTICALS = ("geodetic", "geocentric")
 
 
-def geodetic_up(position_itrs_km: ArrayLike, iterations: int = 6) -> NDArray[np.float64]:
+@renamed_keywords(position_itrs_km="position_itrs")
+def geodetic_up(position_itrs: ArrayLike, iterations: int = 6) -> NDArray[np.float64]:
     """Unit normals of the WGS84 ellipsoid through ITRS points (geodetic zenith), (n, 3).
 
     The geodetic latitude by fixed-point iteration of
@@ -239,7 +240,7 @@ def geodetic_up(position_itrs_km: ArrayLike, iterations: int = 6) -> NDArray[np.
 
     Parameters
     ----------
-    position_itrs_km : array_like, shape (n, 3)
+    position_itrs : array_like, shape (n, 3)
         Positions in the ITRS [km].
     iterations : int
         Fixed-point steps.
@@ -253,16 +254,16 @@ def geodetic_up(position_itrs_km: ArrayLike, iterations: int = 6) -> NDArray[np.
     >>> bool(np.degrees(np.arcsin(geodetic_up(r)[0, 2])) > 45.1)
     True
     """
-    from .earth_shadow import EARTH_RADIUS_KM, WGS84_FLATTENING
+    from .earth_shadow import EARTH_EQUATORIAL_RADIUS_KM, WGS84_FLATTENING
 
-    x = np.asarray(to_unit(position_itrs_km, "km", "position_itrs_km"), dtype=np.float64)
+    x = np.asarray(to_unit(position_itrs, "km", "position_itrs"), dtype=np.float64)
     x = x.reshape(-1, 3)
     e2 = WGS84_FLATTENING * (2.0 - WGS84_FLATTENING)
     p = np.hypot(x[:, 0], x[:, 1])
     lat = np.arctan2(x[:, 2], p)
     for _ in range(iterations):
         s = np.sin(lat)
-        n = EARTH_RADIUS_KM / np.sqrt(1.0 - e2 * s**2)
+        n = EARTH_EQUATORIAL_RADIUS_KM / np.sqrt(1.0 - e2 * s**2)
         lat = np.arctan2(x[:, 2] + e2 * n * s, p)
     lon = np.arctan2(x[:, 1], x[:, 0])
     c = np.cos(lat)
@@ -294,8 +295,8 @@ class YawSteering(AttitudeLaw):
     --------
     >>> from scipy.spatial.transform import Rotation
     >>> from sbrdf_xr.observing import Context
-    >>> ctx = Context(position_km=np.array([[7000.0, 0.0, 0.0]]),
-    ...               sun_km=np.array([[-1e7, 1.5e8, 0.0]]))
+    >>> ctx = Context(position=np.array([[7000.0, 0.0, 0.0]]),
+    ...               sun=np.array([[-1e7, 1.5e8, 0.0]]))
     >>> law = YawSteering(nadir_axis="-z", sun_axis="+y", vertical="geocentric")
     >>> R = Rotation.from_quat(law.quaternions([0.0], ctx))
     >>> np.round(R.apply([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]), 6) + 0.0  # z up, y to the Sun
@@ -347,7 +348,7 @@ class YawSteering(AttitudeLaw):
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         n = np.atleast_1d(np.asarray(times)).shape[0]
-        r, sun = context_fields(context, n, "yaw_steering", "position_km", "sun_km")
+        r, sun = context_fields(context, n, "yaw_steering", "position", "sun")
         up = self._up(times, r, context)
         s = sun / np.linalg.norm(sun, axis=1)[:, None]
         if np.any(np.linalg.norm(np.cross(up, s), axis=1) < 1e-12):
@@ -378,9 +379,9 @@ class SunPointing(AttitudeLaw):
     --------
     >>> from scipy.spatial.transform import Rotation
     >>> from sbrdf_xr.observing import Context
-    >>> ctx = Context(position_km=np.array([[7000.0, 0.0, 0.0]]),
-    ...               velocity_km_s=np.array([[0.0, 7.5, 0.0]]),
-    ...               sun_km=np.array([[0.0, 1.5e8, 0.0]]))
+    >>> ctx = Context(position=np.array([[7000.0, 0.0, 0.0]]),
+    ...               velocity=np.array([[0.0, 7.5, 0.0]]),
+    ...               sun=np.array([[0.0, 1.5e8, 0.0]]))
     >>> q = SunPointing(axis="+z", secondary_axis="+x").quaternions([0.0], ctx)
     >>> R = Rotation.from_quat(q)
     >>> np.round(R.apply([0.0, 0.0, 1.0]), 6) + 0.0, np.round(R.apply([1.0, 0.0, 0.0]), 6) + 0.0
@@ -418,9 +419,9 @@ class SunPointing(AttitudeLaw):
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         n = np.atleast_1d(np.asarray(times)).shape[0]
         a, b, tgt = self._axes
-        (sun,) = context_fields(context, n, "sun_pointing", "sun_km")
+        (sun,) = context_fields(context, n, "sun_pointing", "sun")
         if isinstance(tgt, str) and tgt != "north":
-            r, v = context_fields(context, n, "sun_pointing", "position_km", "velocity_km_s")
+            r, v = context_fields(context, n, "sun_pointing", "position", "velocity")
             target = {"orbit_normal": np.cross(r, v), "nadir": -r, "velocity": v}[tgt]
         else:
             target = np.tile([0.0, 0.0, 1.0] if isinstance(tgt, str) else tgt, (n, 1))
@@ -575,7 +576,7 @@ def compose(outer: AttitudeLaw | ArrayLike, inner: AttitudeLaw | ArrayLike) -> C
 def law_from_dict(table: Mapping[str, Any]) -> AttitudeLaw:
     """Build a law from a TOML table such as ``[observation.attitude]``.
 
-    ``law`` names the law (a key of :data:`LAWS`); the other keys are its parameters.
+    ``law`` names the law (a key of :data:`ATTITUDE_LAWS`); the other keys are its parameters.
     ``spin.initial`` and ``compose.outer``/``inner`` may be nested tables; a
     ``quaternion_series`` reads ``path`` (``.csv`` or ``.nc``).  Example::
 
@@ -603,15 +604,16 @@ def law_from_dict(table: Mapping[str, Any]) -> AttitudeLaw:
     """
     if not isinstance(table, Mapping) or "law" not in table:
         raise AttitudeError(
-            f"attitude: expected a table with a 'law' key (one of {', '.join(sorted(LAWS))}), "
+            "attitude: expected a table with a 'law' key "
+            f"(one of {', '.join(sorted(ATTITUDE_LAWS))}), "
             f"got {table!r}"
         )
     name = table["law"]
-    if name not in LAWS:
+    if name not in ATTITUDE_LAWS:
         raise AttitudeError(
-            f"attitude: unknown law {name!r}; {did_you_mean(name, LAWS, 'allowed laws')}"
+            f"attitude: unknown law {name!r}; {did_you_mean(name, ATTITUDE_LAWS, 'allowed laws')}"
         )
-    cls, allowed = LAWS[name]
+    cls, allowed = ATTITUDE_LAWS[name]
     params = {k: v for k, v in table.items() if k != "law"}
     bad = sorted(set(params) - set(allowed))
     if bad:
@@ -620,3 +622,7 @@ def law_from_dict(table: Mapping[str, Any]) -> AttitudeLaw:
             + did_you_mean(bad[0], allowed, "allowed parameters")
         )
     return cls.from_table(params)
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"LAWS": "ATTITUDE_LAWS"})

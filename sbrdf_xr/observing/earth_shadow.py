@@ -27,12 +27,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._names import SHADOW_EVENTS
-from ..errors import ObservationError
+from ..errors import ObservationError, renamed_attributes, renamed_keywords
 from ..units import to_unit
 
 __all__ = [
+    "EARTH_EQUATORIAL_RADIUS_KM",
     "EARTH_MODELS",
-    "EARTH_RADIUS_KM",
     "SHADOW_EVENTS",
     "SUN_RADIUS_KM",
     "WGS84_FLATTENING",
@@ -43,7 +43,7 @@ __all__ = [
 ]
 
 #: Equatorial radius of the Earth (WGS84) used by the shadow model [km].
-EARTH_RADIUS_KM = 6378.137
+EARTH_EQUATORIAL_RADIUS_KM = 6378.137
 
 #: Flattening of the WGS84 ellipsoid, ``f = 1/298.257223563`` (polar radius ``a (1 - f)``).
 WGS84_FLATTENING = 1.0 / 298.257223563
@@ -113,19 +113,42 @@ def _stretch(x: NDArray[np.float64], pole: NDArray[np.float64], k: float) -> NDA
     return x + (k - 1.0) * np.einsum("...i,...i->...", x, pole)[..., None] * pole
 
 
+@renamed_keywords(
+    position_km="position", sun_km="sun", earth_radius_km="earth_radius", sun_radius_km="sun_radius"
+)
 def shadow_angles(
-    position_km: ArrayLike,
-    sun_km: ArrayLike,
+    position: ArrayLike,
+    sun: ArrayLike,
     earth: str = "wgs84",
     pole: ArrayLike = (0.0, 0.0, 1.0),
-    earth_radius_km: float = EARTH_RADIUS_KM,
-    sun_radius_km: float = SUN_RADIUS_KM,
+    earth_radius: float = EARTH_EQUATORIAL_RADIUS_KM,
+    sun_radius: float = SUN_RADIUS_KM,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Apparent radii of the Sun and the Earth and their separation [rad] (see the module).
 
     The arguments are those of :func:`sunlit_fraction`; returns ``(a, b, c)`` for
     :func:`disc_overlap_fraction`.  The umbra is ``c < b - a``, the penumbra
     ``b - a < c < a + b``.
+
+    Parameters
+    ----------
+    position : array_like, shape (3,) or (n, 3)
+        The spacecraft's geocentric position [km].
+    sun : array_like, shape (3,) or (n, 3)
+        The Sun as seen from the spacecraft [km].
+    earth : {"wgs84", "sphere"}
+        The Earth's shape.
+    pole : array_like, shape (3,) or (n, 3)
+        The Earth's rotation axis (unit vector) [1].
+    earth_radius : float
+        Radius of the spherical Earth, equatorial radius of the ellipsoid [km].
+    sun_radius : float
+        Radius of the Sun [km].
+
+    Returns
+    -------
+    tuple of ndarray
+        ``(a, b, c)`` [rad].
 
     Examples
     --------
@@ -149,10 +172,10 @@ def shadow_angles(
     """
     if earth not in EARTH_MODELS:
         raise ObservationError(f"earth: got {earth!r}; allowed: {', '.join(EARTH_MODELS)}")
-    r = np.asarray(to_unit(position_km, "km", "position_km"), dtype=np.float64)
-    s = np.asarray(to_unit(sun_km, "km", "sun_km"), dtype=np.float64)
-    earth_radius_km = to_unit(earth_radius_km, "km", "earth_radius_km")
-    sun_radius_km = to_unit(sun_radius_km, "km", "sun_radius_km")
+    r = np.asarray(to_unit(position, "km", "position"), dtype=np.float64)
+    s = np.asarray(to_unit(sun, "km", "sun"), dtype=np.float64)
+    earth_radius = to_unit(earth_radius, "km", "earth_radius")
+    sun_radius = to_unit(sun_radius, "km", "sun_radius")
     factor: NDArray[np.float64] | float = 1.0
     if earth == "wgs84":
         p = np.asarray(pole, dtype=np.float64)
@@ -172,17 +195,20 @@ def shadow_angles(
         factor = np.where(ne > 0, np.linalg.norm(_stretch(e, p, k), axis=-1), 1.0)
     dr = np.linalg.norm(r, axis=-1)
     ds = np.linalg.norm(s, axis=-1)
-    a = np.arcsin(np.minimum(sun_radius_km * factor / ds, 1.0))
-    b = np.arcsin(np.minimum(earth_radius_km / dr, 1.0))
+    a = np.arcsin(np.minimum(sun_radius * factor / ds, 1.0))
+    b = np.arcsin(np.minimum(earth_radius / dr, 1.0))
     c = np.arctan2(np.linalg.norm(np.cross(s, -r), axis=-1), np.einsum("...i,...i->...", s, -r))
     return a, b, c
 
 
+@renamed_keywords(
+    position_km="position", sun_km="sun", earth_radius_km="earth_radius", sun_radius_km="sun_radius"
+)
 def sunlit_fraction(
-    position_km: ArrayLike,
-    sun_km: ArrayLike,
-    earth_radius_km: float = EARTH_RADIUS_KM,
-    sun_radius_km: float = SUN_RADIUS_KM,
+    position: ArrayLike,
+    sun: ArrayLike,
+    earth_radius: float = EARTH_EQUATORIAL_RADIUS_KM,
+    sun_radius: float = SUN_RADIUS_KM,
     *,
     earth: str = "wgs84",
     pole: ArrayLike = (0.0, 0.0, 1.0),
@@ -198,16 +224,16 @@ def sunlit_fraction(
 
     Parameters
     ----------
-    position_km : array_like, shape (..., 3)
+    position : array_like, shape (..., 3)
         Geocentric position of the spacecraft [km].
-    sun_km : array_like, shape (..., 3)
+    sun : array_like, shape (..., 3)
         Position of the Sun relative to the spacecraft [km].
-    earth_radius_km, sun_radius_km : float
-        Equatorial radius of the Earth and radius of the Sun [km]; ``sun_radius_km = 0``
+    earth_radius, sun_radius : float
+        Equatorial radius of the Earth and radius of the Sun [km]; ``sun_radius = 0``
         gives a point Sun.
     earth : {"wgs84", "sphere"}
-        The WGS84 ellipsoid (polar radius ``earth_radius_km (1 - f)``,
-        :data:`WGS84_FLATTENING`) or a sphere of radius ``earth_radius_km``.
+        The WGS84 ellipsoid (polar radius ``earth_radius (1 - f)``,
+        :data:`WGS84_FLATTENING`) or a sphere of radius ``earth_radius``.
     pole : array_like, shape (..., 3)
         The Earth's rotation axis in the frame of the vectors (the ITRS ``z`` axis; the
         GCRS ``z`` axis is off it by precession and nutation, 0.13 degree in 2024).
@@ -232,19 +258,22 @@ def sunlit_fraction(
     array([0.913, 0.537])
     """
     return disc_overlap_fraction(
-        *shadow_angles(position_km, sun_km, earth, pole, earth_radius_km, sun_radius_km)
+        *shadow_angles(position, sun, earth, pole, earth_radius, sun_radius)
     )
 
 
+@renamed_keywords(
+    position_km="position", sun_km="sun", earth_radius_km="earth_radius", sun_radius_km="sun_radius"
+)
 def shadow_events(
     times: ArrayLike,
-    position_km: ArrayLike,
-    sun_km: ArrayLike,
+    position: ArrayLike,
+    sun: ArrayLike,
     *,
     earth: str = "wgs84",
     pole: ArrayLike = (0.0, 0.0, 1.0),
-    earth_radius_km: float = EARTH_RADIUS_KM,
-    sun_radius_km: float = SUN_RADIUS_KM,
+    earth_radius: float = EARTH_EQUATORIAL_RADIUS_KM,
+    sun_radius: float = SUN_RADIUS_KM,
 ) -> dict[str, NDArray[np.datetime64]]:
     """UTC times the spacecraft crosses the edges of the penumbra and the umbra.
 
@@ -257,10 +286,12 @@ def shadow_events(
     ----------
     times : array_like of datetime64, shape (n,)
         Strictly increasing UTC times.
-    position_km, sun_km : array_like, shape (n, 3)
-        As in :func:`sunlit_fraction`, at ``times``.
-    earth, pole, earth_radius_km, sun_radius_km
+    position, sun : array_like, shape (n, 3)
+        As in :func:`sunlit_fraction`, at ``times`` [km].
+    earth, pole
         As in :func:`sunlit_fraction`; ``pole`` of shape (3,) or (n, 3).
+    earth_radius, sun_radius : float
+        As in :func:`sunlit_fraction` [km].
 
     Returns
     -------
@@ -290,17 +321,17 @@ def shadow_events(
     if t.size < 2:
         return out
     secs = (t - t[0]).astype(np.int64) / 1e9
-    r = np.asarray(to_unit(position_km, "km", "position_km"), dtype=np.float64)
-    s = np.broadcast_to(np.asarray(to_unit(sun_km, "km", "sun_km"), dtype=np.float64), r.shape)
-    earth_radius_km = to_unit(earth_radius_km, "km", "earth_radius_km")
-    sun_radius_km = to_unit(sun_radius_km, "km", "sun_radius_km")
+    r = np.asarray(to_unit(position, "km", "position"), dtype=np.float64)
+    s = np.broadcast_to(np.asarray(to_unit(sun, "km", "sun"), dtype=np.float64), r.shape)
+    earth_radius = to_unit(earth_radius, "km", "earth_radius")
+    sun_radius = to_unit(sun_radius, "km", "sun_radius")
     p = np.broadcast_to(np.asarray(pole, dtype=np.float64), r.shape)
     spline = CubicSpline(secs, np.concatenate([r, s, p], axis=1), axis=0)
 
     def edges(x: ArrayLike) -> NDArray[np.float64]:
         v = spline(x)
         a, b, c = shadow_angles(
-            v[..., 0:3], v[..., 3:6], earth, v[..., 6:9], earth_radius_km, sun_radius_km
+            v[..., 0:3], v[..., 3:6], earth, v[..., 6:9], earth_radius, sun_radius
         )
         return np.stack([c - (a + b), c - (b - a)], axis=-1)
 
@@ -316,3 +347,9 @@ def shadow_events(
         for k, v in found.items():
             out[k] = t[0] + np.round(np.asarray(v) * 1e9).astype("timedelta64[ns]")
     return out
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(
+    __name__, globals(), {"EARTH_RADIUS_KM": "EARTH_EQUATORIAL_RADIUS_KM"}
+)

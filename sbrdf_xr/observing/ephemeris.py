@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import EphemerisError
+from ..errors import EphemerisError, renamed_keywords
 from ..units import to_unit
 from .timescales import check_times, skyfield_time
 
@@ -89,8 +89,9 @@ FRAMES = ("GCRF", "ICRF", "EME2000", "ITRF", "TEME")
 TIME_SYSTEMS = {"UTC": "utc", "TAI": "tai", "TT": "tt", "GPS": "tai", "TDB": "tdb"}
 
 
+@renamed_keywords(position_km="position", velocity_km_s="velocity")
 def to_gcrs(
-    frame: str, times: ArrayLike, position_km: ArrayLike, velocity_km_s: ArrayLike
+    frame: str, times: ArrayLike, position: ArrayLike, velocity: ArrayLike
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """States in ``frame`` at UTC ``times`` as GCRS position [km] and velocity [km s-1].
 
@@ -103,8 +104,10 @@ def to_gcrs(
         One of :data:`FRAMES`.
     times : array_like of datetime64
         UTC times.
-    position_km, velocity_km_s : array_like, shape (n, 3)
-        Position [km] and velocity [km s-1] in ``frame``.
+    position : array_like, shape (n, 3)
+        Position in ``frame`` [km].
+    velocity : array_like, shape (n, 3)
+        Velocity in ``frame`` [km s-1].
 
     Examples
     --------
@@ -117,8 +120,8 @@ def to_gcrs(
     from skyfield.units import Distance, Velocity
 
     t64 = check_times(times)
-    r = np.asarray(to_unit(position_km, "km", "position_km"), dtype=np.float64).reshape(-1, 3)
-    v = np.asarray(to_unit(velocity_km_s, "km / s", "velocity_km_s"), dtype=np.float64)
+    r = np.asarray(to_unit(position, "km", "position"), dtype=np.float64).reshape(-1, 3)
+    v = np.asarray(to_unit(velocity, "km / s", "velocity"), dtype=np.float64)
     v = v.reshape(-1, 3)
     fr = skyfield_frame(frame)
     if fr is None:
@@ -208,11 +211,12 @@ class Ephemeris:
     method: str = ""
 
     @classmethod
+    @renamed_keywords(position_km="position", velocity_km_s="velocity")
     def from_states(
         cls,
         times: ArrayLike,
-        position_km: ArrayLike,
-        velocity_km_s: ArrayLike | None = None,
+        position: ArrayLike,
+        velocity: ArrayLike | None = None,
         *,
         frame: str = "GCRF",
         segments: Sequence[int] | None = None,
@@ -226,9 +230,9 @@ class Ephemeris:
         ----------
         times : array_like of datetime64
             UTC sample times, strictly increasing.
-        position_km : array_like, shape (n, 3)
+        position : array_like, shape (n, 3)
             Positions in ``frame`` [km].
-        velocity_km_s : array_like, shape (n, 3), optional
+        velocity : array_like, shape (n, 3), optional
             Velocities in ``frame`` [km s-1]; without them the velocity is the derivative
             of the positions' cubic spline.
         frame : str
@@ -247,14 +251,14 @@ class Ephemeris:
         [[0.0, 7.5, 0.0]]
         """
         t64 = check_times(times)
-        r = np.asarray(to_unit(position_km, "km", "position_km"), dtype=np.float64)
+        r = np.asarray(to_unit(position, "km", "position"), dtype=np.float64)
         if r.shape != (t64.size, 3) or not np.all(np.isfinite(r)):
             raise EphemerisError(
                 f"{name}: positions must be finite, shape ({t64.size}, 3); got {r.shape}"
             )
         v = None
-        if velocity_km_s is not None:
-            v = np.asarray(to_unit(velocity_km_s, "km / s", "velocity_km_s"), dtype=np.float64)
+        if velocity is not None:
+            v = np.asarray(to_unit(velocity, "km / s", "velocity"), dtype=np.float64)
             if v.shape != r.shape or not np.all(np.isfinite(v)):
                 raise EphemerisError(
                     f"{name}: velocities must be finite, shape {r.shape}; got {v.shape}"

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from ..errors import AttitudeError, ValidationError
+from ..errors import AttitudeError, ValidationError, renamed_fields
 from ..geometry import check_quaternions
 from ..units import to_unit
 
@@ -163,6 +163,7 @@ def perpendicular_pair(
     return a, b
 
 
+@renamed_fields(position_km="position", velocity_km_s="velocity", sun_km="sun")
 @dataclass(frozen=True)
 class Context:
     """What orbit-following laws need: the spacecraft's state and the Sun, per time.
@@ -171,11 +172,11 @@ class Context:
     ----------
     epoch : numpy.datetime64
         Time origin of float times (UTC).
-    position_km : array_like, shape (n, 3)
+    position : array_like, shape (n, 3)
         Geocentric position of the spacecraft in the inertial frame [km].
-    velocity_km_s : array_like, shape (n, 3)
+    velocity : array_like, shape (n, 3)
         Its velocity [km s-1].
-    sun_km : array_like, shape (n, 3)
+    sun : array_like, shape (n, 3)
         Position of the Sun relative to the spacecraft [km].
 
     A Quantity is converted to the unit of its field.
@@ -183,19 +184,19 @@ class Context:
     Examples
     --------
     >>> ctx = Context(epoch=np.datetime64("2024-03-17T01:20:00", "ns"),
-    ...               position_km=np.array([[7000.0, 0.0, 0.0]]),
-    ...               velocity_km_s=np.array([[0.0, 7.5, 0.0]]))
-    >>> ctx.sun_km is None, ctx.position_km.shape
+    ...               position=np.array([[7000.0, 0.0, 0.0]]),
+    ...               velocity=np.array([[0.0, 7.5, 0.0]]))
+    >>> ctx.sun is None, ctx.position.shape
     (True, (1, 3))
     """
 
     epoch: np.datetime64 | None = None
-    position_km: NDArray[np.float64] | None = None
-    velocity_km_s: NDArray[np.float64] | None = None
-    sun_km: NDArray[np.float64] | None = None
+    position: NDArray[np.float64] | None = None
+    velocity: NDArray[np.float64] | None = None
+    sun: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
-        for name, unit in (("position_km", "km"), ("velocity_km_s", "km / s"), ("sun_km", "km")):
+        for name, unit in (("position", "km"), ("velocity", "km / s"), ("sun", "km")):
             object.__setattr__(self, name, to_unit(getattr(self, name), unit, name))
 
 
@@ -243,15 +244,15 @@ def context_fields(context: Context | None, n: int, law: str, *fields: str) -> l
 
     Examples
     --------
-    >>> ctx = Context(position_km=np.array([[7000.0, 0.0, 0.0]]),
-    ...               velocity_km_s=np.array([[0.0, 7.5, 0.0]]))
-    >>> r, v = context_fields(ctx, 1, "nadir", "position_km", "velocity_km_s")
+    >>> ctx = Context(position=np.array([[7000.0, 0.0, 0.0]]),
+    ...               velocity=np.array([[0.0, 7.5, 0.0]]))
+    >>> r, v = context_fields(ctx, 1, "nadir", "position", "velocity")
     >>> r.tolist(), v.tolist()
     ([[7000.0, 0.0, 0.0]], [[0.0, 7.5, 0.0]])
-    >>> context_fields(ctx, 1, "sun_pointing", "sun_km")
+    >>> context_fields(ctx, 1, "sun_pointing", "sun")
     Traceback (most recent call last):
         ...
-    sbrdf_xr.errors.AttitudeError: sun_pointing: the context lacks sun_km
+    sbrdf_xr.errors.AttitudeError: sun_pointing: the context lacks sun
     """
     if context is None:
         raise AttitudeError(

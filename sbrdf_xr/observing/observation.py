@@ -27,7 +27,8 @@ Frames and models
   (WGS84) horizon.
 * Earth shadow (:mod:`sbrdf_xr.observing.earth_shadow`): the WGS84 ellipsoid (pole the ITRS
   ``z`` axis, polar motion included), or with ``earth="sphere"`` a sphere of radius
-  :data:`~sbrdf_xr.observing.earth_shadow.EARTH_RADIUS_KM`, and the Sun's finite disc (radius
+  :data:`~sbrdf_xr.observing.earth_shadow.EARTH_EQUATORIAL_RADIUS_KM`, and the Sun's finite disc
+  (radius
   :data:`~sbrdf_xr.observing.earth_shadow.SUN_RADIUS_KM`); the sunlit fraction is the fraction of
   the apparent solar disc not covered by the apparent Earth disc, from the exact area of
   overlap of the two circles (Montenbruck & Gill, *Satellite Orbits*, 2000, §3.4.2,
@@ -50,14 +51,15 @@ import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
 
+from .. import errors as _errors
 from .._names import VECTOR, attrs
 from ..errors import AttitudeError, EpochGapWarning, NotObservableError, ObservationError
 from ..geometry import rotation_matrices
 from ..units import to_unit
 from . import attitude as _att
 from .earth_shadow import (
+    EARTH_EQUATORIAL_RADIUS_KM,
     EARTH_MODELS,
-    EARTH_RADIUS_KM,
     SUN_RADIUS_KM,
     WGS84_FLATTENING,
     shadow_events,
@@ -175,6 +177,7 @@ def _as_law(value: Any) -> _att.AttitudeLaw:
 UNOBSERVABLE = ("raise", "empty", "keep")
 
 
+@_errors.renamed_fields(min_elevation_deg="min_elevation")
 @dataclass(frozen=True)
 class Observation:
     """A spacecraft on an orbit, seen from a site at UTC times, in an attitude law.
@@ -193,7 +196,7 @@ class Observation:
         :class:`~sbrdf_xr.observing.attitude.Nadir`.
     airmass_model : str
         One of :data:`~sbrdf_xr.observing.orbits.AIRMASS_MODELS`.
-    min_elevation_deg : float
+    min_elevation : float
         Elevation [degree] below which the object counts as not observable (for the
         whole-window check of :meth:`geometry`).
     name : str
@@ -227,7 +230,7 @@ class Observation:
     times: Any
     attitude: Any = None
     airmass_model: str = "kastenyoung1989"
-    min_elevation_deg: float = 0.0
+    min_elevation: float = 0.0
     name: str = "observation"
     earth: str = "wgs84"
     _cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
@@ -249,11 +252,11 @@ class Observation:
             )
         if self.earth not in EARTH_MODELS:
             raise ObservationError(f"earth: got {self.earth!r}; allowed: {', '.join(EARTH_MODELS)}")
-        min_el = to_unit(self.min_elevation_deg, "deg", "min_elevation_deg")
-        object.__setattr__(self, "min_elevation_deg", min_el)
-        if not -90.0 <= float(self.min_elevation_deg) <= 90.0:
+        min_el = to_unit(self.min_elevation, "deg", "min_elevation")
+        object.__setattr__(self, "min_elevation", min_el)
+        if not -90.0 <= float(self.min_elevation) <= 90.0:
             raise ObservationError(
-                f"min_elevation_deg: must lie in [-90, 90], got {self.min_elevation_deg}"
+                f"min_elevation: must lie in [-90, 90], got {self.min_elevation}"
             )
         if isinstance(self.orbit, Ephemeris):
             self.orbit.check_covers(t)
@@ -275,8 +278,8 @@ class Observation:
         step = f", step {(t[1] - t[0]) / np.timedelta64(1, 's'):g} s" if t.size > 1 else ""
         return (
             f"<Observation {self.name!r}: {self.orbit.name!r} from {self.site.name or 'site'} "
-            f"({self.site.latitude_deg:.4f}, {self.site.longitude_deg:.4f}, "
-            f"{self.site.height_m:g} m), "
+            f"({self.site.latitude:.4f}, {self.site.longitude:.4f}, "
+            f"{self.site.height:g} m), "
             f"{t.size} times {t[0]} .. {t[-1]}{step}, attitude {self.attitude!r}>"
         )
 
@@ -320,13 +323,11 @@ class Observation:
         >>> obs = Observation(orbit, site, times("2024-03-17T01:22:00", "2024-03-17T01:22:10", 5.0),
         ...                   Spin(rate_deg_s=10.0))
         >>> ctx = obs.context()
-        >>> ctx.position_km.shape, round(float(np.linalg.norm(ctx.position_km[0])), 0)  # [km]
+        >>> ctx.position.shape, round(float(np.linalg.norm(ctx.position[0])), 0)  # [km]
         ((3, 3), 7187.0)
         """
         st = self._state()
-        return _att.Context(
-            epoch=self.times[0], position_km=st["r"], velocity_km_s=st["v"], sun_km=st["sun"]
-        )
+        return _att.Context(epoch=self.times[0], position=st["r"], velocity=st["v"], sun=st["sun"])
 
     def quaternions(self) -> NDArray[np.float64]:
         """Attitudes (body -> GCRS) at the observation times, sign-continuous; (n, 4).
@@ -344,7 +345,7 @@ class Observation:
                [0.      , 0.      , 0.766044, 0.642788]])
         """
         ctx = self.context()
-        unknown = ~np.isfinite(np.asarray(ctx.velocity_km_s)).all(axis=1)
+        unknown = ~np.isfinite(np.asarray(ctx.velocity)).all(axis=1)
         try:
             with np.errstate(invalid="ignore"):
                 q = np.asarray(self.attitude.quaternions(self.times, ctx), dtype=np.float64)
@@ -377,7 +378,7 @@ class Observation:
         Parameters
         ----------
         on_unobservable : {"raise", "empty", "keep"}
-            What to do when the object is below ``min_elevation_deg`` at every time, or
+            What to do when the object is below ``min_elevation`` at every time, or
             in the umbra at every time: raise :class:`NotObservableError`, return a
             Dataset with ``time`` of length 0 and the reason in ``attrs["unobservable"]``,
             or return the full Dataset anyway.
@@ -418,7 +419,7 @@ class Observation:
         rng = np.linalg.norm(los, axis=1)
         # Topocentric position in the ITRS, then the geodetic east-north-up frame.
         rel = np.einsum("ijn,nj->ni", rot, -los)
-        lat, lon = np.radians(self.site.latitude_deg), np.radians(self.site.longitude_deg)
+        lat, lon = np.radians(self.site.latitude), np.radians(self.site.longitude)
         east = np.array([-np.sin(lon), np.cos(lon), 0.0])
         north = np.array([-np.sin(lat) * np.cos(lon), -np.sin(lat) * np.sin(lon), np.cos(lat)])
         up = np.array([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)])
@@ -437,10 +438,10 @@ class Observation:
         earth_phase = _angle(sun + r, r)
 
         reasons = []
-        if np.all(elevation < self.min_elevation_deg):
+        if np.all(elevation < self.min_elevation):
             i = int(np.argmax(elevation))
             reasons.append(
-                f"below {self.min_elevation_deg:g} deg elevation at every time "
+                f"below {self.min_elevation:g} deg elevation at every time "
                 f"(highest {elevation[i]:.2f} deg at {self.times[i]}); " + self.next_pass()
             )
         if np.all(sunlit == 0):
@@ -493,13 +494,14 @@ class Observation:
             ds.attrs["unobservable"] = "; ".join(reasons)
         return ds
 
-    def next_pass(self, days: float = 3.0, twilight_deg: float = -12.0) -> str:
-        """When the object next rises above ``min_elevation_deg``, and whether it can be seen.
+    @_errors.renamed_keywords(twilight_deg="twilight")
+    def next_pass(self, days: float = 3.0, twilight: float = -12.0) -> str:
+        """When the object next rises above ``min_elevation``, and whether it can be seen.
 
         From skyfield's :meth:`~skyfield.sgp4lib.EarthSatellite.find_events` over
         ``days`` from the first time of the observation; each pass is then sampled every
         10 s for the Sun: visible where the object is sunlit (half the solar disc or
-        more) and the site's Sun is below ``twilight_deg``.  When the next pass is not
+        more) and the site's Sun is below ``twilight``.  When the next pass is not
         visible, the next visible one is named.  The table of passes, with refined
         edges, is :func:`sbrdf_xr.observing.passes.visible_passes`.
 
@@ -507,7 +509,7 @@ class Observation:
         ----------
         days : float
             How far ahead to look [day]; a Quantity is converted.
-        twilight_deg : float
+        twilight : float
             Site Sun elevation below which the sky is dark enough [degree] (nautical
             twilight by default).
 
@@ -532,21 +534,21 @@ class Observation:
         if isinstance(self.orbit, Ephemeris):
             return "sbrdf_xr.observing.passes.visible_passes finds the passes of an ephemeris"
         days = float(to_unit(days, "day", "days"))
-        twilight_deg = float(to_unit(twilight_deg, "deg", "twilight_deg"))
+        twilight = float(to_unit(twilight, "deg", "twilight"))
         t64 = np.array([self.times[0], self.times[0] + np.timedelta64(round(days * 86400), "s")])
         t0, t1 = skyfield_utc(t64)
         when, kind = self.orbit.satellite.find_events(
-            self.site.position, t0, t1, altitude_degrees=float(self.min_elevation_deg)
+            self.site.position, t0, t1, altitude_degrees=float(self.min_elevation)
         )
         if not len(when):
             return (
-                f"it does not rise above {self.min_elevation_deg:g} deg within {days:g} days "
+                f"it does not rise above {self.min_elevation:g} deg within {days:g} days "
                 f"after {self.times[0]}"
             )
         stamps = [str(np.datetime64(t.replace(tzinfo=None), "s")) for t in when.utc_datetime()]
         kinds = [int(k) for k in kind]
         start = kinds.index(0) if 0 in kinds else 0
-        text = f"it next rises above {self.min_elevation_deg:g} deg at {stamps[start]} UTC"
+        text = f"it next rises above {self.min_elevation:g} deg at {stamps[start]} UTC"
         rest = list(zip(kinds[start + 1 :], stamps[start + 1 :], strict=True))
         culm = next((s for k, s in rest if k == 1), None)
         sets = next((s for k, s in rest if k == 2), None)
@@ -557,7 +559,7 @@ class Observation:
         rises = [i for i in range(start, len(kinds)) if kinds[i] == 0]
         for n, i in enumerate(rises):
             end = next((stamps[j] for j in range(i + 1, len(kinds)) if kinds[j] == 2), None)
-            seen, why = self._visible(stamps[i], end or str(t64[1]), twilight_deg)
+            seen, why = self._visible(stamps[i], end or str(t64[1]), twilight)
             if seen and n == 0:
                 return text + f"; visible {seen}"
             if n == 0:
@@ -572,9 +574,7 @@ class Observation:
 
         grid = times(start, stop, 10.0)
         law = _att.Inertial((0.0, 0.0, 0.0, 1.0))
-        obs = Observation(
-            self.orbit, self.site, grid, law, min_elevation_deg=-90.0, earth=self.earth
-        )
+        obs = Observation(self.orbit, self.site, grid, law, min_elevation=-90.0, earth=self.earth)
         g = obs.geometry(on_unobservable="keep")
         lit = g.sunlit_fraction.values >= 0.5
         dark = g.site_sun_elevation.values < twilight_deg
@@ -604,9 +604,9 @@ class Observation:
             "tle_line2": orbit.line2 if isinstance(orbit, Orbit) else "",
             "orbit_provenance": self.orbit.provenance,
             "site_name": self.site.name,
-            "site_latitude": self.site.latitude_deg,
-            "site_longitude": self.site.longitude_deg,
-            "site_height": self.site.height_m,
+            "site_latitude": self.site.latitude,
+            "site_longitude": self.site.longitude,
+            "site_height": self.site.height,
             "site_source": self.site.source,
             "site_coordinates": (
                 "WGS84 geodetic latitude and east longitude [degree], "
@@ -623,9 +623,10 @@ class Observation:
             ).strip(),
             "shadow_model": (
                 (
-                    f"WGS84 ellipsoid a = {EARTH_RADIUS_KM} km, 1/f = {1 / WGS84_FLATTENING:.9f}"
+                    f"WGS84 ellipsoid a = {EARTH_EQUATORIAL_RADIUS_KM} km, "
+                    f"1/f = {1 / WGS84_FLATTENING:.9f}"
                     if self.earth == "wgs84"
-                    else f"spherical Earth R = {EARTH_RADIUS_KM} km"
+                    else f"spherical Earth R = {EARTH_EQUATORIAL_RADIUS_KM} km"
                 )
                 + f", solar disc R = {SUN_RADIUS_KM} km, "
                 "exact disc-overlap area (Montenbruck & Gill 2000, 3.4.2); "

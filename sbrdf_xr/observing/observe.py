@@ -18,9 +18,14 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, TypedDict
 
-from ..errors import ObservationError, did_you_mean
+from ..errors import ObservationError, did_you_mean, renamed_attributes
 from . import attitude as _att
-from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, disc_overlap_fraction, sunlit_fraction
+from .earth_shadow import (
+    EARTH_EQUATORIAL_RADIUS_KM,
+    SUN_RADIUS_KM,
+    disc_overlap_fraction,
+    sunlit_fraction,
+)
 from .ephemeris import Ephemeris
 from .observation import ATTRS, TIME, Observation
 from .oem_reader import read_oem
@@ -33,6 +38,7 @@ from .orbits import (
     airmass,
     load_orbit_entry,
     load_site_entry,
+    site_fields,
     tle_checksum,
 )
 from .timescales import (
@@ -45,7 +51,7 @@ __all__ = [
     "AIRMASS_MODELS",
     "ATTRS",
     "AU_KM",
-    "EARTH_RADIUS_KM",
+    "EARTH_EQUATORIAL_RADIUS_KM",
     "EPOCH_GAP_DAYS",
     "OBSERVATION_KEYS",
     "SUN_RADIUS_KM",
@@ -105,6 +111,11 @@ OBSERVATION_KEYS: dict[str, tuple[tuple[type, ...], str, str]] = {
 }
 
 
+#: Keys of an ``[observation]`` table that name a field differently (files keep the unit
+#: in the key; :class:`Observation` takes the bare name).
+_FIELD_OF_KEY = {"min_elevation_deg": "min_elevation"}
+
+
 def _site(site_v: Any) -> Site:
     if isinstance(site_v, str):
         return Site.from_catalog(site_v)
@@ -115,7 +126,7 @@ def _site(site_v: Any) -> Site:
                 "[observation] site: needs latitude_deg, longitude_deg "
                 f"(and optional height_m, name); got {sorted(site_v)}"
             )
-        return Site(**site_v)
+        return Site(**site_fields(site_v))
     raise ObservationError(
         f"[observation] site: expected a catalog name or a table, got {site_v!r}"
     )
@@ -240,7 +251,9 @@ def observation_from_dict(
     ):
         att = {**att, "path": str(resolve(att["path"]))}
     kw = {
-        k: table[k] for k in ("airmass_model", "min_elevation_deg", "name", "earth") if k in table
+        _FIELD_OF_KEY.get(k, k): table[k]
+        for k in ("airmass_model", "min_elevation_deg", "name", "earth")
+        if k in table
     }
     return Observation(orbit, site, t, att, **kw)
 
@@ -313,3 +326,9 @@ def canx1_pass(attitude: _att.AttitudeLaw | None = None) -> Observation:
         attitude if attitude is not None else canx1_attitude(),
         name="canx1-pass",
     )
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(
+    __name__, globals(), {"EARTH_RADIUS_KM": "EARTH_EQUATORIAL_RADIUS_KM"}
+)

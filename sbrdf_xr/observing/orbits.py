@@ -18,13 +18,25 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
 
 from .. import _catalog_index
-from .._names import AIRMASS_MODELS as AIRMASS_NAMES
-from ..errors import CatalogError, ObservationError, input_file, reading
+from .._names import AIRMASS_MODELS
+from ..errors import (
+    CatalogError,
+    ObservationError,
+    input_file,
+    reading,
+    renamed_attributes,
+    renamed_fields,
+)
+from ..photometry.atmosphere import airmass
 from ..units import to_unit
-from .earth_shadow import EARTH_RADIUS_KM, SUN_RADIUS_KM, disc_overlap_fraction, sunlit_fraction
+from .earth_shadow import (
+    EARTH_EQUATORIAL_RADIUS_KM,
+    SUN_RADIUS_KM,
+    disc_overlap_fraction,
+    sunlit_fraction,
+)
 from .timescales import (
     KNOT_S,
     check_times,
@@ -39,7 +51,7 @@ from .timescales import (
 __all__ = [
     "AIRMASS_MODELS",
     "AU_KM",
-    "EARTH_RADIUS_KM",
+    "EARTH_EQUATORIAL_RADIUS_KM",
     "EPOCH_GAP_DAYS",
     "KNOT_S",
     "SUN_RADIUS_KM",
@@ -67,11 +79,6 @@ AU_KM = 149597870.700
 #: Times farther than this from the element epoch raise an :class:`EpochGapWarning` [day]:
 #: SGP4 errors of LEO elements grow by about 1-3 km per day from the epoch.
 EPOCH_GAP_DAYS = 7.0
-
-
-#: Relative air-mass models of :func:`pvlib.atmosphere.get_relative_airmass`, those of
-#: :data:`sbrdf_xr._names.AIRMASS_MODELS` (declared there, once).
-AIRMASS_MODELS = tuple(AIRMASS_NAMES)
 
 
 def tle_checksum(line: str) -> int:
@@ -374,17 +381,18 @@ def _check_model(sat: Any, label: str) -> None:
         )
 
 
+@renamed_fields(latitude_deg="latitude", longitude_deg="longitude", height_m="height")
 @dataclass(frozen=True)
 class Site:
     """An observer on the WGS84 ellipsoid.
 
     Parameters
     ----------
-    latitude_deg : float
+    latitude : float
         Geodetic latitude [degree], in [-90, 90].
-    longitude_deg : float
+    longitude : float
         East longitude [degree], in [-180, 360] (stored in [-180, 180)).
-    height_m : float
+    height : float
         Height above the ellipsoid [m], in [-500, 9000].
     name : str
     source : str
@@ -395,25 +403,25 @@ class Site:
     Examples
     --------
     >>> site = Site(45.455, -71.1525, 1111.0, name="Mont Megantic")
-    >>> site.longitude_deg, Site(0.0, 270.0).longitude_deg  # east longitude, stored in [-180, 180)
+    >>> site.longitude, Site(0.0, 270.0).longitude  # east longitude, stored in [-180, 180)
     (-71.1525, -90.0)
     >>> Site(95.0, 0.0)
     Traceback (most recent call last):
         ...
-    sbrdf_xr.errors.ObservationError: site latitude_deg: got 95.0; allowed: [-90, 90]
+    sbrdf_xr.errors.ObservationError: site latitude: got 95.0; allowed: [-90, 90]
     """
 
-    latitude_deg: float
-    longitude_deg: float
-    height_m: float = 0.0
+    latitude: float
+    longitude: float
+    height: float = 0.0
     name: str = ""
     source: str = ""
 
     def __post_init__(self) -> None:
         checks = (
-            ("latitude_deg", -90.0, 90.0, "deg"),
-            ("longitude_deg", -180.0, 360.0, "deg"),
-            ("height_m", -500.0, 9000.0, "m"),
+            ("latitude", -90.0, 90.0, "deg"),
+            ("longitude", -180.0, 360.0, "deg"),
+            ("height", -500.0, 9000.0, "m"),
         )
         for attr, lo, hi, unit in checks:
             v = to_unit(getattr(self, attr), unit, f"site {attr}")
@@ -424,8 +432,8 @@ class Site:
             if not (np.isfinite(x) and lo <= x <= hi):
                 raise ObservationError(f"site {attr}: got {v!r}; allowed: [{lo:g}, {hi:g}]")
             object.__setattr__(self, attr, x)
-        lon = (self.longitude_deg + 180.0) % 360.0 - 180.0
-        object.__setattr__(self, "longitude_deg", lon)
+        lon = (self.longitude + 180.0) % 360.0 - 180.0
+        object.__setattr__(self, "longitude", lon)
 
     @classmethod
     def from_catalog(cls, name: str) -> Site:
@@ -434,7 +442,7 @@ class Site:
         Examples
         --------
         >>> site = Site.from_catalog("mont-megantic")
-        >>> site.name, round(site.latitude_deg, 3)
+        >>> site.name, round(site.latitude, 3)
         ('mont-megantic', 45.456)
         """
         e = _catalog_index.entry(name)
@@ -453,40 +461,7 @@ class Site:
         """
         from skyfield.api import wgs84
 
-        return wgs84.latlon(self.latitude_deg, self.longitude_deg, elevation_m=self.height_m)
-
-
-def airmass(elevation_deg: ArrayLike, model: str = "kastenyoung1989") -> NDArray[np.float64]:
-    """Relative airmass at an elevation (pvlib ``get_relative_airmass``); NaN below the horizon.
-
-    Parameters
-    ----------
-    elevation_deg : array_like
-        Elevation [degree].
-    model : str
-        One of :data:`AIRMASS_MODELS`; ``kastenyoung1989`` is Kasten & Young, Appl. Opt. 28,
-        4735 (1989), ``1 / (cos z + 0.50572 (96.07995 - z)^-1.6364)``.
-
-    Returns
-    -------
-    ndarray
-        Relative airmass [1].
-
-    Examples
-    --------
-    >>> np.round(airmass([90.0, 30.0, 10.0, -5.0]), 4)  # NaN below the horizon
-    array([0.9997, 1.9943, 5.586 ,    nan])
-    """
-    if model not in AIRMASS_MODELS:
-        raise ObservationError(
-            f"airmass_model: got {model!r}; allowed: {', '.join(AIRMASS_MODELS)}"
-        )
-    from pvlib.atmosphere import get_relative_airmass
-
-    el = np.asarray(to_unit(elevation_deg, "deg", "elevation_deg"), dtype=np.float64)
-    zen = np.where(el >= 0, 90.0 - el, 90.0)
-    am = np.asarray(get_relative_airmass(zen, model=model), dtype=np.float64)
-    return np.where(el >= 0, am, np.nan)
+        return wgs84.latlon(self.latitude, self.longitude, elevation_m=self.height)
 
 
 def load_orbit_entry(entry: _catalog_index.CatalogEntry) -> Orbit:
@@ -512,6 +487,33 @@ def load_orbit_entry(entry: _catalog_index.CatalogEntry) -> Orbit:
     return Orbit.from_tle(l1, l2, name, provenance=entry.provenance)
 
 
+#: Keys of a site in files (catalog TOML, ``[observation] site``) -> :class:`Site` fields.
+SITE_FILE_KEYS = {"latitude_deg": "latitude", "longitude_deg": "longitude", "height_m": "height"}
+
+
+def site_fields(table: Mapping[str, Any]) -> dict[str, Any]:
+    """A site table as written in files (``latitude_deg``, ...) as :class:`Site` keywords.
+
+    Files keep their keys, with the unit in the name; :class:`Site` takes bare names.
+
+    Parameters
+    ----------
+    table : mapping
+        Keys of :data:`SITE_FILE_KEYS` and other :class:`Site` fields.
+
+    Returns
+    -------
+    dict
+        The same values under the field names.
+
+    Examples
+    --------
+    >>> site_fields({"latitude_deg": 45.0, "longitude_deg": -71.0, "name": "x"})
+    {'latitude': 45.0, 'longitude': -71.0, 'name': 'x'}
+    """
+    return {SITE_FILE_KEYS.get(k, k): v for k, v in table.items()}
+
+
 def load_site_entry(entry: _catalog_index.CatalogEntry) -> Site:
     """A ``kind = "site"`` entry: the table of that name in a TOML file of sites.
 
@@ -519,7 +521,7 @@ def load_site_entry(entry: _catalog_index.CatalogEntry) -> Site:
     --------
     >>> from sbrdf_xr import _catalog_index
     >>> site = load_site_entry(_catalog_index.entry("haleakala"))
-    >>> site.name, round(site.height_m)
+    >>> site.name, round(site.height)
     ('haleakala', 3058)
     """
     sites = tomllib.loads(entry.file.read_text(encoding="utf-8"))
@@ -536,4 +538,10 @@ def load_site_entry(entry: _catalog_index.CatalogEntry) -> Site:
             f"{extra}; allowed: {sorted(known | {'mpc'})}"
         )
     table.setdefault("source", entry.provenance)
-    return Site(name=entry.name, **table)
+    return Site(name=entry.name, **site_fields(table))
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(
+    __name__, globals(), {"EARTH_RADIUS_KM": "EARTH_EQUATORIAL_RADIUS_KM"}
+)

@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ..errors import ObservationError
+from ..errors import ObservationError, renamed_keywords
 from ..photometry.standard import lambert_sphere_phase
 from ..sources import SUN_V_MAGNITUDE
 from ..units import to_unit
@@ -51,7 +51,7 @@ _IDENTITY = {"law": "inertial", "q": [0.0, 0.0, 0.0, 1.0]}
 
 def _geometry(source: Any, site: Any, t: np.ndarray) -> xr.Dataset:
     site, earth = site if isinstance(site, tuple) else (site, "wgs84")
-    obs = Observation(source, site, t, _IDENTITY, min_elevation_deg=-90.0, earth=earth)
+    obs = Observation(source, site, t, _IDENTITY, min_elevation=-90.0, earth=earth)
     return obs.geometry(on_unobservable="keep")
 
 
@@ -155,16 +155,19 @@ def _window(source: Any, start: Any, stop: Any, step_s: float) -> np.ndarray:
     return t if t[-1] == t1 else np.append(t, t1)
 
 
+@renamed_keywords(
+    cross_section_m2="cross_section", min_elevation_deg="min_elevation", step_s="step"
+)
 def visible_passes(
     source: Orbit | Ephemeris,
     site: Site,
     start: Any,
     stop: Any,
     *,
-    min_elevation_deg: float = 10.0,
+    min_elevation: float = 10.0,
     twilight: str = "nautical",
-    step_s: float = 10.0,
-    cross_section_m2: float = 1.0,
+    step: float = 10.0,
+    cross_section: float = 1.0,
     albedo: float = 0.2,
     include_invisible: bool = False,
     earth: str = "wgs84",
@@ -177,13 +180,13 @@ def visible_passes(
     site : Site
     start, stop : str, datetime or datetime64
         UTC window.
-    min_elevation_deg : float
+    min_elevation : float
         Lowest elevation that counts [degree].
     twilight : {"civil", "nautical", "astronomical", "night"}
         The site's Sun must be below this twilight's elevation (:data:`TWILIGHTS`).
-    step_s : float
+    step : float
         Search grid [s]; events shorter than it may be missed (10 s suits LEO passes).
-    cross_section_m2 : float
+    cross_section : float
         Cross-section of the Lambert sphere of the peak magnitude [m2].
     albedo : float
         Its Bond albedo [1].
@@ -213,19 +216,19 @@ def visible_passes(
     >>> round(float(p.max_elevation[0]), 1), round(float(p.peak_magnitude[0]), 1)
     (76.0, 5.8)
     """
-    min_el = float(to_unit(min_elevation_deg, "deg", "min_elevation_deg"))
-    step_s = float(to_unit(step_s, "s", "step_s"))
-    cross_section_m2 = float(to_unit(cross_section_m2, "m2", "cross_section_m2"))
+    min_el = float(to_unit(min_elevation, "deg", "min_elevation"))
+    step = float(to_unit(step, "s", "step"))
+    cross_section = float(to_unit(cross_section, "m2", "cross_section"))
     if twilight not in TWILIGHTS:
         raise ObservationError(f"twilight: got {twilight!r}; allowed: {', '.join(TWILIGHTS)}")
-    if not (step_s > 0 and cross_section_m2 > 0 and 0 < albedo <= 1):
+    if not (step > 0 and cross_section > 0 and 0 < albedo <= 1):
         raise ObservationError(
-            f"visible_passes: step_s and cross_section_m2 must be > 0 and albedo in (0, 1]; got "
-            f"{step_s}, {cross_section_m2}, {albedo}"
+            f"visible_passes: step and cross_section must be > 0 and albedo in (0, 1]; got "
+            f"{step}, {cross_section}, {albedo}"
         )
     args = (min_el, TWILIGHTS[twilight])
     site_earth = (site, earth)
-    t = _window(source, start, stop, step_s)
+    t = _window(source, start, stop, step)
     cond = _conditions(_geometry(source, site_earth, t), *args)
     found = {k: _edges(source, site_earth, t, v, k, args) for k, v in cond.items()}
     ups = _intervals(t, *found["up"])
@@ -254,12 +257,12 @@ def visible_passes(
             )
             grid = np.unique(np.clip(grid, vis[0][0], vis[-1][1]))
             g = _geometry(source, site_earth, grid)
-            m = _magnitude(g, cross_section_m2, albedo)
+            m = _magnitude(g, cross_section, albedo)
             k = int(np.argmin(m))
             row.update(peak_magnitude=m[k], peak_time=grid[k], peak_range=g.range.values[k])
         if vis or include_invisible:
             rows.append(row)
-    return _table(rows, min_el, twilight, cross_section_m2, albedo, source, site, earth)
+    return _table(rows, min_el, twilight, cross_section, albedo, source, site, earth)
 
 
 _ATTRS = {

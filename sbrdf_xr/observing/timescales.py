@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import ObservationError
+from ..errors import ObservationError, renamed_keywords
 from ..units import to_unit
 
 __all__ = [
@@ -213,16 +213,17 @@ YEARS = (1900, 2200)
 MAX_TIMES = 10**7
 
 
+@renamed_keywords(step_s="step")
 def times(
-    start: Any, stop: Any, step_s: float = 1.0, *, size_limit: float = 1.0
+    start: Any, stop: Any, step: float = 1.0, *, size_limit: float = 1.0
 ) -> NDArray[np.datetime64]:
-    """UTC times from ``start`` to ``stop`` (included when on the grid) every ``step_s``.
+    """UTC times from ``start`` to ``stop`` (included when on the grid) every ``step``.
 
     Parameters
     ----------
     start, stop : str, datetime, datetime64 or astropy Time
         UTC times (naive datetimes and ISO strings without a zone are UTC).
-    step_s : float or Quantity
+    step : float or Quantity
         Step [s], > 0 (a time Quantity is converted).
 
     Returns
@@ -231,30 +232,30 @@ def times(
 
     Examples
     --------
-    >>> t = times("2024-03-17T01:20:00", "2024-03-17T01:20:02", step_s=0.5)
+    >>> t = times("2024-03-17T01:20:00", "2024-03-17T01:20:02", step=0.5)
     >>> t.size, str(t[0]), str(t[-1])
     (5, '2024-03-17T01:20:00.000000000', '2024-03-17T01:20:02.000000000')
     """
     t0, t1 = to_datetime64(start, "start"), to_datetime64(stop, "stop")
-    step_s = to_unit(step_s, "s", "step_s")
-    if isinstance(step_s, bool) or not isinstance(step_s, int | float | np.number):
-        raise ObservationError(f"step_s: expected a number of seconds, got {step_s!r}")
-    if not (np.isfinite(step_s) and step_s >= 1e-6):
+    step = to_unit(step, "s", "step")
+    if isinstance(step, bool) or not isinstance(step, int | float | np.number):
+        raise ObservationError(f"step: expected a number of seconds, got {step!r}")
+    if not (np.isfinite(step) and step >= 1e-6):
         raise ObservationError(
-            f"step_s: must be a positive number of seconds, at least 1e-6 (a microsecond), "
-            f"got {step_s!r}"
+            f"step: must be a positive number of seconds, at least 1e-6 (a microsecond), "
+            f"got {step!r}"
         )
     if t1 < t0:
         raise ObservationError(f"stop {t1} is before start {t0}")
-    step = np.timedelta64(round(step_s * 1e9), "ns")
-    n = int((t1 - t0) // step) + 1
+    step_td = np.timedelta64(round(step * 1e9), "ns")
+    n = int((t1 - t0) // step_td) + 1
     if n > size_limit * MAX_TIMES:
         raise ObservationError(
-            f"step_s: {t0} to {t1} every {step_s:g} s gives {n:.3g} times, beyond the "
+            f"step: {t0} to {t1} every {step:g} s gives {n:.3g} times, beyond the "
             f"{size_limit * MAX_TIMES:.3g} allowed ({MAX_TIMES:.0e} x size_limit); give a "
-            "larger step_s or a shorter window, or raise size_limit"
+            "larger step or a shorter window, or raise size_limit"
         )
-    return t0 + step * np.arange(n)
+    return t0 + step_td * np.arange(n)
 
 
 def check_times(value: Any) -> NDArray[np.datetime64]:

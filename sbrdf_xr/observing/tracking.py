@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import TrackingTableError
+from ..errors import TrackingTableError, renamed_keywords
 from ..units import to_unit
 from .ephemeris import Ephemeris
 from .observation import Observation
@@ -59,7 +59,7 @@ MAX_SPEED_KM_S = 12.0
 
 
 def _enu(site: Site) -> np.ndarray:
-    lat, lon = np.radians(site.latitude_deg), np.radians(site.longitude_deg)
+    lat, lon = np.radians(site.latitude), np.radians(site.longitude)
     east = [-np.sin(lon), np.cos(lon), 0.0]
     north = [-np.sin(lat) * np.cos(lon), -np.sin(lat) * np.sin(lon), np.cos(lat)]
     up = [np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)]
@@ -81,8 +81,9 @@ def _directions_itrs(
     return np.einsum("ijn,nj->ni", itrs.rotation_at(t), u)
 
 
+@renamed_keywords(height_km="height")
 def range_for_height(
-    site: Site, direction_itrs: ArrayLike, height_km: ArrayLike
+    site: Site, direction_itrs: ArrayLike, height: ArrayLike
 ) -> NDArray[np.float64]:
     """Range [km] along ITRS unit directions from ``site`` to a geodetic height [km].
 
@@ -91,7 +92,7 @@ def range_for_height(
     site : Site
     direction_itrs : array_like, shape (n, 3)
         Unit line-of-sight vectors in the ITRS [1].
-    height_km : array_like, shape (n,)
+    height : array_like, shape (n,)
         Heights above the WGS84 ellipsoid [km].
 
     Examples
@@ -104,19 +105,19 @@ def range_for_height(
     from astropy.coordinates import EarthLocation
 
     d = np.asarray(direction_itrs, dtype=np.float64).reshape(-1, 3)
-    h = np.asarray(to_unit(height_km, "km", "height_km"), dtype=np.float64).reshape(-1)
+    h = np.asarray(to_unit(height, "km", "height"), dtype=np.float64).reshape(-1)
     p = np.asarray(site.position.itrs_xyz.km, dtype=np.float64)
-    r_loc = np.linalg.norm(p) - site.height_m / 1000.0
+    r_loc = np.linalg.norm(p) - site.height / 1000.0
     pu = d @ p
 
-    def height(rho: np.ndarray) -> np.ndarray:
+    def height_of(rho: np.ndarray) -> np.ndarray:
         x = p + rho[:, None] * d
         loc = EarthLocation.from_geocentric(x[:, 0], x[:, 1], x[:, 2], unit=u.km)
         return np.asarray(loc.to_geodetic("WGS84").height.to_value(u.km))
 
     rho0 = -pu + np.sqrt(pu**2 - p @ p + (r_loc + h) ** 2)
     rho1 = rho0 + 1.0
-    f0, f1 = height(rho0) - h, height(rho1) - h
+    f0, f1 = height_of(rho0) - h, height_of(rho1) - h
     for _ in range(30):
         moving = np.abs(f1) > 1e-10
         if not moving.any():
@@ -124,16 +125,17 @@ def range_for_height(
         slope = np.where(moving, (f1 - f0) / np.where(rho1 != rho0, rho1 - rho0, 1.0), 1.0)
         rho2 = np.where(moving, rho1 - f1 / slope, rho1)
         rho0, f0 = rho1, f1
-        rho1, f1 = rho2, height(rho2) - h
+        rho1, f1 = rho2, height_of(rho2) - h
     return rho1
 
 
+@renamed_keywords(azimuth_deg="azimuth", elevation_deg="elevation", range_km="range")
 def topocentric_to_gcrs(
     site: Site,
     times: Any,
-    elevation_deg: ArrayLike,
-    azimuth_deg: ArrayLike,
-    range_km: ArrayLike,
+    elevation: ArrayLike,
+    azimuth: ArrayLike,
+    range: ArrayLike,
 ) -> NDArray[np.float64]:
     """GCRS positions [km] of measured elevations, azimuths and ranges from ``site``.
 
@@ -145,9 +147,9 @@ def topocentric_to_gcrs(
     site : Site
     times : array_like of datetime64
         UTC times (the skyfield times are made from the whole array, as an observation does).
-    elevation_deg, azimuth_deg : array_like
+    elevation, azimuth : array_like
         Geodetic elevation and azimuth (north through east) [degree].
-    range_km : array_like
+    range : array_like
         Range [km].
 
     Examples
@@ -160,9 +162,9 @@ def topocentric_to_gcrs(
     """
     t64 = np.asarray(times, dtype="datetime64[ns]")
     t = skyfield_time(t64)
-    el = np.asarray(to_unit(elevation_deg, "deg", "elevation_deg"), dtype=np.float64)
-    az = np.asarray(to_unit(azimuth_deg, "deg", "azimuth_deg"), dtype=np.float64)
-    rng = np.asarray(to_unit(range_km, "km", "range_km"), dtype=np.float64)
+    el = np.asarray(to_unit(elevation, "deg", "elevation"), dtype=np.float64)
+    az = np.asarray(to_unit(azimuth, "deg", "azimuth"), dtype=np.float64)
+    rng = np.asarray(to_unit(range, "km", "range"), dtype=np.float64)
     return _to_gcrs(site, t, _directions_itrs(site, t, el, az, None, None) * rng[:, None])
 
 

@@ -14,7 +14,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import AttitudeError
+from ..errors import AttitudeError, renamed_keywords
 from ..units import to_unit
 from .attitude import AttitudeLaw
 from .frames import Context, check_epoch, check_quaternion, seconds_since
@@ -114,11 +114,12 @@ class Tumble(AttitudeLaw):
         object.__setattr__(self, "epoch", check_epoch(self.epoch))
 
     @classmethod
+    @renamed_keywords(density_kg_m3="density", omega_deg_s="omega")
     def from_spacecraft(
         cls,
         spacecraft: Any,
-        density_kg_m3: float,
-        omega_deg_s: ArrayLike,
+        density: float,
+        omega: ArrayLike,
         initial: ArrayLike = (0.0, 0.0, 0.0, 1.0),
         epoch: Any = None,
     ) -> Tumble:
@@ -128,9 +129,9 @@ class Tumble(AttitudeLaw):
         ----------
         spacecraft : sbrdf_xr.body.spacecraft.Spacecraft
             The body (a closed mesh).
-        density_kg_m3 : float
+        density : float
             Uniform density [kg m-3].
-        omega_deg_s, initial, epoch
+        omega, initial, epoch
             As for :class:`Tumble`.
 
         Examples
@@ -142,8 +143,8 @@ class Tumble(AttitudeLaw):
         >>> np.round(np.diag(law.inertia), 9)  # a 1 kg cube of side 0.1 m [kg m2]
         array([0.00166667, 0.00166667, 0.00166667])
         """
-        density_kg_m3 = to_unit(density_kg_m3, "kg m-3", "density_kg_m3")
-        return cls(spacecraft.inertia(density_kg_m3), omega_deg_s, initial, epoch)
+        density = to_unit(density, "kg m-3", "density")
+        return cls(spacecraft.inertia(density), omega, initial, epoch)
 
     def _rhs_function(self):
         """Right-hand side of Euler's equations and the kinematics, on plain floats (fast)."""

@@ -127,6 +127,7 @@ magnitude are NaN (the colour is undefined).  A negative band signal (possible o
 with noisy tables) gives a NaN magnitude.
 """
 
+from ..errors import renamed_attributes
 from . import (
     agreement,
     atmosphere,
@@ -153,8 +154,8 @@ from .atmosphere import (
 )
 from .bands import (
     BAND_ALIASES,
-    EXTRAPOLATIONS,
     QUADRATURES,
+    SPECTRUM_EXTRAPOLATIONS,
     WEIGHTINGS,
     band_weights,
     filters,
@@ -201,7 +202,6 @@ __all__ = [
     "AB_ZERO_POINT_JY",
     "AIRMASS_MODELS",
     "BAND_ALIASES",
-    "EXTRAPOLATIONS",
     "LIGHT_CURVE_ABSCISSAE",
     "LIGHT_CURVE_COLUMNS",
     "LIGHT_CURVE_OPTIONAL",
@@ -209,6 +209,7 @@ __all__ = [
     "PHASE_FUNCTIONS",
     "QUADRATURES",
     "SOLAR_SPECTRA",
+    "SPECTRUM_EXTRAPOLATIONS",
     "TABLE_FORMATS",
     "WEIGHTINGS",
     "ab_reference_flux",
@@ -267,3 +268,6 @@ __all__ = [
     "trapezoid_weights",
     "vega_spectrum",
 ]
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"EXTRAPOLATIONS": "SPECTRUM_EXTRAPOLATIONS"})

@@ -24,7 +24,7 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from .._names import AIRMASS_MODELS, BAND, WAVELENGTH, attrs
-from ..errors import ValidationError
+from ..errors import ValidationError, renamed_keywords
 from ..units import to_unit
 from .spectra import _check_grid, _choose
 
@@ -39,45 +39,55 @@ def _values(x: Any) -> np.ndarray:
 def airmass(elevation: ArrayLike | xr.DataArray, model: str = "kastenyoung1989") -> Any:
     """Relative optical air mass from the object's elevation above the horizon.
 
+    The one air-mass function of the package (also :func:`sbrdf_xr.observing.airmass`).
     Dispatches to :func:`pvlib.atmosphere.get_relative_airmass` with zenith
     ``90 - elevation``; the models and their papers are listed in
-    :data:`AIRMASS_MODELS`.  Most models expect the apparent (refracted) elevation.
+    :data:`AIRMASS_MODELS` (default Kasten & Young 1989, Appl. Opt. 28, 4735, eq. 3:
+    ``1 / (cos z + 0.50572 (96.07995 - z)^-1.6364)``).  Most models expect the apparent
+    (refracted) elevation.
+
+    Below the horizon (elevation < 0) the air mass is not defined and is NaN, so that a
+    pass sampled through rise and set keeps its shape; NaN elevations give NaN.  At the
+    horizon itself most models are finite (Kasten & Young: 37.92).
 
     Parameters
     ----------
-    elevation : float, array_like or DataArray
-        Elevation above the horizon [degree], in (0, 90].
+    elevation : float, array_like, DataArray or Quantity
+        Elevation above the horizon [degree], in [-90, 90].
     model : str
         A key of :data:`AIRMASS_MODELS`.
 
     Returns
     -------
     float, ndarray or DataArray
-        Air mass [1] (1 at the zenith), the same shape (a DataArray keeps its
-        coordinates and gets the ``airmass`` attributes).
+        Air mass [1] (1 at the zenith, NaN below the horizon), the same shape (a
+        DataArray keeps its coordinates and gets the ``airmass`` attributes).
 
     Raises
     ------
     ValidationError
-        Unknown model; an elevation that is not finite or not in (0, 90] degree.
+        Unknown model; an elevation outside [-90, 90] degree or infinite.
 
     Examples
     --------
-    >>> np.round(airmass([90.0, 30.0, 10.0]), 4)  # Kasten and Young (1989)
-    array([0.9997, 1.9943, 5.586 ])
+    >>> np.round(airmass([90.0, 30.0, 10.0, -5.0]), 4)  # Kasten and Young (1989)
+    array([0.9997, 1.9943, 5.586 ,    nan])
     """
     from pvlib.atmosphere import get_relative_airmass
 
     _choose(model, AIRMASS_MODELS, "airmass model")
     el = _values(to_unit(elevation, "deg", "elevation"))
-    bad = ~np.isfinite(el) | (el <= 0.0) | (el > 90.0)
+    bad = np.isinf(el) | (np.abs(el) > 90.0)
     if np.any(bad):
         first = el.ravel()[np.flatnonzero(bad.ravel())[0]]
         raise ValidationError(
-            f"elevation: must be finite and in (0, 90] degree (above the horizon); "
+            f"elevation: must be in [-90, 90] degree (NaN below the horizon); "
             f"{int(bad.sum())} value(s) are not, the first is {first}"
         )
-    x = np.asarray(get_relative_airmass(90.0 - el, model=model), dtype=np.float64)
+    up = el >= 0.0  # NaN compares False: stays NaN
+    zenith = np.where(up, 90.0 - np.where(up, el, 0.0), 0.0)
+    x = np.asarray(get_relative_airmass(zenith, model=model), dtype=np.float64)
+    x = np.where(up, x, np.nan)
     if isinstance(elevation, xr.DataArray):
         return (
             elevation.copy(data=x)
@@ -174,9 +184,8 @@ def apply_extinction(mags: xr.DataArray, airmass: Any, coefficients: Any) -> xr.
     return out
 
 
-def rayleigh_optical_depth(
-    wavelength: ArrayLike, pressure_hpa: float = SEA_LEVEL_HPA
-) -> np.ndarray:
+@renamed_keywords(pressure_hpa="pressure")
+def rayleigh_optical_depth(wavelength: ArrayLike, pressure: float = SEA_LEVEL_HPA) -> np.ndarray:
     """Rayleigh-scattering optical depth of the atmosphere at the zenith.
 
     ``tau_R = 0.008569 l**-4 (1 + 0.0113 l**-2 + 0.00013 l**-4) P / 1013.25 hPa`` with
@@ -186,7 +195,7 @@ def rayleigh_optical_depth(
     ----------
     wavelength : array_like
         [nm]
-    pressure_hpa : float
+    pressure : float
         Surface pressure [hPa] (1013.25 at sea level; about 780 at 2 km).
 
     Returns
@@ -200,21 +209,18 @@ def rayleigh_optical_depth(
     array([0.3601, 0.0973, 0.0365])
     """
     lam = np.asarray(to_unit(wavelength, "nm", "wavelength", spectral=True), np.float64) / 1000.0
-    pressure_hpa = to_unit(pressure_hpa, "hPa", "pressure_hpa")
+    pressure = to_unit(pressure, "hPa", "pressure")
     return (
-        0.008569
-        * lam**-4
-        * (1.0 + 0.0113 * lam**-2 + 0.00013 * lam**-4)
-        * pressure_hpa
-        / SEA_LEVEL_HPA
+        0.008569 * lam**-4 * (1.0 + 0.0113 * lam**-2 + 0.00013 * lam**-4) * pressure / SEA_LEVEL_HPA
     )
 
 
+@renamed_keywords(pressure_hpa="pressure")
 def transmission(
     wavelength: ArrayLike,
     airmass: float,
     *,
-    pressure_hpa: float = SEA_LEVEL_HPA,
+    pressure: float = SEA_LEVEL_HPA,
     aerosol_optical_depth: float = 0.05,
     angstrom_exponent: float = 1.3,
 ) -> xr.DataArray:
@@ -232,7 +238,7 @@ def transmission(
         Strictly increasing [nm].
     airmass : float
         [1], >= 1.
-    pressure_hpa : float
+    pressure : float
         Surface pressure [hPa].
     aerosol_optical_depth : float
         Aerosol optical depth at 550 nm at the zenith [1] (0.05: a clear site).
@@ -252,10 +258,10 @@ def transmission(
     ('1', array([0.5202, 0.8018, 0.8962]))
     """
     wl = _check_grid(wavelength, "wavelength")
-    pressure_hpa = to_unit(pressure_hpa, "hPa", "pressure_hpa")
+    pressure = to_unit(pressure, "hPa", "pressure")
     for name, v, lo in (
         ("airmass", airmass, 1.0),
-        ("pressure_hpa", pressure_hpa, 0.0),
+        ("pressure", pressure, 0.0),
         ("aerosol_optical_depth", aerosol_optical_depth, 0.0),
     ):
         if not np.isfinite(v) or v < lo:
@@ -263,11 +269,11 @@ def transmission(
     if not np.isfinite(angstrom_exponent):
         raise ValidationError(f"angstrom_exponent: must be finite, got {angstrom_exponent}")
     tau = (
-        rayleigh_optical_depth(wl, pressure_hpa)
+        rayleigh_optical_depth(wl, pressure)
         + aerosol_optical_depth * (wl / 550.0) ** -angstrom_exponent
     )
     desc = (
-        f"Rayleigh (Hansen & Travis 1974, P = {pressure_hpa:g} hPa) + Angstrom aerosols "
+        f"Rayleigh (Hansen & Travis 1974, P = {pressure:g} hPa) + Angstrom aerosols "
         f"(tau_550 = {aerosol_optical_depth:g}, alpha = {angstrom_exponent:g}) "
         f"at air mass {airmass:g}"
     )

@@ -15,7 +15,7 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from .._names import BAND, WAVELENGTH, attrs
-from ..errors import ValidationError
+from ..errors import ValidationError, renamed_attributes
 from .colour_science import as_bands, as_spectrum
 from .infrared import INFRARED_BANDS, band_curve
 from .spectra import (
@@ -68,7 +68,7 @@ QUADRATURES: dict[str, str] = {
 }
 
 #: Allowed values of ``extrapolate`` (how a spectrum is continued past its grid into a band).
-EXTRAPOLATIONS: dict[str | None, str] = {
+SPECTRUM_EXTRAPOLATIONS: dict[str | None, str] = {
     None: "no extrapolation: a spectrum that does not cover a band's support is an error",
     "zero": "the spectrum is zero beyond its grid (the band is truncated)",
     "constant": "the spectrum keeps its end values beyond its grid",
@@ -412,7 +412,7 @@ def band_weights(
     weighting : {"photon", "energy"}
     quadrature : {"trapezoid", "linear"}
     extrapolate : {None, "zero", "constant"}
-        How a spectrum continues past its grid (:data:`EXTRAPOLATIONS`).  By default
+        How a spectrum continues past its grid (:data:`SPECTRUM_EXTRAPOLATIONS`).  By default
         a grid that does not cover a band's non-zero response raises.
     normalize : bool
         Divide each row by the full-band solar integral ``int E_sun T w dlambda``
@@ -451,7 +451,7 @@ def band_weights(
     """
     _choose(weighting, WEIGHTINGS, "weighting")
     _choose(quadrature, QUADRATURES, "quadrature")
-    _choose(extrapolate, EXTRAPOLATIONS, "extrapolate")
+    _choose(extrapolate, SPECTRUM_EXTRAPOLATIONS, "extrapolate")
     t = _check_grid(wavelength, "wavelength")
     bl = _resolve_bands(bands)
     solar = solar_name(solar)
@@ -490,7 +490,7 @@ def _method_attrs(
         "quadrature": quadrature,
         "quadrature_description": QUADRATURES[quadrature],
         "extrapolate": str(extrapolate),
-        "extrapolate_description": EXTRAPOLATIONS[extrapolate],
+        "extrapolate_description": SPECTRUM_EXTRAPOLATIONS[extrapolate],
         **_solar_provenance(solar),
     }
     if transmission is not None:
@@ -585,3 +585,7 @@ def pre_integrate(
     for c in ("filter", "filter_source"):
         out = out.assign_coords({c: w[c]})
     return out
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(__name__, globals(), {"EXTRAPOLATIONS": "SPECTRUM_EXTRAPOLATIONS"})

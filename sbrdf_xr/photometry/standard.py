@@ -19,12 +19,13 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from .._names import WAVELENGTH, attrs
-from ..errors import ValidationError
+from ..errors import ValidationError, renamed_keywords
 from ..units import check_plausible, to_unit
 from .spectra import _check_grid, _choose, trapezoid_weights
 
 
-def lambert_sphere_phase(alpha_deg: ArrayLike) -> np.ndarray:
+@renamed_keywords(alpha_deg="alpha")
+def lambert_sphere_phase(alpha: ArrayLike) -> np.ndarray:
     """Phase function of a diffusely (Lambert) reflecting sphere, 1 at zero phase.
 
     ``Phi(alpha) = ((pi - alpha) cos alpha + sin alpha) / pi`` (Russell 1916, ApJ 43,
@@ -32,7 +33,7 @@ def lambert_sphere_phase(alpha_deg: ArrayLike) -> np.ndarray:
 
     Parameters
     ----------
-    alpha_deg : array_like
+    alpha : array_like
         Phase angle [degree] in [0, 180].
 
     Returns
@@ -45,23 +46,34 @@ def lambert_sphere_phase(alpha_deg: ArrayLike) -> np.ndarray:
     >>> np.round(lambert_sphere_phase([0.0, 90.0, 180.0]), 6)  # 1, 1/pi, 0
     array([1.     , 0.31831, 0.     ])
     """
-    a = np.radians(np.asarray(to_unit(alpha_deg, "deg", "alpha_deg"), dtype=np.float64))
+    a = np.radians(np.asarray(to_unit(alpha, "deg", "alpha"), dtype=np.float64))
     return ((np.pi - a) * np.cos(a) + np.sin(a)) / np.pi
 
 
-def specular_sphere_phase(alpha_deg: ArrayLike) -> np.ndarray:
+@renamed_keywords(alpha_deg="alpha")
+def specular_sphere_phase(alpha: ArrayLike) -> np.ndarray:
     """Phase function of a specular (mirror) sphere: 1 at every phase angle.
 
     A mirror sphere's glint has the same intensity in every direction (the
     reflected-ray density of a sphere is isotropic; e.g. van de Hulst 1957, *Light
     Scattering by Small Particles*, sect. 12.21).
 
+    Parameters
+    ----------
+    alpha : array_like
+        Phase angle [degree].
+
+    Returns
+    -------
+    ndarray
+        Phase function [1], normalised to 1 at zero phase.
+
     Examples
     --------
     >>> specular_sphere_phase([0.0, 90.0])
     array([1., 1.])
     """
-    return np.ones_like(np.asarray(to_unit(alpha_deg, "deg", "alpha_deg"), dtype=np.float64))
+    return np.ones_like(np.asarray(to_unit(alpha, "deg", "alpha"), dtype=np.float64))
 
 
 #: Phase functions for standard magnitudes:
@@ -79,15 +91,16 @@ def _positive(value: Any, what: str) -> np.ndarray:
     return v
 
 
+@renamed_keywords(sun_distance_au="sun_distance", range_km="range", to_range_km="to_range")
 def standard_magnitude(
     mags: xr.DataArray,
-    range_km: Any,
+    range: Any,
     *,
-    to_range_km: float = 1000.0,
+    to_range: float = 1000.0,
     phase_angle: Any = None,
     to_phase_angle: float | None = None,
     phase_function: str = "lambert_sphere",
-    sun_distance_au: Any = None,
+    sun_distance: Any = None,
 ) -> xr.DataArray:
     """Magnitudes normalised to a standard range, optionally phase angle and 1 AU.
 
@@ -95,9 +108,9 @@ def standard_magnitude(
     ----------
     mags : xarray.DataArray
         Apparent magnitudes (any dims).
-    range_km : float, array_like or DataArray
+    range : float, array_like or DataArray
         Observer range of each magnitude [km], > 0; broadcast against ``mags``.
-    to_range_km : float
+    to_range : float
         Standard range [km] (default 1000 km).
     phase_angle : float, array_like or DataArray, optional
         Phase angle of each magnitude [degree]; default the ``phase_angle``
@@ -106,7 +119,7 @@ def standard_magnitude(
         Standard phase angle [degree] (e.g. 0 or 90); default none (phase kept).
     phase_function : str
         A key of :data:`PHASE_FUNCTIONS` (the stated model of the brightness with phase).
-    sun_distance_au : float, array_like or DataArray, optional
+    sun_distance : float, array_like or DataArray, optional
         Sun-object distance [AU]; when given the magnitudes are also normalised to 1 AU.
 
     Returns
@@ -129,21 +142,21 @@ def standard_magnitude(
     """
     if not isinstance(mags, xr.DataArray):
         raise ValidationError(f"mags: expected a DataArray, got {type(mags).__name__}")
-    range_km = to_unit(range_km, "km", "range_km")
-    to_range_km = to_unit(to_range_km, "km", "to_range_km")
+    range = to_unit(range, "km", "range")
+    to_range = to_unit(to_range, "km", "to_range")
     phase_angle = to_unit(phase_angle, "deg", "phase_angle")
     to_phase_angle = to_unit(to_phase_angle, "deg", "to_phase_angle")
-    sun_distance_au = to_unit(sun_distance_au, "au", "sun_distance_au")
-    check_plausible(range_km, "range_km", "range_km")
-    _positive(range_km, "range_km")
-    _positive(to_range_km, "to_range_km")
+    sun_distance = to_unit(sun_distance, "au", "sun_distance")
+    check_plausible(range, "range_km", "range")
+    _positive(range, "range")
+    _positive(to_range, "to_range")
     d = (
-        range_km.astype(np.float64)
-        if isinstance(range_km, xr.DataArray)
-        else np.asarray(range_km, dtype=np.float64)
+        range.astype(np.float64)
+        if isinstance(range, xr.DataArray)
+        else np.asarray(range, dtype=np.float64)
     )
-    out = mags - 5.0 * np.log10(d / float(to_range_km))
-    how = [f"range {to_range_km:g} km"]
+    out = mags - 5.0 * np.log10(d / float(to_range))
+    how = [f"range {to_range:g} km"]
     if to_phase_angle is not None:
         _choose(phase_function, PHASE_FUNCTIONS, "phase_function")
         fn, desc = PHASE_FUNCTIONS[phase_function]
@@ -177,13 +190,9 @@ def standard_magnitude(
             )
         out = out + 2.5 * np.log10(pa / p0)
         how.append(f"phase angle {to_phase_angle:g} deg with the {desc} phase function")
-    if sun_distance_au is not None:
-        _positive(sun_distance_au, "sun_distance_au")
-        r = (
-            sun_distance_au
-            if isinstance(sun_distance_au, xr.DataArray)
-            else np.asarray(sun_distance_au)
-        )
+    if sun_distance is not None:
+        _positive(sun_distance, "sun_distance")
+        r = sun_distance if isinstance(sun_distance, xr.DataArray) else np.asarray(sun_distance)
         out = out - 5.0 * np.log10(r)
         how.append("Sun-object distance 1 AU")
     out = out.transpose(*mags.dims, ...)
@@ -192,7 +201,7 @@ def standard_magnitude(
         **{k: v for k, v in mags.attrs.items() if k not in ("long_name", "range_km")},
         **attrs("magnitude", long_name="standard magnitude of the reflected sunlight"),
         "standardisation": "normalised to " + ", ".join(how),
-        "standard_range_km": float(to_range_km),
+        "standard_range_km": float(to_range),
     }
     if to_phase_angle is not None:
         out.attrs["standard_phase_angle"] = float(to_phase_angle)
@@ -248,11 +257,12 @@ def sun_distance_au(time: Any) -> Any:
     return float(r) if np.ndim(r) == 0 else r
 
 
+@renamed_keywords(fwhm_nm="fwhm")
 def at_resolution(
     spectrum: xr.DataArray,
     *,
     resolving_power: float | None = None,
-    fwhm_nm: float | None = None,
+    fwhm: float | None = None,
     wavelength: ArrayLike | None = None,
 ) -> xr.DataArray:
     """A spectrum as a spectrograph of a given resolution records it, flux-conserving.
@@ -260,7 +270,7 @@ def at_resolution(
     Each element of the (piecewise-linear) spectrum carries its flux
     ``y_k w_k`` (``w_k`` the trapezoid weight of node ``k``) and spreads it with a
     Gaussian line-spread function of FWHM ``lambda_k / R`` (``resolving_power``) or
-    ``fwhm_nm``; the output at node ``t_j`` is the flux falling in its cell (edges
+    ``fwhm``; the output at node ``t_j`` is the flux falling in its cell (edges
     halfway between nodes) divided by the cell width.  Hence the trapezoid integral of
     the output equals that of the input, exactly up to the flux spread past the ends
     of the output grid.
@@ -271,7 +281,7 @@ def at_resolution(
         Anything over ``wavelength`` [nm] (other dims are kept).
     resolving_power : float, optional
         ``R = lambda / FWHM`` [1], > 0.
-    fwhm_nm : float, optional
+    fwhm : float, optional
         Constant FWHM [nm], > 0.  Exactly one of the two.
     wavelength : array_like, optional
         Output grid [nm]; default the input grid.
@@ -287,7 +297,7 @@ def at_resolution(
     >>> wl = np.arange(500.0, 600.01, 0.5)
     >>> line = xr.DataArray(np.exp(-0.5 * ((wl - 550.0) / 1.0) ** 2), dims="wavelength",
     ...                     coords={"wavelength": wl}, attrs={"units": "W m-2 nm-1"})
-    >>> seen = at_resolution(line, fwhm_nm=10.0)  # sigma 1 nm -> sqrt(1 + (10 / 2.3548)**2) nm
+    >>> seen = at_resolution(line, fwhm=10.0)  # sigma 1 nm -> sqrt(1 + (10 / 2.3548)**2) nm
     >>> round(float(seen.max()), 4)
     0.2291
     >>> round(float(seen.integrate("wavelength")), 6), round(float(line.integrate("wavelength")), 6)
@@ -299,21 +309,21 @@ def at_resolution(
         raise ValidationError(
             "spectrum: expected a DataArray with a 'wavelength' dimension and coordinate"
         )
-    fwhm_nm = to_unit(fwhm_nm, "nm", "fwhm_nm")
-    if (resolving_power is None) == (fwhm_nm is None):
-        raise ValidationError("give exactly one of resolving_power (lambda / FWHM) and fwhm_nm")
+    fwhm = to_unit(fwhm, "nm", "fwhm")
+    if (resolving_power is None) == (fwhm is None):
+        raise ValidationError("give exactly one of resolving_power (lambda / FWHM) and fwhm")
     x = _check_grid(spectrum[WAVELENGTH].values, "spectrum wavelength")
     t = x if wavelength is None else _check_grid(wavelength, "wavelength")
     if x.size < 2 or t.size < 2:
         raise ValidationError("spectrum and output grid need >= 2 wavelengths")
     if resolving_power is not None:
         _positive(resolving_power, "resolving_power")
-        fwhm = x / float(resolving_power)
+        fwhm_grid = x / float(resolving_power)
         how = f"Gaussian line-spread function, resolving power R = {resolving_power:g}"
     else:
-        fwhm = np.full(x.size, float(_positive(fwhm_nm, "fwhm_nm")))
-        how = f"Gaussian line-spread function, FWHM {fwhm_nm:g} nm"
-    sigma = fwhm / (2.0 * np.sqrt(2.0 * np.log(2.0)))
+        fwhm_grid = np.full(x.size, float(_positive(fwhm, "fwhm")))
+        how = f"Gaussian line-spread function, FWHM {fwhm:g} nm"
+    sigma = fwhm_grid / (2.0 * np.sqrt(2.0 * np.log(2.0)))
     edges = np.concatenate([[t[0]], 0.5 * (t[1:] + t[:-1]), [t[-1]]])
     cdf = ndtr((edges[:, None] - x[None, :]) / sigma[None, :])  # (n_t + 1, n_x)
     m = np.diff(cdf, axis=0) * trapezoid_weights(x)[None, :] / trapezoid_weights(t)[:, None]

@@ -19,9 +19,10 @@ import numpy as np
 import xarray as xr
 
 from .._names import SHADOW_EVENTS
-from ..errors import ValidationError
+from ..errors import ValidationError, renamed_keywords
+from ..units import to_unit
 from ._labels import STYLES, band_colour, finite, label, outside_legend, spread_indices
-from .curves import light_curve, magnitude_label, spectra
+from .curves import light_curve, magnitude_label, spectrum_curves
 
 __all__ = [
     "CUBE_KINDS",
@@ -74,17 +75,34 @@ def cube_kind(cube: xr.Dataset) -> str:
     )
 
 
+@renamed_keywords(range_km="range")
 def cube_magnitudes(
     cube: xr.Dataset,
     bands: Sequence[str] = ("V", "R", "I"),
-    range_km: float | None = None,
+    range: float | None = None,
     system: str = "AB",
 ) -> xr.DataArray | None:
     """Magnitudes of a cube in those of ``bands`` its spectra cover (None if none).
 
     From ``signal`` over wavelength, else from a band-only cube's ``band_signal``; at the
-    cube's own ``range`` unless ``range_km`` is given, :data:`DEFAULT_RANGE_KM` when the
+    cube's own ``range`` unless ``range`` is given, :data:`DEFAULT_RANGE_KM` when the
     cube records none.
+
+    Parameters
+    ----------
+    cube : xarray.Dataset
+        A simulated cube.
+    bands : sequence of str
+        Band names.
+    range : float, optional
+        Observer range [km].
+    system : str
+        Magnitude system.
+
+    Returns
+    -------
+    xarray.DataArray or None
+        Magnitudes over ``band`` [mag].
 
     Examples
     --------
@@ -98,8 +116,10 @@ def cube_magnitudes(
     """
     from .. import photometry
 
-    if range_km is None and "range" not in cube.variables:
-        range_km = DEFAULT_RANGE_KM
+    if range is None and "range" not in cube.variables:
+        range = DEFAULT_RANGE_KM
+    elif range is not None:
+        range = to_unit(range, "km", "range")
     if "wavelength" in cube.dims and "signal" in cube:
         kept = []
         for b in bands:
@@ -108,13 +128,13 @@ def cube_magnitudes(
             except ValidationError:
                 continue
             kept.append(b)
-        return photometry.magnitudes(cube, kept, range_km, system=system) if kept else None
+        return photometry.magnitudes(cube, kept, range, system=system) if kept else None
     if "band_signal" in cube:
         sb = cube["band_signal"]
         names = sb["filter"].values if "filter" in sb.coords else sb["band"].values
         sun = photometry.sun_magnitudes([str(n) for n in names], system=system)
         sb = sb.assign_coords(sun_magnitude=("band", sun.values))
-        return photometry.magnitudes(sb, range_km=range_km, system=system)
+        return photometry.magnitudes(sb, range_km=range, system=system)
     return None
 
 
@@ -123,11 +143,12 @@ def _phase_indices(cube: xr.Dataset, max_lines: int) -> np.ndarray:
     return spread_indices(n, max_lines)
 
 
+@renamed_keywords(range_km="range")
 def rotation_figure(
     cube: xr.Dataset,
     bands: Sequence[str] = ("V", "R", "I"),
     *,
-    range_km: float | None = None,
+    range: float | None = None,
     system: str = "AB",
     max_lines: int = 4,
 ) -> Any:
@@ -135,6 +156,23 @@ def rotation_figure(
 
     Up to ``max_lines`` phase angles are drawn (line style per phase angle, colour per
     band).  Magnitudes are at the cube's range, else :data:`DEFAULT_RANGE_KM`.
+
+    Parameters
+    ----------
+    cube : xarray.Dataset
+        The cube to draw.
+    bands : sequence of str
+        Band names.
+    range : float, optional
+        Observer range for the magnitudes [km]; default the cube's.
+    system : str
+        Magnitude system.
+    max_lines : int
+        Most phase angles drawn.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
 
     Examples
     --------
@@ -149,7 +187,7 @@ def rotation_figure(
     """
     import matplotlib.pyplot as plt
 
-    mags = cube_magnitudes(cube, bands, range_km, system)
+    mags = cube_magnitudes(cube, bands, range, system)
     panels = ["brdf" in cube, mags is not None]
     if not any(panels):
         raise ValidationError(
@@ -215,11 +253,12 @@ def _shade_shadow(axes: Sequence[Any], cube: xr.Dataset) -> list[Any]:
     return handles
 
 
+@renamed_keywords(range_km="range")
 def observation_figure(
     cube: xr.Dataset,
     bands: Sequence[str] = ("V", "R", "I"),
     *,
-    range_km: float | None = None,
+    range: float | None = None,
     system: str = "AB",
 ) -> Any:
     """A pass: magnitudes, colours and geometry against UTC, with the Earth's shadow.
@@ -229,6 +268,21 @@ def observation_figure(
     phase angle and elevation [deg], and the sunlit fraction of the solar disc (right
     axis).  The umbra and penumbra are shaded on every panel and the UTC times of the
     shadow's edges (the cube's ``umbra_exit``, ... attributes) drawn dashed and listed.
+
+    Parameters
+    ----------
+    cube : xarray.Dataset
+        The cube to draw.
+    bands : sequence of str
+        Band names.
+    range : float, optional
+        Observer range for the magnitudes [km]; default the cube's.
+    system : str
+        Magnitude system.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
 
     Examples
     --------
@@ -246,7 +300,7 @@ def observation_figure(
 
     from .. import photometry
 
-    mags = cube_magnitudes(cube, bands, range_km, system)
+    mags = cube_magnitudes(cube, bands, range, system)
     fig, axes = plt.subplots(3, 1, figsize=(10, 8), sharex=True, layout="constrained",
                              height_ratios=(3, 2, 2))  # fmt: skip
     t = cube["time"].values
@@ -313,11 +367,12 @@ def _bands_figure(cube: xr.Dataset, bands: Sequence[str], system: str) -> Any:
     return fig
 
 
+@renamed_keywords(range_km="range")
 def cube_figure(
     cube: xr.Dataset,
     *,
     bands: Sequence[str] = ("V", "R", "I"),
-    range_km: float | None = None,
+    range: float | None = None,
     system: str = "AB",
     max_lines: int = 6,
 ) -> Any:
@@ -329,7 +384,7 @@ def cube_figure(
         A simulation cube (in memory or opened from a file).
     bands : sequence of str
         Bands of the magnitudes (those the cube's spectra cover).
-    range_km : float, optional
+    range : float, optional
         Range of the magnitudes [km]; default the cube's ``range``, else
         :data:`DEFAULT_RANGE_KM` (said on the axis).
     system : {"AB", "Vega"}
@@ -352,14 +407,15 @@ def cube_figure(
     (2, 'attitude angle [deg]')
     >>> plt.close(fig)
     """
+    range = None if range is None else to_unit(range, "km", "range")
     kind = cube_kind(cube)
     if kind == "observation":
-        return observation_figure(cube, bands, range_km=range_km, system=system)
+        return observation_figure(cube, bands, range=range, system=system)
     if kind == "rotation":
-        return rotation_figure(cube, bands, range_km=range_km, system=system)
+        return rotation_figure(cube, bands, range=range, system=system)
     if kind == "bands":
         return _bands_figure(cube, bands, system)
     var = "spacecraft_sbrdf" if "spacecraft_sbrdf" in cube else "signal"
-    fig = spectra(cube, var, max_lines=max_lines)
+    fig = spectrum_curves(cube, var, max_lines=max_lines)
     fig.axes[0].set_title(str(cube.attrs.get("scene", "")), fontsize="medium")
     return fig

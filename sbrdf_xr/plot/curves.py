@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ..errors import ValidationError
+from ..errors import ValidationError, renamed_attributes
 from ..units import to_unit
 from ._labels import (
     SHORT_LABELS,
@@ -33,9 +33,9 @@ __all__ = [
     "colour_colour",
     "light_curve",
     "lut_slice",
+    "magnitude_curves",
     "magnitude_label",
-    "magnitudes",
-    "spectra",
+    "spectrum_curves",
 ]
 
 #: Coordinates that name a geometry in legends, in order of preference.
@@ -151,7 +151,7 @@ def _line_name(line: xr.DataArray, cube: xr.Dataset | xr.DataArray) -> str:
     return ", ".join(names)
 
 
-def spectra(
+def spectrum_curves(
     cube: xr.Dataset,
     variable: str = "spacecraft_sbrdf",
     ax: Any = None,
@@ -195,7 +195,7 @@ def spectra(
     ...                           {"units": "sr-1"})},
     ...     coords={"geometry": np.arange(100),
     ...             "wavelength": ("wavelength", [450.0, 550.0, 650.0], {"units": "nm"})})
-    >>> fig = spectra(cube)
+    >>> fig = spectrum_curves(cube)
     >>> ax = fig.axes[0]
     >>> len(ax.lines), ax.get_legend().get_title().get_text()
     (6, '6 of 100 spectra, ranked by mean overall sBRDF')
@@ -305,7 +305,7 @@ def magnitude_label(mags: xr.DataArray) -> str:
     return f"magnitude{at} [{system + ' ' if system else ''}mag]"
 
 
-def magnitudes(mags: xr.DataArray, ax: Any = None, x: str | None = None, **sel: Any) -> Any:
+def magnitude_curves(mags: xr.DataArray, ax: Any = None, x: str | None = None, **sel: Any) -> Any:
     """Magnitudes per band against attitude (or rotation angle, or time), brighter up.
 
     Parameters
@@ -336,7 +336,7 @@ def magnitudes(mags: xr.DataArray, ax: Any = None, x: str | None = None, **sel: 
     ...                     attrs={"units": "1", "magnitude_system": "AB", "range_km": 1000.0},
     ...                     coords={"attitude_angle": ("attitude", ang, {"units": "degree"}),
     ...                             "band": ["B", "V"]})
-    >>> fig = magnitudes(mags)
+    >>> fig = magnitude_curves(mags)
     >>> ax = fig.axes[0]
     >>> len(ax.lines), bool(ax.yaxis_inverted()), ax.get_ylabel()  # brighter up
     (2, True, 'magnitude at 1000 km [AB mag]')
@@ -463,3 +463,9 @@ def colour_colour(
     ax.set_xlabel(f"{x} [{unit}]")
     ax.set_ylabel(f"{y} [{unit}]")
     return fig
+
+
+#: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+__getattr__ = renamed_attributes(
+    __name__, globals(), {"magnitudes": "magnitude_curves", "spectra": "spectrum_curves"}
+)

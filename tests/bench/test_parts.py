@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sbrdf_xr.bench.parts import KINDS, canx1_with_wing, parts_rows
+from sbrdf_xr.bench.parts import WING_KINDS, canx1_with_wing, parts_rows
 
 
 def test_the_three_wings_are_the_same_wing():
-    slab, sheet, tracking = (canx1_with_wing(k) for k in KINDS)
+    slab, sheet, tracking = (canx1_with_wing(k) for k in WING_KINDS)
     assert slab.mesh.is_watertight and not sheet.mesh.is_watertight
     assert sheet.n_sides == tracking.n_sides == 684 + 4
     assert [p.name for p in tracking.moving_parts] == ["wing"]

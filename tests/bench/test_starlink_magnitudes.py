@@ -35,7 +35,7 @@ def test_the_shipped_table_is_whole():
     table = pomenis_table()
     assert table.times.size == 1173 and table.dropped == ()
     assert table.columns["ab_magnitude"].size == 1173
-    assert table.site.latitude_deg == 32.4434 and table.site.longitude_deg == -110.7881
+    assert table.site.latitude == 32.4434 and table.site.longitude == -110.7881
 
 
 def test_the_scene_has_the_effects_and_the_tracking_array():

@@ -66,7 +66,7 @@ def test_nadir_law_points_the_chassis_to_nadir():
     from sbrdf_xr.observing.attitude import Nadir
 
     r = np.array([[7000.0, 1000.0, -300.0]])
-    ctx = Context(position_km=r, velocity_km_s=np.array([[0.0, 7.5, 1.0]]))
+    ctx = Context(position=r, velocity=np.array([[0.0, 7.5, 1.0]]))
     q = Nadir(nadir_axis="-z", velocity_axis="+x").quaternions([0.0], ctx)
     chassis_normal = Rotation.from_quat(q).apply([0.0, 0.0, -1.0])
     np.testing.assert_allclose(chassis_normal[0], -r[0] / np.linalg.norm(r), atol=1e-12)

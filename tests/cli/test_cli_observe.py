@@ -96,7 +96,7 @@ def test_an_element_file_a_site_by_coordinates_and_a_tumble(tmp_path):
     from sbrdf_xr.body.spacecraft import canx1
 
     obs = observation_of(args, canx1())
-    assert obs.orbit.name == "CANX-1" and obs.site.height_m == 1528.0
+    assert obs.orbit.name == "CANX-1" and obs.site.height == 1528.0
     assert type(obs.attitude).__name__ == "Tumble" and obs.times.size == 5
     assert np.all(obs.geometry().elevation.values > 20.0)
 

@@ -14,9 +14,9 @@ from sbrdf_xr.engine import Scene
 from sbrdf_xr.engine.run import simulate
 from sbrdf_xr.materials import models
 from sbrdf_xr.materials.schema import lambertian
-from sbrdf_xr.sources import EARTH_RADIUS_KM, _earth_cap, earthshine_irradiance_ratio
+from sbrdf_xr.sources import EARTH_MEAN_RADIUS_KM, _earth_cap, earthshine_irradiance_ratio
 
-R = EARTH_RADIUS_KM
+R = EARTH_MEAN_RADIUS_KM
 WL = [500.0, 600.0, 700.0]
 DOWN = np.array([0.0, 0.0, -1.0])  # the facet looked at: the cube's -z face
 #: the issue's requirement against the exact integral; the engine's quadrature

@@ -53,9 +53,9 @@ def test_the_moon_is_where_astropy_puts_it():
     obs = canx1_pass()
     ctx = obs.context()
     t64 = np.concatenate([obs.times, np.array(["2022-11-08T10:59", "2020-06-01"], "M8[ns]")])
-    r = np.concatenate([ctx.position_km, [[0.0, -42164.0, 0.0], [0.0, 0.0, 7000.0]]])
-    v = np.concatenate([ctx.velocity_km_s, [[3.07, 0.0, 0.0], [0.0, 0.0, 0.0]]])
-    sun = np.concatenate([ctx.sun_km, [[1.5e8, 0.0, 0.0]] * 2])
+    r = np.concatenate([ctx.position, [[0.0, -42164.0, 0.0], [0.0, 0.0, 7000.0]]])
+    v = np.concatenate([ctx.velocity, [[3.07, 0.0, 0.0], [0.0, 0.0, 0.0]]])
+    sun = np.concatenate([ctx.sun, [[1.5e8, 0.0, 0.0]] * 2])
     ours = moon_from_spacecraft(t64, r, v, sun)["moon_km"]
     with (
         iers.conf.set_temp("auto_download", False),
@@ -161,7 +161,7 @@ def test_moonlight_on_a_lambertian_cube_is_the_closed_form():
     cube = simulate(scene)
     assert cube.signal_moonlight.attrs["units"] == "m2 sr-1"
     ctx = obs.context()
-    m = moon_from_spacecraft(obs.times, ctx.position_km, ctx.velocity_km_s, ctx.sun_km)
+    m = moon_from_spacecraft(obs.times, ctx.position, ctx.velocity, ctx.sun)
     q = cube.quaternion.values
     to_moon = np.einsum("nji,nj->ni", geometry.rotation_matrices(q), _unit(m["moon_km"]))
     o = cube.to_observer.values

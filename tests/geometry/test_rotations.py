@@ -48,7 +48,7 @@ def test_compose_matches_matrix_product():
     a = r.axis_rotation([1, 2, 3], 40.0)
     b = r.axis_rotation([0, 1, 0], -70.0)
     np.testing.assert_allclose(
-        r.rotation_matrices(r.compose(a, b)),
+        r.rotation_matrices(r.compose_quaternions(a, b)),
         r.rotation_matrices(a) @ r.rotation_matrices(b),
         atol=1e-12,
     )

@@ -14,7 +14,7 @@ from sbrdf_xr.observing import earth_shadow as es
 from sbrdf_xr.observing import observe
 from sbrdf_xr.observing.timescales import skyfield_time, times
 
-A = es.EARTH_RADIUS_KM
+A = es.EARTH_EQUATORIAL_RADIUS_KM
 B = A * (1 - es.WGS84_FLATTENING)
 AXES = {"wgs84": np.array([A, A, B]), "sphere": np.array([A, A, A])}
 
@@ -53,7 +53,7 @@ def test_point_sun_umbra_is_the_ray_ellipsoid_intersection():
     r *= (rng.uniform(6400.0, 12000.0, n) / np.linalg.norm(r, axis=1))[:, None]
     sun = rng.normal(size=(n, 3))
     sun *= 1.5e8 / np.linalg.norm(sun, axis=1, keepdims=True)
-    f = es.sunlit_fraction(r, sun, sun_radius_km=0.0, pole=pole)
+    f = es.sunlit_fraction(r, sun, sun_radius=0.0, pole=pole)
     # The same in a frame whose z is the pole (any x, y: the ellipsoid is axisymmetric).
     ex = np.cross(pole, rng.normal(size=(n, 3)))
     ex /= np.linalg.norm(ex, axis=1, keepdims=True)
@@ -76,7 +76,7 @@ def exit_window():
     obs = dataclasses.replace(base, times=t)
     ctx = obs.context()
     rot = np.moveaxis(itrs.rotation_at(skyfield_time(t)), -1, 0)  # (n, 3, 3)
-    return obs, t, ctx.position_km, ctx.sun_km, rot
+    return obs, t, ctx.position, ctx.sun, rot
 
 
 def independent_edges(t, r, sun, rot, earth):

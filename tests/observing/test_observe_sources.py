@@ -36,7 +36,7 @@ def test_scene_table_with_an_oem(oem_file):
         "attitude": {"law": "spin", "axis_body": [0.3, 0.4, 0.866], "rate_deg_s": 4.0},
     }
     o2 = observation_from_dict(table, base_dir=path.parent)
-    assert np.abs(o2.context().position_km - obs.context().position_km).max() < POS_ATOL_KM
+    assert np.abs(o2.context().position - obs.context().position).max() < POS_ATOL_KM
     with pytest.raises(ObservationError, match=r"exactly one of orbit, tle.*oem, tracking"):
         observation_from_dict({**table, "orbit": "canx1-example"}, base_dir=path.parent)
 

@@ -55,8 +55,8 @@ def test_each_site_reproduces_its_mpc_parallax_constants(key):
     a = 6378.137
     assert np.hypot(xyz[0], xyz[1]) / a == pytest.approx(rho_cos, abs=6e-6)  # 5-decimal rounding
     assert xyz[2] / a == pytest.approx(rho_sin, abs=6e-6)
-    assert np.mod(site.longitude_deg - lon + 180.0, 360.0) - 180.0 == pytest.approx(0.0, abs=1e-5)
-    assert -500.0 < site.height_m < 4500.0 and isinstance(code, str)
+    assert np.mod(site.longitude - lon + 180.0, 360.0) - 180.0 == pytest.approx(0.0, abs=1e-5)
+    assert -500.0 < site.height < 4500.0 and isinstance(code, str)
 
 
 def test_element_files_with_one_or_many_sets(tmp_path):

@@ -80,7 +80,7 @@ def test_visible_part_dark_sunlit_and_up(canx1, all_passes):
     assert p.sizes["pass"] == 3
     for k in range(3):
         t = times(p.visible_start.values[k], p.visible_stop.values[k], 5.0)
-        g = Observation(orbit, site, t, min_elevation_deg=-90).geometry(on_unobservable="keep")
+        g = Observation(orbit, site, t, min_elevation=-90).geometry(on_unobservable="keep")
         assert g.elevation.min() > 10.0 - 1e-3 and g.sunlit_fraction.min() > 0.5 - 1e-3
         assert g.site_sun_elevation.max() < -12.0 + 1e-3
     mags = p.peak_magnitude.values

@@ -32,7 +32,7 @@ def test_geodetic_up_matches_astropy(lat, lon, height_km):
 
 
 def _ctx(r, sun):
-    return Context(position_km=np.atleast_2d(r), sun_km=np.atleast_2d(sun))
+    return Context(position=np.atleast_2d(r), sun=np.atleast_2d(sun))
 
 
 def test_the_axes_go_down_the_vertical_and_toward_the_sun():

@@ -433,7 +433,9 @@ def reflected(
     if plan.knobs["evaluation"] == "analytic":
         return _analytic_sums(plan, to_source, block.to_observer, fraction, per_material)
     if plan.anisotropic:  # tables with a psi axis (the isotropic ones keep their kernel)
-        return _aniso_kernels.reflected(plan, to_source, block.to_observer, fraction, per_material)
+        return _aniso_kernels.anisotropic_reflected(
+            plan, to_source, block.to_observer, fraction, per_material
+        )
     if plan.knobs["kernel"] == "fused":
         return _kernels.fused_sums(
             to_source,

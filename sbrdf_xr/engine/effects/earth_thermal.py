@@ -101,7 +101,7 @@ def _geometry(scene: SceneView, observed: xr.Dataset | None) -> dict[str, np.nda
         rng = np.full(len(to_earth), float(scene.earth_range_km))
     out = {"to_earth": to_earth, "earth_range": rng}
     if scene.earth_model == "finite":  # facets up to 90 deg + rho from the centre see it
-        out["earth_reach"] = sources.EARTH_RADIUS_KM / rng
+        out["earth_reach"] = sources.EARTH_MEAN_RADIUS_KM / rng
     return out
 
 
@@ -112,7 +112,7 @@ def _plan(inputs: PlanInputs) -> Decision:
     ranges = np.asarray(scene.geometry.sources["earth_range"], dtype=np.float64)
     nearest = float(np.min(ranges)) if ranges.size else float(scene.earth_range_km)
     radiance = sources.planck(wl, scene.earth_temperature)  # [W m-2 sr-1 nm-1]
-    full = np.pi * (sources.EARTH_RADIUS_KM / nearest) ** 2  # an Earth-facing facet [sr]
+    full = np.pi * (sources.EARTH_MEAN_RADIUS_KM / nearest) ** 2  # an Earth-facing facet [sr]
     e_sun = solar_spectrum(wl, solar="astm_g173_extended").values
     worst = float(np.max(full * radiance / np.maximum(e_sun, 1e-300)))
     if worst < THERMAL_NEGLIGIBLE:
@@ -163,7 +163,7 @@ def _contribute(plan: PlanView, block: BlockInputs) -> dict[str, np.ndarray]:
         # the kernel multiplies by cos(theta_i) at the Earth's centre: divide it out
         share = np.divide(view, cos_i, out=np.zeros_like(view), where=cos_i > 0)
     else:  # a distant source: pi sin^2(rho) times the kernel's cos(theta_i)
-        solid = np.pi * (sources.EARTH_RADIUS_KM / np.asarray(rng, dtype=np.float64)) ** 2
+        solid = np.pi * (sources.EARTH_MEAN_RADIUS_KM / np.asarray(rng, dtype=np.float64)) ** 2
         share = np.broadcast_to(solid[:, None], (len(to_earth), len(normals)))
     frac = share if frac is None else frac * share
     p = plan.effect_params["earth_thermal"]

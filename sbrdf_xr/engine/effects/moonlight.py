@@ -47,6 +47,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import constants
 
 from ..._names import WAVELENGTH
+from ...errors import renamed_keywords
 from ...geometry import rotation_matrices
 from ...sources import MOON_RADIUS_KM, moonlight_irradiance_ratio
 from ...units import to_unit
@@ -90,11 +91,12 @@ def _aberrated(u: np.ndarray, beta: np.ndarray) -> np.ndarray:
     return _unit((inv_gamma * u + (1.0 + ub / (1.0 + inv_gamma)) * beta) / (1.0 + ub))
 
 
+@renamed_keywords(position_km="position", sun_km="sun", velocity_km_s="velocity")
 def moon_from_spacecraft(
     times: ArrayLike,
-    position_km: ArrayLike,
-    velocity_km_s: ArrayLike,
-    sun_km: ArrayLike,
+    position: ArrayLike,
+    velocity: ArrayLike,
+    sun: ArrayLike,
     earth: str = "wgs84",
 ) -> dict[str, NDArray[np.float64]]:
     """The Moon seen from a spacecraft, and its light there relative to the Sun's, per time.
@@ -103,9 +105,11 @@ def moon_from_spacecraft(
     ----------
     times : array_like of datetime64, shape (n,)
         UTC times.
-    position_km, velocity_km_s : array_like, shape (n, 3)
-        Geocentric position [km] and velocity [km s-1] of the spacecraft (GCRS).
-    sun_km : array_like, shape (n, 3)
+    position : array_like, shape (n, 3)
+        Geocentric position of the spacecraft (GCRS) [km].
+    velocity : array_like, shape (n, 3)
+        Geocentric velocity of the spacecraft (GCRS) [km s-1].
+    sun : array_like, shape (n, 3)
         Apparent position of the Sun relative to the spacecraft [km].
     earth : {"wgs84", "sphere"}
         The Earth that hides the Moon and casts its shadow.
@@ -153,9 +157,9 @@ def moon_from_spacecraft(
     from ...observing import skyfield_data, skyfield_utc, spline_knots, sunlit_fraction
 
     t64 = np.asarray(times, dtype="datetime64[ns]")
-    r = np.asarray(to_unit(position_km, "km", "position_km"), dtype=np.float64)
-    v = np.asarray(to_unit(velocity_km_s, "km / s", "velocity_km_s"), dtype=np.float64)
-    sun = np.asarray(to_unit(sun_km, "km", "sun_km"), dtype=np.float64)
+    r = np.asarray(to_unit(position, "km", "position"), dtype=np.float64)
+    v = np.asarray(to_unit(velocity, "km / s", "velocity"), dtype=np.float64)
+    sun_v = np.asarray(to_unit(sun, "km", "sun"), dtype=np.float64)
     _, eph = skyfield_data()
     start = t64.min()
     secs, knots = spline_knots(np.array([start, t64.max()]))
@@ -176,10 +180,10 @@ def moon_from_spacecraft(
     rel = moon_geo - r  # the parallax, then the aberration by the spacecraft's own motion
     d = np.linalg.norm(rel, axis=1)
     moon = d[:, None] * _aberrated(rel / d[:, None], (earth_v + v) / _C_KM_S)
-    phase = _angle(sun - moon, -moon)
-    visible = sunlit_fraction(r, moon, sun_radius_km=MOON_RADIUS_KM, earth=earth, pole=pole)
-    sunlit = sunlit_fraction(moon_geo, sun + r - moon_geo, earth=earth, pole=pole)
-    sun_ratio = np.linalg.norm(sun, axis=1) / np.linalg.norm(sun - moon, axis=1)
+    phase = _angle(sun_v - moon, -moon)
+    visible = sunlit_fraction(r, moon, sun_radius=MOON_RADIUS_KM, earth=earth, pole=pole)
+    sunlit = sunlit_fraction(moon_geo, sun_v + r - moon_geo, earth=earth, pole=pole)
+    sun_ratio = np.linalg.norm(sun_v, axis=1) / np.linalg.norm(sun_v - moon, axis=1)
     ratio = moonlight_irradiance_ratio(phase, d, sun_ratio) * visible * sunlit
     return {
         "moon_km": moon,
@@ -194,7 +198,7 @@ def _geometry(scene: SceneView, observed: xr.Dataset | None) -> dict[str, np.nda
     obs = scene.observation
     assert obs is not None and observed is not None  # the effect needs an observation
     ctx = obs.context()
-    r, v, sun = ctx.position_km, ctx.velocity_km_s, ctx.sun_km
+    r, v, sun = ctx.position, ctx.velocity, ctx.sun
     assert r is not None and v is not None and sun is not None  # an observation's context has all
     m = moon_from_spacecraft(obs.times, r, v, sun, obs.earth)
     rot = rotation_matrices(observed["quaternion"].values)  # body -> GCRS
