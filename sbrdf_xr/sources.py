@@ -712,7 +712,7 @@ def earth_view_facets(
             continue
         d, _, _, w = _earth_cap([0.0, 0.0, 1.0], [0.0, 0.0, 1.0], float(r), nodes)
         d, w = d.reshape(-1, 3), w.ravel()
-        for k in range(0, g_cut.size, 64):  # (64, K) at a time
+        for k in np.arange(0, g_cut.size, 64):  # (64, K) at a time
             g, t = rows[g_cut[k : k + 64]], t_cut[k : k + 64]
             # each normal in the cap's frame: only its angle from the centre matters
             c = nz[g, t]

@@ -466,7 +466,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         nodes=(16, 32),
     ),
     "sbrdf_xr.sources.earth_view_facets": lambda: dict(
-        normals=[[0, 0, -1], [1, 0, 0]], to_earth=[[0, 0, -1]], range_km=[7000.0], nodes=(16, 32)
+        normals=[[0, 0, -1], [1, 0, 0]], to_earth=[[0, 0, -1]], range=[7000.0], nodes=(16, 32)
     ),
     "sbrdf_xr.sources.equilibrium_temperature": lambda: dict(
         absorbed=[100.0, 1361.0], emissivity=0.8

@@ -17,9 +17,9 @@ from sbrdf_xr.engine.run import simulate
 from sbrdf_xr.errors import SceneError
 from sbrdf_xr.materials import models
 from sbrdf_xr.materials.schema import lambertian
-from sbrdf_xr.sources import EARTH_RADIUS_KM, planck
+from sbrdf_xr.sources import EARTH_MEAN_RADIUS_KM, planck
 
-R = EARTH_RADIUS_KM
+R = EARTH_MEAN_RADIUS_KM
 WL = [4000.0, 10_000.0, 12_000.0]
 DOWN = np.array([0.0, 0.0, -1.0])  # the facet looked at: the cube's -z face
 #: the issue's requirement against the exact integral; the engine's quadrature

@@ -13,7 +13,7 @@ from sbrdf_xr.engine.run import simulate
 from sbrdf_xr.errors import SceneError, ValidationError
 from sbrdf_xr.materials.schema import lambertian
 from sbrdf_xr.photometry import solar_spectrum
-from sbrdf_xr.sources import EARTH_RADIUS_KM, equilibrium_temperature, planck
+from sbrdf_xr.sources import EARTH_MEAN_RADIUS_KM, equilibrium_temperature, planck
 
 WL = np.array([400.0, 700.0, 1500.0, 4000.0, 8000.0, 12_000.0])
 X = [[1.0, 0.0, 0.0]]  # the Sun and the observer along +x: the +x face faces both
@@ -92,7 +92,7 @@ def test_earth_alone_in_the_shadow_of_the_body():
             earth_temperature=255.0,
         )
     ).compute()
-    want = 255.0 * np.sqrt(EARTH_RADIUS_KM / 42164.0)
+    want = 255.0 * np.sqrt(EARTH_MEAN_RADIUS_KM / 42164.0)
     assert _face(cube, [1.0, 0.0, 0.0])[0] == pytest.approx(want, rel=1e-9)
 
 
@@ -131,7 +131,7 @@ def test_the_earths_shadow_scales_the_absorbed_sunlight():
     np.testing.assert_allclose(t[0.5] ** 4 - t[0.0] ** 4, 0.5 * (t[1.0] ** 4 - t[0.0] ** 4))
     assert np.all(t[0.0] < t[0.5]) and np.all(t[0.5] < t[1.0])
     # the +x face sees the Earth below edge-on: the edge-on view of a GEO Earth
-    h = 42164.0 / EARTH_RADIUS_KM
+    h = 42164.0 / EARTH_MEAN_RADIUS_KM
     edge = np.arctan(1 / np.sqrt(h**2 - 1)) - np.sqrt(h**2 - 1) / h**2  # Howell, [sr]
     j = int(np.flatnonzero(np.all(np.isclose(plan.terms.normal, [1.0, 0.0, 0.0]), axis=1))[0])
     assert t[0.0][j] == pytest.approx(255.0 * (edge / np.pi) ** 0.25, rel=1e-3)
