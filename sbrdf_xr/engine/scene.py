@@ -6,7 +6,7 @@ Re-exported, with the scene files, from :mod:`sbrdf_xr.engine`.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import InitVar, dataclass, field, replace
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
@@ -19,6 +19,7 @@ from ..errors import CatalogError, SceneError, ValidationError, did_you_mean
 from ..kernels.warm import compiling_ahead
 from ..materials.tables import validate_material
 from ..units import check_plausible, to_unit
+from .attitude_table import attitudes_from_table
 from .effects import DEFAULT_EFFECTS, SCENE_EFFECTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS, scene_effects
 from .knobs import KNOBS, PRESETS, apply_preset, check_knob
 from .plan import Plan, compile_plan
@@ -112,6 +113,19 @@ def _optional_array(v: ArrayLike | None) -> np.ndarray | None:
     return None if v is None else np.asarray(v)
 
 
+def _attitude_table(scene: Scene, table: Mapping[str, Any]) -> None:
+    """Set a scene's attitudes (and a sweep's angles) from an ``[attitude]`` table."""
+    if scene.attitudes is not None:
+        raise SceneError(
+            "attitude: give either attitude (a table, as a scene file's [attitude]) or "
+            "attitudes (quaternions), not both"
+        )
+    q, angles = attitudes_from_table(table, "attitude")
+    object.__setattr__(scene, "attitudes", q)
+    if angles is not None and scene.attitude_angle is None:
+        object.__setattr__(scene, "attitude_angle", angles)
+
+
 @dataclass(frozen=True)
 class Scene:
     """A spacecraft, its materials, a geometry sweep, and what to compute.
@@ -129,6 +143,12 @@ class Scene:
         the constructor.
     attitudes : array_like, shape (n, 4), optional
         Attitudes (body -> reference frame, scalar-last unit quaternions).
+    attitude : mapping, optional
+        The attitudes as a scene file's ``[attitude]`` table instead (the same keys,
+        read by the same :func:`~sbrdf_xr.engine.attitude_table.attitudes_from_table`):
+        ``dict(kind="sweep", axis=[0, 0, 1], stop=360, step=1)``, ``kind="uniform"``
+        (``n``, ``seed``), ``"euler"`` (``sequence``, ``angles``) or ``"quaternions"``;
+        angles [degree] may be Quantities.  A sweep's angles become ``attitude_angle``.
     phase_angles : array_like, shape (m,), optional
         Phase angles [degree] of the observation plane (with ``attitudes``).
     bisector, plane_normal : array_like, shape (3,)
@@ -278,9 +298,12 @@ class Scene:
     size_limit: float = 1.0
     name: str = "scene"
     description: str = ""
+    attitude: InitVar[Mapping[str, Any] | None] = None
     _cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
-    def __post_init__(self) -> None:
+    def __post_init__(self, attitude: Mapping[str, Any] | None) -> None:
+        if attitude is not None:
+            _attitude_table(self, attitude)
         _in_units(self)
         bad = [o for o in self.outputs if o not in OUTPUTS]
         if bad:
