@@ -914,6 +914,14 @@ EXEMPT[("sbrdf_xr.body.starlink.starlink_v15", "limits")] = (
 EXEMPT[("sbrdf_xr.bench.suite.bench_geometry", "step_s")] = (
     "a benchmark's problem size: the timing tools take bare numbers"
 )
+for _name, _arg in (
+    ("sbrdf_xr.engine.attitude_table.attitudes_from_table", "table"),
+    ("sbrdf_xr.engine.scene.Scene", "attitude"),
+):
+    EXEMPT[(_name, _arg)] = (
+        "a table (a scene file's [attitude]): its angle keys take Quantities one by one, "
+        "checked in tests/engine/test_attitude_table.py (radians for degrees, metres refused)"
+    )
 EXEMPT[("sbrdf_xr.units.check_wavelengths", "values")] = (
     "the check of bare numbers itself: a Quantity is converted before it"
 )
