@@ -1,8 +1,8 @@
 """The scene-file schema: every key of a TOML scene, its type, default and meaning, once.
 
 :mod:`sbrdf_xr.engine.scene_file` checks a file against these tables, and
-:func:`reference` renders them as the reference of the README ("Scene files: every
-key").  Nothing is written twice: a key that is a numerical knob takes its TOML type,
+:func:`reference` renders them as the scene-file reference of the user guide
+(``docs/guide/scene-file-reference.md``).  Nothing is written twice: a key that is a numerical knob takes its TOML type,
 default, domain and meaning from the knob table (:data:`sbrdf_xr.engine.knobs.KNOBS`); a key
 that is a field of :class:`~sbrdf_xr.engine.Scene` takes its default from the field; the
 values of ``effects`` and ``outputs`` come from the effect registry
@@ -311,7 +311,7 @@ def _md(text: str) -> str:
 
 
 def reference() -> str:
-    """Every key of a scene file as Markdown tables (the README's reference).
+    """Every key of a scene file as Markdown tables (the user guide's reference).
 
     Examples
     --------
