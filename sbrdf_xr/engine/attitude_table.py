@@ -283,3 +283,16 @@ def attitudes_from_table(
     except (ValidationError, ValueError, TypeError) as exc:
         raise SceneError(f"{where}: {exc}") from None
     raise SceneError(f"{where}: unknown kind {kind!r}; allowed: {', '.join(ATTITUDE_KINDS)}")
+
+
+def _scene_attitudes(
+    table: Mapping[str, Any], attitudes: Any, attitude_angle: Any
+) -> tuple[np.ndarray, Any]:
+    """``Scene(attitude=table)``: the attitudes, and the sweep's angles unless labels are given."""
+    if attitudes is not None:
+        raise SceneError(
+            "attitude: give either attitude (a table, as a scene file's [attitude]) or "
+            "attitudes (quaternions), not both"
+        )
+    q, angles = attitudes_from_table(table, "attitude")
+    return q, angles if attitude_angle is None else attitude_angle

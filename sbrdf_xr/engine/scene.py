@@ -19,7 +19,7 @@ from ..errors import CatalogError, SceneError, ValidationError, did_you_mean
 from ..kernels.warm import compiling_ahead
 from ..materials.tables import validate_material
 from ..units import check_plausible, to_unit
-from .attitude_table import attitudes_from_table
+from .attitude_table import _scene_attitudes
 from .effects import DEFAULT_EFFECTS, SCENE_EFFECTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS, scene_effects
 from .knobs import KNOBS, PRESETS, apply_preset, check_knob
 from .plan import Plan, compile_plan
@@ -111,19 +111,6 @@ def _in_units(scene: Scene) -> None:
 
 def _optional_array(v: ArrayLike | None) -> np.ndarray | None:
     return None if v is None else np.asarray(v)
-
-
-def _attitude_table(scene: Scene, table: Mapping[str, Any]) -> None:
-    """Set a scene's attitudes (and a sweep's angles) from an ``[attitude]`` table."""
-    if scene.attitudes is not None:
-        raise SceneError(
-            "attitude: give either attitude (a table, as a scene file's [attitude]) or "
-            "attitudes (quaternions), not both"
-        )
-    q, angles = attitudes_from_table(table, "attitude")
-    object.__setattr__(scene, "attitudes", q)
-    if angles is not None and scene.attitude_angle is None:
-        object.__setattr__(scene, "attitude_angle", angles)
 
 
 @dataclass(frozen=True)
@@ -302,8 +289,10 @@ class Scene:
     _cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self, attitude: Mapping[str, Any] | None) -> None:
-        if attitude is not None:
-            _attitude_table(self, attitude)
+        if attitude is not None:  # a scene file's [attitude] table
+            q, angles = _scene_attitudes(attitude, self.attitudes, self.attitude_angle)
+            object.__setattr__(self, "attitudes", q)
+            object.__setattr__(self, "attitude_angle", angles)
         _in_units(self)
         bad = [o for o in self.outputs if o not in OUTPUTS]
         if bad:

@@ -2,7 +2,8 @@
 
 :mod:`sbrdf_xr.engine.scene_file` checks a file against these tables, and
 :func:`reference` renders them as the scene-file reference of the user guide
-(``docs/guide/scene-file-reference.md``).  Nothing is written twice: a key that is a numerical knob takes its TOML type,
+(``docs/guide/scene-file-reference.md``).  Nothing is written twice: a key that is a
+numerical knob takes its TOML type,
 default, domain and meaning from the knob table (:data:`sbrdf_xr.engine.knobs.KNOBS`); a key
 that is a field of :class:`~sbrdf_xr.engine.Scene` takes its default from the field; the
 values of ``effects`` and ``outputs`` come from the effect registry
