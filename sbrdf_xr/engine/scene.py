@@ -231,6 +231,13 @@ class Scene:
     >>> scene.plan().n_blocks
     1
 
+    The attitudes as a scene file's ``[attitude]`` table, read by the same code:
+
+    >>> swept = Scene(box, {"grey": grey}, attitude={"kind": "sweep", "stop": 90, "step": 30},
+    ...               phase_angles=[0.0])
+    >>> swept.attitude_angle.tolist(), swept.n_geometries
+    ([0.0, 30.0, 60.0], 3)
+
     Knobs and presets give changed copies; explicit body-frame pairs replace the grid:
 
     >>> fast = scene.with_options(preset="fast")
