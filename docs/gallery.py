@@ -1,4 +1,4 @@
-"""Draw the README gallery into docs/img (run from the repository root:
+"""Draw the gallery of the README and the user guide into docs/img (run from the repository root:
 ``python docs/gallery.py``).  The pass, the glints with tilted facets, the brushed panel and
 the accuracy/time figure have their own scripts (``observation.py``, ``imperfections.py``,
 ``anisotropy.py``, ``accuracy_front.py``)."""

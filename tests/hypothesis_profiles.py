@@ -1,6 +1,6 @@
 """Hypothesis profiles of the suite, and the example counts they scale.
 
-``SBRDF_XR_HYPOTHESIS_PROFILE`` selects one (the README's contributor section says how
+``SBRDF_XR_HYPOTHESIS_PROFILE`` selects one (the user guide's contributing page says how
 to run each):
 
 ``ci`` (the default)

@@ -1,7 +1,7 @@
 """The documentation builds offline with warnings as errors.
 
 Runs ``sphinx-build -W --keep-going -b html docs <tmp>`` (the API reference from the
-docstrings, the README as the getting-started page, the notebooks with their stored
+docstrings, the user guide, the README as the getting-started page, the notebooks with their stored
 outputs) and checks that the key pages exist.
 """
 
@@ -101,6 +101,9 @@ def _build(out: Path) -> None:
     "page",
     [
         "index.html",
+        "guide/index.html",
+        "guide/spacecraft-and-scenes.html",
+        "guide/scene-file-reference.html",
         "getting_started.html",
         "api/index.html",
         "api/sbrdf_xr.geometry.html",
@@ -114,6 +117,16 @@ def _build(out: Path) -> None:
 )
 def test_page_is_built(html, page):
     assert (html / page).is_file()
+
+
+def test_the_guide_lists_its_pages_and_comes_first(html):
+    index = (html / "index.html").read_text(encoding="utf-8")
+    assert index.index("guide/index.html") < index.index("getting_started.html")
+    guide = (html / "guide" / "index.html").read_text(encoding="utf-8")
+    for page in sorted((DOCS / "guide").glob("*.md")):  # pages added later appear too
+        assert page.stem == "index" or f"{page.stem}.html" in guide, page.name
+    api = (html / "api" / "index.html").read_text(encoding="utf-8")
+    assert api.index("sbrdf_xr.engine.scene.html") < api.index("sbrdf_xr.kernels.html")
 
 
 def test_api_pages_document_the_functions(html):

@@ -120,7 +120,7 @@ def test_documentation_figures_can_be_read(script):
     try:
         problems = {name: plot.figure_problems(fig) for name, fig in figures.items()}
         assert problems == {name: [] for name in figures}
-        assert all((DOCS / "img" / name).is_file() for name in figures)  # README shows them
+        assert all((DOCS / "img" / name).is_file() for name in figures)  # the guide shows them
     finally:
         for fig in figures.values():
             plt.close(fig)

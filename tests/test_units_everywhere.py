@@ -939,6 +939,14 @@ EXEMPT[("sbrdf_xr.bench.suite.bench_geometry", "step")] = (
 EXEMPT[("sbrdf_xr.materials.optical.optical_material", "thickness")] = EXEMPT[
     ("sbrdf_xr.materials.optical.specular_reflectance", "thickness")
 ] = "a mapping of layer name to thickness: each value is converted (tests/materials/test_optical)"
+for _name, _arg in (
+    ("sbrdf_xr.engine.attitude_table.attitudes_from_table", "table"),
+    ("sbrdf_xr.engine.scene.Scene", "attitude"),
+):
+    EXEMPT[(_name, _arg)] = (
+        "a table (a scene file's [attitude]): its angle keys take Quantities one by one, "
+        "checked in tests/engine/test_attitude_table.py (radians for degrees, metres refused)"
+    )
 EXEMPT[("sbrdf_xr.units.check_wavelengths", "values")] = (
     "the check of bare numbers itself: a Quantity is converted before it"
 )

@@ -13,9 +13,10 @@ Modules
     the outputs of a cube; the rest of the engine reads the entries.
 ``sweep``
     The geometry of a sweep: where the Sun and the observer are, in the body frame.
-``scene``, ``scene_file``, ``schema`` and ``builtin``
+``scene``, ``scene_file``, ``schema``, ``attitude_table`` and ``builtin``
     :class:`Scene`, scene files (TOML), every key of a scene file (its type, default and
-    meaning, and the reference rendered from them) and the built-in scenes.
+    meaning, and the reference rendered from them), the attitude tables that scene files
+    and ``Scene(attitude=...)`` share, and the built-in scenes.
 ``plan``, ``stages`` and ``spectral``
     The plan and its stages.
 ``articulation``
@@ -39,6 +40,7 @@ Modules
 from ..errors import SceneError, renamed_attributes
 from . import (
     articulation,
+    attitude_table,
     builtin,
     effects,
     evaluator,
@@ -56,6 +58,7 @@ from . import (
     views,
 )
 from .articulation import Articulation, BoundGroup
+from .attitude_table import attitudes_from_table
 from .builtin import (
     STARLINK_STAND_INS,
     builtin_scene,
@@ -108,6 +111,8 @@ __all__ = [
     "Terms",
     "apply_preset",
     "articulation",
+    "attitude_table",
+    "attitudes_from_table",
     "builtin",
     "builtin_scene",
     "builtin_scenes",

@@ -11,7 +11,8 @@ reference of their keys (:mod:`sbrdf_xr.engine.schema`) from here, and so do
 line's ``--set`` help.
 
 The presets ``fast``, ``balanced`` and ``reference`` are chosen from the
-accuracy/cost table of ``sbrdf-xr bench`` (README): against ``reference``, linear
+accuracy/cost table of ``sbrdf-xr bench`` (user guide, accuracy and cost): against
+``reference``, linear
 look-up costs about a third of the time for glint errors of tens of mmag (median
 below 1 mmag); float32 adds about 0.001 mmag; the paper's nearest look-up saves
 little more time for about five times the error of linear, so no preset uses it.

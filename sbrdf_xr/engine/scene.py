@@ -6,7 +6,7 @@ Re-exported, with the scene files, from :mod:`sbrdf_xr.engine`.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import InitVar, dataclass, field, replace
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
@@ -19,6 +19,7 @@ from ..errors import CatalogError, SceneError, ValidationError, did_you_mean
 from ..kernels.warm import compiling_ahead
 from ..materials.tables import validate_material
 from ..units import check_plausible, to_unit
+from .attitude_table import _scene_attitudes
 from .effects import DEFAULT_EFFECTS, SCENE_EFFECTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS, scene_effects
 from .knobs import KNOBS, PRESETS, apply_preset, check_knob
 from .plan import Plan, compile_plan
@@ -130,6 +131,12 @@ class Scene:
         the constructor.
     attitudes : array_like, shape (n, 4), optional
         Attitudes (body -> reference frame, scalar-last unit quaternions).
+    attitude : mapping, optional
+        The attitudes as a scene file's ``[attitude]`` table instead (the same keys,
+        read by the same :func:`~sbrdf_xr.engine.attitude_table.attitudes_from_table`):
+        ``dict(kind="sweep", axis=[0, 0, 1], stop=360, step=1)``, ``kind="uniform"``
+        (``n``, ``seed``), ``"euler"`` (``sequence``, ``angles``) or ``"quaternions"``;
+        angles [degree] may be Quantities.  A sweep's angles become ``attitude_angle``.
     phase_angles : array_like, shape (m,), optional
         Phase angles [degree] of the observation plane (with ``attitudes``).
     bisector, plane_normal : array_like, shape (3,)
@@ -230,6 +237,13 @@ class Scene:
     >>> scene.plan().n_blocks
     1
 
+    The attitudes as a scene file's ``[attitude]`` table, read by the same code:
+
+    >>> swept = Scene(box, {"grey": grey}, attitude={"kind": "sweep", "stop": 90, "step": 30},
+    ...               phase_angles=[0.0])
+    >>> swept.attitude_angle.tolist(), swept.n_geometries
+    ([0.0, 30.0, 60.0], 3)
+
     Knobs and presets give changed copies; explicit body-frame pairs replace the grid:
 
     >>> fast = scene.with_options(preset="fast")
@@ -286,9 +300,14 @@ class Scene:
     size_limit: float = 1.0
     name: str = "scene"
     description: str = ""
+    attitude: InitVar[Mapping[str, Any] | None] = None
     _cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
-    def __post_init__(self) -> None:
+    def __post_init__(self, attitude: Mapping[str, Any] | None) -> None:
+        if attitude is not None:  # a scene file's [attitude] table
+            q, angles = _scene_attitudes(attitude, self.attitudes, self.attitude_angle)
+            object.__setattr__(self, "attitudes", q)
+            object.__setattr__(self, "attitude_angle", angles)
         _in_units(self)
         bad = [o for o in self.outputs if o not in OUTPUTS]
         if bad:

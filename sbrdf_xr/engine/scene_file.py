@@ -14,14 +14,22 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import xarray as xr
 
-from .. import geometry
 from ..errors import CatalogError, SceneError, ValidationError, did_you_mean, renamed_attributes
+from .attitude_table import (
+    MAX_SCENE_COUNT,
+    _check_keys,
+    _number,
+    _numbers,
+    _rows,
+    _show,
+    _vector,
+    attitudes_from_table,
+)
 from .knobs import KNOBS
 from .scene import Scene
-from .schema import ATTITUDE_KEYS, GEOMETRY_KEYS, SCENE_KEYS, SPACECRAFT_KEYS, toml_types
+from .schema import GEOMETRY_KEYS, SCENE_KEYS, SPACECRAFT_KEYS, toml_types
 
 __all__ = [
     "MAX_SCENE_COUNT",
@@ -35,101 +43,11 @@ __all__ = [
 
 _SCENE_KEYS = toml_types(SCENE_KEYS)
 _SPACECRAFT_KEYS = toml_types(SPACECRAFT_KEYS)
-_ATTITUDE_KEYS = toml_types(ATTITUDE_KEYS)
 _GEOMETRY_KEYS = toml_types(GEOMETRY_KEYS)
-
-
-def _check_keys(table: Any, allowed: Mapping[str, Any], where: str) -> None:
-    if not isinstance(table, Mapping):
-        raise SceneError(f"{where}: expected a table of keys, got {type(table).__name__}")
-    for k, v in table.items():
-        if k not in allowed:
-            raise SceneError(
-                f"{where}: unknown key {k!r}; {did_you_mean(k, allowed, 'allowed keys')}"
-            )
-        types = allowed[k]
-        types = types if isinstance(types, tuple) else (types,)
-        if not isinstance(v, types) or (isinstance(v, bool) and bool not in types):
-            names = " or ".join(t.__name__ for t in types)
-            raise SceneError(
-                f"{where}: key {k!r} has type {type(v).__name__} ({_show(v)}); expected {names}"
-            )
-
-
-#: Most attitudes or geometry pairs a scene file may list or generate.
-MAX_SCENE_COUNT = 10_000_000
-
-
-#: Largest magnitude of a direction's component in a scene file (its length must not overflow).
-_MAX_COMPONENT = 1e100
-
 
 #: Largest shadow-sampling density a scene may ask for (sub-facet samples per side; the knob
 #: table's bound).
 MAX_SHADOW_DENSITY = int(KNOBS["shadow_density"].high or 0)
-
-
-def _show(v: Any) -> str:
-    text = repr(v)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
-def _is_number(x: Any) -> bool:
-    return isinstance(x, int | float) and not isinstance(x, bool)
-
-
-def _number(v: Any, where: str) -> float:
-    """A finite number from a scene file."""
-    if not _is_number(v):
-        raise SceneError(f"{where}: expected a number, got {_show(v)} ({type(v).__name__})")
-    try:
-        x = float(v)
-    except OverflowError:
-        raise SceneError(f"{where}: {_show(v)} is too large") from None
-    if not np.isfinite(x):
-        raise SceneError(f"{where}: must be finite, got {x}")
-    return x
-
-
-def _numbers(v: Any, where: str, *, allow_empty: bool = False) -> np.ndarray:
-    """A flat list of finite numbers from a scene file."""
-    if not isinstance(v, list):
-        raise SceneError(f"{where}: expected a list of numbers, got {_show(v)}")
-    if not v and not allow_empty:
-        raise SceneError(f"{where}: the list is empty; give at least one value")
-    if len(v) > MAX_SCENE_COUNT:
-        raise SceneError(f"{where}: {len(v)} values; at most {MAX_SCENE_COUNT} are allowed")
-    return np.array([_number(x, f"{where}[{i}]") for i, x in enumerate(v)], dtype=np.float64)
-
-
-def _rows(v: Any, width: int, where: str) -> np.ndarray:
-    """A non-empty list of rows of ``width`` finite numbers (vectors, quaternions)."""
-    if not isinstance(v, list) or not v:
-        raise SceneError(
-            f"{where}: expected a non-empty list of [{', '.join(['x'] * width)}] rows, "
-            f"got {_show(v)}"
-        )
-    if len(v) > MAX_SCENE_COUNT:
-        raise SceneError(f"{where}: {len(v)} rows; at most {MAX_SCENE_COUNT} are allowed")
-    out = np.empty((len(v), width))
-    for i, row in enumerate(v):
-        if not isinstance(row, list) or len(row) != width:
-            raise SceneError(f"{where}[{i}]: expected {width} numbers, got {_show(row)}")
-        out[i] = [_number(x, f"{where}[{i}][{j}]") for j, x in enumerate(row)]
-    return out
-
-
-def _vector(v: Any, where: str) -> tuple[float, float, float]:
-    if not isinstance(v, list) or len(v) != 3:
-        raise SceneError(f"{where}: expected a vector of 3 numbers, got {_show(v)}")
-    x = (_number(v[0], f"{where}[0]"), _number(v[1], f"{where}[1]"), _number(v[2], f"{where}[2]"))
-    if not any(x):
-        raise SceneError(f"{where}: the zero vector has no direction")
-    if max(map(abs, x)) > _MAX_COMPONENT:
-        raise SceneError(
-            f"{where}: components must not exceed {_MAX_COMPONENT:g} in magnitude, got {list(x)}"
-        )
-    return x
 
 
 def _strings(v: Any, where: str, *, allow_empty: bool = True) -> tuple[str, ...]:
@@ -138,86 +56,6 @@ def _strings(v: Any, where: str, *, allow_empty: bool = True) -> tuple[str, ...]
     if not v and not allow_empty:
         raise SceneError(f"{where}: the list is empty; give at least one")
     return tuple(v)
-
-
-def _count(v: Any, where: str) -> int:
-    if not isinstance(v, int) or isinstance(v, bool) or not 1 <= v <= MAX_SCENE_COUNT:
-        raise SceneError(
-            f"{where}: expected an integer from 1 to {MAX_SCENE_COUNT}, got {_show(v)}"
-        )
-    return int(v)
-
-
-def _attitudes_from_table(t: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray | None]:
-    _check_keys(t, _ATTITUDE_KEYS, "[attitude]")
-    kind = t.get("kind", "sweep")
-    try:
-        if kind == "sweep":
-            if "stop" not in t:
-                raise SceneError(
-                    "[attitude]: a sweep needs 'stop' (and optionally 'start' and 'step') [degree]"
-                )
-            start = _number(t.get("start", 0.0), "[attitude] start")
-            stop = _number(t["stop"], "[attitude] stop")
-            step = _number(t.get("step", 1.0), "[attitude] step")
-            if step == 0:
-                raise SceneError("[attitude] step: must not be 0")
-            n = int(np.ceil((stop - start) / step))
-            if n < 1:
-                raise SceneError(
-                    f"[attitude]: a sweep from {start:g} to {stop:g} (excluded) in steps of "
-                    f"{step:g} degree has no attitude; stop must lie beyond start in the "
-                    "direction of step"
-                )
-            if n > MAX_SCENE_COUNT:
-                raise SceneError(
-                    f"[attitude]: the sweep has {n} attitudes; "
-                    f"at most {MAX_SCENE_COUNT} are allowed"
-                )
-            angles = np.arange(start, stop, step)
-            initial = None
-            if "initial_axis" in t:
-                initial = geometry.axis_rotation(
-                    _vector(t["initial_axis"], "[attitude] initial_axis"),
-                    _number(t.get("initial_angle", 0.0), "[attitude] initial_angle"),
-                )
-            axis = _vector(t.get("axis", [0, 0, 1]), "[attitude] axis")
-            return geometry.rotation_sweep(axis, angles, initial), angles
-        if kind == "uniform":
-            if "n" not in t:
-                raise SceneError("[attitude]: kind 'uniform' needs 'n' (the number of attitudes)")
-            seed = t.get("seed", 0)
-            if not 0 <= seed < 2**63:
-                raise SceneError(
-                    f"[attitude] seed: expected an integer from 0 to 2**63 - 1, got {seed}"
-                )
-            return geometry.uniform_attitudes(_count(t["n"], "[attitude] n"), seed), None
-        if kind == "euler":
-            if "sequence" not in t or "angles" not in t:
-                raise SceneError(
-                    "[attitude]: kind 'euler' needs 'sequence' (e.g. 'zyx') and 'angles' [degree]"
-                )
-            seq, ang = t["sequence"], t["angles"]
-            if ang and all(isinstance(a, list) for a in ang):
-                angles = _rows(ang, len(seq), "[attitude] angles")
-            else:
-                angles = _numbers(ang, "[attitude] angles")
-            return geometry.euler_attitudes(seq, angles), None
-        if kind == "quaternions":
-            if "quaternions" not in t:
-                raise SceneError(
-                    "[attitude]: kind 'quaternions' needs 'quaternions' (rows of x, y, z, w)"
-                )
-            return geometry.check_quaternions(
-                _rows(t["quaternions"], 4, "[attitude] quaternions")
-            ), None
-    except SceneError:
-        raise
-    except (ValidationError, ValueError, TypeError) as exc:
-        raise SceneError(f"[attitude]: {exc}") from None
-    raise SceneError(
-        f"[attitude]: unknown kind {kind!r}; allowed: sweep, uniform, euler, quaternions"
-    )
 
 
 def _spacecraft(spec: Any, base_dir: str | Path | None) -> Any:
@@ -426,7 +264,7 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
             )
         if "phase_angles" not in d:
             raise SceneError("scene: an [attitude] table needs 'phase_angles' [degree]")
-        kw["attitudes"], angles = _attitudes_from_table(d["attitude"])
+        kw["attitudes"], angles = attitudes_from_table(d["attitude"])
         if angles is not None:
             kw["attitude_angle"] = angles
         kw["phase_angles"] = _numbers(d["phase_angles"], "phase_angles")

@@ -1,8 +1,9 @@
 """The scene-file schema: every key of a TOML scene, its type, default and meaning, once.
 
 :mod:`sbrdf_xr.engine.scene_file` checks a file against these tables, and
-:func:`reference` renders them as the reference of the README ("Scene files: every
-key").  Nothing is written twice: a key that is a numerical knob takes its TOML type,
+:func:`reference` renders them as the scene-file reference of the user guide
+(``docs/guide/scene-file-reference.md``).  Nothing is written twice: a key that is a
+numerical knob takes its TOML type,
 default, domain and meaning from the knob table (:data:`sbrdf_xr.engine.knobs.KNOBS`); a key
 that is a field of :class:`~sbrdf_xr.engine.Scene` takes its default from the field; the
 values of ``effects`` and ``outputs`` come from the effect registry
@@ -19,6 +20,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..observing.observe import OBSERVATION_KEYS as _OBSERVATION
+from .attitude_table import ATTITUDE_TABLE_KEYS as _ATTITUDE
 from .effects import DEFAULT_EFFECTS, EFFECTS, SCENE_EFFECTS, SCENE_OUTPUTS
 from .knobs import KNOBS
 from .scene import Scene
@@ -255,22 +257,12 @@ SPACECRAFT_KEYS: dict[str, Key] = _table(
     ]
 )
 
-#: Keys of an ``[attitude]`` table; ``kind`` says which others apply.
+#: Keys of an ``[attitude]`` table, as
+#: :data:`sbrdf_xr.engine.attitude_table.ATTITUDE_TABLE_KEYS` declares them for
+#: :func:`~sbrdf_xr.engine.attitude_table.attitudes_from_table`, the reader (of scene files
+#: and of ``Scene(attitude=...)``); ``kind`` says which others apply.
 ATTITUDE_KEYS: dict[str, Key] = _table(
-    [
-        Key("kind", (str,), "sweep, uniform, euler or quaternions", '"sweep"'),
-        Key("axis", (list,), "sweep: rotation axis", "[0, 0, 1]"),
-        Key("start", _NUMBER, "sweep: first angle [degree]", "0"),
-        Key("stop", _NUMBER, "sweep: end angle, excluded [degree]", "required"),
-        Key("step", _NUMBER, "sweep: angle step [degree], not 0", "1"),
-        Key("initial_axis", (list,), "sweep: axis of an initial rotation", "-"),
-        Key("initial_angle", _NUMBER, "sweep: angle of the initial rotation [degree]", "0"),
-        Key("n", (int,), "uniform: number of random attitudes (uniform on SO(3))", "required"),
-        Key("seed", (int,), "uniform: random seed, 0 to 2**63 - 1", "0"),
-        Key("sequence", (str,), 'euler: axis sequence, e.g. "zyx"', "required"),
-        Key("angles", (list,), "euler: angles [degree], one row per attitude", "required"),
-        Key("quaternions", (list,), "quaternions: rows of x, y, z, w", "required"),
-    ]
+    Key(name, types, text, default) for name, (types, text, default) in _ATTITUDE.items()
 )
 
 #: Keys of a ``[geometry]`` table (explicit pairs, body frame).
@@ -326,7 +318,7 @@ def _md(text: str) -> str:
 
 
 def reference() -> str:
-    """Every key of a scene file as Markdown tables (the README's reference).
+    """Every key of a scene file as Markdown tables (the user guide's reference).
 
     Examples
     --------

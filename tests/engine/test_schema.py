@@ -21,17 +21,17 @@ from sbrdf_xr.engine.schema import SCENE_KEYS, reference
 from sbrdf_xr.errors import SceneError
 from sbrdf_xr.materials import models
 
-README = Path(__file__).resolve().parents[2] / "README.md"
+REFERENCE = Path(__file__).resolve().parents[2] / "docs" / "guide" / "scene-file-reference.md"
 X = [[1.0, 0.0, 0.0]]
 
 
-def test_the_readme_reference_is_the_generated_one():
-    text = README.read_text(encoding="utf-8")
+def test_the_guide_reference_is_the_generated_one():
+    text = REFERENCE.read_text(encoding="utf-8")
     found = re.search(r"<!-- scene-keys[^>]*-->\n(.*?)<!-- /scene-keys -->", text, re.DOTALL)
-    assert found, "README: the scene-keys markers are missing"
+    assert found, "docs/guide/scene-file-reference.md: the scene-keys markers are missing"
     assert found.group(1) == reference(), (
-        "README's scene-file reference is stale: paste sbrdf_xr.engine.schema.reference() "
-        "between its scene-keys markers"
+        "docs/guide/scene-file-reference.md is stale: paste "
+        "sbrdf_xr.engine.schema.reference() between its scene-keys markers"
     )
     for key in ("n", "seed", "kind", "quaternions", "to_earth", "earth", "path"):
         assert f"| `{key}` |" in found.group(1)
