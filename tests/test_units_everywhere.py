@@ -45,6 +45,7 @@ PACKAGES = (
     "geometry",
     "invert",
     "kernels",
+    "lightcurves",
     "materials",
     "observing",
     "photometry",
@@ -840,7 +841,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.photometry.bands.filters": lambda: dict(
         bands=["V"], wavelength=np.arange(400.0, 1101.0, 10.0)
     ),
-    "sbrdf_xr.photometry.lightcurves.compare": lambda: dict(
+    "sbrdf_xr.lightcurves.comparison.compare": lambda: dict(
         **_compare_inputs(), max_time_shift_s=10.0, phase_angle=None, fit_phase=True
     ),
     "sbrdf_xr.photometry.magnitude.magnitudes": lambda: dict(

@@ -20,7 +20,7 @@ import re
 from collections.abc import Mapping, Sequence
 
 from ..errors import LightCurveError
-from .bands import BAND_ALIASES, speclite_names
+from ..photometry import BAND_ALIASES, speclite_names
 
 __all__ = ["band_label", "known_bands_text"]
 

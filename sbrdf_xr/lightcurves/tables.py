@@ -5,7 +5,7 @@ observation per row, a band column) or wide (one time per row, a column per band
 one for its uncertainty), in any row order, magnitudes or flux densities, with UTC
 times as ISO 8601 strings, astropy ``Time`` columns or Julian dates in a stated scale;
 filter names are mapped to the package's bands by
-:func:`~sbrdf_xr.photometry.filter_names.band_label`.  Tables other than CSV and netCDF
+:func:`~sbrdf_xr.lightcurves.filter_names.band_label`.  Tables other than CSV and netCDF
 are read with :class:`astropy.table.Table`, so their column units are honoured
 (converted to the package's units) and astropy ``Time`` columns become UTC.
 """
@@ -22,10 +22,10 @@ import xarray as xr
 
 from .._names import BAND, attrs
 from ..errors import LightCurveError, ValidationError, input_file, reading
+from ..photometry import MAGNITUDE_SYSTEMS, check_system
 from . import _curve_forms as forms
 from ._table_io import TABLE_FORMATS, in_unit, read_table
 from .filter_names import band_label
-from .spectra import MAGNITUDE_SYSTEMS, check_system
 
 __all__ = [
     "LIGHT_CURVE_ABSCISSAE",
@@ -63,7 +63,7 @@ def read_light_curve(
     per band, a column and its uncertainty column (``V, V_err``; ``mag_V, e_mag_V``;
     ``Rmag, Rmag_err``; ``flux_g, flux_g_err``): each non-empty cell is an observation.
     Column names are matched without regard to case (the aliases of
-    :data:`~sbrdf_xr.photometry._curve_forms.ROLES`):
+    :data:`~sbrdf_xr.lightcurves._curve_forms.ROLES`):
 
     ============== ========================================================================
     column         meaning
@@ -453,7 +453,7 @@ def _build(
 
 def _pivots(labels: list[str], bands: Sequence[str] | None) -> np.ndarray:
     """Pivot wavelengths [nm] of the bands, ``sqrt(int T l dl / int T / l dl)``."""
-    from .bands import filters
+    from ..photometry import filters
 
     f = filters(sorted(set(labels)))
     wl = f["wavelength"].values

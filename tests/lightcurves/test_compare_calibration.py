@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
+from sbrdf_xr import lightcurves as L
 from sbrdf_xr import photometry as P
 
 ZP = {"V": 0.35, "R": 0.12, "I": -0.08}
@@ -83,7 +84,7 @@ def _draws(sim, n, seed=0):
             coords={"time": ("obs", t_sim[steps]), "band": ("obs", band)},
             attrs={"magnitude_system": "AB"},
         )
-        fit = P.compare(ds, sim, extinction="fit", fit_time_shift=True, max_time_shift_s=3.0)
+        fit = L.compare(ds, sim, extinction="fit", fit_time_shift=True, max_time_shift_s=3.0)
         for p in truth:
             est[p].append(float(fit.estimate.sel(parameter=p)))
             sd[p].append(float(fit.standard_error.sel(parameter=p)))

@@ -1,6 +1,6 @@
 """The Dataset of a light-curve comparison: data, fitted values, covariance, figure curve.
 
-:func:`report` writes what :func:`sbrdf_xr.photometry._comparison.fit_and_report` found.
+:func:`report` writes what :func:`sbrdf_xr.lightcurves._comparison.fit_and_report` found.
 """
 
 from __future__ import annotations

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
+from sbrdf_xr import lightcurves as L
 from sbrdf_xr import photometry as P
 from sbrdf_xr.errors import LightCurveError
 
@@ -70,7 +71,7 @@ def _measured(
 def test_noiseless_zero_points_and_extinction_are_recovered_exactly():
     zp, k = {"V": 0.31, "R": -0.12}, {"V": 0.21, "R": 0.13}
     # measured exactly at simulated nodes (every 2 s on a 0.25 s grid): no interpolation
-    fit = P.compare(_measured(zp, k, sigma=1e-4, seed=1), _sim(), extinction="fit")
+    fit = L.compare(_measured(zp, k, sigma=1e-4, seed=1), _sim(), extinction="fit")
     # noise of 1e-4 mag over 100 points per band: ZP and k to a few 1e-5
     for b in ("V", "R"):
         assert float(fit.zero_point.sel(band=b)) == pytest.approx(zp[b], abs=2e-4)
@@ -80,7 +81,7 @@ def test_noiseless_zero_points_and_extinction_are_recovered_exactly():
     assert float(fit.colour_index_difference.sel(colour="V-R")) == pytest.approx(
         zp["V"] - zp["R"], abs=3e-4
     )
-    common = P.compare(_measured({"V": 0.2, "R": 0.2}, sigma=1e-4), _sim(), zero_points="common")
+    common = L.compare(_measured({"V": 0.2, "R": 0.2}, sigma=1e-4), _sim(), zero_points="common")
     assert float(common.magnitude_offset) == pytest.approx(0.2, abs=1e-4)
     assert common.sizes["parameter"] == 1
 
@@ -88,10 +89,10 @@ def test_noiseless_zero_points_and_extinction_are_recovered_exactly():
 def test_given_extinction_coefficients_are_applied_not_fitted():
     zp, k = {"V": 0.3, "R": 0.1}, {"V": 0.2, "R": 0.1}
     meas = _measured(zp, k, sigma=0.001)
-    fit = P.compare(meas, _sim(), extinction=k)
+    fit = L.compare(meas, _sim(), extinction=k)
     assert float(fit.zero_point.sel(band="V")) == pytest.approx(0.3, abs=5e-4)
     assert fit.sizes["parameter"] == 2 and float(fit.extinction_coefficient_uncertainty[0]) == 0
-    naive = P.compare(meas, _sim())
+    naive = L.compare(meas, _sim())
     # without extinction the airmass swing 1.1-2.2 leaves 0.1-0.2 mag trends: chi2 tells
     assert float(naive.reduced_chi_square) > 100 * float(fit.reduced_chi_square)
 
@@ -100,14 +101,14 @@ def test_a_time_shift_is_recovered():
     """Truth at t + 1.7 s; the simulated curve on a 0.25 s grid (interpolation error of the
     12 s glint: 0.3 (2 pi/12)^2 0.25^2 / 8 ~ 6e-4 mag, below the 0.005 mag noise)."""
     meas = _measured({"V": 0.1, "R": 0.1}, shift=1.7, sigma=0.005, seed=3)
-    fit = P.compare(meas, _sim(), fit_time_shift=True, max_time_shift_s=5.0)
+    fit = L.compare(meas, _sim(), fit_time_shift=True, max_time_shift_s=5.0)
     sigma = float(fit.time_shift_uncertainty)
     assert 0.0 < sigma < 0.05
     assert float(fit.time_shift) == pytest.approx(1.7, abs=4 * sigma)
     assert 0.8 < float(fit.reduced_chi_square) < 1.25  # 200 dof: 1 +- 0.1
     assert "time_shift" in fit.parameter.values.tolist()
     assert fit.chi_square_scan.sizes["shift_scan"] == 720
-    without = P.compare(meas, _sim())
+    without = L.compare(meas, _sim())
     assert float(without.reduced_chi_square) > 10.0
 
 
@@ -117,7 +118,7 @@ def test_the_covariance_is_curve_fits_on_the_same_model():
 
     sim = _sim()
     meas = _measured({"V": 0.3, "R": 0.2}, {"V": 0.2, "R": 0.1}, shift=0.8, sigma=0.01, seed=5)
-    fit = P.compare(meas, sim, extinction="fit", fit_time_shift=True, max_time_shift_s=3.0)
+    fit = L.compare(meas, sim, extinction="fit", fit_time_shift=True, max_time_shift_s=3.0)
     secs_sim = (sim.time.values - T0) / np.timedelta64(1, "s")
     secs = (meas.time.values - T0) / np.timedelta64(1, "s")
     isv = meas.band.values == "V"
@@ -160,13 +161,13 @@ def test_measured_times_outside_the_window_are_refused():
         r"2024-03-17T01:21:00.000 .. 2024-03-17T01:22:40.000 UTC, first at "
         r"2024-03-17T01:22:42.000 UTC \(row 42\)",
     ):
-        P.compare(meas, sim)
+        L.compare(meas, sim)
     late = meas.assign_coords(time=meas.time + np.timedelta64(3600, "s"))
     with pytest.raises(LightCurveError, match="no overlap: the measured times"):
-        P.compare(late, sim)
+        L.compare(late, sim)
     full = _measured({"V": 0.0, "R": 0.0}, span=(0.0, 241.0))  # 0 s to 240 s: all of it
     with pytest.raises(LightCurveError, match="leave no room for a shift of up to 10 s"):
-        P.compare(full, _sim(), fit_time_shift=True)
+        L.compare(full, _sim(), fit_time_shift=True)
 
 
 def test_bands_not_simulated_and_other_bad_input():
@@ -177,7 +178,7 @@ def test_bands_not_simulated_and_other_bad_input():
         match=r"the measured bands \['R'\] are not simulated "
         r"\(simulated bands: \['V', 'I'\]\)",
     ):
-        P.compare(meas, sim)
+        L.compare(meas, sim)
     bad = meas.copy(deep=True)
     bad["magnitude"].values[4] = np.nan
     with pytest.raises(
@@ -185,16 +186,16 @@ def test_bands_not_simulated_and_other_bad_input():
         match=r"observation 4 \(row 5\) has magnitude nan, which "
         r"is not a finite number \(a NaN row\)",
     ):
-        P.compare(bad, _sim())
+        L.compare(bad, _sim())
     neg = meas.copy(deep=True)
     neg["uncertainty"].values[2] = -0.01
     with pytest.raises(LightCurveError, match=r"has uncertainty -0\.01, which is negative"):
-        P.compare(neg, _sim())
+        L.compare(neg, _sim())
     secs = meas.assign_coords(time=("obs", np.arange(meas.sizes["obs"], dtype=float)))
     with pytest.raises(LightCurveError, match="numbers of seconds without an origin"):
-        P.compare(secs, _sim())
+        L.compare(secs, _sim())
     with pytest.raises(LightCurveError, match="in the AB system but the simulation is in Vega"):
-        P.compare(meas, _sim(system="Vega"))
+        L.compare(meas, _sim(system="Vega"))
     for kw, msg in (
         ({"zero_points": "each"}, "zero_points: got 'each'"),
         ({"extinction": 0.2}, "extinction: expected None, 'fit' or a mapping"),
@@ -202,7 +203,7 @@ def test_bands_not_simulated_and_other_bad_input():
         ({"max_time_shift_s": -1.0}, "max_time_shift_s: must be > 0 s"),
     ):
         with pytest.raises(LightCurveError, match=msg):
-            P.compare(meas, _sim(), **kw)
+            L.compare(meas, _sim(), **kw)
 
 
 def test_nothing_is_fitted_to_fewer_samples_than_parameters():
@@ -214,11 +215,11 @@ def test_nothing_is_fitted_to_fewer_samples_than_parameters():
         match=r"2 observation\(s\) .* fitting 2 parameter\(s\) "
         r"\(a zero point per band\) needs at least 3",
     ):
-        P.compare(two, _sim())
-    assert int(P.compare(meas.isel(obs=[0, 1, first_r]), _sim()).degrees_of_freedom) == 1
+        L.compare(two, _sim())
+    assert int(L.compare(meas.isel(obs=[0, 1, first_r]), _sim()).degrees_of_freedom) == 1
     v3 = meas.isel(obs=np.flatnonzero(meas.band.values == "V")[:3])
     with pytest.raises(LightCurveError, match=r"3 observation\(s\) .* fitting 3 parameter"):
-        P.compare(v3, _sim(), extinction="fit", fit_time_shift=True)
+        L.compare(v3, _sim(), extinction="fit", fit_time_shift=True)
     flat = meas.isel(
         obs=np.flatnonzero(meas.band.values == "V")[:1].tolist()
         + np.flatnonzero(meas.band.values == "R")[:40].tolist()
@@ -228,7 +229,7 @@ def test_nothing_is_fitted_to_fewer_samples_than_parameters():
         match=r"band 'V' has 1 observation\(s\) for its 2 "
         "parameters",
     ):
-        P.compare(flat, _sim(), extinction="fit")
+        L.compare(flat, _sim(), extinction="fit")
     short = meas.isel(obs=slice(0, 4))  # 6 s of a 240 s airmass swing: X nearly constant
     sim = _sim().assign_coords(airmass=("time", np.full(_sim().sizes["time"], 1.3)))
     with pytest.raises(
@@ -236,7 +237,7 @@ def test_nothing_is_fitted_to_fewer_samples_than_parameters():
         match=r"in band 'V' the air mass spans only "
         r"1.3000-1.3000: k and the zero point cannot be told apart",
     ):
-        P.compare(short, sim, extinction="fit")
+        L.compare(short, sim, extinction="fit")
 
 
 def test_observations_where_the_model_is_dark_are_excluded_and_listed():
@@ -244,7 +245,7 @@ def test_observations_where_the_model_is_dark_are_excluded_and_listed():
     dark = sim.copy(
         data=np.where((sim.time.values < T0 + np.timedelta64(30, "s"))[:, None], np.inf, sim.values)
     )
-    fit = P.compare(_measured({"V": 0.1, "R": 0.1}, sigma=0.001), dark)
+    fit = L.compare(_measured({"V": 0.1, "R": 0.1}, sigma=0.001), dark)
     n = int(fit.n_excluded)
     assert n == 10 and int(fit.excluded.sum()) == n  # 20-30 s, every 2 s, two bands
     assert fit.attrs["excluded_rows"].split()[:2] == ["1", "2"]
@@ -285,7 +286,7 @@ def test_a_cube_is_compared_in_the_measured_bands_and_system(tmp_path):
         },
         attrs={"magnitude_system": "Vega"},
     )
-    fit = P.compare(meas, cube)
+    fit = L.compare(meas, cube)
     np.testing.assert_allclose(fit.zero_point.values, 0.05, atol=1e-9)
     assert fit.attrs["magnitude_system"] == "Vega"
 
@@ -294,8 +295,8 @@ def test_plot_comparison_of_a_pass(tmp_path):
     from matplotlib.figure import Figure
 
     meas = _measured({"V": 0.3, "R": 0.1}, {"V": 0.2, "R": 0.1}, shift=1.2, sigma=0.02)
-    fit = P.compare(meas, _sim(), extinction="fit", fit_time_shift=True)
-    fig = P.plot_comparison(fit)
+    fit = L.compare(meas, _sim(), extinction="fit", fit_time_shift=True)
+    fig = L.plot_comparison(fit)
     assert isinstance(fig, Figure) and len(fig.axes) == 2
     text = fig.axes[0].texts[0].get_text()
     assert "AB magnitudes" in text and "ZP V = " in text and "time shift = " in text
@@ -311,7 +312,7 @@ def test_the_figures_curve_passes_through_the_model_at_the_observations():
     """model_curve (the fitted model at the simulated nodes, on the figure's abscissa) meets
     model_magnitude at every observation, for a pass and for a rotation sweep."""
     meas = _measured({"V": 0.3, "R": 0.1}, {"V": 0.2, "R": 0.1}, shift=1.2, sigma=0.02)
-    fit = P.compare(meas, _sim(), extinction="fit", fit_time_shift=True)
+    fit = L.compare(meas, _sim(), extinction="fit", fit_time_shift=True)
     secs = (fit.time.values - T0) / np.timedelta64(1, "s")
     curve_s = (fit.curve_time.values - T0) / np.timedelta64(1, "s")
     for i, b in enumerate(fit.band.values):
@@ -336,7 +337,7 @@ def test_the_figures_curve_passes_through_the_model_at_the_observations():
         {"magnitude": ("obs", m), "uncertainty": ("obs", np.full(m.size, 0.01))},
         coords={"rotation_angle": ("obs", theta), "band": ("obs", band)},
     )
-    fit = P.compare(lc, sim)
+    fit = L.compare(lc, sim)
     assert float(fit.phase_offset) == pytest.approx(33.0, abs=0.01)
     for i, b in enumerate(fit.band.values):
         sel = fit.obs_band.values == b

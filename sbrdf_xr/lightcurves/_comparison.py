@@ -1,7 +1,7 @@
-"""The fit of :func:`sbrdf_xr.photometry.lightcurves.compare` and the Dataset it returns.
+"""The fit of :func:`sbrdf_xr.lightcurves.comparison.compare` and the Dataset it returns.
 
-:func:`fit_and_report` takes an :class:`~sbrdf_xr.photometry._alignment.Alignment`, finds
-the shift of least profiled chi-square (:mod:`sbrdf_xr.photometry._fit`), checks that
+:func:`fit_and_report` takes an :class:`~sbrdf_xr.lightcurves._alignment.Alignment`, finds
+the shift of least profiled chi-square (:mod:`sbrdf_xr.lightcurves._fit`), checks that
 the data determine every parameter, and writes the result with its covariance.
 """
 
@@ -62,11 +62,11 @@ def fit_and_report(
     n_scan: int,
     system: str,
 ) -> xr.Dataset:
-    """Fit the model of :func:`~sbrdf_xr.photometry.lightcurves.compare` and report it.
+    """Fit the model of :func:`~sbrdf_xr.lightcurves.comparison.compare` and report it.
 
     Examples
     --------
-    >>> from sbrdf_xr.photometry import compare  # the public entry point; see its examples
+    >>> from sbrdf_xr.lightcurves import compare  # the public entry point; see its examples
     >>> callable(compare)
     True
     """

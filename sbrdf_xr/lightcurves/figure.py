@@ -1,6 +1,6 @@
 """The figure of a light-curve comparison: magnitudes and residuals, the fitted values.
 
-:func:`plot_comparison` draws the result of :func:`sbrdf_xr.photometry.compare`: against
+:func:`plot_comparison` draws the result of :func:`sbrdf_xr.lightcurves.compare`: against
 UTC for a pass (against the rotation angle for a sweep), the measured magnitudes with
 their error bars and the fitted model per band above, the residuals below, and a box
 with the magnitude system and the fitted values with their uncertainties.
@@ -67,7 +67,7 @@ def fitted_values_text(comparison: xr.Dataset) -> str:
 
 
 def plot_comparison(comparison: xr.Dataset, *, title: str | None = None) -> Any:
-    """Figure of a :func:`~sbrdf_xr.photometry.compare` result.
+    """Figure of a :func:`~sbrdf_xr.lightcurves.compare` result.
 
     Top: the measured magnitudes (error bars; hollow where excluded) and the fitted
     model per band, against UTC for a pass, against the simulated rotation angle for a
@@ -77,7 +77,7 @@ def plot_comparison(comparison: xr.Dataset, *, title: str | None = None) -> Any:
     Parameters
     ----------
     comparison : xarray.Dataset
-        From :func:`~sbrdf_xr.photometry.compare`.
+        From :func:`~sbrdf_xr.lightcurves.compare`.
     title : str, optional
 
     Returns
@@ -88,7 +88,7 @@ def plot_comparison(comparison: xr.Dataset, *, title: str | None = None) -> Any:
     --------
     >>> import matplotlib
     >>> matplotlib.use("Agg")
-    >>> from sbrdf_xr.photometry import compare
+    >>> from sbrdf_xr.lightcurves import compare
     >>> ang = np.arange(0.0, 360.0, 10.0)
     >>> sim = xr.DataArray(np.stack([10 + np.cos(np.radians(2 * ang))], 1),
     ...                    dims=("attitude", "band"),

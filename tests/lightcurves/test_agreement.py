@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from scipy.stats import pearsonr
 
 from sbrdf_xr.errors import ValidationError
-from sbrdf_xr.photometry import binned_residuals, compare_magnitudes
+from sbrdf_xr.lightcurves import binned_residuals, compare_magnitudes
 
 # Sums of a few hundred magnitudes of order 10 in float64: 1e-12 is rounding, not method.
 TOL = 1e-12

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from sbrdf_xr import photometry as P
+from sbrdf_xr import lightcurves as L
 from sbrdf_xr.errors import ValidationError
 
 PERIOD_S = 600.0
@@ -104,7 +104,7 @@ def test_tables_with_units_and_absolute_utc_times(tmp_path, suffix, fmt):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # FITS writes the long key magnitude_system as HIERARCH
         tab.write(path, format=fmt)
-    lc = P.read_light_curve(path, system="Vega" if fmt != "ascii.ecsv" else None)
+    lc = L.read_light_curve(path, system="Vega" if fmt != "ascii.ecsv" else None)
     assert lc.time.dtype == np.dtype("datetime64[ns]")
     # times to the ns (FITS/ECSV Time columns round-trip at the us level: jd1+jd2 doubles)
     np.testing.assert_array_less(np.abs((lc.time.values - t) / np.timedelta64(1, "us")), 1.0)
@@ -115,7 +115,7 @@ def test_tables_with_units_and_absolute_utc_times(tmp_path, suffix, fmt):
     np.testing.assert_allclose(lc.range_km.values, 1000.0, rtol=1e-12)  # m -> km
     assert lc.attrs["magnitude_system"] == "Vega"
     assert lc.magnitude.attrs["ancillary_variables"] == "uncertainty"
-    res = P.compare(
+    res = L.compare(
         lc, _sim(range_km=1000.0, system="Vega"), period_s=PERIOD_S, zero_points="common"
     )
     # 240 points over three nights: sigma(phase) ~ 0.04 deg, sigma(offset) ~ 0.0007 mag
@@ -134,16 +134,16 @@ def test_csv_iso_times_need_a_zone_or_a_stated_scale(tmp_path):
         match=r"row 2 \(line 3 of the file\), column 'time': "
         r"'2024-01-01T00:01:00' has no time zone and cannot be read as UTC",
     ):
-        P.read_light_curve(path)
-    lc = P.read_light_curve(path, time_scale="utc")
+        L.read_light_curve(path)
+    lc = L.read_light_curve(path, time_scale="utc")
     assert lc.time.values[1] == np.datetime64("2024-01-01T00:01:00", "ns")
     off = tmp_path / "offset.csv"
     off.write_text("time,band,magnitude,uncertainty\n2024-01-01T02:00:00+02:00,V,12,0.1\n")
-    assert P.read_light_curve(off).time.values[0] == np.datetime64("2024-01-01T00:00:00", "ns")
+    assert L.read_light_curve(off).time.values[0] == np.datetime64("2024-01-01T00:00:00", "ns")
     with pytest.raises(ValidationError, match="time_scale: got 'ut1'; allowed: utc, tai"):
-        P.read_light_curve(path, time_scale="ut1")
+        L.read_light_curve(path, time_scale="ut1")
     # a stated scale converts the zone-less times (TAI - UTC = 37 s in 2024); 'Z' stays UTC
-    tai = P.read_light_curve(path, time_scale="tai")
+    tai = L.read_light_curve(path, time_scale="tai")
     assert tai.time.values[0] == np.datetime64("2024-01-01T00:00:00", "ns")
     assert tai.time.values[1] == np.datetime64("2024-01-01T00:00:23", "ns")
 
@@ -158,12 +158,12 @@ def test_mixed_systems_missing_columns_and_bad_units_are_named(tmp_path):
         match=r"row 2 \(line 3 of the file\), column 'system': 'AB' differs "
         "from 'Vega'",
     ):
-        P.read_light_curve(mixed)
+        L.read_light_curve(mixed)
     one = tmp_path / "one.csv"
     one.write_text("rotation_angle,band,magnitude,uncertainty,system\n0,V,12,0.1,vega\n")
-    assert P.read_light_curve(one).attrs["magnitude_system"] == "Vega"
+    assert L.read_light_curve(one).attrs["magnitude_system"] == "Vega"
     with pytest.raises(ValidationError, match="states the Vega system, not system='AB'"):
-        P.read_light_curve(one, system="AB")
+        L.read_light_curve(one, system="AB")
     import astropy.units as u
     from astropy.table import Table
 
@@ -176,30 +176,30 @@ def test_mixed_systems_missing_columns_and_bad_units_are_named(tmp_path):
     )
     tab.write(tmp_path / "miss.ecsv")
     with pytest.raises(ValidationError, match=r"missing column\(s\) \['uncertainty'\]"):
-        P.read_light_curve(tmp_path / "miss.ecsv")
+        L.read_light_curve(tmp_path / "miss.ecsv")
     tab["uncertainty"] = [0.1, 0.1] * u.s
     tab.write(tmp_path / "unit.ecsv", overwrite=True)
     with pytest.raises(
         ValidationError, match="column 'uncertainty' has unit s, which cannot be converted to mag"
     ):
-        P.read_light_curve(tmp_path / "unit.ecsv")
+        L.read_light_curve(tmp_path / "unit.ecsv")
     tab["uncertainty"] = [0.1, 0.1] * u.mag
     tab["rotation_angle"] = [0.0, 0.5] * u.rad
     tab.write(tmp_path / "rad.ecsv", overwrite=True)
-    assert P.read_light_curve(tmp_path / "rad.ecsv").rotation_angle.values[1] == pytest.approx(
+    assert L.read_light_curve(tmp_path / "rad.ecsv").rotation_angle.values[1] == pytest.approx(
         np.degrees(0.5)
     )
     bad_range = tmp_path / "range.csv"
     bad_range.write_text("rotation_angle,band,magnitude,uncertainty,range_km\n0,V,12,0.1,-3\n")
     with pytest.raises(ValidationError, match="column 'range_km': must be > 0 km"):
-        P.read_light_curve(bad_range)
+        L.read_light_curve(bad_range)
 
 
 def test_the_fit_uses_per_row_range_and_refuses_a_system_mismatch(tmp_path):
     tab, _, _ = _table(range_km=lambda n, rng: rng.uniform(800.0, 3000.0, n))
     tab.write(tmp_path / "r.ecsv")
-    lc = P.read_light_curve(tmp_path / "r.ecsv")
-    res = P.compare(
+    lc = L.read_light_curve(tmp_path / "r.ecsv")
+    res = L.compare(
         lc, _sim(range_km=1000.0, system="Vega"), period_s=PERIOD_S, zero_points="common"
     )
     assert float(res.magnitude_offset) == pytest.approx(
@@ -207,9 +207,9 @@ def test_the_fit_uses_per_row_range_and_refuses_a_system_mismatch(tmp_path):
     )  # the 5 log10 d term is modelled
     assert 0.7 < float(res.reduced_chi_square) < 1.3
     with pytest.raises(ValidationError, match="in the Vega system but the simulation is in AB"):
-        P.compare(lc, _sim(range_km=1000.0, system="AB"), period_s=PERIOD_S, zero_points="common")
+        L.compare(lc, _sim(range_km=1000.0, system="AB"), period_s=PERIOD_S, zero_points="common")
     with pytest.raises(ValidationError, match="no range_km attribute"):
-        P.compare(lc, _sim(system="Vega"), period_s=PERIOD_S, zero_points="common")
+        L.compare(lc, _sim(system="Vega"), period_s=PERIOD_S, zero_points="common")
 
 
 def test_extinction_with_an_airmass_column(tmp_path):
@@ -230,10 +230,10 @@ def test_extinction_with_an_airmass_column(tmp_path):
     pd.DataFrame(
         {"rotation_angle": theta, "band": band, "magnitude": mag, "uncertainty": 0.01, "airmass": x}
     ).to_csv(path, index=False)
-    lc = P.read_light_curve(path)
-    res = P.compare(lc, _sim(), extinction=k, zero_points="common")
+    lc = L.read_light_curve(path)
+    res = L.compare(lc, _sim(), extinction=k, zero_points="common")
     assert float(res.magnitude_offset) == pytest.approx(DM0, abs=0.004)
-    naive = P.compare(lc, _sim(), zero_points="common")
+    naive = L.compare(lc, _sim(), zero_points="common")
     assert float(naive.reduced_chi_square) > 5 * float(res.reduced_chi_square)  # the test can tell
 
 
@@ -245,33 +245,33 @@ def _small(tmp_path, n=3, sigma="0.01"):
 
 
 def test_fit_bad_inputs_get_named_errors(tmp_path):
-    lc = P.read_light_curve(_small(tmp_path, 5))
+    lc = L.read_light_curve(_small(tmp_path, 5))
     for bad in (0, -3, 2.5, True):
         with pytest.raises(ValidationError, match="n_scan: must be an integer >= 1"):
-            P.compare(lc, _sim(), n_scan=bad, zero_points="common")
-    assert np.isfinite(float(P.compare(lc, _sim(), n_scan=1, zero_points="common").chi_square))
-    one = P.read_light_curve(_small(tmp_path, 1))
+            L.compare(lc, _sim(), n_scan=bad, zero_points="common")
+    assert np.isfinite(float(L.compare(lc, _sim(), n_scan=1, zero_points="common").chi_square))
+    one = L.read_light_curve(_small(tmp_path, 1))
     with pytest.raises(ValidationError, match=r"1 observation\(s\).*needs at least 3"):
-        P.compare(one, _sim(), zero_points="common")
+        L.compare(one, _sim(), zero_points="common")
     with pytest.raises(ValidationError, match=r"1 observation\(s\).*needs at least 2"):
-        P.compare(one, _sim(), fit_phase=False, zero_points="common")
-    two = P.read_light_curve(_small(tmp_path, 2))
+        L.compare(one, _sim(), fit_phase=False, zero_points="common")
+    two = L.read_light_curve(_small(tmp_path, 2))
     assert (
-        int(P.compare(two, _sim(), fit_phase=False, zero_points="common").degrees_of_freedom) == 1
+        int(L.compare(two, _sim(), fit_phase=False, zero_points="common").degrees_of_freedom) == 1
     )
     with pytest.raises(ValidationError, match=r"column 'uncertainty': must be >= 1e-06 mag"):
-        P.read_light_curve(_small(tmp_path, 5, sigma="1e-300"))
+        L.read_light_curve(_small(tmp_path, 5, sigma="1e-300"))
     tiny = lc.copy()
     tiny["uncertainty"] = ("obs", np.full(5, 1e-300))
     with pytest.raises(ValidationError, match=r"observation 0 \(row 1\) has uncertainty 1e-300"):
-        P.compare(tiny, _sim(), zero_points="common")
+        L.compare(tiny, _sim(), zero_points="common")
 
 
 def test_netcdf_round_trip_keeps_absolute_times(tmp_path):
     tab, _, _ = _table()
     tab.write(tmp_path / "lc.ecsv")
-    lc = P.read_light_curve(tmp_path / "lc.ecsv")
+    lc = L.read_light_curve(tmp_path / "lc.ecsv")
     lc.to_netcdf(tmp_path / "lc.nc")
-    back = P.read_light_curve(tmp_path / "lc.nc")
+    back = L.read_light_curve(tmp_path / "lc.nc")
     np.testing.assert_array_equal(back.time.values, lc.time.values)
     assert back.attrs["magnitude_system"] == "Vega"

@@ -14,7 +14,7 @@ import pytest
 from astropy.table import Table
 from astropy.time import Time
 
-from sbrdf_xr import photometry as P
+from sbrdf_xr import lightcurves as L
 from sbrdf_xr.errors import LightCurveError
 
 T0 = np.datetime64("2024-03-17T01:21:00", "ns")
@@ -56,7 +56,7 @@ def test_a_wide_table_in_any_row_order(tmp_path, suffix, fmt):
     tab.meta["magnitude_system"] = "Vega"
     path = tmp_path / f"wide{suffix}"
     _write(tab, path, fmt)
-    lc = P.read_light_curve(
+    lc = L.read_light_curve(
         path, system="Vega" if fmt in ("fits", "votable", "ascii.csv") else None
     )
     assert lc.attrs["table_form"] == "wide" and lc.attrs["magnitude_system"] == "Vega"
@@ -90,7 +90,7 @@ def test_a_long_table_grouped_by_band_is_sorted_by_time(tmp_path, suffix, fmt):
     )
     path = tmp_path / f"long{suffix}"
     _write(tab, path, fmt)
-    lc = P.read_light_curve(path, system="AB")
+    lc = L.read_light_curve(path, system="AB")
     assert lc.attrs["table_form"] == "long" and lc.sizes["obs"] == len(rows)
     assert np.all(np.diff(lc.time.values) >= np.timedelta64(0, "ns"))
     # at one time the bands keep the file's order (a stable sort)
@@ -112,7 +112,7 @@ def test_fluxes_become_ab_magnitudes(tmp_path):
         }
     )
     tab.write(tmp_path / "f.ecsv")
-    lc = P.read_light_curve(tmp_path / "f.ecsv")
+    lc = L.read_light_curve(tmp_path / "f.ecsv")
     np.testing.assert_allclose(lc.magnitude.values, mags["V"], atol=1e-12)
     # sigma_m = 2.5 / ln 10 * sigma_f / f, first order
     np.testing.assert_allclose(lc.uncertainty.values, 2.5 / np.log(10) * 0.01, rtol=1e-12)
@@ -120,10 +120,10 @@ def test_fluxes_become_ab_magnitudes(tmp_path):
     tab.meta["magnitude_system"] = "Vega"
     tab.write(tmp_path / "fv.ecsv")
     with pytest.raises(LightCurveError, match=r"fluxes give AB magnitudes, but .* Vega"):
-        P.read_light_curve(tmp_path / "fv.ecsv")
+        L.read_light_curve(tmp_path / "fv.ecsv")
     (tmp_path / "nounit.csv").write_text("time,band,flux,flux_err\n2024-03-17T01:21:00Z,V,1,0.1\n")
     with pytest.raises(LightCurveError, match="fluxes without a unit cannot be magnitudes"):
-        P.read_light_curve(tmp_path / "nounit.csv")
+        L.read_light_curve(tmp_path / "nounit.csv")
 
 
 def test_a_flux_per_wavelength_uses_the_pivot_wavelength(tmp_path):
@@ -146,7 +146,7 @@ def test_a_flux_per_wavelength_uses_the_pivot_wavelength(tmp_path):
         }
     )
     tab.write(tmp_path / "flam.ecsv")
-    lc = P.read_light_curve(tmp_path / "flam.ecsv")
+    lc = L.read_light_curve(tmp_path / "flam.ecsv")
     # the pivot identity is exact for these integrals; speclite and the package
     # integrate the same curve on different grids: 1e-4 mag
     assert float(lc.magnitude[0]) == pytest.approx(want, abs=1e-4)
@@ -159,20 +159,20 @@ def test_the_system_from_column_metadata_a_unit_or_the_argument(tmp_path):
     )
     tab["magnitude"].meta["magnitude_system"] = "Vega"
     tab.write(tmp_path / "colmeta.ecsv")
-    assert P.read_light_curve(tmp_path / "colmeta.ecsv").attrs["magnitude_system"] == "Vega"
+    assert L.read_light_curve(tmp_path / "colmeta.ecsv").attrs["magnitude_system"] == "Vega"
     tab2 = tab.copy()
     tab2["magnitude"].meta = {}
     tab2["magnitude"].unit = u.ABmag
     tab2.write(tmp_path / "abunit.ecsv")
-    assert P.read_light_curve(tmp_path / "abunit.ecsv").attrs["magnitude_system"] == "AB"
+    assert L.read_light_curve(tmp_path / "abunit.ecsv").attrs["magnitude_system"] == "AB"
     with pytest.raises(LightCurveError, match="states the AB system, not system='Vega'"):
-        P.read_light_curve(tmp_path / "abunit.ecsv", system="Vega")
+        L.read_light_curve(tmp_path / "abunit.ecsv", system="Vega")
     tab2.meta = {}
     tab2["magnitude"].unit = None
     tab2.write(tmp_path / "plain.ecsv")
-    assert P.read_light_curve(tmp_path / "plain.ecsv").attrs["magnitude_system"] == "unstated"
+    assert L.read_light_curve(tmp_path / "plain.ecsv").attrs["magnitude_system"] == "unstated"
     assert (
-        P.read_light_curve(tmp_path / "plain.ecsv", system="vega").attrs["magnitude_system"]
+        L.read_light_curve(tmp_path / "plain.ecsv", system="vega").attrs["magnitude_system"]
         == "Vega"
     )
 
@@ -185,12 +185,12 @@ def test_julian_dates_need_a_stated_scale(tmp_path):
     )
     (tmp_path / "mjd.csv").write_text("MJD,band,mag,err\n" + text)
     with pytest.raises(LightCurveError, match="holds modified Julian dates but no time scale"):
-        P.read_light_curve(tmp_path / "mjd.csv")
-    lc = P.read_light_curve(tmp_path / "mjd.csv", time_scale="utc")
+        L.read_light_curve(tmp_path / "mjd.csv")
+    lc = L.read_light_curve(tmp_path / "mjd.csv", time_scale="utc")
     # an MJD double holds times to ~1 us near 2024
     assert np.all(np.abs((lc.time.values - t) / np.timedelta64(1, "us")) < 2.0)
     (tmp_path / "mjd_utc.csv").write_text("mjd_utc,band,mag,err\n" + text)
-    assert P.read_light_curve(tmp_path / "mjd_utc.csv").attrs["time_source"].startswith("MJD")
+    assert L.read_light_curve(tmp_path / "mjd_utc.csv").attrs["time_source"].startswith("MJD")
     # TAI dates: 37 s after UTC in 2024
     jd_tai = Time(t, scale="utc").tai.jd
     rows = "".join(
@@ -199,7 +199,7 @@ def test_julian_dates_need_a_stated_scale(tmp_path):
     )
     tab = tmp_path / "jd.csv"
     tab.write_text("jd,filter,magnitude,uncertainty\n" + rows)
-    lc = P.read_light_curve(tab, time_scale="tai")
+    lc = L.read_light_curve(tab, time_scale="tai")
     assert np.all(np.abs((lc.time.values - t) / np.timedelta64(1, "us")) < 200.0)
     table = Table(
         {
@@ -211,11 +211,11 @@ def test_julian_dates_need_a_stated_scale(tmp_path):
     )
     table.meta["TIMESYS"] = "TT"
     _write(table, tmp_path / "tt.fits", "fits")
-    lc = P.read_light_curve(tmp_path / "tt.fits")
+    lc = L.read_light_curve(tmp_path / "tt.fits")
     assert np.all(np.abs((lc.time.values - t) / np.timedelta64(1, "us")) < 2.0)
     (tmp_path / "bjd.csv").write_text("bjd_tdb,band,mag,err\n2460386.5,V,12,0.1\n")
     with pytest.raises(LightCurveError, match="heliocentric or barycentric dates"):
-        P.read_light_curve(tmp_path / "bjd.csv")
+        L.read_light_curve(tmp_path / "bjd.csv")
 
 
 @pytest.mark.parametrize(
@@ -240,11 +240,11 @@ def test_julian_dates_need_a_stated_scale(tmp_path):
     ],
 )
 def test_filter_names_map_to_the_packages_bands(tmp_path, written, band):
-    assert P.band_label(written) == band
+    assert L.band_label(written) == band
     (tmp_path / "f.csv").write_text(
         f'time,filter,mag,err\n2024-03-17T01:21:00Z,"{written}",12,0.1\n'
     )
-    lc = P.read_light_curve(tmp_path / "f.csv")
+    lc = L.read_light_curve(tmp_path / "f.csv")
     assert lc.band.values.tolist() == [band]
     assert lc.filter_as_written.values.tolist() == [written]
 
@@ -258,17 +258,17 @@ def test_unknown_or_ambiguous_filters_are_refused_with_the_known_bands(tmp_path)
         ("G", "not a band the package knows"),
     ):
         with pytest.raises(LightCurveError, match=why):
-            P.band_label(name)
+            L.band_label(name)
     (tmp_path / "w.csv").write_text(
         "time,Clear,Clear_err,V,V_err\n2024-03-17T01:21:00Z,11,0.1,12,0.1\n"
     )
     with pytest.raises(LightCurveError, match=r"column 'Clear': filter 'Clear': not a band"):
-        P.read_light_curve(tmp_path / "w.csv")
-    lc = P.read_light_curve(tmp_path / "w.csv", band_map={"Clear": "V"})
+        L.read_light_curve(tmp_path / "w.csv")
+    lc = L.read_light_curve(tmp_path / "w.csv", band_map={"Clear": "V"})
     assert lc.band.values.tolist() == ["V", "V"]
     (tmp_path / "noerr.csv").write_text("time,V,R,R_err\n2024-03-17T01:21:00Z,12,11,0.1\n")
     with pytest.raises(LightCurveError, match=r"column 'V' .* has no uncertainty column"):
-        P.read_light_curve(tmp_path / "noerr.csv")
+        L.read_light_curve(tmp_path / "noerr.csv")
 
 
 def test_wide_tables_need_an_uncertainty_for_every_value(tmp_path):
@@ -280,10 +280,10 @@ def test_wide_tables_need_an_uncertainty_for_every_value(tmp_path):
         match=r"row 2 \(line 3 of the file\), column 'V_err': "
         "no uncertainty for the value 12.1",
     ):
-        P.read_light_curve(tmp_path / "gap.csv")
+        L.read_light_curve(tmp_path / "gap.csv")
     (tmp_path / "none.csv").write_text("time,seeing\n2024-03-17T01:21:00Z,1.2\n")
     with pytest.raises(LightCurveError, match="no band column"):
-        P.read_light_curve(tmp_path / "none.csv")
+        L.read_light_curve(tmp_path / "none.csv")
 
 
 def test_long_table_nan_rows_are_named(tmp_path):
@@ -295,4 +295,4 @@ def test_long_table_nan_rows_are_named(tmp_path):
         match=r"row 2 \(line 3 of the file\), column 'mag': "
         "value 'nan' is not a finite number",
     ):
-        P.read_light_curve(tmp_path / "nan.csv")
+        L.read_light_curve(tmp_path / "nan.csv")

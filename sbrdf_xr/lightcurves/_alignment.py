@@ -5,7 +5,7 @@ for a trial shift ``x``: a time shift [s] along a simulated pass (:func:`observa
 the simulated flux interpolated linearly in time, no time outside the simulated window)
 or a rotation-phase offset [degree] along a rotation sweep (:func:`sweep`: periodic in
 360 degree, measured angles or times over a rotation period).  Used by
-:func:`sbrdf_xr.photometry.lightcurves.compare`.
+:func:`sbrdf_xr.lightcurves.comparison.compare`.
 """
 
 from __future__ import annotations

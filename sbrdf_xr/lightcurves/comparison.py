@@ -25,12 +25,12 @@ import xarray as xr
 
 from .._names import ATTITUDE, BAND, PHASE_ANGLE
 from ..errors import LightCurveError
+from ..photometry import BAND_ALIASES
 from ..units import to_unit
 from . import _alignment as align
 from ._comparison import fit_and_report
-from .bands import _canonical
-from .comparison_figure import plot_comparison
-from .measured import MIN_UNCERTAINTY
+from .figure import plot_comparison
+from .tables import MIN_UNCERTAINTY
 
 __all__ = ["compare", "compare_light_curves", "plot_comparison"]
 
@@ -66,7 +66,7 @@ def _check_measured(measured: Any) -> None:
 def _simulated(simulated: Any, measured: xr.Dataset, phase_angle: Any) -> xr.DataArray:
     """Magnitudes over (time or attitude, band): given, or computed from a cube."""
     if isinstance(simulated, xr.Dataset):
-        from .magnitude import magnitudes
+        from ..photometry import magnitudes
 
         labels = sorted({str(b) for b in measured[BAND].values})
         system = str(measured.attrs.get("magnitude_system", "unstated"))
@@ -109,8 +109,8 @@ def _band_columns(measured: xr.Dataset, sim: xr.DataArray) -> np.ndarray:
     for k, b in enumerate(obs):
         if b in labels:
             col[k] = labels.index(b)
-        elif _canonical(b) in filters:
-            col[k] = filters.index(_canonical(b))
+        elif BAND_ALIASES.get(b, b) in filters:
+            col[k] = filters.index(BAND_ALIASES.get(b, b))
         elif b not in missing:
             missing.append(b)
     if missing:
@@ -176,7 +176,7 @@ def compare(
     Parameters
     ----------
     measured : xarray.Dataset
-        From :func:`~sbrdf_xr.photometry.read_light_curve` (or alike: ``magnitude``,
+        From :func:`~sbrdf_xr.lightcurves.read_light_curve` (or alike: ``magnitude``,
         ``uncertainty`` and coordinates ``band`` and ``time`` or ``rotation_angle``).
     simulated : xarray.DataArray or xarray.Dataset
         Magnitudes from :func:`~sbrdf_xr.photometry.magnitudes` over ``(time, band)``
@@ -296,7 +296,7 @@ def compare(
     if extinction is not None:
         align.with_airmass(al, measured, sim, airmass)
     if isinstance(extinction, Mapping):
-        from ._observed import _coefficient
+        from ..photometry._observed import _coefficient
 
         labels = [str(b) for b in sim[BAND].values]
         ks = np.full(len(labels), np.nan)
@@ -339,7 +339,7 @@ def compare_light_curves(measured: xr.Dataset, simulated_mags: xr.DataArray, **k
     (0.5, 'DeprecationWarning')
     """
     warnings.warn(
-        "compare_light_curves is deprecated: use sbrdf_xr.photometry.compare (with "
+        "compare_light_curves is deprecated: use sbrdf_xr.lightcurves.compare (with "
         "zero_points='common' for one offset)",
         DeprecationWarning,
         stacklevel=2,

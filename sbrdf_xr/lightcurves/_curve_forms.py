@@ -5,7 +5,7 @@
 (``V, V_err, R, R_err``; ``mag_V, e_mag_V``; ``flux_V, flux_V_err``);
 :func:`utc_times` reads ISO 8601 strings, astropy ``Time`` columns, Julian and modified
 Julian dates in a stated time scale; :func:`flux_magnitudes` turns flux densities into
-AB magnitudes.  Used by :func:`sbrdf_xr.photometry.measured.read_light_curve`.
+AB magnitudes.  Used by :func:`sbrdf_xr.lightcurves.read_light_curve`.
 """
 
 from __future__ import annotations
