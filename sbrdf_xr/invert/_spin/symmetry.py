@@ -27,7 +27,7 @@ import dataclasses
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import InversionError
+from ...errors import InversionError
 
 __all__ = ["SYMMETRY_TOL", "Symmetry", "body_symmetries", "flip_phase"]
 
@@ -142,7 +142,7 @@ def body_symmetries(
     A 1 x 2 x 3 box, one material: half turns about z (and about x and y, the flips):
 
     >>> import trimesh
-    >>> from sbrdf_xr.invert._symmetry import body_symmetries
+    >>> from sbrdf_xr.invert._spin.symmetry import body_symmetries
     >>> box = trimesh.creation.box(extents=(1.0, 2.0, 3.0))
     >>> syms = body_symmetries(box.face_normals, box.area_faces, np.zeros(12, int), [0, 0, 1])
     >>> [s.name for s in syms]
@@ -200,8 +200,8 @@ def flip_phase(sym: Symmetry, align: np.ndarray, k: np.ndarray, phase: float) ->
     The twin's attitude ``A' R_k(phase')`` equals the spin's turned by the flip, ``A
     R_k(phase) F``:
 
-    >>> from sbrdf_xr.invert._spin_search import align_matrices
-    >>> from sbrdf_xr.invert._symmetry import Symmetry, _rotation, flip_phase
+    >>> from sbrdf_xr.invert._spin.search import align_matrices
+    >>> from sbrdf_xr.invert._spin.symmetry import Symmetry, _rotation, flip_phase
     >>> k = np.array([0.0, 0.0, 1.0])
     >>> flip = Symmetry("flip", _rotation(np.array([1.0, 1.0, 0]), 180.0), "flip", 180.0, k)
     >>> a = align_matrices(k, np.array([[0.0, 0.6, 0.8]]))[0]
@@ -210,7 +210,7 @@ def flip_phase(sym: Symmetry, align: np.ndarray, k: np.ndarray, phase: float) ->
     >>> bool(np.allclose(a2 @ _rotation(k, twin), a @ _rotation(k, 30.0) @ flip.matrix))
     True
     """
-    from ._spin_search import align_matrices
+    from .search import align_matrices
 
     axis = align @ k
     a2 = align_matrices(k, -axis[None, :])[0]

@@ -33,7 +33,7 @@ def stick_breaking(u: np.ndarray) -> np.ndarray:
 
     Examples
     --------
-    >>> from sbrdf_xr.invert._bounds import stick_breaking
+    >>> from sbrdf_xr.invert._joint.bounds import stick_breaking
     >>> stick_breaking(np.array([0.5, 0.5])).tolist()
     [0.5, 0.25, 0.25]
     """
@@ -48,7 +48,7 @@ def stick_breaking_inverse(f: np.ndarray) -> np.ndarray:
 
     Examples
     --------
-    >>> from sbrdf_xr.invert._bounds import stick_breaking_inverse
+    >>> from sbrdf_xr.invert._joint.bounds import stick_breaking_inverse
     >>> stick_breaking_inverse(np.array([0.5, 0.25])).tolist()
     [0.5, 0.5]
     """
@@ -64,7 +64,7 @@ def fractions_of(f_free: np.ndarray) -> np.ndarray:
 
     Examples
     --------
-    >>> from sbrdf_xr.invert._bounds import fractions_of
+    >>> from sbrdf_xr.invert._joint.bounds import fractions_of
     >>> fractions_of(np.array([0.25, 0.5])).tolist()
     [0.25, 0.5, 0.25]
     """
@@ -98,7 +98,7 @@ def covariance(jac: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     Two parameters of which the data see only the sum, and a third (its variance that of
     ``J^T J`` with the two replaced by their sum, ``[[6, 1], [1, 1]]^-1``, 6/5):
 
-    >>> from sbrdf_xr.invert._bounds import covariance
+    >>> from sbrdf_xr.invert._joint.bounds import covariance
     >>> j = np.array([[1.0, 1.0, 0.0], [1.0, 1.0, 1.0], [2.0, 2.0, 0.0]])
     >>> cov, free = covariance(j)
     >>> free.tolist(), round(float(cov[2, 2]), 12)

@@ -7,10 +7,10 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ._quality import quality_attrs
-from ._spin_data import SpinGeometry
-from ._spin_refine import Minimum, axis_angle, lonlat_covariance
-from ._spin_search import Problem, lonlat
+from .._quality import quality_attrs
+from .data import SpinGeometry
+from .refine import Minimum, axis_angle, lonlat_covariance
+from .search import Problem, lonlat
 
 __all__ = ["result_dataset"]
 

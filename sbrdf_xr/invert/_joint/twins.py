@@ -1,6 +1,6 @@
 """The symmetry twins of a joint fit's solution, each evaluated on the data.
 
-See :mod:`sbrdf_xr.invert._symmetry`: a rotation ``F`` of the body frame that maps the
+See :mod:`sbrdf_xr.invert._spin.symmetry`: a rotation ``F`` of the body frame that maps the
 body onto itself gives the twin attitude ``R(t) F``; its chi-square is computed with the
 fit's model at the body-frame directions ``F^T v`` (the same areas, extinction and zero
 points), so an exact symmetry shows a gap of rounding size and an approximate one its
@@ -15,8 +15,8 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ._spin_search import align_matrices, lonlat
-from ._symmetry import Symmetry, flip_phase
+from .._spin.search import align_matrices, lonlat
+from .._spin.symmetry import Symmetry, flip_phase
 
 __all__ = ["twin_dataset"]
 

@@ -10,7 +10,7 @@ import dataclasses
 import numpy as np
 from scipy.optimize import least_squares
 
-from ._spin_search import Problem, lonlat, vec
+from .search import Problem, lonlat, vec
 
 __all__ = ["Minimum", "axis_angle", "exact_minimum", "refine", "twins"]
 
@@ -36,7 +36,7 @@ def axis_angle(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.degrees(np.arccos(np.clip(np.dot(a, b), -1, 1))))
 
 
-def _tangent(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def tangent_frame(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """East and north unit vectors at ``axis`` (an arbitrary pair at the poles)."""
     east = np.array([-axis[1], axis[0], 0.0])
     if np.linalg.norm(east) < 1e-9:
@@ -53,7 +53,7 @@ def _residuals(prob: Problem, axis: np.ndarray, period: float, phase: float) -> 
 def _covariance(prob: Problem, axis: np.ndarray, period: float, phase: float) -> np.ndarray:
     """``(J^T J)^-1`` from central differences of the profiled residuals (the flux scales
     solved at every step) in (east, north, period, phase) at the solution."""
-    e, n = _tangent(axis)
+    e, n = tangent_frame(axis)
     steps = np.array([1e-3, 1e-3, 1e-6 * period, 1e-3])
 
     def at(d: np.ndarray) -> np.ndarray:
@@ -74,7 +74,7 @@ def _covariance(prob: Problem, axis: np.ndarray, period: float, phase: float) ->
 def refine(prob: Problem, axis0: np.ndarray, period0: float, phase0: float, label: str) -> Minimum:
     """Least squares (Levenberg-Marquardt) from a spin state, in tangent-plane coordinates of
     the axis (no singularity at the poles), with the exact model."""
-    e, n = _tangent(axis0)
+    e, n = tangent_frame(axis0)
 
     def axis_of(p: np.ndarray) -> np.ndarray:
         a = axis0 + np.radians(p[0]) * e + np.radians(p[1]) * n
@@ -139,7 +139,7 @@ def lonlat_covariance(m: Minimum) -> tuple[float, float, np.ndarray]:
     """Longitude, latitude [degree] of the axis and the covariance of (lon, lat, period,
     phase) from the tangent-plane one (``d lon = d east / cos lat``, ``d lat = d north``)."""
     lon, lat = (float(v) for v in lonlat(m.axis))
-    e, n = _tangent(m.axis)
+    e, n = tangent_frame(m.axis)
     east0 = np.array([-np.sin(np.radians(lon)), np.cos(np.radians(lon)), 0.0])
     north0 = np.cross(vec(lon, lat), east0)
     c = max(np.cos(np.radians(lat)), 1e-12)
@@ -155,7 +155,7 @@ def symmetry_twins(prob: Problem, best: Minimum, axis_body: np.ndarray) -> str:
     ``theta`` about the spin axis is the phase ``+ theta``, its chi-square evaluated on the
     data; a flip is the antipode with the other sense of rotation (outside the fit's
     parameters, identical for the unshadowed model).  ``"none"`` without symmetries."""
-    from ._symmetry import body_symmetries
+    from .symmetry import body_symmetries
 
     t = prob.kernel.plan.terms
     rows = []

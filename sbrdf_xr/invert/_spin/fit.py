@@ -1,8 +1,8 @@
 """Spin-state fit: global search over candidate spin states and local refinement.
 
 See the package docstring and :func:`fit_spin`.  The model, its chi-square and the grid
-searches are in :mod:`sbrdf_xr.invert._spin_search`; refinement and the ambiguous twins in
-:mod:`sbrdf_xr.invert._spin_refine`; the result Dataset in :mod:`sbrdf_xr.invert._spin_result`.
+searches are in :mod:`sbrdf_xr.invert._spin.search`; refinement and the ambiguous twins in
+:mod:`sbrdf_xr.invert._spin.refine`; the result Dataset in :mod:`sbrdf_xr.invert._spin.result`.
 """
 
 from __future__ import annotations
@@ -16,14 +16,14 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from ..errors import FitQualityWarning, InversionError
-from ..units import to_unit
-from ._quality import fit_quality
-from ._spin_data import band_factors, light_curve_fluxes, spin_geometry
-from ._spin_refine import Minimum, axis_angle, exact_minimum, symmetry_twins, twins
-from ._spin_refine import refine as refine_state
-from ._spin_result import result_dataset
-from ._spin_search import (
+from ...errors import FitQualityWarning, InversionError
+from ...units import to_unit
+from .._quality import fit_quality
+from .data import band_factors, light_curve_fluxes, spin_geometry
+from .refine import Minimum, axis_angle, exact_minimum, symmetry_twins, twins
+from .refine import refine as refine_state
+from .result import result_dataset
+from .search import (
     METHODS,
     Kernel,
     Problem,
@@ -106,7 +106,7 @@ def search_size(
 
 
 def _check_size(size: dict[str, float], what: str, size_limit: float) -> None:
-    from ..engine.stages import describe_bytes
+    from ...engine.stages import describe_bytes
 
     lim_b, lim_w = size_limit * SEARCH_BYTES_LIMIT, size_limit * SEARCH_WORK_LIMIT
     if size["bytes"] > lim_b or size["work"] > lim_w:
@@ -246,7 +246,7 @@ def fit_spin(
     Parameters
     ----------
     light_curve : Dataset
-        :func:`sbrdf_xr.photometry.read_light_curve` output (magnitudes) or the same with
+        :func:`sbrdf_xr.lightcurves.read_light_curve` output (magnitudes) or the same with
         ``flux`` and ``flux_uncertainty``; times UTC (datetime64) or seconds.
     spacecraft : Spacecraft
         The body (its materials from the catalog unless ``materials``).

@@ -24,9 +24,9 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ..errors import InversionError
-from ._bounds import covariance
-from ._spin_search import lonlat
+from ...errors import InversionError
+from .._spin.search import lonlat
+from .bounds import covariance
 
 __all__ = ["MAX_EVALUATIONS", "MODE_CHI2", "sample_posterior"]
 
@@ -51,7 +51,7 @@ def check_budget(walkers: int, steps: int, n_modes: int, seconds_per_call: float
 
     Examples
     --------
-    >>> from sbrdf_xr.invert._posterior import check_budget
+    >>> from sbrdf_xr.invert._joint.posterior import check_budget
     >>> check_budget(32, 300, 2, 0.002)  # 19200 evaluations: allowed
     """
     if not (isinstance(walkers, int) and isinstance(steps, int) and walkers > 0 and steps > 0):

@@ -2,8 +2,8 @@
 material areas at once.
 
 See :func:`fit_observation`; the data and the forward model are in
-:mod:`sbrdf_xr.invert._joint_model`, the result Dataset in
-:mod:`sbrdf_xr.invert._joint_result`.
+:mod:`sbrdf_xr.invert._joint.model`, the result Dataset in
+:mod:`sbrdf_xr.invert._joint.result`.
 """
 
 from __future__ import annotations
@@ -17,34 +17,34 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from ..errors import FitQualityWarning, InversionError
-from ..units import to_unit
-from ._areas import material_areas
-from ._bounds import covariance
-from ._diagnose import likely_causes
-from ._extinction import extinction_prior as _k_prior
-from ._extinction import separable_sd
-from ._joint_model import PassModel, pass_data
-from ._joint_refine import Local, jacobian, outside_physics, refine
-from ._joint_result import Layout, model_check, result_dataset
-from ._joint_starts import minima_dataset, start_states
-from ._joint_status import RECOVER, causes, held_note, status_attrs, with_posterior
-from ._joint_twins import twin_dataset
-from ._model_error import table_widths
-from ._posterior import check_budget
-from ._quality import fit_quality
-from ._spin import AMBIGUITY_CHI2
-from ._spin_search import vec
-from ._symmetry import SYMMETRY_TOL, body_symmetries
+from ...errors import FitQualityWarning, InversionError
+from ...units import to_unit
+from .._areas import material_areas
+from .._quality import fit_quality
+from .._spin.fit import AMBIGUITY_CHI2
+from .._spin.search import vec
+from .._spin.symmetry import SYMMETRY_TOL, body_symmetries
+from .bounds import covariance
+from .diagnose import likely_causes
+from .extinction import extinction_prior as _k_prior
+from .extinction import separable_sd
+from .model import PassModel, pass_data
+from .model_error import table_widths
+from .posterior import check_budget
+from .refine import Local, jacobian, outside_physics, refine
+from .result import Layout, model_check, result_dataset
+from .starts import minima_dataset, start_states
+from .status import RECOVER, causes, held_note, status_attrs, with_posterior
+from .twins import twin_dataset
 
 if TYPE_CHECKING:
-    from ..body import Spacecraft
-    from ..observing import Observation
+    from ...body import Spacecraft
+    from ...observing import Observation
 
 __all__ = ["JOINT_CAUSES", "fit_observation"]
 
 #: Likely causes of a poor joint fit (the warning ranks them from the residuals: see
-#: :mod:`sbrdf_xr.invert._diagnose`).
+#: :mod:`sbrdf_xr.invert._joint.diagnose`).
 JOINT_CAUSES = (
     "the fit stopped in a local minimum: start from a better spin state (fit_spin over the "
     "light curve) or from more (starts='aliases': the period aliases and fit_spin's twins)",
@@ -204,7 +204,7 @@ def fit_observation(
     Parameters
     ----------
     light_curve : Dataset
-        :func:`sbrdf_xr.photometry.read_light_curve` output: ``magnitude``, ``uncertainty``
+        :func:`sbrdf_xr.lightcurves.read_light_curve` output: ``magnitude``, ``uncertainty``
         [mag] over ``obs``, with ``band`` and UTC ``time`` (or seconds from the start of
         the observation); ``attrs["magnitude_system"]`` unless ``system``.
     spacecraft : Spacecraft
@@ -252,7 +252,7 @@ def fit_observation(
         areas within this fraction of the total): every rotation of the body frame that
         maps the body's facets (normals, areas, materials: the model's terms) onto
         themselves gives a twin state of the solution, evaluated on the data and listed
-        over ``twin`` and in ``ambiguity`` (:mod:`sbrdf_xr.invert._symmetry`).
+        over ``twin`` and in ``ambiguity`` (:mod:`sbrdf_xr.invert._spin.symmetry`).
 
     Returns
     -------
@@ -282,7 +282,7 @@ def fit_observation(
     Results stay inside physics: when the lowest minimum needs area fractions outside
     ``[0, 1]`` (or negative scales), every start whose minimum does is refined again on
     the stick-breaking transform of the fractions with box bounds
-    (:mod:`sbrdf_xr.invert._bounds`); if that fit is poor the result is marked
+    (:mod:`sbrdf_xr.invert._joint.bounds`); if that fit is poor the result is marked
     ``"failed"``: impossible areas mean the spin state is wrong.  A parameter whose
     Jacobian column vanishes or lies in its null space (a material never lit and seen,
     extinction and zero point over a constant air mass) is reported as not constrained

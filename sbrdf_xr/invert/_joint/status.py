@@ -12,11 +12,11 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ._diagnose import CAUSES
-from ._joint_model import PassModel
-from ._joint_refine import Local, jacobian, outside_physics
-from ._joint_result import Layout
-from ._posterior import sample_posterior
+from .diagnose import CAUSES
+from .model import PassModel
+from .posterior import sample_posterior
+from .refine import Local, jacobian, outside_physics
+from .result import Layout
 
 __all__ = ["CAUSE_SCORE", "RECOVER", "causes", "held_note", "status_attrs", "with_posterior"]
 

@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InversionError
-from ..units import to_unit
+from ...errors import InversionError
+from ...units import to_unit
 
 __all__ = ["EXTINCTION_PRIOR_WIDTH", "extinction_prior", "separable_sd"]
 
@@ -35,7 +35,7 @@ def separable_sd(airmass: np.ndarray, sigma: np.ndarray, band: np.ndarray, nb: i
 
     Examples
     --------
-    >>> from sbrdf_xr.invert._extinction import separable_sd
+    >>> from sbrdf_xr.invert._joint.extinction import separable_sd
     >>> x = np.array([1.0, 2.0, 5.7818, 5.7820])
     >>> separable_sd(x, np.full(4, 0.01), np.array([0, 0, 1, 1]), 2).round(5).tolist()
     [0.01414, 70.71068]
@@ -66,13 +66,13 @@ def extinction_prior(
 
     Examples
     --------
-    >>> from sbrdf_xr.invert._extinction import extinction_prior
+    >>> from sbrdf_xr.invert._joint.extinction import extinction_prior
     >>> k, sd, how = extinction_prior({"V": (0.2, 0.05)}, ["V"])
     >>> k.tolist(), sd.tolist(), how
     ([0.2], [0.05], 'given')
     """
     if prior is None:
-        from ..photometry import extinction_coefficients
+        from ...photometry import extinction_coefficients
 
         k = np.asarray(extinction_coefficients(list(labels)).values, dtype=np.float64)
         how = (

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InversionError
+from ...errors import InversionError
 
 __all__ = ["PROVENANCE_WIDTH", "table_widths"]
 
@@ -43,7 +43,7 @@ def table_widths(
 
     Examples
     --------
-    >>> from sbrdf_xr.invert._model_error import table_widths
+    >>> from sbrdf_xr.invert._joint.model_error import table_widths
     >>> table_widths("provenance", ["paint", "cell"], {"paint": "synthetic",
     ...                                                "cell": "measured"}).tolist()
     [0.2, 0.05]

@@ -18,11 +18,11 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from ..errors import FitQualityWarning, InversionError
-from ..units import to_unit
-from ._areas import material_areas
-from ._joint import fit_observation
-from ._spin_search import spin_model, vec
+from ...errors import FitQualityWarning, InversionError
+from ...units import to_unit
+from .._areas import material_areas
+from .._spin.search import spin_model, vec
+from .fit import fit_observation
 
 __all__ = ["observation_recovery", "simulated_light_curve"]
 
@@ -66,8 +66,8 @@ def simulated_light_curve(
     >>> lc.sizes["obs"], lc.band.values[:4].tolist(), lc.attrs["magnitude_system"]
     (261, ['V', 'R', 'I', 'V'], 'Vega')
     """
-    from ..engine import Scene, simulate
-    from ..photometry import magnitudes
+    from ...engine import Scene, simulate
+    from ...photometry import magnitudes
 
     epoch = spin.get("epoch")
     law = spin_model(
@@ -191,7 +191,7 @@ def observation_recovery(
     """
     phase_symmetry_deg = to_unit(phase_symmetry_deg, "deg", "phase_symmetry_deg")
     noise_mag = to_unit(noise_mag, "mag", "noise_mag")
-    from ._spin_refine import _tangent
+    from .._spin.refine import tangent_frame
 
     truth_spin = {k: float(spin[k]) for k in ("axis_longitude", "axis_latitude", "period", "phase")}
     epoch = spin.get("epoch", np.asarray(observation.times)[0])
@@ -221,7 +221,7 @@ def observation_recovery(
     )
     off = {"axis": 2.0, "period": 0.05, "phase": 5.0, **(start_offset or {})}
     a0 = vec(truth_spin["axis_longitude"], truth_spin["axis_latitude"])
-    a1 = a0 + np.radians(off["axis"]) * _tangent(a0)[1]
+    a1 = a0 + np.radians(off["axis"]) * tangent_frame(a0)[1]
     lon = float(np.degrees(np.arctan2(a1[1], a1[0])) % 360.0)
     lat = float(np.degrees(np.arcsin(a1[2] / np.linalg.norm(a1))))
     start = {

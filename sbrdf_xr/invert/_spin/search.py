@@ -26,10 +26,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import InversionError
-from ..kernels import sums as _kernels
-from ..units import to_unit
-from ._spin_data import SpinGeometry
+from ...errors import InversionError
+from ...kernels import sums as _kernels
+from ...units import to_unit
+from .data import SpinGeometry
 
 __all__ = [
     "METHODS",
@@ -137,7 +137,7 @@ def spin_model(
     """
     from scipy.spatial.transform import Rotation
 
-    from ..observing.attitude import Spin
+    from ...observing.attitude import Spin
 
     m = align_matrices(np.asarray(axis_body, float), np.asarray(axis, float)[None, :])[0]
     q = Rotation.from_matrix(m).as_quat()
@@ -163,7 +163,7 @@ def body_vectors(v: np.ndarray, align: np.ndarray, k: np.ndarray, angle: np.ndar
 class Kernel:
     """Band signal of a spacecraft for body-frame geometries, on pre-integrated tables,
     times ``band_factors`` (one per band, default 1: see
-    :func:`sbrdf_xr.invert._spin_data.band_factors`)."""
+    :func:`sbrdf_xr.invert._spin.data.band_factors`)."""
 
     def __init__(
         self,
@@ -173,7 +173,7 @@ class Kernel:
         method: str = "linear",
         band_factors: ArrayLike | None = None,
     ) -> None:
-        from ..engine import Scene
+        from ...engine import Scene
 
         f = fibonacci_sphere(256)
         scene = Scene(

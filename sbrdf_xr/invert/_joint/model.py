@@ -24,9 +24,9 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ..errors import InversionError
-from ._spin_data import _check_window, _measured_utc, _rows, _seconds, light_curve_fluxes
-from ._spin_search import Kernel, align_matrices, body_vectors
+from ...errors import InversionError
+from .._spin.data import check_window, light_curve_fluxes, measured_utc, row_list, seconds_since
+from .._spin.search import Kernel, align_matrices, body_vectors
 
 __all__ = ["PassData", "PassModel", "pass_data"]
 
@@ -62,7 +62,7 @@ class PassData:
 
 
 def _system(light_curve: xr.Dataset, system: str | None) -> str:
-    from ..photometry import check_system
+    from ...photometry import check_system
 
     have = light_curve.attrs.get("magnitude_system")
     if system is None and have is None:
@@ -93,8 +93,8 @@ def pass_data(
         Not magnitudes, bands outside ``bands``, times outside the observation window,
         below the horizon or in the Earth's umbra (the model reflects no light there).
     """
-    from ..observing import Inertial, Observation
-    from ..photometry import magnitudes, sun_magnitudes
+    from ...observing import Inertial, Observation
+    from ...photometry import magnitudes, sun_magnitudes
 
     if not isinstance(observation, Observation):
         raise InversionError(
@@ -109,7 +109,7 @@ def pass_data(
         )
         raise InversionError(
             f"light curve: a joint fit needs calibrated magnitudes (magnitude, uncertainty), "
-            f"got {got}; read the table with sbrdf_xr.photometry.read_light_curve"
+            f"got {got}; read the table with sbrdf_xr.lightcurves.read_light_curve"
         )
     have = [str(b) for b in dict.fromkeys(np.asarray(light_curve["band"].values).astype(str))]
     if bands is not None:
@@ -124,8 +124,8 @@ def pass_data(
     labels = tuple(str(b) for b in lc["labels"])
     sys_name = _system(light_curve, system)
     epoch = np.asarray(observation.times)[0].astype(_NS)
-    utc, how = _measured_utc(lc["time"], epoch, "observation")
-    _check_window(utc, observation.times[0], observation.times[-1], "observation window")
+    utc, how = measured_utc(lc["time"], epoch, "observation")
+    check_window(utc, observation.times[0], observation.times[-1], "observation window")
     uniq, t_index = np.unique(utc, return_inverse=True)
     g = dataclasses.replace(observation, times=uniq, attitude=Inertial((0.0, 0.0, 0.0, 1.0)))
     geo = g.geometry(on_unobservable="keep")
@@ -137,7 +137,7 @@ def pass_data(
     ):
         if bad.any():
             raise InversionError(
-                f"light curve: {int(bad.sum())} measured values (rows {_rows(bad)}, from "
+                f"light curve: {int(bad.sum())} measured values (rows {row_list(bad)}, from "
                 f"{utc[bad][0]}) fall where the object is {what}; drop those rows or check "
                 f"the observation ({observation.name!r}: orbit, site, window)"
             )
@@ -163,7 +163,7 @@ def pass_data(
         airmass=np.asarray(geo["airmass"].values, dtype=np.float64)[t_index],
         unit_magnitude=c[t_index, lc["band"]],
         utc=uniq,
-        seconds=_seconds(uniq, epoch),
+        seconds=seconds_since(uniq, epoch),
         to_sun=np.asarray(geo["to_sun"].values, dtype=np.float64),
         to_observer=np.asarray(geo["to_observer"].values, dtype=np.float64),
         sunlit_fraction=lit,

@@ -1,7 +1,7 @@
 """The local refinement of a joint fit from one start, inside the physical bounds when
 its minimum is not.
 
-See :func:`sbrdf_xr.invert.fit_observation` and :mod:`sbrdf_xr.invert._bounds`.
+See :func:`sbrdf_xr.invert.fit_observation` and :mod:`sbrdf_xr.invert._joint.bounds`.
 """
 
 from __future__ import annotations
@@ -13,11 +13,11 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
-from ._bounds import stick_breaking, stick_breaking_inverse
-from ._joint_model import PassModel
-from ._joint_result import Layout
-from ._joint_starts import Start
-from ._spin_refine import _tangent
+from .._spin.refine import tangent_frame
+from .bounds import stick_breaking, stick_breaking_inverse
+from .model import PassModel
+from .result import Layout
+from .starts import Start
 
 __all__ = ["MAX_NFEV", "Local", "jacobian", "outside_physics", "refine"]
 
@@ -45,7 +45,7 @@ def refine(model: PassModel, lay: Layout, st: Start, span: float, bounded: bool 
     transform in ``[0, 1]`` (or scales ``>= 0``), keeping them inside physics."""
     data = model.data
     e0 = st.axis
-    east, north = _tangent(e0)
+    east, north = tangent_frame(e0)
 
     def axis_of(p: np.ndarray) -> np.ndarray:
         a = e0 + np.radians(p[0]) * east + np.radians(p[1]) * north
@@ -106,8 +106,8 @@ def outside_physics(lay: Layout, p: np.ndarray, tol: float = 1e-9) -> list[str]:
 
     Examples
     --------
-    >>> from sbrdf_xr.invert._joint_refine import outside_physics
-    >>> from sbrdf_xr.invert._joint_result import Layout
+    >>> from sbrdf_xr.invert._joint.refine import outside_physics
+    >>> from sbrdf_xr.invert._joint.result import Layout
     >>> lay = Layout(("V",), ("a", "b"), np.array([1.0, 1.0]), "fit", None, "total")
     >>> outside_physics(lay, np.array([0, 0, 10, 0, 0.1, 1.3]))
     ['a 1.3', 'b -0.3']

@@ -87,7 +87,7 @@ def likely_causes(
     --------
     Residuals that are 3 sigma brighter in one band than the model, and noise:
 
-    >>> from sbrdf_xr.invert._diagnose import likely_causes
+    >>> from sbrdf_xr.invert._joint.diagnose import likely_causes
     >>> rng = np.random.default_rng(0)
     >>> n = 200
     >>> band = np.arange(n) % 2

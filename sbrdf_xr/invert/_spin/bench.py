@@ -9,8 +9,8 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ._spin_data import light_curve_fluxes, spin_geometry
-from ._spin_search import Kernel, Problem, fibonacci_sphere, run_search
+from .data import light_curve_fluxes, spin_geometry
+from .search import Kernel, Problem, fibonacci_sphere, run_search
 
 __all__ = ["benchmark_spin_search"]
 
@@ -54,7 +54,7 @@ def benchmark_spin_search(
     >>> sorted(rows[0])
     ['bands', 'candidates', 'method', 'per_candidate_ms', 'samples', 'seconds']
     """
-    from ..body.spacecraft import canx1
+    from ...body.spacecraft import canx1
 
     sc = spacecraft if spacecraft is not None else canx1()
     t = np.linspace(0.0, 300.0, n_samples)

@@ -14,9 +14,9 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ..errors import InversionError
-from ._spin_refine import axis_angle
-from ._spin_search import lonlat, vec
+from ...errors import InversionError
+from .._spin.refine import axis_angle
+from .._spin.search import lonlat, vec
 
 __all__ = ["Start", "minima_dataset", "start_states"]
 

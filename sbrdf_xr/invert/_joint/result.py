@@ -9,11 +9,11 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from .._names import attrs as cf
-from ._joint_model import PassData
-from ._quality import quality_attrs
-from ._spin_search import lonlat
-from ._unseen import correlation
+from ..._names import attrs as cf
+from .._quality import quality_attrs
+from .._spin.search import lonlat
+from .._unseen import correlation
+from .model import PassData
 
 __all__ = ["Layout", "model_check", "result_dataset"]
 
@@ -387,9 +387,9 @@ def model_check(
     """The solution's magnitudes recomputed by :func:`sbrdf_xr.engine.simulate` (spectral
     signal per material) and :func:`sbrdf_xr.photometry.magnitudes`: the largest
     difference from the fitted model, in magnitudes and in sigma."""
-    from ..engine import Scene, simulate
-    from ..photometry import magnitudes
-    from ._spin_search import spin_model
+    from ...engine import Scene, simulate
+    from ...photometry import magnitudes
+    from .._spin.search import spin_model
 
     law = spin_model(
         axis_body,

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ..errors import InversionError
+from ...errors import InversionError
 
 __all__ = [
     "LN10_2P5",
@@ -33,7 +33,7 @@ def light_curve_fluxes(
 ) -> dict[str, np.ndarray]:
     """Times, band index, relative flux and its uncertainty from a light curve.
 
-    ``light_curve`` is what :func:`sbrdf_xr.photometry.read_light_curve` returns (over
+    ``light_curve`` is what :func:`sbrdf_xr.lightcurves.read_light_curve` returns (over
     ``obs``: ``magnitude``, ``uncertainty`` [mag], coords ``band``, ``time`` [s] or UTC
     datetime64) or the same with ``flux`` and ``flux_uncertainty`` instead of magnitudes.
     ``time`` is returned as given (float seconds, or datetime64[ns]).
@@ -80,7 +80,7 @@ def light_curve_fluxes(
         bad_t = ~np.isfinite(t)
     if bad_t.any():
         raise InversionError(
-            f"light curve: {int(bad_t.sum())} times are NaN/NaT (rows {_rows(bad_t)}); "
+            f"light curve: {int(bad_t.sum())} times are NaN/NaT (rows {row_list(bad_t)}); "
             "drop those rows"
         )
     if "band" not in light_curve.variables:
@@ -105,7 +105,7 @@ def light_curve_fluxes(
             bad = ~np.isfinite(m)
             raise InversionError(
                 f"light curve: {int(bad.sum())} magnitudes are NaN or infinite (rows "
-                f"{_rows(bad)}); every magnitude must be finite (drop those rows)"
+                f"{row_list(bad)}); every magnitude must be finite (drop those rows)"
             )
         f = 10 ** (-0.4 * (m - np.median(m)))
         sf = f * LN10_2P5 * sm
@@ -118,13 +118,14 @@ def light_curve_fluxes(
     if not np.all(np.isfinite(f)):
         bad = ~np.isfinite(f)
         raise InversionError(
-            f"light curve: {int(bad.sum())} {what} values are NaN or infinite (rows {_rows(bad)})"
+            f"light curve: {int(bad.sum())} {what} values are NaN or infinite "
+            f"(rows {row_list(bad)})"
         )
     bad = ~(np.isfinite(sf) & (sf > 0))
     if bad.any():
         raise InversionError(
             f"light curve: {int(bad.sum())} uncertainties that are not finite and > 0 (rows "
-            f"{_rows(bad)}, e.g. {sf[bad][0]!r}); allowed: finite values > 0"
+            f"{row_list(bad)}, e.g. {sf[bad][0]!r}); allowed: finite values > 0"
         )
     return {
         "time": t,
@@ -155,7 +156,7 @@ def band_factors(
     system, so the fluxes of a body of the Sun's colour are 1.43 and 1.96 times those in V:
 
     >>> import xarray as xr
-    >>> from sbrdf_xr.invert._spin_data import band_factors
+    >>> from sbrdf_xr.invert._spin.data import band_factors
     >>> lc = xr.Dataset({"magnitude": ("obs", [9.0, 8.6, 8.3]),
     ...                  "uncertainty": ("obs", [0.02] * 3)},
     ...                 coords={"band": ("obs", ["V", "R", "I"])},
@@ -171,7 +172,7 @@ def band_factors(
         return ones, "a free flux scale per band"
     if "magnitude" not in light_curve or "flux" in light_curve:
         return ones, "one flux scale for every band; fluxes proportional to the band signal"
-    from ..photometry import MAGNITUDE_SYSTEMS, sun_magnitudes
+    from ...photometry import MAGNITUDE_SYSTEMS, sun_magnitudes
 
     system = str(
         light_curve.attrs.get(
@@ -195,7 +196,7 @@ def band_factors(
     )
 
 
-def _rows(bad: np.ndarray) -> str:
+def row_list(bad: np.ndarray) -> str:
     idx = np.flatnonzero(bad)
     head = ", ".join(str(i) for i in idx[:5])
     return head + (f", ... ({idx.size} in all)" if idx.size > 5 else "")
@@ -236,11 +237,11 @@ class SpinGeometry:
     notes: tuple[str, ...] = ()
 
 
-def _seconds(t: np.ndarray, epoch: np.datetime64) -> np.ndarray:
+def seconds_since(t: np.ndarray, epoch: np.datetime64) -> np.ndarray:
     return np.asarray((t - epoch) / np.timedelta64(1, "ns"), dtype=np.float64) * 1e-9
 
 
-def _measured_utc(t: np.ndarray, start: np.datetime64, what: str) -> tuple[np.ndarray, str]:
+def measured_utc(t: np.ndarray, start: np.datetime64, what: str) -> tuple[np.ndarray, str]:
     """Measured times as UTC: as given, or seconds counted from the geometry's first time."""
     if np.issubdtype(t.dtype, np.datetime64):
         return t.astype(_NS), "UTC times"
@@ -248,7 +249,7 @@ def _measured_utc(t: np.ndarray, start: np.datetime64, what: str) -> tuple[np.nd
     return start + off, f"light-curve seconds counted from the first time of the {what}"
 
 
-def _check_window(t: np.ndarray, lo: np.datetime64, hi: np.datetime64, what: str) -> None:
+def check_window(t: np.ndarray, lo: np.datetime64, hi: np.datetime64, what: str) -> None:
     out = (t < lo) | (t > hi)
     if out.any():
         raise InversionError(
@@ -269,8 +270,8 @@ def spin_geometry(
     linearly to the measured times; or ``to_sun``, ``to_observer`` give inertial vectors
     directly (one, or one per distinct time).
     """
-    from ..geometry import rotation_matrices
-    from ..observing import Inertial, Observation
+    from ...geometry import rotation_matrices
+    from ...observing import Inertial, Observation
 
     if geometry is not None and (to_sun is not None or to_observer is not None):
         raise InversionError(
@@ -285,7 +286,7 @@ def spin_geometry(
                 "inertial to_sun and to_observer directions"
             )
         epoch = times[0] if np.issubdtype(times.dtype, np.datetime64) else None
-        secs = _seconds(times, epoch) if epoch is not None else times.astype(np.float64)
+        secs = seconds_since(times, epoch) if epoch is not None else times.astype(np.float64)
         uniq, idx = np.unique(secs, return_inverse=True)
         return SpinGeometry(
             uniq,
@@ -299,8 +300,8 @@ def spin_geometry(
         )
     if isinstance(geometry, Observation):
         epoch = geometry.times[0].astype(_NS)
-        utc, how = _measured_utc(times, epoch, "observation")
-        _check_window(utc, geometry.times[0], geometry.times[-1], "observation window")
+        utc, how = measured_utc(times, epoch, "observation")
+        check_window(utc, geometry.times[0], geometry.times[-1], "observation window")
         uniq = np.unique(utc)
         g = dataclasses.replace(geometry, times=uniq, attitude=Inertial((0.0, 0.0, 0.0, 1.0)))
         geo = g.geometry(on_unobservable="keep")
@@ -318,15 +319,15 @@ def spin_geometry(
         if not np.issubdtype(gt.dtype, np.datetime64):
             raise InversionError(f"geometry: time must be UTC datetime64, got {gt.dtype}")
         epoch = gt[0].astype(_NS)
-        utc, how = _measured_utc(times, epoch, "cube")
-        _check_window(utc, gt[0], gt[-1], "cube's time span")
+        utc, how = measured_utc(times, epoch, "cube")
+        check_window(utc, gt[0], gt[-1], "cube's time span")
         uniq = np.unique(utc)
         q = geometry["quaternion"].transpose("time", ...).values
         if "component" in geometry["quaternion"].dims and "component" in geometry.coords:
             order = [list(geometry["component"].values).index(c) for c in "xyzw"]
             q = q[:, order]
         rot = rotation_matrices(q)
-        x, xi = _seconds(gt, epoch), _seconds(uniq, epoch)
+        x, xi = seconds_since(gt, epoch), seconds_since(uniq, epoch)
 
         def inertial(name: str) -> np.ndarray:
             v = np.einsum("nij,nj->ni", rot, geometry[name].transpose("time", ...).values)
@@ -348,8 +349,8 @@ def spin_geometry(
             "geometry: expected an sbrdf_xr.observing.Observation or a Dataset over time, got "
             f"{type(geometry).__name__}"
         )
-    secs = _seconds(utc, epoch)
-    uniq_s = _seconds(uniq, epoch)
+    secs = seconds_since(utc, epoch)
+    uniq_s = seconds_since(uniq, epoch)
     idx = np.searchsorted(uniq_s, secs)
     r_ref = float(np.median(rng))
     if not np.all(np.isfinite(rng) & (rng > 0)):
