@@ -12,11 +12,10 @@ import numpy as np
 import xarray as xr
 
 from .._names import BAND, attrs
+from . import _terms as terms
 from ._alignment import Alignment
 
-
-def _plain(units: str, long_name: str) -> dict[str, str]:
-    return {"units": units, "long_name": long_name}
+_plain = terms.plain
 
 
 def report(
@@ -46,10 +45,10 @@ def report(
     grid: Any,
     system: str,
 ) -> xr.Dataset:
-    """The result Dataset of a comparison."""
+    """The result Dataset of a comparison: the observations, the fitted terms per band, the
+    parameters and their covariance, extinction, colours, the shift and the model curve."""
     resid = np.where(use, m - model, np.nan)
-    n_par = len(names)
-    dof = int(use.sum()) - n_par
+    dof = int(use.sum()) - len(names)
     present = [b for b in range(len(labels)) if np.any(col[use] == b)]
     blabels = [labels[b] for b in present]
     sd = np.sqrt(np.diag(cov))
@@ -63,130 +62,21 @@ def report(
     for b in present:
         sel = use & (col == b)
         mean_res.append(float(np.sum(w[sel] * resid[sel]) / np.sum(w[sel])))
-    data: dict[str, Any] = {
-        "measured_magnitude": ("obs", m, attrs("magnitude", long_name="measured magnitude")),
-        "uncertainty": ("obs", sig, attrs("magnitude_uncertainty")),
-        "simulated_magnitude": (
-            "obs",
-            s,
-            attrs(
-                "magnitude",
-                long_name="simulated magnitude at the aligned time or angle, before "
-                "the fitted terms (+inf: no light reflected)",
-            ),
-        ),
-        "model_magnitude": (
-            "obs",
-            model,
-            attrs("magnitude", long_name="simulated magnitude with the fitted and fixed terms"),
-        ),
-        "residual": (
-            "obs",
-            resid,
-            attrs("magnitude", long_name="measured minus model magnitude (NaN: excluded)"),
-        ),
-        "normalized_residual": ("obs", resid / sig, _plain("1", "residual / uncertainty")),
-        "excluded": ("obs", ~use, _plain("1", "excluded: the model reflects no light there")),
-        "zero_point": (
-            BAND,
-            [z[0] for z in zp],
-            attrs(
-                "magnitude",
-                long_name="fitted zero point, measured minus simulated magnitude"
-                + (" (one common to every band)" if zero_points == "common" else ""),
-            ),
-        ),
-        "zero_point_uncertainty": (
-            BAND,
-            [z[1] for z in zp],
-            attrs("magnitude", long_name="1-sigma uncertainty of the zero point"),
-        ),
-        "n_observations": (
-            BAND,
-            [int(np.sum(use & (col == b))) for b in present],
-            _plain("1", "observations used in the band"),
-        ),
-        "band_mean_residual": (
-            BAND,
-            mean_res,
-            attrs("magnitude", long_name="weighted mean residual in the band after the fit"),
-        ),
-        "estimate": (
-            "parameter",
-            est,
-            _plain(
-                "1",
-                "fitted parameter (zero points and k [mag], time_shift [s], phase_offset [degree])",
-            ),
-        ),
-        "standard_error": ("parameter", sd, _plain("1", "1-sigma uncertainty of the parameter")),
-        "covariance": (
-            ("parameter", "parameter_b"),
-            cov,
-            _plain("1", "covariance of the parameters (Gauss-Newton, stated uncertainties)"),
-        ),
-        "chi_square": ((), fit.chi2, _plain("1", "chi-square of the fit")),
-        "degrees_of_freedom": ((), dof, _plain("1", "observations used minus parameters")),
-        "reduced_chi_square": ((), fit.chi2 / dof, _plain("1", "chi-square per degree of freedom")),
-        "n_excluded": (
-            (),
-            int((~use).sum()),
-            _plain("1", "observations where the model reflects no light (excluded)"),
-        ),
-    }
+    data = terms.observation_terms(m, sig, s, model, resid, use)
+    data.update(terms.band_terms(zp, zero_points, col, use, present, mean_res))
+    data.update(terms.parameter_terms(est, sd, cov, fit.chi2, dof, use))
     if fit_k or fixed_k is not None:
         if fit_k:
             kk = [param(f"k_{labels[b]}") for b in present]
         else:
             given = np.zeros(col.size) if fixed_k is None else fixed_k
             kk = [(float(given[np.flatnonzero(col == b)[0]]), 0.0) for b in present]
-        data["extinction_coefficient"] = (
-            BAND,
-            [k[0] for k in kk],
-            attrs(
-                "magnitude",
-                long_name=("fitted" if fit_k else "given")
-                + " first-order extinction coefficient k (mag per airmass)",
-            ),
-        )
-        data["extinction_coefficient_uncertainty"] = (
-            BAND,
-            [k[1] for k in kk],
-            attrs("magnitude", long_name="1-sigma uncertainty of k (0: given, not fitted)"),
-        )
-        if xa is not None:
-            data["airmass"] = ("obs", xa, attrs("airmass"))
+        data.update(terms.extinction_terms(kk, fit_k, xa))
     if zero_points == "common":
-        data["magnitude_offset"] = (
-            (),
-            zp[0][0],
-            attrs("magnitude", long_name="fitted common magnitude offset (measured - simulated)"),
-        )
-        data["magnitude_offset_uncertainty"] = (
-            (),
-            zp[0][1],
-            attrs("magnitude", long_name="1-sigma uncertainty of the magnitude offset"),
-        )
+        data.update(terms.offset_terms(zp[0]))
     colours = [f"{a}-{b}" for a, b in pairwise(blabels)]
-    ci, ci_sd = [], []
-    for i in range(len(colours)):
-        ci.append((zp[i][0] + mean_res[i]) - (zp[i + 1][0] + mean_res[i + 1]))
-        if zero_points == "band":
-            ja, jb = names.index(f"ZP_{blabels[i]}"), names.index(f"ZP_{blabels[i + 1]}")
-            ci_sd.append(float(np.sqrt(cov[ja, ja] + cov[jb, jb] - 2 * cov[ja, jb])))
-        else:
-            wa = np.sum(w[use & (col == present[i])])
-            wb = np.sum(w[use & (col == present[i + 1])])
-            ci_sd.append(float(np.sqrt(1 / wa + 1 / wb)))
-    data["colour_index_difference"] = (
-        "colour",
-        ci,
-        attrs("colour_index", long_name="measured minus simulated colour index"),
-    )
-    data["colour_index_difference_uncertainty"] = (
-        "colour",
-        ci_sd,
-        attrs("colour_index", long_name="1-sigma uncertainty of the colour index difference"),
+    data.update(
+        terms.colour_terms(zp, mean_res, blabels, present, names, cov, w, use, col, zero_points)
     )
     coords: dict[str, Any] = {
         ("obs_band" if k == BAND else str(k)): v
@@ -204,7 +94,23 @@ def report(
     _shift_terms(data, coords, al, x, names, sd, fit_x, scan, grid, fit.chi2)
     _curve(data, coords, al, sim, present, blabels, x, est, names, zero_points, fit_k, fixed_k, col)
     ds = xr.Dataset(data, coords=coords)
-    ds.attrs = {
+    ds.attrs = _attributes(al, zero_points, fit_k, fixed_k, fit_x, system)
+    if (~use).any():
+        rows = measured["file_row"].values if "file_row" in measured.coords else np.arange(m.size)
+        ds.attrs["excluded_rows"] = " ".join(str(int(r)) for r in rows[~use])
+    return ds
+
+
+def _attributes(
+    al: Alignment,
+    zero_points: str,
+    fit_k: bool,
+    fixed_k: np.ndarray | None,
+    fit_x: bool,
+    system: str,
+) -> dict[str, Any]:
+    """The comparison's attributes: its mode, the model written out, what was fitted."""
+    return {
         "title": "comparison of a measured and a simulated light curve",
         "mode": al.mode,
         "model": "m_obs = m_sim("
@@ -220,10 +126,6 @@ def report(
         "fit_phase": int(fit_x and al.mode != "observation"),
         **{k: v for k, v in al.notes.items() if k != "extinction"},
     }
-    if (~use).any():
-        rows = measured["file_row"].values if "file_row" in measured.coords else np.arange(m.size)
-        ds.attrs["excluded_rows"] = " ".join(str(int(r)) for r in rows[~use])
-    return ds
 
 
 def _shift_terms(

@@ -24,8 +24,8 @@ from .._names import BAND, attrs
 from ..errors import LightCurveError, ValidationError, input_file, reading
 from ..photometry import MAGNITUDE_SYSTEMS, check_system
 from . import _curve_forms as forms
+from . import _rows as rows
 from ._table_io import TABLE_FORMATS, in_unit, read_table
-from .filter_names import band_label
 
 __all__ = [
     "LIGHT_CURVE_ABSCISSAE",
@@ -159,279 +159,42 @@ def _build(
     time_scale: str | None,
     band_map: Mapping[str, str] | None,
 ) -> xr.Dataset:
-    import pandas as pd
-
-    def row_name(k: int) -> str:
-        text = where.format(k + 1, k + 1 + offset) if offset else where.format(k + 1)
-        return f"{path}: {text}"
-
+    """The light curve of a parsed table: its band columns, their values, the abscissa,
+    the magnitude system and the optional columns, in the order of the abscissa."""
+    t = rows.Table(path, df, units, meta, where, offset, bands, band_map)
     if len(df) == 0:
         raise LightCurveError(f"{path}: no observations")
-    cols = [str(c) for c in df.columns]
-    roles = forms.resolve_roles(cols, str(path))
-    absc = [r for r in LIGHT_CURVE_ABSCISSAE if r in roles]
-    if len(absc) != 1:
-        raise LightCurveError(
-            f"{path}: need exactly one column of time (time, jd or mjd, with UTC) or "
-            f"rotation_angle, found {[roles[r] for r in absc] or 'none'} among its "
-            f"{len(cols)} columns"
-        )
-    xrole = absc[0]
-
-    def numeric(values: Any, col: str, rows: np.ndarray, allow_empty: bool = False) -> Any:
-        raw = pd.Series(values).reset_index(drop=True)
-        text = raw.astype(str).str.strip() if raw.dtype == object else raw
-        v = pd.to_numeric(text, errors="coerce").to_numpy(dtype=np.float64)
-        bad = np.flatnonzero(~np.isfinite(v))
-        if allow_empty:
-            empty = raw.isna().to_numpy() | (
-                raw.astype(str).str.strip().isin(["", "nan", "NaN", "--"]).to_numpy()
-            )
-            bad = np.flatnonzero(~np.isfinite(v) & ~empty)
-        if bad.size:
-            val = raw.iloc[bad[0]]
-            val = val.item() if hasattr(val, "item") else val
-            try:  # a number (NaN, inf) is shown; text is not (the file's contents)
-                float(val)
-                shown = f"value {val!r} is not a finite number"
-            except (TypeError, ValueError):
-                shown = f"holds text of {len(str(val))} characters, not a number"
-            raise LightCurveError(f"{row_name(int(rows[bad[0]]))}, column {col!r}: {shown}")
-        return v
-
-    all_rows = np.arange(len(df))
-    parts: list[dict[str, Any]] = []  # per band column (wide) or the whole table (long)
-    if "band" in roles:
-        form = "long"
-        kind = "flux" if "flux" in roles and "magnitude" not in roles else "mag"
-        vcol = (
-            roles["flux" if kind == "flux" else "magnitude"]
-            if kind == "flux"
-            else (roles.get("magnitude"))
-        )
-        ecol = roles.get("flux_uncertainty" if kind == "flux" else "uncertainty")
-        missing = [n for n, c in (("magnitude (or flux)", vcol), ("uncertainty", ecol)) if not c]
-        if missing:
-            raise LightCurveError(
-                f"{path}: missing column(s) {missing}; a long table needs band, magnitude "
-                f"(or flux), uncertainty and a time; found {cols}"
-            )
-        written = [str(b).strip() for b in df[roles["band"]].tolist()]
-        parts.append(
-            dict(
-                rows=all_rows,
-                written=written,
-                value=df[vcol],
-                err=df[ecol],
-                kind=kind,
-                vcol=vcol,
-                ecol=ecol,
-                empty=False,
-            )
-        )
-    else:
-        form = "wide"
-        taken = set(roles.values())
-
-        def is_band(b: str) -> bool:
-            try:
-                band_label(b, band_map=band_map, bands=bands)
-            except LightCurveError:
-                return False
-            return True
-
-        found, _unused = forms.wide_columns([c for c in cols if c not in taken], is_band, str(path))
-        if not found:
-            raise LightCurveError(
-                f"{path}: no band column: a long table needs a band column (band or filter) "
-                "with magnitude and uncertainty; a wide one a column per band and its "
-                f"uncertainty (V, V_err); found {cols}"
-            )
-        for b, vcol, ecol, kind in found:
-            parts.append(
-                dict(
-                    rows=all_rows,
-                    written=[b] * len(df),
-                    value=df[vcol],
-                    err=df[ecol],
-                    kind=kind,
-                    vcol=vcol,
-                    ecol=ecol,
-                    empty=True,
-                )
-            )
-    labels: dict[str, str] = {}
-    rows_l, band_l, written_l, mag_l, unc_l = [], [], [], [], []
-    flux_note = ""
-    for part in parts:
-        v = numeric(part["value"], part["vcol"], part["rows"], part["empty"])
-        keep = np.isfinite(v)
-        e = numeric(part["err"], part["ecol"], part["rows"], part["empty"])
-        lost = np.flatnonzero(keep & ~np.isfinite(e))
-        if lost.size:
-            raise LightCurveError(
-                f"{row_name(int(part['rows'][lost[0]]))}, column {part['ecol']!r}: no "
-                f"uncertainty for the value {v[lost[0]]:g} of column {part['vcol']!r}"
-            )
-        rows = part["rows"][keep]
-        written = [w for w, k in zip(part["written"], keep, strict=True) if k]
-        for w, r in zip(written, rows, strict=True):
-            if w not in labels:
-                try:
-                    labels[w] = band_label(w, band_map=band_map, bands=bands)
-                except LightCurveError as exc:
-                    col = roles.get("band", part["vcol"])
-                    raise LightCurveError(f"{row_name(int(r))}, column {col!r}: {exc}") from None
-        lab = [labels[w] for w in written]
-        v, e = v[keep], e[keep]
-        if part["kind"] == "flux":
-            unit = units.get(part["vcol"]) or meta.get("flux_unit")
-            eunit = units.get(part["ecol"]) or unit
-            if eunit is not None and unit is not None and eunit != unit:
-                e = in_unit(path, part["ecol"], e, eunit, str(unit))
-            v, e, flux_note = forms.flux_magnitudes(
-                v, e, unit, _pivots(lab, bands), f"{path}: column {part['vcol']!r}"
-            )
-        else:
-            v = in_unit(path, part["vcol"], v, units.get(part["vcol"]), "mag")
-            e = in_unit(path, part["ecol"], e, units.get(part["ecol"]), "mag")
-        rows_l.append(rows)
-        band_l += lab
-        written_l += written
-        mag_l.append(v)
-        unc_l.append(e)
-    rows_all = np.concatenate(rows_l)
-    mag, unc = np.concatenate(mag_l), np.concatenate(unc_l)
-    if not mag.size:
-        raise LightCurveError(f"{path}: no observations (every band cell is empty)")
-    bad = np.flatnonzero(unc < MIN_UNCERTAINTY)
-    if bad.size:
-        k = int(bad[0])
-        rule = (
-            "must be > 0"
-            if unc[k] <= 0
-            else f"must be >= {MIN_UNCERTAINTY:g} mag (no photometry is that precise)"
-        )
-        raise LightCurveError(
-            f"{row_name(int(rows_all[k]))}, column 'uncertainty': {rule}, got {unc[k]:g}"
-        )
-    scale = time_scale if time_scale is not None else meta.get("time_scale", meta.get("timesys"))
-    if scale is not None:
-        scale = str(scale).strip().lower()
-        if scale not in forms.TIME_SCALES:
-            raise LightCurveError(
-                f"time_scale: got {scale!r}; allowed: {', '.join(forms.TIME_SCALES)} "
-                "(UT1 needs Earth-rotation tables: convert to UTC first)"
-            )
-    xcol = roles[xrole]
-    xraw = df[xcol].to_numpy()[rows_all]
-    x_attrs: dict[str, Any]
-    time_source = ""
-    if xrole == "rotation_angle":
-        x = in_unit(path, xcol, numeric(xraw, xcol, rows_all), units.get(xcol), "deg")
-        x_attrs, xname = attrs("rotation_angle"), "rotation_angle"
-    else:
-        xname = "time"
-        as_num = pd.to_numeric(pd.Series(xraw).astype(str).str.strip(), errors="coerce")
-        if xrole == "time" and units.get(xcol) != "utc" and as_num.notna().all():
-            x = as_num.to_numpy(dtype=np.float64)
-            x = in_unit(path, xcol, x, units.get(xcol), "s")
-            x_attrs = attrs(
-                "time_since_first",
-                long_name="observation time",
-                time_origin="as in the file (numeric seconds are kept unchanged)",
-            )
-            time_source = f"numbers of seconds (column {xcol})"
-        else:
-            own = forms.jd_scale(xcol) if xrole != "time" else None
-            x, time_source = forms.utc_times(
-                xraw,
-                xrole,
-                xcol,
-                units.get(xcol),
-                own or scale,
-                lambda k: row_name(int(rows_all[k])),
-            )
-            x_attrs = attrs("time", standard_name="time")
+    t.roles = forms.resolve_roles([str(c) for c in df.columns], str(path))
+    xrole = rows.abscissa_role(t, LIGHT_CURVE_ABSCISSAE)
+    form, parts = rows.band_parts(t)
+    values = rows.band_values(t, parts)
+    _check_uncertainties(t, values)
+    scale = rows.time_scale_of(time_scale, meta)
+    xname, x, x_attrs, time_source = rows.abscissa(t, xrole, values.rows, scale)
     key = x if x.dtype.kind != "M" else (x - x.min()) / np.timedelta64(1, "s")
-    order = np.lexsort((rows_all, key))
-    sorted_already = bool(np.all(order == np.arange(order.size)))
-    stated = _stated_system(path, df, meta, row_name, roles.get("system"))
-    if flux_note:
-        if stated not in (None, "AB") or (system is not None and check_system(system) != "AB"):
-            raise LightCurveError(
-                f"{path}: fluxes give AB magnitudes, but the table or the argument states "
-                f"{stated or system}; give magnitudes in that system instead"
-            )
-        stated = "AB"
-    if system is not None:
-        system = check_system(system)
-        if stated is not None and stated != system:
-            raise LightCurveError(
-                f"{path}: the table states the {stated} system, not system={system!r}"
-            )
-    mag_system = stated or system or "unstated"
-    data: dict[str, Any] = {
-        "magnitude": (
-            "obs",
-            mag[order],
-            attrs(
-                "magnitude",
-                long_name="measured magnitude",
-                magnitude_system=mag_system,
-                ancillary_variables="uncertainty",
-            ),
-        ),
-        "uncertainty": (
-            "obs",
-            unc[order],
-            attrs("magnitude_uncertainty", magnitude_system=mag_system),
-        ),
-    }
-    for name, (unit, akey) in LIGHT_CURVE_OPTIONAL.items():
-        col = roles.get(name) or (roles.get("range") if name == "range_km" else None)
-        if col is None:
-            continue
-        if name == "range_km" and col == roles.get("range") and units.get(col) is None:
-            raise LightCurveError(
-                f"{path}: column 'range' has no length unit; give one (e.g. km) or name "
-                "the column 'range_km'"
-            )
-        v = numeric(df[col].to_numpy()[rows_all], col, rows_all)
-        v = in_unit(path, col, v, units.get(col), unit)
-        ok = (
-            (v > 0)
-            if name == "range_km"
-            else (v >= 1.0)
-            if name == "airmass"
-            else ((v >= 0) & (v <= 180))
-        )
-        bad = np.flatnonzero(~ok)
-        if bad.size:
-            k = int(bad[0])
-            rules = {"range_km": "> 0 km", "airmass": ">= 1", "phase_angle": "in [0, 180] degree"}
-            raise LightCurveError(
-                f"{row_name(int(rows_all[k]))}, column {col!r}: must be {rules[name]}, got {v[k]:g}"
-            )
-        data[name] = ("obs", v[order], attrs(akey))
+    order = np.lexsort((values.rows, key))
+    mag_system = _magnitude_system(t, system, values.flux_note)
+    data = _observations(values, order, mag_system)
+    data.update(_optional_columns(t, values.rows, order))
     ds = xr.Dataset(
         data,
         coords={
-            "obs": ("obs", np.arange(mag.size), attrs("obs")),
-            BAND: ("obs", np.array(band_l, dtype=object)[order].astype(str), attrs(BAND)),
+            "obs": ("obs", np.arange(values.magnitude.size), attrs("obs")),
+            BAND: ("obs", np.array(values.bands, dtype=object)[order].astype(str), attrs(BAND)),
             "filter_as_written": (
                 "obs",
-                np.array(written_l, dtype=object)[order].astype(str),
+                np.array(values.written, dtype=object)[order].astype(str),
                 {"long_name": "filter name as written in the file"},
             ),
             "file_row": (
                 "obs",
-                rows_all[order] + 1,
+                values.rows[order] + 1,
                 {"units": "1", "long_name": f"row in {path.name}"},
             ),
             xname: ("obs", x[order], x_attrs),
         },
     )
+    sorted_already = bool(np.all(order == np.arange(order.size)))
     ds.attrs = {
         "source_file": str(path),
         "abscissa": xname,
@@ -446,22 +209,99 @@ def _build(
     }
     if time_source:
         ds.attrs["time_source"] = time_source
-    if flux_note:
-        ds.attrs["flux_conversion"] = flux_note
+    if values.flux_note:
+        ds.attrs["flux_conversion"] = values.flux_note
     return ds
 
 
-def _pivots(labels: list[str], bands: Sequence[str] | None) -> np.ndarray:
-    """Pivot wavelengths [nm] of the bands, ``sqrt(int T l dl / int T / l dl)``."""
-    from ..photometry import filters
+def _check_uncertainties(t: rows.Table, values: rows.Values) -> None:
+    """Uncertainties of at least :data:`MIN_UNCERTAINTY` [mag], or the first row named."""
+    unc = values.uncertainty
+    bad = np.flatnonzero(unc < MIN_UNCERTAINTY)
+    if bad.size:
+        k = int(bad[0])
+        rule = (
+            "must be > 0"
+            if unc[k] <= 0
+            else f"must be >= {MIN_UNCERTAINTY:g} mag (no photometry is that precise)"
+        )
+        raise LightCurveError(
+            f"{t.row_name(int(values.rows[k]))}, column 'uncertainty': {rule}, got {unc[k]:g}"
+        )
 
-    f = filters(sorted(set(labels)))
-    wl = f["wavelength"].values
-    piv = {}
-    for b in f[BAND].values:
-        t = f.sel({BAND: b}).values
-        piv[str(b)] = float(np.sqrt(np.trapezoid(t * wl, wl) / np.trapezoid(t / wl, wl)))
-    return np.array([piv[b] for b in labels])
+
+def _magnitude_system(t: rows.Table, system: str | None, flux_note: str) -> str:
+    """The system the table states (AB for fluxes), checked against ``system=``."""
+    stated = _stated_system(t.path, t.df, t.meta, t.row_name, t.roles.get("system"))
+    if flux_note:
+        if stated not in (None, "AB") or (system is not None and check_system(system) != "AB"):
+            raise LightCurveError(
+                f"{t.path}: fluxes give AB magnitudes, but the table or the argument states "
+                f"{stated or system}; give magnitudes in that system instead"
+            )
+        stated = "AB"
+    if system is not None:
+        system = check_system(system)
+        if stated is not None and stated != system:
+            raise LightCurveError(
+                f"{t.path}: the table states the {stated} system, not system={system!r}"
+            )
+    return stated or system or "unstated"
+
+
+def _observations(values: rows.Values, order: np.ndarray, mag_system: str) -> dict[str, Any]:
+    """The ``magnitude`` and ``uncertainty`` variables, in the order of the abscissa."""
+    return {
+        "magnitude": (
+            "obs",
+            values.magnitude[order],
+            attrs(
+                "magnitude",
+                long_name="measured magnitude",
+                magnitude_system=mag_system,
+                ancillary_variables="uncertainty",
+            ),
+        ),
+        "uncertainty": (
+            "obs",
+            values.uncertainty[order],
+            attrs("magnitude_uncertainty", magnitude_system=mag_system),
+        ),
+    }
+
+
+def _optional_columns(t: rows.Table, rows_all: np.ndarray, order: np.ndarray) -> dict[str, Any]:
+    """The optional per-row columns (:data:`LIGHT_CURVE_OPTIONAL`) present, checked."""
+    data: dict[str, Any] = {}
+    roles, units = t.roles, t.units
+    for name, (unit, akey) in LIGHT_CURVE_OPTIONAL.items():
+        col = roles.get(name) or (roles.get("range") if name == "range_km" else None)
+        if col is None:
+            continue
+        if name == "range_km" and col == roles.get("range") and units.get(col) is None:
+            raise LightCurveError(
+                f"{t.path}: column 'range' has no length unit; give one (e.g. km) or name "
+                "the column 'range_km'"
+            )
+        v = t.numeric(t.df[col].to_numpy()[rows_all], col, rows_all)
+        v = in_unit(t.path, col, v, units.get(col), unit)
+        ok = (
+            (v > 0)
+            if name == "range_km"
+            else (v >= 1.0)
+            if name == "airmass"
+            else ((v >= 0) & (v <= 180))
+        )
+        bad = np.flatnonzero(~ok)
+        if bad.size:
+            k = int(bad[0])
+            rules = {"range_km": "> 0 km", "airmass": ">= 1", "phase_angle": "in [0, 180] degree"}
+            raise LightCurveError(
+                f"{t.row_name(int(rows_all[k]))}, column {col!r}: must be {rules[name]}, "
+                f"got {v[k]:g}"
+            )
+        data[name] = ("obs", v[order], attrs(akey))
+    return data
 
 
 def _stated_system(

@@ -11,6 +11,7 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -344,22 +345,13 @@ def fit_observation(
     ([0.82, 0.18], 'consistent')
     """
     t_start = time.perf_counter()
-    if method not in ("point", "posterior"):
-        raise InversionError(
-            f"method: {method!r}; allowed 'point' (least squares, uncertainties from the "
-            "Jacobian) or 'posterior' (emcee from every minimum)"
-        )
+    _check_method(method)
     start, epoch = _read_start(spin)
     ab = _axis_body(spin, axis_body)
     data = pass_data(light_curve, observation, bands, system)
-    k_mode = _options(extinction, offset, areas, data.labels)
-    k_prior = _k_prior(extinction_prior, data.labels)
-    k_sep = separable_sd(data.airmass, data.sigma, data.band, len(data.labels))
-    held = None
-    if isinstance(k_mode, str) and bool(np.any(k_sep > k_prior[1])):
-        k_mode, held = k_prior[0], held_note(data, k_sep, k_prior, offset, areas)
-        if offset is None and areas != "free":
-            offset = "band"  # k Xbar over the pass is a zero point: fitted as one
+    k_mode, k_prior, held, offset = _extinction_mode(
+        data, extinction, offset, areas, extinction_prior
+    )
     model = PassModel(data, spacecraft, ab, materials)
     terms = model.kernel.plan.terms
     syms = body_symmetries(terms.normal, terms.area, terms.material, ab, symmetry_tolerance)
@@ -369,31 +361,124 @@ def fit_observation(
         model.terms(vec(start["axis_longitude"], start["axis_latitude"]), start["period"], 0.0)
         check_budget(posterior_walkers, posterior_steps, 1, time.perf_counter() - t0)
     area_of = material_areas(spacecraft)
-    a_model = np.array([area_of.get(m, 0.0) for m in names])
-    if epoch is None:
-        epoch = data.epoch
     lay = Layout(
         data.labels,
         names,
-        a_model,
+        np.array([area_of.get(m, 0.0) for m in names]),
         k_mode,
         offset,
         areas,
         None if held is None else k_prior[1],
         table_widths(material_scale, names, model.kernel.sources),
     )
-    if method == "posterior" and isinstance(posterior_walkers, int):
-        if posterior_walkers < 2 * lay.n:
-            raise InversionError(
-                f"posterior: {posterior_walkers} walkers for {lay.n} parameters; allowed at "
-                f"least 2 x {lay.n} = {2 * lay.n} (emcee's affine-invariant moves need them)"
+    _check_counts(method, posterior_walkers, data, lay)
+    if epoch is None:
+        epoch = data.epoch
+    dt_epoch, local, best, unbounded = _minimise(model, lay, data, spin, start, starts, epoch)
+    p = local[best].x
+    stats = _statistics(model, lay, data, local[best], unbounded, scale_uncertainties, held)
+    fit_s = time.perf_counter() - t_start
+    ds = result_dataset(
+        lay=lay,
+        data=data,
+        light_curve=light_curve,
+        p=p,
+        cov=stats.cov,
+        free=stats.free,
+        axis_of=local[best].axis_of,
+        t_ref=model.t_ref,
+        dt_epoch=dt_epoch,
+        epoch=epoch,
+        residual=stats.r * data.sigma,
+        chi2=stats.chi2,
+        dof=stats.dof,
+        quality=stats.quality,
+        attrs={
+            "axis_body": str(ab.tolist()),
+            "start": ", ".join(f"{k} {v:.6g}" for k, v in start.items()),
+            "uncertainty_scaling": (
+                "scaled by the reduced chi-square" if scale_uncertainties else "unscaled"
             )
+            + ": covariance (J^T J)^-1 of the normalised residuals, J by central differences "
+            "at the solution",
+            "optimizer": f"scipy least_squares ({'trf, bounded' if local[best].bounded else 'lm'})"
+            f": {local[best].res.message} ({local[best].res.nfev} evaluations)",
+            **stats.status,
+            "likely_causes": "residual patterns, (delta chi2 - k) / sqrt(2 k), about 0 +- 1 "
+            "for noise: " + ", ".join(f"{k} {v:.3g}" for k, v in stats.ranked),
+            "n_model_evaluations": int(model.n_calls),
+            "fit_seconds": fit_s,  # the fit, without the check
+            "time_source": data.time_source,
+        },
+    )
+    ds = _with_warnings_and_twins(ds, stats, local, best, model, lay, syms, dt_epoch)
+    if method == "posterior":
+        ds = with_posterior(
+            ds, lay, local, best, model, dt_epoch, fit_s, posterior_walkers, posterior_steps, seed
+        )
+    if check:
+        t0 = time.perf_counter()
+        ds.attrs["model_check"] = model_check(
+            ds, observation, spacecraft, materials, ab, data, lay, p
+        )
+        ds.attrs["check_seconds"] = time.perf_counter() - t0
+    return ds
+
+
+def _check_method(method: str) -> None:
+    if method not in ("point", "posterior"):
+        raise InversionError(
+            f"method: {method!r}; allowed 'point' (least squares, uncertainties from the "
+            "Jacobian) or 'posterior' (emcee from every minimum)"
+        )
+
+
+def _extinction_mode(
+    data: Any,
+    extinction: Any,
+    offset: str | None,
+    areas: str,
+    extinction_prior: Mapping[str, Any] | None,
+) -> tuple[Any, Any, str | None, str | None]:
+    """How extinction enters (fitted, given or held at its prior), the prior, the note
+    when it is held (a pass too short to separate it from a zero point), the offset."""
+    k_mode = _options(extinction, offset, areas, data.labels)
+    k_prior = _k_prior(extinction_prior, data.labels)
+    k_sep = separable_sd(data.airmass, data.sigma, data.band, len(data.labels))
+    held = None
+    if isinstance(k_mode, str) and bool(np.any(k_sep > k_prior[1])):
+        k_mode, held = k_prior[0], held_note(data, k_sep, k_prior, offset, areas)
+        if offset is None and areas != "free":
+            offset = "band"  # k Xbar over the pass is a zero point: fitted as one
+    return k_mode, k_prior, held, offset
+
+
+def _check_counts(method: str, walkers: Any, data: Any, lay: Layout) -> None:
+    """Enough walkers for the posterior and more values than parameters."""
+    if method == "posterior" and isinstance(walkers, int) and walkers < 2 * lay.n:
+        raise InversionError(
+            f"posterior: {walkers} walkers for {lay.n} parameters; allowed at "
+            f"least 2 x {lay.n} = {2 * lay.n} (emcee's affine-invariant moves need them)"
+        )
     if data.magnitude.size <= lay.n - lay.n_prior:
         raise InversionError(
             f"light curve: {data.magnitude.size} values for {lay.n} parameters "
             f"({', '.join(lay.names)}); need more values than parameters (fix some: "
             "extinction=None or a mapping, offset=None, areas='fixed')"
         )
+
+
+def _minimise(
+    model: PassModel,
+    lay: Layout,
+    data: Any,
+    spin: Any,
+    start: dict[str, float],
+    starts: Any,
+    epoch: Any,
+) -> tuple[float, list[Local], int, bool]:
+    """Refine from every start (inside the bounds where a minimum left physics); the
+    epoch [s from the data's], the minima, the best one, whether it was unbounded."""
 
     def seconds_of(t: Any) -> float:
         return float((t - data.epoch) / np.timedelta64(1, "ns")) * 1e-9
@@ -412,18 +497,43 @@ def fit_observation(
         if outside_physics(lay, local[i].x):
             local[i] = refine(model, lay, st, span, bounded=True)
     best = min(range(len(local)), key=lambda i: local[i].chi2)
-    res, axis_of, residuals = local[best].res, local[best].axis_of, local[best].residuals
     p = local[best].x
     if not p[2] > 0:
         raise InversionError(
             f"the fit ran to a period of {p[2]:.4g} s from {start['period']:.4g} s: start "
             "from a better spin state (fit_spin)"
         )
-    r_all = residuals(p)
+    return dt_epoch, local, best, unbounded
+
+
+@dataclass
+class _Statistics:
+    r: np.ndarray
+    chi2: float
+    dof: int
+    cov: np.ndarray
+    free: Any
+    ranked: Any
+    quality: Any
+    status: dict[str, Any]
+
+
+def _statistics(
+    model: PassModel,
+    lay: Layout,
+    data: Any,
+    solution: Local,
+    unbounded: bool,
+    scale_uncertainties: bool,
+    held: str | None,
+) -> _Statistics:
+    """Chi-square, degrees of freedom, covariance, the likely causes of a misfit, status."""
+    p = solution.x
+    r_all = solution.residuals(p)
     r = r_all[: data.magnitude.size]
     chi2 = float(r_all @ r_all)  # with the priors' terms, each a datum: dof counts them
     dof = data.magnitude.size + lay.n_prior - lay.n
-    jac = jacobian(residuals, p, lay.steps(p[2]))
+    jac = jacobian(solution.residuals, p, lay.steps(p[2]))
     cov, free = covariance(jac)
     if scale_uncertainties:
         cov = cov * chi2 / dof
@@ -435,74 +545,49 @@ def fit_observation(
         data.seconds[data.t_index],
     )
     quality = fit_quality(chi2, dof, "joint fit", causes(ranked))
-    status = status_attrs(lay, local[best], unbounded, free, quality, chi2 / dof)
+    status = status_attrs(lay, solution, unbounded, free, quality, chi2 / dof)
     if held is not None:
         status["unconstrained"] = ", ".join(
             [f"extinction_{b}" for b in lay.bands]
             + [n for n in [status["unconstrained"]] if n != "none"]
         )
         status["extinction_note"] = held
-    fit_s = time.perf_counter() - t_start
-    ds = result_dataset(
-        lay=lay,
-        data=data,
-        light_curve=light_curve,
-        p=p,
-        cov=cov,
-        free=free,
-        axis_of=axis_of,
-        t_ref=model.t_ref,
-        dt_epoch=dt_epoch,
-        epoch=epoch,
-        residual=r * data.sigma,
-        chi2=chi2,
-        dof=dof,
-        quality=quality,
-        attrs={
-            "axis_body": str(ab.tolist()),
-            "start": ", ".join(f"{k} {v:.6g}" for k, v in start.items()),
-            "uncertainty_scaling": (
-                "scaled by the reduced chi-square" if scale_uncertainties else "unscaled"
-            )
-            + ": covariance (J^T J)^-1 of the normalised residuals, J by central differences "
-            "at the solution",
-            "optimizer": f"scipy least_squares ({'trf, bounded' if local[best].bounded else 'lm'})"
-            f": {res.message} ({res.nfev} evaluations)",
-            **status,
-            "likely_causes": "residual patterns, (delta chi2 - k) / sqrt(2 k), about 0 +- 1 "
-            "for noise: " + ", ".join(f"{k} {v:.3g}" for k, v in ranked),
-            "n_model_evaluations": int(model.n_calls),
-            "fit_seconds": fit_s,  # the fit, without the check
-            "time_source": data.time_source,
-        },
-    )
+    return _Statistics(r, chi2, dof, cov, free, ranked, quality, status)
+
+
+def _with_warnings_and_twins(
+    ds: xr.Dataset,
+    stats: _Statistics,
+    local: list[Local],
+    best: int,
+    model: PassModel,
+    lay: Layout,
+    syms: Any,
+    dt_epoch: float,
+) -> xr.Dataset:
+    """The status checked against the covariance and warned; the other minima, the
+    ambiguity and the symmetry twins added."""
+    status = stats.status
     if ds.attrs["status"] == "ok" and bool(np.isnan(ds["uncertainty"].values).any()):
         ds.attrs["status"] = "failed"
         ds.attrs["status_note"] = f"the fit failed: its covariance is not finite. {RECOVER}"
         status["status_note"] = ds.attrs["status_note"]
     for key in ("status_note", "unconstrained_note", "extinction_note"):
         if key in status:
-            warnings.warn(f"joint fit: {status[key]}", FitQualityWarning, stacklevel=2)
+            warnings.warn(f"joint fit: {status[key]}", FitQualityWarning, stacklevel=3)
     ds = ds.merge(_minima(local, best, model.t_ref, dt_epoch))
     ds.attrs["ambiguity"] = _ambiguity(ds)
     if ds.attrs["ambiguity"] != "none":
-        warnings.warn(f"joint fit: {ds.attrs['ambiguity']}", FitQualityWarning, stacklevel=2)
-    twins, twin_text = twin_dataset(model, lay, local[best], p, chi2, syms, float(ds["phase"]))
+        warnings.warn(f"joint fit: {ds.attrs['ambiguity']}", FitQualityWarning, stacklevel=3)
+    p = local[best].x
+    twins, twin_text = twin_dataset(
+        model, lay, local[best], p, stats.chi2, syms, float(ds["phase"])
+    )
     ds = ds.merge(twins)
     ds.attrs["symmetry_twins"] = twin_text
     if twin_text != "none":
         have = ds.attrs["ambiguity"]
         ds.attrs["ambiguity"] = twin_text if have == "none" else f"{have}; {twin_text}"
-    if method == "posterior":
-        ds = with_posterior(
-            ds, lay, local, best, model, dt_epoch, fit_s, posterior_walkers, posterior_steps, seed
-        )
-    if check:
-        t0 = time.perf_counter()
-        ds.attrs["model_check"] = model_check(
-            ds, observation, spacecraft, materials, ab, data, lay, p
-        )
-        ds.attrs["check_seconds"] = time.perf_counter() - t0
     return ds
 
 

@@ -182,23 +182,15 @@ def result_dataset(
     quality: Mapping[str, Any],
     attrs: Mapping[str, Any],
 ) -> xr.Dataset:
+    """The result Dataset of the joint fit: estimates, their uncertainties and
+    correlations (carried to the reported parameters), the spin, extinction, zero points,
+    areas, table scales, the fit's statistics and the per-observation residuals."""
     axis = axis_of(p)
     lon, lat = (float(v) for v in lonlat(axis))
     phase = (p[3] - 360.0 * (t_ref - dt_epoch) / p[2]) % 360.0
-    t = _transform(lay, p, axis_of, t_ref, dt_epoch)
-    # a parameter the data do not constrain (free) carries an infinite variance into every
-    # output that depends on it; the others' covariance is carried through t
-    finite = bool(np.all(np.isfinite(cov[np.ix_(~free, ~free)])))
-    c_out = t @ np.where(np.outer(free, free) | ~np.isfinite(cov), 0.0, cov) @ t.T
-    if not finite:
-        c_out = np.full_like(cov, np.nan)
-    free_out = (np.abs(t) @ free.astype(float)) > 0
-    c_out[free_out, :] = 0.0
-    c_out[:, free_out] = 0.0
-    c_out[free_out, free_out] = np.inf
+    c_out, free_out, finite = _reported_covariance(lay, p, cov, free, axis_of, t_ref, dt_epoch)
     sd = np.sqrt(np.clip(np.diag(c_out), 0, None))
     est = np.array([lon, lat, p[2], phase, *p[4:]])
-    corr = correlation(c_out)
     ds = xr.Dataset(
         coords={
             "parameter": ("parameter", lay.names, _cf("1", "fitted parameter")),
@@ -213,14 +205,86 @@ def result_dataset(
     ds["uncertainty"] = ("parameter", sd, _cf("1", "1-sigma uncertainty (units: parameter_units)"))
     ds["correlation"] = (
         ("parameter", "parameter_b"),
-        corr,
+        correlation(c_out),
         _cf("1", "correlation of the estimates (Jacobian at the solution)"),
     )
+    _spin_terms(ds, est, sd, c_out, free_out, finite, axis)
+    k_how = _band_terms(ds, lay, p, sd)
+    _areas(ds, lay, p, c_out)
+    _table_scales(ds, lay, p, sd)
+    scal = {
+        "chi2": (chi2, "chi-square of the fit"),
+        "dof": (dof, "degrees of freedom (values minus fitted parameters)"),
+        "reduced_chi2": (chi2 / dof, "chi-square per degree of freedom"),
+        "fit_probability": (
+            quality["fit_probability"],
+            "probability of a chi-square at least this large for a right model",
+        ),
+    }
+    for key, (val, ln) in scal.items():
+        ds[key] = ((), val, _cf("1", ln))
+    ds = _per_observation(ds, light_curve, data, residual)
+    ds.attrs = {
+        **attrs,
+        "epoch": str(np.asarray(epoch).astype("datetime64[ms]")),
+        "phase_reference": "phase is the spin angle at the epoch (sbrdf_xr.invert.spin_model)",
+        "bands": ", ".join(lay.bands),
+        "magnitude_system": data.system,
+        "extinction": k_how,
+        "offset": str(lay.offset),
+        "areas": {
+            "total": "fractions of every material but the last fitted; the last takes the rest "
+            "(the areas add up to the mesh's)",
+            "free": "a free area scale per material",
+            "fixed": "the model's areas",
+        }[lay.areas],
+        **quality_attrs(quality),
+    }
+    return ds
+
+
+def _reported_covariance(
+    lay: Layout,
+    p: np.ndarray,
+    cov: np.ndarray,
+    free: np.ndarray,
+    axis_of: Any,
+    t_ref: float,
+    dt_epoch: float,
+) -> tuple[np.ndarray, np.ndarray, bool]:
+    """The covariance of the reported parameters, which of them are unconstrained, and
+    whether the constrained part is finite."""
+    t = _transform(lay, p, axis_of, t_ref, dt_epoch)
+    # a parameter the data do not constrain (free) carries an infinite variance into every
+    # output that depends on it; the others' covariance is carried through t
+    finite = bool(np.all(np.isfinite(cov[np.ix_(~free, ~free)])))
+    c_out = t @ np.where(np.outer(free, free) | ~np.isfinite(cov), 0.0, cov) @ t.T
+    if not finite:
+        c_out = np.full_like(cov, np.nan)
+    free_out = (np.abs(t) @ free.astype(float)) > 0
+    c_out[free_out, :] = 0.0
+    c_out[:, free_out] = 0.0
+    c_out[free_out, free_out] = np.inf
+    return c_out, free_out, finite
+
+
+def _spin_terms(
+    ds: xr.Dataset,
+    est: np.ndarray,
+    sd: np.ndarray,
+    c_out: np.ndarray,
+    free_out: np.ndarray,
+    finite: bool,
+    axis: np.ndarray,
+) -> None:
+    """The spin axis [degree], period [s] and phase [degree] with their uncertainties;
+    the major semi-axis of the axis's 1-sigma ellipse; the axis vector."""
+    lat = float(est[1])
     spin = {
-        "axis_longitude": (lon, "degree", "longitude of the inertial spin axis"),
+        "axis_longitude": (float(est[0]), "degree", "longitude of the inertial spin axis"),
         "axis_latitude": (lat, "degree", "latitude of the inertial spin axis"),
-        "period": (float(p[2]), "s", "spin period"),
-        "phase": (float(phase), "degree", "spin angle at the epoch"),
+        "period": (float(est[2]), "s", "spin period"),
+        "phase": (float(est[3]), "degree", "spin angle at the epoch"),
     }
     for j, (key, (val, u, ln)) in enumerate(spin.items()):
         ds[key] = ((), val, _cf(u, ln))
@@ -237,6 +301,11 @@ def result_dataset(
         _cf("degree", "major semi-axis of the 1-sigma ellipse of the spin axis"),
     )
     ds["axis_vector"] = ("xyz", axis, _cf("1", "unit vector of the inertial spin axis"))
+
+
+def _band_terms(ds: xr.Dataset, lay: Layout, p: np.ndarray, sd: np.ndarray) -> str:
+    """Extinction coefficients and zero points (or the common offset) [mag] per band;
+    returns how extinction was treated."""
     nb = len(lay.bands)
     k_sd = sd[lay.sl["k"]] if isinstance(lay.k_mode, str) else np.zeros(nb)
     k_how = "fitted" if isinstance(lay.k_mode, str) else "given (not fitted)"
@@ -268,47 +337,48 @@ def result_dataset(
             float(sd[lay.sl["z"]][0]),
             cf("magnitude", long_name="1-sigma uncertainty of the magnitude offset"),
         )
-    else:
-        z_how = "fitted" if lay.offset == "band" else "held at 0 (a calibrated table)"
-        ds["zero_point"] = (
-            "band",
-            lay.zero_points(p),
-            cf("magnitude", long_name=f"zero point, measured - model ({z_how})"),
-        )
-        ds["zero_point_uncertainty"] = (
-            "band",
-            sd[lay.sl["z"]] if lay.offset == "band" else np.zeros(nb),
-            cf("magnitude", long_name="1-sigma uncertainty of the zero point (0: not fitted)"),
-        )
-    _areas(ds, lay, p, c_out)
-    if lay.m_sd is not None:
-        sl = lay.sl["s"]
-        ds["table_scale"] = (
-            "material",
-            p[sl],
-            _cf("1", "fitted scale of the material's table (nuisance parameter: model error)"),
-        )
-        ds["table_scale_uncertainty"] = (
-            "material",
-            sd[sl],
-            _cf("1", "1-sigma uncertainty of the table's scale"),
-        )
-        ds["table_scale_prior_width"] = (
-            "material",
-            lay.m_sd,
-            _cf("1", "prior width of the table's scale (prior 1 +- width)"),
-        )
-    scal = {
-        "chi2": (chi2, "chi-square of the fit"),
-        "dof": (dof, "degrees of freedom (values minus fitted parameters)"),
-        "reduced_chi2": (chi2 / dof, "chi-square per degree of freedom"),
-        "fit_probability": (
-            quality["fit_probability"],
-            "probability of a chi-square at least this large for a right model",
-        ),
-    }
-    for key, (val, ln) in scal.items():
-        ds[key] = ((), val, _cf("1", ln))
+        return k_how
+    z_how = "fitted" if lay.offset == "band" else "held at 0 (a calibrated table)"
+    ds["zero_point"] = (
+        "band",
+        lay.zero_points(p),
+        cf("magnitude", long_name=f"zero point, measured - model ({z_how})"),
+    )
+    ds["zero_point_uncertainty"] = (
+        "band",
+        sd[lay.sl["z"]] if lay.offset == "band" else np.zeros(nb),
+        cf("magnitude", long_name="1-sigma uncertainty of the zero point (0: not fitted)"),
+    )
+    return k_how
+
+
+def _table_scales(ds: xr.Dataset, lay: Layout, p: np.ndarray, sd: np.ndarray) -> None:
+    """The fitted scale of each material's table, when model error is fitted."""
+    if lay.m_sd is None:
+        return
+    sl = lay.sl["s"]
+    ds["table_scale"] = (
+        "material",
+        p[sl],
+        _cf("1", "fitted scale of the material's table (nuisance parameter: model error)"),
+    )
+    ds["table_scale_uncertainty"] = (
+        "material",
+        sd[sl],
+        _cf("1", "1-sigma uncertainty of the table's scale"),
+    )
+    ds["table_scale_prior_width"] = (
+        "material",
+        lay.m_sd,
+        _cf("1", "prior width of the table's scale (prior 1 +- width)"),
+    )
+
+
+def _per_observation(
+    ds: xr.Dataset, light_curve: xr.Dataset, data: PassData, residual: np.ndarray
+) -> xr.Dataset:
+    """Model magnitude, residual [mag] and air mass of every observation, with its time
+    and band."""
     obs = str(light_curve["magnitude"].dims[0])
     keep = {c: light_curve[c] for c in ("time", "band") if c in light_curve.coords}
     per_obs = {
@@ -318,24 +388,9 @@ def result_dataset(
     for key, (val, ln) in per_obs.items():
         ds[key] = xr.DataArray(val, dims=obs, attrs=cf("magnitude", long_name=ln))
     ds["airmass"] = xr.DataArray(data.airmass, dims=obs, attrs=cf("airmass"))
-    ds = ds.assign_coords({f"{k}_{obs}" if k == "band" else k: v.variable for k, v in keep.items()})
-    ds.attrs = {
-        **attrs,
-        "epoch": str(np.asarray(epoch).astype("datetime64[ms]")),
-        "phase_reference": "phase is the spin angle at the epoch (sbrdf_xr.invert.spin_model)",
-        "bands": ", ".join(lay.bands),
-        "magnitude_system": data.system,
-        "extinction": k_how,
-        "offset": str(lay.offset),
-        "areas": {
-            "total": "fractions of every material but the last fitted; the last takes the rest "
-            "(the areas add up to the mesh's)",
-            "free": "a free area scale per material",
-            "fixed": "the model's areas",
-        }[lay.areas],
-        **quality_attrs(quality),
-    }
-    return ds
+    return ds.assign_coords(
+        {f"{k}_{obs}" if k == "band" else k: v.variable for k, v in keep.items()}
+    )
 
 
 def _areas(ds: xr.Dataset, lay: Layout, p: np.ndarray, c_out: np.ndarray) -> None:

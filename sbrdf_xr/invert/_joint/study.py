@@ -191,8 +191,6 @@ def observation_recovery(
     """
     phase_symmetry_deg = to_unit(phase_symmetry_deg, "deg", "phase_symmetry_deg")
     noise_mag = to_unit(noise_mag, "mag", "noise_mag")
-    from .._spin.refine import tangent_frame
-
     truth_spin = {k: float(spin[k]) for k in ("axis_longitude", "axis_latitude", "period", "phase")}
     epoch = spin.get("epoch", np.asarray(observation.times)[0])
     lc0, _ = simulated_light_curve(
@@ -219,18 +217,7 @@ def observation_recovery(
         )[1]
         for _ in range(3)
     )
-    off = {"axis": 2.0, "period": 0.05, "phase": 5.0, **(start_offset or {})}
-    a0 = vec(truth_spin["axis_longitude"], truth_spin["axis_latitude"])
-    a1 = a0 + np.radians(off["axis"]) * tangent_frame(a0)[1]
-    lon = float(np.degrees(np.arctan2(a1[1], a1[0])) % 360.0)
-    lat = float(np.degrees(np.arcsin(a1[2] / np.linalg.norm(a1))))
-    start = {
-        "axis_longitude": lon,
-        "axis_latitude": lat,
-        "period": truth_spin["period"] + off["period"],
-        "phase": truth_spin["phase"] + off["phase"],
-        "epoch": str(np.datetime64(str(epoch), "ns")),
-    }
+    start, a0 = _offset_start(truth_spin, epoch, start_offset)
     truth = {**truth_spin}
     truth.update({f"extinction_{b}": float(extinction[b]) for b in bands})
     truth.update({f"area_fraction_{m}": float(v) for m, v in area_fraction.items()})
@@ -249,36 +236,101 @@ def observation_recovery(
             fit = fit_observation(lc, spacecraft, obs_at, start, check=False, **options)
         secs.append(time.perf_counter() - t0)
         n_warn += any(issubclass(w.category, FitQualityWarning) for w in caught)
-        row = {k: (float(fit[k]), float(fit[k + "_uncertainty"])) for k in truth_spin}
-        for b in bands:
-            row[f"extinction_{b}"] = (
-                float(fit.extinction_coefficient.sel(band=b)),
-                float(fit.extinction_coefficient_uncertainty.sel(band=b)),
-            )
-        for m in fit["material"].values:
-            row[f"area_fraction_{m}"] = (
-                float(fit.area_fraction.sel(material=m)),
-                float(fit.area_fraction_uncertainty.sel(material=m)),
-            )
-        if "posterior_median" in fit:  # method="posterior": its median and sd
-            post = fit.set_index(posterior_parameter="posterior_parameter")
-            for k in list(row):
-                key = k.replace("area_fraction_", "fraction_")
-                row[k] = (
-                    float(post.posterior_median.sel(posterior_parameter=key)),
-                    float(post.posterior_sd.sel(posterior_parameter=key)),
-                )
-        for k, per in (("phase", phase_symmetry_deg), ("axis_longitude", 360.0)):
-            row[k] = (truth[k] + _wrap(row[k][0] - truth[k], per), row[k][1])
-        rows.append(row)
+        rows.append(_draw_row(fit, truth, bands, phase_symmetry_deg))
         cosang = float(np.clip(fit["axis_vector"].values @ a0, -1.0, 1.0))
         ax_err.append(float(np.degrees(np.arccos(cosang))))
+    ds = _recovery_statistics(rows, truth, n_draws, ax_err)
+    per_fit = float(np.median(secs)) if secs else float("nan")
+    scalars = {
+        "n_draws": (n_draws, "1", "noise draws"),
+        "quality_warnings": (n_warn, "1", "draws with a FitQualityWarning"),
+        "seconds_per_fit": (per_fit, "s", "median wall time of a fit"),
+        "simulate_seconds": (
+            sim_s,
+            "s",
+            "wall time of one simulate of the measured times (per material, best of 3)",
+        ),
+        "fit_to_simulate": (per_fit / sim_s, "1", "wall time per fit over that of one simulate"),
+    }
+    for k, (v, u, ln) in scalars.items():
+        ds[k] = ((), v, {"units": u, "long_name": ln})
+    ds.attrs = {
+        "n_values": int(lc0.sizes["obs"]),
+        "noise_mag": noise_mag,
+        "seed": seed,
+        "start": ", ".join(f"{k} {v}" for k, v in start.items()),
+        "phase_symmetry_deg": phase_symmetry_deg,
+        "load_average": f"{load0:.2f} before, {os.getloadavg()[0]:.2f} after",
+        "options": repr(options),
+    }
+    return ds
+
+
+def _offset_start(
+    truth_spin: dict[str, float], epoch: Any, start_offset: Mapping[str, float] | None
+) -> tuple[dict[str, Any], np.ndarray]:
+    """The fits' start: the truth moved by ``start_offset`` (axis [degree] north, period
+    [s], phase [degree]); and the true axis."""
+    from .._spin.refine import tangent_frame
+
+    off = {"axis": 2.0, "period": 0.05, "phase": 5.0, **(start_offset or {})}
+    a0 = vec(truth_spin["axis_longitude"], truth_spin["axis_latitude"])
+    a1 = a0 + np.radians(off["axis"]) * tangent_frame(a0)[1]
+    lon = float(np.degrees(np.arctan2(a1[1], a1[0])) % 360.0)
+    lat = float(np.degrees(np.arcsin(a1[2] / np.linalg.norm(a1))))
+    start = {
+        "axis_longitude": lon,
+        "axis_latitude": lat,
+        "period": truth_spin["period"] + off["period"],
+        "phase": truth_spin["phase"] + off["phase"],
+        "epoch": str(np.datetime64(str(epoch), "ns")),
+    }
+    return start, a0
+
+
+def _draw_row(
+    fit: xr.Dataset, truth: dict[str, float], bands: Sequence[str], phase_symmetry: float
+) -> dict[str, tuple[float, float]]:
+    """(estimate, uncertainty) of every parameter of one draw's fit (the posterior's
+    median and sd when sampled); angles wrapped next to the truth."""
+    spin_keys = ("axis_longitude", "axis_latitude", "period", "phase")
+    row = {k: (float(fit[k]), float(fit[k + "_uncertainty"])) for k in spin_keys}
+    for b in bands:
+        row[f"extinction_{b}"] = (
+            float(fit.extinction_coefficient.sel(band=b)),
+            float(fit.extinction_coefficient_uncertainty.sel(band=b)),
+        )
+    for m in fit["material"].values:
+        row[f"area_fraction_{m}"] = (
+            float(fit.area_fraction.sel(material=m)),
+            float(fit.area_fraction_uncertainty.sel(material=m)),
+        )
+    if "posterior_median" in fit:  # method="posterior": its median and sd
+        post = fit.set_index(posterior_parameter="posterior_parameter")
+        for k in list(row):
+            key = k.replace("area_fraction_", "fraction_")
+            row[k] = (
+                float(post.posterior_median.sel(posterior_parameter=key)),
+                float(post.posterior_sd.sel(posterior_parameter=key)),
+            )
+    for k, per in (("phase", phase_symmetry), ("axis_longitude", 360.0)):
+        row[k] = (truth[k] + _wrap(row[k][0] - truth[k], per), row[k][1])
+    return row
+
+
+def _recovery_statistics(
+    rows: list[dict[str, tuple[float, float]]],
+    truth: dict[str, float],
+    n_draws: int,
+    ax_err: list[float],
+) -> xr.Dataset:
+    """Per parameter over the draws: truth, mean and spread of the estimates, pulls and
+    coverage; the pull of every draw and the angle of its axis from the truth [degree]."""
     names = [k for k in truth if k in rows[0]] if rows else list(truth)
     values = np.array([[r[k] for k in names] for r in rows]).reshape(n_draws, len(names), 2)
     est, unc = values[..., 0], values[..., 1]
     tv = np.array([truth[k] for k in names])
     pull = (est - tv) / unc
-    per_fit = float(np.median(secs)) if secs else float("nan")
     stats = {
         "truth": (tv, "true value"),
         "estimate_mean": (est.mean(0), "mean of the estimates"),
@@ -306,26 +358,4 @@ def observation_recovery(
         np.asarray(ax_err),
         {"units": "degree", "long_name": "angle between the fitted and the true spin axis"},
     )
-    scalars = {
-        "n_draws": (n_draws, "1", "noise draws"),
-        "quality_warnings": (n_warn, "1", "draws with a FitQualityWarning"),
-        "seconds_per_fit": (per_fit, "s", "median wall time of a fit"),
-        "simulate_seconds": (
-            sim_s,
-            "s",
-            "wall time of one simulate of the measured times (per material, best of 3)",
-        ),
-        "fit_to_simulate": (per_fit / sim_s, "1", "wall time per fit over that of one simulate"),
-    }
-    for k, (v, u, ln) in scalars.items():
-        ds[k] = ((), v, {"units": u, "long_name": ln})
-    ds.attrs = {
-        "n_values": int(lc0.sizes["obs"]),
-        "noise_mag": noise_mag,
-        "seed": seed,
-        "start": ", ".join(f"{k} {v}" for k, v in start.items()),
-        "phase_symmetry_deg": phase_symmetry_deg,
-        "load_average": f"{load0:.2f} before, {os.getloadavg()[0]:.2f} after",
-        "options": repr(options),
-    }
     return ds

@@ -45,6 +45,56 @@ def result_dataset(
     dof: int,
     attrs: dict[str, Any],
 ) -> xr.Dataset:
+    """The result Dataset of the spin fit: the solution with its uncertainties, the fit's
+    statistics, the chi-square map of the axes, the ambiguous twins and the minima."""
+    ds = _solution(prob, best, axes, alts, minima)
+    scal = {
+        "chi2": (best.chi2, "chi-square of the solution"),
+        "dof": (dof, "degrees of freedom (values minus spin parameters and flux scales)"),
+        "reduced_chi2": (
+            best.chi2 / dof if dof > 0 else np.nan,
+            "chi-square per degree of freedom",
+        ),
+        "fit_probability": (
+            quality["fit_probability"],
+            "probability of a chi-square at least this large for a right model",
+        ),
+    }
+    for key, (val, ln) in scal.items():
+        ds[key] = ((), val, {"units": "1", "long_name": ln})
+    ds["chi2_map"] = (
+        "axis",
+        grid.min(axis=(1, 2)),
+        {
+            "units": "1",
+            "long_name": "chi-square of the axis, minimised over the period and phase grid",
+        },
+    )
+    _twins_and_minima(ds, prob, best, alts, minima)
+    epoch = (
+        str(geo.epoch.astype("datetime64[ms]"))
+        if geo.epoch is not None
+        else "t = 0 s of the light curve"
+    )
+    ds.attrs = {
+        **attrs,
+        "epoch": epoch,
+        "phase_reference": (
+            f"phase is the spin angle at the epoch; the search defined it at {prob.t_ref:.6g} s "
+            "after the epoch (the middle of the light curve)"
+        ),
+        "geometry_source": geo.source,
+        "geometry_notes": "; ".join(geo.notes),
+        **quality_attrs(quality),
+    }
+    return ds
+
+
+def _solution(
+    prob: Problem, best: Minimum, axes: np.ndarray, alts: list[Minimum], minima: list[Minimum]
+) -> xr.Dataset:
+    """The coordinates, and the solution's axis [degree], period [s] and phase [degree]
+    at the epoch with their uncertainties and the axis's 1-sigma ellipse."""
     lon, lat, _ = lonlat_covariance(best)
     phase0, cov = _at_epoch(prob, best)
     sig = np.sqrt(np.clip(np.diag(cov), 0, None)) if np.all(np.isfinite(cov)) else np.diag(cov)
@@ -103,28 +153,13 @@ def result_dataset(
         best.axis,
         {"units": "1", "long_name": "unit vector of the inertial spin axis"},
     )
-    scal = {
-        "chi2": (best.chi2, "chi-square of the solution"),
-        "dof": (dof, "degrees of freedom (values minus spin parameters and flux scales)"),
-        "reduced_chi2": (
-            best.chi2 / dof if dof > 0 else np.nan,
-            "chi-square per degree of freedom",
-        ),
-        "fit_probability": (
-            quality["fit_probability"],
-            "probability of a chi-square at least this large for a right model",
-        ),
-    }
-    for key, (val, ln) in scal.items():
-        ds[key] = ((), val, {"units": "1", "long_name": ln})
-    ds["chi2_map"] = (
-        "axis",
-        grid.min(axis=(1, 2)),
-        {
-            "units": "1",
-            "long_name": "chi-square of the axis, minimised over the period and phase grid",
-        },
-    )
+    return ds
+
+
+def _twins_and_minima(
+    ds: xr.Dataset, prob: Problem, best: Minimum, alts: list[Minimum], minima: list[Minimum]
+) -> None:
+    """The ambiguous twins of the solution and every refined local minimum."""
     rows = {
         "solution_chi2": ([a.chi2 for a in alts], "1", "chi-square of the twin"),
         "chi2_gap": (
@@ -171,20 +206,3 @@ def result_dataset(
     }
     for key, (values, u, ln) in local.items():
         ds[key] = ("minimum", np.asarray(values, dtype=float), {"units": u, "long_name": ln})
-    epoch = (
-        str(geo.epoch.astype("datetime64[ms]"))
-        if geo.epoch is not None
-        else "t = 0 s of the light curve"
-    )
-    ds.attrs = {
-        **attrs,
-        "epoch": epoch,
-        "phase_reference": (
-            f"phase is the spin angle at the epoch; the search defined it at {prob.t_ref:.6g} s "
-            "after the epoch (the middle of the light curve)"
-        ),
-        "geometry_source": geo.source,
-        "geometry_notes": "; ".join(geo.notes),
-        **quality_attrs(quality),
-    }
-    return ds
