@@ -190,10 +190,8 @@ def against_flow(graph: dict[str, set[str]]) -> list[str]:
 MAX_MODULE_CODE_LINES = 400
 
 
-def code_lines(path: Path) -> int:
-    """Lines that hold code: not blank, not only a comment, not inside a docstring."""
-    src = path.read_text(encoding="utf-8")
-    tree = ast.parse(src)
+def _docstring_lines(tree: ast.AST) -> set[int]:
+    """Line numbers inside the docstrings of the module, its classes and functions."""
     doc: set[int] = set()
     for node in ast.walk(tree):
         if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
@@ -204,12 +202,52 @@ def code_lines(path: Path) -> int:
             if isinstance(stmt, ast.Expr) and isinstance(stmt.value, ast.Constant):
                 if isinstance(stmt.value.value, str):
                     doc.update(range(stmt.lineno, (stmt.end_lineno or stmt.lineno) + 1))
-    n = 0
-    for i, line in enumerate(src.splitlines(), start=1):
-        text = line.strip()
-        if text and not text.startswith("#") and i not in doc:
-            n += 1
-    return n
+    return doc
+
+
+def _is_code(line: str, i: int, doc: set[int]) -> bool:
+    text = line.strip()
+    return bool(text) and not text.startswith("#") and i not in doc
+
+
+def code_lines(path: Path) -> int:
+    """Lines that hold code: not blank, not only a comment, not inside a docstring."""
+    src = path.read_text(encoding="utf-8")
+    doc = _docstring_lines(ast.parse(src))
+    return sum(_is_code(line, i, doc) for i, line in enumerate(src.splitlines(), start=1))
+
+
+#: A function with more lines of code than this tells more than one story: split it into
+#: named steps.  Counted like a module's lines (no blank lines, no comment-only lines, no
+#: docstring lines) from its ``def`` (decorators included) to its last line, so the lines
+#: of functions nested in it count as its own (a closure is not a way out).
+MAX_FUNCTION_CODE_LINES = 150
+
+
+def function_lines(path: Path) -> dict[str, int]:
+    """``"qualified.name:line" -> lines of code`` of every function and method in a file."""
+    src = path.read_text(encoding="utf-8")
+    tree = ast.parse(src)
+    doc = _docstring_lines(tree)
+    lines = src.splitlines()
+    out: dict[str, int] = {}
+
+    def visit(node: ast.AST, prefix: str) -> None:
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                first = min([child.lineno] + [d.lineno for d in child.decorator_list])
+                last = child.end_lineno or child.lineno
+                out[f"{prefix}{child.name}:{child.lineno}"] = sum(
+                    _is_code(lines[i - 1], i, doc) for i in range(first, last + 1)
+                )
+                visit(child, f"{prefix}{child.name}.")
+            elif isinstance(child, ast.ClassDef):
+                visit(child, f"{prefix}{child.name}.")
+            else:
+                visit(child, prefix)
+
+    visit(tree, "")
+    return out
 
 
 def test_code_lines_leave_out_docstrings_and_comments(tmp_path):
@@ -228,6 +266,28 @@ def test_no_module_is_over_the_code_limit():
         if (n := code_lines(p)) > MAX_MODULE_CODE_LINES
     }
     assert not long, f"modules over {MAX_MODULE_CODE_LINES} lines of code (split by job): {long}"
+
+
+def test_function_lines_count_code_of_nested_functions_too(tmp_path):
+    f = tmp_path / "m.py"
+    f.write_text(
+        '@decorator\ndef f(x):\n    """Doc.\n\n    More."""\n\n    # a comment\n'
+        "    def g():\n        return x\n\n    return g\n\n\nclass C:\n"
+        "    def m(self):\n        pass\n"
+    )
+    assert function_lines(f) == {"f:2": 5, "f.g:8": 2, "C.m:15": 2}
+
+
+def test_no_function_is_over_the_code_limit():
+    long = {
+        f"{p.relative_to(PACKAGE)}:{name}": n
+        for p in sorted(PACKAGE.rglob("*.py"))
+        for name, n in function_lines(p).items()
+        if n > MAX_FUNCTION_CODE_LINES
+    }
+    assert not long, (
+        f"functions over {MAX_FUNCTION_CODE_LINES} lines of code (split into named steps): {long}"
+    )
 
 
 def test_every_module_has_a_layer():

@@ -476,9 +476,10 @@ def _minimise(
     start: dict[str, float],
     starts: Any,
     epoch: Any,
-) -> tuple[float, list[Local], int, bool]:
+) -> tuple[float, list[Local], int, list[str]]:
     """Refine from every start (inside the bounds where a minimum left physics); the
-    epoch [s from the data's], the minima, the best one, whether it was unbounded."""
+    epoch [s from the data's], the minima, the best one, and the parameters the lowest
+    minimum left outside physics."""
 
     def seconds_of(t: Any) -> float:
         return float((t - data.epoch) / np.timedelta64(1, "ns")) * 1e-9
@@ -523,7 +524,7 @@ def _statistics(
     lay: Layout,
     data: Any,
     solution: Local,
-    unbounded: bool,
+    unbounded: list[str],
     scale_uncertainties: bool,
     held: str | None,
 ) -> _Statistics:
