@@ -26,8 +26,9 @@ from astropy.time import Time
 
 from sbrdf_xr.engine import builtin_scene
 from sbrdf_xr.engine.run import simulate
+from sbrdf_xr.lightcurves import compare, plot_comparison, read_light_curve
 from sbrdf_xr.observing.observe import Observation, times
-from sbrdf_xr.photometry import compare, magnitudes, plot_comparison, read_light_curve
+from sbrdf_xr.photometry import magnitudes
 
 OUT = Path(__file__).parent / "img" / "canx1_pass_comparison.png"
 ZP = {"V": 0.30, "R": 0.15, "I": -0.05}

@@ -15,7 +15,8 @@ The packages are the layers, lowest first; a package imports only from lower one
   (analytic BRDF models);
 * :mod:`~sbrdf_xr.materials` (tables, models, measurements), :mod:`~sbrdf_xr.body`
   (spacecraft meshes, facets, shadowing), :mod:`~sbrdf_xr.photometry` (bands,
-  magnitudes, light curves), :mod:`~sbrdf_xr.observing` (orbits, sites, times,
+  magnitudes, colours), :mod:`~sbrdf_xr.lightcurves` (measured light curves read and
+  compared with a simulation), :mod:`~sbrdf_xr.observing` (orbits, sites, times,
   attitude laws, the Earth's shadow);
 * :mod:`~sbrdf_xr.catalog` (the shipped data, loaded by kind);
 * :mod:`~sbrdf_xr.store` (the output formats and cube writers) and :mod:`~sbrdf_xr.engine` (scenes,
@@ -83,6 +84,7 @@ _SUBMODULES = (
     "geometry",
     "invert",
     "kernels",
+    "lightcurves",
     "materials",
     "observing",
     "photometry",
@@ -114,6 +116,7 @@ __all__ = [
     "invert",
     "kernels",
     "lambertian",
+    "lightcurves",
     "load_scene",
     "load_spacecraft",
     "lookup",

@@ -529,7 +529,11 @@ def renamed_keywords(**old_to_new: str) -> Callable[[_F], _F]:
 
 
 def renamed_attributes(
-    module: str, namespace: Mapping[str, Any], old_to_new: Mapping[str, str]
+    module: str,
+    namespace: Mapping[str, Any],
+    old_to_new: Mapping[str, str],
+    *,
+    new_module: str | None = None,
 ) -> Callable[[str], Any]:
     """A module ``__getattr__`` that serves renamed attributes under their old names.
 
@@ -541,6 +545,9 @@ def renamed_attributes(
         The module's globals (``globals()``), where the new names live.
     old_to_new : mapping
         Old attribute name -> new attribute name.
+    new_module : str, optional
+        Where the new names live when they moved to another module (``namespace`` is
+        then that module's globals); default ``module``.
 
     Returns
     -------
@@ -563,7 +570,7 @@ def renamed_attributes(
         if name in old_to_new:
             new = old_to_new[name]
             warnings.warn(
-                f"{module}.{name} is renamed {module}.{new}; "
+                f"{module}.{name} is renamed {new_module or module}.{new}; "
                 f"the old name will be removed in the next release",
                 RenamedWarning,
                 stacklevel=2,

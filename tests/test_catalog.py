@@ -16,10 +16,10 @@ from astropy.table import Table
 from sbrdf_xr import catalog
 from sbrdf_xr.body.spacecraft import canx1
 from sbrdf_xr.errors import CatalogError, ValidationError
+from sbrdf_xr.lightcurves import read_light_curve
 from sbrdf_xr.materials import energy
 from sbrdf_xr.materials import tables as material
 from sbrdf_xr.observing import Observation, Orbit, Site
-from sbrdf_xr.photometry import read_light_curve
 
 
 def test_every_entry_has_provenance_and_loads():

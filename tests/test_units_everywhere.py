@@ -45,6 +45,7 @@ PACKAGES = (
     "geometry",
     "invert",
     "kernels",
+    "lightcurves",
     "materials",
     "observing",
     "photometry",
@@ -596,15 +597,15 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.invert._data.magnitudes_to_signal": lambda: dict(
         light_curve=_light_curve(), range_km=1000.0
     ),
-    "sbrdf_xr.invert._spin.fit_spin": _spin_lc,
+    "sbrdf_xr.invert._spin.fit.fit_spin": _spin_lc,
     "sbrdf_xr.invert._unmix.unmix": lambda: _unmix_inputs(),
-    "sbrdf_xr.invert._spin.period_grid": lambda: dict(p_min=60.0, p_max=70.0, span_s=240.0),
-    "sbrdf_xr.invert._spin.axis_vector": lambda: dict(
+    "sbrdf_xr.invert._spin.fit.period_grid": lambda: dict(p_min=60.0, p_max=70.0, span_s=240.0),
+    "sbrdf_xr.invert._spin.fit.axis_vector": lambda: dict(
         longitude=[30.0, 60.0], latitude=[20.0, -5.0]
     ),
     "sbrdf_xr.invert._studies.spin_recovery": lambda: _recovery_inputs(),
-    "sbrdf_xr.invert._joint.fit_observation": lambda: _joint_inputs(),
-    "sbrdf_xr.invert._joint_study.observation_recovery": lambda: dict(
+    "sbrdf_xr.invert._joint.fit.fit_observation": lambda: _joint_inputs(),
+    "sbrdf_xr.invert._joint.study.observation_recovery": lambda: dict(
         spacecraft=_box("lambertian-grey-50"),
         observation=_joint_inputs()["observation"],
         spin=dict(_SPIN),
@@ -615,7 +616,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         noise_mag=0.02,
         phase_symmetry_deg=180.0,
     ),
-    "sbrdf_xr.invert._spin_search.spin_model": lambda: dict(
+    "sbrdf_xr.invert._spin.search.spin_model": lambda: dict(
         axis_body=[0, 0, 1], axis=[1.0, 0.0, 0.0], period_s=60.0, phase_deg=30.0
     ),
     # --- materials
@@ -862,7 +863,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.photometry.bands.filters": lambda: dict(
         bands=["V"], wavelength=np.arange(400.0, 1101.0, 10.0)
     ),
-    "sbrdf_xr.photometry.lightcurves.compare": lambda: dict(
+    "sbrdf_xr.lightcurves.comparison.compare": lambda: dict(
         **_compare_inputs(), max_time_shift_s=10.0, phase_angle=None, fit_phase=True
     ),
     "sbrdf_xr.photometry.magnitude.magnitudes": lambda: dict(
@@ -921,7 +922,7 @@ for _name, _arg in (
     ("sbrdf_xr.photometry.bands.filters", "bands"),
     ("sbrdf_xr.materials.goniometer.measure", "func"),
     ("sbrdf_xr.materials.goniometer.scheme_extents", "func"),
-    ("sbrdf_xr.invert._joint.fit_observation", "light_curve"),
+    ("sbrdf_xr.invert._joint.fit.fit_observation", "light_curve"),
 ):
     EXEMPT[(_name, _arg)] = _CONTAINER
 for _arg in ("ra_deg", "dec_deg"):
@@ -1185,9 +1186,9 @@ def _mags() -> xr.DataArray:
 #: Cases whose comparison is long (a fit or a simulation): ``-m slow`` runs it; the
 #: refusal of a wrong unit, at the door, always runs.
 SLOW = {
-    "sbrdf_xr.invert._joint.fit_observation",
-    "sbrdf_xr.invert._joint_study.observation_recovery",
-    "sbrdf_xr.invert._spin.fit_spin",
+    "sbrdf_xr.invert._joint.fit.fit_observation",
+    "sbrdf_xr.invert._joint.study.observation_recovery",
+    "sbrdf_xr.invert._spin.fit.fit_spin",
     "sbrdf_xr.invert._studies.spin_recovery",
     "sbrdf_xr.plot.cube.cube_figure",
     "sbrdf_xr.plot.cube.rotation_figure",
@@ -1210,7 +1211,7 @@ NOT_COMPARED = {
 POST = {
     "sbrdf_xr.observing.ephemeris.Ephemeris.from_states": lambda e: e.state(_T2),
     "sbrdf_xr.invert._studies.spin_recovery": lambda ds: ds.drop_vars("seconds"),
-    "sbrdf_xr.invert._joint_study.observation_recovery": lambda ds: ds.drop_vars(
+    "sbrdf_xr.invert._joint.study.observation_recovery": lambda ds: ds.drop_vars(
         ["seconds_per_fit", "simulate_seconds", "fit_to_simulate"]
     ),
     "sbrdf_xr.materials.models.spectrum_function": lambda f: f(*np.array([[30.0], [0.0], [5.0]])),

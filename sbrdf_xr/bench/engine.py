@@ -39,12 +39,12 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import Any
 
 import numba
 import numpy as np
 
 from ..store.disk import drop_behind
+from ._kernel_rows import _sweep_scene, kernel_rows
 from .rows import BenchRow, best_time
 
 __all__ = ["disk_rate", "engine_rows", "sweep_job", "thread_scaling"]
@@ -52,21 +52,7 @@ __all__ = ["disk_rate", "engine_rows", "sweep_job", "thread_scaling"]
 #: The sweeps: canx1 at random attitudes, phase angle 10 deg, default outputs.
 _SIZES_QUICK = (10_000, 100_000)
 _SIZES = (10_000, 100_000, 1_000_000)
-
-
-def _sweep_scene(n: int, bands: bool = False) -> Any:
-    from .. import geometry
-    from ..engine import builtin_scene
-
-    scene = builtin_scene("canx1-rotation").with_options(
-        attitudes=geometry.uniform_attitudes(n, seed=11),
-        attitude_angle=None,
-        outputs=("spacecraft_sbrdf", "signal", "brdf", "area"),
-        name=f"random-{n}",
-    )
-    if bands:
-        scene = scene.with_options(outputs=("band_signal", "area"), bands=("V", "R", "I"))
-    return scene
+_WRITTEN = "sweeps written to netCDF, default settings, 141 wavelengths"
 
 
 def sweep_job(
@@ -269,99 +255,6 @@ def _subprocess(
         return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def _matmul_rate(threads: int = 1) -> float:
-    """Dense float64 matmul rate [flop/s] of this machine on ``threads`` BLAS threads."""
-    from threadpoolctl import threadpool_limits
-
-    a = np.random.default_rng(0).random((1024, 1024))
-    with threadpool_limits(threads):
-        t = best_time(lambda: a @ a, 3)
-    return 2 * 1024**3 / t
-
-
-def kernel_rows(repeat: int = 3) -> list[BenchRow]:
-    """Kernel throughput (linear, 141 wavelengths, unmerged CanX-1 rotation, one thread),
-    and the band-only kernel against the full-spectrum one on random CanX-1 attitudes.
-
-    Examples
-    --------
-    The rows time the CanX-1 rotation with its measured tables; not run here:
-
-    >>> import inspect
-    >>> from sbrdf_xr.bench.engine import kernel_rows
-    >>> list(inspect.signature(kernel_rows).parameters)
-    ['repeat']
-    >>> [r.name for r in kernel_rows(repeat=1)][:2]  # doctest: +SKIP
-    ['kernel: numpy reference (sparse matrix)', 'kernel: fused (numba)']
-    """
-    from ..engine import builtin_scene
-    from ..engine.run import run_block
-    from ..kernels.sums import fused_sums
-
-    scene = builtin_scene("canx1-rotation").with_options(merge=False, outputs=("signal", "area"))
-    plan = scene.plan()
-    numpy_plan = scene.with_options(kernel="numpy").plan()
-    b = plan.geometry.block(slice(None))
-    t = plan.terms
-    n_wl = plan.tables.n_spectral
-
-    def fused() -> None:
-        fused_sums(b.to_sun, b.to_observer, t.normal, t.area, t.material, plan.tables, "linear")
-
-    t_fused = best_time(fused, repeat)
-    t_numpy = best_time(lambda: run_block(numpy_plan, slice(None)), max(1, repeat - 1))
-    pairs = b.to_sun.shape[0] * t.size
-    lit = int(np.sum((b.to_sun @ t.normal.T > 0) & (b.to_observer @ t.normal.T > 0)))
-    rate = _matmul_rate(1)
-    ceiling = rate / (
-        2 * 8 * n_wl
-    )  # 8 weighted table rows of n_wl multiply-adds per facet-spectrum
-    # band-only against full spectrum, kernel alone: random CanX-1 attitudes (merged terms)
-    per_lit: dict[bool, tuple[float, float, float]] = {}
-    for bands in (False, True):
-        sp = _sweep_scene(20_000, bands).plan()
-        sb, st = sp.geometry.block(slice(None)), sp.terms
-
-        def sweep_kernel(sp: Any = sp, sb: Any = sb, st: Any = st) -> None:
-            fused_sums(
-                sb.to_sun, sb.to_observer, st.normal, st.area, st.material, sp.tables, "linear"
-            )
-
-        sec = best_time(sweep_kernel, repeat)
-        n_lit = int(np.sum((sb.to_sun @ st.normal.T > 0) & (sb.to_observer @ st.normal.T > 0)))
-        per_lit[bands] = (sec, sec / n_lit, n_lit / len(sb.to_sun))
-    band_row = BenchRow(
-        "kernel: band-only (V, R, I), 2e4 random attitudes",
-        per_lit[True][0],
-        "full spectrum, same geometries",
-        per_lit[True][0] / per_lit[False][0],
-        f"{per_lit[True][1] * 1e9:.0f} ns against {per_lit[False][1] * 1e9:.0f} ns per lit "
-        f"and seen facet, every cost included ({per_lit[True][2]:.1f} per attitude): "
-        f"{per_lit[False][0] / per_lit[True][0]:.1f}x faster",
-        sweep="kernel, canx1 sweep, merged, linear, 1 thread",
-    )
-    return [
-        BenchRow(
-            "kernel: numpy reference (sparse matrix)",
-            t_numpy,
-            "numpy reference",
-            1.0,
-            f"{lit / t_numpy:,.0f} facet-spectra/s ({pairs} pairs, {lit} lit and seen)",
-            sweep="kernel, canx1-rotation unmerged, linear, 141 nm, 1 thread",
-        ),
-        BenchRow(
-            "kernel: fused (numba)",
-            t_fused,
-            "numpy reference",
-            t_fused / t_numpy,
-            f"{lit / t_fused:,.0f} facet-spectra/s = {(lit / t_fused) / ceiling:.0%} of the "
-            f"dense-matmul ceiling ({ceiling:,.0f}/s at {rate / 1e9:.1f} GFLOP/s, 1 thread)",
-            sweep="kernel, canx1-rotation unmerged, linear, 141 nm, 1 thread",
-        ),
-        band_row,
-    ]
-
-
 def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
     """All engine rows (see the module docstring); ``quick`` leaves out 1e6 and the cluster.
 
@@ -378,13 +271,33 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
     >>> rows[0].name  # doctest: +SKIP
     'canx1-rotation, full spectrum, per attitude-spectrum'
     """
+    # the kernel rows first, in a process and on a machine that the sweeps (gigabytes
+    # written, a cluster started and stopped) have not loaded yet
+    kernel = kernel_rows(repeat)
+    rows = _warm_rows(repeat)
+    sizes = _SIZES_QUICK if quick else _SIZES
+    results = {n: _subprocess(n) for n in sizes}
+    rows += _sweep_rows(sizes, results)
+    rows += _core_rows(results, repeat)
+    if not quick:
+        rows += _cluster_rows()
+    # one geometry: the compiled evaluator against simulate and the bare kernel
+    from .calls import single_call_rows
+
+    rows += single_call_rows(repeat=max(repeat, 5))
+    # open surfaces and articulated parts against the rigid closed path
+    from .parts import parts_rows
+
+    rows += parts_rows(repeat=max(repeat, 5))
+    return rows + kernel
+
+
+def _warm_rows(repeat: int) -> list[BenchRow]:
+    """CanX-1 rotation warm, a fresh scene, and one geometry (end to end, in this process)."""
     from ..engine import builtin_scene
     from ..engine.run import simulate
 
     rows: list[BenchRow] = []
-    # the kernel rows first, in a process and on a machine that the sweeps (gigabytes
-    # written, a cluster started and stopped) have not loaded yet
-    kernel = kernel_rows(repeat)
     rot = builtin_scene("canx1-rotation")
     simulate(rot).compute()
     # many repeats: the best of a few short calls is at the mercy of the machine's load
@@ -432,10 +345,13 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
         )
     )
 
-    sizes = _SIZES_QUICK if quick else _SIZES
-    results = {n: _subprocess(n) for n in sizes}
+    return rows
+
+
+def _sweep_rows(sizes: tuple[int, ...], results: dict[int, dict[str, float]]) -> list[BenchRow]:
+    """Each sweep written, against the bare kernel and against its floor; band-only."""
+    rows: list[BenchRow] = []
     kernels = {n: _subprocess(n, mode="kernel") for n in sizes}
-    sw = "sweeps written to netCDF, default settings, 141 wavelengths"
     prev = None
     for n in sizes:
         r, k = results[n], kernels[n]
@@ -456,7 +372,7 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
                 r["seconds"] / k["seconds"],
                 f"{r['seconds']:.2f} s in {int(r['blocks'])} blocks, peak RSS "
                 f"{r['rss'] / 2**30:.2f} GiB{exp}",
-                sweep=sw,
+                sweep=_WRITTEN,
             )
         )
         # the disk's rate for as many bytes as the cube (a virtual disk's write-back cache
@@ -472,10 +388,17 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
                 f"{r['bytes'] / 1e6:.0f} MB file: the disk writes and syncs as many bytes in "
                 f"{r['bytes'] / rate:.2f} s ({rate / 1e6:.0f} MB/s), the kernel takes "
                 f"{k['seconds']:.2f} s",
-                sweep=sw,
+                sweep=_WRITTEN,
             )
         )
         prev = n
+    return rows
+
+
+def _core_rows(results: dict[int, dict[str, float]], repeat: int) -> list[BenchRow]:
+    """Band-only against full spectrum at 1e5; two cores against one (written, computed,
+    bare kernel) and the machine's two-thread ceiling."""
+    rows: list[BenchRow] = []
     n5 = 100_000
     band = _subprocess(n5, bands=True)
     rows.append(
@@ -485,7 +408,7 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
             "full spectrum, same sweep",
             band["seconds"] / results[n5]["seconds"],
             f"{results[n5]['seconds'] / band['seconds']:.1f}x faster",
-            sweep=sw,
+            sweep=_WRITTEN,
         )
     )
     runs = max(1, repeat)
@@ -509,7 +432,7 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
             w1["seconds"] / w2["seconds"],
             f"two cores are {w1['seconds'] / w2['seconds']:.2f}x one core "
             f"(fastest of {runs} alternated runs each)",
-            sweep=sw,
+            sweep=_WRITTEN,
         )
     )
     one_t, two_t = thread_scaling()
@@ -548,28 +471,25 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
             sweep="compute only, default settings, 141 wavelengths",
         )
     )
-    if not quick:
-        # 1e6: each worker first receives the plan with its tables (about 240 MB), a fixed
-        # cost that a 1e5 sweep (seconds) cannot amortise
-        n6 = _SIZES[-1]
-        z1 = _subprocess(n6, mode="zarr", workers=1)
-        z2 = _subprocess(n6, mode="zarr", workers=2)
-        rows.append(
-            BenchRow(
-                f"{n6:.0e} attitudes, LocalCluster, 1 process worker, Zarr by blocks",
-                z1["seconds"],
-                "2 process workers",
-                z1["seconds"] / z2["seconds"],
-                f"2 workers are {z1['seconds'] / z2['seconds']:.2f}x one worker",
-                sweep=sw,
-            )
+    return rows
+
+
+def _cluster_rows() -> list[BenchRow]:
+    """1e6 attitudes on a LocalCluster of two process workers against one."""
+    rows: list[BenchRow] = []
+    # 1e6: each worker first receives the plan with its tables (about 240 MB), a fixed
+    # cost that a 1e5 sweep (seconds) cannot amortise
+    n6 = _SIZES[-1]
+    z1 = _subprocess(n6, mode="zarr", workers=1)
+    z2 = _subprocess(n6, mode="zarr", workers=2)
+    rows.append(
+        BenchRow(
+            f"{n6:.0e} attitudes, LocalCluster, 1 process worker, Zarr by blocks",
+            z1["seconds"],
+            "2 process workers",
+            z1["seconds"] / z2["seconds"],
+            f"2 workers are {z1['seconds'] / z2['seconds']:.2f}x one worker",
+            sweep=_WRITTEN,
         )
-    # one geometry: the compiled evaluator against simulate and the bare kernel
-    from .calls import single_call_rows
-
-    rows += single_call_rows(repeat=max(repeat, 5))
-    # open surfaces and articulated parts against the rigid closed path
-    from .parts import parts_rows
-
-    rows += parts_rows(repeat=max(repeat, 5))
-    return rows + kernel
+    )
+    return rows

@@ -30,7 +30,7 @@ continued as constants (``band_extrapolate="constant"``) and the magnitudes are 
 Bessell V band: for a grey body the band signal is the 532 nm signal, and the choice of
 band only moves every magnitude by the same amount (the Sun's V magnitude against its
 flux density at 532 nm, which the paper's code, lumos-sat, converts with), which the one
-free zero point of :func:`~sbrdf_xr.photometry.agreement.compare_magnitudes` absorbs.
+free zero point of :func:`~sbrdf_xr.lightcurves.agreement.compare_magnitudes` absorbs.
 
 :func:`predict_starlink` returns, per row, the observed magnitude, the model's (sunlight
 plus earthshine), its sunlight-only part, and the diffuse-sphere control (a Lambert sphere

@@ -121,7 +121,57 @@ def fit_robertson_sandford(
     {'rho_D': [0.6], 'epsilon': [0.2], 'b': 0.1, 'e': 0.3}
     """
     wl = _check_wavelength(wavelength)
+    ang, y, ref, sig = _checked_samples(theta_i, delta_theta, phi, wl.size, sbrdf, reference, sigma)
+    geo = _FitGeometry(*ang)
+    use = (~ref) & np.isfinite(y) & (y > 0) & geo.valid[:, None]
+    n_geom = int(np.sum(np.any(use, axis=1)))
+    per_wl = np.sum(use, axis=0)
+    if n_geom < 4 or np.any(per_wl < 2):
+        raise ValidationError(
+            f"sbrdf: {n_geom} usable (non-reference, positive, lit and visible) geometries "
+            f"and at least {int(per_wl.min())} per wavelength; need >= 4 geometries to "
+            "constrain (rho_D, epsilon, b, e) and >= 2 per wavelength"
+        )
+    prob = _Problem(geo, cutoff, y, sig, use)
+    sol = prob.solve(*prob.start())
     n_wl = wl.size
+    chi2 = float(np.sum(sol.fun**2))
+    dof = max(prob.n_res - (2 * n_wl + 2), 1)
+    chi2_red = chi2 / dof
+    jm = sol.jac
+    cov = np.linalg.pinv(np.asarray((jm.T @ jm).todense()) if sparse.issparse(jm) else jm.T @ jm)
+    if sigma is None:
+        cov = cov * chi2_red
+    u = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    rho, eps, b, e = prob.unpack(sol.x)
+    return {
+        "rho_D": rho.copy(),
+        "epsilon": eps.copy(),
+        "b": b,
+        "e": e,
+        "u_rho_D": u[:n_wl],
+        "u_epsilon": u[n_wl : 2 * n_wl],
+        "u_b": float(u[-2]),
+        "u_e": float(e * u[-1]),
+        "covariance": cov,
+        "chi2_reduced": chi2_red,
+        "n_used": prob.n_res,
+        "success": bool(sol.success),
+        "message": str(sol.message),
+    }
+
+
+def _checked_samples(
+    theta_i: ArrayLike,
+    delta_theta: ArrayLike,
+    phi: ArrayLike,
+    n_wl: int,
+    sbrdf: ArrayLike,
+    reference: ArrayLike | None,
+    sigma: ArrayLike | None,
+) -> tuple[list[np.ndarray], np.ndarray, np.ndarray, np.ndarray]:
+    """The angles [degree], the sBRDF, the reference mask and the relative uncertainties
+    of the samples, checked against one another's shapes."""
     ang = [np.asarray(a, dtype=np.float64) for a in (theta_i, delta_theta, phi)]
     names = ("theta_i", "delta_theta", "phi")
     for name, a in zip(names, ang, strict=True):
@@ -152,91 +202,87 @@ def fit_robertson_sandford(
                 f"reference: expected shape ({n_s},) or ({n_s}, {n_wl}), got {r.shape}"
             ) from exc
     if sigma is None:
-        sig = np.ones((n_s, n_wl))
-    else:
-        try:
-            sig = np.broadcast_to(np.asarray(sigma, dtype=np.float64), (n_s, n_wl))
-        except ValueError as exc:
-            raise ValidationError(
-                f"sigma: not broadcastable to {(n_s, n_wl)}, got shape {np.shape(sigma)}"
-            ) from exc
-        if not np.all(np.isfinite(sig)) or np.any(sig <= 0):
-            raise ValidationError("sigma: relative uncertainties must be finite and > 0 [1]")
-
-    geo = _FitGeometry(*ang)
-    use = (~ref) & np.isfinite(y) & (y > 0) & geo.valid[:, None]
-    n_geom = int(np.sum(np.any(use, axis=1)))
-    per_wl = np.sum(use, axis=0)
-    if n_geom < 4 or np.any(per_wl < 2):
+        return ang, y, ref, np.ones((n_s, n_wl))
+    try:
+        sig = np.broadcast_to(np.asarray(sigma, dtype=np.float64), (n_s, n_wl))
+    except ValueError as exc:
         raise ValidationError(
-            f"sbrdf: {n_geom} usable (non-reference, positive, lit and visible) geometries "
-            f"and at least {int(per_wl.min())} per wavelength; need >= 4 geometries to "
-            "constrain (rho_D, epsilon, b, e) and >= 2 per wavelength"
-        )
-    ly = np.log(np.where(use, y, 1.0))
-    tiny = np.finfo(np.float64).tiny
+            f"sigma: not broadcastable to {(n_s, n_wl)}, got shape {np.shape(sigma)}"
+        ) from exc
+    if not np.all(np.isfinite(sig)) or np.any(sig <= 0):
+        raise ValidationError("sigma: relative uncertainties must be finite and > 0 [1]")
+    return ang, y, ref, sig
 
-    def model(rho: np.ndarray, eps: np.ndarray, b: float, e: float) -> tuple[np.ndarray, ...]:
-        a_d, b_s, gi = geo.components(b, e, cutoff)
+
+class _Problem:
+    """The least-squares problem in log sBRDF: parameters ``(rho_D[l], epsilon[l], b, ln e)``."""
+
+    def __init__(
+        self, geo: _FitGeometry, cutoff: bool, y: np.ndarray, sig: np.ndarray, use: np.ndarray
+    ) -> None:
+        self.geo, self.cutoff, self.y, self.sig, self.use = geo, cutoff, y, sig, use
+        self.n_wl = y.shape[1]
+        self.ly = np.log(np.where(use, y, 1.0))
+        s_idx, l_idx = np.nonzero(use)  # residual order of resid() (row-major over samples)
+        self.n_res = n_res = s_idx.size
+        n_wl = self.n_wl
+        self.rows = np.repeat(np.arange(n_res), 4)
+        self.cols = np.stack(
+            [l_idx, n_wl + l_idx, np.full(n_res, 2 * n_wl), np.full(n_res, 2 * n_wl + 1)], 1
+        ).ravel()
+
+    def model(self, rho: np.ndarray, eps: np.ndarray, b: float, e: float) -> tuple[np.ndarray, ...]:
+        """The model sBRDF [sr-1] and its diffuse, specular and normalisation terms."""
+        a_d, b_s, gi = self.geo.components(b, e, self.cutoff)
         rho_s = 1.0 - (rho + eps)[None, :] * gi[:, None]
         pos = rho_s > 0
         f = rho[None, :] * a_d[:, None] + np.where(pos, rho_s, 0.0) * b_s[:, None]
-        return np.maximum(f, tiny), a_d, b_s, gi, pos
+        return np.maximum(f, np.finfo(np.float64).tiny), a_d, b_s, gi, pos
 
-    # -- start: grid over (b, e), linear relative-weighted LS for (rho_D, eps) --
-    b_grid = np.array([0.0, 0.03, 0.08, 0.15, 0.3, 0.6, 1.0])
-    e_grid = np.geomspace(1e-3, 1.0, 19)
-    w = np.where(use, 1.0 / (np.where(use, y, 1.0) * sig), 0.0)
-    best: tuple[float, np.ndarray, np.ndarray, float, float] | None = None
-    for b0 in b_grid:  # a handful of start nodes, vectorised over samples and wavelengths
-        for e0 in e_grid:
-            a_d, b_s, gi = geo.components(b0, e0, cutoff)
-            pcol = (a_d - gi * b_s)[:, None] * w
-            qcol = (-gi * b_s)[:, None] * w
-            rhs = (y - b_s[:, None]) * w
-            a11, a12, a22 = (pcol**2).sum(0), (pcol * qcol).sum(0), (qcol**2).sum(0)
-            r1, r2 = (pcol * rhs).sum(0), (qcol * rhs).sum(0)
-            det = a11 * a22 - a12**2
-            ok = np.abs(det) > 1e-300
-            dsafe = np.where(ok, det, 1.0)
-            rho0 = np.where(ok, (a22 * r1 - a12 * r2) / dsafe, 0.05)
-            eps0 = np.where(ok, (a11 * r2 - a12 * r1) / dsafe, 0.5)
-            rho0 = np.clip(rho0, 1e-4, 1.0)
-            eps0 = np.clip(eps0, 1e-4, 1.0)
-            g_b = float(normalisation_G(b0))
-            scale = np.minimum(1.0, 0.999 * g_b / (rho0 + eps0))
-            rho0, eps0 = rho0 * scale, eps0 * scale
-            f0 = model(rho0, eps0, b0, e0)[0]
-            cost = float(np.sum(np.where(use, ((np.log(f0) - ly) / sig) ** 2, 0.0)))
-            if best is None or cost < best[0]:
-                best = (cost, rho0, eps0, b0, e0)
-    assert best is not None
-    _, rho0, eps0, b0, e0 = best
+    def start(self) -> tuple[np.ndarray, np.ndarray, float, float]:
+        """Start: a grid over (b, e), linear relative-weighted LS for (rho_D, epsilon)."""
+        y, sig, use, ly = self.y, self.sig, self.use, self.ly
+        b_grid = np.array([0.0, 0.03, 0.08, 0.15, 0.3, 0.6, 1.0])
+        e_grid = np.geomspace(1e-3, 1.0, 19)
+        w = np.where(use, 1.0 / (np.where(use, y, 1.0) * sig), 0.0)
+        best: tuple[float, np.ndarray, np.ndarray, float, float] | None = None
+        for b0 in b_grid:  # a handful of start nodes, vectorised over samples and wavelengths
+            for e0 in e_grid:
+                a_d, b_s, gi = self.geo.components(b0, e0, self.cutoff)
+                pcol = (a_d - gi * b_s)[:, None] * w
+                qcol = (-gi * b_s)[:, None] * w
+                rhs = (y - b_s[:, None]) * w
+                a11, a12, a22 = (pcol**2).sum(0), (pcol * qcol).sum(0), (qcol**2).sum(0)
+                r1, r2 = (pcol * rhs).sum(0), (qcol * rhs).sum(0)
+                det = a11 * a22 - a12**2
+                ok = np.abs(det) > 1e-300
+                dsafe = np.where(ok, det, 1.0)
+                rho0 = np.where(ok, (a22 * r1 - a12 * r2) / dsafe, 0.05)
+                eps0 = np.where(ok, (a11 * r2 - a12 * r1) / dsafe, 0.5)
+                rho0 = np.clip(rho0, 1e-4, 1.0)
+                eps0 = np.clip(eps0, 1e-4, 1.0)
+                g_b = float(normalisation_G(b0))
+                scale = np.minimum(1.0, 0.999 * g_b / (rho0 + eps0))
+                rho0, eps0 = rho0 * scale, eps0 * scale
+                f0 = self.model(rho0, eps0, b0, e0)[0]
+                cost = float(np.sum(np.where(use, ((np.log(f0) - ly) / sig) ** 2, 0.0)))
+                if best is None or cost < best[0]:
+                    best = (cost, rho0, eps0, b0, e0)
+        assert best is not None
+        return best[1], best[2], best[3], best[4]
 
-    lower = np.concatenate([np.zeros(2 * n_wl), [0.0, np.log(1e-6)]])
-    upper = np.concatenate([np.ones(2 * n_wl), [10.0, np.log(10.0)]])
-    x0 = np.concatenate([rho0, eps0, [max(b0, 1e-3), np.log(e0)]])
-    x0 = np.clip(x0, lower + 1e-9, upper - 1e-9)
-
-    def unpack(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
+    def unpack(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
+        n_wl = self.n_wl
         return x[:n_wl], x[n_wl : 2 * n_wl], float(x[-2]), float(np.exp(x[-1]))
 
-    def resid(x: np.ndarray) -> np.ndarray:
-        rho, eps, b, e = unpack(x)
-        f = model(rho, eps, b, e)[0]
-        return ((np.log(f) - ly) / sig)[use]
+    def resid(self, x: np.ndarray) -> np.ndarray:
+        f = self.model(*self.unpack(x))[0]
+        return ((np.log(f) - self.ly) / self.sig)[self.use]
 
-    s_idx, l_idx = np.nonzero(use)  # residual order of resid() (row-major over samples)
-    n_res = s_idx.size
-    rows = np.repeat(np.arange(n_res), 4)
-    cols = np.stack(
-        [l_idx, n_wl + l_idx, np.full(n_res, 2 * n_wl), np.full(n_res, 2 * n_wl + 1)], 1
-    ).ravel()
-
-    def jac(x: np.ndarray) -> sparse.csr_matrix:
+    def jac(self, x: np.ndarray) -> sparse.csr_matrix:
         """Sparse Jacobian: a residual at wavelength l depends on rho_D[l], epsilon[l], b, ln e."""
-        rho, eps, b, e = unpack(x)
-        f, a_d, b_s, gi, pos = model(rho, eps, b, e)
+        n_wl, use, sig = self.n_wl, self.use, self.sig
+        f, a_d, b_s, gi, pos = self.model(*self.unpack(x))
         spec = np.where(pos, gi[:, None] * b_s[:, None], 0.0)
         d_rho = (a_d[:, None] - spec) / f
         d_eps = -spec / f
@@ -245,50 +291,34 @@ def fit_robertson_sandford(
             xp, xm = x.copy(), x.copy()
             xp[k] += step
             xm[k] -= step
-            fp = model(*unpack(xp))[0]
-            fm = model(*unpack(xm))[0]
+            fp = self.model(*self.unpack(xp))[0]
+            fm = self.model(*self.unpack(xm))[0]
             shared.append((np.log(fp) - np.log(fm)) / (2 * step))
         vals = (
             np.stack([d_rho[use], d_eps[use], shared[0][use], shared[1][use]], 1)
             / sig[use][:, None]
         )
-        return sparse.csr_matrix((vals.ravel(), (rows, cols)), shape=(n_res, 2 * n_wl + 2))
+        return sparse.csr_matrix(
+            (vals.ravel(), (self.rows, self.cols)), shape=(self.n_res, 2 * n_wl + 2)
+        )
 
-    sol = optimize.least_squares(
-        resid,
-        x0,
-        jac=jac,
-        bounds=(lower, upper),
-        method="trf",
-        x_scale="jac",
-        tr_solver="lsmr",
-        xtol=1e-12,
-        ftol=1e-12,
-        gtol=1e-12,
-        max_nfev=500,
-    )
-    n_par = 2 * n_wl + 2
-    chi2 = float(np.sum(sol.fun**2))
-    dof = max(n_res - n_par, 1)
-    chi2_red = chi2 / dof
-    jm = sol.jac
-    cov = np.linalg.pinv(np.asarray((jm.T @ jm).todense()) if sparse.issparse(jm) else jm.T @ jm)
-    if sigma is None:
-        cov = cov * chi2_red
-    u = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    rho, eps, b, e = unpack(sol.x)
-    return {
-        "rho_D": rho.copy(),
-        "epsilon": eps.copy(),
-        "b": b,
-        "e": e,
-        "u_rho_D": u[:n_wl],
-        "u_epsilon": u[n_wl : 2 * n_wl],
-        "u_b": float(u[-2]),
-        "u_e": float(e * u[-1]),
-        "covariance": cov,
-        "chi2_reduced": chi2_red,
-        "n_used": n_res,
-        "success": bool(sol.success),
-        "message": str(sol.message),
-    }
+    def solve(self, rho0: np.ndarray, eps0: np.ndarray, b0: float, e0: float) -> Any:
+        """Trust-region reflective least squares within the parameters' bounds."""
+        n_wl = self.n_wl
+        lower = np.concatenate([np.zeros(2 * n_wl), [0.0, np.log(1e-6)]])
+        upper = np.concatenate([np.ones(2 * n_wl), [10.0, np.log(10.0)]])
+        x0 = np.concatenate([rho0, eps0, [max(b0, 1e-3), np.log(e0)]])
+        x0 = np.clip(x0, lower + 1e-9, upper - 1e-9)
+        return optimize.least_squares(
+            self.resid,
+            x0,
+            jac=self.jac,
+            bounds=(lower, upper),
+            method="trf",
+            x_scale="jac",
+            tr_solver="lsmr",
+            xtol=1e-12,
+            ftol=1e-12,
+            gtol=1e-12,
+            max_nfev=500,
+        )

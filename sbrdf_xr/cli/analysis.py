@@ -255,7 +255,7 @@ def _isel(terms, items: list[str] | None, cube: str):
 def _unmix(args: argparse.Namespace):
     from .. import invert
     from ..errors import InversionError
-    from ..photometry import read_light_curve
+    from ..lightcurves import read_light_curve
 
     if args.range_km is not None and not (math.isfinite(args.range_km) and args.range_km > 0):
         raise InversionError(  # refused for a spectrum too, which does not use it
@@ -361,7 +361,7 @@ def _spin(args: argparse.Namespace):
     from .. import invert
     from ..engine import resolve_scene
     from ..errors import InversionError
-    from ..photometry import read_light_curve
+    from ..lightcurves import read_light_curve
 
     given = [
         name

@@ -40,6 +40,7 @@ import signal
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from .. import _startup, catalog
 from .._names import __version__
@@ -82,24 +83,8 @@ def _mesh_options(q: argparse.ArgumentParser) -> None:
     )
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of ``sbrdf-xr``.
-
-    Examples
-    --------
-    >>> from sbrdf_xr.cli.parser import build_parser
-    >>> args = build_parser().parse_args(
-    ...     ["simulate", "canx1-rotation", "-o", "cube.nc", "--preset", "fast"]
-    ... )
-    >>> args.command, args.scene, args.output, args.preset, args.complevel
-    ('simulate', 'canx1-rotation', 'cube.nc', 'fast', None)
-    """
-    p = argparse.ArgumentParser(
-        prog="sbrdf-xr", description="Spectral BRDF simulation of unresolved spacecraft."
-    )
-    p.add_argument("--version", action="version", version=f"sbrdf_xr {__version__}")
-    sub = p.add_subparsers(dest="command", required=True)
-
+def _add_catalog(sub: Any) -> None:
+    """``catalog list`` and ``catalog show``."""
     pc = sub.add_parser(
         "catalog", help="list or show the catalog entries (shipped, and SBRDF_XR_CATALOG_PATH)"
     )
@@ -111,6 +96,9 @@ def build_parser() -> argparse.ArgumentParser:
     ps.add_argument("name")
     ps.set_defaults(func=cmd_catalog_show)
 
+
+def _add_info_and_knobs(sub: Any) -> None:
+    """``info`` and ``knobs``."""
     pi = sub.add_parser("info", help="versions, or a summary of a netCDF file")
     pi.add_argument("file", nargs="?")
     pi.set_defaults(func=cmd_info)
@@ -120,6 +108,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     pk.set_defaults(func=cmd_knobs)
 
+
+def _add_bench(sub: Any) -> None:
+    """``bench``: the accuracy and cost tables."""
     pb = sub.add_parser("bench", help="accuracy/cost benchmarks (timings as ratios)")
     pb.add_argument("--quick", action="store_true", help="small problems, for a smoke run")
     pb.add_argument(
@@ -144,6 +135,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     pb.set_defaults(func=cmd_bench)
 
+
+def _add_simulate(sub: Any) -> None:
+    """``simulate``: a scene into a cube, with its knobs, output and resume options."""
     psim = sub.add_parser("simulate", help="run a scene into a netCDF cube")
     psim.add_argument(
         "scene", help=f"built-in scene name ({', '.join(builtin_scenes())}) or a TOML file"
@@ -215,6 +209,9 @@ def build_parser() -> argparse.ArgumentParser:
     psim.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     psim.set_defaults(func=cmd_simulate)
 
+
+def _add_photometry(sub: Any) -> None:
+    """``photometry``: band magnitudes and colours of a cube."""
     pph = sub.add_parser("photometry", help="band magnitudes and colours of a cube")
     pph.add_argument("cube", help="netCDF cube written by 'sbrdf-xr simulate'")
     pph.add_argument(
@@ -269,6 +266,9 @@ def build_parser() -> argparse.ArgumentParser:
     pph.add_argument("--overwrite", action="store_true", help="replace existing output files")
     pph.set_defaults(func=cmd_photometry)
 
+
+def _add_invert(sub: Any) -> None:
+    """``invert unmix`` and ``invert spin``."""
     pinv = sub.add_parser("invert", help="materials or spin state from measured data")
     isub = pinv.add_subparsers(dest="invert_command", required=True)
     pu = isub.add_parser("unmix", help="material areas from a measured spectrum or band magnitudes")
@@ -354,9 +354,9 @@ def build_parser() -> argparse.ArgumentParser:
         q.add_argument("--overwrite", action="store_true", help="replace an existing output file")
         q.set_defaults(func=cmd_invert)
 
-    add_observe_parser(sub, _mesh_options)
-    add_material_parser(sub)
 
+def _add_plot(sub: Any) -> None:
+    """``plot``: a cube's figure."""
     pp = sub.add_parser(
         "plot",
         help="draw a cube's figure",
@@ -368,6 +368,35 @@ def build_parser() -> argparse.ArgumentParser:
     pp.add_argument("-o", "--output", required=True, help="the image file (PNG, PDF, SVG, ...)")
     pp.add_argument("--overwrite", action="store_true", help="replace an existing image file")
     pp.set_defaults(func=cmd_plot)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of ``sbrdf-xr``.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.cli.parser import build_parser
+    >>> args = build_parser().parse_args(
+    ...     ["simulate", "canx1-rotation", "-o", "cube.nc", "--preset", "fast"]
+    ... )
+    >>> args.command, args.scene, args.output, args.preset, args.complevel
+    ('simulate', 'canx1-rotation', 'cube.nc', 'fast', None)
+    """
+    p = argparse.ArgumentParser(
+        prog="sbrdf-xr", description="Spectral BRDF simulation of unresolved spacecraft."
+    )
+    p.add_argument("--version", action="version", version=f"sbrdf_xr {__version__}")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    _add_catalog(sub)
+    _add_info_and_knobs(sub)
+    _add_bench(sub)
+    _add_simulate(sub)
+    _add_photometry(sub)
+    _add_invert(sub)
+    add_observe_parser(sub, _mesh_options)
+    add_material_parser(sub)
+    _add_plot(sub)
     return p
 
 

@@ -417,32 +417,7 @@ def compile_plan(scene: SceneView) -> Plan:
     params.update(late_params)
 
     # ---- outputs: the scene's, then those of the effects that run
-    names = []
-    wanted = [SCENE_OUTPUTS[o] for o in scene.outputs]
-    for e in active:  # an effect's own, or those its planner names in params["outputs"]
-        filled = params.get(e, {}).get("outputs")
-        wanted += [o.name for o in EFFECTS[e].declares if filled is None or o.name in filled]
-    for v in wanted:
-        if pre and OUTPUTS[v].tail and OUTPUTS[v].tail[-1] == WAVELENGTH:
-            continue
-        if v not in names:
-            names.append(v)
-    sizes = {WAVELENGTH: wl.size, BAND: len(scene.bands), MATERIAL: len(used), FACET: terms.size}
-    lead_dims, lead_shape = geo.dims, geo.shape
-    outputs = []
-    for v in names:
-        spec = OUTPUTS[v]
-        dt = dtype if spec.spectral else np.dtype(np.float64)
-        outputs.append(
-            PlannedOutput(
-                v,
-                (*lead_dims, *spec.tail),
-                (*lead_shape, *(sizes[d] for d in spec.tail)),
-                dt,
-                MappingProxyType(spec.attrs),
-            )
-        )
-    steps.append(("outputs", ", ".join(names)))
+    outputs = _planned_outputs(scene, geo, active, params, terms.size, pre, wl, used, dtype, steps)
 
     # ---- blocks and estimate
     per_lead = sum(o.nbytes for o in outputs) / max(1, geo.n_lead)
@@ -472,11 +447,97 @@ def compile_plan(scene: SceneView) -> Plan:
     steps.append(
         (
             "blocks",
-            f"{n_blocks} blocks of {chunk} {lead_dims[0]}s, {describe_bytes(per_lead * chunk)} "
+            f"{n_blocks} blocks of {chunk} {geo.dims[0]}s, {describe_bytes(per_lead * chunk)} "
             f"each; {describe_bytes(out_bytes)} of outputs, at most {work:.3g} multiply-adds",
         )
     )
 
+    attrs = _cube_attrs(scene, geo, knobs, dtype, active, used, fingerprint)
+    plan = Plan(
+        name=scene.name,
+        description=scene.description,
+        spacecraft=scene.spacecraft,
+        geometry=geo,
+        terms=terms,
+        materials=tuple(used),
+        tables=sx.tables,
+        wavelength=readonly(wl),
+        bands=tuple(scene.bands),
+        band_weights=None if bw is None else readonly(bw),
+        band_coords=MappingProxyType(sx.band_coords),
+        pre_integrated=pre,
+        merged=merged,
+        effects=tuple(active),
+        effect_params=MappingProxyType(params),
+        models=MappingProxyType(sx.models),
+        knobs=MappingProxyType(knobs),
+        outputs=tuple(outputs),
+        chunk=int(chunk),
+        estimate=est,
+        steps=tuple(steps),
+        attrs=MappingProxyType(attrs),
+        anisotropic=MappingProxyType(sx.anisotropic),
+        articulation=Articulation(parts, group_terms(terms)) if parts else None,
+    )
+    attrs["plan"] = str(plan)
+    return plan
+
+
+def _planned_outputs(
+    scene: SceneView,
+    geo: Any,
+    active: list[str],
+    params: dict[str, Any],
+    n_terms: int,
+    pre: bool,
+    wl: np.ndarray,
+    used: list[str],
+    dtype: np.dtype,
+    steps: list[tuple[str, str]],
+) -> list[PlannedOutput]:
+    """The cube's variables: the scene's outputs, then those of the effects that run
+    (an effect's own, or those its planner names in ``params[effect]["outputs"]``; no
+    spectral ones when the tables are pre-integrated over the bands)."""
+    names = []
+    wanted = [SCENE_OUTPUTS[o] for o in scene.outputs]
+    for e in active:
+        filled = params.get(e, {}).get("outputs")
+        wanted += [o.name for o in EFFECTS[e].declares if filled is None or o.name in filled]
+    for v in wanted:
+        if pre and OUTPUTS[v].tail and OUTPUTS[v].tail[-1] == WAVELENGTH:
+            continue
+        if v not in names:
+            names.append(v)
+    sizes = {WAVELENGTH: wl.size, BAND: len(scene.bands), MATERIAL: len(used), FACET: n_terms}
+    lead_dims, lead_shape = geo.dims, geo.shape
+    outputs = []
+    for v in names:
+        spec = OUTPUTS[v]
+        dt = dtype if spec.spectral else np.dtype(np.float64)
+        outputs.append(
+            PlannedOutput(
+                v,
+                (*lead_dims, *spec.tail),
+                (*lead_shape, *(sizes[d] for d in spec.tail)),
+                dt,
+                MappingProxyType(spec.attrs),
+            )
+        )
+    steps.append(("outputs", ", ".join(names)))
+    return outputs
+
+
+def _cube_attrs(
+    scene: SceneView,
+    geo: Any,
+    knobs: dict[str, Any],
+    dtype: np.dtype,
+    active: list[str],
+    used: list[str],
+    fingerprint: dict[str, Any],
+) -> dict[str, Any]:
+    """The cube's global attributes: CF conventions, provenance, the knobs, the effects,
+    the materials' provenance, the geometry's and the scene's fingerprint."""
     provenance = {m: scene.material_data[m].attrs.get("provenance", "") for m in used}
     attrs = {
         "Conventions": "CF-1.10",
@@ -507,31 +568,4 @@ def compile_plan(scene: SceneView) -> Plan:
         **geo.attrs,
         **fingerprint,  # checked when an interrupted write is resumed
     }
-    plan = Plan(
-        name=scene.name,
-        description=scene.description,
-        spacecraft=scene.spacecraft,
-        geometry=geo,
-        terms=terms,
-        materials=tuple(used),
-        tables=sx.tables,
-        wavelength=readonly(wl),
-        bands=tuple(scene.bands),
-        band_weights=None if bw is None else readonly(bw),
-        band_coords=MappingProxyType(sx.band_coords),
-        pre_integrated=pre,
-        merged=merged,
-        effects=tuple(active),
-        effect_params=MappingProxyType(params),
-        models=MappingProxyType(sx.models),
-        knobs=MappingProxyType(knobs),
-        outputs=tuple(outputs),
-        chunk=int(chunk),
-        estimate=est,
-        steps=tuple(steps),
-        attrs=MappingProxyType(attrs),
-        anisotropic=MappingProxyType(sx.anisotropic),
-        articulation=Articulation(parts, group_terms(terms)) if parts else None,
-    )
-    attrs["plan"] = str(plan)
-    return plan
+    return attrs

@@ -51,11 +51,12 @@ magnitude system the light curve states (AB or Vega).
 
 from ..errors import FitQualityWarning, InversionError
 from ._areas import material_areas
-from ._bench import benchmark_spin_search
 from ._data import band_terms, magnitudes_to_signal, measured_kind, read_spectrum
-from ._joint import JOINT_CAUSES, fit_observation
-from ._joint_study import observation_recovery, simulated_light_curve
-from ._spin import (
+from ._joint.fit import JOINT_CAUSES, fit_observation
+from ._joint.study import observation_recovery, simulated_light_curve
+from ._spin.bench import benchmark_spin_search
+from ._spin.data import light_curve_fluxes
+from ._spin.fit import (
     AMBIGUITY_CHI2,
     SEARCH_BYTES_LIMIT,
     SEARCH_WORK_LIMIT,
@@ -66,8 +67,7 @@ from ._spin import (
     period_grid,
     search_size,
 )
-from ._spin_data import light_curve_fluxes
-from ._spin_search import fibonacci_sphere, spin_model
+from ._spin.search import fibonacci_sphere, spin_model
 from ._studies import spin_recovery, unmix_calibration
 from ._unmix import DEGENERACY_THRESHOLD, DROP_BIAS, unmix
 

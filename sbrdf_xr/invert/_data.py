@@ -12,7 +12,7 @@ import xarray as xr
 
 from ..errors import InversionError, check_declared_size
 from ..units import check_plausible, to_unit
-from ._spin_data import LN10_2P5
+from ._spin.data import LN10_2P5
 
 __all__ = ["band_terms", "magnitudes_to_signal", "measured_kind", "read_spectrum"]
 

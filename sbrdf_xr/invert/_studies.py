@@ -198,7 +198,7 @@ def spin_recovery(
     from ..geometry import rotation_matrices
     from ..observing import Inertial, Spin
     from ..observing.frames import axis_vector as body_axis
-    from ._spin import axis_separation, fit_spin
+    from ._spin.fit import axis_separation, fit_spin
 
     law = observation.attitude
     if not isinstance(law, Spin) or not isinstance(law.initial, Inertial):

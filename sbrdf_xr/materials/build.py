@@ -11,7 +11,6 @@ and every row can be renormalised to the model's directional-hemispherical refle
 from __future__ import annotations
 
 import functools
-import threading
 from collections.abc import Callable
 from typing import Any
 
@@ -23,24 +22,19 @@ from .._names import DELTA_THETA, MEASURED, PHI, SAMPLE, THETA_I, WAVELENGTH
 from ..errors import ValidationError
 from ..kernels import lut as _lut
 from ..units import to_unit
+from . import _fill as fill
 from . import models
-from ._jobs import _by_rows, _Done, _Job, _Parts
+from ._jobs import _Job, _Parts
 from .construction import (
-    _held_product,
     azimuthal_average,
-    blend_weights,
-    extend_grid,
     lut_edges,
     paper_delta_theta_grid,
     paper_phi_grid,
-    per_theta_tables,
 )
 from .coverage import (
     _at_horizon,
     _coverage_attrs,
     _in_plane_phi_grid,
-    _ratio_across_theta,
-    _ratio_tables,
     _resolve_below_noise,
     _specular_nodes,
     scan_layout,
@@ -318,18 +312,7 @@ def build_lut(
     ds = validate_measurements(measurements, duplicates=duplicates)
     if duplicates == "mean":
         ds = average_duplicates(ds)
-    if extrapolation not in EXTRAPOLATIONS:
-        raise ValidationError(
-            f"extrapolation: got {extrapolation!r}; allowed: {', '.join(EXTRAPOLATIONS)}"
-        )
-    if normal_incidence not in ("paper", "symmetric"):
-        raise ValidationError(
-            f"normal_incidence: got {normal_incidence!r}; allowed: symmetric, paper"
-        )
-    if below_noise not in BELOW_NOISE:
-        raise ValidationError(
-            f"below_noise: got {below_noise!r}; allowed: {', '.join(BELOW_NOISE)}"
-        )
+    _check_policies(extrapolation, normal_incidence, below_noise)
     ref = reference_mask(ds)
     ti_s, dt_s, ph_s = (snap_angles(ds[d].values) for d in (THETA_I, DELTA_THETA, PHI))
     measured_ti = np.unique(ti_s)
@@ -340,17 +323,7 @@ def build_lut(
     rows_only = all(lay == "rows" for lay in layouts)
     if extrapolation == "auto":
         extrapolation = "cubic" if rows_only else "model"
-    if renormalise not in RENORMALISE:
-        raise ValidationError(
-            f"renormalise: got {renormalise!r}; allowed: {', '.join(RENORMALISE)}"
-        )
-    if renormalise == "auto":  # keep measured values where the data are not in rows
-        renormalise = "model" if below_noise == "model" and rows_only else "none"
-    elif renormalise == "model" and below_noise != "model":
-        raise ValidationError(
-            "renormalise: 'model' corrects a table made of a model times a ratio and needs "
-            f"below_noise='model', got below_noise={below_noise!r}"
-        )
+    renormalise = _resolve_renormalise(renormalise, below_noise, rows_only)
     report = progress or _no_progress
     report(0.0, "measurements")
     wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
@@ -361,12 +334,7 @@ def build_lut(
             "theta_i: need measurements at >= 2 incidence angles to build a table, "
             f"got {measured_ti.tolist()}"
         )
-    if all(lay == "in-plane" for lay in layouts):  # the scans' own nodes
-        dt_grid = _specular_nodes(dt_s)
-        phi_grid = _in_plane_phi_grid(float(np.median(np.diff(np.unique(dt_s)))))
-    else:
-        phi_grid = paper_phi_grid(ph_s.max(), n_phi)
-        dt_grid = paper_delta_theta_grid(dt_s.min(), dt_s.max(), n_delta_theta)
+    dt_grid, phi_grid = _angle_grids(layouts, dt_s, ph_s, n_phi, n_delta_theta)
     ti_out = np.arange(0.0, 91.0) if theta_i is None else np.asarray(theta_i, dtype=np.float64)
     if theta_i is None and not rows_only:  # the measured incidence angles are rows
         ti_out = np.union1d(ti_out, measured_ti)
@@ -383,74 +351,19 @@ def build_lut(
     steps = {k: v for k, v in _MODEL_STEPS.items() if rho_given is None or k != "model reflectance"}
     parts = _Parts(report, steps)
     rho_job: _Job | None = None
+    samples = fill.Samples(measured_ti, ti_s, dt_s, ph_s, spectra, ref, rows_only, wl)
+    grid = fill.Grid(ti_out, dt_grid, phi_grid, lam)
     if below_noise == "zero":
-        # Table edges: zero beyond them if the extreme samples are reference points.
-        edges = {
-            "edge_delta_theta_min": "zero" if np.all(ref[dt_s == dt_s.min()]) else "hold",
-            "edge_delta_theta_max": "zero" if np.all(ref[dt_s == dt_s.max()]) else "hold",
-            "edge_phi_max": "zero" if np.all(ref[ph_s == ph_s.max()]) else "hold",
-        }
-        per_theta = per_theta_tables(measured_ti, ti_s, dt_s, ph_s, spectra, ref, dt_grid, phi_grid)
-        spline_mode = "linear" if extrapolation == "model" else extrapolation
-        e = _lut.smoothing_spline_matrix(measured_ti, ti_out, lam, spline_mode)
-        lut = np.tensordot(e, per_theta, axes=(1, 0))
-        np.maximum(lut, 0.0, out=lut)
-        if extrapolation == "model":
-            assert fit_model is not None  # fitted above whenever a model is used
-            w = blend_weights(ti_out, measured_ti[0], measured_ti[-1], blend)
-            rows = np.flatnonzero(w > 0)
-            if rows.size:
-                report(0.1, "model on the grid")
-                filled = _model_rows(fit_model, ti_out[rows], dt_grid, phi_grid, wl)
-                wr = w[rows][:, None, None, None]
-                lut[rows] = (1.0 - wr) * lut[rows] + wr * filled
+        lut, edges = fill.zero_below_noise(samples, grid, extrapolation, fit_model, blend, report)
+        base = lut  # not used: renormalise="model" needs below_noise="model"
     else:
         assert fit_model is not None  # fitted above whenever a model is used
-        dt_grid = extend_grid(dt_grid, -180.0, 90.0)
-        phi_grid = extend_grid(phi_grid, phi_grid[0], 90.0)
         if not rows_only:
             extra.update(_coverage_attrs(layouts, measured_ti, fit_model))
-        # Beyond -180/90 and phi = 90 lies the far side of the horizon: nothing to hold.
-        edges = {
-            "edge_delta_theta_min": "zero",
-            "edge_delta_theta_max": "zero",
-            "edge_phi_max": "zero",
-        }
-        report(0.0, "ratio to the model")
-        truth_s = _model_at(fit_model, ti_s, dt_s, ph_s, wl)
-        ok = ~ref
-        ratio = np.divide(spectra, truth_s, out=np.ones_like(spectra), where=truth_s > 0)
-        per_theta, _ = _ratio_tables(
-            measured_ti, ti_s[ok], dt_s[ok], ph_s[ok], ratio[ok], dt_grid, phi_grid
+        lut, base, edges, rho_job, grid = fill.model_ratio(
+            samples, grid, extrapolation, fit_model, blend, report, renormalise, rho_given, parts
         )
-        if rows_only:
-            spline_mode = "constant" if extrapolation == "model" else extrapolation
-            e = _lut.smoothing_spline_matrix(measured_ti, ti_out, lam, spline_mode)
-            r_lut = np.tensordot(e, per_theta, axes=(1, 0))
-            np.maximum(r_lut, 0.0, out=r_lut)
-        else:  # orders of magnitude between incidence angles: no overshoot below zero
-            r_lut = _ratio_across_theta(measured_ti, per_theta, ti_out)
-        if extrapolation == "model":
-            # Towards grazing incidence the measured ratio does not carry over (the
-            # lobe meets the horizon): the model alone, reached over ``blend`` degrees.
-            w = blend_weights(ti_out, -np.inf, measured_ti[-1], blend)[:, None, None, None]
-            r_lut *= 1.0 - w  # in place: (1 - w) r + w, one table in memory
-            r_lut += w
-        if renormalise == "model" and rho_given is not None:
-            rho_job = _Done(rho_given)
-        elif renormalise == "model":  # the model's reflectance, while the grid is filled
-            rho_job = _Job(
-                _model_reflectance, fit_model, ti_out, wl, parts.part("model reflectance")
-            )
-        try:
-            base = _model_rows(fit_model, ti_out, dt_grid, phi_grid, wl, parts.part("model grid"))
-        except BaseException:
-            if rho_job is not None:
-                rho_job.cancel()
-            raise
-        lut = _held_product(base, r_lut, ti_out, dt_grid, renormalise == "model")
-        if extrapolation == "model" and renormalise == "none":
-            _bound_grazing_rows(lut, ti_out, dt_grid, phi_grid, wl, fit_model, measured_ti[-1])
+        dt_grid, phi_grid = grid.dt, grid.phi
     if fit_model is not None and (extrapolation == "model" or below_noise == "model"):
         extra.update(
             extrapolation_model=fit_model.attrs.get("model", ""),
@@ -466,7 +379,7 @@ def build_lut(
     if renormalise == "model":
         if rho_job is None:  # pragma: no cover - below_noise="model" needs the model
             raise ValidationError("renormalise='model' needs the table's model")
-        _renormalise_rows(
+        fill._renormalise_rows(
             lut,
             base,
             (ti_out, dt_grid, phi_grid),
@@ -510,21 +423,79 @@ def build_lut(
         **edges,
         **extra,
     )
-    samples = (ds, (ti_s, dt_s, ph_s), spectra, ref)
-    out.attrs.update(_self_check(out, *samples, floor=check_floor, bound=check_bound))
-    if check_energy:
-        report(0.95, "energy check")
-        _check_energy_conservation(out, np.unique(np.concatenate([ti_out[::5], ti_out[-1:]])))
+    measured = (ds, (ti_s, dt_s, ph_s), spectra, ref)
+    _check_table(out, measured, ti_out, call, report, check_floor, check_bound, check_energy)
     if holdout and not rows_only:  # a fitted fill: predict samples it has not seen
         report(0.97, "leave-out check")
         opts = {**call, "holdout": 0, "check_energy": check_energy == "clamp" and "clamp"}
         opts["progress"] = None
         rebuild = functools.partial(build_lut, **opts)  # a fit's name: the held-in's own fit
-        out.attrs.update(_holdout_check(rebuild, *samples, every=int(holdout), floor=check_floor))
+        out.attrs.update(_holdout_check(rebuild, *measured, every=int(holdout), floor=check_floor))
     # last: shown by print(table) beside the checks
     out.attrs.update({k: out.attrs.pop(k) for k in ("layout", "modelled") if k in out.attrs})
     report(1.0, "built")
     return out
+
+
+def _check_table(
+    out: xr.DataArray,
+    measured: tuple[Any, ...],
+    ti_out: np.ndarray,
+    call: dict[str, Any],
+    report: Callable[[float, str], None],
+    floor: float,
+    bound: float,
+    check_energy: bool | str,
+) -> None:
+    """The table against its own samples, and (``check_energy``) its energy bound."""
+    out.attrs.update(_self_check(out, *measured, floor=floor, bound=bound))
+    if check_energy:
+        report(0.95, "energy check")
+        _check_energy_conservation(out, np.unique(np.concatenate([ti_out[::5], ti_out[-1:]])))
+
+
+def _check_policies(extrapolation: str, normal_incidence: str, below_noise: str) -> None:
+    """The policies of :func:`build_lut` are among those it knows."""
+    if extrapolation not in EXTRAPOLATIONS:
+        raise ValidationError(
+            f"extrapolation: got {extrapolation!r}; allowed: {', '.join(EXTRAPOLATIONS)}"
+        )
+    if normal_incidence not in ("paper", "symmetric"):
+        raise ValidationError(
+            f"normal_incidence: got {normal_incidence!r}; allowed: symmetric, paper"
+        )
+    if below_noise not in BELOW_NOISE:
+        raise ValidationError(
+            f"below_noise: got {below_noise!r}; allowed: {', '.join(BELOW_NOISE)}"
+        )
+
+
+def _resolve_renormalise(renormalise: str, below_noise: str, rows_only: bool) -> str:
+    """``renormalise`` checked, and ``"auto"`` resolved from the data's layout."""
+    if renormalise not in RENORMALISE:
+        raise ValidationError(
+            f"renormalise: got {renormalise!r}; allowed: {', '.join(RENORMALISE)}"
+        )
+    if renormalise == "auto":  # keep measured values where the data are not in rows
+        return "model" if below_noise == "model" and rows_only else "none"
+    if renormalise == "model" and below_noise != "model":
+        raise ValidationError(
+            "renormalise: 'model' corrects a table made of a model times a ratio and needs "
+            f"below_noise='model', got below_noise={below_noise!r}"
+        )
+    return renormalise
+
+
+def _angle_grids(
+    layouts: list[str], dt_s: np.ndarray, ph_s: np.ndarray, n_phi: int, n_delta_theta: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """The ``delta_theta`` and ``phi`` grids [degree]: the in-plane scans' own nodes, or
+    the paper's grids over the measured span."""
+    if all(lay == "in-plane" for lay in layouts):  # the scans' own nodes
+        dt_grid = _specular_nodes(dt_s)
+        return dt_grid, _in_plane_phi_grid(float(np.median(np.diff(np.unique(dt_s)))))
+    phi_grid = paper_phi_grid(ph_s.max(), n_phi)
+    return paper_delta_theta_grid(dt_s.min(), dt_s.max(), n_delta_theta), phi_grid
 
 
 def _no_progress(fraction: float, step: str) -> None:
@@ -540,133 +511,3 @@ _MODEL_STEPS = {
     "table reflectance": 0.2,
     "energy check": 0.05,
 }
-
-
-def _model_reflectance(
-    model: xr.Dataset,
-    ti: np.ndarray,
-    wl: np.ndarray,
-    done: Callable[[float], None],
-    stop: threading.Event | None = None,
-) -> np.ndarray:
-    """The model's directional-hemispherical reflectance at every row ``(ti, wl)``."""
-    mod, _, kw = models.model_parameters(_model_for(model, wl))
-    return _by_rows(
-        lambda t: mod.directional_hemispherical_reflectance(np.minimum(t, 90.0), wl, **kw),
-        ti,
-        done,
-        stop,
-    )
-
-
-def _bound_grazing_rows(
-    lut: np.ndarray,
-    ti: np.ndarray,
-    dt: np.ndarray,
-    ph: np.ndarray,
-    wl: np.ndarray,
-    model: xr.Dataset,
-    above: float,
-) -> None:
-    """Scale every row above the measured incidence angles whose reflectance exceeds the
-    model's (in place), so that grazing extrapolation never creates energy: a glossy
-    lobe meeting the horizon between grid nodes is overestimated by interpolation."""
-    rows = np.flatnonzero(ti > above)
-    if rows.size == 0:
-        return
-    mod, _, kw = models.model_parameters(_model_for(model, wl))
-    rho_m = mod.directional_hemispherical_reflectance(np.minimum(ti[rows], 90.0), wl, **kw)
-    rho_t = _lut.hemispherical_reflectance_kernel(
-        lut, ti, dt, ph, ti[rows], "linear", zero_edges=(True, True, True)
-    )
-    scale = np.where(rho_t > rho_m, rho_m / np.maximum(rho_t, 1e-300), 1.0)
-    lut[rows] *= scale[:, None, None, :]
-
-
-def _renormalise_rows(
-    lut: np.ndarray,
-    base: np.ndarray,
-    grids: tuple[np.ndarray, np.ndarray, np.ndarray],
-    rho_job: _Job,
-    zero_edges: tuple[bool, bool, bool],
-    normal_blend: float,
-    parts: _Parts,
-) -> None:
-    """Scale every row ``(theta_i, wavelength)`` of ``lut`` (in place) by the energy its
-    model loses or gains on the grid: ``rho_model / rho_grid``, with ``rho_model`` the
-    model's own directional-hemispherical reflectance and ``rho_grid`` that of ``base``
-    (the model rendered on the table grid) by the quadrature of the look-up's
-    interpolant (:func:`sbrdf_xr.kernels.lut.hemispherical_reflectance_kernel`), the
-    model's computed by ``rho_job`` in the background."""
-    ti = grids[0]
-    tg, dg, pg = grids
-    try:
-        rho_g = _by_rows(
-            lambda t: _lut.hemispherical_reflectance_kernel(
-                base, tg, dg, pg, t, "linear", zero_edges=zero_edges, normal_blend=normal_blend
-            ),
-            ti,
-            parts.part("table reflectance"),
-        )
-    except BaseException:
-        rho_job.cancel()
-        raise
-    rho_m = rho_job.result(lambda: parts.part("model reflectance")(parts.done["model reflectance"]))
-    scale = np.divide(rho_m, rho_g, out=np.ones_like(rho_m), where=rho_g > 0)
-    # Below ``normal_blend`` a look-up mixes the row with the theta_i = 0 profile: with
-    # that profile already scaled, the row's own part takes the rest.
-    blended = np.flatnonzero((ti > 0) & (ti < normal_blend)) if ti[0] == 0.0 else np.zeros(0, int)
-    if len(blended):
-        idx = np.concatenate([[0], blended])
-        sub = base[idx].copy()
-        sub[0] *= scale[0]
-        both = _lut.hemispherical_reflectance_kernel(
-            sub, ti[idx], dg, pg, None, zero_edges=zero_edges, normal_blend=normal_blend
-        )[1:]
-        sub[1:] = 0.0
-        part0 = _lut.hemispherical_reflectance_kernel(
-            sub, ti[idx], dg, pg, None, zero_edges=zero_edges, normal_blend=normal_blend
-        )[1:]
-        own = both - part0
-        scale[blended] = np.divide(rho_m[blended] - part0, own, out=scale[blended], where=own > 0)
-    lut *= scale[:, None, None, :]
-
-
-def _model_for(model: xr.Dataset, wl: np.ndarray) -> xr.Dataset:
-    if not np.array_equal(np.asarray(model[WAVELENGTH].values), wl):
-        model = model.interp({WAVELENGTH: wl})
-    return model
-
-
-def _model_rows(
-    model: xr.Dataset,
-    ti: np.ndarray,
-    dt: np.ndarray,
-    ph: np.ndarray,
-    wl: np.ndarray,
-    done: Callable[[float], None] | None = None,
-) -> np.ndarray:
-    """A model material rendered on the table grid (rows ``ti``) at wavelengths ``wl``
-    (below-horizon nodes carry the limit from the hemisphere,
-    :func:`sbrdf_xr.materials.models.render`)."""
-    mod, _, kw = models.model_parameters(_model_for(model, wl))
-    out = np.empty((ti.size, dt.size, ph.size, wl.size))
-    step = max(1, _RENDER_CHUNK // (dt.size * ph.size * wl.size))
-    for a in range(0, ti.size, step):  # a few rows at a time: bounded temporaries
-        if done is not None:
-            done(a / ti.size)
-        out[a : a + step] = models.render_values(mod, ti[a : a + step], dt, ph, wl, kw)
-    if done is not None:
-        done(1.0)
-    return out
-
-
-#: Table values rendered at once by :func:`_model_rows` (bounds its temporaries).
-_RENDER_CHUNK = 2_000_000
-
-
-def _model_at(
-    model: xr.Dataset, ti: np.ndarray, dt: np.ndarray, ph: np.ndarray, wl: np.ndarray
-) -> np.ndarray:
-    """A model material's spectra at sample geometries (1-D angle arrays)."""
-    return models.spectra(_model_for(model, wl), ti, dt, ph)

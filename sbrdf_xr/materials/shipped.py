@@ -22,7 +22,7 @@ import xarray as xr
 from .._names import THETA_I, WAVELENGTH
 from .._output import write_netcdf
 from . import models
-from .build import _model_reflectance
+from ._fill import _model_reflectance
 from .cache import build_modules
 
 __all__ = ["REFLECTANCE_SUFFIX", "read_reflectance", "reflectance_digest", "write_reflectance"]

@@ -18,11 +18,8 @@ The chain from a simulation cube to what a telescope measures:
    band numbers to float rounding.
 4. :func:`band_signal` and :func:`magnitudes` from a cube; :func:`colour_indices`;
    :func:`srgb` swatches; :func:`photometry` bundles them (``ds.sbrdf.photometry``).
-5. :func:`read_light_curve` (CSV, ECSV, FITS, VOTable, netCDF; long or wide tables in
-   any row order, magnitudes or fluxes, UTC times or Julian dates; filter names mapped
-   by :func:`band_label`), :func:`compare` (a measured light curve against a simulated
-   pass or rotation sweep: zero points, extinction, time shift or rotation phase, with
-   uncertainties) and :func:`plot_comparison`.
+5. Measured light curves (reading observers' tables, the comparison with a simulation,
+   its figure) are the package :mod:`sbrdf_xr.lightcurves`, which builds on this one.
 6. :mod:`~sbrdf_xr.photometry.atmosphere` - air mass (:func:`airmass`, pvlib's
    models), extinction (:func:`apply_extinction`, :func:`transmission` folded into
    the band weights); :func:`standard_magnitude` (to a range, a phase angle, 1 AU),
@@ -46,9 +43,12 @@ naming the argument); bare wavelength axes and ranges far outside their unit's s
 with the likely mistake.
 
 Modules: ``spectra`` (reference spectra, quadrature), ``bands``, ``magnitude``,
-``atmosphere``, ``standard``, ``colour``, ``colour_science``, ``filter_names``, ``measured``,
-``lightcurves``, ``files``, ``agreement`` (predicted against observed magnitudes after one
-zero point: :func:`compare_magnitudes`, :func:`binned_residuals`).
+``atmosphere``, ``standard``, ``colour``, ``colour_science``, ``inband``, ``infrared``,
+``files``.  The names of the measured-light-curve workflow that lived here
+(``read_light_curve``, ``compare``, ``plot_comparison``,
+``compare_magnitudes``, ...) are served under this old path until the next release, with a
+:class:`~sbrdf_xr.errors.RenamedWarning` naming their new place in
+:mod:`sbrdf_xr.lightcurves`.
 
 Conventions
 -----------
@@ -127,9 +127,11 @@ magnitude are NaN (the colour is undefined).  A negative band signal (possible o
 with noisy tables) gives a NaN magnitude.
 """
 
-from ..errors import renamed_attributes
+import importlib as _importlib
+from typing import Any as _Any
+
+from ..errors import renamed_attributes as _renamed_attributes
 from . import (
-    agreement,
     atmosphere,
     bands,
     colour,
@@ -137,13 +139,10 @@ from . import (
     files,
     inband,
     infrared,
-    lightcurves,
     magnitude,
-    measured,
     spectra,
     standard,
 )
-from .agreement import binned_residuals, compare_magnitudes
 from .atmosphere import (
     AIRMASS_MODELS,
     airmass,
@@ -165,17 +164,8 @@ from .bands import (
 from .colour import srgb
 from .colour_science import from_colour, to_colour
 from .files import cf_decode, cf_encode, open_photometry, to_netcdf
-from .filter_names import band_label
 from .inband import in_band
-from .lightcurves import compare, compare_light_curves, plot_comparison
 from .magnitude import band_signal, colour_indices, magnitudes, photometry, sun_magnitudes
-from .measured import (
-    LIGHT_CURVE_ABSCISSAE,
-    LIGHT_CURVE_COLUMNS,
-    LIGHT_CURVE_OPTIONAL,
-    TABLE_FORMATS,
-    read_light_curve,
-)
 from .spectra import (
     AB_ZERO_POINT_JY,
     MAGNITUDE_SYSTEMS,
@@ -202,36 +192,26 @@ __all__ = [
     "AB_ZERO_POINT_JY",
     "AIRMASS_MODELS",
     "BAND_ALIASES",
-    "LIGHT_CURVE_ABSCISSAE",
-    "LIGHT_CURVE_COLUMNS",
-    "LIGHT_CURVE_OPTIONAL",
     "MAGNITUDE_SYSTEMS",
     "PHASE_FUNCTIONS",
     "QUADRATURES",
     "SOLAR_SPECTRA",
     "SPECTRUM_EXTRAPOLATIONS",
-    "TABLE_FORMATS",
     "WEIGHTINGS",
     "ab_reference_flux",
-    "agreement",
     "airmass",
     "apply_extinction",
     "at_resolution",
     "atmosphere",
-    "band_label",
     "band_signal",
     "band_weights",
     "bands",
-    "binned_residuals",
     "cf_decode",
     "cf_encode",
     "check_system",
     "colour",
     "colour_indices",
     "colour_science",
-    "compare",
-    "compare_light_curves",
-    "compare_magnitudes",
     "extinction_coefficients",
     "files",
     "filters",
@@ -241,16 +221,12 @@ __all__ = [
     "inband",
     "infrared",
     "lambert_sphere_phase",
-    "lightcurves",
     "magnitude",
     "magnitudes",
-    "measured",
     "open_photometry",
     "photometry",
-    "plot_comparison",
     "pre_integrate",
     "rayleigh_optical_depth",
-    "read_light_curve",
     "reference_flux",
     "solar_name",
     "solar_spectrum",
@@ -270,4 +246,38 @@ __all__ = [
 ]
 
 #: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.
-__getattr__ = renamed_attributes(__name__, globals(), {"EXTRAPOLATIONS": "SPECTRUM_EXTRAPOLATIONS"})
+_RENAMED = _renamed_attributes(__name__, globals(), {"EXTRAPOLATIONS": "SPECTRUM_EXTRAPOLATIONS"})
+
+#: Old name under ``sbrdf_xr.photometry`` -> its name in :mod:`sbrdf_xr.lightcurves`, where
+#: the measured-light-curve workflow moved; served here with a RenamedWarning until the
+#: next release.  The modules keep their old attribute names (``photometry.measured`` is
+#: ``lightcurves.tables``).
+_MOVED_TO_LIGHTCURVES = {
+    "LIGHT_CURVE_ABSCISSAE": "LIGHT_CURVE_ABSCISSAE",
+    "LIGHT_CURVE_COLUMNS": "LIGHT_CURVE_COLUMNS",
+    "LIGHT_CURVE_OPTIONAL": "LIGHT_CURVE_OPTIONAL",
+    "TABLE_FORMATS": "TABLE_FORMATS",
+    "agreement": "agreement",
+    "band_label": "band_label",
+    "binned_residuals": "binned_residuals",
+    "compare": "compare",
+    "compare_light_curves": "compare_light_curves",
+    "compare_magnitudes": "compare_magnitudes",
+    "comparison_figure": "figure",
+    "filter_names": "filter_names",
+    "lightcurves": "comparison",
+    "measured": "tables",
+    "plot_comparison": "plot_comparison",
+    "read_light_curve": "read_light_curve",
+}
+
+
+def __getattr__(name: str) -> _Any:
+    if name in _MOVED_TO_LIGHTCURVES:
+        # By name, on first use: photometry stands below lightcurves and imports nothing of it.
+        moved = _importlib.import_module("sbrdf_xr.lightcurves")
+        serve = _renamed_attributes(
+            __name__, vars(moved), _MOVED_TO_LIGHTCURVES, new_module=moved.__name__
+        )
+        return serve(name)
+    return _RENAMED(name)

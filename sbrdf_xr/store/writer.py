@@ -133,7 +133,6 @@ from pathlib import Path
 from typing import Any, NoReturn
 
 import netCDF4
-import numpy as np
 import xarray as xr
 
 from .._output import (
@@ -145,23 +144,19 @@ from .._output import (
 from ..errors import (
     CubeLockedError,
     CubeWriteError,
-    SbrdfError,
     SchedulerError,
     ValidationError,
     WorkersLostError,
 )
+from . import _blocks as blocks
 from .disk import (
     HEAD_BYTES,
     SyncBehind,
-    _NoRoom,
-    check_held,
-    check_room,
     cut_back,
     drop_behind,
     fix,
     let_go,
     reason,
-    reserve,
     reserve_file,
 )
 from .files import (
@@ -171,25 +166,19 @@ from .files import (
     check_destination,
     check_finished,
     clear_leftovers,
-    create_part,
     discard_hint,
     make_parent,
-    open_part,
     part_complevel,
     publish,
     read_back_error,
     read_log,
     started_again,
-    to_storage,
-    write_header,
 )
 from .layout import (
     VOLATILE_ATTRS,
     BlockLayout,
-    block_bytes,
     difference,
     layout_of,
-    lazy_bytes,
     storage_kind,
 )
 from .lock import LOCK_SUFFIX, _Lock
@@ -404,22 +393,7 @@ def _write_locked(
     resuming = state == "resume" and not started_again(part, log)
     done: set[int] = set()
     if resuming:
-        header, done = read_log(log, part)
-        if header.get("fingerprint") != plan.fingerprint:
-            why = difference(header.get("structure", {}), plan.structure)
-            raise CubeWriteError(
-                f"{part} belongs to a different cube ({why}); it was left untouched. "
-                f"Resume with the same inputs, or {discard_hint()}"
-            )
-        kept = header.get("complevel")
-        if kept is None:  # a sidecar written before it recorded the level: read the file
-            with contextlib.suppress(OSError), netCDF4.Dataset(part, mode="r") as nc_read:
-                kept = part_complevel(nc_read, plan)
-        if complevel is None:  # a resume keeps the level the cube was started with
-            complevel = DEFAULT_COMPLEVEL if kept is None else int(kept)
-        elif kept is not None and int(kept) != int(complevel):
-            _refuse_complevel(part, int(kept), complevel)
-        done = {k for k in done if 0 <= k < plan.n_blocks}
+        done, complevel = _resumed(part, log, plan, complevel)
     level = DEFAULT_COMPLEVEL if complevel is None else int(complevel)
 
     runner = _runner(client, scheduler)
@@ -429,87 +403,26 @@ def _write_locked(
         [b for b in range(plan.n_blocks) if b not in done],
         int(max_in_flight or runner.n_workers + 1),
     )
-    nc: netCDF4.Dataset | None = None
-    try:
-        if resuming:
-            size0 = part.stat().st_size
-            check_held(part)
-            try:
-                check_room(part, block_bytes(plan))
-                nc = open_part(part, ds, plan)
-            except Exception as exc:
-                if not done and not isinstance(exc, _NoRoom):
-                    resuming = not started_again(part, log, exc)  # nothing recorded
-                elif isinstance(exc, CubeWriteError):
-                    raise
-                else:
-                    if not isinstance(exc, _NoRoom):
-                        with contextlib.suppress(OSError):
-                            os.truncate(part, size0)  # undo a half-written attribute update
-                    why = reason(exc, part)
-                    raise CubeWriteError(
-                        f"cannot resume {path}: {why}. The {len(done)} of {plan.n_blocks} "
-                        f"blocks written so far are kept in {part}; {fix(why)} and "
-                        f"{again_hint()}"
-                    ) from exc
-            if resuming:
-                feed.fill()
-        if not resuming:
-            log.unlink(missing_ok=True)
-            part.unlink(missing_ok=True)
-            # an uncompressed cube is laid out whole at creation: its room is needed now
-            need = 0 if level else lazy_bytes(plan)
-
-            def creation_failed(exc: BaseException) -> NoReturn:
-                if nc is not None:
-                    with contextlib.suppress(Exception):
-                        nc.close()
-                why = reason(exc, part, need) if isinstance(exc, Exception) else ""
-                part.unlink(missing_ok=True)  # nothing recorded yet: nothing lost
-                log.unlink(missing_ok=True)
-                if not isinstance(exc, Exception) or isinstance(exc, SbrdfError):
-                    raise exc
-                raise CubeWriteError(
-                    f"cannot write {path}: creating {part} failed: {why}. Nothing was "
-                    f"written; {fix(why)} and write again"
-                ) from exc
-
-            try:
-                check_room(part, need)  # before any block is computed
-            except BaseException as exc:
-                creation_failed(exc)
-            feed.fill()  # the first blocks compute while the file is created and laid out
-            try:
-                # the bookkeeping first: a .part never exists without it, so a writer
-                # killed at any instant leaves a .part that a resume continues
-                write_header(log, plan, level)
-                nc = create_part(part, ds, plan, level)
-            except BaseException as exc:
-                creation_failed(exc)
-    except BaseException:
-        runner.close()
-        raise
-
-    assert nc is not None  # opened (resumed) or created above, or an error was raised
+    nc: netCDF4.Dataset | None
+    nc, resuming = blocks.open_or_create(
+        ds, path, part, log, plan, runner, feed, done, resuming, level
+    )
     bar: Any = NoProgress()
     sync: SyncBehind | None = None
     fd = log_fd = -1
-    k = -1
-    writing = False
-    in_hdf5 = False  # inside an HDF5 write: its metadata in memory may be torn if it fails
-    good, head = -1, b""
+    cur = blocks.Cursor()  # where the writer is, for its error handling
     damaged: str | None = None
     try:
-        writing = True
+        cur.writing = True
         fd = open_regular(part, os.O_RDWR, error=CubeWriteError)
         os.fsync(fd)
-        good, head = os.fstat(fd).st_size, os.pread(fd, HEAD_BYTES, 0)
+        cur.good, cur.head = os.fstat(fd).st_size, os.pread(fd, HEAD_BYTES, 0)
         log_fd = open_regular(log, os.O_WRONLY | os.O_APPEND, error=CubeWriteError)
         # blocks grow the file only where a variable is chunked (compressed)
         grows = any(nc.variables[v.name].chunking() != "contiguous" for v in plan.lazy)
         if not grows:
             reserve_file(fd)
-        writing = False
+        cur.writing = False
         release_freed_memory()  # what preparing the cube freed, before the blocks stream
         # each block goes to disk (fsync, then the log) in a thread of its own while the
         # next one is computed and written; it is reported once it is there
@@ -526,51 +439,14 @@ def _write_locked(
         kinds = {str(n): storage_kind(n, v.dtype) for n, v in ds.variables.items()}
         # a cube held in memory is written with its header: no blocks to count
         bar = progress_bar(progress and plan.n_blocks > 0, plan.n_blocks, len(done), path.name)
-        while True:
-            feed.fill()
-            if not runner.pending:
-                break
-            k, handle = runner.next_done()
-            arrays = runner.result(handle)
-            if k in done:  # a block is written exactly once
-                continue
-            block = feed.pieces.pop(k)
-            nbytes = sum(np.asarray(a).nbytes for a in arrays)
-            if grows:
-                check_room(part, nbytes)
-                reserve(fd, nbytes)
-            writing = in_hdf5 = True
-            for (name, region, _), values in zip(block, arrays, strict=True):
-                expected = tuple(s.stop - s.start for s in region)
-                if np.shape(values) != expected:
-                    raise CubeWriteError(
-                        f"block {k}: {name!r} computed with shape {np.shape(values)}, "
-                        f"expected {expected} from the chunks"
-                    )
-                nc.variables[name][region] = to_storage(values, kinds[name])
-            del arrays
-            nc.sync()
-            in_hdf5 = False
-            good, head = os.fstat(fd).st_size, os.pread(fd, HEAD_BYTES, 0)
-            sync.submit(k)
-            # the previous block, synced while this one was computed and written
-            ready = sync.wait_oldest() if len(sync.pending) > 1 else None
-            writing = False
-            if ready is not None:
-                report(ready)
-            k = -1
-        writing = True
-        ready = sync.wait_oldest() if sync.pending else None
-        writing = False
-        if ready is not None:
-            report(ready)
-        writing = in_hdf5 = True
+        blocks.stream(cur, nc, fd, sync, feed, runner, plan, kinds, grows, part, done, report)
+        cur.writing = cur.in_hdf5 = True
         nc.close()
         nc = None
-        in_hdf5 = False
+        cur.in_hdf5 = False
         os.ftruncate(fd, os.fstat(fd).st_size)  # release room reserved past the end
         os.fsync(fd)
-        writing = False
+        cur.writing = False
         refuse_special([path, part], error=CubeWriteError)  # nothing else appeared meanwhile
         # a .part resumed, or one whose chunk index grew with its blocks, may carry HDF5
         # metadata torn by an earlier failure; a fresh uncompressed cube's were written
@@ -587,23 +463,25 @@ def _write_locked(
     except Exception as exc:
         if sync is not None:  # before anything is cut back: the blocks synced behind count
             done.update(sync.settle())
-        where = f"at block {k} ({_describe(plan.slices(k))}) " if k >= 0 else ""
+        where = f"at block {cur.k} ({_describe(plan.slices(cur.k))}) " if cur.k >= 0 else ""
         why = (
             reason(exc, part)
-            if isinstance(exc, OSError) or writing
+            if isinstance(exc, OSError) or cur.writing
             else f"{type(exc).__name__}: {exc}"
         )
         lost = None
-        if writing and good >= 0:  # an I/O failure: cut the file back to its last synced state
-            let_go(nc, part, in_hdf5)
+        if (
+            cur.writing and cur.good >= 0
+        ):  # an I/O failure: cut the file back to its last synced state
+            let_go(nc, part, cur.in_hdf5)
             nc = None
-            lost = cut_back(part, good, head)
+            lost = cut_back(part, cur.good, cur.head)
         intro = f"writing {path} failed {where}after {len(done)} of {plan.n_blocks} blocks: {why}. "
         if lost is not None:
             raise CubeWriteError(
                 f"{intro}{part} could not be kept ({lost}); {discard_hint()}"
             ) from exc
-        if writing and good >= 0 and in_hdf5:
+        if cur.writing and cur.good >= 0 and cur.in_hdf5:
             raise CubeWriteError(
                 f"{intro}HDF5 failed in the middle of a block; {part} was cut back to its last "
                 f"synced state, with the blocks written so far. "
@@ -646,6 +524,30 @@ def _write_locked(
     log.unlink(missing_ok=True)
     fsync_dir(path.parent)
     return path
+
+
+def _resumed(
+    part: Path, log: Path, plan: BlockLayout, complevel: int | None
+) -> tuple[set[int], int]:
+    """The blocks a resumed ``.part`` holds and the level it was started with, checked
+    against this write's cube and level."""
+    header, done = read_log(log, part)
+    if header.get("fingerprint") != plan.fingerprint:
+        why = difference(header.get("structure", {}), plan.structure)
+        raise CubeWriteError(
+            f"{part} belongs to a different cube ({why}); it was left untouched. "
+            f"Resume with the same inputs, or {discard_hint()}"
+        )
+    kept = header.get("complevel")
+    if kept is None:  # a sidecar written before it recorded the level: read the file
+        with contextlib.suppress(OSError), netCDF4.Dataset(part, mode="r") as nc_read:
+            kept = part_complevel(nc_read, plan)
+    if complevel is None:  # a resume keeps the level the cube was started with
+        complevel = DEFAULT_COMPLEVEL if kept is None else int(kept)
+    elif kept is not None and int(kept) != int(complevel):
+        _refuse_complevel(part, int(kept), complevel)
+    done = {k for k in done if 0 <= k < plan.n_blocks}
+    return done, complevel
 
 
 def _describe(slices: Mapping[str, slice]) -> str:

@@ -7,7 +7,7 @@ special files), sites (unknown names, latitudes beyond the poles, heights of 1e9
 windows (years 99999, stop before start, no zone, nonsense) and steps (zero, negative,
 NaN, 1e-9 s: a time axis beyond the plan's size limit), given to
 :func:`sbrdf_xr.engine.load_scene`.  Light curves: CSV and ECSV files spoilt in their
-bytes, columns and values, given to :func:`sbrdf_xr.photometry.read_light_curve`.
+bytes, columns and values, given to :func:`sbrdf_xr.lightcurves.read_light_curve`.
 """
 
 from __future__ import annotations
@@ -234,7 +234,7 @@ def _curve_usable(ds) -> None:
     junk=st.binary(max_size=16),
 )
 def test_light_curve_files(tmp_path, spoilt, suffix, how, at, junk):
-    from sbrdf_xr.photometry import read_light_curve
+    from sbrdf_xr.lightcurves import read_light_curve
 
     path = tmp_path / f"curve{suffix}"
     data = CURVE_SPOILS[spoilt].encode("utf-8")
@@ -254,7 +254,7 @@ def test_light_curve_files(tmp_path, spoilt, suffix, how, at, junk):
 @pytest.mark.parametrize("kind", SPECIAL)
 @pytest.mark.parametrize("suffix", [".csv", ".ecsv", ".nc"])
 def test_special_light_curve_files(tmp_path, kind, suffix):
-    from sbrdf_xr.photometry import read_light_curve
+    from sbrdf_xr.lightcurves import read_light_curve
 
     path = special_file(tmp_path, kind, suffix)
     run_case(

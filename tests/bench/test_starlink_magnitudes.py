@@ -11,9 +11,9 @@ import pytest
 
 from sbrdf_xr.bench import pomenis_table, predict_starlink, starlink_scene
 from sbrdf_xr.errors import TrackingTableError, ValidationError
+from sbrdf_xr.lightcurves import compare_magnitudes
 from sbrdf_xr.observing import read_pomenis
 from sbrdf_xr.photometry import (
-    compare_magnitudes,
     lambert_sphere_phase,
     sun_distance_au,
     sun_magnitudes,

@@ -69,8 +69,8 @@ def test_a_measured_file_declaring_a_huge_dimension_is_refused(tmp_path, reader,
     estimate, with each reader's own error (before: xarray allocated until MemoryError)."""
     from sbrdf_xr import errors
     from sbrdf_xr.invert import read_spectrum
+    from sbrdf_xr.lightcurves import read_light_curve
     from sbrdf_xr.observing.series import QuaternionSeries
-    from sbrdf_xr.photometry import read_light_curve
 
     read = {
         "light curve": read_light_curve,
@@ -91,7 +91,7 @@ def test_a_fits_light_curve_declaring_1e9_rows_is_refused(tmp_path):
     from astropy.io import fits
 
     from sbrdf_xr.errors import LightCurveError
-    from sbrdf_xr.photometry import read_light_curve
+    from sbrdf_xr.lightcurves import read_light_curve
 
     path = tmp_path / "lc.fits"
     cols = [fits.Column(name=n, format="D", array=np.zeros(4)) for n in ("mjd_utc", "V", "V_err")]
@@ -109,7 +109,7 @@ def test_a_votable_light_curve_declaring_1e9_rows_is_refused(tmp_path):
     from astropy.table import Table
 
     from sbrdf_xr.errors import LightCurveError
-    from sbrdf_xr.photometry import read_light_curve
+    from sbrdf_xr.lightcurves import read_light_curve
 
     path = tmp_path / "lc.vot"
     table = {"mjd_utc": [60000.0, 60000.1], "V": [10.0, 10.1], "V_err": [0.01, 0.01]}

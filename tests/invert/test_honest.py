@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 
 from sbrdf_xr import invert
 from sbrdf_xr.errors import FitQualityWarning
-from sbrdf_xr.invert._bounds import covariance, stick_breaking, stick_breaking_inverse
+from sbrdf_xr.invert._joint.bounds import covariance, stick_breaking, stick_breaking_inverse
 from sbrdf_xr.observing import Observation, Orbit, Site, times
 
 FRACTIONS = {"aluminium-6061-t6": 0.2, "tjpv-cell": 0.25, "white-paint-a276": 0.55}
@@ -184,7 +184,7 @@ def test_symmetry_twins_from_the_mesh(box_wing, geo_curve):
     np.testing.assert_allclose(twin_lc.magnitude.values, lc.magnitude.values, atol=1e-9, rtol=0)
     # about z the half turn takes the cells to the back: no such twin
     from sbrdf_xr.engine import Scene
-    from sbrdf_xr.invert._symmetry import body_symmetries
+    from sbrdf_xr.invert._spin.symmetry import body_symmetries
 
     t = Scene(box_wing, to_sun=[[1.0, 0, 0]], to_observer=[[1.0, 0, 0]]).plan().terms
     names = [s.name for s in body_symmetries(t.normal, t.area, t.material, [0, 0, 1])]

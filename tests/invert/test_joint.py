@@ -16,8 +16,8 @@ from astropy.table import Table
 
 from sbrdf_xr import catalog, invert
 from sbrdf_xr.errors import FitQualityWarning, InversionError
+from sbrdf_xr.lightcurves import read_light_curve
 from sbrdf_xr.observing import Observation, Orbit, Site, times
-from sbrdf_xr.photometry import read_light_curve
 
 ECSV = "observe/canx1-zimmerwald-night.ecsv"
 TRUTH_SPIN = {

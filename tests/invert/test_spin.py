@@ -18,7 +18,8 @@ from sbrdf_xr import geometry, invert
 from sbrdf_xr.engine import Scene
 from sbrdf_xr.engine.run import simulate
 from sbrdf_xr.errors import FitQualityWarning, InversionError
-from sbrdf_xr.invert import _spin_data, _spin_search
+from sbrdf_xr.invert._spin import data as _spin_data
+from sbrdf_xr.invert._spin import search as _spin_search
 from sbrdf_xr.observing.observe import canx1_pass
 
 BANDS = ("V", "R", "I")

@@ -26,7 +26,7 @@ from sbrdf_xr import invert
 from sbrdf_xr.engine import Scene
 from sbrdf_xr.engine.run import simulate
 from sbrdf_xr.errors import FitQualityWarning, InversionError
-from sbrdf_xr.invert._spin_data import band_factors
+from sbrdf_xr.invert._spin.data import band_factors
 from sbrdf_xr.observing.observe import canx1_pass
 from sbrdf_xr.photometry import magnitudes
 

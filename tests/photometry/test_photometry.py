@@ -10,6 +10,7 @@ import pytest
 import xarray as xr
 
 from sbrdf_xr import catalog, geometry
+from sbrdf_xr import lightcurves as L
 from sbrdf_xr import photometry as P
 from sbrdf_xr import testing as T
 from sbrdf_xr.cli import main
@@ -496,9 +497,9 @@ def _write_curve(path, phi0=47.3, dm0=1.234, sigma=0.01, extra_b=0.0, seed=3, n=
 
 
 def test_light_curve_fit_recovers_injected_offsets(tmp_path):
-    lc = P.read_light_curve(_write_curve(tmp_path / "lc.csv", extra_b=0.05))
+    lc = L.read_light_curve(_write_curve(tmp_path / "lc.csv", extra_b=0.05))
     assert lc.magnitude.attrs["units"] == "1" and lc.rotation_angle.attrs["units"] == "degree"
-    res = P.compare(lc, _sim_curve(), zero_points="common")
+    res = L.compare(lc, _sim_curve(), zero_points="common")
     # The 0.05 mag extra in B moves the common offset by about half of it and appears as the
     # B-V difference.  Unmodelled, it leaves +-0.025 mag band residuals (>> the noise) that
     # leak into the phase (bias ~0.2 deg over seeds 3-5), hence the looser phase bound here.
@@ -506,8 +507,8 @@ def test_light_curve_fit_recovers_injected_offsets(tmp_path):
     assert float(res.magnitude_offset) == pytest.approx(1.234 + 0.025, abs=0.01)
     assert float(res.colour_index_difference.sel(colour="B-V")) == pytest.approx(0.05, abs=0.005)
     assert res.degrees_of_freedom == 298
-    clean = P.compare(
-        P.read_light_curve(_write_curve(tmp_path / "c.csv")), _sim_curve(), zero_points="common"
+    clean = L.compare(
+        L.read_light_curve(_write_curve(tmp_path / "c.csv")), _sim_curve(), zero_points="common"
     )
     # 300 points of 0.01 mag on a curve of slope ~0.8 mag/rad: sigma(phase) ~ 0.03 deg,
     # sigma(offset) ~ 0.0006 mag; bounds at ~3 sigma.  chi2/dof of 298 dof: 1 +- 0.08 (1 sigma).
@@ -515,7 +516,7 @@ def test_light_curve_fit_recovers_injected_offsets(tmp_path):
     assert float(clean.magnitude_offset) == pytest.approx(1.234, abs=0.003)
     assert 0.75 < float(clean.reduced_chi_square) < 1.25
     # the covariance of the offset and the phase against scipy's curve_fit of the same model
-    lc = P.read_light_curve(_write_curve(tmp_path / "c.csv"))
+    lc = L.read_light_curve(_write_curve(tmp_path / "c.csv"))
     pars, pcov = _curve_fit_offset_and_phase(lc, float(clean.phase_offset))
     assert float(clean.magnitude_offset) == pytest.approx(pars[0], abs=1e-7)
     assert float(clean.phase_offset) == pytest.approx(pars[1], abs=1e-5)
@@ -561,10 +562,10 @@ def _curve_fit_offset_and_phase(lc, phase0):
 
 
 def test_light_curve_without_phase_fit_is_the_weighted_mean(tmp_path):
-    lc = P.read_light_curve(_write_curve(tmp_path / "lc.csv", phi0=0.0, dm0=-0.5, n=50, sigma=0.05))
+    lc = L.read_light_curve(_write_curve(tmp_path / "lc.csv", phi0=0.0, dm0=-0.5, n=50, sigma=0.05))
     sig = np.linspace(0.01, 0.2, 50)  # unequal uncertainties: weighted != plain mean
     lc["uncertainty"] = ("obs", sig, lc.uncertainty.attrs)
-    res = P.compare(lc, _sim_curve(0.5), fit_phase=False, zero_points="common")
+    res = L.compare(lc, _sim_curve(0.5), fit_phase=False, zero_points="common")
     model = np.array(
         [
             _sim_at(None, b, np.array([t]))[0]
@@ -585,15 +586,15 @@ def test_light_curve_without_phase_fit_is_the_weighted_mean(tmp_path):
 
 def test_light_curve_by_time_needs_a_period_and_netcdf_reads(tmp_path):
     path = _write_curve(tmp_path / "t.csv", time=True)
-    lc = P.read_light_curve(path)
+    lc = L.read_light_curve(path)
     assert lc.time.attrs["units"] == "s"
     with pytest.raises(ValidationError, match="period_s"):
-        P.compare(lc, _sim_curve())
-    res = P.compare(lc, _sim_curve(), period_s=600.0, zero_points="common")
+        L.compare(lc, _sim_curve())
+    res = L.compare(lc, _sim_curve(), period_s=600.0, zero_points="common")
     assert float(res.phase_offset) == pytest.approx(47.3, abs=0.1)
     nc = tmp_path / "lc.nc"
     lc.reset_coords().rename(obs="row").to_netcdf(nc)
-    back = P.read_light_curve(nc)
+    back = L.read_light_curve(nc)
     np.testing.assert_allclose(back.magnitude, lc.magnitude)
     assert back.band.values.tolist() == lc.band.values.tolist()
 
@@ -601,8 +602,8 @@ def test_light_curve_by_time_needs_a_period_and_netcdf_reads(tmp_path):
 def test_plot_comparison_returns_a_figure(tmp_path):
     from matplotlib.figure import Figure
 
-    res = P.compare(P.read_light_curve(_write_curve(tmp_path / "lc.csv", n=60)), _sim_curve())
-    fig = P.plot_comparison(res)
+    res = L.compare(L.read_light_curve(_write_curve(tmp_path / "lc.csv", n=60)), _sim_curve())
+    fig = L.plot_comparison(res)
     assert isinstance(fig, Figure) and len(fig.axes) == 2
     fig.savefig(tmp_path / "cmp.png")
 
@@ -646,7 +647,7 @@ def test_bad_light_curve_files(tmp_path, text, match):
     path = tmp_path / "bad.csv"
     path.write_text(text)
     with pytest.raises(ValidationError, match=match):
-        P.read_light_curve(path)
+        L.read_light_curve(path)
 
 
 def test_light_curve_iso_times_and_band_whitelist(tmp_path):
@@ -656,15 +657,15 @@ def test_light_curve_iso_times_and_band_whitelist(tmp_path):
         "2024-01-01T00:01:00Z,my-band,12,0.1\n"
     )
     with pytest.raises(ValidationError, match="filter 'my-band': not a band the package knows"):
-        P.read_light_curve(path)
-    lc = P.read_light_curve(path, bands=["V", "my-band"])
+        L.read_light_curve(path)
+    lc = L.read_light_curve(path, bands=["V", "my-band"])
     assert lc.time.dtype == np.dtype("datetime64[ns]")  # absolute UTC times are kept
     np.testing.assert_array_equal(
         lc.time.values,
         np.array(["2024-01-01T00:00:00", "2024-01-01T00:01:00"], dtype="datetime64[ns]"),
     )
     with pytest.raises(ValidationError, match=r"measured bands \['my-band'\] are not simulated"):
-        P.compare(lc, _sim_curve(), period_s=600.0)
+        L.compare(lc, _sim_curve(), period_s=600.0)
 
 
 def test_light_curve_fit_reports_the_half_turn_ambiguity_of_a_symmetric_body(tmp_path):
@@ -699,13 +700,13 @@ def test_light_curve_fit_reports_the_half_turn_ambiguity_of_a_symmetric_body(tmp
             "uncertainty": 0.01,
         }
     ).to_csv(path, index=False)
-    res = P.compare(P.read_light_curve(path), sim, zero_points="common")
+    res = L.compare(L.read_light_curve(path), sim, zero_points="common")
     best = float(res.phase_offset)
     assert min(abs(best - 20.0), abs(best - 200.0)) < 0.5
     alt = float(res.alternative_phase_offset)
     assert abs(((alt - best) % 360) - 180) < 1.0  # the other minimum is half a turn away ...
     assert float(res.alternative_delta_chi_square) < 4.0  # ... and not distinguished
-    asym = P.compare(
-        P.read_light_curve(_write_curve(tmp_path / "a.csv")), _sim_curve(), zero_points="common"
+    asym = L.compare(
+        L.read_light_curve(_write_curve(tmp_path / "a.csv")), _sim_curve(), zero_points="common"
     )
     assert float(asym.alternative_delta_chi_square) > 100.0

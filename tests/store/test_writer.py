@@ -598,7 +598,7 @@ def flagged_cube() -> xr.Dataset:
 def test_first_blocks_compute_while_the_file_is_created(tmp_path, monkeypatch):
     """Blocks are submitted once the room is checked, before the ``.part`` is created
     and laid out, so the kernel does not wait for the file's preparation."""
-    import sbrdf_xr.store.writer as writer
+    import sbrdf_xr.store._blocks as writer  # the writer's step that creates the .part
 
     create = writer.create_part
     seen: list[bool] = []
@@ -618,7 +618,7 @@ def test_first_blocks_compute_while_the_file_is_created(tmp_path, monkeypatch):
 def test_no_block_is_computed_when_the_room_is_refused(tmp_path, monkeypatch):
     import errno
 
-    import sbrdf_xr.store.writer as writer
+    import sbrdf_xr.store._blocks as writer  # the writer's step that checks the room
     from sbrdf_xr.store.disk import _NoRoom
 
     def full(part, need):

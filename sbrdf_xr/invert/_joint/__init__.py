@@ -1,0 +1,2 @@
+"""The joint fit of :func:`sbrdf_xr.invert.fit_observation`: model, starts, refinement,
+result, twins, studies."""

@@ -1,0 +1,206 @@
+"""The joint posterior of a pass's fit, sampled where a point estimate misleads.
+
+See :func:`sbrdf_xr.invert.fit_observation` (``method="posterior"``).  The posterior of
+the fitted parameters ``p`` is ``exp(-chi2(p) / 2)`` (Gaussian errors, the priors of the
+tables' scales as data, flat priors elsewhere) inside the physical bounds (area
+fractions in ``[0, 1]``, scales ``>= 0``, period ``> 0``).  It is sampled by the affine-
+invariant ensemble sampler of Goodman & Weare (2010, Comm. App. Math. Comp. Sci. 5, 65)
+as implemented by emcee (Foreman-Mackey et al. 2013, PASP 125, 306), from every minimum
+the point fit found within :data:`MODE_CHI2` of the best (period aliases, other axes),
+its walkers drawn from the Gaussian of its own covariance (the typical set).  Each
+mode's probability is its Laplace evidence ``exp(-chi2_i / 2) sqrt(det 2 pi C_i)``
+(MacKay 2003, *Information Theory, Inference and Learning Algorithms*, §27.1),
+normalised; the summary (median, standard deviation, 2.5 and 97.5 % points) is over the
+modes' samples weighted so.  The body's symmetry
+twins are exact copies of a mode (the same probability) and are listed, not sampled.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from ...errors import InversionError
+from .._spin.search import lonlat
+from .bounds import covariance
+
+__all__ = ["MAX_EVALUATIONS", "MODE_CHI2", "sample_posterior"]
+
+#: Minima within this chi-square of the best are sampled as modes.
+MODE_CHI2 = 25.0
+#: Largest number of model evaluations (walkers x steps x modes) a posterior may take.
+MAX_EVALUATIONS = 200_000
+
+
+def _outputs(
+    lay: Any, axis_of: Callable[[np.ndarray], np.ndarray], p: np.ndarray, shift: float
+) -> np.ndarray:
+    """The reported parameters of ``p`` (longitude, latitude, period, phase at the epoch,
+    the rest as fitted) and every material's area fraction."""
+    lon, lat = (float(v) for v in lonlat(axis_of(p)))
+    phase = p[3] - shift / p[2]
+    return np.concatenate([[lon, lat, p[2], phase], p[4:], lay.fractions(p)])
+
+
+def check_budget(walkers: int, steps: int, n_modes: int, seconds_per_call: float) -> None:
+    """Refuse a sampler budget beyond :data:`MAX_EVALUATIONS`, with its estimated time.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.invert._joint.posterior import check_budget
+    >>> check_budget(32, 300, 2, 0.002)  # 19200 evaluations: allowed
+    """
+    if not (isinstance(walkers, int) and isinstance(steps, int) and walkers > 0 and steps > 0):
+        raise InversionError(
+            f"posterior: walkers {walkers!r}, steps {steps!r}; allowed positive integers"
+        )
+    n = walkers * steps * n_modes
+    if n > MAX_EVALUATIONS:
+        raise InversionError(
+            f"posterior: {walkers} walkers x {steps} steps x {n_modes} modes = {n} model "
+            f"evaluations (about {n * seconds_per_call:.0f} s at {seconds_per_call * 1e3:.2g} "
+            f"ms each) exceed the bound {MAX_EVALUATIONS}; allowed fewer walkers or steps"
+        )
+
+
+def sample_posterior(
+    lay: Any,
+    local: Sequence[Any],
+    best: int,
+    chi2_of: Callable[[Any, np.ndarray], float],
+    jacobian: Callable[[Any, np.ndarray], np.ndarray],
+    shift: float,
+    *,
+    walkers: int,
+    steps: int,
+    seed: int,
+    seconds_per_call: float,
+) -> tuple[xr.Dataset, dict[str, Any]]:
+    """Sample the posterior from every mode; the summary Dataset and attributes.
+
+    ``local``: the minima (``x``, ``chi2``, ``axis_of``, ``label``); ``chi2_of(m, p)``
+    the total chi-square of ``p`` in mode ``m``'s parametrisation, ``inf`` outside the
+    bounds; ``jacobian(m, p)`` the normalised residuals' Jacobian; ``shift`` is ``360
+    (t_ref - t_epoch)`` [degree s] (the phase at the epoch is ``p[3] - shift / P``).
+    """
+    import emcee
+
+    chi_best = local[best].chi2
+    modes = [
+        i for i, m in enumerate(local) if np.isfinite(m.chi2) and m.chi2 - chi_best < MODE_CHI2
+    ]
+    # the same minimum reached from two starts: keep one
+    kept: list[int] = []
+    for i in modes:
+        o = _outputs(lay, local[i].axis_of, local[i].x, shift)
+        if not any(
+            np.allclose(o, _outputs(lay, local[j].axis_of, local[j].x, shift), rtol=1e-6, atol=1e-6)
+            for j in kept
+        ):
+            kept.append(i)
+    check_budget(walkers, steps, len(kept), seconds_per_call)
+    if walkers < 2 * lay.n:
+        raise InversionError(
+            f"posterior: {walkers} walkers for {lay.n} parameters; allowed at least 2 x "
+            f"{lay.n} = {2 * lay.n} (emcee's affine-invariant moves need them)"
+        )
+    rng = np.random.default_rng(seed)
+    t0 = time.perf_counter()
+    samples, log_z, accept, labels = [], [], [], []
+    for i in kept:
+        m = local[i]
+        cov, free = covariance(jacobian(m, m.x))
+        cov = np.where(free[:, None] | free[None, :], 0.0, cov)
+        sd = np.sqrt(np.clip(np.diag(cov), 0, None))
+        sign, logdet = np.linalg.slogdet(2 * np.pi * cov[np.ix_(~free, ~free)])
+        log_z.append(-0.5 * m.chi2 + 0.5 * (logdet if sign > 0 else -np.inf))
+
+        def log_prob(p: np.ndarray, m: Any = m) -> float:
+            c = chi2_of(m, p)
+            return -0.5 * c if np.isfinite(c) else -np.inf
+
+        # walkers start in the typical set: draws of the Gaussian (Laplace) approximation
+        ev, vec = np.linalg.eigh(cov)
+        root = vec * np.sqrt(np.clip(ev, 0, None))
+        start = m.x + rng.standard_normal((walkers, lay.n)) @ root.T
+        for w in range(walkers):  # a start outside the bounds: pulled onto the minimum
+            if not np.isfinite(log_prob(start[w])):
+                start[w] = m.x + 1e-3 * sd * rng.standard_normal(lay.n)
+        sampler = emcee.EnsembleSampler(walkers, lay.n, log_prob)
+        sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()
+        sampler.run_mcmc(start, steps, progress=False)
+        chain = sampler.get_chain(discard=steps // 2, flat=True)
+        samples.append(np.array([_outputs(lay, m.axis_of, p, shift) for p in chain]))
+        accept.append(float(np.mean(sampler.acceptance_fraction)))
+        labels.append(m.label)
+    lz = np.array(log_z)
+    prob = np.exp(lz - lz.max())
+    prob /= prob.sum()
+    # the mixture: every mode's samples with its probability (equal sample counts)
+    ref = samples[0][0]
+    stacked = np.concatenate(samples)
+    weights = np.concatenate(
+        [np.full(len(s), w / len(s)) for s, w in zip(samples, prob, strict=True)]
+    )
+    stacked[:, 3] = ref[3] + (stacked[:, 3] - ref[3] + 180.0) % 360.0 - 180.0  # phase, unwrapped
+    stacked[:, 0] = ref[0] + (stacked[:, 0] - ref[0] + 180.0) % 360.0 - 180.0  # longitude
+    summary = _summary(stacked, weights)
+    seconds = time.perf_counter() - t0
+    names = [*lay.names, *(f"fraction_{m}" for m in lay.materials)]
+    ds = xr.Dataset(
+        {
+            f"posterior_{k}": (
+                "posterior_parameter",
+                v,
+                {
+                    "units": "1",
+                    "long_name": f"posterior {k} (units: parameter_units of the same name)",
+                },
+            )
+            for k, v in summary.items()
+        },
+        coords={
+            "posterior_parameter": (
+                "posterior_parameter",
+                names,
+                {"units": "1", "long_name": "parameter (and every material's area fraction)"},
+            ),
+            "mode": ("mode", labels, {"units": "1", "long_name": "start whose minimum is sampled"}),
+        },
+    )
+    ds["mode_probability"] = (
+        "mode",
+        prob,
+        {"units": "1", "long_name": "probability of the mode (Laplace evidence, normalised)"},
+    )
+    ds["mode_acceptance"] = (
+        "mode",
+        np.array(accept),
+        {"units": "1", "long_name": "mean acceptance fraction of the mode's walkers"},
+    )
+    attrs = {
+        "posterior": f"emcee affine-invariant ensemble: {walkers} walkers x {steps} steps per "
+        f"mode (first half discarded), {len(kept)} modes, seed {seed}",
+        "posterior_seconds": seconds,
+    }
+    return ds, attrs
+
+
+def _summary(x: np.ndarray, w: np.ndarray) -> dict[str, np.ndarray]:
+    """Weighted median, standard deviation and 2.5 / 97.5 % points of every column."""
+    out: dict[str, list[float]] = {"median": [], "sd": [], "low": [], "high": []}
+    for j in range(x.shape[1]):
+        order = np.argsort(x[:, j])
+        cw = np.cumsum(w[order])
+        cw /= cw[-1]
+        col = x[order, j]
+        out["median"].append(float(np.interp(0.5, cw, col)))
+        out["low"].append(float(np.interp(0.025, cw, col)))
+        out["high"].append(float(np.interp(0.975, cw, col)))
+        mean = float(np.sum(w * x[:, j]) / w.sum())
+        out["sd"].append(float(np.sqrt(np.sum(w * (x[:, j] - mean) ** 2) / w.sum())))
+    return {k: np.asarray(v) for k, v in out.items()}
