@@ -15,6 +15,7 @@ from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .. import geometry
 from ..errors import SceneError, ValidationError, did_you_mean
@@ -296,3 +297,28 @@ def _scene_attitudes(
         )
     q, angles = attitudes_from_table(table, "attitude")
     return q, angles if attitude_angle is None else attitude_angle
+
+
+_UNIT_TOL = 1e-6
+
+
+def _unit_vectors(v: ArrayLike, name: str) -> np.ndarray:
+    try:
+        arr = np.asarray(v, dtype=np.float64)
+    except (ValueError, TypeError) as exc:
+        raise SceneError(f"{name}: expected n vectors of 3 numbers (shape (n, 3)); {exc}") from None
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise SceneError(f"{name}: expected shape (n, 3), got {arr.shape}")
+    if arr.shape[0] == 0:
+        raise SceneError(f"{name}: needs at least one vector, got none")
+    if not np.all(np.isfinite(arr)):
+        raise SceneError(f"{name}: contains NaN or infinite components")
+    with np.errstate(over="ignore"):  # a huge component: length inf, refused below
+        norm = np.linalg.norm(arr, axis=1)
+    bad = np.flatnonzero(~(np.abs(norm - 1.0) <= _UNIT_TOL))
+    if bad.size:
+        raise SceneError(
+            f"{name}: vector {bad[0]} {arr[bad[0]].tolist()} has length {norm[bad[0]]:.6g}; "
+            f"directions must be unit vectors (|length - 1| <= {_UNIT_TOL})"
+        )
+    return arr / norm[:, None]

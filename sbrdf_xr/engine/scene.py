@@ -19,7 +19,7 @@ from ..errors import CatalogError, SceneError, ValidationError, did_you_mean
 from ..kernels.warm import compiling_ahead
 from ..materials.tables import validate_material
 from ..units import check_plausible, to_unit
-from .attitude_table import _scene_attitudes
+from .attitude_table import _scene_attitudes, _unit_vectors
 from .effects import DEFAULT_EFFECTS, SCENE_EFFECTS, SCENE_OUTPUTS, SPECTRAL_OUTPUTS, scene_effects
 from .knobs import KNOBS, PRESETS, apply_preset, check_knob
 from .plan import Plan, compile_plan
@@ -60,31 +60,8 @@ def _needs_observation(scene: Scene, effect: str) -> None:
 _NEEDS = {"to_earth": _needs_to_earth, "observation": _needs_observation}
 
 
-_UNIT_TOL = 1e-6
 #: The hottest facet temperature a scene accepts [K].
 MAX_TEMPERATURE_K = 1e4
-
-
-def _unit_vectors(v: ArrayLike, name: str) -> np.ndarray:
-    try:
-        arr = np.asarray(v, dtype=np.float64)
-    except (ValueError, TypeError) as exc:
-        raise SceneError(f"{name}: expected n vectors of 3 numbers (shape (n, 3)); {exc}") from None
-    if arr.ndim != 2 or arr.shape[1] != 3:
-        raise SceneError(f"{name}: expected shape (n, 3), got {arr.shape}")
-    if arr.shape[0] == 0:
-        raise SceneError(f"{name}: needs at least one vector, got none")
-    if not np.all(np.isfinite(arr)):
-        raise SceneError(f"{name}: contains NaN or infinite components")
-    with np.errstate(over="ignore"):  # a huge component: length inf, refused below
-        norm = np.linalg.norm(arr, axis=1)
-    bad = np.flatnonzero(~(np.abs(norm - 1.0) <= _UNIT_TOL))
-    if bad.size:
-        raise SceneError(
-            f"{name}: vector {bad[0]} {arr[bad[0]].tolist()} has length {norm[bad[0]]:.6g}; "
-            f"directions must be unit vectors (|length - 1| <= {_UNIT_TOL})"
-        )
-    return arr / norm[:, None]
 
 
 #: Scene fields with a unit: a Quantity (or a mapping of them per material) is converted.

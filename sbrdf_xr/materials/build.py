@@ -426,15 +426,28 @@ def build_lut(
     measured = (ds, (ti_s, dt_s, ph_s), spectra, ref)
     _check_table(out, measured, ti_out, call, report, check_floor, check_bound, check_energy)
     if holdout and not rows_only:  # a fitted fill: predict samples it has not seen
-        report(0.97, "leave-out check")
-        opts = {**call, "holdout": 0, "check_energy": check_energy == "clamp" and "clamp"}
-        opts["progress"] = None
-        rebuild = functools.partial(build_lut, **opts)  # a fit's name: the held-in's own fit
-        out.attrs.update(_holdout_check(rebuild, *measured, every=int(holdout), floor=check_floor))
+        _leave_out_check(out, measured, call, report, int(holdout), check_floor)
     # last: shown by print(table) beside the checks
     out.attrs.update({k: out.attrs.pop(k) for k in ("layout", "modelled") if k in out.attrs})
     report(1.0, "built")
     return out
+
+
+def _leave_out_check(
+    out: xr.DataArray,
+    measured: tuple[Any, ...],
+    call: dict[str, Any],
+    report: Callable[[float, str], None],
+    every: int,
+    floor: float,
+) -> None:
+    """Every ``every``-th sample left out, the table rebuilt from the rest (a fit's name:
+    the held-in samples' own fit) and compared with the samples it has not seen."""
+    report(0.97, "leave-out check")
+    clamp = call["check_energy"] == "clamp" and "clamp"
+    opts = {**call, "holdout": 0, "check_energy": clamp, "progress": None}
+    rebuild = functools.partial(build_lut, **opts)
+    out.attrs.update(_holdout_check(rebuild, *measured, every=every, floor=floor))
 
 
 def _check_table(
