@@ -171,5 +171,5 @@ def test_validation():
         optics.fresnel_thin_film_stack(1.0, WL, [(1.5, -1.0)], 3.5)
     with pytest.raises(ValidationError, match="shape"):
         optics.fresnel_thin_film_stack(1.0, WL, [(np.ones(3) * 1.5, 10.0)], 3.5)
-    with pytest.raises(ValidationError, match="wavelength_nm"):
+    with pytest.raises(ValidationError, match="wavelength"):
         optics.aluminium_index([0.0, 500.0])
