@@ -66,7 +66,7 @@ def fitted() -> Any:
     path = Path(tempfile.mkdtemp()) / "canx1-pass-measured.ecsv"
     measured_table(sim, path)
     measured = read_light_curve(path)
-    return compare(measured, sim, extinction="fit", fit_time_shift=True, max_time_shift_s=5.0)
+    return compare(measured, sim, extinction="fit", fit_time_shift=True, max_time_shift=5.0)
 
 
 def figures(fit: Any = None) -> dict[str, Any]:

@@ -13,6 +13,8 @@ from typing import Any
 import xarray as xr
 from numpy.typing import ArrayLike
 
+from .errors import renamed_keywords
+
 __all__ = ["SbrdfDataArrayAccessor", "SbrdfDatasetAccessor"]
 
 
@@ -135,19 +137,30 @@ class SbrdfDatasetAccessor:
     >>> band = cube.sbrdf.band_signal(["V"])
     >>> band.dims, round(float(band.squeeze()), 6)
     (('geometry', 'band'), 0.31831)
-    >>> cube.sbrdf.magnitudes(["V", "R"], range_km=1000).round(3).values
+    >>> cube.sbrdf.magnitudes(["V", "R"], range=1000).round(3).values
     array([[4.475, 4.28 ]])
     """
 
     def __init__(self, ds: xr.Dataset) -> None:
         self._ds = ds
 
-    def photometry(self, bands: Any, range_km: Any = None, **kwargs: Any) -> xr.Dataset:
+    @renamed_keywords(range_km="range")
+    def photometry(self, bands: Any, range: Any = None, **kwargs: Any) -> xr.Dataset:
         """:func:`sbrdf_xr.photometry.photometry` of this cube (its own ``range`` and
-        ``sun_distance`` unless given)."""
+        ``sun_distance`` unless given).
+
+        Parameters
+        ----------
+        bands : str, sequence, mapping or DataArray
+            See :func:`sbrdf_xr.photometry.filters`.
+        range : float, array_like, DataArray or astropy Quantity, optional
+            Observer range [km], > 0; default the cube's ``range``.
+        **kwargs
+            The other keywords of :func:`sbrdf_xr.photometry.photometry`.
+        """
         from . import photometry as _phot
 
-        return _phot.photometry(self._ds, bands, range_km, **kwargs)
+        return _phot.photometry(self._ds, bands, range, **kwargs)
 
     def band_signal(self, bands: Any, **kwargs: Any) -> xr.DataArray:
         """:func:`sbrdf_xr.photometry.band_signal` of this cube."""
@@ -155,12 +168,23 @@ class SbrdfDatasetAccessor:
 
         return _phot.band_signal(self._ds, bands, **kwargs)
 
-    def magnitudes(self, bands: Any = None, range_km: Any = None, **kwargs: Any) -> xr.DataArray:
+    @renamed_keywords(range_km="range")
+    def magnitudes(self, bands: Any = None, range: Any = None, **kwargs: Any) -> xr.DataArray:
         """:func:`sbrdf_xr.photometry.magnitudes` of this cube (its own ``range`` and
-        ``sun_distance`` unless given; ``extinction={band: k}`` with its ``airmass``)."""
+        ``sun_distance`` unless given; ``extinction={band: k}`` with its ``airmass``).
+
+        Parameters
+        ----------
+        bands : str, sequence, mapping or DataArray
+            See :func:`sbrdf_xr.photometry.filters`.
+        range : float, array_like, DataArray or astropy Quantity, optional
+            Observer range [km], > 0; default the cube's ``range``.
+        **kwargs
+            The other keywords of :func:`sbrdf_xr.photometry.magnitudes`.
+        """
         from . import photometry as _phot
 
-        return _phot.magnitudes(self._ds, bands, range_km, **kwargs)
+        return _phot.magnitudes(self._ds, bands, range, **kwargs)
 
     def srgb(self, **kwargs: Any) -> xr.DataArray:
         """:func:`sbrdf_xr.photometry.srgb` of this cube."""

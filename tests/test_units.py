@@ -43,9 +43,9 @@ def test_observing_arguments_take_quantities():
     assert a.latitude == pytest.approx(20.708333, abs=1e-6) and a.height == 3058.0
     with pytest.raises(UnitError, match=r"site height: got 3\.0 s"):
         Site(0.0, 0.0, 3.0 * u.s)
-    spin = Spin(rate_deg_s=np.pi / 90 * u.rad / u.s, phase_deg=0.5 * u.rad)
-    assert spin.rate_deg_s == pytest.approx(2.0) and spin.phase_deg == pytest.approx(28.64789, 1e-6)
-    assert Nadir(yaw_deg=0.25 * u.cycle).yaw_deg == pytest.approx(90.0)
+    spin = Spin(rate=np.pi / 90 * u.rad / u.s, phase=0.5 * u.rad)
+    assert spin.rate == pytest.approx(2.0) and spin.phase == pytest.approx(28.64789, 1e-6)
+    assert Nadir(yaw=0.25 * u.cycle).yaw == pytest.approx(90.0)
     t = times(Time("2024-03-17T01:20:37", scale="tai"), "2024-03-17T01:21:00", 0.5 * u.min)
     assert [str(x)[11:19] for x in t] == ["01:20:00", "01:20:30", "01:21:00"]  # TAI - UTC = 37 s
     np.testing.assert_allclose(airmass(np.pi / 2 * u.rad), airmass(90.0))
@@ -96,11 +96,11 @@ def test_ranges_and_distances_outside_their_plausible_span_warn():
         {"signal": (("geometry", "wavelength"), np.full((1, wl.size), 0.1), {"units": "m2 sr-1"})},
         coords={"wavelength": ("wavelength", wl, {"units": "nm"})},
     )
-    with pytest.warns(UnitWarning, match="sun_distance_au: 1.496e\\+08 au is above"):
-        P.magnitudes(cube, ["V"], range_km=1000.0, sun_distance_au=1.496e8)
-    m = P.standard_magnitude(P.magnitudes(cube, ["V"], range_km=2000.0), 2e6 * u.m)
+    with pytest.warns(UnitWarning, match="sun_distance: 1.496e\\+08 au is above"):
+        P.magnitudes(cube, ["V"], range=1000.0, sun_distance=1.496e8)
+    m = P.standard_magnitude(P.magnitudes(cube, ["V"], range=2000.0), 2e6 * u.m)
     np.testing.assert_allclose(
-        m.values, P.standard_magnitude(P.magnitudes(cube, ["V"], range_km=2000.0), 2000.0).values
+        m.values, P.standard_magnitude(P.magnitudes(cube, ["V"], range=2000.0), 2000.0).values
     )
 
 

@@ -330,7 +330,7 @@ def _compare_inputs() -> dict[str, Any]:
         },
         coords={"time": ("obs", t), "band": ("obs", ["V"] * 9)},
     )
-    return {"measured": lc, "simulated": sim, "period_s": 360.0 / 10.0 * 3.0}
+    return {"measured": lc, "simulated": sim, "period": 360.0 / 10.0 * 3.0}
 
 
 def _time_curve() -> dict[str, Any]:
@@ -352,7 +352,7 @@ def _spin_lc() -> dict[str, Any]:
     from sbrdf_xr import Scene, geometry, simulate
     from sbrdf_xr.invert import axis_vector, spin_model
 
-    spin = spin_model([0, 0, 1], axis_vector(60.0, 30.0), period_s=20.0, phase_deg=30.0)
+    spin = spin_model([0, 0, 1], axis_vector(60.0, 30.0), period=20.0, phase=30.0)
     t = np.arange(0.0, 24.0, 1.0)
     box = _box()
     scene = Scene(
@@ -566,10 +566,10 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.body.spacecraft.Spacecraft.plot": lambda: dict(self=_box(), elev=25.0, azim=35.0),
     "sbrdf_xr.body.spacecraft.Spacecraft.inertia": lambda: dict(self=_box(), density=100.0),
     "sbrdf_xr.accessors.SbrdfDatasetAccessor.magnitudes": lambda: dict(
-        self=_cube().sbrdf, bands=["V"], range_km=1000.0
+        self=_cube().sbrdf, bands=["V"], range=1000.0
     ),
     "sbrdf_xr.accessors.SbrdfDatasetAccessor.photometry": lambda: dict(
-        self=_cube().sbrdf, bands=["V", "R"], range_km=1000.0
+        self=_cube().sbrdf, bands=["V", "R"], range=1000.0
     ),
     "sbrdf_xr.observing.observation.Observation.next_pass": lambda: dict(
         self=_observation(), days=0.5, twilight=-12.0
@@ -595,11 +595,11 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.engine.effects.moonlight.moon_from_spacecraft": lambda: _moon_inputs(),
     # --- invert
     "sbrdf_xr.invert._data.magnitudes_to_signal": lambda: dict(
-        light_curve=_light_curve(), range_km=1000.0
+        light_curve=_light_curve(), range=1000.0
     ),
     "sbrdf_xr.invert._spin.fit.fit_spin": _spin_lc,
     "sbrdf_xr.invert._unmix.unmix": lambda: _unmix_inputs(),
-    "sbrdf_xr.invert._spin.fit.period_grid": lambda: dict(p_min=60.0, p_max=70.0, span_s=240.0),
+    "sbrdf_xr.invert._spin.fit.period_grid": lambda: dict(p_min=60.0, p_max=70.0, span=240.0),
     "sbrdf_xr.invert._spin.fit.axis_vector": lambda: dict(
         longitude=[30.0, 60.0], latitude=[20.0, -5.0]
     ),
@@ -613,11 +613,11 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         extinction={"V": 0.2},
         bands=("V",),
         n_draws=1,
-        noise_mag=0.02,
-        phase_symmetry_deg=180.0,
+        noise=0.02,
+        phase_symmetry=180.0,
     ),
     "sbrdf_xr.invert._spin.search.spin_model": lambda: dict(
-        axis_body=[0, 0, 1], axis=[1.0, 0.0, 0.0], period_s=60.0, phase_deg=30.0
+        axis_body=[0, 0, 1], axis=[1.0, 0.0, 0.0], period=60.0, phase=30.0
     ),
     # --- materials
     "sbrdf_xr.materials.schema.lambertian": lambda: dict(albedo=0.5, wavelength=WL),
@@ -761,7 +761,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         spec=_aniso_spec(), theta_i=[30.0, 40.0], delta_theta=[5.0], phi=[10.0], psi=[20.0]
     ),
     # --- observing
-    "sbrdf_xr.observing.attitude.Nadir": lambda: dict(yaw_deg=30.0),
+    "sbrdf_xr.observing.attitude.Nadir": lambda: dict(yaw=30.0),
     "sbrdf_xr.observing.attitude.geodetic_up": lambda: dict(
         position_itrs=[[5000.0, 100.0, 5000.0]]
     ),
@@ -776,9 +776,9 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         min_elevation=25.0,
         on_bad="drop",
     ),
-    "sbrdf_xr.observing.attitude.Spin": lambda: dict(rate_deg_s=2.0, phase_deg=30.0),
+    "sbrdf_xr.observing.attitude.Spin": lambda: dict(rate=2.0, phase=30.0),
     "sbrdf_xr.observing.tumble.Tumble": lambda: dict(
-        inertia=(1.0, 2.0, 3.0), omega_deg_s=(1.0, 2.0, 3.0)
+        inertia=(1.0, 2.0, 3.0), omega=(1.0, 2.0, 3.0)
     ),
     "sbrdf_xr.observing.orbits.Site": lambda: dict(latitude=20.7, longitude=-156.3, height=3058.0),
     "sbrdf_xr.observing.observation.Observation": lambda: dict(
@@ -864,13 +864,13 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         bands=["V"], wavelength=np.arange(400.0, 1101.0, 10.0)
     ),
     "sbrdf_xr.lightcurves.comparison.compare": lambda: dict(
-        **_compare_inputs(), max_time_shift_s=10.0, phase_angle=None, fit_phase=True
+        **_compare_inputs(), max_time_shift=10.0, phase_angle=None, fit_phase=True
     ),
     "sbrdf_xr.photometry.magnitude.magnitudes": lambda: dict(
-        cube=_cube(), bands=["V"], range_km=1000.0, sun_distance_au=1.01
+        cube=_cube(), bands=["V"], range=1000.0, sun_distance=1.01
     ),
     "sbrdf_xr.photometry.magnitude.photometry": lambda: dict(
-        cube=_cube(), bands=["V", "R"], range_km=1000.0, sun_distance_au=1.01
+        cube=_cube(), bands=["V", "R"], range=1000.0, sun_distance=1.01
     ),
     "sbrdf_xr.photometry.spectra.ab_reference_flux": lambda: dict(wavelength=WL),
     "sbrdf_xr.photometry.spectra.reference_flux": lambda: dict(system="Vega", wavelength=WL),
@@ -1096,7 +1096,7 @@ def _recovery_inputs() -> dict[str, Any]:
         n_axes=12,
         n_phases=8,
         n_starts=1,
-        axis_tolerance_deg=1.0,
+        axis_tolerance=1.0,
         n_threads=1,
     )
 
@@ -1180,7 +1180,7 @@ def _solar() -> xr.DataArray:
 def _mags() -> xr.DataArray:
     from sbrdf_xr.photometry import magnitudes
 
-    return magnitudes(_cube(), ["V"], range_km=2000.0)
+    return magnitudes(_cube(), ["V"], range=2000.0)
 
 
 #: Cases whose comparison is long (a fit or a simulation): ``-m slow`` runs it; the
@@ -1412,58 +1412,27 @@ UNIT_ENDING_ALLOWED: dict[tuple[str, str], str] = {
     ("sbrdf_xr.brdf.microfacet.distribution_ggx", "sin2_h"): "h is the half vector, not hours",
     ("sbrdf_xr.materials.construction.paper_delta_theta_grid", "dt_min"): "the smallest step",
     ("sbrdf_xr.materials.goniometer.paper_scheme", "dt_min"): "the smallest step, not minutes",
-    ("sbrdf_xr.invert._spin.period_grid", "p_min"): "the shortest period, not minutes",
+    ("sbrdf_xr.invert._spin.fit.period_grid", "p_min"): "the shortest period, not minutes",
     ("sbrdf_xr.engine.plan.Estimate", "output_bytes"): "a count of bytes, a plain integer",
     ("sbrdf_xr.engine.plan.Estimate", "block_bytes"): "a count of bytes, a plain integer",
     ("sbrdf_xr.engine.scene.Scene", "block_bytes"): "a count of bytes, a plain integer",
     ("sbrdf_xr.materials.models.render", "max_bytes"): "a count of bytes, a plain integer",
 }
-#: Not renamed yet, each with why: called under this name from modules that another
-#: change is moving (``invert/``, the measured light-curve workflow in ``photometry``),
-#: or a dataclass field (a file's key) whose rename needs its readers changed with it.
+#: Not renamed yet, each with why.  ``Scene`` is at the module's line cap and its field
+#: names are the scene file's keys (the schema, the reader and the fingerprint list them);
+#: the tracking table's fields are its files' column names, read by ``tracking_io``.
 UNIT_ENDING_PENDING: dict[tuple[str, str], str] = {
+    ("sbrdf_xr.engine.scene.Scene", "earth_range_km"): "a scene-file key; scene.py at its cap",
     **{
-        (f"sbrdf_xr.{where}", "range_km"): "photometry.magnitudes: called so from invert/"
-        for where in (
-            "photometry.magnitude.magnitudes",
-            "photometry.magnitude.photometry",
-            "accessors.SbrdfDatasetAccessor.magnitudes",
-            "accessors.SbrdfDatasetAccessor.photometry",
-        )
-    },
-    **{
-        (f"sbrdf_xr.photometry.magnitude.{f}", "sun_distance_au"): "with range_km, from invert/"
-        for f in ("magnitudes", "photometry")
-    },
-    **{
-        (name, arg): "invert/ and the light-curve modules are being reorganised apart"
-        for name, arg in (
-            ("sbrdf_xr.invert._data.magnitudes_to_signal", "range_km"),
-            ("sbrdf_xr.invert._joint_study.observation_recovery", "noise_mag"),
-            ("sbrdf_xr.invert._joint_study.observation_recovery", "phase_symmetry_deg"),
-            ("sbrdf_xr.invert._spin.period_grid", "span_s"),
-            ("sbrdf_xr.invert._spin_search.spin_model", "period_s"),
-            ("sbrdf_xr.invert._spin_search.spin_model", "phase_deg"),
-            ("sbrdf_xr.invert._studies.spin_recovery", "axis_tolerance_deg"),
-            ("sbrdf_xr.photometry.lightcurves.compare", "max_time_shift_s"),
-            ("sbrdf_xr.photometry.lightcurves.compare", "period_s"),
-            ("sbrdf_xr.observing.attitude.Spin", "rate_deg_s"),
-            ("sbrdf_xr.observing.attitude.Spin", "phase_deg"),
-        )
-    },
-    **{
-        (name, arg): "a dataclass field named as the scene or tracking file's key"
-        for name, arg in (
-            ("sbrdf_xr.engine.scene.Scene", "earth_range_km"),
-            ("sbrdf_xr.observing.attitude.Nadir", "yaw_deg"),
-            ("sbrdf_xr.observing.tracking.TrackingTable", "elevation_deg"),
-            ("sbrdf_xr.observing.tracking.TrackingTable", "azimuth_deg"),
-            ("sbrdf_xr.observing.tracking.TrackingTable", "ra_deg"),
-            ("sbrdf_xr.observing.tracking.TrackingTable", "dec_deg"),
-            ("sbrdf_xr.observing.tracking.TrackingTable", "range_km"),
-            ("sbrdf_xr.observing.tracking.TrackingTable", "height_km"),
-            ("sbrdf_xr.observing.tracking.TrackingTable", "max_gap_s"),
-            ("sbrdf_xr.observing.tumble.Tumble", "omega_deg_s"),
+        ("sbrdf_xr.observing.tracking.TrackingTable", field): "a tracking file's column name"
+        for field in (
+            "elevation_deg",
+            "azimuth_deg",
+            "ra_deg",
+            "dec_deg",
+            "range_km",
+            "height_km",
+            "max_gap_s",
         )
     },
 }

@@ -175,7 +175,7 @@ def cmd_photometry(args: argparse.Namespace) -> int:
                 range_km,
                 pairs=colours,
                 system=args.system,
-                sun_distance_au=args.sun_distance_au,
+                sun_distance=args.sun_distance_au,
                 extinction=extinction,
                 weighting=args.weighting,
                 quadrature=args.quadrature,
@@ -302,8 +302,9 @@ def _unmix(args: argparse.Namespace):
             text = f"{args.measured} against {args.cube}: {text}"
         raise InversionError(text) from None
     print(
-        f"unmix {args.measured}: chi2 {float(ds.chi2):.4g} for {int(ds.dof)} degrees of "
-        f"freedom, reduced {float(ds.reduced_chi2):.4g} ({ds.attrs['fit_quality']}); "
+        f"unmix {args.measured}: chi2 {float(ds.chi2):.4g} for "
+        f"{int(ds.degrees_of_freedom)} degrees of freedom, "
+        f"reduced {float(ds.reduced_chi_square):.4g} ({ds.attrs['fit_quality']}); "
         f"{args.criterion} selection: {ds.attrs['selected_materials']}"
     )
     for m in ds.material.values:
@@ -408,7 +409,7 @@ def _spin(args: argparse.Namespace):
         f"spin fit of {args.measured}: {ds.attrs['n_candidates']} candidates by "
         f"{ds.attrs['search_method']} in {ds.attrs['search_seconds']:.1f} s "
         f"({ds.attrs['search_check']}); chi2 {float(ds.chi2):.4g}, reduced "
-        f"{float(ds.reduced_chi2):.4g} ({ds.attrs['fit_quality']}); epoch {ds.attrs['epoch']}"
+        f"{float(ds.reduced_chi_square):.4g} ({ds.attrs['fit_quality']}); epoch {ds.attrs['epoch']}"
     )
     for k in ("axis_longitude", "axis_latitude", "period", "phase"):
         print(

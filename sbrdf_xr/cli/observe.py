@@ -118,7 +118,7 @@ def attitude_of(args: argparse.Namespace, spacecraft: Any = None) -> Any:
     >>> args = build_parser().parse_args([*base, "--attitude", "spin", "--period", "90",
     ...                                   "--spin-axis", "0,0,1", "--initial", "nadir"])
     >>> law = attitude_of(args)
-    >>> type(law).__name__, law.rate_deg_s, type(law.initial).__name__
+    >>> type(law).__name__, law.rate, type(law.initial).__name__
     ('Spin', 4.0, 'Nadir')
     >>> attitude_of(build_parser().parse_args([*base, "--attitude", "spin"]))
     Traceback (most recent call last):

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ..errors import InversionError, check_declared_size
+from ..errors import InversionError, check_declared_size, renamed_keywords
 from ..units import check_plausible, to_unit
 from ._spin.data import LN10_2P5
 
@@ -64,8 +64,9 @@ def band_terms(per_material: xr.DataArray, bands: Sequence[str]) -> xr.DataArray
     return out
 
 
+@renamed_keywords(range_km="range")
 def magnitudes_to_signal(
-    light_curve: xr.Dataset, range_km: float, *, system: str | None = None
+    light_curve: xr.Dataset, range: float, *, system: str | None = None
 ) -> tuple[xr.DataArray, xr.DataArray]:
     """Band signal [m2 sr-1] and its uncertainty from measured magnitudes (one per band).
 
@@ -80,7 +81,7 @@ def magnitudes_to_signal(
     ----------
     light_curve : Dataset
         ``magnitude`` and ``uncertainty`` over ``band``.
-    range_km : float
+    range : float
         Observer range [km]; a Quantity is converted.
 
     Examples
@@ -91,7 +92,7 @@ def magnitudes_to_signal(
     >>> from sbrdf_xr.invert import magnitudes_to_signal
     >>> mags = xr.Dataset({"magnitude": ("band", [8.0, 7.6]),
     ...                    "uncertainty": ("band", [0.02, 0.02])}, coords={"band": ["V", "R"]})
-    >>> signal, sigma = magnitudes_to_signal(mags, range_km=1000.0)
+    >>> signal, sigma = magnitudes_to_signal(mags, range=1000.0)
     >>> signal.round(6).values.tolist(), signal.attrs["units"]
     ([0.012381, 0.014961], 'm2 sr-1')
     >>> round(float(sigma[0] / signal[0]), 6)  # ln(10) / 2.5 * 0.02
@@ -104,10 +105,10 @@ def magnitudes_to_signal(
     """
     from ..photometry import MAGNITUDE_SYSTEMS, sun_magnitudes
 
-    range_km = to_unit(range_km, "km", "range_km")
+    range_km = to_unit(range, "km", "range")
     if not np.isfinite(range_km) or range_km <= 0:
-        raise InversionError(f"range_km: must be finite and > 0, got {range_km}")
-    check_plausible(range_km, "range_km", "range_km")
+        raise InversionError(f"range: must be finite and > 0, got {range_km}")
+    check_plausible(range_km, "range_km", "range")
     bands = [str(b) for b in light_curve["band"].values]
     if len(set(bands)) != len(bands):
         raise InversionError(

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from ..errors import FitQualityWarning, InversionError
+from ..errors import FitQualityWarning, InversionError, renamed_keywords
 from ..units import to_unit
 from ._unmix import MATERIAL, unmix
 
@@ -115,6 +115,7 @@ def unmix_calibration(
     return ds
 
 
+@renamed_keywords(axis_tolerance_deg="axis_tolerance")
 def spin_recovery(
     spacecraft: Any,
     observation: Any,
@@ -125,7 +126,7 @@ def spin_recovery(
     n_draws: int = 20,
     seed: int = 0,
     times: Any = None,
-    axis_tolerance_deg: float = 1.0,
+    axis_tolerance: float = 1.0,
     period_tolerance_sigma: float = 3.0,
     **options: Any,
 ) -> xr.Dataset:
@@ -138,7 +139,7 @@ def spin_recovery(
     the fluxes ``band_signal (r_ref / range)**2`` get Gaussian noise of standard
     deviation ``relative_noise`` times ``(flux + 0.1 median flux)`` and are fitted with
     the observation as geometry (``options`` passed on to :func:`fit_spin`).  A draw
-    succeeds when the axis is within ``axis_tolerance_deg`` and the period within
+    succeeds when the axis is within ``axis_tolerance`` and the period within
     ``period_tolerance_sigma`` of its stated uncertainty.
 
     Parameters
@@ -157,7 +158,7 @@ def spin_recovery(
         Noise draws and the seed of the first.
     times : array_like of datetime64, optional
         The times measured.
-    axis_tolerance_deg : float
+    axis_tolerance : float
         Largest axis error of a success [degree].
     period_tolerance_sigma : float
         Largest period error of a success, in its uncertainties.
@@ -170,7 +171,7 @@ def spin_recovery(
     -------
     xarray.Dataset
         Over ``draw``: ``axis_error`` [degree], ``axis_uncertainty`` [degree], ``period``,
-        ``period_uncertainty`` [s], ``period_pull`` [1], ``reduced_chi2``, ``success``,
+        ``period_uncertainty`` [s], ``period_pull`` [1], ``reduced_chi_square``, ``success``,
         ``ambiguous`` (a twin fitted about as well), ``seconds`` (wall time of the fit);
         attributes ``truth_axis``, ``truth_period``, ``success_rate``, ``search_methods``
         and ``load_average`` (1-minute, before and after).
@@ -191,7 +192,7 @@ def spin_recovery(
     (2, 90.0)
     """
     periods = to_unit(periods, "s", "periods")
-    axis_tolerance_deg = to_unit(axis_tolerance_deg, "deg", "axis_tolerance_deg")
+    axis_tolerance = to_unit(axis_tolerance, "deg", "axis_tolerance")
     import os
 
     from ..engine import Scene, simulate
@@ -209,8 +210,8 @@ def spin_recovery(
     q0 = law.initial.quaternions([0.0])
     axis_b = body_axis(law.axis_body, "axis_body")
     truth_axis = rotation_matrices(q0)[0] @ (axis_b / np.linalg.norm(axis_b))
-    truth_period = 360.0 / abs(law.rate_deg_s)
-    if law.rate_deg_s < 0:
+    truth_period = 360.0 / abs(law.rate)
+    if law.rate < 0:
         truth_axis = -truth_axis
     obs = observation if times is None else _at_times(observation, times)
     cube = simulate(
@@ -228,7 +229,7 @@ def spin_recovery(
             "period",
             "period_uncertainty",
             "period_pull",
-            "reduced_chi2",
+            "reduced_chi_square",
             "success",
             "ambiguous",
             "seconds",
@@ -252,7 +253,7 @@ def spin_recovery(
         dt = time.perf_counter() - t0
         err = axis_separation(fit["axis_vector"].values, truth_axis)
         pull = (float(fit["period"]) - truth_period) / float(fit["period_uncertainty"])
-        ok = err <= axis_tolerance_deg and abs(pull) <= period_tolerance_sigma
+        ok = err <= axis_tolerance and abs(pull) <= period_tolerance_sigma
         methods.append(str(fit.attrs["search_method"]))
         for k, v in (
             ("axis_error", err),
@@ -260,7 +261,7 @@ def spin_recovery(
             ("period", float(fit["period"])),
             ("period_uncertainty", float(fit["period_uncertainty"])),
             ("period_pull", pull),
-            ("reduced_chi2", float(fit["reduced_chi2"])),
+            ("reduced_chi_square", float(fit["reduced_chi_square"])),
             ("success", float(ok)),
             ("ambiguous", float(fit.attrs["ambiguity"] != "none")),
             ("seconds", dt),

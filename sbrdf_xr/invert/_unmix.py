@@ -192,7 +192,7 @@ def unmix(
     constraint, the leave-out bias is that of the constrained full fit (adding ``x_D =
     0`` to the constraint shifts the kept estimates by ``-C_c,SD C_c,DD^-1 x_c,D``, the
     same formula on the constrained covariance), and the criteria, ``dof`` and
-    ``reduced_chi2`` count one free parameter less.  Use it when the library holds every
+    ``reduced_chi_square`` count one free parameter less.  Use it when the library holds every
     material of the body and the data are calibrated: the total then pins down a
     material the spectrum hardly sees (dark, or never lit), by elimination.
 
@@ -238,12 +238,13 @@ def unmix(
         ``selected`` (bool), ``importance`` (the summed weights of the subsets holding the
         material), ``area``, ``area_uncertainty`` [m2], ``area_fraction`` and
         ``area_fraction_uncertainty`` [1] (with ``areas``), ``correlation`` (material,
-        material_b); scalars ``chi2``, ``reduced_chi2``, ``dof``, ``fit_probability``,
-        ``aic``, ``bic``, ``condition_number``; over ``subset``: ``subset_chi2``,
-        ``subset_aic``, ``subset_bic``, ``subset_weight``, ``subset_bias_ratio``,
-        ``subset_admissible``; ``total_area`` [m2] (with the constraint); attributes
-        ``selected_materials``, ``selection_note``, ``degenerate``, ``fit_quality`` (and
-        ``fit_quality_note``), ``library_note``, ``area_constraint``.
+        material_b); scalars ``chi2``, ``reduced_chi_square``, ``degrees_of_freedom``,
+        ``fit_probability``, ``aic``, ``bic``, ``condition_number``; over ``subset``:
+        ``subset_chi2``, ``subset_aic``, ``subset_bic``, ``subset_weight``,
+        ``subset_bias_ratio``, ``subset_admissible``; ``total_area`` [m2] (with the
+        constraint); attributes ``selected_materials``, ``selection_note``,
+        ``degenerate``, ``fit_quality`` (and ``fit_quality_note``), ``library_note``,
+        ``area_constraint``.
 
     Warns
     -----
@@ -304,8 +305,10 @@ def unmix(
     and the fractions add up to 1 exactly:
 
     >>> tied = unmix(measured, cube, sigma, areas=material_areas(box), total_area=6.2)
-    >>> tied.scale.round(3).values.tolist(), int(tied.dof), int(fit.dof)
-    ([0.805, 1.491], 25, 24)
+    >>> tied.scale.round(3).values.tolist()
+    [0.805, 1.491]
+    >>> int(tied.degrees_of_freedom), int(fit.degrees_of_freedom)
+    (25, 24)
     >>> round(float(tied.area_fraction.sum()), 12), tied.area_fraction.attrs["long_name"]
     (1.0, 'fraction of total_area, the constrained sum of the areas')
     """
@@ -535,14 +538,17 @@ def _result(
     chi2, dof, n, npar = (scalars[k_] for k_ in ("chi2", "dof", "n", "npar"))
     scal = {
         "chi2": (chi2, "chi-square of the chosen model"),
-        "dof": (
+        "degrees_of_freedom": (
             dof,
             "degrees of freedom (values minus fitted scale factors, plus one for the area "
             "constraint)"
             if total is not None
             else "degrees of freedom (values minus fitted scale factors)",
         ),
-        "reduced_chi2": (chi2 / dof if dof > 0 else np.nan, "chi-square per degree of freedom"),
+        "reduced_chi_square": (
+            chi2 / dof if dof > 0 else np.nan,
+            "chi-square per degree of freedom",
+        ),
         "fit_probability": (
             quality["fit_probability"],
             "probability of a chi-square at least this large for a right model",

@@ -24,7 +24,7 @@ import numpy as np
 import xarray as xr
 
 from .._names import ATTITUDE, BAND, PHASE_ANGLE
-from ..errors import LightCurveError
+from ..errors import LightCurveError, renamed_keywords
 from ..photometry import BAND_ALIASES
 from ..units import to_unit
 from . import _alignment as align
@@ -133,6 +133,7 @@ def _system(measured: xr.Dataset, sim: xr.DataArray) -> str:
     return have if have != "unstated" else want
 
 
+@renamed_keywords(max_time_shift_s="max_time_shift", period_s="period")
 def compare(
     measured: xr.Dataset,
     simulated: xr.DataArray | xr.Dataset,
@@ -141,9 +142,9 @@ def compare(
     extinction: str | Mapping[str, float] | None = None,
     airmass: str = "auto",
     fit_time_shift: bool = False,
-    max_time_shift_s: Any = 10.0,
+    max_time_shift: Any = 10.0,
     fit_phase: bool = True,
-    period_s: Any = None,
+    period: Any = None,
     epoch: Any = None,
     phase_angle: Any = None,
     n_scan: int = 720,
@@ -157,10 +158,10 @@ def compare(
     * a **pass** (``simulated`` over ``time``): the simulated flux is interpolated
       linearly in time at the measured UTC times; a measured time outside the simulated
       window is an error.  ``dt`` is fitted when ``fit_time_shift`` (within
-      ``max_time_shift_s``, the shifted times inside the window), else 0.
+      ``max_time_shift``, the shifted times inside the window), else 0.
     * a **rotation sweep** (over ``attitude`` with ``attitude_angle``): the curve is
       periodic in 360 degree, the measured rotation angles (or times times
-      ``360 / period_s``) are offset by a fitted phase (``fit_phase``); a ``range_km``
+      ``360 / period``) are offset by a fitted phase (``fit_phase``); a ``range_km``
       column adds ``5 log10(range / range_sim)``.
 
     ``ZP_b`` is a zero point per band (``zero_points="band"``; their differences are
@@ -189,11 +190,11 @@ def compare(
         the simulated pass's ``airmass`` coordinate.
     fit_time_shift : bool
         A pass: fit ``dt`` [s].
-    max_time_shift_s : float or Quantity
+    max_time_shift : float or Quantity
         Bound of ``|dt|`` [s].
     fit_phase : bool
         A rotation sweep: fit the phase offset [degree].
-    period_s : float or Quantity, optional
+    period : float or Quantity, optional
         A rotation sweep compared over times: the rotation period [s].
     epoch : datetime64 or str, optional
         A rotation sweep compared over UTC times: the time of rotation angle 0
@@ -272,11 +273,11 @@ def compare(
         raise LightCurveError(
             f"n_scan: must be an integer >= 1 (trial shifts of the scan), got {n_scan!r}"
         )
-    max_shift = float(to_unit(max_time_shift_s, "s", "max_time_shift_s"))
+    max_shift = float(to_unit(max_time_shift, "s", "max_time_shift"))
     if not (np.isfinite(max_shift) and max_shift > 0):
-        raise LightCurveError(f"max_time_shift_s: must be > 0 s, got {max_time_shift_s!r}")
+        raise LightCurveError(f"max_time_shift: must be > 0 s, got {max_time_shift!r}")
     phase_angle = to_unit(phase_angle, "deg", "phase_angle")
-    period_s = to_unit(period_s, "s", "period_s")
+    period = to_unit(period, "s", "period")
     sim = _simulated(simulated, measured, phase_angle)
     system = _system(measured, sim)
     col = _band_columns(measured, sim)
@@ -289,7 +290,7 @@ def compare(
                 "fit_time_shift: a rotation sweep has no time axis; its phase offset is "
                 "fitted with fit_phase"
             )
-        period = None if period_s is None else float(to_unit(period_s, "s", "period_s"))
+        period = None if period is None else float(period)
         al = align.sweep(measured, sim, period, epoch)
         fit_x = bool(fit_phase)
     fixed_k = None

@@ -50,7 +50,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from ..errors import AttitudeError, did_you_mean, renamed_attributes, renamed_keywords
+from ..errors import (
+    AttitudeError,
+    did_you_mean,
+    renamed_attributes,
+    renamed_fields,
+    renamed_keywords,
+)
 from ..units import to_unit
 from .frames import (
     Context,
@@ -88,17 +94,20 @@ class AttitudeLaw:
 
     ``outer * inner`` composes two laws (:class:`Composed`).  A subclass that sets
     ``law_name`` (the ``law`` of a TOML table) and ``law_parameters`` (its other keys)
-    enters :data:`ATTITUDE_LAWS`; :meth:`from_table` builds it from such a table.
+    enters :data:`ATTITUDE_LAWS`; :meth:`from_table` builds it from such a table, a key
+    spelled with its unit (``rate_deg_s``) given to its bare field (``rate``) through
+    ``table_keys``.
 
     Examples
     --------
-    >>> law = Spin(axis_body="+z", rate_deg_s=90.0)
+    >>> law = Spin(axis_body="+z", rate=90.0)
     >>> isinstance(law, AttitudeLaw), law.quaternions([0.0, 1.0]).shape
     (True, (2, 4))
     """
 
     law_name: ClassVar[str] = ""
     law_parameters: ClassVar[tuple[str, ...]] = ()
+    table_keys: ClassVar[Mapping[str, str]] = {}
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
@@ -116,7 +125,7 @@ class AttitudeLaw:
         Inertial(q=(0.0, 0.0, 1.0, 0.0))
         """
         try:
-            return cls(**params)
+            return cls(**{cls.table_keys.get(k, k): v for k, v in params.items()})
         except TypeError as exc:
             raise AttitudeError(f"attitude law {cls.law_name!r}: {exc}") from None
 
@@ -125,7 +134,7 @@ class AttitudeLaw:
 
         Examples
         --------
-        >>> np.round(Spin(rate_deg_s=180.0).quaternions([0.0, 1.0]), 6)  # half a turn in 1 s
+        >>> np.round(Spin(rate=180.0).quaternions([0.0, 1.0]), 6)  # half a turn in 1 s
         array([[0., 0., 0., 1.],
                [0., 0., 1., 0.]])
         """
@@ -167,6 +176,7 @@ class Inertial(AttitudeLaw):
         return np.tile(np.asarray(self.q), (n, 1))
 
 
+@renamed_fields(yaw_deg="yaw")
 @dataclass(frozen=True)
 class Nadir(AttitudeLaw):
     """Nadir pointing in the local-vertical local-horizontal (LVLH) frame, with a yaw.
@@ -174,12 +184,12 @@ class Nadir(AttitudeLaw):
     At yaw 0 the body ``nadir_axis`` points from the spacecraft to the Earth's centre
     (``-r/|r|``) and ``velocity_axis`` along the along-track direction (the part of
     the velocity perpendicular to ``r``).  The yaw then turns the body about the nadir
-    axis by ``yaw_deg`` (right-handed about ``nadir_axis``), so the nadir axis stays on
+    axis by ``yaw`` (right-handed about ``nadir_axis``), so the nadir axis stays on
     the geocentre.
 
     Parameters
     ----------
-    yaw_deg : float
+    yaw : float
         Yaw about the nadir axis [degree].
     nadir_axis, velocity_axis : str or array_like
         Perpendicular body axes (``"+z"``, ``"-x"``, ... or 3 components).
@@ -197,16 +207,17 @@ class Nadir(AttitudeLaw):
 
     law_name: ClassVar[str] = "nadir"
     law_parameters: ClassVar[tuple[str, ...]] = ("yaw_deg", "nadir_axis", "velocity_axis")
+    table_keys: ClassVar[Mapping[str, str]] = {"yaw_deg": "yaw"}
 
-    yaw_deg: float = 0.0
+    yaw: float = 0.0
     nadir_axis: Any = "+z"
     velocity_axis: Any = "+x"
     _axes: tuple[np.ndarray, np.ndarray] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "yaw_deg", to_unit(self.yaw_deg, "deg", "yaw_deg"))
-        if not np.isfinite(self.yaw_deg):
-            raise AttitudeError(f"nadir yaw_deg: must be finite, got {self.yaw_deg}")
+        object.__setattr__(self, "yaw", to_unit(self.yaw, "deg", "yaw"))
+        if not np.isfinite(self.yaw):
+            raise AttitudeError(f"nadir yaw: must be finite, got {self.yaw}")
         a, b = perpendicular_pair(
             axis_vector(self.nadir_axis, "nadir_axis"),
             axis_vector(self.velocity_axis, "velocity_axis"),
@@ -219,8 +230,8 @@ class Nadir(AttitudeLaw):
         r, v = context_fields(context, n, "nadir", "position", "velocity")
         a, b = self._axes
         q = triad(a, b, -r, v)
-        if self.yaw_deg:
-            yaw = Rotation.from_rotvec(np.radians(self.yaw_deg) * a)
+        if self.yaw:
+            yaw = Rotation.from_rotvec(np.radians(self.yaw) * a)
             q = (Rotation.from_quat(q) * yaw).as_quat().reshape(-1, 4)
         return q
 
@@ -428,12 +439,13 @@ class SunPointing(AttitudeLaw):
         return triad(a, b, sun, target)
 
 
+@renamed_fields(rate_deg_s="rate", phase_deg="phase")
 @dataclass(frozen=True)
 class Spin(AttitudeLaw):
     """Rotation about a body axis at a constant rate, after an initial attitude.
 
     ``R(t) = R_initial(t) R_axis(phase + rate t)``: the body turns about its own
-    ``axis_body`` (right-handed) by the angle ``phase_deg + rate_deg_s * t``, starting
+    ``axis_body`` (right-handed) by the angle ``phase + rate * t``, starting
     from ``initial`` (a quaternion: the attitude at angle 0; or a law, e.g. :class:`Nadir`
     for a nadir-pointer spinning about its nadir axis).  With an inertial ``initial`` this
     equals :func:`sbrdf_xr.geometry.rotation_sweep` about the inertial axis
@@ -443,18 +455,18 @@ class Spin(AttitudeLaw):
     ----------
     axis_body : str or array_like
         Spin axis in the body frame.
-    rate_deg_s : float
+    rate : float
         Spin rate [degree s-1].
-    phase_deg : float
+    phase : float
         Angle at the epoch [degree].
     initial : quaternion, law or table
         Attitude at angle 0 (default: identity).
     epoch : datetime64 or str, optional
-        Time of ``phase_deg`` (default: the start of the observation).
+        Time of ``phase`` (default: the start of the observation).
 
     Examples
     --------
-    >>> spin = Spin(axis_body="+z", rate_deg_s=10.0, phase_deg=5.0)
+    >>> spin = Spin(axis_body="+z", rate=10.0, phase=5.0)
     >>> spin.angles([0.0, 1.0, 2.0])  # [degree]
     array([ 5., 15., 25.])
     >>> np.round(spin.quaternions([0.0]), 6)
@@ -469,16 +481,17 @@ class Spin(AttitudeLaw):
         "initial",
         "epoch",
     )
+    table_keys: ClassVar[Mapping[str, str]] = {"rate_deg_s": "rate", "phase_deg": "phase"}
 
     axis_body: Any = "+z"
-    rate_deg_s: float = 1.0
-    phase_deg: float = 0.0
+    rate: float = 1.0
+    phase: float = 0.0
     initial: Any = (0.0, 0.0, 0.0, 1.0)
     epoch: Any = None
     _axis_vec: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        for name, unit in (("rate_deg_s", "deg / s"), ("phase_deg", "deg")):
+        for name, unit in (("rate", "deg / s"), ("phase", "deg")):
             val = to_unit(getattr(self, name), unit, name)
             object.__setattr__(self, name, val)
             if not isinstance(val, int | float | np.floating | np.integer) or not np.isfinite(val):
@@ -492,10 +505,10 @@ class Spin(AttitudeLaw):
 
         Examples
         --------
-        >>> Spin(rate_deg_s=2.0).angles([0.0, 0.5, 10.0])
+        >>> Spin(rate=2.0).angles([0.0, 0.5, 10.0])
         array([ 0.,  1., 20.])
         """
-        return self.phase_deg + self.rate_deg_s * seconds_since(times, self.epoch, context)
+        return self.phase + self.rate * seconds_since(times, self.epoch, context)
 
     def quaternions(self, times: ArrayLike, context: Context | None = None) -> NDArray[np.float64]:
         ang = np.radians(self.angles(times, context))
@@ -511,7 +524,7 @@ class Composed(AttitudeLaw):
     Examples
     --------
     >>> s = float(np.sqrt(0.5))
-    >>> law = Composed(Inertial((0.0, 0.0, s, s)), Spin(rate_deg_s=90.0))
+    >>> law = Composed(Inertial((0.0, 0.0, s, s)), Spin(rate=90.0))
     >>> np.round(law.quaternions([1.0]), 6)  # 90 degree then 90 degree about z
     array([[0., 0., 1., 0.]])
     """
@@ -566,7 +579,7 @@ def compose(outer: AttitudeLaw | ArrayLike, inner: AttitudeLaw | ArrayLike) -> C
     Examples
     --------
     >>> s = float(np.sqrt(0.5))
-    >>> law = compose([0.0, 0.0, s, s], Spin(rate_deg_s=90.0))
+    >>> law = compose([0.0, 0.0, s, s], Spin(rate=90.0))
     >>> type(law).__name__, np.round(law.quaternions([1.0]), 6)
     ('Composed', array([[0., 0., 1., 0.]]))
     """
@@ -595,7 +608,7 @@ def law_from_dict(table: Mapping[str, Any]) -> AttitudeLaw:
     --------
     >>> law = law_from_dict({"law": "spin", "axis_body": "+x", "rate_deg_s": 6.0})
     >>> law
-    Spin(axis_body='+x', rate_deg_s=6.0, phase_deg=0.0,
+    Spin(axis_body='+x', rate=6.0, phase=0.0,
          initial=Inertial(q=(0.0, 0.0, 0.0, 1.0)), epoch=None)
     >>> law_from_dict({"law": "wobble"})
     Traceback (most recent call last):

@@ -215,8 +215,8 @@ class Observation:
     >>> from sbrdf_xr.observing.timescales import times
     >>> obs = Observation(Orbit.from_catalog("canx1-example"), Site.from_catalog("mont-megantic"),
     ...                   times("2024-03-17T01:22:00", "2024-03-17T01:22:10", 5.0),
-    ...                   Spin(rate_deg_s=10.0))
-    >>> obs.times.size, obs.attitude.rate_deg_s
+    ...                   Spin(rate=10.0))
+    >>> obs.times.size, obs.attitude.rate
     (3, 10.0)
     >>> g = obs.geometry()
     >>> sorted(g.data_vars)
@@ -321,7 +321,7 @@ class Observation:
         >>> from sbrdf_xr.observing.timescales import times
         >>> orbit, site = Orbit.from_catalog("canx1-example"), Site.from_catalog("mont-megantic")
         >>> obs = Observation(orbit, site, times("2024-03-17T01:22:00", "2024-03-17T01:22:10", 5.0),
-        ...                   Spin(rate_deg_s=10.0))
+        ...                   Spin(rate=10.0))
         >>> ctx = obs.context()
         >>> ctx.position.shape, round(float(np.linalg.norm(ctx.position[0])), 0)  # [km]
         ((3, 3), 7187.0)
@@ -338,7 +338,7 @@ class Observation:
         >>> from sbrdf_xr.observing.timescales import times
         >>> orbit, site = Orbit.from_catalog("canx1-example"), Site.from_catalog("mont-megantic")
         >>> obs = Observation(orbit, site, times("2024-03-17T01:22:00", "2024-03-17T01:22:10", 5.0),
-        ...                   Spin(rate_deg_s=10.0))
+        ...                   Spin(rate=10.0))
         >>> np.round(obs.quaternions(), 6)  # 10 degree s-1 about +z
         array([[0.      , 0.      , 0.      , 1.      ],
                [0.      , 0.      , 0.422618, 0.906308],
@@ -402,7 +402,7 @@ class Observation:
         >>> from sbrdf_xr.observing.timescales import times
         >>> orbit, site = Orbit.from_catalog("canx1-example"), Site.from_catalog("mont-megantic")
         >>> obs = Observation(orbit, site, times("2024-03-17T01:22:00", "2024-03-17T01:22:10", 5.0),
-        ...                   Spin(rate_deg_s=10.0))
+        ...                   Spin(rate=10.0))
         >>> g = obs.geometry()
         >>> dict(g.sizes)
         {'time': 3, 'xyz': 3, 'component': 4}

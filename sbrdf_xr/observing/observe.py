@@ -294,8 +294,8 @@ def canx1_attitude() -> _att.AttitudeLaw:
     """
     return _att.Spin(
         axis_body=(0.3, 0.4, 0.866),
-        rate_deg_s=4.0,
-        phase_deg=0.0,
+        rate=4.0,
+        phase=0.0,
         initial=_att.Inertial((0.2, -0.1, 0.3, 0.92736185)),
     )
 

@@ -8,13 +8,14 @@ uniform density (:meth:`Tumble.from_spacecraft`).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import AttitudeError, renamed_keywords
+from ..errors import AttitudeError, renamed_fields, renamed_keywords
 from ..units import to_unit
 from .attitude import AttitudeLaw
 from .frames import Context, check_epoch, check_quaternion, seconds_since
@@ -58,6 +59,7 @@ def _inertia(value: ArrayLike) -> NDArray[np.float64]:
     return 0.5 * (arr + arr.T)
 
 
+@renamed_fields(omega_deg_s="omega")
 @dataclass(frozen=True)
 class Tumble(AttitudeLaw):
     """Torque-free rigid-body motion (Euler's equations).
@@ -75,7 +77,7 @@ class Tumble(AttitudeLaw):
     inertia : array_like, shape (3,) or (3, 3)
         Inertia tensor about the centre of mass in the body frame [kg m2] (or its
         principal moments), e.g. :meth:`sbrdf_xr.body.spacecraft.Spacecraft.inertia`.
-    omega_deg_s : array_like, shape (3,)
+    omega : array_like, shape (3,)
         Body angular velocity at the epoch [degree s-1].
     initial : array_like, shape (4,)
         Attitude at the epoch.
@@ -84,7 +86,7 @@ class Tumble(AttitudeLaw):
 
     Examples
     --------
-    >>> law = Tumble(inertia=(1.0, 2.0, 3.0), omega_deg_s=(0.0, 0.0, 10.0))  # a principal axis
+    >>> law = Tumble(inertia=(1.0, 2.0, 3.0), omega=(0.0, 0.0, 10.0))  # a principal axis
     >>> omega, q = law.states([0.0, 9.0])
     >>> np.round(np.degrees(omega), 9) + 0.0  # steady spin about z [degree s-1]
     array([[ 0.,  0., 10.],
@@ -95,21 +97,21 @@ class Tumble(AttitudeLaw):
 
     law_name: ClassVar[str] = "tumble"
     law_parameters: ClassVar[tuple[str, ...]] = ("inertia", "omega_deg_s", "initial", "epoch")
+    table_keys: ClassVar[Mapping[str, str]] = {"omega_deg_s": "omega"}
 
     inertia: Any = (1.0, 1.0, 1.0)
-    omega_deg_s: Any = (0.0, 0.0, 1.0)
+    omega: Any = (0.0, 0.0, 1.0)
     initial: Any = (0.0, 0.0, 0.0, 1.0)
     epoch: Any = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "inertia", _inertia(self.inertia))
-        w = np.asarray(to_unit(self.omega_deg_s, "deg / s", "omega_deg_s"), dtype=np.float64)
+        w = np.asarray(to_unit(self.omega, "deg / s", "omega"), dtype=np.float64)
         if w.shape != (3,) or not np.all(np.isfinite(w)):
             raise AttitudeError(
-                "tumble omega_deg_s: expected 3 finite body rates [degree s-1], "
-                f"got {self.omega_deg_s!r}"
+                f"tumble omega: expected 3 finite body rates [degree s-1], got {self.omega!r}"
             )
-        object.__setattr__(self, "omega_deg_s", w)
+        object.__setattr__(self, "omega", w)
         object.__setattr__(self, "initial", check_quaternion(self.initial, "tumble initial"))
         object.__setattr__(self, "epoch", check_epoch(self.epoch))
 
@@ -193,13 +195,13 @@ class Tumble(AttitudeLaw):
 
         t = seconds_since(times, self.epoch, context)
         rhs = self._rhs_function()
-        y0 = np.concatenate([np.radians(self.omega_deg_s), self.initial])
+        y0 = np.concatenate([np.radians(self.omega), self.initial])
         span = float(np.max(np.abs(t))) if t.size else 0.0
-        turns = float(np.linalg.norm(self.omega_deg_s)) * span / 360.0
+        turns = float(np.linalg.norm(self.omega)) * span / 360.0
         if not turns <= MAX_TUMBLE_TURNS:  # the integrator's work grows with the turns
             raise AttitudeError(
-                f"tumble omega_deg_s: {turns:.3g} turns at |omega| "
-                f"{float(np.linalg.norm(self.omega_deg_s)):.3g} degree s-1 over {span:.3g} s "
+                f"tumble omega: {turns:.3g} turns at |omega| "
+                f"{float(np.linalg.norm(self.omega)):.3g} degree s-1 over {span:.3g} s "
                 f"from the epoch; allowed at most {MAX_TUMBLE_TURNS:g} turns (slower rates, "
                 "or a shorter window nearer the epoch)"
             )

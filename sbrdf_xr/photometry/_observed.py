@@ -61,9 +61,7 @@ def _range_m(range_km: Any) -> xr.DataArray | np.ndarray:
         vals = np.asarray(range_km, dtype=np.float64)
         r = vals * 1e3
     if vals.size == 0 or not np.all(np.isfinite(vals)) or np.any(vals <= 0):
-        raise ValidationError(
-            f"range_km: must be finite and > 0 km, got {vals.ravel()[:5].tolist()}"
-        )
+        raise ValidationError(f"range: must be finite and > 0 km, got {vals.ravel()[:5].tolist()}")
     return r
 
 
@@ -75,15 +73,16 @@ def _positive(value: Any, what: str) -> Any:
     return value.astype(np.float64) if isinstance(value, xr.DataArray) else vals
 
 
-def _term(cube: Any, value: Any, name: str, arg: str, unit: str, attrs: dict[str, str]) -> Any:
-    """The value of ``arg``, else the cube's ``name`` (or None); notes go into ``attrs``."""
+def _term(cube: Any, value: Any, name: str, unit: str, attrs: dict[str, str]) -> Any:
+    """The argument ``name``'s value, else the cube's ``name`` (or None); notes into ``attrs``."""
+    arg = name
     rec = _recorded(cube, name, unit)
     if value is None:
         if rec is not None:
             attrs[f"{name}_source"] = f"the cube's {name!r} ({_describe(rec, unit)})"
         return rec
     given = to_unit(value, unit, arg)
-    check_plausible(given, arg, arg)
+    check_plausible(given, f"{name}_{unit}", arg)
     attrs[f"{name}_source"] = f"argument {arg} ({_describe(given, unit)})"
     if rec is not None:
         attrs[f"{name}_override"] = (
@@ -93,20 +92,20 @@ def _term(cube: Any, value: Any, name: str, arg: str, unit: str, attrs: dict[str
     return given
 
 
-def _distances(cube: Any, range_km: Any, sun_distance_au: Any) -> tuple[Any, Any, dict[str, str]]:
+def _distances(cube: Any, range_: Any, sun_distance: Any) -> tuple[Any, Any, dict[str, str]]:
     """Observer range [m], Sun distance [au] and notes: the cube's unless given."""
     notes: dict[str, str] = {}
-    rng = _term(cube, range_km, "range", "range_km", "km", notes)
+    rng = _term(cube, range_, "range", "km", notes)
     if rng is None:
         raise ValidationError(
-            "range_km: the observer range [km] is required: the cube records no 'range' "
-            "(e.g. range_km=1000.0, or 1000 * u.km)"
+            "range: the observer range [km] is required: the cube records no 'range' "
+            "(e.g. range=1000.0, or 1000 * u.km)"
         )
-    sun = _term(cube, sun_distance_au, "sun_distance", "sun_distance_au", "au", notes)
+    sun = _term(cube, sun_distance, "sun_distance", "au", notes)
     if sun is None:
         sun = 1.0
         notes["sun_distance_source"] = "default 1 au (the cube records no 'sun_distance')"
-    return _range_m(rng), _positive(sun, "sun_distance_au"), notes
+    return _range_m(rng), _positive(sun, "sun_distance"), notes
 
 
 def _coefficient(mags: xr.DataArray, coefficients: dict[Any, Any], label: str, i: int) -> float:

@@ -131,7 +131,7 @@ def apply_extinction(mags: xr.DataArray, airmass: Any, coefficients: Any) -> xr.
     >>> cube = xr.Dataset({"signal": (("geometry", "wavelength"), grey, {"units": "m2 sr-1"})},
     ...                   coords={"wavelength": ("wavelength", wl, {"units": "nm"})})
     >>> from sbrdf_xr.photometry import magnitudes
-    >>> m = magnitudes(cube, ["B", "V"], range_km=1000.0)
+    >>> m = magnitudes(cube, ["B", "V"], range=1000.0)
     >>> seen = apply_extinction(m, 2.0, {"B": 0.25, "V": 0.15})
     >>> np.round((seen - m).isel(geometry=0).values, 6)
     array([0.5, 0.3])

@@ -10,7 +10,7 @@ import numpy as np
 import xarray as xr
 
 from .._names import BAND, WAVELENGTH, attrs
-from ..errors import ValidationError
+from ..errors import ValidationError, renamed_keywords
 from ._observed import _distances, _with_extinction
 from .bands import (
     WEIGHTINGS,
@@ -209,13 +209,14 @@ def band_signal(
     return out
 
 
+@renamed_keywords(range_km="range", sun_distance_au="sun_distance")
 def magnitudes(
     cube: xr.Dataset | xr.DataArray,
     bands: Any = None,
-    range_km: Any = None,
+    range: Any = None,
     *,
     system: str = "AB",
-    sun_distance_au: Any = None,
+    sun_distance: Any = None,
     extinction: dict[str, float] | None = None,
     weighting: str = "photon",
     quadrature: str = "trapezoid",
@@ -231,7 +232,7 @@ def magnitudes(
 
     A cube of an observation records ``range`` [km] and ``sun_distance`` [au] (per time
     or scalar, coordinates or variables, converted from their ``units``): they are used
-    unless ``range_km`` or ``sun_distance_au`` is given.  The attributes
+    unless ``range`` or ``sun_distance`` is given.  The attributes
     ``range_source`` and ``sun_distance_source`` say where each came from;
     ``range_override`` / ``sun_distance_override`` note an argument that replaced the
     cube's value, and which value that was.
@@ -243,7 +244,7 @@ def magnitudes(
         (then ``bands`` is not needed).
     bands : str, sequence, mapping or DataArray
         See :func:`filters`.
-    range_km : float, array_like, DataArray or astropy Quantity, optional
+    range : float, array_like, DataArray or astropy Quantity, optional
         Observer range [km], > 0; broadcast against the cube (a DataArray aligns by
         dims).  A Quantity of length is converted (``1e6 * u.m`` is 1000 km), any other
         Quantity refused.  Default the cube's ``range``; required if it has none.
@@ -251,9 +252,9 @@ def magnitudes(
         Magnitude system, any case (:data:`~sbrdf_xr.photometry.MAGNITUDE_SYSTEMS`);
         recorded in the attribute ``magnitude_system``.  A :func:`band_signal` input
         must have been made in the same system.
-    sun_distance_au : float, array_like, DataArray or astropy Quantity, optional
+    sun_distance : float, array_like, DataArray or astropy Quantity, optional
         Sun-object distance [AU], > 0 (e.g. :func:`sun_distance_au` of the
-        observation times); broadcast like ``range_km``.  Default the cube's
+        observation times); broadcast like ``range``.  Default the cube's
         ``sun_distance``, else 1 AU.
     extinction : mapping, optional
         ``{band: k}`` [mag per airmass], >= 0, for every band: adds ``k X`` with ``X``
@@ -274,17 +275,17 @@ def magnitudes(
     >>> grey = np.full((2, wl.size), 0.1)  # 0.1 m2 sr-1 at every wavelength, two geometries
     >>> cube = xr.Dataset({"signal": (("geometry", "wavelength"), grey, {"units": "m2 sr-1"})},
     ...                   coords={"wavelength": ("wavelength", wl, {"units": "nm"})})
-    >>> m = magnitudes(cube, ["B", "V"], range_km=1000.0)
+    >>> m = magnitudes(cube, ["B", "V"], range=1000.0)
     >>> m.dims, np.round(m.isel(geometry=0).values, 4)
     (('geometry', 'band'), array([6.257 , 5.7318]))
-    >>> round(float(magnitudes(cube, ["V"], range_km=2000.0)[0, 0] - m[0, 1]), 6)  # 5 log10 2
+    >>> round(float(magnitudes(cube, ["V"], range=2000.0)[0, 0] - m[0, 1]), 6)  # 5 log10 2
     1.50515
     >>> import astropy.units as u
-    >>> round(float(magnitudes(cube, ["V"], range_km=2e6 * u.m)[0, 0] - m[0, 1]), 6)  # 2000 km
+    >>> round(float(magnitudes(cube, ["V"], range=2e6 * u.m)[0, 0] - m[0, 1]), 6)  # 2000 km
     1.50515
     """
     system = check_system(system)
-    d, r, notes = _distances(cube, range_km, sun_distance_au)
+    d, r, notes = _distances(cube, range, sun_distance)
     if isinstance(cube, xr.DataArray) and BAND in cube.dims and "sun_magnitude" in cube.coords:
         sb = cube
         have = sb.attrs.get(
@@ -366,7 +367,7 @@ def colour_indices(
     >>> grey = np.full((2, wl.size), 0.1)  # 0.1 m2 sr-1 at every wavelength, two geometries
     >>> cube = xr.Dataset({"signal": (("geometry", "wavelength"), grey, {"units": "m2 sr-1"})},
     ...                   coords={"wavelength": ("wavelength", wl, {"units": "nm"})})
-    >>> ci = colour_indices(magnitudes(cube, ["B", "V", "R"], range_km=1000.0))
+    >>> ci = colour_indices(magnitudes(cube, ["B", "V", "R"], range=1000.0))
     >>> ci.colour.values.tolist(), np.round(ci.isel(geometry=0).values, 4)  # the Sun's AB colours
     (['B-V', 'V-R'], array([0.5252, 0.1944]))
     """
@@ -424,14 +425,15 @@ def _band_index(mags: xr.DataArray, label: str) -> int:
     raise ValidationError(f"pairs: band {label!r} is not among the bands {labels}")
 
 
+@renamed_keywords(range_km="range", sun_distance_au="sun_distance")
 def photometry(
     cube: xr.Dataset | xr.DataArray,
     bands: Any,
-    range_km: Any = None,
+    range: Any = None,
     *,
     pairs: Sequence[tuple[str, str]] | None = None,
     system: str = "AB",
-    sun_distance_au: Any = None,
+    sun_distance: Any = None,
     extinction: dict[str, float] | None = None,
     weighting: str = "photon",
     quadrature: str = "trapezoid",
@@ -441,8 +443,19 @@ def photometry(
 ) -> xr.Dataset:
     """Band signal, magnitudes and colour indices of a cube, as one Dataset.
 
-    Parameters are those of :func:`band_signal`, :func:`magnitudes` and
-    :func:`colour_indices`.  Also ``ds.sbrdf.photometry(bands=..., range_km=...)``.
+    The other parameters are those of :func:`band_signal`, :func:`magnitudes` and
+    :func:`colour_indices`.  Also ``ds.sbrdf.photometry(bands=..., range=...)``.
+
+    Parameters
+    ----------
+    cube : xarray.Dataset or DataArray
+        A cube (or spectrum over ``wavelength``).
+    bands : str, sequence, mapping or DataArray
+        See :func:`filters`.
+    range : float, array_like, DataArray or astropy Quantity, optional
+        Observer range [km], > 0; default the cube's ``range`` (see :func:`magnitudes`).
+    sun_distance : float, array_like, DataArray or astropy Quantity, optional
+        Sun-object distance [AU], > 0; default the cube's ``sun_distance``, else 1 AU.
 
     Returns
     -------
@@ -462,7 +475,7 @@ def photometry(
     (['band_signal', 'colour_index', 'magnitude'], 'AB')
     """
     system = check_system(system)
-    d, r, notes = _distances(cube, range_km, sun_distance_au)
+    d, r, notes = _distances(cube, range, sun_distance)
     sb = band_signal(
         cube,
         bands,

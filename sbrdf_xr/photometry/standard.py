@@ -135,7 +135,7 @@ def standard_magnitude(
     >>> cube = xr.Dataset({"signal": (("geometry", "wavelength"), grey, {"units": "m2 sr-1"})},
     ...                   coords={"wavelength": ("wavelength", wl, {"units": "nm"})})
     >>> from sbrdf_xr.photometry import magnitudes
-    >>> m = magnitudes(cube, ["V"], range_km=2000.0)
+    >>> m = magnitudes(cube, ["V"], range=2000.0)
     >>> std = standard_magnitude(m, 2000.0)  # to 1000 km: 5 log10(2) brighter
     >>> round(float((m - std)[0, 0]), 6)
     1.50515

@@ -134,7 +134,7 @@ def cube_magnitudes(
         names = sb["filter"].values if "filter" in sb.coords else sb["band"].values
         sun = photometry.sun_magnitudes([str(n) for n in names], system=system)
         sb = sb.assign_coords(sun_magnitude=("band", sun.values))
-        return photometry.magnitudes(sb, range_km=range, system=system)
+        return photometry.magnitudes(sb, range=range, system=system)
     return None
 
 

@@ -210,7 +210,7 @@ def spin_files(tmp_path_factory):
 
     box = load_spacecraft(mesh, material="lambertian-grey-50")
     axis = invert.axis_vector(60.0, 30.0)
-    law = invert.spin_model([0, 0, 1], axis, period_s=20.0, phase_deg=30.0)
+    law = invert.spin_model([0, 0, 1], axis, period=20.0, phase=30.0)
     obs = Observation(
         Orbit.from_catalog("canx1-example"),
         Site.from_catalog("mont-megantic"),

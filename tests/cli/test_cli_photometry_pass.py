@@ -63,14 +63,14 @@ def test_range_override_and_extinction_flags(pass_path, tmp_path, capsys):
     args = ["photometry", str(path), "--bands", "V", "R", "-q"]
     assert main([*args, "--range-km", "1300", "-o", str(base)]) == 0
     text = capsys.readouterr().out
-    assert "range override: range_km (1300 km) overrides the cube's 'range'" in text
+    assert "range override: range (1300 km) overrides the cube's 'range'" in text
     assert (
         main([*args, "--range-km", "1300", "--extinction", "V=0.2", "R=0.1", "-o", str(seen)]) == 0
     )
     assert "extinction coefficients: V: 0.2, R: 0.1" in capsys.readouterr().out
     with P.open_photometry(base) as a, P.open_photometry(seen) as b:
         diff = (b.magnitude - a.magnitude).transpose("time", "band").values
-        assert a.attrs["range_override"].startswith("range_km (1300 km)")
+        assert a.attrs["range_override"].startswith("range (1300 km)")
     x = cube["airmass"].values
     np.testing.assert_allclose(diff, x[:, None] * np.array([[0.2, 0.1]]), rtol=0, atol=1e-12)
     assert main([*args, "--extinction", "V=0.2"]) == 2

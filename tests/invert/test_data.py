@@ -20,7 +20,7 @@ def test_magnitudes_to_signal_inverts_magnitudes(per_material, system):
     the light curve states; read in the other system, the colours are off by the
     difference of the Sun's colours in the two (tenths of a magnitude)."""
     spectrum = per_material.isel(geometry=4).sum("material")
-    mags = magnitudes(spectrum, BANDS, range_km=1500.0, system=system)
+    mags = magnitudes(spectrum, BANDS, range=1500.0, system=system)
     lc = xr.Dataset(
         {"magnitude": ("band", mags.values), "uncertainty": ("band", np.full(len(BANDS), 0.01))},
         coords={"band": BANDS},

@@ -252,7 +252,9 @@ def test_material_scale_is_a_nuisance_parameter(box_wing):
             lc, box_wing, dao_pass(), start, check=False, material_scale="provenance"
         )
     assert fit.table_scale_prior_width.values.tolist() == [0.2, 0.2, 0.2]
-    assert int(fit.dof) == int(exact.dof)  # three scales, three priors
+    assert int(fit.degrees_of_freedom) == int(
+        exact.degrees_of_freedom
+    )  # three scales, three priors
     assert "table_scale_white-paint-a276" in fit.parameter.values
     assert np.all(fit.area_fraction_uncertainty.values > 2 * exact.area_fraction_uncertainty)
     truth = np.array(list(DAO_FRACTIONS.values()))
@@ -378,7 +380,7 @@ def test_posterior_coverage_study(box_wing):
         box_wing,
         100,
         5,
-        noise_mag=0.02,
+        noise=0.02,
         method="posterior",
         posterior_walkers=20,
         posterior_steps=120,
@@ -402,7 +404,7 @@ def test_model_error_study(box_wing, truth, noise, goal):
     fractions 1.0 at 0.02 mag and 0.87 at 0.05 mag (seed 3; without the nuisance 0.0-0.53
     and 0.40-0.87); the self-shadowed truth warns in 30 of 30 fits.  Asserted: coverage >=
     0.80 (0.87 less 1 binomial sigma of 30 draws), warnings >= 95 %."""
-    study = _dao_study(box_wing, 30, 3, noise_mag=noise, material_scale="provenance", **truth)
+    study = _dao_study(box_wing, 30, 3, noise=noise, material_scale="provenance", **truth)
     fractions = [p for p in study.parameter.values if str(p).startswith("area_fraction")]
     if goal == "coverage":
         assert float(study.coverage_2sigma.sel(parameter=fractions).min()) >= 0.80

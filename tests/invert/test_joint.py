@@ -86,8 +86,8 @@ def test_noise_free_pass_gives_the_truth(sc, night):
 def test_the_night_is_fitted_within_its_uncertainties(fit, lc):
     truth = Table.read(catalog.data_path(ECSV)).meta["simulated_truth"]
     assert fit.attrs["fit_quality"] == "consistent"
-    assert 0.8 < float(fit.reduced_chi2) < 1.25  # 271 dof: 99.9 % interval 0.76 .. 1.29
-    assert int(fit.dof) == lc.sizes["obs"] - fit.sizes["parameter"] == 271
+    assert 0.8 < float(fit.reduced_chi_square) < 1.25  # 271 dof: 99.9 % interval 0.76 .. 1.29
+    assert int(fit.degrees_of_freedom) == lc.sizes["obs"] - fit.sizes["parameter"] == 271
     pulls = {
         "axis_longitude": float(fit.axis_longitude) - truth["spin_axis_longitude_deg"],
         "axis_latitude": float(fit.axis_latitude) - truth["spin_axis_latitude_deg"],
@@ -171,7 +171,7 @@ def test_options(sc, lc, night, fit):
     assert float(free.chi2) <= float(fit.chi2) + 1e-6
     scaled = invert.fit_observation(lc, sc, night, START, scale_uncertainties=True, check=False)
     ratio = scaled.uncertainty / fit.uncertainty
-    np.testing.assert_allclose(ratio, np.sqrt(float(fit.reduced_chi2)), rtol=1e-3)
+    np.testing.assert_allclose(ratio, np.sqrt(float(fit.reduced_chi_square)), rtol=1e-3)
 
 
 def test_a_wrong_model_warns(sc, lc, night):
@@ -245,7 +245,7 @@ def test_aliases_find_the_minimum_a_start_misses(sc):
         local = invert.fit_observation(lc, sc, pass_, start, check=False)
     said = " ".join(str(w.message) for w in caught)
     assert "beyond the 99.9 %" in said and "the fit failed" in said and "fit_spin" in said
-    assert float(local.reduced_chi2) > 5 and abs(float(local.period) - 10.0) > 0.2
+    assert float(local.reduced_chi_square) > 5 and abs(float(local.period) - 10.0) > 0.2
     # its minimum needs impossible areas: refined inside the bounds, and marked failed
     assert local.attrs["status"] == "failed" and "outside physics" in local.attrs["bounded"]
     f = local.area_fraction.values
@@ -259,7 +259,10 @@ def test_aliases_find_the_minimum_a_start_misses(sc):
     ]  # fmt: skip
     # no other minimum is ambiguous; CanX-1's symmetries give exact twins (a half turn
     # about its spin axis and two flips), named in ambiguity, their chi2 gaps of rounding
-    assert float(fit.reduced_chi2) < 1.25 and fit.attrs["ambiguity"] == fit.attrs["symmetry_twins"]
+    assert (
+        float(fit.reduced_chi_square) < 1.25
+        and fit.attrs["ambiguity"] == fit.attrs["symmetry_twins"]
+    )
     assert fit.twin.values.tolist() == [
         "turn 180 deg",
         "flip about [0, 1, 0]",
@@ -286,7 +289,7 @@ def _recovery(sc, n_draws: int, seed: int):
         extinction=EXTINCTION,
         n_draws=n_draws,
         seed=seed,
-        phase_symmetry_deg=180.0,
+        phase_symmetry=180.0,
     )
 
 
@@ -307,8 +310,8 @@ def test_recovery_calibrated():
 
     study = _recovery(canx1(), 200, seed=2)
     # 200 draws: a pull width scatters by 1/sqrt(400) = 0.05 and a pull mean by 0.07;
-    # 1000 draws (README) measured widths 0.98 .. 1.04 and 1.10 for the axis longitude,
-    # so 0.83 .. 1.27 allows the measured spread plus 3 of that scatter
+    # 1000 draws (docs/guide/inversion.md) measured widths 0.98 .. 1.04 and 1.10 for the
+    # axis longitude, so 0.83 .. 1.27 allows the measured spread plus 3 of that scatter
     assert np.all((study.pull_width > 0.83) & (study.pull_width < 1.27))
     assert np.all(np.abs(study.pull_mean) < 0.25)
     # coverage of 2 sigma: 0.954 for a Gaussian, 0.924 measured for the axis longitude;

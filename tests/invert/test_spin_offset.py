@@ -128,10 +128,10 @@ def test_common_offset_fits_magnitudes(held_out, system):
     d = held_out
     lc = _light_curve(d, 5, system)
     common, band = _fit(d, lc, "common"), _fit(d, lc, "band")
-    lo, hi = _limits(int(common["dof"]))
-    assert lo < float(common["chi2"]) < hi, float(common["reduced_chi2"])
+    lo, hi = _limits(int(common["degrees_of_freedom"]))
+    assert lo < float(common["chi2"]) < hi, float(common["reduced_chi_square"])
     assert common.attrs["fit_quality"] == "consistent" and system in common.attrs["offset_note"]
-    assert int(common["dof"]) == int(band["dof"]) + 2
+    assert int(common["degrees_of_freedom"]) == int(band["degrees_of_freedom"]) + 2
     assert 0 <= float(common["chi2"]) - float(band["chi2"]) < chi2_dist.ppf(1 - 1e-3, 2)
     assert invert.axis_separation(common["axis_vector"].values, d["axis"]) < 1.0
     assert abs(float(common["period"]) - d["period"]) < 3 * float(common["period_uncertainty"])
@@ -144,10 +144,10 @@ def test_common_offset_reveals_band_offsets_and_wrong_systems(held_out):
     read as AB: 78).  offset="band" absorbs both (1.02, 0.84)."""
     d = held_out
     shifted = _light_curve(d, 6, band_offset=(0.0, 0.15, 0.0))
-    assert float(_fit(d, shifted, "common")["reduced_chi2"]) > 10
+    assert float(_fit(d, shifted, "common")["reduced_chi_square"]) > 10
     assert _fit(d, shifted, "band").attrs["fit_quality"] == "consistent"
     mislabelled = _light_curve(d, 7, "Vega", label="AB")
-    assert float(_fit(d, mislabelled, "common")["reduced_chi2"]) > 10
+    assert float(_fit(d, mislabelled, "common")["reduced_chi_square"]) > 10
     with pytest.raises(InversionError, match=r"states 'unstated'.*offset='band'"):
         invert.fit_spin(
             _light_curve(d, 8, label="unstated"),
@@ -169,13 +169,13 @@ def test_common_offset_noise_draws(held_out):
         r = _fit(d, _light_curve(d, seed), "common")
         rows.append(
             (
-                float(r["reduced_chi2"]),
+                float(r["reduced_chi_square"]),
                 invert.axis_separation(r["axis_vector"].values, d["axis"]),
                 (float(r["period"]) - d["period"]) / float(r["period_uncertainty"]),
             )
         )
     red, axis_err, pull = np.array(rows).T
-    dof = int(r["dof"])
+    dof = int(r["degrees_of_freedom"])
     print(f"\nreduced chi2 {np.round(red, 3).tolist()}; axis error max {axis_err.max():.3f} deg")
     assert np.all(np.abs(red - 1) < 5 * np.sqrt(2 / dof))
     assert abs(red.mean() - 1) < 4 * np.sqrt(2 / (red.size * dof))

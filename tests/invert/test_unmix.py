@@ -144,7 +144,7 @@ def test_missing_material_warns(per_material):
     with pytest.warns(FitQualityWarning, match="missing from the candidate library") as rec:
         r = invert.unmix(y, lib, sigma)
     assert "99.9 % point" in str(rec[0].message) and r.attrs["fit_quality"] == "poor"
-    assert float(r["reduced_chi2"]) > 5
+    assert float(r["reduced_chi_square"]) > 5
 
 
 def test_wrong_geometry_warns(per_material):
@@ -169,7 +169,7 @@ def test_zero_degrees_of_freedom_warn(per_material):
     y, sigma = _noisy(_mix(pm, [0.6, 1.0, 0.25]), 0.01, 4)
     with pytest.warns(FitQualityWarning, match="0 degrees of freedom") as rec:
         r = invert.unmix(y, pm, sigma, select=None)
-    assert int(r["dof"]) == 0 and r.attrs["fit_quality"] == "undetermined"
+    assert int(r["degrees_of_freedom"]) == 0 and r.attrs["fit_quality"] == "undetermined"
     assert "3 measured values for 3 free parameters" in str(rec[0].message)
     assert r.attrs["fit_quality_note"] == str(rec[0].message)
     # one value more: a fit with a degree of freedom to test, no such warning
@@ -291,8 +291,11 @@ def test_total_area_equals_independent_constrained_least_squares(per_material, s
     np.testing.assert_allclose(r["scale"].values, x, rtol=1e-8)
     np.testing.assert_allclose(r["scale_uncertainty"].values, np.sqrt(np.diag(cov)), rtol=1e-8)
     assert float(r["chi2"]) == pytest.approx(chi2, rel=1e-8)
-    assert int(r["dof"]) == y.size - 2 and "area constraint" in r["dof"].attrs["long_name"]
-    assert float(r["reduced_chi2"]) == pytest.approx(chi2 / (y.size - 2))
+    assert (
+        int(r["degrees_of_freedom"]) == y.size - 2
+        and "area constraint" in r["degrees_of_freedom"].attrs["long_name"]
+    )
+    assert float(r["reduced_chi_square"]) == pytest.approx(chi2 / (y.size - 2))
     assert float(r["aic"]) == pytest.approx(chi2 + 2 * 2)  # two free parameters
     assert float(r["area"].sum()) == pytest.approx(nominal.sum(), rel=1e-12)
     assert float(r["area_fraction"].sum()) == pytest.approx(1.0, rel=1e-12)

@@ -101,7 +101,7 @@ def test_a_time_shift_is_recovered():
     """Truth at t + 1.7 s; the simulated curve on a 0.25 s grid (interpolation error of the
     12 s glint: 0.3 (2 pi/12)^2 0.25^2 / 8 ~ 6e-4 mag, below the 0.005 mag noise)."""
     meas = _measured({"V": 0.1, "R": 0.1}, shift=1.7, sigma=0.005, seed=3)
-    fit = L.compare(meas, _sim(), fit_time_shift=True, max_time_shift_s=5.0)
+    fit = L.compare(meas, _sim(), fit_time_shift=True, max_time_shift=5.0)
     sigma = float(fit.time_shift_uncertainty)
     assert 0.0 < sigma < 0.05
     assert float(fit.time_shift) == pytest.approx(1.7, abs=4 * sigma)
@@ -118,7 +118,7 @@ def test_the_covariance_is_curve_fits_on_the_same_model():
 
     sim = _sim()
     meas = _measured({"V": 0.3, "R": 0.2}, {"V": 0.2, "R": 0.1}, shift=0.8, sigma=0.01, seed=5)
-    fit = L.compare(meas, sim, extinction="fit", fit_time_shift=True, max_time_shift_s=3.0)
+    fit = L.compare(meas, sim, extinction="fit", fit_time_shift=True, max_time_shift=3.0)
     secs_sim = (sim.time.values - T0) / np.timedelta64(1, "s")
     secs = (meas.time.values - T0) / np.timedelta64(1, "s")
     isv = meas.band.values == "V"
@@ -200,7 +200,7 @@ def test_bands_not_simulated_and_other_bad_input():
         ({"zero_points": "each"}, "zero_points: got 'each'"),
         ({"extinction": 0.2}, "extinction: expected None, 'fit' or a mapping"),
         ({"airmass": "table"}, "airmass: got 'table'"),
-        ({"max_time_shift_s": -1.0}, "max_time_shift_s: must be > 0 s"),
+        ({"max_time_shift": -1.0}, "max_time_shift: must be > 0 s"),
     ):
         with pytest.raises(LightCurveError, match=msg):
             L.compare(meas, _sim(), **kw)

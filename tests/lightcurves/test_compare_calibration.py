@@ -84,7 +84,7 @@ def _draws(sim, n, seed=0):
             coords={"time": ("obs", t_sim[steps]), "band": ("obs", band)},
             attrs={"magnitude_system": "AB"},
         )
-        fit = L.compare(ds, sim, extinction="fit", fit_time_shift=True, max_time_shift_s=3.0)
+        fit = L.compare(ds, sim, extinction="fit", fit_time_shift=True, max_time_shift=3.0)
         for p in truth:
             est[p].append(float(fit.estimate.sel(parameter=p)))
             sd[p].append(float(fit.standard_error.sel(parameter=p)))

@@ -115,9 +115,7 @@ def test_tables_with_units_and_absolute_utc_times(tmp_path, suffix, fmt):
     np.testing.assert_allclose(lc.range_km.values, 1000.0, rtol=1e-12)  # m -> km
     assert lc.attrs["magnitude_system"] == "Vega"
     assert lc.magnitude.attrs["ancillary_variables"] == "uncertainty"
-    res = L.compare(
-        lc, _sim(range_km=1000.0, system="Vega"), period_s=PERIOD_S, zero_points="common"
-    )
+    res = L.compare(lc, _sim(range_km=1000.0, system="Vega"), period=PERIOD_S, zero_points="common")
     # 240 points over three nights: sigma(phase) ~ 0.04 deg, sigma(offset) ~ 0.0007 mag
     assert float(res.phase_offset) == pytest.approx(PHI0, abs=0.15)
     assert float(res.magnitude_offset) == pytest.approx(DM0, abs=0.003)
@@ -199,17 +197,15 @@ def test_the_fit_uses_per_row_range_and_refuses_a_system_mismatch(tmp_path):
     tab, _, _ = _table(range_km=lambda n, rng: rng.uniform(800.0, 3000.0, n))
     tab.write(tmp_path / "r.ecsv")
     lc = L.read_light_curve(tmp_path / "r.ecsv")
-    res = L.compare(
-        lc, _sim(range_km=1000.0, system="Vega"), period_s=PERIOD_S, zero_points="common"
-    )
+    res = L.compare(lc, _sim(range_km=1000.0, system="Vega"), period=PERIOD_S, zero_points="common")
     assert float(res.magnitude_offset) == pytest.approx(
         DM0, abs=0.003
     )  # the 5 log10 d term is modelled
     assert 0.7 < float(res.reduced_chi_square) < 1.3
     with pytest.raises(ValidationError, match="in the Vega system but the simulation is in AB"):
-        L.compare(lc, _sim(range_km=1000.0, system="AB"), period_s=PERIOD_S, zero_points="common")
+        L.compare(lc, _sim(range_km=1000.0, system="AB"), period=PERIOD_S, zero_points="common")
     with pytest.raises(ValidationError, match="no range_km attribute"):
-        L.compare(lc, _sim(system="Vega"), period_s=PERIOD_S, zero_points="common")
+        L.compare(lc, _sim(system="Vega"), period=PERIOD_S, zero_points="common")
 
 
 def test_extinction_with_an_airmass_column(tmp_path):

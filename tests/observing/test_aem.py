@@ -62,7 +62,7 @@ def _aem(path, t, q, frame="GCRF", direction="A2B", first=False, stop=None, reco
 
 @pytest.fixture(scope="module")
 def nadir():
-    obs = canx1_pass(Nadir(yaw_deg=20.0))
+    obs = canx1_pass(Nadir(yaw=20.0))
     return obs, obs.geometry()
 
 

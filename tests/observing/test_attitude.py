@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 import trimesh
@@ -13,7 +15,7 @@ from scipy.spatial.transform import Rotation
 from sbrdf_xr import geometry
 from sbrdf_xr import observing as att
 from sbrdf_xr.body.spacecraft import Spacecraft
-from sbrdf_xr.errors import AttitudeError
+from sbrdf_xr.errors import AttitudeError, RenamedWarning
 
 # Rotations built from the same float64 quaternion algebra agree to a few ulps; 1e-12
 # leaves room for the products of several rotations.
@@ -59,13 +61,13 @@ def test_spin_reproduces_rotation_sweep():
     # Paper 000 section 4, second scenario: 25 deg about +z, then 1 deg steps about -z.
     initial = geometry.axis_rotation([0, 0, 1], 25.0)
     sweep = geometry.rotation_sweep([0, 0, -1], np.arange(360.0), initial)
-    spin = att.Spin(axis_body="-z", rate_deg_s=1.0, initial=initial)
+    spin = att.Spin(axis_body="-z", rate=1.0, initial=initial)
     same_rotation(spin.quaternions(np.arange(360.0)), sweep)
     # A tilted body axis from a general start: the inertial axis is R_initial axis_body.
     q0 = Rotation.from_euler("zyx", [30, -20, 65], degrees=True).as_quat()
     axis_b = np.array([0.3, -0.5, 0.81])
     t = np.linspace(-20.0, 90.0, 111)
-    spin = att.Spin(axis_b, rate_deg_s=3.5, phase_deg=12.0, initial=q0)
+    spin = att.Spin(axis_b, rate=3.5, phase=12.0, initial=q0)
     axis_ref = geometry.rotation_matrices(q0) @ (axis_b / np.linalg.norm(axis_b))
     same_rotation(spin.quaternions(t), geometry.rotation_sweep(axis_ref, 12.0 + 3.5 * t, q0))
 
@@ -73,7 +75,7 @@ def test_spin_reproduces_rotation_sweep():
 def test_spin_datetime_times_and_epoch():
     t0 = np.datetime64("2024-01-01T00:00:00", "ns")
     t = t0 + np.arange(10) * np.timedelta64(1, "s")
-    spin = att.Spin("+x", rate_deg_s=10.0, phase_deg=0.0, epoch="2024-01-01T00:00:05")
+    spin = att.Spin("+x", rate=10.0, phase=0.0, epoch="2024-01-01T00:00:05")
     np.testing.assert_allclose(spin.angles(t), 10.0 * (np.arange(10) - 5.0))
     ctx = att.Context(epoch=t0)
     np.testing.assert_allclose(spin.angles(np.arange(10.0), ctx), 10.0 * (np.arange(10) - 5.0))
@@ -83,7 +85,7 @@ def test_tumble_conserves_energy_and_momentum():
     # A general (non-diagonal) tensor and a rate near the intermediate axis: the hard case.
     inertia = np.array([[3.0, 0.2, -0.1], [0.2, 2.0, 0.15], [-0.1, 0.15, 1.2]])
     tumble = att.Tumble(
-        inertia, omega_deg_s=(0.5, 20.0, 3.0), initial=geometry.axis_rotation([1, 1, 0], 30)
+        inertia, omega=(0.5, 20.0, 3.0), initial=geometry.axis_rotation([1, 1, 0], 30)
     )
     t = np.linspace(-600.0, 3600.0, 801)
     w, q = tumble.states(t)
@@ -103,7 +105,7 @@ def test_tumble_axisymmetric_closed_form():
     # I1 = I2: w3 constant, (w1, w2) turns at lambda = (I3 - I1) / I1 * w3 (Landau & Lifshitz §33).
     i1, i3 = 2.0, 3.0
     w0 = np.radians([4.0, 0.0, 10.0])
-    tumble = att.Tumble((i1, i1, i3), omega_deg_s=np.degrees(w0))
+    tumble = att.Tumble((i1, i1, i3), omega=np.degrees(w0))
     t = np.linspace(0.0, 500.0, 101)
     w, _ = tumble.states(t)
     lam = (i3 - i1) / i1 * w0[2]
@@ -112,7 +114,7 @@ def test_tumble_axisymmetric_closed_form():
     )
     np.testing.assert_allclose(w, expected, atol=1e-10 * np.linalg.norm(w0))
     # Spin about a principal axis of a symmetric body is a pure spin.
-    pure = att.Tumble((i1, i1, i3), omega_deg_s=(0, 0, 6.0))
+    pure = att.Tumble((i1, i1, i3), omega=(0, 0, 6.0))
     same_rotation(pure.quaternions(t), att.Spin("+z", 6.0).quaternions(t), atol=1e-9)
 
 
@@ -134,15 +136,15 @@ def test_tumble_bad_parameters():
         att.Tumble((-1.0, 1.0, 1.0))
     with pytest.raises(AttitudeError, match="symmetric"):
         att.Tumble([[1, 0.5, 0], [0, 1, 0], [0, 0, 1]])
-    with pytest.raises(AttitudeError, match="omega_deg_s"):
-        att.Tumble((1, 1, 1), omega_deg_s=(1, 2))
+    with pytest.raises(AttitudeError, match="tumble omega"):
+        att.Tumble((1, 1, 1), omega=(1, 2))
 
 
 def test_nadir_keeps_the_nadir_axis_on_the_geocentre():
     t, ctx = circular_context()
     for law, axis, vel_axis in [
         (att.Nadir(), [0, 0, 1], [1, 0, 0]),
-        (att.Nadir(yaw_deg=33.0, nadir_axis="-x", velocity_axis="+y"), [-1, 0, 0], None),
+        (att.Nadir(yaw=33.0, nadir_axis="-x", velocity_axis="+y"), [-1, 0, 0], None),
     ]:
         rot = geometry.rotation_matrices(law.quaternions(t, ctx))
         nadir = -ctx.position / np.linalg.norm(ctx.position, axis=1, keepdims=True)
@@ -158,7 +160,7 @@ def test_nadir_keeps_the_nadir_axis_on_the_geocentre():
             )  # circular: v perpendicular to r
     # The yaw turns the velocity axis about the nadir by the yaw angle.
     q0 = att.Nadir().quaternions(t, ctx)
-    q1 = att.Nadir(yaw_deg=30.0).quaternions(t, ctx)
+    q1 = att.Nadir(yaw=30.0).quaternions(t, ctx)
     x0 = geometry.rotation_matrices(q0) @ [1.0, 0, 0]
     x1 = geometry.rotation_matrices(q1) @ [1.0, 0, 0]
     np.testing.assert_allclose(np.einsum("ni,ni->n", x0, x1), np.cos(np.radians(30.0)), atol=1e-12)
@@ -202,12 +204,10 @@ def test_sun_pointing_axis_and_secondary_constraint():
 
 def test_composition_forms_agree():
     t, ctx = circular_context(n=20)
-    spin = att.Spin("+z", rate_deg_s=5.0, phase_deg=10.0)
-    a = (att.Nadir(yaw_deg=5.0) * spin).quaternions(t, ctx)
-    b = att.compose(att.Nadir(yaw_deg=5.0), spin).quaternions(t, ctx)
-    c = att.Spin("+z", rate_deg_s=5.0, phase_deg=10.0, initial=att.Nadir(yaw_deg=5.0)).quaternions(
-        t, ctx
-    )
+    spin = att.Spin("+z", rate=5.0, phase=10.0)
+    a = (att.Nadir(yaw=5.0) * spin).quaternions(t, ctx)
+    b = att.compose(att.Nadir(yaw=5.0), spin).quaternions(t, ctx)
+    c = att.Spin("+z", rate=5.0, phase=10.0, initial=att.Nadir(yaw=5.0)).quaternions(t, ctx)
     same_rotation(a, b)
     same_rotation(a, c)
     # A nadir-pointer spinning about its nadir axis keeps it on the geocentre.
@@ -263,10 +263,31 @@ def test_law_from_dict_builds_every_law_and_rejects_bad_tables():
         att.law_from_dict({"law": "spin", "rpm": 3})
     with pytest.raises(AttitudeError, match=r"\['rate_deg'\]; did you mean 'rate_deg_s'"):
         att.law_from_dict({"law": "spin", "rate_deg": 3.0})
-    with pytest.raises(AttitudeError, match="rate_deg_s"):
+    with pytest.raises(AttitudeError, match="spin rate"):
         att.law_from_dict({"law": "spin", "rate_deg_s": "fast"})
     with pytest.raises(AttitudeError, match="'law' key"):
         att.law_from_dict({"rate_deg_s": 1.0})
+
+
+def test_table_keys_fill_the_bare_fields_and_old_keywords_warn():
+    # a file's keys keep their unit spelling and reach the bare fields with no warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        spin = att.law_from_dict({"law": "spin", "rate_deg_s": 3.0, "phase_deg": 7.0})
+        nadir = att.law_from_dict({"law": "nadir", "yaw_deg": 10.0})
+        tumble = att.law_from_dict({"law": "tumble", "omega_deg_s": [1.0, 0.0, 5.0]})
+    assert (spin.rate, spin.phase, nadir.yaw) == (3.0, 7.0, 10.0)
+    np.testing.assert_array_equal(tumble.omega, [1.0, 0.0, 5.0])
+    # the old keywords and attributes answer one release, with a warning
+    with pytest.warns(RenamedWarning, match="rate_deg_s"):
+        old = att.Spin(rate_deg_s=3.0, phase=7.0)
+    assert old == spin
+    with pytest.warns(RenamedWarning, match="yaw_deg"):
+        assert att.Nadir(yaw_deg=10.0) == nadir
+    with pytest.warns(RenamedWarning, match="yaw_deg"):
+        assert nadir.yaw_deg == 10.0
+    with pytest.warns(RenamedWarning, match="omega_deg_s"):
+        np.testing.assert_array_equal(tumble.omega_deg_s, tumble.omega)
 
 
 unit3 = st.tuples(*[st.floats(-1, 1) for _ in range(3)]).filter(lambda v: np.linalg.norm(v) > 0.1)

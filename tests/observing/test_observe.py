@@ -312,7 +312,7 @@ def test_geometry_round_trips_through_netcdf(canx1, tmp_path):
 def test_nadir_observation_points_at_the_geocentre(canx1):
     obs, _ = canx1
     nadir = observe.Observation(
-        obs.orbit, obs.site, obs.times, att.Nadir(yaw_deg=20.0, nadir_axis="+z")
+        obs.orbit, obs.site, obs.times, att.Nadir(yaw=20.0, nadir_axis="+z")
     )
     to_earth = nadir.geometry().to_earth.values
     angle = np.arctan2(np.hypot(to_earth[:, 0], to_earth[:, 1]), to_earth[:, 2])

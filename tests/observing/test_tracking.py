@@ -83,7 +83,7 @@ def test_altaz_range_table_gives_the_tle_cube(tle_pass):
 
 def test_nadir_law_through_the_spline_velocity(tle_pass):
     obs, g = tle_pass
-    law = Nadir(yaw_deg=10.0)
+    law = Nadir(yaw=10.0)
     ref = canx1_pass(law).geometry()
     table = TrackingTable(
         obs.site,

@@ -151,8 +151,8 @@ def test_spectra_as_spectral_distributions(cube):
         P.band_signal(s, ["V", "R"]).values, P.band_signal(cube, ["V", "R"]).values[0], rtol=1e-13
     )
     np.testing.assert_allclose(
-        P.magnitudes(s, ["V", "R"], range_km=1e3).values,
-        P.magnitudes(cube, ["V", "R"], range_km=1e3).values[0],
+        P.magnitudes(s, ["V", "R"], range=1e3).values,
+        P.magnitudes(cube, ["V", "R"], range=1e3).values[0],
         rtol=1e-13,
     )
 

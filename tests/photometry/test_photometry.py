@@ -368,7 +368,7 @@ def test_nothing_reflected_is_infinite_magnitude_without_warnings():
 
 @pytest.mark.parametrize("bad", [-1.0, 0.0, np.nan, [100.0, -5.0]])
 def test_bad_range_raises(white_cube, bad):
-    with pytest.raises(ValidationError, match="range_km"):
+    with pytest.raises(ValidationError, match="range: "):
         P.magnitudes(white_cube, ["V"], bad)
 
 
@@ -590,7 +590,7 @@ def test_light_curve_by_time_needs_a_period_and_netcdf_reads(tmp_path):
     assert lc.time.attrs["units"] == "s"
     with pytest.raises(ValidationError, match="period_s"):
         L.compare(lc, _sim_curve())
-    res = L.compare(lc, _sim_curve(), period_s=600.0, zero_points="common")
+    res = L.compare(lc, _sim_curve(), period=600.0, zero_points="common")
     assert float(res.phase_offset) == pytest.approx(47.3, abs=0.1)
     nc = tmp_path / "lc.nc"
     lc.reset_coords().rename(obs="row").to_netcdf(nc)
@@ -665,7 +665,7 @@ def test_light_curve_iso_times_and_band_whitelist(tmp_path):
         np.array(["2024-01-01T00:00:00", "2024-01-01T00:01:00"], dtype="datetime64[ns]"),
     )
     with pytest.raises(ValidationError, match=r"measured bands \['my-band'\] are not simulated"):
-        L.compare(lc, _sim_curve(), period_s=600.0)
+        L.compare(lc, _sim_curve(), period=600.0)
 
 
 def test_light_curve_fit_reports_the_half_turn_ambiguity_of_a_symmetric_body(tmp_path):

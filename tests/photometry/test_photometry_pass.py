@@ -8,7 +8,7 @@ import pytest
 import xarray as xr
 
 from sbrdf_xr import photometry as P
-from sbrdf_xr.errors import UnitError, ValidationError
+from sbrdf_xr.errors import RenamedWarning, UnitError, ValidationError
 from sbrdf_xr.observing import observe
 from sbrdf_xr.observing.orbits import Orbit, Site
 from sbrdf_xr.observing.timescales import times
@@ -74,7 +74,7 @@ def test_magnitudes_use_the_cubes_range_and_sun_distance_per_time(pass_cube):
 
 def test_an_explicit_value_overrides_and_says_so(pass_cube):
     cube, c = pass_cube
-    m = P.magnitudes(cube, ["V"], range_km=1300.0, sun_distance_au=1.0)
+    m = P.magnitudes(cube, ["V"], range=1300.0, sun_distance=1.0)
     np.testing.assert_allclose(
         m.values, _closed_form(c, np.full(c.size, 1300.0), np.ones(c.size), ["V"]), atol=1e-12
     )
@@ -82,28 +82,45 @@ def test_an_explicit_value_overrides_and_says_so(pass_cube):
     note = m.attrs["range_override"]
     assert "1300 km" in note and f"{lo:.6g} to {hi:.6g} km over time" in note
     assert "overrides the cube's 'sun_distance'" in m.attrs["sun_distance_override"]
-    assert m.attrs["range_source"] == "argument range_km (1300 km)"
+    assert m.attrs["range_source"] == "argument range (1300 km)"
 
 
 def test_a_length_quantity_is_converted_and_other_quantities_refused(pass_cube):
     cube, _ = pass_cube
-    a = P.magnitudes(cube, ["V"], range_km=1e6 * u.m, sun_distance_au=1.0 * u.au)
-    b = P.magnitudes(cube, ["V"], range_km=1000.0, sun_distance_au=1.0)
+    a = P.magnitudes(cube, ["V"], range=1e6 * u.m, sun_distance=1.0 * u.au)
+    b = P.magnitudes(cube, ["V"], range=1000.0, sun_distance=1.0)
     np.testing.assert_allclose(a.values, b.values, rtol=0, atol=1e-12)
     column = cube["range"].values[:, None] * 1e3 * u.m  # (time, 1) against (time, band)
-    per_time = P.magnitudes(cube, ["V"], range_km=column)
+    per_time = P.magnitudes(cube, ["V"], range=column)
     np.testing.assert_allclose(per_time.values, P.magnitudes(cube, ["V"]).values, atol=1e-12)
     au_km = (1.0 * u.au).to_value(u.km)
-    c = P.magnitudes(cube, ["V"], range_km=1000.0, sun_distance_au=au_km * u.km)
+    c = P.magnitudes(cube, ["V"], range=1000.0, sun_distance=au_km * u.km)
     np.testing.assert_allclose(c.values, b.values, atol=1e-12)
     with pytest.raises(
-        UnitError, match=r"range_km: got 3.0 s \(time\), which is not in km \(length\)"
+        UnitError, match=r"range: got 3.0 s \(time\), which is not in km \(length\)"
     ):
-        P.magnitudes(cube, ["V"], range_km=3.0 * u.s)
-    with pytest.raises(UnitError, match=r"sun_distance_au: got 1.0 kg \(mass\)"):
-        P.magnitudes(cube, ["V"], sun_distance_au=1.0 * u.kg)
-    with pytest.raises(ValidationError, match="range_km: must be finite and > 0"):
-        P.magnitudes(cube, ["V"], range_km=-1.0 * u.km)
+        P.magnitudes(cube, ["V"], range=3.0 * u.s)
+    with pytest.raises(UnitError, match=r"sun_distance: got 1.0 kg \(mass\)"):
+        P.magnitudes(cube, ["V"], sun_distance=1.0 * u.kg)
+    with pytest.raises(ValidationError, match="range: must be finite and > 0"):
+        P.magnitudes(cube, ["V"], range=-1.0 * u.km)
+
+
+@pytest.mark.parametrize("call", ["magnitudes", "photometry"])
+def test_the_old_distance_keywords_answer_one_release_with_a_warning(pass_cube, call):
+    cube, _ = pass_cube
+    new = getattr(P, call)(cube, ["V"], range=1000.0, sun_distance=1.0)
+    with pytest.warns(RenamedWarning, match="range_km"):
+        old = getattr(P, call)(cube, ["V"], range_km=1000.0, sun_distance=1.0)
+    xr.testing.assert_identical(old, new)
+    with pytest.warns(RenamedWarning, match="sun_distance_au"):
+        old = getattr(P, call)(cube, ["V"], range=1000.0, sun_distance_au=1.0)
+    xr.testing.assert_identical(old, new)
+    with pytest.warns(RenamedWarning, match=f"SbrdfDatasetAccessor.{call}.*range_km"):
+        old = getattr(cube.sbrdf, call)(["V"], range_km=1000.0, sun_distance=1.0)
+    xr.testing.assert_identical(old, new)
+    with pytest.raises(ValidationError, match="received both 'range_km' and 'range'"):
+        getattr(P, call)(cube, ["V"], range=1000.0, range_km=1000.0)
 
 
 def test_extinction_adds_k_times_the_cubes_airmass(pass_cube):
@@ -138,7 +155,7 @@ def test_a_rotation_cube_still_needs_a_range_and_has_no_airmass():
         {"signal": (("attitude", "wavelength"), np.full((2, wl.size), 0.1), {"units": "m2 sr-1"})},
         coords={"wavelength": ("wavelength", wl, {"units": "nm"})},
     )
-    with pytest.raises(ValidationError, match=r"range_km: the observer range .* no 'range'"):
+    with pytest.raises(ValidationError, match=r"range: the observer range .* no 'range'"):
         P.magnitudes(cube, ["V"])
     m = P.magnitudes(cube, ["V"], 1000.0)
     assert m.attrs["sun_distance_source"].startswith("default 1 au")

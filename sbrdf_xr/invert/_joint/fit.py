@@ -194,9 +194,10 @@ def fit_observation(
     The uncertainties are ``sqrt(diag(J^T J)^-1)`` from a central-difference Jacobian of
     the normalised residuals at the solution, unscaled (the measured uncertainties taken
     as right; ``scale_uncertainties=True`` multiplies the covariance by the reduced
-    chi-square).  Over 1000 noise draws of a CanX-1 pass (0.02 mag, README) their pulls
-    had widths 0.98 to 1.04, and 1.10 for the axis longitude, which is not linear over a
-    sigma (1.05 at 0.005 mag).  They describe the neighbourhood of the minimum reached.
+    chi-square).  Over 1000 noise draws of a CanX-1 pass (0.02 mag; the user guide's
+    inversion page, docs/guide/inversion.md) their pulls had widths 0.98 to 1.04, and
+    1.10 for the axis longitude, which is not linear over a sigma (1.05 at 0.005 mag).
+    They describe the neighbourhood of the minimum reached.
     The fit is local: from a start too far off (for a period ``P`` over a span ``T``, a
     phase slip of a quarter turn or more over the pass, ``|dP| > P**2 / (4 T)``) it stops
     in another minimum; ``starts="aliases"`` refines from the period aliases and the spin's
@@ -266,7 +267,7 @@ def fit_observation(
         ``parameter``: ``estimate``, ``uncertainty``, ``correlation``; over ``twin`` the
         body's symmetry twins of the solution (``twin_chi2_gap``, ``twin_phase``,
         ``twin_axis_longitude``, ``twin_axis_latitude``, ``twin_sense``); ``chi2``, ``dof``,
-        ``reduced_chi2``, ``fit_probability``; over ``obs``: ``model_magnitude``,
+        ``reduced_chi_square``, ``fit_probability``; over ``obs``: ``model_magnitude``,
         ``residual``, ``airmass``; over ``start``: the minimum refined from each start
         (``start_chi2``, ``start_chi2_gap`` above the solution's, ``start_period``,
         ``start_phase``, ``start_axis_longitude``, ``start_axis_latitude``,

@@ -150,8 +150,8 @@ def pass_data(
     )
     c = magnitudes(
         unit,
-        range_km=xr.DataArray(geo["range"].values, dims="time"),
-        sun_distance_au=xr.DataArray(geo["sun_distance"].values, dims="time"),
+        range=xr.DataArray(geo["range"].values, dims="time"),
+        sun_distance=xr.DataArray(geo["sun_distance"].values, dims="time"),
         system=sys_name,
     ).values
     return PassData(

@@ -214,8 +214,8 @@ def result_dataset(
     _table_scales(ds, lay, p, sd)
     scal = {
         "chi2": (chi2, "chi-square of the fit"),
-        "dof": (dof, "degrees of freedom (values minus fitted parameters)"),
-        "reduced_chi2": (chi2 / dof, "chi-square per degree of freedom"),
+        "degrees_of_freedom": (dof, "degrees of freedom (values minus fitted parameters)"),
+        "reduced_chi_square": (chi2 / dof, "chi-square per degree of freedom"),
         "fit_probability": (
             quality["fit_probability"],
             "probability of a chi-square at least this large for a right model",

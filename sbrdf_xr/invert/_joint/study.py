@@ -18,7 +18,7 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from ...errors import FitQualityWarning, InversionError
+from ...errors import FitQualityWarning, InversionError, renamed_keywords
 from ...units import to_unit
 from .._areas import material_areas
 from .._spin.search import spin_model, vec
@@ -131,6 +131,7 @@ def _wrap(d: float, period: float) -> float:
     return (d + 0.5 * period) % period - 0.5 * period
 
 
+@renamed_keywords(noise_mag="noise", phase_symmetry_deg="phase_symmetry")
 def observation_recovery(
     spacecraft: Any,
     observation: Any,
@@ -140,11 +141,11 @@ def observation_recovery(
     extinction: Mapping[str, float],
     bands: Sequence[str] = ("V", "R", "I"),
     axis_body: ArrayLike = (0.0, 0.0, 1.0),
-    noise_mag: float = 0.02,
+    noise: float = 0.02,
     n_draws: int = 20,
     seed: int = 0,
     start_offset: Mapping[str, float] | None = None,
-    phase_symmetry_deg: float = 360.0,
+    phase_symmetry: float = 360.0,
     brightness: Mapping[str, float] | None = None,
     effects: Sequence[str] = (),
     **options: Any,
@@ -152,15 +153,30 @@ def observation_recovery(
     """Pulls and coverage of :func:`fit_observation` over noise draws of a simulated pass.
 
     The truth (``spin``, ``area_fraction``, ``extinction``) is simulated once by
-    :func:`simulated_light_curve`; every draw adds Gaussian noise of ``noise_mag`` [mag]
+    :func:`simulated_light_curve`; every draw adds Gaussian noise of ``noise`` [mag]
     and is fitted by :func:`fit_observation` (``options`` passed on, ``check=False``)
     from the truth moved by ``start_offset``: ``axis`` [degree] towards the north,
     ``period`` [s], ``phase`` [degree] (default 2 deg, 0.05 s, 5 deg).  The phase is
-    compared modulo ``phase_symmetry_deg`` (180 for a body that looks the same turned half
+    compared modulo ``phase_symmetry`` (180 for a body that looks the same turned half
     a turn about its spin axis; a Quantity is converted).  ``brightness`` and ``effects``
     make the truth other than the fit's model (see :func:`simulated_light_curve`): the
     pulls then measure what a model error does to the stated uncertainties, and
     ``quality_warnings`` how often the fit says so.
+
+    Parameters
+    ----------
+    spacecraft, observation, spin, area_fraction, extinction, bands, axis_body
+        The truth, as for :func:`simulated_light_curve`.
+    noise : float or Quantity
+        Standard deviation of the Gaussian noise of each magnitude [mag].
+    n_draws, seed : int
+        Noise draws and the seed of the generator.
+    start_offset : mapping, optional
+        How far from the truth each fit starts.
+    phase_symmetry : float or Quantity
+        Period of the phase's symmetry [degree] (360, or 180 for a two-fold body).
+    brightness, effects, **options
+        See above.
 
     Returns
     -------
@@ -175,7 +191,7 @@ def observation_recovery(
 
     Examples
     --------
-    Three draws on the built-in CanX-1 pass (see the tests and the README for more):
+    Three draws on the built-in CanX-1 pass (more in the tests and docs/guide/inversion.md):
 
     >>> from sbrdf_xr.body.spacecraft import canx1
     >>> from sbrdf_xr.invert import observation_recovery
@@ -185,12 +201,12 @@ def observation_recovery(
     ...     {"axis_longitude": 215.0, "axis_latitude": 40.0, "period": 57.0, "phase": 30.0},
     ...     area_fraction={"aluminium-6061-t6": 0.15, "tjpv-cell": 0.30,
     ...                    "white-paint-a276": 0.55},
-    ...     extinction={"V": 0.22, "R": 0.15, "I": 0.09}, n_draws=3, phase_symmetry_deg=180.0)
+    ...     extinction={"V": 0.22, "R": 0.15, "I": 0.09}, n_draws=3, phase_symmetry=180.0)
     >>> int(study.n_draws), study.parameter.values[:4].tolist()
     (3, ['axis_longitude', 'axis_latitude', 'period', 'phase'])
     """
-    phase_symmetry_deg = to_unit(phase_symmetry_deg, "deg", "phase_symmetry_deg")
-    noise_mag = to_unit(noise_mag, "mag", "noise_mag")
+    phase_symmetry = to_unit(phase_symmetry, "deg", "phase_symmetry")
+    noise = to_unit(noise, "mag", "noise")
     truth_spin = {k: float(spin[k]) for k in ("axis_longitude", "axis_latitude", "period", "phase")}
     epoch = spin.get("epoch", np.asarray(observation.times)[0])
     lc0, _ = simulated_light_curve(
@@ -228,15 +244,15 @@ def observation_recovery(
     load0 = os.getloadavg()[0]
     for _ in range(n_draws):
         lc = lc0.copy()
-        lc["magnitude"] = lc0["magnitude"] + rng.normal(0.0, noise_mag, lc0.sizes["obs"])
-        lc["uncertainty"] = lc0["uncertainty"] + noise_mag
+        lc["magnitude"] = lc0["magnitude"] + rng.normal(0.0, noise, lc0.sizes["obs"])
+        lc["uncertainty"] = lc0["uncertainty"] + noise
         t0 = time.perf_counter()
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", FitQualityWarning)
             fit = fit_observation(lc, spacecraft, obs_at, start, check=False, **options)
         secs.append(time.perf_counter() - t0)
         n_warn += any(issubclass(w.category, FitQualityWarning) for w in caught)
-        rows.append(_draw_row(fit, truth, bands, phase_symmetry_deg))
+        rows.append(_draw_row(fit, truth, bands, phase_symmetry))
         cosang = float(np.clip(fit["axis_vector"].values @ a0, -1.0, 1.0))
         ax_err.append(float(np.degrees(np.arccos(cosang))))
     ds = _recovery_statistics(rows, truth, n_draws, ax_err)
@@ -256,10 +272,10 @@ def observation_recovery(
         ds[k] = ((), v, {"units": u, "long_name": ln})
     ds.attrs = {
         "n_values": int(lc0.sizes["obs"]),
-        "noise_mag": noise_mag,
+        "noise_mag": noise,
         "seed": seed,
         "start": ", ".join(f"{k} {v}" for k, v in start.items()),
-        "phase_symmetry_deg": phase_symmetry_deg,
+        "phase_symmetry_deg": phase_symmetry,
         "load_average": f"{load0:.2f} before, {os.getloadavg()[0]:.2f} after",
         "options": repr(options),
     }

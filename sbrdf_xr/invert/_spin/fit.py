@@ -16,7 +16,7 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from ...errors import FitQualityWarning, InversionError
+from ...errors import FitQualityWarning, InversionError, renamed_keywords
 from ...units import to_unit
 from .._quality import fit_quality
 from .data import band_factors, light_curve_fluxes, spin_geometry
@@ -295,7 +295,7 @@ def fit_spin(
     xarray.Dataset
         Scalars ``axis_longitude``, ``axis_latitude`` [degree], ``period`` [s], ``phase``
         [degree] with ``*_uncertainty``, ``axis_uncertainty`` [degree] (the major
-        semi-axis of the axis's 1-sigma ellipse), ``chi2``, ``reduced_chi2``,
+        semi-axis of the axis's 1-sigma ellipse), ``chi2``, ``reduced_chi_square``,
         ``fit_probability``; ``chi2_map`` over ``axis``; the twins over ``solution`` with
         their ``chi2_gap``; the refined local minima over ``minimum``; attributes
         ``search_method`` (what was used), ``search_method_requested``, ``search_check``,
@@ -330,7 +330,7 @@ def fit_spin(
     >>> from sbrdf_xr.invert import axis_vector, fit_spin, spin_model
     >>> box = load_spacecraft(trimesh.creation.box(extents=(1.0, 2.0, 3.0)),
     ...                       material="lambertian-grey-50")
-    >>> spin = spin_model([0, 0, 1], axis_vector(60.0, 30.0), period_s=20.0, phase_deg=30.0)
+    >>> spin = spin_model([0, 0, 1], axis_vector(60.0, 30.0), period=20.0, phase=30.0)
     >>> t = np.arange(0.0, 40.0, 1.0)
     >>> scene = Scene(box, attitudes=spin.quaternions(t), phase_angles=[30.0],
     ...               outputs=("band_signal",), bands=("V", "R"))
@@ -550,17 +550,18 @@ def _solve(
     return best, minima, alts
 
 
-def period_grid(p_min: float, p_max: float, span_s: float, n_phases: int = 16) -> np.ndarray:
+@renamed_keywords(span_s="span")
+def period_grid(p_min: float, p_max: float, span: float, n_phases: int = 16) -> np.ndarray:
     """Candidate periods [s] from ``p_min`` to (at least) ``p_max``, spaced so that over a
-    light curve of ``span_s`` seconds the phase slips by at most half a phase step of a
-    ``n_phases`` grid between neighbours: ``dP = P**2 / (n_phases span_s)`` (the search
+    light curve of ``span`` seconds the phase slips by at most half a phase step of a
+    ``n_phases`` grid between neighbours: ``dP = P**2 / (n_phases span)`` (the search
     defines the phase at the middle of the light curve), growing with ``P``.
 
     Parameters
     ----------
     p_min, p_max : float
         The range of periods [s].
-    span_s : float
+    span : float
         Time span of the light curve [s].
     n_phases : int
         Phases of the search grid.
@@ -575,17 +576,17 @@ def period_grid(p_min: float, p_max: float, span_s: float, n_phases: int = 16) -
     (11, [60.0, 60.938, 61.905])
     """
     p_min, p_max = to_unit(p_min, "s", "p_min"), to_unit(p_max, "s", "p_max")
-    span_s = to_unit(span_s, "s", "span_s")
-    if not (0 < p_min <= p_max and np.isfinite(p_max) and span_s > 0 and n_phases >= 1):
+    span = to_unit(span, "s", "span")
+    if not (0 < p_min <= p_max and np.isfinite(p_max) and span > 0 and n_phases >= 1):
         raise InversionError(
-            f"period_grid: need 0 < p_min <= p_max, span_s > 0 and n_phases >= 1, got "
-            f"{p_min!r}, {p_max!r}, {span_s!r}, {n_phases!r}"
+            f"period_grid: need 0 < p_min <= p_max, span > 0 and n_phases >= 1, got "
+            f"{p_min!r}, {p_max!r}, {span!r}, {n_phases!r}"
         )
     out = [float(p_min)]
     while out[-1] < p_max:
         if len(out) > 10**6:
             raise InversionError("period_grid: more than 1e6 periods; narrow the range")
-        out.append(out[-1] + out[-1] ** 2 / (n_phases * span_s))
+        out.append(out[-1] + out[-1] ** 2 / (n_phases * span))
     return np.array(out)
 
 

@@ -50,8 +50,11 @@ def result_dataset(
     ds = _solution(prob, best, axes, alts, minima)
     scal = {
         "chi2": (best.chi2, "chi-square of the solution"),
-        "dof": (dof, "degrees of freedom (values minus spin parameters and flux scales)"),
-        "reduced_chi2": (
+        "degrees_of_freedom": (
+            dof,
+            "degrees of freedom (values minus spin parameters and flux scales)",
+        ),
+        "reduced_chi_square": (
             best.chi2 / dof if dof > 0 else np.nan,
             "chi-square per degree of freedom",
         ),

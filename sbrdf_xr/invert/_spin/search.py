@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...errors import InversionError
+from ...errors import InversionError, renamed_keywords
 from ...kernels import sums as _kernels
 from ...units import to_unit
 from .data import SpinGeometry
@@ -101,12 +101,13 @@ def align_matrices(axis_body: np.ndarray, axes: np.ndarray) -> np.ndarray:
     return Rotation.from_rotvec(u * ang[:, None]).as_matrix()
 
 
+@renamed_keywords(period_s="period", phase_deg="phase")
 def spin_model(
-    axis_body: ArrayLike, axis: ArrayLike, period_s: float, phase_deg: float, epoch: Any = None
+    axis_body: ArrayLike, axis: ArrayLike, period: float, phase: float, epoch: Any = None
 ) -> Any:
     """The :class:`sbrdf_xr.observing.attitude.Spin` law of a spin state: the body turns about
-    ``axis_body`` at ``360/period_s`` degree s-1 from the attitude that takes
-    ``axis_body`` to the inertial ``axis`` by the shortest arc, angle ``phase_deg`` at
+    ``axis_body`` at ``360/period`` degree s-1 from the attitude that takes
+    ``axis_body`` to the inertial ``axis`` by the shortest arc, angle ``phase`` at
     ``epoch`` (UTC; default t = 0, or the start of an observation).
 
     Parameters
@@ -115,12 +116,12 @@ def spin_model(
         The body's spin axis.
     axis : array_like, shape (3,)
         Its inertial direction.
-    period_s : float
+    period : float
         Spin period [s]; a Quantity is converted.
-    phase_deg : float
+    phase : float
         Spin angle at ``epoch`` [degree]; a Quantity is converted.
     epoch : optional
-        UTC time of ``phase_deg``.
+        UTC time of ``phase``.
 
     Examples
     --------
@@ -128,8 +129,8 @@ def spin_model(
 
     >>> from sbrdf_xr import geometry
     >>> from sbrdf_xr.invert import spin_model
-    >>> spin = spin_model([0, 0, 1], [1.0, 0.0, 0.0], period_s=60.0, phase_deg=0.0)
-    >>> spin.rate_deg_s, spin.phase_deg
+    >>> spin = spin_model([0, 0, 1], [1.0, 0.0, 0.0], period=60.0, phase=0.0)
+    >>> spin.rate, spin.phase
     (6.0, 0.0)
     >>> q = spin.quaternions([0.0, 15.0])
     >>> geometry.to_body_frame(q, [1.0, 0.0, 0.0]).round(6).tolist()  # inertial x: body z
@@ -143,8 +144,8 @@ def spin_model(
     q = Rotation.from_matrix(m).as_quat()
     return Spin(
         axis_body=np.asarray(axis_body, float),
-        rate_deg_s=360.0 / float(to_unit(period_s, "s", "period_s")),
-        phase_deg=float(to_unit(phase_deg, "deg", "phase_deg")),
+        rate=360.0 / float(to_unit(period, "s", "period")),
+        phase=float(to_unit(phase, "deg", "phase")),
         initial=q,
         epoch=epoch,
     )
