@@ -54,7 +54,7 @@ import numpy as np
 from ... import geometry, sources
 from ..._names import WAVELENGTH
 from ...photometry import solar_spectrum
-from ._limb import limb_reflectance, limb_signal
+from ._limb import limb_signal, limb_tables
 from .base import (
     BlockInputs,
     Decision,
@@ -138,7 +138,7 @@ def _plan(inputs: PlanInputs) -> Decision:
         f"the {'finite ' if finite else ''}Earth's emission at {scene.earth_temperature:g} K "
         f"({where}{dist}): irradiance up to {worst:.3g} of the Sun's on an Earth-facing facet "
         f"at {wl[0]:g}-{wl[-1]:g} nm, {how}",
-        {"radiance": readonly(radiance), "reflectance": limb_reflectance(inputs, wl)},
+        {"radiance": readonly(radiance), "limb_tables": limb_tables(inputs)},
     )
 
 
@@ -160,7 +160,7 @@ def _contribute(plan: PlanView, block: BlockInputs) -> dict[str, np.ndarray]:
     p = plan.effect_params["earth_thermal"]
     out = _reflected(plan, block, to_earth, frac, False).signal.astype(np.float64)
     if plan.knobs["earth_model"] == "finite":
-        out = out + limb_signal(plan, block, view, cos_i, p["reflectance"])
+        out = out + limb_signal(plan, block, view, cos_i, p["limb_tables"], "earth_thermal_limb")
     out = out * p["radiance"]
     return {"earth_thermal_intensity": out.astype(np.dtype(plan.knobs["dtype"]))}
 

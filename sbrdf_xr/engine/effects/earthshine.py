@@ -56,7 +56,7 @@ import numpy as np
 from ... import geometry
 from ..._names import WAVELENGTH
 from ...sources import EARTH_MEAN_RADIUS_KM, earthshine_facets, earthshine_irradiance_ratio
-from ._limb import limb_reflectance, limb_signal
+from ._limb import limb_signal, limb_tables
 from .base import BlockInputs, Decision, Effect, Output, PlanInputs, facet_fraction, reflected
 
 if TYPE_CHECKING:
@@ -123,7 +123,7 @@ def _plan(inputs: PlanInputs) -> Decision:
             True,
             f"{what} (albedo {scene.earth_albedo:g}) at the observation's distance and phase "
             f"at every time: {how}",
-            {"ratio": None, "albedo": scene.earth_albedo, "reflectance": _limb(inputs)},
+            {"ratio": None, "albedo": scene.earth_albedo, "limb_tables": _limb(inputs)},
         )
     if es is not None:  # an observation: per geometry
         return Decision(
@@ -146,15 +146,13 @@ def _plan(inputs: PlanInputs) -> Decision:
         f"{what} (albedo {scene.earth_albedo:g}, range "
         f"{scene.earth_range_km:g} km, phase {scene.earth_phase_angle:g} deg): irradiance "
         f"{ratio:.3g} of the Sun's{' on an Earth-facing facet' if finite else ''}, {how}",
-        {"ratio": ratio, "albedo": scene.earth_albedo, "reflectance": _limb(inputs)},
+        {"ratio": ratio, "albedo": scene.earth_albedo, "limb_tables": _limb(inputs)},
     )
 
 
-def _limb(inputs: PlanInputs) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
-    """The materials' hemispherical reflectance for the facets that see only the limb."""
-    if inputs.scene.earth_model != "finite" or inputs.wavelength is None:
-        return ()
-    return limb_reflectance(inputs, inputs.wavelength)
+def _limb(inputs: PlanInputs) -> tuple[xr.DataArray, ...]:
+    """The materials' tables, for the facets that see only the limb."""
+    return limb_tables(inputs) if inputs.scene.earth_model == "finite" else ()
 
 
 def _earth_sun(to_earth: np.ndarray, to_sun: np.ndarray, phase_deg: np.ndarray) -> np.ndarray:
@@ -189,7 +187,7 @@ def _contribute(plan: PlanView, block: BlockInputs) -> dict[str, np.ndarray]:
         frac = share if frac is None else frac * share
         r = reflected(plan, block, to_earth, frac, False)
         p = plan.effect_params["earthshine"]
-        limb = limb_signal(plan, block, irr, cos_i, p.get("reflectance", ()))
+        limb = limb_signal(plan, block, irr, cos_i, p["limb_tables"], "earthshine_limb")
         return {"signal_earthshine": (r.signal + limb).astype(r.signal.dtype)}
     r = reflected(plan, block, to_earth, frac, False)
     scale = block.sources.get("earth_scale")
