@@ -243,8 +243,9 @@ KNOBS: dict[str, Knob] = {
             "none",
             str,
             "conductance model of temperature='equilibrium': none: each facet an insulated "
-            "panel radiating from its front; two_sided: a thin plate radiating from both faces",
-            allowed=("none", "two_sided"),
+            "panel radiating from its front; two_sided: a thin plate radiating from both faces; "
+            "isothermal: all facets of a material at one temperature",
+            allowed=("none", "two_sided", "isothermal"),
         ),
         Knob(
             "chunk",

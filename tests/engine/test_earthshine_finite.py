@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy import integrate
 
 from sbrdf_xr import testing as T
@@ -87,6 +89,13 @@ CASES = [
     (30.0, 7000.0, 80.0),
     (87.0, 7000.0, 30.0),  # grazing: the horizon cuts the disc
     (80.0, 6771.0, 45.0),  # grazing, 400 km
+    # limb only: the Earth's centre below the face's horizon, part of the day side above it
+    # (reach 90 + rho: 98.7 deg at GEO, 155.5 at 7000 km, 160.2 at 6771 km)
+    (95.0, 42164.0, 30.0),
+    (100.0, 7000.0, 0.0),
+    (120.0, 7000.0, 60.0),
+    (150.0, 7000.0, 30.0),
+    (130.0, 6771.0, 45.0),
 ]
 
 
@@ -100,6 +109,32 @@ def test_lambertian_facet_against_the_exact_integral(tilt, r, phase):
     want = 0.5 / np.pi * _reference(DOWN, e, s, r)
     print(f"lambertian {(tilt, r, phase)}: rel {got / want - 1:+.2e}")
     assert got == pytest.approx(want, rel=TOL)
+
+
+def test_limb_only_facet_is_kept_by_the_plan():
+    """Only the -z face is seen, its horizon hides the Earth's centre (120 deg at 7000 km):
+    the plan keeps it (the Earth reaches 90 + rho = 155.5 deg) and it gets earthshine."""
+    e, s = _geometry(120.0, 0.0)
+    s = np.array([0.0, 0.0, 1.0])  # the Sun lights only the +z face, which is not seen
+    cube = simulate(_scene(e, s, 7000.0, 60.0, _lambert())).compute()
+    assert float(cube.signal_earthshine.isel(geometry=0, wavelength=0)) > 0.0
+
+
+@settings(max_examples=20, deadline=None)
+@given(
+    tilt=st.floats(0.0, 180.0),
+    phase=st.floats(0.0, 180.0),
+    r=st.sampled_from([6771.0, 7000.0, 42164.0]),
+)
+def test_finite_earth_is_never_negative_nor_above_the_full_cap(tilt, phase, r):
+    """``0 <= E <= a sin^2(rho)``: the irradiance of a plate facing a fully lit visible cap
+    (``(a/pi) int max(n.d, 0) dOmega`` is largest, ``pi sin^2(rho)``, for a facing plate and
+    ``max(u.s, 0) <= 1``).  The face has area 1 and albedo 0.5: ``signal = 0.5/pi E``."""
+    e, s = _geometry(tilt, phase)
+    cube = simulate(_scene(e, s, r, phase, _lambert())).compute()
+    got = float(cube.signal_earthshine.isel(geometry=0, wavelength=0)) / (0.5 / np.pi)
+    assert got >= 0.0
+    assert got <= 0.3 * (R / r) ** 2 * (1 + 1e-9)
 
 
 def test_point_source_knob_keeps_the_old_light():
@@ -156,3 +191,38 @@ def test_glossy_facet_centre_direction_error_is_measured(case, bound):
     want = _glossy_truth(scene.plan(), e, s, r)
     print(f"glossy {case}: engine {got:.6e} exact {want:.6e} rel {got / want - 1:+.2e}")
     assert abs(got / want - 1) < bound
+
+
+#: the measured error of the diffuse-sky reflectance rho(theta_r)/pi for the same glossy
+#: paint on a face that sees only the limb (the light arrives at grazing incidence, where
+#: its lobe and Fresnel term are above their hemispherical average): the engine is low by
+#: 14 % (GEO, 95 deg), 42 % (7000 km, 100 deg), 40 % (120 deg) and 19 % (150 deg); the
+#: bound is about 1.2 x the measured error, the sign is asserted
+GLOSSY_LIMB = [
+    ((95.0, 42164.0, 30.0), 0.17),
+    ((100.0, 7000.0, 0.0), 0.5),
+    ((120.0, 7000.0, 60.0), 0.48),
+    ((150.0, 7000.0, 30.0), 0.23),
+]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("case", "bound"), GLOSSY_LIMB)
+def test_glossy_limb_only_facet_error_is_measured(case, bound):
+    tilt, r, phase = case
+    paint = models.model_material(
+        "robertson_sandford",
+        WL,
+        material=T.TEST_SPACECRAFT_MATERIAL,
+        provenance="glossy test paint",
+        rho_D=0.8,
+        epsilon=0.12,
+        b=0.1,
+        e=0.35,
+    )
+    e, s = _geometry(tilt, phase)
+    scene = _scene(e, s, r, phase, paint)
+    got = float(simulate(scene).compute().signal_earthshine.isel(geometry=0, wavelength=0))
+    want = _glossy_truth(scene.plan(), e, s, r)
+    print(f"glossy limb {case}: engine {got:.6e} exact {want:.6e} rel {got / want - 1:+.2e}")
+    assert -bound < got / want - 1 < 0.0

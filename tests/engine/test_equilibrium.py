@@ -1,11 +1,13 @@
 """Facet temperatures from radiative equilibrium inside the cube (issue 46, item 2):
-``temperature="equilibrium"`` with the conductance models ``none`` and ``two_sided``,
-against the closed forms of :func:`sbrdf_xr.sources.equilibrium_temperature` and Planck."""
+``temperature="equilibrium"`` with the conductance models ``none``, ``two_sided`` and
+``isothermal``, against the closed forms of
+:func:`sbrdf_xr.sources.equilibrium_temperature` and Planck."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy import constants
 
 from sbrdf_xr import testing as T
 from sbrdf_xr.engine import Scene
@@ -54,6 +56,27 @@ def test_grey_plate_facing_the_sun_is_the_closed_form(conductance, sides):
     )
     assert cube.facet_temperature.attrs["units"] == "K"
     assert cube.facet_temperature.dims == ("geometry", "facet")
+
+
+@pytest.mark.parametrize(
+    ("to_sun", "projected"),
+    [([1.0, 0.0, 0.0], 1.0), (np.ones(3) / np.sqrt(3.0), np.sqrt(3.0))],
+)
+def test_isothermal_cube_is_the_closed_form(to_sun, projected):
+    """One temperature for the whole (grey, alpha = eps = 0.7) unit cube: absorbed
+    ``alpha S A_proj`` (its area projected toward the Sun: 1 face-on, sqrt(3) along a
+    diagonal) equals ``eps sigma T^4 6``, so ``T = (S A_proj / (6 sigma))^(1/4)``, on the
+    seen faces and on the faces the plan drops alike; the seen face emits ``eps B(T)``."""
+    cube = simulate(_scene(0.3, to_sun=[to_sun], conductance="isothermal")).compute()
+    temps = cube.facet_temperature.isel(geometry=0).values
+    want = (S * projected / (6.0 * constants.sigma)) ** 0.25
+    np.testing.assert_allclose(temps, want, rtol=1e-12)  # the same closed form, to rounding
+    assert float(equilibrium_temperature(0.7 * S * projected / 6.0, 0.7)) == pytest.approx(want)
+    np.testing.assert_allclose(
+        cube.thermal_intensity.isel(geometry=0).values, 0.7 * planck(WL, want), rtol=1e-9
+    )
+    line = dict(_scene(0.3, conductance="isothermal").plan().steps)["thermal"]
+    assert "isothermal: one temperature per material" in line
 
 
 def test_oblique_sun_scales_the_absorbed_power_by_cos_theta_i():
@@ -105,7 +128,7 @@ def test_bad_input_is_named():
     with pytest.raises(SceneError, match="temperature"):
         _scene(0.3).with_options(temperature="hot")
     with pytest.raises(SceneError, match="conductance"):
-        _scene(0.3, conductance="isothermal")
+        _scene(0.3, conductance="conduction")
     with pytest.raises(ValidationError, match="emissivity"):
         simulate(_scene(1.0))
 

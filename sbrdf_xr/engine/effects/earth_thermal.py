@@ -52,10 +52,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ... import geometry, sources
-from ..._names import PSI, WAVELENGTH
-from ...geometry.anisotropy import psi_average
-from ...materials.energy import hemispherical_reflectance
+from ..._names import WAVELENGTH
 from ...photometry import solar_spectrum
+from ._limb import limb_signal, limb_tables
 from .base import (
     BlockInputs,
     Decision,
@@ -64,7 +63,6 @@ from .base import (
     PlanInputs,
     facet_fraction,
     readonly,
-    table_on,
 )
 from .base import reflected as _reflected
 from .thermal import THERMAL_NEGLIGIBLE
@@ -135,19 +133,12 @@ def _plan(inputs: PlanInputs) -> Decision:
         if finite
         else "a distant source at the Earth's centre"
     )
-    reflectance = []
-    for m in inputs.materials:  # for the facets that see only the limb
-        da = table_on(scene.tables[m], wl, None)
-        th = np.asarray(da["theta_i"].values, dtype=np.float64)
-        rho_da = hemispherical_reflectance(da, th, warn=False)
-        rho = psi_average(rho_da.values, da[PSI].values, 1) if PSI in rho_da.dims else rho_da.values
-        reflectance.append((readonly(th), readonly(rho)))
     return Decision(
         True,
         f"the {'finite ' if finite else ''}Earth's emission at {scene.earth_temperature:g} K "
         f"({where}{dist}): irradiance up to {worst:.3g} of the Sun's on an Earth-facing facet "
         f"at {wl[0]:g}-{wl[-1]:g} nm, {how}",
-        {"radiance": readonly(radiance), "reflectance": tuple(reflectance)},
+        {"radiance": readonly(radiance), "limb_tables": limb_tables(inputs)},
     )
 
 
@@ -169,38 +160,9 @@ def _contribute(plan: PlanView, block: BlockInputs) -> dict[str, np.ndarray]:
     p = plan.effect_params["earth_thermal"]
     out = _reflected(plan, block, to_earth, frac, False).signal.astype(np.float64)
     if plan.knobs["earth_model"] == "finite":
-        out = out + _limb(plan, block, view, cos_i, p["reflectance"])
+        out = out + limb_signal(plan, block, view, cos_i, p["limb_tables"], "earth_thermal_limb")
     out = out * p["radiance"]
     return {"earth_thermal_intensity": out.astype(np.dtype(plan.knobs["dtype"]))}
-
-
-def _limb(
-    plan: PlanView,
-    block: BlockInputs,
-    view: np.ndarray,
-    cos_i: np.ndarray,
-    reflectance: tuple[tuple[np.ndarray, np.ndarray], ...],
-) -> np.ndarray:
-    """``sum_j A_j cos(theta_r) rho(theta_r) / pi V_j`` (G, L) over the facets that see the
-    Earth's limb with its centre below their horizon (``V > 0``, ``cos(theta_i) <= 0``),
-    where the Earth's centre cannot be the direction of their BRDF: the light is reflected
-    with the facet's directional-hemispherical reflectance at the emission angle
-    (reciprocity; exact for a Lambertian facet, a diffuse-sky approximation otherwise)."""
-    t = plan.terms
-    o = block.to_observer
-    out = np.zeros((o.shape[0], plan.wavelength.size))
-    limb = (cos_i <= 0) & (view > 0)
-    if not limb.any():
-        return out
-    for m, (theta, rho) in enumerate(reflectance):
-        sel = t.material == m
-        cos_r = o @ t.normal[sel].T  # (G, T_m)
-        w = np.where(limb[:, sel] & (cos_r > 0), cos_r * view[:, sel], 0.0) * t.area[sel]
-        if not w.any():
-            continue
-        theta_r = np.degrees(np.arctan2(np.sqrt(np.clip(1 - cos_r**2, 0, None)), cos_r))
-        out += np.einsum("gf,gfl->gl", w, sources.emissivity_at(rho, theta, theta_r)) / np.pi
-    return out
 
 
 #: The Earth's thermal emission reflected by the facets.

@@ -15,10 +15,13 @@ The knob ``earth_model`` chooses the Earth:
     at the direction of the Earth's centre: ``A cos(theta_r) f_r(e, o) E_facet``.  This
     is exact for a Lambertian facet; for a glossy one it replaces the BRDF averaged over
     the disc by its value at the centre (measured in ``tests/engine/test_earthshine_finite.py``).
-    A facet whose horizon hides the Earth's centre gets no earthshine, even when it
-    still sees a sliver of the limb.  The Sun that lights the Earth is at the scene's
-    ``earth_phase_angle`` from the spacecraft, on the side of the spacecraft's Sun
-    (for an observation, the true one).
+    A facet whose horizon hides the Earth's centre but still sees part of the lit Earth
+    (up to ``90 deg + rho`` from the centre, ``sin(rho) = R / r``) reflects the irradiance
+    it receives with its directional-hemispherical reflectance at the emission angle,
+    ``rho(theta_r) / pi`` (reciprocity: exact for a Lambertian facet, the diffuse-sky
+    approximation for a glossy one), as in the ``earth_thermal`` effect.  The Sun that
+    lights the Earth is at the scene's ``earth_phase_angle`` from the spacecraft, on the
+    side of the spacecraft's Sun (for an observation, the true one).
 ``point``
     A distant source from the Earth's centre with the diffuse-sphere phase law
     (:func:`sbrdf_xr.sources.earthshine_irradiance_ratio`): 9.8 % low at GEO for an
@@ -52,7 +55,8 @@ import numpy as np
 
 from ... import geometry
 from ..._names import WAVELENGTH
-from ...sources import earthshine_facets, earthshine_irradiance_ratio
+from ...sources import EARTH_MEAN_RADIUS_KM, earthshine_facets, earthshine_irradiance_ratio
+from ._limb import limb_signal, limb_tables
 from .base import BlockInputs, Decision, Effect, Output, PlanInputs, facet_fraction, reflected
 
 if TYPE_CHECKING:
@@ -79,7 +83,7 @@ def _geometry(scene: SceneView, observed: xr.Dataset | None) -> dict[str, np.nda
         phase = np.asarray(observed["earth_phase_angle"].values, dtype=np.float64)
         out = {"to_earth": np.ascontiguousarray(observed["to_earth"].values)}
         if finite:
-            return {**out, "earth_range": dist, "earth_phase": phase}
+            return {**out, **_finite(dist, phase)}
         ratio = [
             earthshine_irradiance_ratio(scene.earth_albedo, r, a)
             for r, a in zip(dist, phase, strict=True)
@@ -93,9 +97,15 @@ def _geometry(scene: SceneView, observed: xr.Dataset | None) -> dict[str, np.nda
         out = {"to_earth": np.asarray(scene.to_earth)}
         n = len(out["to_earth"])
     if finite:
-        out["earth_range"] = np.full(n, float(scene.earth_range_km))
-        out["earth_phase"] = np.full(n, float(scene.earth_phase_angle))
+        rng = np.full(n, float(scene.earth_range_km))
+        out.update(_finite(rng, np.full(n, float(scene.earth_phase_angle))))
     return out
+
+
+def _finite(rng: np.ndarray, phase: np.ndarray) -> dict[str, np.ndarray]:
+    """The finite Earth's range [km] and phase [degree], and its reach ``sin(rho) = R / r``:
+    facets up to ``90 deg + rho`` from its centre see part of it (so the plan keeps them)."""
+    return {"earth_range": rng, "earth_phase": phase, "earth_reach": EARTH_MEAN_RADIUS_KM / rng}
 
 
 def _plan(inputs: PlanInputs) -> Decision:
@@ -113,7 +123,7 @@ def _plan(inputs: PlanInputs) -> Decision:
             True,
             f"{what} (albedo {scene.earth_albedo:g}) at the observation's distance and phase "
             f"at every time: {how}",
-            {"ratio": None, "albedo": scene.earth_albedo},
+            {"ratio": None, "albedo": scene.earth_albedo, "limb_tables": _limb(inputs)},
         )
     if es is not None:  # an observation: per geometry
         return Decision(
@@ -136,8 +146,13 @@ def _plan(inputs: PlanInputs) -> Decision:
         f"{what} (albedo {scene.earth_albedo:g}, range "
         f"{scene.earth_range_km:g} km, phase {scene.earth_phase_angle:g} deg): irradiance "
         f"{ratio:.3g} of the Sun's{' on an Earth-facing facet' if finite else ''}, {how}",
-        {"ratio": ratio, "albedo": scene.earth_albedo},
+        {"ratio": ratio, "albedo": scene.earth_albedo, "limb_tables": _limb(inputs)},
     )
+
+
+def _limb(inputs: PlanInputs) -> tuple[xr.DataArray, ...]:
+    """The materials' tables, for the facets that see only the limb."""
+    return limb_tables(inputs) if inputs.scene.earth_model == "finite" else ()
 
 
 def _earth_sun(to_earth: np.ndarray, to_sun: np.ndarray, phase_deg: np.ndarray) -> np.ndarray:
@@ -171,7 +186,9 @@ def _contribute(plan: PlanView, block: BlockInputs) -> dict[str, np.ndarray]:
         share = np.divide(irr, cos_i, out=np.zeros_like(irr), where=cos_i > 0)
         frac = share if frac is None else frac * share
         r = reflected(plan, block, to_earth, frac, False)
-        return {"signal_earthshine": r.signal}
+        p = plan.effect_params["earthshine"]
+        limb = limb_signal(plan, block, irr, cos_i, p["limb_tables"], "earthshine_limb")
+        return {"signal_earthshine": (r.signal + limb).astype(r.signal.dtype)}
     r = reflected(plan, block, to_earth, frac, False)
     scale = block.sources.get("earth_scale")
     if scale is not None:  # per geometry (an observation's Earth distance and phase)

@@ -29,10 +29,13 @@ the table's wavelengths weighted by the Sun's spectrum, the infrared emissivity
 :data:`EMISSIVITY_WEIGHT_K`: a table that covers only part of the Sun's or the
 emission's spectrum gives the means over what it covers.  The knob ``conductance``
 states the conductance model: ``none`` (each facet an insulated panel radiating from
-its front, ``sides = 1``) or ``two_sided`` (a thin plate radiating from both faces, its
-back absorbing nothing).  Self-shadowing does not cut the absorbed sunlight.  The
-temperatures leave as ``facet_temperature`` [K] (geometry x facet, the plan's terms:
-facets sharing a normal and a material are merged, facets never seen are dropped).
+its front, ``sides = 1``), ``two_sided`` (a thin plate radiating from both faces, its
+back absorbing nothing) or ``isothermal`` (infinite conductance within a material: all
+its facets, seen or not, share one temperature, ``sum_j A_j q_j = eps_IR sigma T^4
+sum_j A_j``; a closed body radiating from its outer faces).  Self-shadowing does not cut
+the absorbed sunlight.  The temperatures leave as ``facet_temperature`` [K] (geometry x
+facet, the plan's terms: facets sharing a normal and a material are merged, facets never
+seen are dropped).
 
 >>> import numpy as np
 >>> import trimesh
@@ -65,7 +68,7 @@ import numpy as np
 from scipy import constants
 
 from ... import sources
-from ..._names import FACET, PSI, WAVELENGTH
+from ..._names import FACET, MATERIAL, PSI, WAVELENGTH
 from ...errors import ValidationError
 from ...geometry.anisotropy import psi_average
 from ...materials.energy import hemispherical_reflectance
@@ -277,7 +280,10 @@ def _plan(inputs: PlanInputs) -> Decision:
     )
     if scene.temperature == "equilibrium":
         props = [equilibrium_properties(scene.tables[m], wl) for m in inputs.materials]
-        sides = {"none": 1, "two_sided": 2}[inputs.knobs["conductance"]]
+        conductance = inputs.knobs["conductance"]
+        sides = {"none": 1, "two_sided": 2, "isothermal": 1}[conductance]
+        if conductance == "isothermal":  # every term of a material, seen or not
+            params["isothermal"] = _isothermal_terms(scene, inputs.materials)
         params.update(
             absorptance=tuple((readonly(th), readonly(a)) for th, a, _ in props),
             emissivity_ir=tuple(e for _, _, e in props),
@@ -289,14 +295,31 @@ def _plan(inputs: PlanInputs) -> Decision:
         given = ", ".join(
             f"{m} {e:.3g}" for m, (_, _, e) in zip(inputs.materials, props, strict=True)
         )
+        how = (
+            "one temperature per material: its absorbed power equals its emission over "
+            "all its facets"
+            if conductance == "isothermal"
+            else f"{sides} radiating face{'s' * (sides > 1)}"
+        )
         line += (
             f"; facet temperatures from radiative equilibrium, steady state (conductance "
-            f"{inputs.knobs['conductance']}: {sides} radiating face{'s' * (sides > 1)}), "
-            f"infrared emissivity {given}"
+            f"{conductance}: {how}), infrared emissivity {given}"
         )
     else:
         params["outputs"] = ("thermal_intensity",)
     return Decision(True, line, params)
+
+
+def _isothermal_terms(
+    scene: SceneView, materials: tuple[str, ...]
+) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
+    """Per material, the normals (N_m, 3) and areas (N_m,) [m2] of all its facets, merged
+    by normal, including those the plan drops (never seen): they absorb and emit too."""
+    merged = scene.spacecraft.merged()
+    names = np.asarray(merged[MATERIAL].values).astype(str)
+    normal = np.asarray(merged["normal"].values, dtype=np.float64)
+    area = np.asarray(merged["area"].values, dtype=np.float64)
+    return tuple((readonly(normal[names == m]), readonly(area[names == m])) for m in materials)
 
 
 def _absorbed(plan: PlanView, block: BlockInputs, m: int, normals: np.ndarray) -> np.ndarray:
@@ -358,7 +381,12 @@ def _contribute(plan: PlanView, block: BlockInputs) -> dict[str, np.ndarray]:
         if temps is None:
             out += np.einsum("gf,gfl->gl", w, eps) * p["radiance"][m]
             continue
-        q = _absorbed(plan, block, m, t.normal[sel])
+        if "isothermal" in p:  # sum_j A_j q_j = eps sigma T^4 sum_j A_j over the material
+            normal, area = p["isothermal"][m]
+            q = (_absorbed(plan, block, m, normal) @ area / np.sum(area))[:, None]
+        else:
+            q = _absorbed(plan, block, m, t.normal[sel])
+        q = np.broadcast_to(q, cos_r.shape)
         temps[:, sel] = (q / (p["sides"] * p["emissivity_ir"][m] * constants.sigma)) ** 0.25
         radiance = sources.planck(plan.wavelength, temps[:, sel])  # (G, T_m, L)
         out += np.einsum("gf,gfl,gfl->gl", w, eps, radiance)
