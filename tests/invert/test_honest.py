@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from sbrdf_xr import invert
-from sbrdf_xr.errors import FitQualityWarning
+from sbrdf_xr.errors import ChainLengthWarning, FitQualityWarning
 from sbrdf_xr.invert._joint.bounds import covariance, stick_breaking, stick_breaking_inverse
 from sbrdf_xr.observing import Observation, Orbit, Site, times
 
@@ -304,17 +304,23 @@ def test_posterior_from_every_minimum(box_wing):
     stated."""
     lc = _dao_curve(box_wing, 0.02, 3)
     start = {**DAO_SPIN, "axis_longitude": 101.0, "period": 47.03}
-    fit = invert.fit_observation(
-        lc,
-        box_wing,
-        dao_pass(),
-        start,
-        check=False,
-        method="posterior",
-        posterior_walkers=20,
-        posterior_steps=60,
-    )
+    # 60 steps are far fewer than 50 autocorrelation times: said, with the steps to ask for
+    with pytest.warns(ChainLengthWarning, match=r"ask for posterior_steps >= \d+"):
+        fit = invert.fit_observation(
+            lc,
+            box_wing,
+            dao_pass(),
+            start,
+            check=False,
+            method="posterior",
+            posterior_walkers=20,
+            posterior_steps=60,
+        )
     assert fit.mode_probability.values.tolist() == [1.0]
+    tau = float(fit.mode_autocorrelation_time[0])
+    assert 1.0 < tau and 60 < 50 * tau  # the warning's condition, reported per mode
+    # effective samples = walkers x kept steps / tau (20 x 30 / tau)
+    assert float(fit.mode_effective_samples[0]) == pytest.approx(600 / tau)
     post = fit.set_index(posterior_parameter="posterior_parameter")
     truth = {
         "period": 47.0,
@@ -427,3 +433,25 @@ def test_fit_spin_names_the_symmetry_twins(box_wing):
     assert "turn 180 deg: phase + 180 deg (chi2 gap" in text
     gap = float(text.split("chi2 gap ")[1].split(")")[0])
     assert abs(gap) < 1e-6
+
+
+def test_chain_convergence_against_the_ar1_closed_form():
+    """An AR(1) chain x_t = phi x_(t-1) + e_t has the integrated autocorrelation time
+    (1 + phi) / (1 - phi) = 9 for phi = 0.8; 16 walkers x 4000 steps estimate it to a few
+    per cent (Sokal's window; 15 % allowed, about 4 standard errors)."""
+    from sbrdf_xr.invert._joint.posterior import MIN_TAUS, _warn_short, chain_convergence
+
+    rng = np.random.default_rng(11)
+    phi, n = 0.8, 4000
+    e = rng.standard_normal((n, 16, 2))
+    x = np.zeros_like(e)
+    for t in range(1, n):
+        x[t] = phi * x[t - 1] + e[t]
+    tau, n_eff = chain_convergence(x, 1000)
+    assert tau == pytest.approx(9.0, rel=0.15)
+    assert n_eff == pytest.approx(16 * 3000 / tau)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _warn_short([tau], ["start"], n, 16)  # 4000 steps > 50 x 9: converged, silent
+    with pytest.warns(ChainLengthWarning, match=rf"fewer than {MIN_TAUS} .* start \(tau 9"):
+        _warn_short([9.0], ["start"], 300, 16)
