@@ -280,6 +280,43 @@ def test_material_scale_bad_input(box_wing, bad, match):
         invert.fit_observation(lc, box_wing, dao_pass(), DAO_SPIN, material_scale=bad)
 
 
+def test_model_discrepancy_floor_in_quadrature(box_wing):
+    """A floor equal to the measured uncertainty (0.02 mag in every band) weighs every value
+    alike, so the minimum is the same; the chi-square halves and the uncertainties grow by
+    sqrt(2) (sigma'^2 = 2 sigma^2).  Tolerances: the two fits stop at the optimizer's
+    tolerance (parameters to 1e-4 of their sigma), the covariance by central differences."""
+    lc = _dao_curve(box_wing, 0.02, 4)
+    start = {**DAO_SPIN, "axis_longitude": 101.0, "period": 47.03}
+    exact = invert.fit_observation(lc, box_wing, dao_pass(), start, check=False)
+    # a floor where the model is right overstates the errors: said by the chi-square test
+    with pytest.warns(FitQualityWarning, match="below the 0.1 % point"):
+        floored = invert.fit_observation(
+            lc, box_wing, dao_pass(), start, check=False, model_discrepancy=0.02
+        )
+    assert float(floored.chi2) == pytest.approx(float(exact.chi2) / 2, rel=1e-3)
+    ratio = floored.uncertainty.values / exact.uncertainty.values
+    assert np.allclose(ratio, np.sqrt(2), rtol=2e-3)
+    assert np.all(np.abs(floored.estimate - exact.estimate) < 1e-2 * exact.uncertainty)
+    assert floored.attrs["model_discrepancy"].endswith("V 0.02 mag, R 0.02 mag, I 0.02 mag")
+    assert exact.attrs["model_discrepancy"].startswith("none")
+
+
+@pytest.mark.parametrize(
+    ("bad", "match"),
+    [
+        (-0.01, r"model_discrepancy\['V'\]: -0.01; allowed a floor >= 0 \[mag\]"),
+        (float("nan"), "allowed a floor >= 0"),
+        ({"K": 0.01}, r"bands \['K'\] are not fitted"),
+    ],
+)
+def test_model_discrepancy_bad_input(box_wing, bad, match):
+    from sbrdf_xr.errors import InversionError
+
+    lc = _dao_curve(box_wing, 0.02, 1)
+    with pytest.raises(InversionError, match=match):
+        invert.fit_observation(lc, box_wing, dao_pass(), DAO_SPIN, model_discrepancy=bad)
+
+
 def test_the_warning_names_the_causes_the_residuals_show(box_wing):
     """A truth with self-shadowing fitted without it: the warning names a cause that holds
     self-shadowing first (ranked by the residual patterns, not a fixed order), and

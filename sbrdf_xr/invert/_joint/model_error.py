@@ -10,18 +10,27 @@ than the data demand, and carries the tables' uncertainty into the areas' uncert
 a nuisance parameter marginalised to first order.  The widths default to the table's
 ``source``: a measured table :data:`PROVENANCE_WIDTH` ``["measured"]``, a model fitted to
 measurements ``["model"]``, a synthetic one ``["synthetic"]``.
+
+What no table scale absorbs (a shape, an effect or a colour the model lacks) can be stated
+as a model-discrepancy floor per band, ``s_b`` [mag], added in quadrature to every
+measured uncertainty of the band (``sigma'^2 = sigma^2 + s_b^2``: an independent Gaussian
+model error, the simplest discrepancy term of Kennedy & O'Hagan 2001, J. R. Stat. Soc. B
+63, 425, §4.2).  The chi-square, the warnings and the uncertainties are then those of the
+model with its stated error.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
 from ...errors import InversionError
+from ...units import to_unit
 
-__all__ = ["PROVENANCE_WIDTH", "table_widths"]
+__all__ = ["PROVENANCE_WIDTH", "discrepancy_floor", "table_widths", "with_floor"]
 
 #: Default prior width of a table's scale by its ``source``: absolute BRDF calibration of a
 #: laboratory measurement (a few per cent), a model fitted to measurements, and a table
@@ -87,3 +96,67 @@ def table_widths(
             )
         out.append(w)
     return np.array(out)
+
+
+def discrepancy_floor(
+    model_discrepancy: float | Mapping[str, float] | None, labels: Sequence[str]
+) -> np.ndarray | None:
+    """The model-discrepancy floor of every band [mag], or None (the model taken as exact).
+
+    A number (or a Quantity in mag): the same floor in every band; a mapping ``{band:
+    floor}``: per band, bands left out 0.  Each floor finite and >= 0.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.invert._joint.model_error import discrepancy_floor
+    >>> discrepancy_floor(0.01, ["V", "R"]).tolist()
+    [0.01, 0.01]
+    >>> discrepancy_floor({"R": 0.03}, ["V", "R"]).tolist()
+    [0.0, 0.03]
+    """
+    if model_discrepancy is None:
+        return None
+    if isinstance(model_discrepancy, Mapping):
+        unknown = sorted(set(map(str, model_discrepancy)) - set(labels))
+        if unknown:
+            raise InversionError(
+                f"model_discrepancy: bands {unknown} are not fitted; have {list(labels)}"
+            )
+        given: dict[str, Any] = {str(k): v for k, v in model_discrepancy.items()}
+    else:
+        given = dict.fromkeys(labels, model_discrepancy)
+    out = []
+    for b in labels:
+        v = to_unit(given.get(b, 0.0), "mag", f"model_discrepancy[{b!r}]")
+        try:
+            v = float(v)
+        except (TypeError, ValueError):
+            v = float("nan")
+        if not (np.isfinite(v) and v >= 0):
+            raise InversionError(
+                f"model_discrepancy[{b!r}]: {given.get(b)!r}; allowed a floor >= 0 [mag] "
+                "(a number, or a mapping {band: floor})"
+            )
+        out.append(v)
+    return np.array(out)
+
+
+def with_floor(data: Any, floor: np.ndarray | None) -> Any:
+    """``data`` (a :class:`PassData`) with each band's floor [mag] added in quadrature to
+    its uncertainties; unchanged for None.
+
+    Examples
+    --------
+    >>> import dataclasses, numpy as np
+    >>> from sbrdf_xr.invert._joint.model_error import with_floor
+    >>> @dataclasses.dataclass(frozen=True)
+    ... class D:
+    ...     sigma: np.ndarray
+    ...     band: np.ndarray
+    >>> with_floor(D(np.array([0.03, 0.03]), np.array([0, 1])), np.array([0.04, 0.0])).sigma
+    array([0.05, 0.03])
+    """
+    if floor is None:
+        return data
+    sigma = np.sqrt(np.asarray(data.sigma) ** 2 + floor[np.asarray(data.band)] ** 2)
+    return dataclasses.replace(data, sigma=sigma)
