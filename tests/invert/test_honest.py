@@ -301,12 +301,32 @@ def test_model_discrepancy_floor_in_quadrature(box_wing):
     assert exact.attrs["model_discrepancy"].startswith("none")
 
 
+def test_model_discrepancy_estimated_from_the_residuals(box_wing):
+    """A self-shadowed truth fitted without shadowing (chi-square about 55 times its
+    degrees of freedom): the floor estimated from the residuals brings the chi-square per
+    value near 1 (method of moments: 1 up to p / N and the floor's own scatter over three
+    bands of about 40 values, 0.7-1.3 allowed), and the fit's cost is stated."""
+    lc = _dao_curve(box_wing, 0.02, 2, effects=("shadowing",))
+    with warnings.catch_warnings():  # the wider errors leave the extinction to its prior
+        warnings.simplefilter("ignore", FitQualityWarning)
+        fit = invert.fit_observation(
+            lc, box_wing, dao_pass(), DAO_SPIN, check=False, model_discrepancy="estimate"
+        )
+    said = fit.attrs["model_discrepancy"]
+    assert said.startswith("estimated from the residuals (method of moments, iterated)")
+    floors = [float(t.split()[1]) for t in said.split(": ")[1].split(", ")]
+    assert len(floors) == 3 and min(floors) > 0.02  # far above the noise
+    assert 0.7 < float(fit.chi2) / lc.sizes["obs"] < 1.3
+    assert fit.attrs["model_discrepancy_seconds"] > 0
+
+
 @pytest.mark.parametrize(
     ("bad", "match"),
     [
         (-0.01, r"model_discrepancy\['V'\]: -0.01; allowed a floor >= 0 \[mag\]"),
         (float("nan"), "allowed a floor >= 0"),
         ({"K": 0.01}, r"bands \['K'\] are not fitted"),
+        ("median", "model_discrepancy: 'median'; allowed 'estimate', a floor >= 0"),
     ],
 )
 def test_model_discrepancy_bad_input(box_wing, bad, match):

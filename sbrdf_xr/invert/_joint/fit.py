@@ -30,7 +30,7 @@ from .diagnose import likely_causes
 from .extinction import extinction_prior as _k_prior
 from .extinction import separable_sd
 from .model import PassModel, pass_data
-from .model_error import discrepancy_floor, table_widths, with_floor
+from .model_error import discrepancy_floor, estimate_floor, table_widths, with_floor
 from .posterior import check_budget
 from .refine import Local, jacobian, outside_physics, refine
 from .result import Layout, model_check, result_dataset
@@ -140,6 +140,10 @@ def _options(extinction: Any, offset: str | None, areas: str, labels: Sequence[s
     )
 
 
+#: Most fits made to estimate the model-discrepancy floor (``model_discrepancy="estimate"``).
+FLOOR_ROUNDS = 4
+
+
 def fit_observation(
     light_curve: xr.Dataset,
     spacecraft: Spacecraft,
@@ -159,7 +163,7 @@ def fit_observation(
     extinction_prior: Mapping[str, Any] | None = None,
     symmetry_tolerance: float = SYMMETRY_TOL,
     material_scale: str | Mapping[str, float] | None = None,
-    model_discrepancy: float | Mapping[str, float] | None = None,
+    model_discrepancy: str | float | Mapping[str, float] | None = None,
     method: str = "point",
     posterior_walkers: int = 32,
     posterior_steps: int = 300,
@@ -255,11 +259,13 @@ def fit_observation(
         maps the body's facets (normals, areas, materials: the model's terms) onto
         themselves gives a twin state of the solution, evaluated on the data and listed
         over ``twin`` and in ``ambiguity`` (:mod:`sbrdf_xr.invert._spin.symmetry`).
-    model_discrepancy : float or mapping of str to float, optional
+    model_discrepancy : "estimate", float or mapping of str to float, optional
         A model-discrepancy floor [mag] (one for every band, or ``{band: floor}``, bands
         left out 0), added in quadrature to the measured uncertainties
         (:mod:`sbrdf_xr.invert._joint.model_error`): the model's own error where the
-        tables' scales do not absorb it.  Default None: the model taken as exact.
+        tables' scales do not absorb it; ``"estimate"``: each band's floor estimated from
+        the residuals of a point fit without one, then the pass fitted again with it
+        (twice the cost).  Default None: the model taken as exact.
 
     Returns
     -------
@@ -350,6 +356,8 @@ def fit_observation(
     >>> fit.area_fraction.round(2).values.tolist(), fit.attrs["fit_quality"]
     ([0.82, 0.18], 'consistent')
     """
+    if isinstance(model_discrepancy, str):  # estimated: a fit without, then with
+        return _estimated_floor(dict(locals()))
     t_start = time.perf_counter()
     _check_method(method)
     start, epoch = _read_start(spin)
@@ -434,6 +442,49 @@ def fit_observation(
             ds, observation, spacecraft, materials, ab, data, lay, p
         )
         ds.attrs["check_seconds"] = time.perf_counter() - t0
+    return ds
+
+
+def _estimated_floor(args: dict[str, Any]) -> xr.Dataset:
+    """``model_discrepancy="estimate"``: a point fit without a floor, each band's floor from
+    its residuals (:func:`.model_error.estimate_floor`), refitted with it until the floors
+    settle (within 5 % or 0.001 mag, at most :data:`FLOOR_ROUNDS` fits), then the fit asked
+    for with them."""
+    if args["model_discrepancy"] != "estimate":
+        raise InversionError(
+            f"model_discrepancy: {args['model_discrepancy']!r}; allowed 'estimate', a floor "
+            ">= 0 [mag] or a mapping {band: floor}"
+        )
+    t0 = time.perf_counter()
+    floor: dict[str, float] | None = None
+    sigma = np.asarray(args["light_curve"]["uncertainty"].values)
+    for _ in range(FLOOR_ROUNDS):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FitQualityWarning)
+            fit = fit_observation(
+                **{**args, "model_discrepancy": floor, "method": "point", "check": False}
+            )
+        res = fit["residual"]
+        band = next(c for c in res.coords if str(c).startswith("band"))
+        new = estimate_floor(
+            res.values,
+            sigma,
+            res[band].values,
+            fit.sizes["parameter"],
+        )
+        settled = floor is not None and all(
+            abs(new[b] - floor[b]) <= max(0.05 * floor[b], 1e-3) for b in new
+        )
+        floor = new
+        if settled:
+            break
+    first_s = time.perf_counter() - t0
+    ds = fit_observation(**{**args, "model_discrepancy": floor})
+    ds.attrs["model_discrepancy"] = (
+        "estimated from the residuals (method of moments, iterated), "
+        + ds.attrs["model_discrepancy"]
+    )
+    ds.attrs["model_discrepancy_seconds"] = first_s  # the estimating fits' cost, on top
     return ds
 
 

@@ -16,7 +16,10 @@ as a model-discrepancy floor per band, ``s_b`` [mag], added in quadrature to eve
 measured uncertainty of the band (``sigma'^2 = sigma^2 + s_b^2``: an independent Gaussian
 model error, the simplest discrepancy term of Kennedy & O'Hagan 2001, J. R. Stat. Soc. B
 63, 425, §4.2).  The chi-square, the warnings and the uncertainties are then those of the
-model with its stated error.
+model with its stated error.  Estimated (``"estimate"``), each band's floor is the method-
+of-moments value ``s_b^2 = max(0, mean_b(r^2) N / (N - p) - mean_b(sigma^2))`` from the
+residuals ``r`` of a fit without a floor (``N`` values, ``p`` parameters), and the pass is
+fitted again with it.
 """
 
 from __future__ import annotations
@@ -30,7 +33,13 @@ import numpy as np
 from ...errors import InversionError
 from ...units import to_unit
 
-__all__ = ["PROVENANCE_WIDTH", "discrepancy_floor", "table_widths", "with_floor"]
+__all__ = [
+    "PROVENANCE_WIDTH",
+    "discrepancy_floor",
+    "estimate_floor",
+    "table_widths",
+    "with_floor",
+]
 
 #: Default prior width of a table's scale by its ``source``: absolute BRDF calibration of a
 #: laboratory measurement (a few per cent), a model fitted to measurements, and a table
@@ -160,3 +169,35 @@ def with_floor(data: Any, floor: np.ndarray | None) -> Any:
         return data
     sigma = np.sqrt(np.asarray(data.sigma) ** 2 + floor[np.asarray(data.band)] ** 2)
     return dataclasses.replace(data, sigma=sigma)
+
+
+def estimate_floor(
+    residual: np.ndarray, sigma: np.ndarray, band: Sequence[str], n_parameters: int
+) -> dict[str, float]:
+    """Each band's model-discrepancy floor [mag] estimated from a fit's residuals [mag]
+    and the measured uncertainties [mag] (method of moments, see the module).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.invert._joint.model_error import estimate_floor
+    >>> r = np.array([0.05, -0.05, 0.05, -0.05, 0.01, -0.01, 0.01, -0.01])
+    >>> f = estimate_floor(r, np.full(8, 0.01), ["V"] * 4 + ["R"] * 4, 0)
+    >>> {b: round(v, 4) for b, v in f.items()}  # V: sqrt(0.05^2 - 0.01^2); R: none
+    {'V': 0.049, 'R': 0.0}
+    """
+    r = np.asarray(residual, dtype=np.float64)
+    s2 = np.asarray(sigma, dtype=np.float64) ** 2
+    labels = np.asarray(band).astype(str)
+    n = r.size
+    if n <= n_parameters:
+        raise InversionError(
+            f"model_discrepancy='estimate': {n} values for {n_parameters} parameters; "
+            "allowed more values than parameters (or state the floor)"
+        )
+    scale = n / (n - n_parameters)  # residuals of a fit are smaller than the errors
+    out = {}
+    for b in dict.fromkeys(labels.tolist()):
+        m = labels == b
+        out[b] = float(np.sqrt(max(0.0, np.mean(r[m] ** 2) * scale - np.mean(s2[m]))))
+    return out
