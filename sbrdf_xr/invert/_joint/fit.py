@@ -30,7 +30,7 @@ from .diagnose import likely_causes
 from .extinction import extinction_prior as _k_prior
 from .extinction import separable_sd
 from .model import PassModel, pass_data
-from .model_error import discrepancy_floor, estimate_floor, table_widths, with_floor
+from .model_error import discrepancy_floor, estimated_floor, table_widths, with_floor
 from .posterior import check_budget
 from .refine import Local, jacobian, outside_physics, refine
 from .result import Layout, model_check, result_dataset
@@ -138,10 +138,6 @@ def _options(extinction: Any, offset: str | None, areas: str, labels: Sequence[s
         f"extinction: {extinction!r}; allowed 'fit', None (no extinction) or a mapping "
         "{band: k} [mag per airmass]"
     )
-
-
-#: Most fits made to estimate the model-discrepancy floor (``model_discrepancy="estimate"``).
-FLOOR_ROUNDS = 4
 
 
 def fit_observation(
@@ -357,7 +353,7 @@ def fit_observation(
     ([0.82, 0.18], 'consistent')
     """
     if isinstance(model_discrepancy, str):  # estimated: a fit without, then with
-        return _estimated_floor(dict(locals()))
+        return estimated_floor(fit_observation, dict(locals()))
     t_start = time.perf_counter()
     _check_method(method)
     start, epoch = _read_start(spin)
@@ -442,49 +438,6 @@ def fit_observation(
             ds, observation, spacecraft, materials, ab, data, lay, p
         )
         ds.attrs["check_seconds"] = time.perf_counter() - t0
-    return ds
-
-
-def _estimated_floor(args: dict[str, Any]) -> xr.Dataset:
-    """``model_discrepancy="estimate"``: a point fit without a floor, each band's floor from
-    its residuals (:func:`.model_error.estimate_floor`), refitted with it until the floors
-    settle (within 5 % or 0.001 mag, at most :data:`FLOOR_ROUNDS` fits), then the fit asked
-    for with them."""
-    if args["model_discrepancy"] != "estimate":
-        raise InversionError(
-            f"model_discrepancy: {args['model_discrepancy']!r}; allowed 'estimate', a floor "
-            ">= 0 [mag] or a mapping {band: floor}"
-        )
-    t0 = time.perf_counter()
-    floor: dict[str, float] | None = None
-    sigma = np.asarray(args["light_curve"]["uncertainty"].values)
-    for _ in range(FLOOR_ROUNDS):
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", FitQualityWarning)
-            fit = fit_observation(
-                **{**args, "model_discrepancy": floor, "method": "point", "check": False}
-            )
-        res = fit["residual"]
-        band = next(c for c in res.coords if str(c).startswith("band"))
-        new = estimate_floor(
-            res.values,
-            sigma,
-            res[band].values,
-            fit.sizes["parameter"],
-        )
-        settled = floor is not None and all(
-            abs(new[b] - floor[b]) <= max(0.05 * floor[b], 1e-3) for b in new
-        )
-        floor = new
-        if settled:
-            break
-    first_s = time.perf_counter() - t0
-    ds = fit_observation(**{**args, "model_discrepancy": floor})
-    ds.attrs["model_discrepancy"] = (
-        "estimated from the residuals (method of moments, iterated), "
-        + ds.attrs["model_discrepancy"]
-    )
-    ds.attrs["model_discrepancy_seconds"] = first_s  # the estimating fits' cost, on top
     return ds
 
 

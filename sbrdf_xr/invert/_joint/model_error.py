@@ -25,18 +25,21 @@ fitted again with it.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping, Sequence
+import time
+import warnings
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
-from ...errors import InversionError
+from ...errors import FitQualityWarning, InversionError
 from ...units import to_unit
 
 __all__ = [
     "PROVENANCE_WIDTH",
     "discrepancy_floor",
     "estimate_floor",
+    "estimated_floor",
     "table_widths",
     "with_floor",
 ]
@@ -45,6 +48,8 @@ __all__ = [
 #: laboratory measurement (a few per cent), a model fitted to measurements, and a table
 #: made from a model alone (its parameters from the literature, not from the flight part).
 PROVENANCE_WIDTH = {"measured": 0.05, "model": 0.1, "synthetic": 0.2}
+#: Most fits made to estimate the model-discrepancy floor (``model_discrepancy="estimate"``).
+FLOOR_ROUNDS = 4
 
 
 def table_widths(
@@ -201,3 +206,55 @@ def estimate_floor(
         m = labels == b
         out[b] = float(np.sqrt(max(0.0, np.mean(r[m] ** 2) * scale - np.mean(s2[m]))))
     return out
+
+
+def estimated_floor(fit_observation: Callable[..., Any], args: dict[str, Any]) -> Any:
+    """``model_discrepancy="estimate"``: a point fit without a floor, each band's floor from
+    its residuals (:func:`estimate_floor`), refitted with it until the floors
+    settle (within 5 % or 0.001 mag, at most :data:`FLOOR_ROUNDS` fits), then the fit asked
+    for with them (``fit_observation`` called with ``args``, its own arguments).
+
+    Examples
+    --------
+    >>> from sbrdf_xr.invert._joint.model_error import estimated_floor
+    >>> estimated_floor(print, {"model_discrepancy": "median"})
+    Traceback (most recent call last):
+    ...
+    sbrdf_xr.errors.InversionError: model_discrepancy: 'median'; allowed 'estimate', ...
+    """
+    if args["model_discrepancy"] != "estimate":
+        raise InversionError(
+            f"model_discrepancy: {args['model_discrepancy']!r}; allowed 'estimate', a floor "
+            ">= 0 [mag] or a mapping {band: floor}"
+        )
+    t0 = time.perf_counter()
+    floor: dict[str, float] | None = None
+    sigma = np.asarray(args["light_curve"]["uncertainty"].values)
+    for _ in range(FLOOR_ROUNDS):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FitQualityWarning)
+            fit = fit_observation(
+                **{**args, "model_discrepancy": floor, "method": "point", "check": False}
+            )
+        res = fit["residual"]
+        band = next(c for c in res.coords if str(c).startswith("band"))
+        new = estimate_floor(
+            res.values,
+            sigma,
+            res[band].values,
+            fit.sizes["parameter"],
+        )
+        settled = floor is not None and all(
+            abs(new[b] - floor[b]) <= max(0.05 * floor[b], 1e-3) for b in new
+        )
+        floor = new
+        if settled:
+            break
+    first_s = time.perf_counter() - t0
+    ds = fit_observation(**{**args, "model_discrepancy": floor})
+    ds.attrs["model_discrepancy"] = (
+        "estimated from the residuals (method of moments, iterated), "
+        + ds.attrs["model_discrepancy"]
+    )
+    ds.attrs["model_discrepancy_seconds"] = first_s  # the estimating fits' cost, on top
+    return ds
