@@ -25,6 +25,7 @@ __all__ = [
     "AttitudeError",
     "CacheWarning",
     "CatalogError",
+    "ChainLengthWarning",
     "CubeLockedError",
     "CubeWriteError",
     "DirectionError",
@@ -466,6 +467,12 @@ class FitQualityWarning(SbrdfWarning):
     its chi-square distribution (the model does not describe the data within their
     uncertainties) or below its 0.1 % point (the uncertainties are overstated), or another
     solution (a mirror or period-alias twin) fits about as well as the one reported."""
+
+
+class ChainLengthWarning(SbrdfWarning):
+    """A posterior sample from Markov chains shorter than 50 of their integrated
+    autocorrelation times (emcee's criterion): the reported widths and percentiles are not
+    converged; the message names the number of steps to ask for."""
 
 
 # --- renamed names, kept for one release ---------------------------------------

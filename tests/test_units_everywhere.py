@@ -604,7 +604,10 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         longitude=[30.0, 60.0], latitude=[20.0, -5.0]
     ),
     "sbrdf_xr.invert._studies.spin_recovery": lambda: _recovery_inputs(),
-    "sbrdf_xr.invert._joint.fit.fit_observation": lambda: _joint_inputs(),
+    "sbrdf_xr.invert._joint.fit.fit_observation": lambda: {
+        **_joint_inputs(),
+        "model_discrepancy": 0.01,
+    },
     "sbrdf_xr.invert._joint.study.observation_recovery": lambda: dict(
         spacecraft=_box("lambertian-grey-50"),
         observation=_joint_inputs()["observation"],

@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from sbrdf_xr import invert
-from sbrdf_xr.errors import FitQualityWarning
+from sbrdf_xr.errors import ChainLengthWarning, FitQualityWarning
 from sbrdf_xr.invert._joint.bounds import covariance, stick_breaking, stick_breaking_inverse
 from sbrdf_xr.observing import Observation, Orbit, Site, times
 
@@ -282,6 +282,63 @@ def test_material_scale_bad_input(box_wing, bad, match):
         invert.fit_observation(lc, box_wing, dao_pass(), DAO_SPIN, material_scale=bad)
 
 
+def test_model_discrepancy_floor_in_quadrature(box_wing):
+    """A floor equal to the measured uncertainty (0.02 mag in every band) weighs every value
+    alike, so the minimum is the same; the chi-square halves and the uncertainties grow by
+    sqrt(2) (sigma'^2 = 2 sigma^2).  Tolerances: the two fits stop at the optimizer's
+    tolerance (parameters to 1e-4 of their sigma), the covariance by central differences."""
+    lc = _dao_curve(box_wing, 0.02, 4)
+    start = {**DAO_SPIN, "axis_longitude": 101.0, "period": 47.03}
+    exact = invert.fit_observation(lc, box_wing, dao_pass(), start, check=False)
+    # a floor where the model is right overstates the errors: said by the chi-square test
+    with pytest.warns(FitQualityWarning, match="below the 0.1 % point"):
+        floored = invert.fit_observation(
+            lc, box_wing, dao_pass(), start, check=False, model_discrepancy=0.02
+        )
+    assert float(floored.chi2) == pytest.approx(float(exact.chi2) / 2, rel=1e-3)
+    ratio = floored.uncertainty.values / exact.uncertainty.values
+    assert np.allclose(ratio, np.sqrt(2), rtol=2e-3)
+    assert np.all(np.abs(floored.estimate - exact.estimate) < 1e-2 * exact.uncertainty)
+    assert floored.attrs["model_discrepancy"].endswith("V 0.02 mag, R 0.02 mag, I 0.02 mag")
+    assert exact.attrs["model_discrepancy"].startswith("none")
+
+
+def test_model_discrepancy_estimated_from_the_residuals(box_wing):
+    """A self-shadowed truth fitted without shadowing (chi-square about 55 times its
+    degrees of freedom): the floor estimated from the residuals brings the chi-square per
+    value near 1 (method of moments: 1 up to p / N and the floor's own scatter over three
+    bands of about 40 values, 0.7-1.3 allowed), and the fit's cost is stated."""
+    lc = _dao_curve(box_wing, 0.02, 2, effects=("shadowing",))
+    with warnings.catch_warnings():  # the wider errors leave the extinction to its prior
+        warnings.simplefilter("ignore", FitQualityWarning)
+        fit = invert.fit_observation(
+            lc, box_wing, dao_pass(), DAO_SPIN, check=False, model_discrepancy="estimate"
+        )
+    said = fit.attrs["model_discrepancy"]
+    assert said.startswith("estimated from the residuals (method of moments, iterated)")
+    floors = [float(t.split()[1]) for t in said.split(": ")[1].split(", ")]
+    assert len(floors) == 3 and min(floors) > 0.02  # far above the noise
+    assert 0.7 < float(fit.chi2) / lc.sizes["obs"] < 1.3
+    assert fit.attrs["model_discrepancy_seconds"] > 0
+
+
+@pytest.mark.parametrize(
+    ("bad", "match"),
+    [
+        (-0.01, r"model_discrepancy\['V'\]: -0.01; allowed a floor >= 0 \[mag\]"),
+        (float("nan"), "allowed a floor >= 0"),
+        ({"K": 0.01}, r"bands \['K'\] are not fitted"),
+        ("median", "model_discrepancy: 'median'; allowed 'estimate', a floor >= 0"),
+    ],
+)
+def test_model_discrepancy_bad_input(box_wing, bad, match):
+    from sbrdf_xr.errors import InversionError
+
+    lc = _dao_curve(box_wing, 0.02, 1)
+    with pytest.raises(InversionError, match=match):
+        invert.fit_observation(lc, box_wing, dao_pass(), DAO_SPIN, model_discrepancy=bad)
+
+
 def test_the_warning_names_the_causes_the_residuals_show(box_wing):
     """A truth with self-shadowing fitted without it: the warning names a cause that holds
     self-shadowing first (ranked by the residual patterns, not a fixed order), and
@@ -306,17 +363,23 @@ def test_posterior_from_every_minimum(box_wing):
     stated."""
     lc = _dao_curve(box_wing, 0.02, 3)
     start = {**DAO_SPIN, "axis_longitude": 101.0, "period": 47.03}
-    fit = invert.fit_observation(
-        lc,
-        box_wing,
-        dao_pass(),
-        start,
-        check=False,
-        method="posterior",
-        posterior_walkers=20,
-        posterior_steps=60,
-    )
+    # 60 steps are far fewer than 50 autocorrelation times: said, with the steps to ask for
+    with pytest.warns(ChainLengthWarning, match=r"ask for posterior_steps >= \d+"):
+        fit = invert.fit_observation(
+            lc,
+            box_wing,
+            dao_pass(),
+            start,
+            check=False,
+            method="posterior",
+            posterior_walkers=20,
+            posterior_steps=60,
+        )
     assert fit.mode_probability.values.tolist() == [1.0]
+    tau = float(fit.mode_autocorrelation_time[0])
+    assert 1.0 < tau and 60 < 50 * tau  # the warning's condition, reported per mode
+    # effective samples = walkers x kept steps / tau (20 x 30 / tau)
+    assert float(fit.mode_effective_samples[0]) == pytest.approx(600 / tau)
     post = fit.set_index(posterior_parameter="posterior_parameter")
     truth = {
         "period": 47.0,
@@ -429,3 +492,25 @@ def test_fit_spin_names_the_symmetry_twins(box_wing):
     assert "turn 180 deg: phase + 180 deg (chi2 gap" in text
     gap = float(text.split("chi2 gap ")[1].split(")")[0])
     assert abs(gap) < 1e-6
+
+
+def test_chain_convergence_against_the_ar1_closed_form():
+    """An AR(1) chain x_t = phi x_(t-1) + e_t has the integrated autocorrelation time
+    (1 + phi) / (1 - phi) = 9 for phi = 0.8; 16 walkers x 4000 steps estimate it to a few
+    per cent (Sokal's window; 15 % allowed, about 4 standard errors)."""
+    from sbrdf_xr.invert._joint.posterior import MIN_TAUS, _warn_short, chain_convergence
+
+    rng = np.random.default_rng(11)
+    phi, n = 0.8, 4000
+    e = rng.standard_normal((n, 16, 2))
+    x = np.zeros_like(e)
+    for t in range(1, n):
+        x[t] = phi * x[t - 1] + e[t]
+    tau, n_eff = chain_convergence(x, 1000)
+    assert tau == pytest.approx(9.0, rel=0.15)
+    assert n_eff == pytest.approx(16 * 3000 / tau)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _warn_short([tau], ["start"], n, 16)  # 4000 steps > 50 x 9: converged, silent
+    with pytest.warns(ChainLengthWarning, match=rf"fewer than {MIN_TAUS} .* start \(tau 9"):
+        _warn_short([9.0], ["start"], 300, 16)

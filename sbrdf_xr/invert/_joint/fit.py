@@ -30,7 +30,7 @@ from .diagnose import likely_causes
 from .extinction import extinction_prior as _k_prior
 from .extinction import separable_sd
 from .model import PassModel, pass_data
-from .model_error import table_widths
+from .model_error import discrepancy_floor, estimated_floor, table_widths, with_floor
 from .posterior import check_budget
 from .refine import Local, jacobian, outside_physics, refine
 from .result import Layout, model_check, result_dataset
@@ -159,6 +159,7 @@ def fit_observation(
     extinction_prior: Mapping[str, Any] | None = None,
     symmetry_tolerance: float = SYMMETRY_TOL,
     material_scale: str | Mapping[str, float] | None = None,
+    model_discrepancy: str | float | Mapping[str, float] | None = None,
     method: str = "point",
     posterior_walkers: int = 32,
     posterior_steps: int = 300,
@@ -255,6 +256,13 @@ def fit_observation(
         maps the body's facets (normals, areas, materials: the model's terms) onto
         themselves gives a twin state of the solution, evaluated on the data and listed
         over ``twin`` and in ``ambiguity`` (:mod:`sbrdf_xr.invert._spin.symmetry`).
+    model_discrepancy : "estimate", float or mapping of str to float, optional
+        A model-discrepancy floor [mag] (one for every band, or ``{band: floor}``, bands
+        left out 0), added in quadrature to the measured uncertainties
+        (:mod:`sbrdf_xr.invert._joint.model_error`): the model's own error where the
+        tables' scales do not absorb it; ``"estimate"``: each band's floor estimated from
+        the residuals of a point fit without one, then the pass fitted again with it
+        (twice the cost).  Default None: the model taken as exact.
 
     Returns
     -------
@@ -345,11 +353,15 @@ def fit_observation(
     >>> fit.area_fraction.round(2).values.tolist(), fit.attrs["fit_quality"]
     ([0.82, 0.18], 'consistent')
     """
+    if isinstance(model_discrepancy, str):  # estimated: a fit without, then with
+        return estimated_floor(fit_observation, dict(locals()))
     t_start = time.perf_counter()
     _check_method(method)
     start, epoch = _read_start(spin)
     ab = _axis_body(spin, axis_body)
     data = pass_data(light_curve, observation, bands, system)
+    floor = discrepancy_floor(model_discrepancy, data.labels)
+    data = with_floor(data, floor)
     k_mode, k_prior, held, offset = _extinction_mode(
         data, extinction, offset, areas, extinction_prior
     )
@@ -410,6 +422,10 @@ def fit_observation(
             "n_model_evaluations": int(model.n_calls),
             "fit_seconds": fit_s,  # the fit, without the check
             "time_source": data.time_source,
+            "model_discrepancy": "none (the model taken as exact)"
+            if floor is None
+            else "floor added in quadrature to the uncertainties: "
+            + ", ".join(f"{b} {f:.3g} mag" for b, f in zip(data.labels, floor, strict=True)),
         },
     )
     ds = _with_warnings_and_twins(ds, stats, local, best, model, lay, syms, dt_epoch)

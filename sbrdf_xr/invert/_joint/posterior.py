@@ -13,27 +13,59 @@ mode's probability is its Laplace evidence ``exp(-chi2_i / 2) sqrt(det 2 pi C_i)
 normalised; the summary (median, standard deviation, 2.5 and 97.5 % points) is over the
 modes' samples weighted so.  The body's symmetry
 twins are exact copies of a mode (the same probability) and are listed, not sampled.
+
+Convergence is checked per mode with the integrated autocorrelation time ``tau`` of the
+chain (in steps; Goodman & Weare 2010, §3; emcee's ``get_autocorr_time``, the estimator
+of Sokal 1997 with its automatic window).  A chain shorter than :data:`MIN_TAUS` ``tau``
+steps gives neither a reliable ``tau`` nor a reliable width (emcee's own criterion), and
+is reported with a :class:`~sbrdf_xr.errors.ChainLengthWarning` naming the steps to ask
+for; the per-mode ``tau`` and effective sample size are part of the result.
 """
 
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from ...errors import InversionError
+from ...errors import ChainLengthWarning, InversionError
 from .._spin.search import lonlat
 from .bounds import covariance
 
-__all__ = ["MAX_EVALUATIONS", "MODE_CHI2", "sample_posterior"]
+__all__ = ["MAX_EVALUATIONS", "MIN_TAUS", "MODE_CHI2", "chain_convergence", "sample_posterior"]
 
 #: Minima within this chi-square of the best are sampled as modes.
 MODE_CHI2 = 25.0
 #: Largest number of model evaluations (walkers x steps x modes) a posterior may take.
 MAX_EVALUATIONS = 200_000
+#: A chain is long enough when it spans at least this many autocorrelation times (emcee's
+#: ``get_autocorr_time`` default ``tol``: shorter chains misjudge ``tau`` and the widths).
+MIN_TAUS = 50
+
+
+def chain_convergence(chain: np.ndarray, discard: int) -> tuple[float, float]:
+    """Longest integrated autocorrelation time [steps] over the parameters of an emcee
+    chain ``(steps, walkers, parameters)`` and the effective number of independent samples
+    [1] after ``discard`` steps of burn-in (walkers x kept steps / tau).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sbrdf_xr.invert._joint.posterior import chain_convergence
+    >>> rng = np.random.default_rng(0)
+    >>> tau, n_eff = chain_convergence(rng.standard_normal((400, 8, 2)), 0)
+    >>> bool(0.5 < tau < 2.0), bool(1500 < n_eff < 6500)  # white noise: tau = 1
+    (True, True)
+    """
+    import emcee
+
+    tau = float(np.max(emcee.autocorr.integrated_time(chain, tol=0, quiet=True)))
+    kept = chain.shape[0] - discard
+    return tau, chain.shape[1] * kept / max(tau, 1.0)
 
 
 def _outputs(
@@ -110,7 +142,7 @@ def sample_posterior(
         )
     rng = np.random.default_rng(seed)
     t0 = time.perf_counter()
-    samples, log_z, accept, labels = [], [], [], []
+    samples, log_z, accept, labels, taus, n_effs = [], [], [], [], [], []
     for i in kept:
         m = local[i]
         cov, free = covariance(jacobian(m, m.x))
@@ -134,9 +166,13 @@ def sample_posterior(
         sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()
         sampler.run_mcmc(start, steps, progress=False)
         chain = sampler.get_chain(discard=steps // 2, flat=True)
+        tau, n_eff = chain_convergence(sampler.get_chain(), steps // 2)
+        taus.append(tau)
+        n_effs.append(n_eff)
         samples.append(np.array([_outputs(lay, m.axis_of, p, shift) for p in chain]))
         accept.append(float(np.mean(sampler.acceptance_fraction)))
         labels.append(m.label)
+    _warn_short(taus, labels, steps, walkers)
     lz = np.array(log_z)
     prob = np.exp(lz - lz.max())
     prob /= prob.sum()
@@ -182,12 +218,38 @@ def sample_posterior(
         np.array(accept),
         {"units": "1", "long_name": "mean acceptance fraction of the mode's walkers"},
     )
+    ds["mode_autocorrelation_time"] = (
+        "mode",
+        np.array(taus),
+        {"units": "1", "long_name": "integrated autocorrelation time of the mode's chain [steps]"},
+    )
+    ds["mode_effective_samples"] = (
+        "mode",
+        np.array(n_effs),
+        {"units": "1", "long_name": "effective number of independent samples of the mode"},
+    )
     attrs = {
         "posterior": f"emcee affine-invariant ensemble: {walkers} walkers x {steps} steps per "
         f"mode (first half discarded), {len(kept)} modes, seed {seed}",
         "posterior_seconds": seconds,
     }
     return ds, attrs
+
+
+def _warn_short(taus: Sequence[float], labels: Sequence[str], steps: int, walkers: int) -> None:
+    """A :class:`~sbrdf_xr.errors.ChainLengthWarning` for the modes whose chains span fewer
+    than :data:`MIN_TAUS` autocorrelation times, with the steps to ask for."""
+    short = [(lab, t) for lab, t in zip(labels, taus, strict=True) if steps < MIN_TAUS * t]
+    if short:
+        need = int(np.ceil(MIN_TAUS * max(t for _, t in short)))
+        listed = ", ".join(f"{lab!s} (tau {t:.3g} steps)" for lab, t in short)
+        warnings.warn(
+            f"posterior: chains of {steps} steps x {walkers} walkers span fewer than "
+            f"{MIN_TAUS} autocorrelation times in mode(s) {listed}: the widths and the 2.5 / "
+            f"97.5 % points are not converged; ask for posterior_steps >= {need}",
+            ChainLengthWarning,
+            stacklevel=4,
+        )
 
 
 def _summary(x: np.ndarray, w: np.ndarray) -> dict[str, np.ndarray]:
