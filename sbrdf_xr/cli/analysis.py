@@ -72,8 +72,8 @@ _PHOTOMETRY_FLAGS = {
     "bands": "--bands",
     "pairs": "--colours",
     "extinction": "--extinction",
-    "sun_distance_au": "--sun-distance-au",
-    "range_km": "--range-km",
+    "sun_distance": "--sun-distance-au",
+    "range": "--range-km",
     "system": "--system",
     "extrapolate": "--extrapolate",
 }
