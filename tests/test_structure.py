@@ -397,13 +397,7 @@ def test_domain_modules_do_not_import_the_catalog(mod):
 # Any other use is listed here, with the reason it stands, or fails the test.
 
 #: (importer, "module._name" or "module") -> why the use stands.
-PRIVATE_USES: dict[tuple[str, str], str] = {
-    ("lightcurves.comparison", "photometry._observed._coefficient"): (
-        "compare(extinction={band: k}) finds a band's coefficient by the rule of "
-        "magnitudes(extinction=) (label, or the filter behind an alias): one rule, kept "
-        "where synthetic photometry defines it; moved with the light curves out of photometry"
-    ),
-}
+PRIVATE_USES: dict[tuple[str, str], str] = {}
 
 
 def _is_private(name: str) -> bool:

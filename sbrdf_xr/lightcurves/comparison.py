@@ -25,7 +25,7 @@ import xarray as xr
 
 from .._names import ATTITUDE, BAND, PHASE_ANGLE
 from ..errors import LightCurveError, renamed_keywords
-from ..photometry import BAND_ALIASES
+from ..photometry import BAND_ALIASES, extinction_for_band
 from ..units import to_unit
 from . import _alignment as align
 from ._comparison import fit_and_report
@@ -297,12 +297,10 @@ def compare(
     if extinction is not None:
         align.with_airmass(al, measured, sim, airmass)
     if isinstance(extinction, Mapping):
-        from ..photometry._observed import _coefficient
-
         labels = [str(b) for b in sim[BAND].values]
         ks = np.full(len(labels), np.nan)
         for i in np.unique(col):  # the measured bands need a coefficient, the others not
-            ks[i] = _coefficient(
+            ks[i] = extinction_for_band(
                 sim.isel({BAND: np.unique(col)}),
                 dict(extinction),
                 labels[i],

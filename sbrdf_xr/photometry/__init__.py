@@ -148,6 +148,7 @@ from .atmosphere import (
     airmass,
     apply_extinction,
     extinction_coefficients,
+    extinction_for_band,
     rayleigh_optical_depth,
     transmission,
 )
@@ -213,6 +214,7 @@ __all__ = [
     "colour_indices",
     "colour_science",
     "extinction_coefficients",
+    "extinction_for_band",
     "files",
     "filters",
     "from_colour",

@@ -19,7 +19,7 @@ import xarray as xr
 from .._names import BAND
 from ..errors import ValidationError
 from ..units import check_plausible, to_unit
-from .bands import _canonical
+from .atmosphere import extinction_for_band
 
 
 def _recorded(cube: Any, name: str, unit: str | None) -> xr.DataArray | None:
@@ -108,21 +108,6 @@ def _distances(cube: Any, range_: Any, sun_distance: Any) -> tuple[Any, Any, dic
     return _range_m(rng), _positive(sun, "sun_distance"), notes
 
 
-def _coefficient(mags: xr.DataArray, coefficients: dict[Any, Any], label: str, i: int) -> float:
-    have = {str(b): v for b, v in coefficients.items()}
-    if label in have:
-        return float(have[label])
-    if "filter" in mags.coords:
-        filt = str(mags["filter"].values[i])
-        for b, v in have.items():
-            if _canonical(b) == filt:
-                return float(v)
-    raise ValidationError(
-        f"extinction: no coefficient for band {label!r}; given for {sorted(have)} "
-        f"(every band of {[str(b) for b in mags[BAND].values]} needs one)"
-    )
-
-
 def _with_extinction(mags: xr.DataArray, cube: Any, coefficients: Any) -> xr.DataArray:
     """``mags + k_band X`` with the cube's ``airmass`` ``X`` (first-order extinction)."""
     if not isinstance(coefficients, dict):
@@ -137,7 +122,7 @@ def _with_extinction(mags: xr.DataArray, cube: Any, coefficients: Any) -> xr.Dat
             "use apply_extinction(mags, airmass, coefficients) with an air mass of your own"
         )
     labels = [str(b) for b in mags[BAND].values]
-    k = np.array([_coefficient(mags, coefficients, b, i) for i, b in enumerate(labels)])
+    k = np.array([extinction_for_band(mags, coefficients, b, i) for i, b in enumerate(labels)])
     if not np.all(np.isfinite(k)) or np.any(k < 0):
         raise ValidationError(
             f"extinction: coefficients must be finite and >= 0, "
