@@ -148,7 +148,6 @@ from .atmosphere import (
     airmass,
     apply_extinction,
     extinction_coefficients,
-    extinction_for_band,
     rayleigh_optical_depth,
     transmission,
 )
@@ -158,6 +157,7 @@ from .bands import (
     SPECTRUM_EXTRAPOLATIONS,
     WEIGHTINGS,
     band_weights,
+    extinction_for_band,
     filters,
     pre_integrate,
     speclite_names,

@@ -17,7 +17,6 @@ Two ways to put the atmosphere into simulated magnitudes:
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -27,7 +26,6 @@ from numpy.typing import ArrayLike
 from .._names import AIRMASS_MODELS, BAND, WAVELENGTH, attrs
 from ..errors import ValidationError, renamed_keywords
 from ..units import to_unit
-from .bands import _canonical
 from .spectra import _check_grid, _choose
 
 #: Standard sea-level pressure [hPa].
@@ -330,53 +328,3 @@ def extinction_coefficients(
         solar_spectrum=solar,
     )
     return k
-
-
-def extinction_for_band(
-    mags: xr.DataArray, coefficients: Mapping[Any, Any], band: str, index: int
-) -> float:
-    """The extinction coefficient of one band of ``mags`` from a mapping given by band:
-    by its label, or else by the filter behind an alias (the ``filter`` coordinate), the
-    rule of ``magnitudes(extinction={band: k})``.
-
-    Parameters
-    ----------
-    mags : xarray.DataArray
-        Magnitudes over ``band`` (a ``filter`` coordinate names each band's filter).
-    coefficients : mapping
-        Band label or filter name -> coefficient.
-    band : str
-        The band's label.
-    index : int
-        Its position along ``band`` (for its ``filter``).
-
-    Returns
-    -------
-    float
-        The coefficient, as given [magnitudes per air mass].
-
-    Raises
-    ------
-    ValidationError
-        No coefficient for the band, under its label or its filter.
-
-    Examples
-    --------
-    >>> import xarray as xr
-    >>> filters = ("band", ["bessell-V", "sdss2010-g"])
-    >>> m = xr.DataArray([10.0, 11.0], dims="band", coords={"band": ["V", "g"], "filter": filters})
-    >>> extinction_for_band(m, {"V": 0.2, "sdss2010-g": 0.25}, "g", 1)
-    0.25
-    """
-    have = {str(b): v for b, v in coefficients.items()}
-    if band in have:
-        return float(have[band])
-    if "filter" in mags.coords:
-        filt = str(mags["filter"].values[index])
-        for b, v in have.items():
-            if _canonical(b) == filt:
-                return float(v)
-    raise ValidationError(
-        f"extinction: no coefficient for band {band!r}; given for {sorted(have)} "
-        f"(every band of {[str(b) for b in mags[BAND].values]} needs one)"
-    )
