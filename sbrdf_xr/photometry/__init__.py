@@ -133,6 +133,7 @@ from typing import Any as _Any
 from ..errors import renamed_attributes as _renamed_attributes
 from . import (
     atmosphere,
+    band_lookup,
     bands,
     colour,
     colour_science,
@@ -151,13 +152,13 @@ from .atmosphere import (
     rayleigh_optical_depth,
     transmission,
 )
+from .band_lookup import extinction_for_band
 from .bands import (
     BAND_ALIASES,
     QUADRATURES,
     SPECTRUM_EXTRAPOLATIONS,
     WEIGHTINGS,
     band_weights,
-    extinction_for_band,
     filters,
     pre_integrate,
     speclite_names,
@@ -204,6 +205,7 @@ __all__ = [
     "apply_extinction",
     "at_resolution",
     "atmosphere",
+    "band_lookup",
     "band_signal",
     "band_weights",
     "bands",

@@ -19,7 +19,7 @@ import xarray as xr
 from .._names import BAND
 from ..errors import ValidationError
 from ..units import check_plausible, to_unit
-from .bands import extinction_for_band
+from .band_lookup import extinction_for_band
 
 
 def _recorded(cube: Any, name: str, unit: str | None) -> xr.DataArray | None:
