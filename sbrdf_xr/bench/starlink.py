@@ -103,9 +103,9 @@ def pomenis_table(
     return TrackingTable(
         table.site,
         table.times[rows],
-        elevation_deg=table.elevation_deg[rows],
-        azimuth_deg=table.azimuth_deg[rows],
-        height_km=table.height_km[rows],
+        elevation=table.elevation[rows],
+        azimuth=table.azimuth[rows],
+        height=table.height[rows],
         rows=table.rows[rows],
         columns={k: np.asarray(v)[rows] for k, v in table.columns.items()},
         dropped=table.dropped,

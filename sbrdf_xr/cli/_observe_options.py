@@ -20,7 +20,7 @@ def orbit_and_site(po: argparse.ArgumentParser) -> None:
         "--tracking",
         metavar="FILE",
         help="instead of --elements and the window: an observer's tracking table (CSV: "
-        "columns time, elevation, azimuth [degree] and range_km or height_km; "
+        "columns time, elevation, azimuth [degree] and range or height [km]; "
         "--tracking-format pomenis: the Pomenis Starlink table at its own site)",
     )
     g.add_argument(

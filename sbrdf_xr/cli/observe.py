@@ -11,7 +11,7 @@ simulated, written by :func:`sbrdf_xr.store.write` and drawn with ``--plot``::
 
 Instead of elements and a window, ``--tracking FILE`` takes an observer's tracking table
 (:mod:`sbrdf_xr.observing.tracking_io`: a CSV of ``time``, ``elevation``, ``azimuth`` and
-``range_km`` or ``height_km`` at ``--site``, or with ``--tracking-format pomenis`` the
+``range`` or ``height`` at ``--site``, or with ``--tracking-format pomenis`` the
 Pomenis Starlink table at its own site); ``--elements`` also takes a CCSDS OEM file and
 ``--series`` a CCSDS AEM.
 

@@ -17,7 +17,7 @@ at the measured times: the same cube as from elements.
   (astropy's ``EarthLocation.to_geodetic``, ERFA ``gc2gd``) equals the given height, by a
   secant iteration from the spherical-Earth value, to 1e-9 km.
 * Velocity: rows are grouped in tracks (a ``track`` label, or else consecutive rows at most
-  ``max_gap_s`` apart whose positions imply a speed below :data:`MAX_SPEED_KM_S`); the
+  ``max_gap`` apart whose positions imply a speed below :data:`MAX_SPEED_KM_S`); the
   velocity is the derivative of a not-a-knot cubic spline of each track's GCRS positions
   (:meth:`Ephemeris.from_states <sbrdf_xr.observing.ephemeris.Ephemeris.from_states>`), and
   is unknown (NaN) for a track of one row: the laws that need it refuse by name.
@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import TrackingTableError, renamed_keywords
+from ..errors import TrackingTableError, renamed_fields, renamed_keywords
 from ..units import to_unit
 from .ephemeris import Ephemeris
 from .observation import Observation
@@ -175,6 +175,15 @@ def _to_gcrs(site: Site, t: Any, rel_itrs: np.ndarray) -> np.ndarray:
     return site_r + np.einsum("jin,nj->ni", itrs.rotation_at(t), rel_itrs)
 
 
+@renamed_fields(
+    elevation_deg="elevation",
+    azimuth_deg="azimuth",
+    ra_deg="ra",
+    dec_deg="dec",
+    range_km="range",
+    height_km="height",
+    max_gap_s="max_gap",
+)
 @dataclass(frozen=True)
 class TrackingTable:
     """An observer's measurements of one or more passes: times, directions, range or height.
@@ -184,14 +193,14 @@ class TrackingTable:
     site : Site
     times : array_like of datetime64
         UTC times, strictly increasing (a reader sorts them and keeps ``rows``).
-    elevation_deg, azimuth_deg : array_like, optional
+    elevation, azimuth : array_like, optional
         Topocentric geodetic elevation and azimuth (north through east) [degree].
-    ra_deg, dec_deg : array_like, optional
+    ra, dec : array_like, optional
         Topocentric right ascension and declination on the GCRS axes [degree], instead.
-    range_km : array_like, optional
+    range : array_like, optional
         Range [km].
-    height_km : array_like, optional
-        Height above the WGS84 ellipsoid [km] (with ``range_km``, checked against it
+    height : array_like, optional
+        Height above the WGS84 ellipsoid [km] (with ``range``, checked against it
         within :data:`HEIGHT_TOLERANCE_KM`).
     track : array_like, optional
         A label per row; rows of one label are one object's track.
@@ -202,18 +211,23 @@ class TrackingTable:
     dropped : sequence of (int, str), optional
         Rows a reader left out and why.
     name, source : str
-    max_gap_s : float
+    max_gap : float
         Consecutive rows further apart than this start a new track [s].
+
+    Every number with a unit also takes an astropy Quantity.  The old field names
+    (``elevation_deg``, ``azimuth_deg``, ``ra_deg``, ``dec_deg``, ``range_km``,
+    ``height_km``, ``max_gap_s``) are accepted, and read, for one release with a
+    :class:`~sbrdf_xr.errors.RenamedWarning`.
 
     Examples
     --------
     >>> t = np.array(["2024-03-17T01:22:00", "2024-03-17T01:22:05"], dtype="datetime64[ns]")
-    >>> table = TrackingTable(Site(45.455, -71.1525, 1111.0), t, elevation_deg=[75.8, 75.9],
-    ...                       azimuth_deg=[10.0, 12.0], range_km=[841.0, 840.0])
+    >>> table = TrackingTable(Site(45.455, -71.1525, 1111.0), t, elevation=[75.8, 75.9],
+    ...                       azimuth=[10.0, 12.0], range=[841.0, 840.0])
     >>> table.positions().shape, table.tracks().tolist()
     ((2, 3), [0, 0])
-    >>> TrackingTable(Site(45.0, -71.0), t, elevation_deg=[-5.0, 10.0], azimuth_deg=[0.0, 0.0],
-    ...               range_km=[900.0, 900.0])
+    >>> TrackingTable(Site(45.0, -71.0), t, elevation=[-5.0, 10.0], azimuth=[0.0, 0.0],
+    ...               range=[900.0, 900.0])
     Traceback (most recent call last):
         ...
     sbrdf_xr.errors.TrackingTableError: tracking table: row 0: elevation -5 deg is below ...
@@ -221,19 +235,19 @@ class TrackingTable:
 
     site: Site
     times: Any
-    elevation_deg: Any = None
-    azimuth_deg: Any = None
-    ra_deg: Any = None
-    dec_deg: Any = None
-    range_km: Any = None
-    height_km: Any = None
+    elevation: Any = None
+    azimuth: Any = None
+    ra: Any = None
+    dec: Any = None
+    range: Any = None
+    height: Any = None
     track: Any = None
     rows: Any = None
     columns: Mapping[str, Any] = field(default_factory=dict)
     dropped: Sequence[tuple[int, str]] = ()
     name: str = "tracking table"
     source: str = ""
-    max_gap_s: float = 30.0
+    max_gap: float = 30.0
     _cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -241,15 +255,15 @@ class TrackingTable:
 
         t = check_times(self.times)
         object.__setattr__(self, "times", t)
-        gap = float(to_unit(self.max_gap_s, "s", "max_gap_s"))
+        gap = float(to_unit(self.max_gap, "s", "max_gap"))
         if not gap > 0:
-            raise TrackingTableError(f"{self.name}: max_gap_s must be > 0 s, got {gap}")
-        object.__setattr__(self, "max_gap_s", gap)
+            raise TrackingTableError(f"{self.name}: max_gap must be > 0 s, got {gap}")
+        object.__setattr__(self, "max_gap", gap)
         n = t.size
         rows = np.arange(n) if self.rows is None else np.asarray(self.rows)
         object.__setattr__(self, "rows", rows)
-        units = {"elevation_deg": "deg", "azimuth_deg": "deg", "ra_deg": "deg", "dec_deg": "deg"}
-        units.update(range_km="km", height_km="km")
+        units = {"elevation": "deg", "azimuth": "deg", "ra": "deg", "dec": "deg"}
+        units.update(range="km", height="km")
         for key, unit in units.items():
             val = getattr(self, key)
             if val is not None:
@@ -262,15 +276,14 @@ class TrackingTable:
                         f"{self.name}: row {rows[bad[0]]}: {key} is {arr[bad[0]]}, not a number"
                     )
                 object.__setattr__(self, key, arr)
-        altaz = self.elevation_deg is not None and self.azimuth_deg is not None
-        radec = self.ra_deg is not None and self.dec_deg is not None
+        altaz = self.elevation is not None and self.azimuth is not None
+        radec = self.ra is not None and self.dec is not None
         if altaz == radec:
             raise TrackingTableError(
-                f"{self.name}: give elevation_deg and azimuth_deg, or ra_deg and dec_deg "
-                "(exactly one pair)"
+                f"{self.name}: give elevation and azimuth, or ra and dec (exactly one pair)"
             )
-        if self.range_km is None and self.height_km is None:
-            raise TrackingTableError(f"{self.name}: give range_km or height_km (or both)")
+        if self.range is None and self.height is None:
+            raise TrackingTableError(f"{self.name}: give range or height (or both)")
         el = self.elevations()
         low = np.flatnonzero(el < MIN_ELEVATION_DEG)
         if low.size:
@@ -289,9 +302,8 @@ class TrackingTable:
 
     def _dirs(self) -> np.ndarray:
         if "dirs" not in self._cache:
-            el, az = self.elevation_deg, self.azimuth_deg
             self._cache["dirs"] = _directions_itrs(
-                self.site, self._skyfield(), el, az, self.ra_deg, self.dec_deg
+                self.site, self._skyfield(), self.elevation, self.azimuth, self.ra, self.dec
             )
         return self._cache["dirs"]
 
@@ -301,12 +313,12 @@ class TrackingTable:
         Examples
         --------
         >>> t = np.array(["2024-03-17T01:22:00"], dtype="datetime64[ns]")
-        >>> TrackingTable(Site(45.0, -71.0), t, elevation_deg=[30.0], azimuth_deg=[0.0],
-        ...               range_km=[900.0]).elevations()
+        >>> TrackingTable(Site(45.0, -71.0), t, elevation=[30.0], azimuth=[0.0],
+        ...               range=[900.0]).elevations()
         array([30.])
         """
-        if self.elevation_deg is not None:
-            return np.asarray(self.elevation_deg)
+        if self.elevation is not None:
+            return np.asarray(self.elevation)
         up = self._dirs() @ _enu(self.site)[2]
         return np.degrees(np.arcsin(np.clip(up, -1.0, 1.0)))
 
@@ -316,30 +328,30 @@ class TrackingTable:
         Examples
         --------
         >>> t = np.array(["2024-03-17T01:22:00"], dtype="datetime64[ns]")
-        >>> table = TrackingTable(Site(0.0, 0.0, 0.0), t, elevation_deg=[90.0],
-        ...                       azimuth_deg=[0.0], height_km=[550.0])
+        >>> table = TrackingTable(Site(0.0, 0.0, 0.0), t, elevation=[90.0],
+        ...                       azimuth=[0.0], height=[550.0])
         >>> table.ranges().round(9)  # [km]
         array([550.])
         """
-        if self.range_km is not None:
-            return np.asarray(self.range_km)
+        if self.range is not None:
+            return np.asarray(self.range)
         if "range" not in self._cache:
-            self._cache["range"] = range_for_height(self.site, self._dirs(), self.height_km)
+            self._cache["range"] = range_for_height(self.site, self._dirs(), self.height)
         return self._cache["range"]
 
     def _check_range_height(self) -> None:
-        if self.range_km is None or self.height_km is None:
+        if self.range is None or self.height is None:
             return
-        implied = range_for_height(self.site, self._dirs(), self.height_km)
-        diff = np.abs(implied - np.asarray(self.range_km))
+        implied = range_for_height(self.site, self._dirs(), self.height)
+        diff = np.abs(implied - np.asarray(self.range))
         # A kilometre of height is ~1 km of range near the zenith, more near the horizon.
         sin_el = np.maximum(np.sin(np.radians(np.maximum(self.elevations(), 1.0))), 0.05)
         bad = np.flatnonzero(diff * sin_el > HEIGHT_TOLERANCE_KM)
         if bad.size:
             k = bad[0]
             raise TrackingTableError(
-                f"{self.name}: row {self.rows[k]}: range {self.range_km[k]:.6g} km disagrees "
-                f"with height {self.height_km[k]:.6g} km (which gives a range of "
+                f"{self.name}: row {self.rows[k]}: range {self.range[k]:.6g} km disagrees "
+                f"with height {self.height[k]:.6g} km (which gives a range of "
                 f"{implied[k]:.6g} km) by more than {HEIGHT_TOLERANCE_KM:g} km of height "
                 f"({bad.size} row(s) do)"
             )
@@ -350,8 +362,8 @@ class TrackingTable:
         Examples
         --------
         >>> t = np.array(["2024-03-17T01:22:00"], dtype="datetime64[ns]")
-        >>> table = TrackingTable(Site(0.0, 0.0, 0.0), t, elevation_deg=[90.0],
-        ...                       azimuth_deg=[0.0], range_km=[500.0])
+        >>> table = TrackingTable(Site(0.0, 0.0, 0.0), t, elevation=[90.0],
+        ...                       azimuth=[0.0], range=[500.0])
         >>> round(float(np.linalg.norm(table.positions())), 3)  # [km]
         6878.137
         """
@@ -366,8 +378,8 @@ class TrackingTable:
         Examples
         --------
         >>> t = np.array(["2024-03-17T01:22:00", "2024-03-17T03:00:00"], dtype="datetime64[ns]")
-        >>> TrackingTable(Site(45.0, -71.0), t, elevation_deg=[30.0, 40.0],
-        ...               azimuth_deg=[0.0, 0.0], range_km=[900.0, 800.0]).tracks().tolist()
+        >>> TrackingTable(Site(45.0, -71.0), t, elevation=[30.0, 40.0],
+        ...               azimuth=[0.0, 0.0], range=[900.0, 800.0]).tracks().tolist()
         [0, 1]
         """
         n = self.times.size
@@ -378,7 +390,7 @@ class TrackingTable:
             dt = np.diff(self.times).astype(np.int64) / 1e9
             r = self.positions()
             speed = np.linalg.norm(np.diff(r, axis=0), axis=1) / np.maximum(dt, 1e-9)
-            new = np.concatenate([[True], (dt > self.max_gap_s) | (speed > MAX_SPEED_KM_S)])
+            new = np.concatenate([[True], (dt > self.max_gap) | (speed > MAX_SPEED_KM_S)])
         return (np.cumsum(new) - 1) if n else np.zeros(0, dtype=np.int64)
 
     def ephemeris(self) -> Ephemeris:
@@ -387,8 +399,8 @@ class TrackingTable:
         Examples
         --------
         >>> t = np.array(["2024-03-17T01:22:00"], dtype="datetime64[ns]")
-        >>> eph = TrackingTable(Site(45.0, -71.0), t, elevation_deg=[30.0],
-        ...                     azimuth_deg=[0.0], range_km=[900.0]).ephemeris()
+        >>> eph = TrackingTable(Site(45.0, -71.0), t, elevation=[30.0],
+        ...                     azimuth=[0.0], range=[900.0]).ephemeris()
         >>> bool(np.isnan(eph.state(t)[1]).all())  # one row: no velocity
         True
         """
@@ -413,8 +425,8 @@ class TrackingTable:
         Examples
         --------
         >>> t = np.array(["2024-03-17T01:22:00"], dtype="datetime64[ns]")
-        >>> table = TrackingTable(Site(45.0, -71.0), t, elevation_deg=[30.0],
-        ...                       azimuth_deg=[0.0], range_km=[900.0])
+        >>> table = TrackingTable(Site(45.0, -71.0), t, elevation=[30.0],
+        ...                       azimuth=[0.0], range=[900.0])
         >>> obs = table.observation({"law": "inertial", "q": [0.0, 0.0, 0.0, 1.0]})
         >>> float(obs.geometry(on_unobservable="keep").range[0].round(9))  # [km]
         900.0

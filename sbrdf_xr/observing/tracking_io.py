@@ -96,6 +96,27 @@ def _number(row: dict[str, str], col: str, line: int, what: str) -> float:
     return x
 
 
+#: The unit a column name may carry after its bare name (``elevation_deg``, ``range_km``).
+_COLUMN_UNITS = {"elevation": "deg", "azimuth": "deg", "ra": "deg", "dec": "deg"}
+_COLUMN_UNITS.update(range="km", height="km")
+
+
+def _spelling(column: str | None, header: list[str]) -> str | None:
+    """The header's spelling of ``column``: as named, or else with (or without) its unit.
+
+    A file may name its columns bare (``elevation``, ``range``) or with the unit the
+    reader takes them in (``elevation_deg``, ``range_km``); either is read.
+    """
+    if column is None or column in header:
+        return column
+    bare, _, unit = column.rpartition("_")
+    if _COLUMN_UNITS.get(bare) == unit and bare in header:
+        return bare
+    if column in _COLUMN_UNITS and f"{column}_{_COLUMN_UNITS[column]}" in header:
+        return f"{column}_{_COLUMN_UNITS[column]}"
+    return column
+
+
 def read_tracking_table(
     path: str | Path,
     site: Site,
@@ -123,7 +144,10 @@ def read_tracking_table(
     site : Site
     time, elevation, azimuth, ra, dec, range_column, height_column, track : str
         Column names (``ra``/``dec`` replace ``elevation``/``azimuth``); the columns hold
-        degrees (angles) and kilometres (range, height above the WGS84 ellipsoid).
+        degrees (angles) and kilometres (range, height above the WGS84 ellipsoid).  A
+        direction, range or height column named bare is also found under its name with
+        the unit, and the other way round (``elevation`` reads a column
+        ``elevation_deg``, ``range_km`` a column ``range``).
     keep : tuple of str
         Other numeric columns to keep (``table.columns``).
     time_zone : {None, "UTC"}
@@ -164,6 +188,9 @@ def read_tracking_table(
         raise TrackingTableError(f"{what}: holds no header line")
     reader = csv.DictReader([ln for _, ln in lines])
     header = reader.fieldnames or []
+    ra, dec, elevation, azimuth, range_column, height_column = (
+        _spelling(c, header) for c in (ra, dec, elevation, azimuth, range_column, height_column)
+    )
     angles = (ra, dec) if ra is not None else (elevation, azimuth)
     wanted = [time, *angles, range_column, height_column, track, *keep]
     missing = [c for c in wanted if c is not None and c not in header]
@@ -211,15 +238,15 @@ def read_tracking_table(
             stacklevel=2,
         )
     kw: dict[str, Any] = {
-        "range_km": cols.get(range_column) if range_column else None,
-        "height_km": cols.get(height_column) if height_column else None,
+        "range": cols.get(range_column) if range_column else None,
+        "height": cols.get(height_column) if height_column else None,
         "track": np.array([g[3] for g in good]) if track else None,
     }
     if ra is not None:
-        kw.update(ra_deg=cols[ra], dec_deg=cols[dec] if dec else None)
+        kw.update(ra=cols[ra], dec=cols[dec] if dec else None)
     else:
-        kw.update(elevation_deg=cols[elevation] if elevation else None)
-        kw.update(azimuth_deg=cols[azimuth] if azimuth else None)
+        kw.update(elevation=cols[elevation] if elevation else None)
+        kw.update(azimuth=cols[azimuth] if azimuth else None)
     return TrackingTable(
         site,
         tt,
@@ -304,8 +331,9 @@ def tracking_from_dict(
 
     ``path`` (relative to ``base_dir``), ``format`` (``"csv"``, the default, read by
     :func:`read_tracking_table` with the column names and options of
-    :data:`TRACKING_KEYS`, at ``site``, the range or height from a column ``range_km`` or
-    ``height_km`` unless named; or ``"pomenis"``, :func:`read_pomenis`, at its own site).
+    :data:`TRACKING_KEYS`, at ``site``, the range or height from a column ``range`` or
+    ``height`` (or ``range_km``, ``height_km``) unless named; or ``"pomenis"``,
+    :func:`read_pomenis`, at its own site).
 
     Examples
     --------
@@ -346,13 +374,14 @@ def tracking_from_dict(
         raise TrackingTableError("[observation]: a csv tracking table needs the site")
     if "range_column" not in opts and "height_column" not in opts:
         header = _header(path)
-        found = [c for c in ("range_km", "height_km") if c in header]
+        found = [c for c in ("range", "range_km", "height", "height_km") if c in header]
         if not found:
             raise TrackingTableError(
-                f"[observation.tracking]: {path} has no column range_km or height_km; name "
-                f"the one it has with range_column or height_column (its header: {header})"
+                f"[observation.tracking]: {path} has no column range or height (nor range_km, "
+                "height_km); name the one it has with range_column or height_column (its "
+                f"header: {header})"
             )
-        opts[found[0].replace("_km", "_column")] = found[0]
+        opts[found[0].removesuffix("_km") + "_column"] = found[0]
     return read_tracking_table(path, site, **opts)
 
 

@@ -78,8 +78,8 @@ def test_the_prediction_is_complete_and_labelled(twelve):
 def test_a_table_without_magnitudes_is_refused():
     table = pomenis_table(rows=slice(0, 3))
     bare = type(table)(
-        table.site, table.times, elevation_deg=table.elevation_deg,
-        azimuth_deg=table.azimuth_deg, height_km=table.height_km,
+        table.site, table.times, elevation=table.elevation,
+        azimuth=table.azimuth, height=table.height,
     )  # fmt: skip
     with pytest.raises(ValidationError, match="no column 'ab_magnitude'"):
         predict_starlink(bare)

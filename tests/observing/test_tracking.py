@@ -64,9 +64,9 @@ def test_altaz_range_table_gives_the_tle_cube(tle_pass):
     table = TrackingTable(
         obs.site,
         obs.times,
-        elevation_deg=g.elevation.values,
-        azimuth_deg=g.azimuth.values,
-        range_km=g.range.values,
+        elevation=g.elevation.values,
+        azimuth=g.azimuth.values,
+        range=g.range.values,
     )
     g2 = table.observation(obs.attitude).geometry()
     for k in NOT_VELOCITY:
@@ -88,9 +88,9 @@ def test_nadir_law_through_the_spline_velocity(tle_pass):
     table = TrackingTable(
         obs.site,
         obs.times,
-        elevation_deg=g.elevation.values,
-        azimuth_deg=g.azimuth.values,
-        range_km=g.range.values,
+        elevation=g.elevation.values,
+        azimuth=g.azimuth.values,
+        range=g.range.values,
     )
     g2 = table.observation(law).geometry()
     for k in ("to_sun", "to_observer", "quaternion"):
@@ -109,16 +109,16 @@ def _heights(obs):
 def test_height_route_and_range_height_check(tle_pass):
     obs, g = tle_pass
     h = _heights(obs)  # astropy/ERFA geodetic heights of the SGP4 positions
-    kw = {"elevation_deg": g.elevation.values, "azimuth_deg": g.azimuth.values}
-    table = TrackingTable(obs.site, obs.times, height_km=h, **kw)
+    kw = {"elevation": g.elevation.values, "azimuth": g.azimuth.values}
+    table = TrackingTable(obs.site, obs.times, height=h, **kw)
     assert _rel(g.range.values, table.ranges()) < RTOL
     g2 = table.observation(obs.attitude).geometry()
     assert _rel(g.phase_angle, g2.phase_angle) < RTOL
-    TrackingTable(obs.site, obs.times, height_km=h, range_km=g.range.values, **kw)  # agree
+    TrackingTable(obs.site, obs.times, height=h, range=g.range.values, **kw)  # agree
     bad = h.copy()
     bad[7] += 5.0
     with pytest.raises(TrackingTableError, match=r"row 7: range .* disagrees with height"):
-        TrackingTable(obs.site, obs.times, height_km=bad, range_km=g.range.values, **kw)
+        TrackingTable(obs.site, obs.times, height=bad, range=g.range.values, **kw)
 
 
 def test_radec_route(tle_pass):
@@ -127,27 +127,25 @@ def test_radec_route(tle_pass):
     los = st["r"] - st["site"]
     ra = np.degrees(np.arctan2(los[:, 1], los[:, 0])) % 360.0
     dec = np.degrees(np.arctan2(los[:, 2], np.hypot(los[:, 0], los[:, 1])))
-    table = TrackingTable(obs.site, obs.times, ra_deg=ra, dec_deg=dec, range_km=g.range.values)
+    table = TrackingTable(obs.site, obs.times, ra=ra, dec=dec, range=g.range.values)
     assert np.abs(table.positions() - st["r"]).max() < RTOL * 7000.0
     assert np.abs(table.elevations() - g.elevation.values).max() < 1e-9
 
 
 def test_bad_rows_are_named(tle_pass):
     obs, g = tle_pass
-    kw = {"azimuth_deg": g.azimuth.values, "range_km": g.range.values}
+    kw = {"azimuth": g.azimuth.values, "range": g.range.values}
     el = g.elevation.values.copy()
     el[3] = -2.5
     with pytest.raises(TrackingTableError, match=r"row 3: elevation -2.5 deg is below -2"):
-        TrackingTable(obs.site, obs.times, elevation_deg=el, **kw)
+        TrackingTable(obs.site, obs.times, elevation=el, **kw)
     el[3] = np.nan
-    with pytest.raises(TrackingTableError, match="row 3: elevation_deg is nan"):
-        TrackingTable(obs.site, obs.times, elevation_deg=el, **kw)
+    with pytest.raises(TrackingTableError, match="row 3: elevation is nan"):
+        TrackingTable(obs.site, obs.times, elevation=el, **kw)
     with pytest.raises(TrackingTableError, match="exactly one pair"):
-        TrackingTable(obs.site, obs.times, range_km=g.range.values)
-    with pytest.raises(TrackingTableError, match="range_km or height_km"):
-        TrackingTable(
-            obs.site, obs.times, elevation_deg=g.elevation.values, azimuth_deg=kw["azimuth_deg"]
-        )
+        TrackingTable(obs.site, obs.times, range=g.range.values)
+    with pytest.raises(TrackingTableError, match="range or height"):
+        TrackingTable(obs.site, obs.times, elevation=g.elevation.values, azimuth=kw["azimuth"])
 
 
 def _csv(tmp_path, body, header="time,el,az,rng"):
@@ -200,8 +198,8 @@ def test_pomenis_excerpt_is_utc_dark_site_sunlit_satellite():
     # Times read as UTC put the site in astronomical twilight or darker and every
     # satellite in sunlight (read as local time, 13:28 would be day at Mount Lemmon).
     assert g.site_sun_elevation.max() < -10.0 and g.sunlit_fraction.min() > 0.4
-    assert np.abs(g.elevation.values - table.elevation_deg).max() < 1e-9
-    assert np.abs(g.azimuth.values - table.azimuth_deg).max() < 1e-9
+    assert np.abs(g.elevation.values - table.elevation).max() < 1e-9
+    assert np.abs(g.azimuth.values - table.azimuth).max() < 1e-9
     assert table.tracks().max() == 39  # one satellite per row: no velocity
     with pytest.raises(AttitudeError, match="velocity is unknown"):
         table.observation(Nadir()).geometry()
@@ -237,14 +235,101 @@ def test_radec_quantities_are_converted(tle_pass):
     los = st["r"] - st["site"]
     ra = np.degrees(np.arctan2(los[:, 1], los[:, 0])) % 360.0
     dec = np.degrees(np.arctan2(los[:, 2], np.hypot(los[:, 0], los[:, 1])))
-    bare = TrackingTable(obs.site, obs.times, ra_deg=ra, dec_deg=dec, range_km=g.range.values)
+    bare = TrackingTable(obs.site, obs.times, ra=ra, dec=dec, range=g.range.values)
     qty = TrackingTable(
         obs.site,
         obs.times,
-        ra_deg=np.radians(ra) * u.rad,
-        dec_deg=np.radians(dec) * u.rad,
-        range_km=g.range.values * u.km,
+        ra=np.radians(ra) * u.rad,
+        dec=np.radians(dec) * u.rad,
+        range=g.range.values * u.km,
     )
     np.testing.assert_allclose(qty.positions(), bare.positions(), rtol=1e-12)
-    with pytest.raises(UnitError, match="dec_deg"):
-        TrackingTable(obs.site, obs.times, ra_deg=ra, dec_deg=dec * u.kg, range_km=[1.0])
+    with pytest.raises(UnitError, match=r"\bdec\b"):
+        TrackingTable(obs.site, obs.times, ra=ra, dec=dec * u.kg, range=[1.0])
+
+
+def test_old_field_names_answer_with_a_warning(tle_pass):
+    """The fields named with their unit (one release): same table, a RenamedWarning each."""
+    from sbrdf_xr.errors import RenamedWarning, ValidationError
+
+    obs, g = tle_pass
+    new = TrackingTable(
+        obs.site,
+        obs.times,
+        elevation=g.elevation.values,
+        azimuth=g.azimuth.values,
+        range=g.range.values,
+        max_gap=60.0,
+    )
+    with pytest.warns(RenamedWarning) as caught:
+        old = TrackingTable(
+            obs.site,
+            obs.times,
+            elevation_deg=g.elevation.values,
+            azimuth_deg=g.azimuth.values,
+            range_km=g.range.values,
+            max_gap_s=60.0,
+        )
+    said = " ".join(str(w.message) for w in caught)
+    for name in ("elevation_deg", "azimuth_deg", "range_km", "max_gap_s"):
+        assert f"'{name}' is renamed" in said
+    np.testing.assert_array_equal(old.positions(), new.positions())
+    assert old.max_gap == new.max_gap == 60.0
+    for old_name, new_name in (
+        ("elevation_deg", "elevation"),
+        ("azimuth_deg", "azimuth"),
+        ("ra_deg", "ra"),
+        ("dec_deg", "dec"),
+        ("range_km", "range"),
+        ("height_km", "height"),
+        ("max_gap_s", "max_gap"),
+    ):
+        with pytest.warns(RenamedWarning, match=f"TrackingTable.{old_name} is renamed"):
+            value = getattr(new, old_name)
+        assert value is getattr(new, new_name)
+    with pytest.raises(ValidationError, match="received both 'range_km' and 'range'"):
+        TrackingTable(obs.site, obs.times, range=[1.0], range_km=[1.0])
+
+
+@pytest.mark.parametrize(
+    "columns",
+    [
+        ("elevation", "azimuth", "range"),
+        ("elevation_deg", "azimuth_deg", "range_km"),
+        ("elevation", "azimuth_deg", "height"),
+        ("elevation_deg", "azimuth", "height_km"),
+    ],
+)
+def test_files_name_columns_bare_or_with_their_unit(tmp_path, tle_pass, columns):
+    """A file's direction, range and height columns are read under either spelling, by the
+    reader and by a scene file's [observation.tracking] table (which finds the range or
+    height column itself)."""
+    from sbrdf_xr.observing.tracking_io import tracking_from_dict
+
+    obs, g = tle_pass
+    g = g.isel(time=slice(60, 66))
+    third = g.range.values if columns[2].startswith("range") else _heights(obs)[60:66]
+    rows = [
+        f"{str(t)[:23]}Z,{float(e)!r},{float(a)!r},{float(x)!r}"
+        for t, e, a, x in zip(
+            g.time.values, g.elevation.values, g.azimuth.values, third, strict=True
+        )
+    ]
+    path = _csv(tmp_path, "\n".join(rows) + "\n", "time," + ",".join(columns))
+    reference = TrackingTable(
+        obs.site,
+        g.time.values,
+        elevation=g.elevation.values,
+        azimuth=g.azimuth.values,
+        range=g.range.values,
+    )
+    kind = "range_column" if columns[2].startswith("range") else "height_column"
+    for name in (columns[2].removesuffix("_km"), columns[2].removesuffix("_km") + "_km"):
+        read = read_tracking_table(path, obs.site, **{kind: name})
+        assert _rel(read.ranges(), reference.ranges()) < RTOL
+    found = tracking_from_dict({"path": str(path)}, obs.site)
+    np.testing.assert_allclose(found.positions(), reference.positions(), rtol=RTOL, atol=0)
+    read = read_tracking_table(
+        path, obs.site, elevation="elevation_deg", azimuth="azimuth_deg", **{kind: columns[2]}
+    )
+    np.testing.assert_allclose(read.positions(), reference.positions(), rtol=RTOL, atol=0)
