@@ -585,7 +585,7 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         phase_angles=[20.0, 60.0],
         attitude_angle=[15.0],
         surface_tilt=2.0,
-        earth_range_km=42164.0,
+        earth_range=42164.0,
         earth_phase_angle=60.0,
         temperature=300.0,
         earth_temperature=255.0,
@@ -836,11 +836,11 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.observing.tracking.TrackingTable": lambda: dict(
         site=_observation().site,
         times=_T2,
-        elevation_deg=[90.0, 90.0],
-        azimuth_deg=[0.0, 30.0],
-        range_km=[500.0, 570.0],
-        height_km=[501.111, 571.111],  # at the zenith of a site 1111 m up
-        max_gap_s=30.0,
+        elevation=[90.0, 90.0],
+        azimuth=[0.0, 30.0],
+        range=[500.0, 570.0],
+        height=[501.111, 571.111],  # at the zenith of a site 1111 m up
+        max_gap=30.0,
     ),
     "sbrdf_xr.observing.tracking.range_for_height": lambda: dict(
         site=_observation().site, direction_itrs=[[1.0, 0.0, 0.0]], height=[550.0]
@@ -928,9 +928,9 @@ for _name, _arg in (
     ("sbrdf_xr.invert._joint.fit.fit_observation", "light_curve"),
 ):
     EXEMPT[(_name, _arg)] = _CONTAINER
-for _arg in ("ra_deg", "dec_deg"):
+for _arg in ("ra", "dec"):
     EXEMPT[("sbrdf_xr.observing.tracking.TrackingTable", _arg)] = (
-        "exclusive with elevation_deg/azimuth_deg, whose case runs the same conversion; "
+        "exclusive with elevation/azimuth, whose case runs the same conversion; "
         "tests/observing/test_tracking.py converts RA/Dec Quantities"
     )
 EXEMPT[("sbrdf_xr.body.starlink.starlink_v15", "limits")] = (
@@ -1421,24 +1421,6 @@ UNIT_ENDING_ALLOWED: dict[tuple[str, str], str] = {
     ("sbrdf_xr.engine.scene.Scene", "block_bytes"): "a count of bytes, a plain integer",
     ("sbrdf_xr.materials.models.render", "max_bytes"): "a count of bytes, a plain integer",
 }
-#: Not renamed yet, each with why.  ``Scene`` is at the module's line cap and its field
-#: names are the scene file's keys (the schema, the reader and the fingerprint list them);
-#: the tracking table's fields are its files' column names, read by ``tracking_io``.
-UNIT_ENDING_PENDING: dict[tuple[str, str], str] = {
-    ("sbrdf_xr.engine.scene.Scene", "earth_range_km"): "a scene-file key; scene.py at its cap",
-    **{
-        ("sbrdf_xr.observing.tracking.TrackingTable", field): "a tracking file's column name"
-        for field in (
-            "elevation_deg",
-            "azimuth_deg",
-            "ra_deg",
-            "dec_deg",
-            "range_km",
-            "height_km",
-            "max_gap_s",
-        )
-    },
-}
 
 
 def unit_endings() -> set[tuple[str, str]]:
@@ -1460,11 +1442,11 @@ def test_the_unit_ending_rule_sees_units_and_spares_words():
 
 def test_no_public_argument_name_ends_in_a_unit():
     found = unit_endings()
-    listed = set(UNIT_ENDING_ALLOWED) | set(UNIT_ENDING_PENDING)
+    listed = set(UNIT_ENDING_ALLOWED)
     new = sorted(found - listed)
     assert not new, (
         "arguments named with a unit (name them bare, give the unit in brackets in the "
         f"docstring and take a Quantity; see docs/guide/conventions.md): {new}"
     )
     stale = sorted(listed - found)
-    assert not stale, f"allowed or pending unit endings that no longer exist: {stale}"
+    assert not stale, f"allowed unit endings that no longer exist: {stale}"

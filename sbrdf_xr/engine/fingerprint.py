@@ -55,6 +55,9 @@ _GEOMETRY_FIELDS = (
 )
 #: Scene fields hashed on their own, or labels that do not change any value.
 _OTHER_FIELDS = ("spacecraft", "materials", "name", "description", "_checked", "_cache")
+#: Knobs renamed since cubes were first written, under the name their fingerprint keeps
+#: (so that a cube written before the rename still resumes).
+_FINGERPRINT_NAMES = {"earth_range": "earth_range_km"}
 
 
 def _canonical(value: Any) -> Any:
@@ -393,7 +396,11 @@ def scene_fingerprint(scene: SceneView) -> dict[str, str]:
     out[f"{PREFIX}_mesh"] = _mesh_sha(scene.spacecraft)
     out[f"{PREFIX}_filters"] = _filters_sha(getattr(scene, "bands", ()))
     fields = [f.name for f in dataclasses.fields(scene)]
-    knobs = {f: getattr(scene, f) for f in fields if f not in _GEOMETRY_FIELDS + _OTHER_FIELDS}
+    knobs = {
+        _FINGERPRINT_NAMES.get(f, f): getattr(scene, f)
+        for f in fields
+        if f not in _GEOMETRY_FIELDS + _OTHER_FIELDS
+    }
     out[KNOBS_JSON] = _json(knobs)
     out[f"{PREFIX}_knobs"] = _sha(out[KNOBS_JSON])
     out[f"{PREFIX}_geometry"] = _sha(

@@ -15,7 +15,7 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from .. import catalog, geometry
-from ..errors import CatalogError, SceneError, ValidationError, did_you_mean
+from ..errors import CatalogError, SceneError, ValidationError, did_you_mean, renamed_fields
 from ..kernels.warm import compiling_ahead
 from ..materials.tables import validate_material
 from ..units import check_plausible, to_unit
@@ -69,7 +69,7 @@ _UNITS = {
     "phase_angles": "deg",
     "attitude_angle": "deg",
     "surface_tilt": "deg",
-    "earth_range_km": "km",
+    "earth_range": "km",
     "earth_phase_angle": "deg",
     "temperature": "K",
     "earth_temperature": "K",
@@ -91,6 +91,7 @@ def _optional_array(v: ArrayLike | None) -> np.ndarray | None:
     return None if v is None else np.asarray(v)
 
 
+@renamed_fields(earth_range_km="earth_range")
 @dataclass(frozen=True)
 class Scene:
     """A spacecraft, its materials, a geometry sweep, and what to compute.
@@ -168,8 +169,10 @@ class Scene:
         The same in the body frame, one per explicit geometry pair.
     earth_albedo : float
         Bond albedo of the Lambertian Earth [1].
-    earth_range_km : float
-        Distance from the spacecraft to the Earth's centre [km].
+    earth_range : float
+        Distance from the spacecraft to the Earth's centre [km] (formerly
+        ``earth_range_km``, accepted and read for one release with a
+        :class:`~sbrdf_xr.errors.RenamedWarning`).
     earth_phase_angle : float
         Sun-Earth-spacecraft angle seen from the Earth's centre [degree] (0: the
         spacecraft sees a full Earth).
@@ -190,7 +193,7 @@ class Scene:
     name, description : str
         Labels stored in the output.
 
-    Every number with a unit (the angles [degree], ``earth_range_km`` [km],
+    Every number with a unit (the angles [degree], ``earth_range`` [km],
     ``temperature`` [K], the knobs with a unit, a material table's sBRDF [sr-1] given as a
     DataArray holding a Quantity) also takes an astropy Quantity, converted when the
     scene is made; one of another kind raises :class:`~sbrdf_xr.errors.UnitError` naming
@@ -267,7 +270,7 @@ class Scene:
     earth_direction: tuple[float, float, float] = (0.0, -1.0, 0.0)
     to_earth: ArrayLike | None = None
     earth_albedo: float = 0.3
-    earth_range_km: float = 42164.0
+    earth_range: float = 42164.0
     earth_phase_angle: float = 90.0
     earth_model: str = KNOBS["earth_model"].default
     conductance: str = KNOBS["conductance"].default
@@ -325,10 +328,9 @@ class Scene:
                 raise SceneError(f"bands: {exc}") from None
         if not 0.0 <= self.earth_albedo <= 1.0:
             raise SceneError(f"earth_albedo: must lie in [0, 1], got {self.earth_albedo}")
-        if not self.earth_range_km > 6371.0:
+        if not self.earth_range > 6371.0:
             raise SceneError(
-                "earth_range_km: must exceed the Earth's radius (6371 km), "
-                f"got {self.earth_range_km}"
+                f"earth_range: must exceed the Earth's radius (6371 km), got {self.earth_range}"
             )
         if not 0.0 <= self.earth_phase_angle <= 180.0:
             raise SceneError(
@@ -353,7 +355,7 @@ class Scene:
                 f"band_extrapolate: got {self.band_extrapolate!r}; allowed: 'zero', 'constant' "
                 "(or leave it out to refuse bands beyond the wavelengths)"
             )
-        check_plausible(self.earth_range_km, "range_km", "earth_range_km")
+        check_plausible(self.earth_range, "range_km", "earth_range")
         for key in ("temperature", "surface_tilt"):
             value = getattr(self, key)
             have = getattr(self.spacecraft, "materials", None)

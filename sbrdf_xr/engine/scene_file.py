@@ -10,13 +10,21 @@ is allowed) before any catalog entry or file is loaded.  Both are re-exported fr
 from __future__ import annotations
 
 import tomllib
+import warnings
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import xarray as xr
 
-from ..errors import CatalogError, SceneError, ValidationError, did_you_mean, renamed_attributes
+from ..errors import (
+    CatalogError,
+    RenamedWarning,
+    SceneError,
+    ValidationError,
+    did_you_mean,
+    renamed_attributes,
+)
 from .attitude_table import (
     MAX_SCENE_COUNT,
     _check_keys,
@@ -29,7 +37,7 @@ from .attitude_table import (
 )
 from .knobs import KNOBS
 from .scene import Scene
-from .schema import GEOMETRY_KEYS, SCENE_KEYS, SPACECRAFT_KEYS, toml_types
+from .schema import GEOMETRY_KEYS, RENAMED_SCENE_KEYS, SCENE_KEYS, SPACECRAFT_KEYS, toml_types
 
 __all__ = [
     "MAX_SCENE_COUNT",
@@ -56,6 +64,29 @@ def _strings(v: Any, where: str, *, allow_empty: bool = True) -> tuple[str, ...]
     if not v and not allow_empty:
         raise SceneError(f"{where}: the list is empty; give at least one")
     return tuple(v)
+
+
+def _renamed_keys(d: Any) -> Any:
+    """``d`` with the old keys of :data:`~sbrdf_xr.engine.schema.RENAMED_SCENE_KEYS` read
+    as their new ones, each with a :class:`~sbrdf_xr.errors.RenamedWarning`."""
+    if not isinstance(d, Mapping) or not set(d) & set(RENAMED_SCENE_KEYS):
+        return d
+    d = dict(d)
+    for old, new in RENAMED_SCENE_KEYS.items():
+        if old in d:
+            if new in d:
+                raise SceneError(
+                    f"scene: keys {old!r} and {new!r} both given; {old!r} is the old name of "
+                    f"{new!r}: give only {new!r}"
+                )
+            warnings.warn(
+                f"scene: the key {old!r} is renamed {new!r}; the old name will be removed in "
+                "the next release",
+                RenamedWarning,
+                stacklevel=3,
+            )
+            d[new] = d.pop(old)
+    return d
 
 
 def _spacecraft(spec: Any, base_dir: str | Path | None) -> Any:
@@ -200,6 +231,7 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
     ...
     sbrdf_xr.errors.SceneError: scene: unknown key 'colour'; allowed keys: ...
     """
+    d = _renamed_keys(d)
     _check_keys(d, _SCENE_KEYS, "scene")
 
     kw: dict[str, Any] = {
@@ -216,7 +248,7 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
             if isinstance(st, Mapping)
             else _number(st, "surface_tilt")
         )
-    for k in ("earth_albedo", "earth_range_km", "earth_phase_angle", "earth_temperature"):
+    for k in ("earth_albedo", "earth_range", "earth_phase_angle", "earth_temperature"):
         if k in d:
             kw[k] = _number(d[k], k)
     if "temperature" in d:

@@ -29,6 +29,7 @@ __all__ = [
     "ATTITUDE_KEYS",
     "GEOMETRY_KEYS",
     "OBSERVATION_KEYS",
+    "RENAMED_SCENE_KEYS",
     "SCENE_KEYS",
     "SPACECRAFT_KEYS",
     "Key",
@@ -196,7 +197,7 @@ SCENE_KEYS: dict[str, Key] = _table(
         ),
         Key("earth_albedo", _NUMBER, "Bond albedo of the Lambertian Earth, 0-1"),
         Key(
-            "earth_range_km",
+            "earth_range",
             _NUMBER,
             "a grid's or pairs' distance to the Earth's centre [km], > 6371",
         ),
@@ -219,6 +220,9 @@ SCENE_KEYS: dict[str, Key] = _table(
     ]
 )
 SCENE_KEYS.update({k: _knob_key(k) for k in KNOBS if k not in SCENE_KEYS})  # every knob a key
+#: Top-level keys renamed: old key -> new key.  A scene file's old key is read as the new
+#: one for one release, with a :class:`~sbrdf_xr.errors.RenamedWarning`.
+RENAMED_SCENE_KEYS: dict[str, str] = {"earth_range_km": "earth_range"}
 
 #: Keys of a ``[spacecraft]`` table (a mesh file).
 SPACECRAFT_KEYS: dict[str, Key] = _table(
@@ -333,6 +337,8 @@ def reference() -> str:
 
     out = ["Top-level keys (the numerical knobs among them are `sbrdf-xr knobs`'s):", ""]
     out += _rows(SCENE_KEYS)
+    renamed = ", ".join(f"`{old}` (now `{new}`)" for old, new in RENAMED_SCENE_KEYS.items())
+    out += ["", f"Old keys, read for one release with a warning: {renamed}."]
     out += ["", "`effects`:", "", "| effect | asked for | what it adds |", "|---|---|---|"]
     for e in EFFECTS.values():
         asked = {"always": "always on", "asked": "when listed", "automatic": "by the geometry"}

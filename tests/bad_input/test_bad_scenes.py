@@ -78,7 +78,7 @@ TOP_KEYS = [
     "band_extrapolate",
     "earth_direction",
     "earth_albedo",
-    "earth_range_km",
+    "earth_range",
     "earth_phase_angle",
     "temperature",
     "unknown_key",
@@ -94,7 +94,7 @@ KEY_VALUES = {
     "tilt_nodes": [0, 1, 32, 33],
     "phase_angles": [[-10.0], [181.0], [1e9], [0.0, 180.0], [360.0], [-1e-9], [1e-300]],
     "temperature": [1e9, 1e5, 6000.0, 300.0, 3.0, 1e-300, {"tjpv-cell": 1e9}, {"krypton": 300.0}],
-    "earth_range_km": [6371.0, 6372.0, 4.2e4, 1e12, 1e30],
+    "earth_range": [6371.0, 6372.0, 4.2e4, 1e12, 1e30],
     "earth_albedo": [1e6, 1.0, 0.0, -0.1],
     "earth_phase_angle": [180.0, 181.0, -1.0, 1e9],
     "band_extrapolate": ["bogus", "zero", "constant", "", "ZERO"],
@@ -140,7 +140,7 @@ def _wrong(key: str, value) -> bool:
         return any(k not in BASE["materials"] for k in value)
     if key == "band_extrapolate" and isinstance(value, str):
         return value not in ("zero", "constant")
-    if key == "earth_range_km" and num(value):
+    if key == "earth_range" and num(value):
         return value > 1e9
     return False
 

@@ -71,7 +71,7 @@ def _scene(e, r, **kw):
         to_observer=[DOWN],
         to_earth=[e],
         effects=("sunlight", "earth_thermal"),
-        earth_range_km=r,
+        earth_range=r,
         **kw,
     )
 
@@ -124,7 +124,7 @@ def test_random_geometries_sum_every_facet_that_sees_the_earth():
         to_observer=o,
         to_earth=e,
         effects=("earth_thermal",),
-        earth_range_km=7200.0,
+        earth_range=7200.0,
         outputs=("signal",),
     )
     got = simulate(scene).compute().earth_thermal_intensity.values

@@ -68,7 +68,7 @@ def _scene(e, s, r, phase, material, **kw):
         to_earth=[e],
         effects=("sunlight", "earthshine"),
         earth_albedo=0.3,
-        earth_range_km=r,
+        earth_range=r,
         earth_phase_angle=phase,
         evaluation="analytic",
         **kw,

@@ -129,3 +129,35 @@ PINNED = {
     "fingerprint_materials": "7a53b719791efdbb79d3811b17766d1c3784da77a6dde48ba299eceed4151fc7",
     "fingerprint_mesh": "2bb062f8b6878db9a016451670b81728b9bfba791983facc18939c9d934127cc",
 }
+
+
+def test_a_renamed_field_keeps_its_old_name_in_the_fingerprint():
+    """``Scene.earth_range`` was ``earth_range_km``: the knobs JSON (and so the digest of a
+    scene that did not change) still says ``earth_range_km``, whichever name built the
+    scene, in Python or in a scene file (the old key with a RenamedWarning)."""
+    import json
+
+    import pytest
+    import trimesh
+
+    from sbrdf_xr import Scene, load_spacecraft
+    from sbrdf_xr.engine import scene_from_dict
+    from sbrdf_xr.errors import RenamedWarning
+    from sbrdf_xr.materials.schema import lambertian
+
+    box = load_spacecraft(trimesh.creation.box(), material="grey")
+    grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    kw = dict(attitudes=[[0, 0, 0, 1.0]], phase_angles=[0.0, 60.0])
+    new = fp.scene_fingerprint(Scene(box, {"grey": grey}, earth_range=7000.0, **kw))
+    knobs = json.loads(new["fingerprint_knobs_json"])
+    assert knobs["earth_range_km"] == "7000.0" and "earth_range" not in knobs
+    assert '"earth_range_km":"7000.0"' in new["fingerprint_knobs_json"]  # the bytes hashed
+    with pytest.warns(RenamedWarning, match="'earth_range_km' is renamed 'earth_range'"):
+        old = fp.scene_fingerprint(Scene(box, {"grey": grey}, earth_range_km=7000.0, **kw))
+    assert old == new
+    table = {"spacecraft": "canx1", "attitude": {"kind": "sweep", "stop": 1}, "phase_angles": [0.0]}
+    from_new = fp.scene_fingerprint(scene_from_dict({**table, "earth_range": 7000.0}))
+    with pytest.warns(RenamedWarning, match="scene: the key 'earth_range_km' is renamed"):
+        from_old = fp.scene_fingerprint(scene_from_dict({**table, "earth_range_km": 7000.0}))
+    assert from_old == from_new
+    assert fp.scene_fingerprint(scene_from_dict(table)) != from_new

@@ -238,7 +238,7 @@ def test_earthshine_is_a_second_lambertian_source():
             to_earth=e,
             effects=("sunlight", "earthshine"),
             earth_albedo=0.3,
-            earth_range_km=42164.0,
+            earth_range=42164.0,
             earth_phase_angle=60.0,
             earth_model="point",  # the finite Earth: tests/engine/test_earthshine_finite.py
         )

@@ -5,7 +5,7 @@ The Earth is a Lambertian emitter at one brightness temperature, the scene's
 so its radiance is Planck's ``B(lambda, T_E)`` over the whole disc, day and night side
 alike (paper 001 §1 counts the Earth's emission among the sources a surface scatters).
 Its distance and direction are those of the ``earthshine`` effect (the scene's
-``earth_range_km`` and ``earth_direction`` or ``to_earth``, an observation's at every
+``earth_range`` and ``earth_direction`` or ``to_earth``, an observation's at every
 time).  Each facet receives ``E_j(lambda) = B(lambda, T_E) V_j`` with ``V_j`` the
 cosine-weighted solid angle of the part of the Earth above its horizon
 (:func:`sbrdf_xr.sources.earth_view_facets`, the knob ``earth_model="finite"``, default)
@@ -32,7 +32,7 @@ band).  It is skipped where it stays below
 >>> grey = lambertian(0.5, [8000.0, 10000.0, 12000.0], material="grey")
 >>> x, y = [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]]
 >>> scene = Scene(box, {"grey": grey}, to_sun=x, to_observer=y, to_earth=y,
-...               effects=("sunlight", "earth_thermal"), earth_range_km=7000.0)
+...               effects=("sunlight", "earth_thermal"), earth_range=7000.0)
 >>> plan = scene.plan()
 >>> plan.effects
 ('sunlight', 'earth_thermal')
@@ -96,7 +96,7 @@ def _geometry(scene: SceneView, observed: xr.Dataset | None) -> dict[str, np.nda
             to_earth = np.broadcast_to(e, (n, 3)).copy()
         else:
             to_earth = np.asarray(scene.to_earth)
-        rng = np.full(len(to_earth), float(scene.earth_range_km))
+        rng = np.full(len(to_earth), float(scene.earth_range))
     out = {"to_earth": to_earth, "earth_range": rng}
     if scene.earth_model == "finite":  # facets up to 90 deg + rho from the centre see it
         out["earth_reach"] = sources.EARTH_MEAN_RADIUS_KM / rng
@@ -108,7 +108,7 @@ def _plan(inputs: PlanInputs) -> Decision:
     scene, wl = inputs.scene, inputs.wavelength
     assert wl is not None  # planned after the spectral stage
     ranges = np.asarray(scene.geometry.sources["earth_range"], dtype=np.float64)
-    nearest = float(np.min(ranges)) if ranges.size else float(scene.earth_range_km)
+    nearest = float(np.min(ranges)) if ranges.size else float(scene.earth_range)
     radiance = sources.planck(wl, scene.earth_temperature)  # [W m-2 sr-1 nm-1]
     full = np.pi * (sources.EARTH_MEAN_RADIUS_KM / nearest) ** 2  # an Earth-facing facet [sr]
     e_sun = solar_spectrum(wl, solar="astm_g173_extended").values
@@ -181,7 +181,7 @@ EFFECT = Effect(
     reads=(
         "earth_direction",
         "to_earth",
-        "earth_range_km",
+        "earth_range",
         "earth_temperature",
         "earth_model",
     ),

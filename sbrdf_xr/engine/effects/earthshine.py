@@ -1,7 +1,7 @@
 """Earthshine: sunlight reflected by the Earth onto the spacecraft.
 
 The Earth is a Lambertian sphere of albedo ``earth_albedo``.  For a grid or explicit pairs
-its distance and phase are the scene's ``earth_range_km`` and ``earth_phase_angle`` and
+its distance and phase are the scene's ``earth_range`` and ``earth_phase_angle`` and
 its direction ``earth_direction`` (a grid, reference frame) or ``to_earth`` (pairs, body
 frame); an observation gives all three at every time.  The light it reflects is
 ``signal_earthshine``, per unit solar irradiance, and it adds to ``band_signal``.
@@ -97,7 +97,7 @@ def _geometry(scene: SceneView, observed: xr.Dataset | None) -> dict[str, np.nda
         out = {"to_earth": np.asarray(scene.to_earth)}
         n = len(out["to_earth"])
     if finite:
-        rng = np.full(n, float(scene.earth_range_km))
+        rng = np.full(n, float(scene.earth_range))
         out.update(_finite(rng, np.full(n, float(scene.earth_phase_angle))))
     return out
 
@@ -134,17 +134,17 @@ def _plan(inputs: PlanInputs) -> Decision:
             {"ratio": float(np.max(es)) if es.size else 0.0, "albedo": scene.earth_albedo},
         )
     ratio = earthshine_irradiance_ratio(
-        scene.earth_albedo, scene.earth_range_km, scene.earth_phase_angle
+        scene.earth_albedo, scene.earth_range, scene.earth_phase_angle
     )
     if finite:  # an Earth-facing plate, the Sun in the x-z plane as seen from the Earth
         a = np.radians(scene.earth_phase_angle)
         down, sun = [0.0, 0.0, -1.0], [np.sin(a), 0.0, np.cos(a)]
-        facing = earthshine_facets([down], [down], [sun], scene.earth_range_km, scene.earth_albedo)
+        facing = earthshine_facets([down], [down], [sun], scene.earth_range, scene.earth_albedo)
         ratio = float(facing[0, 0])
     return Decision(
         True,
         f"{what} (albedo {scene.earth_albedo:g}, range "
-        f"{scene.earth_range_km:g} km, phase {scene.earth_phase_angle:g} deg): irradiance "
+        f"{scene.earth_range:g} km, phase {scene.earth_phase_angle:g} deg): irradiance "
         f"{ratio:.3g} of the Sun's{' on an Earth-facing facet' if finite else ''}, {how}",
         {"ratio": ratio, "albedo": scene.earth_albedo, "limb_tables": _limb(inputs)},
     )
@@ -212,7 +212,7 @@ EFFECT = Effect(
         "earth_direction",
         "to_earth",
         "earth_albedo",
-        "earth_range_km",
+        "earth_range",
         "earth_phase_angle",
         "earth_model",
     ),
