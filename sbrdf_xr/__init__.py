@@ -1,6 +1,7 @@
 """sbrdf_xr: spectral BRDF simulation of unresolved spacecraft with xarray and Dask.
 
-Importing the package registers the ``.sbrdf`` xarray accessors.  The main entry
+Importing the package registers the ``.sbrdf`` xarray accessors: at once if xarray is
+imported, or else the moment it is (``sbrdf_xr._startup.when_imported``).  The main entry
 points: :func:`build_lut` and :func:`lookup` (materials), :func:`load_spacecraft` and
 :func:`canx1` (spacecraft), :class:`Scene`, :func:`simulate` and :func:`write`
 (simulations), :mod:`sbrdf_xr.photometry` (colour photometry) and
@@ -27,16 +28,13 @@ The packages are the layers, lowest first; a package imports only from lower one
 
 ``dir(sbrdf_xr)`` lists :data:`__all__`: the functions and classes above and every
 public package and module, each imported on first use, so that ``import sbrdf_xr`` loads
-xarray and the accessors but not Dask, numba, trimesh, netCDF4 or SciPy.
+none of xarray, pandas, NumPy, Dask, numba, trimesh, netCDF4 or SciPy.
 """
 
 import importlib as _importlib
 from typing import TYPE_CHECKING
 
-from . import (
-    _startup,  # noqa: F401  first: Ctrl-C while the command line starts
-    accessors,  # registers the .sbrdf accessors (light: their methods import on first call)
-)
+from . import _startup  # first: Ctrl-C while the command line starts
 from ._names import __version__
 
 if TYPE_CHECKING:  # what __getattr__ serves, for type checkers
@@ -135,6 +133,14 @@ __all__ = [
 
 
 assert set(_SUBMODULES) | set(_EXPORTS) <= set(__all__)
+
+
+def _register_accessors(xarray: object) -> None:
+    """Register the ``.sbrdf`` accessors (xarray is imported)."""
+    _importlib.import_module(f"{__name__}.accessors")
+
+
+_startup.when_imported("xarray", _register_accessors)
 
 
 def __getattr__(name: str) -> object:

@@ -2,8 +2,10 @@
 
 Compose, never subclass: every accessor method is a one-line call of the function
 documented in :mod:`sbrdf_xr.materials.tables` or :mod:`sbrdf_xr.photometry`.  Importing
-:mod:`sbrdf_xr` registers the accessors; each method imports the module it calls on its
-first call, so that registering them loads nothing but xarray.
+:mod:`sbrdf_xr` registers the accessors, at once if xarray is imported or else right after
+xarray's first import (``sbrdf_xr._startup.when_imported``), so that they are on every
+xarray object whichever of the two is imported first; each method imports the module it
+calls on its first call, so that registering them loads nothing but xarray.
 """
 
 from __future__ import annotations
