@@ -20,6 +20,7 @@ from __future__ import annotations
 import csv
 import re
 import warnings
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -101,7 +102,7 @@ _COLUMN_UNITS = {"elevation": "deg", "azimuth": "deg", "ra": "deg", "dec": "deg"
 _COLUMN_UNITS.update(range="km", height="km")
 
 
-def _spelling(column: str | None, header: list[str]) -> str | None:
+def _spelling(column: str | None, header: Sequence[str]) -> str | None:
     """The header's spelling of ``column``: as named, or else with (or without) its unit.
 
     A file may name its columns bare (``elevation``, ``range``) or with the unit the
