@@ -352,17 +352,24 @@ def test_a_merl_file_of_a_known_model_round_trips_and_builds(tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("name", "bound"), [("solar-array", 0.10), ("chassis", 0.25)])
-def test_the_starlink_tables_predict_held_out_samples(name, bound):
+def test_the_starlink_solar_array_predicts_held_out_samples():
     """Every 4th sample of each scan left out (the build's own leave-out check), over
-    the samples above 1e-3 of their scan's peak: the solar array meets the 10 % of the
-    issue (1.4 %); the chassis's 1-degree scan does not resolve its sub-degree mirror
-    core (16 %, its wings within a few %), held here against regressions."""
-    meas = catalog.load(f"starlink-v1.5-{name}-measurements")
-    if name == "chassis":  # its 1-degree mirror core, isotropic about specular: rho 1.1-1.4
-        with pytest.warns(NonPhysicalWarning, match="does not conserve energy"):
-            table = build_lut(meas)
-    else:
-        table = build_lut(meas)
+    the samples above 1e-3 of their scan's peak: the issue's 10 % (measured 1.4 %)."""
+    table = build_lut(catalog.load("starlink-v1.5-solar-array-measurements"))
     assert table.attrs["self_check_worst"] < 1e-9
-    assert table.attrs["holdout_check_median"] < bound
+    assert table.attrs["holdout_check_median"] < 0.10
+
+
+@pytest.mark.slow
+def test_the_starlink_chassis_predicts_held_out_samples_with_its_specular_core():
+    """The shipped chassis (a Robertson-Sandford fill with a Beckmann core) against the
+    same leave-out check.  Its 13 held-out samples above the floor: median 11.7 %, 95th
+    percentile 45 %, worst 63 % (16.1 %, 73 %, 76 % with the Robertson-Sandford fill
+    alone).  A 1-D log-linear interpolation of each scan's kept samples reaches 17 % (the
+    best of five interpolants 15 %): the mirror core, narrower than the 1-degree step,
+    is predicted only by a model whose core has its width.  Bounds hold the gain."""
+    table = catalog.load("starlink-v1.5-chassis")
+    assert table.attrs["extrapolation_model"] == "robertson_sandford_core"
+    assert table.attrs["self_check_worst"] < 1e-9
+    assert table.attrs["holdout_check_median"] < 0.13
+    assert table.attrs["holdout_check_p95"] < 0.5
