@@ -527,7 +527,11 @@ def fit_robertson_sandford_core(measurements: xr.Dataset) -> xr.Dataset:
 
     The body is :func:`fit_robertson_sandford`'s; the core (Beckmann, one rms slope,
     a reflectance per wavelength; :mod:`sbrdf_xr.brdf.specular_core`) is then fitted
-    beside it to all the samples (:func:`sbrdf_xr.brdf.specular_core.fit_core`).  For a
+    beside it to all the samples (:func:`sbrdf_xr.brdf.specular_core.fit_core`).  The
+    body is then fitted again without the samples where the fitted core exceeds it,
+    and the core again beside it, until the core's rms slope changes by less than 0.1 %
+    (at most :data:`_CORE_ITERATIONS` times): a body fitted to the core's samples
+    widens to take part of the core.  For a
     near-mirror whose core is narrower than a broad lobe can follow (the Starlink
     chassis).
 
@@ -553,16 +557,29 @@ def fit_robertson_sandford_core(measurements: xr.Dataset) -> xr.Dataset:
     """
     from .._names import MEASURED, SAMPLE
     from ..brdf import specular_core
+    from ..geometry import facet_vectors
     from .schema import reference_mask, validate_measurements
 
     ds = validate_measurements(measurements, duplicates="mean")
-    body = fit_robertson_sandford(ds)
     wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
     angles = (ds[THETA_I].values, ds[DELTA_THETA].values, ds[PHI].values)
     spectra_ = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64)
-    core = specular_core.fit_core(
-        *angles, spectra_, spectra(body, *angles), reference=reference_mask(ds)
-    )
+    ref = reference_mask(ds)
+    body_at = np.ones(ref.size, dtype=bool)  # the samples the body is fitted to
+    last = np.inf
+    for _ in range(_CORE_ITERATIONS):
+        body = fit_robertson_sandford(ds.isel({SAMPLE: np.flatnonzero(body_at)}))
+        b_vals = spectra(body, *angles)
+        core = specular_core.fit_core(*angles, spectra_, b_vals, reference=ref)
+        if abs(core["core_roughness"] / last - 1.0) < 1e-3:
+            break
+        last = core["core_roughness"]
+        c_vals = specular_core.core_brdf(
+            *facet_vectors(*angles),
+            core["core_rho"],
+            np.full(core["core_rho"].shape, core["core_roughness"]),
+        )
+        body_at = np.all(c_vals < b_vals, axis=1) | ref  # the core's samples left to it
     name = ds.attrs.get("material", "unnamed")
     params = {k: body[k].values for k in ("rho_D", "epsilon", "b", "e")}
     out = model_material(
@@ -576,6 +593,9 @@ def fit_robertson_sandford_core(measurements: xr.Dataset) -> xr.Dataset:
     out.attrs["source"] = "model:robertson_sandford_core"
     return out
 
+
+#: Most fits of the body and the core of :func:`fit_robertson_sandford_core`.
+_CORE_ITERATIONS = 8
 
 #: The model fits :func:`~sbrdf_xr.materials.build.build_lut` can fill a table with, by name.
 FITS = {
