@@ -41,6 +41,7 @@ from scipy.optimize import least_squares
 
 from . import robertson_sandford as rs
 from ._common import _angles_to_vectors, _cast_out, _check_theta_i, _facet_frame
+from ..units import to_unit
 from ._model import Model, Parameter
 
 __all__ = [
@@ -329,8 +330,8 @@ def fit_core(
     >>> round(float(fit["core_roughness"]), 6), np.round(fit["core_rho"], 6).tolist()
     (0.008, [0.3])
     """
-    y = np.asarray(spectra, dtype=np.float64)
-    base = np.asarray(body, dtype=np.float64)
+    y = np.asarray(to_unit(spectra, "sr-1", "spectra"), dtype=np.float64)
+    base = np.asarray(to_unit(body, "sr-1", "body"), dtype=np.float64)
     ok = np.all(y > 0, axis=1) & np.all(base > 0, axis=1)
     if reference is not None:
         ok &= ~np.asarray(reference, dtype=bool)
