@@ -218,6 +218,10 @@ def _rs() -> dict[str, Any]:
     return dict(TABLE4["AFGL-01"])
 
 
+def _core() -> dict[str, Any]:
+    return {**_rs(), "core_rho": 0.2, "core_roughness": 0.01}
+
+
 _MICRO = {"roughness": 0.2, "n": 1.5, "k": 0.0, "rho_d": 0.1}
 _ANISO = {"alpha_x": 0.2, "alpha_y": 0.3, "n": 1.5, "k": 0.0, "rho_d": 0.1}
 _LAMBERT = {"rho": 0.4}
@@ -548,6 +552,21 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.brdf.robertson_sandford.check_params": lambda: dict(wavelength=[4000.0], **_rs()),
     "sbrdf_xr.brdf.robertson_sandford.brdf_angles": _angles_case("robertson_sandford", _rs),
     "sbrdf_xr.brdf.robertson_sandford.render_grid": _angles_case("robertson_sandford", _rs),
+    "sbrdf_xr.brdf.specular_core.brdf": _brdf_case(_core, wl=[4000.0]),
+    "sbrdf_xr.brdf.specular_core.directional_hemispherical_reflectance": lambda: dict(
+        theta_i=[20.0, 60.0], wavelength=[4000.0], **_core()
+    ),
+    "sbrdf_xr.brdf.specular_core.check_params": lambda: dict(wavelength=[4000.0], **_core()),
+    "sbrdf_xr.brdf.specular_core.brdf_angles": _angles_case("specular_core", _core),
+    "sbrdf_xr.brdf.specular_core.render_grid": _angles_case("specular_core", _core),
+    "sbrdf_xr.brdf.specular_core.core_loss": lambda: dict(theta_i=[0.0, 60.0], core_roughness=0.2),
+    "sbrdf_xr.brdf.specular_core.fit_core": lambda: dict(
+        theta_i=np.full(9, 30.0),
+        delta_theta=np.linspace(-4.0, 4.0, 9),
+        phi=np.zeros(9),
+        spectra=np.full((9, 1), 0.2) + np.exp(-(np.linspace(-4.0, 4.0, 9) ** 2))[:, None],
+        body=np.full((9, 1), 0.2),
+    ),
     "sbrdf_xr.brdf.robertson_sandford_angular.angular_g": lambda: dict(theta=[20.0, 45.0], b=0.5),
     "sbrdf_xr.brdf.robertson_sandford_angular.cutoff_factor": lambda: dict(
         theta_r=[45.0, 85.0], b=0.12
@@ -979,7 +998,7 @@ EXEMPT[("sbrdf_xr.brdf._model.Model", "brdf")] = (
     "a function (the model's sBRDF), not a value: its results are in sr-1 by contract"
 )
 
-for _model_name in ("lambert", "microfacet", "robertson_sandford"):
+for _model_name in ("lambert", "microfacet", "robertson_sandford", "specular_core"):
     for _method in ("brdf_angles", "render_grid"):
         EXEMPT[(f"sbrdf_xr.brdf.{_model_name}.{_method}", "psi")] = "an isotropic model refuses psi"
 

@@ -29,6 +29,9 @@ Models
 ``"microfacet"``
     Cook–Torrance / Walter et al. 2007 GGX microfacet model with exact Fresnel terms
     (:mod:`~sbrdf_xr.brdf.microfacet`, :mod:`~sbrdf_xr.brdf.optics`).
+``"robertson_sandford_core"``
+    Robertson–Sandford plus a narrow Beckmann specular core, for near-mirrors measured
+    in-plane (:mod:`~sbrdf_xr.brdf.specular_core`).
 
 Anisotropic models (:data:`ANISOTROPIC_MODELS`) take the facet tangent as well: their
 ``brdf`` has a ``tangent`` keyword, ``brdf_angles`` and ``render_grid`` a ``psi``
@@ -46,6 +49,7 @@ from . import (
     optics,
     robertson_sandford,
     robertson_sandford_angular,
+    specular_core,
 )
 from ._model import Model, ModelRegistry, Parameter
 
@@ -64,6 +68,7 @@ __all__ = [
     "register_model",
     "robertson_sandford",
     "robertson_sandford_angular",
+    "specular_core",
     "unregister_model",
 ]
 
@@ -75,7 +80,7 @@ MODELS = BRDF_MODELS.view(anisotropic=False)
 ANISOTROPIC_MODELS = BRDF_MODELS.view(anisotropic=True)
 
 #: The package's models, one line each.
-_REGISTERED = (lambert, robertson_sandford, microfacet, anisotropic)
+_REGISTERED = (lambert, robertson_sandford, microfacet, anisotropic, specular_core)
 
 
 def get_model(name: str) -> Model:

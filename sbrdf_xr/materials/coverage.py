@@ -32,6 +32,7 @@ Angles are in degree (astropy Quantities are converted, :func:`sbrdf_xr.units.to
 
 from __future__ import annotations
 
+import itertools
 import warnings
 from typing import Any
 
@@ -214,24 +215,41 @@ def _in_plane_phi_grid(step: float) -> np.ndarray:
 SPECULAR_REFINE = 5
 
 
+#: Within this many scan steps of specular, the ``delta_theta`` nodes of an in-plane table
+#: are at most :data:`SPECULAR_SUBSTEP` of a step apart (:func:`_specular_nodes`).
+SPECULAR_STEPS = 10
+#: The largest node spacing near specular, as a fraction of the scan's step.
+SPECULAR_SUBSTEP = 0.25
+
+
 def _specular_nodes(dt: np.ndarray) -> np.ndarray:
-    """The ``delta_theta`` nodes of an in-plane table: the scans' own, and nodes at
-    ``+-step / 2**k`` (``k = 1..SPECULAR_REFINE``) about specular, so that the look-up's
-    linear interpolation follows a mirror peak that falls by orders of magnitude within
-    one step of the scan (not a pyramid one step wide, which holds tens of times its
-    energy).
+    """The ``delta_theta`` nodes of an in-plane table: the scans' own, nodes at
+    ``+-step / 2**k`` (``k = 1..SPECULAR_REFINE``) about specular, and within
+    :data:`SPECULAR_STEPS` steps of specular every gap between nodes split to at most
+    :data:`SPECULAR_SUBSTEP` of a step.  The look-up interpolates linearly between nodes;
+    a mirror core and its shoulders fall by orders of magnitude within one step of the
+    scan, so nodes a step apart turn the fill's curve into chords far above it (a
+    pyramid one step wide holds tens of times the energy of the peak it stands for, and
+    misses the samples between nodes by tens of per cent).
 
     Examples
     --------
     >>> import numpy as np
     >>> from sbrdf_xr.materials.coverage import _specular_nodes
-    >>> _specular_nodes(np.array([-2.0, -1.0, 0.0, 1.0, 2.0])).size
-    15
+    >>> nodes = _specular_nodes(np.arange(-20.0, 21.0))
+    >>> float(np.diff(nodes[np.abs(nodes) <= 10.0]).max()), float(np.diff(nodes).max())
+    (0.25, 1.0)
     """
     nodes = np.unique(dt)
     step = float(np.median(np.diff(nodes))) if nodes.size > 1 else 1.0
     fine = step * 2.0 ** -np.arange(1, SPECULAR_REFINE + 1)
-    return np.unique(np.concatenate([nodes, fine, -fine]))
+    nodes = np.unique(np.concatenate([nodes, fine, -fine]))
+    near = nodes[np.abs(nodes) <= SPECULAR_STEPS * step + 1e-9]
+    extra = [
+        np.linspace(a, b, int(np.ceil((b - a) / (SPECULAR_SUBSTEP * step) - 1e-9)) + 1)[1:-1]
+        for a, b in itertools.pairwise(near)
+    ]
+    return np.unique(np.concatenate([nodes, *extra])) if extra else nodes
 
 
 def _in_plane(dt: np.ndarray, ratio: np.ndarray, dt_grid: np.ndarray, phi_grid: np.ndarray):

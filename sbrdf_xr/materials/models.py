@@ -37,6 +37,7 @@ __all__ = [
     "fit_microfacet",
     "fit_model",
     "fit_robertson_sandford",
+    "fit_robertson_sandford_core",
     "measure",
     "model_material",
     "model_parameters",
@@ -521,8 +522,87 @@ def fit_microfacet(measurements: xr.Dataset) -> xr.Dataset:
     return out
 
 
+def fit_robertson_sandford_core(measurements: xr.Dataset) -> xr.Dataset:
+    """Fit the Robertson-Sandford model with a specular core to a measurement set.
+
+    The body is :func:`fit_robertson_sandford`'s; the core (Beckmann, one rms slope,
+    a reflectance per wavelength; :mod:`sbrdf_xr.brdf.specular_core`) is then fitted
+    beside it to all the samples (:func:`sbrdf_xr.brdf.specular_core.fit_core`).  The
+    body is then fitted again without the samples where the fitted core exceeds it,
+    and the core again beside it, until the core's rms slope changes by less than 0.1 %
+    (at most :data:`_CORE_ITERATIONS` times): a body fitted to the core's samples
+    widens to take part of the core.  For a
+    near-mirror whose core is narrower than a broad lobe can follow (the Starlink
+    chassis).
+
+    Parameters
+    ----------
+    measurements : xarray.Dataset
+        A measurement set (:func:`sbrdf_xr.materials.tables.validate_measurements`).
+
+    Returns
+    -------
+    xarray.Dataset
+        The fitted model material (``robertson_sandford_core``; attribute ``rms_log``,
+        the core fit's root-mean-square log residual [1]).
+
+    Examples
+    --------
+    >>> spec = model_material("robertson_sandford_core", [550.0], material="glint",
+    ...                       provenance="doc", rho_D=0.3, epsilon=0.1, b=0.1, e=0.3,
+    ...                       core_rho=0.2, core_roughness=0.01)
+    >>> fit = fit_robertson_sandford_core(measure(spec, [20.0, 40.0, 60.0]))
+    >>> fit.attrs["source"], bool(fit.core_rho[0] > 0)
+    ('model:robertson_sandford_core', True)
+    """
+    from .._names import MEASURED, SAMPLE
+    from ..brdf import specular_core
+    from ..geometry import facet_vectors
+    from .schema import reference_mask, validate_measurements
+
+    ds = validate_measurements(measurements, duplicates="mean")
+    wl = np.asarray(ds[WAVELENGTH].values, dtype=np.float64)
+    angles = (ds[THETA_I].values, ds[DELTA_THETA].values, ds[PHI].values)
+    spectra_ = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64)
+    ref = reference_mask(ds)
+    body_at = np.ones(ref.size, dtype=bool)  # the samples the body is fitted to
+    last = np.inf
+    for _ in range(_CORE_ITERATIONS):
+        body = fit_robertson_sandford(ds.isel({SAMPLE: np.flatnonzero(body_at)}))
+        b_vals = spectra(body, *angles)
+        core = specular_core.fit_core(*angles, spectra_, b_vals, reference=ref)
+        if abs(core["core_roughness"] / last - 1.0) < 1e-3:
+            break
+        last = core["core_roughness"]
+        c_vals = specular_core.core_brdf(
+            *facet_vectors(*angles),
+            core["core_rho"],
+            np.full(core["core_rho"].shape, core["core_roughness"]),
+        )
+        body_at = np.all(c_vals < b_vals, axis=1) | ref  # the core's samples left to it
+    name = ds.attrs.get("material", "unnamed")
+    params = {k: body[k].values for k in ("rho_D", "epsilon", "b", "e")}
+    out = model_material(
+        "robertson_sandford_core", wl, material=name,
+        provenance=f"Robertson-Sandford fit with a specular core to the measurements of {name} "
+        f"(core rms slope {core['core_roughness']:.3g}, rms log residual "
+        f"{core['rms_log']:.3g}, {core['n_used']} residuals)",
+        core_rho=core["core_rho"], core_roughness=core["core_roughness"], **params,
+    )  # fmt: skip
+    out.attrs["rms_log"] = core["rms_log"]
+    out.attrs["source"] = "model:robertson_sandford_core"
+    return out
+
+
+#: Most fits of the body and the core of :func:`fit_robertson_sandford_core`.
+_CORE_ITERATIONS = 8
+
 #: The model fits :func:`~sbrdf_xr.materials.build.build_lut` can fill a table with, by name.
-FITS = {"robertson-sandford": fit_robertson_sandford, "microfacet": fit_microfacet}
+FITS = {
+    "robertson-sandford": fit_robertson_sandford,
+    "microfacet": fit_microfacet,
+    "robertson-sandford-core": fit_robertson_sandford_core,
+}
 
 
 def fit_model(measurements: xr.Dataset, name: str = "robertson-sandford") -> xr.Dataset:
@@ -532,7 +612,7 @@ def fit_model(measurements: xr.Dataset, name: str = "robertson-sandford") -> xr.
     ----------
     measurements : xarray.Dataset
         A measurement set.
-    name : {"robertson-sandford", "microfacet"}
+    name : {"robertson-sandford", "microfacet", "robertson-sandford-core"}
         The fit.
 
     Returns

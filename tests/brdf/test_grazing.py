@@ -48,6 +48,7 @@ PARAMS = {
         "rho_d": 0.01,
     },
     "robertson_sandford": dict(RS.TABLE4["AFGL-01"]),
+    "robertson_sandford_core": {**RS.TABLE4["AFGL-01"], "core_rho": 0.2, "core_roughness": 0.01},
 }
 RECIPROCAL = sorted(name for name, m in BRDF_MODELS.items() if m.reciprocal)
 TANGENT = np.array([np.cos(0.4), np.sin(0.4), 0.0])

@@ -352,17 +352,45 @@ def test_a_merl_file_of_a_known_model_round_trips_and_builds(tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("name", "bound"), [("solar-array", 0.10), ("chassis", 0.25)])
-def test_the_starlink_tables_predict_held_out_samples(name, bound):
+def test_the_starlink_solar_array_predicts_held_out_samples():
     """Every 4th sample of each scan left out (the build's own leave-out check), over
-    the samples above 1e-3 of their scan's peak: the solar array meets the 10 % of the
-    issue (1.4 %); the chassis's 1-degree scan does not resolve its sub-degree mirror
-    core (16 %, its wings within a few %), held here against regressions."""
-    meas = catalog.load(f"starlink-v1.5-{name}-measurements")
-    if name == "chassis":  # its 1-degree mirror core, isotropic about specular: rho 1.1-1.4
-        with pytest.warns(NonPhysicalWarning, match="does not conserve energy"):
-            table = build_lut(meas)
-    else:
-        table = build_lut(meas)
+    the samples above 1e-3 of their scan's peak: the issue's 10 % (measured 1.4 %)."""
+    table = build_lut(catalog.load("starlink-v1.5-solar-array-measurements"))
     assert table.attrs["self_check_worst"] < 1e-9
-    assert table.attrs["holdout_check_median"] < bound
+    assert table.attrs["holdout_check_median"] < 0.10
+
+
+@pytest.mark.slow
+def test_the_starlink_chassis_predicts_held_out_samples_with_its_specular_core():
+    """The shipped chassis (a Robertson-Sandford fill with a Beckmann core) against the
+    same leave-out check.  Its 13 held-out samples above the floor: median 10.7 %, 95th
+    percentile 56 %, worst 60 % (16.1 %, 75 %, 76 % with the Robertson-Sandford fill
+    alone).  A 1-D interpolation of each scan's kept samples reaches 17.5 % log-linear
+    (linear, or PCHIP, Akima, cubic in the logarithm: 17.7-24 %): the mirror core,
+    narrower than the 1-degree step, is predicted only by a model that has a core.  The
+    bounds hold the gain (0.12 over a median of 13 samples that moves by a few per cent
+    with one sample)."""
+    table = catalog.load("starlink-v1.5-chassis")
+    assert table.attrs["extrapolation_model"] == "robertson_sandford_core"
+    assert table.attrs["self_check_worst"] < 1e-9
+    assert table.attrs["holdout_check_median"] < 0.12
+    assert table.attrs["holdout_check_p95"] < 0.65
+
+
+def test_the_core_fit_recovers_a_known_core_from_an_in_plane_scan():
+    """A scan of the model itself, 0.5-degree steps: the body is refitted without the
+    core's samples until the core's width settles.  Fitting the body once, to every
+    sample, returns 0.0048 and 0.26 (the body takes part of the core); the iteration
+    brings both within 2 % (what is left is the body's fit, whose own tolerance sets it)."""
+    spec = models.model_material(
+        "robertson_sandford_core", [532.0], material="glint", provenance="test",
+        rho_D=0.05, epsilon=0.5, b=0.05, e=0.04, core_rho=0.4, core_roughness=0.006,
+    )  # fmt: skip
+    ti, dt = np.meshgrid([5.0, 40.0, 60.0], np.arange(-20.0, 20.5, 0.5), indexing="ij")
+    ti, dt = ti.ravel(), dt.ravel()
+    scan = measurement_set(ti, dt, np.zeros(ti.size), [532.0],
+                           models.spectra(spec, ti, dt, 0.0), material="glint",
+                           provenance="test")  # fmt: skip
+    fit = models.fit_model(scan, "robertson-sandford-core")
+    assert float(fit.core_roughness[0]) == pytest.approx(0.006, rel=0.02)
+    assert float(fit.core_rho[0]) == pytest.approx(0.4, rel=0.02)
