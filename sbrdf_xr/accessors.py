@@ -120,7 +120,10 @@ class _Plotter:
 class SbrdfDatasetAccessor:
     """Methods of a simulation cube, as ``ds.sbrdf.photometry(...)`` and friends.
 
-    Each method forwards to the function of the same name in :mod:`sbrdf_xr.photometry`.
+    Each method forwards to the function of the same name in :mod:`sbrdf_xr.photometry`,
+    on the cube with the variables its writer left out computed again
+    (:meth:`with_derived`): a cube opened with :func:`xarray.open_dataset` works as one
+    opened with :func:`sbrdf_xr.store.open_cube`.
 
     Examples
     --------
@@ -144,7 +147,19 @@ class SbrdfDatasetAccessor:
     """
 
     def __init__(self, ds: xr.Dataset) -> None:
-        self._ds = ds
+        self._raw = ds
+
+    @property
+    def _ds(self) -> xr.Dataset:
+        return self.with_derived()
+
+    def with_derived(self) -> xr.Dataset:
+        """:func:`sbrdf_xr.store.derived.with_derived` of this cube: the variables its
+        writer left out (``signal``, ``brdf``; its attribute ``derived_variables``)
+        computed again, so ``cube.sbrdf.with_derived().signal`` reads as before the write."""
+        from .store import derived
+
+        return derived.with_derived(self._raw)
 
     @renamed_keywords(range_km="range")
     def photometry(self, bands: Any, range: Any = None, **kwargs: Any) -> xr.Dataset:

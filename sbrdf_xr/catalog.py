@@ -171,7 +171,9 @@ def _built_material(
         return da
 
     try:
-        da = cached_table(name, _table_inputs(measurements, kw), repr(options), build, write, read)
+        inputs = _table_inputs(measurements, kw)
+        # memory-mapped from a values file beside the cache file: one copy for every process
+        da = cached_table(name, inputs, repr(options), build, write, read, dtype or "float64")
     finally:
         if bar:
             bar[0].n = 100.0 if bar[0].n >= 90.0 else bar[0].n

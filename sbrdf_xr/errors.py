@@ -48,6 +48,7 @@ __all__ = [
     "SceneError",
     "SchedulerError",
     "StalePlanError",
+    "TableFileChangedError",
     "TrackingTableError",
     "UnitError",
     "UnitWarning",
@@ -363,6 +364,12 @@ class StalePlanError(SbrdfError):
     """A compiled evaluator whose plan no longer holds the tables or terms it was compiled
     with (a field replaced, a table array made writeable, or its sampled content changed):
     compile it again from the plan."""
+
+
+class TableFileChangedError(SbrdfError):
+    """A memory-mapped table values file of the table cache
+    (:mod:`sbrdf_xr.materials.mapped`) that changed on disk, or is gone, since its digest
+    was recorded: its values are no longer those a plan or a fingerprint was made from."""
 
 
 class ObservationError(ValidationError):

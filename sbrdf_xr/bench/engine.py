@@ -56,7 +56,12 @@ _WRITTEN = "sweeps written to netCDF, default settings, 141 wavelengths"
 
 
 def sweep_job(
-    n: int, path: str, bands: bool = False, mode: str = "write", workers: int = 0
+    n: int,
+    path: str,
+    bands: bool = False,
+    mode: str = "write",
+    workers: int = 0,
+    outputs: str = "independent",
 ) -> dict[str, float]:
     """Run one sweep in this process (the subprocess side of :func:`engine_rows`).
 
@@ -64,7 +69,8 @@ def sweep_job(
     kernel over the same geometries and threads, outputs discarded), ``compute``
     (every block's outputs computed in full, :func:`~sbrdf_xr.engine.run.run_block`,
     on the same threads, nothing written), ``zarr`` (a LocalCluster of ``workers``
-    single-threaded processes writing a Zarr store).
+    single-threaded processes writing a Zarr store; ``workers=0``: this process's threads).
+    ``outputs``: the writer's (:mod:`sbrdf_xr.store.derived`), ``all`` for every variable.
     Returns seconds (after planning and a warm-up of the compiled kernel) and the
     peak RSS [byte].
 
@@ -76,7 +82,7 @@ def sweep_job(
     >>> import inspect
     >>> from sbrdf_xr.bench.engine import sweep_job
     >>> list(inspect.signature(sweep_job).parameters)
-    ['n', 'path', 'bands', 'mode', 'workers']
+    ['n', 'path', 'bands', 'mode', 'workers', 'outputs']
     >>> sorted(sweep_job(1000, "cube.nc"))  # doctest: +SKIP
     ['blocks', 'rss', 'seconds']
     """
@@ -84,6 +90,7 @@ def sweep_job(
     from ..engine.run import default_n_threads, run_block, simulate
     from ..store import write
 
+    private = _PrivatePeak()  # the peak of this process's own memory, sampled
     scene = _sweep_scene(n, bands)
     plan = scene.plan()
     run_block(plan, slice(0, min(8, n)))  # load the compiled kernel
@@ -114,6 +121,10 @@ def sweep_job(
         with ThreadPoolExecutor(default_n_threads()) as pool:
             list(pool.map(one, blocks))
         seconds = time.perf_counter() - t0
+    elif mode == "zarr" and not workers:
+        t0 = time.perf_counter()
+        write(simulate(plan, lazy=True), path, overwrite=True, outputs=outputs)
+        seconds = time.perf_counter() - t0
     elif mode == "zarr":
         from distributed import Client, LocalCluster
 
@@ -129,16 +140,29 @@ def sweep_job(
         ):
             client.run(lambda: run_block(plan, slice(0, 8)))  # compile on the workers
             t0 = time.perf_counter()
-            write(simulate(plan, client=client), path, overwrite=True, client=client)
+            cube = simulate(plan, client=client)
+            write(cube, path, overwrite=True, client=client, outputs=outputs)
             seconds = time.perf_counter() - t0
     else:
         t0 = time.perf_counter()
-        write(simulate(plan), path, overwrite=True)
+        write(simulate(plan), path, overwrite=True, outputs=outputs)
         seconds = time.perf_counter() - t0
-    out = {"seconds": seconds, "rss": float(_peak_rss()), "blocks": float(plan.n_blocks)}
-    if mode == "write":
-        out["bytes"] = float(os.path.getsize(path))
+    out = {
+        "seconds": seconds,
+        "rss": float(_peak_rss()),
+        "rss_private": float(private.stop()),
+        "blocks": float(plan.n_blocks),
+    }
+    if mode in ("write", "zarr"):
+        out["bytes"] = float(_size(Path(path)))
     return out
+
+
+def _size(path: Path) -> int:
+    """Bytes of a file, or of every file under a directory (a Zarr store)."""
+    if path.is_file():
+        return path.stat().st_size
+    return sum(p.stat().st_size for p in path.rglob("*") if p.is_file())
 
 
 @numba.njit(nogil=True, cache=True)
@@ -201,6 +225,41 @@ def disk_rate(where: str | None = None, nbytes: int = 512 * 2**20) -> float:
     return done / seconds
 
 
+class _PrivatePeak:
+    """The peak of this process's anonymous (private) resident memory [byte], sampled
+    every 5 ms in a thread: what the peak RSS is less the pages of files it maps (the
+    memory-mapped tables, shared by every process that maps them)."""
+
+    def __init__(self) -> None:
+        import threading
+
+        self.peak = 0
+        self.done = threading.Event()
+        self.thread = threading.Thread(target=self._run, daemon=True)
+        self.thread.start()
+
+    def _run(self) -> None:
+        while not self.done.wait(0.005):
+            self.peak = max(self.peak, _status("RssAnon"))
+
+    def stop(self) -> int:
+        self.done.set()
+        self.thread.join()
+        return max(self.peak, _status("RssAnon"))
+
+
+def _status(field: str) -> int:
+    """A memory field of ``/proc/self/status`` [byte] (0 where there is none)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith(field + ":"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return 0
+
+
 def _peak_rss() -> int:
     """Peak resident memory of this process [byte].
 
@@ -226,6 +285,7 @@ def _subprocess(
     workers: int = 0,
     threads: int | None = None,
     where: str | None = None,
+    outputs: str = "independent",
 ) -> dict[str, float]:
     with tempfile.TemporaryDirectory(prefix="sbrdf-bench-", dir=where) as tmp:
         path = str(Path(tmp) / ("cube.zarr" if mode == "zarr" else "cube.nc"))
@@ -245,7 +305,8 @@ def _subprocess(
         )
         code = (
             f"{pin}import json, sys; from sbrdf_xr.bench.engine import sweep_job; "
-            f"print(json.dumps(sweep_job({n}, {path!r}, {bands}, {mode!r}, {workers})))"
+            f"print(json.dumps(sweep_job({n}, {path!r}, {bands}, {mode!r}, {workers}, "
+            f"{outputs!r})))"
         )
         out = subprocess.run(
             [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=False
@@ -278,9 +339,10 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
     sizes = _SIZES_QUICK if quick else _SIZES
     results = {n: _subprocess(n) for n in sizes}
     rows += _sweep_rows(sizes, results)
+    rows += _lean_rows(sizes, results)
     rows += _core_rows(results, repeat)
     if not quick:
-        rows += _cluster_rows()
+        rows += _cluster_rows(results)
     # one geometry: the compiled evaluator against simulate and the bare kernel
     from .calls import single_call_rows
 
@@ -371,7 +433,8 @@ def _sweep_rows(sizes: tuple[int, ...], results: dict[int, dict[str, float]]) ->
                 "bare kernel, same geometries",
                 r["seconds"] / k["seconds"],
                 f"{r['seconds']:.2f} s in {int(r['blocks'])} blocks, peak RSS "
-                f"{r['rss'] / 2**30:.2f} GiB{exp}",
+                f"{r['rss'] / 1e9:.2f} GB (private {r['rss_private'] / 1e9:.2f} GB, the rest "
+                f"file pages: the mapped tables every process shares){exp}",
                 sweep=_WRITTEN,
             )
         )
@@ -474,14 +537,48 @@ def _core_rows(results: dict[int, dict[str, float]], repeat: int) -> list[BenchR
     return rows
 
 
-def _cluster_rows() -> list[BenchRow]:
-    """1e6 attitudes on a LocalCluster of two process workers against one."""
+def _lean_rows(sizes: tuple[int, ...], results: dict[int, dict[str, float]]) -> list[BenchRow]:
+    """Bytes written with the derived variables left out (the default) against every
+    variable written (``outputs="all"``), on the largest sweep."""
+    n = sizes[-1]
+    full = _subprocess(n, outputs="all")
+    lean = results[n]
+    return [
+        BenchRow(
+            f"{n:.0e} attitudes, bytes written, derived variables left out",
+            lean["bytes"],
+            'every variable written (outputs="all")',
+            lean["bytes"] / full["bytes"],
+            f"{lean['bytes'] / 1e6:.0f} MB against {full['bytes'] / 1e6:.0f} MB; "
+            f"{lean['seconds']:.2f} s against {full['seconds']:.2f} s",
+            sweep=_WRITTEN,
+        )
+    ]
+
+
+def _cluster_rows(results: dict[int, dict[str, float]]) -> list[BenchRow]:
+    """1e6 attitudes on a LocalCluster of two process workers against one, and against
+    the threaded default (netCDF, and Zarr written by this process's threads)."""
     rows: list[BenchRow] = []
-    # 1e6: each worker first receives the plan with its tables (about 240 MB), a fixed
-    # cost that a 1e5 sweep (seconds) cannot amortise
+    # the plan travels to each worker once, its tables as handles to their memory-mapped
+    # files (sbrdf_xr.materials.mapped): each worker maps the pages every process shares
     n6 = _SIZES[-1]
     z1 = _subprocess(n6, mode="zarr", workers=1)
     z2 = _subprocess(n6, mode="zarr", workers=2)
+    zt = _subprocess(n6, mode="zarr")
+    nc = results[n6]
+    rows.append(
+        BenchRow(
+            f"{n6:.0e} attitudes, threaded default (netCDF)",
+            nc["seconds"],
+            "LocalCluster, 2 process workers, Zarr by blocks",
+            nc["seconds"] / z2["seconds"],
+            f"2 workers are {nc['seconds'] / z2['seconds']:.2f}x the threaded netCDF write "
+            f"({z2['seconds']:.2f} s against {nc['seconds']:.2f} s) and "
+            f"{zt['seconds'] / z2['seconds']:.2f}x the threaded Zarr write ({zt['seconds']:.2f} s)",
+            sweep=_WRITTEN,
+        )
+    )
     rows.append(
         BenchRow(
             f"{n6:.0e} attitudes, LocalCluster, 1 process worker, Zarr by blocks",

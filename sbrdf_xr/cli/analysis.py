@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SbrdfError, ValidationError
-from ..store import formats
+from ..store import derived, formats
 from .commands import spacecraft_of
 from .output import open_dataset
 
@@ -125,7 +125,6 @@ def cmd_photometry(args: argparse.Namespace) -> int:
     colour V-R        median 0.194 mag
     """
     import numpy as np
-    import xarray as xr
     from tqdm.dask import TqdmCallback
 
     from .. import photometry as phot
@@ -154,7 +153,7 @@ def cmd_photometry(args: argparse.Namespace) -> int:
             )
     colours = _parse_colours(args.colours)
     extinction = _parse_extinction(args.extinction)
-    with xr.open_dataset(args.cube, chunks={}) as cube:
+    with derived.open_cube(args.cube) as cube:  # lazily, its derived variables put back
         range_km = args.range_km
         if range_km is None and "range" not in cube.variables:
             range_km = _cube_range_km(cube)

@@ -152,6 +152,9 @@ def _check_declared(path: Path, variables: Mapping[Any, Any], what: str) -> None
 def open_cube(path: str | Path) -> Any:
     """A loaded simulation cube, or :class:`ValidationError` naming what is missing.
 
+    The variables its writer left out (``brdf``, ``signal`` beside ``signal_material``:
+    :mod:`sbrdf_xr.store.derived`) are computed again.
+
     Examples
     --------
     >>> import tempfile
@@ -173,7 +176,10 @@ def open_cube(path: str | Path) -> Any:
     >>> cube.signal.values.tolist()
     [[0.1, 0.2]]
     """
-    with open_dataset(path) as ds:
+    from ..store.derived import with_derived
+
+    with open_dataset(path) as raw:
+        ds = with_derived(raw)  # the variables its writer left out, computed again
         spectral = [
             v for v in ("spacecraft_sbrdf", "signal") if v in ds and "wavelength" in ds[v].dims
         ]

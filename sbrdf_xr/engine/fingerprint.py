@@ -16,7 +16,10 @@ values array and coordinate variables (index coordinates cannot be written in pl
 equal attributes, checked on every call, so a scene that differs from the last one only in
 geometry or knobs does not hash its tables again; writeable arrays are hashed every time.
 (Making a read-only array writeable again and changing it in place defeats this; the
-catalog's tables are read-only so that they can be shared.)
+catalog's tables are read-only so that they can be shared.)  A catalog table memory-mapped
+from the table cache (:mod:`sbrdf_xr.materials.mapped`) is not read at all: the digest of
+its values was recorded, by the same formula, when its values file was written, and the
+file is checked to be unchanged on every call.
 """
 
 from __future__ import annotations
@@ -34,6 +37,7 @@ import numpy as np
 import xarray as xr
 
 from .._names import __version__
+from ..materials.mapped import recorded_digest
 from ..store.fingerprint import KNOBS_JSON, MATERIAL_NAMES, MATERIAL_PREFIX, PREFIX
 
 if TYPE_CHECKING:
@@ -147,6 +151,9 @@ def _array_sha(a: Any) -> str:
     """
     if not isinstance(a, np.ndarray) or a.dtype.kind in "OUS" or not _read_only(a):
         return _array_sha_now(a)
+    recorded = recorded_digest(a)  # a memory-mapped table: its digest without its pages
+    if recorded is not None:
+        return recorded
     key, layout = id(a), _layout(a)
     with _DIGESTS_LOCK:
         hit = _DIGESTS.get(key)

@@ -34,6 +34,7 @@ from .._names import BAND, FACET, MATERIAL, PSI, WAVELENGTH, __version__
 from ..errors import SceneError
 from ..kernels import PackedTables
 from ..kernels.anisotropic import AnisotropicTable
+from ..materials.mapped import restore, share
 from ..materials.models import model_parameters
 from ..store.fingerprint import PREFIX
 from .articulation import Articulation, describe_parts, group_terms
@@ -203,6 +204,25 @@ class Plan:
     articulation: Any = None
     #: Products of the plan made on first use (the cube's coordinate template).
     cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    # ----------------------------------------------------------- pickling
+    def __getstate__(self) -> dict[str, Any]:
+        """The plan as it travels to a Dask worker: each table that views a memory-mapped
+        values file of the table cache as a handle to it (the file, its digest and which
+        bytes: :func:`sbrdf_xr.materials.mapped.share`), not its values; the cache of
+        products made on first use left behind."""
+        state = dict(self.__dict__)
+        state["tables"] = self.tables._replace(values=tuple(map(share, self.tables.values)))
+        state["cache"] = {}
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        """A pickled plan restored: its mapped tables mapped in this process (once per file),
+        a file changed on disk since it was recorded refused
+        (:class:`~sbrdf_xr.errors.TableFileChangedError`)."""
+        tables = state["tables"]
+        state["tables"] = tables._replace(values=tuple(map(restore, tables.values)))
+        self.__dict__.update(state)
 
     # ----------------------------------------------------------- derived
     def __getattr__(self, name: str) -> bool:

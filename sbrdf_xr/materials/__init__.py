@@ -21,6 +21,9 @@ Modules
 ``cache``
     The disk cache of tables built on load from their measurements, keyed by their inputs
     and the sources of the code that builds them.
+``mapped``
+    The cached tables memory-mapped from values files beside them: one copy in memory
+    for every process and Dask worker, handed to workers as handles.
 ``files``
     Lossless, atomic netCDF files of tables and measurement sets.
 ``model_schema`` and ``models``
@@ -47,6 +50,7 @@ from . import (
     energy,
     files,
     goniometer,
+    mapped,
     merl,
     model_schema,
     models,
@@ -125,6 +129,7 @@ __all__ = [
     "lambertian",
     "lookup",
     "lookup_anisotropic",
+    "mapped",
     "merl",
     "model_material",
     "model_parameters",

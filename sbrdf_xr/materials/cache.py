@@ -20,13 +20,14 @@ import os
 import re
 import warnings
 from collections.abc import Callable, Iterable, Iterator
-from functools import cache
+from functools import cache, partial
 from pathlib import Path
 
 import xarray as xr
 
 from .._output import file_kind
 from ..errors import CacheWarning, OutputError
+from .mapped import mapped_table
 
 __all__ = ["build_modules", "cache_dir", "cache_file", "cached_table", "source_digest"]
 
@@ -285,6 +286,7 @@ def cached_table(
     build: Callable[[], xr.DataArray],
     write: Callable[[xr.DataArray, Path], object],
     read: Callable[[Path], xr.DataArray],
+    dtype: str | None = None,
 ) -> xr.DataArray:
     """The table ``build()`` would give, from the cache when it is there.
 
@@ -303,6 +305,11 @@ def cached_table(
         Builds the table (called only when no cache file is there).
     write, read : callable
         Write a table to a path (atomically) and read it back.
+    dtype : str, optional
+        Return the table with its values memory-mapped in this dtype (``float64`` or
+        ``float32``) from a values file beside the cache file
+        (:func:`sbrdf_xr.materials.mapped.mapped_table`): every process shares one copy of
+        it in memory.  None: read into memory.
 
     Returns
     -------
@@ -330,6 +337,8 @@ def cached_table(
     if path is None:
         return build()
     d = path.parent
+    if dtype is not None:  # mapped: the values file beside the table, or made from it
+        read = partial(mapped_table, read=read, dtype=dtype)
     if file_kind(path) == "file":  # a symbolic link or special file there is not followed
         try:
             return read(path)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import warnings
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -35,6 +36,11 @@ from .._names import (
 from ..errors import NonPhysicalWarning, ValidationError
 from ..units import check_wavelengths, to_unit
 from .coverage import snap_angles
+
+#: Tests that an array's values were checked already (finite, non-negative), so that
+#: :func:`validate_material` need not read them: a table memory-mapped from the table
+#: cache, checked when its file was written (registered by :mod:`sbrdf_xr.materials.mapped`).
+VALUES_CHECKED: list[Callable[[Any], bool]] = []
 
 __all__ = [
     "DUPLICATES",
@@ -181,7 +187,7 @@ def validate_material(da: xr.DataArray, *, check_values: bool = True) -> xr.Data
     if "source" in da.attrs:
         _check_source(da.attrs["source"])
     _check_float(da, SBRDF)
-    if check_values:
+    if check_values and not any(checked(da.variable.data) for checked in VALUES_CHECKED):
         v = np.asarray(da.values)
         if not np.all(np.isfinite(v)):
             raise ValidationError(

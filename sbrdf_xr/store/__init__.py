@@ -19,6 +19,9 @@ Modules
 ``layout``, ``files``, ``disk``, ``runners``, ``progress``, ``lock``
     The block layout, the files of a netCDF cube being written, disk durability and the
     words for its failures, the block computation, progress bars, the writer lock.
+``derived``
+    The variables computed from others: left out by the writers unless asked, put back on
+    read by :func:`open_cube`.
 ``fingerprint``
     The content fingerprint a cube stores as global attributes (computed by the engine,
     :mod:`sbrdf_xr.engine.fingerprint`), and what changed between two.
@@ -32,6 +35,7 @@ from ..errors import (
     WorkersLostError,
 )
 from . import (
+    derived,
     disk,
     files,
     fingerprint,
@@ -43,6 +47,7 @@ from . import (
     writer,
     zarr_store,
 )
+from .derived import open_cube
 from .files import LOG_SUFFIX, PART_SUFFIX
 from .formats import FORMATS, Format, check, format_for, save_figure, write
 from .layout import BlockLayout, layout_of
@@ -67,6 +72,7 @@ __all__ = [
     "WorkersLostError",
     "check",
     "connect",
+    "derived",
     "disk",
     "files",
     "fingerprint",
@@ -75,6 +81,7 @@ __all__ = [
     "layout",
     "layout_of",
     "lock",
+    "open_cube",
     "progress",
     "runners",
     "save_figure",

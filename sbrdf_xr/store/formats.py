@@ -46,6 +46,7 @@ from .._output import (
     refuse_special,
 )
 from ..errors import CubeWriteError, OutputError, ValidationError
+from .derived import lean
 from .files import LOG_SUFFIX, PART_SUFFIX, read_log
 from .files import check_destination as cube_destination
 from .layout import describe_chunks, encode_times
@@ -65,6 +66,7 @@ __all__ = [
     "table_to_csv",
     "write",
     "write_netcdf_cube",
+    "write_zarr_cube",
 ]
 
 #: What the package writes, one kind per sort of object, and its name in messages.
@@ -131,9 +133,12 @@ class Format:
     unfinished: Callable[[str | os.PathLike[str]], str | None] | None = None
 
 
-def write_netcdf_cube(cube: Any, path: str | os.PathLike[str], **options: Any) -> Path:
+def write_netcdf_cube(
+    cube: Any, path: str | os.PathLike[str], *, outputs: str = "independent", **options: Any
+) -> Path:
     """:func:`~sbrdf_xr.store.writer.write_cube` of ``cube`` with its times encoded as CF
-    numbers (:func:`~sbrdf_xr.store.layout.encode_times`).
+    numbers (:func:`~sbrdf_xr.store.layout.encode_times`), its derived variables left out
+    unless ``outputs="all"`` (:func:`~sbrdf_xr.store.derived.lean`).
 
     Examples
     --------
@@ -150,7 +155,30 @@ def write_netcdf_cube(cube: Any, path: str | os.PathLike[str], **options: Any) -
     ...         print(back.time.values.tolist() == cube.time.values.tolist())
     True
     """
-    return write_cube(encode_times(cube), path, **options)
+    return write_cube(encode_times(lean(cube, outputs)), path, **options)
+
+
+def write_zarr_cube(
+    cube: Any, path: str | os.PathLike[str], *, outputs: str = "independent", **options: Any
+) -> Path:
+    """:func:`~sbrdf_xr.store.zarr_store.write_zarr` of ``cube``, its derived variables left
+    out unless ``outputs="all"`` (:func:`~sbrdf_xr.store.derived.lean`).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import xarray as xr
+    >>> from sbrdf_xr.store.formats import write_zarr_cube
+    >>> cube = xr.Dataset({"signal_material": (("g", "material"), [[1.0, 2.0]]),
+    ...                    "signal": ("g", [3.0])}).chunk(g=1)
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = write_zarr_cube(cube, Path(tmp) / "cube.zarr")
+    ...     with xr.open_zarr(path) as back:
+    ...         print(list(back.data_vars))
+    ['signal_material']
+    """
+    return write_zarr(lean(cube, outputs), path, **options)
 
 
 def _netcdf_unfinished(path: str | os.PathLike[str]) -> str | None:
@@ -285,7 +313,7 @@ FORMATS: dict[str, Format] = {
             "zarr-cube",
             "cube",
             (".zarr",),
-            write_zarr,
+            write_zarr_cube,
             "Zarr",
             "a cube as a Zarr store, each block stored by the worker that computes it",
             directory=True,
@@ -503,7 +531,11 @@ def write(obj: Any, path: str | os.PathLike[str], *, kind: str = "cube", **optio
     in ``.zarr`` a Zarr store whose blocks the Dask workers (or threads) that compute
     them store themselves (:func:`~sbrdf_xr.store.zarr_store.write_zarr`); both take
     ``overwrite``, ``resume``, ``client``, ``scheduler``, ``max_in_flight``, ``progress``,
-    ``complevel`` and ``on_block``.
+    ``complevel`` and ``on_block``.  A cube is written with its independent variables
+    only (``outputs="independent"``, the default): those computed from others
+    (``brdf``, and ``signal`` beside ``signal_material``) are recorded and computed again
+    on read by :func:`~sbrdf_xr.store.derived.open_cube`; ``outputs="all"`` writes every
+    variable (:mod:`sbrdf_xr.store.derived`).
 
     Returns
     -------

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import dask
 import numpy as np
+from dask.core import istask
 from dask.system import CPU_COUNT
 
 from .._output import cli_style, libc_function
@@ -28,6 +29,8 @@ from .files import again_hint
 if TYPE_CHECKING:
     from .layout import BlockLayout
 
+#: Graph values sent as they are (a key, a number, a small literal), never scattered.
+_PLAIN = (str, bytes, int, float, complex, bool, tuple, list, type(None))
 _SYNC_NAMES = ("sync", "synchronous", "single-threaded")
 _THREAD_NAMES = ("threads", "threading")
 
@@ -235,6 +238,8 @@ class _DistributedRunner:
         self.owned = owned
         self.done = as_completed(loop=client.loop)
         self.futures: dict[str, tuple[int, Any]] = {}
+        #: data values of the graphs, scattered once (:meth:`_shared`), by key
+        self.shared: dict[Any, Any] = {}
         self.n_workers = max(1, sum(client.nthreads().values()))
 
     @property
@@ -242,9 +247,20 @@ class _DistributedRunner:
         return len(self.futures)
 
     def submit(self, k: int, task: tuple[dict[Any, Any], Any]) -> None:
-        fut = self.client.get(task[0], task[1], sync=False)
+        graph = {key: self._shared(key, value) for key, value in task[0].items()}
+        fut = self.client.get(graph, task[1], sync=False)
         self.futures[fut.key] = (k, fut)
         self.done.add(fut)
+
+    def _shared(self, key: Any, value: Any) -> Any:
+        """A value the graph holds as data (the plan of a cube computed without this
+        client) sent to every worker once, by key; each block's graph then names it
+        instead of carrying it (a task or a plain value is left as it is)."""
+        if istask(value) or isinstance(value, _PLAIN):
+            return value
+        if key not in self.shared:
+            self.shared[key] = self.client.scatter(value, broadcast=True, hash=False)
+        return self.shared[key]
 
     def _workers(self) -> int:
         try:
@@ -317,6 +333,7 @@ class _DistributedRunner:
             if self.futures:
                 self.client.cancel([f for _, f in self.futures.values()])
         self.futures.clear()
+        self.shared.clear()  # the scattered values, released
         if self.owned:
             with contextlib.suppress(Exception):
                 self.client.close()

@@ -256,6 +256,7 @@ def test_workers_write_their_own_zarr_blocks_on_a_local_cluster(tmp_path):
         ) as cluster,
         distributed.Client(cluster) as client,
     ):
-        path = write(simulate(s, client=client), tmp_path / "c.zarr", client=client)
+        # every variable written (outputs="all"), to compare with the cube as simulated
+        path = write(simulate(s, client=client), tmp_path / "c.zarr", client=client, outputs="all")
     with xr.open_zarr(path) as back:
         xr.testing.assert_identical(back.load(), ref)

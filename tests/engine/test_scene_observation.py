@@ -11,7 +11,7 @@ from sbrdf_xr.engine import Scene, builtin_scene, load_scene
 from sbrdf_xr.engine.run import simulate
 from sbrdf_xr.errors import SceneError
 from sbrdf_xr.observing import observe
-from sbrdf_xr.store import write
+from sbrdf_xr.store import open_cube, write
 
 PASS_TOML = """
 name = "toml-pass"
@@ -77,9 +77,14 @@ def test_umbra_is_skipped_and_the_penumbra_scales_the_sunlight(cube):
 
 
 def test_pass_round_trips_through_netcdf(cube, tmp_path):
-    path = write(cube, tmp_path / "pass.nc")
+    path = write(cube, tmp_path / "pass.nc", outputs="all")  # every variable
     with xr.open_dataset(path) as back:
         xr.testing.assert_identical(back.load(), cube)
+    # by default the derived ones (brdf) are left out and computed again on read
+    lean = write(cube, tmp_path / "lean.nc")
+    with open_cube(lean) as back:
+        xr.testing.assert_allclose(back.load(), cube, rtol=1e-12, atol=0)
+        assert back.brdf.attrs == cube.brdf.attrs
 
 
 def test_toml_observation_scene(tmp_path):
