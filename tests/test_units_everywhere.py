@@ -876,6 +876,12 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.photometry.atmosphere.rayleigh_optical_depth": lambda: dict(
         wavelength=WL, pressure=700.0
     ),
+    "sbrdf_xr.photometry.limb.limb_ray": lambda: dict(
+        position=[[7000.0, 0.0, 0.0]], to_sun=[[-0.2, 0.98, 0.0]]
+    ),
+    "sbrdf_xr.photometry.limb.limb_transmission": lambda: dict(
+        tangent_height=[25.0, 40.0], distance=2700.0, wavelength=550.0, sun_radius=0.2666
+    ),
     "sbrdf_xr.photometry.atmosphere.transmission": lambda: dict(
         wavelength=WL, airmass=1.5, pressure=700.0
     ),

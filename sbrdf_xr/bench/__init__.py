@@ -54,7 +54,7 @@ from .shadowing import (
     markdown,
     scaling_rows,
 )
-from .starlink import pomenis_table, predict_starlink, starlink_scene
+from .starlink import limb_sunlight, pomenis_table, predict_starlink, starlink_scene
 from .suite import bench_build_lut, bench_geometry, bench_lookup, kernel_throughput, run
 
 __all__ = [
@@ -82,6 +82,7 @@ __all__ = [
     "geometries",
     "kernel_throughput",
     "lambertian_signal",
+    "limb_sunlight",
     "load_presets",
     "load_warning",
     "markdown",

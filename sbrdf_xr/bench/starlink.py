@@ -23,7 +23,14 @@ and azimuth of a Starlink v1.5 satellite seen from Mount Lemmon, and its AB magn
   Bond albedo 0.3 of finite size (the package's ``earthshine`` effect with its default
   ``earth_model="finite"``: each facet's irradiance integrated over the sunlit Earth its
   horizon sees, the BRDF taken at the direction of the Earth's centre; no measured Earth
-  BRDF).
+  BRDF);
+* the atmosphere at the Earth's limb (``predict_starlink(atmosphere=True)``, the
+  default): near the edge of the Earth's shadow the satellite's sunlight has crossed
+  the atmosphere low over the limb; :func:`limb_sunlight` gives its refraction and
+  extinction (:mod:`sbrdf_xr.photometry.limb`: US Standard Atmosphere 1976, Rayleigh
+  and ozone in V, averaged over the Sun's disc), which replaces the solid Earth's
+  sunlit fraction.  On these rows the ray's lowest point is 2-550 km up; below ~40 km
+  the sunlight is dimmed by 0.3 to 4 mag.  Nothing in it is fitted to the magnitudes.
 
 Band: the scans are at 532 nm and the surfaces are taken as grey, so the tables are
 continued as constants (``band_extrapolate="constant"``) and the magnitudes are AB in the
@@ -53,6 +60,7 @@ __all__ = [
     "POMENIS_DATA",
     "SPHERE_AREA_ALBEDO",
     "STARLINK_TABLES",
+    "limb_sunlight",
     "pomenis_table",
     "predict_starlink",
     "starlink_scene",
@@ -174,24 +182,110 @@ def _mags(signal: xr.DataArray) -> xr.DataArray:
     return magnitudes(signal, _BAND, system="AB", extrapolate="constant")
 
 
-def predict_starlink(table: Any = None, **scene_options: Any) -> xr.Dataset:
+def limb_sunlight(table: Any = None) -> xr.Dataset:
+    """The sunlight that reaches the satellite of every row through the Earth's limb.
+
+    The satellite's position (the table's, rotated to the ITRS by skyfield) and the
+    Sun's (DE421) give the straight ray toward the Sun
+    (:func:`~sbrdf_xr.photometry.limb.limb_ray`); its refraction and extinction by the
+    atmosphere, averaged over the Sun's disc, give the factor on the sunlight
+    (:func:`~sbrdf_xr.photometry.limb.limb_transmission` in V: 550 nm, ozone 0.03).
+
+    Parameters
+    ----------
+    table : TrackingTable, optional
+        Default :func:`pomenis_table`.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``time``: ``tangent_height`` and ``limb_distance`` [km], ``limb_transmission``
+        [1].
+
+    Examples
+    --------
+    Of the first rows, the first passes 352 km above the Earth, the 29th grazes it at 22 km
+    and keeps 31 % of the sunlight (the mean Sun distance of the rows sets the disc):
+
+    >>> limb = limb_sunlight(pomenis_table(rows=slice(0, 29, 28)))
+    >>> limb.tangent_height.values.round(1), limb.limb_transmission.values.round(3)
+    (array([352.1,  22.2]), array([1.   , 0.313]))
+    """
+    from skyfield.framelib import itrs
+
+    from ..observing.timescales import skyfield_data, skyfield_time
+    from ..photometry.limb import limb_ray, limb_transmission
+
+    table = pomenis_table() if table is None else table
+    _, eph = skyfield_data()
+    t = skyfield_time(np.asarray(table.times))
+    rot = itrs.rotation_at(t)
+    sun = np.einsum(
+        "ijn,jn->ni", rot, np.reshape((eph["sun"] - eph["earth"]).at(t).position.km, (3, -1))
+    )
+    sat = np.einsum("ijn,nj->ni", rot, table.positions())
+    height, distance = limb_ray(sat, sun - sat)
+    # the Sun's angular radius at the rows' mean distance (+-1.7 % over the year)
+    radius = np.degrees(np.arcsin(695700.0 / np.mean(np.linalg.norm(sun - sat, axis=1))))
+    trans = limb_transmission(height, distance, wavelength=550.0, sun_radius=radius)
+    return xr.Dataset(
+        {
+            "tangent_height": (
+                "time",
+                height,
+                {
+                    "units": "km",
+                    "long_name": "least height above WGS84 of the straight ray to the Sun",
+                },
+            ),
+            "limb_distance": (
+                "time",
+                distance,
+                {
+                    "units": "km",
+                    "long_name": "distance from the ray's lowest point to the satellite",
+                },
+            ),
+            "limb_transmission": (
+                "time",
+                trans,
+                {
+                    "units": "1",
+                    "long_name": "sunlight through the Earth's limb (refraction, Rayleigh, ozone), "
+                    "per unit sunlight",
+                },
+            ),
+        },
+        coords={"time": np.asarray(table.times)},
+    )
+
+
+def predict_starlink(
+    table: Any = None, *, atmosphere: bool = True, **scene_options: Any
+) -> xr.Dataset:
     """Predicted and observed AB magnitudes at every row of ``table`` (module docstring).
 
     Parameters
     ----------
     table : TrackingTable, optional
         With the column ``ab_magnitude``; default :func:`pomenis_table`.
+    atmosphere : bool
+        Dim the sunlight by the Earth's limb (:func:`limb_sunlight`), in place of the
+        solid Earth's sunlit fraction of the Sun's disc.
     **scene_options
         ``shadowing``, ``earthshine``, ``materials`` of :func:`starlink_scene`.
 
     Returns
     -------
     xarray.Dataset
-        Over ``time``: ``magnitude_observed``, ``magnitude_model`` (sunlight and, if on,
-        earthshine), ``magnitude_sunlight``, ``magnitude_sphere``, ``signal_chassis`` and
-        ``signal_array`` [m2 sr-1], with the coordinates ``phase_angle``, ``elevation``,
-        ``site_sun_elevation``, ``range``, ``sunlit_fraction``.  Magnitudes are AB in
-        Bessell V (``band`` attribute), before any zero point.
+        Over ``time``: ``magnitude_observed``, ``magnitude_model`` (sunlight through the
+        limb if ``atmosphere``, and, if on, earthshine), ``magnitude_sunlight`` (the
+        sunlight part), ``magnitude_sphere``, ``signal_chassis`` and ``signal_array``
+        [m2 sr-1] (sunlight in the solid Earth's shadow), with the coordinates
+        ``phase_angle``, ``elevation``, ``site_sun_elevation``, ``range``,
+        ``sunlit_fraction`` and, if ``atmosphere``, ``tangent_height`` and
+        ``limb_transmission``.  Magnitudes are AB in Bessell V (``band`` attribute),
+        before any zero point.
 
     Examples
     --------
@@ -212,9 +306,20 @@ def predict_starlink(table: Any = None, **scene_options: Any) -> xr.Dataset:
     scene = starlink_scene(table, **scene_options)
     cube = simulate(scene).compute()
     sun = cube["signal"]
-    total = sun + cube["signal_earthshine"] if "signal_earthshine" in cube else sun
     geo = ("phase_angle", "elevation", "site_sun_elevation", "range", "sunlit_fraction")
     coords = {k: cube[k] for k in geo}
+    if atmosphere:
+        limb = limb_sunlight(table)
+        # the limb's factor holds the solid Earth's cut of the disc: the sunlit fraction
+        # the eclipse effect applied is taken out (no row is in the umbra, where it is 0)
+        frac = np.asarray(cube["sunlit_fraction"].values)
+        factor = np.divide(
+            limb.limb_transmission.values, frac, out=np.zeros_like(frac), where=frac > 0
+        )
+        sun = sun * xr.DataArray(factor, dims="time")
+        for k in ("tangent_height", "limb_transmission"):
+            coords[k] = xr.DataArray(limb[k].values, dims="time", attrs=limb[k].attrs)
+    total = sun + cube["signal_earthshine"] if "signal_earthshine" in cube else sun
     alpha = np.asarray(cube["phase_angle"].values)
     from ..photometry import lambert_sphere_phase
 
@@ -240,7 +345,8 @@ def predict_starlink(table: Any = None, **scene_options: Any) -> xr.Dataset:
     )
     long = {
         "magnitude_model": "predicted AB magnitude: sunlight and earthshine",
-        "magnitude_sunlight": "predicted AB magnitude: sunlight only",
+        "magnitude_sunlight": "predicted AB magnitude: sunlight only"
+        + (" (through the limb)" if atmosphere else ""),
         "magnitude_sphere": "AB magnitude of the diffuse (Lambert) sphere control",
         "signal_chassis": "radiometric signal of the chassis, sunlight",
         "signal_array": "radiometric signal of the solar array, sunlight",
@@ -252,6 +358,12 @@ def predict_starlink(table: Any = None, **scene_options: Any) -> xr.Dataset:
         effects=", ".join(scene.plan().effects),
         earthshine="Lambertian Earth, Bond albedo 0.3, finite disc (earth_model finite)",
         attitude="YawSteering: -z on the geodetic nadir, +y toward the Sun; array sun-tracking",
+        atmosphere=(
+            "sunlight through the Earth's limb: refraction, Rayleigh and ozone (V, US "
+            "Standard Atmosphere 1976), over the Sun's disc"
+            if atmosphere
+            else "none: the solid Earth's shadow"
+        ),
         sphere_area_albedo_m2=SPHERE_AREA_ALBEDO,
         source=table.source,
     )

@@ -43,7 +43,9 @@ naming the argument); bare wavelength axes and ranges far outside their unit's s
 with the likely mistake.
 
 Modules: ``spectra`` (reference spectra, quadrature), ``bands``, ``magnitude``,
-``atmosphere``, ``standard``, ``colour``, ``colour_science``, ``inband``, ``infrared``,
+``atmosphere``, ``limb`` (sunlight through the Earth's limb to a spacecraft:
+:func:`limb_ray`, :func:`limb_transmission`), ``standard``, ``colour``,
+``colour_science``, ``inband``, ``infrared``,
 ``files``.  The names of the measured-light-curve workflow that lived here
 (``read_light_curve``, ``compare``, ``plot_comparison``,
 ``compare_magnitudes``, ...) are served under this old path until the next release, with a
@@ -140,6 +142,7 @@ from . import (
     files,
     inband,
     infrared,
+    limb,
     magnitude,
     spectra,
     standard,
@@ -167,6 +170,7 @@ from .colour import srgb
 from .colour_science import from_colour, to_colour
 from .files import cf_decode, cf_encode, open_photometry, to_netcdf
 from .inband import in_band
+from .limb import OZONE_OPTICAL_DEPTH_V, limb_ray, limb_transmission
 from .magnitude import band_signal, colour_indices, magnitudes, photometry, sun_magnitudes
 from .spectra import (
     AB_ZERO_POINT_JY,
@@ -195,6 +199,7 @@ __all__ = [
     "AIRMASS_MODELS",
     "BAND_ALIASES",
     "MAGNITUDE_SYSTEMS",
+    "OZONE_OPTICAL_DEPTH_V",
     "PHASE_FUNCTIONS",
     "QUADRATURES",
     "SOLAR_SPECTRA",
@@ -225,6 +230,9 @@ __all__ = [
     "inband",
     "infrared",
     "lambert_sphere_phase",
+    "limb",
+    "limb_ray",
+    "limb_transmission",
     "magnitude",
     "magnitudes",
     "open_photometry",
