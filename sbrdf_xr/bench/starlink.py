@@ -29,8 +29,9 @@ and azimuth of a Starlink v1.5 satellite seen from Mount Lemmon, and its AB magn
   the atmosphere low over the limb; :func:`limb_sunlight` gives its refraction and
   extinction (:mod:`sbrdf_xr.photometry.limb`: US Standard Atmosphere 1976, Rayleigh
   and ozone in V, averaged over the Sun's disc), which replaces the solid Earth's
-  sunlit fraction.  On these rows the ray's lowest point is 2-550 km up; below ~40 km
-  the sunlight is dimmed by 0.3 to 4 mag.  Nothing in it is fitted to the magnitudes.
+  sunlit fraction.  On these rows the ray's lowest point is 0.1-553 km up; at the 74
+  below 40 km the sunlight is dimmed by 0.1 to 3.8 mag.  Nothing in it is fitted to the
+  magnitudes.
 
 Band: the scans are at 532 nm and the surfaces are taken as grey, so the tables are
 continued as constants (``band_extrapolate="constant"``) and the magnitudes are AB in the
