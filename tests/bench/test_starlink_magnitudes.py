@@ -101,11 +101,11 @@ def _skyfield_geometry(table):
         for _ in range(60):
             rho = 0.5 * (lo + hi)
             rel = here.from_altaz(
-                alt_degrees=table.elevation_deg[k], az_degrees=table.azimuth_deg[k],
+                alt_degrees=table.elevation[k], az_degrees=table.azimuth[k],
                 distance=Distance(km=rho),
             )  # fmt: skip
             sat = Geocentric((here.position.km + rel.position.km) / AU_KM, t=t, center=399)
-            high = wgs84.height_of(sat).km > table.height_km[k]
+            high = wgs84.height_of(sat).km > table.height[k]
             lo, hi = (lo, rho) if high else (rho, hi)
         sun = (eph["sun"] - eph["earth"]).at(t).position.km
         r = sat.position.km
