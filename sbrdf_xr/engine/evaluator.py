@@ -36,7 +36,7 @@ import numpy as np
 from ..errors import DirectionError, SceneError, StalePlanError
 from ..kernels.sums import BoundSums
 from .effects import EFFECTS, BlockInputs, finish
-from .effects.base import _trapezoid_weights
+from .effects.base import trapezoid_weights
 from .sweep import GridGeometry
 
 if TYPE_CHECKING:
@@ -447,18 +447,17 @@ class Evaluator:
         steps of :func:`~sbrdf_xr.engine.effects.finish` this plan needs; None where the
         input is not two plain vectors of unit length (the general path then raises the
         error that says why)."""
-        if not (_three(to_sun) and _three(to_observer)):
+        lean, bound = self._lean, self._bound
+        if lean is None or bound is None or not (_three(to_sun) and _three(to_observer)):
             return None
         self.check()
         try:
-            ok, sig, pap, area, pm = self._bound.one(  # type: ignore[union-attr]
-                to_sun, to_observer, UNIT_TOLERANCE, self._lean.eq4
-            )
+            got: Any = bound.one(to_sun, to_observer, UNIT_TOLERANCE, lean.eq4)
         except (TypeError, ValueError):
             return None
+        ok, sig, pap, area, pm = got
         if not ok:
             return None
-        lean = self._lean
         out: dict[str, np.ndarray] = {}
         for name in self.output_names:
             if name == "signal":
@@ -496,7 +495,7 @@ class _Lean(NamedTuple):
     are pre-integrated) and the outputs' dtype."""
 
     eq4: bool
-    trapezoid: np.ndarray | None
+    trapezoid: np.ndarray
     band: np.ndarray | None
     dtype: np.dtype
 
@@ -519,7 +518,7 @@ def _lean(plan: Plan) -> _Lean | None:
     pre = plan.pre_integrated or plan.band_weights is None
     return _Lean(
         "spacecraft_sbrdf" in names or "brdf" in names,
-        _trapezoid_weights(plan) if "brdf" in names else None,
+        trapezoid_weights(plan),
         None if pre else plan.band_weights,
         np.dtype(plan.knobs["dtype"]),
     )
