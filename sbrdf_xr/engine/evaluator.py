@@ -29,13 +29,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
 from ..errors import DirectionError, SceneError, StalePlanError
 from ..kernels.sums import BoundSums
 from .effects import EFFECTS, BlockInputs, finish
+from .effects.base import trapezoid_weights
 from .sweep import GridGeometry
 
 if TYPE_CHECKING:
@@ -250,6 +251,7 @@ class Evaluator:
                 "signal_material" in self.output_names,
                 t.normal_rows,
             )
+        self._lean = _lean(plan) if self._bound is not None and self._bound.n_terms else None
 
     def __reduce__(self) -> tuple[Any, tuple[()]]:
         # an evaluator is not sent along with its plan (its kernel entry point cannot
@@ -401,6 +403,10 @@ class Evaluator:
         ...
         sbrdf_xr.errors.DirectionError: to_sun has 1 rows and to_observer 2; allowed: ...
         """
+        if self._lean is not None and attitudes is None and sun_scale is None and not sources:
+            one = self._one(to_sun, to_observer)
+            if one is not None:
+                return one
         s = _vectors(to_sun, "to_sun")
         o = _vectors(to_observer, "to_observer")
         if s.shape != o.shape:
@@ -436,6 +442,40 @@ class Evaluator:
         n = len(block.lead_shape)
         return {k: v.reshape((*lead, *v.shape[n:])) for k, v in out.items()}
 
+    def _one(self, to_sun: Any, to_observer: Any) -> dict[str, np.ndarray] | None:
+        """One body-frame geometry in one compiled call (:meth:`BoundSums.one`) and the
+        steps of :func:`~sbrdf_xr.engine.effects.finish` this plan needs; None where the
+        input is not two plain vectors of unit length (the general path then raises the
+        error that says why)."""
+        lean, bound = self._lean, self._bound
+        if lean is None or bound is None or not (_three(to_sun) and _three(to_observer)):
+            return None
+        self.check()
+        try:
+            got: Any = bound.one(to_sun, to_observer, UNIT_TOLERANCE, lean.eq4)
+        except (TypeError, ValueError):
+            return None
+        ok, sig, pap, area, pm = got
+        if not ok:
+            return None
+        out: dict[str, np.ndarray] = {}
+        for name in self.output_names:
+            if name == "signal":
+                out[name] = sig[0]
+            elif name == "spacecraft_sbrdf":
+                out[name] = pap[0]
+            elif name == "area":
+                out[name] = area.reshape(())
+            elif name == "brdf":
+                out[name] = np.einsum("gl,l->g", pap, lean.trapezoid).astype(lean.dtype)[0]
+            elif name == "signal_material":
+                out[name] = pm[0]
+            elif lean.band is None:  # band_signal, the tables pre-integrated
+                out[name] = sig[0].astype(lean.dtype)
+            else:
+                out[name] = np.einsum("gl,bl->gb", sig, lean.band).astype(lean.dtype)[0]
+        return out
+
     def _extra(self, sources: Mapping[str, Any] | None, n: int) -> dict[str, np.ndarray]:
         """The other sources' arrays, exactly the keys the plan's geometry carries."""
         if not sources and not self._sources:
@@ -447,6 +487,48 @@ class Evaluator:
                 f"{sorted(self._sources)}"
             )
         return {k: np.asarray(v, dtype=np.float64) for k, v in given.items()}
+
+
+class _Lean(NamedTuple):
+    """What the one-geometry path needs of :func:`~sbrdf_xr.engine.effects.finish`: the
+    division of Eq. 4, the trapezoid weights, the band weights (None when the tables
+    are pre-integrated) and the outputs' dtype."""
+
+    eq4: bool
+    trapezoid: np.ndarray
+    band: np.ndarray | None
+    dtype: np.dtype
+
+
+#: The outputs :meth:`Evaluator._one` computes as ``finish`` does.
+_LEAN_OUTPUTS = frozenset(
+    {"signal", "spacecraft_sbrdf", "area", "brdf", "signal_material", "band_signal"}
+)
+
+
+def _lean(plan: Plan) -> _Lean | None:
+    """The one-geometry steps of a fast plan, or None if its outputs need others."""
+    names = set(plan.output_names)
+    if not names <= _LEAN_OUTPUTS or not plan.tables.values or plan.geometry.sources:
+        return None
+    if "band_signal" in names:
+        keys = {"signal", "paper", "area", "signal_material"}
+        if [k for e in plan.active_effects for k in e.band if k in keys] != ["signal"]:
+            return None
+    pre = plan.pre_integrated or plan.band_weights is None
+    return _Lean(
+        "spacecraft_sbrdf" in names or "brdf" in names,
+        trapezoid_weights(plan),
+        None if pre else plan.band_weights,
+        np.dtype(plan.knobs["dtype"]),
+    )
+
+
+def _three(v: Any) -> bool:
+    """``v`` is a list or tuple of three items or a float array of shape (3,)."""
+    if type(v) is np.ndarray:
+        return v.shape == (3,) and v.dtype.kind == "f"
+    return type(v) in (list, tuple) and len(v) == 3
 
 
 def _none() -> None:

@@ -230,6 +230,33 @@ def _fused_sums(s, o, facets, values, grids, opts, out):  # pragma: no cover - c
             t = stop
 
 
+@numba.njit(nogil=True, cache=True)
+def _one_geometry(
+    sx, sy, sz, ox, oy, oz, unit_tol, eq4, facets, values, grids, opts, n_mat, want_pm
+):  # pragma: no cover - compiled
+    proto = values[0]  # the outputs' dtype is the tables'
+    n_wl = proto.shape[1]
+    sig = np.zeros((1, n_wl), dtype=proto.dtype)
+    pap = np.zeros((1, n_wl), dtype=proto.dtype)
+    area = np.zeros(1)
+    pm = np.zeros((1, n_mat, n_wl) if want_pm else (0, 0, 0), dtype=proto.dtype)
+    # the lengths as numpy's row norms give them, and the scene's normalisation
+    ls = np.sqrt((sx * sx + sy * sy) + sz * sz)
+    lo = np.sqrt((ox * ox + oy * oy) + oz * oz)
+    if not (abs(ls - 1.0) <= unit_tol and abs(lo - 1.0) <= unit_tol):  # NaN too
+        return False, sig, pap, area, pm
+    s = np.empty((1, 3))
+    o = np.empty((1, 3))
+    s[0, 0], s[0, 1], s[0, 2] = sx / ls, sy / ls, sz / ls
+    o[0, 0], o[0, 1], o[0, 2] = ox / lo, oy / lo, oz / lo
+    if facets[0].shape[0]:
+        _fused_sums(s, o, facets, values, grids, opts, (sig, pap, area, np.zeros(1), pm))
+    if eq4 and area[0] > 0.0:  # paper 000 Eq. 4 in place, as effects.finish divides
+        for k in range(n_wl):
+            pap[0, k] = pap[0, k] / area[0]
+    return True, sig, pap, area, pm
+
+
 def normal_rows(normals: NDArray[np.floating]) -> NDArray[np.int64]:
     """The row of each term's normal among the distinct ones: terms whose normals are
     bit-identical (one face, several materials) share the fused kernel's angles.
@@ -427,6 +454,7 @@ class BoundSums:
         )
         self._shape = (tables.n_spectral, tables.dtype, tables.edges.shape[0])
         self._entry: Any = None
+        self._one: Any = None
 
     def __call__(self, to_sun: NDArray[np.float64], to_observer: NDArray[np.float64]) -> FusedSums:
         """The sums for ``(G, 3)`` unit vectors [1] (their length is not checked)."""
@@ -449,6 +477,71 @@ class BoundSums:
             else:
                 self._entry(*args)
         return out if self.per_material else out._replace(per_material=None)
+
+    def one(
+        self, to_sun: Any, to_observer: Any, unit_tol: float, eq4: bool = False
+    ) -> tuple[bool, NDArray[np.floating], NDArray[np.floating], NDArray[np.float64], Any]:
+        """The sums of one geometry in one compiled call: both directions checked for
+        unit length and normalised (as a scene normalises its pairs), the outputs
+        allocated, the kernel run and, with ``eq4``, the paper sum divided by the area in
+        place where it is positive (paper 000 Eq. 4, as
+        :func:`~sbrdf_xr.engine.effects.finish` divides it).
+
+        Parameters
+        ----------
+        to_sun, to_observer : sequence of 3 numbers
+            Directions [1]; a length farther than ``unit_tol`` from 1 (or not finite)
+            is no error here: the first value returned is then False.
+        unit_tol : float
+            Largest accepted ``| |v| - 1 |`` [1].
+        eq4 : bool
+            Divide the paper sum by the area.
+
+        Returns
+        -------
+        tuple
+            ``(ok, signal, paper, area, per_material)``: arrays shaped ``(1, L)``,
+            ``(1, L)``, ``(1,)`` and ``(1, M, L)`` (``(0, 0, 0)`` unless
+            ``per_material``), zeros unless ``ok``.
+
+        Raises
+        ------
+        TypeError
+            Components that are not numbers.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from sbrdf_xr.kernels.packing import pack_tables
+        >>> from sbrdf_xr.kernels.sums import BoundSums
+        >>> g = np.array([0.0, 90.0])
+        >>> tables = pack_tables([(np.ones((2, 2, 2, 3)), g, g - 90, g, (True, True, True))])
+        >>> bound = BoundSums(np.array([[0.0, 0, 1]]), np.array([2.0]), np.zeros(1, int), tables)
+        >>> bound.one((0.0, 0.6, 0.8), (0.0, 0.0, 2.0), 1e-6)[0]  # not of unit length
+        False
+        >>> ok, sig, pap, area, _ = bound.one((0.0, 0.6, 0.8), (0.0, 0.6, 0.8), 1e-6, eq4=True)
+        >>> sig.round(6).tolist(), pap.round(6).tolist(), area.tolist()  # Eq. 4: 1 sr-1
+        ([[1.28, 1.28, 1.28]], [[1.0, 1.0, 1.0]], [1.6])
+        """
+        sx, sy, sz = to_sun
+        ox, oy, oz = to_observer
+        if self._one is None:  # compile (or load) the signature of floats, whatever came
+            rest = (*self.bundle, self.per_material)
+            probe = (0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1e-6, False, *rest)
+            _one_geometry(*probe)
+            sig = tuple(numba.typeof(a) for a in probe)
+            self._one = getattr(_one_geometry.overloads[sig], "entry_point")  # noqa: B009
+            self._one_rest = rest
+        return cast(
+            "tuple[bool, Any, Any, Any, Any]",
+            self._one(sx, sy, sz, ox, oy, oz, unit_tol, eq4, *self._one_rest),
+        )
+
+    @property
+    def bundle(self) -> tuple[Any, ...]:
+        """The kernel's prepared arguments: terms, table values, grids, options and the
+        number of materials."""
+        return (self._facets, self._values, self._grids, self._opts, self._shape[2])
 
 
 def _kernel_vectors(v: NDArray[np.floating]) -> NDArray[np.float64]:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import trimesh
 
@@ -20,9 +22,16 @@ def _scene():
 
 def test_single_call_times_every_path():
     times = single_call_times(_scene().plan(), repeat=2, calls=3)
-    assert len(times) == 7
+    assert len(times) == 8
     for best, spread in times.values():
         assert best > 0.0 and spread >= 0.0
+
+
+def test_single_call_times_in_cpu_time():
+    """The CPU time of this thread (a loaded machine's other processes do not add to
+    it): every path costs some, and never more than a second for three calls."""
+    cpu = single_call_times(_scene().plan(), repeat=2, calls=3, clock=time.thread_time)
+    assert all(0.0 < best < 1.0 for best, _ in cpu.values())
 
 
 def test_fixed_cost_rows_are_their_own_rows():

@@ -40,6 +40,7 @@ __all__ = [
     "readonly",
     "reflected",
     "table_on",
+    "trapezoid_weights",
 ]
 
 
@@ -520,9 +521,23 @@ def _analytic_sums(
     )
 
 
-def _trapezoid_weights(plan: PlanView) -> np.ndarray:
-    """Weights ``w`` with ``y @ w`` the trapezoid integral of ``y`` over the wavelength grid
-    (paper 000 Eq. 2); a single wavelength has weight 1.  Made once per plan."""
+def trapezoid_weights(plan: PlanView) -> np.ndarray:
+    """Weights ``w`` [nm] with ``y @ w`` the trapezoid integral of ``y`` over the
+    wavelength grid (paper 000 Eq. 2); a single wavelength has weight 1.  Made once per
+    plan (kept in ``plan.cache``).
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> from sbrdf_xr import Scene, load_spacecraft
+    >>> from sbrdf_xr.engine.effects.base import trapezoid_weights
+    >>> from sbrdf_xr.materials.schema import lambertian
+    >>> box = load_spacecraft(trimesh.creation.box(), material="grey")
+    >>> grey = lambertian(0.5, [500.0, 600.0, 700.0], material="grey")
+    >>> x = [[1.0, 0.0, 0.0]]
+    >>> trapezoid_weights(Scene(box, {"grey": grey}, to_sun=x, to_observer=x).plan()).tolist()
+    [50.0, 100.0, 50.0]
+    """
     w = plan.cache.get("trapezoid_weights")
     if w is None:
         wl = np.asarray(plan.wavelength, dtype=np.float64)
@@ -589,7 +604,7 @@ def finish(
         if "spacecraft_sbrdf" in names:
             out["spacecraft_sbrdf"] = sbrdf
         if "brdf" in names:
-            out["brdf"] = np.einsum("gl,l->g", sbrdf, _trapezoid_weights(plan)).astype(dt)
+            out["brdf"] = np.einsum("gl,l->g", sbrdf, trapezoid_weights(plan)).astype(dt)
     for k in names:
         if k not in out and k in sums:
             out[k] = sums[k]
