@@ -39,9 +39,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
+from ..units import to_unit
 from . import robertson_sandford as rs
 from ._common import _angles_to_vectors, _cast_out, _check_theta_i, _facet_frame
-from ..units import to_unit
 from ._model import Model, Parameter
 
 __all__ = [
@@ -196,7 +196,7 @@ def brdf(
     True
     """
     p = MODEL.check_params(wavelength, **params)
-    body = {k: p[k] for k in rs.PARAMS}
+    body: dict[str, Any] = {k: p[k] for k in rs.PARAMS}
     _, _, _, _, _, _, dtype = _facet_frame(normal, to_sun, to_observer)
     out = np.asarray(rs.brdf(normal, to_sun, to_observer, wavelength, **body), dtype=np.float64)
     out = out + core_brdf(normal, to_sun, to_observer, p["core_rho"], p["core_roughness"])
@@ -279,7 +279,8 @@ def directional_hemispherical_reflectance(
     """
     p = MODEL.check_params(wavelength, **params)
     ti = _check_theta_i(theta_i)
-    body = rs.directional_hemispherical_reflectance(ti, wavelength, **{k: p[k] for k in rs.PARAMS})
+    body_params: dict[str, Any] = {k: p[k] for k in rs.PARAMS}
+    body = rs.directional_hemispherical_reflectance(ti, wavelength, **body_params)
     ms, inverse = np.unique(p["core_roughness"], return_inverse=True)
     loss = np.stack([core_loss(ti, mj) for mj in ms], axis=-1)[..., inverse.ravel()]
     return body + p["core_rho"] * loss

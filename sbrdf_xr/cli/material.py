@@ -16,7 +16,7 @@ from typing import Any
 __all__ = ["MODELS", "add_material_parser", "cmd_material_build"]
 
 #: The fitted models ``--model`` names (or a model netCDF file).
-MODELS = ("robertson-sandford", "microfacet")
+MODELS = ("robertson-sandford", "microfacet", "robertson-sandford-core")
 
 
 def add_material_parser(sub: Any) -> argparse.ArgumentParser:

@@ -581,7 +581,7 @@ def fit_robertson_sandford_core(measurements: xr.Dataset) -> xr.Dataset:
         )
         body_at = np.all(c_vals < b_vals, axis=1) | ref  # the core's samples left to it
     name = ds.attrs.get("material", "unnamed")
-    params = {k: body[k].values for k in ("rho_D", "epsilon", "b", "e")}
+    params: dict[str, Any] = {k: body[k].values for k in ("rho_D", "epsilon", "b", "e")}
     out = model_material(
         "robertson_sandford_core", wl, material=name,
         provenance=f"Robertson-Sandford fit with a specular core to the measurements of {name} "
