@@ -168,9 +168,8 @@ def _file_digest(path: Path) -> str:
         version = fmt.read_magic(f)
         header = fmt.read_array_header_1_0 if version == (1, 0) else fmt.read_array_header_2_0
         got_shape, fortran, got_dtype = header(f)
-        if fortran:  # another layout: other values in effect
-            got_shape = (*got_shape, "F")
-        h = hashlib.sha256(f"{got_dtype.str}{tuple(got_shape)}".encode())
+        layout = " F" if fortran else ""  # another layout: other values in effect
+        h = hashlib.sha256(f"{got_dtype.str}{tuple(got_shape)}{layout}".encode())
         for chunk in iter(lambda: f.read(_CHUNK), b""):
             h.update(chunk)
     return h.hexdigest()
@@ -223,7 +222,7 @@ def open_values(file: TableFile) -> np.ndarray:
     with _LOCK:
         if key not in _BY_FILE:
             _BY_FILE[key] = arr
-            _BY_MAP[id(arr._mmap)] = (file, arr)  # type: ignore[attr-defined]
+            _BY_MAP[id(arr._mmap)] = (file, arr)
         return _BY_FILE[key]
 
 
