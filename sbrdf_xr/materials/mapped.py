@@ -77,8 +77,10 @@ class TableFile(NamedTuple):
         The ``.npy`` file.
     sha256 : str
         SHA-256 of the values' dtype, shape and bytes (:func:`values_digest`).
-    size, mtime_ns : int
-        The file's size [byte] and modification time [ns] when recorded.
+    size : int
+        The file's size when recorded [byte].
+    mtime_ns : int
+        Its modification time when recorded [ns].
     dtype : str
         The values' dtype (``float64`` or ``float32``).
     shape : tuple of int
@@ -107,9 +109,11 @@ class MappedSlice(NamedTuple):
     file : TableFile
         The mapped file.
     offset : int
-        Byte offset of the array's first element in the values.
-    shape, strides : tuple of int
-        The array's shape and strides [byte].
+        Offset of the array's first element in the values [byte].
+    shape : tuple of int
+        The array's shape.
+    strides : tuple of int
+        The array's strides [byte].
     dtype : str
         The array's dtype.
 
