@@ -532,7 +532,7 @@ def test_the_private_check_catches_imports_and_attributes(tmp_path):
 #: ``lightcurves``, split out of ``photometry`` by job, brings its own edges: down to
 #: ``photometry``, ``_names``, ``errors`` and ``units``, and ``cli -> lightcurves`` (the
 #: commands that read a measured light curve).
-GRAPH_LIMITS = {"nodes": 30, "depth": 12, "edges": 116}
+GRAPH_LIMITS = {"nodes": 30, "depth": 12, "edges": 118}
 
 
 def node_of(mod: str, root: Path = PACKAGE) -> str:

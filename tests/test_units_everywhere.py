@@ -989,6 +989,10 @@ for _row, _arg in (
     ("sbrdf_xr.engine.plan.Estimate", "output_bytes"),
     ("sbrdf_xr.engine.plan.Estimate", "block_bytes"),
     ("sbrdf_xr.engine.views.Terms", "area"),
+    ("sbrdf_xr.materials.mapped.TableFile", "size"),
+    ("sbrdf_xr.materials.mapped.TableFile", "mtime_ns"),
+    ("sbrdf_xr.materials.mapped.MappedSlice", "offset"),
+    ("sbrdf_xr.materials.mapped.MappedSlice", "strides"),
 ):
     EXEMPT[(_row, _arg)] = "a result record the package fills, not an input"
 

@@ -147,12 +147,8 @@ def sweep_job(
         t0 = time.perf_counter()
         write(simulate(plan), path, overwrite=True, outputs=outputs)
         seconds = time.perf_counter() - t0
-    out = {
-        "seconds": seconds,
-        "rss": float(_peak_rss()),
-        "rss_private": float(private.stop()),
-        "blocks": float(plan.n_blocks),
-    }
+    out = {"seconds": seconds, "rss": float(_peak_rss()), "blocks": float(plan.n_blocks)}
+    out["rss_private"] = float(private.stop())
     if mode in ("write", "zarr"):
         out["bytes"] = float(_size(Path(path)))
     return out
@@ -252,12 +248,9 @@ def _status(field: str) -> int:
     """A memory field of ``/proc/self/status`` [byte] (0 where there is none)."""
     try:
         with open("/proc/self/status", encoding="ascii") as f:
-            for line in f:
-                if line.startswith(field + ":"):
-                    return int(line.split()[1]) * 1024
+            return next((int(x.split()[1]) * 1024 for x in f if x.startswith(field + ":")), 0)
     except OSError:
-        pass
-    return 0
+        return 0
 
 
 def _peak_rss() -> int:
@@ -268,14 +261,7 @@ def _peak_rss() -> int:
     """
     import resource
 
-    try:
-        with open("/proc/self/status", encoding="ascii") as f:
-            for line in f:
-                if line.startswith("VmHWM:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+    return _status("VmHWM") or resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 
 
 def _subprocess(

@@ -144,7 +144,9 @@ def cmd_photometry(args: argparse.Namespace) -> int:
         if out is not None:  # refused before anything is computed
             formats.check(out, "photometry", overwrite=args.overwrite, name=name)
     with open_dataset(args.cube) as probe:
-        if not any(
+        # a signal its writer left out (computed from signal_material on read) counts
+        left_out = "signal" in derived.recorded(probe) and "wavelength" in probe.dims
+        if not left_out and not any(
             v in probe and "wavelength" in probe[v].dims for v in ("signal", "spacecraft_sbrdf")
         ):
             raise ValidationError(

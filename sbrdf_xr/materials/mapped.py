@@ -77,8 +77,10 @@ class TableFile(NamedTuple):
         The ``.npy`` file.
     sha256 : str
         SHA-256 of the values' dtype, shape and bytes (:func:`values_digest`).
-    size, mtime_ns : int
-        The file's size [byte] and modification time [ns] when recorded.
+    size : int
+        The file's size when recorded [byte].
+    mtime_ns : int
+        Its modification time when recorded [ns].
     dtype : str
         The values' dtype (``float64`` or ``float32``).
     shape : tuple of int
@@ -107,9 +109,11 @@ class MappedSlice(NamedTuple):
     file : TableFile
         The mapped file.
     offset : int
-        Byte offset of the array's first element in the values.
-    shape, strides : tuple of int
-        The array's shape and strides [byte].
+        Offset of the array's first element in the values [byte].
+    shape : tuple of int
+        The array's shape.
+    strides : tuple of int
+        The array's strides [byte].
     dtype : str
         The array's dtype.
 
@@ -168,9 +172,8 @@ def _file_digest(path: Path) -> str:
         version = fmt.read_magic(f)
         header = fmt.read_array_header_1_0 if version == (1, 0) else fmt.read_array_header_2_0
         got_shape, fortran, got_dtype = header(f)
-        if fortran:  # another layout: other values in effect
-            got_shape = (*got_shape, "F")
-        h = hashlib.sha256(f"{got_dtype.str}{tuple(got_shape)}".encode())
+        layout = " F" if fortran else ""  # another layout: other values in effect
+        h = hashlib.sha256(f"{got_dtype.str}{tuple(got_shape)}{layout}".encode())
         for chunk in iter(lambda: f.read(_CHUNK), b""):
             h.update(chunk)
     return h.hexdigest()
@@ -223,7 +226,7 @@ def open_values(file: TableFile) -> np.ndarray:
     with _LOCK:
         if key not in _BY_FILE:
             _BY_FILE[key] = arr
-            _BY_MAP[id(arr._mmap)] = (file, arr)  # type: ignore[attr-defined]
+            _BY_MAP[id(arr._mmap)] = (file, arr)
         return _BY_FILE[key]
 
 
