@@ -31,7 +31,7 @@ from .extinction import extinction_prior as _k_prior
 from .extinction import separable_sd
 from .model import PassModel, pass_data
 from .model_error import discrepancy_floor, estimated_floor, table_widths, with_floor
-from .posterior import check_budget
+from .posterior import CHUNK_STEPS, check_budget
 from .refine import Local, jacobian, outside_physics, refine
 from .result import Layout, model_check, result_dataset
 from .starts import minima_dataset, start_states
@@ -161,8 +161,8 @@ def fit_observation(
     material_scale: str | Mapping[str, float] | None = None,
     model_discrepancy: str | float | Mapping[str, float] | None = None,
     method: str = "point",
-    posterior_walkers: int = 32,
-    posterior_steps: int = 300,
+    posterior_walkers: int | None = None,
+    posterior_steps: int | None = None,
     seed: int = 0,
 ) -> xr.Dataset:
     """Spin state, extinction, zero points and material areas fitted jointly to the
@@ -263,6 +263,21 @@ def fit_observation(
         tables' scales do not absorb it; ``"estimate"``: each band's floor estimated from
         the residuals of a point fit without one, then the pass fitted again with it
         (twice the cost).  Default None: the model taken as exact.
+    method : {"point", "posterior"}
+        ``"posterior"``: the joint posterior sampled by emcee from every minimum within a
+        chi-square of 25 of the best (:mod:`sbrdf_xr.invert._joint.posterior`): the
+        point fit's covariance sets the walkers' start and the independence proposal;
+        medians, standard deviations and 2.5 / 97.5 % points per parameter, each mode's
+        probability, autocorrelation time and cost (``posterior_cost``).
+    posterior_walkers : int, optional
+        Walkers of the ensemble (default ``2 n + 2`` for ``n`` fitted parameters).
+    posterior_steps : int, optional
+        Steps per mode (default: grown 50 at a time until the chain spans 50
+        autocorrelation times, within the budget).  Chains shorter than that raise a
+        :class:`~sbrdf_xr.errors.ChainLengthWarning`; a budget beyond 200000 model
+        evaluations is refused with its estimated time.
+    seed : int
+        Seed of the sampler's generator.
 
     Returns
     -------
@@ -372,7 +387,12 @@ def fit_observation(
     if method == "posterior":  # refuse a budget beyond the bound before fitting
         t0 = time.perf_counter()
         model.terms(vec(start["axis_longitude"], start["axis_latitude"]), start["period"], 0.0)
-        check_budget(posterior_walkers, posterior_steps, 1, time.perf_counter() - t0)
+        check_budget(
+            posterior_walkers or 1,
+            posterior_steps or CHUNK_STEPS,
+            1,
+            time.perf_counter() - t0,
+        )
     area_of = material_areas(spacecraft)
     lay = Layout(
         data.labels,
