@@ -6,6 +6,7 @@ See the package docstring.
 from __future__ import annotations
 
 import itertools
+import time
 import warnings
 from collections.abc import Mapping
 from typing import Any
@@ -19,6 +20,7 @@ from ..units import to_unit
 from ._areas import add_areas, area_constraint, material_areas
 from ._library import MATERIAL, design, library
 from ._quality import fit_quality
+from ._unmix_posterior import unmix_posterior
 from ._unseen import constrained_by as _pinned_by
 from ._unseen import correlation, unconstrained_note, unseen_columns
 
@@ -161,6 +163,10 @@ def unmix(
     degeneracy_threshold: float = DEGENERACY_THRESHOLD,
     drop_bias: float = DROP_BIAS,
     total_area: float | bool | None = None,
+    method: str = "point",
+    posterior_walkers: int | None = None,
+    posterior_steps: int | None = None,
+    seed: int = 0,
 ) -> xr.Dataset:
     """Effective area scale factor of each material from a measured spectrum or band fluxes.
 
@@ -230,6 +236,17 @@ def unmix(
     drop_bias : float
         Largest bias, in units of the kept estimates' uncertainties, that leaving
         materials out may cause (default :data:`DROP_BIAS`).
+    method : {"point", "posterior"}
+        ``"posterior"``: the chosen model's scales also sampled by emcee inside physics
+        (scales >= 0, no area above the body's, on the plane of ``total_area``;
+        :mod:`sbrdf_xr.invert._unmix_posterior`), adding ``posterior_median``,
+        ``posterior_sd``, ``posterior_low``, ``posterior_high`` (and
+        ``posterior_fraction_*`` with ``areas``) over ``material``; a material never lit
+        and seen gets its prior (or what the constraint leaves it).
+    posterior_walkers, posterior_steps, seed
+        The sampler's walkers (default ``2 n + 2``, at least 8), steps (default: grown
+        until the chain spans 50 autocorrelation times) and seed; a budget beyond 200000
+        evaluations is refused.
 
     Returns
     -------
@@ -312,6 +329,11 @@ def unmix(
     >>> round(float(tied.area_fraction.sum()), 12), tied.area_fraction.attrs["long_name"]
     (1.0, 'fraction of total_area, the constrained sum of the areas')
     """
+    t_point = time.perf_counter()
+    if method not in ("point", "posterior"):
+        raise InversionError(
+            f"method: {method!r}; allowed 'point' (least squares) or 'posterior' (emcee)"
+        )
     if isinstance(areas, Mapping):
         areas = {k: to_unit(v, "m2", "areas") for k, v in areas.items()}
     total_area = to_unit(total_area, "m2", "total_area")
@@ -404,7 +426,7 @@ def unmix(
             "fewer candidate materials, to test the model"
         )
         warnings.warn(quality["fit_quality_note"], FitQualityWarning, stacklevel=2)
-    return _result(
+    ds = _result(
         names=names,
         x=x,
         sig=sig,
@@ -448,6 +470,22 @@ def unmix(
         quality=quality,
         degeneracy_threshold=degeneracy_threshold,
     )
+    if method == "posterior":
+        ds = unmix_posterior(
+            ds,
+            aw=aw,
+            yw=yw,
+            x=x,
+            cov=cov,
+            cols=cols,
+            areas=areas,
+            con=con,
+            point_seconds=time.perf_counter() - t_point,
+            walkers=posterior_walkers,
+            steps=posterior_steps,
+            seed=seed,
+        )
+    return ds
 
 
 def _result(

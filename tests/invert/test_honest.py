@@ -500,7 +500,7 @@ def test_chain_convergence_against_the_ar1_closed_form():
     """An AR(1) chain x_t = phi x_(t-1) + e_t has the integrated autocorrelation time
     (1 + phi) / (1 - phi) = 9 for phi = 0.8; 16 walkers x 4000 steps estimate it to a few
     per cent (Sokal's window; 15 % allowed, about 4 standard errors)."""
-    from sbrdf_xr.invert._joint.posterior import MIN_TAUS, _warn_short, chain_convergence
+    from sbrdf_xr.invert._joint.posterior import MIN_TAUS, warn_short, chain_convergence
 
     rng = np.random.default_rng(11)
     phi, n = 0.8, 4000
@@ -513,6 +513,6 @@ def test_chain_convergence_against_the_ar1_closed_form():
     assert n_eff == pytest.approx(16 * 3000 / tau)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        _warn_short([tau], ["start"], n, 16)  # 4000 steps > 50 x 9: converged, silent
+        warn_short([tau], ["start"], n, 16)  # 4000 steps > 50 x 9: converged, silent
     with pytest.warns(ChainLengthWarning, match=rf"fewer than {MIN_TAUS} .* start \(tau 9"):
-        _warn_short([9.0], ["start"], 300, 16)
+        warn_short([9.0], ["start"], 300, 16)

@@ -53,7 +53,9 @@ __all__ = [
     "chain_convergence",
     "default_walkers",
     "laplace_move",
+    "run_chain",
     "sample_posterior",
+    "warn_short",
 ]
 
 #: Minima within this chi-square of the best are sampled as modes.
@@ -98,7 +100,7 @@ def laplace_move(mean: np.ndarray, cov: np.ndarray, dof: float = PROPOSAL_DOF) -
     >>> from sbrdf_xr.invert._joint.posterior import laplace_move
     >>> move = laplace_move(np.zeros(2), np.diag([1.0, 4.0]))
     >>> x, log_ratio = move.get_proposal(np.zeros((3, 2)), np.random.RandomState(0))
-    >>> x.shape, bool(np.all(log_ratio <= 0))  # from the centre every move is downhill in q
+    >>> x.shape, bool(np.all(log_ratio >= 0))  # q peaks at the centre: ratios favour leaving
     ((3, 2), True)
     """
     import emcee
@@ -237,7 +239,7 @@ def sample_posterior(
             c = chi2_of(m, p)
             return -0.5 * c if np.isfinite(c) else -np.inf
 
-        chain, tau, accepted = _run_mode(
+        chain, tau, accepted = run_chain(
             m.x, cov, log_prob, walkers, steps, int(max_steps or 0), rng
         )
         burn = min(chain.shape[0] // 2, max(int(np.ceil(5 * tau)), 1))
@@ -248,7 +250,7 @@ def sample_posterior(
         samples.append(np.array([_outputs(lay, m.axis_of, p, shift) for p in flat]))
         accept.append(accepted)
         labels.append(m.label)
-    _warn_short(taus, labels, ran, walkers)
+    warn_short(taus, labels, ran, walkers)
     lz = np.array(log_z)
     prob = np.exp(lz - lz.max())
     prob /= prob.sum()
@@ -321,7 +323,7 @@ def sample_posterior(
     return ds, attrs
 
 
-def _warn_short(
+def warn_short(
     taus: Sequence[float], labels: Sequence[str], steps: Sequence[int] | int, walkers: int
 ) -> None:
     """A :class:`~sbrdf_xr.errors.ChainLengthWarning` for the modes whose chains span fewer
@@ -341,7 +343,7 @@ def _warn_short(
         )
 
 
-def _run_mode(
+def run_chain(
     x: np.ndarray,
     cov: np.ndarray,
     log_prob: Callable[[np.ndarray], float],
@@ -352,7 +354,25 @@ def _run_mode(
 ) -> tuple[np.ndarray, float, float]:
     """One mode's emcee chain ``(steps, walkers, parameters)``, its autocorrelation time
     [steps] and mean acceptance fraction; ``steps=None``: grown by :data:`CHUNK_STEPS`
-    until it spans :data:`MIN_TAUS` autocorrelation times or reaches ``max_steps``."""
+    until it spans :data:`MIN_TAUS` autocorrelation times or reaches ``max_steps``.
+
+    The walkers start at draws of the Gaussian ``N(x, cov)`` (those outside the support
+    of ``log_prob`` pulled next to ``x``); the moves are :func:`laplace_move` of ``(x,
+    cov)`` and emcee's ``DEMove``.
+
+    Examples
+    --------
+    A correlated Gaussian target is sampled with its own covariance as the proposal's:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.invert._joint.posterior import run_chain
+    >>> cov = np.array([[1.0, 0.8], [0.8, 1.0]])
+    >>> icov = np.linalg.inv(cov)
+    >>> chain, tau, acc = run_chain(np.zeros(2), cov, lambda p: -0.5 * p @ icov @ p, 8,
+    ...                             None, 2000, np.random.default_rng(0))
+    >>> bool(tau < 5), bool(chain.shape[0] >= 50 * tau), bool(0.3 < acc < 1)
+    (True, True, True)
+    """
     import emcee
 
     n = x.size
@@ -360,9 +380,11 @@ def _run_mode(
     # walkers start in the typical set: draws of the Gaussian (Laplace) approximation
     ev, vec = np.linalg.eigh(cov)
     start = x + rng.standard_normal((walkers, n)) @ (vec * np.sqrt(np.clip(ev, 0, None))).T
-    for w in range(walkers):  # a start outside the bounds: pulled onto the minimum
+    for w in range(walkers):  # a start outside the bounds: pulled next to (or onto) x
         if not np.isfinite(log_prob(start[w])):
             start[w] = x + 1e-3 * sd * rng.standard_normal(n)
+            if not np.isfinite(log_prob(start[w])):
+                start[w] = x
     moves = [(laplace_move(x, cov), 1.0 - DE_SHARE), (emcee.moves.DEMove(), DE_SHARE)]
     sampler = emcee.EnsembleSampler(walkers, n, log_prob, moves=moves)
     sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()
