@@ -30,7 +30,14 @@ from .diagnose import likely_causes
 from .extinction import extinction_prior as _k_prior
 from .extinction import separable_sd
 from .model import PassModel, pass_data
-from .model_error import discrepancy_floor, estimated_floor, table_widths, with_floor
+from .model_error import (
+    band_offsets,
+    discrepancy_floor,
+    estimated_floor,
+    table_widths,
+    tilt_widths,
+    with_floor,
+)
 from .posterior import CHUNK_STEPS, check_budget
 from .refine import Local, jacobian, outside_physics, refine
 from .result import Layout, model_check, result_dataset
@@ -159,6 +166,7 @@ def fit_observation(
     extinction_prior: Mapping[str, Any] | None = None,
     symmetry_tolerance: float = SYMMETRY_TOL,
     material_scale: str | Mapping[str, float] | None = None,
+    colour_tilt: bool | float | Mapping[str, float] | None = None,
     model_discrepancy: str | float | Mapping[str, float] | None = None,
     method: str = "point",
     posterior_walkers: int | None = None,
@@ -256,6 +264,12 @@ def fit_observation(
         maps the body's facets (normals, areas, materials: the model's terms) onto
         themselves gives a twin state of the solution, evaluated on the data and listed
         over ``twin`` and in ``ambiguity`` (:mod:`sbrdf_xr.invert._spin.symmetry`).
+    colour_tilt : bool, float or mapping of str to float, optional
+        Fit a colour tilt of each material's table as a nuisance parameter too: the table
+        scaled in band ``b`` by ``1 + t_m x_b`` (``x_b`` the band's mean wavelength less
+        the bands' mean [100 nm]) with the prior ``t_m ~ N(0, w_m^2)``; True: ``w_m`` 0.05
+        per 100 nm, a number or ``{material: width}`` given (> 0).  Default None: the
+        tables' colours taken as exact.  Reported as ``table_tilt`` over ``material``.
     model_discrepancy : "estimate", float or mapping of str to float, optional
         A model-discrepancy floor [mag] (one for every band, or ``{band: floor}``, bands
         left out 0), added in quadrature to the measured uncertainties
@@ -403,6 +417,7 @@ def fit_observation(
         areas,
         None if held is None else k_prior[1],
         table_widths(material_scale, names, model.kernel.sources),
+        *_tilt(colour_tilt, names, data.labels),
     )
     _check_counts(method, posterior_walkers, data, lay)
     if epoch is None:
@@ -460,6 +475,12 @@ def fit_observation(
         )
         ds.attrs["check_seconds"] = time.perf_counter() - t0
     return ds
+
+
+def _tilt(colour_tilt: Any, names: Sequence[str], labels: Sequence[str]) -> tuple[Any, Any]:
+    """Prior widths of the tables' colour tilts and the bands' offsets, or (None, None)."""
+    widths = tilt_widths(colour_tilt, names)
+    return widths, None if widths is None else band_offsets(labels)
 
 
 def _check_method(method: str) -> None:

@@ -41,7 +41,7 @@ def simulated_light_curve(
     axis_body: ArrayLike = (0.0, 0.0, 1.0),
     system: str = "Vega",
     zero_point: Mapping[str, float] | None = None,
-    brightness: Mapping[str, float] | None = None,
+    brightness: Mapping[str, Any] | None = None,
     effects: Sequence[str] = (),
 ) -> tuple[xr.Dataset, float]:
     """Noise-free magnitudes of a pass, one band per time in turn, and the wall time [s] of
@@ -53,7 +53,8 @@ def simulated_light_curve(
     :func:`sbrdf_xr.photometry.magnitudes` (the cube's range and Sun distance), and
     ``k_b X + z_b`` is added with the cube's air mass.  Times in the Earth's umbra or
     below the horizon are left out.  A truth other than the fit's model: ``brightness``
-    scales a material's signal (``{"white-paint-a276": 1.1}``: its table 10 % too dark),
+    scales a material's signal (``{"white-paint-a276": 1.1}``: its table 10 % too dark;
+    ``{"white-paint-a276": {"V": 1.05, "I": 1.2}}``: per band, a colour too),
     ``effects`` adds effects of :func:`sbrdf_xr.engine.simulate` (``("shadowing",)``).
 
     Examples
@@ -98,14 +99,20 @@ def simulated_light_curve(
     total = sum(areas.values())
     names = [str(m) for m in cube["material"].values]
     gain = brightness or {}
+
+    def gains(m: str) -> list[float]:  # a factor, or one per band {band: factor}
+        g = gain.get(m, 1.0)
+        return [float(g.get(b, 1.0)) if isinstance(g, Mapping) else float(g) for b in bands]
+
     scale = xr.DataArray(
-        [area_fraction[m] * total / areas[m] * float(gain.get(m, 1.0)) for m in names],
-        dims="material",
-        coords={"material": names},
+        [[area_fraction[m] * total / areas[m] * f for f in gains(m)] for m in names],
+        dims=("material", "band"),
+        coords={"material": names, "band": list(bands)},
     )
     per = cube[["signal_material"]].rename(signal_material="signal")
     mm = magnitudes(per, list(bands), system=system)
-    flux = (10 ** (-0.4 * mm) * scale).sum("material").transpose("time", "band").values
+    flux = (10 ** (-0.4 * mm) * scale.sel(band=mm["band"])).sum("material")
+    flux = flux.transpose("time", "band").values
     with np.errstate(divide="ignore"):
         mix = -2.5 * np.log10(flux)
     x = cube["airmass"].values
@@ -149,7 +156,7 @@ def observation_recovery(
     seed: int = 0,
     start_offset: Mapping[str, float] | None = None,
     phase_symmetry: float = 360.0,
-    brightness: Mapping[str, float] | None = None,
+    brightness: Mapping[str, Any] | None = None,
     effects: Sequence[str] = (),
     **options: Any,
 ) -> xr.Dataset:
