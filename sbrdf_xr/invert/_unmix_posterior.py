@@ -127,7 +127,7 @@ def unmix_posterior(
     x0 = _inside(x0, log_prob, to_a, lo, hi, con, nominal, use)
     n = x0.size
     walkers = max(default_walkers(n), 8) if walkers is None else walkers
-    check_budget(walkers, steps or CHUNK_STEPS, 1, 1e-5)
+    check_budget(walkers, CHUNK_STEPS if steps is None else steps, 1, 1e-5)
     t0 = time.perf_counter()
     chain, tau, acc = run_chain(
         x0, cz, log_prob, walkers, steps, MAX_EVALUATIONS // walkers, np.random.default_rng(seed)

@@ -500,7 +500,7 @@ def test_chain_convergence_against_the_ar1_closed_form():
     """An AR(1) chain x_t = phi x_(t-1) + e_t has the integrated autocorrelation time
     (1 + phi) / (1 - phi) = 9 for phi = 0.8; 16 walkers x 4000 steps estimate it to a few
     per cent (Sokal's window; 15 % allowed, about 4 standard errors)."""
-    from sbrdf_xr.invert._joint.posterior import MIN_TAUS, warn_short, chain_convergence
+    from sbrdf_xr.invert._joint.posterior import MIN_TAUS, chain_convergence, warn_short
 
     rng = np.random.default_rng(11)
     phi, n = 0.8, 4000

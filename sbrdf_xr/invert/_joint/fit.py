@@ -267,8 +267,9 @@ def fit_observation(
     colour_tilt : bool, float or mapping of str to float, optional
         Fit a colour tilt of each material's table as a nuisance parameter too: the table
         scaled in band ``b`` by ``1 + t_m x_b`` (``x_b`` the band's mean wavelength less
-        the bands' mean [100 nm]) with the prior ``t_m ~ N(0, w_m^2)``; True: ``w_m`` 0.05
-        per 100 nm, a number or ``{material: width}`` given (> 0).  Default None: the
+        the bands' mean, counted in hundreds of nanometres) with the prior ``t_m ~ N(0,
+        w_m^2)``; True: ``w_m`` 0.05 per 100 nm, a number or ``{material: width}`` given
+        (> 0).  Default None: the
         tables' colours taken as exact.  Reported as ``table_tilt`` over ``material``.
     model_discrepancy : "estimate", float or mapping of str to float, optional
         A model-discrepancy floor [mag] (one for every band, or ``{band: floor}``, bands
@@ -402,8 +403,8 @@ def fit_observation(
         t0 = time.perf_counter()
         model.terms(vec(start["axis_longitude"], start["axis_latitude"]), start["period"], 0.0)
         check_budget(
-            posterior_walkers or 1,
-            posterior_steps or CHUNK_STEPS,
+            1 if posterior_walkers is None else posterior_walkers,
+            CHUNK_STEPS if posterior_steps is None else posterior_steps,
             1,
             time.perf_counter() - t0,
         )
