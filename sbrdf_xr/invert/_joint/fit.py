@@ -19,7 +19,6 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from ...errors import FitQualityWarning, InversionError
-from ...units import to_unit
 from .._areas import material_areas
 from .._quality import fit_quality
 from .._spin.fit import AMBIGUITY_CHI2
@@ -30,18 +29,11 @@ from .diagnose import likely_causes
 from .extinction import extinction_prior as _k_prior
 from .extinction import separable_sd
 from .model import PassModel, pass_data
-from .model_error import (
-    band_offsets,
-    discrepancy_floor,
-    estimated_floor,
-    table_widths,
-    tilt_widths,
-    with_floor,
-)
+from .model_error import discrepancy_floor, estimated_floor, table_widths, tilt_layout, with_floor
 from .posterior import CHUNK_STEPS, check_budget
 from .refine import Local, jacobian, outside_physics, refine
 from .result import Layout, model_check, result_dataset
-from .starts import minima_dataset, start_states
+from .starts import axis_body_of, minima_dataset, read_start, start_states
 from .status import RECOVER, causes, held_note, status_attrs, with_posterior
 from .twins import twin_dataset
 
@@ -62,54 +54,6 @@ JOINT_CAUSES = (
     "(try offset='band')",
     "the uncertainties are understated",
 )
-
-
-def _read_start(spin: Any) -> tuple[dict[str, float], Any]:
-    """Start values (axis_longitude, axis_latitude, period, phase) and their epoch (UTC or
-    None), from a :func:`fit_spin` result or a mapping."""
-    keys = ("axis_longitude", "axis_latitude", "period", "phase")
-    have: Mapping[Any, Any]
-    attrs: Mapping[Any, Any]
-    if isinstance(spin, xr.Dataset):
-        have, attrs = {k: spin[k].values for k in spin.variables}, spin.attrs
-    elif isinstance(spin, Mapping):
-        have, attrs = spin, spin
-    else:
-        raise InversionError(
-            f"spin: expected the Dataset of fit_spin or a mapping of {list(keys)} (and epoch), "
-            f"got {type(spin).__name__}"
-        )
-    missing = [k for k in keys if k not in have]
-    if missing:
-        raise InversionError(f"spin: missing {missing}; a start needs {list(keys)}")
-    units = {"axis_longitude": "deg", "axis_latitude": "deg", "period": "s", "phase": "deg"}
-    out = {k: float(np.asarray(to_unit(have[k], units[k], f"spin {k}"))) for k in keys}
-    if not all(np.isfinite(v) for v in out.values()) or out["period"] <= 0:
-        raise InversionError(f"spin: start values must be finite with period > 0 [s], got {out}")
-    epoch = attrs.get("epoch")
-    if epoch is not None:
-        try:
-            epoch = np.datetime64(str(epoch)).astype("datetime64[ns]")
-        except ValueError:
-            raise InversionError(
-                f"spin: epoch {epoch!r} is not a UTC time; the spin must be fitted to the "
-                "observation (fit_spin(..., geometry=observation)) or give epoch as UTC"
-            ) from None
-    return out, epoch
-
-
-def _axis_body(spin: Any, axis_body: ArrayLike | None) -> np.ndarray:
-    """The body axis of the spin: given, else the :func:`fit_spin` result's, else z."""
-    attrs = spin.attrs if isinstance(spin, xr.Dataset) else spin
-    ab = axis_body
-    if ab is None:
-        ab = attrs.get("axis_body", (0.0, 0.0, 1.0))
-        if isinstance(ab, str):
-            ab = [float(v) for v in ab.strip("[]()").split(",")]
-    abv = np.asarray(ab, dtype=np.float64)
-    if abv.shape != (3,) or not np.all(np.isfinite(abv)) or np.linalg.norm(abv) == 0:
-        raise InversionError(f"axis_body: {ab!r}; allowed a finite nonzero 3-vector")
-    return abv
 
 
 def _options(extinction: Any, offset: str | None, areas: str, labels: Sequence[str]) -> Any:
@@ -387,8 +331,8 @@ def fit_observation(
         return estimated_floor(fit_observation, dict(locals()))
     t_start = time.perf_counter()
     _check_method(method)
-    start, epoch = _read_start(spin)
-    ab = _axis_body(spin, axis_body)
+    start, epoch = read_start(spin)
+    ab = axis_body_of(spin, axis_body)
     data = pass_data(light_curve, observation, bands, system)
     floor = discrepancy_floor(model_discrepancy, data.labels)
     data = with_floor(data, floor)
@@ -418,7 +362,7 @@ def fit_observation(
         areas,
         None if held is None else k_prior[1],
         table_widths(material_scale, names, model.kernel.sources),
-        *_tilt(colour_tilt, names, data.labels),
+        *tilt_layout(colour_tilt, names, data.labels),
     )
     _check_counts(method, posterior_walkers, data, lay)
     if epoch is None:
@@ -476,12 +420,6 @@ def fit_observation(
         )
         ds.attrs["check_seconds"] = time.perf_counter() - t0
     return ds
-
-
-def _tilt(colour_tilt: Any, names: Sequence[str], labels: Sequence[str]) -> tuple[Any, Any]:
-    """Prior widths of the tables' colour tilts and the bands' offsets, or (None, None)."""
-    widths = tilt_widths(colour_tilt, names)
-    return widths, None if widths is None else band_offsets(labels)
 
 
 def _check_method(method: str) -> None:
@@ -544,7 +482,7 @@ def _minimise(
         return float((t - data.epoch) / np.timedelta64(1, "ns")) * 1e-9
 
     def read(s: Any) -> tuple[dict[str, float], float | None]:
-        values, t = _read_start(s)
+        values, t = read_start(s)
         return values, None if t is None else seconds_of(t)
 
     dt_epoch = seconds_of(epoch)

@@ -43,6 +43,7 @@ __all__ = [
     "estimate_floor",
     "estimated_floor",
     "table_widths",
+    "tilt_layout",
     "tilt_widths",
     "with_floor",
 ]
@@ -164,6 +165,22 @@ def tilt_widths(
             )
         out.append(w)
     return np.array(out)
+
+
+def tilt_layout(
+    colour_tilt: Any, materials: Sequence[str], labels: Sequence[str]
+) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Prior widths of the tables' colour tilts (:func:`tilt_widths`) and the bands'
+    offsets (:func:`band_offsets`), or ``(None, None)`` when not fitted.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.invert._joint.model_error import tilt_layout
+    >>> tilt_layout(None, ["paint"], ["V", "R"])
+    (None, None)
+    """
+    widths = tilt_widths(colour_tilt, materials)
+    return widths, None if widths is None else band_offsets(labels)
 
 
 def band_offsets(labels: Sequence[str]) -> np.ndarray:

@@ -14,6 +14,7 @@ from .._quality import quality_attrs
 from .._spin.search import lonlat
 from .._unseen import correlation
 from .model import PassData
+from .nuisance import table_scales, table_tilts
 
 __all__ = ["Layout", "model_check", "result_dataset"]
 
@@ -226,8 +227,8 @@ def result_dataset(
     _spin_terms(ds, est, sd, c_out, free_out, finite, axis)
     k_how = _band_terms(ds, lay, p, sd)
     _areas(ds, lay, p, c_out)
-    _table_scales(ds, lay, p, sd)
-    _table_tilts(ds, lay, p, sd)
+    table_scales(ds, lay, p, sd)
+    table_tilts(ds, lay, p, sd)
     scal = {
         "chi2": (chi2, "chi-square of the fit"),
         "degrees_of_freedom": (dof, "degrees of freedom (values minus fitted parameters)"),
@@ -366,51 +367,6 @@ def _band_terms(ds: xr.Dataset, lay: Layout, p: np.ndarray, sd: np.ndarray) -> s
         cf("magnitude", long_name="1-sigma uncertainty of the zero point (0: not fitted)"),
     )
     return k_how
-
-
-def _table_scales(ds: xr.Dataset, lay: Layout, p: np.ndarray, sd: np.ndarray) -> None:
-    """The fitted scale of each material's table, when model error is fitted."""
-    if lay.m_sd is None:
-        return
-    sl = lay.sl["s"]
-    ds["table_scale"] = (
-        "material",
-        p[sl],
-        _cf("1", "fitted scale of the material's table (nuisance parameter: model error)"),
-    )
-    ds["table_scale_uncertainty"] = (
-        "material",
-        sd[sl],
-        _cf("1", "1-sigma uncertainty of the table's scale"),
-    )
-    ds["table_scale_prior_width"] = (
-        "material",
-        lay.m_sd,
-        _cf("1", "prior width of the table's scale (prior 1 +- width)"),
-    )
-
-
-def _table_tilts(ds: xr.Dataset, lay: Layout, p: np.ndarray, sd: np.ndarray) -> None:
-    """The fitted colour tilt of each material's table, when fitted."""
-    if lay.c_sd is None:
-        return
-    sl = lay.sl["c"]
-    per = "per 100 nm of band mean wavelength"
-    ds["table_tilt"] = (
-        "material",
-        p[sl],
-        _cf("1", f"fitted colour tilt of the material's table, fractional {per} (nuisance)"),
-    )
-    ds["table_tilt_uncertainty"] = (
-        "material",
-        sd[sl],
-        _cf("1", f"1-sigma uncertainty of the table's colour tilt, {per}"),
-    )
-    ds["table_tilt_prior_width"] = (
-        "material",
-        lay.c_sd,
-        _cf("1", f"prior width of the table's colour tilt (prior 0 +- width), {per}"),
-    )
 
 
 def _per_observation(

@@ -111,8 +111,8 @@ def simulated_light_curve(
     )
     per = cube[["signal_material"]].rename(signal_material="signal")
     mm = magnitudes(per, list(bands), system=system)
-    flux = (10 ** (-0.4 * mm) * scale.sel(band=mm["band"])).sum("material")
-    flux = flux.transpose("time", "band").values
+    mixed = (10 ** (-0.4 * mm) * scale.sel(band=mm["band"])).sum("material")
+    flux = mixed.transpose("time", "band").values
     with np.errstate(divide="ignore"):
         mix = -2.5 * np.log10(flux)
     x = cube["airmass"].values
