@@ -435,22 +435,27 @@ def _dao_study(box_wing, n_draws, seed, **options):
         )
 
 
+def test_posterior_coverage_small(box_wing):
+    """Two held-out draws with the default sampler (2 n + 2 walkers, the chain grown to 50
+    autocorrelation times): no ChainLengthWarning, every posterior median within 3.5 sd
+    of the truth (a 5e-4 chance per value for a calibrated posterior), the cost stated."""
+    study = _dao_study(box_wing, 2, 21, noise=0.02, method="posterior")
+    assert int(study.chain_warnings) == 0
+    assert float(np.abs(study.pull).max()) < 3.5, study.to_dataframe()
+    assert float(study.posterior_to_point) > 1
+
+
 @pytest.mark.slow
 def test_posterior_coverage_study(box_wing):
-    """100 held-out draws (box-wing over DAO, 0.02 mag) with method="posterior" (20
-    walkers x 120 steps): measured 2-sigma coverage 0.88-0.96 and pull widths 0.97-1.26
-    (seed 5); the chains are short, so the spin's posterior widths come out 10-25 % narrow.
-    Asserted: coverage >= 0.84 (0.90 less 2 binomial sigma of 100 draws, 0.03 each)."""
-    study = _dao_study(
-        box_wing,
-        100,
-        5,
-        noise=0.02,
-        method="posterior",
-        posterior_walkers=20,
-        posterior_steps=120,
-    )
-    assert float(study.coverage_2sigma.min()) >= 0.84, study.to_dataframe()
+    """100 held-out draws (box-wing over DAO, 0.02 mag; ten runs of 10, seeds 10-19) with
+    method="posterior" and its defaults: see docs/guide/inversion.md for the measured pull
+    widths and coverage.  Asserted here on one run of 100 (seed 10): 2-sigma coverage >=
+    0.89 for every parameter (0.9545 less 3 binomial sigma of 100 draws, 0.021 each), no
+    ChainLengthWarning."""
+    study = _dao_study(box_wing, 100, 10, noise=0.02, method="posterior")
+    print(study.to_dataframe().to_string())
+    assert int(study.chain_warnings) == 0
+    assert float(study.coverage_2sigma.min()) >= 0.89, study.to_dataframe()
 
 
 @pytest.mark.slow
