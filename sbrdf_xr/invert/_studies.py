@@ -41,8 +41,11 @@ def unmix_calibration(
     xarray.Dataset
         Over ``material``: ``truth``, ``estimate_mean``, ``estimate_std``,
         ``uncertainty_median``, ``pull_mean``, ``pull_width``, ``coverage_1sigma``,
-        ``coverage_2sigma`` (fractions of draws within 1 and 2 sigma) and
-        ``selected_fraction``; scalars ``n_draws``, ``quality_warnings`` (draws whose chi2
+        ``coverage_2sigma`` (fractions of draws within 1 and 2 sigma), its binomial
+        ``coverage_2sigma_uncertainty``, ``selected_fraction`` and, with
+        ``method="posterior"`` (the posterior's median and sd then stand for the estimate
+        and its uncertainty), ``coverage_interval`` (draws whose 2.5-97.5 % interval holds
+        the truth); scalars ``n_draws``, ``quality_warnings`` (draws whose chi2
         left the central 99.8 % of its distribution) and ``seconds_per_fit``.
 
     Examples
@@ -77,6 +80,7 @@ def unmix_calibration(
     sigma = relative_noise * np.abs(y0) + 1e-300
     rng = np.random.default_rng(seed)
     est, unc, sel = (np.empty((n_draws, len(names))) for _ in range(3))
+    inside = np.full((n_draws, len(names)), np.nan)
     n_warn = 0
     t0 = time.perf_counter()
     for i in range(n_draws):
@@ -86,6 +90,10 @@ def unmix_calibration(
             fit = unmix(y, terms, sigma, **options)
         n_warn += any(issubclass(w.category, FitQualityWarning) for w in caught)
         est[i], unc[i], sel[i] = fit.scale.values, fit.scale_uncertainty.values, fit.selected.values
+        if "posterior_median" in fit:  # method="posterior": its median, sd and 95 % interval
+            est[i], unc[i] = fit.posterior_median.values, fit.posterior_sd.values
+            lo, hi = fit.posterior_low.values, fit.posterior_high.values
+            inside[i] = (lo <= t.values) & (t.values <= hi)
     dt = (time.perf_counter() - t0) / max(1, n_draws)
     pull = (est - t.values) / unc
     within = np.abs(pull)
@@ -99,6 +107,16 @@ def unmix_calibration(
         "coverage_1sigma": ((within <= 1).mean(0), "fraction of draws within 1 sigma"),
         "coverage_2sigma": ((within <= 2).mean(0), "fraction of draws within 2 sigma"),
         "selected_fraction": (sel.mean(0), "fraction of draws keeping the material"),
+        "coverage_interval": (
+            inside.mean(0),
+            "fraction of draws whose posterior 2.5-97.5 % interval holds the truth "
+            "(method='posterior'; else NaN)",
+        ),
+        "coverage_2sigma_uncertainty": (
+            np.full(len(names), np.sqrt(0.9545 * 0.0455 / max(n_draws, 1))),
+            "binomial standard deviation of the 2-sigma coverage of a calibrated estimator "
+            "over the draws, sqrt(p (1 - p) / n) with p = 0.9545",
+        ),
     }
     ds = xr.Dataset(
         {k: (MATERIAL, v, {"units": "1", "long_name": ln}) for k, (v, ln) in out.items()},

@@ -5,7 +5,7 @@ See the package docstring.
 
 from __future__ import annotations
 
-import itertools
+import time
 import warnings
 from collections.abc import Mapping
 from typing import Any
@@ -19,6 +19,8 @@ from ..units import to_unit
 from ._areas import add_areas, area_constraint, material_areas
 from ._library import MATERIAL, design, library
 from ._quality import fit_quality
+from ._selection import DROP_Z, bias_ratio, subsets_to_score
+from ._unmix_posterior import unmix_posterior
 from ._unseen import constrained_by as _pinned_by
 from ._unseen import correlation, unconstrained_note, unseen_columns
 
@@ -36,8 +38,6 @@ DEGENERACY_THRESHOLD = 0.95
 #: A material is left out of the model only if the bias its omission can cause on every other
 #: estimate stays below this fraction of that estimate's uncertainty.
 DROP_BIAS = 0.5
-#: The bias bound takes the left-out material's scale up to ``|estimate| + DROP_Z sigma``.
-DROP_Z = 2.0
 
 UNMIX_CAUSES = (
     "the simulated geometry differs from that of the measurement (attitude, Sun or observer "
@@ -107,48 +107,6 @@ def _wls(
     return x, cov, float(r @ r)
 
 
-def _bias_ratio(
-    x_full: np.ndarray, cov_full: np.ndarray, cols: list[int], cov: np.ndarray
-) -> float:
-    """Largest bias the omission of the other columns can cause, over the uncertainty.
-
-    Leaving out the columns ``D`` shifts the estimates of the kept ones ``S`` by
-    ``-C_SD C_DD^-1 x_D`` (``C`` the covariance of the full fit, Seber & Lee 2003, *Linear
-    Regression Analysis*, §9.2); with ``|x_D|`` up to ``|estimate| + DROP_Z sigma`` of the
-    full fit, the bias on estimate ``i`` is at most ``sum_j |B_ij| (|x_j| + DROP_Z s_j)``.
-    """
-    k = x_full.size
-    dropped = [j for j in range(k) if j not in cols]
-    if not dropped:
-        return 0.0
-    b = cov_full[np.ix_(cols, dropped)] @ np.linalg.pinv(cov_full[np.ix_(dropped, dropped)])
-    reach = np.abs(x_full[dropped]) + DROP_Z * np.sqrt(np.clip(np.diag(cov_full)[dropped], 0, None))
-    bias = np.abs(b) @ reach
-    sig = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
-    return float(np.max(bias / sig))
-
-
-def _subsets(select: str | None, k: int, kmax: int, score: Any) -> list[tuple[int, ...]]:
-    """The subsets to score: all up to ``kmax``, a forward greedy path, or the full set."""
-    full = tuple(range(k))
-    if select is None:
-        return [full]
-    if select == "all":
-        every = [c for r in range(1, kmax + 1) for c in itertools.combinations(range(k), r)]
-        return every if full in every else [*every, full]
-    chosen: tuple[int, ...] = ()
-    out: list[tuple[int, ...]] = []
-    best = np.inf
-    while len(chosen) < kmax:  # forward greedy addition while the criterion drops
-        trial = [tuple(sorted((*chosen, j))) for j in range(k) if j not in chosen]
-        out.extend(trial)
-        cand = min(trial, key=score)
-        if score(cand) >= best:
-            break
-        chosen, best = cand, score(cand)
-    return list(dict.fromkeys([*out, full]))
-
-
 def unmix(
     measured: xr.DataArray,
     simulated: xr.DataArray | xr.Dataset | Mapping[str, xr.DataArray],
@@ -161,6 +119,10 @@ def unmix(
     degeneracy_threshold: float = DEGENERACY_THRESHOLD,
     drop_bias: float = DROP_BIAS,
     total_area: float | bool | None = None,
+    method: str = "point",
+    posterior_walkers: int | None = None,
+    posterior_steps: int | None = None,
+    seed: int = 0,
 ) -> xr.Dataset:
     """Effective area scale factor of each material from a measured spectrum or band fluxes.
 
@@ -230,6 +192,17 @@ def unmix(
     drop_bias : float
         Largest bias, in units of the kept estimates' uncertainties, that leaving
         materials out may cause (default :data:`DROP_BIAS`).
+    method : {"point", "posterior"}
+        ``"posterior"``: the chosen model's scales also sampled by emcee inside physics
+        (scales >= 0, no area above the body's, on the plane of ``total_area``;
+        :mod:`sbrdf_xr.invert._unmix_posterior`), adding ``posterior_median``,
+        ``posterior_sd``, ``posterior_low``, ``posterior_high`` (and
+        ``posterior_fraction_*`` with ``areas``) over ``material``; a material never lit
+        and seen gets its prior (or what the constraint leaves it).
+    posterior_walkers, posterior_steps, seed
+        The sampler's walkers (default ``2 n + 2``, at least 8), steps (default: grown
+        until the chain spans 50 autocorrelation times) and seed; a budget beyond 200000
+        evaluations is refused.
 
     Returns
     -------
@@ -312,33 +285,18 @@ def unmix(
     >>> round(float(tied.area_fraction.sum()), 12), tied.area_fraction.attrs["long_name"]
     (1.0, 'fraction of total_area, the constrained sum of the areas')
     """
+    t_point = time.perf_counter()
     if isinstance(areas, Mapping):
         areas = {k: to_unit(v, "m2", "areas") for k, v in areas.items()}
     total_area = to_unit(total_area, "m2", "total_area")
-    if not isinstance(measured, xr.DataArray):
-        raise InversionError(
-            f"measured: expected a DataArray over wavelength or band, got {type(measured).__name__}"
-        )
-    if criterion not in ("aic", "bic"):
-        raise InversionError(f"criterion: {criterion!r}; allowed 'aic', 'bic'")
-    if select not in ("all", "greedy", None):
-        raise InversionError(f"select: {select!r}; allowed 'all', 'greedy', None")
-    if not (np.isfinite(drop_bias) and drop_bias >= 0):
-        raise InversionError(f"drop_bias: {drop_bias!r}; allowed a finite number >= 0")
+    _check_options(measured, criterion, select, drop_bias, method)
     lib, notes = library(simulated, measured)
     names = [str(m) for m in lib[MATERIAL].values]
     con = area_constraint(total_area, areas, names)
     n_con = 0 if con is None else 1
     a, y, s = design(measured, uncertainty, lib)
     n, k = a.shape
-    if n < k - n_con:
-        raise InversionError(
-            f"measured: {n} values for {k - n_con} material parameters ({', '.join(names)}"
-            f"{', their areas summing to total_area' if con else ''}); need at least as many "
-            "values as parameters (more wavelengths, bands or geometries, or fewer candidates)"
-        )
-    if max_materials is not None and int(max_materials) < 1:
-        raise InversionError(f"max_materials: {max_materials!r}; allowed an integer >= 1")
+    _check_sizes(n, k, n_con, names, max_materials)
     aw, yw = a / s[:, None], y / s
     kmax = k if max_materials is None else min(int(max_materials), k)
     x_full, cov_full, _ = _wls(aw, yw, list(range(k)), con)
@@ -356,11 +314,11 @@ def unmix(
     def score(c: tuple[int, ...]) -> float:
         if c not in fits:
             x, cov, chi2 = _wls(aw, yw, list(c), con)
-            bias = _bias_ratio(x_full, cov_full, list(c), cov) if np.isfinite(chi2) else np.inf
+            bias = bias_ratio(x_full, cov_full, list(c), cov) if np.isfinite(chi2) else np.inf
             fits[c] = (x, cov, chi2, bias)
         return fits[c][2] + pen * npar(c)
 
-    subsets = _subsets(select, k, kmax, score)
+    subsets = subsets_to_score(select, k, kmax, score)
     for c in subsets:
         score(c)
     admissible = [c for c in subsets if fits[c][3] <= drop_bias]
@@ -404,7 +362,7 @@ def unmix(
             "fewer candidate materials, to test the model"
         )
         warnings.warn(quality["fit_quality_note"], FitQualityWarning, stacklevel=2)
-    return _result(
+    ds = _result(
         names=names,
         x=x,
         sig=sig,
@@ -448,6 +406,44 @@ def unmix(
         quality=quality,
         degeneracy_threshold=degeneracy_threshold,
     )
+    if method == "posterior":
+        opts: dict[str, Any] = {"walkers": posterior_walkers, "steps": posterior_steps}
+        t_point = time.perf_counter() - t_point
+        fit: dict[str, Any] = {"aw": aw, "yw": yw, "x": x, "cov": cov, "cols": cols, "con": con}
+        ds = unmix_posterior(ds, areas=areas, point_seconds=t_point, seed=seed, **fit, **opts)
+    return ds
+
+
+def _check_options(
+    measured: Any, criterion: str, select: Any, drop_bias: float, method: str
+) -> None:
+    """Refuse options outside their allowed values."""
+    if method not in ("point", "posterior"):
+        raise InversionError(
+            f"method: {method!r}; allowed 'point' (least squares) or 'posterior' (emcee)"
+        )
+    if not isinstance(measured, xr.DataArray):
+        raise InversionError(
+            f"measured: expected a DataArray over wavelength or band, got {type(measured).__name__}"
+        )
+    if criterion not in ("aic", "bic"):
+        raise InversionError(f"criterion: {criterion!r}; allowed 'aic', 'bic'")
+    if select not in ("all", "greedy", None):
+        raise InversionError(f"select: {select!r}; allowed 'all', 'greedy', None")
+    if not (np.isfinite(drop_bias) and drop_bias >= 0):
+        raise InversionError(f"drop_bias: {drop_bias!r}; allowed a finite number >= 0")
+
+
+def _check_sizes(n: int, k: int, n_con: int, names: list[str], max_materials: Any) -> None:
+    """Enough values for the parameters; a largest subset of at least one material."""
+    if n < k - n_con:
+        raise InversionError(
+            f"measured: {n} values for {k - n_con} material parameters ({', '.join(names)}"
+            f"{', their areas summing to total_area' if n_con else ''}); need at least as many "
+            "values as parameters (more wavelengths, bands or geometries, or fewer candidates)"
+        )
+    if max_materials is not None and int(max_materials) < 1:
+        raise InversionError(f"max_materials: {max_materials!r}; allowed an integer >= 1")
 
 
 def _result(

@@ -378,8 +378,10 @@ def test_posterior_from_every_minimum(box_wing):
     assert fit.mode_probability.values.tolist() == [1.0]
     tau = float(fit.mode_autocorrelation_time[0])
     assert 1.0 < tau and 60 < 50 * tau  # the warning's condition, reported per mode
-    # effective samples = walkers x kept steps / tau (20 x 30 / tau)
-    assert float(fit.mode_effective_samples[0]) == pytest.approx(600 / tau)
+    # effective samples = walkers x kept steps / tau, the burn-in 5 tau (at most half)
+    burn = min(30, int(np.ceil(5 * tau)))
+    assert int(fit.mode_steps[0]) == 60
+    assert float(fit.mode_effective_samples[0]) == pytest.approx(20 * (60 - burn) / tau)
     post = fit.set_index(posterior_parameter="posterior_parameter")
     truth = {
         "period": 47.0,
@@ -433,22 +435,27 @@ def _dao_study(box_wing, n_draws, seed, **options):
         )
 
 
+def test_posterior_coverage_small(box_wing):
+    """Two held-out draws with the default sampler (2 n + 2 walkers, the chain grown to 50
+    autocorrelation times): no ChainLengthWarning, every posterior median within 3.5 sd
+    of the truth (a 5e-4 chance per value for a calibrated posterior), the cost stated."""
+    study = _dao_study(box_wing, 2, 21, noise=0.02, method="posterior")
+    assert int(study.chain_warnings) == 0
+    assert float(np.abs(study.pull).max()) < 3.5, study.to_dataframe()
+    assert float(study.posterior_to_point) > 1
+
+
 @pytest.mark.slow
 def test_posterior_coverage_study(box_wing):
-    """100 held-out draws (box-wing over DAO, 0.02 mag) with method="posterior" (20
-    walkers x 120 steps): measured 2-sigma coverage 0.88-0.96 and pull widths 0.97-1.26
-    (seed 5); the chains are short, so the spin's posterior widths come out 10-25 % narrow.
-    Asserted: coverage >= 0.84 (0.90 less 2 binomial sigma of 100 draws, 0.03 each)."""
-    study = _dao_study(
-        box_wing,
-        100,
-        5,
-        noise=0.02,
-        method="posterior",
-        posterior_walkers=20,
-        posterior_steps=120,
-    )
-    assert float(study.coverage_2sigma.min()) >= 0.84, study.to_dataframe()
+    """100 held-out draws (box-wing over DAO, 0.02 mag; ten runs of 10, seeds 10-19) with
+    method="posterior" and its defaults: see docs/guide/inversion.md for the measured pull
+    widths and coverage.  Asserted here on one run of 100 (seed 10): 2-sigma coverage >=
+    0.89 for every parameter (0.9545 less 3 binomial sigma of 100 draws, 0.021 each), no
+    ChainLengthWarning."""
+    study = _dao_study(box_wing, 100, 10, noise=0.02, method="posterior")
+    print(study.to_dataframe().to_string())
+    assert int(study.chain_warnings) == 0
+    assert float(study.coverage_2sigma.min()) >= 0.89, study.to_dataframe()
 
 
 @pytest.mark.slow
@@ -498,7 +505,7 @@ def test_chain_convergence_against_the_ar1_closed_form():
     """An AR(1) chain x_t = phi x_(t-1) + e_t has the integrated autocorrelation time
     (1 + phi) / (1 - phi) = 9 for phi = 0.8; 16 walkers x 4000 steps estimate it to a few
     per cent (Sokal's window; 15 % allowed, about 4 standard errors)."""
-    from sbrdf_xr.invert._joint.posterior import MIN_TAUS, _warn_short, chain_convergence
+    from sbrdf_xr.invert._joint.posterior import MIN_TAUS, chain_convergence, warn_short
 
     rng = np.random.default_rng(11)
     phi, n = 0.8, 4000
@@ -511,6 +518,105 @@ def test_chain_convergence_against_the_ar1_closed_form():
     assert n_eff == pytest.approx(16 * 3000 / tau)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        _warn_short([tau], ["start"], n, 16)  # 4000 steps > 50 x 9: converged, silent
+        warn_short([tau], ["start"], n, 16)  # 4000 steps > 50 x 9: converged, silent
     with pytest.warns(ChainLengthWarning, match=rf"fewer than {MIN_TAUS} .* start \(tau 9"):
-        _warn_short([9.0], ["start"], 300, 16)
+        warn_short([9.0], ["start"], 300, 16)
+
+
+def _redder(box_wing):
+    """The paint 10 % brighter than its table and redder: + 5 % per 100 nm of the bands'
+    mean wavelength (V 1.033, R 1.093, I 1.174)."""
+    from sbrdf_xr.invert._joint.model_error import band_offsets
+
+    x = band_offsets(["V", "R", "I"])
+    return {"white-paint-a276": {b: 1.1 * (1 + 0.05 * xi) for b, xi in zip("VRI", x, strict=True)}}
+
+
+def test_band_offsets_are_the_filters_mean_wavelengths():
+    """Bessell V, R, I mean wavelengths int T l dl / int T dl by numpy on the filters'
+    own grid (551, 664, 806 nm): the offsets from their mean, in 100 nm, to 1e-9."""
+    from sbrdf_xr.invert._joint.model_error import band_offsets
+    from sbrdf_xr.photometry import filters
+
+    f = filters(["V", "R", "I"])
+    wl = f.wavelength.values
+    mean = [np.sum(t * wl) / np.sum(t) for t in f.values]  # even grid: the trapezoid's ends cancel
+    got = band_offsets(["V", "R", "I"])
+    assert got.sum() == pytest.approx(0.0, abs=1e-12)
+    np.testing.assert_allclose(np.diff(got), np.diff(mean) / 100.0, atol=2e-2)
+    assert 1.5 < got[2] - got[1] + got[1] - got[0] < 3.0  # V to I: about 250 nm
+
+
+def test_colour_tilt_is_a_nuisance_parameter(box_wing):
+    """The paint brighter and redder than its table (one draw at 0.02 mag): with the
+    tables' colour tilts fitted too (prior 0 +- 0.05 per 100 nm) every physical parameter
+    lies within 2 sigma of the truth, the tilts are reported with their prior widths, and
+    the priors count as data (degrees of freedom unchanged); the solution recomputed
+    through simulate and photometry.magnitudes agrees with the fit's model (to 1e-9 mag:
+    the per-material band signals by another route, times the same tilt factors)."""
+    lc = _dao_curve(box_wing, 0.02, 3, brightness=_redder(box_wing))
+    start = {**DAO_SPIN, "axis_longitude": 101.0, "period": 47.03}
+    scale = invert.fit_observation(lc, box_wing, dao_pass(), start, material_scale="provenance")
+    tilt = invert.fit_observation(
+        lc, box_wing, dao_pass(), start, material_scale="provenance", colour_tilt=True
+    )
+    assert tilt.table_tilt_prior_width.values.tolist() == [0.05, 0.05, 0.05]
+    assert "table_tilt_white-paint-a276" in tilt.parameter.values
+    assert int(tilt.degrees_of_freedom) == int(scale.degrees_of_freedom)
+    assert float(tilt.attrs["model_check"].split("difference ")[1].split(" mag")[0]) < 1e-9
+    truth = {
+        "axis_longitude": 100.0,
+        "axis_latitude": 20.0,
+        "period": 47.0,
+        **{f"extinction_{b}": v for b, v in DAO_EXTINCTION.items()},
+    }
+    for k, v in truth.items():
+        assert abs(float(tilt.estimate.sel(parameter=k)) - v) < 2 * float(
+            tilt.uncertainty.sel(parameter=k)
+        ), k
+    pull = (
+        tilt.area_fraction.values - list(DAO_FRACTIONS.values())
+    ) / tilt.area_fraction_uncertainty
+    assert np.all(np.abs(pull.values) < 2)
+
+
+@pytest.mark.parametrize(
+    ("bad", "match"),
+    [
+        (0.0, r"colour_tilt\['aluminium-6061-t6'\]: 0.0; allowed a prior width > 0"),
+        (-0.1, "allowed a prior width > 0"),
+        ({"unobtainium": 0.1}, r"colour_tilt: \['unobtainium'\] are not materials of the body"),
+        ("yes", "allowed a prior width > 0"),
+    ],
+)
+def test_colour_tilt_bad_input(box_wing, bad, match):
+    from sbrdf_xr.errors import InversionError
+
+    lc = _dao_curve(box_wing, 0.02, 1)
+    with pytest.raises(InversionError, match=match):
+        invert.fit_observation(lc, box_wing, dao_pass(), DAO_SPIN, colour_tilt=bad)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("tilt", [None, True], ids=["scale-only", "scale-and-tilt"])
+def test_colour_tilt_study(box_wing, tilt):
+    """30 held-out draws of the paint 10 % brighter and redder (0.02 mag, seed 3), fitted
+    with the tables' scales (material_scale="provenance"): without the tilt the colour
+    error goes to the extinction and the axis (2-sigma coverage of k_V 0.20, k_I 0.30,
+    axis longitude 0.40, cells' fraction 0.80) and no fit warns (0 of 30); with the tilt
+    every parameter's coverage is 0.90-1.00 (0 warnings).  Asserted with the tilt: >= 0.80
+    (0.95 less 3.5 binomial sigma of 30 draws, 0.04 each)."""
+    study = _dao_study(
+        box_wing,
+        30,
+        3,
+        noise=0.02,
+        material_scale="provenance",
+        colour_tilt=tilt,
+        brightness=_redder(box_wing),
+    )
+    print(study[["pull_mean", "pull_width", "coverage_2sigma"]].to_dataframe().to_string())
+    if tilt:
+        assert float(study.coverage_2sigma.min()) >= 0.80
+    else:  # the colour error is not absorbed: the extinction is biased
+        assert float(study.coverage_2sigma.sel(parameter="extinction_V")) < 0.5

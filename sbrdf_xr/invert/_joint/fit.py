@@ -19,7 +19,6 @@ import xarray as xr
 from numpy.typing import ArrayLike
 
 from ...errors import FitQualityWarning, InversionError
-from ...units import to_unit
 from .._areas import material_areas
 from .._quality import fit_quality
 from .._spin.fit import AMBIGUITY_CHI2
@@ -30,11 +29,11 @@ from .diagnose import likely_causes
 from .extinction import extinction_prior as _k_prior
 from .extinction import separable_sd
 from .model import PassModel, pass_data
-from .model_error import discrepancy_floor, estimated_floor, table_widths, with_floor
-from .posterior import check_budget
+from .model_error import discrepancy_floor, estimated_floor, table_widths, tilt_layout, with_floor
+from .posterior import CHUNK_STEPS, check_budget
 from .refine import Local, jacobian, outside_physics, refine
 from .result import Layout, model_check, result_dataset
-from .starts import minima_dataset, start_states
+from .starts import axis_body_of, minima_dataset, read_start, start_states
 from .status import RECOVER, causes, held_note, status_attrs, with_posterior
 from .twins import twin_dataset
 
@@ -55,54 +54,6 @@ JOINT_CAUSES = (
     "(try offset='band')",
     "the uncertainties are understated",
 )
-
-
-def _read_start(spin: Any) -> tuple[dict[str, float], Any]:
-    """Start values (axis_longitude, axis_latitude, period, phase) and their epoch (UTC or
-    None), from a :func:`fit_spin` result or a mapping."""
-    keys = ("axis_longitude", "axis_latitude", "period", "phase")
-    have: Mapping[Any, Any]
-    attrs: Mapping[Any, Any]
-    if isinstance(spin, xr.Dataset):
-        have, attrs = {k: spin[k].values for k in spin.variables}, spin.attrs
-    elif isinstance(spin, Mapping):
-        have, attrs = spin, spin
-    else:
-        raise InversionError(
-            f"spin: expected the Dataset of fit_spin or a mapping of {list(keys)} (and epoch), "
-            f"got {type(spin).__name__}"
-        )
-    missing = [k for k in keys if k not in have]
-    if missing:
-        raise InversionError(f"spin: missing {missing}; a start needs {list(keys)}")
-    units = {"axis_longitude": "deg", "axis_latitude": "deg", "period": "s", "phase": "deg"}
-    out = {k: float(np.asarray(to_unit(have[k], units[k], f"spin {k}"))) for k in keys}
-    if not all(np.isfinite(v) for v in out.values()) or out["period"] <= 0:
-        raise InversionError(f"spin: start values must be finite with period > 0 [s], got {out}")
-    epoch = attrs.get("epoch")
-    if epoch is not None:
-        try:
-            epoch = np.datetime64(str(epoch)).astype("datetime64[ns]")
-        except ValueError:
-            raise InversionError(
-                f"spin: epoch {epoch!r} is not a UTC time; the spin must be fitted to the "
-                "observation (fit_spin(..., geometry=observation)) or give epoch as UTC"
-            ) from None
-    return out, epoch
-
-
-def _axis_body(spin: Any, axis_body: ArrayLike | None) -> np.ndarray:
-    """The body axis of the spin: given, else the :func:`fit_spin` result's, else z."""
-    attrs = spin.attrs if isinstance(spin, xr.Dataset) else spin
-    ab = axis_body
-    if ab is None:
-        ab = attrs.get("axis_body", (0.0, 0.0, 1.0))
-        if isinstance(ab, str):
-            ab = [float(v) for v in ab.strip("[]()").split(",")]
-    abv = np.asarray(ab, dtype=np.float64)
-    if abv.shape != (3,) or not np.all(np.isfinite(abv)) or np.linalg.norm(abv) == 0:
-        raise InversionError(f"axis_body: {ab!r}; allowed a finite nonzero 3-vector")
-    return abv
 
 
 def _options(extinction: Any, offset: str | None, areas: str, labels: Sequence[str]) -> Any:
@@ -159,10 +110,11 @@ def fit_observation(
     extinction_prior: Mapping[str, Any] | None = None,
     symmetry_tolerance: float = SYMMETRY_TOL,
     material_scale: str | Mapping[str, float] | None = None,
+    colour_tilt: bool | float | Mapping[str, float] | None = None,
     model_discrepancy: str | float | Mapping[str, float] | None = None,
     method: str = "point",
-    posterior_walkers: int = 32,
-    posterior_steps: int = 300,
+    posterior_walkers: int | None = None,
+    posterior_steps: int | None = None,
     seed: int = 0,
 ) -> xr.Dataset:
     """Spin state, extinction, zero points and material areas fitted jointly to the
@@ -256,6 +208,13 @@ def fit_observation(
         maps the body's facets (normals, areas, materials: the model's terms) onto
         themselves gives a twin state of the solution, evaluated on the data and listed
         over ``twin`` and in ``ambiguity`` (:mod:`sbrdf_xr.invert._spin.symmetry`).
+    colour_tilt : bool, float or mapping of str to float, optional
+        Fit a colour tilt of each material's table as a nuisance parameter too: the table
+        scaled in band ``b`` by ``1 + t_m x_b`` (``x_b`` the band's mean wavelength less
+        the bands' mean, counted in hundreds of nanometres) with the prior ``t_m ~ N(0,
+        w_m^2)``; True: ``w_m`` 0.05 per 100 nm, a number or ``{material: width}`` given
+        (> 0).  Default None: the
+        tables' colours taken as exact.  Reported as ``table_tilt`` over ``material``.
     model_discrepancy : "estimate", float or mapping of str to float, optional
         A model-discrepancy floor [mag] (one for every band, or ``{band: floor}``, bands
         left out 0), added in quadrature to the measured uncertainties
@@ -263,6 +222,21 @@ def fit_observation(
         tables' scales do not absorb it; ``"estimate"``: each band's floor estimated from
         the residuals of a point fit without one, then the pass fitted again with it
         (twice the cost).  Default None: the model taken as exact.
+    method : {"point", "posterior"}
+        ``"posterior"``: the joint posterior sampled by emcee from every minimum within a
+        chi-square of 25 of the best (:mod:`sbrdf_xr.invert._joint.posterior`): the
+        point fit's covariance sets the walkers' start and the independence proposal;
+        medians, standard deviations and 2.5 / 97.5 % points per parameter, each mode's
+        probability, autocorrelation time and cost (``posterior_cost``).
+    posterior_walkers : int, optional
+        Walkers of the ensemble (default ``2 n + 2`` for ``n`` fitted parameters).
+    posterior_steps : int, optional
+        Steps per mode (default: grown 50 at a time until the chain spans 50
+        autocorrelation times, within the budget).  Chains shorter than that raise a
+        :class:`~sbrdf_xr.errors.ChainLengthWarning`; a budget beyond 200000 model
+        evaluations is refused with its estimated time.
+    seed : int
+        Seed of the sampler's generator.
 
     Returns
     -------
@@ -357,8 +331,8 @@ def fit_observation(
         return estimated_floor(fit_observation, dict(locals()))
     t_start = time.perf_counter()
     _check_method(method)
-    start, epoch = _read_start(spin)
-    ab = _axis_body(spin, axis_body)
+    start, epoch = read_start(spin)
+    ab = axis_body_of(spin, axis_body)
     data = pass_data(light_curve, observation, bands, system)
     floor = discrepancy_floor(model_discrepancy, data.labels)
     data = with_floor(data, floor)
@@ -372,7 +346,12 @@ def fit_observation(
     if method == "posterior":  # refuse a budget beyond the bound before fitting
         t0 = time.perf_counter()
         model.terms(vec(start["axis_longitude"], start["axis_latitude"]), start["period"], 0.0)
-        check_budget(posterior_walkers, posterior_steps, 1, time.perf_counter() - t0)
+        check_budget(
+            1 if posterior_walkers is None else posterior_walkers,
+            CHUNK_STEPS if posterior_steps is None else posterior_steps,
+            1,
+            time.perf_counter() - t0,
+        )
     area_of = material_areas(spacecraft)
     lay = Layout(
         data.labels,
@@ -383,6 +362,7 @@ def fit_observation(
         areas,
         None if held is None else k_prior[1],
         table_widths(material_scale, names, model.kernel.sources),
+        *tilt_layout(colour_tilt, names, data.labels),
     )
     _check_counts(method, posterior_walkers, data, lay)
     if epoch is None:
@@ -502,7 +482,7 @@ def _minimise(
         return float((t - data.epoch) / np.timedelta64(1, "ns")) * 1e-9
 
     def read(s: Any) -> tuple[dict[str, float], float | None]:
-        values, t = _read_start(s)
+        values, t = read_start(s)
         return values, None if t is None else seconds_of(t)
 
     dt_epoch = seconds_of(epoch)

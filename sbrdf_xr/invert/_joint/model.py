@@ -226,7 +226,11 @@ class PassModel:
         return out
 
     def magnitudes(self, terms: np.ndarray, scales: np.ndarray) -> np.ndarray:
-        """Model magnitudes (N,) of the body with each material's area scaled (no extinction
-        or zero point); a non-positive summed signal is clipped to 1e-300 m2 sr-1."""
-        flux = terms @ scales
+        """Model magnitudes (N,) of the body with each material's area scaled, ``scales``
+        (M,) or per band (B, M) (no extinction or zero point); a non-positive summed
+        signal is clipped to 1e-300 m2 sr-1."""
+        if np.ndim(scales) == 2:
+            flux = np.einsum("nm,nm->n", terms, scales[self.data.band])
+        else:
+            flux = terms @ scales
         return self.data.unit_magnitude - 2.5 * np.log10(np.maximum(flux, 1e-300))

@@ -37,10 +37,14 @@ from ...units import to_unit
 
 __all__ = [
     "PROVENANCE_WIDTH",
+    "TILT_WIDTH",
+    "band_offsets",
     "discrepancy_floor",
     "estimate_floor",
     "estimated_floor",
     "table_widths",
+    "tilt_layout",
+    "tilt_widths",
     "with_floor",
 ]
 
@@ -48,6 +52,9 @@ __all__ = [
 #: laboratory measurement (a few per cent), a model fitted to measurements, and a table
 #: made from a model alone (its parameters from the literature, not from the flight part).
 PROVENANCE_WIDTH = {"measured": 0.05, "model": 0.1, "synthetic": 0.2}
+#: Default prior width of a table's colour tilt: a fractional change of its signal of 5 %
+#: per 100 nm (a white paint yellowed by ultraviolet, a cell's coating thicker than made).
+TILT_WIDTH = 0.05
 #: Most fits made to estimate the model-discrepancy floor (``model_discrepancy="estimate"``).
 FLOOR_ROUNDS = 4
 
@@ -110,6 +117,90 @@ def table_widths(
             )
         out.append(w)
     return np.array(out)
+
+
+def tilt_widths(
+    colour_tilt: bool | float | Mapping[str, float] | None, materials: Sequence[str]
+) -> np.ndarray | None:
+    """Prior width of each material's colour tilt [1 per 100 nm], or None (not fitted).
+
+    The table of material ``m`` is scaled in band ``b`` by ``1 + t_m x_b``, ``x_b`` the
+    band's mean wavelength less the mean over the fitted bands [100 nm], with the prior
+    ``t_m ~ N(0, w_m^2)``.  ``None`` or False: not fitted; True: :data:`TILT_WIDTH` for
+    every material; a number: that width for every material; a mapping: per material,
+    the others :data:`TILT_WIDTH`.  Widths finite and > 0.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.invert._joint.model_error import tilt_widths
+    >>> tilt_widths(True, ["paint", "cell"]).tolist()
+    [0.05, 0.05]
+    >>> tilt_widths({"cell": 0.1}, ["paint", "cell"]).tolist()
+    [0.05, 0.1]
+    """
+    if colour_tilt is None or colour_tilt is False:
+        return None
+    if isinstance(colour_tilt, Mapping):
+        unknown = sorted(set(map(str, colour_tilt)) - set(materials))
+        if unknown:
+            raise InversionError(
+                f"colour_tilt: {unknown} are not materials of the body; have {list(materials)}"
+            )
+        given: dict[str, Any] = {str(k): v for k, v in colour_tilt.items()}
+    elif colour_tilt is True:
+        given = {}
+    else:
+        given = dict.fromkeys(materials, colour_tilt)
+    out = []
+    for m in materials:
+        w: Any = given.get(m, TILT_WIDTH)
+        try:
+            w = float(w)
+        except (TypeError, ValueError):
+            w = float("nan")
+        if not (np.isfinite(w) and w > 0):
+            raise InversionError(
+                f"colour_tilt[{m!r}]: {given.get(m)!r}; allowed a prior width > 0 (a "
+                "fractional change of the table per 100 nm), True (0.05 each) or None"
+            )
+        out.append(w)
+    return np.array(out)
+
+
+def tilt_layout(
+    colour_tilt: Any, materials: Sequence[str], labels: Sequence[str]
+) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Prior widths of the tables' colour tilts (:func:`tilt_widths`) and the bands'
+    offsets (:func:`band_offsets`), or ``(None, None)`` when not fitted.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.invert._joint.model_error import tilt_layout
+    >>> tilt_layout(None, ["paint"], ["V", "R"])
+    (None, None)
+    """
+    widths = tilt_widths(colour_tilt, materials)
+    return widths, None if widths is None else band_offsets(labels)
+
+
+def band_offsets(labels: Sequence[str]) -> np.ndarray:
+    """Each band's mean wavelength ``int T l dl / int T dl`` (its filter response ``T``)
+    less the mean over ``labels`` [100 nm].
+
+    Examples
+    --------
+    >>> from sbrdf_xr.invert._joint.model_error import band_offsets
+    >>> x = band_offsets(["V", "I"])
+    >>> bool(abs(x.sum()) < 1e-12), bool(2.0 < x[1] - x[0] < 3.0)  # V 550, I 800 nm
+    (True, True)
+    """
+    from ...photometry import filters
+
+    f = filters(list(labels))
+    wl = f["wavelength"].values
+    t = f.values
+    mean = np.trapezoid(t * wl, wl, axis=1) / np.trapezoid(t, wl, axis=1)
+    return np.asarray((mean - mean.mean()) / 100.0)
 
 
 def discrepancy_floor(

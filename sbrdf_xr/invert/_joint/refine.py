@@ -53,7 +53,7 @@ def refine(model: PassModel, lay: Layout, st: Start, span: float, bounded: bool 
 
     def residuals(p: np.ndarray) -> np.ndarray:
         terms = model.terms(axis_of(p), p[2], p[3])
-        m = model.magnitudes(terms, lay.scales(p)) + lay.extra(p, data)
+        m = model.magnitudes(terms, lay.band_scales(p)) + lay.extra(p, data)
         return np.append((data.magnitude - m) / data.sigma, lay.prior_residuals(p))
 
     p0 = lay.start(st.period, st.phase_ref)

@@ -14,6 +14,7 @@ from .._quality import quality_attrs
 from .._spin.search import lonlat
 from .._unseen import correlation
 from .model import PassData
+from .nuisance import table_scales, table_tilts
 
 __all__ = ["Layout", "model_check", "result_dataset"]
 
@@ -38,6 +39,8 @@ class Layout:
     areas: str
     k_prior_sd: np.ndarray | None = None  # extinction held at its prior: the prior's width
     m_sd: np.ndarray | None = None  # prior widths of the tables' scales (nuisance), or None
+    c_sd: np.ndarray | None = None  # prior widths of the tables' colour tilts, or None
+    tilt_x: np.ndarray | None = None  # each band's mean wavelength less the bands' [100 nm]
 
     def __post_init__(self) -> None:
         nb, nm = len(self.bands), len(self.materials)
@@ -46,6 +49,7 @@ class Layout:
             "z": {None: 0, "band": nb, "common": 1}[self.offset],
             "f": {"total": nm - 1, "free": nm, "fixed": 0}[self.areas],
             "s": 0 if self.m_sd is None else nm,
+            "c": 0 if self.c_sd is None else nm,
         }
         i = 4
         self.sl: dict[str, slice] = {}
@@ -69,8 +73,9 @@ class Layout:
             *(zn if self.offset != "common" else ["magnitude_offset"]),
             *fn,
             *([f"table_scale_{m}" for m in self.materials] if sizes["s"] else []),
+            *([f"table_tilt_{m}" for m in self.materials] if sizes["c"] else []),
         ]
-        self.n_prior = sizes["s"]
+        self.n_prior = sizes["s"] + sizes["c"]
         self.units = ["degree", "degree", "s", "degree"] + ["1"] * (i - 4)
 
     def fractions(self, p: np.ndarray) -> np.ndarray:
@@ -99,9 +104,19 @@ class Layout:
 
     def prior_residuals(self, p: np.ndarray) -> np.ndarray:
         """``(s_m - 1) / w_m`` of the tables' scales (none when not fitted)."""
-        if self.m_sd is None:
-            return np.zeros(0)
-        return np.asarray((p[self.sl["s"]] - 1.0) / self.m_sd)
+        out = [] if self.m_sd is None else [(p[self.sl["s"]] - 1.0) / self.m_sd]
+        if self.c_sd is not None:
+            out.append(p[self.sl["c"]] / self.c_sd)
+        return np.concatenate(out) if out else np.zeros(0)
+
+    def band_scales(self, p: np.ndarray) -> np.ndarray:
+        """Scale of each material's signal in each band (B, M): :meth:`scales` times the
+        colour tilt ``1 + t_m x_b`` (``x_b`` the band's mean wavelength less the bands'
+        mean [100 nm]; 1 when not fitted)."""
+        sc = self.scales(p)[None, :]
+        if self.c_sd is None or self.tilt_x is None:
+            return np.asarray(np.repeat(sc, len(self.bands), axis=0))
+        return np.asarray(sc * (1.0 + self.tilt_x[:, None] * p[self.sl["c"]][None, :]))
 
     def area_scales(self, p: np.ndarray) -> np.ndarray:
         """Area scale ``a_m`` of each material (without its table's scale)."""
@@ -142,6 +157,7 @@ class Layout:
         h[:4] = [1e-3, 1e-3, 1e-6 * period, 1e-3]
         h[self.sl["f"]] = 1e-5
         h[self.sl["s"]] = 1e-5
+        h[self.sl["c"]] = 1e-5
         return h
 
 
@@ -211,7 +227,8 @@ def result_dataset(
     _spin_terms(ds, est, sd, c_out, free_out, finite, axis)
     k_how = _band_terms(ds, lay, p, sd)
     _areas(ds, lay, p, c_out)
-    _table_scales(ds, lay, p, sd)
+    table_scales(ds, lay, p, sd)
+    table_tilts(ds, lay, p, sd)
     scal = {
         "chi2": (chi2, "chi-square of the fit"),
         "degrees_of_freedom": (dof, "degrees of freedom (values minus fitted parameters)"),
@@ -352,28 +369,6 @@ def _band_terms(ds: xr.Dataset, lay: Layout, p: np.ndarray, sd: np.ndarray) -> s
     return k_how
 
 
-def _table_scales(ds: xr.Dataset, lay: Layout, p: np.ndarray, sd: np.ndarray) -> None:
-    """The fitted scale of each material's table, when model error is fitted."""
-    if lay.m_sd is None:
-        return
-    sl = lay.sl["s"]
-    ds["table_scale"] = (
-        "material",
-        p[sl],
-        _cf("1", "fitted scale of the material's table (nuisance parameter: model error)"),
-    )
-    ds["table_scale_uncertainty"] = (
-        "material",
-        sd[sl],
-        _cf("1", "1-sigma uncertainty of the table's scale"),
-    )
-    ds["table_scale_prior_width"] = (
-        "material",
-        lay.m_sd,
-        _cf("1", "prior width of the table's scale (prior 1 +- width)"),
-    )
-
-
 def _per_observation(
     ds: xr.Dataset, light_curve: xr.Dataset, data: PassData, residual: np.ndarray
 ) -> xr.Dataset:
@@ -462,7 +457,9 @@ def model_check(
     # a material that reflects nothing at any time may be left out of the cube
     mags = mags.reindex(material=list(lay.materials), fill_value=np.inf)
     mm = mags.transpose("time", "material", "band").values
-    flux = (10 ** (-0.4 * mm[data.t_index, :, data.band])) @ lay.scales(p)
+    flux = np.einsum(
+        "nm,nm->n", 10 ** (-0.4 * mm[data.t_index, :, data.band]), lay.band_scales(p)[data.band]
+    )
     m = -2.5 * np.log10(np.maximum(flux, 1e-300)) + lay.extra(p, data)
     d = np.abs(m - ds["model_magnitude"].values)
     return (

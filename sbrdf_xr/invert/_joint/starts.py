@@ -13,12 +13,63 @@ from typing import Any
 
 import numpy as np
 import xarray as xr
+from numpy.typing import ArrayLike
 
 from ...errors import InversionError
+from ...units import to_unit
 from .._spin.refine import axis_angle
 from .._spin.search import lonlat, vec
 
-__all__ = ["Start", "minima_dataset", "start_states"]
+__all__ = ["Start", "axis_body_of", "minima_dataset", "read_start", "start_states"]
+
+
+def read_start(spin: Any) -> tuple[dict[str, float], Any]:
+    """Start values (axis_longitude, axis_latitude, period, phase) and their epoch (UTC or
+    None), from a :func:`fit_spin` result or a mapping."""
+    keys = ("axis_longitude", "axis_latitude", "period", "phase")
+    have: Mapping[Any, Any]
+    attrs: Mapping[Any, Any]
+    if isinstance(spin, xr.Dataset):
+        have, attrs = {k: spin[k].values for k in spin.variables}, spin.attrs
+    elif isinstance(spin, Mapping):
+        have, attrs = spin, spin
+    else:
+        raise InversionError(
+            f"spin: expected the Dataset of fit_spin or a mapping of {list(keys)} (and epoch), "
+            f"got {type(spin).__name__}"
+        )
+    missing = [k for k in keys if k not in have]
+    if missing:
+        raise InversionError(f"spin: missing {missing}; a start needs {list(keys)}")
+    units = {"axis_longitude": "deg", "axis_latitude": "deg", "period": "s", "phase": "deg"}
+    out = {k: float(np.asarray(to_unit(have[k], units[k], f"spin {k}"))) for k in keys}
+    if not all(np.isfinite(v) for v in out.values()) or out["period"] <= 0:
+        raise InversionError(f"spin: start values must be finite with period > 0 [s], got {out}")
+    epoch = attrs.get("epoch")
+    if epoch is not None:
+        try:
+            epoch = np.datetime64(str(epoch)).astype("datetime64[ns]")
+        except ValueError:
+            raise InversionError(
+                f"spin: epoch {epoch!r} is not a UTC time; the spin must be fitted to the "
+                "observation (fit_spin(..., geometry=observation)) or give epoch as UTC"
+            ) from None
+    return out, epoch
+
+
+def axis_body_of(spin: Any, axis_body: ArrayLike | None) -> np.ndarray:
+    """The body axis of the spin: given, else the :func:`fit_spin` result's, else z."""
+    attrs = spin.attrs if isinstance(spin, xr.Dataset) else spin
+    ab = axis_body
+    if ab is None:
+        ab = attrs.get("axis_body", (0.0, 0.0, 1.0))
+        if isinstance(ab, str):
+            ab = [float(v) for v in ab.strip("[]()").split(",")]
+    abv = np.asarray(ab, dtype=np.float64)
+    if abv.shape != (3,) or not np.all(np.isfinite(abv)) or np.linalg.norm(abv) == 0:
+        raise InversionError(f"axis_body: {ab!r}; allowed a finite nonzero 3-vector")
+    return abv
+
 
 #: Half turns more and fewer over the measured span tried by ``starts="aliases"``.
 ALIAS_HALF_TURNS = (-2, -1, 1, 2)

@@ -115,8 +115,8 @@ def with_posterior(
     model: PassModel,
     dt_epoch: float,
     fit_s: float,
-    walkers: int,
-    steps: int,
+    walkers: int | None,
+    steps: int | None,
     seed: int,
 ) -> xr.Dataset:
     """The result with the posterior sampled from every minimum (:mod:`._posterior`)."""

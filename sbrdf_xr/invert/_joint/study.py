@@ -18,13 +18,16 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
-from ...errors import FitQualityWarning, InversionError, renamed_keywords
+from ...errors import ChainLengthWarning, FitQualityWarning, InversionError, renamed_keywords
 from ...units import to_unit
 from .._areas import material_areas
 from .._spin.search import spin_model, vec
 from .fit import fit_observation
 
-__all__ = ["observation_recovery", "simulated_light_curve"]
+__all__ = ["COVERAGE_2SIGMA", "observation_recovery", "simulated_light_curve"]
+
+#: Probability of a Gaussian estimate within 2 sigma of the truth.
+COVERAGE_2SIGMA = 0.9545
 
 
 def simulated_light_curve(
@@ -38,7 +41,7 @@ def simulated_light_curve(
     axis_body: ArrayLike = (0.0, 0.0, 1.0),
     system: str = "Vega",
     zero_point: Mapping[str, float] | None = None,
-    brightness: Mapping[str, float] | None = None,
+    brightness: Mapping[str, Any] | None = None,
     effects: Sequence[str] = (),
 ) -> tuple[xr.Dataset, float]:
     """Noise-free magnitudes of a pass, one band per time in turn, and the wall time [s] of
@@ -50,7 +53,8 @@ def simulated_light_curve(
     :func:`sbrdf_xr.photometry.magnitudes` (the cube's range and Sun distance), and
     ``k_b X + z_b`` is added with the cube's air mass.  Times in the Earth's umbra or
     below the horizon are left out.  A truth other than the fit's model: ``brightness``
-    scales a material's signal (``{"white-paint-a276": 1.1}``: its table 10 % too dark),
+    scales a material's signal (``{"white-paint-a276": 1.1}``: its table 10 % too dark;
+    ``{"white-paint-a276": {"V": 1.05, "I": 1.2}}``: per band, a colour too),
     ``effects`` adds effects of :func:`sbrdf_xr.engine.simulate` (``("shadowing",)``).
 
     Examples
@@ -95,14 +99,20 @@ def simulated_light_curve(
     total = sum(areas.values())
     names = [str(m) for m in cube["material"].values]
     gain = brightness or {}
+
+    def gains(m: str) -> list[float]:  # a factor, or one per band {band: factor}
+        g = gain.get(m, 1.0)
+        return [float(g.get(b, 1.0)) if isinstance(g, Mapping) else float(g) for b in bands]
+
     scale = xr.DataArray(
-        [area_fraction[m] * total / areas[m] * float(gain.get(m, 1.0)) for m in names],
-        dims="material",
-        coords={"material": names},
+        [[area_fraction[m] * total / areas[m] * f for f in gains(m)] for m in names],
+        dims=("material", "band"),
+        coords={"material": names, "band": list(bands)},
     )
     per = cube[["signal_material"]].rename(signal_material="signal")
     mm = magnitudes(per, list(bands), system=system)
-    flux = (10 ** (-0.4 * mm) * scale).sum("material").transpose("time", "band").values
+    mixed = (10 ** (-0.4 * mm) * scale.sel(band=mm["band"])).sum("material")
+    flux = mixed.transpose("time", "band").values
     with np.errstate(divide="ignore"):
         mix = -2.5 * np.log10(flux)
     x = cube["airmass"].values
@@ -146,7 +156,7 @@ def observation_recovery(
     seed: int = 0,
     start_offset: Mapping[str, float] | None = None,
     phase_symmetry: float = 360.0,
-    brightness: Mapping[str, float] | None = None,
+    brightness: Mapping[str, Any] | None = None,
     effects: Sequence[str] = (),
     **options: Any,
 ) -> xr.Dataset:
@@ -183,8 +193,11 @@ def observation_recovery(
     xarray.Dataset
         Over ``parameter``: ``truth``, ``estimate_mean``, ``estimate_std``,
         ``uncertainty_median``, ``pull_mean``, ``pull_width``, ``coverage_1sigma``,
-        ``coverage_2sigma``; ``pull`` over (``draw``, ``parameter``); ``axis_error``
-        [degree] over ``draw``; scalars ``n_draws``, ``quality_warnings``,
+        ``coverage_2sigma`` and its binomial ``coverage_2sigma_uncertainty``; ``pull``
+        over (``draw``, ``parameter``); ``axis_error`` [degree] over ``draw``; scalars
+        ``n_draws``, ``quality_warnings``, ``chain_warnings`` and ``posterior_to_point``
+        (with ``method="posterior"``: draws with a ChainLengthWarning, the median cost of
+        the sampling over its point fit),
         ``seconds_per_fit`` (median), ``simulate_seconds`` (one
         :func:`sbrdf_xr.engine.simulate` of the measured times with the per-material
         output, best of 3 in the same run) and ``fit_to_simulate``.
@@ -240,7 +253,8 @@ def observation_recovery(
     rng = np.random.default_rng(seed)
     rows: list[dict[str, tuple[float, float]]] = []
     ax_err, secs = [], []
-    n_warn = 0
+    n_warn = n_chain = 0
+    post_cost: list[float] = []
     load0 = os.getloadavg()[0]
     for _ in range(n_draws):
         lc = lc0.copy()
@@ -249,9 +263,13 @@ def observation_recovery(
         t0 = time.perf_counter()
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", FitQualityWarning)
+            warnings.simplefilter("always", ChainLengthWarning)
             fit = fit_observation(lc, spacecraft, obs_at, start, check=False, **options)
         secs.append(time.perf_counter() - t0)
         n_warn += any(issubclass(w.category, FitQualityWarning) for w in caught)
+        n_chain += any(issubclass(w.category, ChainLengthWarning) for w in caught)
+        if "posterior_seconds" in fit.attrs:
+            post_cost.append(fit.attrs["posterior_seconds"] / fit.attrs["fit_seconds"])
         rows.append(_draw_row(fit, truth, bands, phase_symmetry))
         cosang = float(np.clip(fit["axis_vector"].values @ a0, -1.0, 1.0))
         ax_err.append(float(np.degrees(np.arccos(cosang))))
@@ -267,6 +285,12 @@ def observation_recovery(
             "wall time of one simulate of the measured times (per material, best of 3)",
         ),
         "fit_to_simulate": (per_fit / sim_s, "1", "wall time per fit over that of one simulate"),
+        "chain_warnings": (n_chain, "1", "draws with a ChainLengthWarning (method='posterior')"),
+        "posterior_to_point": (
+            float(np.median(post_cost)) if post_cost else float("nan"),
+            "1",
+            "median wall time of the posterior sampling over that of its point fit",
+        ),
     }
     for k, (v, u, ln) in scalars.items():
         ds[k] = ((), v, {"units": u, "long_name": ln})
@@ -356,6 +380,11 @@ def _recovery_statistics(
         "pull_width": (pull.std(0), "standard deviation of (estimate - truth) / uncertainty"),
         "coverage_1sigma": ((np.abs(pull) <= 1).mean(0), "fraction of draws within 1 sigma"),
         "coverage_2sigma": ((np.abs(pull) <= 2).mean(0), "fraction of draws within 2 sigma"),
+        "coverage_2sigma_uncertainty": (
+            np.full(len(names), np.sqrt(COVERAGE_2SIGMA * (1 - COVERAGE_2SIGMA) / max(n_draws, 1))),
+            "binomial standard deviation of the 2-sigma coverage of a calibrated estimator "
+            "over the draws, sqrt(p (1 - p) / n) with p = 0.9545",
+        ),
     }
     units = ["degree", "degree", "s", "degree"] + ["1"] * (len(names) - 4)
     ds = xr.Dataset(

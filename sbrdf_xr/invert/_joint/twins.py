@@ -49,7 +49,7 @@ def twin_dataset(
             tw_axis, phase, sense = axis, (phase_epoch + sym.angle) % 360.0, 1
         else:
             terms = model.terms(axis, p[2], p[3], body_rotation=sym.matrix)
-            m = model.magnitudes(terms, lay.scales(p)) + lay.extra(p, data)
+            m = model.magnitudes(terms, lay.band_scales(p)) + lay.extra(p, data)
             r = np.append((data.magnitude - m) / data.sigma, lay.prior_residuals(p))
             align = align_matrices(model.k, axis[None, :])[0]
             tw_axis, sense = -axis, -1
