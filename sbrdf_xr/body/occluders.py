@@ -11,10 +11,10 @@ Sun or the observer, cached with the body:
   coplanar to :data:`COPLANAR` of the body's size (float rounding of a flat CAD face), to
   face the same way, to be of the same kind (one-sided facets of an open surface or not),
   and the union to stay strictly convex, with at most
-  :data:`~sbrdf_xr.kernels.shadow_pairs.MAX_OCCLUDER_VERTICES` vertices.
+  :data:`~sbrdf_xr.kernels.pair_table.MAX_OCCLUDER_VERTICES` vertices.
 * :func:`pair_table`: for every facet that can be shadowed, the occluders with a vertex in
   front of its plane, cut and stored in its frame with the box of the directions from
-  which they can reach it (:func:`sbrdf_xr.kernels.shadow_pairs.pair_table`).  The table
+  which they can reach it (:func:`sbrdf_xr.kernels.pair_table.pair_table`).  The table
   grows as (receivers x occluders in front), so past :data:`MAX_PAIR_WORK` pairs examined
   it is not built and the exact method falls back to its direction grid.
 """
@@ -25,8 +25,8 @@ from typing import Any
 
 import numpy as np
 
-from ..kernels.shadow_pairs import MAX_OCCLUDER_VERTICES
-from ..kernels.shadow_pairs import pair_table as _pair_kernel
+from ..kernels.pair_table import MAX_OCCLUDER_VERTICES
+from ..kernels.pair_table import pair_table as _pair_kernel
 
 __all__ = ["COPLANAR", "MAX_PAIR_WORK", "occluder_polygons", "pair_table"]
 
@@ -88,7 +88,7 @@ def occluder_polygons(frames: dict[str, Any]) -> dict[str, np.ndarray]:
     ----------
     frames : dict
         The exact method's per-facet arrays (``V``, ``F``, ``N``, ``P0``, ``E1``, ``E2``,
-        ``open_facet``, ``scale`` [m]) of :func:`sbrdf_xr.body.visibility.exact_frames`.
+        ``open_facet``, ``scale``) of :func:`sbrdf_xr.body.visibility.exact_frames`.
 
     Returns
     -------
@@ -148,7 +148,7 @@ def pair_table(frames: dict[str, Any], cache: dict[str, Any]) -> dict[str, Any] 
     -------
     dict or None
         ``occluders`` (:func:`occluder_polygons`) and ``table``, the arrays of
-        :func:`sbrdf_xr.kernels.shadow_pairs.pair_table`.
+        :func:`sbrdf_xr.kernels.pair_table.pair_table`.
 
     Examples
     --------

@@ -26,7 +26,7 @@ Modules
 ``anisotropic``
     The facet sums of anisotropic tables (a ``psi`` axis), on the same angles, look-up
     and accumulation.
-``polygon``, ``shadow`` and ``shadow_pairs``
+``polygon``, ``shadow``, ``pair_table`` and ``shadow_pairs``
     Plane-polygon clipping and the exact shadow kernels of :mod:`sbrdf_xr.body.visibility`:
     candidate occluders by a grid per direction, or from a table of the pairs that can
     shadow each other, built once per body.
@@ -39,6 +39,7 @@ from . import (
     lookup,
     lut,
     packing,
+    pair_table,
     polygon,
     reference,
     shadow,
@@ -141,6 +142,7 @@ __all__ = [
     "pack_anisotropic",
     "pack_tables",
     "packing",
+    "pair_table",
     "plan_step",
     "polygon",
     "reference",
