@@ -111,7 +111,7 @@ def occluder_polygons(frames: dict[str, Any]) -> dict[str, np.ndarray]:
     F = frames["F"]
     ok = np.linalg.norm(frames["N"], axis=1) > 0
     edges = {
-        (int(F[f, v]), int(F[f, (v + 1) % 3])): f for f in np.flatnonzero(ok) for v in range(3)
+        (int(F[f, v]), int(F[f, (v + 1) % 3])): int(f) for f in np.flatnonzero(ok) for v in range(3)
     }
     free = ok.copy()
     polys, members = [], []

@@ -333,13 +333,20 @@ def _exact(
     pairs = pair_table(frames, cache)
     if pairs is not None:  # the pairs that can shadow each other, found once per body
         occ = pairs["occluders"]
+        recv, pstart, pgroup, pcount, cut, box, r2 = pairs["table"]
         frac = pairs_kernel(
             normals,
             frames["N"],
             frames["E1"],
             frames["E2"],
             frames["T2"],
-            *pairs["table"],
+            recv,
+            pstart,
+            pgroup,
+            pcount,
+            cut,
+            box,
+            r2,
             occ["normal"],
             occ["open"],
             dirs,
