@@ -324,33 +324,18 @@ def _exact(
     """Exact fraction unobstructed along every direction of the list, shape (n_geom, n_facets)."""
     mesh, cache = mesh_of(spacecraft)
     normals = np.ascontiguousarray(mesh.face_normals, dtype=np.float64)
-    if convex_shortcut and is_convex(spacecraft):
+    shortcut = convex_shortcut and is_convex(spacecraft)
+    if shortcut or not exact_frames(mesh, cache)["receiver"].any():  # nothing is shadowed
         return _front(directions, normals).astype(np.float64)
     frames = exact_frames(mesh, cache)
     dirs = np.ascontiguousarray(np.stack(directions, axis=1), dtype=np.float64)  # (G, K, 3)
-    if not frames["receiver"].any():
-        return _front(directions, normals).astype(np.float64)
     pairs = pair_table(frames, cache)
     if pairs is not None:  # the pairs that can shadow each other, found once per body
         occ = pairs["occluders"]
         recv, pstart, pgroup, pcount, cut, box, r2 = pairs["table"]
-        frac = pairs_kernel(
-            normals,
-            frames["N"],
-            frames["E1"],
-            frames["E2"],
-            frames["T2"],
-            recv,
-            pstart,
-            pgroup,
-            pcount,
-            cut,
-            box,
-            r2,
-            occ["normal"],
-            occ["open"],
-            dirs,
-        )
+        frame = (frames["N"], frames["E1"], frames["E2"], frames["T2"])
+        args = (recv, pstart, pgroup, pcount, cut, box, r2, occ["normal"], occ["open"], dirs)
+        frac = pairs_kernel(normals, *frame, *args)
     else:  # too many pairs to tabulate: candidate occluders by a grid per direction
         frac = np.where(_front(directions, normals), _grid_fractions(frames, dirs), 0.0)
     # a facet facing a direction per the stored normals but not per its winding (or
