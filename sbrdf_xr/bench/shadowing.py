@@ -25,7 +25,7 @@ import numpy as np
 
 from .. import testing
 from ..body.spacecraft import Spacecraft, canx1
-from ..body.visibility import lit_visible_fraction
+from ..body.visibility import lit_visible_fraction, mesh_of
 
 __all__ = [
     "ACCURACY_BODIES",
@@ -36,6 +36,7 @@ __all__ = [
     "geometries",
     "lambertian_signal",
     "markdown",
+    "pairs_rows",
     "scaling_rows",
 ]
 
@@ -349,6 +350,104 @@ def canx1_sweep_rows(n_attitudes: int = 360, density: int = 4, repeat: int = 2) 
             "largest |S_off - S_exact| / S_exact",
         ),
     ]
+
+
+def _rotation(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Sun along +x, observer at 30 deg phase, CanX-1 spun about z in n steps (body frame)."""
+    ang = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    c, sn = np.cos(ang), np.sin(ang)
+    p = np.radians(30.0)
+    s = np.column_stack([c, -sn, np.zeros(n)])
+    o = np.column_stack([c * np.cos(p) + sn * np.sin(p), -sn * np.cos(p) + c * np.sin(p), 0 * c])
+    return s, o
+
+
+def pairs_rows(n_geometries: int = 360, n_sweep: int = 10_000, repeat: int = 3) -> list[CostRow]:
+    """The exact method with its pair table against the grid kernel it replaced, same run.
+
+    Rows: microseconds per geometry of :func:`~sbrdf_xr.body.visibility.lit_visible_fraction`
+    on CanX-1, ``n_geometries`` of the :func:`canx1_sweep_rows` rotation batched in one
+    call, by the grid kernel (``before``: a body whose cache holds no pair table) and by the
+    pair table (``after``, its ``ratio`` over ``before``); the one-off cost of building the
+    table; and ``simulate`` of ``n_sweep`` random attitudes of the ``canx1-rotation`` scene
+    with exact shadowing over the same sweep without it, by each kernel.  Best of
+    ``repeat``, the two kernels timed in turns so that a load falls on both alike.
+
+    Examples
+    --------
+    Seconds even for a few geometries (the sweeps plan and compute CanX-1); not run here:
+
+    >>> from sbrdf_xr.bench.shadowing import pairs_rows
+    >>> rows = pairs_rows(n_geometries=8, n_sweep=100, repeat=1)  # doctest: +SKIP
+    >>> [r.label for r in rows][:2]  # doctest: +SKIP
+    ['grid kernel (before)', 'pair table (after)']
+    """
+    from .. import geometry
+    from ..engine import builtin_scene
+    from ..engine.run import simulate
+
+    s, o = _rotation(n_geometries)
+    grid, table = canx1(), canx1()
+    mesh_of(grid)[1]["exact:pairs"] = None  # a cached None: no table, the grid kernel
+    lit_visible_fraction(grid, s[:2], o[:2])
+    t0 = time.perf_counter()
+    lit_visible_fraction(table, s[:2], o[:2])  # builds the table (and compiles)
+    build = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    lit_visible_fraction(canx1(), s[:2], o[:2])  # the table alone, compiled
+    build = min(build, time.perf_counter() - t0)
+    tg = tp = np.inf
+    for _ in range(max(1, repeat)):
+        tg = min(tg, _timed(partial(lit_visible_fraction, grid, s, o), 1)[1])
+        tp = min(tp, _timed(partial(lit_visible_fraction, table, s, o), 1)[1])
+    n = table.n_facets
+    us = 1e3 / n_geometries  # ms per geometry per second
+    rows = [
+        CostRow("grid kernel (before)", table.name, n, n_geometries, us * tg, 1.0, "before"),
+        CostRow("pair table (after)", table.name, n, n_geometries, us * tp, tp / tg, "before"),
+        CostRow(
+            "pair table build (once per body)",
+            table.name,
+            n,
+            0,
+            1e3 * build,
+            build / tg,
+            "before, all geometries",
+        ),
+    ]
+    base = builtin_scene("canx1-rotation").with_options(
+        attitudes=geometry.uniform_attitudes(n_sweep, seed=3), attitude_angle=None
+    )
+    plans = {
+        e: base.with_options(effects=e, outputs=("signal",)).plan()
+        for e in (("sunlight",), ("sunlight", "shadowing"))
+    }
+    cache = mesh_of(plans[("sunlight", "shadowing")].spacecraft)[1]
+    times: dict[str, float] = {}
+    for label in ("off", "grid", "pairs"):
+        plan = plans[("sunlight",)] if label == "off" else plans[("sunlight", "shadowing")]
+        if label == "grid":
+            cache["exact:pairs"] = None
+        elif label == "pairs":
+            cache.pop("exact:pairs", None)
+        simulate(plan, lazy=False)  # warm: tables, caches
+        times[label] = min(
+            _timed(partial(simulate, plan, lazy=False), 1)[1]
+            for _ in range(max(1, repeat if label != "grid" else 1))
+        )
+    for label in ("grid", "pairs"):
+        rows.append(
+            CostRow(
+                f"{n_sweep} random attitudes simulated, shadowing by {label}",
+                table.name,
+                n,
+                n_sweep,
+                1e3 * times[label] / n_sweep,
+                times[label] / times["off"],
+                "the same sweep without shadowing",
+            )
+        )
+    return rows
 
 
 def scaling_rows(

@@ -14,6 +14,9 @@ Modules
 ``visibility``
     Self-shadowing and self-occlusion: exact polygon clipping, or sampled rays, beside
     the mesh access both methods read.
+``occluders``
+    What the exact method finds once per body: coplanar facets merged into convex
+    occluders, and the pairs of facets that can shadow each other.
 ``rays``
     The sampled method's tools: sampling densities, point sets on facets, ray engines.
 ``picture``
@@ -35,6 +38,7 @@ from . import (
     geo_comsat,
     imperfections,
     meshes,
+    occluders,
     parts,
     picture,
     posed,
@@ -161,6 +165,7 @@ __all__ = [
     "mesh_of",
     "meshes",
     "normalise_map",
+    "occluders",
     "part_from_spec",
     "parts",
     "picture",

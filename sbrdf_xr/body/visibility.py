@@ -83,7 +83,9 @@ from .._names import FACET, GEOMETRY, VECTOR, attrs
 from ..errors import ValidationError
 from ..geometry import normalize
 from ..kernels.shadow import exact_kernel, facet_shadows
+from ..kernels.shadow_pairs import pairs_kernel
 from ..units import to_unit
+from .occluders import pair_table
 from .rays import (
     MAX_RAYS_PER_CALL,
     OFFSET_FACTOR,
@@ -101,6 +103,7 @@ __all__ = [
     "METHODS",
     "PLANE_TOLERANCE",
     "escape_masks",
+    "exact_frames",
     "facet_visibility",
     "is_convex",
     "lit_fraction",
@@ -220,10 +223,22 @@ def supporting(mesh: trimesh.Trimesh, cache: dict[str, Any], tol: float) -> np.n
 # ----------------------------------------------------------------------------- exact method
 
 
-def _plane_frames(mesh: trimesh.Trimesh, cache: dict[str, Any]) -> dict[str, Any]:
-    """Per-facet arrays of the exact method: vertices, faces, normals from the winding, an
-    in-plane orthonormal frame (E1 along the first edge, E2 = N x E1), the triangle in that
-    frame (counter-clockwise), the receivers that can be shadowed and the surface type."""
+def exact_frames(mesh: trimesh.Trimesh, cache: dict[str, Any]) -> dict[str, Any]:
+    """Per-facet arrays of the exact method (cached): vertices ``V``, faces ``F``, normals
+    ``N`` from the winding, an in-plane orthonormal frame (``E1`` along the first edge,
+    ``E2 = N x E1``) at the first vertex ``P0``, the triangle in that frame ``T2``
+    (counter-clockwise), the ``receiver`` facets that can be shadowed, the plane tolerance
+    ``eps`` [m], the body's size ``scale`` [m] and the ``open_facet`` flags.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.body.visibility import exact_frames
+    >>> from sbrdf_xr.testing import l_shaped_spacecraft
+    >>> body = l_shaped_spacecraft()
+    >>> frames = exact_frames(body.mesh, body._cache)
+    >>> frames["T2"].shape, int(frames["receiver"].sum())  # the floor and the inner wall
+    ((20, 3, 2), 4)
+    """
     if "exact:frames" in cache:
         return cache["exact:frames"]
     V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
@@ -253,10 +268,14 @@ def _plane_frames(mesh: trimesh.Trimesh, cache: dict[str, Any]) -> dict[str, Any
         "T2": np.ascontiguousarray(T2),
         "receiver": receiver,
         "eps": tol,
+        "scale": float(mesh.scale),
         "open_facet": _open_facets(mesh),
     }
     cache["exact:frames"] = frames
     return frames
+
+
+_plane_frames = exact_frames  # the name the posed bodies use
 
 
 def _open_facets(mesh: trimesh.Trimesh) -> np.ndarray:
@@ -293,20 +312,42 @@ def _geos_fraction(frames: dict[str, Any], i: int, dirs: np.ndarray) -> float:
     return float(min(1.0, max(0.0, 1.0 - shadow.area / tri.area)))
 
 
+def _front(directions: list[np.ndarray], normals: np.ndarray) -> np.ndarray:
+    """Facets facing every direction (an elementwise sum: a BLAS product spins its threads
+    on a loaded machine), (n_geom, n_facets)."""
+    return np.logical_and.reduce([np.einsum("gx,fx->gf", d, normals) > 0 for d in directions])
+
+
 def _exact(
     spacecraft: Spacecraft | trimesh.Trimesh, directions: list[np.ndarray], convex_shortcut: bool
 ) -> np.ndarray:
     """Exact fraction unobstructed along every direction of the list, shape (n_geom, n_facets)."""
     mesh, cache = mesh_of(spacecraft)
-    normals = np.asarray(mesh.face_normals, dtype=np.float64)
-    front = np.logical_and.reduce([d @ normals.T > 0 for d in directions])
-    if convex_shortcut and is_convex(spacecraft):
-        return front.astype(np.float64)
-    frames = _plane_frames(mesh, cache)
+    normals = np.ascontiguousarray(mesh.face_normals, dtype=np.float64)
+    shortcut = convex_shortcut and is_convex(spacecraft)
+    if shortcut or not exact_frames(mesh, cache)["receiver"].any():  # nothing is shadowed
+        return _front(directions, normals).astype(np.float64)
+    frames = exact_frames(mesh, cache)
     dirs = np.ascontiguousarray(np.stack(directions, axis=1), dtype=np.float64)  # (G, K, 3)
-    if not frames["receiver"].any():
-        return front.astype(np.float64)
-    frac = exact_kernel(
+    pairs = pair_table(frames, cache)
+    if pairs is not None:  # the pairs that can shadow each other, found once per body
+        occ = pairs["occluders"]
+        recv, pstart, pgroup, pcount, cut, box, r2 = pairs["table"]
+        frame = (frames["N"], frames["E1"], frames["E2"], frames["T2"])
+        args = (recv, pstart, pgroup, pcount, cut, box, r2, occ["normal"], occ["open"], dirs)
+        frac = pairs_kernel(normals, *frame, *args)
+    else:  # too many pairs to tabulate: candidate occluders by a grid per direction
+        frac = np.where(_front(directions, normals), _grid_fractions(frames, dirs), 0.0)
+    # a facet facing a direction per the stored normals but not per its winding (or
+    # vice versa) gets 0, as the sampled method does
+    for g, i in np.argwhere(np.isnan(frac)):
+        frac[g, i] = _geos_fraction(frames, int(i), dirs[g])
+    return frac
+
+
+def _grid_fractions(frames: dict[str, Any], dirs: np.ndarray) -> np.ndarray:
+    """The fractions by :func:`~sbrdf_xr.kernels.shadow.exact_kernel` (a grid per direction)."""
+    return exact_kernel(
         frames["V"],
         frames["F"],
         frames["N"],
@@ -319,11 +360,6 @@ def _exact(
         frames["open_facet"],
         frames["eps"],
     )
-    for g, i in np.argwhere(np.isnan(frac)):
-        frac[g, i] = _geos_fraction(frames, int(i), dirs[g])
-    # a facet facing a direction per the stored normals but not per its winding (or
-    # vice versa) keeps the stored normals' verdict, as the sampled method does
-    return np.where(front, frac, 0.0)
 
 
 # ----------------------------------------------------------------------------- sampled method

@@ -26,12 +26,26 @@ Modules
 ``anisotropic``
     The facet sums of anisotropic tables (a ``psi`` axis), on the same angles, look-up
     and accumulation.
-``polygon`` and ``shadow``
-    Plane-polygon clipping and the exact shadow kernel of :mod:`sbrdf_xr.body.visibility`.
+``polygon``, ``shadow``, ``pair_table`` and ``shadow_pairs``
+    Plane-polygon clipping and the exact shadow kernels of :mod:`sbrdf_xr.body.visibility`:
+    candidate occluders by a grid per direction, or from a table of the pairs that can
+    shadow each other, built once per body.
 """
 
 from ..errors import ValidationError, renamed_attributes
-from . import angles, anisotropic, lookup, lut, packing, polygon, reference, shadow, sums
+from . import (
+    angles,
+    anisotropic,
+    lookup,
+    lut,
+    packing,
+    pair_table,
+    polygon,
+    reference,
+    shadow,
+    shadow_pairs,
+    sums,
+)
 from .angles import (
     atan2_pos,
     chunk_angles,
@@ -128,10 +142,12 @@ __all__ = [
     "pack_anisotropic",
     "pack_tables",
     "packing",
+    "pair_table",
     "plan_step",
     "polygon",
     "reference",
     "shadow",
+    "shadow_pairs",
     "signed_area",
     "smoothing_spline_matrix",
     "sums",

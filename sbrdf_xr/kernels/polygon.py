@@ -21,6 +21,7 @@ __all__ = [
     "hull",
     "signed_area",
     "union_area",
+    "union_area_boxes",
     "union_area_slabs",
 ]
 
@@ -231,6 +232,30 @@ def union_area(gx, gy, gn, m, tiny, stack_x, stack_y, stack_n, nxt, tx, ty):
     """
     box = np.empty((m, 4))
     sbox = np.empty((m + 1, 4))
+    return union_area_boxes(gx, gy, gn, m, tiny, stack_x, stack_y, stack_n, nxt, tx, ty, box, sbox)
+
+
+@nb.njit(cache=True, nogil=True)
+def union_area_boxes(gx, gy, gn, m, tiny, stack_x, stack_y, stack_n, nxt, tx, ty, box, sbox):
+    """:func:`union_area` with the scratch of the bounding boxes given: ``box`` (>= m, 4) and
+    ``sbox`` (>= m + 1, 4), so that a kernel calling it for every facet allocates nothing.
+
+    Examples
+    --------
+    The example of :func:`union_area`, with the boxes' scratch passed in:
+
+    >>> import numpy as np
+    >>> gx = np.array([[0.0, 1, 1, 0], [0.5, 1.5, 1.5, 0.5], [0.25, 1.25, 1.25, 0.25]])
+    >>> gy = np.array([[0.0, 0, 1, 1], [0.0, 0, 1, 1], [0.5, 0.5, 1.5, 1.5]])
+    >>> from sbrdf_xr.kernels.polygon import MAXM, MAXV, union_area_boxes
+    >>> stack_x, stack_y = np.empty((MAXM + 1, MAXV)), np.empty((MAXM + 1, MAXV))
+    >>> stack_n, nxt = np.empty(MAXM + 1, dtype=np.int64), np.empty(MAXM + 1, dtype=np.int64)
+    >>> tx, ty, box, sbox = np.empty(MAXV), np.empty(MAXV), np.empty((3, 4)), np.empty((4, 4))
+    >>> area, ok = union_area_boxes(gx, gy, np.array([4, 4, 4]), 3, 1e-15, stack_x, stack_y,
+    ...                             stack_n, nxt, tx, ty, box, sbox)
+    >>> round(area, 12), ok
+    (2.0, True)
+    """
     for k in range(m):
         bounds(gx[k], gy[k], gn[k], box[k])
     total = 0.0

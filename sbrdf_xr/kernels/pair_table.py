@@ -1,0 +1,257 @@
+"""The table of the pairs of facets that can shadow each other, built once per body (numba).
+
+For every receiving facet ``i``, the occluders that can ever shadow it are those with a
+part strictly in front of its plane (the half-space test); each is cut to that part and
+stored in the plane frame of ``i`` as vertices ``(u, v, h)`` (in-plane coordinates and
+height above the plane), with the box of the slopes ``s = (E1_i.d, E2_i.d) / N_i.d`` of the
+directions ``d`` from which its shadow can reach the facet: the quotients ``(u - a) / h``
+over the cut vertices and the facet's vertices ``a`` bound it (a linear-fractional function
+takes its extremes at vertices), a vertex on the plane (``h = 0``) opening the box on the
+side its numerator has.  The pairs of a facet are sorted by the distance of their box
+from ``s = 0``.  :func:`sbrdf_xr.kernels.shadow_pairs.pairs_kernel` reads the table.
+"""
+
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+
+__all__ = ["MARGIN", "MAX_OCCLUDER_VERTICES", "pair_table"]
+
+#: Vertices of a merged occluder polygon at most (its cut adds one, the clip three more).
+MAX_OCCLUDER_VERTICES = 8
+#: Relative widening of every slope box (the rounding of the slopes is ~1e-16 relative).
+MARGIN = 1e-12
+_CUT = MAX_OCCLUDER_VERTICES + 1  # vertices of a cut occluder
+
+
+@nb.njit(cache=True, nogil=True)
+def _cut(i, idx, n, V, N, P0, E1, E2, out):
+    """The part of the polygon ``V[idx[:n]]`` on or in front of the plane of facet i, in the
+    frame of i: rows (u, v, h) of ``out``; returns the vertex count."""
+    m = 0
+    for a in range(n):
+        b = a + 1 if a + 1 < n else 0
+        fa = idx[a]
+        fb = idx[b]
+        ha = N[i, 0] * (V[fa, 0] - P0[i, 0]) + N[i, 1] * (V[fa, 1] - P0[i, 1])
+        ha += N[i, 2] * (V[fa, 2] - P0[i, 2])
+        hb = N[i, 0] * (V[fb, 0] - P0[i, 0]) + N[i, 1] * (V[fb, 1] - P0[i, 1])
+        hb += N[i, 2] * (V[fb, 2] - P0[i, 2])
+        if ha >= 0.0:
+            y0 = V[fa, 0] - P0[i, 0]
+            y1 = V[fa, 1] - P0[i, 1]
+            y2 = V[fa, 2] - P0[i, 2]
+            out[m, 0] = E1[i, 0] * y0 + E1[i, 1] * y1 + E1[i, 2] * y2
+            out[m, 1] = E2[i, 0] * y0 + E2[i, 1] * y1 + E2[i, 2] * y2
+            out[m, 2] = ha
+            m += 1
+        if (ha >= 0.0) != (hb >= 0.0):
+            t = ha / (ha - hb)
+            y0 = V[fa, 0] + t * (V[fb, 0] - V[fa, 0]) - P0[i, 0]
+            y1 = V[fa, 1] + t * (V[fb, 1] - V[fa, 1]) - P0[i, 1]
+            y2 = V[fa, 2] + t * (V[fb, 2] - V[fa, 2]) - P0[i, 2]
+            out[m, 0] = E1[i, 0] * y0 + E1[i, 1] * y1 + E1[i, 2] * y2
+            out[m, 1] = E2[i, 0] * y0 + E2[i, 1] * y1 + E2[i, 2] * y2
+            out[m, 2] = 0.0
+            m += 1
+    return m
+
+
+@nb.njit(cache=True, nogil=True)
+def _slope_box(cut, n, tri, box):
+    """Bounding box (s1 lo, s1 hi, s2 lo, s2 hi) of the slopes s for which the cut polygon
+    (rows u, v, h) projected along d can meet the triangle ``tri`` (3, 2); returns its
+    squared distance from s = 0."""
+    r2 = 0.0
+    for c in range(2):
+        t_lo = min(tri[0, c], tri[1, c], tri[2, c])
+        t_hi = max(tri[0, c], tri[1, c], tri[2, c])
+        lo = np.inf
+        hi = -np.inf
+        for v in range(n):
+            x = cut[v, c]
+            h = cut[v, 2]
+            if h > 0.0:
+                lo = min(lo, (x - t_hi) / h)
+                hi = max(hi, (x - t_lo) / h)
+            else:
+                if x > t_lo:
+                    hi = np.inf
+                if x < t_hi:
+                    lo = -np.inf
+        lo -= MARGIN * (1.0 + abs(lo))
+        hi += MARGIN * (1.0 + abs(hi))
+        box[2 * c] = lo
+        box[2 * c + 1] = hi
+        if lo > 0.0:
+            r2 += lo * lo
+        elif hi < 0.0:
+            r2 += hi * hi
+    return r2
+
+
+@nb.njit(cache=True, nogil=True)
+def _height_range(i, f, V, F, N, P0):
+    lo = np.inf
+    hi = -np.inf
+    for v in range(3):
+        x = F[f, v]
+        h = N[i, 0] * (V[x, 0] - P0[i, 0]) + N[i, 1] * (V[x, 1] - P0[i, 1])
+        h += N[i, 2] * (V[x, 2] - P0[i, 2])
+        lo = min(lo, h)
+        hi = max(hi, h)
+    return lo, hi
+
+
+@nb.njit(cache=True, nogil=True)
+def pair_table(
+    V, F, N, P0, E1, E2, T2, receiver, poly, npoly, gnorm, gopen, mstart, members, eps_h
+):
+    """The pairs (receiver, occluder) that can shadow each other, once per body.
+
+    ``poly`` (n_groups, :data:`MAX_OCCLUDER_VERTICES`) holds the vertex indices of every
+    occluder polygon (``npoly`` of them used, counter-clockwise about ``gnorm``), whose
+    facets are ``members[mstart[g]:mstart[g + 1]]``.  A pair is kept when the occluder has
+    a vertex higher than ``eps_h`` above the receiver's plane and is not parallel to it
+    facing the same way (such a one-sided facet is never an occluder while the receiver
+    faces the light).  Returns ``(recv, pstart, pgroup, pcount, cut, box, r2)``: the
+    receivers, CSR offsets of their pairs, each pair's occluder, its cut polygon (count and
+    rows u, v, h in the receiver's frame), its slope box and the squared distance of the
+    box from 0 (ascending within a receiver).
+
+    Examples
+    --------
+    The two plates of :func:`sbrdf_xr.kernels.shadow.exact_kernel` (a 2 x 2 plate at
+    z = 0, a 1 x 2 plate above its left half at z = 1, open: one-sided facets blocking from
+    both sides), each facet its own occluder: both lower facets can be shadowed by both
+    upper ones, and nothing can shadow the upper ones.
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.pair_table import pair_table
+    >>> V = np.array([[0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0],
+    ...               [0, 0, 1], [1, 0, 1], [1, 2, 1], [0, 2, 1]], dtype=float)
+    >>> F = np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])
+    >>> N = np.tile([0.0, 0.0, 1.0], (4, 1))
+    >>> E1 = V[F[:, 1]] - V[F[:, 0]]
+    >>> E1 /= np.linalg.norm(E1, axis=1, keepdims=True)
+    >>> E2 = np.cross(N, E1)
+    >>> rel = V[F] - V[F[:, :1]]
+    >>> T2 = np.ascontiguousarray(np.stack(
+    ...     [np.einsum("fvx,fx->fv", rel, E1), np.einsum("fvx,fx->fv", rel, E2)], axis=-1))
+    >>> poly = np.zeros((4, 8), dtype=np.int64)
+    >>> poly[:, :3] = F
+    >>> npoly, gopen = np.full(4, 3), np.ones(4, bool)
+    >>> mstart, members = np.arange(5), np.arange(4)
+    >>> recv, pstart, pgroup, pcount, cut, box, r2 = pair_table(
+    ...     V, F, N, V[F[:, 0]], E1, E2, T2, np.ones(4, bool), poly, npoly, N, gopen,
+    ...     mstart, members, 1e-9)
+    >>> recv.tolist(), pstart.tolist(), sorted(pgroup[:2].tolist()), pcount.tolist()
+    ([0, 1, 2, 3], [0, 2, 4, 4, 4], [2, 3], [3, 3, 3, 3])
+    >>> cut[0, :3, 2].tolist()  # heights of the upper facets above the lower plane
+    [1.0, 1.0, 1.0]
+    """
+    nf = F.shape[0]
+    ng = poly.shape[0]
+    cap = max(16, 4 * nf)
+    pgroup = np.empty(cap, dtype=np.int64)
+    pcount = np.empty(cap, dtype=np.int64)
+    cut = np.empty((cap, _CUT, 3))
+    box = np.empty((cap, 4))
+    r2 = np.empty(cap)
+    recv = np.empty(nf, dtype=np.int64)
+    pstart = np.zeros(nf + 1, dtype=np.int64)
+    scratch = np.empty((_CUT, 3))
+    one = np.empty(3, dtype=np.int64)
+    nr = 0
+    n = 0
+    for i in range(nf):
+        if not receiver[i]:
+            continue
+        first = n
+        tri = T2[i]
+        for g in range(ng):
+            if (
+                not gopen[g]
+                and gnorm[g, 0] == N[i, 0]
+                and gnorm[g, 1] == N[i, 1]
+                and gnorm[g, 2] == N[i, 2]
+            ):
+                continue
+            hmax = -np.inf
+            for v in range(npoly[g]):
+                x = poly[g, v]
+                h = N[i, 0] * (V[x, 0] - P0[i, 0]) + N[i, 1] * (V[x, 1] - P0[i, 1])
+                hmax = max(hmax, h + N[i, 2] * (V[x, 2] - P0[i, 2]))
+            if hmax <= eps_h:
+                continue
+            whole = True  # no facet of it a sliver in the tolerance band: merged is exact
+            if mstart[g + 1] - mstart[g] > 1:
+                for q in range(mstart[g], mstart[g + 1]):
+                    _, hi = _height_range(i, members[q], V, F, N, P0)
+                    if hi <= eps_h and hi >= 0.0:
+                        whole = False
+            for q in range(mstart[g], mstart[g + 1] if not whole else mstart[g] + 1):
+                if whole:
+                    m = _cut(i, poly[g], npoly[g], V, N, P0, E1, E2, scratch)
+                else:
+                    f = members[q]
+                    _, hi = _height_range(i, f, V, F, N, P0)
+                    if hi <= eps_h or f == i:
+                        continue
+                    for v in range(3):
+                        one[v] = F[f, v]
+                    m = _cut(i, one, 3, V, N, P0, E1, E2, scratch)
+                if m < 3:
+                    continue
+                if n == cap:  # grow
+                    cap *= 2
+                    pgroup = _grown(pgroup, cap)
+                    pcount = _grown(pcount, cap)
+                    cut = _grown3(cut, cap)
+                    box = _grown2(box, cap)
+                    r2 = _grown(r2, cap)
+                pgroup[n] = g
+                pcount[n] = m
+                cut[n, :m] = scratch[:m]
+                r2[n] = _slope_box(scratch, m, tri, box[n])
+                n += 1
+        order = np.argsort(r2[first:n], kind="mergesort") + first
+        pgroup[first:n] = pgroup[order]
+        pcount[first:n] = pcount[order]
+        cut[first:n] = cut[order]
+        box[first:n] = box[order]
+        r2[first:n] = r2[order]
+        recv[nr] = i
+        nr += 1
+        pstart[nr] = n
+    return (
+        recv[:nr].copy(),
+        pstart[: nr + 1].copy(),
+        pgroup[:n].copy(),
+        pcount[:n].copy(),
+        cut[:n].copy(),
+        box[:n].copy(),
+        r2[:n].copy(),
+    )
+
+
+@nb.njit(cache=True, nogil=True)
+def _grown(a, cap):
+    out = np.empty(cap, dtype=a.dtype)
+    out[: a.shape[0]] = a
+    return out
+
+
+@nb.njit(cache=True, nogil=True)
+def _grown2(a, cap):
+    out = np.empty((cap, a.shape[1]), dtype=a.dtype)
+    out[: a.shape[0]] = a
+    return out
+
+
+@nb.njit(cache=True, nogil=True)
+def _grown3(a, cap):
+    out = np.empty((cap, a.shape[1], a.shape[2]), dtype=a.dtype)
+    out[: a.shape[0]] = a
+    return out
