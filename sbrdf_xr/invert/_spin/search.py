@@ -12,6 +12,10 @@ See :func:`sbrdf_xr.invert.fit_spin`.  Three ways to evaluate the grid:
 ``shift``
     One such table per axis at the mean Sun and observer directions: exact in the
     geometry only when the directions are fixed.
+``bound``
+    Such tables with an error estimate give every candidate a lower bound of its
+    chi-square; only candidates that can still beat the best go through the kernel
+    (:mod:`sbrdf_xr.invert._spin.bound`): the best state is the ``direct`` one's.
 
 An approximate search is checked against the exact model (:func:`approximation_error`).
 """
@@ -46,7 +50,7 @@ __all__ = [
 ]
 
 #: Grid evaluations of :func:`run_search`.
-METHODS = ("direct", "table", "shift")
+METHODS = ("direct", "table", "shift", "bound")
 #: Working memory of one block of the search (candidates x times, or periods x values).
 BLOCK_BYTES = 64 * 2**20
 
@@ -428,6 +432,10 @@ def run_search(
     """The chi-square grid by ``method`` (one of :data:`METHODS`)."""
     if method == "direct":
         return search_direct(prob, axes, periods, phases, n_threads)
+    if method == "bound":
+        from .bound import bound_angles, search_bound
+
+        return search_bound(prob, axes, periods, phases, n_threads, bound_angles(n_angles)).grid
     return search_table(prob, axes, periods, phases, n_threads, n_angles, method == "shift")
 
 
