@@ -98,6 +98,13 @@ def search_size(
     if method == "direct":
         working = 8.0 * n_times * (6 + 2 * n_bands) + 32.0 * n_values
         work = cells * n_values
+    elif method == "bound":
+        from .bound import bound_angles
+
+        grid = 25.0 * cells + 8.0 * n_axes  # chi-square, bound, approximation, flag
+        n = bound_angles(n_angles)
+        working = 8.0 * n_times * n * (2 * n_bands + 12)
+        work = float(n_axes) * n_times * n * n_bands + cells * n_values
     else:
         rows = 1 if method == "shift" else n_times
         working = 8.0 * rows * n_angles * (n_bands + 12) + 96.0 * n_phases * n_values
@@ -176,8 +183,8 @@ def _chain(
     method: str, fixed: bool, size: dict[str, dict[str, float]], n_times: int, n_values: int
 ) -> list[str]:
     """The searches to try in turn: an approximation first where it is cheaper, then exact."""
-    if method == "direct":
-        return ["direct"]
+    if method in ("direct", "bound"):
+        return [method]
     if method == "table":
         return ["table", "direct"]
     if method == "shift":
@@ -192,7 +199,7 @@ def _chain(
         table = size[m]["work"] - size[m]["cells"] * n_values
         return table / n_bands * _COST_KERNEL + size[m]["cells"] * n_values * _COST_GATHER
 
-    return ["table", "direct"] if cost("table") < cost("direct") else ["direct"]
+    return ["bound"] if cost("bound") < cost("direct") else ["direct"]
 
 
 def fit_spin(
@@ -279,7 +286,7 @@ def fit_spin(
         Refine the best candidates by least squares (else the grid's best, unrefined).
     n_starts : int
         Refinements started from the best grid state of the ``n_starts`` best axes.
-    method : {"auto", "direct", "table", "shift"}
+    method : {"auto", "direct", "table", "shift", "bound"}
         Grid evaluation (see above).
     n_angles : int
         Spin angles of the ``table`` and ``shift`` searches.
@@ -422,6 +429,10 @@ def fit_spin(
     checks: list[str] = []
     for used in chain:
         _check_size(sizes[used], what, size_limit)
+        if used == "bound":
+            grid, note = _bound_grid(grid_prob, axes, per, phases, n_threads, n_angles, n_starts)
+            checks.append(note)
+            break
         grid = run_search(used, grid_prob, axes, per, phases, n_threads, n_angles)
         if used == "direct":
             break
@@ -475,6 +486,31 @@ def fit_spin(
         warnings.warn(f"spin fit: {ds.attrs['ambiguity']}", FitQualityWarning, stacklevel=2)
     ds.attrs["symmetry_twins"] = symmetry_twins(prob, best, ab)
     return ds
+
+
+def _bound_grid(
+    prob: Problem,
+    axes: np.ndarray,
+    periods: np.ndarray,
+    phases: np.ndarray,
+    n_threads: int | None,
+    n_angles: int,
+    n_starts: int,
+) -> tuple[np.ndarray, str]:
+    """The grid by branch and bound, exact at the best state of the ``n_starts`` best axes
+    (where the refinements start), and what it did."""
+    from .bound import SAFETY, bound_angles, search_bound
+
+    n = bound_angles(n_angles)
+    res = search_bound(prob, axes, periods, phases, n_threads, n, n_best=n_starts)
+    note = (
+        f"bound ({n} spin angles, error estimate {SAFETY:g} x the coarse tables' midpoint "
+        f"error): {res.n_exact} of {res.grid.size} candidates evaluated exactly, every other "
+        f"one's lower bound above the {min(n_starts, len(axes))}-th best axis's chi-square "
+        f"{res.threshold:.6g}; the best states are the direct search's, the chi2_map of the "
+        "other axes the tables' approximation"
+    )
+    return res.grid, note
 
 
 def _ambiguity(ds: xr.Dataset) -> str:
