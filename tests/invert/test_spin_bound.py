@@ -76,11 +76,15 @@ def _same_best(exact, found):
     phase=st.floats(0.0, 360.0),
     seed=st.integers(0, 2**16),
     offset=st.sampled_from(["band", "common"]),
+    stride=st.sampled_from([1, 4]),
 )
-def test_bound_search_finds_the_exact_best_of_random_truths(lon, lat, period, phase, seed, offset):
+def test_bound_search_finds_the_exact_best_of_random_truths(
+    lon, lat, period, phase, seed, offset, stride
+):
+    """Random truths, both offsets, with and without the first pass on every 4th time."""
     prob = _problem(invert.axis_vector(lon, lat), period, phase, seed, offset)
     exact = _spin_search.run_search("direct", prob, *GRID, 1, 360)
-    found = _bound.search_bound(prob, *GRID, 1, 720)
+    found = _bound.search_bound(prob, *GRID, 1, 720, stride=stride)
     _same_best(exact, found)
     assert found.n_exact < exact.size  # it pruned
 

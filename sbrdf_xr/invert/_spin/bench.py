@@ -198,7 +198,12 @@ def benchmark_spin_bound(
                 abs(grid.min() - found.grid.min()) <= 1e-9 * grid.min()
             )
             row["same_best"] = same
-            direct: dict[str, Any] | None = {"seconds": td, "measured": True, "n_exact": nc, "chi2": float(grid.min())}
+            direct: dict[str, Any] | None = {
+                "seconds": td,
+                "measured": True,
+                "n_exact": nc,
+                "chi2": float(grid.min()),
+            }
         elif rate is not None:
             direct = {"seconds": nc / rate, "measured": False, "n_exact": nc, "chi2": None}
         else:

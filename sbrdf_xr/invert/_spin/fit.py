@@ -241,8 +241,14 @@ def fit_spin(
     ``shift``: the mean geometry), an approximation being used only when its model error
     at the best and at random candidates is below ``tolerance`` times the noise (rms over
     the values), else the next search is run (``shift`` -> ``table`` -> ``direct``);
-    ``auto`` takes the cheapest.  Then :func:`scipy.optimize.least_squares` from the best
-    grid state of each of the ``n_starts`` best axes, with the exact model.  The reported
+    ``bound`` reads every candidate from per-axis spin-angle tables with an error
+    estimate that gives it a lower bound of its chi-square, and evaluates exactly only the
+    candidates that can still beat the best state of the ``n_starts`` best axes: those
+    states are the ``direct`` search's (while the estimate holds), the tables'
+    approximation elsewhere in ``chi2_map``; ``auto`` takes ``bound`` where its tables cost
+    less than ``direct`` (``shift`` first at fixed directions).  Then
+    :func:`scipy.optimize.least_squares` from the best grid state of each of the
+    ``n_starts`` best axes, with the exact model.  The reported
     solution is the lowest chi-square found; its twins (antipode, mirror, half and double
     period) are searched in phase and refined too, and any twin that fits better becomes
     the solution.
