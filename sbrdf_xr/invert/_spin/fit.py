@@ -56,6 +56,8 @@ SEARCH_WORK_LIMIT = 1e11
 #: likelihood ratio above exp(-4.5) = 1.1 %): the fit warns that the solution is ambiguous.
 AMBIGUITY_CHI2 = 9.0
 
+#: Grid searches of :func:`fit_spin`: those of ``run_search`` and the branch and bound.
+SEARCHES = (*METHODS, "bound")
 #: Cost of a kernel geometry and of one interpolated model value, relative (for ``auto``).
 _COST_KERNEL, _COST_GATHER = 1.0, 0.03
 
@@ -368,8 +370,10 @@ def fit_spin(
     """
     periods = to_unit(periods, "s", "periods")
     t_start = time.perf_counter()
-    if method not in ("auto", *METHODS):
-        raise InversionError(f"method: {method!r}; allowed 'auto', {', '.join(map(repr, METHODS))}")
+    if method not in ("auto", *SEARCHES):
+        raise InversionError(
+            f"method: {method!r}; allowed 'auto', {', '.join(map(repr, SEARCHES))}"
+        )
     n_axes = _positive_int(n_axes, "n_axes (--n-axes)")
     n_phases = _positive_int(n_phases, "n_phases (--n-phases)")
     n_starts = _positive_int(n_starts, "n_starts")
@@ -414,7 +418,7 @@ def fit_spin(
             n_angles,
             1 if n_threads is None else n_threads,
         )
-        for m in METHODS
+        for m in SEARCHES
     }
     what = (
         f"{n_axes} axes x {per.size:.4g} periods x {n_phases} phases x {n_search} times x "

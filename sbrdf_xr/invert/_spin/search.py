@@ -50,7 +50,7 @@ __all__ = [
 ]
 
 #: Grid evaluations of :func:`run_search`.
-METHODS = ("direct", "table", "shift", "bound")
+METHODS = ("direct", "table", "shift")
 #: Working memory of one block of the search (candidates x times, or periods x values).
 BLOCK_BYTES = 64 * 2**20
 
@@ -432,10 +432,6 @@ def run_search(
     """The chi-square grid by ``method`` (one of :data:`METHODS`)."""
     if method == "direct":
         return search_direct(prob, axes, periods, phases, n_threads)
-    if method == "bound":
-        from .bound import bound_angles, search_bound
-
-        return search_bound(prob, axes, periods, phases, n_threads, bound_angles(n_angles)).grid
     return search_table(prob, axes, periods, phases, n_threads, n_angles, method == "shift")
 
 
