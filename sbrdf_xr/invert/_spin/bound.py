@@ -184,70 +184,75 @@ def lower_bound(syy: float, sym: float, smm: float, see: float) -> tuple[float, 
 
 @numba.njit(nogil=True, cache=True)
 def _bound_axis(  # pragma: no cover - compiled
-    fp, ep, times, v_start, v_band, v_group, v_y, v_w, factor, periods, phases, syy, approx, lower
+    fp, ep, times, v_start, v_band, v_group, v_y, v_w, factor, periods, phases, cells, syy, out
 ):
     """Approximate chi-square and its lower bound for every (period, phase) of one axis.
 
     ``fp`` (T, B, n + 3): the tables per time and band, padded periodically (entry ``j +
     1`` is angle ``j``); ``ep`` (T, B, n): the error estimate per cell; the values sorted
-    by time (``v_start`` (T + 1,) their offsets).  Time outer, candidates inner: one
-    time's rows stay in cache while every candidate reads them.
+    by time (``v_start`` (T + 1,) their offsets); ``cells`` the candidates (flat indices
+    into periods x phases); ``out`` (2, cells): the approximation and the bound.  Time
+    outer, candidates inner: one time's rows stay in cache while every candidate reads
+    them.
     """
     n = ep.shape[2]
-    n_p, n_q = periods.shape[0], phases.shape[0]
+    n_q = phases.shape[0]
     n_groups = syy.shape[0]
-    acc = np.zeros((n_p * n_q, n_groups, 3))
+    acc = np.zeros((cells.shape[0], n_groups, 3))
     for ti in range(times.shape[0]):
         a0, a1 = v_start[ti], v_start[ti + 1]
         if a1 == a0:
             continue
         fac = factor[ti]
         afac = abs(fac)
-        for p in range(n_p):
-            turn = times[ti] * n / periods[p]
-            for q in range(n_q):
-                x = (phases[q] * n / 360.0 + turn) % n
-                j = int(x)
-                if j >= n:
-                    j = n - 1
-                u = x - j
-                u2 = u * u
-                u3 = u2 * u
-                c0 = 0.5 * (-u + 2.0 * u2 - u3)
-                c1 = 1.0 + 0.5 * (3.0 * u3 - 5.0 * u2)
-                c2 = 0.5 * (u + 4.0 * u2 - 3.0 * u3)
-                c3 = 0.5 * (u3 - u2)
-                s = p * n_q + q
-                for i in range(a0, a1):
-                    b = v_band[i]
-                    m = (
-                        c0 * fp[ti, b, j]
-                        + c1 * fp[ti, b, j + 1]
-                        + c2 * fp[ti, b, j + 2]
-                        + c3 * fp[ti, b, j + 3]
-                    ) * fac
-                    e = ep[ti, b, j] * afac
-                    g = v_group[i]
-                    wi = v_w[i]
-                    acc[s, g, 0] += wi * v_y[i] * m
-                    acc[s, g, 1] += wi * m * m
-                    acc[s, g, 2] += wi * e * e
-    for p in range(n_p):
-        for q in range(n_q):
-            s = p * n_q + q
-            a = 0.0
-            lb = 0.0
-            for g in range(n_groups):
-                c, r = lower_bound(syy[g], acc[s, g, 0], acc[s, g, 1], acc[s, g, 2])
-                a += c
-                lb += r
-            approx[p, q] = a
-            lower[p, q] = lb
+        for s in range(cells.shape[0]):
+            p = cells[s] // n_q
+            q = cells[s] - p * n_q
+            x = (phases[q] * n / 360.0 + times[ti] * n / periods[p]) % n
+            j = int(x)
+            if j >= n:
+                j = n - 1
+            u = x - j
+            u2 = u * u
+            u3 = u2 * u
+            c0 = 0.5 * (-u + 2.0 * u2 - u3)
+            c1 = 1.0 + 0.5 * (3.0 * u3 - 5.0 * u2)
+            c2 = 0.5 * (u + 4.0 * u2 - 3.0 * u3)
+            c3 = 0.5 * (u3 - u2)
+            for i in range(a0, a1):
+                b = v_band[i]
+                m = (
+                    c0 * fp[ti, b, j]
+                    + c1 * fp[ti, b, j + 1]
+                    + c2 * fp[ti, b, j + 2]
+                    + c3 * fp[ti, b, j + 3]
+                ) * fac
+                e = ep[ti, b, j] * afac
+                g = v_group[i]
+                wi = v_w[i]
+                acc[s, g, 0] += wi * v_y[i] * m
+                acc[s, g, 1] += wi * m * m
+                acc[s, g, 2] += wi * e * e
+    for s in range(cells.shape[0]):
+        a = 0.0
+        lb = 0.0
+        for g in range(n_groups):
+            c, r = lower_bound(syy[g], acc[s, g, 0], acc[s, g, 1], acc[s, g, 2])
+            a += c
+            lb += r
+        out[0, s] = a
+        out[1, s] = lb
 
 
 def _axis_bounds(
-    prob: Problem, axis: np.ndarray, periods: np.ndarray, phases: np.ndarray, n_angles: int
-) -> tuple[np.ndarray, np.ndarray]:
+    prob: Problem,
+    axis: np.ndarray,
+    periods: np.ndarray,
+    phases: np.ndarray,
+    n_angles: int,
+    cells: np.ndarray,
+) -> np.ndarray:
+    """Approximation and bound (2, cells) of the candidates ``cells`` of one axis."""
     f = np.asarray(_tables(prob, axis, n_angles, False), dtype=np.float64)  # (T, n, B)
     eps = np.ascontiguousarray(table_errors(f).transpose(0, 2, 1))
     ft = f.transpose(0, 2, 1)
@@ -256,8 +261,7 @@ def _axis_bounds(
     group = (prob.band if prob.offset == "band" else np.zeros_like(prob.band))[order]
     y, w = np.asarray(prob.y, np.float64), np.asarray(prob.w, np.float64)
     syy = np.bincount(group, weights=(w * y * y)[order], minlength=prob.n_scales)
-    approx = np.empty((periods.size, phases.size))
-    lower = np.empty_like(approx)
+    out = np.empty((2, cells.size))
     _bound_axis(
         fp,
         eps,
@@ -270,11 +274,11 @@ def _axis_bounds(
         np.asarray(prob.factor, dtype=np.float64),
         np.asarray(periods, dtype=np.float64),
         np.asarray(phases, dtype=np.float64),
+        np.ascontiguousarray(cells, dtype=np.int64),
         syy,
-        approx,
-        lower,
+        out,
     )
-    return approx, lower
+    return out
 
 
 def _kth(best: np.ndarray, k: int) -> float:
@@ -311,11 +315,15 @@ def search_bound(
     exact = np.zeros(shape, dtype=bool)
     best_axis = np.full(shape[0], np.inf)
 
+    every = np.arange(shape[1] * shape[2])
+    tau = np.inf
+
     def fill(pr: Problem, which: np.ndarray) -> None:
         def run(j: int) -> None:
-            i = which[j]
-            approx[i], low = _axis_bounds(pr, axes[i], periods, phases, n_angles)
-            lower[i] = np.maximum(lower[i], low)
+            a, low = approx[which[j]].reshape(-1), lower[which[j]].reshape(-1)
+            cells = every[low <= tau * (1 + SLACK)]  # only candidates that can still win
+            a[cells], new = _axis_bounds(pr, axes[which[j]], periods, phases, n_angles, cells)
+            low[cells] = np.maximum(low[cells], new)
 
         _map(run, len(which), n_threads)
 
