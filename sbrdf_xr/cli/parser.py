@@ -339,9 +339,10 @@ def _add_invert(sub: Any) -> None:
     pspin.add_argument("--offset", choices=("band", "common"), default="band")
     pspin.add_argument(
         "--method",
-        choices=("auto", "direct", "table", "shift"),
+        choices=("auto", "direct", "table", "shift", "bound"),
         default="auto",
-        help="grid evaluation: exact (direct), or spin-angle tables checked against it",
+        help="grid evaluation: exact (direct), spin-angle tables checked against it, or "
+        "tables bounding the chi-square with exact evaluation where a candidate can win (bound)",
     )
     pspin.add_argument(
         "--size-limit",

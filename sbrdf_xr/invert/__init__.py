@@ -54,7 +54,7 @@ from ._areas import material_areas
 from ._data import band_terms, magnitudes_to_signal, measured_kind, read_spectrum
 from ._joint.fit import JOINT_CAUSES, fit_observation
 from ._joint.study import observation_recovery, simulated_light_curve
-from ._spin.bench import benchmark_spin_search
+from ._spin.bench import benchmark_spin_bound, benchmark_spin_search
 from ._spin.data import light_curve_fluxes
 from ._spin.fit import (
     AMBIGUITY_CHI2,
@@ -83,6 +83,7 @@ __all__ = [
     "axis_separation",
     "axis_vector",
     "band_terms",
+    "benchmark_spin_bound",
     "benchmark_spin_search",
     "check_search_size",
     "fibonacci_sphere",

@@ -77,8 +77,8 @@ def test_fit_spin_recovers_truth_moving_geometry(sc, moving):
     assert invert.axis_separation(r["axis_vector"].values, moving["truth"]) < 1.0
     assert abs(float(r["period"]) - 30.0) < 3 * float(r["period_uncertainty"])
     assert r.attrs["fit_quality"] == "consistent"
-    # the default search on moving directions is exact or checked: never the mean geometry
-    assert r.attrs["search_method"] in ("direct", "table")
+    # the default search on moving directions is exact or bounded: never the mean geometry
+    assert r.attrs["search_method"] in ("direct", "bound")
     assert set(r["solution"].values) == {"antipode", "mirror", "half_period", "double_period"}
     # the reported solution is the lowest chi-square found: every twin and local minimum
     # lies at or above it

@@ -56,6 +56,8 @@ SEARCH_WORK_LIMIT = 1e11
 #: likelihood ratio above exp(-4.5) = 1.1 %): the fit warns that the solution is ambiguous.
 AMBIGUITY_CHI2 = 9.0
 
+#: Grid searches of :func:`fit_spin`: those of ``run_search`` and the branch and bound.
+SEARCHES = (*METHODS, "bound")
 #: Cost of a kernel geometry and of one interpolated model value, relative (for ``auto``).
 _COST_KERNEL, _COST_GATHER = 1.0, 0.03
 
@@ -98,6 +100,13 @@ def search_size(
     if method == "direct":
         working = 8.0 * n_times * (6 + 2 * n_bands) + 32.0 * n_values
         work = cells * n_values
+    elif method == "bound":
+        from .bound import bound_angles
+
+        grid = 25.0 * cells + 8.0 * n_axes  # chi-square, bound, approximation, flag
+        n = bound_angles(n_angles)
+        working = 8.0 * n_times * n * (2 * n_bands + 12)
+        work = float(n_axes) * n_times * n * n_bands + cells * n_values
     else:
         rows = 1 if method == "shift" else n_times
         working = 8.0 * rows * n_angles * (n_bands + 12) + 96.0 * n_phases * n_values
@@ -176,8 +185,8 @@ def _chain(
     method: str, fixed: bool, size: dict[str, dict[str, float]], n_times: int, n_values: int
 ) -> list[str]:
     """The searches to try in turn: an approximation first where it is cheaper, then exact."""
-    if method == "direct":
-        return ["direct"]
+    if method in ("direct", "bound"):
+        return [method]
     if method == "table":
         return ["table", "direct"]
     if method == "shift":
@@ -192,7 +201,7 @@ def _chain(
         table = size[m]["work"] - size[m]["cells"] * n_values
         return table / n_bands * _COST_KERNEL + size[m]["cells"] * n_values * _COST_GATHER
 
-    return ["table", "direct"] if cost("table") < cost("direct") else ["direct"]
+    return ["bound"] if cost("bound") < cost("direct") else ["direct"]
 
 
 def fit_spin(
@@ -234,8 +243,14 @@ def fit_spin(
     ``shift``: the mean geometry), an approximation being used only when its model error
     at the best and at random candidates is below ``tolerance`` times the noise (rms over
     the values), else the next search is run (``shift`` -> ``table`` -> ``direct``);
-    ``auto`` takes the cheapest.  Then :func:`scipy.optimize.least_squares` from the best
-    grid state of each of the ``n_starts`` best axes, with the exact model.  The reported
+    ``bound`` reads every candidate from per-axis spin-angle tables with an error
+    estimate that gives it a lower bound of its chi-square, and evaluates exactly only the
+    candidates that can still beat the best state of the ``n_starts`` best axes: those
+    states are the ``direct`` search's (while the estimate holds), the tables'
+    approximation elsewhere in ``chi2_map``; ``auto`` takes ``bound`` where its tables cost
+    less than ``direct`` (``shift`` first at fixed directions).  Then
+    :func:`scipy.optimize.least_squares` from the best grid state of each of the
+    ``n_starts`` best axes, with the exact model.  The reported
     solution is the lowest chi-square found; its twins (antipode, mirror, half and double
     period) are searched in phase and refined too, and any twin that fits better becomes
     the solution.
@@ -279,7 +294,7 @@ def fit_spin(
         Refine the best candidates by least squares (else the grid's best, unrefined).
     n_starts : int
         Refinements started from the best grid state of the ``n_starts`` best axes.
-    method : {"auto", "direct", "table", "shift"}
+    method : {"auto", "direct", "table", "shift", "bound"}
         Grid evaluation (see above).
     n_angles : int
         Spin angles of the ``table`` and ``shift`` searches.
@@ -355,8 +370,10 @@ def fit_spin(
     """
     periods = to_unit(periods, "s", "periods")
     t_start = time.perf_counter()
-    if method not in ("auto", *METHODS):
-        raise InversionError(f"method: {method!r}; allowed 'auto', {', '.join(map(repr, METHODS))}")
+    if method not in ("auto", *SEARCHES):
+        raise InversionError(
+            f"method: {method!r}; allowed 'auto', {', '.join(map(repr, SEARCHES))}"
+        )
     n_axes = _positive_int(n_axes, "n_axes (--n-axes)")
     n_phases = _positive_int(n_phases, "n_phases (--n-phases)")
     n_starts = _positive_int(n_starts, "n_starts")
@@ -401,7 +418,7 @@ def fit_spin(
             n_angles,
             1 if n_threads is None else n_threads,
         )
-        for m in METHODS
+        for m in SEARCHES
     }
     what = (
         f"{n_axes} axes x {per.size:.4g} periods x {n_phases} phases x {n_search} times x "
@@ -422,6 +439,10 @@ def fit_spin(
     checks: list[str] = []
     for used in chain:
         _check_size(sizes[used], what, size_limit)
+        if used == "bound":
+            grid, note = _bound_grid(grid_prob, axes, per, phases, n_threads, n_angles, n_starts)
+            checks.append(note)
+            break
         grid = run_search(used, grid_prob, axes, per, phases, n_threads, n_angles)
         if used == "direct":
             break
@@ -475,6 +496,31 @@ def fit_spin(
         warnings.warn(f"spin fit: {ds.attrs['ambiguity']}", FitQualityWarning, stacklevel=2)
     ds.attrs["symmetry_twins"] = symmetry_twins(prob, best, ab)
     return ds
+
+
+def _bound_grid(
+    prob: Problem,
+    axes: np.ndarray,
+    periods: np.ndarray,
+    phases: np.ndarray,
+    n_threads: int | None,
+    n_angles: int,
+    n_starts: int,
+) -> tuple[np.ndarray, str]:
+    """The grid by branch and bound, exact at the best state of the ``n_starts`` best axes
+    (where the refinements start), and what it did."""
+    from .bound import SAFETY, bound_angles, search_bound
+
+    n = bound_angles(n_angles)
+    res = search_bound(prob, axes, periods, phases, n_threads, n, n_best=n_starts)
+    note = (
+        f"bound ({n} spin angles, error estimate {SAFETY:g} x the coarse tables' midpoint "
+        f"error): {res.n_exact} of {res.grid.size} candidates evaluated exactly, every other "
+        f"one's lower bound above the {min(n_starts, len(axes))}-th best axis's chi-square "
+        f"{res.threshold:.6g}; the best states are the direct search's, the chi2_map of the "
+        "other axes the tables' approximation"
+    )
+    return res.grid, note
 
 
 def _ambiguity(ds: xr.Dataset) -> str:

@@ -12,6 +12,10 @@ See :func:`sbrdf_xr.invert.fit_spin`.  Three ways to evaluate the grid:
 ``shift``
     One such table per axis at the mean Sun and observer directions: exact in the
     geometry only when the directions are fixed.
+``bound``
+    Such tables with an error estimate give every candidate a lower bound of its
+    chi-square; only candidates that can still beat the best go through the kernel
+    (:mod:`sbrdf_xr.invert._spin.bound`): the best state is the ``direct`` one's.
 
 An approximate search is checked against the exact model (:func:`approximation_error`).
 """
