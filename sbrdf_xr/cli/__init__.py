@@ -14,6 +14,7 @@ Modules
     What the command line reads and prints.
 """
 
+from ..errors import renamed_attributes
 from . import analysis, commands, observe, output, parser
 from .analysis import cmd_invert, cmd_photometry
 from .commands import (
@@ -27,7 +28,7 @@ from .commands import (
     spacecraft_of,
 )
 from .observe import cmd_observe
-from .output import escape, escaped_attrs, open_cube, open_dataset
+from .output import escape, escaped_attrs, load_cube, open_dataset
 from .parser import main
 
 __all__ = [
@@ -45,11 +46,15 @@ __all__ = [
     "commands",
     "escape",
     "escaped_attrs",
+    "load_cube",
     "main",
     "observe",
-    "open_cube",
     "open_dataset",
     "output",
     "parser",
     "spacecraft_of",
 ]
+
+# ``open_cube`` was this package's name for the loader: ``sbrdf_xr.store.open_cube`` now
+# opens a cube lazily, so the command line's validating, eager loader is ``load_cube``.
+__getattr__ = renamed_attributes(__name__, globals(), {"open_cube": "load_cube"})

@@ -17,7 +17,7 @@ from .._names import __version__
 from .._output import file_kind
 from ..errors import SbrdfError, ValidationError, did_you_mean
 from ..store import PART_SUFFIX, formats
-from .output import escape, escaped_attrs, open_cube, open_dataset
+from .output import escape, escaped_attrs, load_cube, open_dataset
 
 if TYPE_CHECKING:
     from ..engine import Scene
@@ -499,7 +499,7 @@ def _save_figure(
     from ..plot import cube_figure
 
     formats.check(figure_path, "figure", overwrite=overwrite)
-    cube = open_cube(cube_path)
+    cube = load_cube(cube_path)
     try:
         fig = cube_figure(cube, bands=bands)
     except (KeyError, ValueError, IndexError) as exc:

@@ -14,7 +14,7 @@ from typing import Any
 
 from ..errors import ValidationError
 
-__all__ = ["escape", "escaped_attrs", "open_cube", "open_dataset"]
+__all__ = ["escape", "escaped_attrs", "load_cube", "open_dataset"]
 
 
 def escape(text: Any, newlines: bool = False) -> str:
@@ -149,8 +149,11 @@ def _check_declared(path: Path, variables: Mapping[Any, Any], what: str) -> None
         )
 
 
-def open_cube(path: str | Path) -> Any:
+def load_cube(path: str | Path) -> Any:
     """A loaded simulation cube, or :class:`ValidationError` naming what is missing.
+
+    The command line's loader: the cube is read whole and checked (to open one lazily,
+    use :func:`sbrdf_xr.store.open_cube`).
 
     The variables its writer left out (``brdf``, ``signal`` beside ``signal_material``:
     :mod:`sbrdf_xr.store.derived`) are computed again.
@@ -160,16 +163,16 @@ def open_cube(path: str | Path) -> Any:
     >>> import tempfile
     >>> from pathlib import Path
     >>> import xarray as xr
-    >>> from sbrdf_xr.cli import open_cube
+    >>> from sbrdf_xr.cli import load_cube
     >>> from sbrdf_xr.errors import ValidationError
     >>> spectra = xr.Dataset({"signal": (("attitude", "wavelength"), [[0.1, 0.2]])},
     ...                      coords={"wavelength": [500.0, 600.0]})
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     spectra.to_netcdf(Path(tmp) / "cube.nc")
-    ...     cube = open_cube(Path(tmp) / "cube.nc")  # loaded: usable after the file is gone
+    ...     cube = load_cube(Path(tmp) / "cube.nc")  # loaded: usable after the file is gone
     ...     xr.Dataset({"area": ("x", [1.0])}).to_netcdf(Path(tmp) / "area.nc")
     ...     try:
-    ...         open_cube(Path(tmp) / "area.nc")
+    ...         load_cube(Path(tmp) / "area.nc")
     ...     except ValidationError as exc:
     ...         print(str(exc).split("; ")[-1])
     its variables: area)
