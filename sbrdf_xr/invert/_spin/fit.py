@@ -100,6 +100,7 @@ def search_size(
     if method == "direct":
         working = 8.0 * n_times * (6 + 2 * n_bands) + 32.0 * n_values
         work = cells * n_values
+        geometries = cells * n_times
     elif method == "bound":
         from .bound import bound_angles
 
@@ -107,11 +108,18 @@ def search_size(
         n = bound_angles(n_angles)
         working = 8.0 * n_times * n * (2 * n_bands + 12)
         work = float(n_axes) * n_times * n * n_bands + cells * n_values
+        geometries = float(n_axes) * n_times * n
     else:
         rows = 1 if method == "shift" else n_times
         working = 8.0 * rows * n_angles * (n_bands + 12) + 96.0 * n_phases * n_values
         work = float(n_axes) * rows * n_angles * n_bands + cells * n_values
-    return {"bytes": grid + max(1, n_threads) * working, "work": work, "cells": cells}
+        geometries = float(n_axes) * rows * n_angles
+    return {
+        "bytes": grid + max(1, n_threads) * working,
+        "work": work,
+        "cells": cells,
+        "geometries": geometries,
+    }
 
 
 def _check_size(size: dict[str, float], what: str, size_limit: float) -> None:
@@ -193,13 +201,10 @@ def _chain(
         return ["shift", "direct"] if fixed else ["shift", "table", "direct"]
     if fixed:
         return ["shift", "direct"]
-    n_bands = max(1, round(n_values / max(1, n_times)))
 
-    def cost(m: str) -> float:
-        if m == "direct":
-            return size[m]["cells"] * n_times * _COST_KERNEL
-        table = size[m]["work"] - size[m]["cells"] * n_values
-        return table / n_bands * _COST_KERNEL + size[m]["cells"] * n_values * _COST_GATHER
+    def cost(m: str) -> float:  # kernel geometries (every band at once) and table reads
+        gather = 0.0 if m == "direct" else size[m]["cells"] * n_values * _COST_GATHER
+        return size[m]["geometries"] * _COST_KERNEL + gather
 
     return ["bound"] if cost("bound") < cost("direct") else ["direct"]
 
