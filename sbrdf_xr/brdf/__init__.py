@@ -108,7 +108,8 @@ def get_model(name: str) -> Model:
     Traceback (most recent call last):
     ...
     sbrdf_xr.errors.ValidationError: model: got 'phong'; valid model names are
-    ['anisotropic_microfacet', 'lambert', 'microfacet', 'robertson_sandford'] (case-insensitive)
+    ['anisotropic_microfacet', 'lambert', 'microfacet', 'robertson_sandford',
+    'robertson_sandford_core'] (case-insensitive)
     """
     return BRDF_MODELS[name]
 

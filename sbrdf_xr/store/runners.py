@@ -259,7 +259,14 @@ class _DistributedRunner:
         if istask(value) or isinstance(value, _PLAIN):
             return value
         if key not in self.shared:
-            self.shared[key] = self.client.scatter(value, broadcast=True, hash=False)
+            try:
+                self.shared[key] = self.client.scatter(value, broadcast=True, hash=False)
+            except Exception as exc:
+                if type(exc).__name__ != "CommClosedError":
+                    raise
+                raise ClusterLost(
+                    f"the Dask scheduler no longer answers ({type(exc).__name__}: {exc})"
+                ) from exc
         return self.shared[key]
 
     def _workers(self) -> int:
@@ -322,6 +329,11 @@ class _DistributedRunner:
                 raise ClusterLost(
                     f"the Dask cluster cancelled the block ({type(exc).__name__}: {first}); its "
                     "scheduler or every worker went away"
+                ) from exc
+            if type(exc).__name__ == "CommClosedError":  # the result's fetch lost the scheduler
+                first = (str(exc).splitlines() or [""])[0]
+                raise ClusterLost(
+                    f"the Dask scheduler no longer answers ({type(exc).__name__}: {first})"
                 ) from exc
             raise
         finally:

@@ -13,13 +13,21 @@ PARAMS = {
     "lambert": {"rho": [0.2, 0.4, 0.6]},
     "robertson_sandford": {"rho_D": 0.07, "epsilon": [0.85, 0.8, 0.7], "b": 0.12, "e": 0.12},
     "microfacet": {"roughness": 0.2, "n": [1.5, 1.5, 1.48], "k": 0.0, "rho_d": 0.1},
+    "robertson_sandford_core": {
+        "rho_D": 0.07,
+        "epsilon": [0.85, 0.8, 0.7],
+        "b": 0.12,
+        "e": 0.12,
+        "core_rho": [0.2, 0.25, 0.3],
+        "core_roughness": 0.05,
+    },
 }
 #: render_grid and brdf_angles evaluate the same arithmetic on the same points.
 TOL_SAME = 1e-14
 
 
 def test_registry_names():
-    assert set(MODELS) == {"lambert", "robertson_sandford", "microfacet"}
+    assert set(MODELS) == {"lambert", "robertson_sandford", "microfacet", "robertson_sandford_core"}
     assert set(PARAMS) == set(MODELS)
 
 

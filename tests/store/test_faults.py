@@ -480,11 +480,11 @@ KILLER = textwrap.dedent(
     import os, signal, sys
     sys.path[:0] = [{repo!r}]
     from sbrdf_xr import simulate
-    from sbrdf_xr.store.writer import write_cube
+    from sbrdf_xr.store.formats import write_netcdf_cube  # what 'sbrdf-xr simulate' writes
     def on_block(event):
         if event.n_written == 8:
             os.kill(os.getpid(), signal.SIGKILL)
-    write_cube(simulate(sys.argv[1]), sys.argv[2], max_in_flight=1, on_block=on_block)
+    write_netcdf_cube(simulate(sys.argv[1]), sys.argv[2], max_in_flight=1, on_block=on_block)
     """
 )
 
@@ -527,7 +527,9 @@ def test_resume_after_a_changed_table_is_refused(tmp_path, capsys):
 
     assert main(["simulate", str(scene), "-o", str(path), "--resume", "-q"]) == 0
     assert f"wrote {path}" in capsys.readouterr().out
-    clean = write_cube(simulate(scene), tmp_path / "clean.nc")
+    from sbrdf_xr.store.formats import write_netcdf_cube
+
+    clean = write_netcdf_cube(simulate(scene), tmp_path / "clean.nc")  # what the CLI writes
     got, want = read(path), read(clean)
     xr.testing.assert_identical(got.drop_attrs(), want.drop_attrs())
     fp = scene_fingerprint(load_scene(scene))
