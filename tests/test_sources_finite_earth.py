@@ -85,7 +85,7 @@ def test_emitted_view_factor_against_surface_integral(normal, r):
 VIEW_NORMALS = [DOWN, [1.0, 0.0, -0.05], [1.0, 0.0, 0.0], [1.0, 0.0, 0.1], [0.6, 0.0, -0.8]]
 
 
-@pytest.mark.parametrize("r", [42164.0, 7000.0, 6771.0])
+@pytest.mark.parametrize("r", [42164.0, 7000.0, pytest.param(6771.0, marks=pytest.mark.slow)])
 def test_view_facets_against_surface_integral(r):
     """Many plates at once (whole cap, horizon-cut, edge-on, beyond the centre's horizon):
     the default 64 x 128 nodes are within 1e-3 of the largest value (the horizon kink

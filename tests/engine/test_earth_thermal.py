@@ -81,11 +81,11 @@ CASES = [
     (0.0, 42164.0),  # GEO, Earth-facing
     (60.0, 42164.0),
     (0.0, 7000.0),
-    (45.0, 7000.0),
+    pytest.param(*(45.0, 7000.0), marks=pytest.mark.slow),
     (87.0, 7000.0),  # grazing: the horizon cuts the disc
-    (80.0, 6771.0),  # grazing, 400 km
+    pytest.param(*(80.0, 6771.0), marks=pytest.mark.slow),  # grazing, 400 km
     (110.0, 7000.0),  # the Earth's centre below the horizon: only the limb is seen
-    (140.0, 6771.0),
+    pytest.param(*(140.0, 6771.0), marks=pytest.mark.slow),
 ]
 
 

@@ -86,16 +86,16 @@ CASES = [
     (0.0, 42164.0, 0.0),  # GEO, full Earth, Earth-facing
     (30.0, 42164.0, 60.0),
     (0.0, 7000.0, 0.0),
-    (30.0, 7000.0, 80.0),
+    pytest.param(*(30.0, 7000.0, 80.0), marks=pytest.mark.slow),
     (87.0, 7000.0, 30.0),  # grazing: the horizon cuts the disc
-    (80.0, 6771.0, 45.0),  # grazing, 400 km
+    pytest.param(*(80.0, 6771.0, 45.0), marks=pytest.mark.slow),  # grazing, 400 km
     # limb only: the Earth's centre below the face's horizon, part of the day side above it
     # (reach 90 + rho: 98.7 deg at GEO, 155.5 at 7000 km, 160.2 at 6771 km)
     (95.0, 42164.0, 30.0),
     (100.0, 7000.0, 0.0),
-    (120.0, 7000.0, 60.0),
-    (150.0, 7000.0, 30.0),
-    (130.0, 6771.0, 45.0),
+    pytest.param(*(120.0, 7000.0, 60.0), marks=pytest.mark.slow),
+    pytest.param(*(150.0, 7000.0, 30.0), marks=pytest.mark.slow),
+    pytest.param(*(130.0, 6771.0, 45.0), marks=pytest.mark.slow),
 ]
 
 
