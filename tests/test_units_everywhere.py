@@ -560,11 +560,17 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.brdf.specular_core.brdf_angles": _angles_case("specular_core", _core),
     "sbrdf_xr.brdf.specular_core.render_grid": _angles_case("specular_core", _core),
     "sbrdf_xr.brdf.specular_core.core_loss": lambda: dict(theta_i=[0.0, 60.0], core_roughness=0.2),
+    "sbrdf_xr.brdf.specular_core.energy_scale": lambda: dict(
+        theta_i=[20.0, 60.0], wavelength=[4000.0], **_core()
+    ),
     "sbrdf_xr.brdf.specular_core.fit_core": lambda: dict(
         theta_i=np.full(9, 30.0),
         delta_theta=np.linspace(-4.0, 4.0, 9),
         phi=np.zeros(9),
-        spectra=np.full((9, 1), 0.2) + np.exp(-(np.linspace(-4.0, 4.0, 9) ** 2))[:, None],
+        # a lobe the core does not fit exactly (a well-conditioned residual)
+        spectra=(0.2 + np.exp(-(np.linspace(-4.0, 4.0, 9) ** 2)) * (1.0 + 0.1 * np.arange(9)))[
+            :, None
+        ],
         body=np.full((9, 1), 0.2),
     ),
     "sbrdf_xr.brdf.robertson_sandford_angular.angular_g": lambda: dict(theta=[20.0, 45.0], b=0.5),
