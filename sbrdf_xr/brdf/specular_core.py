@@ -448,7 +448,7 @@ def fit_core(
     hi = np.concatenate([[np.log(0.5)], np.zeros(n_wl), np.full(n_scan, 1.0)])
     for m0 in (0.003, 0.01, 0.03):
         x0 = np.concatenate([[np.log(m0)], np.full(n_wl, np.log(0.1)), np.zeros(n_scan)])
-        res = least_squares(residuals, x0, bounds=(lo, hi), x_scale=1.0)
+        res = least_squares(residuals, x0, bounds=(lo, hi), x_scale=1.0, **_TOLERANCES)
         if best is None or res.cost < best.cost:
             best = res
     assert best is not None
@@ -460,6 +460,12 @@ def fit_core(
         "rms_log": float(np.sqrt(np.mean(log_res**2))),
         "n_used": int(y.size),
     }
+
+
+#: Stopping tolerances of :func:`fit_core`'s least squares: converged to the optimum's
+#: last digits, so that inputs equal to rounding give fits equal to ~1e-10 (scipy's
+#: defaults, 1e-8, stop where the result still moves at 1e-7).
+_TOLERANCES = {"ftol": 1e-12, "xtol": 1e-12, "gtol": 1e-12}
 
 
 def _constraint(checked: dict[str, NDArray[np.float64]]) -> None:
