@@ -218,6 +218,19 @@ def _rs() -> dict[str, Any]:
     return dict(TABLE4["AFGL-01"])
 
 
+def _fit_core_case() -> dict[str, Any]:
+    """A Beckmann core 0.3 deg off specular on a sloping body it cannot take, 0.2-deg steps:
+    a residual far from zero and every parameter far from zero, so the fit is well
+    conditioned and compared relatively."""
+    from sbrdf_xr.brdf.specular_core import core_brdf
+    from sbrdf_xr.geometry import facet_vectors
+
+    t, d, p = np.full(41, 30.0), np.linspace(-4.0, 4.0, 41), np.zeros(41)
+    core = core_brdf(*facet_vectors(t, d - 0.3, p), [0.3], [0.008])
+    spectra = 0.2 + 0.02 * d[:, None] + core
+    return dict(theta_i=t, delta_theta=d, phi=p, spectra=spectra, body=np.full((41, 1), 0.2))
+
+
 def _core() -> dict[str, Any]:
     return {**_rs(), "core_rho": 0.2, "core_roughness": 0.01}
 
@@ -560,13 +573,10 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     "sbrdf_xr.brdf.specular_core.brdf_angles": _angles_case("specular_core", _core),
     "sbrdf_xr.brdf.specular_core.render_grid": _angles_case("specular_core", _core),
     "sbrdf_xr.brdf.specular_core.core_loss": lambda: dict(theta_i=[0.0, 60.0], core_roughness=0.2),
-    "sbrdf_xr.brdf.specular_core.fit_core": lambda: dict(
-        theta_i=np.full(9, 30.0),
-        delta_theta=np.linspace(-4.0, 4.0, 9),
-        phi=np.zeros(9),
-        spectra=np.full((9, 1), 0.2) + np.exp(-(np.linspace(-4.0, 4.0, 9) ** 2))[:, None],
-        body=np.full((9, 1), 0.2),
+    "sbrdf_xr.brdf.specular_core.energy_scale": lambda: dict(
+        theta_i=[20.0, 60.0], wavelength=[4000.0], **_core()
     ),
+    "sbrdf_xr.brdf.specular_core.fit_core": _fit_core_case,
     "sbrdf_xr.brdf.robertson_sandford_angular.angular_g": lambda: dict(theta=[20.0, 45.0], b=0.5),
     "sbrdf_xr.brdf.robertson_sandford_angular.cutoff_factor": lambda: dict(
         theta_r=[45.0, 85.0], b=0.12

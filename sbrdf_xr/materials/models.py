@@ -526,8 +526,10 @@ def fit_robertson_sandford_core(measurements: xr.Dataset) -> xr.Dataset:
     """Fit the Robertson-Sandford model with a specular core to a measurement set.
 
     The body is :func:`fit_robertson_sandford`'s; the core (Beckmann, one rms slope,
-    a reflectance per wavelength; :mod:`sbrdf_xr.brdf.specular_core`) is then fitted
-    beside it to all the samples (:func:`sbrdf_xr.brdf.specular_core.fit_core`).  The
+    a reflectance per wavelength that follows the incidence angle and is bounded by the
+    body's emissivity; :mod:`sbrdf_xr.brdf.specular_core`) is then fitted beside it to
+    all the samples, in the values, each scan's core free to sit a fraction of a degree
+    from specular (:func:`sbrdf_xr.brdf.specular_core.fit_core`).  The
     body is then fitted again without the samples where the fitted core exceeds it,
     and the core again beside it, until the core's rms slope changes by less than 0.1 %
     (at most :data:`_CORE_ITERATIONS` times): a body fitted to the core's samples
@@ -576,7 +578,7 @@ def fit_robertson_sandford_core(measurements: xr.Dataset) -> xr.Dataset:
         last = core["core_roughness"]
         c_vals = specular_core.core_brdf(
             *facet_vectors(*angles),
-            core["core_rho"],
+            core["core_rho"] * np.cos(np.radians(angles[0]))[:, None],  # its fitted law
             np.full(core["core_rho"].shape, core["core_roughness"]),
         )
         body_at = np.all(c_vals < b_vals, axis=1) | ref  # the core's samples left to it
@@ -585,7 +587,8 @@ def fit_robertson_sandford_core(measurements: xr.Dataset) -> xr.Dataset:
     out = model_material(
         "robertson_sandford_core", wl, material=name,
         provenance=f"Robertson-Sandford fit with a specular core to the measurements of {name} "
-        f"(core rms slope {core['core_roughness']:.3g}, rms log residual "
+        f"(core rms slope {core['core_roughness']:.3g}, core offsets "
+        f"{', '.join(f'{x:.2f}' for x in core['core_offset'])} deg, rms log residual "
         f"{core['rms_log']:.3g}, {core['n_used']} residuals)",
         core_rho=core["core_rho"], core_roughness=core["core_roughness"], **params,
     )  # fmt: skip

@@ -3,6 +3,7 @@ data, the self-check, the readers and the ``material build`` command."""
 
 from __future__ import annotations
 
+import functools
 import warnings
 
 import numpy as np
@@ -30,7 +31,7 @@ from sbrdf_xr.materials.coverage import (
     specular_distance,
 )
 from sbrdf_xr.materials.readers import measurement_set
-from sbrdf_xr.materials.selfcheck import _self_check, sample_errors
+from sbrdf_xr.materials.selfcheck import _kfold_check, _self_check, sample_errors
 
 WL = np.array([450.0, 550.0, 650.0])
 #: Lambert 0.3 plus a lobe: the Robertson-Sandford model (paper 001) with rho_D = 0.3.
@@ -362,19 +363,52 @@ def test_the_starlink_solar_array_predicts_held_out_samples():
 
 @pytest.mark.slow
 def test_the_starlink_chassis_predicts_held_out_samples_with_its_specular_core():
-    """The shipped chassis (a Robertson-Sandford fill with a Beckmann core) against the
-    same leave-out check.  Its 13 held-out samples above the floor: median 10.7 %, 95th
-    percentile 56 %, worst 60 % (16.1 %, 75 %, 76 % with the Robertson-Sandford fill
-    alone).  A 1-D interpolation of each scan's kept samples reaches 17.5 % log-linear
-    (linear, or PCHIP, Akima, cubic in the logarithm: 17.7-24 %): the mirror core,
-    narrower than the 1-degree step, is predicted only by a model that has a core.  The
-    bounds hold the gain (0.12 over a median of 13 samples that moves by a few per cent
-    with one sample)."""
+    """The shipped chassis (a Robertson-Sandford fill with a Beckmann core that follows
+    the incidence angle) against the same leave-out check.  Its 13 held-out samples
+    above the floor: median 11.8 %, 95th percentile 60 %, worst 63 % (10.7 %, 56 %,
+    60 % with one constant core fitted in the logarithm; 16.1 %, 75 %, 76 % with the
+    Robertson-Sandford fill alone).  The core samples at 5, 41.4 and 60 deg are now
+    within 8 %, 6 % and 19 % (54 %, 52 %, 23 % before); what is left is the halo two to
+    four degrees from specular, which neither the Gaussian core nor the body's lobe
+    follows.  The build is deterministic: the bounds leave room for the optimiser's
+    rounding across platforms, not for a worse fit."""
     table = catalog.load("starlink-v1.5-chassis")
     assert table.attrs["extrapolation_model"] == "robertson_sandford_core"
     assert table.attrs["self_check_worst"] < 1e-9
-    assert table.attrs["holdout_check_median"] < 0.12
-    assert table.attrs["holdout_check_p95"] < 0.65
+    assert table.attrs["holdout_check_n"] == 13
+    assert table.attrs["holdout_check_median"] < 0.125
+    assert table.attrs["holdout_check_p95"] < 0.62
+    assert table.attrs["holdout_check_worst"] < 0.65
+
+
+def _scans(name):
+    """A catalog measurement set as the build checks it: snapped angles, the samples
+    with reference points zeroed, the reference mask."""
+    ds = catalog.load(name)
+    angles = tuple(snap_angles(ds[d].values) for d in ("theta_i", "delta_theta", "phi"))
+    spectra = ds.measured_sbrdf.transpose("sample", "wavelength").values.copy()
+    ref = ds.reference.values.copy()
+    spectra[ref] = 0.0
+    return ds, angles, spectra, ref
+
+
+@pytest.mark.slow
+def test_the_starlink_chassis_k_fold_leave_out_check():
+    """All four folds of the leave-out check (each inner sample of each scan held out
+    once, four builds): 54 held-out samples above the floor instead of 13, so one sample
+    moves the median by about 1 % instead of several.  Measured: median 11.7 %, 95th
+    percentile 216 %, worst 280 %, fold medians 9.1, 27.6, 11.8, 11.5 % (one constant
+    core fitted in the logarithm: 19.3 %, 180 %, 493 %).  Fold 2 is the build's own
+    check, to the last bit."""
+    ds, angles, spectra, ref = _scans("starlink-v1.5-chassis-measurements")
+    build = functools.partial(
+        build_lut, model="robertson-sandford-core", check_energy="clamp", holdout=0
+    )
+    out = _kfold_check(build, ds, angles, spectra, ref)
+    assert out["holdout_kfold_n"] == 54
+    assert out["holdout_kfold_median"] < 0.125
+    table = catalog.load("starlink-v1.5-chassis")
+    assert out["holdout_fold_medians"][2] == table.attrs["holdout_check_median"]
 
 
 def test_the_core_fit_recovers_a_known_core_from_an_in_plane_scan():
