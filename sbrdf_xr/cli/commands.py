@@ -172,7 +172,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
     ``--engine`` the engine rows), their table printed and written to the files of
     ``--output`` (netCDF), ``--csv`` and ``--plot`` (PNG); returns 0.
 
-    With ``--quick`` the benchmarks run for about a minute, without it for many.
+    With ``--quick`` the benchmarks run for about a minute, without it for many.  The
+    table's first line gives the load average at the start and at the end of the run.
 
     Examples
     --------
@@ -191,14 +192,17 @@ def cmd_bench(args: argparse.Namespace) -> int:
     for out, kind in ((args.output, "table"), (args.csv, "table"), (args.plot, "figure")):
         if out:  # refused before minutes of benchmarks, not after
             formats.check(out, kind, overwrite=args.overwrite)
+    if args.repeat is not None and args.repeat < 1:
+        raise ValidationError(f"--repeat: got {args.repeat}; expected a whole number >= 1")
+    start = bench.rows.load_average()
     if args.engine:
         from ..bench.engine import engine_rows
 
         rows = engine_rows(quick=args.quick)
     else:
-        if args.repeat is not None and args.repeat < 1:
-            raise ValidationError(f"--repeat: got {args.repeat}; expected a whole number >= 1")
         rows = bench.run(quick=args.quick, repeat=args.repeat)
+    header = bench.rows.load_header(start, bench.rows.load_average())
+    print(header)
     print(bench.format_rows(rows))
     loaded = bench.rows.load_warning(rows)
     if loaded:
@@ -207,7 +211,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         command = "sbrdf-xr bench" + (" --quick" if args.quick else "")
         path = bench.write_presets(bench.presets_record(rows, command))
         print(f"wrote {path}")
-    ds = bench.rows_to_dataset(rows)
+    ds = bench.rows_to_dataset(rows).assign_attrs(load_average=header)
     if args.output:
         formats.write(ds, args.output, kind="table", overwrite=args.overwrite)
         print(f"wrote {args.output}")
