@@ -289,6 +289,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             f"({', '.join(builtin_scenes())}) or a scene TOML file"
         )
     scene = resolve_scene(args.scene)
+    outputs = args.outputs or _scene_file_outputs(args.scene)
     scene = _with_body(scene, args)
     changes = _knob_values(args.set or [])
     given = [f"--preset {args.preset!r}"] if args.preset is not None else []
@@ -332,6 +333,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             client=client,
             progress=not args.quiet,
             complevel=args.complevel,
+            outputs=outputs,
         )
     finally:
         if client is not None:
@@ -345,6 +347,17 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     if args.plot:
         _save_figure(path, args.plot, overwrite=args.overwrite)
     return 0
+
+
+def _scene_file_outputs(spec: str) -> str | None:
+    """The ``outputs`` of a scene file's ``[write]`` table (None for a built-in scene or a
+    file without one: the writer's default)."""
+    from ..engine.builtin import builtin_scenes
+    from ..engine.scene_file import write_options
+
+    if spec in builtin_scenes() or not Path(spec).is_file():
+        return None
+    return write_options(spec).get("outputs")
 
 
 def spacecraft_of(args: argparse.Namespace) -> Any:
