@@ -109,11 +109,26 @@ GOALS: dict[str, Goal] = {
     ),
 }
 
-#: How a value of each unit is printed.
-_SHOW = {
-    "s": lambda x: f"{x * 1e6:.1f} us" if x < 1e-3 else f"{x:.3g} s",
-    "byte": lambda x: f"{x / 1e9:.3f} GB",
-}
+
+def _shown(units: str, *values: float) -> list[str]:
+    """``values`` in words, on one scale (that of the largest): microseconds,
+    milliseconds or seconds for ``s``, GB for ``byte``.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench.goals import _shown
+    >>> _shown("s", 455e-6, 1.18e-3), _shown("byte", 0.8e9)
+    (['0.46 ms', '1.18 ms'], ['0.800 GB'])
+    """
+    top = max((abs(v) for v in values if math.isfinite(v)), default=0.0)
+    if units == "byte":
+        scale, name, digits = 1e9, "GB", 3
+    elif units == "s":
+        scale, name = (1e-6, "us") if top < 1e-3 else (1e-3, "ms") if top < 1.0 else (1.0, "s")
+        digits = 1 if name == "us" else 2
+    else:
+        scale, name, digits = 1.0, units, 4
+    return [f"{v / scale:.{digits}f} {name}" for v in values]
 
 
 def goal_row(
@@ -148,12 +163,9 @@ def goal_row(
     goal = GOALS[key]
     ratio = value / baseline_value if baseline_value else math.nan
     met = goal.met(value, ratio) if held else None
-    show = _SHOW.get(units, lambda x: f"{x:.4g} {units}")
+    shown = _shown(units, value, baseline_value)
     verdict = "n/a" if met is None else "met" if met else "NOT met"
-    extra = (
-        f"{show(value)} against {show(baseline_value)}; goal (item {goal.item}): "
-        f"{goal.text}: {verdict}"
-    )
+    extra = f"{shown[0]} against {shown[1]}; goal (item {goal.item}): {goal.text}: {verdict}"
     return BenchRow(
         name,
         value if units == "s" else math.nan,
