@@ -14,6 +14,10 @@ Modules
     The accuracy/cost sweep of the knobs and presets.
 ``engine``
     What a sweep costs end to end.
+``goals``
+    The goals of issue 47, each a row: value, baseline, ratio, goal, met.
+``machine``
+    This machine's own ceilings: its disk's write rate, two threads against one.
 ``calls``
     What a small call costs: one geometry through the compiled evaluator, ``simulate``
     and the bare kernel.
@@ -29,9 +33,22 @@ Modules
 """
 
 from ..errors import renamed_attributes
-from . import accuracy, calls, engine, parts, presets, rows, shadowing, starlink, suite
+from . import (
+    accuracy,
+    calls,
+    engine,
+    goals,
+    machine,
+    parts,
+    presets,
+    rows,
+    shadowing,
+    starlink,
+    suite,
+)
 from .accuracy import BANDS, CANX1_MATERIALS, accuracy_cost, shadow_rows
-from .engine import disk_rate, engine_rows, sweep_job, thread_scaling
+from .engine import engine_rows, sweep_job
+from .machine import disk_rate, thread_scaling
 from .parts import WING_KINDS, canx1_with_wing, parts_rows
 from .presets import load_presets, presets_record, presets_table, write_presets
 from .rows import (
@@ -80,11 +97,13 @@ __all__ = [
     "engine_rows",
     "format_rows",
     "geometries",
+    "goals",
     "kernel_throughput",
     "lambertian_signal",
     "limb_sunlight",
     "load_presets",
     "load_warning",
+    "machine",
     "markdown",
     "parts",
     "parts_rows",

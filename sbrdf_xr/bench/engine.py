@@ -1,5 +1,7 @@
 """Engine benchmarks (``sbrdf-xr bench --engine``): what a sweep costs end to end.
 
+The table opens with the goals of issue 47, each a row (:mod:`sbrdf_xr.bench.goals`).
+
 Every row is a ratio or a rate measured in one run on this machine, never an
 absolute claim:
 
@@ -14,14 +16,15 @@ absolute claim:
   wavelengths written to netCDF at default settings, each in a fresh process: the
   wall time, its growth exponent between sizes, the ratio to the bare kernel time
   over the same geometries, the ratio to its floor (the slower of the bare kernel and
-  the disk writing and syncing as many bytes, :func:`disk_rate`), and the peak
-  resident memory;
+  the disk writing and syncing as many bytes,
+  :func:`~sbrdf_xr.bench.machine.disk_rate`), and the peak resident memory;
 * band-only (V, R, I) against full spectrum on the 1e5 sweep;
 * two cores against one (one thread everywhere: ``SBRDF_XR_NUM_THREADS=1``, and the
   process, its writer thread too, pinned to one CPU), written, computed only (every
   output, nothing written) and the bare kernel alone, and
   two process workers against one on a ``LocalCluster`` writing a Zarr store by
-  blocks; beside them the machine's own two-thread ceiling (:func:`thread_scaling`);
+  blocks; beside them the machine's own two-thread ceiling
+  (:func:`~sbrdf_xr.bench.machine.thread_scaling`);
 * open surfaces and sun-tracking parts against the rigid closed path
   (:mod:`sbrdf_xr.bench.parts`);
 * kernel throughput (facet-spectra per second, linear, 141 wavelengths, unmerged)
@@ -40,14 +43,13 @@ import tempfile
 import time
 from pathlib import Path
 
-import numba
 import numpy as np
 
-from ..store.disk import drop_behind
 from ._kernel_rows import _sweep_scene, kernel_rows
+from .machine import disk_rate, thread_scaling
 from .rows import BenchRow, best_time
 
-__all__ = ["disk_rate", "engine_rows", "sweep_job", "thread_scaling"]
+__all__ = ["engine_rows", "sweep_job"]
 
 #: The sweeps: canx1 at random attitudes, phase angle 10 deg, default outputs.
 _SIZES_QUICK = (10_000, 100_000)
@@ -161,66 +163,6 @@ def _size(path: Path) -> int:
     return sum(p.stat().st_size for p in path.rglob("*") if p.is_file())
 
 
-@numba.njit(nogil=True, cache=True)
-def _scalar_loop(n: int) -> float:  # pragma: no cover - compiled
-    """Square roots and additions only: arithmetic that touches no memory."""
-    s = 0.0
-    for i in range(n):
-        s += np.sqrt(i + 1.0) * 1e-9
-    return s
-
-
-def thread_scaling(n: int = 50_000_000, jobs: int = 4, repeat: int = 3) -> tuple[float, float]:
-    """Seconds for ``jobs`` equal compute-bound jobs (:func:`_scalar_loop`: no memory
-    traffic, the GIL released) on one thread and on two.  Their ratio is this machine's
-    own ceiling for any two-thread speed-up.
-
-    Examples
-    --------
-    >>> from sbrdf_xr.bench.engine import thread_scaling
-    >>> one, two = thread_scaling(n=200_000, repeat=1)
-    >>> one > 0.0 and two > 0.0  # their ratio is a measurement, not a property to assert
-    True
-    """
-    from concurrent.futures import ThreadPoolExecutor
-
-    _scalar_loop(10)
-
-    def run(threads: int) -> None:
-        with ThreadPoolExecutor(threads) as pool:
-            list(pool.map(_scalar_loop, [n] * jobs))
-
-    return best_time(lambda: run(1), repeat), best_time(lambda: run(2), repeat)
-
-
-def disk_rate(where: str | None = None, nbytes: int = 512 * 2**20) -> float:
-    """Rate [byte/s] at which this machine writes ``nbytes`` to a new file in ``where``
-    (the temporary directory by default) as the cube writer does: 32 MiB at a time, each
-    flushed to disk (``fsync``) and dropped from the page cache.  The floor under any
-    cube write of that size there.
-
-    Examples
-    --------
-    >>> from sbrdf_xr.bench.engine import disk_rate
-    >>> disk_rate(nbytes=2**20) > 0.0
-    True
-    """
-    block = np.ones(min(nbytes, 32 * 2**20) // 8)
-    with tempfile.TemporaryDirectory(prefix="sbrdf-disk-", dir=where) as tmp:
-        path = Path(tmp) / "probe.bin"
-        t0 = time.perf_counter()
-        with open(path, "wb") as f:
-            done = 0
-            while done < nbytes:
-                block.tofile(f)
-                done += block.nbytes
-                f.flush()
-                os.fsync(f.fileno())
-                drop_behind(f.fileno())  # as the cube writer does after each block
-        seconds = time.perf_counter() - t0
-    return done / seconds
-
-
 class _PrivatePeak:
     """The peak of this process's anonymous (private) resident memory [byte], sampled
     every 5 ms in a thread: what the peak RSS is less the pages of files it maps (the
@@ -303,7 +245,8 @@ def _subprocess(
 
 
 def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
-    """All engine rows (see the module docstring); ``quick`` leaves out 1e6 and the cluster.
+    """All engine rows (see the module docstring), the goals of issue 47 first
+    (:mod:`sbrdf_xr.bench.goals`); ``quick`` leaves out 1e6 and the cluster.
 
     Examples
     --------
@@ -337,7 +280,10 @@ def engine_rows(quick: bool = False, repeat: int = 3) -> list[BenchRow]:
     from .parts import parts_rows
 
     rows += parts_rows(repeat=max(repeat, 5))
-    return rows + kernel
+    # each goal of issue 47 a row, first in the table (bench.goals)
+    from .goals import engine_goals
+
+    return engine_goals(rows + kernel, results, quick, repeat) + rows + kernel
 
 
 def _warm_rows(repeat: int) -> list[BenchRow]:

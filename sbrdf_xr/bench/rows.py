@@ -22,6 +22,8 @@ __all__ = [
     "BenchRow",
     "best_time",
     "format_rows",
+    "load_average",
+    "load_header",
     "load_warning",
     "plot_front",
     "rows_to_dataset",
@@ -60,6 +62,10 @@ class BenchRow:
         machine moved the time of this row between repeats.
     model_mmag_max, model_mmag_median : float
         Error against the materials' generating models (NaN when not measured).
+    goal : str
+        The goal this row is held to, in words ("" for none; :mod:`sbrdf_xr.bench.goals`).
+    met : bool or None
+        Whether the measured value meets ``goal`` (None: no goal, or not measured).
 
     Examples
     --------
@@ -82,6 +88,8 @@ class BenchRow:
     spread: float = float("nan")
     model_mmag_max: float = float("nan")
     model_mmag_median: float = float("nan")
+    goal: str = ""
+    met: bool | None = None
 
 
 def best_time(func: Callable[[], object], repeat: int = 3, number: int = 1) -> float:
@@ -182,6 +190,50 @@ def load_warning(rows: list[BenchRow], limit: float = LOADED_SPREAD) -> str | No
     )
 
 
+def load_average() -> tuple[float, float, float] | None:
+    """The load average over 1, 5 and 15 minutes (processes running or waiting), or
+    None where the platform gives none.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench.rows import load_average
+    >>> load = load_average()
+    >>> load is None or (len(load) == 3 and min(load) >= 0.0)
+    True
+    """
+    import os
+
+    try:
+        one, five, fifteen = os.getloadavg()
+    except (OSError, AttributeError):  # pragma: no cover - not on every platform
+        return None
+    return (float(one), float(five), float(fifteen))
+
+
+def load_header(
+    start: tuple[float, float, float] | None, end: tuple[float, float, float] | None
+) -> str:
+    """The line above a benchmark table: the load average (1, 5, 15 minutes) at the start
+    and at the end of the run, on this machine's CPUs.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench.rows import load_header
+    >>> line = load_header((0.5, 0.4, 0.3), (2.0, 1.25, 0.5))
+    >>> print(line.partition(" on ")[0])
+    load average (1, 5, 15 min): 0.50, 0.40, 0.30 at the start, 2.00, 1.25, 0.50 at the end,
+    """
+    import os
+
+    def text(load: tuple[float, float, float] | None) -> str:
+        return "unknown" if load is None else ", ".join(f"{x:.2f}" for x in load)
+
+    return (
+        f"load average (1, 5, 15 min): {text(start)} at the start, {text(end)} at the end, "
+        f"on {os.cpu_count()} CPUs"
+    )
+
+
 def format_rows(rows: list[BenchRow]) -> str:
     """A plain-text table of benchmark rows (time as a ratio to the row's baseline).
 
@@ -263,7 +315,11 @@ def rows_to_dataset(rows: list[BenchRow]) -> xr.Dataset:
             "time_ratio": (
                 "case",
                 col("ratio"),
-                {"units": "1", "long_name": "wall time / baseline wall time"},
+                {
+                    "units": "1",
+                    "long_name": "wall time / baseline wall time (or measured value / baseline "
+                    "value, as the notes say)",
+                },
             ),
             "mmag_max": (
                 "case",
@@ -296,6 +352,12 @@ def rows_to_dataset(rows: list[BenchRow]) -> xr.Dataset:
                 {"units": "mmag", "long_name": "median band error against the generating models"},
             ),
             "baseline": ("case", col("baseline"), {"long_name": "baseline of the time ratio"}),
+            "goal": ("case", col("goal"), {"long_name": "goal the case is held to"}),
+            "goal_met": (
+                "case",
+                ["" if r.met is None else "met" if r.met else "not met" for r in rows],
+                {"long_name": "whether the measured value meets the goal"},
+            ),
             "sweep": ("case", col("sweep"), {"long_name": "sweep"}),
             "notes": ("case", col("extra"), {"long_name": "notes"}),
         },

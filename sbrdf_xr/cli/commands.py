@@ -172,7 +172,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
     ``--engine`` the engine rows), their table printed and written to the files of
     ``--output`` (netCDF), ``--csv`` and ``--plot`` (PNG); returns 0.
 
-    With ``--quick`` the benchmarks run for about a minute, without it for many.
+    With ``--quick`` the benchmarks run for about a minute, without it for many.  The
+    table's first line gives the load average at the start and at the end of the run.
 
     Examples
     --------
@@ -191,14 +192,17 @@ def cmd_bench(args: argparse.Namespace) -> int:
     for out, kind in ((args.output, "table"), (args.csv, "table"), (args.plot, "figure")):
         if out:  # refused before minutes of benchmarks, not after
             formats.check(out, kind, overwrite=args.overwrite)
+    if args.repeat is not None and args.repeat < 1:
+        raise ValidationError(f"--repeat: got {args.repeat}; expected a whole number >= 1")
+    start = bench.rows.load_average()
     if args.engine:
         from ..bench.engine import engine_rows
 
         rows = engine_rows(quick=args.quick)
     else:
-        if args.repeat is not None and args.repeat < 1:
-            raise ValidationError(f"--repeat: got {args.repeat}; expected a whole number >= 1")
         rows = bench.run(quick=args.quick, repeat=args.repeat)
+    header = bench.rows.load_header(start, bench.rows.load_average())
+    print(header)
     print(bench.format_rows(rows))
     loaded = bench.rows.load_warning(rows)
     if loaded:
@@ -207,7 +211,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         command = "sbrdf-xr bench" + (" --quick" if args.quick else "")
         path = bench.write_presets(bench.presets_record(rows, command))
         print(f"wrote {path}")
-    ds = bench.rows_to_dataset(rows)
+    ds = bench.rows_to_dataset(rows).assign_attrs(load_average=header)
     if args.output:
         formats.write(ds, args.output, kind="table", overwrite=args.overwrite)
         print(f"wrote {args.output}")
@@ -285,6 +289,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             f"({', '.join(builtin_scenes())}) or a scene TOML file"
         )
     scene = resolve_scene(args.scene)
+    outputs = args.outputs or _scene_file_outputs(args.scene)
     scene = _with_body(scene, args)
     changes = _knob_values(args.set or [])
     given = [f"--preset {args.preset!r}"] if args.preset is not None else []
@@ -328,6 +333,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             client=client,
             progress=not args.quiet,
             complevel=args.complevel,
+            outputs=outputs,
         )
     finally:
         if client is not None:
@@ -341,6 +347,17 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     if args.plot:
         _save_figure(path, args.plot, overwrite=args.overwrite)
     return 0
+
+
+def _scene_file_outputs(spec: str) -> str | None:
+    """The ``outputs`` of a scene file's ``[write]`` table (None for a built-in scene or a
+    file without one: the writer's default)."""
+    from ..engine.builtin import builtin_scenes
+    from ..engine.scene_file import write_options
+
+    if spec in builtin_scenes() or not Path(spec).is_file():
+        return None
+    return write_options(spec).get("outputs")
 
 
 def spacecraft_of(args: argparse.Namespace) -> Any:

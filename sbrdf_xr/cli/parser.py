@@ -8,6 +8,7 @@ Sub-commands::
     sbrdf-xr bench [--quick]                accuracy/cost benchmarks, timings as ratios in one run
     sbrdf-xr simulate SCENE -o CUBE.nc      run a scene (built-in name or TOML file) into a cube
              [--scheduler ADDR] [--preset NAME] [--plot FIG.png] [--overwrite | --resume] [--plan]
+             [--outputs independent|all]
              [--spacecraft NAME|MESH [--mesh-material M | --material-map MAP.toml]]
              [--material M=NAME|FILE.nc ...]
     sbrdf-xr observe -o CUBE.nc             a real pass: elements, a site, a UTC window, an
@@ -49,6 +50,7 @@ from ..engine.builtin import builtin_scenes
 from ..engine.knobs import KNOBS, PRESETS
 from ..errors import SbrdfError
 from ..store import DEFAULT_COMPLEVEL, PART_SUFFIX
+from ..store.derived import OUTPUTS
 from .analysis import cmd_invert, cmd_photometry
 from .commands import (
     cmd_bench,
@@ -176,6 +178,15 @@ def _add_simulate(sub: Any) -> None:
         help=f"compression of the cube: 0 none, 1-9 zlib with byte shuffle (default: netCDF "
         f"{DEFAULT_COMPLEVEL}, uncompressed, the fastest and resumable after a kill at any "
         "instant; Zarr its own LZ4); a resume keeps the level the cube was started with",
+    )
+    psim.add_argument(
+        "--outputs",
+        choices=OUTPUTS,
+        default=None,
+        help="the cube's variables: independent (those no other gives; brdf, and signal "
+        "beside signal_material, recorded and computed on read) or all (every one written); "
+        "default: the scene file's [write] outputs, else independent; a resume keeps the "
+        "variables the .part was started with",
     )
     psim.add_argument(
         "--plot",

@@ -37,7 +37,14 @@ from .attitude_table import (
 )
 from .knobs import KNOBS
 from .scene import Scene
-from .schema import GEOMETRY_KEYS, RENAMED_SCENE_KEYS, SCENE_KEYS, SPACECRAFT_KEYS, toml_types
+from .schema import (
+    GEOMETRY_KEYS,
+    RENAMED_SCENE_KEYS,
+    SCENE_KEYS,
+    SPACECRAFT_KEYS,
+    WRITE_KEYS,
+    toml_types,
+)
 
 __all__ = [
     "MAX_SCENE_COUNT",
@@ -46,12 +53,14 @@ __all__ = [
     "load_scene",
     "scene_from_dict",
     "scene_material_tables",
+    "write_options",
 ]
 
 
 _SCENE_KEYS = toml_types(SCENE_KEYS)
 _SPACECRAFT_KEYS = toml_types(SPACECRAFT_KEYS)
 _GEOMETRY_KEYS = toml_types(GEOMETRY_KEYS)
+_WRITE_KEYS = toml_types(WRITE_KEYS)
 
 #: Largest shadow-sampling density a scene may ask for (sub-facet samples per side; the knob
 #: table's bound).
@@ -274,6 +283,7 @@ def scene_from_dict(d: Mapping[str, Any], base_dir: str | Path | None = None) ->
             kw[k] = _rows(g[k], 3, f"[geometry] {k}")
         if "to_earth" in g:
             kw["to_earth"] = _rows(g["to_earth"], 3, "[geometry] to_earth")
+    _write_table(d)  # checked here, used by the writer (write_options)
     if "observation" in d:
         from ..observing.observe import observation_from_dict
 
@@ -417,6 +427,12 @@ def load_scene(path: str | Path) -> Scene:
     ('grey-canx1', 2, 684)
     """
     path = Path(path)
+    return scene_from_dict(_read_toml(path), path.parent)
+
+
+def _read_toml(path: Path) -> dict[str, Any]:
+    """The contents of a TOML scene file; a :class:`SceneError` for a file that cannot be
+    read or is not UTF-8 TOML."""
     try:
         raw = path.read_bytes()
     except OSError as exc:
@@ -435,7 +451,54 @@ def load_scene(path: str | Path) -> Scene:
         raise SceneError(f"{path}: invalid TOML: {why}") from None
     except RecursionError:
         raise SceneError(f"{path}: invalid TOML: nested too deeply") from None
-    return scene_from_dict(d, path.parent)
+    return d
+
+
+def _write_table(d: Mapping[str, Any]) -> dict[str, str]:
+    """The ``[write]`` table of a scene file's contents, checked (empty when none)."""
+    from ..store.derived import OUTPUTS
+
+    t = d.get("write", {})
+    _check_keys(t, _WRITE_KEYS, "[write]")
+    out = dict(t)
+    if "outputs" in out and out["outputs"] not in OUTPUTS:
+        raise SceneError(
+            f"[write] outputs: got {out['outputs']!r}; allowed: "
+            f"{', '.join(repr(o) for o in OUTPUTS)}"
+        )
+    return out
+
+
+def write_options(path: str | Path) -> dict[str, str]:
+    """How ``sbrdf-xr simulate`` writes the cube of a scene file: its ``[write]`` table
+    (:data:`~sbrdf_xr.engine.schema.WRITE_KEYS`; the keyword arguments of
+    :func:`sbrdf_xr.store.write` of the same names), checked; empty when it has none.
+
+    Raises
+    ------
+    SceneError
+        The file cannot be read, is not TOML, or its ``[write]`` table has an unknown
+        key or value.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.engine.scene_file import write_options
+    >>> from sbrdf_xr.errors import SceneError
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = Path(tmp) / "scene.toml"
+    ...     _ = path.write_text('spacecraft = "canx1"\\n[write]\\noutputs = "all"\\n')
+    ...     print(write_options(path))
+    ...     _ = path.write_text('spacecraft = "canx1"\\n[write]\\noutputs = "some"\\n')
+    ...     try:
+    ...         write_options(path)
+    ...     except SceneError as exc:
+    ...         print(exc)
+    {'outputs': 'all'}
+    [write] outputs: got 'some'; allowed: 'independent', 'all'
+    """
+    return _write_table(_read_toml(Path(path)))
 
 
 #: Old names, served one release with a :class:`~sbrdf_xr.errors.RenamedWarning`.

@@ -32,6 +32,7 @@ __all__ = [
     "RENAMED_SCENE_KEYS",
     "SCENE_KEYS",
     "SPACECRAFT_KEYS",
+    "WRITE_KEYS",
     "Key",
     "reference",
     "toml_types",
@@ -157,6 +158,13 @@ SCENE_KEYS: dict[str, Key] = _table(
             f"among {', '.join(SCENE_OUTPUTS)} (per_material adds signal_material)",
         ),
         Key(
+            "write",
+            (dict,),
+            "[write] table (below): how sbrdf-xr simulate writes the cube (not a part of "
+            "the scene: the values computed do not depend on it)",
+            "-",
+        ),
+        Key(
             "effects",
             (list,),
             f"among {', '.join(SCENE_EFFECTS)} (the effects table below; "
@@ -223,6 +231,21 @@ SCENE_KEYS.update({k: _knob_key(k) for k in KNOBS if k not in SCENE_KEYS})  # ev
 #: Top-level keys renamed: old key -> new key.  A scene file's old key is read as the new
 #: one for one release, with a :class:`~sbrdf_xr.errors.RenamedWarning`.
 RENAMED_SCENE_KEYS: dict[str, str] = {"earth_range_km": "earth_range"}
+
+#: Keys of a ``[write]`` table: how ``sbrdf-xr simulate`` writes the cube (the keyword
+#: arguments of :func:`sbrdf_xr.store.write` of the same names).
+WRITE_KEYS: dict[str, Key] = _table(
+    [
+        Key(
+            "outputs",
+            (str,),
+            'the cube\'s variables: "independent" (those no other gives; the derived ones, '
+            "brdf and signal beside signal_material, recorded and computed on read) or "
+            '"all" (every one written); the option --outputs overrides it',
+            '"independent"',
+        ),
+    ]
+)
 
 #: Keys of a ``[spacecraft]`` table (a mesh file).
 SPACECRAFT_KEYS: dict[str, Key] = _table(
@@ -348,6 +371,7 @@ def reference() -> str:
         ("`[attitude]` (`kind` says which keys apply)", ATTITUDE_KEYS),
         ("`[geometry]`", GEOMETRY_KEYS),
         ("`[observation]`", OBSERVATION_KEYS),
+        ("`[write]` (how `sbrdf-xr simulate` writes the cube)", WRITE_KEYS),
     ):
         out += ["", f"{title}:", "", *_rows(keys)]
     out += ["", "`[observation.attitude]`: `law` and its parameters:", ""]

@@ -37,19 +37,22 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import xarray as xr
+
 from .._output import (
     atomic_file,
     check_output,
+    cli_style,
     error_words,
     file_kind,
     option,
     refuse_special,
 )
 from ..errors import CubeWriteError, OutputError, ValidationError
-from .derived import lean
-from .files import LOG_SUFFIX, PART_SUFFIX, read_log
+from .derived import OUTPUTS, lean
+from .files import LOG_SUFFIX, PART_SUFFIX, discard_hint, read_log
 from .files import check_destination as cube_destination
-from .layout import describe_chunks, encode_times
+from .layout import describe_chunks, encode_times, layout_of
 from .lock import LOCK_SUFFIX
 from .writer import write_cube
 from .zarr_store import check_destination as zarr_destination
@@ -134,11 +137,17 @@ class Format:
 
 
 def write_netcdf_cube(
-    cube: Any, path: str | os.PathLike[str], *, outputs: str = "independent", **options: Any
+    cube: Any, path: str | os.PathLike[str], *, outputs: str | None = None, **options: Any
 ) -> Path:
     """:func:`~sbrdf_xr.store.writer.write_cube` of ``cube`` with its times encoded as CF
     numbers (:func:`~sbrdf_xr.store.layout.encode_times`), its derived variables left out
     unless ``outputs="all"`` (:func:`~sbrdf_xr.store.derived.lean`).
+
+    ``outputs=None`` (the default) is ``"independent"``, except on a resume of a ``.part``
+    started with every variable (by ``outputs="all"``, or by a version that wrote every
+    variable): the resume keeps the variables the ``.part`` has.  An ``outputs`` given
+    that differs from the ``.part``'s is refused (:class:`~sbrdf_xr.errors.CubeWriteError`
+    naming the value to resume with).
 
     Examples
     --------
@@ -155,14 +164,40 @@ def write_netcdf_cube(
     ...         print(back.time.values.tolist() == cube.time.values.tolist())
     True
     """
+    outputs = _part_outputs(cube, Path(path), outputs, bool(options.get("resume")))
     return write_cube(encode_times(lean(cube, outputs)), path, **options)
 
 
+def _part_outputs(cube: Any, path: Path, outputs: str | None, resume: bool) -> str:
+    """The ``outputs`` of a netCDF write: those asked (``"independent"`` for None), or on
+    a resume those the ``.part`` was started with, recognised by its fingerprint."""
+    part = path.with_name(path.name + PART_SUFFIX)
+    if not resume or not isinstance(cube, xr.Dataset) or outputs not in (None, *OUTPUTS):
+        return outputs or OUTPUTS[0]  # (an unknown value: lean says what is allowed)
+    try:
+        header, _ = read_log(path.with_name(path.name + LOG_SUFFIX), part)
+    except (OutputError, OSError):  # nothing to resume: the writer says what is there
+        return outputs or OUTPUTS[0]
+    prints = {o: layout_of(encode_times(lean(cube, o))).fingerprint for o in OUTPUTS}
+    started = next((o for o, f in prints.items() if f == header.get("fingerprint")), None)
+    if started is None or len(set(prints.values())) == 1 or outputs in (None, started):
+        return started or outputs or OUTPUTS[0]  # (another cube: the writer refuses it)
+    how = {"all": "every variable written", "independent": "the derived variables left out"}
+    again = f"--outputs {started}" if cli_style() else f"outputs={started!r}"
+    raise CubeWriteError(
+        f"{part} was started with outputs={started!r} ({how[started]}) and this write asks "
+        f"for outputs={outputs!r}: its blocks keep their variables, so it is resumed only "
+        f"with the same. Resume with {again} (or without it: a resume keeps the variables "
+        f"the .part has), or {discard_hint()}"
+    )
+
+
 def write_zarr_cube(
-    cube: Any, path: str | os.PathLike[str], *, outputs: str = "independent", **options: Any
+    cube: Any, path: str | os.PathLike[str], *, outputs: str | None = None, **options: Any
 ) -> Path:
     """:func:`~sbrdf_xr.store.zarr_store.write_zarr` of ``cube``, its derived variables left
-    out unless ``outputs="all"`` (:func:`~sbrdf_xr.store.derived.lean`).
+    out unless ``outputs="all"`` (:func:`~sbrdf_xr.store.derived.lean`; None is
+    ``"independent"``).
 
     Examples
     --------
@@ -178,7 +213,7 @@ def write_zarr_cube(
     ...         print(list(back.data_vars))
     ['signal_material']
     """
-    return write_zarr(lean(cube, outputs), path, **options)
+    return write_zarr(lean(cube, outputs or OUTPUTS[0]), path, **options)
 
 
 def _netcdf_unfinished(path: str | os.PathLike[str]) -> str | None:

@@ -69,6 +69,9 @@ def test_bench_quick_runs_and_reports_ratios(capsys, tmp_path):
         and "shadowing: sampled density" in out
     )
     ds = xr.open_dataset(nc)
+    # the load average at both ends of the run heads the table and is kept with it
+    assert out.startswith("load average (1, 5, 15 min): ") and " at the end, on " in out
+    assert ds.attrs["load_average"] == out.splitlines()[0]
     # The reference row is its own baseline; float32 changes magnitudes by far less than 1 mmag.
     ref = [c for c in ds.case.values if c.startswith("reference")]
     assert ref and float(ds.time_ratio.sel(case=ref[0])[0]) == 1.0
