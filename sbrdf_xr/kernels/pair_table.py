@@ -7,8 +7,14 @@ height above the plane), with the box of the slopes ``s = (E1_i.d, E2_i.d) / N_i
 directions ``d`` from which its shadow can reach the facet: the quotients ``(u - a) / h``
 over the cut vertices and the facet's vertices ``a`` bound it (a linear-fractional function
 takes its extremes at vertices), a vertex on the plane (``h = 0``) opening the box on the
-side its numerator has.  The pairs of a facet are sorted by the distance of their box
-from ``s = 0``.  :func:`sbrdf_xr.kernels.shadow_pairs.pairs_kernel` reads the table.
+side its numerator has.  Three more bounds use the facet's edges as separating axes: with
+``w`` the unit direction of edge ``e`` (from corner ``c``), the projected vertex
+``(u - h s_1, v - h s_2)`` is on or outside the edge when ``w x (u - c) - h (w x s) <= 0``,
+so the whole shadow is outside it when ``sigma = w_1 s_2 - w_2 s_1`` exceeds
+``tau = max (w x (u - c)) / h`` over the cut vertices (``+inf`` if a vertex on the plane
+is inside the edge line); ``tau`` is widened by the same margin as the box.  The pairs of
+a facet are sorted by the distance of their box from ``s = 0``.
+:func:`sbrdf_xr.kernels.shadow_pairs.pairs_kernel` reads the table.
 """
 
 from __future__ import annotations
@@ -61,7 +67,8 @@ def _cut(i, idx, n, V, N, P0, E1, E2, out):
 @nb.njit(cache=True, nogil=True)
 def _slope_box(cut, n, tri, box):
     """Bounding box (s1 lo, s1 hi, s2 lo, s2 hi) of the slopes s for which the cut polygon
-    (rows u, v, h) projected along d can meet the triangle ``tri`` (3, 2); returns its
+    (rows u, v, h) projected along d can meet the triangle ``tri`` (3, 2), then the three
+    thresholds past which it lies outside an edge of the triangle; returns the box's
     squared distance from s = 0."""
     r2 = 0.0
     for c in range(2):
@@ -88,6 +95,21 @@ def _slope_box(cut, n, tri, box):
             r2 += lo * lo
         elif hi < 0.0:
             r2 += hi * hi
+    for e in range(3):  # the triangle's edges as separating axes (module docstring)
+        e1 = e + 1 if e < 2 else 0
+        ux = tri[e1, 0] - tri[e, 0]
+        uy = tri[e1, 1] - tri[e, 1]
+        norm = np.sqrt(ux * ux + uy * uy)
+        ux /= norm
+        uy /= norm
+        tau = -np.inf
+        for v in range(n):
+            a = ux * (cut[v, 1] - tri[e, 1]) - uy * (cut[v, 0] - tri[e, 0])
+            if cut[v, 2] > 0.0:
+                tau = max(tau, a / cut[v, 2])
+            elif a > 0.0:
+                tau = np.inf
+        box[4 + e] = tau + MARGIN * (1.0 + abs(tau)) if np.isfinite(tau) else tau
     return r2
 
 
@@ -117,8 +139,9 @@ def pair_table(
     facing the same way (such a one-sided facet is never an occluder while the receiver
     faces the light).  Returns ``(recv, pstart, pgroup, pcount, cut, box, r2)``: the
     receivers, CSR offsets of their pairs, each pair's occluder, its cut polygon (count and
-    rows u, v, h in the receiver's frame), its slope box and the squared distance of the
-    box from 0 (ascending within a receiver).
+    rows u, v, h in the receiver's frame), its slope box (columns 0-3) and edge thresholds
+    (columns 4-6, module docstring) and the squared distance of the box from 0 (ascending
+    within a receiver).
 
     Examples
     --------
@@ -157,7 +180,7 @@ def pair_table(
     pgroup = np.empty(cap, dtype=np.int64)
     pcount = np.empty(cap, dtype=np.int64)
     cut = np.empty((cap, _CUT, 3))
-    box = np.empty((cap, 4))
+    box = np.empty((cap, 7))
     r2 = np.empty(cap)
     recv = np.empty(nf, dtype=np.int64)
     pstart = np.zeros(nf + 1, dtype=np.int64)
