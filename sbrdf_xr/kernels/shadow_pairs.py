@@ -407,10 +407,17 @@ def pairs_kernel(
     >>> print(np.round(pairs_kernel(N, N, E1, E2, T2, *table, N, gopen, dirs), 6))
     [[0.75 0.25 1.   1.  ]]
     """
-    G = dirs.shape[0]
+    frac = np.empty((dirs.shape[0], N.shape[0]))
+    table = (recv, pstart, pgroup, pcount, cut, box, r2)
+    _pairs_into(frac, normals, N, E1, E2, T2, table, gnorm, gopen, dirs, _buffers(dirs, gnorm))
+    return frac
+
+
+@nb.njit(cache=True, nogil=True)
+def _buffers(dirs, gnorm):
+    """The scratch of :func:`_pairs_into` for directions like ``dirs`` and the occluders of
+    ``gnorm`` (allocated once per call of :func:`pairs_kernel`, or once per posed sweep)."""
     K = dirs.shape[1]
-    nf = N.shape[0]
-    frac = np.empty((G, nf))
     gx = np.empty((MAX_SHADOWS, _SHADOW))
     gy = np.empty((MAX_SHADOWS, _SHADOW))
     gn = np.empty(MAX_SHADOWS, dtype=np.int64)
@@ -441,6 +448,16 @@ def pairs_kernel(
         np.empty((_PIECES, MAXV)),
         np.empty(_PIECES, dtype=np.int64),
     )
+    return gx, gy, gn, px, py, qx, qy, tx, ty, cx, cy, w, occ, s, scratch
+
+
+@nb.njit(cache=True, nogil=True)
+def _pairs_into(frac, normals, N, E1, E2, T2, table, gnorm, gopen, dirs, buf):
+    """:func:`pairs_kernel` written into ``frac`` (G, n_facets), with its scratch ``buf``."""
+    recv, pstart, pgroup, pcount, cut, box, r2 = table
+    gx, gy, gn, px, py, qx, qy, tx, ty, cx, cy, w, occ, s, scratch = buf
+    G = dirs.shape[0]
+    K = dirs.shape[1]
     for g0 in range(0, G, _CHUNK):  # a chunk of geometries, then each receiver through them
         g1 = min(G, g0 + _CHUNK)
         for g in range(g0, g1):
