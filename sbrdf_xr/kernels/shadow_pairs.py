@@ -34,7 +34,7 @@ PIECES_FROM = 4
 #: 7 terms).
 SMALL_UNION = 3
 _PIECES = 256  # lit pieces held (more: inclusion-exclusion, then slabs)
-_CHUNK = 64  # geometries whose facing flags are held while each receiver runs through them
+_CHUNK = 512  # geometries whose facing flags are held while each receiver runs through them
 
 
 @nb.njit(cache=True, nogil=True)

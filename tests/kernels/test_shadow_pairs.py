@@ -29,10 +29,10 @@ from fractions import Fraction
 import numpy as np
 import pytest
 import shapely
-from shapely.geometry.polygon import orient
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from hypothesis_profiles import examples
+from shapely.geometry.polygon import orient
 
 from sbrdf_xr.bench.shadowing import geometries
 from sbrdf_xr.body import spacecraft as sc
