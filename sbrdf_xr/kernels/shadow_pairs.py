@@ -418,20 +418,12 @@ def _buffers(dirs, gnorm):
     """The scratch of :func:`_pairs_into` for directions like ``dirs`` and the occluders of
     ``gnorm`` (allocated once per call of :func:`pairs_kernel`, or once per posed sweep)."""
     K = dirs.shape[1]
-    gx = np.empty((MAX_SHADOWS, _SHADOW))
-    gy = np.empty((MAX_SHADOWS, _SHADOW))
+    gx, gy = np.empty((MAX_SHADOWS, _SHADOW)), np.empty((MAX_SHADOWS, _SHADOW))
     gn = np.empty(MAX_SHADOWS, dtype=np.int64)
-    px = np.empty(_SHADOW)
-    py = np.empty(_SHADOW)
-    qx = np.empty(MAXV)
-    qy = np.empty(MAXV)
-    tx = np.empty(MAXV)
-    ty = np.empty(MAXV)
-    cx = np.empty(3)
-    cy = np.empty(3)
-    w = np.empty((3, 2))
+    px, py, cx, cy = np.empty(_SHADOW), np.empty(_SHADOW), np.empty(3), np.empty(3)
+    w, s = np.empty((3, 2)), np.empty((K, 2))
+    qx, qy, tx, ty = np.empty(MAXV), np.empty(MAXV), np.empty(MAXV), np.empty(MAXV)
     occ = np.empty((_CHUNK, K, gnorm.shape[0]), dtype=np.bool_)
-    s = np.empty((K, 2))
     scratch = (
         np.empty((MAXM + 1, MAXV)),
         np.empty((MAXM + 1, MAXV)),
