@@ -91,16 +91,12 @@ def _posed_pairs(spacecraft: Spacecraft) -> dict | None:
             seeds = occ["members"][occ["start"][:-1]]
             groups = (seeds, s.group, s.group[seeds])
             occluders = (ok, occ["poly"], occ["count"], occ["open"], occ["start"], occ["members"])
-            frame = tuple(rest[k] for k in ("V", "F", "N", "P0", "E1", "E2", "T2"))
+            V, F, N, P0, E1, E2, T2 = (rest[k] for k in ("V", "F", "N", "P0", "E1", "E2", "T2"))
+            poly, count, gopen, start, members = occluders[1:]
             within = grouped_pair_table(
-                *frame,
-                *occluders[:3],
-                occ["normal"],
-                *occluders[3:],
-                rest["eps"],
-                *groups[1:],
-                True,
-            )
+                V, F, N, P0, E1, E2, T2, ok, poly, count, occ["normal"], gopen, start, members,
+                rest["eps"], s.group, s.group[seeds], True,
+            )  # fmt: skip
             out = {"occluders": (*occluders, *groups), "within": within}
         cache["posed:pairs"] = out
     return cache["posed:pairs"]
