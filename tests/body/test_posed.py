@@ -5,8 +5,10 @@ coordinates do not change when the group turns) and finds those between groups p
 The grid kernel (:func:`sbrdf_xr.kernels.shadow.exact_kernel`, every facet tested per
 direction) is the independent check: the two project and clip the same shadows, in other
 frames and orders, so they agree to rounding (the fractions' tolerance of
-``tests/kernels/test_shadow_pairs.py`` is 1e-15 (1 + |s|) scale / l: at most ~1e-13 on
-these bodies at the directions drawn; rtol 1e-12 with an absolute 1e-13 below it).
+``tests/kernels/test_shadow_pairs.py``, 1e-15 (1 + |s|) scale / l, is ~1e-13 on these
+bodies).  Measured on 360 random geometries: at most 1.3e-13 apart on the box with a plate
+(relative 1.02e-12 on a fraction of 0.13), 6.7e-16 on the GEO comsat; the geometries drawn
+here hold rtol 1e-12 with no absolute tolerance.
 """
 
 from __future__ import annotations
@@ -40,7 +42,7 @@ def test_sun_tracking_poses_pair_table_against_grid_kernel(factory):
     grid = posed._exact_posed(body, rot, dirs, tabled=False)
     assert body._cache["posed:pairs"] is not None  # the table ran
     assert np.any((tabled > 0) & (tabled < 1))
-    np.testing.assert_allclose(tabled, grid, rtol=1e-12, atol=1e-13)
+    np.testing.assert_allclose(tabled, grid, rtol=1e-12, atol=0)
 
 
 def test_fixed_poses_and_a_pose_that_shades_the_bus():
@@ -54,7 +56,7 @@ def test_fixed_poses_and_a_pose_that_shades_the_bus():
     dirs = np.ascontiguousarray(np.stack([up, obs], axis=1))
     tabled = posed.posed_fraction(body, rot, [up, obs])
     grid = posed._exact_posed(body, rot, dirs, tabled=False)
-    np.testing.assert_allclose(tabled, grid, rtol=1e-12, atol=1e-13)
+    np.testing.assert_allclose(tabled, grid, rtol=1e-12, atol=0)
     top = [4, 6]  # the two facets of the cube's +z face
     assert tabled[0, top].max() < 0.1 and tabled[4, top].min() > 0.6
 
