@@ -7,11 +7,16 @@ lit-and-visible fractions on the union, so parts shadow the bus, the bus shadows
 and parts shadow each other.
 
 ``"exact"``
-    The compiled kernel of :func:`sbrdf_xr.body.visibility.lit_fraction`, one geometry
+    The pair-table kernel of :func:`sbrdf_xr.body.visibility.lit_fraction`, one geometry
     at a time, on the rest frames turned by the pose (a rotation turns a facet's normal,
-    in-plane frame and first vertex; its in-plane triangle is unchanged).  The facets
-    that cannot be shadowed are found per pose from the convex hull of each group's
-    vertices (turned with its group).
+    in-plane frame and first vertex; its in-plane triangle is unchanged).  The pairs
+    within a rigid group (the bus, each part) keep their coordinates in the receiver's
+    frame, their slope boxes and thresholds when the group turns, so they are found once
+    per body (:func:`sbrdf_xr.kernels.pair_table.grouped_pair_table`); the pairs between
+    groups are found per pose and merged in (:func:`~sbrdf_xr.kernels.pair_table.
+    merged_tables`).  Past :data:`~sbrdf_xr.body.occluders.MAX_PAIR_WORK` the grid kernel
+    runs instead.  Geometries where no facet can be shadowed are found per pose from the
+    convex hull of each group's vertices (turned with its group).
 ``"sampled"``
     The sampled method on the posed mesh, one geometry at a time (a new ray-engine scene
     per geometry: slow on long sweeps).
@@ -39,7 +44,9 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
+from ..kernels.pair_table import grouped_pair_table, posed_pairs_kernel
 from ..kernels.shadow import exact_kernel
+from .occluders import MAX_PAIR_WORK, occluder_polygons
 from .rays import SEED
 from .sides import posed_vertices
 from .spacecraft import Spacecraft
@@ -70,8 +77,36 @@ def _group_hulls(spacecraft: Spacecraft) -> list[np.ndarray]:
     return cache["posed:hulls"]
 
 
-def _exact_posed(spacecraft: Spacecraft, rot: np.ndarray, dirs: np.ndarray) -> np.ndarray:
-    """Exact fractions (G, n_sides) for poses ``rot`` (G, P, 3, 3) and directions (G, K, 3).
+def _posed_pairs(spacecraft: Spacecraft) -> dict | None:
+    """The occluder polygons and the pairs within each rigid group (cached), or None past
+    :data:`~sbrdf_xr.body.occluders.MAX_PAIR_WORK`."""
+    cache = spacecraft._cache
+    if "posed:pairs" not in cache:
+        s = spacecraft.sides
+        rest = _plane_frames(s.mesh, cache)
+        occ = occluder_polygons(rest)
+        ok = np.linalg.norm(rest["N"], axis=1) > 0
+        out = None
+        if int(ok.sum()) * len(occ["count"]) <= MAX_PAIR_WORK:
+            seeds = occ["members"][occ["start"][:-1]]
+            groups = (seeds, s.group, s.group[seeds])
+            occluders = (ok, occ["poly"], occ["count"], occ["open"], occ["start"], occ["members"])
+            V, F, N, P0, E1, E2, T2 = (rest[k] for k in ("V", "F", "N", "P0", "E1", "E2", "T2"))
+            poly, count, gopen, start, members = occluders[1:]
+            within = grouped_pair_table(
+                V, F, N, P0, E1, E2, T2, ok, poly, count, occ["normal"], gopen, start, members,
+                rest["eps"], s.group, s.group[seeds], True,
+            )  # fmt: skip
+            out = {"occluders": (*occluders, *groups), "within": within}
+        cache["posed:pairs"] = out
+    return cache["posed:pairs"]
+
+
+def _exact_posed(
+    spacecraft: Spacecraft, rot: np.ndarray, dirs: np.ndarray, tabled: bool = True
+) -> np.ndarray:
+    """Exact fractions (G, n_sides) for poses ``rot`` (G, P, 3, 3) and directions (G, K, 3),
+    by the pair table (``tabled``, unless past its work bound) or the grid kernel.
 
     The bus rows of the frames stay as they are; only the rows of the parts are turned at
     each geometry, in place in buffers the kernel reads (their cost grows with the parts,
@@ -124,16 +159,26 @@ def _exact_posed(spacecraft: Spacecraft, rot: np.ndarray, dirs: np.ndarray) -> n
     height = np.maximum(height, np.einsum("gmj,gnj->gnm", moved, allN).max(axis=2) - off)
     receiver = (np.linalg.norm(N, axis=1) > 0) & (height > tol)  # (G, n)
     front = np.all(np.einsum("gkj,gnj->gkn", dirs, allN) > 0, axis=1)  # (G, n)
-    out = np.zeros((G, s.n_sides))
-    for g in range(G):
-        if not (receiver[g] & front[g]).any():
-            out[g] = front[g]
-            continue
+    active = (receiver & front).any(axis=1)
+    out = front.astype(np.float64)  # nothing can be shadowed where no receiver faces
+    todo = np.flatnonzero(active)
+    pairs = _posed_pairs(spacecraft) if tabled else None
+    if pairs is not None:  # every pose in one compiled call
+        frames = (V.copy(), rest["F"], N.copy(), P0.copy(), E1.copy(), E2.copy(), rest["T2"])
+        posed = (pV, pN, pE1, pE2, pP0, vrows, rows)
+        frac = posed_pairs_kernel(
+            frames, posed, pairs["occluders"], pairs["within"], active, tol, dirs
+        )
+        out[active] = np.where(front, frac, 0.0)[active]
+        todo = np.flatnonzero(active & np.isnan(frac).any(axis=1))  # past the buffers
+    for g in todo:
         V[vrows], N[rows], E1[rows], E2[rows], P0[rows] = pV[g], pN[g], pE1[g], pE2[g], pP0[g]
         d = np.ascontiguousarray(dirs[g : g + 1])
-        frac = exact_kernel(
-            V, rest["F"], N, P0, E1, E2, rest["T2"], receiver[g], d, rest["open_facet"], tol
-        )[0]
+        frac = np.full(s.n_sides, np.nan)
+        if pairs is None:
+            frac = exact_kernel(
+                V, rest["F"], N, P0, E1, E2, rest["T2"], receiver[g], d, rest["open_facet"], tol
+            )[0]
         if np.isnan(frac).any():  # past the kernel's budget: the posed mesh through GEOS
             mesh = trimesh.Trimesh(V.copy(), rest["F"], process=False)
             frac = _fractions(

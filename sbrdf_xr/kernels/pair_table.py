@@ -7,8 +7,14 @@ height above the plane), with the box of the slopes ``s = (E1_i.d, E2_i.d) / N_i
 directions ``d`` from which its shadow can reach the facet: the quotients ``(u - a) / h``
 over the cut vertices and the facet's vertices ``a`` bound it (a linear-fractional function
 takes its extremes at vertices), a vertex on the plane (``h = 0``) opening the box on the
-side its numerator has.  The pairs of a facet are sorted by the distance of their box
-from ``s = 0``.  :func:`sbrdf_xr.kernels.shadow_pairs.pairs_kernel` reads the table.
+side its numerator has.  Three more bounds use the facet's edges as separating axes: with
+``w`` the unit direction of edge ``e`` (from corner ``c``), the projected vertex
+``(u - h s_1, v - h s_2)`` is on or outside the edge when ``w x (u - c) - h (w x s) <= 0``,
+so the whole shadow is outside it when ``sigma = w_1 s_2 - w_2 s_1`` exceeds
+``tau = max (w x (u - c)) / h`` over the cut vertices (``+inf`` if a vertex on the plane
+is inside the edge line); ``tau`` is widened by the same margin as the box.  The pairs of
+a facet are sorted by the distance of their box from ``s = 0``.
+:func:`sbrdf_xr.kernels.shadow_pairs.pairs_kernel` reads the table.
 """
 
 from __future__ import annotations
@@ -16,7 +22,16 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-__all__ = ["MARGIN", "MAX_OCCLUDER_VERTICES", "pair_table"]
+from .shadow_pairs import _buffers, _pairs_into
+
+__all__ = [
+    "MARGIN",
+    "MAX_OCCLUDER_VERTICES",
+    "grouped_pair_table",
+    "merged_tables",
+    "pair_table",
+    "posed_pairs_kernel",
+]
 
 #: Vertices of a merged occluder polygon at most (its cut adds one, the clip three more).
 MAX_OCCLUDER_VERTICES = 8
@@ -61,7 +76,8 @@ def _cut(i, idx, n, V, N, P0, E1, E2, out):
 @nb.njit(cache=True, nogil=True)
 def _slope_box(cut, n, tri, box):
     """Bounding box (s1 lo, s1 hi, s2 lo, s2 hi) of the slopes s for which the cut polygon
-    (rows u, v, h) projected along d can meet the triangle ``tri`` (3, 2); returns its
+    (rows u, v, h) projected along d can meet the triangle ``tri`` (3, 2), then the three
+    thresholds past which it lies outside an edge of the triangle; returns the box's
     squared distance from s = 0."""
     r2 = 0.0
     for c in range(2):
@@ -88,6 +104,21 @@ def _slope_box(cut, n, tri, box):
             r2 += lo * lo
         elif hi < 0.0:
             r2 += hi * hi
+    for e in range(3):  # the triangle's edges as separating axes (module docstring)
+        e1 = e + 1 if e < 2 else 0
+        ux = tri[e1, 0] - tri[e, 0]
+        uy = tri[e1, 1] - tri[e, 1]
+        norm = np.sqrt(ux * ux + uy * uy)
+        ux /= norm
+        uy /= norm
+        tau = -np.inf
+        for v in range(n):
+            a = ux * (cut[v, 1] - tri[e, 1]) - uy * (cut[v, 0] - tri[e, 0])
+            if cut[v, 2] > 0.0:
+                tau = max(tau, a / cut[v, 2])
+            elif a > 0.0:
+                tau = np.inf
+        box[4 + e] = tau + MARGIN * (1.0 + abs(tau)) if np.isfinite(tau) else tau
     return r2
 
 
@@ -117,8 +148,9 @@ def pair_table(
     facing the same way (such a one-sided facet is never an occluder while the receiver
     faces the light).  Returns ``(recv, pstart, pgroup, pcount, cut, box, r2)``: the
     receivers, CSR offsets of their pairs, each pair's occluder, its cut polygon (count and
-    rows u, v, h in the receiver's frame), its slope box and the squared distance of the
-    box from 0 (ascending within a receiver).
+    rows u, v, h in the receiver's frame), its slope box (columns 0-3) and edge thresholds
+    (columns 4-6, module docstring) and the squared distance of the box from 0 (ascending
+    within a receiver).
 
     Examples
     --------
@@ -151,13 +183,87 @@ def pair_table(
     >>> cut[0, :3, 2].tolist()  # heights of the upper facets above the lower plane
     [1.0, 1.0, 1.0]
     """
+    same = np.zeros(max(F.shape[0], poly.shape[0]), dtype=np.int64)
+    return grouped_pair_table(
+        V,
+        F,
+        N,
+        P0,
+        E1,
+        E2,
+        T2,
+        receiver,
+        poly,
+        npoly,
+        gnorm,
+        gopen,
+        mstart,
+        members,
+        eps_h,
+        same[: F.shape[0]],
+        same[: poly.shape[0]],
+        True,
+    )
+
+
+@nb.njit(cache=True, nogil=True)
+def grouped_pair_table(
+    V,
+    F,
+    N,
+    P0,
+    E1,
+    E2,
+    T2,
+    receiver,
+    poly,
+    npoly,
+    gnorm,
+    gopen,
+    mstart,
+    members,
+    eps_h,
+    rgroup,
+    ogroup,
+    within,
+):
+    """:func:`pair_table` of the pairs within the rigid groups of a posed body (``within``
+    True: receiver ``i`` and occluder ``g`` with ``rgroup[i] == ogroup[g]``) or between
+    them (False).  The pairs within a group keep their frame coordinates, boxes and
+    thresholds when the group turns, so they are found once; those between groups per pose.
+
+    Examples
+    --------
+    The two plates of :func:`pair_table`'s example, the upper one a group of its own: all
+    the pairs are between groups.
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.pair_table import grouped_pair_table
+    >>> V = np.array([[0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0],
+    ...               [0, 0, 1], [1, 0, 1], [1, 2, 1], [0, 2, 1]], dtype=float)
+    >>> F = np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])
+    >>> N = np.tile([0.0, 0.0, 1.0], (4, 1))
+    >>> E1 = V[F[:, 1]] - V[F[:, 0]]
+    >>> E1 /= np.linalg.norm(E1, axis=1, keepdims=True)
+    >>> E2 = np.cross(N, E1)
+    >>> rel = V[F] - V[F[:, :1]]
+    >>> T2 = np.ascontiguousarray(np.stack(
+    ...     [np.einsum("fvx,fx->fv", rel, E1), np.einsum("fvx,fx->fv", rel, E2)], axis=-1))
+    >>> poly = np.zeros((4, 8), dtype=np.int64)
+    >>> poly[:, :3] = F
+    >>> group = np.array([0, 0, 1, 1])
+    >>> args = (V, F, N, V[F[:, 0]], E1, E2, T2, np.ones(4, bool), poly, np.full(4, 3), N,
+    ...         np.ones(4, bool), np.arange(5), np.arange(4), 1e-9, group, group)
+    >>> [grouped_pair_table(*args, w)[1].tolist() for w in (True, False)]  # pstart
+    [[0, 0, 0, 0, 0], [0, 2, 4, 4, 4]]
+    """
     nf = F.shape[0]
     ng = poly.shape[0]
     cap = max(16, 4 * nf)
     pgroup = np.empty(cap, dtype=np.int64)
     pcount = np.empty(cap, dtype=np.int64)
     cut = np.empty((cap, _CUT, 3))
-    box = np.empty((cap, 4))
+    box = np.empty((cap, 7))
     r2 = np.empty(cap)
     recv = np.empty(nf, dtype=np.int64)
     pstart = np.zeros(nf + 1, dtype=np.int64)
@@ -171,6 +277,8 @@ def pair_table(
         first = n
         tri = T2[i]
         for g in range(ng):
+            if (rgroup[i] == ogroup[g]) != within:
+                continue
             if (
                 not gopen[g]
                 and gnorm[g, 0] == N[i, 0]
@@ -255,3 +363,158 @@ def _grown3(a, cap):
     out = np.empty((cap, a.shape[1], a.shape[2]), dtype=a.dtype)
     out[: a.shape[0]] = a
     return out
+
+
+@nb.njit(cache=True, nogil=True)
+def merged_tables(a, b):
+    """Two tables of the same receivers (as :func:`grouped_pair_table` gives them for one
+    receiver mask) merged into one, each receiver's pairs still in ascending ``r2``.
+
+    Examples
+    --------
+    The tables within and between the groups of :func:`grouped_pair_table`'s example
+    give :func:`pair_table`'s:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.pair_table import grouped_pair_table, merged_tables
+    >>> V = np.array([[0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0],
+    ...               [0, 0, 1], [1, 0, 1], [1, 2, 1], [0, 2, 1]], dtype=float)
+    >>> F = np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])
+    >>> N = np.tile([0.0, 0.0, 1.0], (4, 1))
+    >>> E1 = V[F[:, 1]] - V[F[:, 0]]
+    >>> E1 /= np.linalg.norm(E1, axis=1, keepdims=True)
+    >>> E2 = np.cross(N, E1)
+    >>> rel = V[F] - V[F[:, :1]]
+    >>> T2 = np.ascontiguousarray(np.stack(
+    ...     [np.einsum("fvx,fx->fv", rel, E1), np.einsum("fvx,fx->fv", rel, E2)], axis=-1))
+    >>> poly = np.zeros((4, 8), dtype=np.int64)
+    >>> poly[:, :3] = F
+    >>> group = np.array([0, 0, 1, 1])
+    >>> args = (V, F, N, V[F[:, 0]], E1, E2, T2, np.ones(4, bool), poly, np.full(4, 3), N,
+    ...         np.ones(4, bool), np.arange(5), np.arange(4), 1e-9, group, group)
+    >>> table = merged_tables(grouped_pair_table(*args, True), grouped_pair_table(*args, False))
+    >>> table[1].tolist(), table[2].tolist()
+    ([0, 2, 4, 4, 4], [2, 3, 2, 3])
+    """
+    recv, pa, ga, ca, cuta, boxa, ra = a
+    _, pb, gb, cb, cutb, boxb, rb = b
+    n = ga.shape[0] + gb.shape[0]
+    pstart = np.zeros(recv.shape[0] + 1, dtype=np.int64)
+    pgroup = np.empty(n, dtype=np.int64)
+    pcount = np.empty(n, dtype=np.int64)
+    cut = np.empty((n, cuta.shape[1], 3))
+    box = np.empty((n, boxa.shape[1]))
+    r2 = np.empty(n)
+    k = 0
+    for r in range(recv.shape[0]):
+        i = pa[r]
+        j = pb[r]
+        while i < pa[r + 1] or j < pb[r + 1]:
+            if j == pb[r + 1] or (i < pa[r + 1] and ra[i] <= rb[j]):
+                pgroup[k], pcount[k], cut[k], box[k], r2[k] = ga[i], ca[i], cuta[i], boxa[i], ra[i]
+                i += 1
+            else:
+                pgroup[k], pcount[k], cut[k], box[k], r2[k] = gb[j], cb[j], cutb[j], boxb[j], rb[j]
+                j += 1
+            k += 1
+        pstart[r + 1] = k
+    return recv, pstart, pgroup, pcount, cut, box, r2
+
+
+@nb.njit(cache=True, nogil=True)
+def posed_pairs_kernel(frames, turned, occluders, within, active, eps_h, dirs):
+    """Lit fractions (G, n_facets) of a posed body, one pose per geometry, by the pair table.
+
+    ``frames`` (V, F, N, P0, E1, E2, T2): the rest frames, copies whose rows this turns;
+    ``turned`` (pV, pN, pE1, pE2, pP0, vrows, rows): per geometry, the posed vertices
+    ``vrows`` and the posed frames of the facets ``rows`` (the parts'); ``occluders``
+    (receiver, poly, count, open, start, members, seeds, rgroup, ogroup): the occluder
+    polygons (their normals are their seed facets' posed ones), the facets' and polygons'
+    groups; ``within``: :func:`grouped_pair_table` of the pairs within groups, found once.
+    Per pose the pairs between groups are found and merged in, and
+    :func:`~sbrdf_xr.kernels.shadow_pairs.pairs_kernel` runs (one scratch for all poses).
+    Rows of geometries not ``active`` stay 0 (the caller knows nothing is shadowed there).
+
+    Examples
+    --------
+    The two plates of :func:`pair_table`'s example, the upper one a part turned by 0 and by
+    90 degree about the line x = 0.5, z = 1 (edge-on: it shades nothing), lit from +z:
+
+    >>> import numpy as np
+    >>> from sbrdf_xr.kernels.pair_table import grouped_pair_table, posed_pairs_kernel
+    >>> V = np.array([[0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0],
+    ...               [0, 0, 1], [1, 0, 1], [1, 2, 1], [0, 2, 1]], dtype=float)
+    >>> F = np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])
+    >>> N = np.tile([0.0, 0.0, 1.0], (4, 1))
+    >>> E1 = V[F[:, 1]] - V[F[:, 0]]
+    >>> E1 /= np.linalg.norm(E1, axis=1, keepdims=True)
+    >>> E2 = np.cross(N, E1)
+    >>> rel = V[F] - V[F[:, :1]]
+    >>> T2 = np.ascontiguousarray(np.stack(
+    ...     [np.einsum("fvx,fx->fv", rel, E1), np.einsum("fvx,fx->fv", rel, E2)], axis=-1))
+    >>> poly = np.zeros((4, 8), dtype=np.int64)
+    >>> poly[:, :3] = F
+    >>> group, ok, gopen = np.array([0, 0, 1, 1]), np.ones(4, bool), np.ones(4, bool)
+    >>> frames = (V, F, N, V[F[:, 0]], E1, E2, T2)
+    >>> occ = (ok, poly, np.full(4, 3), gopen, np.arange(5), np.arange(4), np.arange(4),
+    ...        group, group)
+    >>> within = grouped_pair_table(*frames, *occ[:3], N, *occ[3:6], 1e-9, group, group, True)
+    >>> R = np.array([np.eye(3), [[0, 0, 1.0], [0, 1, 0], [-1.0, 0, 0]]])  # about y
+    >>> hinge = np.array([0.5, 0.0, 1.0])
+    >>> pV = hinge + np.einsum("gij,vj->gvi", R, V[4:] - hinge)
+    >>> turn = lambda a: np.einsum("gij,fj->gfi", R, a[2:])
+    >>> turned = (pV, turn(N), turn(E1), turn(E2), hinge + turn(V[F[:, 0]] - hinge),
+    ...           np.arange(4, 8), np.arange(2, 4))
+    >>> dirs = np.tile([0.0, 0.0, 1.0], (2, 1, 1))
+    >>> copies = tuple(a.copy() for a in frames)
+    >>> f = posed_pairs_kernel(copies, turned, occ, within, np.ones(2, bool), 1e-9, dirs)
+    >>> print(np.round(f[:, :2], 6))  # the lower plate's two triangles
+    [[0.75 0.25]
+     [1.   1.  ]]
+    """
+    V, F, N, P0, E1, E2, T2 = frames
+    pV, pN, pE1, pE2, pP0, vrows, rows = turned
+    receiver, poly, npoly, gopen, mstart, members, seeds, rgroup, ogroup = occluders
+    G = dirs.shape[0]
+    frac = np.zeros((G, N.shape[0]))
+    gnorm = np.empty((seeds.shape[0], 3))
+    buf = _buffers(dirs, gnorm)
+    for g in range(G):
+        if not active[g]:
+            continue
+        for a in range(vrows.shape[0]):
+            for c in range(3):
+                V[vrows[a], c] = pV[g, a, c]
+        for a in range(rows.shape[0]):
+            for c in range(3):
+                N[rows[a], c] = pN[g, a, c]
+                E1[rows[a], c] = pE1[g, a, c]
+                E2[rows[a], c] = pE2[g, a, c]
+                P0[rows[a], c] = pP0[g, a, c]
+        for q in range(seeds.shape[0]):
+            for c in range(3):
+                gnorm[q, c] = N[seeds[q], c]
+        between = grouped_pair_table(
+            V,
+            F,
+            N,
+            P0,
+            E1,
+            E2,
+            T2,
+            receiver,
+            poly,
+            npoly,
+            gnorm,
+            gopen,
+            mstart,
+            members,
+            eps_h,
+            rgroup,
+            ogroup,
+            False,
+        )
+        table = merged_tables(within, between)
+        d = dirs[g : g + 1]
+        _pairs_into(frac[g : g + 1], N, N, E1, E2, T2, table, gnorm, gopen, d, buf)
+    return frac

@@ -21,16 +21,20 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .polygon import MAXM, MAXV, clip, hull, signed_area, union_area_boxes, union_area_slabs
+from .polygon import MAXM, MAXV, clip, signed_area, union_area_boxes, union_area_slabs
 from .shadow import MAX_SHADOWS
 
-__all__ = ["PIECES_FROM", "lit_area", "pairs_kernel"]
+__all__ = ["PIECES_FROM", "SMALL_UNION", "lit_area", "pairs_kernel"]
 
 _SHADOW = 16  # vertices of a clipped shadow: at most (occluder vertices + 1) + 3
 #: Shadows on one facet from which their union is taken as lit pieces, not by
 #: inclusion-exclusion (whose alternating sum loses ~1e-16 of its terms' total).
 PIECES_FROM = 4
+#: Shadows on one facet at most united by inclusion-exclusion clipped directly (at most
+#: 7 terms).
+SMALL_UNION = 3
 _PIECES = 256  # lit pieces held (more: inclusion-exclusion, then slabs)
+_CHUNK = 512  # geometries whose facing flags are held while each receiver runs through them
 
 
 @nb.njit(cache=True, nogil=True)
@@ -84,10 +88,40 @@ def _shadow(cut, p, n, s1, s2, cx, cy, area_t, px, py, ox, oy, tx, ty):
 
 
 @nb.njit(cache=True, nogil=True)
-def _convex(gx, gy, gn, m, tx, ty, idx):
+def _scan(px, py, n, ox, oy):
+    """Convex hull of a polygon convex up to rounding (counter-clockwise; duplicate,
+    collinear and slightly reflex vertices dropped), by Graham's scan in the polygon's own
+    order from its lowest (then leftmost) vertex: its vertices are already sorted by angle
+    about that vertex, so no sort is needed.  Written to (ox, oy); returns the count."""
+    s0 = 0
+    for v in range(1, n):
+        if py[v] < py[s0] or (py[v] == py[s0] and px[v] < px[s0]):
+            s0 = v
+    m = 0
+    for j in range(n + 1):
+        v = s0 + j if s0 + j < n else s0 + j - n
+        x = px[v]
+        y = py[v]
+        while (
+            m >= 2
+            and (ox[m - 1] - ox[m - 2]) * (y - oy[m - 2])
+            - (oy[m - 1] - oy[m - 2]) * (x - ox[m - 2])
+            <= 0.0
+        ):
+            m -= 1
+        if j < n:
+            ox[m] = x
+            oy[m] = y
+            m += 1
+    return m
+
+
+@nb.njit(cache=True, nogil=True)
+def _convex(gx, gy, gn, m, tx, ty):
     """Replace each of the m clipped shadows that is not strictly convex (a clip is convex
-    only up to rounding) by its convex hull, as the inclusion-exclusion needs every edge
-    line to support its polygon; returns the count left (hulls of no area dropped)."""
+    only up to rounding) by its convex hull (:func:`_scan`), as the inclusion-exclusion
+    needs every edge line to support its polygon; returns the count left (hulls of no area
+    dropped)."""
     kept = 0
     for k in range(m):
         n = gn[k]
@@ -107,7 +141,7 @@ def _convex(gx, gy, gn, m, tx, ty, idx):
                 gn[kept] = n
             kept += 1
             continue
-        nq = hull(gx[k], gy[k], n, tx, ty, idx)
+        nq = _scan(gx[k], gy[k], n, tx, ty)
         if nq < 3:
             continue
         for v in range(nq):
@@ -268,6 +302,69 @@ def _facing(dirs, g, normals, gnorm, gopen, occ, frac):
 
 
 @nb.njit(cache=True, nogil=True)
+def _union_small(gx, gy, gn, m, tiny, bx, by, tx, ty):
+    """Area of the union of m <= :data:`SMALL_UNION` convex counter-clockwise polygons by
+    inclusion-exclusion, each intersection clipped directly into ``bx[depth]`` (the terms
+    of :func:`~sbrdf_xr.kernels.polygon.union_area_boxes`, an intersection of area <=
+    ``tiny`` dropped with its supersets, without its stack and boxes)."""
+    total = 0.0
+    for a in range(m):
+        total += signed_area(gx[a], gy[a], gn[a])
+        for b in range(a + 1, m):
+            n1 = clip(gx[a], gy[a], gn[a], gx[b], gy[b], gn[b], bx[0], by[0], tx, ty)
+            if n1 < 3:
+                continue
+            area = signed_area(bx[0], by[0], n1)
+            if area <= tiny:
+                continue
+            total -= area
+            for c in range(b + 1, m):
+                n2 = clip(bx[0], by[0], n1, gx[c], gy[c], gn[c], bx[1], by[1], tx, ty)
+                if n2 < 3:
+                    continue
+                area = signed_area(bx[1], by[1], n2)
+                if area <= tiny:
+                    continue
+                total += area
+                for e in range(c + 1, m):
+                    n3 = clip(bx[1], by[1], n2, gx[e], gy[e], gn[e], bx[2], by[2], tx, ty)
+                    if n3 >= 3:
+                        area = signed_area(bx[2], by[2], n3)
+                        if area > tiny:
+                            total -= area
+    return total
+
+
+@nb.njit(cache=True, nogil=True)
+def _lit(cx, cy, area_t, gx, gy, gn, m, scratch):
+    """Lit fraction of the triangle (cx, cy) of area ``area_t`` left by its m clipped
+    shadows (one: its area; up to :data:`SMALL_UNION`: inclusion-exclusion by
+    :func:`_union_small`; from :data:`PIECES_FROM` on: lit pieces; slabs past the
+    budgets)."""
+    stack_x, stack_y, stack_n, nxt, tx, ty, ubox, sbox, ax, ay, an, bx, by, bn = scratch
+    if m == 1:
+        shadow = signed_area(gx[0], gy[0], gn[0])
+    else:
+        m = _convex(gx, gy, gn, m, tx, ty)
+        if m >= PIECES_FROM and m > SMALL_UNION:
+            lit = lit_area(cx, cy, gx, gy, gn, m, 1e-17 * area_t, ax, ay, an, bx, by, bn, tx, ty)
+            if lit >= 0.0:
+                return min(1.0, lit / area_t)
+        ok = False
+        shadow = 0.0
+        if m <= SMALL_UNION:
+            shadow = _union_small(gx, gy, gn, m, 1e-15 * area_t, stack_x, stack_y, tx, ty)
+            ok = True
+        elif m <= MAXM:
+            shadow, ok = union_area_boxes(
+                gx, gy, gn, m, 1e-15 * area_t, stack_x, stack_y, stack_n, nxt, tx, ty, ubox, sbox
+            )
+        if not ok:
+            shadow = union_area_slabs(gx, gy, gn, m)
+    return min(1.0, max(0.0, 1.0 - shadow / area_t))
+
+
+@nb.njit(cache=True, nogil=True)
 def pairs_kernel(
     normals, N, E1, E2, T2, recv, pstart, pgroup, pcount, cut, box, r2, gnorm, gopen, dirs
 ):
@@ -310,136 +407,129 @@ def pairs_kernel(
     >>> print(np.round(pairs_kernel(N, N, E1, E2, T2, *table, N, gopen, dirs), 6))
     [[0.75 0.25 1.   1.  ]]
     """
+    frac = np.empty((dirs.shape[0], N.shape[0]))
+    table = (recv, pstart, pgroup, pcount, cut, box, r2)
+    _pairs_into(frac, normals, N, E1, E2, T2, table, gnorm, gopen, dirs, _buffers(dirs, gnorm))
+    return frac
+
+
+@nb.njit(cache=True, nogil=True)
+def _buffers(dirs, gnorm):
+    """The scratch of :func:`_pairs_into` for directions like ``dirs`` and the occluders of
+    ``gnorm`` (allocated once per call of :func:`pairs_kernel`, or once per posed sweep)."""
+    K = dirs.shape[1]
+    gx, gy = np.empty((MAX_SHADOWS, _SHADOW)), np.empty((MAX_SHADOWS, _SHADOW))
+    gn = np.empty(MAX_SHADOWS, dtype=np.int64)
+    px, py, cx, cy = np.empty(_SHADOW), np.empty(_SHADOW), np.empty(3), np.empty(3)
+    w, s = np.empty((3, 2)), np.empty((K, 2))
+    qx, qy, tx, ty = np.empty(MAXV), np.empty(MAXV), np.empty(MAXV), np.empty(MAXV)
+    occ = np.empty((_CHUNK, K, gnorm.shape[0]), dtype=np.bool_)
+    scratch = (
+        np.empty((MAXM + 1, MAXV)),
+        np.empty((MAXM + 1, MAXV)),
+        np.empty(MAXM + 1, dtype=np.int64),
+        np.empty(MAXM + 1, dtype=np.int64),
+        np.empty(MAXV),
+        np.empty(MAXV),
+        np.empty((MAXM, 4)),
+        np.empty((MAXM + 1, 4)),
+        np.empty((_PIECES, MAXV)),
+        np.empty((_PIECES, MAXV)),
+        np.empty(_PIECES, dtype=np.int64),
+        np.empty((_PIECES, MAXV)),
+        np.empty((_PIECES, MAXV)),
+        np.empty(_PIECES, dtype=np.int64),
+    )
+    return gx, gy, gn, px, py, qx, qy, tx, ty, cx, cy, w, occ, s, scratch
+
+
+@nb.njit(cache=True, nogil=True)
+def _pairs_into(frac, normals, N, E1, E2, T2, table, gnorm, gopen, dirs, buf):
+    """:func:`pairs_kernel` written into ``frac`` (G, n_facets), with its scratch ``buf``."""
+    recv, pstart, pgroup, pcount, cut, box, r2 = table
+    gx, gy, gn, px, py, qx, qy, tx, ty, cx, cy, w, occ, s, scratch = buf
     G = dirs.shape[0]
     K = dirs.shape[1]
-    nf = N.shape[0]
-    frac = np.empty((G, nf))
-    gx = np.empty((MAX_SHADOWS, _SHADOW))
-    gy = np.empty((MAX_SHADOWS, _SHADOW))
-    gn = np.empty(MAX_SHADOWS, dtype=np.int64)
-    stack_x = np.empty((MAXM + 1, MAXV))
-    stack_y = np.empty((MAXM + 1, MAXV))
-    stack_n = np.empty(MAXM + 1, dtype=np.int64)
-    nxt = np.empty(MAXM + 1, dtype=np.int64)
-    tx = np.empty(MAXV)
-    ty = np.empty(MAXV)
-    px = np.empty(_SHADOW)
-    py = np.empty(_SHADOW)
-    qx = np.empty(MAXV)
-    qy = np.empty(MAXV)
-    idx = np.empty(MAXV, dtype=np.int64)
-    cx = np.empty(3)
-    cy = np.empty(3)
-    occ = np.empty((K, gnorm.shape[0]), dtype=np.bool_)
-    s = np.empty((K, 2))
-    ubox = np.empty((MAXM, 4))
-    ax = np.empty((_PIECES, MAXV))
-    ay = np.empty((_PIECES, MAXV))
-    bx = np.empty((_PIECES, MAXV))
-    by = np.empty((_PIECES, MAXV))
-    an = np.empty(_PIECES, dtype=np.int64)
-    bn = np.empty(_PIECES, dtype=np.int64)
-    sbox = np.empty((MAXM + 1, 4))
-    for g in range(G):
-        _facing(dirs, g, normals, gnorm, gopen, occ, frac)
+    for g0 in range(0, G, _CHUNK):  # a chunk of geometries, then each receiver through them
+        g1 = min(G, g0 + _CHUNK)
+        for g in range(g0, g1):
+            _facing(dirs, g, normals, gnorm, gopen, occ[g - g0], frac)
         for r in range(recv.shape[0]):
             i = recv[r]
-            rad = 0.0
-            facing = True
-            for k in range(K):
-                d0 = dirs[g, k, 0]
-                d1 = dirs[g, k, 1]
-                d2 = dirs[g, k, 2]
-                nd = N[i, 0] * d0 + N[i, 1] * d1 + N[i, 2] * d2
-                if nd <= 0.0:
-                    facing = False
-                    break
-                s[k, 0] = (E1[i, 0] * d0 + E1[i, 1] * d1 + E1[i, 2] * d2) / nd
-                s[k, 1] = (E2[i, 0] * d0 + E2[i, 1] * d1 + E2[i, 2] * d2) / nd
-                rad = max(rad, s[k, 0] * s[k, 0] + s[k, 1] * s[k, 1])
-            if not facing or frac[g, i] == 0.0:
-                frac[g, i] = 0.0
-                continue
             p0 = pstart[r]
             p1 = pstart[r + 1]
-            if p0 == p1 or r2[p0] > rad:
-                continue  # nothing can reach this high above the facet: fraction 1
             for c in range(3):
                 cx[c] = T2[i, c, 0]
                 cy[c] = T2[i, c, 1]
+            for e in range(3):  # unit edge directions: the separating axes of the table
+                e1 = e + 1 if e < 2 else 0
+                norm = np.sqrt((cx[e1] - cx[e]) ** 2 + (cy[e1] - cy[e]) ** 2)
+                w[e, 0] = (cx[e1] - cx[e]) / norm
+                w[e, 1] = (cy[e1] - cy[e]) / norm
             area_t = signed_area(cx, cy, 3)
-            m = 0
-            too_many = False
-            covered = False
-            for p in range(p0, p1):
-                if r2[p] > rad:
-                    break
-                q = pgroup[p]
+            for g in range(g0, g1):
+                rad = 0.0
+                facing = True
                 for k in range(K):
-                    s1 = s[k, 0]
-                    s2 = s[k, 1]
-                    if (
-                        not occ[k, q]
-                        or s1 < box[p, 0]
-                        or s1 > box[p, 1]
-                        or s2 < box[p, 2]
-                        or s2 > box[p, 3]
-                    ):
-                        continue
-                    nq = _shadow(cut, p, pcount[p], s1, s2, cx, cy, area_t, px, py, qx, qy, tx, ty)
-                    if nq == 0:
-                        continue
-                    if nq < 0:
-                        covered = True
+                    d0 = dirs[g, k, 0]
+                    d1 = dirs[g, k, 1]
+                    d2 = dirs[g, k, 2]
+                    nd = N[i, 0] * d0 + N[i, 1] * d1 + N[i, 2] * d2
+                    if nd <= 0.0:
+                        facing = False
                         break
-                    if m == MAX_SHADOWS or nq > _SHADOW:
-                        too_many = True
-                        continue
-                    for v in range(nq):
-                        gx[m, v] = qx[v]
-                        gy[m, v] = qy[v]
-                    gn[m] = nq
-                    m += 1
+                    s[k, 0] = (E1[i, 0] * d0 + E1[i, 1] * d1 + E1[i, 2] * d2) / nd
+                    s[k, 1] = (E2[i, 0] * d0 + E2[i, 1] * d1 + E2[i, 2] * d2) / nd
+                    rad = max(rad, s[k, 0] * s[k, 0] + s[k, 1] * s[k, 1])
+                if not facing or frac[g, i] == 0.0:
+                    frac[g, i] = 0.0
+                    continue
+                if p0 == p1 or r2[p0] > rad:
+                    continue  # nothing can reach this high above the facet: fraction 1
+                og = occ[g - g0]
+                m = 0
+                too_many = False
+                covered = False
+                for p in range(p0, p1):
+                    if r2[p] > rad:
+                        break
+                    q = pgroup[p]
+                    for k in range(K):
+                        s1 = s[k, 0]
+                        s2 = s[k, 1]
+                        if (
+                            not og[k, q]
+                            or s1 < box[p, 0]
+                            or s1 > box[p, 1]
+                            or s2 < box[p, 2]
+                            or s2 > box[p, 3]
+                            or w[0, 0] * s2 - w[0, 1] * s1 > box[p, 4]
+                            or w[1, 0] * s2 - w[1, 1] * s1 > box[p, 5]
+                            or w[2, 0] * s2 - w[2, 1] * s1 > box[p, 6]
+                        ):
+                            continue
+                        nq = _shadow(
+                            cut, p, pcount[p], s1, s2, cx, cy, area_t, px, py, qx, qy, tx, ty
+                        )
+                        if nq == 0:
+                            continue
+                        if nq < 0:
+                            covered = True
+                            break
+                        if m == MAX_SHADOWS or nq > _SHADOW:
+                            too_many = True
+                            continue
+                        for v in range(nq):
+                            gx[m, v] = qx[v]
+                            gy[m, v] = qy[v]
+                        gn[m] = nq
+                        m += 1
+                    if covered:
+                        break
                 if covered:
-                    break
-            if covered:
-                frac[g, i] = 0.0
-                continue
-            if m == 0:
-                continue
-            if too_many:
-                frac[g, i] = np.nan
-                continue
-            if m == 1:
-                shadow = signed_area(gx[0], gy[0], gn[0])
-            else:
-                m = _convex(gx, gy, gn, m, tx, ty, idx)
-                if m >= PIECES_FROM:
-                    lit = lit_area(
-                        cx, cy, gx, gy, gn, m, 1e-17 * area_t, ax, ay, an, bx, by, bn, tx, ty
-                    )
-                    if lit >= 0.0:
-                        frac[g, i] = min(1.0, lit / area_t)
-                        continue
-                ok = False
-                shadow = 0.0
-                if m <= MAXM:
-                    shadow, ok = union_area_boxes(
-                        gx,
-                        gy,
-                        gn,
-                        m,
-                        1e-15 * area_t,
-                        stack_x,
-                        stack_y,
-                        stack_n,
-                        nxt,
-                        tx,
-                        ty,
-                        ubox,
-                        sbox,
-                    )
-                if not ok:
-                    shadow = union_area_slabs(gx, gy, gn, m)
-            frac[g, i] = min(1.0, max(0.0, 1.0 - shadow / area_t))
+                    frac[g, i] = 0.0
+                elif too_many:
+                    frac[g, i] = np.nan
+                elif m > 0:
+                    frac[g, i] = _lit(cx, cy, area_t, gx, gy, gn, m, scratch)
     return frac

@@ -32,11 +32,14 @@ import shapely
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from hypothesis_profiles import examples
+from shapely.geometry.polygon import orient
 
 from sbrdf_xr.bench.shadowing import geometries
 from sbrdf_xr.body import spacecraft as sc
 from sbrdf_xr.body import visibility as vis
 from sbrdf_xr.body.occluders import pair_table
+from sbrdf_xr.kernels import shadow_pairs as sp
+from sbrdf_xr.kernels.polygon import MAXV, signed_area
 from sbrdf_xr.kernels.shadow_pairs import pairs_kernel
 from sbrdf_xr.testing import (
     bus_with_panel_spacecraft,
@@ -336,9 +339,10 @@ def test_random_directions_against_grid_kernel(name, s, o):
 @given(s=unit_vectors, seed=st.integers(0, 2**32 - 1))
 @example(s=unit((1.0, -1.0, -4.468198529266746e-28)), seed=21613)  # grazing the z faces
 def test_skipped_pairs_cast_no_shadow(s, seed):
-    """The slope box never drops a shadow: for random receivers of CanX-1 and a direction,
-    every occluder facet whose pair the box rejects (or whose box lies past the |s| bound)
-    casts a shadow that meets the facet in no area, in exact arithmetic."""
+    """The slope box and the edge thresholds never drop a shadow: for random receivers of
+    CanX-1 and a direction, every occluder facet whose pair they reject (or whose box lies
+    past the |s| bound) casts a shadow that meets the facet in no area, in exact
+    arithmetic."""
     craft = body("canx1")
     mesh, cache = vis.mesh_of(craft)
     frames = vis.exact_frames(mesh, cache)
@@ -346,6 +350,8 @@ def test_skipped_pairs_cast_no_shadow(s, seed):
     recv, pstart, pgroup, _, _, box, r2 = table["table"]
     occ = table["occluders"]
     N, E1, E2 = frames["N"], frames["E1"], frames["E2"]
+    edges = np.roll(frames["T2"], -1, axis=1) - frames["T2"]
+    edges /= np.linalg.norm(edges, axis=2, keepdims=True)
     rng = np.random.default_rng(seed)
     for r in rng.choice(len(recv), 12, replace=False):
         i = recv[r]
@@ -360,12 +366,53 @@ def test_skipped_pairs_cast_no_shadow(s, seed):
             if occ["normal"][g] @ s >= 0:
                 continue
             inside = box[p, 0] <= slope[0] <= box[p, 1] and box[p, 2] <= slope[1] <= box[p, 3]
+            for e, w in enumerate(edges[i]):  # the facet's edges as separating axes
+                inside = inside and w[0] * slope[1] - w[1] * slope[0] <= box[p, 4 + e]
             if inside and not far[p - pstart[r]]:
                 continue
             members = occ["members"][occ["start"][g] : occ["start"][g + 1]]
             tri = mesh.triangles[i]
             for poly in exact_shadows(tri, mesh.triangles[members], s, frames["eps"], True):
                 assert not exact_overlap(poly), (i, members, s)
+
+
+convex_polygons = st.lists(
+    st.tuples(st.floats(-2, 2, allow_nan=False), st.floats(-2, 2, allow_nan=False)),
+    min_size=3,
+    max_size=7,
+).map(lambda pts: shapely.MultiPoint(pts).convex_hull)
+
+
+@settings(max_examples=examples(60))
+@given(polys=st.lists(convex_polygons, min_size=2, max_size=3), repeat=st.integers(0, 3))
+def test_small_unions_and_hulls_against_geos(polys, repeat):
+    """The clipped inclusion-exclusion of two or three convex shadows and the hull by a scan
+    in polygon order (with a vertex repeated and an edge's midpoint added, as clipping
+    leaves them): GEOS's union area to 1e-12 of the total (float64 overlays, a few ulps)."""
+    polys = [orient(p) for p in polys if p.geom_type == "Polygon" and p.area > 1e-6]
+    if len(polys) < 2:
+        return
+    gx, gy = np.zeros((len(polys), 16)), np.zeros((len(polys), 16))
+    gn = np.zeros(len(polys), dtype=np.int64)
+    for k, p in enumerate(polys):
+        xy = np.asarray(p.exterior.coords)[:-1]
+        xy = np.insert(xy, 1, 0.5 * (xy[0] + xy[1]), axis=0)  # a collinear vertex
+        xy = np.insert(xy, repeat % len(xy), xy[repeat % len(xy)], axis=0)  # a duplicate
+        gx[k, : len(xy)], gy[k, : len(xy)], gn[k] = xy[:, 0], xy[:, 1], len(xy)
+    tx, ty = np.empty(MAXV), np.empty(MAXV)
+    m = sp._convex(gx, gy, gn, len(polys), tx, ty)
+    assert m == len(polys)
+    for k, p in enumerate(polys):  # the scan gives the hull: strictly convex, its area
+        x, y = gx[k, : gn[k]], gy[k, : gn[k]]
+        turn = (x - np.roll(x, 1)) * (np.roll(y, -1) - y) - (y - np.roll(y, 1)) * (
+            np.roll(x, -1) - x
+        )
+        assert np.all(turn > 0) and gn[k] <= len(p.exterior.coords)  # the midpoint at most
+        assert abs(signed_area(gx[k], gy[k], gn[k]) - p.area) <= 1e-12 * p.area
+    bx, by = np.empty((3, MAXV)), np.empty((3, MAXV))
+    area = sp._union_small(gx, gy, gn, m, 0.0, bx, by, tx, ty)
+    total = sum(p.area for p in polys)
+    assert abs(area - shapely.union_all(polys).area) <= 1e-12 * total
 
 
 def test_kernel_flags_and_fallbacks():
