@@ -150,6 +150,7 @@ def sweep_job(
         seconds = time.perf_counter() - t0
     out = {"seconds": seconds, "rss": float(_peak_rss()), "blocks": float(plan.n_blocks)}
     out["rss_private"] = float(private.stop())
+    out["pss"] = float(private.pss)
     if mode in ("write", "zarr"):
         out["bytes"] = float(_size(Path(path)))
     return out
@@ -225,19 +226,25 @@ def disk_rate(where: str | None = None, nbytes: int = 512 * 2**20) -> float:
 class _PrivatePeak:
     """The peak of this process's anonymous (private) resident memory [byte], sampled
     every 5 ms in a thread: what the peak RSS is less the pages of files it maps (the
-    memory-mapped tables, shared by every process that maps them)."""
+    memory-mapped tables, shared by every process that maps them); and the peak of its
+    proportional set size (``pss``, every 50 ms: each shared page counted once over the
+    processes that map it, ``/proc/self/smaps_rollup``)."""
 
     def __init__(self) -> None:
         import threading
 
-        self.peak = 0
+        self.peak = self.pss = 0
         self.done = threading.Event()
         self.thread = threading.Thread(target=self._run, daemon=True)
         self.thread.start()
 
     def _run(self) -> None:
-        while not self.done.wait(0.005):
+        for i in itertools.count():
+            if self.done.wait(0.005):
+                break
             self.peak = max(self.peak, _status("RssAnon"))
+            if i % 10 == 0:
+                self.pss = max(self.pss, _status("Pss", "/proc/self/smaps_rollup"))
 
     def stop(self) -> int:
         self.done.set()
@@ -245,10 +252,10 @@ class _PrivatePeak:
         return max(self.peak, _status("RssAnon"))
 
 
-def _status(field: str) -> int:
-    """A memory field of ``/proc/self/status`` [byte] (0 where there is none)."""
+def _status(field: str, where: str = "/proc/self/status") -> int:
+    """A memory field of ``/proc/self/status`` (or ``where``) [byte] (0 where there is none)."""
     try:
-        with open("/proc/self/status", encoding="ascii") as f:
+        with open(where, encoding="ascii") as f:
             return next((int(x.split()[1]) * 1024 for x in f if x.startswith(field + ":")), 0)
     except OSError:
         return 0
@@ -404,15 +411,10 @@ def _sweep_rows(sizes: tuple[int, ...], results: dict[int, dict[str, float]]) ->
     prev = None
     for n in sizes:
         r, k = results[n], kernels[n]
-        exp = (
-            ""
-            if prev is None
-            else (
-                "; exponent "
-                f"{np.log(r['seconds'] / results[prev]['seconds']) / np.log(n / prev):.3f} "
-                f"from {prev:.0e}"
-            )
-        )
+        exp = ""
+        if prev is not None:
+            growth = np.log(r["seconds"] / results[prev]["seconds"]) / np.log(n / prev)
+            exp = f"; exponent {growth:.3f} from {prev:.0e}"
         rows.append(
             BenchRow(
                 f"{n:.0e} attitudes, write",
@@ -421,7 +423,8 @@ def _sweep_rows(sizes: tuple[int, ...], results: dict[int, dict[str, float]]) ->
                 r["seconds"] / k["seconds"],
                 f"{r['seconds']:.2f} s in {int(r['blocks'])} blocks, peak RSS "
                 f"{r['rss'] / 1e9:.2f} GB (private {r['rss_private'] / 1e9:.2f} GB, the rest "
-                f"file pages: the mapped tables every process shares){exp}",
+                "file pages: libraries and the mapped tables every process shares; PSS "
+                f"{r.get('pss', 0.0) / 1e9:.2f} GB){exp}",
                 sweep=_WRITTEN,
             )
         )
