@@ -72,8 +72,8 @@ def sweep_job(
     on the same threads, nothing written), ``zarr`` (a LocalCluster of ``workers``
     single-threaded processes writing a Zarr store; ``workers=0``: this process's threads).
     ``outputs``: the writer's (:mod:`sbrdf_xr.store.derived`), ``all`` for every variable.
-    Returns seconds (after planning and a warm-up of the compiled kernel) and the
-    peak RSS [byte].
+    Returns seconds (after planning and a warm-up of the compiled kernel), the peak RSS,
+    private memory and PSS [byte] (:class:`_PrivatePeak`) and the bytes written.
 
     Examples
     --------
@@ -85,7 +85,7 @@ def sweep_job(
     >>> list(inspect.signature(sweep_job).parameters)
     ['n', 'path', 'bands', 'mode', 'workers', 'outputs']
     >>> sorted(sweep_job(1000, "cube.nc"))  # doctest: +SKIP
-    ['blocks', 'rss', 'seconds']
+    ['blocks', 'bytes', 'pss', 'rss', 'rss_private', 'seconds']
     """
 
     from ..engine.run import default_n_threads, run_block, simulate
