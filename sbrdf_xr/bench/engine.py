@@ -249,6 +249,7 @@ class _PrivatePeak:
     def stop(self) -> int:
         self.done.set()
         self.thread.join()
+        self.pss = max(self.pss, _status("Pss", "/proc/self/smaps_rollup"))
         return max(self.peak, _status("RssAnon"))
 
 
