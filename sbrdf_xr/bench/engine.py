@@ -73,8 +73,8 @@ def sweep_job(
     on the same threads, nothing written), ``zarr`` (a LocalCluster of ``workers``
     single-threaded processes writing a Zarr store; ``workers=0``: this process's threads).
     ``outputs``: the writer's (:mod:`sbrdf_xr.store.derived`), ``all`` for every variable.
-    Returns seconds (after planning and a warm-up of the compiled kernel) and the
-    peak RSS [byte].
+    Returns seconds (after planning and a warm-up of the compiled kernel), the peak RSS,
+    private memory and PSS [byte] (:class:`_PrivatePeak`) and the bytes written.
 
     Examples
     --------
@@ -86,7 +86,7 @@ def sweep_job(
     >>> list(inspect.signature(sweep_job).parameters)
     ['n', 'path', 'bands', 'mode', 'workers', 'outputs']
     >>> sorted(sweep_job(1000, "cube.nc"))  # doctest: +SKIP
-    ['blocks', 'rss', 'seconds']
+    ['blocks', 'bytes', 'pss', 'rss', 'rss_private', 'seconds']
     """
 
     from ..engine.run import default_n_threads, run_block, simulate
@@ -151,6 +151,7 @@ def sweep_job(
         seconds = time.perf_counter() - t0
     out = {"seconds": seconds, "rss": float(_peak_rss()), "blocks": float(plan.n_blocks)}
     out["rss_private"] = float(private.stop())
+    out["pss"] = float(private.pss)
     if mode in ("write", "zarr"):
         out["bytes"] = float(_size(Path(path)))
     return out
@@ -166,30 +167,37 @@ def _size(path: Path) -> int:
 class _PrivatePeak:
     """The peak of this process's anonymous (private) resident memory [byte], sampled
     every 5 ms in a thread: what the peak RSS is less the pages of files it maps (the
-    memory-mapped tables, shared by every process that maps them)."""
+    memory-mapped tables, shared by every process that maps them); and the peak of its
+    proportional set size (``pss``, every 50 ms: each shared page counted once over the
+    processes that map it, ``/proc/self/smaps_rollup``)."""
 
     def __init__(self) -> None:
         import threading
 
-        self.peak = 0
+        self.peak = self.pss = 0
         self.done = threading.Event()
         self.thread = threading.Thread(target=self._run, daemon=True)
         self.thread.start()
 
     def _run(self) -> None:
-        while not self.done.wait(0.005):
+        for i in itertools.count():
+            if self.done.wait(0.005):
+                break
             self.peak = max(self.peak, _status("RssAnon"))
+            if i % 10 == 0:
+                self.pss = max(self.pss, _status("Pss", "/proc/self/smaps_rollup"))
 
     def stop(self) -> int:
         self.done.set()
         self.thread.join()
+        self.pss = max(self.pss, _status("Pss", "/proc/self/smaps_rollup"))
         return max(self.peak, _status("RssAnon"))
 
 
-def _status(field: str) -> int:
-    """A memory field of ``/proc/self/status`` [byte] (0 where there is none)."""
+def _status(field: str, where: str = "/proc/self/status") -> int:
+    """A memory field of ``/proc/self/status`` (or ``where``) [byte] (0 where there is none)."""
     try:
-        with open("/proc/self/status", encoding="ascii") as f:
+        with open(where, encoding="ascii") as f:
             return next((int(x.split()[1]) * 1024 for x in f if x.startswith(field + ":")), 0)
     except OSError:
         return 0
@@ -349,15 +357,10 @@ def _sweep_rows(sizes: tuple[int, ...], results: dict[int, dict[str, float]]) ->
     prev = None
     for n in sizes:
         r, k = results[n], kernels[n]
-        exp = (
-            ""
-            if prev is None
-            else (
-                "; exponent "
-                f"{np.log(r['seconds'] / results[prev]['seconds']) / np.log(n / prev):.3f} "
-                f"from {prev:.0e}"
-            )
-        )
+        exp = ""
+        if prev is not None:
+            growth = np.log(r["seconds"] / results[prev]["seconds"]) / np.log(n / prev)
+            exp = f"; exponent {growth:.3f} from {prev:.0e}"
         rows.append(
             BenchRow(
                 f"{n:.0e} attitudes, write",
@@ -366,7 +369,8 @@ def _sweep_rows(sizes: tuple[int, ...], results: dict[int, dict[str, float]]) ->
                 r["seconds"] / k["seconds"],
                 f"{r['seconds']:.2f} s in {int(r['blocks'])} blocks, peak RSS "
                 f"{r['rss'] / 1e9:.2f} GB (private {r['rss_private'] / 1e9:.2f} GB, the rest "
-                f"file pages: the mapped tables every process shares){exp}",
+                "file pages: libraries and the mapped tables every process shares; PSS "
+                f"{r.get('pss', 0.0) / 1e9:.2f} GB){exp}",
                 sweep=_WRITTEN,
             )
         )

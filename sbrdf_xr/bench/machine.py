@@ -15,6 +15,7 @@ from pathlib import Path
 import numba
 import numpy as np
 
+from ..engine.knobs import KNOBS
 from ..store.disk import drop_behind
 from .rows import best_time
 
@@ -55,9 +56,9 @@ def thread_scaling(n: int = 50_000_000, jobs: int = 4, repeat: int = 3) -> tuple
 
 def disk_rate(where: str | None = None, nbytes: int = 512 * 2**20) -> float:
     """Rate [byte/s] at which this machine writes ``nbytes`` to a new file in ``where``
-    (the temporary directory by default) as the cube writer does: 32 MiB at a time, each
-    flushed to disk (``fsync``) and dropped from the page cache.  The floor under any
-    cube write of that size there.
+    (the temporary directory by default) as the cube writer does: a default block
+    (the knob ``block_bytes``, 8 MiB) at a time, each flushed to disk (``fsync``) and
+    dropped from the page cache.  The floor under any cube write of that size there.
 
     Examples
     --------
@@ -65,7 +66,7 @@ def disk_rate(where: str | None = None, nbytes: int = 512 * 2**20) -> float:
     >>> disk_rate(nbytes=2**20) > 0.0
     True
     """
-    block = np.ones(min(nbytes, 32 * 2**20) // 8)
+    block = np.ones(min(nbytes, KNOBS["block_bytes"].default) // 8)
     with tempfile.TemporaryDirectory(prefix="sbrdf-disk-", dir=where) as tmp:
         path = Path(tmp) / "probe.bin"
         t0 = time.perf_counter()

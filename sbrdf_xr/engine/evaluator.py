@@ -22,7 +22,8 @@ Bad input raises named errors: directions of the wrong shape, not finite or not 
 unit length raise :class:`~sbrdf_xr.errors.DirectionError`; a plan whose tables or
 terms changed since it was compiled raises :class:`~sbrdf_xr.errors.StalePlanError`
 (per call a cheap identity check: the same table and term objects, still read-only;
-:meth:`Evaluator.verify` also compares a sample of the table values).
+:meth:`Evaluator.verify` also compares a sample of the table values, or the record
+of a memory-mapped table's file, whose read-only pages cannot change in place).
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ import numpy as np
 
 from ..errors import DirectionError, SceneError, StalePlanError
 from ..kernels.sums import BoundSums
+from ..materials.mapped import TableFile, mapping_of
 from .effects import EFFECTS, BlockInputs, finish
 from .effects.base import trapezoid_weights
 from .sweep import GridGeometry
@@ -76,10 +78,22 @@ def _flags(plan: Plan) -> tuple[bool, ...]:
     return (*(v.flags.writeable for v in plan.tables.values), t.normal.flags.writeable)
 
 
-def _sample(plan: Plan) -> tuple[float, ...]:
-    """Sums of an even sample of each table's values and of the terms' normals and areas."""
-    out = []
+def _sample(plan: Plan) -> tuple[float | TableFile, ...]:
+    """Sums of an even sample of each table's values and of the terms' normals and areas.
+
+    A table that views a memory-mapped values file of the table cache
+    (:mod:`sbrdf_xr.materials.mapped`) gives the file's record instead: its mapping is
+    read-only (no change in place is possible; a file changed on disk is refused by its
+    recorded digest), and a sample spread over it would make every page of the table
+    resident in this process (each read faults in the pages around it), where a sweep
+    reads about a third of them.
+    """
+    out: list[float | TableFile] = []
     for v in plan.tables.values:
+        file = mapping_of(v)
+        if file is not None and not v.flags.writeable:
+            out.append(file)
+            continue
         flat = v.reshape(-1)
         out.append(float(np.sum(flat[:: max(1, flat.size // _SAMPLE)], dtype=np.float64)))
     out += [float(plan.terms.normal.sum()), float(plan.terms.area.sum())]
@@ -294,8 +308,9 @@ class Evaluator:
 
     def verify(self) -> None:
         """:meth:`check`, and compare whether the tables and terms are writeable and an
-        even sample of every table's values and of the terms' normals and areas with
-        those taken when it was compiled (a change in place raises
+        even sample of every table's values (a memory-mapped table: its file's record)
+        and of the terms' normals and areas with those taken when it was compiled (a
+        change in place raises
         :class:`~sbrdf_xr.errors.StalePlanError`).
 
         Examples

@@ -33,7 +33,10 @@ The cube (DESIGN.md data model)
     ``signal`` per material (with the ``per_material`` output).
 
 Coordinates carry the geometry: ``to_sun`` and ``to_observer`` (body frame),
-the attitude quaternions and the phase angle.  :data:`sbrdf_xr.engine.effects.OUTPUTS`
+the attitude quaternions and the phase angle.  In a lazy cube over attitudes x phase
+angles the body-frame directions are lazy too, made by each block's task with its
+outputs (the same rotation, the same bits): a sweep never holds them for every
+attitude at once.  :data:`sbrdf_xr.engine.effects.OUTPUTS`
 declares every variable and its attributes.
 """
 
@@ -57,11 +60,12 @@ from .._names import FACET, WAVELENGTH, attrs
 from ..errors import SceneError
 from .articulation import articulated_sums
 from .builtin import resolve_scene
-from .effects import finish
+from .effects import BlockInputs, finish
 from .evaluator import block_outputs
 from .plan import Plan
 from .reuse import INDEXES
 from .scene import Scene
+from .sweep import GridGeometry
 
 __all__ = ["IN_PROCESS_BYTES", "run_block", "simulate"]
 
@@ -104,14 +108,35 @@ def run_block(plan: Plan, sl: slice) -> dict[str, np.ndarray]:
     >>> round(float(out["signal"][0, 0, 0]), 6)
     0.159155
     """
-    block = plan.geometry.block(sl)
+    return _outputs(plan, plan.geometry.block(sl), sl)
+
+
+def _outputs(plan: Plan, block: BlockInputs, sl: slice) -> dict[str, np.ndarray]:
     if plan.articulation is not None:  # parts that turn: every group in its own frame
         return finish(plan, articulated_sums(plan, block, sl), block.lead_shape)
     return block_outputs(plan, block)  # the plan's evaluator where it allows
 
 
-def _block_task(plan: Plan, k: int) -> dict[str, np.ndarray]:
-    return run_block(plan, plan.block_slice(k))
+#: The coordinates a lazy cube over attitudes x phase angles makes by block (:func:`_lazy`).
+_DIRECTIONS = ("to_sun", "to_observer")
+
+
+def _block_task(plan: Plan, k: int, directions: bool = False) -> dict[str, np.ndarray]:
+    """Block ``k``'s outputs and, with ``directions``, its body-frame directions."""
+    sl = plan.block_slice(k)
+    block = plan.geometry.block(sl)
+    out = _outputs(plan, block, sl)
+    if directions:
+        shape = (*block.lead_shape, 3)
+        out["to_sun"] = block.to_sun.reshape(shape)
+        out["to_observer"] = block.to_observer.reshape(shape)
+    return out
+
+
+def _lazy_directions(plan: Plan) -> bool:
+    """Whether a lazy cube makes its ``to_sun`` and ``to_observer`` by block: over
+    attitudes x phase angles (explicit pairs carry their own) of a rigid body."""
+    return isinstance(plan.geometry, GridGeometry) and plan.articulation is None
 
 
 def default_n_threads() -> int:
@@ -163,7 +188,8 @@ def _lazy(plan: Plan, client: Any = None) -> dict[str, dsa.Array]:
 
     The graph is written directly: the plan enters it once (scattered to the workers
     with ``client``), each block task refers to it by key, and nothing is tokenized
-    per block.
+    per block.  Over attitudes x phase angles the block tasks also give the
+    body-frame directions, as arrays under their coordinate names.
     """
     token = uuid.uuid4().hex
     plan_key = f"sbrdf-plan-{token}"
@@ -175,22 +201,26 @@ def _lazy(plan: Plan, client: Any = None) -> dict[str, dsa.Array]:
         plan_ref = plan_key
         layer0 = {plan_key: plan}
     nb = plan.n_blocks
-    blocks = {(block_name, k): (_block_task, plan_ref, k) for k in range(nb)}
+    directions = _lazy_directions(plan)
+    blocks = {(block_name, k): (_block_task, plan_ref, k, directions) for k in range(nb)}
     block_layer = {**layer0, **blocks}
     lead = tuple(plan.block_slice(k).stop - plan.block_slice(k).start for k in range(nb))
+    picked = [(o.name, o.shape, o.dtype) for o in plan.outputs]
+    if directions:
+        picked += [(d, (*plan.geometry.shape, 3), np.dtype(np.float64)) for d in _DIRECTIONS]
     out = {}
-    for o in plan.outputs:
-        name = f"sbrdf-{o.name}-{token}"
-        rest = (0,) * (len(o.shape) - 1)
+    for what, shape, dtype in picked:
+        name = f"sbrdf-{what}-{token}"
+        rest = (0,) * (len(shape) - 1)
         layer: dict[Key, Any] = {
-            (name, k, *rest): (_pick, (block_name, k), o.name) for k in range(nb)
+            (name, k, *rest): (_pick, (block_name, k), what) for k in range(nb)
         }
         graph = HighLevelGraph(
             layers={block_name: block_layer, name: layer},
             dependencies={block_name: set(), name: {block_name}},
         )
-        chunks = (lead, *((s,) for s in o.shape[1:]))
-        out[o.name] = dsa.Array(graph, name, chunks, dtype=o.dtype)
+        chunks = (lead, *((s,) for s in shape[1:]))
+        out[what] = dsa.Array(graph, name, chunks, dtype=dtype)
     return out
 
 
@@ -202,7 +232,18 @@ def _template(plan: Plan) -> xr.Dataset:
     """The cube's coordinates and attributes (made once per plan)."""
     if "template" in plan.cache:
         return plan.cache["template"]
-    coords = plan.geometry.coords()
+    plan.cache["template"] = _coordinates(plan)
+    return plan.cache["template"]
+
+
+def _coordinates(plan: Plan, directions: dict[str, Any] | None = None) -> xr.Dataset:
+    """The cube's coordinates and attributes; ``directions``: a lazy cube's own
+    ``to_sun`` and ``to_observer`` (:func:`_lazy`)."""
+    geo = plan.geometry
+    if directions is not None and isinstance(geo, GridGeometry):
+        coords = geo.coords(directions)
+    else:
+        coords = geo.coords()
     coords["xyz"] = ("xyz", ["x", "y", "z"], attrs("xyz"))
     if plan.articulation is not None:  # the hinge angle of every part at every geometry
         sun = coords["to_sun"]
@@ -218,8 +259,7 @@ def _template(plan: Plan) -> xr.Dataset:
     if FACET in dims:  # the plan's terms: a facet, or the first of those merged into it
         coords[FACET] = (FACET, np.asarray(plan.terms.facet), attrs(FACET))
         coords["facet_normal"] = ((FACET, "xyz"), np.asarray(plan.terms.normal), attrs("normal"))
-    plan.cache["template"] = _coordinates_only(coords, dict(plan.attrs))
-    return plan.cache["template"]
+    return _coordinates_only(coords, dict(plan.attrs))
 
 
 def _coordinates_only(coords: dict[str, Any], attributes: dict[str, Any]) -> xr.Dataset:
@@ -269,7 +309,8 @@ def _dataset(plan: Plan, arrays: dict[str, Any]) -> xr.Dataset:
     Assembled from the plan's template without re-deriving coordinates or indexes
     (xarray's direct constructor): a single-geometry call costs microseconds here.
     """
-    t = _template(plan)
+    directions = {d: arrays[d] for d in _DIRECTIONS if d in arrays}
+    t = _coordinates(plan, directions) if directions else _template(plan)
     variables = dict(t.variables)
     for o in plan.outputs:
         variables[o.name] = xr.Variable(o.dims, arrays[o.name], attrs=dict(o.attrs))

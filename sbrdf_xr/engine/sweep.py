@@ -120,10 +120,18 @@ class GridGeometry:
         }
         return BlockInputs(s, o, None, (len(q), p), extra)
 
-    def coords(self) -> dict[str, Any]:
-        """Coordinates of a cube over this geometry."""
-        b = self.block(slice(None))
-        s, o = b.to_sun.reshape(*self.shape, 3), b.to_observer.reshape(*self.shape, 3)
+    def coords(self, directions: Mapping[str, Any] | None = None) -> dict[str, Any]:
+        """Coordinates of a cube over this geometry.
+
+        ``directions``: the body-frame ``to_sun`` and ``to_observer``, shaped
+        ``(attitude, phase_angle, 3)``, made elsewhere (a lazy cube's, block by block with
+        its outputs) instead of computed here for every attitude at once.
+        """
+        if directions is None:
+            b = self.block(slice(None))
+            s, o = b.to_sun.reshape(*self.shape, 3), b.to_observer.reshape(*self.shape, 3)
+        else:
+            s, o = directions["to_sun"], directions["to_observer"]
         c: dict[str, Any] = {
             ATTITUDE: (ATTITUDE, np.arange(self.n_lead), attrs("attitude")),
             PHASE_ANGLE: (PHASE_ANGLE, np.asarray(self.phase_angles), attrs(PHASE_ANGLE)),

@@ -127,7 +127,11 @@ def write_zarr(
     The arguments, returns and errors are those of
     :func:`sbrdf_xr.store.writer.write_cube` (see the module documentation for the
     store's files); ``path`` is a directory (``cube.zarr``), and ``complevel`` defaults
-    to Zarr's own compression (see ``Compression`` above).
+    to Zarr's own compression (see ``Compression`` above).  ``max_in_flight`` defaults to
+    two blocks per worker thread and one more: a block's result never comes back to this
+    process (its worker stores it), so blocks waiting in a worker's queue hold no memory,
+    and a worker that finishes one starts the next at once instead of waiting for this
+    process to hand it out.
 
     Examples
     --------
@@ -479,7 +483,7 @@ def _stream(
         return {**graph, out: (store_block, str(part), k, regions, key)}, out
 
     todo = [b for b in range(plan.n_blocks) if b not in done]
-    feed = Feed(plan, runner, todo, int(max_in_flight or runner.n_workers + 1), wrap)
+    feed = Feed(plan, runner, todo, int(max_in_flight or 2 * runner.n_workers + 1), wrap)
     if done:
         _log.info("resuming %s: %d of %d blocks are kept", part, len(done), plan.n_blocks)
     bar: Any = NoProgress()

@@ -22,3 +22,5 @@ def test_the_private_peak_is_sampled_and_below_the_peak_rss():
     private = peak.stop()
     assert private >= 64 * 2**20
     assert private <= engine._peak_rss()  # private pages are a part of the resident ones
+    # a private page counts whole in the proportional set size, a shared one in part
+    assert 64 * 2**20 <= peak.pss <= engine._peak_rss()

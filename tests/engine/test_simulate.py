@@ -103,6 +103,29 @@ def test_simulate_builds_a_lazy_graph():
     xr.testing.assert_identical(eager, threaded)
 
 
+def test_a_lazy_cube_makes_its_directions_by_block_with_the_same_bits():
+    """Over attitudes x phase angles a lazy cube's body-frame directions come from the
+    block tasks (no array over every attitude when it is built), equal bit for bit to
+    those the in-process cube computes at once."""
+    scene = cube_scene(
+        attitudes=geometry.uniform_attitudes(23, seed=4), phase_angles=[10.0, 75.0], chunk=7
+    )
+    plan = scene.plan()
+    with dask.config.set(scheduler=_RaiseIfComputes()):
+        lazy = simulate(plan, lazy=True)
+    assert "template" not in plan.cache  # nothing made for every attitude at once
+    for name in ("to_sun", "to_observer"):
+        assert lazy[name].chunks == ((7, 7, 7, 2), (2,), (3,))
+        assert name in lazy.coords
+    eager = simulate(plan, lazy=False)
+    assert isinstance(eager.to_sun.data, np.ndarray)
+    computed = lazy.compute(scheduler="threads")
+    xr.testing.assert_identical(computed, eager)
+    for name in ("to_sun", "to_observer"):
+        assert computed[name].values.tobytes() == eager[name].values.tobytes()
+    assert list(computed.variables) == list(eager.variables)  # the same order
+
+
 def test_plan_says_what_runs_and_why():
     scene = cube_scene(
         attitudes=geometry.rotation_sweep([0, 0, 1], np.arange(0, 360, 30.0)),

@@ -150,3 +150,36 @@ def test_the_catalog_fingerprint_is_that_of_the_table_read(cached_lobe, tmp_path
         ".float64.meta",
         ".float64.npy",
     ]
+
+
+def _resident(path) -> int:
+    """Resident bytes of this process's mappings of ``path`` (``/proc/self/smaps``)."""
+    total, inside = 0, False
+    with open("/proc/self/smaps", encoding="ascii", errors="replace") as f:
+        for line in f:
+            head = line.split()
+            if head and "-" in head[0] and not head[0].endswith(":"):  # a mapping's header
+                inside = len(head) > 5 and head[5] == str(path)
+            elif inside and head[0] == "Rss:":
+                total += int(head[1]) * 1024
+    return total
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/self/smaps"), reason="Linux's /proc")
+def test_compiling_an_evaluator_reads_no_page_of_a_mapped_table(cached_lobe):
+    """The evaluator's record of the tables (for ``verify``) is the mapped file's, not a
+    sample spread over its values: a sample faults in the pages around every value it
+    reads, which made every page of the tables resident in each process and worker."""
+    from sbrdf_xr.engine.evaluator import Evaluator
+
+    (npy,) = {mapped.mapping_of(v).path for v in (cached_lobe.values,)}
+    box = load_spacecraft(trimesh.creation.box(), material="lobe")
+    scene = Scene(box, {"lobe": cached_lobe}, to_sun=[[1.0, 0, 0]], to_observer=[[1.0, 0, 0]])
+    plan = scene.plan()
+    assert all(mapped.mapping_of(v) is not None for v in plan.tables.values)
+    before = _resident(npy)
+    ev = Evaluator(plan)
+    ev.verify()
+    # one geometry reads a few cells; the table is cached_lobe.values.nbytes (42 MB)
+    ev([1.0, 0, 0], [1.0, 0, 0])
+    assert _resident(npy) - before < 0.05 * cached_lobe.values.nbytes
