@@ -31,8 +31,9 @@ from .extinction import separable_sd
 from .model import PassModel, pass_data
 from .model_error import discrepancy_floor, estimated_floor, table_widths, tilt_layout, with_floor
 from .posterior import CHUNK_STEPS, check_budget
+from .profile import INTERVALS, spin_intervals, with_intervals
 from .refine import Local, jacobian, outside_physics, refine
-from .result import Layout, model_check, result_dataset
+from .result import Layout, model_check, reported_jacobian, result_dataset
 from .starts import axis_body_of, minima_dataset, read_start, start_states
 from .status import RECOVER, causes, held_note, status_attrs, with_posterior
 from .twins import twin_dataset
@@ -113,6 +114,7 @@ def fit_observation(
     colour_tilt: bool | float | Mapping[str, float] | None = None,
     model_discrepancy: str | float | Mapping[str, float] | None = None,
     method: str = "point",
+    intervals: str = "auto",
     posterior_walkers: int | None = None,
     posterior_steps: int | None = None,
     seed: int = 0,
@@ -228,6 +230,17 @@ def fit_observation(
         point fit's covariance sets the walkers' start and the independence proposal;
         medians, standard deviations and 2.5 / 97.5 % points per parameter, each mode's
         probability, autocorrelation time and cost (``posterior_cost``).
+    intervals : {"auto", "quadratic", "profile"}
+        How the spin parameters' intervals are found.  ``"auto"``: the chi-square is
+        evaluated along the quadratic approximation's profile line of each (axis
+        longitude and latitude, period, phase) at +-2 sigma; where its signed root misses
+        +-2 by more than :data:`~sbrdf_xr.invert._joint.profile.QUADRATIC_TOL` (the model
+        not linear over the interval: a spin at 0.05 mag of noise), the parameter's
+        interval is its profile likelihood's (``Delta chi2 = 1`` and 4 crossings, every
+        other parameter refitted; :mod:`sbrdf_xr.invert._joint.profile`), its uncertainty
+        half the 1-sigma interval.  ``"quadratic"``: ``(J^T J)^-1`` only; ``"profile"``:
+        every spin parameter profiled.  Reported as ``lower_2sigma``, ``upper_2sigma``
+        and ``quadratic_miss`` over ``parameter`` and ``attrs["intervals"]``.
     posterior_walkers : int, optional
         Walkers of the ensemble (default ``2 n + 2`` for ``n`` fitted parameters).
     posterior_steps : int, optional
@@ -330,7 +343,7 @@ def fit_observation(
     if isinstance(model_discrepancy, str):  # estimated: a fit without, then with
         return estimated_floor(fit_observation, dict(locals()))
     t_start = time.perf_counter()
-    _check_method(method)
+    _check_method(method, intervals)
     start, epoch = read_start(spin)
     ab = axis_body_of(spin, axis_body)
     data = pass_data(light_curve, observation, bands, system)
@@ -409,6 +422,7 @@ def fit_observation(
         },
     )
     ds = _with_warnings_and_twins(ds, stats, local, best, model, lay, syms, dt_epoch)
+    ds = _intervals(ds, stats, local[best], model, lay, dt_epoch, intervals, scale_uncertainties)
     if method == "posterior":
         ds = with_posterior(
             ds, lay, local, best, model, dt_epoch, fit_s, posterior_walkers, posterior_steps, seed
@@ -422,12 +436,54 @@ def fit_observation(
     return ds
 
 
-def _check_method(method: str) -> None:
+def _check_method(method: str, intervals: str) -> None:
     if method not in ("point", "posterior"):
         raise InversionError(
             f"method: {method!r}; allowed 'point' (least squares, uncertainties from the "
             "Jacobian) or 'posterior' (emcee from every minimum)"
         )
+    if intervals not in INTERVALS:
+        raise InversionError(
+            f"intervals: {intervals!r}; allowed 'auto' (the profile likelihood where the "
+            "quadratic approximation does not hold), 'quadratic' or 'profile'"
+        )
+
+
+def _intervals(
+    ds: xr.Dataset,
+    stats: _Statistics,
+    sol: Local,
+    model: PassModel,
+    lay: Layout,
+    dt_epoch: float,
+    mode: str,
+    scaled: bool,
+) -> xr.Dataset:
+    """The spin parameters' intervals: quadratic, or the profile likelihood's where the
+    quadratic approximation does not hold (:mod:`sbrdf_xr.invert._joint.profile`)."""
+    quad = "the quadratic approximation (J^T J)^-1"
+    if mode == "quadratic":
+        return with_intervals(ds, None, f"{quad} (intervals='quadratic')")
+    if ds.attrs["status"] != "ok" or sol.bounded or bool(stats.free.any()):
+        return with_intervals(
+            ds, None, f"{quad}: no profile of a failed, bounded or partly unconstrained fit"
+        )
+    p = sol.x
+    shift = 360.0 * (model.t_ref - dt_epoch)
+    t = reported_jacobian(lay, p, sol.axis_of, model.t_ref, dt_epoch)
+    birge = stats.chi2 / stats.dof if scaled else 1.0  # Delta chi2 levels scaled alike
+    lon, lat = float(ds["axis_longitude"]), float(ds["axis_latitude"])
+    q = np.concatenate([[lon, lat, p[2], p[3] - shift / p[2]], p[4:]])
+    ints = spin_intervals(
+        lambda x: sol.residuals(x) / np.sqrt(birge),
+        sol.axis_of,
+        shift,
+        q,
+        t @ stats.cov @ t.T,
+        stats.chi2 / birge,
+        mode,
+    )
+    return with_intervals(ds, ints, quad)
 
 
 def _extinction_mode(

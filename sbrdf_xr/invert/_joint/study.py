@@ -355,6 +355,12 @@ def _draw_row(
             )
     for k, per in (("phase", phase_symmetry), ("axis_longitude", 360.0)):
         row[k] = (truth[k] + _wrap(row[k][0] - truth[k], per), row[k][1])
+    if "lower_2sigma" in fit and "posterior_median" not in fit:  # the side's half-interval
+        for k in spin_keys:
+            est, fit_est = row[k][0], float(fit[k])
+            side = "lower_2sigma" if est > truth[k] else "upper_2sigma"
+            half = abs(float(fit[side].sel(parameter=k)) - fit_est) / 2.0
+            row[k] = (est, half if half > 0 else row[k][1])
     return row
 
 
