@@ -620,3 +620,36 @@ def test_colour_tilt_study(box_wing, tilt):
         assert float(study.coverage_2sigma.min()) >= 0.80
     else:  # the colour error is not absorbed: the extinction is biased
         assert float(study.coverage_2sigma.sel(parameter="extinction_V")) < 0.5
+
+
+def test_spin_intervals_from_the_profile(box_wing):
+    """One draw at 0.05 mag: intervals="quadratic" (the default) gives estimate -+ 2 sigma;
+    "profile" gives the profile likelihood's 2-sigma bounds of the spin parameters around
+    the estimate, the quadratic check's miss of each (nan for the other parameters, whose
+    uncertainties are untouched), and says so."""
+    lc = _dao_curve(box_wing, 0.05, 3)
+    start = {**DAO_SPIN, "axis_longitude": 101.0, "period": 47.03}
+    spin = ["axis_longitude", "axis_latitude", "period", "phase"]
+    quad = invert.fit_observation(lc, box_wing, dao_pass(), start, check=False)
+    prof = invert.fit_observation(lc, box_wing, dao_pass(), start, check=False, intervals="profile")
+    np.testing.assert_array_equal(quad.lower_2sigma, quad.estimate - 2 * quad.uncertainty)
+    np.testing.assert_array_equal(quad.upper_2sigma, quad.estimate + 2 * quad.uncertainty)
+    assert quad.attrs["intervals"].endswith("(intervals='quadratic')")
+    assert prof.attrs["intervals"].startswith("the profile likelihood (Delta chi2 = 1 and 4")
+    assert np.isfinite(prof.quadratic_miss.sel(parameter=spin)).all()
+    assert np.isnan(prof.quadratic_miss.drop_sel(parameter=spin)).all()
+    np.testing.assert_array_equal(prof.estimate, quad.estimate)
+    s = prof.sel(parameter=spin)
+    assert np.all(s.lower_2sigma < s.estimate) and np.all(s.estimate < s.upper_2sigma)
+    for k in spin:
+        assert float(prof[k + "_uncertainty"]) == float(prof.uncertainty.sel(parameter=k))
+    rest = prof.drop_sel(parameter=spin)
+    np.testing.assert_array_equal(rest.uncertainty, quad.drop_sel(parameter=spin).uncertainty)
+
+
+def test_intervals_bad_input(box_wing):
+    from sbrdf_xr.errors import InversionError
+
+    lc = _dao_curve(box_wing, 0.02, 1)
+    with pytest.raises(InversionError, match="intervals: 'hessian'; allowed 'quadratic'"):
+        invert.fit_observation(lc, box_wing, dao_pass(), DAO_SPIN, intervals="hessian")
