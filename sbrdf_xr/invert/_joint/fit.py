@@ -31,9 +31,9 @@ from .extinction import separable_sd
 from .model import PassModel, pass_data
 from .model_error import discrepancy_floor, estimated_floor, table_widths, tilt_layout, with_floor
 from .posterior import CHUNK_STEPS, check_budget
-from .profile import INTERVALS, spin_intervals, with_intervals
+from .profile import INTERVALS, point_intervals
 from .refine import Local, jacobian, outside_physics, refine
-from .result import Layout, model_check, reported_jacobian, result_dataset
+from .result import Layout, model_check, result_dataset
 from .starts import axis_body_of, minima_dataset, read_start, start_states
 from .status import RECOVER, causes, held_note, status_attrs, with_posterior
 from .twins import twin_dataset
@@ -424,7 +424,16 @@ def fit_observation(
         },
     )
     ds = _with_warnings_and_twins(ds, stats, local, best, model, lay, syms, dt_epoch)
-    ds = _intervals(ds, stats, local[best], model, lay, dt_epoch, intervals, scale_uncertainties)
+    ds = point_intervals(
+        ds,
+        local[best],
+        (stats.cov, stats.free, stats.chi2, stats.dof),
+        lay,
+        model.t_ref,
+        dt_epoch,
+        intervals,
+        scale_uncertainties,
+    )
     if method == "posterior":
         ds = with_posterior(
             ds, lay, local, best, model, dt_epoch, fit_s, posterior_walkers, posterior_steps, seed
@@ -449,43 +458,6 @@ def _check_method(method: str, intervals: str) -> None:
             f"intervals: {intervals!r}; allowed 'quadratic' (the Jacobian's) or 'profile' "
             "(the profile likelihood's, the others refitted)"
         )
-
-
-def _intervals(
-    ds: xr.Dataset,
-    stats: _Statistics,
-    sol: Local,
-    model: PassModel,
-    lay: Layout,
-    dt_epoch: float,
-    mode: str,
-    scaled: bool,
-) -> xr.Dataset:
-    """The spin parameters' intervals: quadratic, or the profile likelihood's where the
-    quadratic approximation does not hold (:mod:`sbrdf_xr.invert._joint.profile`)."""
-    quad = "the quadratic approximation (J^T J)^-1"
-    if mode == "quadratic":
-        return with_intervals(ds, None, f"{quad} (intervals='quadratic')")
-    if ds.attrs["status"] != "ok" or sol.bounded or bool(stats.free.any()):
-        return with_intervals(
-            ds, None, f"{quad}: no profile of a failed, bounded or partly unconstrained fit"
-        )
-    p = sol.x
-    shift = 360.0 * (model.t_ref - dt_epoch)
-    t = reported_jacobian(lay, p, sol.axis_of, model.t_ref, dt_epoch)
-    birge = stats.chi2 / stats.dof if scaled else 1.0  # Delta chi2 levels scaled alike
-    lon, lat = float(ds["axis_longitude"]), float(ds["axis_latitude"])
-    q = np.concatenate([[lon, lat, p[2], p[3] - shift / p[2]], p[4:]])
-    ints = spin_intervals(
-        lambda x: sol.residuals(x) / np.sqrt(birge),
-        sol.axis_of,
-        shift,
-        q,
-        t @ stats.cov @ t.T,
-        stats.chi2 / birge,
-        mode,
-    )
-    return with_intervals(ds, ints, quad)
 
 
 def _extinction_mode(

@@ -29,11 +29,14 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
+from .result import reported_jacobian
+
 __all__ = [
     "INTERVALS",
     "PROFILE_GRID",
     "QUADRATIC_TOL",
     "SPIN_PROFILED",
+    "point_intervals",
     "profile_crossing",
     "quadratic_check",
     "reported_map",
@@ -353,3 +356,43 @@ def _note(ints: dict[str, Any], said: list[str]) -> str:
             else ""
         )
     )
+
+
+def point_intervals(
+    ds: Any,
+    sol: Any,
+    stats: tuple[np.ndarray, np.ndarray, float, int],
+    lay: Any,
+    t_ref: float,
+    dt_epoch: float,
+    mode: str,
+    scaled: bool,
+) -> Any:
+    """The point fit's result with its spin parameters' intervals: the quadratic's, or
+    (``mode="profile"``) the profile likelihood's; ``sol`` the solution's minimum
+    (``x``, ``residuals``, ``axis_of``, ``bounded``), ``stats`` its covariance, the
+    unconstrained parameters, chi-square and degrees of freedom."""
+    cov, free, chi2, dof = stats
+    quad = "the quadratic approximation (J^T J)^-1"
+    if mode == "quadratic":
+        return with_intervals(ds, None, f"{quad} (intervals='quadratic')")
+    if ds.attrs["status"] != "ok" or sol.bounded or bool(np.any(free)):
+        return with_intervals(
+            ds, None, f"{quad}: no profile of a failed, bounded or partly unconstrained fit"
+        )
+    p = sol.x
+    shift = 360.0 * (t_ref - dt_epoch)
+    t = reported_jacobian(lay, p, sol.axis_of, t_ref, dt_epoch)
+    birge = chi2 / dof if scaled else 1.0  # scaled uncertainties: the levels scaled alike
+    lon, lat = float(ds["axis_longitude"]), float(ds["axis_latitude"])
+    q = np.concatenate([[lon, lat, p[2], p[3] - shift / p[2]], p[4:]])
+    ints = spin_intervals(
+        lambda x: sol.residuals(x) / np.sqrt(birge),
+        sol.axis_of,
+        shift,
+        q,
+        t @ cov @ t.T,
+        chi2 / birge,
+        mode,
+    )
+    return with_intervals(ds, ints, quad)
