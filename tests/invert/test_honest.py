@@ -598,28 +598,36 @@ def test_colour_tilt_bad_input(box_wing, bad, match):
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("noise", [0.02, 0.05], ids=["0.02", "0.05"])
 @pytest.mark.parametrize("tilt", [None, True], ids=["scale-only", "scale-and-tilt"])
-def test_colour_tilt_study(box_wing, tilt):
-    """30 held-out draws of the paint 10 % brighter and redder (0.02 mag, seed 3), fitted
-    with the tables' scales (material_scale="provenance"): without the tilt the colour
+def test_colour_tilt_study(box_wing, tilt, noise):
+    """30 held-out draws of the paint 10 % brighter and redder (seed 3), fitted with the
+    tables' scales (material_scale="provenance").  At 0.02 mag without the tilt the colour
     error goes to the extinction and the axis (2-sigma coverage of k_V 0.20, k_I 0.30,
     axis longitude 0.40, cells' fraction 0.80) and no fit warns (0 of 30); with the tilt
-    every parameter's coverage is 0.90-1.00 (0 warnings).  Asserted with the tilt: >= 0.80
-    (0.95 less 3.5 binomial sigma of 30 draws, 0.04 each)."""
+    every parameter's coverage is 0.90-1.00 (0 warnings).  At 0.05 mag without the tilt:
+    k_V 0.63 (pull mean +1.53), k_I 0.80, the cells' and the paint's fractions 0.80 and
+    0.83, axis longitude and phase 0.87, no warning; with it 0.90-1.00 (the phase 0.90),
+    no warning.  Asserted with the tilt: >= 0.80 (0.95 less 3.5 binomial sigma of 30
+    draws, 0.04 each); without, the extinction's bias (at 0.05 mag its pull mean > 0.9:
+    1.53 less 3 times 1 / sqrt(30))."""
     study = _dao_study(
         box_wing,
         30,
         3,
-        noise=0.02,
+        noise=noise,
         material_scale="provenance",
         colour_tilt=tilt,
         brightness=_redder(box_wing),
     )
     print(study[["pull_mean", "pull_width", "coverage_2sigma"]].to_dataframe().to_string())
+    print("warnings", int(study.quality_warnings), "of", int(study.n_draws))
     if tilt:
         assert float(study.coverage_2sigma.min()) >= 0.80
-    else:  # the colour error is not absorbed: the extinction is biased
+    elif noise < 0.03:  # the colour error is not absorbed: the extinction is biased
         assert float(study.coverage_2sigma.sel(parameter="extinction_V")) < 0.5
+    else:
+        assert float(study.pull_mean.sel(parameter="extinction_V")) > 0.9
 
 
 def test_spin_intervals_from_the_profile(box_wing):
