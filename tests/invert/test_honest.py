@@ -672,18 +672,23 @@ SPIN_KEYS = ["axis_longitude", "axis_latitude", "period", "phase"]
     [
         ({}, "quadratic", 0.82),
         ({}, "profile", 0.83),
-        ({"brightness": {"white-paint-a276": 1.1}}, "quadratic", 0.80),
-        ({"brightness": {"white-paint-a276": 1.1}}, "profile", 0.80),
+        ({"brightness": {"white-paint-a276": 1.1}}, "quadratic", 0.82),
+        ({"brightness": {"white-paint-a276": 1.1}}, "profile", 0.83),
     ],
     ids=["model-quadratic", "model-profile", "paint-quadratic", "paint-profile"],
 )
 def test_spin_coverage_at_005(box_wing, truth, intervals, bound):
-    """60 held-out draws at 0.05 mag (seed 3, material_scale="provenance"), the truth the
-    model's or the paint 10 % brighter: the spin's 2-sigma coverage and pull widths with
-    the Jacobian's intervals and with the profile likelihood's (measured numbers in
-    docs/guide/inversion.md: the profile's are no wider, its coverage the same within a
-    binomial sigma of 0.027).  Asserted: the lowest spin coverage >= the measured value
-    less 3 binomial sigma (0.08), rounded down."""
+    """60 held-out draws at 0.05 mag (seed 3, material_scale="provenance", binomial sigma
+    0.027), the truth the model's or the paint 10 % brighter: the spin's 2-sigma coverage
+    (longitude, latitude, period, phase) and pull widths with the Jacobian's intervals and
+    with the profile likelihood's.  Measured: the model's truth, quadratic 0.95, 0.93,
+    0.93, 0.90 (widths 0.99, 1.13, 1.14, 1.12); profiled where the quadratic check missed
+    by more than 0.1 (most) 0.92, 0.93, 0.93, 0.92 (0.99, 1.09, 1.12, 1.09); the paint,
+    quadratic 0.93, 0.93, 0.93, 0.90 (0.97, 1.14, 1.11, 1.09), profile 0.92, 0.93, 0.93,
+    0.93 (0.99, 1.09, 1.11, 1.07), every pull mean within -0.15..+0.05 and no warning:
+    the profile's intervals are no wider than the quadratic's (docs/guide/inversion.md).
+    Asserted: the lowest spin coverage >= the measured one less 3 binomial sigma (0.08),
+    rounded down."""
     study = _dao_study(
         box_wing, 60, 3, noise=0.05, material_scale="provenance", intervals=intervals, **truth
     )
