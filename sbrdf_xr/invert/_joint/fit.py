@@ -236,8 +236,8 @@ def fit_observation(
         likelihood's ``Delta chi2 = 1`` and 4 crossings of the axis longitude and
         latitude, the period and the phase, every other parameter refitted
         (:mod:`sbrdf_xr.invert._joint.profile`: asymmetric where the model is not linear
-        over the interval, the outermost crossing of a rippled chi-square; about 10 times
-        the point fit's cost), with the quadratic check's miss.  Reported as
+        over the interval, the outermost crossing of a rippled chi-square; 15-80 times
+        the point fit's wall time), with the quadratic check's miss.  Reported as
         ``lower_2sigma``, ``upper_2sigma`` (and ``quadratic_miss``) over ``parameter``
         and ``attrs["intervals"]``.  At 0.05 mag of noise neither is calibrated for the
         spin (pull widths 1.09-1.14 over 60 held-out draws; the user guide's inversion
