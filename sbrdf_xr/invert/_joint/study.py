@@ -171,7 +171,10 @@ def observation_recovery(
     a turn about its spin axis; a Quantity is converted).  ``brightness`` and ``effects``
     make the truth other than the fit's model (see :func:`simulated_light_curve`): the
     pulls then measure what a model error does to the stated uncertainties, and
-    ``quality_warnings`` how often the fit says so.
+    ``quality_warnings`` how often the fit says so.  A spin parameter's pull divides by
+    half its 2-sigma half-interval on the truth's side (``lower_2sigma``,
+    ``upper_2sigma``: the profile's are asymmetric, ``intervals="profile"``), so that
+    ``|pull| <= 2`` is the truth inside the interval.
 
     Parameters
     ----------
