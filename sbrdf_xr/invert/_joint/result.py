@@ -16,7 +16,7 @@ from .._unseen import correlation
 from .model import PassData
 from .nuisance import table_scales, table_tilts
 
-__all__ = ["Layout", "model_check", "result_dataset"]
+__all__ = ["Layout", "model_check", "reported_jacobian", "result_dataset"]
 
 
 def _cf(units: str, long_name: str) -> dict[str, str]:
@@ -161,7 +161,7 @@ class Layout:
         return h
 
 
-def _transform(
+def reported_jacobian(
     lay: Layout, p: np.ndarray, axis_of: Any, t_ref: float, dt_epoch: float
 ) -> np.ndarray:
     """d(output parameters) / d(fitted parameters): (lon, lat) from the tangent-plane
@@ -271,7 +271,7 @@ def _reported_covariance(
 ) -> tuple[np.ndarray, np.ndarray, bool]:
     """The covariance of the reported parameters, which of them are unconstrained, and
     whether the constrained part is finite."""
-    t = _transform(lay, p, axis_of, t_ref, dt_epoch)
+    t = reported_jacobian(lay, p, axis_of, t_ref, dt_epoch)
     # a parameter the data do not constrain (free) carries an infinite variance into every
     # output that depends on it; the others' covariance is carried through t
     finite = bool(np.all(np.isfinite(cov[np.ix_(~free, ~free)])))

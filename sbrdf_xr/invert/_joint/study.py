@@ -171,7 +171,10 @@ def observation_recovery(
     a turn about its spin axis; a Quantity is converted).  ``brightness`` and ``effects``
     make the truth other than the fit's model (see :func:`simulated_light_curve`): the
     pulls then measure what a model error does to the stated uncertainties, and
-    ``quality_warnings`` how often the fit says so.
+    ``quality_warnings`` how often the fit says so.  A spin parameter's pull divides by
+    half its 2-sigma half-interval on the truth's side (``lower_2sigma``,
+    ``upper_2sigma``: the profile's are asymmetric, ``intervals="profile"``), so that
+    ``|pull| <= 2`` is the truth inside the interval.
 
     Parameters
     ----------
@@ -355,6 +358,12 @@ def _draw_row(
             )
     for k, per in (("phase", phase_symmetry), ("axis_longitude", 360.0)):
         row[k] = (truth[k] + _wrap(row[k][0] - truth[k], per), row[k][1])
+    if "lower_2sigma" in fit and "posterior_median" not in fit:  # the side's half-interval
+        for k in spin_keys:
+            est, fit_est = row[k][0], float(fit[k])
+            side = "lower_2sigma" if est > truth[k] else "upper_2sigma"
+            half = abs(float(fit[side].sel(parameter=k)) - fit_est) / 2.0
+            row[k] = (est, half if half > 0 else row[k][1])
     return row
 
 
