@@ -9,6 +9,7 @@ that loses power would.
 
 from __future__ import annotations
 
+import re
 import signal
 import subprocess
 import sys
@@ -145,7 +146,10 @@ def test_a_part_begun_with_every_variable_resumes_with_them(tmp_path, scene, cap
     # without --outputs the resume keeps the variables the .part has, and finishes it
     assert main(argv) == 0
     printed = capsys.readouterr().out
-    assert "resumed" in printed and "2 of 5 blocks" in printed, printed
+    # the kill comes after the second block is recorded; the writer's thread may record
+    # one more before the signal lands
+    kept = re.search(r"resumed .*: (\d) of 5 blocks written", printed)
+    assert kept and 2 <= int(kept.group(1)) < 5, printed
     clean = write_netcdf_cube(simulate(scene), tmp_path / "clean.nc", outputs="all")
     with xr.open_dataset(out) as got, xr.open_dataset(clean) as want:
         assert DERIVED <= set(map(str, got.data_vars))
