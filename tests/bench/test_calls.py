@@ -5,6 +5,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
+import pytest
 import trimesh
 
 from sbrdf_xr import Scene, load_spacecraft
@@ -20,6 +21,8 @@ def _scene():
     return Scene(box, {"grey": grey}, attitudes=[[0, 0, 0, 1.0]] * 3, phase_angles=[10.0])
 
 
+# ~30 s on a fresh machine; the evaluator's results: tests/engine/test_evaluator.py
+@pytest.mark.slow
 def test_single_call_times_every_path():
     times = single_call_times(_scene().plan(), repeat=2, calls=3)
     assert len(times) == 8

@@ -20,6 +20,7 @@ def test_the_three_wings_are_the_same_wing():
     assert sorted(set(wing.material.values.tolist())) == ["tjpv-cell", "white-paint-a276"]
 
 
+@pytest.mark.slow  # ~45 s on a fresh machine (the wing tables built and compiled)
 def test_rows_compare_each_wing_with_the_slab():
     rows = parts_rows(40, 4, repeat=1)
     assert len(rows) == 6
