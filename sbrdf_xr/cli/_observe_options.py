@@ -177,4 +177,6 @@ def spacecraft_and_output(po: argparse.ArgumentParser, mesh_options: Any) -> Non
     s.add_argument("--plot", metavar="FIG.png", help="also write the light-curve figure")
     s.add_argument("--overwrite", action="store_true", help="replace an existing output file")
     s.add_argument("--plan", action="store_true", help="print the plan and stop")
-    s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    s.add_argument(
+        "-q", "--quiet", action="store_true", help="no plan (unless --plan) and no progress bar"
+    )

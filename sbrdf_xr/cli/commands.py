@@ -302,7 +302,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     except SbrdfError as exc:  # the option named, with the knob's own message
         raise ValidationError(f"{', '.join(given)}: {exc}") from None
     plan = scene.plan()  # the catalog's tables built as one batch, the kernel compiling meanwhile
-    print(plan)
+    if args.plan or not args.quiet:  # --quiet: the result lines only
+        print(plan)
     if args.plan:
         return 0
     part = out.with_name(out.name + PART_SUFFIX)

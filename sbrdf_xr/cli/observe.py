@@ -345,7 +345,8 @@ def cmd_observe(args: argparse.Namespace) -> int:
         keep = {"spacecraft": None, "mesh_material": None, "material_map": None}
         scene = _with_body(scene, argparse.Namespace(**{**vars(args), **keep, "length_unit": None}))
     plan = scene.plan()
-    print(plan)
+    if args.plan or not args.quiet:  # --quiet: the result lines only
+        print(plan)
     if args.plan:
         return 0
     path = fmt.writer(

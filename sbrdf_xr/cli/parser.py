@@ -217,7 +217,9 @@ def _add_simulate(sub: Any) -> None:
         help="the table of a material: a catalog name or a netCDF table or model file (repeatable)",
     )
     psim.add_argument("--plan", action="store_true", help="print the plan and stop")
-    psim.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    psim.add_argument(
+        "-q", "--quiet", action="store_true", help="no plan (unless --plan) and no progress bar"
+    )
     psim.set_defaults(func=cmd_simulate)
 
 

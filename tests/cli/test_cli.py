@@ -209,3 +209,14 @@ def test_simulate_misspelt_materials_get_suggestions(user_files, capsys, extra, 
     err = capsys.readouterr().err
     assert re.search(match, err), err
     assert not [n for n in catalog.names("site") + catalog.names("orbit") if n in err]
+
+
+def test_simulate_quiet_prints_only_what_it_wrote(user_files, capsys):
+    """``-q``: no plan, no progress bar, the line naming the cube; ``--plan -q`` still
+    prints the plan (asked for)."""
+    out = user_files / "quiet.nc"
+    assert main(["simulate", "canx1-plusx-specular", "-o", str(out), "-q"]) == 0
+    captured = capsys.readouterr()
+    assert captured.out.splitlines() == [f"wrote {out}"]
+    assert main(["simulate", "canx1-plusx-specular", "-o", str(out), "-q", "--plan"]) == 0
+    assert capsys.readouterr().out.startswith("plan for scene")
