@@ -46,6 +46,7 @@ from .._output import (
     error_words,
     file_kind,
     option,
+    read_marker,
     refuse_special,
 )
 from ..errors import CubeWriteError, OutputError, ValidationError
@@ -168,18 +169,24 @@ def write_netcdf_cube(
     return write_cube(encode_times(lean(cube, outputs)), path, **options)
 
 
-def _part_outputs(cube: Any, path: Path, outputs: str | None, resume: bool) -> str:
-    """The ``outputs`` of a netCDF write: those asked (``"independent"`` for None), or on
-    a resume those the ``.part`` was started with, recognised by its fingerprint."""
+def _part_outputs(
+    cube: Any,
+    path: Path,
+    outputs: str | None,
+    resume: bool,
+    recorded: Callable[[Path], str | None] | None = None,
+) -> str:
+    """The ``outputs`` of a write: those asked (``"independent"`` for None), or on a resume
+    those the ``.part`` was started with, recognised by its fingerprint (``recorded(part)``:
+    the one its record holds, None where there is none; default the netCDF block log's)."""
     part = path.with_name(path.name + PART_SUFFIX)
     if not resume or not isinstance(cube, xr.Dataset) or outputs not in (None, *OUTPUTS):
         return outputs or OUTPUTS[0]  # (an unknown value: lean says what is allowed)
-    try:
-        header, _ = read_log(path.with_name(path.name + LOG_SUFFIX), part)
-    except (OutputError, OSError):  # nothing to resume: the writer says what is there
+    found = (recorded or _log_fingerprint)(part)
+    if found is None:  # nothing to resume: the writer says what is there
         return outputs or OUTPUTS[0]
     prints = {o: layout_of(encode_times(lean(cube, o))).fingerprint for o in OUTPUTS}
-    started = next((o for o, f in prints.items() if f == header.get("fingerprint")), None)
+    started = next((o for o, f in prints.items() if f == found), None)
     if started is None or len(set(prints.values())) == 1 or outputs in (None, started):
         return started or outputs or OUTPUTS[0]  # (another cube: the writer refuses it)
     how = {"all": "every variable written", "independent": "the derived variables left out"}
@@ -192,12 +199,29 @@ def _part_outputs(cube: Any, path: Path, outputs: str | None, resume: bool) -> s
     )
 
 
+def _log_fingerprint(part: Path) -> str | None:
+    """The fingerprint in the block log of a netCDF ``.part`` (None without one)."""
+    try:
+        header, _ = read_log(part.with_name(part.name[: -len(PART_SUFFIX)] + LOG_SUFFIX), part)
+    except (OutputError, OSError):
+        return None
+    return header.get("fingerprint")
+
+
+def _marker_fingerprint(part: Path) -> str | None:
+    """The fingerprint in the marker of a Zarr ``.part`` store (None without one)."""
+    return (read_marker(part) or {}).get("fingerprint")
+
+
 def write_zarr_cube(
     cube: Any, path: str | os.PathLike[str], *, outputs: str | None = None, **options: Any
 ) -> Path:
     """:func:`~sbrdf_xr.store.zarr_store.write_zarr` of ``cube``, its derived variables left
-    out unless ``outputs="all"`` (:func:`~sbrdf_xr.store.derived.lean`; None is
-    ``"independent"``).
+    out unless ``outputs="all"`` (:func:`~sbrdf_xr.store.derived.lean`).
+
+    ``outputs=None`` (the default) is ``"independent"``, except on a resume of a ``.part``
+    store started with every variable: as :func:`write_netcdf_cube`, the resume keeps the
+    variables the ``.part`` has, and an ``outputs`` that differs from them is refused.
 
     Examples
     --------
@@ -213,7 +237,10 @@ def write_zarr_cube(
     ...         print(list(back.data_vars))
     ['signal_material']
     """
-    return write_zarr(lean(cube, outputs or OUTPUTS[0]), path, **options)
+    outputs = _part_outputs(
+        cube, Path(path), outputs, bool(options.get("resume")), _marker_fingerprint
+    )
+    return write_zarr(lean(cube, outputs), path, **options)
 
 
 def _netcdf_unfinished(path: str | os.PathLike[str]) -> str | None:

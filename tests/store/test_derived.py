@@ -9,7 +9,7 @@ import trimesh
 import xarray as xr
 
 from sbrdf_xr import Scene, geometry, load_spacecraft, simulate, write
-from sbrdf_xr.errors import ValidationError
+from sbrdf_xr.errors import CubeWriteError, ValidationError
 from sbrdf_xr.materials.schema import lambertian
 from sbrdf_xr.store import derived, open_cube
 from sbrdf_xr.testing import l_shaped_spacecraft, make_material
@@ -116,3 +116,31 @@ def test_bad_records_and_options_are_named(tmp_path):
     bad.attrs["derived_variables"] = "{not json"
     with pytest.raises(ValidationError, match="not readable JSON"):
         derived.with_derived(bad)
+
+
+class _Stop(Exception):
+    """Raised after the first stored block: a write cut short, its ``.part`` kept."""
+
+
+def _cut_after_one_block(event: object) -> None:
+    raise _Stop
+
+
+@pytest.mark.parametrize("name", ["cube.nc", "cube.zarr"])
+def test_a_part_begun_with_every_variable_resumes_with_them(tmp_path, name):
+    """A ``.part`` started with ``outputs="all"`` (or by a version that wrote every
+    variable) resumes with every variable when ``outputs`` is not given; another
+    ``outputs`` is refused, naming the one to resume with."""
+    scene = _scene()
+    path = tmp_path / name
+    with pytest.raises(Exception) as info:  # the writer wraps what stopped it
+        write(simulate(scene, chunk=4), path, outputs="all", on_block=_cut_after_one_block)
+    assert isinstance(info.value, _Stop) or isinstance(info.value.__cause__, _Stop)
+    assert not path.exists() and path.with_name(name + ".part").exists()
+    with pytest.raises(CubeWriteError, match=r"started with outputs='all'.*outputs='all'"):
+        write(simulate(scene, chunk=4), path, outputs="independent", resume=True)
+    write(simulate(scene, chunk=4), path, resume=True)
+    opened = xr.open_zarr(path) if name.endswith(".zarr") else xr.open_dataset(path)
+    with opened as back:
+        assert {"signal", "brdf", "signal_material"} <= set(back.data_vars)
+        _close(simulate(scene).signal, back.signal.load())
