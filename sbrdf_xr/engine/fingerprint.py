@@ -57,8 +57,19 @@ _GEOMETRY_FIELDS = (
     "attitude_angle",
     "observation",
 )
-#: Scene fields hashed on their own, or labels that do not change any value.
-_OTHER_FIELDS = ("spacecraft", "materials", "name", "description", "_checked", "_cache")
+#: Scene fields hashed on their own, or labels that do not change any value (the block
+#: sizes: a cube's values are those of every block size, so a ``.part`` begun with other
+#: blocks resumes, rechunked to its own).
+_OTHER_FIELDS = (
+    "spacecraft",
+    "materials",
+    "name",
+    "description",
+    "_checked",
+    "_cache",
+    "chunk",
+    "block_bytes",
+)
 #: Knobs renamed since cubes were first written, under the name their fingerprint keeps
 #: (so that a cube written before the rename still resumes).
 _FINGERPRINT_NAMES = {"earth_range": "earth_range_km"}

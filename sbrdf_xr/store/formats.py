@@ -148,7 +148,8 @@ def write_netcdf_cube(
     started with every variable (by ``outputs="all"``, or by a version that wrote every
     variable): the resume keeps the variables the ``.part`` has.  An ``outputs`` given
     that differs from the ``.part``'s is refused (:class:`~sbrdf_xr.errors.CubeWriteError`
-    naming the value to resume with).
+    naming the value to resume with).  A lazy cube is rechunked to the block sizes the
+    ``.part`` was started with (an older default ``block_bytes``, or another value of it).
 
     Examples
     --------
@@ -165,30 +166,36 @@ def write_netcdf_cube(
     ...         print(back.time.values.tolist() == cube.time.values.tolist())
     True
     """
-    outputs = _part_outputs(cube, Path(path), outputs, bool(options.get("resume")))
-    return write_cube(encode_times(lean(cube, outputs)), path, **options)
+    cube = _as_part(cube, Path(path), outputs, bool(options.get("resume")), _log_header)
+    return write_cube(encode_times(cube), path, **options)
 
 
-def _part_outputs(
+def _as_part(
     cube: Any,
     path: Path,
     outputs: str | None,
     resume: bool,
-    recorded: Callable[[Path], str | None] | None = None,
-) -> str:
-    """The ``outputs`` of a write: those asked (``"independent"`` for None), or on a resume
-    those the ``.part`` was started with, recognised by its fingerprint (``recorded(part)``:
-    the one its record holds, None where there is none; default the netCDF block log's)."""
+    recorded: Callable[[Path], dict[str, Any] | None],
+) -> Any:
+    """The cube to write: its derived variables left out unless ``outputs="all"``; on a
+    resume, the variables and the block sizes the ``.part`` was started with.
+
+    A ``.part`` is recognised by its fingerprint (``recorded(part)``: the header of its
+    record, None where there is none): a ``.part`` begun with every variable resumes with
+    them (an ``outputs`` asked that differs is refused, naming the one to resume with);
+    one begun with other block sizes (an older default ``block_bytes``) has the cube's
+    chunks made its own.  Anything else is left to the writer, which names what differs.
+    """
     part = path.with_name(path.name + PART_SUFFIX)
-    if not resume or not isinstance(cube, xr.Dataset) or outputs not in (None, *OUTPUTS):
-        return outputs or OUTPUTS[0]  # (an unknown value: lean says what is allowed)
-    found = (recorded or _log_fingerprint)(part)
-    if found is None:  # nothing to resume: the writer says what is there
-        return outputs or OUTPUTS[0]
-    prints = {o: layout_of(encode_times(lean(cube, o))).fingerprint for o in OUTPUTS}
+    header = recorded(part) if resume and isinstance(cube, xr.Dataset) else None
+    if header is None or outputs not in (None, *OUTPUTS):
+        return lean(cube, outputs or OUTPUTS[0])  # (an unknown value: lean says what is allowed)
+    found = header.get("fingerprint")
+    cubes = {o: _part_chunks(lean(cube, o), header) for o in OUTPUTS}
+    prints = {o: layout_of(encode_times(c)).fingerprint for o, c in cubes.items()}
     started = next((o for o, f in prints.items() if f == found), None)
     if started is None or len(set(prints.values())) == 1 or outputs in (None, started):
-        return started or outputs or OUTPUTS[0]  # (another cube: the writer refuses it)
+        return cubes[started or outputs or OUTPUTS[0]]  # (another cube: the writer refuses it)
     how = {"all": "every variable written", "independent": "the derived variables left out"}
     again = f"--outputs {started}" if cli_style() else f"outputs={started!r}"
     raise CubeWriteError(
@@ -199,18 +206,60 @@ def _part_outputs(
     )
 
 
-def _log_fingerprint(part: Path) -> str | None:
-    """The fingerprint in the block log of a netCDF ``.part`` (None without one)."""
+def _part_chunks(cube: xr.Dataset, header: dict[str, Any]) -> xr.Dataset:
+    """``cube`` rechunked to the block sizes recorded in a ``.part``'s ``header`` where it
+    is lazy and they tile its dimensions; unchanged otherwise."""
+    chunks = dict((header.get("structure") or {}).get("chunks") or [])
+    try:
+        now = cube.chunks
+    except ValueError:  # variables chunked differently along a dimension
+        now = {"": ()}
+    if not now or not chunks:
+        return cube
+    if any(
+        d not in cube.sizes or not isinstance(c, list) or sum(c) != cube.sizes[d]
+        for d, c in chunks.items()
+    ):
+        return cube
+    if all(tuple(now.get(d, ())) == tuple(c) for d, c in chunks.items()):
+        return cube
+
+    lazy = {v.get("name") for v in header["structure"].get("variables", []) if v.get("lazy")}
+
+    def own(names: Any) -> dict[Any, xr.Variable]:  # lazy or eager as in the .part
+        return {  # (variables: a DataArray would rechunk its coordinates with it)
+            n: cube[n].variable.chunk({d: tuple(chunks[d]) for d in cube[n].dims if d in chunks})
+            if n in lazy
+            else cube[n].variable.load()
+            for n in names
+            if n not in cube.indexes and (n in lazy or cube[n].chunks is not None)
+        }
+
+    out = cube.assign_coords(own(cube.coords)).assign(own(cube.data_vars))
+    recorded = (header.get("structure") or {}).get("attrs") or {}
+    out.attrs = {  # the attributes that describe the blocks: those of the .part's
+        **cube.attrs,
+        **{k: recorded[k] for k in _BLOCK_ATTRS if k in recorded and k in cube.attrs},
+    }
+    return out
+
+
+#: Global attributes of a simulated cube that describe its blocks, not its values.
+_BLOCK_ATTRS = ("knob_chunk", "plan")
+
+
+def _log_header(part: Path) -> dict[str, Any] | None:
+    """The header of the block log of a netCDF ``.part`` (None without one)."""
     try:
         header, _ = read_log(part.with_name(part.name[: -len(PART_SUFFIX)] + LOG_SUFFIX), part)
     except (OutputError, OSError):
         return None
-    return header.get("fingerprint")
+    return dict(header)
 
 
-def _marker_fingerprint(part: Path) -> str | None:
-    """The fingerprint in the marker of a Zarr ``.part`` store (None without one)."""
-    return (read_marker(part) or {}).get("fingerprint")
+def _marker_header(part: Path) -> dict[str, Any] | None:
+    """The marker of a Zarr ``.part`` store (None without one)."""
+    return read_marker(part)
 
 
 def write_zarr_cube(
@@ -219,9 +268,8 @@ def write_zarr_cube(
     """:func:`~sbrdf_xr.store.zarr_store.write_zarr` of ``cube``, its derived variables left
     out unless ``outputs="all"`` (:func:`~sbrdf_xr.store.derived.lean`).
 
-    ``outputs=None`` (the default) is ``"independent"``, except on a resume of a ``.part``
-    store started with every variable: as :func:`write_netcdf_cube`, the resume keeps the
-    variables the ``.part`` has, and an ``outputs`` that differs from them is refused.
+    A resume keeps the variables and the block sizes the ``.part`` store was started with,
+    as :func:`write_netcdf_cube`.
 
     Examples
     --------
@@ -237,10 +285,11 @@ def write_zarr_cube(
     ...         print(list(back.data_vars))
     ['signal_material']
     """
-    outputs = _part_outputs(
-        cube, Path(path), outputs, bool(options.get("resume")), _marker_fingerprint
+    return write_zarr(
+        _as_part(cube, Path(path), outputs, bool(options.get("resume")), _marker_header),
+        path,
+        **options,
     )
-    return write_zarr(lean(cube, outputs), path, **options)
 
 
 def _netcdf_unfinished(path: str | os.PathLike[str]) -> str | None:

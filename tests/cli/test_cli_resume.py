@@ -2,8 +2,9 @@
 
 A run is interrupted (``KeyboardInterrupt`` from the block callback, as Ctrl-C would)
 after two of five blocks; the command line's ``--resume`` then prints what the ``.part``
-keeps (blocks, complevel, chunks) and finishes the cube, or refuses a resume whose
-complevel, chunking or format differ from the ``.part``'s (a ``.part`` of the other
+keeps (blocks, complevel, chunks) and finishes the cube (with the ``.part``'s blocks if
+others are asked), or refuses a resume whose complevel, settings or format differ from the
+``.part``'s (a ``.part`` of the other
 format under the name, or the cube unfinished under the other format's suffix), in one
 line that names the difference, leaving the ``.part`` as it was.
 """
@@ -94,9 +95,9 @@ def test_resume_states_what_it_keeps(tmp_path, scene, capsys, suffix, level):
     ("extra", "match"),
     [
         (["--complevel", "5"], "started with complevel 2 .*Resume with --complevel 2"),
-        (["--set", "chunk=5"], r"different cube \(setting 'chunk': 2 -> 5\)"),
+        (["--set", "method=cubic"], r"different cube \(setting 'method': 'linear' -> 'cubic'\)"),
     ],
-    ids=["complevel", "chunking"],
+    ids=["complevel", "setting"],
 )
 def test_resume_refuses_another_layout_in_one_line(tmp_path, scene, capsys, suffix, extra, match):
     if suffix == ".zarr":
@@ -110,6 +111,22 @@ def test_resume_refuses_another_layout_in_one_line(tmp_path, scene, capsys, suff
     assert len(err) == 1 and re.search(match, err[0]), err
     assert "--overwrite" in err[0]
     assert snapshot(part) == before and not out.exists()
+
+
+@pytest.mark.parametrize("suffix", [".nc", ".zarr"])
+def test_resume_with_other_blocks_finishes_with_the_parts_own(tmp_path, scene, capsys, suffix):
+    """Block sizes do not change a value: a ``.part`` begun with other blocks (another
+    ``chunk`` or ``block_bytes``, or an older default) is finished with its own."""
+    if suffix == ".zarr":
+        pytest.importorskip("zarr")
+    out = tmp_path / f"cube{suffix}"
+    interrupted(scene, out, complevel=2)
+    argv = ["simulate", str(scene), "-o", str(out), "--resume", "-q", "--set", "chunk=5"]
+    assert main(argv) == 0
+    assert "those were kept" in capsys.readouterr().out
+    clean = write(simulate(scene), tmp_path / f"clean{suffix}", complevel=2)
+    xr.testing.assert_identical(read(out).drop_attrs(), read(clean).drop_attrs())
+    assert read(out).attrs["knob_chunk"] == 2  # the blocks it was begun with
 
 
 def test_resume_refuses_the_part_of_another_format(tmp_path, scene, capsys):

@@ -144,3 +144,19 @@ def test_a_part_begun_with_every_variable_resumes_with_them(tmp_path, name):
     with opened as back:
         assert {"signal", "brdf", "signal_material"} <= set(back.data_vars)
         _close(simulate(scene).signal, back.signal.load())
+
+
+@pytest.mark.parametrize("name", ["cube.nc", "cube.zarr"])
+def test_a_part_begun_with_other_block_sizes_resumes_with_them(tmp_path, name):
+    """A ``.part`` begun with other blocks (an older default ``block_bytes``) is finished
+    with its own: the resumed cube is rechunked to them, and equals one written whole."""
+    scene = _scene()
+    path = tmp_path / name
+    with pytest.raises(Exception):  # noqa: B017 - the writer wraps what stopped it
+        write(simulate(scene, chunk=4), path, on_block=_cut_after_one_block)
+    write(simulate(scene, chunk=7), path, resume=True)
+    opened = xr.open_zarr(path) if name.endswith(".zarr") else xr.open_dataset(path)
+    with opened as back:
+        _close(simulate(scene).signal_material, back.signal_material.load())
+        if name.endswith(".zarr"):
+            assert back.signal_material.encoding["chunks"][0] == 4  # the .part's blocks
