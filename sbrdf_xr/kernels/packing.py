@@ -19,6 +19,7 @@ from __future__ import annotations
 import threading
 from typing import Any, NamedTuple
 
+import numba
 import numba.typed
 import numpy as np
 from numpy.typing import DTypeLike, NDArray
@@ -353,9 +354,25 @@ _TYPED_LOCK = threading.Lock()
 _TYPED_KEEP = 8
 
 
+@numba.njit(cache=True, nogil=True)
+def _list_of(first):  # pragma: no cover - compiled
+    out = numba.typed.List()
+    out.append(first)
+    return out
+
+
+@numba.njit(cache=True, nogil=True)
+def _append(values, item):  # pragma: no cover - compiled
+    values.append(item)
+
+
 def typed_values(tables: PackedTables) -> Any:
     """``tables.values`` as the ``numba.typed.List`` the kernels take, built once per
     packing (building it costs about 70 us, paid on every block otherwise).
+
+    The list is made by two small compiled functions kept in numba's disk cache: a
+    ``numba.typed.List`` made from Python compiles its methods in every new process
+    (~2 s of CPU on the first list of each array type: each command, each Dask worker).
 
     Examples
     --------
@@ -372,7 +389,10 @@ def typed_values(tables: PackedTables) -> Any:
         hit = _TYPED.get(key)
         if hit is not None and hit[0] is tables.values:
             return hit[1]
-    typed = numba.typed.List([_readonly(v) for v in tables.values])
+    values = [_readonly(v) for v in tables.values]
+    typed = _list_of(values[0]) if values else numba.typed.List()
+    for v in values[1:]:
+        _append(typed, v)
     with _TYPED_LOCK:
         while len(_TYPED) >= _TYPED_KEEP:
             del _TYPED[next(iter(_TYPED))]
