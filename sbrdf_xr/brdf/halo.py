@@ -173,7 +173,8 @@ def halo_reflectance(
     a, b, g = (np.atleast_1d(np.asarray(x, dtype=np.float64)) for x in (halo_a, halo_b, halo_g))
     psi = np.arange(_N_PSI) * (2.0 * np.pi / _N_PSI)
     sb = np.sin(ti)
-    edge = -sb * np.cos(psi)[:, None] + np.sqrt(1.0 - (sb * np.sin(psi)[:, None]) ** 2)
+    root = np.sqrt(np.maximum(1.0 - (sb * np.sin(psi)[:, None]) ** 2, 0.0))
+    edge = np.maximum(root - sb * np.cos(psi)[:, None], 0.0)  # 0 at grazing, forward
     return a * _radial(edge, b, g).mean(axis=-2) * 2.0 * np.pi
 
 
