@@ -444,3 +444,28 @@ def test_the_core_fit_recovers_a_known_core_from_an_in_plane_scan():
     fit = models.fit_model(scan, "robertson-sandford-core")
     assert float(fit.core_roughness[0]) == pytest.approx(0.006, rel=0.02)
     assert float(fit.core_rho[0]) == pytest.approx(0.4, rel=0.02)
+
+
+@pytest.mark.slow
+def test_the_halo_fit_follows_a_known_halo_but_does_not_identify_it():
+    """A scan of the model with a halo (0.5-degree steps, three incidence angles): the
+    fitted model follows the scan to 2.4 % rms in the logarithm, but its parameters are
+    not the model's: the body's lobe takes part of the halo (b 0.10 for 0.05) and the
+    halo's power goes to its bound 4 (for 2.8).  The fit alternates body and core plus
+    halo; a joint fit of all of them would be needed to identify them.  The core is
+    recovered (rms slope within 1 %)."""
+    spec = models.model_material(
+        "robertson_sandford_halo", [532.0], material="glint", provenance="test",
+        rho_D=0.05, epsilon=0.5, b=0.05, e=0.04, core_rho=0.4, core_roughness=0.006,
+        halo_a=1e-4, halo_b=0.01**2.8, halo_g=2.8,
+    )  # fmt: skip
+    ti, dt = np.meshgrid([5.0, 40.0, 60.0], np.arange(-20.0, 20.5, 0.5), indexing="ij")
+    ti, dt = ti.ravel(), dt.ravel()
+    truth = models.spectra(spec, ti, dt, 0.0)
+    scan = measurement_set(ti, dt, np.zeros(ti.size), [532.0], truth, material="glint",
+                           provenance="test")  # fmt: skip
+    fit = models.fit_model(scan, "robertson-sandford-halo")
+    assert fit.attrs["rms_log"] < 0.03
+    assert float(fit.core_roughness[0]) == pytest.approx(0.006, rel=0.01)
+    err = np.abs(np.log(models.spectra(fit, ti, dt, 0.0) / truth))
+    assert np.median(err) < 0.03
