@@ -16,11 +16,12 @@ r"""Robertson–Sandford body, Beckmann specular core and a Harvey–Shack ABg h
   that a polished surface's scatter is shift-invariant in direction-cosine space: the
   same function of ``|beta - beta_0|`` at every incidence angle.  It is reciprocal
   (symmetric in ``s`` and ``o``) and isotropic about the mirror direction.  Measured
-  in-plane scans of a near-mirror show it: the Starlink chassis' scans (532 nm) fall
-  from the core to the body over two to four degrees as a power of the angle from
-  specular, and the halo at 5 and 60 deg incidence agrees once the angle is
-  measured in direction cosines (``cos theta_r`` times the angle), where a Gaussian
-  core is 10 to 100 times below it.
+  in-plane scans of a near-mirror show such a halo: the Starlink chassis' scans (532
+  nm) fall from the core to the body over two to four degrees as a power of the angle
+  from specular (about the 2.5th power at 60 deg incidence, and the halo at 5 and 60
+  deg follows one such power law once the angle is measured in direction cosines,
+  ``cos theta_r`` times the angle), where a Gaussian core as wide as the measured peak
+  falls a factor 3 below the samples at two degrees and orders of magnitude at three.
 * Energy (:func:`energy_scale`): the model is scaled at each incidence angle by
   ``s = min(1, 1 / (1 - epsilon(theta_i) + core_rho cos theta_i + H(theta_i)))``,
   ``H`` a bound of the halo's directional-hemispherical reflectance: the halo over the
