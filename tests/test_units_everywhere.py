@@ -235,6 +235,27 @@ def _core() -> dict[str, Any]:
     return {**_rs(), "core_rho": 0.2, "core_roughness": 0.01}
 
 
+def _halo() -> dict[str, Any]:
+    return {**_core(), "halo_a": 1e-3, "halo_b": 1e-5, "halo_g": 2.5}
+
+
+def _fit_halo_case() -> dict[str, Any]:
+    """Core and halo 0.3 deg off specular on a flat body, the model itself (the fit
+    converges to rounding), and one sample below the horizon the model cannot take
+    (rms_log far from zero, no parameter moved by it); the core alone fitted as the start."""
+    from sbrdf_xr.brdf.halo import halo_brdf
+    from sbrdf_xr.brdf.specular_core import core_brdf, fit_core
+    from sbrdf_xr.geometry import facet_vectors
+
+    t, d, p = np.full(82, 30.0), np.append(np.linspace(-8.0, 8.0, 81), 70.0), np.zeros(82)
+    vec = facet_vectors(t, d - 0.3, p)
+    spectra = 0.2 + core_brdf(*vec, [0.3 * np.cos(np.radians(30.0))], [0.008])
+    spectra = spectra + halo_brdf(*vec, [1e-2], [0.03**2.5], [2.5])
+    spectra[-1] = 0.3
+    case = dict(theta_i=t, delta_theta=d, phi=p, spectra=spectra, body=np.full((82, 1), 0.2))
+    return {**case, "core": fit_core(**case)}
+
+
 _MICRO = {"roughness": 0.2, "n": 1.5, "k": 0.0, "rho_d": 0.1}
 _ANISO = {"alpha_x": 0.2, "alpha_y": 0.3, "n": 1.5, "k": 0.0, "rho_d": 0.1}
 _LAMBERT = {"rho": 0.4}
@@ -577,6 +598,25 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         theta_i=[20.0, 60.0], wavelength=[4000.0], **_core()
     ),
     "sbrdf_xr.brdf.specular_core.fit_core": _fit_core_case,
+    "sbrdf_xr.brdf.halo.brdf": _brdf_case(_halo, wl=[4000.0]),
+    "sbrdf_xr.brdf.halo.directional_hemispherical_reflectance": lambda: dict(
+        theta_i=[20.0, 60.0], wavelength=[4000.0], **_halo()
+    ),
+    "sbrdf_xr.brdf.halo.energy_scale": lambda: dict(
+        theta_i=[20.0, 60.0], wavelength=[4000.0], **_halo()
+    ),
+    "sbrdf_xr.brdf.halo.halo_reflectance": lambda: dict(
+        theta_i=[0.0, 60.0], halo_a=[1e-3], halo_b=[1e-5], halo_g=[2.5]
+    ),
+    "sbrdf_xr.brdf.halo.fit_halo": _fit_halo_case,
+    "sbrdf_xr.brdf.halo.halo_brdf": lambda: dict(
+        normal=[0.0, 0.0, 1.0],
+        to_sun=[0.5, 0.0, 0.866],
+        to_observer=[-0.52, 0.0, 0.85],
+        halo_a=[1e-3],
+        halo_b=[1e-5],
+        halo_g=[2.5],
+    ),
     "sbrdf_xr.brdf.robertson_sandford_angular.angular_g": lambda: dict(theta=[20.0, 45.0], b=0.5),
     "sbrdf_xr.brdf.robertson_sandford_angular.cutoff_factor": lambda: dict(
         theta_r=[45.0, 85.0], b=0.12

@@ -32,6 +32,9 @@ Models
 ``"robertson_sandford_core"``
     Robertson–Sandford plus a narrow Beckmann specular core, for near-mirrors measured
     in-plane (:mod:`~sbrdf_xr.brdf.specular_core`).
+``"robertson_sandford_halo"``
+    The same with a Harvey–Shack ABg halo between the core and the body
+    (:mod:`~sbrdf_xr.brdf.halo`).
 
 Anisotropic models (:data:`ANISOTROPIC_MODELS`) take the facet tangent as well: their
 ``brdf`` has a ``tangent`` keyword, ``brdf_angles`` and ``render_grid`` a ``psi``
@@ -44,6 +47,7 @@ keyword (a table with an extra ``psi`` axis).
 
 from . import (
     anisotropic,
+    halo,
     lambert,
     microfacet,
     optics,
@@ -62,6 +66,7 @@ __all__ = [
     "Parameter",
     "anisotropic",
     "get_model",
+    "halo",
     "lambert",
     "microfacet",
     "optics",
@@ -80,7 +85,7 @@ MODELS = BRDF_MODELS.view(anisotropic=False)
 ANISOTROPIC_MODELS = BRDF_MODELS.view(anisotropic=True)
 
 #: The package's models, one line each.
-_REGISTERED = (lambert, robertson_sandford, microfacet, anisotropic, specular_core)
+_REGISTERED = (lambert, robertson_sandford, microfacet, anisotropic, specular_core, halo)
 
 
 def get_model(name: str) -> Model:
@@ -109,7 +114,7 @@ def get_model(name: str) -> Model:
     ...
     sbrdf_xr.errors.ValidationError: model: got 'phong'; valid model names are
     ['anisotropic_microfacet', 'lambert', 'microfacet', 'robertson_sandford',
-    'robertson_sandford_core'] (case-insensitive)
+    'robertson_sandford_core', 'robertson_sandford_halo'] (case-insensitive)
     """
     return BRDF_MODELS[name]
 

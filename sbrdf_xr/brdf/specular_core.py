@@ -228,6 +228,15 @@ def brdf(
     True
     """
     p = MODEL.check_params(wavelength, **params)
+    out, ti, dtype = _unscaled(normal, to_sun, to_observer, wavelength, p)
+    return _cast_out(out * _scale(ti, wavelength, p), dtype)
+
+
+def _unscaled(
+    normal: ArrayLike, to_sun: ArrayLike, to_observer: ArrayLike, wavelength: ArrayLike, p: Any
+) -> tuple[NDArray[np.float64], NDArray[np.float64], np.dtype]:
+    """Body plus core before :func:`energy_scale` [sr-1], the incidence angles [degree]
+    (90 where unlit) and the output dtype; ``p`` checked parameters."""
     body: dict[str, Any] = {k: p[k] for k in rs.PARAMS}
     n, s, _, cos_i, _, _, dtype = _facet_frame(normal, to_sun, to_observer)
     out = np.asarray(rs.brdf(normal, to_sun, to_observer, wavelength, **body), dtype=np.float64)
@@ -235,15 +244,20 @@ def brdf(
     ti = np.degrees(np.arctan2(sin_i, np.maximum(cos_i, 0.0)))  # 90 where unlit: no light
     rho = p["core_rho"] * np.cos(np.radians(ti))[..., None]
     out = out + core_brdf(normal, to_sun, to_observer, rho, p["core_roughness"])
-    return _cast_out(out * _scale(ti, wavelength, p), dtype)
+    return out, ti, dtype
+
+
+def _most(ti: np.ndarray, wavelength: ArrayLike, p: Any) -> NDArray[np.float64]:
+    """``1 - epsilon(theta_i) + core_rho cos theta_i``: at least what body and core
+    reflect [1], ``ti.shape + (n_wl,)``."""
+    body: dict[str, Any] = {k: p[k] for k in rs.PARAMS}
+    most = 1.0 - rs.directional_emissivity(ti, wavelength, **body)
+    return np.asarray(most + p["core_rho"] * np.cos(np.radians(ti))[..., None], dtype=np.float64)
 
 
 def _scale(ti: np.ndarray, wavelength: ArrayLike, p: dict[str, Any]) -> NDArray[np.float64]:
     """``min(1, 1 / (1 - epsilon(theta_i) + core_rho cos theta_i))``, ``ti.shape + (n_wl,)``."""
-    body: dict[str, Any] = {k: p[k] for k in rs.PARAMS}
-    most = 1.0 - rs.directional_emissivity(ti, wavelength, **body)
-    most = most + p["core_rho"] * np.cos(np.radians(ti))[..., None]
-    return 1.0 / np.maximum(most, 1.0)
+    return 1.0 / np.maximum(_most(ti, wavelength, p), 1.0)
 
 
 def energy_scale(theta_i: ArrayLike, wavelength: ArrayLike, **params: Any) -> NDArray[np.float64]:
@@ -358,12 +372,17 @@ def directional_hemispherical_reflectance(
     """
     p = MODEL.check_params(wavelength, **params)
     ti = _check_theta_i(theta_i)
+    return _unscaled_reflectance(ti, wavelength, p) * _scale(ti, wavelength, p)
+
+
+def _unscaled_reflectance(ti: np.ndarray, wavelength: ArrayLike, p: Any) -> NDArray[np.float64]:
+    """Body's plus core's reflectance before :func:`energy_scale` [1]."""
     body_params: dict[str, Any] = {k: p[k] for k in rs.PARAMS}
     body = rs.directional_hemispherical_reflectance(ti, wavelength, **body_params)
     ms, inverse = np.unique(p["core_roughness"], return_inverse=True)
     loss = np.stack([core_loss(ti, mj) for mj in ms], axis=-1)[..., inverse.ravel()]
     core = p["core_rho"] * np.cos(np.radians(ti))[..., None] * loss
-    return (body + core) * _scale(ti, wavelength, p)
+    return np.asarray(body + core, dtype=np.float64)
 
 
 def fit_core(

@@ -16,7 +16,12 @@ from typing import Any
 __all__ = ["MODELS", "add_material_parser", "cmd_material_build"]
 
 #: The fitted models ``--model`` names (or a model netCDF file).
-MODELS = ("robertson-sandford", "microfacet", "robertson-sandford-core")
+MODELS = (
+    "robertson-sandford",
+    "microfacet",
+    "robertson-sandford-core",
+    "robertson-sandford-halo",
+)
 
 
 def add_material_parser(sub: Any) -> argparse.ArgumentParser:

@@ -38,6 +38,7 @@ __all__ = [
     "fit_model",
     "fit_robertson_sandford",
     "fit_robertson_sandford_core",
+    "fit_robertson_sandford_halo",
     "measure",
     "model_material",
     "model_parameters",
@@ -557,7 +558,48 @@ def fit_robertson_sandford_core(measurements: xr.Dataset) -> xr.Dataset:
     >>> fit.attrs["source"], bool(fit.core_rho[0] > 0)
     ('model:robertson_sandford_core', True)
     """
+    return _fit_body_core(measurements, halo=False)
+
+
+def fit_robertson_sandford_halo(measurements: xr.Dataset) -> xr.Dataset:
+    """Fit the Robertson-Sandford model with a specular core and an ABg halo.
+
+    As :func:`fit_robertson_sandford_core`, with the core and a Harvey-Shack ABg halo
+    (:mod:`sbrdf_xr.brdf.halo`) fitted together beside the body, in the logarithm,
+    after each fit of the core alone (:func:`sbrdf_xr.brdf.halo.fit_halo`); the body
+    refitted without the samples where core and halo together exceed it, until the
+    core's rms slope and the halo's power change by less than 0.1 %.  For a near-mirror
+    whose measured peak falls to the body through a halo of a few degrees (the
+    Starlink chassis).
+
+    Parameters
+    ----------
+    measurements : xarray.Dataset
+        A measurement set (:func:`sbrdf_xr.materials.tables.validate_measurements`).
+
+    Returns
+    -------
+    xarray.Dataset
+        The fitted model material (``robertson_sandford_halo``; attribute ``rms_log``,
+        the fit's root-mean-square log residual [1]).
+
+    Examples
+    --------
+    >>> spec = model_material("robertson_sandford_halo", [550.0], material="glint",
+    ...                       provenance="doc", rho_D=0.3, epsilon=0.1, b=0.1, e=0.3,
+    ...                       core_rho=0.2, core_roughness=0.01, halo_a=1e-3,
+    ...                       halo_b=1e-5, halo_g=2.5)
+    >>> fit = fit_robertson_sandford_halo(measure(spec, [20.0, 40.0, 60.0]))
+    >>> fit.attrs["source"], bool(fit.halo_a[0] > 0)
+    ('model:robertson_sandford_halo', True)
+    """
+    return _fit_body_core(measurements, halo=True)
+
+
+def _fit_body_core(measurements: xr.Dataset, halo: bool) -> xr.Dataset:
+    """The body, the core and (``halo``) the halo fitted in turn (the fits above)."""
     from .._names import MEASURED, SAMPLE
+    from ..brdf import halo as halo_model
     from ..brdf import specular_core
     from ..geometry import facet_vectors
     from .schema import reference_mask, validate_measurements
@@ -568,32 +610,45 @@ def fit_robertson_sandford_core(measurements: xr.Dataset) -> xr.Dataset:
     spectra_ = np.asarray(ds[MEASURED].transpose(SAMPLE, WAVELENGTH).values, dtype=np.float64)
     ref = reference_mask(ds)
     body_at = np.ones(ref.size, dtype=bool)  # the samples the body is fitted to
-    last = np.inf
+    last = np.array([np.inf, np.inf])
+    vectors = facet_vectors(*angles)
     for _ in range(_CORE_ITERATIONS):
         body = fit_robertson_sandford(ds.isel({SAMPLE: np.flatnonzero(body_at)}))
         b_vals = spectra(body, *angles)
         core = specular_core.fit_core(*angles, spectra_, b_vals, reference=ref)
-        if abs(core["core_roughness"] / last - 1.0) < 1e-3:
+        if halo:
+            core = halo_model.fit_halo(*angles, spectra_, b_vals, core, reference=ref)
+        now = np.array([core["core_roughness"], core.get("halo_g", 1.0)])
+        if np.all(np.abs(now / last - 1.0) < 1e-3):
             break
-        last = core["core_roughness"]
+        last = now
         c_vals = specular_core.core_brdf(
-            *facet_vectors(*angles),
+            *vectors,
             core["core_rho"] * np.cos(np.radians(angles[0]))[:, None],  # its fitted law
             np.full(core["core_rho"].shape, core["core_roughness"]),
         )
+        if halo:
+            h = [np.broadcast_to(core[k], wl.shape) for k in ("halo_a", "halo_b", "halo_g")]
+            c_vals = c_vals + halo_model.halo_brdf(*vectors, *h)
         body_at = np.all(c_vals < b_vals, axis=1) | ref  # the core's samples left to it
     name = ds.attrs.get("material", "unnamed")
     params: dict[str, Any] = {k: body[k].values for k in ("rho_D", "epsilon", "b", "e")}
+    params.update(core_rho=core["core_rho"], core_roughness=core["core_roughness"])
+    what, model = "a specular core", "robertson_sandford_core"
+    if halo:
+        params.update({k: core[k] for k in ("halo_a", "halo_b", "halo_g")})
+        what = f"a specular core and an ABg halo (g {core['halo_g']:.3g}, B {core['halo_b']:.3g})"
+        model = "robertson_sandford_halo"
     out = model_material(
-        "robertson_sandford_core", wl, material=name,
-        provenance=f"Robertson-Sandford fit with a specular core to the measurements of {name} "
+        model, wl, material=name,
+        provenance=f"Robertson-Sandford fit with {what} to the measurements of {name} "
         f"(core rms slope {core['core_roughness']:.3g}, core offsets "
         f"{', '.join(f'{x:.2f}' for x in core['core_offset'])} deg, rms log residual "
         f"{core['rms_log']:.3g}, {core['n_used']} residuals)",
-        core_rho=core["core_rho"], core_roughness=core["core_roughness"], **params,
+        **params,
     )  # fmt: skip
     out.attrs["rms_log"] = core["rms_log"]
-    out.attrs["source"] = "model:robertson_sandford_core"
+    out.attrs["source"] = f"model:{model}"
     return out
 
 
@@ -605,6 +660,7 @@ FITS = {
     "robertson-sandford": fit_robertson_sandford,
     "microfacet": fit_microfacet,
     "robertson-sandford-core": fit_robertson_sandford_core,
+    "robertson-sandford-halo": fit_robertson_sandford_halo,
 }
 
 
@@ -615,8 +671,9 @@ def fit_model(measurements: xr.Dataset, name: str = "robertson-sandford") -> xr.
     ----------
     measurements : xarray.Dataset
         A measurement set.
-    name : {"robertson-sandford", "microfacet", "robertson-sandford-core"}
-        The fit.
+    name : str
+        The fit: ``"robertson-sandford"``, ``"microfacet"``, ``"robertson-sandford-core"``
+        or ``"robertson-sandford-halo"``.
 
     Returns
     -------

@@ -15,7 +15,7 @@ that is zero where samples above the floor are not is an error
 from __future__ import annotations
 
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 import numpy as np
@@ -253,7 +253,7 @@ def _holdout_check(
     *,
     every: int = 4,
     floor: float = CHECK_FLOOR,
-    fold: int | None = None,
+    folds: Iterable[int] | None = None,
 ) -> dict[str, Any]:
     """The leave-out check: held-out samples predicted by a table built without them.
 
@@ -261,7 +261,10 @@ def _holdout_check(
     its two ends kept in) is left out; ``build`` makes a table from the rest (with its
     own fit), which is looked up at them.  The floor is that of the whole scan.  Fold
     ``j`` holds out the samples whose index among the scan's inner samples is ``j``
-    modulo ``every``; the check is fold ``every // 2`` (:func:`_kfold_check` runs them all).
+    modulo ``every``.  The build's own check is fold ``every // 2`` (``folds`` not
+    given); ``folds=range(every)`` holds every inner sample out once (``every``
+    builds) and pools the relative errors of all folds: about ``every`` times the
+    held-out samples, so one sample moves the median far less.
 
     Parameters
     ----------
@@ -279,14 +282,17 @@ def _holdout_check(
         Hold out every ``every``-th sample, ``>= 2``.
     floor : float, default :data:`CHECK_FLOOR`
         Relative noise floor [1].
-    fold : int, optional
-        Which of the ``every`` folds, ``0 <= fold < every``; default ``every // 2``.
+    folds : iterable of int, optional
+        Which folds, each ``0 <= j < every``; default the one fold ``every // 2``.
 
     Returns
     -------
     dict
-        ``holdout_check_median``, ``_p95``, ``_worst``, ``_n`` and ``holdout_every``;
-        with ``fold`` given, the relative errors too (``rel``, NaN where not held out).
+        Without ``folds``: ``holdout_check_median``, ``_p95``, ``_worst``, ``_n`` and
+        ``holdout_every`` (the build's attributes).  With ``folds``: the same statistics
+        pooled over the folds as ``holdout_kfold_*``, ``holdout_every``,
+        ``holdout_fold_medians`` (one per fold) and the relative errors ``rel`` (NaN
+        where not held out).
 
     Examples
     --------
@@ -297,16 +303,49 @@ def _holdout_check(
     >>> from sbrdf_xr.materials import constant_material
     >>> from sbrdf_xr.materials.selfcheck import _holdout_check
     >>> ti, dt, ph = np.full(9, 30.0), np.linspace(-20.0, 20.0, 9), np.zeros(9)
-    >>> out = _holdout_check(lambda m: constant_material(0.1, [550.0], material="c"),
-    ...                     xr.Dataset(), (ti, dt, ph), np.full((9, 1), 0.1), np.zeros(9, bool))
+    >>> args = (lambda m: constant_material(0.1, [550.0], material="c"), xr.Dataset(),
+    ...         (ti, dt, ph), np.full((9, 1), 0.1), np.zeros(9, bool))
+    >>> out = _holdout_check(*args)
     >>> out["holdout_check_n"], out["holdout_check_worst"]
     (2, 0.0)
+    >>> out = _holdout_check(*args, folds=range(4))
+    >>> out["holdout_kfold_n"], out["holdout_kfold_worst"], out["holdout_fold_medians"]
+    (7, 0.0, [0.0, 0.0, 0.0, 0.0])
     """
     if int(every) < 2:
         raise ValidationError(f"holdout: must be >= 2 (or 0 for none), got {every}")
-    j = every // 2 if fold is None else int(fold)
-    if not 0 <= j < every:
-        raise ValidationError(f"fold: must lie in [0, {every - 1}], got {fold}")
+    chosen = [every // 2] if folds is None else [int(j) for j in folds]
+    for j in chosen:
+        if not 0 <= j < every:
+            raise ValidationError(f"folds: each must lie in [0, {every - 1}], got {j}")
+    rel = np.full(np.shape(spectra), np.nan)
+    medians = []
+    for j in chosen:
+        one = _one_fold(build, ds, angles, spectra, reference, every, floor, j)
+        medians.append(_summary(one)["median"])
+        rel = np.where(np.isfinite(one), one, rel)
+    if folds is None:
+        return {**check_attrs("holdout_check", rel), "holdout_every": int(every)}
+    return {
+        **check_attrs("holdout_kfold", rel),
+        "holdout_every": int(every),
+        "holdout_fold_medians": medians,
+        "rel": rel,
+    }
+
+
+def _one_fold(
+    build: Callable[[xr.Dataset], xr.DataArray],
+    ds: xr.Dataset,
+    angles: tuple[np.ndarray, np.ndarray, np.ndarray],
+    spectra: np.ndarray,
+    reference: np.ndarray,
+    every: int,
+    floor: float,
+    j: int,
+) -> np.ndarray:
+    """Fold ``j`` of :func:`_holdout_check`: the relative errors [1] at its held-out
+    samples, NaN elsewhere."""
     ti, dt, _ = angles
     hold = np.zeros(ti.size, dtype=bool)
     for t in np.unique(ti):
@@ -318,58 +357,4 @@ def _holdout_check(
         table = build(ds.isel({SAMPLE: np.flatnonzero(~hold)}) if SAMPLE in ds.dims else ds)
     rel, _, _ = sample_errors(table, *angles, spectra, reference, floor)
     rel[~hold] = np.nan
-    out = {**check_attrs("holdout_check", rel), "holdout_every": int(every)}
-    return out if fold is None else {**out, "rel": rel}
-
-
-def _kfold_check(
-    build: Callable[[xr.Dataset], xr.DataArray],
-    ds: xr.Dataset,
-    angles: tuple[np.ndarray, np.ndarray, np.ndarray],
-    spectra: np.ndarray,
-    reference: np.ndarray,
-    *,
-    every: int = 4,
-    floor: float = CHECK_FLOOR,
-) -> dict[str, Any]:
-    """The leave-out check over all ``every`` folds: every inner sample held out once.
-
-    :func:`_holdout_check` for folds ``0 .. every - 1`` (``every`` builds), the relative
-    errors of all folds pooled: about ``every`` times the held-out samples of the one
-    fold the build records, so one sample moves the median far less.
-
-    Parameters
-    ----------
-    build, ds, angles, spectra, reference, every, floor
-        As :func:`_holdout_check` (``floor`` [1]).
-
-    Returns
-    -------
-    dict
-        ``holdout_kfold_median``, ``_p95``, ``_worst``, ``_n``, ``holdout_every`` and
-        ``holdout_fold_medians`` (one per fold).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> import xarray as xr
-    >>> from sbrdf_xr.materials import constant_material
-    >>> from sbrdf_xr.materials.selfcheck import _kfold_check
-    >>> ti, dt, ph = np.full(9, 30.0), np.linspace(-20.0, 20.0, 9), np.zeros(9)
-    >>> out = _kfold_check(lambda m: constant_material(0.1, [550.0], material="c"),
-    ...                    xr.Dataset(), (ti, dt, ph), np.full((9, 1), 0.1), np.zeros(9, bool))
-    >>> out["holdout_kfold_n"], out["holdout_kfold_worst"]
-    (7, 0.0)
-    """
-    folds = [
-        _holdout_check(build, ds, angles, spectra, reference, every=every, floor=floor, fold=j)
-        for j in range(int(every))
-    ]
-    rel = np.full(np.shape(spectra), np.nan)
-    for f in folds:
-        rel = np.where(np.isfinite(f["rel"]), f["rel"], rel)
-    return {
-        **check_attrs("holdout_kfold", rel),
-        "holdout_every": int(every),
-        "holdout_fold_medians": [f["holdout_check_median"] for f in folds],
-    }
+    return rel

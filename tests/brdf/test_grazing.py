@@ -49,6 +49,14 @@ PARAMS = {
     },
     "robertson_sandford": dict(RS.TABLE4["AFGL-01"]),
     "robertson_sandford_core": {**RS.TABLE4["AFGL-01"], "core_rho": 0.2, "core_roughness": 0.01},
+    "robertson_sandford_halo": {
+        **RS.TABLE4["AFGL-01"],
+        "core_rho": 0.2,
+        "core_roughness": 0.01,
+        "halo_a": 1e-3,
+        "halo_b": 1e-5,
+        "halo_g": 2.5,
+    },
 }
 RECIPROCAL = sorted(name for name, m in BRDF_MODELS.items() if m.reciprocal)
 TANGENT = np.array([np.cos(0.4), np.sin(0.4), 0.0])

@@ -21,13 +21,30 @@ PARAMS = {
         "core_rho": [0.2, 0.25, 0.3],
         "core_roughness": 0.05,
     },
+    "robertson_sandford_halo": {
+        "rho_D": 0.07,
+        "epsilon": [0.85, 0.8, 0.7],
+        "b": 0.12,
+        "e": 0.12,
+        "core_rho": [0.2, 0.25, 0.3],
+        "core_roughness": 0.05,
+        "halo_a": [1e-3, 2e-3, 3e-3],
+        "halo_b": 1e-5,
+        "halo_g": 2.5,
+    },
 }
 #: render_grid and brdf_angles evaluate the same arithmetic on the same points.
 TOL_SAME = 1e-14
 
 
 def test_registry_names():
-    assert set(MODELS) == {"lambert", "robertson_sandford", "microfacet", "robertson_sandford_core"}
+    assert set(MODELS) == {
+        "lambert",
+        "robertson_sandford",
+        "microfacet",
+        "robertson_sandford_core",
+        "robertson_sandford_halo",
+    }
     assert set(PARAMS) == set(MODELS)
 
 

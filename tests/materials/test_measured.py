@@ -31,7 +31,7 @@ from sbrdf_xr.materials.coverage import (
     specular_distance,
 )
 from sbrdf_xr.materials.readers import measurement_set
-from sbrdf_xr.materials.selfcheck import _kfold_check, _self_check, sample_errors
+from sbrdf_xr.materials.selfcheck import _holdout_check, _self_check, sample_errors
 
 WL = np.array([450.0, 550.0, 650.0])
 #: Lambert 0.3 plus a lobe: the Robertson-Sandford model (paper 001) with rho_D = 0.3.
@@ -362,23 +362,37 @@ def test_the_starlink_solar_array_predicts_held_out_samples():
 
 
 @pytest.mark.slow
-def test_the_starlink_chassis_predicts_held_out_samples_with_its_specular_core():
+def test_the_starlink_chassis_predicts_held_out_samples_with_its_core_and_halo():
     """The shipped chassis (a Robertson-Sandford fill with a Beckmann core that follows
-    the incidence angle) against the same leave-out check.  Its 13 held-out samples
-    above the floor: median 11.8 %, 95th percentile 60 %, worst 63 % (10.7 %, 56 %,
-    60 % with one constant core fitted in the logarithm; 16.1 %, 75 %, 76 % with the
-    Robertson-Sandford fill alone).  The core samples at 5, 41.4 and 60 deg are now
-    within 8 %, 6 % and 19 % (54 %, 52 %, 23 % before); what is left is the halo two to
-    four degrees from specular, which neither the Gaussian core nor the body's lobe
-    follows.  The build is deterministic: the bounds leave room for the optimiser's
-    rounding across platforms, not for a worse fit."""
+    the incidence angle and a Harvey-Shack ABg halo, fitted together in the logarithm)
+    against the same leave-out check.  Its 13 held-out samples above the floor: median
+    8.7 %, 95th percentile 38 %, worst 38 % (11.8 %, 60 %, 63 % with the core alone;
+    10.7 %, 56 %, 60 % with one constant core fitted in the logarithm; 16.1 %, 75 %,
+    76 % with the Robertson-Sandford fill alone).  The halo takes the samples two to
+    four degrees from specular (at 75 deg incidence, -2 and +2 deg: 1 % and 9 %, 63 % and
+    57 % with the core alone).  The build is deterministic: the bounds leave room for
+    the optimiser's rounding across platforms, not for a worse fit."""
     table = catalog.load("starlink-v1.5-chassis")
-    assert table.attrs["extrapolation_model"] == "robertson_sandford_core"
+    assert table.attrs["extrapolation_model"] == "robertson_sandford_halo"
     assert table.attrs["self_check_worst"] < 1e-9
     assert table.attrs["holdout_check_n"] == 13
-    assert table.attrs["holdout_check_median"] < 0.125
-    assert table.attrs["holdout_check_p95"] < 0.62
-    assert table.attrs["holdout_check_worst"] < 0.65
+    assert table.attrs["holdout_check_median"] < 0.09
+    assert table.attrs["holdout_check_p95"] < 0.39
+    assert table.attrs["holdout_check_worst"] < 0.39
+
+
+@pytest.mark.slow
+def test_the_starlink_chassis_fit_reflects_at_most_one():
+    """The fitted model of the chassis (body, core and halo; the halo's fitted power
+    3.6) reflects at most one at every incidence angle, by the model's own reflectance
+    (its quadratures are checked against independent ones in tests/brdf/test_halo.py)."""
+    fit = models.fit_model(
+        catalog.load("starlink-v1.5-chassis-measurements"), "robertson-sandford-halo"
+    )
+    mod, wl, kw = models.model_parameters(fit)
+    rho = mod.directional_hemispherical_reflectance(np.arange(0.0, 90.5, 1.0), wl, **kw)
+    assert np.all(np.isfinite(rho)) and np.all(rho <= 1.0 + 1e-12)
+    assert float(fit.halo_a[0]) > 0.0 and 1.0 < float(fit.halo_g[0]) < 4.0
 
 
 def _scans(name):
@@ -396,17 +410,19 @@ def _scans(name):
 def test_the_starlink_chassis_k_fold_leave_out_check():
     """All four folds of the leave-out check (each inner sample of each scan held out
     once, four builds): 54 held-out samples above the floor instead of 13, so one sample
-    moves the median by about 1 % instead of several.  Measured: median 11.7 %, 95th
-    percentile 216 %, worst 280 %, fold medians 9.1, 27.6, 11.8, 11.5 % (one constant
-    core fitted in the logarithm: 19.3 %, 180 %, 493 %).  Fold 2 is the build's own
-    check, to the last bit."""
+    moves the median by about 1 % instead of several.  Measured: median 11.4 %, 95th
+    percentile 141 %, worst 356 %, fold medians 12.9, 7.9, 8.7, 12.8 % (with the core
+    alone: 11.7 %, 216 %, 280 %, folds 9.1, 27.6, 11.8, 11.5 %; one constant core
+    fitted in the logarithm: 19.3 %, 180 %, 493 %).  Fold 2 is the build's own check,
+    to the last bit."""
     ds, angles, spectra, ref = _scans("starlink-v1.5-chassis-measurements")
     build = functools.partial(
-        build_lut, model="robertson-sandford-core", check_energy="clamp", holdout=0
+        build_lut, model="robertson-sandford-halo", check_energy="clamp", holdout=0
     )
-    out = _kfold_check(build, ds, angles, spectra, ref)
+    out = _holdout_check(build, ds, angles, spectra, ref, folds=range(4))
     assert out["holdout_kfold_n"] == 54
-    assert out["holdout_kfold_median"] < 0.125
+    assert out["holdout_kfold_median"] < 0.116
+    assert out["holdout_kfold_p95"] < 1.45
     table = catalog.load("starlink-v1.5-chassis")
     assert out["holdout_fold_medians"][2] == table.attrs["holdout_check_median"]
 
@@ -428,3 +444,28 @@ def test_the_core_fit_recovers_a_known_core_from_an_in_plane_scan():
     fit = models.fit_model(scan, "robertson-sandford-core")
     assert float(fit.core_roughness[0]) == pytest.approx(0.006, rel=0.02)
     assert float(fit.core_rho[0]) == pytest.approx(0.4, rel=0.02)
+
+
+@pytest.mark.slow
+def test_the_halo_fit_follows_a_known_halo_but_does_not_identify_it():
+    """A scan of the model with a halo (0.5-degree steps, three incidence angles): the
+    fitted model follows the scan to 2.4 % rms in the logarithm, but its parameters are
+    not the model's: the body's lobe takes part of the halo (b 0.10 for 0.05) and the
+    halo's power goes to its bound 4 (for 2.8).  The fit alternates body and core plus
+    halo; a joint fit of all of them would be needed to identify them.  The core is
+    recovered (rms slope within 1 %)."""
+    spec = models.model_material(
+        "robertson_sandford_halo", [532.0], material="glint", provenance="test",
+        rho_D=0.05, epsilon=0.5, b=0.05, e=0.04, core_rho=0.4, core_roughness=0.006,
+        halo_a=1e-4, halo_b=0.01**2.8, halo_g=2.8,
+    )  # fmt: skip
+    ti, dt = np.meshgrid([5.0, 40.0, 60.0], np.arange(-20.0, 20.5, 0.5), indexing="ij")
+    ti, dt = ti.ravel(), dt.ravel()
+    truth = models.spectra(spec, ti, dt, 0.0)
+    scan = measurement_set(ti, dt, np.zeros(ti.size), [532.0], truth, material="glint",
+                           provenance="test")  # fmt: skip
+    fit = models.fit_model(scan, "robertson-sandford-halo")
+    assert fit.attrs["rms_log"] < 0.03
+    assert float(fit.core_roughness[0]) == pytest.approx(0.006, rel=0.01)
+    err = np.abs(np.log(models.spectra(fit, ti, dt, 0.0) / truth))
+    assert np.median(err) < 0.03
