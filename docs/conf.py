@@ -116,6 +116,23 @@ def _list_reexports(app, what, name, obj, options, lines):
         lines += ["", ".. rubric:: Also importable from this module", "", ", ".join(names), ""]
 
 
+def _bound_method_signature(app, obj, bound_method):
+    """Undo what ``autodoc_preserve_defaults`` does to a bound method documented as a
+    module's function (``brdf_angles = MODEL.brdf_angles``): it stores the method's
+    signature, ``self`` already dropped, on the function all models share, so every
+    such alias would show one parameter fewer than the one before.  ``self`` is put back
+    in front of the stored signature."""
+    func = getattr(obj, "__func__", None)
+    if not inspect.ismethod(obj) or "__signature__" not in getattr(func, "__dict__", {}):
+        return
+    sig = func.__dict__["__signature__"]
+    first = func.__code__.co_varnames[0]
+    if first not in sig.parameters:
+        own = inspect.Parameter(first, inspect.Parameter.POSITIONAL_OR_KEYWORD)
+        func.__signature__ = sig.replace(parameters=[own, *sig.parameters.values()])
+
+
 def setup(app):
+    app.connect("autodoc-before-process-signature", _bound_method_signature)
     app.connect("autodoc-skip-member", _skip_reexports)
     app.connect("autodoc-process-docstring", _list_reexports)

@@ -66,11 +66,14 @@ __all__ = [
     "MODEL",
     "PARAMS",
     "brdf",
+    "brdf_angles",
+    "check_params",
     "directional_hemispherical_reflectance",
     "energy_scale",
     "fit_halo",
     "halo_brdf",
     "halo_reflectance",
+    "render_grid",
 ]
 
 #: The parameters: the Robertson-Sandford and core ones, then the halo's.
@@ -419,7 +422,4 @@ MODEL = Model(
     constraint=_constraint,
 )
 PARAMS = MODEL.param_names
-# Not in __all__ (MODEL's methods are the interface): Sphinx's autodoc_preserve_defaults
-# stores each documented alias's signature on the one function the models share, one
-# parameter fewer each time, and a seventh alias leaves it none.
 check_params, brdf_angles, render_grid = MODEL.check_params, MODEL.brdf_angles, MODEL.render_grid
