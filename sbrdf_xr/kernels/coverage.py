@@ -42,12 +42,12 @@ def workspace(n_polygons):
     >>> from sbrdf_xr.kernels.coverage import workspace
     >>> poly, count, work, wn = workspace(4)
     >>> poly.shape, count.shape, work.shape[0], wn.shape
-    ((6, 2, 16), (6,), 258, (258,))
+    ((6, 2, 16), (6,), 259, (259,))
     """
     poly = np.empty((n_polygons + 2, 2, VERTICES))
     count = np.zeros(n_polygons + 2, dtype=np.int64)
-    work = np.empty((2 * _PIECES + 2, 2, _PIECE))
-    wn = np.zeros(2 * _PIECES + 2, dtype=np.int64)
+    work = np.empty((2 * _PIECES + 3, 2, _PIECE))
+    wn = np.zeros(2 * _PIECES + 3, dtype=np.int64)
     return poly, count, work, wn
 
 
@@ -260,9 +260,61 @@ def _supporting(poly, count, k, scratch):
     return m
 
 
+@nb.njit(cache=True, nogil=True, inline="always")
+def _split(work, r, n, ax, ay, ex, ey, out, inside):
+    """``work[r, :, :n]`` split by the line through (ax, ay) along (ex, ey): the part right
+    of it into ``work[out]``, the part left of it into ``work[inside]``, in one pass.
+    Returns ``(n_out, n_in)``; ``(0, -1)`` when all of it is left of the line (nothing
+    written: it stays as it is), ``(-1, 0)`` when none is (nothing written: all of it is
+    outside)."""
+    d = work.shape[0] - 1  # the sides, in row d
+    lo = np.inf
+    hi = -np.inf
+    for v in range(n):
+        side = ex * (work[r, 1, v] - ay) - ey * (work[r, 0, v] - ax)
+        work[d, 0, v] = side
+        lo = min(lo, side)
+        hi = max(hi, side)
+    if lo >= 0.0:
+        return 0, -1
+    if hi <= 0.0:
+        return -1, 0
+    no = 0
+    ni = 0
+    px = work[r, 0, n - 1]
+    py = work[r, 1, n - 1]
+    dp = work[d, 0, n - 1]
+    for v in range(n):
+        qx = work[r, 0, v]
+        qy = work[r, 1, v]
+        dq = work[d, 0, v]
+        if (dp < 0.0 and dq > 0.0) or (dp > 0.0 and dq < 0.0):
+            t = dp / (dp - dq)
+            x = px + t * (qx - px)
+            y = py + t * (qy - py)
+            work[out, 0, no] = x
+            work[out, 1, no] = y
+            work[inside, 0, ni] = x
+            work[inside, 1, ni] = y
+            no += 1
+            ni += 1
+        if dq <= 0.0:
+            work[out, 0, no] = qx
+            work[out, 1, no] = qy
+            no += 1
+        if dq >= 0.0:
+            work[inside, 0, ni] = qx
+            work[inside, 1, ni] = qy
+            ni += 1
+        px = qx
+        py = qy
+        dp = dq
+    return no, ni
+
+
 @nb.njit(cache=True, nogil=True)
 def _minus(work, wn, src, dst, out, poly, count, j, tiny):
-    """The pieces ``work[src:src + out[0]]`` less the convex ``poly[j]``, appended to
+    """The pieces ``work[src:src + out]`` less the convex ``poly[j]``, written to
     ``work[dst:]``; returns the new piece count, -1 past the capacity."""
     n = count[j]
     x0 = x1 = poly[j, 0, 0]
@@ -283,34 +335,40 @@ def _minus(work, wn, src, dst, out, poly, count, j, tiny):
             hx = max(hx, work[a, 0, v])
             ly = min(ly, work[a, 1, v])
             hy = max(hy, work[a, 1, v])
-        if lx >= x1 or hx <= x0 or ly >= y1 or hy <= y0:  # apart: the piece stays
-            if made == _PIECES:
-                return -1
-            for v in range(na):
-                work[dst + made, 0, v] = work[a, 0, v]
-                work[dst + made, 1, v] = work[a, 1, v]
-            wn[dst + made] = na
-            made += 1
-            continue
         r = a
         nr = na
-        for e in range(n):
-            e1 = e + 1 if e + 1 < n else 0
-            ax = poly[j, 0, e]
-            ay = poly[j, 1, e]
-            ex = poly[j, 0, e1] - ax
-            ey = poly[j, 1, e1] - ay
-            if made == _PIECES or nr + 1 > _PIECE:
-                return -1
-            no = _cut(work, r, nr, dst + made, ax, ay, -ex, -ey)  # outside: a piece
-            if no >= 3 and _area(work, dst + made, no) > tiny:
-                wn[dst + made] = no
-                made += 1
-            t = rest if r != rest else rest + 1
-            nr = _cut(work, r, nr, t, ax, ay, ex, ey)
-            r = t
+        if not (lx >= x1 or hx <= x0 or ly >= y1 or hy <= y0):  # boxes overlap
+            for e in range(n):
+                e1 = e + 1 if e + 1 < n else 0
+                ax = poly[j, 0, e]
+                ay = poly[j, 1, e]
+                if made == _PIECES or nr + 1 > _PIECE:
+                    return -1
+                t = rest if r != rest else rest + 1
+                no, ni = _split(
+                    work, r, nr, ax, ay, poly[j, 0, e1] - ax, poly[j, 1, e1] - ay, dst + made, t
+                )
+                if no < 0:  # all of the rest is outside this edge: it is the piece
+                    break
+                if no >= 3 and _area(work, dst + made, no) > tiny:
+                    wn[dst + made] = no
+                    made += 1
+                if ni >= 0:
+                    r = t
+                    nr = ni
+                if nr < 3:
+                    break
+            else:
+                continue  # what is left is inside the polygon: dropped
             if nr < 3:
-                break
+                continue
+        if made == _PIECES:
+            return -1
+        for v in range(nr):  # the piece (or its rest) stays
+            work[dst + made, 0, v] = work[r, 0, v]
+            work[dst + made, 1, v] = work[r, 1, v]
+        wn[dst + made] = nr
+        made += 1
     return made
 
 
