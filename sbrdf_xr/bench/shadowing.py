@@ -496,7 +496,8 @@ def pairs_profile(n_geometries: int = 360, repeat: int = 5) -> list[CostRow]:
         best = [np.inf] * len(STAGES)
         for _ in range(max(1, repeat)):
             for k in range(len(STAGES)):
-                t = _timed(partial(pairs_kernel, *args, k + 1), 1, time.process_time)[1]
+                upto = (*args, k + 1)  # the kernel stopped after step k + 1
+                t = _timed(partial(pairs_kernel, *upto), 1, time.process_time)[1]
                 best[k] = min(best[k], t)
         steps = np.diff([0.0, *best])
         for label, t in zip(STAGES, steps, strict=True):
