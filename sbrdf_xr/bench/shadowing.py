@@ -36,6 +36,7 @@ __all__ = [
     "geometries",
     "lambertian_signal",
     "markdown",
+    "pairs_profile",
     "pairs_rows",
     "scaling_rows",
 ]
@@ -188,14 +189,16 @@ def lambertian_signal(
 _T = TypeVar("_T")
 
 
-def _timed(func: Callable[[], _T], repeat: int) -> tuple[_T, float]:
-    t0 = time.perf_counter()
+def _timed(
+    func: Callable[[], _T], repeat: int, clock: Callable[[], float] = time.perf_counter
+) -> tuple[_T, float]:
+    t0 = clock()
     out = func()
-    best = time.perf_counter() - t0
+    best = clock() - t0
     for _ in range(max(1, repeat) - 1):
-        t0 = time.perf_counter()
+        t0 = clock()
         out = func()
-        best = min(best, time.perf_counter() - t0)
+        best = min(best, clock() - t0)
     return out, best
 
 
@@ -397,9 +400,10 @@ def pairs_rows(n_geometries: int = 360, n_sweep: int = 10_000, repeat: int = 3) 
     lit_visible_fraction(canx1(), s[:2], o[:2])  # the table alone, compiled
     build = min(build, time.perf_counter() - t0)
     tg = tp = np.inf
+    cpu = time.process_time
     for _ in range(max(1, repeat)):
-        tg = min(tg, _timed(partial(lit_visible_fraction, grid, s, o), 1)[1])
-        tp = min(tp, _timed(partial(lit_visible_fraction, table, s, o), 1)[1])
+        tg = min(tg, _timed(partial(lit_visible_fraction, grid, s, o), 1, cpu)[1])
+        tp = min(tp, _timed(partial(lit_visible_fraction, table, s, o), 1, cpu)[1])
     n = table.n_facets
     us = 1e3 / n_geometries  # ms per geometry per second
     rows = [
@@ -447,6 +451,67 @@ def pairs_rows(n_geometries: int = 360, n_sweep: int = 10_000, repeat: int = 3) 
                 "the same sweep without shadowing",
             )
         )
+    return rows
+
+
+def pairs_profile(n_geometries: int = 360, repeat: int = 5) -> list[CostRow]:
+    """Where the pair kernel's time goes on CanX-1: CPU microseconds per geometry of each
+    step of :data:`~sbrdf_xr.kernels.shadow_pairs.STAGES` (the kernel run to the end of a
+    step, less the run to the end of the one before), for the :func:`canx1_sweep_rows`
+    rotation and for random geometries (:func:`geometries`), ``n_geometries`` batched.
+
+    Each row's ``ms_per_geometry`` is the step's time [ms] and its ``ratio`` its share of
+    the whole kernel.  Best of ``repeat`` runs, the stages timed in turns.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench.shadowing import pairs_profile
+    >>> rows = pairs_profile(n_geometries=8, repeat=1)
+    >>> [r.label for r in rows[:4]]
+    ['rotation: facing', 'rotation: walk', 'rotation: shadows', 'rotation: union']
+    >>> round(sum(r.ratio for r in rows[:4]), 6)
+    1.0
+    """
+    from ..body.occluders import pair_table
+    from ..body.visibility import exact_frames
+    from ..kernels.shadow_pairs import STAGES, pairs_kernel
+
+    craft = canx1()
+    mesh, cache = mesh_of(craft)
+    frames = exact_frames(mesh, cache)
+    pairs = pair_table(frames, cache)
+    if pairs is None:  # pragma: no cover - CanX-1 is far under the table's bound
+        return []
+    occ = pairs["occluders"]
+    normals = np.ascontiguousarray(mesh.face_normals, dtype=np.float64)
+    head = (normals, frames["N"], frames["E1"], frames["E2"], frames["T2"], *pairs["table"])
+    rows = []
+    for name, (s, o) in {
+        "rotation": _rotation(n_geometries),
+        "random": geometries(n_geometries, seed=7),
+    }.items():
+        dirs = np.ascontiguousarray(np.stack([s, o], axis=1))
+        args = (*head, occ["normal"], occ["open"], dirs)
+        pairs_kernel(*args)  # compiled, warm
+        best = [np.inf] * len(STAGES)
+        for _ in range(max(1, repeat)):
+            for k in range(len(STAGES)):
+                upto = (*args, k + 1)  # the kernel stopped after step k + 1
+                t = _timed(partial(pairs_kernel, *upto), 1, time.process_time)[1]
+                best[k] = min(best[k], t)
+        steps = np.diff([0.0, *best])
+        for label, t in zip(STAGES, steps, strict=True):
+            rows.append(
+                CostRow(
+                    f"{name}: {label}",
+                    craft.name,
+                    craft.n_facets,
+                    n_geometries,
+                    1e3 * max(float(t), 0.0) / n_geometries,
+                    max(float(t), 0.0) / max(float(steps.clip(0.0).sum()), 1e-300),
+                    "the whole kernel (CPU time)",
+                )
+            )
     return rows
 
 

@@ -10,8 +10,10 @@ Sun or the observer, cached with the body:
   fewer, larger shadows are united per receiving facet.  A merge needs the facets to be
   coplanar to :data:`COPLANAR` of the body's size (float rounding of a flat CAD face), to
   face the same way, to be of the same kind (one-sided facets of an open surface or not),
-  and the union to stay strictly convex, with at most
-  :data:`~sbrdf_xr.kernels.pair_table.MAX_OCCLUDER_VERTICES` vertices.
+  and the union to stay convex, with at most
+  :data:`~sbrdf_xr.kernels.pair_table.MAX_OCCLUDER_VERTICES` corners: a vertex exactly on
+  the line of its neighbours (the seed's frame, as along a straight edge of a CAD face
+  cut by the triangulation) is no corner and is dropped, so a strip of facets merges.
 * :func:`pair_table`: for every facet that can be shadowed, the occluders with a vertex in
   front of its plane, cut and stored in its frame with the box of the directions from
   which they can reach it (:func:`sbrdf_xr.kernels.pair_table.pair_table`).  The table
@@ -38,9 +40,17 @@ COPLANAR = 1e-15
 MAX_PAIR_WORK = 4_000_000
 
 
-def _convex_at(xy: np.ndarray, a: int, b: int, c: int) -> bool:
+def _turn(xy: np.ndarray, a: int, b: int, c: int) -> float:
     (ax, ay), (bx, by), (cx, cy) = xy[a], xy[b], xy[c]
-    return bool((bx - ax) * (cy - ay) - (by - ay) * (cx - ax) > 0.0)
+    return float((bx - ax) * (cy - ay) - (by - ay) * (cx - ax))
+
+
+def _corners(poly: list[int], xy: np.ndarray) -> list[int]:
+    """The vertices of ``poly`` that are corners: those on the line of their neighbours
+    (a turn of exactly 0 in the seed's frame, as the vertices along a straight edge of a
+    CAD face are) dropped."""
+    n = len(poly)
+    return [v for k, v in enumerate(poly) if _turn(xy, poly[k - 1], v, poly[(k + 1) % n]) != 0.0]
 
 
 def _grow(
@@ -58,7 +68,7 @@ def _grow(
     members = [seed]
     free[seed] = False
     grown = True
-    while grown and len(poly) < MAX_OCCLUDER_VERTICES:
+    while grown and len(_corners(poly, xy)) < MAX_OCCLUDER_VERTICES:
         grown = False
         for e in range(len(poly)):
             a, b = poly[e], poly[(e + 1) % len(poly)]
@@ -69,16 +79,16 @@ def _grow(
             if c in poly or abs(h[c]) > tol:
                 continue
             prev, after = poly[e - 1], poly[(e + 2) % len(poly)]
-            if not (_convex_at(xy, prev, a, c) and _convex_at(xy, a, c, b)):
+            if _turn(xy, prev, a, c) < 0.0 or _turn(xy, a, c, b) <= 0.0:
                 continue
-            if not _convex_at(xy, c, b, after):
+            if _turn(xy, c, b, after) < 0.0:  # (a vertex on a straight edge may stay)
                 continue
             poly.insert(e + 1, c)
             free[f] = False
             members.append(int(f))
             grown = True
             break
-    return poly, members
+    return _corners(poly, xy), members
 
 
 def occluder_polygons(frames: dict[str, Any]) -> dict[str, np.ndarray]:

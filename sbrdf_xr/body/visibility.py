@@ -340,7 +340,7 @@ def _exact(
         frac = np.where(_front(directions, normals), _grid_fractions(frames, dirs), 0.0)
     # a facet facing a direction per the stored normals but not per its winding (or
     # vice versa) gets 0, as the sampled method does
-    for g, i in np.argwhere(np.isnan(frac)):
+    for g, i in np.argwhere(np.isnan(frac)) if np.isnan(frac).any() else ():
         frac[g, i] = _geos_fraction(frames, int(i), dirs[g])
     return frac
 

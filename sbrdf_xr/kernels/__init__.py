@@ -26,16 +26,17 @@ Modules
 ``anisotropic``
     The facet sums of anisotropic tables (a ``psi`` axis), on the same angles, look-up
     and accumulation.
-``polygon``, ``shadow``, ``pair_table`` and ``shadow_pairs``
+``polygon``, ``shadow``, ``pair_table``, ``shadow_pairs`` and ``coverage``
     Plane-polygon clipping and the exact shadow kernels of :mod:`sbrdf_xr.body.visibility`:
     candidate occluders by a grid per direction, or from a table of the pairs that can
-    shadow each other, built once per body.
+    shadow each other, built once per body; the area of a facet its shadows cover.
 """
 
 from ..errors import ValidationError, renamed_attributes
 from . import (
     angles,
     anisotropic,
+    coverage,
     lookup,
     lut,
     packing,
@@ -124,6 +125,7 @@ __all__ = [
     "bucket_map",
     "chunk_angles",
     "clip",
+    "coverage",
     "facet_frame",
     "forward_direction",
     "frame_angles",
