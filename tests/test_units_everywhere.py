@@ -599,6 +599,9 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
     ),
     "sbrdf_xr.brdf.specular_core.fit_core": _fit_core_case,
     "sbrdf_xr.brdf.halo.brdf": _brdf_case(_halo, wl=[4000.0]),
+    "sbrdf_xr.brdf.halo.check_params": lambda: dict(wavelength=[4000.0], **_halo()),
+    "sbrdf_xr.brdf.halo.brdf_angles": _angles_case("halo", _halo),
+    "sbrdf_xr.brdf.halo.render_grid": _angles_case("halo", _halo),
     "sbrdf_xr.brdf.halo.directional_hemispherical_reflectance": lambda: dict(
         theta_i=[20.0, 60.0], wavelength=[4000.0], **_halo()
     ),
@@ -1058,7 +1061,7 @@ EXEMPT[("sbrdf_xr.brdf._model.Model", "brdf")] = (
     "a function (the model's sBRDF), not a value: its results are in sr-1 by contract"
 )
 
-for _model_name in ("lambert", "microfacet", "robertson_sandford", "specular_core"):
+for _model_name in ("lambert", "microfacet", "robertson_sandford", "specular_core", "halo"):
     for _method in ("brdf_angles", "render_grid"):
         EXEMPT[(f"sbrdf_xr.brdf.{_model_name}.{_method}", "psi")] = "an isotropic model refuses psi"
 

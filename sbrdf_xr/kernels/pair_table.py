@@ -22,6 +22,10 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+# Compiled into this module's kernels: numba's disk cache of a module is keyed by its own
+# source file only, so a change of these two (shadow_pairs) must come with an edit here,
+# or a tree that already compiled this module loads machine code built against the old
+# ones (a crash).  Last rebuilt against them: the coverage pieces of the pair kernel.
 from .shadow_pairs import _buffers, _pairs_into
 
 __all__ = [

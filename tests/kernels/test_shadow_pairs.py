@@ -451,14 +451,15 @@ def test_clipped_shadow_against_geos(shadow, height, slope, flip):
     args = (cut, 0, len(xy), slope[0], slope[1], *tri.ravel(), 0.0, True, poly, 0)
     n = coverage.clipped_shadow(*args)
     moved = shapely.affinity.translate(shadow, -height * slope[0], -height * slope[1])
+    area = shapely.Polygon(tri).area  # 0.78125
     want = moved.intersection(shapely.Polygon(tri)).area
     if n == -1:
-        assert want >= (1 - 1e-12) * 0.8125  # the triangle's area
+        assert want >= (1 - 1e-12) * area
     elif n == 0:
         assert want <= 1e-12
     else:
         got = signed_area(poly[0, 0].copy(), poly[0, 1].copy(), n)
-        assert abs(got - want) <= 1e-12 * 0.8125
+        assert abs(got - want) <= 1e-12 * area
 
 
 def test_kernel_flags_and_fallbacks():
@@ -478,3 +479,17 @@ def test_kernel_flags_and_fallbacks():
     np.testing.assert_array_equal(f[0, facing & ~frames["receiver"]], 1.0)
     flipped = pairs_kernel(-normals, *args, *occ)  # stored normals decide
     np.testing.assert_array_equal(flipped[0, facing], 0.0)
+
+
+def test_a_shadow_covering_the_facet_with_a_corner_on_its_edge():
+    """The case hypothesis found: the facet inside the shadow, one corner shared and one
+    on the shadow's edge: covered (-1), GEOS's intersection the whole facet."""
+    shadow = shapely.Polygon([(0.0, 0.0), (2.0, -1.0), (0.0, 2.0)])
+    xy = np.asarray(orient(shadow).exterior.coords)[:-1]
+    cut = np.zeros((1, 9, 3))
+    cut[0, : len(xy), :2], cut[0, : len(xy), 2] = xy, 1.0
+    tri = np.array([[0.0, 0.0], [1.5, -0.25], [0.25, 1.0]])
+    poly = coverage.workspace(1)[0]
+    n = coverage.clipped_shadow(cut, 0, len(xy), 0.0, 0.0, *tri.ravel(), 0.0, True, poly, 0)
+    assert n == -1
+    assert shadow.intersection(shapely.Polygon(tri)).area == shapely.Polygon(tri).area
