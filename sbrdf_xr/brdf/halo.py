@@ -57,7 +57,6 @@ from scipy.optimize import least_squares
 from scipy.special import hyp2f1
 
 from ..units import to_unit
-from . import robertson_sandford as rs
 from . import specular_core as sc
 from ._common import _angles_to_vectors, _cast_out, _check_theta_i, _facet_frame
 from ._model import Model, Parameter
@@ -404,12 +403,6 @@ def fit_halo(
     }
 
 
-def _constraint(checked: dict[str, NDArray[np.float64]]) -> None:
-    """The Robertson-Sandford part's joint condition (``rho_s >= 0``)."""
-    if rs.MODEL.constraint is not None:
-        rs.MODEL.constraint({k: checked[k] for k in rs.PARAMS})
-
-
 #: The Robertson-Sandford model with a specular core and an ABg halo.
 MODEL = Model(
     name="robertson_sandford_halo",
@@ -419,7 +412,7 @@ MODEL = Model(
     citation="Harvey, PhD thesis 1976 (ABg); Pfisterer, OPN 2011; Sandford, paper 001 "
     "section 4 (Eqs. 13, 15); Walter et al., EGSR 2007, Eqs. 20, 25, 27",
     reflectance=directional_hemispherical_reflectance,
-    constraint=_constraint,
+    constraint=sc.MODEL.constraint,  # the Robertson-Sandford part's (rho_s >= 0)
 )
 PARAMS = MODEL.param_names
 check_params, brdf_angles, render_grid = MODEL.check_params, MODEL.brdf_angles, MODEL.render_grid
