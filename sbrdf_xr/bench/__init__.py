@@ -48,7 +48,7 @@ from . import (
 )
 from .accuracy import BANDS, CANX1_MATERIALS, accuracy_cost, shadow_rows
 from .engine import engine_rows, sweep_job
-from .machine import disk_rate, thread_scaling
+from .machine import DiskCost, disk_cost, disk_rate, thread_scaling
 from .parts import WING_KINDS, canx1_with_wing, parts_rows
 from .presets import load_presets, presets_record, presets_table, write_presets
 from .rows import (
@@ -81,6 +81,7 @@ __all__ = [
     "WING_KINDS",
     "BenchRow",
     "CostRow",
+    "DiskCost",
     "ShadowRow",
     "accuracy",
     "accuracy_cost",
@@ -92,6 +93,7 @@ __all__ = [
     "calls",
     "canx1_sweep_rows",
     "canx1_with_wing",
+    "disk_cost",
     "disk_rate",
     "engine",
     "engine_rows",

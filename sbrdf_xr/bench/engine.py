@@ -15,9 +15,9 @@ absolute claim:
 * sweeps of 1e4, 1e5 (and, without ``quick``, 1e6) random attitudes x 141
   wavelengths written to netCDF at default settings, each in a fresh process: the
   wall time, its growth exponent between sizes, the ratio to the bare kernel time
-  over the same geometries, the ratio to its floor (the slower of the bare kernel and
-  the disk writing and syncing as many bytes,
-  :func:`~sbrdf_xr.bench.machine.disk_rate`), and the peak resident memory;
+  over the same geometries, the ratio to its floor (the slowest of the bare kernel, the
+  disk writing and syncing as many bytes, and the processor time of both shared by the
+  cores, :func:`~sbrdf_xr.bench.machine.disk_cost`), and the peak resident memory;
 * band-only (V, R, I) against full spectrum on the 1e5 sweep;
 * two cores against one (one thread everywhere: ``SBRDF_XR_NUM_THREADS=1``, and the
   process, its writer thread too, pinned to one CPU), written, computed only (every
@@ -45,11 +45,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import ValidationError
 from ._kernel_rows import _sweep_scene, kernel_rows
-from .machine import disk_rate, thread_scaling
+from .machine import DiskCost, disk_cost, thread_scaling
 from .rows import BenchRow, best_time
 
-__all__ = ["engine_rows", "sweep_job"]
+__all__ = ["engine_rows", "sweep_job", "write_floor"]
 
 #: The sweeps: canx1 at random attitudes, phase angle 10 deg, default outputs.
 _SIZES_QUICK = (10_000, 100_000)
@@ -73,7 +74,8 @@ def sweep_job(
     on the same threads, nothing written), ``zarr`` (a LocalCluster of ``workers``
     single-threaded processes writing a Zarr store; ``workers=0``: this process's threads).
     ``outputs``: the writer's (:mod:`sbrdf_xr.store.derived`), ``all`` for every variable.
-    Returns seconds (after planning and a warm-up of the compiled kernel), the peak RSS,
+    Returns seconds (after planning and a warm-up of the compiled kernel) and the
+    processor time of this process over them, the peak RSS,
     private memory and PSS [byte] (:class:`_PrivatePeak`) and the bytes written.
 
     Examples
@@ -86,7 +88,7 @@ def sweep_job(
     >>> list(inspect.signature(sweep_job).parameters)
     ['n', 'path', 'bands', 'mode', 'workers', 'outputs']
     >>> sorted(sweep_job(1000, "cube.nc"))  # doctest: +SKIP
-    ['blocks', 'bytes', 'pss', 'rss', 'rss_private', 'seconds']
+    ['blocks', 'bytes', 'cpu', 'pss', 'rss', 'rss_private', 'seconds']
     """
 
     from ..engine.run import default_n_threads, run_block, simulate
@@ -119,14 +121,14 @@ def sweep_job(
                 plan.knobs["method"],
             )
 
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         with ThreadPoolExecutor(default_n_threads()) as pool:
             list(pool.map(one, blocks))
-        seconds = time.perf_counter() - t0
+        seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     elif mode == "zarr" and not workers:
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         write(simulate(plan, lazy=True), path, overwrite=True, outputs=outputs)
-        seconds = time.perf_counter() - t0
+        seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     elif mode == "zarr":
         from distributed import Client, LocalCluster
 
@@ -141,15 +143,20 @@ def sweep_job(
             Client(cluster) as client,
         ):
             client.run(lambda: run_block(plan, slice(0, 8)))  # compile on the workers
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             cube = simulate(plan, client=client)
             write(cube, path, overwrite=True, client=client, outputs=outputs)
-            seconds = time.perf_counter() - t0
+            seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     else:
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         write(simulate(plan), path, overwrite=True, outputs=outputs)
-        seconds = time.perf_counter() - t0
-    out = {"seconds": seconds, "rss": float(_peak_rss()), "blocks": float(plan.n_blocks)}
+        seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
+    out = {
+        "seconds": seconds,
+        "cpu": cpu,
+        "rss": float(_peak_rss()),
+        "blocks": float(plan.n_blocks),
+    }
     out["rss_private"] = float(private.stop())
     out["pss"] = float(private.pss)
     if mode in ("write", "zarr"):
@@ -352,6 +359,31 @@ def _warm_rows(repeat: int) -> list[BenchRow]:
     return rows
 
 
+def write_floor(
+    kernel_seconds: float, kernel_cpu: float, disk: DiskCost, cores: int
+) -> tuple[float, float]:
+    """The shortest time [s] a cube write can take, and its processor-bound part [s].
+
+    The write computes the blocks (the bare kernel: ``kernel_seconds`` of wall time,
+    ``kernel_cpu`` of processor time) and writes their bytes (``disk``,
+    :func:`~sbrdf_xr.bench.machine.disk_cost`).  It takes at least as long as either
+    alone, and at least as long as both processor times spread over ``cores``.
+
+    Examples
+    --------
+    >>> from sbrdf_xr.bench.engine import write_floor
+    >>> from sbrdf_xr.bench.machine import DiskCost
+    >>> write_floor(2.0, 4.0, DiskCost(2_000_000_000, 1.5, 1.0), cores=2)  # the cores bound
+    (2.5, 2.5)
+    >>> write_floor(2.0, 4.0, DiskCost(2_000_000_000, 3.0, 1.0), cores=2)  # the disk bounds
+    (3.0, 2.5)
+    """
+    if cores < 1:
+        raise ValidationError(f"cores: must be >= 1, got {cores}")
+    shared = (kernel_cpu + disk.cpu_seconds) / cores
+    return max(kernel_seconds, disk.seconds, shared), shared
+
+
 def _sweep_rows(sizes: tuple[int, ...], results: dict[int, dict[str, float]]) -> list[BenchRow]:
     """Each sweep written, against the bare kernel and against its floor; band-only."""
     rows: list[BenchRow] = []
@@ -377,18 +409,23 @@ def _sweep_rows(sizes: tuple[int, ...], results: dict[int, dict[str, float]]) ->
             )
         )
         # the disk's rate for as many bytes as the cube (a virtual disk's write-back cache
-        # makes small writes look faster than a large one can be)
-        rate = disk_rate(nbytes=int(r["bytes"]))
-        floor = max(k["seconds"], r["bytes"] / rate)
+        # makes small writes look faster than a large one can be), and the processor time
+        # writing them takes, which the cores that compute the blocks also have to give
+        disk = disk_cost(nbytes=int(r["bytes"]))
+        cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 1
+        floor, shared = write_floor(k["seconds"], k["cpu"], disk, cores)
         rows.append(
             BenchRow(
                 f"{n:.0e} attitudes, write, against its floor",
                 r["seconds"],
-                "the slower of the bare kernel and the disk",
+                "the slowest of the bare kernel, the disk and the cores shared",
                 r["seconds"] / floor,
                 f"{r['bytes'] / 1e6:.0f} MB file: the disk writes and syncs as many bytes in "
-                f"{r['bytes'] / rate:.2f} s ({rate / 1e6:.0f} MB/s), the kernel takes "
-                f"{k['seconds']:.2f} s",
+                f"{disk.seconds:.2f} s ({disk.rate / 1e6:.0f} MB/s) with {disk.cpu_seconds:.2f} s "
+                f"of processor time, the kernel takes {k['seconds']:.2f} s ({k['cpu']:.2f} s of "
+                f"processor time), both on {cores} cores at best {shared:.2f} s; the write used "
+                f"{r['cpu']:.2f} s of processor time (the kernel's write-back threads not "
+                "counted)",
                 sweep=_WRITTEN,
             )
         )

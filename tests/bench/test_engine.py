@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 from sbrdf_xr.bench import engine
 
 
@@ -24,3 +26,30 @@ def test_the_private_peak_is_sampled_and_below_the_peak_rss():
     assert private <= engine._peak_rss()  # private pages are a part of the resident ones
     # a private page counts whole in the proportional set size, a shared one in part
     assert 64 * 2**20 <= peak.pss <= engine._peak_rss()
+
+
+def test_the_write_floor_is_the_slowest_of_kernel_disk_and_shared_cores():
+    from sbrdf_xr.bench.machine import DiskCost
+    from sbrdf_xr.errors import ValidationError
+
+    disk = DiskCost(2_000_000_000, seconds=1.0, cpu_seconds=0.8)
+    # kernel 2 s on 2 cores = 4 s of processor time, + 0.8 s writing: 2.4 s on 2 cores
+    assert engine.write_floor(2.0, 4.0, disk, cores=2) == (2.4, 2.4)
+    # one core: the sum of both processor times
+    assert engine.write_floor(2.0, 4.0, disk, cores=1) == (4.8, 4.8)
+    # a slow disk bounds it, a slow kernel too
+    assert engine.write_floor(2.0, 4.0, disk._replace(seconds=3.0), cores=2)[0] == 3.0
+    assert engine.write_floor(5.0, 4.0, disk, cores=8)[0] == 5.0
+    with pytest.raises(ValidationError, match="cores: must be >= 1, got 0"):
+        engine.write_floor(2.0, 4.0, disk, cores=0)
+
+
+def test_the_disk_cost_writes_whole_blocks_and_counts_processor_time(tmp_path):
+    from sbrdf_xr.bench.machine import disk_cost
+
+    cost = disk_cost(str(tmp_path), nbytes=2**20 + 1)
+    # blocks of min(nbytes, block_bytes) rounded down to float64: two of 1 MiB
+    assert cost.nbytes == 2 * 2**20
+    assert cost.seconds > 0.0 and cost.cpu_seconds >= 0.0
+    assert cost.rate == cost.nbytes / cost.seconds
+    assert list(tmp_path.iterdir()) == []  # the probe file is gone
