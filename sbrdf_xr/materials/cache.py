@@ -467,7 +467,7 @@ class CacheEntry(NamedTuple):
         Their total size [byte].
     last_use : float
         When an install last loaded it, as POSIX time [s]: the newest modification time
-        of its files (the marker's is set on every load).
+        of its files but temporaries (the marker's is set on every load).
     current : bool or None
         Whether this installation loads it (None: not asked).
 
@@ -582,7 +582,7 @@ def _entry(table: Path, files: list[tuple[Path, Any, bool]], current: Any) -> Ca
         table,
         tuple(f for f, _, _ in files),
         sum(st.st_size for _, st, _ in files),
-        max(st.st_mtime for _, st, _ in files),
+        max([st.st_mtime for _, st, part in files if not part] or [files[0][1].st_mtime]),
         None if current is None else table in current,
     )
 
