@@ -466,8 +466,11 @@ class CacheEntry(NamedTuple):
     size : int
         Their total size [byte].
     last_use : float
-        When an install last loaded it, as POSIX time [s]: the newest modification time
-        of its files but temporaries (the marker's is set on every load).
+        When an install last loaded it, as POSIX time [s]: the newest modification or
+        access time of its files but temporaries (0 if it has no other).  The marker's
+        modification time is set on every load; the access times count the loads of
+        versions that set no marker, where the file system records them (with
+        ``relatime``, to within a day).
     current : bool or None
         Whether this installation loads it (None: not asked).
 
@@ -582,7 +585,7 @@ def _entry(table: Path, files: list[tuple[Path, Any, bool]], current: Any) -> Ca
         table,
         tuple(f for f, _, _ in files),
         sum(st.st_size for _, st, _ in files),
-        max([st.st_mtime for _, st, part in files if not part] or [files[0][1].st_mtime]),
+        max([max(st.st_mtime, st.st_atime) for _, st, part in files if not part] or [0.0]),
         None if current is None else table in current,
     )
 

@@ -79,7 +79,7 @@ def test_a_load_from_the_cache_records_its_use_and_touches_no_table_file(cache_p
     (entry,) = cache.cache_entries([table])
     assert entry.name == "grey" and entry.current is True
     assert entry.size == sum(p.stat().st_size for p in (table, used, npy, meta))
-    assert entry.last_use == used.stat().st_mtime
+    assert entry.last_use >= used.stat().st_mtime  # (or a later access time of a file)
 
 
 def test_prune_removes_old_entries_whole_and_nothing_else(cache_path, tmp_path):
