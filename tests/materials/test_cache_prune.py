@@ -265,3 +265,20 @@ def test_the_catalog_tables_are_current_for_this_installation(cache_path):
     assert {p.name.rsplit("-", 1)[0] for p in current} == built
     assert [(e.name, e.current) for e in cache.cache_entries(current)] == [("example-lobe", True)]
     assert cache.prune(stale=True, current=current) == []
+
+
+def test_a_load_by_a_version_that_sets_no_marker_counts_by_access_time(cache_path):
+    """An older version reads the record and values without setting a marker: the files'
+    access times (kept by the file system) are their last use."""
+    load("legacy")
+    table = cache.cache_file("legacy", [], repr(0.1))
+    table.with_name(table.name + ".used").unlink()
+    files = files_of("legacy", cache_path)
+    now, then = time.time(), time.time() - 40 * DAY
+    for p in files:
+        os.utime(p, (then, then))
+    meta = table.with_name(table.name + ".float64.meta")
+    os.utime(meta, (now, then))  # read now, written 40 days ago
+    assert cache.prune(30) == []
+    os.utime(meta, (then, then))
+    assert [e.name for e in cache.prune(30)] == ["legacy"]
