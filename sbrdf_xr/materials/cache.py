@@ -16,8 +16,10 @@ hexadecimal digits) with the files the cache makes beside it: the mapped values 
 their records (``.nc.float64.npy``, ``.nc.float64.meta``, also in ``float32``; older
 versions left ``.nc.float64.meta.nc``), the temporaries of their atomic writes
 (``<file>.<8 characters>.part``) and a marker ``.nc.used`` whose modification time is
-the entry's last use, set on every load from the cache (the table and values files are
-never touched: the values' record holds their times).  :func:`cache_entries` lists the
+set on every load from the cache: the entry's last use (the table and values files are
+never touched: the values' record holds their times; their access times count the loads
+of versions that set no marker).  No build-lock file is made: the lock is the
+directory's own (:func:`cached_table`).  :func:`cache_entries` lists the
 entries, :func:`prune` removes them, and every build of a table prunes the entries no
 install sharing the directory used for :func:`keep_days` days.  Nothing else in the
 directory is ever removed.
