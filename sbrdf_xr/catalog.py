@@ -82,6 +82,7 @@ __all__ = [
     "material_tables",
     "names",
     "showing_progress",
+    "table_cache_files",
     "to_build",
     "user_catalog_dirs",
 ]
@@ -274,14 +275,54 @@ def to_build(wanted: Iterable[str]) -> list[str]:
         if name not in known or name in _LOADED:
             continue
         e = entry(name)
-        source = e.extra.get("build_from")
-        if e.kind != "material" or source is None:
+        if e.kind != "material" or e.extra.get("build_from") is None:
             continue
-        kw = dict(e.extra.get("build", {}))
-        options = tuple(sorted(kw.items()))
-        path = cache_file(name, _table_inputs(source, kw), repr(options))
+        path = _cache_path(e)
         if path is None or not path.is_file():
             out.append(name)
+    return out
+
+
+def _cache_path(e: CatalogEntry) -> Path | None:
+    """The table-cache file of built material entry ``e`` (None: the cache is off), keyed
+    as :func:`_built_material` keys it."""
+    kw = dict(e.extra.get("build", {}))
+    options = tuple(sorted(kw.items()))
+    return cache_file(e.name, _table_inputs(e.extra["build_from"], kw), repr(options))
+
+
+def table_cache_files() -> list[Path]:
+    """The table-cache files this installation loads its built materials from.
+
+    Every ``material`` entry with ``build_from`` (shipped, and of the user catalogs of
+    ``SBRDF_XR_CATALOG_PATH``) is built on its first load and kept in the table cache
+    (:mod:`sbrdf_xr.materials.cache`) under a key of its files, its options and the
+    code that builds it: these are the files of those keys, whether built yet or not.
+    The other entries of the cache are stale for this installation
+    (:func:`sbrdf_xr.materials.cache.prune`); an entry whose files cannot be read is
+    left out.
+
+    Returns
+    -------
+    list of pathlib.Path
+        Empty when the cache is switched off.
+
+    Examples
+    --------
+    >>> files = table_cache_files()
+    >>> any(f.name.startswith("tjpv-cell-") for f in files), files[0].suffix
+    (True, '.nc')
+    """
+    out = []
+    for e in entries("material"):
+        if e.extra.get("build_from") is None:
+            continue
+        try:
+            path = _cache_path(e)
+        except (OSError, CatalogError):  # its measurements or fit missing: never loads
+            continue
+        if path is not None:
+            out.append(path)
     return out
 
 

@@ -446,6 +446,23 @@ def _angles_case(module: str, params: Any) -> Callable:
 
 #: (callable, its keyword arguments): every argument with a unit is checked by replacing
 #: its value.  ``slow``: the comparison runs with ``--runslow`` only (the refusal always).
+def _cache_with_entries() -> Any:
+    """A table cache directory with an entry last used 3 days ago and one used now: a
+    prune of entries unused for 2 days (48 h) takes the first only."""
+    import os
+    import tempfile
+    import time
+    from pathlib import Path
+
+    d = Path(tempfile.mkdtemp(prefix="sbrdf-cache-"))
+    for key, days in (("0", 3.0), ("1", 0.0)):
+        table = d / f"grey-{key * 32}.nc"
+        table.write_bytes(b"table")
+        t = time.time() - days * 86400.0
+        os.utime(table, (t, t))
+    return d
+
+
 CASES: dict[str, Callable[[], dict[str, Any]]] = {
     # --- articulated parts and the Starlink body
     "sbrdf_xr.body.parts.Part": lambda: dict(
@@ -755,6 +772,9 @@ CASES: dict[str, Callable[[], dict[str, Any]]] = {
         phi=np.array([0.0, 5.0]),
         spectra=np.full((2, 3), 0.2),
     ),
+    "sbrdf_xr.materials.cache.prune": lambda: dict(
+        older_than=2.0, dry_run=True, directory=_cache_with_entries()
+    ),
     "sbrdf_xr.materials.build.build_lut": lambda: dict(
         measurements=_measurements((20.0, 35.0, 55.0)),
         n_phi=7,
@@ -1046,6 +1066,8 @@ for _row, _arg in (
     ("sbrdf_xr.materials.mapped.TableFile", "mtime_ns"),
     ("sbrdf_xr.materials.mapped.MappedSlice", "offset"),
     ("sbrdf_xr.materials.mapped.MappedSlice", "strides"),
+    ("sbrdf_xr.materials.cache.CacheEntry", "size"),
+    ("sbrdf_xr.materials.cache.CacheEntry", "last_use"),
 ):
     EXEMPT[(_row, _arg)] = "a result record the package fills, not an input"
 

@@ -12,6 +12,8 @@ Modules
     The sub-command that simulates a real pass from elements, a site and a window.
 ``output``
     What the command line reads and prints.
+``material`` and ``cache``
+    Material tables built from measurement files; the table cache shown and pruned.
 """
 
 from ..errors import renamed_attributes

@@ -26,6 +26,8 @@ Sub-commands::
              [--format table|scan] [--wavelength NM] [--zenith theta|phi]   a measured table
     sbrdf-xr invert spin CURVE (--cube CUBE.nc | --scene SCENE | --to-sun X Y Z --to-observer X Y Z)
              --periods MIN MAX N [-o OUT.nc]                                      spin state
+    sbrdf-xr cache info [-q]                the table cache: entries, sizes, last use, current
+    sbrdf-xr cache prune (--older-than DAYS | --stale | --all) [--dry-run] [-q]   remove entries
 
 Wherever a spacecraft or a material is named, a file may stand instead: a mesh file
 (``--mesh-material`` or ``--material-map`` label its facets) or a netCDF material table
@@ -52,6 +54,7 @@ from ..errors import SbrdfError
 from ..store import DEFAULT_COMPLEVEL, PART_SUFFIX
 from ..store.derived import OUTPUTS
 from .analysis import cmd_invert, cmd_photometry
+from .cache import add_cache_parser
 from .commands import (
     cmd_bench,
     cmd_catalog_list,
@@ -410,6 +413,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_invert(sub)
     add_observe_parser(sub, _mesh_options)
     add_material_parser(sub)
+    add_cache_parser(sub)
     _add_plot(sub)
     return p
 

@@ -9,6 +9,20 @@ either builds anew.
 
 The directory is ``$SBRDF_XR_CACHE_DIR`` if set (``off`` disables the cache), else
 ``$XDG_CACHE_HOME/sbrdf_xr`` or ``~/.cache/sbrdf_xr``.
+
+Every change of those sources (a new release installed) keys new tables, so the cache
+keeps its upkeep here.  An entry is a table file ``{name}-{key}.nc`` (``key``: 32
+hexadecimal digits) with the files the cache makes beside it: the mapped values and
+their records (``.nc.float64.npy``, ``.nc.float64.meta``, also in ``float32``; older
+versions left ``.nc.float64.meta.nc``), the temporaries of their atomic writes
+(``<file>.<8 characters>.part``) and a marker ``.nc.used`` whose modification time is
+set on every load from the cache: the entry's last use (the table and values files are
+never touched: the values' record holds their times; their access times count the loads
+of versions that set no marker).  No build-lock file is made: the lock is the
+directory's own (:func:`cached_table`).  :func:`cache_entries` lists the
+entries, :func:`prune` removes them, and every build of a table prunes the entries no
+install sharing the directory used for :func:`keep_days` days.  Nothing else in the
+directory is ever removed.
 """
 
 from __future__ import annotations
@@ -18,18 +32,34 @@ import contextlib
 import hashlib
 import os
 import re
+import stat
+import time
 import warnings
 from collections.abc import Callable, Iterable, Iterator
 from functools import cache, partial
 from pathlib import Path
+from typing import Any, NamedTuple
 
 import xarray as xr
 
 from .._output import file_kind
-from ..errors import CacheWarning, OutputError
+from ..errors import CacheWarning, OutputError, ValidationError
+from ..units import to_unit
 from .mapped import mapped_table
 
-__all__ = ["build_modules", "cache_dir", "cache_file", "cached_table", "source_digest"]
+__all__ = [
+    "KEEP_DAYS",
+    "KEEP_DAYS_ENV",
+    "CacheEntry",
+    "build_modules",
+    "cache_dir",
+    "cache_entries",
+    "cache_file",
+    "cached_table",
+    "keep_days",
+    "prune",
+    "source_digest",
+]
 
 
 def cache_dir() -> Path | None:
@@ -340,6 +370,7 @@ def cached_table(
     if dtype is not None:  # mapped: the values file beside the table, or made from it
         read = partial(mapped_table, read=read, dtype=dtype)
     if file_kind(path) == "file":  # a symbolic link or special file there is not followed
+        _record_use(path)
         try:
             return read(path)
         except (OSError, ValueError) as exc:  # a damaged cache file: build again
@@ -360,6 +391,8 @@ def cached_table(
         try:
             d.mkdir(parents=True, exist_ok=True)
             write(table, path)  # atomic: a temporary file renamed, so two builders cannot clash
+            _record_use(path)
+            _auto_prune(d)  # a new table: the ones no install used for keep_days() go
             return read(path)
         except (OSError, OutputError) as exc:  # read-only, full or a special file in the way:
             _unusable(d, name, exc)  # the built table, uncached
@@ -399,3 +432,335 @@ def _building(d: Path) -> Iterator[None]:
     finally:
         if fd is not None:
             os.close(fd)  # closing releases the lock
+
+
+# --------------------------------------------------------------------------- upkeep
+
+#: The environment variable that sets :func:`keep_days` (a number of days, or ``off``).
+KEEP_DAYS_ENV = "SBRDF_XR_CACHE_KEEP_DAYS"
+#: Days an entry no install used is kept when a table is built, unless
+#: :data:`KEEP_DAYS_ENV` says otherwise [day].
+KEEP_DAYS = 30.0
+#: A temporary younger than this is a write in progress (a values file is written outside
+#: the build lock): never removed [s].
+_PART_AGE = 86400.0
+_DAY = 86400.0
+#: The files of an entry, as the cache names them: the table, a marker of its last use,
+#: the mapped values and their records (``.meta.nc``: older versions), and the
+#: temporaries of their atomic writes (:func:`sbrdf_xr._output.atomic_file`).
+_ENTRY_FILE = re.compile(
+    r"(?P<table>(?P<name>.+)-[0-9a-f]{32}\.nc)"
+    r"(?:\.used|(?:\.float(?:32|64)\.(?:npy|meta|meta\.nc))?(?P<part>\.[a-z0-9_]{8}\.part)?)"
+)
+
+
+class CacheEntry(NamedTuple):
+    """One table of the cache with the files the cache made beside it.
+
+    Attributes
+    ----------
+    name : str
+        The table's catalog name.
+    table : pathlib.Path
+        Its table file ``{name}-{key}.nc`` (it may be gone, its other files left).
+    files : tuple of pathlib.Path
+        Its files (for a pruned entry: those removed, or that a dry run would remove).
+    size : int
+        Their total size [byte].
+    last_use : float
+        When an install last loaded it, as POSIX time [s]: the newest modification or
+        access time of its files but temporaries (0 if it has no other).  The marker's
+        modification time is set on every load; the access times count the loads of
+        versions that set no marker, where the file system records them (with
+        ``relatime``, to within a day).
+    current : bool or None
+        Whether this installation loads it (None: not asked).
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> from sbrdf_xr.materials.cache import CacheEntry
+    >>> e = CacheEntry("grey", Path("grey-" + "0" * 32 + ".nc"), (), 0, 0.0, None)
+    >>> e.name, e.table.suffix
+    ('grey', '.nc')
+    """
+
+    name: str
+    table: Path
+    files: tuple[Path, ...]
+    size: int
+    last_use: float
+    current: bool | None
+
+
+def _record_use(path: Path) -> None:
+    """Set the modification time of ``path``'s marker ``.used`` to now (made if missing):
+    its last use.  Anything but a regular file there, or a read-only cache: nothing."""
+    used = path.with_name(path.name + ".used")
+    with contextlib.suppress(OSError):
+        kind = file_kind(used)
+        if kind == "file":
+            os.utime(used, follow_symlinks=False)
+        elif kind is None:
+            os.close(os.open(used, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o666))
+
+
+def keep_days() -> float | None:
+    """The days an entry no install used is kept when the cache builds a table.
+
+    Returns
+    -------
+    float or None
+        ``$SBRDF_XR_CACHE_KEEP_DAYS`` (a number of days > 0), :data:`KEEP_DAYS` when it is
+        unset, or None (no automatic prune) for ``off``, ``never`` or ``none``.  Another
+        value warns (:class:`~sbrdf_xr.errors.CacheWarning`) and keeps the default.
+
+    Examples
+    --------
+    >>> import os
+    >>> os.environ["SBRDF_XR_CACHE_KEEP_DAYS"] = "7"
+    >>> keep_days()
+    7.0
+    >>> os.environ["SBRDF_XR_CACHE_KEEP_DAYS"] = "off"
+    >>> keep_days() is None
+    True
+    >>> del os.environ["SBRDF_XR_CACHE_KEEP_DAYS"]
+    >>> keep_days()
+    30.0
+    """
+    text = os.environ.get(KEEP_DAYS_ENV, "").strip()
+    if not text:
+        return KEEP_DAYS
+    if text.lower() in ("off", "never", "none"):
+        return None
+    try:
+        days = float(text)
+    except ValueError:
+        days = float("nan")
+    if days > 0 and days < float("inf"):
+        return days
+    warnings.warn(
+        f"{KEEP_DAYS_ENV}: got {text!r}; allowed: a number of days > 0, or 'off'; "
+        f"keeping tables {KEEP_DAYS:g} days",
+        CacheWarning,
+        stacklevel=2,
+    )
+    return KEEP_DAYS
+
+
+def _directory(directory: str | os.PathLike[str] | None) -> Path:
+    if directory is not None:
+        return Path(directory)
+    d = cache_dir()
+    if d is None:
+        raise ValidationError(
+            f"the table cache is switched off (SBRDF_XR_CACHE_DIR="
+            f"{os.environ.get('SBRDF_XR_CACHE_DIR', '')!r}): it has no entries; unset it, "
+            "or set it to a directory, to use one"
+        )
+    return d
+
+
+def _scan(d: Path) -> dict[Path, list[tuple[Path, os.stat_result, bool]]]:
+    """table file -> (file, its stat, whether a temporary) of every regular file of the
+    cache's naming in ``d``."""
+    out: dict[Path, list[tuple[Path, os.stat_result, bool]]] = {}
+    try:
+        names = sorted(os.listdir(d))
+    except FileNotFoundError:
+        return out
+    for n in names:
+        m = _ENTRY_FILE.fullmatch(n)
+        if m is None:
+            continue
+        with contextlib.suppress(OSError):
+            st = os.lstat(d / n)
+            if stat.S_ISREG(st.st_mode):  # a link or special file: not the cache's
+                out.setdefault(d / m["table"], []).append((d / n, st, bool(m["part"])))
+    return out
+
+
+def _entry(table: Path, files: list[tuple[Path, Any, bool]], current: Any) -> CacheEntry:
+    name = _ENTRY_FILE.fullmatch(table.name)["name"]  # type: ignore[index]
+    return CacheEntry(
+        name,
+        table,
+        tuple(f for f, _, _ in files),
+        sum(st.st_size for _, st, _ in files),
+        max([max(st.st_mtime, st.st_atime) for _, st, part in files if not part] or [0.0]),
+        None if current is None else table in current,
+    )
+
+
+def cache_entries(
+    current: Iterable[str | os.PathLike[str]] | None = None,
+    directory: str | os.PathLike[str] | None = None,
+) -> list[CacheEntry]:
+    """The entries of the table cache, by name and then last use (newest first).
+
+    Parameters
+    ----------
+    current : iterable of path-like, optional
+        The table files this installation loads (:func:`sbrdf_xr.catalog.table_cache_files`):
+        each entry's ``current`` says whether it is one.  None: not asked.
+    directory : path-like, optional
+        The cache directory (default :func:`cache_dir`).
+
+    Returns
+    -------
+    list of CacheEntry
+
+    Raises
+    ------
+    ValidationError
+        The cache is switched off and no ``directory`` is given.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> d = Path(tempfile.mkdtemp())
+    >>> table = d / ("grey-" + "ab" * 16 + ".nc")
+    >>> for f in (table, d / (table.name + ".float64.npy"), d / "notes.txt"):
+    ...     _ = f.write_bytes(b"12345")
+    >>> [(e.name, len(e.files), e.size, e.current) for e in cache_entries([table], d)]
+    [('grey', 2, 10, True)]
+    """
+    d = _directory(directory)
+    keep = None if current is None else {d / Path(p).name for p in current}
+    found = [_entry(t, files, keep) for t, files in _scan(d).items()]
+    return sorted(found, key=lambda e: (e.name, -e.last_use, e.table.name))
+
+
+def prune(
+    older_than: Any = None,
+    *,
+    stale: bool = False,
+    current: Iterable[str | os.PathLike[str]] | None = None,
+    dry_run: bool = False,
+    directory: str | os.PathLike[str] | None = None,
+) -> list[CacheEntry]:
+    """Remove entries of the table cache: those unused for a while, or not this install's.
+
+    An entry goes when every criterion given holds.  It is removed whole (its table, its
+    values files and records, its marker), except a temporary younger than a day (a
+    write in progress); no other file is ever removed.  The cache's build lock is held
+    while removing: a build in progress, in any process, finishes first.
+
+    A process that loaded a pruned table keeps its values (a mapped file stays readable
+    once removed), but a Dask worker that restores a plan made from it maps the file by
+    name and raises :class:`~sbrdf_xr.errors.TableFileChangedError` (``gone``): restart
+    the process that planned the scene and plan it again; loading the material builds
+    the table anew.
+
+    Parameters
+    ----------
+    older_than : float, optional
+        Remove entries not used for this many days [day] (0: every entry).
+    stale : bool
+        Remove entries that are not among ``current``.  Another install sharing the
+        directory may still use them: add ``older_than`` to spare its recent ones.
+    current : iterable of path-like, optional
+        The table files this installation loads
+        (:func:`sbrdf_xr.catalog.table_cache_files`); required by ``stale``.
+    dry_run : bool
+        Remove nothing; return what would go.
+    directory : path-like, optional
+        The cache directory (default :func:`cache_dir`).
+
+    Returns
+    -------
+    list of CacheEntry
+        The entries removed (or that would be), with the files that went and their size.
+
+    Raises
+    ------
+    ValidationError
+        No criterion, ``older_than`` negative or not a number, ``stale`` without
+        ``current``, or the cache switched off and no ``directory`` given.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from pathlib import Path
+    >>> d = Path(tempfile.mkdtemp())
+    >>> old, new = (d / (f"grey-{k * 32}.nc") for k in "01")
+    >>> for f in (old, new, d / "notes.txt"):
+    ...     _ = f.write_bytes(b"12345")
+    >>> os.utime(old, (0.0, 0.0))  # last used in 1970
+    >>> [e.table.name[:6] for e in prune(older_than=30, directory=d)]
+    ['grey-0']
+    >>> sorted(p.name[:6] for p in d.iterdir())
+    ['grey-1', 'notes.']
+    >>> [e.size for e in prune(stale=True, current=[new], directory=d, dry_run=True)]
+    []
+    """
+    d = _directory(directory)
+    days = None if older_than is None else to_unit(older_than, "day", "older_than")
+    try:
+        days = None if days is None else float(days)
+    except (TypeError, ValueError):
+        days = float("nan")
+    if days is not None and not 0 <= days < float("inf"):
+        raise ValidationError(
+            f"older_than: got {older_than!r}; allowed: a number of days >= 0 (0: every entry)"
+        )
+    if days is None and not stale:
+        raise ValidationError(
+            "prune: no entries chosen; give older_than (days unused, 0: every entry) "
+            "and/or stale=True (not this installation's)"
+        )
+    if stale and current is None:
+        raise ValidationError(
+            "stale=True: give current=, the table files this installation loads "
+            "(sbrdf_xr.catalog.table_cache_files())"
+        )
+    keep = list(current) if stale and current is not None else None
+    if dry_run or not d.is_dir():
+        return _prune(d, days, keep, dry_run=True)
+    with _building(d):  # chosen and removed while no build runs
+        return _prune(d, days, keep)
+
+
+def _prune(d: Path, days: float | None, current: Any, dry_run: bool = False) -> list[CacheEntry]:
+    """Remove the entries of ``d`` unused for ``days`` and not among ``current`` (None:
+    either criterion not asked); the entries as removed (those of which something went)."""
+    cutoff = None if days is None else time.time() - days * _DAY
+    out = []
+    for e in cache_entries(current, d):
+        if (cutoff is None or e.last_use < cutoff) and not e.current:
+            gone = _remove(e, dry_run)
+            if gone.files:
+                out.append(gone)
+    return out
+
+
+def _remove(entry: CacheEntry, dry_run: bool = False) -> CacheEntry:
+    """Remove the files of ``entry`` (a young temporary stays); the entry as removed."""
+    now = time.time()
+    gone: list[tuple[Path, os.stat_result, bool]] = []
+    for f in entry.files:
+        try:
+            st = os.lstat(f)
+        except OSError:
+            continue
+        young = f.name.endswith(".part") and st.st_mtime > now - _PART_AGE
+        if young or not stat.S_ISREG(st.st_mode):
+            continue
+        try:
+            if not dry_run:
+                f.unlink()
+        except OSError:
+            continue
+        gone.append((f, st, False))
+    size = sum(st.st_size for _, st, _ in gone)
+    return entry._replace(files=tuple(f for f, _, _ in gone), size=size)
+
+
+def _auto_prune(d: Path) -> None:
+    """Within the build lock: remove the entries of ``d`` that no install used for
+    :func:`keep_days` days (every install records its loads on the same markers)."""
+    days = keep_days()
+    if days is not None:
+        with contextlib.suppress(OSError):
+            _prune(d, days, None)

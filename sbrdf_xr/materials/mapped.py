@@ -239,7 +239,11 @@ def _check(file: TableFile) -> None:
     except OSError as exc:
         raise TableFileChangedError(
             f"table values file {p}: gone ({type(exc).__name__}); it held the values of "
-            f"digest {file.sha256[:16]}...; load the material again (the cache rebuilds it)"
+            f"digest {file.sha256[:16]}...: the table cache was pruned or cleared since "
+            "the scene was planned (sbrdf-xr cache prune, or a table build pruning the "
+            "tables unused for SBRDF_XR_CACHE_KEEP_DAYS days); restart the process that "
+            "planned the scene (it keeps the table it loaded) and plan it again: loading "
+            "the material rebuilds the file"
         ) from None
     stat = (st.st_size, st.st_mtime_ns)
     if stat == (file.size, file.mtime_ns) or _VERIFIED.get((file.path, file.sha256)) == stat:

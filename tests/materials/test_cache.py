@@ -220,7 +220,9 @@ def test_two_processes_building_one_table_at_once_agree(tmp_path, monkeypatch):
     shas = {o.strip() for o, _ in outs}
     assert len(shas) == 1
     # beside the table, its memory-mapped values and their record (sbrdf_xr.materials.mapped)
-    assert sorted(p.suffix for p in tmp_path.iterdir() if p.suffix != ".nc") == [".meta", ".npy"]
+    # and the marker of its last use (cache.prune)
+    suffixes = sorted(p.suffix for p in tmp_path.iterdir() if p.suffix != ".nc")
+    assert suffixes == [".meta", ".npy", ".used"]
     assert len(list(tmp_path.glob("example-lobe-*.nc"))) == 1
     from sbrdf_xr.engine.fingerprint import _table_sha
 

@@ -149,6 +149,7 @@ def test_the_catalog_fingerprint_is_that_of_the_table_read(cached_lobe, tmp_path
         "",
         ".float64.meta",
         ".float64.npy",
+        ".used",  # the marker of its last use (cache.prune)
     ]
 
 
