@@ -9,25 +9,16 @@ from sbrdf_xr.brdf import MODELS, get_model
 from sbrdf_xr.errors import ValidationError
 
 WL = np.array([450.0, 650.0, 900.0])
+_RS = {"rho_D": 0.07, "epsilon": [0.85, 0.8, 0.7], "b": 0.12, "e": 0.12}
+_CORE = {**_RS, "core_rho": [0.2, 0.25, 0.3], "core_roughness": 0.05}
 PARAMS = {
     "lambert": {"rho": [0.2, 0.4, 0.6]},
-    "robertson_sandford": {"rho_D": 0.07, "epsilon": [0.85, 0.8, 0.7], "b": 0.12, "e": 0.12},
+    "robertson_sandford": _RS,
     "microfacet": {"roughness": 0.2, "n": [1.5, 1.5, 1.48], "k": 0.0, "rho_d": 0.1},
-    "robertson_sandford_core": {
-        "rho_D": 0.07,
-        "epsilon": [0.85, 0.8, 0.7],
-        "b": 0.12,
-        "e": 0.12,
-        "core_rho": [0.2, 0.25, 0.3],
-        "core_roughness": 0.05,
-    },
+    "robertson_sandford_core": _CORE,
+    # each model extends the one before it: its parameters are the core's and the halo's
     "robertson_sandford_halo": {
-        "rho_D": 0.07,
-        "epsilon": [0.85, 0.8, 0.7],
-        "b": 0.12,
-        "e": 0.12,
-        "core_rho": [0.2, 0.25, 0.3],
-        "core_roughness": 0.05,
+        **_CORE,
         "halo_a": [1e-3, 2e-3, 3e-3],
         "halo_b": 1e-5,
         "halo_g": 2.5,
